@@ -1,0 +1,100 @@
+//! Command-line arguments (clap derive): one struct per subcommand.
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+
+/// termid: identify equations of motion from time series.
+#[derive(Debug, Parser)]
+#[command(name = "termid", version, about, long_about = None)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Select terms and fit coefficients of one equation from one or several runs.
+    Identify(IdentifyCommand),
+}
+
+/// Output format.
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum Format {
+    /// Human-readable tables.
+    Text,
+    /// JSON on standard output.
+    Json,
+}
+
+/// Step rule names on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum RuleName {
+    /// First step after which F no longer rises (by more than --step-tolerance).
+    FMax,
+    /// First step after which the standard error no longer falls by more than --step-tolerance.
+    SePlateau,
+    /// The last step.
+    Last,
+}
+
+/// `termid identify`.
+#[derive(Debug, Args)]
+pub struct IdentifyCommand {
+    /// CSV files with a header row; several are combined (the paper's "Komb. Daten").
+    #[arg(long = "data", short = 'd', required = true, num_args = 1..)]
+    pub data: Vec<PathBuf>,
+    /// Name of the time column.
+    #[arg(long, default_value = "t")]
+    pub time: String,
+    /// The rows are not a time series (no time column; derivative targets are refused).
+    #[arg(long, conflicts_with = "time")]
+    pub no_time: bool,
+    /// What to explain: a column (`r_dot`) or the derivative of one (`dr/dt`).
+    #[arg(long)]
+    pub target: String,
+    /// Candidate terms, e.g. --terms "u*v" "u*r" "u^2*δ".
+    #[arg(long, num_args = 1.., required_unless_present = "terms_file")]
+    pub terms: Vec<String>,
+    /// A file of candidate terms, one per line (`#` starts a comment).
+    #[arg(long)]
+    pub terms_file: Option<PathBuf>,
+    /// Terms that always enter first.
+    #[arg(long, num_args = 1..)]
+    pub forced: Vec<String>,
+    /// Terms that never enter.
+    #[arg(long, num_args = 1..)]
+    pub exclude: Vec<String>,
+    /// Per-run parameters: `u0=2.01`, `u0=first:u` (first value of u in each run) or `u0=mean:u`.
+    #[arg(long = "param", num_args = 1..)]
+    pub params: Vec<String>,
+    /// Derived variables: `Δu=u-u0`.
+    #[arg(long = "derive", num_args = 1..)]
+    pub derived: Vec<String>,
+    /// Aliases: `du=Δu`.
+    #[arg(long = "alias", num_args = 1..)]
+    pub aliases: Vec<String>,
+    /// Regression back-end.
+    #[arg(long, default_value = "stepwise")]
+    pub backend: String,
+    /// Derivative method for `dX/dt` targets.
+    #[arg(long, default_value = "central")]
+    pub derivative: String,
+    /// Fit without an intercept b0.
+    #[arg(long)]
+    pub no_intercept: bool,
+    /// Stepwise: stop when the next term's share of the total sum of squares is below this.
+    #[arg(long, default_value_t = 0.0)]
+    pub min_proportion: f64,
+    /// Stepwise: how the reported step is chosen.
+    #[arg(long, value_enum, default_value = "f-max")]
+    pub step_rule: RuleName,
+    /// Stepwise: tolerance of the step rule (relative).
+    #[arg(long, default_value_t = 0.0)]
+    pub step_tolerance: f64,
+    /// Output format.
+    #[arg(long, value_enum, default_value = "text")]
+    pub format: Format,
+}

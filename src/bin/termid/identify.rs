@@ -1,0 +1,198 @@
+//! `termid identify`: data files + candidate terms → the chosen equation.
+
+use std::collections::BTreeMap;
+
+use anyhow::{bail, Context, Result};
+use termid::data::{differentiator, Frame};
+use termid::identify::{Fit, Identification, ParamValue, Target};
+use termid::select::{Backend, StepRule};
+use termid::term::{parse_terms, Vocabulary};
+
+use crate::args::{Format, IdentifyCommand, RuleName};
+
+fn split_pair<'a>(text: &'a str, what: &str) -> Result<(&'a str, &'a str)> {
+    text.split_once('=')
+        .map(|(a, b)| (a.trim(), b.trim()))
+        .with_context(|| format!("{what} `{text}` must have the form NAME=VALUE"))
+}
+
+pub fn run(cmd: IdentifyCommand) -> Result<()> {
+    let frames = cmd
+        .data
+        .iter()
+        .map(|p| if cmd.no_time { Frame::read_csv_untimed(p) } else { Frame::read_csv(p, &cmd.time) })
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut vocab = Vocabulary::new();
+    let mut params = BTreeMap::new();
+    for p in &cmd.params {
+        let (name, value) = split_pair(p, "parameter")?;
+        let value = match value.parse::<f64>() {
+            Ok(v) => ParamValue::Value(v),
+            Err(_) => ParamValue::Rule(value.to_string()),
+        };
+        params.insert(name.to_string(), value);
+    }
+    let target = Target::parse(&cmd.target);
+    if cmd.no_time && matches!(target, Target::Derivative(_)) {
+        bail!("--no-time data have no time axis, so `{}` cannot be differentiated", cmd.target);
+    }
+    for name in frames[0].names() {
+        if cmd.no_time && name == "row" {
+            continue;
+        }
+        if !params.contains_key(name) {
+            vocab.variable(name)?;
+        }
+    }
+    for name in params.keys() {
+        vocab.parameter(name)?;
+    }
+    for d in &cmd.derived {
+        let (name, def) = split_pair(d, "derived variable")?;
+        vocab.derive(name, def).with_context(|| format!("in --derive `{d}`"))?;
+    }
+    for a in &cmd.aliases {
+        let (alias, target) = split_pair(a, "alias")?;
+        vocab.alias(alias, target)?;
+    }
+    let mut texts = cmd.terms.clone();
+    if let Some(path) = &cmd.terms_file {
+        let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+        texts.extend(
+            text.lines()
+                .map(|l| l.split('#').next().unwrap_or("").trim())
+                .filter(|l| !l.is_empty())
+                .map(str::to_string),
+        );
+    }
+    if texts.is_empty() {
+        bail!("no candidate terms: give --terms or --terms-file");
+    }
+    let candidates = parse_terms(&texts, &vocab)?;
+    let forced = parse_terms(&cmd.forced, &vocab)?;
+    let excluded = parse_terms(&cmd.exclude, &vocab)?;
+    let mut backend = Backend::by_name(&cmd.backend)?;
+    match &mut backend {
+        Backend::Stepwise(s) => {
+            s.min_proportion = cmd.min_proportion;
+            s.step_rule = match cmd.step_rule {
+                RuleName::FMax => StepRule::FirstFMaximum { tolerance: cmd.step_tolerance },
+                RuleName::SePlateau => StepRule::StandardErrorPlateau { tolerance: cmd.step_tolerance },
+                RuleName::Last => StepRule::Last,
+            };
+        }
+    }
+    let selector = backend.build()?;
+    let diff = differentiator(&cmd.derivative)?;
+    let identification = Identification {
+        vocabulary: &vocab,
+        parameters: &params,
+        differentiator: diff.as_ref(),
+        intercept: !cmd.no_intercept,
+    };
+    let fit = identification.fit(&target, &candidates, &forced, &excluded, &frames, selector.as_ref())?;
+    match cmd.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&json(&fit))?),
+        Format::Text => print!("{}", text(&fit)),
+    }
+    Ok(())
+}
+
+/// Significant-figure formatting that stays fixed-point where a reader expects it.
+pub fn num(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e6).contains(&x.abs()) {
+        let digits = (5 - x.abs().log10().floor() as i32).clamp(0, 9) as usize;
+        format!("{x:.digits$}")
+    } else {
+        format!("{x:.4e}")
+    }
+}
+
+fn text(fit: &Fit) -> String {
+    let s = &fit.selection;
+    let mut out = format!(
+        "{} on {} rows, {} candidates, back-end {}\n\n",
+        fit.target,
+        s.rows,
+        fit.candidates.len(),
+        s.backend
+    );
+    if !s.steps.is_empty() {
+        out +=
+            &format!("{:>4}  {:<22} {:>12} {:>12} {:>10}\n", "step", "term entered", "std. error", "F", "R²");
+        for st in &s.steps {
+            let mark = if st.step == s.chosen_step { " ← chosen" } else { "" };
+            let forced = if st.forced { " (forced)" } else { "" };
+            out += &format!(
+                "{:>4}  {:<22} {:>12} {:>12} {:>10.6}{forced}{mark}\n",
+                st.step,
+                st.term,
+                num(st.standard_error),
+                num(st.f),
+                st.r2
+            );
+        }
+        out += "\n";
+    }
+    out += &format!("{} =", fit.target);
+    let mut first = true;
+    if let Some(b0) = &s.intercept {
+        out += &format!(" {}", num(b0.value));
+        first = false;
+    }
+    for t in &s.terms {
+        let sign = if t.coefficient < 0.0 {
+            "-"
+        } else if first {
+            ""
+        } else {
+            "+"
+        };
+        out += &format!("\n    {sign} {}*{}", num(t.coefficient.abs()), t.term);
+        first = false;
+    }
+    out += "\n\n";
+    out += &format!("{:<22} {:>12} {:>12} {:>9}\n", "term", "coefficient", "std. error", "t");
+    if let Some(b0) = &s.intercept {
+        out +=
+            &format!("{:<22} {:>12} {:>12} {:>9.2}\n", "(intercept)", num(b0.value), num(b0.std_error), b0.t);
+    }
+    for t in &s.terms {
+        out += &format!("{:<22} {:>12} {:>12} {:>9.2}\n", t.term, num(t.coefficient), num(t.std_error), t.t);
+    }
+    out += &format!("\nstopped: {:?}\n", s.stop);
+    for n in &s.notes {
+        out += &format!("note: {n}\n");
+    }
+    out
+}
+
+fn json(fit: &Fit) -> serde_json::Value {
+    let s = &fit.selection;
+    serde_json::json!({
+        "target": fit.target,
+        "backend": s.backend,
+        "rows": s.rows,
+        "candidates": fit.candidates,
+        "steps": s.steps.iter().map(|st| serde_json::json!({
+            "step": st.step,
+            "term": st.term,
+            "forced": st.forced,
+            "standard_error": st.standard_error,
+            "f": st.f,
+            "r2": st.r2,
+            "proportion": st.proportion,
+        })).collect::<Vec<_>>(),
+        "chosen_step": s.chosen_step,
+        "terms": s.terms.iter().map(|t| serde_json::json!({
+            "term": t.term,
+            "coefficient": t.coefficient,
+            "std_error": t.std_error,
+            "t": t.t,
+        })).collect::<Vec<_>>(),
+        "intercept": s.intercept.as_ref().map(|b| b.value),
+        "intercept_std_error": s.intercept.as_ref().map(|b| b.std_error),
+        "stop": s.stop,
+        "notes": s.notes,
+    })
+}

@@ -1,0 +1,140 @@
+//! CSV in and out. A header row names the columns; every other cell must be a finite number.
+
+use std::path::Path;
+
+use super::{DataError, Frame};
+
+impl Frame {
+    /// Reads a CSV file whose header names the columns; `time` names the time column.
+    pub fn read_csv(path: &Path, time: &str) -> Result<Frame, DataError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| DataError::Io { file: file.clone(), message: e.to_string() })?;
+        Frame::parse_csv(&text, &file, time)
+    }
+
+    /// Reads a CSV file of rows that are not a time series (e.g. the Hald cement data):
+    /// a column `row` numbered 1..n stands in for time.
+    pub fn read_csv_untimed(path: &Path) -> Result<Frame, DataError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| DataError::Io { file: file.clone(), message: e.to_string() })?;
+        Frame::parse_csv_untimed(&text, &file)
+    }
+
+    /// Parses CSV text without a time column (rows numbered 1..n in a column `row`).
+    pub fn parse_csv_untimed(text: &str, origin: &str) -> Result<Frame, DataError> {
+        let mut numbered = String::with_capacity(text.len() + 8 * text.lines().count());
+        let mut row = 0usize;
+        for line in text.lines() {
+            if line.trim().is_empty() || line.trim_start().starts_with('#') {
+                continue;
+            }
+            if row == 0 {
+                numbered.push_str("row,");
+            } else {
+                numbered.push_str(&format!("{row},"));
+            }
+            numbered.push_str(line);
+            numbered.push('\n');
+            row += 1;
+        }
+        Frame::parse_csv(&numbered, origin, "row")
+    }
+
+    /// Parses CSV text; `origin` names it in errors.
+    pub fn parse_csv(text: &str, origin: &str, time: &str) -> Result<Frame, DataError> {
+        let io = |e: csv::Error| DataError::Io { file: origin.into(), message: e.to_string() };
+        let mut reader = csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .flexible(true)
+            .comment(Some(b'#'))
+            .from_reader(text.as_bytes());
+        let header: Vec<String> = reader.headers().map_err(io)?.iter().map(str::to_string).collect();
+        for (i, h) in header.iter().enumerate() {
+            if header[..i].contains(h) {
+                return Err(DataError::DuplicateColumn { file: origin.into(), column: h.clone() });
+            }
+        }
+        let time_index = header.iter().position(|h| h == time).ok_or_else(|| DataError::MissingColumn {
+            file: origin.into(),
+            column: time.into(),
+            available: header.join(", "),
+        })?;
+        let mut columns: Vec<Vec<f64>> = vec![Vec::new(); header.len()];
+        for (r, record) in reader.records().enumerate() {
+            let record = record.map_err(io)?;
+            let row = r + 1;
+            if record.len() != header.len() {
+                return Err(DataError::Ragged {
+                    file: origin.into(),
+                    row,
+                    expected: header.len(),
+                    found: record.len(),
+                });
+            }
+            for (c, cell) in record.iter().enumerate() {
+                let v: f64 = cell.parse().map_err(|_| DataError::NotNumeric {
+                    file: origin.into(),
+                    row,
+                    column: header[c].clone(),
+                    cell: cell.into(),
+                })?;
+                columns[c].push(v);
+            }
+        }
+        let mut frame = Frame::new(origin, time, std::mem::take(&mut columns[time_index]))?;
+        for (name, values) in header.iter().zip(columns) {
+            if name != time {
+                frame.push(name, values)?;
+            }
+        }
+        Ok(frame)
+    }
+
+    /// Writes the frame as CSV (time first), numbers in shortest round-trip form.
+    pub fn write_csv(&self, path: &Path) -> Result<(), DataError> {
+        std::fs::write(path, self.to_csv())
+            .map_err(|e| DataError::Io { file: path.display().to_string(), message: e.to_string() })
+    }
+
+    /// The frame as CSV text.
+    pub fn to_csv(&self) -> String {
+        let mut out = self.names().join(",");
+        out.push('\n');
+        let cols: Vec<&[f64]> = self.names().iter().filter_map(|n| self.column(n)).collect();
+        for r in 0..self.len() {
+            let row: Vec<String> = cols.iter().map(|c| format!("{:?}", c[r])).collect();
+            out.push_str(&row.join(","));
+            out.push('\n');
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trip_and_errors() {
+        let f = Frame::parse_csv("t,u\n0,1.5\n0.2,2\n", "a.csv", "t").unwrap();
+        assert_eq!(Frame::parse_csv(&f.to_csv(), "a.csv", "t").unwrap(), f);
+        let e = Frame::parse_csv("t,u\n0,1\n0.2,x\n", "a.csv", "t").unwrap_err().to_string();
+        assert_eq!(e, "a.csv: row 2, column `u`: `x` is not a number");
+        let e = Frame::parse_csv("t,u\n0,1\n0.2,NaN\n", "a.csv", "t").unwrap_err().to_string();
+        assert!(e.contains("row 2, column `u`") && e.contains("not finite"), "{e}");
+        let e = Frame::parse_csv("t,u\n0,1\n0,2\n", "a.csv", "t").unwrap_err().to_string();
+        assert!(e.contains("row 2") && e.contains("does not increase"), "{e}");
+        assert!(matches!(Frame::parse_csv("t,u\n", "a.csv", "t"), Err(DataError::Empty { .. })));
+        assert!(matches!(Frame::parse_csv("", "a.csv", "t"), Err(DataError::MissingColumn { .. })));
+        assert!(matches!(
+            Frame::parse_csv("time,u\n0,1\n", "a.csv", "t"),
+            Err(DataError::MissingColumn { .. })
+        ));
+        assert!(matches!(
+            Frame::parse_csv("t,u\n0,1,2\n", "a.csv", "t"),
+            Err(DataError::Ragged { row: 1, .. })
+        ));
+    }
+}

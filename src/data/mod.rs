@@ -1,0 +1,270 @@
+//! Time series as a [`Frame`] of named f64 columns with a time column, read from and written
+//! to CSV with errors that name the file, row and column; and numerical derivatives behind
+//! the [`Differentiator`] interface.
+
+mod csv_io;
+mod derivative;
+
+pub use derivative::{differentiator, CentralDifference, Differentiator, DIFFERENTIATORS};
+
+/// Something wrong with a data set. Every variant names where.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum DataError {
+    /// The file could not be read or written.
+    #[error("{file}: {message}")]
+    Io {
+        /// The file.
+        file: String,
+        /// What the system said.
+        message: String,
+    },
+    /// No data rows.
+    #[error("{file}: no data rows")]
+    Empty {
+        /// The file.
+        file: String,
+    },
+    /// A required column is absent.
+    #[error("{file}: no column `{column}` (columns: {available})")]
+    MissingColumn {
+        /// The file.
+        file: String,
+        /// The missing column.
+        column: String,
+        /// The columns there are.
+        available: String,
+    },
+    /// A column name occurs twice.
+    #[error("{file}: column `{column}` appears twice")]
+    DuplicateColumn {
+        /// The file.
+        file: String,
+        /// The column.
+        column: String,
+    },
+    /// A cell is not a number.
+    #[error("{file}: row {row}, column `{column}`: `{cell}` is not a number")]
+    NotNumeric {
+        /// The file.
+        file: String,
+        /// 1-based data row (the header is row 0).
+        row: usize,
+        /// The column.
+        column: String,
+        /// The cell's text.
+        cell: String,
+    },
+    /// NaN or infinite value.
+    #[error("{file}: row {row}, column `{column}`: value {value} is not finite")]
+    NonFinite {
+        /// The file.
+        file: String,
+        /// 1-based data row.
+        row: usize,
+        /// The column.
+        column: String,
+        /// The value.
+        value: f64,
+    },
+    /// A row with the wrong number of cells.
+    #[error("{file}: row {row} has {found} cells, the header has {expected}")]
+    Ragged {
+        /// The file.
+        file: String,
+        /// 1-based data row.
+        row: usize,
+        /// Header width.
+        expected: usize,
+        /// Cells found.
+        found: usize,
+    },
+    /// Time that does not increase.
+    #[error("{file}: row {row}, column `{column}`: time {this} does not increase (previous row {previous})")]
+    TimeNotIncreasing {
+        /// The file.
+        file: String,
+        /// 1-based data row.
+        row: usize,
+        /// The time column.
+        column: String,
+        /// This row's time.
+        this: f64,
+        /// The previous row's time.
+        previous: f64,
+    },
+    /// A column of the wrong length.
+    #[error("{file}: column `{column}` has {found} values, the time column {expected}")]
+    Length {
+        /// The file.
+        file: String,
+        /// The column.
+        column: String,
+        /// Rows of the frame.
+        expected: usize,
+        /// Values given.
+        found: usize,
+    },
+    /// Too few rows for an operation.
+    #[error("{file}: {rows} rows are too few for {what} (needs {needed})")]
+    TooShort {
+        /// The file.
+        file: String,
+        /// Rows there are.
+        rows: usize,
+        /// Rows needed.
+        needed: usize,
+        /// What needed them.
+        what: String,
+    },
+    /// Unknown derivative method.
+    #[error("unknown derivative method `{0}` (known: {1})")]
+    UnknownMethod(String, String),
+}
+
+/// Named f64 columns over a strictly increasing time column.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    origin: String,
+    time_name: String,
+    names: Vec<String>,
+    columns: Vec<Vec<f64>>,
+}
+
+impl Frame {
+    /// A frame with only its time column; `origin` names it in errors (usually the file).
+    pub fn new(origin: &str, time_name: &str, time: Vec<f64>) -> Result<Frame, DataError> {
+        if time.is_empty() {
+            return Err(DataError::Empty { file: origin.into() });
+        }
+        let mut f =
+            Frame { origin: origin.into(), time_name: time_name.into(), names: vec![], columns: vec![] };
+        f.push(time_name, time)?;
+        Ok(f)
+    }
+
+    /// Adds a column, refusing NaN/∞, a wrong length, a duplicate name and, for the time
+    /// column, time that does not increase.
+    pub fn push(&mut self, name: &str, values: Vec<f64>) -> Result<(), DataError> {
+        if self.names.iter().any(|n| n == name) {
+            return Err(DataError::DuplicateColumn { file: self.origin.clone(), column: name.into() });
+        }
+        if let Some(t) = self.columns.first() {
+            if t.len() != values.len() {
+                return Err(DataError::Length {
+                    file: self.origin.clone(),
+                    column: name.into(),
+                    expected: t.len(),
+                    found: values.len(),
+                });
+            }
+        }
+        if let Some((i, &v)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(DataError::NonFinite {
+                file: self.origin.clone(),
+                row: i + 1,
+                column: name.into(),
+                value: v,
+            });
+        }
+        if self.columns.is_empty() {
+            if let Some(i) = (1..values.len()).find(|&i| values[i] <= values[i - 1]) {
+                return Err(DataError::TimeNotIncreasing {
+                    file: self.origin.clone(),
+                    row: i + 1,
+                    column: name.into(),
+                    this: values[i],
+                    previous: values[i - 1],
+                });
+            }
+        }
+        self.names.push(name.into());
+        self.columns.push(values);
+        Ok(())
+    }
+
+    /// Replaces or adds a column.
+    pub fn set(&mut self, name: &str, values: Vec<f64>) -> Result<(), DataError> {
+        if let Some(i) = self.names.iter().position(|n| n == name) {
+            if i == 0 {
+                return Err(DataError::DuplicateColumn { file: self.origin.clone(), column: name.into() });
+            }
+            self.names.remove(i);
+            self.columns.remove(i);
+        }
+        self.push(name, values)
+    }
+
+    /// Where the frame came from (file name), for messages.
+    pub fn origin(&self) -> &str {
+        &self.origin
+    }
+
+    /// Name of the time column.
+    pub fn time_name(&self) -> &str {
+        &self.time_name
+    }
+
+    /// The time column.
+    pub fn time(&self) -> &[f64] {
+        &self.columns[0]
+    }
+
+    /// Number of rows.
+    pub fn len(&self) -> usize {
+        self.columns[0].len()
+    }
+
+    /// Always false: a frame has at least one row.
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// Column names, time first.
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// A column by name.
+    pub fn column(&self, name: &str) -> Option<&[f64]> {
+        self.names.iter().position(|n| n == name).map(|i| self.columns[i].as_slice())
+    }
+
+    /// A column by name, or an error naming the file and the columns there are.
+    pub fn require(&self, name: &str) -> Result<&[f64], DataError> {
+        self.column(name).ok_or_else(|| DataError::MissingColumn {
+            file: self.origin.clone(),
+            column: name.into(),
+            available: self.names.join(", "),
+        })
+    }
+
+    /// Rows `range` as a new frame.
+    pub fn slice(&self, range: std::ops::Range<usize>) -> Frame {
+        Frame {
+            origin: self.origin.clone(),
+            time_name: self.time_name.clone(),
+            names: self.names.clone(),
+            columns: self.columns.iter().map(|c| c[range.clone()].to_vec()).collect(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn refuses_bad_columns() {
+        let mut f = Frame::new("run.csv", "t", vec![0.0, 0.1, 0.2]).unwrap();
+        assert!(matches!(f.push("u", vec![1.0, f64::NAN, 2.0]), Err(DataError::NonFinite { row: 2, .. })));
+        assert!(matches!(f.push("u", vec![1.0]), Err(DataError::Length { .. })));
+        assert!(matches!(
+            Frame::new("run.csv", "t", vec![0.0, 0.1, 0.1]),
+            Err(DataError::TimeNotIncreasing { row: 3, .. })
+        ));
+        f.push("u", vec![1.0, 2.0, 3.0]).unwrap();
+        let e = f.require("v").unwrap_err().to_string();
+        assert!(e.contains("run.csv") && e.contains("`v`") && e.contains("t, u"), "{e}");
+    }
+}

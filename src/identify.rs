@@ -1,0 +1,239 @@
+//! Identification of one equation from one or several runs: evaluate the candidate terms on
+//! every run (with the run's own parameters, e.g. its `u0`), take the target as a column or
+//! the derivative of a state, accumulate the sufficient statistics run by run (the paper's
+//! "Komb. Daten" is simply all runs together) and hand them to a back-end.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+use crate::data::{DataError, Differentiator, Frame};
+use crate::select::{Accumulator, Moments, Problem, SelectError, Selection, Selector};
+use crate::term::{Library, Term, TermError, Vocabulary};
+
+/// What the equation explains.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Target {
+    /// A column of the data (e.g. measured accelerations `r_dot`).
+    Column(String),
+    /// The time derivative of a column, computed by the chosen differentiator.
+    Derivative(String),
+}
+
+impl Target {
+    /// Parses `dX/dt` as the derivative of X, anything else as a column name.
+    pub fn parse(text: &str) -> Target {
+        match text.strip_prefix('d').and_then(|s| s.strip_suffix("/dt")) {
+            Some(state) if !state.is_empty() => Target::Derivative(state.to_string()),
+            _ => Target::Column(text.to_string()),
+        }
+    }
+}
+
+impl std::fmt::Display for Target {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Target::Column(c) => write!(f, "{c}"),
+            Target::Derivative(s) => write!(f, "d{s}/dt"),
+        }
+    }
+}
+
+/// Where a parameter's value comes from in each run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum ParamValue {
+    /// The same value for every run.
+    Value(f64),
+    /// A rule evaluated on each run: `first:u` is the run's first value of `u`.
+    Rule(String),
+}
+
+impl ParamValue {
+    /// The value in one run.
+    pub fn resolve(&self, name: &str, frame: &Frame) -> Result<f64, IdentifyError> {
+        match self {
+            ParamValue::Value(v) => Ok(*v),
+            ParamValue::Rule(rule) => match rule.split_once(':') {
+                Some(("first", col)) => Ok(frame.require(col)?[0]),
+                Some(("mean", col)) => {
+                    let c = frame.require(col)?;
+                    Ok(c.iter().sum::<f64>() / c.len() as f64)
+                }
+                _ => Err(IdentifyError::Parameter(format!(
+                    "parameter `{name}`: `{rule}` is neither a number nor `first:COLUMN` / `mean:COLUMN`"
+                ))),
+            },
+        }
+    }
+}
+
+/// Why identification failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum IdentifyError {
+    /// In a term.
+    #[error(transparent)]
+    Term(#[from] TermError),
+    /// In the data.
+    #[error(transparent)]
+    Data(#[from] DataError),
+    /// In the regression.
+    #[error(transparent)]
+    Select(#[from] SelectError),
+    /// A term evaluates to NaN or ±∞ on some row.
+    #[error(
+        "{file}: row {row}: term `{term}` evaluates to {value} (check its denominators and the data there)"
+    )]
+    NonFinite {
+        /// The run.
+        file: String,
+        /// 1-based row.
+        row: usize,
+        /// The term.
+        term: String,
+        /// Its value.
+        value: f64,
+    },
+    /// A parameter could not be set.
+    #[error("{0}")]
+    Parameter(String),
+    /// Something the caller asked for does not fit together.
+    #[error("{0}")]
+    Setup(String),
+}
+
+/// The settings shared by the equations of one identification.
+pub struct Identification<'a> {
+    /// The names terms may use.
+    pub vocabulary: &'a Vocabulary,
+    /// Per-run parameters.
+    pub parameters: &'a BTreeMap<String, ParamValue>,
+    /// Derivative method for `Target::Derivative`.
+    pub differentiator: &'a dyn Differentiator,
+    /// Fit an intercept.
+    pub intercept: bool,
+}
+
+/// A fitted equation with its candidates.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Fit {
+    /// What was explained.
+    pub target: String,
+    /// The candidate terms, canonical text, in column order.
+    pub candidates: Vec<String>,
+    /// The back-end's result.
+    pub selection: Selection,
+}
+
+impl Identification<'_> {
+    /// The per-run parameter values.
+    pub fn run_parameters(&self, frame: &Frame) -> Result<BTreeMap<String, f64>, IdentifyError> {
+        self.parameters.iter().map(|(n, v)| Ok((n.clone(), v.resolve(n, frame)?))).collect()
+    }
+
+    /// The target values of one run.
+    pub fn target(&self, target: &Target, frame: &Frame) -> Result<Vec<f64>, IdentifyError> {
+        Ok(match target {
+            Target::Column(c) => frame.require(c)?.to_vec(),
+            Target::Derivative(s) => {
+                let x = frame.require(s)?;
+                self.differentiator.differentiate(frame.time(), x).map_err(|e| match e {
+                    DataError::TooShort { rows, needed, what, .. } => {
+                        DataError::TooShort { file: frame.origin().into(), rows, needed, what }
+                    }
+                    e => e,
+                })?
+            }
+        })
+    }
+
+    /// Sufficient statistics of the compiled candidates against the target on one run.
+    pub fn moments(
+        &self,
+        library: &Library,
+        target: &Target,
+        frame: &Frame,
+    ) -> Result<Moments, IdentifyError> {
+        let y = self.target(target, frame)?;
+        let params = self.run_parameters(frame)?;
+        let sources = library.bind(&|n| frame.column(n), &|n| params.get(n).copied())?;
+        let mut acc = Accumulator::new(library.len());
+        let mut bad: Option<IdentifyError> = None;
+        library.for_each_block(&sources, frame.len(), |start, rows, block| {
+            if bad.is_some() {
+                return;
+            }
+            if let Some(i) = block.iter().position(|v| !v.is_finite()) {
+                bad = Some(IdentifyError::NonFinite {
+                    file: frame.origin().into(),
+                    row: start + i % rows + 1,
+                    term: library.terms()[i / rows].to_string(),
+                    value: block[i],
+                });
+                return;
+            }
+            acc.push(block, &y[start..start + rows], None);
+        });
+        match bad {
+            Some(e) => Err(e),
+            None => Ok(acc.finish()),
+        }
+    }
+
+    /// Identifies one equation from all runs together ("Komb. Daten").
+    pub fn fit(
+        &self,
+        target: &Target,
+        candidates: &[Term],
+        forced: &[Term],
+        excluded: &[Term],
+        frames: &[Frame],
+        backend: &dyn Selector,
+    ) -> Result<Fit, IdentifyError> {
+        if frames.is_empty() {
+            return Err(IdentifyError::Setup("no data: give at least one run".into()));
+        }
+        let library = Library::compile(candidates, self.vocabulary)?;
+        let mut total: Option<Moments> = None;
+        for f in frames {
+            let m = self.moments(&library, target, f)?;
+            match total.as_mut() {
+                Some(t) => t.merge(&m),
+                None => total = Some(m),
+            }
+        }
+        let moments = total.unwrap_or_else(|| Moments::new(candidates.len()));
+        let names: Vec<String> = candidates.iter().map(Term::to_string).collect();
+        let index_of = |t: &Term, role: &str| {
+            candidates
+                .iter()
+                .position(|c| c == t)
+                .ok_or_else(|| IdentifyError::Setup(format!("{role} term `{t}` is not among the candidates")))
+        };
+        let forced = forced.iter().map(|t| index_of(t, "forced")).collect::<Result<Vec<_>, _>>()?;
+        let excluded = excluded.iter().map(|t| index_of(t, "excluded")).collect::<Result<Vec<_>, _>>()?;
+        let problem = Problem {
+            moments: &moments,
+            names: &names,
+            forced: &forced,
+            excluded: &excluded,
+            intercept: self.intercept,
+        };
+        let selection = backend.select(&problem)?;
+        Ok(Fit { target: target.to_string(), candidates: names, selection })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn target_syntax() {
+        assert_eq!(Target::parse("dr/dt"), Target::Derivative("r".into()));
+        assert_eq!(Target::parse("r_dot"), Target::Column("r_dot".into()));
+        assert_eq!(Target::parse("d/dt"), Target::Column("d/dt".into()));
+    }
+}

@@ -1,0 +1,9 @@
+//! termid identifies equations of motion from time series. Candidate terms are written as
+//! text in a small language ([`term`]), evaluated on data ([`data`]), and a regression
+//! back-end ([`select`]) chooses the terms that matter ([`identify`]).
+#![warn(missing_docs)]
+
+pub mod data;
+pub mod identify;
+pub mod select;
+pub mod term;

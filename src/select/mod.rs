@@ -1,0 +1,241 @@
+//! Term selection: regression back-ends that choose which candidate terms enter an equation
+//! and fit their coefficients. Every back-end works on the same sufficient statistics
+//! ([`Moments`]) and implements [`Selector`]; [`Backend`] picks one by name for the CLI and
+//! model files. A new back-end is one new file and one row in [`Backend`].
+
+mod moments;
+mod stepwise;
+
+use serde::{Deserialize, Serialize};
+
+pub use moments::{Accumulator, Moments};
+pub use stepwise::{StepRule, Stepwise};
+
+/// What a back-end is asked to do.
+#[derive(Clone, Copy, Debug)]
+pub struct Problem<'a> {
+    /// Statistics of the candidates (columns 0..p) and the target (column p).
+    pub moments: &'a Moments,
+    /// Candidate names, aligned with the columns.
+    pub names: &'a [String],
+    /// Columns that always enter (first, for physical reasons).
+    pub forced: &'a [usize],
+    /// Columns that never enter.
+    pub excluded: &'a [usize],
+    /// Fit an intercept b0 (the paper does).
+    pub intercept: bool,
+}
+
+/// A coefficient with its standard error and t-value.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Estimate {
+    /// The value.
+    pub value: f64,
+    /// Its standard error.
+    pub std_error: f64,
+    /// value / std_error.
+    pub t: f64,
+}
+
+/// A term in a fitted equation.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FittedTerm {
+    /// The term's canonical text.
+    pub term: String,
+    /// Its candidate column.
+    pub index: usize,
+    /// The coefficient.
+    pub coefficient: f64,
+    /// Standard error of the coefficient.
+    pub std_error: f64,
+    /// t-value.
+    pub t: f64,
+}
+
+/// One step of a stepwise regression (Oltmann 1973, App. A, eqs. A2-A14).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Step {
+    /// 1-based step number = number of terms in.
+    pub step: usize,
+    /// The term entered.
+    pub term: String,
+    /// Its candidate column.
+    pub index: usize,
+    /// Entered because forced.
+    pub forced: bool,
+    /// Its sum-of-squares reduction S_i (A2).
+    pub reduction: f64,
+    /// Its share of the total sum of squares, S_i / D (A3).
+    pub proportion: f64,
+    /// Cumulative share P_cum (A5) = R².
+    pub r2: f64,
+    /// Multiple correlation R (A6).
+    pub r: f64,
+    /// Adjusted multiple correlation R_c.
+    pub r_adjusted: f64,
+    /// Standard error of estimate s (A7).
+    pub standard_error: f64,
+    /// Adjusted standard error s_c.
+    pub standard_error_adjusted: f64,
+    /// F-value (A8); infinite at an exact fit.
+    pub f: f64,
+    /// Coefficients of the terms in, in order of entry (A11, A13, A14).
+    pub terms: Vec<FittedTerm>,
+    /// Intercept b0 (A12), if fitted.
+    pub intercept: Option<Estimate>,
+}
+
+/// Why a selection stopped adding terms.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "reason", rename_all = "snake_case")]
+pub enum Stop {
+    /// Every allowed candidate is in (or refused).
+    AllEntered,
+    /// The next term's share of the total fell below the user's constant.
+    BelowThreshold {
+        /// The term that would have entered next.
+        term: String,
+        /// Its share.
+        proportion: f64,
+        /// The constant.
+        threshold: f64,
+    },
+    /// The residual is zero to round-off: later steps would be chosen by round-off.
+    ExactFit {
+        /// Residual share 1 − R² at the stop.
+        residual_share: f64,
+    },
+    /// No degrees of freedom left for another term.
+    NoDegreesOfFreedom,
+    /// The back-end finished by its own rule.
+    Converged,
+}
+
+/// What a back-end returns: the chosen equation plus everything a report needs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Selection {
+    /// Back-end name.
+    pub backend: String,
+    /// Rows used.
+    pub rows: usize,
+    /// Every step taken (empty for back-ends without steps).
+    pub steps: Vec<Step>,
+    /// The chosen step (1-based; 0 if nothing entered).
+    pub chosen_step: usize,
+    /// The terms of the chosen equation, in order of entry.
+    pub terms: Vec<FittedTerm>,
+    /// The intercept of the chosen equation.
+    pub intercept: Option<Estimate>,
+    /// Why stepping stopped.
+    pub stop: Stop,
+    /// Things the user should know (refused collinear terms, round-off stops, …).
+    pub notes: Vec<String>,
+}
+
+/// Why a back-end failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SelectError {
+    /// Fewer rows than the fit needs.
+    #[error("{rows} rows cannot determine {terms} terms{}", if *.intercept { " and an intercept" } else { "" })]
+    TooFewRows {
+        /// Rows.
+        rows: usize,
+        /// Terms asked for.
+        terms: usize,
+        /// Whether an intercept is fitted too.
+        intercept: bool,
+    },
+    /// The target does not vary.
+    #[error("the target has no variance: there is nothing to explain")]
+    NoVariance,
+    /// A forced term is collinear with those before it.
+    #[error("forced term `{term}` is collinear with the terms already in (pivot {pivot:e} ≤ tolerance {tolerance:e})")]
+    ForcedCollinear {
+        /// The term.
+        term: String,
+        /// Its pivot (share of its variance not explained by the terms in).
+        pivot: f64,
+        /// The tolerance.
+        tolerance: f64,
+    },
+    /// Settings out of range.
+    #[error("invalid setting: {0}")]
+    Config(String),
+    /// Index out of range or names not matching the statistics.
+    #[error("problem does not fit together: {0}")]
+    Shape(String),
+}
+
+impl Problem<'_> {
+    /// Checks indices and sizes before any back-end runs.
+    pub fn validate(&self) -> Result<(), SelectError> {
+        let p = self.moments.regressors();
+        if self.names.len() != p {
+            return Err(SelectError::Shape(format!("{} names for {p} columns", self.names.len())));
+        }
+        if let Some(&i) = self.forced.iter().chain(self.excluded).find(|&&i| i >= p) {
+            return Err(SelectError::Shape(format!("term index {i} ≥ {p} candidates")));
+        }
+        if let Some(&i) = self.forced.iter().find(|i| self.excluded.contains(i)) {
+            return Err(SelectError::Shape(format!("`{}` is both forced and excluded", self.names[i])));
+        }
+        let needed = self.forced.len() + usize::from(self.intercept) + 1;
+        if self.moments.count() < needed.max(2) {
+            return Err(SelectError::TooFewRows {
+                rows: self.moments.count(),
+                terms: self.forced.len().max(1),
+                intercept: self.intercept,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// A term-selection back-end.
+pub trait Selector: Send + Sync {
+    /// Stable name used in model files, on the CLI (`--backend stepwise`) and in reports.
+    fn name(&self) -> &'static str;
+    /// Chooses terms and fits their coefficients.
+    fn select(&self, problem: &Problem<'_>) -> Result<Selection, SelectError>;
+}
+
+/// Back-end settings as written in model files and chosen on the CLI, by `method` name.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "method", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum Backend {
+    /// The IBM SSP forward stepwise regression (STPRG) the paper used.
+    Stepwise(Stepwise),
+}
+
+impl Default for Backend {
+    fn default() -> Self {
+        Backend::Stepwise(Stepwise::default())
+    }
+}
+
+impl Backend {
+    /// The names of all back-ends.
+    pub const NAMES: &'static [&'static str] = &["stepwise"];
+
+    /// A back-end with default settings, by name.
+    pub fn by_name(name: &str) -> Result<Backend, SelectError> {
+        match name {
+            "stepwise" | "stprg" => Ok(Backend::Stepwise(Stepwise::default())),
+            other => Err(SelectError::Config(format!(
+                "unknown back-end `{other}` (known: {})",
+                Backend::NAMES.join(", ")
+            ))),
+        }
+    }
+
+    /// Checks the settings and returns the runnable back-end.
+    pub fn build(&self) -> Result<Box<dyn Selector>, SelectError> {
+        match self {
+            Backend::Stepwise(s) => {
+                s.validate()?;
+                Ok(Box::new(s.clone()))
+            }
+        }
+    }
+}

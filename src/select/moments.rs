@@ -1,0 +1,266 @@
+//! Sufficient statistics of a linear regression: the weighted means and the corrected sums
+//! of cross-products a_jk = Σ w (z_j − z̄_j)(z_k − z̄_k) of the regressors and the target
+//! (target last), accumulated in one pass over the rows. Rows arrive in blocks; each chunk
+//! is centred on its own mean, its cross-products formed by a BLAS-class product (matrixmultiply
+//! through nalgebra on a transposed view), and chunks are merged with the pairwise update of
+//! Chan, Golub & LeVeque (1979). Statistics of several files simply [`Moments::merge`].
+
+/// Rows per chunk handed to the matrix product.
+const CHUNK: usize = 2048;
+
+/// Means and corrected cross-products of `p` regressors and one target.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Moments {
+    p: usize,
+    count: usize,
+    weight: f64,
+    mean: Vec<f64>,
+    /// (p+1)² column-major, symmetric.
+    comoment: Vec<f64>,
+}
+
+impl Moments {
+    /// Empty statistics for `p` regressors.
+    pub fn new(p: usize) -> Moments {
+        let m = p + 1;
+        Moments { p, count: 0, weight: 0.0, mean: vec![0.0; m], comoment: vec![0.0; m * m] }
+    }
+
+    /// Number of regressors.
+    pub fn regressors(&self) -> usize {
+        self.p
+    }
+
+    /// Number of rows seen.
+    pub fn count(&self) -> usize {
+        self.count
+    }
+
+    /// Sum of the weights (= rows when unweighted).
+    pub fn weight(&self) -> f64 {
+        self.weight
+    }
+
+    /// Weighted means; the target's is last.
+    pub fn means(&self) -> &[f64] {
+        &self.mean
+    }
+
+    /// Corrected cross-product of variables `i` and `j` (index `p` is the target).
+    pub fn corrected(&self, i: usize, j: usize) -> f64 {
+        self.comoment[i + j * (self.p + 1)]
+    }
+
+    /// Cross-product about the origin, Σ w z_i z_j.
+    pub fn raw(&self, i: usize, j: usize) -> f64 {
+        self.corrected(i, j) + self.weight * self.mean[i] * self.mean[j]
+    }
+
+    /// Adds another set of statistics over the same variables (e.g. another file).
+    pub fn merge(&mut self, other: &Moments) {
+        assert_eq!(self.p, other.p, "moments of different regressor sets");
+        if other.weight == 0.0 {
+            self.count += other.count;
+            return;
+        }
+        let m = self.p + 1;
+        let total = self.weight + other.weight;
+        let f = self.weight * other.weight / total;
+        let delta: Vec<f64> = other.mean.iter().zip(&self.mean).map(|(b, a)| b - a).collect();
+        for j in 0..m {
+            for i in 0..m {
+                self.comoment[i + j * m] += other.comoment[i + j * m] + f * delta[i] * delta[j];
+            }
+        }
+        for (mu, d) in self.mean.iter_mut().zip(&delta) {
+            *mu += d * other.weight / total;
+        }
+        self.weight = total;
+        self.count += other.count;
+    }
+}
+
+/// C = ZᵀZ for Z of `n` rows and `m` columns stored column-major with leading dimension
+/// `ld`. Zᵀ is the same memory read with swapped strides, so matrixmultiply's packed kernel
+/// (the one nalgebra's gemm uses) runs at full speed without a transposed copy.
+fn gram(z: &[f64], ld: usize, n: usize, m: usize, c: &mut [f64]) {
+    assert!(n <= ld && z.len() >= ld * m && c.len() == m * m, "gram: buffer sizes");
+    // SAFETY: the asserts above keep every index matrixmultiply forms inside the slices:
+    // Zᵀ(i, r) = z[i*ld + r] and Z(r, j) = z[j*ld + r] with r < n ≤ ld, i, j < m;
+    // C(i, j) = c[i + j*m].
+    unsafe {
+        matrixmultiply::dgemm(
+            m,
+            n,
+            m,
+            1.0,
+            z.as_ptr(),
+            ld as isize,
+            1,
+            z.as_ptr(),
+            1,
+            ld as isize,
+            0.0,
+            c.as_mut_ptr(),
+            1,
+            m as isize,
+        );
+    }
+}
+
+/// Accumulates [`Moments`] from blocks of rows without keeping them.
+#[derive(Debug)]
+pub struct Accumulator {
+    moments: Moments,
+    /// Chunk buffer, (p+1) columns of CHUNK rows, column-major.
+    buf: Vec<f64>,
+    w: Vec<f64>,
+    filled: usize,
+    weighted: bool,
+}
+
+impl Accumulator {
+    /// An accumulator for `p` regressors.
+    pub fn new(p: usize) -> Accumulator {
+        Accumulator {
+            moments: Moments::new(p),
+            buf: vec![0.0; (p + 1) * CHUNK],
+            w: vec![0.0; CHUNK],
+            filled: 0,
+            weighted: false,
+        }
+    }
+
+    /// Adds `rows` rows: `x` column-major `rows × p`, target `y`, optional weights.
+    pub fn push(&mut self, x: &[f64], y: &[f64], weights: Option<&[f64]>) {
+        let p = self.moments.p;
+        let rows = y.len();
+        assert_eq!(x.len(), rows * p, "block must hold rows × p values");
+        let mut done = 0;
+        while done < rows {
+            let take = (CHUNK - self.filled).min(rows - done);
+            for j in 0..p {
+                let src = &x[j * rows + done..j * rows + done + take];
+                self.buf[j * CHUNK + self.filled..j * CHUNK + self.filled + take].copy_from_slice(src);
+            }
+            self.buf[p * CHUNK + self.filled..p * CHUNK + self.filled + take]
+                .copy_from_slice(&y[done..done + take]);
+            let w = &mut self.w[self.filled..self.filled + take];
+            match weights {
+                Some(ws) => {
+                    self.weighted = true;
+                    w.copy_from_slice(&ws[done..done + take]);
+                }
+                None => w.fill(1.0),
+            }
+            self.filled += take;
+            done += take;
+            if self.filled == CHUNK {
+                self.flush();
+            }
+        }
+    }
+
+    fn flush(&mut self) {
+        let n = self.filled;
+        if n == 0 {
+            return;
+        }
+        let m = self.moments.p + 1;
+        let w = &self.w[..n];
+        let wsum: f64 = w.iter().sum();
+        let mut chunk = Moments::new(self.moments.p);
+        chunk.count = n;
+        chunk.weight = wsum;
+        // centre each column on the chunk mean, scale rows by √w
+        for j in 0..m {
+            let col = &mut self.buf[j * CHUNK..j * CHUNK + n];
+            let mean = if self.weighted {
+                col.iter().zip(w).map(|(x, w)| x * w).sum::<f64>() / wsum
+            } else {
+                col.iter().sum::<f64>() / n as f64
+            };
+            chunk.mean[j] = mean;
+            if self.weighted {
+                for (x, w) in col.iter_mut().zip(w) {
+                    *x = (*x - mean) * w.sqrt();
+                }
+            } else {
+                col.iter_mut().for_each(|x| *x -= mean);
+            }
+        }
+        if wsum > 0.0 {
+            gram(&self.buf, CHUNK, n, m, &mut chunk.comoment);
+        }
+        self.moments.merge(&chunk);
+        self.filled = 0;
+    }
+
+    /// The statistics of all rows pushed.
+    pub fn finish(mut self) -> Moments {
+        self.flush();
+        self.moments
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn matches_two_pass_formula_and_merges() {
+        let n = 5000;
+        let x: Vec<f64> = (0..n * 2).map(|i| ((i * 7919) % 1000) as f64 / 100.0 + 1e6).collect();
+        let y: Vec<f64> = (0..n).map(|i| (i as f64).sin()).collect();
+        let mut acc = Accumulator::new(2);
+        acc.push(&x, &y, None);
+        let m = acc.finish();
+        let col = |j: usize| -> Vec<f64> {
+            if j < 2 {
+                x[j * n..(j + 1) * n].to_vec()
+            } else {
+                y.clone()
+            }
+        };
+        for i in 0..3 {
+            for j in 0..3 {
+                let (a, b) = (col(i), col(j));
+                let (ma, mb) = (a.iter().sum::<f64>() / n as f64, b.iter().sum::<f64>() / n as f64);
+                let c: f64 = a.iter().zip(&b).map(|(a, b)| (a - ma) * (b - mb)).sum();
+                assert!((m.corrected(i, j) - c).abs() <= 1e-9 * c.abs().max(1.0), "{i}{j}");
+            }
+        }
+        // two halves merged = whole
+        let (mut a1, mut a2) = (Accumulator::new(2), Accumulator::new(2));
+        let half = n / 2;
+        let xa: Vec<f64> = (0..2).flat_map(|j| x[j * n..j * n + half].to_vec()).collect();
+        let xb: Vec<f64> = (0..2).flat_map(|j| x[j * n + half..(j + 1) * n].to_vec()).collect();
+        a1.push(&xa, &y[..half], None);
+        a2.push(&xb, &y[half..], None);
+        let mut merged = a1.finish();
+        merged.merge(&a2.finish());
+        for i in 0..3 {
+            for j in 0..3 {
+                assert!(
+                    (merged.corrected(i, j) - m.corrected(i, j)).abs()
+                        <= 1e-9 * m.corrected(i, j).abs().max(1.0)
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn integer_weights_equal_repeated_rows() {
+        let x = vec![1.0, 2.0, 4.0];
+        let y = vec![1.0, 3.0, 2.0];
+        let mut a = Accumulator::new(1);
+        a.push(&x, &y, Some(&[1.0, 2.0, 1.0]));
+        let a = a.finish();
+        let mut b = Accumulator::new(1);
+        b.push(&[1.0, 2.0, 2.0, 4.0], &[1.0, 3.0, 3.0, 2.0], None);
+        let b = b.finish();
+        for (i, j) in [(0, 0), (0, 1), (1, 1)] {
+            assert!((a.corrected(i, j) - b.corrected(i, j)).abs() < 1e-12);
+        }
+    }
+}

@@ -1,0 +1,338 @@
+//! Forward stepwise multiple regression as in the IBM System/360 Scientific Subroutine
+//! Package, subroutine STPRG, the way Oltmann (1973, Appendix A) used it.
+//!
+//! Work on the corrected cross-product matrix of candidates and target, scaled to
+//! correlations. Each step takes the candidate with the largest sum-of-squares reduction
+//! c_j = a_jy²/a_jj (eq. A2) — forced terms first, in that order of size — stops when that
+//! share of the total (A3) is below a constant, and sweeps the matrix on it (A9-A10, A15-A17),
+//! which leaves the coefficients (A11), the residual and the inverse in place. Terms are only
+//! ever added. A candidate whose pivot (the share of its variance not yet explained by the terms
+//! in) is non-positive or tiny is refused rather than divided by.
+
+use serde::{Deserialize, Serialize};
+
+use super::{Estimate, FittedTerm, Problem, SelectError, Selection, Selector, Step, Stop};
+
+/// How the step whose coefficients are reported is chosen (Oltmann 1973, Figs. 2-4).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "rule", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum StepRule {
+    /// The first step after which F no longer rises by more than `tolerance` (relative):
+    /// with 0, the first relative maximum of F.
+    FirstFMaximum {
+        /// Relative rise of F that still counts as rising.
+        #[serde(default)]
+        tolerance: f64,
+    },
+    /// The first step after which the standard error no longer falls by more than
+    /// `tolerance` (relative).
+    StandardErrorPlateau {
+        /// Relative fall that still counts as falling materially.
+        tolerance: f64,
+    },
+    /// The last step taken.
+    Last,
+}
+
+impl Default for StepRule {
+    fn default() -> Self {
+        StepRule::FirstFMaximum { tolerance: 0.0 }
+    }
+}
+
+/// Settings of the STPRG back-end.
+///
+/// | setting | default | meaning |
+/// |---|---|---|
+/// | `min_proportion` | 0 | stop when the next term's share of the total sum of squares is below this (0: every step, as the paper) |
+/// | `pivot_tolerance` | 1e-10 | refuse a term whose unexplained share of variance is at most this |
+/// | `exact_fit` | 1e-13 | stop when 1 − R² is at most this: later steps would be chosen by round-off |
+/// | `step_rule` | first F maximum | which step's coefficients are reported |
+/// | `max_steps` | none | stop after this many terms |
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Stepwise {
+    /// Stop constant for the share of the next term (A3).
+    pub min_proportion: f64,
+    /// Refusal threshold for a term's pivot (correlation scale).
+    pub pivot_tolerance: f64,
+    /// Residual share at which the fit counts as exact.
+    pub exact_fit: f64,
+    /// Rule choosing the reported step.
+    pub step_rule: StepRule,
+    /// Maximum number of terms.
+    pub max_steps: Option<usize>,
+}
+
+impl Default for Stepwise {
+    fn default() -> Self {
+        Stepwise {
+            min_proportion: 0.0,
+            pivot_tolerance: 1e-10,
+            exact_fit: 1e-13,
+            step_rule: StepRule::default(),
+            max_steps: None,
+        }
+    }
+}
+
+impl Stepwise {
+    /// Checks the settings.
+    pub fn validate(&self) -> Result<(), SelectError> {
+        let bad =
+            |what: &str, v: f64| SelectError::Config(format!("stepwise {what} must be in [0, 1), is {v}"));
+        if !(0.0..1.0).contains(&self.min_proportion) {
+            return Err(bad("min_proportion", self.min_proportion));
+        }
+        if !(0.0..1.0).contains(&self.pivot_tolerance) {
+            return Err(bad("pivot_tolerance", self.pivot_tolerance));
+        }
+        if !(0.0..1.0).contains(&self.exact_fit) {
+            return Err(bad("exact_fit", self.exact_fit));
+        }
+        match self.step_rule {
+            StepRule::FirstFMaximum { tolerance } | StepRule::StandardErrorPlateau { tolerance }
+                if !(0.0..1.0).contains(&tolerance) =>
+            {
+                Err(bad("step_rule tolerance", tolerance))
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+/// Goodnight's sweep of a symmetric matrix (row-major, size m) on pivot k.
+fn sweep(a: &mut [f64], m: usize, k: usize) {
+    let d = a[k * m + k];
+    for j in 0..m {
+        a[k * m + j] /= d;
+    }
+    for i in 0..m {
+        if i == k {
+            continue;
+        }
+        let b = a[i * m + k];
+        if b == 0.0 {
+            continue;
+        }
+        for j in 0..m {
+            a[i * m + j] -= b * a[k * m + j];
+        }
+        a[i * m + k] = -b / d;
+    }
+    a[k * m + k] = 1.0 / d;
+}
+
+/// Chooses the reported step (1-based) from the steps taken.
+pub(crate) fn choose_step(rule: StepRule, steps: &[Step], n_forced: usize) -> usize {
+    let n = steps.len();
+    if n == 0 {
+        return 0;
+    }
+    let first = n_forced.max(1).min(n);
+    match rule {
+        StepRule::Last => n,
+        StepRule::FirstFMaximum { tolerance } => {
+            (first..n).find(|&i| steps[i].f <= steps[i - 1].f * (1.0 + tolerance)).unwrap_or(n)
+        }
+        StepRule::StandardErrorPlateau { tolerance } => (first..n)
+            .find(|&i| steps[i].standard_error >= steps[i - 1].standard_error * (1.0 - tolerance))
+            .unwrap_or(n),
+    }
+}
+
+impl Selector for Stepwise {
+    fn name(&self) -> &'static str {
+        "stepwise"
+    }
+
+    fn select(&self, pb: &Problem<'_>) -> Result<Selection, SelectError> {
+        pb.validate()?;
+        self.validate()?;
+        let mo = pb.moments;
+        let p = mo.regressors();
+        let m = p + 1;
+        let n = mo.count();
+        let cross = |i: usize, j: usize| if pb.intercept { mo.corrected(i, j) } else { mo.raw(i, j) };
+        let total = cross(p, p);
+        if total.is_nan() || total <= 0.0 {
+            return Err(SelectError::NoVariance);
+        }
+        // correlation scaling: pivots become shares of variance, comparable across terms
+        let d: Vec<f64> = (0..m).map(|i| cross(i, i).max(0.0).sqrt()).collect();
+        let mut a = vec![0.0; m * m];
+        for i in 0..m {
+            for j in 0..m {
+                if d[i] > 0.0 && d[j] > 0.0 {
+                    a[i * m + j] = cross(i, j) / (d[i] * d[j]);
+                }
+            }
+        }
+        let means = mo.means();
+        let n_eff = if pb.intercept { n as f64 - 1.0 } else { n as f64 };
+        let mut entered: Vec<usize> = Vec::new();
+        let mut refused: Vec<usize> = Vec::new();
+        let mut notes = Vec::new();
+        let mut steps: Vec<Step> = Vec::new();
+        let stop = loop {
+            if self.max_steps.is_some_and(|k| entered.len() >= k) {
+                break Stop::Converged;
+            }
+            let open = |j: &usize| !entered.contains(j) && !refused.contains(j) && !pb.excluded.contains(j);
+            let forced_left: Vec<usize> = pb.forced.iter().copied().filter(open).collect();
+            let forcing = !forced_left.is_empty();
+            let pool: Vec<usize> = if forcing { forced_left } else { (0..p).filter(open).collect() };
+            if pool.is_empty() {
+                break Stop::AllEntered;
+            }
+            let mut best: Option<(usize, f64)> = None;
+            for &j in &pool {
+                let pivot = a[j * m + j];
+                // a NaN pivot is refused too
+                if pivot.is_nan() || pivot <= self.pivot_tolerance {
+                    if forcing {
+                        return Err(SelectError::ForcedCollinear {
+                            term: pb.names[j].clone(),
+                            pivot,
+                            tolerance: self.pivot_tolerance,
+                        });
+                    }
+                    refused.push(j);
+                    notes.push(format!(
+                        "`{}` refused: collinear with the terms in (pivot {pivot:.3e} ≤ {:.0e})",
+                        pb.names[j], self.pivot_tolerance
+                    ));
+                    continue;
+                }
+                let c = a[j * m + p] * a[j * m + p] / pivot; // eq. (A2), as a share of D
+                if best.is_none_or(|(_, bc)| c > bc) {
+                    best = Some((j, c));
+                }
+            }
+            let Some((j, share)) = best else { break Stop::AllEntered };
+            if !forcing && share < self.min_proportion {
+                break Stop::BelowThreshold {
+                    term: pb.names[j].clone(),
+                    proportion: share,
+                    threshold: self.min_proportion,
+                };
+            }
+            let k = entered.len() + 1;
+            let dof = n_eff - k as f64;
+            if dof < 1.0 {
+                if forcing {
+                    return Err(SelectError::TooFewRows { rows: n, terms: k, intercept: pb.intercept });
+                }
+                break Stop::NoDegreesOfFreedom;
+            }
+            sweep(&mut a, m, j);
+            entered.push(j);
+            steps.push(self.statistics(pb, &a, &d, &entered, j, share, total, dof, n_eff, forcing, means));
+            let residual_share = a[p * m + p];
+            if residual_share <= self.exact_fit {
+                notes.push(format!(
+                    "exact fit after step {k} (1 − R² = {residual_share:.1e}): further steps would be chosen by round-off, so stepping stopped"
+                ));
+                break Stop::ExactFit { residual_share };
+            }
+        };
+        let chosen = choose_step(self.step_rule, &steps, pb.forced.len());
+        let (terms, intercept) = match chosen {
+            0 => (vec![], None),
+            c => (steps[c - 1].terms.clone(), steps[c - 1].intercept.clone()),
+        };
+        Ok(Selection {
+            backend: self.name().into(),
+            rows: n,
+            steps,
+            chosen_step: chosen,
+            terms,
+            intercept,
+            stop,
+            notes,
+        })
+    }
+}
+
+impl Stepwise {
+    #[allow(clippy::too_many_arguments)]
+    fn statistics(
+        &self,
+        pb: &Problem<'_>,
+        a: &[f64],
+        d: &[f64],
+        entered: &[usize],
+        j: usize,
+        share: f64,
+        total: f64,
+        dof: f64,
+        n_eff: f64,
+        forced: bool,
+        means: &[f64],
+    ) -> Step {
+        let p = pb.moments.regressors();
+        let m = p + 1;
+        let k = entered.len() as f64;
+        let residual = (a[p * m + p] * total).max(0.0);
+        let r2 = 1.0 - a[p * m + p];
+        let s = (residual / dof).sqrt(); // eq. (A7)
+        let terms: Vec<FittedTerm> = entered
+            .iter()
+            .map(|&i| {
+                let coefficient = a[i * m + p] * d[p] / d[i]; // eq. (A11), unscaled
+                let std_error = s * a[i * m + i].max(0.0).sqrt() / d[i]; // eq. (A13)
+                FittedTerm {
+                    term: pb.names[i].clone(),
+                    index: i,
+                    coefficient,
+                    std_error,
+                    t: coefficient / std_error,
+                }
+            })
+            .collect();
+        let intercept = pb.intercept.then(|| {
+            let value = means[p] - terms.iter().map(|t| t.coefficient * means[t.index]).sum::<f64>(); // eq. (A12)
+            let mut q = 1.0 / pb.moments.weight();
+            for &i in entered {
+                for &l in entered {
+                    q += means[i] * means[l] * a[i * m + l] / (d[i] * d[l]);
+                }
+            }
+            let std_error = s * q.max(0.0).sqrt();
+            Estimate { value, std_error, t: value / std_error }
+        });
+        Step {
+            step: entered.len(),
+            term: pb.names[j].clone(),
+            index: j,
+            forced,
+            reduction: share * total,
+            proportion: share,
+            r2,
+            r: r2.max(0.0).sqrt(),
+            r_adjusted: (1.0 - (1.0 - r2) * n_eff / (n_eff + 1.0 - k)).max(0.0).sqrt(),
+            standard_error: s,
+            standard_error_adjusted: s * (n_eff / (n_eff + 1.0 - k)).sqrt(),
+            f: (r2 * total / k) / (residual / dof), // eq. (A8)
+            terms,
+            intercept,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sweep_inverts() {
+        // [[4,2],[2,3]]⁻¹ = [[3,-2],[-2,4]]/8
+        let mut a = vec![4.0, 2.0, 2.0, 3.0];
+        sweep(&mut a, 2, 0);
+        sweep(&mut a, 2, 1);
+        let want = [3.0 / 8.0, -2.0 / 8.0, -2.0 / 8.0, 4.0 / 8.0];
+        for (x, w) in a.iter().zip(want) {
+            assert!((x - w).abs() < 1e-15);
+        }
+    }
+}

@@ -1,0 +1,35 @@
+//! The term language: candidate regressors written as text (`u*Δu`, `r*v^2/u`), parsed with
+//! pest into a spanned [`Expr`], resolved against a [`Vocabulary`] into a canonical [`Term`]
+//! (so `v*r` and `r*v` are one term), and compiled into a fast evaluator ([`Library`]).
+
+mod canon;
+mod compile;
+mod error;
+mod functions;
+mod parse;
+mod vocabulary;
+
+pub use canon::{Atom, Monomial, Term};
+pub use compile::{Library, RowScratch, Source};
+pub use error::TermError;
+pub use functions::{Function, FUNCTIONS};
+pub use parse::{parse_expr, BinOp, Expr, ExprKind};
+pub use vocabulary::{Derived, Vocabulary};
+
+/// Parses and resolves a list of candidate terms, refusing a duplicate (two spellings of
+/// one canonical term, e.g. `v*r` and `r*v`) with an error that names both.
+pub fn parse_terms<S: AsRef<str>>(texts: &[S], vocab: &Vocabulary) -> Result<Vec<Term>, TermError> {
+    let mut terms: Vec<Term> = Vec::with_capacity(texts.len());
+    for (i, text) in texts.iter().enumerate() {
+        let term = vocab.parse(text.as_ref())?;
+        if let Some(j) = terms.iter().position(|t| *t == term) {
+            return Err(TermError::Duplicate {
+                first: texts[j].as_ref().to_string(),
+                second: texts[i].as_ref().to_string(),
+                canonical: term.to_string(),
+            });
+        }
+        terms.push(term);
+    }
+    Ok(terms)
+}

@@ -1,0 +1,184 @@
+//! Stage one of reading a term: text → spanned [`Expr`] (pest grammar + Pratt parser).
+//! Names are not looked up here; that is [`super::Vocabulary::resolve`]'s job.
+
+use std::sync::LazyLock;
+
+use pest::iterators::Pairs;
+use pest::pratt_parser::{Assoc, Op, PrattParser};
+use pest::Parser;
+
+use super::error::TermError;
+
+#[derive(pest_derive::Parser)]
+#[grammar = "grammars/term.pest"]
+struct TermParser;
+
+static PRATT: LazyLock<PrattParser<Rule>> = LazyLock::new(|| {
+    PrattParser::new()
+        .op(Op::infix(Rule::add, Assoc::Left) | Op::infix(Rule::sub, Assoc::Left))
+        .op(Op::infix(Rule::mul, Assoc::Left) | Op::infix(Rule::div, Assoc::Left))
+        .op(Op::prefix(Rule::neg))
+});
+
+/// A binary operator.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BinOp {
+    /// `+`
+    Add,
+    /// `-`
+    Sub,
+    /// `*`
+    Mul,
+    /// `/`
+    Div,
+}
+
+/// A parsed term before names are resolved; every node keeps its byte span in the text.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Expr {
+    /// What the node is.
+    pub kind: ExprKind,
+    /// Byte range in the source text.
+    pub span: (usize, usize),
+}
+
+/// The node kinds of [`Expr`].
+#[derive(Clone, Debug, PartialEq)]
+pub enum ExprKind {
+    /// A number literal.
+    Num(f64),
+    /// A name (variable, parameter, derived variable or alias).
+    Var(String),
+    /// Unary minus.
+    Neg(Box<Expr>),
+    /// Binary operation.
+    Bin(BinOp, Box<Expr>, Box<Expr>),
+    /// Integer power.
+    Pow(Box<Expr>, i32),
+    /// Function call, with the span of the function's name.
+    Call(String, (usize, usize), Vec<Expr>),
+}
+
+fn rename(rule: &Rule) -> String {
+    match rule {
+        Rule::EOI => "end of term".into(),
+        Rule::expr | Rule::factor => "a variable, number, function call or `(`".into(),
+        Rule::add | Rule::sub | Rule::mul | Rule::div => "an operator (+ - * /)".into(),
+        Rule::neg => "a sign `-`".into(),
+        Rule::exponent | Rule::int => "an integer exponent".into(),
+        Rule::call => "a function call".into(),
+        Rule::number => "a number".into(),
+        Rule::ident => "a variable or function name".into(),
+        other => format!("{other:?}"),
+    }
+}
+
+/// Parses a term's text into a spanned expression (syntax only).
+pub fn parse_expr(input: &str) -> Result<Expr, TermError> {
+    let mut pairs = TermParser::parse(Rule::term, input)
+        .map_err(|e| TermError::Invalid(Box::new(e.renamed_rules(rename))))?;
+    let expr = pairs.next().ok_or_else(|| TermError::at(input, 0, 0, "expected a term"))?;
+    build(expr.into_inner(), input)
+}
+
+fn build(pairs: Pairs<'_, Rule>, input: &str) -> Result<Expr, TermError> {
+    PRATT
+        .map_primary(|p| primary(p, input))
+        .map_prefix(|op, rhs| {
+            let rhs = rhs?;
+            let span = (op.as_span().start(), rhs.span.1);
+            Ok(Expr { kind: ExprKind::Neg(Box::new(rhs)), span })
+        })
+        .map_infix(|lhs, op, rhs| {
+            let (lhs, rhs) = (lhs?, rhs?);
+            let bin = match op.as_rule() {
+                Rule::add => BinOp::Add,
+                Rule::sub => BinOp::Sub,
+                Rule::mul => BinOp::Mul,
+                _ => BinOp::Div,
+            };
+            let span = (lhs.span.0, rhs.span.1);
+            Ok(Expr { kind: ExprKind::Bin(bin, Box::new(lhs), Box::new(rhs)), span })
+        })
+        .parse(pairs)
+}
+
+fn primary(pair: pest::iterators::Pair<'_, Rule>, input: &str) -> Result<Expr, TermError> {
+    let span = (pair.as_span().start(), pair.as_span().end());
+    match pair.as_rule() {
+        Rule::factor => {
+            let mut inner = pair.into_inner();
+            let base = inner.next().ok_or_else(|| TermError::at(input, span.0, span.1, "empty factor"))?;
+            let base = primary(base, input)?;
+            match inner.next() {
+                None => Ok(base),
+                Some(exp) => {
+                    let (s, e) = (exp.as_span().start(), exp.as_span().end());
+                    let digits = exp.as_str().trim_matches(|c| c == '(' || c == ')').trim();
+                    let k: i32 = digits.parse().map_err(|_| {
+                        TermError::at(input, s, e, "exponent out of range (at most ±2147483647)")
+                    })?;
+                    Ok(Expr { kind: ExprKind::Pow(Box::new(base), k), span })
+                }
+            }
+        }
+        Rule::expr => build(pair.into_inner(), input),
+        Rule::number => {
+            let v: f64 =
+                pair.as_str().parse().map_err(|_| TermError::at(input, span.0, span.1, "not a number"))?;
+            if !v.is_finite() {
+                return Err(TermError::at(input, span.0, span.1, "number out of range"));
+            }
+            Ok(Expr { kind: ExprKind::Num(v), span })
+        }
+        Rule::ident => Ok(Expr { kind: ExprKind::Var(pair.as_str().to_string()), span }),
+        Rule::call => {
+            let mut inner = pair.into_inner();
+            let name =
+                inner.next().ok_or_else(|| TermError::at(input, span.0, span.1, "missing function name"))?;
+            let name_span = (name.as_span().start(), name.as_span().end());
+            let args = inner.map(|a| build(a.into_inner(), input)).collect::<Result<Vec<_>, _>>()?;
+            Ok(Expr { kind: ExprKind::Call(name.as_str().to_string(), name_span, args), span })
+        }
+        other => Err(TermError::at(
+            input,
+            span.0,
+            span.1,
+            format!("internal: unexpected {other:?} where a factor belongs"),
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn precedence_and_spans() {
+        let e = parse_expr("-u^2").unwrap();
+        match e.kind {
+            ExprKind::Neg(inner) => assert!(matches!(inner.kind, ExprKind::Pow(_, 2))),
+            k => panic!("{k:?}"),
+        }
+        let e = parse_expr("a + b*c").unwrap();
+        assert!(matches!(e.kind, ExprKind::Bin(BinOp::Add, _, _)));
+        assert_eq!(e.span, (0, 7));
+        assert!(parse_expr("u^-1").is_ok());
+        assert!(parse_expr("u^(-2)").is_ok());
+        assert!(parse_expr("Δu*δ^3").is_ok());
+        assert!(parse_expr("∆u").is_ok());
+    }
+
+    #[test]
+    fn syntax_errors_have_carets() {
+        for (text, col) in [("u**v", 3), ("u*(v", 5), ("u^v", 3), ("", 1), ("u v", 3)] {
+            let err = parse_expr(text).unwrap_err();
+            let msg = err.to_string();
+            assert!(msg.contains('^'), "{text}: {msg}");
+            assert_eq!(err.line_col(), Some((1, col)), "{text}: {msg}");
+        }
+        let msg = parse_expr("u**v").unwrap_err().to_string();
+        assert!(msg.contains("expected"), "{msg}");
+        assert!(!msg.contains("Rule"), "{msg}");
+    }
+}

@@ -1,0 +1,283 @@
+//! What names a term may use: variables (data columns, model states and inputs),
+//! parameters (per-run constants such as `u0`), derived variables (`Δu = u - u0`) and
+//! aliases (`du` → `Δu`). All are declared, none hard-coded; stage two of reading a term
+//! ([`Vocabulary::resolve`]) binds names against it and canonicalises.
+
+use std::collections::BTreeMap;
+
+use super::canon::{Atom, Term};
+use super::error::TermError;
+use super::functions::{function, FUNCTIONS};
+use super::parse::{parse_expr, BinOp, Expr, ExprKind};
+
+/// A derived variable: a name for a term over earlier names, evaluated before the terms.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Derived {
+    /// Its canonical name.
+    pub name: String,
+    /// Its definition.
+    pub definition: Term,
+}
+
+/// The names terms may use.
+#[derive(Clone, Debug, Default)]
+pub struct Vocabulary {
+    variables: Vec<String>,
+    parameters: Vec<String>,
+    derived: Vec<Derived>,
+    aliases: BTreeMap<String, String>,
+    open: bool,
+}
+
+/// `∆` (U+2206, the increment sign keyboards produce) is read as `Δ` (U+0394).
+fn normalise_name(name: &str) -> String {
+    name.replace('\u{2206}', "\u{394}")
+}
+
+fn is_identifier(name: &str) -> bool {
+    matches!(parse_expr(name), Ok(Expr { kind: ExprKind::Var(_), .. }))
+}
+
+impl Vocabulary {
+    /// An empty vocabulary.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// A vocabulary that accepts any identifier as a variable (for ad-hoc use and tests).
+    pub fn open() -> Self {
+        Vocabulary { open: true, ..Self::default() }
+    }
+
+    fn check_new(&self, name: &str) -> Result<String, TermError> {
+        let name = normalise_name(name);
+        if !is_identifier(&name) {
+            return Err(TermError::Declaration(format!("`{name}` is not a valid name")));
+        }
+        if self.is_declared(&name) || self.aliases.contains_key(&name) {
+            return Err(TermError::Declaration(format!("`{name}` is declared twice")));
+        }
+        if function(&name).is_some() {
+            return Err(TermError::Declaration(format!("`{name}` is a function name")));
+        }
+        Ok(name)
+    }
+
+    fn is_declared(&self, name: &str) -> bool {
+        self.variables.iter().any(|v| v == name)
+            || self.parameters.iter().any(|v| v == name)
+            || self.derived.iter().any(|d| d.name == name)
+    }
+
+    /// Declares a variable (a data column, state or input).
+    pub fn variable(&mut self, name: &str) -> Result<&mut Self, TermError> {
+        let name = self.check_new(name)?;
+        self.variables.push(name);
+        Ok(self)
+    }
+
+    /// Declares a parameter (a constant per data set, e.g. `u0`).
+    pub fn parameter(&mut self, name: &str) -> Result<&mut Self, TermError> {
+        let name = self.check_new(name)?;
+        self.parameters.push(name);
+        Ok(self)
+    }
+
+    /// Declares `name = definition`, the definition using earlier names only.
+    pub fn derive(&mut self, name: &str, definition: &str) -> Result<&mut Self, TermError> {
+        let name = self.check_new(name)?;
+        let definition = self.parse(definition)?;
+        self.derived.push(Derived { name, definition });
+        Ok(self)
+    }
+
+    /// Declares `alias` as another spelling of `target` (e.g. `du` for `Δu`).
+    pub fn alias(&mut self, alias: &str, target: &str) -> Result<&mut Self, TermError> {
+        let alias = self.check_new(alias)?;
+        let target = normalise_name(target);
+        if !self.is_declared(&target) {
+            return Err(TermError::Declaration(format!(
+                "alias `{alias}` points to `{target}`, which is not declared"
+            )));
+        }
+        self.aliases.insert(alias, target);
+        Ok(self)
+    }
+
+    /// The declared variables, in order.
+    pub fn variables(&self) -> &[String] {
+        &self.variables
+    }
+
+    /// The declared parameters, in order.
+    pub fn parameters(&self) -> &[String] {
+        &self.parameters
+    }
+
+    /// The derived variables, in order of declaration.
+    pub fn derived(&self) -> &[Derived] {
+        &self.derived
+    }
+
+    /// The aliases (alias → canonical name).
+    pub fn aliases(&self) -> &BTreeMap<String, String> {
+        &self.aliases
+    }
+
+    /// A derived variable's definition.
+    pub fn derived_definition(&self, name: &str) -> Option<&Term> {
+        self.derived.iter().find(|d| d.name == name).map(|d| &d.definition)
+    }
+
+    /// The canonical spelling of a name, if the vocabulary knows it.
+    pub fn canonical(&self, name: &str) -> Option<String> {
+        let name = normalise_name(name);
+        if self.is_declared(&name) {
+            return Some(name);
+        }
+        if let Some(t) = self.aliases.get(&name) {
+            return Some(t.clone());
+        }
+        (self.open && function(&name).is_none()).then_some(name)
+    }
+
+    /// Parses and resolves a term's text.
+    pub fn parse(&self, text: &str) -> Result<Term, TermError> {
+        let expr = parse_expr(text)?;
+        self.resolve(&expr, text)
+    }
+
+    /// Binds the names of a parsed expression and canonicalises it.
+    pub fn resolve(&self, expr: &Expr, input: &str) -> Result<Term, TermError> {
+        let at = |msg: String| TermError::at(input, expr.span.0, expr.span.1, msg);
+        match &expr.kind {
+            ExprKind::Num(v) => Ok(Term::constant(*v)),
+            ExprKind::Var(name) => match self.canonical(name) {
+                Some(c) => Ok(Term::var(&c)),
+                None if function(name).is_some() => {
+                    Err(at(format!("`{name}` is a function: write `{name}(…)`")))
+                }
+                None => Err(at(format!("unknown variable `{name}`; {}", self.known_names()))),
+            },
+            ExprKind::Neg(e) => self.resolve(e, input)?.scale(-1.0).map_err(at),
+            ExprKind::Pow(e, k) => self.resolve(e, input)?.powi(*k).map_err(at),
+            ExprKind::Bin(op, a, b) => {
+                let (a, b) = (self.resolve(a, input)?, self.resolve(b, input)?);
+                match op {
+                    BinOp::Add => a.add(&b),
+                    BinOp::Sub => a.add(&b.scale(-1.0).map_err(at)?),
+                    BinOp::Mul => a.mul(&b),
+                    BinOp::Div => b.powi(-1).and_then(|inv| a.mul(&inv)),
+                }
+                .map_err(at)
+            }
+            ExprKind::Call(name, name_span, args) => {
+                let Some((_, func)) = function(name) else {
+                    let known: Vec<_> = FUNCTIONS.iter().map(|f| f.name).collect();
+                    return Err(TermError::at(
+                        input,
+                        name_span.0,
+                        name_span.1,
+                        format!("unknown function `{name}`; known: {}", known.join(", ")),
+                    ));
+                };
+                if args.len() != func.arity {
+                    return Err(at(format!(
+                        "function `{name}` takes {} argument{}, found {}",
+                        func.arity,
+                        if func.arity == 1 { "" } else { "s" },
+                        args.len()
+                    )));
+                }
+                let args = args.iter().map(|a| self.resolve(a, input)).collect::<Result<Vec<_>, _>>()?;
+                Ok(Term::atom(Atom::Call(name.clone(), args)))
+            }
+        }
+    }
+
+    fn known_names(&self) -> String {
+        let mut names: Vec<String> = self
+            .variables
+            .iter()
+            .chain(&self.parameters)
+            .cloned()
+            .chain(self.derived.iter().map(|d| d.name.clone()))
+            .collect();
+        names.extend(self.aliases.iter().map(|(a, t)| format!("{a} (= {t})")));
+        if names.is_empty() {
+            "no names are declared".into()
+        } else {
+            format!("known: {}", names.join(", "))
+        }
+    }
+
+    /// Tree-walking interpreter of a parsed expression, the reference the compiled evaluator
+    /// is tested against. `value` gives base variables and parameters; derived variables are
+    /// expanded through their definitions.
+    pub fn interpret(&self, expr: &Expr, value: &dyn Fn(&str) -> f64) -> f64 {
+        match &expr.kind {
+            ExprKind::Num(v) => *v,
+            ExprKind::Var(name) => self.value_of(&self.canonical(name).unwrap_or_default(), value),
+            ExprKind::Neg(e) => -self.interpret(e, value),
+            ExprKind::Pow(e, k) => self.interpret(e, value).powi(*k),
+            ExprKind::Bin(op, a, b) => {
+                let (a, b) = (self.interpret(a, value), self.interpret(b, value));
+                match op {
+                    BinOp::Add => a + b,
+                    BinOp::Sub => a - b,
+                    BinOp::Mul => a * b,
+                    BinOp::Div => a / b,
+                }
+            }
+            ExprKind::Call(name, _, args) => {
+                let args: Vec<f64> = args.iter().map(|a| self.interpret(a, value)).collect();
+                function(name).map_or(f64::NAN, |(_, f)| (f.eval)(&args))
+            }
+        }
+    }
+
+    /// Value of a canonical name: a base value, or a derived variable's definition.
+    pub fn value_of(&self, name: &str, value: &dyn Fn(&str) -> f64) -> f64 {
+        match self.derived_definition(name) {
+            Some(def) => def.eval(&|n| self.value_of(n, value)),
+            None => value(name),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ship() -> Vocabulary {
+        let mut v = Vocabulary::new();
+        v.variable("u").unwrap().variable("v").unwrap().variable("r").unwrap();
+        v.variable("δ").unwrap().parameter("u0").unwrap();
+        v.derive("Δu", "u - u0").unwrap();
+        v.alias("du", "Δu").unwrap().alias("delta", "δ").unwrap();
+        v
+    }
+
+    #[test]
+    fn aliases_and_math_delta_resolve() {
+        let v = ship();
+        assert_eq!(v.parse("u*du").unwrap(), v.parse("Δu*u").unwrap());
+        assert_eq!(v.parse("u*∆u").unwrap(), v.parse("u*Δu").unwrap());
+        assert_eq!(v.parse("u^2*delta^3").unwrap().to_string(), "u^2*δ^3");
+        assert_eq!(v.parse("v^2*r/u").unwrap().to_string(), "r*v^2/u");
+    }
+
+    #[test]
+    fn meaning_errors_point_at_the_name() {
+        let v = ship();
+        let e = v.parse("u*w").unwrap_err();
+        assert_eq!(e.line_col(), Some((1, 3)));
+        assert!(e.to_string().contains("unknown variable `w`"), "{e}");
+        let e = v.parse("foo(u)").unwrap_err();
+        assert!(e.to_string().contains("unknown function `foo`"), "{e}");
+        let e = v.parse("abs(u, v)").unwrap_err();
+        assert!(e.to_string().contains("takes 1 argument, found 2"), "{e}");
+        let e = v.parse("u/0").unwrap_err();
+        assert!(e.to_string().contains("division by zero"), "{e}");
+    }
+}

@@ -1,0 +1,15 @@
+//! One integration-test binary (fast to link); each module tests one part through the
+//! public API or the CLI.
+
+// Shared helpers: reference least squares, data generators.
+#[path = "integration/common.rs"]
+mod common;
+// Term language: accept/reject tables, caret texts, parse∘print, compiled = interpreter, fuzz.
+#[path = "integration/grammar.rs"]
+mod grammar;
+// STPRG on the Hald cement data and on synthetic data with a known equation; proptest laws.
+#[path = "integration/stepwise.rs"]
+mod stepwise;
+// The `termid` binary end to end.
+#[path = "integration/cli.rs"]
+mod cli;

@@ -1,0 +1,53 @@
+//! Helpers shared by the integration tests.
+
+use nalgebra::{DMatrix, DVector};
+use termid::select::{Accumulator, Moments};
+
+/// Least squares by Householder QR on [1 | X] (or X alone): the independent reference.
+pub fn qr_fit(columns: &[Vec<f64>], y: &[f64], intercept: bool) -> (Option<f64>, Vec<f64>) {
+    let n = y.len();
+    let k = columns.len() + usize::from(intercept);
+    let mut a = DMatrix::<f64>::zeros(n, k);
+    let mut c = 0;
+    if intercept {
+        a.column_mut(0).fill(1.0);
+        c = 1;
+    }
+    for (j, col) in columns.iter().enumerate() {
+        a.column_mut(c + j).copy_from_slice(col);
+    }
+    let qr = a.qr();
+    let qty = qr.q().transpose() * DVector::from_column_slice(y);
+    let b = qr.r().solve_upper_triangular(&qty).expect("full rank");
+    if intercept {
+        (Some(b[0]), b.iter().skip(1).copied().collect())
+    } else {
+        (None, b.iter().copied().collect())
+    }
+}
+
+/// Moments of column vectors and a target.
+pub fn moments_of(columns: &[Vec<f64>], y: &[f64]) -> Moments {
+    let flat: Vec<f64> = columns.iter().flatten().copied().collect();
+    let mut acc = Accumulator::new(columns.len());
+    acc.push(&flat, y, None);
+    acc.finish()
+}
+
+/// Relative closeness with a floor for values near zero.
+pub fn close(a: f64, b: f64, rel: f64) -> bool {
+    (a - b).abs() <= rel * a.abs().max(b.abs()).max(1e-300)
+}
+
+/// A small deterministic pseudo-random generator (tests must not depend on a seed source).
+pub struct Lcg(pub u64);
+impl Lcg {
+    pub fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+    pub fn normal(&mut self) -> f64 {
+        let (u1, u2) = (self.next().max(1e-300), self.next());
+        (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+    }
+}
