@@ -1,1 +1,139 @@
-fn main() {}
+//! Sufficient statistics and back-ends: the one-pass cross-product accumulation on 10⁶ × 30
+//! against a BLAS-class XᵀX (nalgebra's gemm through a transposed view), and STPRG on the
+//! paper's combined-data size (2 505 rows × 29 candidates) including the design.
+
+use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion};
+use nalgebra::{DMatrix, DMatrixView, Dyn};
+use termid::select::{Accumulator, Problem, Selector, StepRule, Stepwise};
+use termid::term::{parse_terms, Library, Vocabulary};
+
+#[path = "term_eval.rs"]
+#[allow(dead_code)]
+mod term_eval;
+
+fn lcg(seed: &mut u64) -> f64 {
+    *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+    (*seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+}
+
+fn bench(c: &mut Criterion) {
+    // 10⁶ × 30 cross products
+    let (n, p) = (1_000_000usize, 29usize);
+    let mut seed = 1;
+    let x: Vec<f64> = (0..n * p).map(|_| lcg(&mut seed)).collect();
+    let y: Vec<f64> = (0..n).map(|_| lcg(&mut seed)).collect();
+    let mut g = c.benchmark_group("cross_products_1e6x30");
+    g.sample_size(10);
+    g.bench_function("termid_accumulator", |b| {
+        b.iter(|| {
+            let mut acc = Accumulator::new(p);
+            acc.push(black_box(&x), black_box(&y), None);
+            black_box(acc.finish())
+        })
+    });
+    let mut z = x.clone();
+    z.extend_from_slice(&y);
+    g.bench_function("nalgebra_gemm_xtx", |b| {
+        b.iter(|| {
+            let zv = DMatrixView::from_slice(&z, n, p + 1);
+            let zt = DMatrixView::from_slice_with_strides_generic(&z, Dyn(p + 1), Dyn(n), Dyn(n), Dyn(1));
+            let mut cmat = DMatrix::<f64>::zeros(p + 1, p + 1);
+            cmat.gemm(1.0, &zt, &zv, 0.0);
+            black_box(cmat)
+        })
+    });
+    g.finish();
+
+    // STPRG on 2 505 × 29 including the design (the paper's Komb. Daten size)
+    let rows = 2505;
+    let t: Vec<f64> = (0..rows).map(|i| i as f64 * 0.2).collect();
+    let u: Vec<f64> = t.iter().map(|t| 1.9 + 0.1 * (0.05 * t).cos()).collect();
+    let v: Vec<f64> = t.iter().map(|t| 0.1 * (0.11 * t).sin()).collect();
+    let r: Vec<f64> = t.iter().map(|t| 0.05 * (0.13 * t).sin()).collect();
+    let d: Vec<f64> = t.iter().map(|t| 0.3 * (0.07 * t).sin()).collect();
+    let target: Vec<f64> = (0..rows)
+        .map(|i| {
+            -0.28 * u[i] * r[i] - 0.18 * u[i] * v[i] + 0.03 * u[i] * u[i] * d[i] + 1e-3 * (i as f64).sin()
+        })
+        .collect();
+    let mut vocab = Vocabulary::new();
+    for n in ["u", "v", "r", "δ"] {
+        vocab.variable(n).unwrap();
+    }
+    vocab.parameter("u0").unwrap();
+    vocab.derive("Δu", "u - u0").unwrap();
+    vocab.alias("du", "Δu").unwrap().alias("delta", "δ").unwrap();
+    let terms = parse_terms(&term_eval::TERMS_29, &vocab).unwrap();
+    let lib = Library::compile(&terms, &vocab).unwrap();
+    let names: Vec<String> = terms.iter().map(|t| t.to_string()).collect();
+    let stepwise = Stepwise { step_rule: StepRule::Last, ..Stepwise::default() };
+    let mut g = c.benchmark_group("stepwise");
+    g.bench_with_input(BenchmarkId::new("design_and_stprg", rows), &rows, |b, &rows| {
+        b.iter(|| {
+            let sources = lib
+                .bind(
+                    &|name| match name {
+                        "u" => Some(u.as_slice()),
+                        "v" => Some(v.as_slice()),
+                        "r" => Some(r.as_slice()),
+                        "δ" => Some(d.as_slice()),
+                        _ => None,
+                    },
+                    &|name| (name == "u0").then_some(2.01),
+                )
+                .unwrap();
+            let mut acc = Accumulator::new(lib.len());
+            lib.for_each_block(&sources, rows, |start, len, block| {
+                acc.push(block, &target[start..start + len], None)
+            });
+            let m = acc.finish();
+            let pb =
+                Problem { moments: &m, names: &names, forced: &[1, 2, 3], excluded: &[], intercept: true };
+            black_box(stepwise.select(&pb).unwrap())
+        })
+    });
+    // where the time goes
+    let sources = lib
+        .bind(
+            &|name| match name {
+                "u" => Some(u.as_slice()),
+                "v" => Some(v.as_slice()),
+                "r" => Some(r.as_slice()),
+                "δ" => Some(d.as_slice()),
+                _ => None,
+            },
+            &|name| (name == "u0").then_some(2.01),
+        )
+        .unwrap();
+    let mut design = vec![0.0; rows * lib.len()];
+    g.bench_function("design_only_2505", |b| {
+        b.iter(|| lib.fill(black_box(&sources), rows, black_box(&mut design)))
+    });
+    g.bench_function("moments_only_2505", |b| {
+        b.iter(|| {
+            let mut acc = Accumulator::new(lib.len());
+            acc.push(black_box(&design), &target, None);
+            black_box(acc.finish())
+        })
+    });
+    let mut zc = design.clone();
+    zc.extend_from_slice(&target);
+    let mut cm = vec![0.0; 30 * 30];
+    g.bench_function("gram_kernel_only_2505", |b| {
+        b.iter(|| termid::select::gram::gram(black_box(&zc), rows, rows, 30, black_box(&mut cm)))
+    });
+    let mut acc = Accumulator::new(lib.len());
+    acc.push(&design, &target, None);
+    let m = acc.finish();
+    g.bench_function("stprg_only_2505", |b| {
+        b.iter(|| {
+            let pb =
+                Problem { moments: &m, names: &names, forced: &[1, 2, 3], excluded: &[], intercept: true };
+            black_box(stepwise.select(&pb).unwrap())
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -3,6 +3,8 @@
 //! ([`Moments`]) and implements [`Selector`]; [`Backend`] picks one by name for the CLI and
 //! model files. A new back-end is one new file and one row in [`Backend`].
 
+#[doc(hidden)]
+pub mod gram;
 mod moments;
 mod stepwise;
 
@@ -79,8 +81,11 @@ pub struct Step {
     pub standard_error_adjusted: f64,
     /// F-value (A8); infinite at an exact fit.
     pub f: f64,
-    /// Coefficients of the terms in, in order of entry (A11, A13, A14).
-    pub terms: Vec<FittedTerm>,
+    /// Coefficients of the terms in, in order of entry (A11); the terms are those of steps
+    /// 1..=step. [`Selection::terms_at`] pairs them with names, standard errors and t.
+    pub coefficients: Vec<f64>,
+    /// Standard errors of those coefficients (A13).
+    pub std_errors: Vec<f64>,
     /// Intercept b0 (A12), if fitted.
     pub intercept: Option<Estimate>,
 }
@@ -130,6 +135,24 @@ pub struct Selection {
     pub stop: Stop,
     /// Things the user should know (refused collinear terms, round-off stops, …).
     pub notes: Vec<String>,
+}
+
+impl Selection {
+    /// The fitted terms after step `k` (1-based), in order of entry.
+    pub fn terms_at(&self, k: usize) -> Vec<FittedTerm> {
+        let Some(step) = k.checked_sub(1).and_then(|i| self.steps.get(i)) else { return vec![] };
+        self.steps[..k]
+            .iter()
+            .zip(step.coefficients.iter().zip(&step.std_errors))
+            .map(|(s, (&coefficient, &std_error))| FittedTerm {
+                term: s.term.clone(),
+                index: s.index,
+                coefficient,
+                std_error,
+                t: coefficient / std_error,
+            })
+            .collect()
+    }
 }
 
 /// Why a back-end failed.

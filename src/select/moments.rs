@@ -5,7 +5,7 @@
 //! through nalgebra on a transposed view), and chunks are merged with the pairwise update of
 //! Chan, Golub & LeVeque (1979). Statistics of several files simply [`Moments::merge`].
 
-/// Rows per chunk handed to the matrix product.
+/// Most rows per chunk handed to the Gram kernel (the buffer grows to this as rows come).
 const CHUNK: usize = 2048;
 
 /// Means and corrected cross-products of `p` regressors and one target.
@@ -80,40 +80,40 @@ impl Moments {
     }
 }
 
-/// C = ZᵀZ for Z of `n` rows and `m` columns stored column-major with leading dimension
-/// `ld`. Zᵀ is the same memory read with swapped strides, so matrixmultiply's packed kernel
-/// (the one nalgebra's gemm uses) runs at full speed without a transposed copy.
-fn gram(z: &[f64], ld: usize, n: usize, m: usize, c: &mut [f64]) {
-    assert!(n <= ld && z.len() >= ld * m && c.len() == m * m, "gram: buffer sizes");
-    // SAFETY: the asserts above keep every index matrixmultiply forms inside the slices:
-    // Zᵀ(i, r) = z[i*ld + r] and Z(r, j) = z[j*ld + r] with r < n ≤ ld, i, j < m;
-    // C(i, j) = c[i + j*m].
-    unsafe {
-        matrixmultiply::dgemm(
-            m,
-            n,
-            m,
-            1.0,
-            z.as_ptr(),
-            ld as isize,
-            1,
-            z.as_ptr(),
-            1,
-            ld as isize,
-            0.0,
-            c.as_mut_ptr(),
-            1,
-            m as isize,
-        );
+/// Σ x with four independent partial sums: a single running sum is a dependent chain of
+/// additions (latency-bound, ~4× slower), and the compiler may not reorder it itself.
+fn sum4(x: &[f64]) -> f64 {
+    let mut lanes = [0.0f64; 4];
+    let chunks = x.chunks_exact(4);
+    let rest: f64 = chunks.remainder().iter().sum();
+    for c in chunks {
+        for l in 0..4 {
+            lanes[l] += c[l];
+        }
     }
+    (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + rest
+}
+
+/// Σ x·w, four partial sums (see [`sum4`]).
+fn dot4(x: &[f64], w: &[f64]) -> f64 {
+    let mut lanes = [0.0f64; 4];
+    let (xc, wc) = (x.chunks_exact(4), w.chunks_exact(4));
+    let rest: f64 = xc.remainder().iter().zip(wc.remainder()).map(|(a, b)| a * b).sum();
+    for (a, b) in xc.zip(wc) {
+        for l in 0..4 {
+            lanes[l] += a[l] * b[l];
+        }
+    }
+    (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + rest
 }
 
 /// Accumulates [`Moments`] from blocks of rows without keeping them.
 #[derive(Debug)]
 pub struct Accumulator {
     moments: Moments,
-    /// Chunk buffer, (p+1) columns of CHUNK rows, column-major.
+    /// Chunk buffer, (p+1) columns of `ld` rows, column-major.
     buf: Vec<f64>,
+    ld: usize,
     w: Vec<f64>,
     filled: usize,
     weighted: bool,
@@ -124,8 +124,9 @@ impl Accumulator {
     pub fn new(p: usize) -> Accumulator {
         Accumulator {
             moments: Moments::new(p),
-            buf: vec![0.0; (p + 1) * CHUNK],
-            w: vec![0.0; CHUNK],
+            buf: Vec::new(),
+            ld: 0,
+            w: Vec::new(),
             filled: 0,
             weighted: false,
         }
@@ -138,12 +139,16 @@ impl Accumulator {
         assert_eq!(x.len(), rows * p, "block must hold rows × p values");
         let mut done = 0;
         while done < rows {
-            let take = (CHUNK - self.filled).min(rows - done);
+            if self.filled == self.ld && self.ld < CHUNK {
+                self.grow((self.filled + rows - done).clamp(2 * self.ld, CHUNK));
+            }
+            let ld = self.ld;
+            let take = (ld - self.filled).min(rows - done);
             for j in 0..p {
                 let src = &x[j * rows + done..j * rows + done + take];
-                self.buf[j * CHUNK + self.filled..j * CHUNK + self.filled + take].copy_from_slice(src);
+                self.buf[j * ld + self.filled..j * ld + self.filled + take].copy_from_slice(src);
             }
-            self.buf[p * CHUNK + self.filled..p * CHUNK + self.filled + take]
+            self.buf[p * ld + self.filled..p * ld + self.filled + take]
                 .copy_from_slice(&y[done..done + take]);
             let w = &mut self.w[self.filled..self.filled + take];
             match weights {
@@ -161,6 +166,20 @@ impl Accumulator {
         }
     }
 
+    /// Re-lays the chunk buffer out for `ld` rows per column (small data never pays for a
+    /// full-size chunk).
+    fn grow(&mut self, ld: usize) {
+        let m = self.moments.p + 1;
+        let mut buf = vec![0.0; m * ld];
+        for j in 0..m {
+            buf[j * ld..j * ld + self.filled]
+                .copy_from_slice(&self.buf[j * self.ld..j * self.ld + self.filled]);
+        }
+        self.buf = buf;
+        self.w.resize(ld, 0.0);
+        self.ld = ld;
+    }
+
     fn flush(&mut self) {
         let n = self.filled;
         if n == 0 {
@@ -173,13 +192,10 @@ impl Accumulator {
         chunk.count = n;
         chunk.weight = wsum;
         // centre each column on the chunk mean, scale rows by √w
+        let ld = self.ld;
         for j in 0..m {
-            let col = &mut self.buf[j * CHUNK..j * CHUNK + n];
-            let mean = if self.weighted {
-                col.iter().zip(w).map(|(x, w)| x * w).sum::<f64>() / wsum
-            } else {
-                col.iter().sum::<f64>() / n as f64
-            };
+            let col = &mut self.buf[j * ld..j * ld + n];
+            let mean = if self.weighted { dot4(col, w) / wsum } else { sum4(col) / n as f64 };
             chunk.mean[j] = mean;
             if self.weighted {
                 for (x, w) in col.iter_mut().zip(w) {
@@ -190,7 +206,7 @@ impl Accumulator {
             }
         }
         if wsum > 0.0 {
-            gram(&self.buf, CHUNK, n, m, &mut chunk.comoment);
+            super::gram::gram(&self.buf, ld, n, m, &mut chunk.comoment);
         }
         self.moments.merge(&chunk);
         self.filled = 0;

@@ -11,7 +11,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{Estimate, FittedTerm, Problem, SelectError, Selection, Selector, Step, Stop};
+use super::{Estimate, Problem, SelectError, Selection, Selector, Step, Stop};
 
 /// How the step whose coefficients are reported is chosen (Oltmann 1973, Figs. 2-4).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -104,23 +104,22 @@ impl Stepwise {
 /// Goodnight's sweep of a symmetric matrix (row-major, size m) on pivot k.
 fn sweep(a: &mut [f64], m: usize, k: usize) {
     let d = a[k * m + k];
-    for j in 0..m {
-        a[k * m + j] /= d;
-    }
-    for i in 0..m {
+    let mut pivot_row: Vec<f64> = a[k * m..(k + 1) * m].iter().map(|x| x / d).collect();
+    for (i, row) in a.chunks_exact_mut(m).enumerate() {
         if i == k {
             continue;
         }
-        let b = a[i * m + k];
+        let b = row[k];
         if b == 0.0 {
             continue;
         }
-        for j in 0..m {
-            a[i * m + j] -= b * a[k * m + j];
+        for (x, p) in row.iter_mut().zip(&pivot_row) {
+            *x -= b * p;
         }
-        a[i * m + k] = -b / d;
+        row[k] = -b / d;
     }
-    a[k * m + k] = 1.0 / d;
+    pivot_row[k] = 1.0 / d;
+    a[k * m..(k + 1) * m].copy_from_slice(&pivot_row);
 }
 
 /// Chooses the reported step (1-based) from the steps taken.
@@ -237,20 +236,19 @@ impl Selector for Stepwise {
             }
         };
         let chosen = choose_step(self.step_rule, &steps, pb.forced.len());
-        let (terms, intercept) = match chosen {
-            0 => (vec![], None),
-            c => (steps[c - 1].terms.clone(), steps[c - 1].intercept.clone()),
-        };
-        Ok(Selection {
+        let intercept = chosen.checked_sub(1).and_then(|c| steps[c].intercept.clone());
+        let mut selection = Selection {
             backend: self.name().into(),
             rows: n,
             steps,
             chosen_step: chosen,
-            terms,
+            terms: vec![],
             intercept,
             stop,
             notes,
-        })
+        };
+        selection.terms = selection.terms_at(chosen);
+        Ok(selection)
     }
 }
 
@@ -276,22 +274,12 @@ impl Stepwise {
         let residual = (a[p * m + p] * total).max(0.0);
         let r2 = 1.0 - a[p * m + p];
         let s = (residual / dof).sqrt(); // eq. (A7)
-        let terms: Vec<FittedTerm> = entered
-            .iter()
-            .map(|&i| {
-                let coefficient = a[i * m + p] * d[p] / d[i]; // eq. (A11), unscaled
-                let std_error = s * a[i * m + i].max(0.0).sqrt() / d[i]; // eq. (A13)
-                FittedTerm {
-                    term: pb.names[i].clone(),
-                    index: i,
-                    coefficient,
-                    std_error,
-                    t: coefficient / std_error,
-                }
-            })
-            .collect();
+                                         // eq. (A11), unscaled from correlation units; eq. (A13)
+        let coefficients: Vec<f64> = entered.iter().map(|&i| a[i * m + p] * d[p] / d[i]).collect();
+        let std_errors: Vec<f64> = entered.iter().map(|&i| s * a[i * m + i].max(0.0).sqrt() / d[i]).collect();
         let intercept = pb.intercept.then(|| {
-            let value = means[p] - terms.iter().map(|t| t.coefficient * means[t.index]).sum::<f64>(); // eq. (A12)
+            // eq. (A12)
+            let value = means[p] - entered.iter().zip(&coefficients).map(|(&i, b)| b * means[i]).sum::<f64>();
             let mut q = 1.0 / pb.moments.weight();
             for &i in entered {
                 for &l in entered {
@@ -314,7 +302,8 @@ impl Stepwise {
             standard_error: s,
             standard_error_adjusted: s * (n_eff / (n_eff + 1.0 - k)).sqrt(),
             f: (r2 * total / k) / (residual / dof), // eq. (A8)
-            terms,
+            coefficients,
+            std_errors,
             intercept,
         }
     }

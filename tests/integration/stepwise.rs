@@ -29,31 +29,32 @@ fn hald_order_statistics_and_coefficients() {
     assert_eq!(order, ["x4", "x1", "x2", "x3"]); // Draper & Smith's forward selection
                                                  // Draper & Smith: y = 117.57 − 0.7382 x4, s = 8.964, F = 22.80, R² = 0.6745
     let s1 = &sel.steps[0];
-    assert!(close(s1.terms[0].coefficient, -0.738162, 1e-5));
+    assert!(close(sel.terms_at(1)[0].coefficient, -0.738162, 1e-5));
     assert!(close(s1.intercept.as_ref().unwrap().value, 117.5679, 1e-6));
     assert!(close(s1.standard_error, 8.96390, 1e-5));
     assert!(close(s1.f, 22.7985, 1e-5));
     assert!(close(s1.r2, 0.674542, 1e-5));
     // y = 103.10 + 1.440 x1 − 0.6140 x4, R² = 0.9725
     let s2 = &sel.steps[1];
-    assert!(close(s2.terms[1].coefficient, 1.43996, 1e-5));
-    assert!(close(s2.terms[0].coefficient, -0.613954, 1e-5));
+    assert!(close(sel.terms_at(2)[1].coefficient, 1.43996, 1e-5));
+    assert!(close(sel.terms_at(2)[0].coefficient, -0.613954, 1e-5));
     assert!(close(s2.r2, 0.972471, 1e-5));
     // full model: 62.405 + 1.5511 x1 + 0.5102 x2 + 0.1019 x3 − 0.1441 x4, s = 2.446
     let s4 = &sel.steps[3];
     let b0 = s4.intercept.as_ref().unwrap();
     assert!(close(b0.value, 62.4054, 1e-5) && close(b0.std_error, 70.0710, 1e-5));
-    let se: Vec<f64> = s4.terms.iter().map(|t| t.std_error).collect();
+    let se: Vec<f64> = sel.terms_at(4).iter().map(|t| t.std_error).collect();
     for (got, want) in se.iter().zip([0.709052, 0.744770, 0.723788, 0.754709]) {
         assert!(close(*got, want, 1e-5), "{got} vs {want}");
     }
     assert!(close(s4.standard_error, 2.44601, 1e-5));
     // every step against an independent QR solve of the same subset
     for st in &sel.steps {
-        let sub: Vec<Vec<f64>> = st.terms.iter().map(|t| cols[t.index].clone()).collect();
+        let terms = sel.terms_at(st.step);
+        let sub: Vec<Vec<f64>> = terms.iter().map(|t| cols[t.index].clone()).collect();
         let (b0, b) = qr_fit(&sub, &y, true);
         assert!(close(st.intercept.as_ref().unwrap().value, b0.unwrap(), 1e-9));
-        for (t, want) in st.terms.iter().zip(b) {
+        for (t, want) in terms.iter().zip(b) {
             assert!(close(t.coefficient, want, 1e-9), "step {}: {} vs {want}", st.step, t.coefficient);
         }
     }
@@ -162,11 +163,12 @@ proptest! {
             prop_assert!(w[1].r2 >= w[0].r2 - 1e-12, "R² fell: {} → {}", w[0].r2, w[1].r2);
         }
         for st in &sel.steps {
-            let sub: Vec<Vec<f64>> = st.terms.iter().map(|t| cols[t.index].clone()).collect();
+            let terms = sel.terms_at(st.step);
+            let sub: Vec<Vec<f64>> = terms.iter().map(|t| cols[t.index].clone()).collect();
             let (b0, b) = qr_fit(&sub, &y, intercept);
             // relative to the coefficient, or to its standard error where the coefficient is
             // statistically zero (there, relative digits of a tiny number mean nothing)
-            for (t, want) in st.terms.iter().zip(&b) {
+            for (t, want) in terms.iter().zip(&b) {
                 let scale = want.abs().max(t.std_error);
                 prop_assert!((t.coefficient - want).abs() <= 1e-9 * scale, "step {}: {} vs {}", st.step, t.coefficient, want);
             }
