@@ -2,7 +2,7 @@
 //! termid's compiled library against a hand-written Rust loop computing the same columns.
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use termid::term::{parse_terms, Library, Source, Vocabulary};
+use termid::term::{parse_terms, Library, Vocabulary};
 
 pub const TERMS_29: [&str; 29] = [
     "u^2",
