@@ -51,6 +51,19 @@ pub enum ParamValue {
 }
 
 impl ParamValue {
+    /// Checks a rule's syntax without data.
+    pub fn check_rule(&self, name: &str) -> Result<(), String> {
+        match self {
+            ParamValue::Value(_) => Ok(()),
+            ParamValue::Rule(rule) => match rule.split_once(':') {
+                Some(("first" | "mean", col)) if !col.is_empty() => Ok(()),
+                _ => Err(format!(
+                    "parameter `{name}`: `{rule}` is neither a number nor `first:COLUMN` / `mean:COLUMN`"
+                )),
+            },
+        }
+    }
+
     /// The value in one run.
     pub fn resolve(&self, name: &str, frame: &Frame) -> Result<f64, IdentifyError> {
         match self {
@@ -224,6 +237,51 @@ impl Identification<'_> {
         let selection = backend.select(&problem)?;
         Ok(Fit { target: target.to_string(), candidates: names, selection })
     }
+}
+
+
+/// Identifies one equation of a model from runs: candidates, forced and excluded terms and
+/// the back-end come from the model file; the target is the column `<state>_dot` where every
+/// run has it, else the derivative of the state.
+pub fn fit_equation(
+    model: &crate::model::Model,
+    equation: &str,
+    frames: &[Frame],
+    differentiator: &dyn Differentiator,
+    intercept: bool,
+    target: Option<Target>,
+) -> Result<Fit, IdentifyError> {
+    let eq = model
+        .equation(equation)
+        .ok_or_else(|| IdentifyError::Setup(format!("{}: no equation `{equation}`", model.path)))?;
+    if eq.candidates.is_empty() {
+        return Err(IdentifyError::Setup(format!("{}: equation `{equation}` has no candidates", model.path)));
+    }
+    let target = target.unwrap_or_else(|| {
+        let column = format!("{}_dot", eq.state);
+        if frames.iter().all(|f| f.column(&column).is_some()) {
+            Target::Column(column)
+        } else {
+            Target::Derivative(eq.state.clone())
+        }
+    });
+    let rules = model.parameter_rules();
+    let identification =
+        Identification { vocabulary: &model.vocabulary, parameters: &rules, differentiator, intercept };
+    let backend = eq.backend.build()?;
+    identification.fit(&target, &eq.candidates, &eq.forced, &eq.excluded, frames, backend.as_ref())
+}
+
+/// The identified coefficients of a fit, as a model stores them (term, value, std. error).
+pub fn coefficients_of(
+    fit: &Fit,
+    vocabulary: &Vocabulary,
+) -> Result<Vec<(Term, f64, Option<f64>)>, IdentifyError> {
+    fit.selection
+        .terms
+        .iter()
+        .map(|t| Ok((vocabulary.parse(&t.term)?, t.coefficient, Some(t.std_error))))
+        .collect()
 }
 
 #[cfg(test)]

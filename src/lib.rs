@@ -5,5 +5,9 @@
 
 pub mod data;
 pub mod identify;
+pub mod model;
+pub mod plot;
 pub mod select;
+pub mod ship;
+pub mod sim;
 pub mod term;

@@ -18,6 +18,8 @@ pub struct Cli {
 pub enum Command {
     /// Select terms and fit coefficients of one equation from one or several runs.
     Identify(IdentifyCommand),
+    /// Simulate a model file (the default ship model if none) under a manoeuvre or inputs.
+    Simulate(SimulateCommand),
 }
 
 /// Output format.
@@ -52,12 +54,22 @@ pub struct IdentifyCommand {
     /// The rows are not a time series (no time column; derivative targets are refused).
     #[arg(long, conflicts_with = "time")]
     pub no_time: bool,
-    /// What to explain: a column (`r_dot`) or the derivative of one (`dr/dt`).
-    #[arg(long)]
-    pub target: String,
+    /// What to explain: a column (`r_dot`) or the derivative of one (`dr/dt`). With --model
+    /// the default is each equation's `<state>_dot` column, else the state's derivative.
+    #[arg(long, required_unless_present = "model")]
+    pub target: Option<String>,
     /// Candidate terms, e.g. --terms "u*v" "u*r" "u^2*δ".
-    #[arg(long, num_args = 1.., required_unless_present = "terms_file")]
+    #[arg(long, num_args = 1.., required_unless_present_any = ["terms_file", "model"])]
     pub terms: Vec<String>,
+    /// Take vocabulary, candidates, forced terms and back-end from a model file.
+    #[arg(long, conflicts_with_all = ["terms", "terms_file", "params", "derived", "aliases"])]
+    pub model: Option<PathBuf>,
+    /// With --model: the equation(s) to identify (default: all that are identifiable).
+    #[arg(long, num_args = 1.., requires = "model")]
+    pub equation: Vec<String>,
+    /// With --model: write the model with the identified coefficients to this file.
+    #[arg(long, requires = "model")]
+    pub out: Option<PathBuf>,
     /// A file of candidate terms, one per line (`#` starts a comment).
     #[arg(long)]
     pub terms_file: Option<PathBuf>,
@@ -95,6 +107,51 @@ pub struct IdentifyCommand {
     #[arg(long, default_value_t = 0.0)]
     pub step_tolerance: f64,
     /// Output format.
+    #[arg(long, value_enum, default_value = "text")]
+    pub format: Format,
+}
+
+/// `termid simulate`.
+#[derive(Debug, Args)]
+pub struct SimulateCommand {
+    /// Model file (default: the embedded Oltmann 1973 ship model).
+    #[arg(long)]
+    pub model: Option<PathBuf>,
+    /// Ship models: zigzag:20/20[:port], turning:35, spiral[:MAX/STEP/HOLD], pullout:20,
+    /// replay:FILE.csv. Any model: replay:FILE.csv.
+    #[arg(long, short = 'm')]
+    pub manoeuvre: Option<String>,
+    /// Integrator: b8 (Oltmann's modified Euler, eq. B8) or rk4.
+    #[arg(long, default_value = "b8")]
+    pub integrator: String,
+    /// Step, s.
+    #[arg(long, default_value_t = 0.04)]
+    pub dt: f64,
+    /// Output interval, s (a multiple of the step).
+    #[arg(long, default_value_t = 0.2)]
+    pub sample: f64,
+    /// Duration, s (default: the manoeuvre's own).
+    #[arg(long)]
+    pub duration: Option<f64>,
+    /// Write the run as CSV (SI units, angles in rad).
+    #[arg(long, short = 'o')]
+    pub out: Option<PathBuf>,
+    /// Write a figure (SVG).
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
+    /// Models without a manoeuvre: constant inputs NAME=VALUE.
+    #[arg(long = "input", num_args = 1..)]
+    pub inputs: Vec<String>,
+    /// Initial states NAME=VALUE (default: the model file's).
+    #[arg(long = "initial", num_args = 1..)]
+    pub initial: Vec<String>,
+    /// Parameters NAME=VALUE (default: the model file's).
+    #[arg(long = "param", num_args = 1..)]
+    pub params: Vec<String>,
+    /// Include each equation's stored intercept b0 in the right-hand side.
+    #[arg(long)]
+    pub with_intercept: bool,
+    /// Output format of the summary.
     #[arg(long, value_enum, default_value = "text")]
     pub format: Format,
 }

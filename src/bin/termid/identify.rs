@@ -17,6 +17,9 @@ fn split_pair<'a>(text: &'a str, what: &str) -> Result<(&'a str, &'a str)> {
 }
 
 pub fn run(cmd: IdentifyCommand) -> Result<()> {
+    if cmd.model.is_some() {
+        return run_model(cmd);
+    }
     let frames = cmd
         .data
         .iter()
@@ -32,9 +35,9 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
         };
         params.insert(name.to_string(), value);
     }
-    let target = Target::parse(&cmd.target);
+    let target = Target::parse(cmd.target.as_deref().unwrap_or_default());
     if cmd.no_time && matches!(target, Target::Derivative(_)) {
-        bail!("--no-time data have no time axis, so `{}` cannot be differentiated", cmd.target);
+        bail!("--no-time data have no time axis, so `{target}` cannot be differentiated");
     }
     for name in frames[0].names() {
         if cmd.no_time && name == "row" {
@@ -71,17 +74,7 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     let candidates = parse_terms(&texts, &vocab)?;
     let forced = parse_terms(&cmd.forced, &vocab)?;
     let excluded = parse_terms(&cmd.exclude, &vocab)?;
-    let mut backend = Backend::by_name(&cmd.backend)?;
-    match &mut backend {
-        Backend::Stepwise(s) => {
-            s.min_proportion = cmd.min_proportion;
-            s.step_rule = match cmd.step_rule {
-                RuleName::FMax => StepRule::FirstFMaximum { tolerance: cmd.step_tolerance },
-                RuleName::SePlateau => StepRule::StandardErrorPlateau { tolerance: cmd.step_tolerance },
-                RuleName::Last => StepRule::Last,
-            };
-        }
-    }
+    let backend = configure_backend(&cmd)?;
     let selector = backend.build()?;
     let diff = differentiator(&cmd.derivative)?;
     let identification = Identification {
@@ -94,6 +87,85 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     match cmd.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&json(&fit))?),
         Format::Text => print!("{}", text(&fit)),
+    }
+    Ok(())
+}
+
+fn configure_backend(cmd: &IdentifyCommand) -> Result<Backend> {
+    let mut backend = Backend::by_name(&cmd.backend)?;
+    match &mut backend {
+        Backend::Stepwise(s) => {
+            s.min_proportion = cmd.min_proportion;
+            s.step_rule = match cmd.step_rule {
+                RuleName::FMax => StepRule::FirstFMaximum { tolerance: cmd.step_tolerance },
+                RuleName::SePlateau => StepRule::StandardErrorPlateau { tolerance: cmd.step_tolerance },
+                RuleName::Last => StepRule::Last,
+            };
+        }
+    }
+    Ok(backend)
+}
+
+/// `identify --model`: every identifiable equation (or the chosen ones) from the runs, each
+/// with the model's candidates, forced terms and back-end; optionally written back.
+fn run_model(cmd: IdentifyCommand) -> Result<()> {
+    let path = cmd.model.clone().context("--model")?;
+    let mut model = termid::model::Model::load(&path)?;
+    let time = model.spec.model.time.clone();
+    let frames = cmd.data.iter().map(|p| Frame::read_csv(p, &time)).collect::<Result<Vec<_>, _>>()?;
+    let names: Vec<String> = if cmd.equation.is_empty() {
+        model
+            .equations
+            .iter()
+            .filter(|e| e.identify && !e.candidates.is_empty())
+            .map(|e| e.name.clone())
+            .collect()
+    } else {
+        cmd.equation.clone()
+    };
+    if cmd.target.is_some() && names.len() != 1 {
+        bail!("--target applies to one equation: name it with --equation");
+    }
+    let diff = differentiator(&cmd.derivative)?;
+    let mut fits = Vec::new();
+    for name in &names {
+        let fit = termid::identify::fit_equation(
+            &model,
+            name,
+            &frames,
+            diff.as_ref(),
+            !cmd.no_intercept,
+            cmd.target.as_deref().map(Target::parse),
+        )
+        .with_context(|| format!("identifying `{name}`"))?;
+        let coefficients = termid::identify::coefficients_of(&fit, &model.vocabulary)?;
+        model.set_coefficients(name, coefficients, fit.selection.intercept.as_ref().map(|b| b.value));
+        fits.push((name.clone(), fit));
+    }
+    if let Some(out) = &cmd.out {
+        model.spec.model.provenance = format!(
+            "identified by termid from {} ({})",
+            cmd.data.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "),
+            model.spec.model.provenance
+        );
+        std::fs::write(out, model.to_toml()).with_context(|| format!("writing {}", out.display()))?;
+    }
+    match cmd.format {
+        Format::Json => {
+            let all: serde_json::Map<String, serde_json::Value> =
+                fits.iter().map(|(n, f)| (n.clone(), json(f))).collect();
+            println!("{}", serde_json::to_string_pretty(&all)?);
+        }
+        Format::Text => {
+            for (name, fit) in &fits {
+                println!("== {name} ==");
+                print!("{}", text(fit));
+                println!();
+            }
+            if let Some(out) = &cmd.out {
+                println!("wrote {}", out.display());
+            }
+        }
     }
     Ok(())
 }

@@ -2,6 +2,7 @@
 
 mod args;
 mod identify;
+mod simulate;
 
 use std::process::ExitCode;
 
@@ -11,6 +12,7 @@ fn main() -> ExitCode {
     let cli = args::Cli::parse();
     let result = match cli.command {
         args::Command::Identify(cmd) => identify::run(cmd),
+        args::Command::Simulate(cmd) => simulate::run(cmd),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,233 @@
+//! The serde shape of a model file. `models/README.md` documents each key.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+use crate::select::Backend;
+
+/// A whole model file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelFile {
+    /// Name and provenance.
+    pub model: Meta,
+    /// Integrated states, in order.
+    #[serde(default)]
+    pub states: Vec<StateSpec>,
+    /// Inputs (controls), e.g. the rudder angle.
+    #[serde(default)]
+    pub inputs: Vec<InputSpec>,
+    /// Constants, possibly set per run (`u0`).
+    #[serde(default)]
+    pub parameters: BTreeMap<String, ParameterSpec>,
+    /// Derived variables, in order (each may use earlier ones).
+    #[serde(default)]
+    pub derived: Vec<DerivedSpec>,
+    /// Other spellings of names (`du` → `Δu`).
+    #[serde(default)]
+    pub aliases: BTreeMap<String, String>,
+    /// Equations by name.
+    #[serde(default)]
+    pub equations: BTreeMap<String, EquationSpec>,
+    /// The ship plug-in's particulars (only for ship models).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ship: Option<ShipSpec>,
+}
+
+/// `[model]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Meta {
+    /// Human-readable name.
+    pub name: String,
+    /// Where the model and its numbers come from.
+    #[serde(default)]
+    pub provenance: String,
+    /// Free notes (kept on write).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
+    /// Name of the time column in data and output.
+    #[serde(default = "default_time")]
+    pub time: String,
+}
+
+fn default_time() -> String {
+    "t".into()
+}
+
+/// `[[states]]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StateSpec {
+    /// Name used in terms.
+    pub name: String,
+    /// Unit (documentation and output headers).
+    #[serde(default)]
+    pub unit: String,
+    /// Initial value for simulation.
+    #[serde(default)]
+    pub initial: f64,
+    /// A simulation leaving [min, max] stops with an error.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min: Option<f64>,
+    /// See `min`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max: Option<f64>,
+}
+
+/// `[[inputs]]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InputSpec {
+    /// Name used in terms.
+    pub name: String,
+    /// Unit.
+    #[serde(default)]
+    pub unit: String,
+    /// Value when nothing else is given.
+    #[serde(default)]
+    pub initial: f64,
+}
+
+/// `[parameters.NAME]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParameterSpec {
+    /// Value for simulation (and identification unless `per_run`).
+    pub value: f64,
+    /// Unit.
+    #[serde(default)]
+    pub unit: String,
+    /// For identification, the value in each run: `first:u` (the run's first u) or `mean:u`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub per_run: Option<String>,
+}
+
+/// `[[derived]]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DerivedSpec {
+    /// Its name.
+    pub name: String,
+    /// A term over earlier names.
+    pub definition: String,
+}
+
+/// `[equations.NAME]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EquationSpec {
+    /// The state whose time derivative this equation gives.
+    pub state: String,
+    /// Whether `identify` fits it (false for known kinematics).
+    #[serde(default = "yes")]
+    pub identify: bool,
+    /// Candidate terms.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub candidates: Vec<String>,
+    /// Terms that always enter first.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub forced: Vec<String>,
+    /// Terms that never enter.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub excluded: Vec<String>,
+    /// Regression back-end and its settings.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub backend: Option<Backend>,
+    /// Constant b0 of the regression.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub intercept: Option<f64>,
+    /// Coefficients by term.
+    #[serde(default)]
+    pub coefficients: BTreeMap<String, CoefficientSpec>,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// A coefficient: a number, or a table with its standard error.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum CoefficientSpec {
+    /// Just the value.
+    Value(f64),
+    /// Value and standard error.
+    WithError {
+        /// The value.
+        value: f64,
+        /// Its standard error.
+        std_error: f64,
+    },
+}
+
+impl CoefficientSpec {
+    /// (value, standard error).
+    pub fn value_and_error(&self) -> (f64, Option<f64>) {
+        match self {
+            CoefficientSpec::Value(v) => (*v, None),
+            CoefficientSpec::WithError { value, std_error } => (*value, Some(*std_error)),
+        }
+    }
+}
+
+/// `[ship]`: particulars for the manoeuvring plug-in. Lengths in m, angles in degrees.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShipSpec {
+    /// Length between perpendiculars, m.
+    pub lpp: f64,
+    /// Beam, m.
+    #[serde(default)]
+    pub beam: f64,
+    /// Draught, m.
+    #[serde(default)]
+    pub draught: f64,
+    /// Displacement volume, m³.
+    #[serde(default)]
+    pub displacement: f64,
+    /// Rudder rate, °/s.
+    pub rudder_rate: f64,
+    /// Largest rudder angle, °.
+    pub rudder_limit: f64,
+    /// Approach speed, m/s.
+    pub u0: f64,
+    /// State names the plug-in reads (defaults: u, v, r, ψ, x0, y0) and the rudder input (δ).
+    #[serde(default)]
+    pub names: ShipNames,
+}
+
+/// Which model names play the ship's roles.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ShipNames {
+    /// Surge velocity.
+    pub u: String,
+    /// Sway velocity.
+    pub v: String,
+    /// Yaw rate.
+    pub r: String,
+    /// Heading.
+    pub psi: String,
+    /// North (initial course) position.
+    pub x0: String,
+    /// East position.
+    pub y0: String,
+    /// Rudder angle.
+    pub rudder: String,
+}
+
+impl Default for ShipNames {
+    fn default() -> Self {
+        ShipNames {
+            u: "u".into(),
+            v: "v".into(),
+            r: "r".into(),
+            psi: "ψ".into(),
+            x0: "x0".into(),
+            y0: "y0".into(),
+            rudder: "δ".into(),
+        }
+    }
+}

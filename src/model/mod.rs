@@ -1,0 +1,380 @@
+//! Model files (TOML): the states, inputs, parameters, derived variables and aliases of a
+//! system, and per equation its candidate terms, forced terms, back-end and identified
+//! coefficients. One format serves identification and simulation; `models/README.md`
+//! documents every key. Errors name the file, the line and the key, and for a bad term the
+//! caret inside it.
+
+mod file;
+
+pub use file::{
+    CoefficientSpec, EquationSpec, InputSpec, Meta, ModelFile, ParameterSpec, ShipSpec, StateSpec,
+};
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use crate::identify::ParamValue;
+use crate::select::Backend;
+use crate::term::{Library, Term, TermError, Vocabulary};
+
+/// The default model: HSVA model 1512 as identified by Oltmann (1973), true coefficients.
+pub const DEFAULT_MODEL: &str = include_str!("../../models/oltmann1973.toml");
+/// The name the default model reports as its file.
+pub const DEFAULT_MODEL_PATH: &str = "models/oltmann1973.toml";
+
+/// A model file that could not be used.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ModelError {
+    /// Unreadable file.
+    #[error("{file}: {message}")]
+    Io {
+        /// The file.
+        file: String,
+        /// What the system said.
+        message: String,
+    },
+    /// TOML syntax or a wrong type (toml's message carries line and column).
+    #[error("{file}: {message}")]
+    Syntax {
+        /// The file.
+        file: String,
+        /// toml's message.
+        message: String,
+    },
+    /// A key whose value does not make sense.
+    #[error("{file}:{line}: `{key}`: {message}")]
+    Key {
+        /// The file.
+        file: String,
+        /// 1-based line of the key (0 if unknown).
+        line: usize,
+        /// The key's dotted path.
+        key: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A term inside a key.
+    #[error("{file}:{line}: `{key}`:\n{source}")]
+    Term {
+        /// The file.
+        file: String,
+        /// 1-based line of the key.
+        line: usize,
+        /// The key.
+        key: String,
+        /// The term error with its caret.
+        source: Box<TermError>,
+    },
+}
+
+/// One equation of a loaded model.
+#[derive(Clone, Debug)]
+pub struct Equation {
+    /// Its name in the file (`u_dot`).
+    pub name: String,
+    /// The state whose derivative it gives.
+    pub state: String,
+    /// Candidate terms for identification.
+    pub candidates: Vec<Term>,
+    /// Terms that always enter.
+    pub forced: Vec<Term>,
+    /// Terms that never enter.
+    pub excluded: Vec<Term>,
+    /// Back-end for identification.
+    pub backend: Backend,
+    /// Identified (or true) coefficients: term, value, standard error.
+    pub coefficients: Vec<(Term, f64, Option<f64>)>,
+    /// Constant term b0 of the regression, if stored.
+    pub intercept: Option<f64>,
+    /// Whether `termid identify` fits it (kinematic equations are fixed).
+    pub identify: bool,
+}
+
+impl Equation {
+    /// The right-hand side Σ cⱼ·termⱼ (+ b0 if `with_intercept`) as one canonical term.
+    pub fn rhs(&self, with_intercept: bool) -> Result<Term, TermError> {
+        let mut sum = Term::constant(if with_intercept { self.intercept.unwrap_or(0.0) } else { 0.0 });
+        for (t, c, _) in &self.coefficients {
+            let scaled = t.scale(*c).map_err(TermError::Declaration)?;
+            sum = sum.add(&scaled).map_err(TermError::Declaration)?;
+        }
+        Ok(sum)
+    }
+
+    /// The coefficient of a term (0 if absent).
+    pub fn coefficient(&self, term: &Term) -> f64 {
+        self.coefficients.iter().find(|(t, _, _)| t == term).map_or(0.0, |(_, c, _)| *c)
+    }
+}
+
+/// A loaded, checked model.
+#[derive(Clone, Debug)]
+pub struct Model {
+    /// Where it came from.
+    pub path: String,
+    /// The parsed file.
+    pub spec: ModelFile,
+    /// Names usable in terms.
+    pub vocabulary: Vocabulary,
+    /// The equations, in the order of the states they integrate.
+    pub equations: Vec<Equation>,
+}
+
+impl Model {
+    /// Reads and checks a model file.
+    pub fn load(path: &Path) -> Result<Model, ModelError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| ModelError::Io { file: file.clone(), message: e.to_string() })?;
+        Model::parse(&text, &file)
+    }
+
+    /// The default model (embedded in the binary).
+    pub fn default_model() -> Model {
+        Model::parse(DEFAULT_MODEL, DEFAULT_MODEL_PATH).expect("the embedded default model is valid (tested)")
+    }
+
+    /// Parses and checks model text; `file` names it in errors.
+    pub fn parse(text: &str, file: &str) -> Result<Model, ModelError> {
+        let spec: ModelFile = toml::from_str(text)
+            .map_err(|e| ModelError::Syntax { file: file.into(), message: e.to_string() })?;
+        Model::from_spec(spec, text, file)
+    }
+
+    /// Checks a parsed file and resolves its terms.
+    pub fn from_spec(spec: ModelFile, text: &str, file: &str) -> Result<Model, ModelError> {
+        let line_of = |key: &str| locate(text, key);
+        let key_err = |key: &str, line_key: &str, message: String| ModelError::Key {
+            file: file.into(),
+            line: line_of(line_key),
+            key: key.into(),
+            message,
+        };
+        let mut vocab = Vocabulary::new();
+        for (i, s) in spec.states.iter().enumerate() {
+            vocab
+                .variable(&s.name)
+                .map_err(|e| key_err(&format!("states[{i}].name"), &s.name, e.to_string()))?;
+            if let (Some(lo), Some(hi)) = (s.min, s.max) {
+                if lo >= hi {
+                    return Err(key_err(
+                        &format!("states[{i}]"),
+                        &s.name,
+                        format!("min {lo} is not below max {hi}"),
+                    ));
+                }
+            }
+        }
+        for (i, s) in spec.inputs.iter().enumerate() {
+            vocab
+                .variable(&s.name)
+                .map_err(|e| key_err(&format!("inputs[{i}].name"), &s.name, e.to_string()))?;
+        }
+        for (name, p) in &spec.parameters {
+            vocab.parameter(name).map_err(|e| key_err(&format!("parameters.{name}"), name, e.to_string()))?;
+            if let Some(rule) = &p.per_run {
+                ParamValue::Rule(rule.clone())
+                    .check_rule(name)
+                    .map_err(|m| key_err(&format!("parameters.{name}.per_run"), rule, m))?;
+            }
+        }
+        for (i, d) in spec.derived.iter().enumerate() {
+            vocab.derive(&d.name, &d.definition).map_err(|e| ModelError::Term {
+                source: Box::new(e),
+                file: file.into(),
+                line: line_of(&d.definition),
+                key: format!("derived[{i}].definition"),
+            })?;
+        }
+        for (alias, target) in &spec.aliases {
+            vocab
+                .alias(alias, target)
+                .map_err(|e| key_err(&format!("aliases.{alias}"), alias, e.to_string()))?;
+        }
+        let mut equations = Vec::new();
+        for (name, eq) in &spec.equations {
+            let state = vocab.canonical(&eq.state).filter(|s| vocab.variables().contains(s));
+            let Some(state) = state.filter(|s| spec.states.iter().any(|st| &st.name == s)) else {
+                return Err(key_err(
+                    &format!("equations.{name}.state"),
+                    &format!("[equations.{name}]"),
+                    format!("`{}` is not a declared state", eq.state),
+                ));
+            };
+            let parse_list = |list: &[String], what: &str| -> Result<Vec<Term>, ModelError> {
+                let mut out: Vec<Term> = Vec::new();
+                for (i, text) in list.iter().enumerate() {
+                    let t = vocab.parse(text).map_err(|e| ModelError::Term {
+                        source: Box::new(e),
+                        file: file.into(),
+                        line: line_of(&format!("\"{text}\"")),
+                        key: format!("equations.{name}.{what}[{i}]"),
+                    })?;
+                    if let Some(j) = out.iter().position(|o| *o == t) {
+                        return Err(key_err(
+                            &format!("equations.{name}.{what}[{i}]"),
+                            &format!("\"{text}\""),
+                            format!("`{text}` is the same term as `{}` (both `{t}`)", list[j]),
+                        ));
+                    }
+                    out.push(t);
+                }
+                Ok(out)
+            };
+            let candidates = parse_list(&eq.candidates, "candidates")?;
+            let forced = parse_list(&eq.forced, "forced")?;
+            let excluded = parse_list(&eq.excluded, "excluded")?;
+            for (what, list, texts) in
+                [("forced", &forced, &eq.forced), ("excluded", &excluded, &eq.excluded)]
+            {
+                if let Some((t, text)) = list.iter().zip(texts).find(|(t, _)| !candidates.contains(t)) {
+                    return Err(key_err(
+                        &format!("equations.{name}.{what}"),
+                        &format!("\"{text}\""),
+                        format!("`{t}` is not among the candidates"),
+                    ));
+                }
+            }
+            let mut coefficients: Vec<(Term, f64, Option<f64>)> = Vec::new();
+            for (text, c) in &eq.coefficients {
+                let key = format!("equations.{name}.coefficients.\"{text}\"");
+                let t = vocab.parse(text).map_err(|e| ModelError::Term {
+                    source: Box::new(e),
+                    file: file.into(),
+                    line: line_of(&format!("\"{text}\"")),
+                    key: key.clone(),
+                })?;
+                let (value, se) = c.value_and_error();
+                if !value.is_finite() || se.is_some_and(|s| !s.is_finite() || s < 0.0) {
+                    return Err(key_err(
+                        &key,
+                        &format!("\"{text}\""),
+                        "value and std_error must be finite (std_error ≥ 0)".into(),
+                    ));
+                }
+                if coefficients.iter().any(|(o, _, _)| *o == t) {
+                    return Err(key_err(
+                        &key,
+                        &format!("\"{text}\""),
+                        format!("term `{t}` has two coefficients"),
+                    ));
+                }
+                coefficients.push((t, value, se));
+            }
+            let backend = eq.backend.clone().unwrap_or_default();
+            backend
+                .build()
+                .map_err(|e| key_err(&format!("equations.{name}.backend"), "backend", e.to_string()))?;
+            equations.push(Equation {
+                name: name.clone(),
+                state,
+                candidates,
+                forced,
+                excluded,
+                backend,
+                coefficients,
+                intercept: eq.intercept,
+                identify: eq.identify,
+            });
+        }
+        // integrate in the order the states are declared
+        equations.sort_by_key(|e| spec.states.iter().position(|s| s.name == e.state));
+        for w in equations.windows(2) {
+            if w[0].state == w[1].state {
+                return Err(key_err(
+                    &format!("equations.{}.state", w[1].name),
+                    &format!("[equations.{}]", w[1].name),
+                    format!("state `{}` already has equation `{}`", w[1].state, w[0].name),
+                ));
+            }
+        }
+        Ok(Model { path: file.into(), spec, vocabulary: vocab, equations })
+    }
+
+    /// An equation by name.
+    pub fn equation(&self, name: &str) -> Option<&Equation> {
+        self.equations.iter().find(|e| e.name == name)
+    }
+
+    /// Parameter values of the model file (their `value`s).
+    pub fn parameter_values(&self) -> BTreeMap<String, f64> {
+        self.spec.parameters.iter().map(|(n, p)| (n.clone(), p.value)).collect()
+    }
+
+    /// Per-run parameter rules for identification: `per_run` where given, else the value.
+    pub fn parameter_rules(&self) -> BTreeMap<String, ParamValue> {
+        self.spec
+            .parameters
+            .iter()
+            .map(|(n, p)| {
+                let v = match &p.per_run {
+                    Some(rule) => ParamValue::Rule(rule.clone()),
+                    None => ParamValue::Value(p.value),
+                };
+                (n.clone(), v)
+            })
+            .collect()
+    }
+
+    /// Compiles every equation's right-hand side into one evaluator (one output per equation).
+    pub fn compile_rhs(&self, with_intercept: bool) -> Result<Library, TermError> {
+        let rhs = self.equations.iter().map(|e| e.rhs(with_intercept)).collect::<Result<Vec<_>, _>>()?;
+        Library::compile(&rhs, &self.vocabulary)
+    }
+
+    /// Replaces an equation's coefficients (e.g. with an identification's result).
+    pub fn set_coefficients(
+        &mut self,
+        equation: &str,
+        coefficients: Vec<(Term, f64, Option<f64>)>,
+        intercept: Option<f64>,
+    ) {
+        if let Some(eq) = self.equations.iter_mut().find(|e| e.name == equation) {
+            eq.coefficients = coefficients;
+            eq.intercept = intercept;
+        }
+        if let Some(spec) = self.spec.equations.get_mut(equation) {
+            let eq = self.equations.iter().find(|e| e.name == equation).expect("same names");
+            spec.coefficients = eq
+                .coefficients
+                .iter()
+                .map(|(t, v, se)| {
+                    let c = match se {
+                        Some(s) => CoefficientSpec::WithError { value: *v, std_error: *s },
+                        None => CoefficientSpec::Value(*v),
+                    };
+                    (t.to_string(), c)
+                })
+                .collect();
+            spec.intercept = intercept;
+        }
+    }
+
+    /// The model as TOML text (what `identify --out` writes and `simulate` reads back).
+    pub fn to_toml(&self) -> String {
+        let body =
+            toml::to_string_pretty(&self.spec).unwrap_or_else(|e| format!("# could not serialise: {e}\n"));
+        format!("# written by termid {}\n{body}", env!("CARGO_PKG_VERSION"))
+    }
+}
+
+/// 1-based line of the first occurrence of `needle` in `text` (0 if absent).
+fn locate(text: &str, needle: &str) -> usize {
+    text.find(needle).map_or(0, |i| text[..i].matches('\n').count() + 1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_model_loads() {
+        let m = Model::default_model();
+        let names: Vec<&str> = m.equations.iter().map(|e| e.name.as_str()).collect();
+        assert_eq!(&names[..3], ["u_dot", "v_dot", "r_dot"]);
+        assert_eq!(m.equation("u_dot").unwrap().candidates.len(), 18);
+        assert_eq!(m.equation("v_dot").unwrap().candidates.len(), 29);
+        assert_eq!(m.equation("r_dot").unwrap().candidates.len(), 29);
+    }
+}

@@ -1,0 +1,82 @@
+//! Pull-out (Burcher): a steady turn at a rudder angle, then the rudder back to the
+//! straight-run angle δ0; a course-stable ship's yaw rate decays to zero, an unstable one's
+//! to a residual rate.
+
+use serde::Serialize;
+
+use super::zigzag::RudderOnly;
+use super::{Servo, Ship, StraightRun};
+use crate::sim::{Controller, Trajectory};
+
+/// A pull-out manoeuvre.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PullOut {
+    /// Rudder angle of the turn, degrees.
+    pub rudder_deg: f64,
+    /// Time in the turn before the rudder returns, s.
+    pub turn_s: f64,
+    /// Time after the return, s.
+    pub after_s: f64,
+}
+
+impl Default for PullOut {
+    fn default() -> Self {
+        PullOut { rudder_deg: 20.0, turn_s: 100.0, after_s: 100.0 }
+    }
+}
+
+/// Pull-out metrics.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct PullOutMetrics {
+    /// Yaw rate when the rudder is returned, °/s.
+    pub turning_yaw_rate_deg_s: f64,
+    /// Yaw rate at the end of the run, °/s.
+    pub residual_yaw_rate_deg_s: f64,
+    /// Time for |r| to fall to 1/e of its turning value after the return, s.
+    pub decay_time_s: Option<f64>,
+}
+
+pub struct PullOutControl {
+    servo: Servo,
+    turn: f64,
+    back: f64,
+    switch_at: f64,
+}
+
+impl Controller for PullOutControl {
+    fn input(&mut self, t: f64, _x: &[f64], out: &mut [f64]) {
+        let command = if t < self.switch_at { self.turn } else { self.back };
+        out[0] = self.servo.step(t, command);
+    }
+}
+
+impl PullOut {
+    pub(crate) fn controller(&self, ship: &Ship, start: &StraightRun) -> RudderOnly<PullOutControl> {
+        RudderOnly::new(
+            ship,
+            start,
+            PullOutControl {
+                servo: Servo::new(ship, start),
+                turn: self.rudder_deg.to_radians(),
+                back: start.input[ship.roles.rudder],
+                switch_at: self.turn_s,
+            },
+        )
+    }
+
+    /// Metrics from a run sampled at every step.
+    pub fn metrics(&self, ship: &Ship, run: &Trajectory) -> PullOutMetrics {
+        let r = &run.states[ship.roles.r];
+        let i_sw = run.time.iter().position(|t| *t >= self.turn_s).unwrap_or(r.len() - 1);
+        let r_turn = r[i_sw];
+        let decay = r[i_sw..]
+            .iter()
+            .position(|v| v.abs() <= r_turn.abs() / std::f64::consts::E)
+            .map(|k| run.time[i_sw + k] - run.time[i_sw]);
+        PullOutMetrics {
+            turning_yaw_rate_deg_s: r_turn.to_degrees(),
+            residual_yaw_rate_deg_s: r[r.len() - 1].to_degrees(),
+            decay_time_s: decay,
+        }
+    }
+}

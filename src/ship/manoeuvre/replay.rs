@@ -1,0 +1,32 @@
+//! Recorded inputs replayed (the paper's "modified" manoeuvres): the rudder history of a
+//! run is fed to the model as it was, linearly interpolated; the run starts from the
+//! recording's first state where the file has the state columns, else from the straight run.
+
+use super::Ship;
+use crate::data::Frame;
+use crate::ship::ShipError;
+use crate::sim::Replay;
+
+/// A recorded run whose inputs are replayed.
+#[derive(Clone, Debug)]
+pub struct Replayed {
+    /// The recording (time column `t`).
+    pub frame: Frame,
+}
+
+impl Replayed {
+    /// Reads a recording.
+    pub fn read(path: &str) -> Result<Replayed, ShipError> {
+        Ok(Replayed { frame: Frame::read_csv(std::path::Path::new(path), "t")? })
+    }
+
+    /// Length of the recording.
+    pub fn duration(&self) -> f64 {
+        let t = self.frame.time();
+        t[t.len() - 1] - t[0]
+    }
+
+    pub(crate) fn controller(&self, ship: &Ship) -> Result<Replay, ShipError> {
+        Ok(Replay::new(&self.frame, &ship.system.inputs)?)
+    }
+}

@@ -1,0 +1,134 @@
+//! Spiral test (Dieudonné): the rudder is held at a sequence of angles from +max down to
+//! −max and back up, each long enough for the yaw rate to settle; the steady yaw rate
+//! against the rudder angle, on the way down and on the way back, shows a course-unstable
+//! ship's hysteresis loop. Loop width: the distance between the rudder angles at which r
+//! changes sign on the two branches.
+
+use serde::Serialize;
+
+use super::zigzag::RudderOnly;
+use super::{Servo, Ship, StraightRun};
+use crate::sim::{Controller, Trajectory};
+
+/// A spiral test.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Spiral {
+    /// Largest rudder angle, degrees.
+    pub max_deg: f64,
+    /// Rudder step, degrees.
+    pub step_deg: f64,
+    /// Time at each angle, s.
+    pub hold_s: f64,
+}
+
+impl Default for Spiral {
+    fn default() -> Self {
+        Spiral { max_deg: 20.0, step_deg: 2.0, hold_s: 120.0 }
+    }
+}
+
+/// One point of the spiral curve.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SpiralPoint {
+    /// Rudder angle, degrees.
+    pub rudder_deg: f64,
+    /// Steady yaw rate (mean over the last fifth of the hold), °/s.
+    pub yaw_rate_deg_s: f64,
+    /// `down` (from +max) or `up` (back from −max).
+    pub branch: String,
+}
+
+/// Spiral metrics.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct SpiralMetrics {
+    /// r(δ) on both branches.
+    pub points: Vec<SpiralPoint>,
+    /// Width of the hysteresis loop, degrees (0 for a course-stable ship).
+    pub loop_width_deg: Option<f64>,
+    /// Largest change of r over the last fifth of any hold, °/s (settling check).
+    pub unsettled_deg_s: f64,
+}
+
+impl Spiral {
+    /// The rudder angles, in order.
+    pub fn angles(&self) -> Vec<f64> {
+        let n = (self.max_deg / self.step_deg).round() as i64;
+        let down: Vec<f64> = (-n..=n).rev().map(|k| k as f64 * self.step_deg).collect();
+        let up: Vec<f64> = down.iter().rev().skip(1).copied().collect();
+        down.into_iter().chain(up).collect()
+    }
+
+    /// Length of the whole test, s.
+    pub fn duration(&self) -> f64 {
+        self.angles().len() as f64 * self.hold_s
+    }
+
+    pub(crate) fn controller(&self, ship: &Ship, start: &StraightRun) -> RudderOnly<SpiralControl> {
+        RudderOnly::new(
+            ship,
+            start,
+            SpiralControl {
+                servo: Servo::new(ship, start),
+                angles: self.angles().iter().map(|a| a.to_radians()).collect(),
+                hold: self.hold_s,
+            },
+        )
+    }
+
+    /// Metrics from a run sampled at every step.
+    pub fn metrics(&self, ship: &Ship, run: &Trajectory) -> SpiralMetrics {
+        let angles = self.angles();
+        let half = angles.len() / 2 + 1;
+        let r = &run.states[ship.roles.r];
+        let mut points = Vec::new();
+        let mut unsettled: f64 = 0.0;
+        for (k, a) in angles.iter().enumerate() {
+            let (t0, t1) = (self.hold_s * (k as f64 + 0.8), self.hold_s * (k as f64 + 1.0));
+            let window: Vec<f64> = run
+                .time
+                .iter()
+                .zip(r)
+                .filter(|(t, _)| **t >= t0 - 1e-9 && **t <= t1 + 1e-9)
+                .map(|(_, r)| *r)
+                .collect();
+            if window.is_empty() {
+                break;
+            }
+            let mean = window.iter().sum::<f64>() / window.len() as f64;
+            let span = window.iter().fold(f64::NEG_INFINITY, |m, v| m.max(*v))
+                - window.iter().fold(f64::INFINITY, |m, v| m.min(*v));
+            unsettled = unsettled.max(span.to_degrees());
+            points.push(SpiralPoint {
+                rudder_deg: *a,
+                yaw_rate_deg_s: mean.to_degrees(),
+                branch: if k < half { "down".into() } else { "up".into() },
+            });
+        }
+        let crossing = |branch: &str| -> Option<f64> {
+            let p: Vec<&SpiralPoint> = points.iter().filter(|p| p.branch == branch).collect();
+            p.windows(2).find(|w| w[0].yaw_rate_deg_s.signum() != w[1].yaw_rate_deg_s.signum()).map(|w| {
+                let (a, b) = (w[0], w[1]);
+                a.rudder_deg
+                    + (b.rudder_deg - a.rudder_deg) * a.yaw_rate_deg_s / (a.yaw_rate_deg_s - b.yaw_rate_deg_s)
+            })
+        };
+        let loop_width_deg = match (crossing("down"), crossing("up")) {
+            (Some(d), Some(u)) => Some((d - u).abs()),
+            _ => None,
+        };
+        SpiralMetrics { points, loop_width_deg, unsettled_deg_s: unsettled }
+    }
+}
+
+pub struct SpiralControl {
+    servo: Servo,
+    angles: Vec<f64>,
+    hold: f64,
+}
+
+impl Controller for SpiralControl {
+    fn input(&mut self, t: f64, _x: &[f64], out: &mut [f64]) {
+        let k = ((t / self.hold) as usize).min(self.angles.len() - 1);
+        out[0] = self.servo.step(t, self.angles[k]);
+    }
+}

@@ -1,0 +1,156 @@
+//! Zigzag (Z-manoeuvre) δ/ψ: the rudder is laid to δ0 ∓ δ_z (relative to the straight-run
+//! angle δ0, Oltmann 1973 §5) and reversed each time the heading change from the initial
+//! heading reaches ±ψ_z. Overshoot is the heading beyond the switching heading (not beyond
+//! the rudder angle; for a 20°/10° zigzag those differ), IMO MSC.137(76).
+
+use serde::Serialize;
+
+use super::{Servo, Ship, StraightRun};
+use crate::sim::{Controller, Trajectory};
+
+/// A zigzag manoeuvre.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ZigZag {
+    /// Rudder angle δ_z, degrees (relative to δ0).
+    pub rudder_deg: f64,
+    /// Heading change ψ_z at which the rudder is reversed, degrees.
+    pub heading_deg: f64,
+    /// First turn to starboard (ψ increasing), else to port.
+    pub starboard_first: bool,
+}
+
+/// Zigzag metrics (IMO MSC.137(76), ITTC 7.5-04-02-01).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct ZigZagMetrics {
+    /// Time from rudder execute to the first rudder reversal, s.
+    pub initial_turning_time_s: Option<f64>,
+    /// First overshoot angle, degrees.
+    pub first_overshoot_deg: Option<f64>,
+    /// Second overshoot angle, degrees.
+    pub second_overshoot_deg: Option<f64>,
+    /// Time between the first and third rudder reversals (one full cycle), s.
+    pub period_s: Option<f64>,
+    /// Times of the rudder reversals, s.
+    pub reversals_s: Vec<f64>,
+}
+
+/// Reversal logic shared by the controller and the metrics.
+#[derive(Clone, Debug)]
+struct Switch {
+    dir: f64,
+    limit: f64,
+}
+
+impl Switch {
+    /// Updates the direction from the heading change `h`; true when it reversed.
+    fn update(&mut self, h: f64) -> bool {
+        if (self.dir > 0.0 && h >= self.limit) || (self.dir < 0.0 && h <= -self.limit) {
+            self.dir = -self.dir;
+            true
+        } else {
+            false
+        }
+    }
+}
+
+/// The zigzag controller.
+pub struct ZigZagControl {
+    servo: Servo,
+    switch: Switch,
+    delta0: f64,
+    amplitude: f64,
+    turn_sign: f64,
+    psi: usize,
+    psi0: f64,
+}
+
+impl Controller for ZigZagControl {
+    fn input(&mut self, t: f64, x: &[f64], out: &mut [f64]) {
+        out.fill(0.0);
+        self.switch.update(x[self.psi] - self.psi0);
+        // rudder for a turn in direction `dir` (+ = starboard): sign from ∂ṙ/∂δ
+        let command = self.delta0 + self.turn_sign * self.switch.dir * self.amplitude;
+        out[0] = self.servo.step(t, command);
+    }
+}
+
+impl ZigZag {
+    fn dir0(&self) -> f64 {
+        if self.starboard_first {
+            1.0
+        } else {
+            -1.0
+        }
+    }
+
+    pub(crate) fn controller(&self, ship: &Ship, start: &StraightRun) -> RudderOnly<ZigZagControl> {
+        RudderOnly::new(
+            ship,
+            start,
+            ZigZagControl {
+                servo: Servo::new(ship, start),
+                switch: Switch { dir: self.dir0(), limit: self.heading_deg.to_radians() },
+                delta0: start.input[ship.roles.rudder],
+                amplitude: self.rudder_deg.to_radians(),
+                turn_sign: ship.turn_sign,
+                psi: ship.roles.psi,
+                psi0: start.x[ship.roles.psi],
+            },
+        )
+    }
+
+    /// Metrics from a run sampled at every step.
+    pub fn metrics(&self, ship: &Ship, run: &Trajectory) -> ZigZagMetrics {
+        let psi = &run.states[ship.roles.psi];
+        let h: Vec<f64> = psi.iter().map(|p| (p - psi[0]).to_degrees()).collect();
+        let mut sw = Switch { dir: self.dir0(), limit: self.heading_deg };
+        let mut idx = Vec::new();
+        for (i, &hi) in h.iter().enumerate() {
+            if sw.update(hi) {
+                idx.push(i);
+            }
+        }
+        let t = &run.time;
+        let d0 = self.dir0();
+        // heading beyond the switching heading between reversal k and k+1, in the turn's direction
+        let overshoot = |k: usize| -> Option<f64> {
+            let (a, b) = (*idx.get(k)?, *idx.get(k + 1)?);
+            let dir = if k.is_multiple_of(2) { d0 } else { -d0 };
+            let extreme = h[a..=b].iter().map(|v| v * dir).fold(f64::NEG_INFINITY, f64::max);
+            Some(extreme - self.heading_deg)
+        };
+        ZigZagMetrics {
+            initial_turning_time_s: idx.first().map(|&i| t[i]),
+            first_overshoot_deg: overshoot(0),
+            second_overshoot_deg: overshoot(1),
+            period_s: idx.get(2).map(|&i| t[i] - t[idx[0]]),
+            reversals_s: idx.iter().map(|&i| t[i]).collect(),
+        }
+    }
+}
+
+/// Wraps a rudder controller: the rudder goes to the rudder input, every other input keeps
+/// its straight-run value.
+pub struct RudderOnly<C> {
+    inner: C,
+    rudder: usize,
+    base: Vec<f64>,
+}
+
+impl<C: Controller> RudderOnly<C> {
+    pub(crate) fn new(ship: &Ship, start: &StraightRun, inner: C) -> Self {
+        RudderOnly { inner, rudder: ship.roles.rudder, base: start.input.clone() }
+    }
+}
+
+impl<C: Controller> Controller for RudderOnly<C> {
+    fn input(&mut self, t: f64, x: &[f64], out: &mut [f64]) {
+        out.copy_from_slice(&self.base);
+        let mut r = [0.0];
+        self.inner.input(t, x, &mut r);
+        out[self.rudder] = r[0];
+    }
+    fn done(&self, t: f64, x: &[f64]) -> bool {
+        self.inner.done(t, x)
+    }
+}

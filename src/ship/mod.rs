@@ -1,0 +1,244 @@
+//! The ship-manoeuvring plug-in: particulars, the straight run that precedes a manoeuvre,
+//! the standard manoeuvres (zigzag, turning circle, spiral, pull-out, replay) as controllers
+//! of the generic simulator, and their metrics as naval architects define them (IMO
+//! MSC.137(76), ITTC 7.5-04-02-01). Angles are radians inside, degrees in metrics.
+
+pub mod figure;
+pub mod manoeuvre;
+
+use std::collections::BTreeMap;
+
+pub use manoeuvre::{Manoeuvre, Metrics};
+
+use crate::data::{DataError, Frame};
+use crate::model::{Model, ShipSpec};
+use crate::sim::{self, simulate, Settings, SimError, SteadyProblem, System, Trajectory, Unknown};
+
+/// Why a ship run failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ShipError {
+    /// The model lacks the `[ship]` section or a role's state.
+    #[error("{0}")]
+    Model(String),
+    /// The simulation failed.
+    #[error(transparent)]
+    Sim(#[from] SimError),
+    /// Data (replay) problem.
+    #[error(transparent)]
+    Data(#[from] DataError),
+    /// A manoeuvre string that does not parse.
+    #[error("manoeuvre `{text}`: {message}")]
+    Manoeuvre {
+        /// What was given.
+        text: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// Indices of the ship's roles in the system.
+#[derive(Clone, Copy, Debug)]
+pub struct Roles {
+    /// Surge velocity state.
+    pub u: usize,
+    /// Sway velocity state.
+    pub v: usize,
+    /// Yaw rate state.
+    pub r: usize,
+    /// Heading state.
+    pub psi: usize,
+    /// Position along the initial course.
+    pub x0: usize,
+    /// Position across it.
+    pub y0: usize,
+    /// Rudder input.
+    pub rudder: usize,
+}
+
+/// The straight run before a manoeuvre: rudder δ0 and sway v0 that cancel the asymmetry
+/// terms at u = u0, r = 0.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StraightRun {
+    /// Initial state of the system.
+    pub x: Vec<f64>,
+    /// Inputs (δ0 in the rudder slot).
+    pub input: Vec<f64>,
+    /// δ0 in degrees.
+    pub delta0_deg: f64,
+    /// Steady sway v0 in m/s.
+    pub v0: f64,
+    /// u̇ left at the straight run (the model's surge balance at u0; ideally 0), m/s².
+    pub surge_residual: f64,
+}
+
+/// A ship model ready to manoeuvre.
+#[derive(Clone, Debug)]
+pub struct Ship {
+    /// Particulars.
+    pub spec: ShipSpec,
+    /// The compiled equations.
+    pub system: System,
+    /// Where the roles are.
+    pub roles: Roles,
+    /// sign(∂ṙ/∂δ): −1 when positive rudder turns to port (the paper's convention).
+    pub turn_sign: f64,
+}
+
+/// One simulated manoeuvre.
+#[derive(Clone, Debug)]
+pub struct Run {
+    /// The manoeuvre.
+    pub manoeuvre: Manoeuvre,
+    /// The straight run it started from.
+    pub start: StraightRun,
+    /// Output samples.
+    pub trajectory: Trajectory,
+    /// Metrics (from the run at full step resolution).
+    pub metrics: Metrics,
+}
+
+impl Ship {
+    /// A ship from a model with a `[ship]` section.
+    pub fn new(model: &Model, with_intercept: bool) -> Result<Ship, ShipError> {
+        let spec = model.spec.ship.clone().ok_or_else(|| {
+            ShipError::Model(format!("{}: no [ship] section: not a ship model", model.path))
+        })?;
+        let system = System::new(model, &BTreeMap::new(), with_intercept)?;
+        let state = |name: &str| {
+            let canonical = model.vocabulary.canonical(name).unwrap_or_else(|| name.to_string());
+            system.state_index(&canonical).ok_or_else(|| {
+                ShipError::Model(format!(
+                    "{}: [ship] names state `{name}`, which has no equation",
+                    model.path
+                ))
+            })
+        };
+        let n = &spec.names;
+        let rudder_name = model.vocabulary.canonical(&n.rudder).unwrap_or_else(|| n.rudder.clone());
+        let roles = Roles {
+            u: state(&n.u)?,
+            v: state(&n.v)?,
+            r: state(&n.r)?,
+            psi: state(&n.psi)?,
+            x0: state(&n.x0)?,
+            y0: state(&n.y0)?,
+            rudder: system.input_index(&rudder_name).ok_or_else(|| {
+                ShipError::Model(format!("{}: rudder input `{}` is not declared", model.path, n.rudder))
+            })?,
+        };
+        let mut ship = Ship { spec, system, roles, turn_sign: -1.0 };
+        ship.turn_sign = ship.rudder_effect()?.signum();
+        Ok(ship)
+    }
+
+    fn rudder_effect(&self) -> Result<f64, ShipError> {
+        let mut ws = self.system.workspace();
+        let mut x = vec![0.0; self.system.dim()];
+        x[self.roles.u] = self.spec.u0;
+        let mut input = vec![0.0; self.system.inputs.len()];
+        let mut d = vec![0.0; x.len()];
+        input[self.roles.rudder] = 0.01;
+        self.system.derivatives(&x, &input, &mut ws, &mut d);
+        let plus = d[self.roles.r];
+        input[self.roles.rudder] = -0.01;
+        self.system.derivatives(&x, &input, &mut ws, &mut d);
+        let effect = plus - d[self.roles.r];
+        if effect == 0.0 || !effect.is_finite() {
+            return Err(ShipError::Model("the rudder has no effect on the yaw rate at u0".into()));
+        }
+        Ok(effect)
+    }
+
+    /// Steady straight running at u0: δ0 and v0 with v̇ = ṙ = 0 (r = 0, heading 0).
+    pub fn straight_run(&self) -> Result<StraightRun, ShipError> {
+        let r = &self.roles;
+        let mut x = vec![0.0; self.system.dim()];
+        x[r.u] = self.spec.u0;
+        let input = vec![0.0; self.system.inputs.len()];
+        let p = SteadyProblem {
+            system: &self.system,
+            x,
+            input,
+            unknowns: vec![Unknown::State(r.v), Unknown::Input(r.rudder)],
+            zero: vec![r.v, r.r],
+        };
+        let (x, input) = sim::solve_steady(&p)?;
+        let mut ws = self.system.workspace();
+        let mut d = vec![0.0; x.len()];
+        self.system.derivatives(&x, &input, &mut ws, &mut d);
+        Ok(StraightRun {
+            delta0_deg: input[r.rudder].to_degrees(),
+            v0: x[r.v],
+            surge_residual: d[r.u],
+            x,
+            input,
+        })
+    }
+
+    /// Simulates a manoeuvre from the straight run. Metrics use every step; the trajectory
+    /// is sampled at `settings.sample`.
+    pub fn run(&self, manoeuvre: &Manoeuvre, settings: &Settings) -> Result<Run, ShipError> {
+        let mut start = self.straight_run()?;
+        if let Manoeuvre::Replay(r) = manoeuvre {
+            // a recording starts from its own first state where it has the columns
+            for (i, name) in self.system.states.iter().enumerate() {
+                if let Some(c) = r.frame.column(name) {
+                    start.x[i] = c[0];
+                }
+            }
+            for (i, name) in self.system.inputs.iter().enumerate() {
+                if let Some(c) = r.frame.column(name) {
+                    start.input[i] = c[0];
+                }
+            }
+        }
+        self.run_from(manoeuvre, settings, start)
+    }
+
+    /// Like [`Ship::run`], from a given start.
+    pub fn run_from(
+        &self,
+        manoeuvre: &Manoeuvre,
+        settings: &Settings,
+        start: StraightRun,
+    ) -> Result<Run, ShipError> {
+        let fine = Settings { sample: settings.dt, ..*settings };
+        let mut controller = manoeuvre.controller(self, &start)?;
+        let full = simulate(&self.system, &start.x, controller.as_mut(), &fine)?;
+        let metrics = manoeuvre.metrics(self, &full);
+        let every = ((settings.sample / settings.dt).round() as usize).max(1);
+        let trajectory = downsample(&full, every);
+        Ok(Run { manoeuvre: manoeuvre.clone(), start, trajectory, metrics })
+    }
+
+    /// Speed U = √(u² + v²) and drift angle β = −atan(v/u) (eq. B10) of a trajectory.
+    pub fn speed_and_drift(&self, t: &Trajectory) -> (Vec<f64>, Vec<f64>) {
+        let (u, v) = (&t.states[self.roles.u], &t.states[self.roles.v]);
+        let speed = u.iter().zip(v).map(|(u, v)| u.hypot(*v)).collect();
+        let drift = u.iter().zip(v).map(|(u, v)| (-v).atan2(*u)).collect();
+        (speed, drift)
+    }
+
+    /// The trajectory as a frame with U and β added (SI units, radians).
+    pub fn frame(&self, t: &Trajectory, origin: &str) -> Result<Frame, DataError> {
+        let mut f = t.to_frame(origin, "t")?;
+        let (speed, drift) = self.speed_and_drift(t);
+        f.push("U", speed)?;
+        f.push("β", drift)?;
+        Ok(f)
+    }
+}
+
+fn downsample(t: &Trajectory, every: usize) -> Trajectory {
+    let keep: Vec<usize> = (0..t.time.len()).filter(|i| i % every == 0 || *i == t.time.len() - 1).collect();
+    let pick = |c: &Vec<f64>| keep.iter().map(|&i| c[i]).collect::<Vec<f64>>();
+    Trajectory {
+        time: pick(&t.time),
+        state_names: t.state_names.clone(),
+        input_names: t.input_names.clone(),
+        states: t.states.iter().map(pick).collect(),
+        inputs: t.inputs.iter().map(pick).collect(),
+        derivatives: t.derivatives.iter().map(pick).collect(),
+    }
+}

@@ -1,0 +1,237 @@
+//! Fixed-step integration. `ModifiedEuler` is Oltmann's eq. (B8): explicit Euler with the
+//! inputs taken at the *end* of the step, δ(t+Δt), so that v and r respond in the first step;
+//! it is the reproduction default. `Rk4` is the classical fourth-order Runge-Kutta method with
+//! inputs interpolated linearly within the step.
+
+// The stage updates index several parallel arrays at once; index loops read best there.
+#![allow(clippy::needless_range_loop)]
+
+use serde::{Deserialize, Serialize};
+
+use super::controller::Controller;
+use super::system::System;
+use super::SimError;
+use crate::data::Frame;
+
+/// The integration method.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Integrator {
+    /// Oltmann's modified Euler (eq. B8), first order.
+    #[default]
+    ModifiedEuler,
+    /// Classical Runge-Kutta, fourth order.
+    Rk4,
+}
+
+impl Integrator {
+    /// By name: `b8` (or `euler`) and `rk4`.
+    pub fn by_name(name: &str) -> Result<Integrator, SimError> {
+        match name {
+            "b8" | "euler" | "modified-euler" => Ok(Integrator::ModifiedEuler),
+            "rk4" => Ok(Integrator::Rk4),
+            other => Err(SimError::Settings(format!("unknown integrator `{other}` (known: b8, rk4)"))),
+        }
+    }
+}
+
+/// Step, duration and output interval, in seconds (or the model's time unit).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Settings {
+    /// Method.
+    pub integrator: Integrator,
+    /// Step Δt.
+    pub dt: f64,
+    /// Length of the run.
+    pub duration: f64,
+    /// Output interval, a whole multiple of `dt`.
+    pub sample: f64,
+}
+
+impl Settings {
+    fn validate(&self) -> Result<(usize, usize), SimError> {
+        let bad = |m: String| Err(SimError::Settings(m));
+        if self.dt.is_nan() || self.dt <= 0.0 || self.dt.is_infinite() {
+            return bad(format!("step {} must be positive", self.dt));
+        }
+        if self.duration.is_nan() || self.duration < 0.0 || self.duration.is_infinite() {
+            return bad(format!("duration {} must be ≥ 0", self.duration));
+        }
+        let every = (self.sample / self.dt).round();
+        if every < 1.0 || (every * self.dt - self.sample).abs() > 1e-9 * self.sample.max(self.dt) {
+            return bad(format!(
+                "output interval {} is not a whole multiple of the step {}",
+                self.sample, self.dt
+            ));
+        }
+        let steps = (self.duration / self.dt).round();
+        if steps > 1e9 {
+            return bad(format!("{steps} steps are too many"));
+        }
+        Ok((steps as usize, every as usize))
+    }
+}
+
+/// A simulated run, sampled at the output interval.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Trajectory {
+    /// Sample times.
+    pub time: Vec<f64>,
+    /// State names.
+    pub state_names: Vec<String>,
+    /// Input names.
+    pub input_names: Vec<String>,
+    /// One column per state.
+    pub states: Vec<Vec<f64>>,
+    /// One column per input (the inputs in force at the sample time).
+    pub inputs: Vec<Vec<f64>>,
+    /// One column per state: ẋ = f(x(t), input(t)) at the sample time.
+    pub derivatives: Vec<Vec<f64>>,
+}
+
+impl Trajectory {
+    /// A state's column.
+    pub fn state(&self, name: &str) -> Option<&[f64]> {
+        self.state_names.iter().position(|n| n == name).map(|i| self.states[i].as_slice())
+    }
+
+    /// An input's column.
+    pub fn input(&self, name: &str) -> Option<&[f64]> {
+        self.input_names.iter().position(|n| n == name).map(|i| self.inputs[i].as_slice())
+    }
+
+    /// As a frame: time, states, inputs, and `<state>_dot` derivatives.
+    pub fn to_frame(&self, origin: &str, time_name: &str) -> Result<Frame, crate::data::DataError> {
+        let mut f = Frame::new(origin, time_name, self.time.clone())?;
+        for (n, c) in self.state_names.iter().zip(&self.states) {
+            f.push(n, c.clone())?;
+        }
+        for (n, c) in self.input_names.iter().zip(&self.inputs) {
+            f.push(n, c.clone())?;
+        }
+        for (n, c) in self.state_names.iter().zip(&self.derivatives) {
+            f.push(&format!("{n}_dot"), c.clone())?;
+        }
+        Ok(f)
+    }
+
+    /// The last state.
+    pub fn last_state(&self) -> Vec<f64> {
+        self.states.iter().map(|c| *c.last().unwrap_or(&f64::NAN)).collect()
+    }
+}
+
+/// Integrates `system` from `x0` under `controller`.
+pub fn simulate(
+    system: &System,
+    x0: &[f64],
+    controller: &mut dyn Controller,
+    settings: &Settings,
+) -> Result<Trajectory, SimError> {
+    let (steps, every) = settings.validate()?;
+    let (n, m) = (system.dim(), system.inputs.len());
+    if x0.len() != n {
+        return Err(SimError::Settings(format!("{} initial values for {n} states", x0.len())));
+    }
+    let dt = settings.dt;
+    let mut ws = system.workspace();
+    let mut x = x0.to_vec();
+    let mut u_now = vec![0.0; m];
+    let mut u_next = vec![0.0; m];
+    controller.input(0.0, &x, &mut u_now);
+    let cap = steps / every + 1;
+    let mut out = Trajectory {
+        time: Vec::with_capacity(cap),
+        state_names: system.states.clone(),
+        input_names: system.inputs.clone(),
+        states: vec![Vec::with_capacity(cap); n],
+        inputs: vec![Vec::with_capacity(cap); m],
+        derivatives: vec![Vec::with_capacity(cap); n],
+    };
+    let mut f = vec![0.0; n];
+    let mut record =
+        |t: f64, x: &[f64], u: &[f64], out: &mut Trajectory, ws: &mut super::system::Workspace| {
+            system.derivatives(x, u, ws, &mut f);
+            out.time.push(t);
+            for i in 0..n {
+                out.states[i].push(x[i]);
+                out.derivatives[i].push(f[i]);
+            }
+            for k in 0..m {
+                out.inputs[k].push(u[k]);
+            }
+        };
+    check(system, 0.0, &x, x0)?;
+    record(0.0, &x, &u_now, &mut out, &mut ws);
+    let mut k = [vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+    let mut tmp = vec![0.0; n];
+    let mut u_mid = vec![0.0; m];
+    let mut prev = x.clone();
+    for step in 1..=steps {
+        let t1 = step as f64 * dt;
+        controller.input(t1, &x, &mut u_next);
+        prev.copy_from_slice(&x);
+        match settings.integrator {
+            Integrator::ModifiedEuler => {
+                // eq. (B8): rudder at the end of the step
+                system.derivatives(&x, &u_next, &mut ws, &mut k[0]);
+                for i in 0..n {
+                    x[i] += dt * k[0][i];
+                }
+            }
+            Integrator::Rk4 => {
+                for j in 0..m {
+                    u_mid[j] = 0.5 * (u_now[j] + u_next[j]);
+                }
+                system.derivatives(&x, &u_now, &mut ws, &mut k[0]);
+                for i in 0..n {
+                    tmp[i] = x[i] + 0.5 * dt * k[0][i];
+                }
+                system.derivatives(&tmp, &u_mid, &mut ws, &mut k[1]);
+                for i in 0..n {
+                    tmp[i] = x[i] + 0.5 * dt * k[1][i];
+                }
+                system.derivatives(&tmp, &u_mid, &mut ws, &mut k[2]);
+                for i in 0..n {
+                    tmp[i] = x[i] + dt * k[2][i];
+                }
+                system.derivatives(&tmp, &u_next, &mut ws, &mut k[3]);
+                for i in 0..n {
+                    x[i] += dt / 6.0 * (k[0][i] + 2.0 * k[1][i] + 2.0 * k[2][i] + k[3][i]);
+                }
+            }
+        }
+        check(system, t1, &x, &prev)?;
+        std::mem::swap(&mut u_now, &mut u_next);
+        let done = controller.done(t1, &x);
+        if step % every == 0 || done {
+            record(t1, &x, &u_now, &mut out, &mut ws);
+        }
+        if done {
+            break;
+        }
+    }
+    Ok(out)
+}
+
+fn check(system: &System, t: f64, x: &[f64], prev: &[f64]) -> Result<(), SimError> {
+    for (i, &v) in x.iter().enumerate() {
+        let (lo, hi) = system.bounds[i];
+        let why = if !v.is_finite() {
+            "not finite".to_string()
+        } else if v < lo || v > hi {
+            format!("outside its bounds [{lo}, {hi}]")
+        } else {
+            continue;
+        };
+        let snapshot = system
+            .states
+            .iter()
+            .zip(prev)
+            .map(|(n, v)| format!("{n} = {v:.6}"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        return Err(SimError::Diverged { t, state: system.states[i].clone(), value: v, why, snapshot });
+    }
+    Ok(())
+}

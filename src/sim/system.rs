@@ -1,0 +1,128 @@
+//! A model's equations as an ODE system ẋ = f(x, input; parameters).
+
+use std::collections::BTreeMap;
+
+use super::SimError;
+use crate::model::Model;
+use crate::term::{Library, RowScratch};
+
+/// The compiled right-hand side of a model with its states, inputs and parameters.
+#[derive(Clone, Debug)]
+pub struct System {
+    /// State names, in integration order.
+    pub states: Vec<String>,
+    /// Input names.
+    pub inputs: Vec<String>,
+    /// Lower and upper bounds per state (±∞ when not declared).
+    pub bounds: Vec<(f64, f64)>,
+    rhs: Library,
+    /// For each library input: where its value comes from.
+    map: Vec<Slot>,
+    params: Vec<f64>,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Slot {
+    State(usize),
+    Input(usize),
+    Param(usize),
+}
+
+impl System {
+    /// Compiles a model's equations. `parameters` override the file's values.
+    pub fn new(
+        model: &Model,
+        parameters: &BTreeMap<String, f64>,
+        with_intercept: bool,
+    ) -> Result<System, SimError> {
+        let states: Vec<String> = model.equations.iter().map(|e| e.state.clone()).collect();
+        let missing: Vec<&str> = model
+            .spec
+            .states
+            .iter()
+            .map(|s| s.name.as_str())
+            .filter(|s| !states.iter().any(|t| t == s))
+            .collect();
+        if !missing.is_empty() {
+            return Err(SimError::Settings(format!(
+                "{}: state(s) {} have no equation, so the model cannot be simulated",
+                model.path,
+                missing.join(", ")
+            )));
+        }
+        let inputs: Vec<String> = model.spec.inputs.iter().map(|i| i.name.clone()).collect();
+        let mut values = model.parameter_values();
+        values.extend(parameters.iter().map(|(k, v)| (k.clone(), *v)));
+        let param_names: Vec<String> = values.keys().cloned().collect();
+        let rhs = model.compile_rhs(with_intercept)?;
+        let map = rhs
+            .inputs()
+            .iter()
+            .map(|n| {
+                states
+                    .iter()
+                    .position(|s| s == n)
+                    .map(Slot::State)
+                    .or_else(|| inputs.iter().position(|s| s == n).map(Slot::Input))
+                    .or_else(|| param_names.iter().position(|s| s == n).map(Slot::Param))
+                    .ok_or_else(|| {
+                        SimError::Settings(format!(
+                            "{}: `{n}` is neither a state, an input nor a parameter",
+                            model.path
+                        ))
+                    })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let bounds = states
+            .iter()
+            .map(|s| {
+                let spec = model.spec.states.iter().find(|t| &t.name == s);
+                (
+                    spec.and_then(|t| t.min).unwrap_or(f64::NEG_INFINITY),
+                    spec.and_then(|t| t.max).unwrap_or(f64::INFINITY),
+                )
+            })
+            .collect();
+        Ok(System { states, inputs, bounds, rhs, map, params: values.into_values().collect() })
+    }
+
+    /// Number of states.
+    pub fn dim(&self) -> usize {
+        self.states.len()
+    }
+
+    /// Scratch space for [`System::derivatives`].
+    pub fn workspace(&self) -> Workspace {
+        Workspace { args: vec![0.0; self.map.len()], scratch: self.rhs.scratch() }
+    }
+
+    /// ẋ = f(x, input).
+    #[inline]
+    pub fn derivatives(&self, x: &[f64], input: &[f64], ws: &mut Workspace, dx: &mut [f64]) {
+        for (a, slot) in ws.args.iter_mut().zip(&self.map) {
+            *a = match *slot {
+                Slot::State(i) => x[i],
+                Slot::Input(i) => input[i],
+                Slot::Param(i) => self.params[i],
+            };
+        }
+        self.rhs.eval_row(&ws.args, &mut ws.scratch, dx);
+    }
+
+    /// Index of a state by name.
+    pub fn state_index(&self, name: &str) -> Option<usize> {
+        self.states.iter().position(|s| s == name)
+    }
+
+    /// Index of an input by name.
+    pub fn input_index(&self, name: &str) -> Option<usize> {
+        self.inputs.iter().position(|s| s == name)
+    }
+}
+
+/// Per-thread scratch of a [`System`].
+#[derive(Clone, Debug)]
+pub struct Workspace {
+    args: Vec<f64>,
+    scratch: RowScratch,
+}
