@@ -239,7 +239,6 @@ impl Identification<'_> {
     }
 }
 
-
 /// Identifies one equation of a model from runs: candidates, forced and excluded terms and
 /// the back-end come from the model file; the target is the column `<state>_dot` where every
 /// run has it, else the derivative of the state.

@@ -13,3 +13,12 @@ mod stepwise;
 // The `termid` binary end to end.
 #[path = "integration/cli.rs"]
 mod cli;
+// Model files: the default model against the paper, error locations, round trip.
+#[path = "integration/model.rs"]
+mod model;
+// Simulator and ship plug-in: symmetry, integrator order, steady turning, manoeuvres.
+#[path = "integration/ship.rs"]
+mod ship;
+// Non-ship models (Lorenz, Duffing) through the same library and commands.
+#[path = "integration/generic.rs"]
+mod generic;

@@ -49,6 +49,11 @@ impl Default for StepRule {
 /// | `exact_fit` | 1e-13 | stop when 1 − R² is at most this: later steps would be chosen by round-off |
 /// | `step_rule` | first F maximum | which step's coefficients are reported |
 /// | `max_steps` | none | stop after this many terms |
+/// | `prune_t` | 0 (off) | after the chosen step, remove the term with the smallest \|t\| while it is below this, refitting each time |
+/// | `prune_beta` | 0 (off) | likewise for the standardised coefficient \|b\|·sd(x)/sd(y) (a scale-free magnitude threshold, as sequential thresholding in SINDy) |
+///
+/// STPRG itself never removes a term; the two prune rules are termid's additions, off by
+/// default so that the paper's procedure is reproduced as it was.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Stepwise {
@@ -62,6 +67,10 @@ pub struct Stepwise {
     pub step_rule: StepRule,
     /// Maximum number of terms.
     pub max_steps: Option<usize>,
+    /// Remove terms with |t| below this after the chosen step (0: off).
+    pub prune_t: f64,
+    /// Remove terms whose standardised coefficient is below this after the chosen step (0: off).
+    pub prune_beta: f64,
 }
 
 impl Default for Stepwise {
@@ -72,6 +81,8 @@ impl Default for Stepwise {
             exact_fit: 1e-13,
             step_rule: StepRule::default(),
             max_steps: None,
+            prune_t: 0.0,
+            prune_beta: 0.0,
         }
     }
 }
@@ -89,6 +100,12 @@ impl Stepwise {
         }
         if !(0.0..1.0).contains(&self.exact_fit) {
             return Err(bad("exact_fit", self.exact_fit));
+        }
+        if self.prune_t.is_nan() || self.prune_t < 0.0 || self.prune_beta.is_nan() || self.prune_beta < 0.0 {
+            return Err(SelectError::Config(format!(
+                "stepwise prune_t and prune_beta must be ≥ 0, are {} and {}",
+                self.prune_t, self.prune_beta
+            )));
         }
         match self.step_rule {
             StepRule::FirstFMaximum { tolerance } | StepRule::StandardErrorPlateau { tolerance }
@@ -167,6 +184,7 @@ impl Selector for Stepwise {
                 }
             }
         }
+        let a0 = a.clone();
         let means = mo.means();
         let n_eff = if pb.intercept { n as f64 - 1.0 } else { n as f64 };
         let mut entered: Vec<usize> = Vec::new();
@@ -237,6 +255,7 @@ impl Selector for Stepwise {
         };
         let chosen = choose_step(self.step_rule, &steps, pb.forced.len());
         let intercept = chosen.checked_sub(1).and_then(|c| steps[c].intercept.clone());
+        let pruned = self.prune(pb, &a0, &d, &steps[..chosen], total, n_eff, means, &mut notes);
         let mut selection = Selection {
             backend: self.name().into(),
             rows: n,
@@ -248,11 +267,77 @@ impl Selector for Stepwise {
             notes,
         };
         selection.terms = selection.terms_at(chosen);
+        if let Some(fit) = pruned {
+            let kept: Vec<usize> = fit.0;
+            selection.terms = kept
+                .iter()
+                .zip(fit.1.coefficients.iter().zip(&fit.1.std_errors))
+                .map(|(&i, (&coefficient, &std_error))| super::FittedTerm {
+                    term: pb.names[i].clone(),
+                    index: i,
+                    coefficient,
+                    std_error,
+                    t: coefficient / std_error,
+                })
+                .collect();
+            selection.intercept = fit.1.intercept;
+        }
         Ok(selection)
     }
 }
 
 impl Stepwise {
+    /// The backward pass of `prune_t` / `prune_beta` on the chosen step's terms: refits by
+    /// sweeping a fresh copy of the scaled matrix on the terms kept. None if nothing goes.
+    #[allow(clippy::too_many_arguments)]
+    fn prune(
+        &self,
+        pb: &Problem<'_>,
+        a0: &[f64],
+        d: &[f64],
+        chosen: &[Step],
+        total: f64,
+        n_eff: f64,
+        means: &[f64],
+        notes: &mut Vec<String>,
+    ) -> Option<(Vec<usize>, Step)> {
+        if (self.prune_t == 0.0 && self.prune_beta == 0.0) || chosen.is_empty() {
+            return None;
+        }
+        let p = pb.moments.regressors();
+        let m = p + 1;
+        let mut kept: Vec<usize> = chosen.iter().map(|s| s.index).collect();
+        let mut removed_any = false;
+        loop {
+            let mut a = a0.to_vec();
+            for &j in &kept {
+                sweep(&mut a, m, j);
+            }
+            let dof = n_eff - kept.len() as f64;
+            let last = *kept.last()?;
+            let fit = self.statistics(pb, &a, d, &kept, last, f64::NAN, total, dof, n_eff, false, means);
+            // standardised coefficient = coefficient in correlation units, |a[j][y]|
+            let worst = kept
+                .iter()
+                .enumerate()
+                .filter(|(_, j)| !pb.forced.contains(j))
+                .map(|(k, &j)| (k, j, (fit.coefficients[k] / fit.std_errors[k]).abs(), a[j * m + p].abs()))
+                .filter(|&(_, _, t, beta)| t < self.prune_t || beta < self.prune_beta)
+                .min_by(|x, y| x.3.total_cmp(&y.3));
+            match worst {
+                Some((k, j, t, beta)) if kept.len() > 1 => {
+                    notes.push(format!(
+                        "pruned `{}` after the chosen step (|t| = {t:.3}, standardised coefficient {beta:.2e})",
+                        pb.names[j]
+                    ));
+                    kept.remove(k);
+                    removed_any = true;
+                }
+                _ => return removed_any.then_some((kept, fit)),
+            }
+        }
+    }
+
     #[allow(clippy::too_many_arguments)]
     fn statistics(
         &self,

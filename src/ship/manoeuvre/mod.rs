@@ -185,6 +185,15 @@ impl Manoeuvre {
         }
     }
 
+    /// The manoeuvre's controller, for benchmarks and custom integration loops.
+    pub fn controller_for_bench(
+        &self,
+        ship: &Ship,
+        start: &StraightRun,
+    ) -> Result<Box<dyn Controller>, ShipError> {
+        self.controller(ship, start)
+    }
+
     pub(crate) fn controller(
         &self,
         ship: &Ship,

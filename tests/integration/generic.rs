@@ -1,0 +1,166 @@
+//! The core knows nothing of ships: the Lorenz system and a forced Duffing oscillator are
+//! simulated and identified with the same code and commands.
+
+use std::collections::BTreeMap;
+use std::process::Command;
+
+use termid::data::{CentralDifference, Frame};
+use termid::identify::{fit_equation, Target};
+use termid::model::Model;
+use termid::sim::{simulate, Constant, Integrator, Replay, Settings, System};
+
+fn lorenz_run() -> (Model, Frame) {
+    let m = Model::load(std::path::Path::new("models/lorenz.toml")).unwrap();
+    let system = System::new(&m, &BTreeMap::new(), false).unwrap();
+    let x0: Vec<f64> = m.spec.states.iter().map(|s| s.initial).collect();
+    let s = Settings { integrator: Integrator::Rk4, dt: 0.001, duration: 10.0, sample: 0.001 };
+    let traj = simulate(&system, &x0, &mut Constant(vec![]), &s).unwrap();
+    let f = traj.to_frame("lorenz", "t").unwrap();
+    (m, f)
+}
+
+fn check(m: &Model, frames: &[Frame], target: fn(&str) -> Option<Target>, rel: f64) {
+    for eq in &m.equations {
+        let fit = fit_equation(m, &eq.name, frames, &CentralDifference, false, target(&eq.state)).unwrap();
+        let mut got: Vec<(String, f64)> =
+            fit.selection.terms.iter().map(|t| (t.term.clone(), t.coefficient)).collect();
+        got.sort_by(|a, b| a.0.cmp(&b.0));
+        let mut want: Vec<(String, f64)> =
+            eq.coefficients.iter().map(|(t, c, _)| (t.to_string(), *c)).collect();
+        want.sort_by(|a, b| a.0.cmp(&b.0));
+        let names = |v: &[(String, f64)]| v.iter().map(|x| x.0.clone()).collect::<Vec<_>>();
+        assert_eq!(names(&got), names(&want), "{}: terms (notes: {:?})", eq.name, fit.selection.notes);
+        for ((t, g), (_, w)) in got.iter().zip(&want) {
+            assert!((g - w).abs() <= rel * w.abs(), "{} {t}: {g} vs {w}", eq.name);
+        }
+    }
+}
+
+#[test]
+fn lorenz_identified_exactly_from_exact_derivatives() {
+    let (m, f) = lorenz_run();
+    check(&m, &[f], |_| None, 1e-6);
+}
+
+#[test]
+fn lorenz_identified_to_one_percent_from_central_differences() {
+    let (m, f) = lorenz_run();
+    check(&m, &[f], |s| Some(Target::Derivative(s.to_string())), 0.01);
+}
+
+#[test]
+fn duffing_with_replayed_forcing() {
+    let m = Model::load(std::path::Path::new("models/duffing.toml")).unwrap();
+    let system = System::new(&m, &BTreeMap::new(), false).unwrap();
+    let t: Vec<f64> = (0..=4000).map(|i| i as f64 * 0.01).collect();
+    let mut forcing = Frame::new("forcing", "t", t.clone()).unwrap();
+    forcing.push("F", t.iter().map(|t| 0.8 * (0.7 * t).sin() + 0.5 * (1.9 * t).sin()).collect()).unwrap();
+    let mut replay = Replay::new(&forcing, &system.inputs).unwrap();
+    let s = Settings { integrator: Integrator::Rk4, dt: 0.005, duration: 40.0, sample: 0.01 };
+    let traj = simulate(&system, &[0.5, 0.0], &mut replay, &s).unwrap();
+    let f = traj.to_frame("duffing", "t").unwrap();
+    let fit = fit_equation(&m, "v_dot", &[f], &CentralDifference, false, None).unwrap();
+    let mut got: Vec<(String, f64)> =
+        fit.selection.terms.iter().map(|t| (t.term.clone(), t.coefficient)).collect();
+    got.sort_by(|a, b| a.0.cmp(&b.0));
+    assert_eq!(got.len(), 4, "{got:?}");
+    for ((name, g), (wn, w)) in got.iter().zip([("F", 1.0), ("v", -0.1), ("x", -1.0), ("x^3", -0.2)]) {
+        assert_eq!(name, wn);
+        assert!((g - w).abs() < 1e-6, "{name}: {g}");
+    }
+}
+
+fn termid(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_termid")).args(args).output().expect("run termid");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+#[test]
+fn same_commands_for_lorenz_and_the_ship() {
+    let dir = std::env::temp_dir().join(format!("termid-generic-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("lorenz.csv");
+    let out = dir.join("lorenz-identified.toml");
+    let (ok, _, err) = termid(&[
+        "simulate",
+        "--model",
+        "models/lorenz.toml",
+        "--integrator",
+        "rk4",
+        "--dt",
+        "0.001",
+        "--sample",
+        "0.001",
+        "--duration",
+        "5",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let (ok, _, err) = termid(&[
+        "identify",
+        "--model",
+        "models/lorenz.toml",
+        "--data",
+        csv.to_str().unwrap(),
+        "--no-intercept",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let back = Model::load(&out).unwrap();
+    assert_eq!(back.equation("y_dot").unwrap().coefficients.len(), 3);
+    let (ok, stdout, err) =
+        termid(&["simulate", "--model", out.to_str().unwrap(), "--duration", "1", "--format", "json"]);
+    assert!(ok, "{err}");
+    assert!(stdout.contains("final_state"));
+    // the ship: default model, metrics as JSON, CSV and SVG written
+    let ship_csv = dir.join("z.csv");
+    let svg = dir.join("z.svg");
+    let (ok, stdout, err) = termid(&[
+        "simulate",
+        "-m",
+        "zigzag:20/20",
+        "--format",
+        "json",
+        "--out",
+        ship_csv.to_str().unwrap(),
+        "--svg",
+        svg.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert!(v["metrics"]["first_overshoot_deg"].as_f64().unwrap() > 5.0);
+    let frame = Frame::read_csv(&ship_csv, "t").unwrap();
+    for c in ["u", "v", "r", "δ", "ψ", "x0", "y0", "U", "β", "u_dot", "v_dot", "r_dot"] {
+        assert!(frame.column(c).is_some(), "column {c}");
+    }
+    assert!(std::fs::read_to_string(&svg).unwrap().starts_with("<svg"));
+    // a diverging run writes no file
+    let bad = dir.join("bad.toml");
+    std::fs::write(
+        &bad,
+        std::fs::read_to_string("models/duffing.toml").unwrap().replace("\"v\" = -0.1", "\"v\" = 2.0"),
+    )
+    .unwrap();
+    let never = dir.join("never.csv");
+    let (ok, _, err) = termid(&[
+        "simulate",
+        "--model",
+        bad.to_str().unwrap(),
+        "--input",
+        "F=1",
+        "--duration",
+        "60",
+        "--out",
+        never.to_str().unwrap(),
+    ]);
+    assert!(!ok);
+    assert!(err.contains("diverged at t =") && err.contains("outside its bounds"), "{err}");
+    assert!(!never.exists());
+    std::fs::remove_dir_all(&dir).ok();
+}

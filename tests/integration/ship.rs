@@ -1,0 +1,190 @@
+//! The simulator and the ship plug-in on the default model: symmetry, integrator order,
+//! steady turning against a nonlinear solve, the paper's manoeuvres, divergence.
+
+use std::collections::BTreeMap;
+
+use termid::model::Model;
+use termid::ship::{Manoeuvre, Metrics, Ship};
+use termid::sim::{
+    simulate, solve_steady, Constant, Integrator, Settings, SimError, SteadyProblem, System, Unknown,
+};
+use termid::term::Term;
+
+fn settings(integrator: Integrator, dt: f64, duration: f64) -> Settings {
+    Settings { integrator, dt, duration, sample: dt }
+}
+
+/// Degree of a term in the variables that change sign when the ship is mirrored.
+fn odd_degree(t: &Term) -> i32 {
+    let m = &t.monomials()[0];
+    m.factors
+        .iter()
+        .filter(|(a, _)| matches!(a, termid::term::Atom::Var(n) if n == "v" || n == "r" || n == "δ"))
+        .map(|(_, k)| *k)
+        .sum()
+}
+
+fn mirror_symmetric_model() -> Model {
+    let mut m = Model::default_model();
+    for (name, keep_parity) in [("u_dot", 0), ("v_dot", 1), ("r_dot", 1)] {
+        let eq = m.equation(name).unwrap().clone();
+        let kept = eq
+            .coefficients
+            .into_iter()
+            .filter(|(t, _, _)| odd_degree(t).rem_euclid(2) == keep_parity)
+            .collect();
+        m.set_coefficients(name, kept, None);
+    }
+    m
+}
+
+#[test]
+fn symmetric_model_turns_port_and_starboard_as_mirror_images() {
+    let ship = Ship::new(&mirror_symmetric_model(), false).unwrap();
+    let start = ship.straight_run().unwrap();
+    assert!(start.delta0_deg.abs() < 1e-12 && start.v0.abs() < 1e-12);
+    let s = settings(Integrator::ModifiedEuler, 0.04, 150.0);
+    let run =
+        |d: f64| match ship.run(&Manoeuvre::parse(&format!("turning:{d}")).unwrap(), &s).unwrap().metrics {
+            Metrics::Turning(t) => t,
+            _ => unreachable!(),
+        };
+    let (port, stbd) = (run(20.0), run(-20.0));
+    assert_ne!(port.direction, stbd.direction);
+    for (a, b) in [
+        (port.advance_m.unwrap(), stbd.advance_m.unwrap()),
+        (port.transfer_m.unwrap(), stbd.transfer_m.unwrap()),
+        (port.tactical_diameter_m.unwrap(), stbd.tactical_diameter_m.unwrap()),
+        (port.steady_diameter_m, stbd.steady_diameter_m),
+        (port.speed_ratio, stbd.speed_ratio),
+        (port.drift_angle_deg, -stbd.drift_angle_deg),
+        (port.yaw_rate_deg_s, -stbd.yaw_rate_deg_s),
+    ] {
+        assert!((a - b).abs() <= 1e-9 * a.abs().max(1.0), "{a} vs {b}");
+    }
+}
+
+/// States after 20 s with a fixed rudder from the straight run (smooth input, so the
+/// integrators show their order).
+fn end_state(ship: &Ship, integrator: Integrator, dt: f64) -> Vec<f64> {
+    let start = ship.straight_run().unwrap();
+    let mut input = start.input.clone();
+    input[ship.roles.rudder] = 0.25;
+    let t = simulate(&ship.system, &start.x, &mut Constant(input), &settings(integrator, dt, 20.0)).unwrap();
+    t.last_state()
+}
+
+#[test]
+fn integrator_orders() {
+    let ship = Ship::new(&Model::default_model(), false).unwrap();
+    let reference = end_state(&ship, Integrator::Rk4, 0.00125);
+    let err = |integrator, dt| {
+        let x = end_state(&ship, integrator, dt);
+        (x[ship.roles.psi] - reference[ship.roles.psi]).abs()
+            + (x[ship.roles.r] - reference[ship.roles.r]).abs()
+    };
+    let rk4 = err(Integrator::Rk4, 0.08) / err(Integrator::Rk4, 0.04);
+    let b8 = err(Integrator::ModifiedEuler, 0.08) / err(Integrator::ModifiedEuler, 0.04);
+    assert!((12.0..20.0).contains(&rk4), "RK4 error ratio {rk4}");
+    assert!((1.7..2.3).contains(&b8), "B8 error ratio {b8}");
+}
+
+#[test]
+fn steady_turning_equals_the_roots_of_the_equations() {
+    let model = Model::default_model();
+    let ship = Ship::new(&model, false).unwrap();
+    let run = ship
+        .run(
+            &Manoeuvre::parse("turning:20").unwrap(),
+            &Settings { integrator: Integrator::Rk4, dt: 0.02, duration: 400.0, sample: 1.0 },
+        )
+        .unwrap();
+    let last = run.trajectory.last_state();
+    let r = ship.roles;
+    let mut input = run.start.input.clone();
+    input[r.rudder] = 20f64.to_radians();
+    let p = SteadyProblem {
+        system: &ship.system,
+        x: last.clone(),
+        input,
+        unknowns: vec![Unknown::State(r.u), Unknown::State(r.v), Unknown::State(r.r)],
+        zero: vec![r.u, r.v, r.r],
+    };
+    let (x, _) = solve_steady(&p).unwrap();
+    for i in [r.u, r.v, r.r] {
+        assert!(
+            (x[i] - last[i]).abs() <= 1e-7 * x[i].abs().max(1e-3),
+            "{}: {} vs {}",
+            ship.system.states[i],
+            x[i],
+            last[i]
+        );
+    }
+}
+
+#[test]
+fn default_model_manoeuvres_look_like_the_papers_ship() {
+    let ship = Ship::new(&Model::default_model(), false).unwrap();
+    let start = ship.straight_run().unwrap();
+    assert!((start.delta0_deg - -0.8).abs() < 0.05, "δ0 = {}", start.delta0_deg); // NOTES.md §5: about −0.8°
+    let s = settings(Integrator::ModifiedEuler, 0.04, 100.0);
+    for z in ["zigzag:20/20", "zigzag:30/10"] {
+        let Metrics::ZigZag(m) = ship.run(&Manoeuvre::parse(z).unwrap(), &s).unwrap().metrics else {
+            unreachable!()
+        };
+        for o in [m.first_overshoot_deg.unwrap(), m.second_overshoot_deg.unwrap()] {
+            assert!((5.0..25.0).contains(&o), "{z}: overshoot {o}");
+        }
+    }
+    let spiral = Manoeuvre::parse("spiral:10/2/80").unwrap();
+    let Metrics::Spiral(sp) = ship
+        .run(&spiral, &settings(Integrator::ModifiedEuler, 0.04, spiral.default_duration()))
+        .unwrap()
+        .metrics
+    else {
+        unreachable!()
+    };
+    assert!(sp.loop_width_deg.unwrap() < 0.01, "course-stable: no loop ({:?})", sp.loop_width_deg);
+}
+
+#[test]
+fn zigzag_overshoot_is_measured_beyond_the_switching_heading() {
+    let ship = Ship::new(&Model::default_model(), false).unwrap();
+    let run = ship
+        .run(&Manoeuvre::parse("zigzag:20/10").unwrap(), &settings(Integrator::ModifiedEuler, 0.04, 100.0))
+        .unwrap();
+    let Metrics::ZigZag(m) = &run.metrics else { unreachable!() };
+    let psi = &run.trajectory.states[ship.roles.psi];
+    let t1 = m.reversals_s[0];
+    let t2 = m.reversals_s[1];
+    let peak = run
+        .trajectory
+        .time
+        .iter()
+        .zip(psi)
+        .filter(|(t, _)| **t >= t1 && **t <= t2)
+        .map(|(_, p)| p.to_degrees())
+        .fold(f64::MIN, f64::max);
+    assert!((m.first_overshoot_deg.unwrap() - (peak - 10.0)).abs() < 1e-9);
+}
+
+#[test]
+fn divergence_stops_with_time_and_state() {
+    let mut m = Model::default_model();
+    let t = m.vocabulary.parse("u*r").unwrap();
+    let mut coefs = m.equation("r_dot").unwrap().coefficients.clone();
+    coefs.retain(|(c, _, _)| *c != t);
+    coefs.push((t, 3.0, None)); // yaw damping of the wrong sign: r grows without bound
+    m.set_coefficients("r_dot", coefs, None);
+    let system = System::new(&m, &BTreeMap::new(), false).unwrap();
+    let mut x0: Vec<f64> = vec![2.01, 0.0, 0.01, 0.0, 0.0, 0.0];
+    x0[0] = 2.01;
+    let err =
+        simulate(&system, &x0, &mut Constant(vec![0.0]), &settings(Integrator::ModifiedEuler, 0.04, 100.0))
+            .unwrap_err();
+    let SimError::Diverged { t, state, .. } = &err else { panic!("{err}") };
+    assert!(*t > 0.0 && *t < 100.0);
+    assert!(!state.is_empty());
+    let msg = err.to_string();
+    assert!(msg.contains("diverged at t =") && msg.contains("state was u ="), "{msg}");
+}
