@@ -112,6 +112,18 @@ pub struct PlotError {
     pub message: String,
 }
 
+/// Axis numbers without trailing noise: 0.25, 30, 1e-4.
+fn short(v: f64) -> String {
+    if v == 0.0 {
+        "0".into()
+    } else if v.abs() >= 1e-3 && v.abs() < 1e5 {
+        let s = format!("{v:.3}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        format!("{v:.1e}")
+    }
+}
+
 impl Figure {
     /// A figure of the given panels, 760 px wide, 240 px per panel.
     pub fn new(title: &str, panels: Vec<Panel>) -> Figure {
@@ -161,11 +173,22 @@ impl Figure {
             .y_label_area_size(60);
         if panel.log_y {
             let mut chart = builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale())?;
-            chart.configure_mesh().x_desc(&panel.x_label).y_desc(&panel.y_label).draw()?;
+            chart
+                .configure_mesh()
+                .x_desc(&panel.x_label)
+                .y_desc(&panel.y_label)
+                .y_label_formatter(&|v| format!("{v:.0e}"))
+                .draw()?;
             draw_series(&mut chart, panel, y0, y1)?;
         } else {
             let mut chart = builder.build_cartesian_2d(x0..x1, y0..y1)?;
-            chart.configure_mesh().x_desc(&panel.x_label).y_desc(&panel.y_label).draw()?;
+            chart
+                .configure_mesh()
+                .x_desc(&panel.x_label)
+                .y_desc(&panel.y_label)
+                .x_label_formatter(&|v| short(*v))
+                .y_label_formatter(&|v| short(*v))
+                .draw()?;
             draw_series(&mut chart, panel, y0, y1)?;
         }
         Ok(())

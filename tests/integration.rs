@@ -22,3 +22,6 @@ mod ship;
 // Non-ship models (Lorenz, Duffing) through the same library and commands.
 #[path = "integration/generic.rs"]
 mod generic;
+// The paper end to end (`termid reproduce`) through the library.
+#[path = "integration/reproduce.rs"]
+mod reproduce;

@@ -17,8 +17,8 @@ use super::{Estimate, Problem, SelectError, Selection, Selector, Step, Stop};
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "rule", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum StepRule {
-    /// The first step after which F no longer rises by more than `tolerance` (relative):
-    /// with 0, the first relative maximum of F.
+    /// The first relative maximum of F: a step that F rose into and after which it rises by
+    /// no more than `tolerance` (relative). Without one, the last forced step.
     FirstFMaximum {
         /// Relative rise of F that still counts as rising.
         #[serde(default)]
@@ -28,6 +28,14 @@ pub enum StepRule {
     /// `tolerance` (relative).
     StandardErrorPlateau {
         /// Relative fall that still counts as falling materially.
+        tolerance: f64,
+    },
+    /// Oltmann's reading (1973, Figs. 2-4) of "the standard error no longer falls
+    /// materially": the first step after which the standard error never again falls by more
+    /// than `tolerance` (relative) in any later step. With exact data that is the step of the
+    /// exact fit; with noisy data, where the standard error levels off.
+    StandardErrorSettled {
+        /// Relative fall that counts as material.
         tolerance: f64,
     },
     /// The last step taken.
@@ -47,7 +55,7 @@ impl Default for StepRule {
 /// | `min_proportion` | 0 | stop when the next term's share of the total sum of squares is below this (0: every step, as the paper) |
 /// | `pivot_tolerance` | 1e-10 | refuse a term whose unexplained share of variance is at most this |
 /// | `exact_fit` | 1e-13 | stop when 1 − R² is at most this: later steps would be chosen by round-off |
-/// | `step_rule` | first F maximum | which step's coefficients are reported |
+/// | `step_rule` | first F maximum | which step's coefficients are reported (an exact fit always reports its own step) |
 /// | `max_steps` | none | stop after this many terms |
 /// | `prune_t` | 0 (off) | after the chosen step, remove the term with the smallest \|t\| while it is below this, refitting each time |
 /// | `prune_beta` | 0 (off) | likewise for the standardised coefficient \|b\|·sd(x)/sd(y) (a scale-free magnitude threshold, as sequential thresholding in SINDy) |
@@ -113,6 +121,9 @@ impl Stepwise {
             {
                 Err(bad("step_rule tolerance", tolerance))
             }
+            StepRule::StandardErrorSettled { tolerance } if !(0.0..1.0).contains(&tolerance) => {
+                Err(bad("step_rule tolerance", tolerance))
+            }
             _ => Ok(()),
         }
     }
@@ -149,12 +160,30 @@ pub(crate) fn choose_step(rule: StepRule, steps: &[Step], n_forced: usize) -> us
     match rule {
         StepRule::Last => n,
         StepRule::FirstFMaximum { tolerance } => {
-            (first..n).find(|&i| steps[i].f <= steps[i - 1].f * (1.0 + tolerance)).unwrap_or(n)
+            f_maximum(steps, first, tolerance, |_| true).unwrap_or(first)
         }
+        StepRule::StandardErrorSettled { tolerance } => (first..=n)
+            .find(|&i| {
+                let se = steps[i - 1].standard_error;
+                steps[i..].iter().all(|later| later.standard_error >= se * (1.0 - tolerance))
+            })
+            .unwrap_or(n),
         StepRule::StandardErrorPlateau { tolerance } => (first..n)
             .find(|&i| steps[i].standard_error >= steps[i - 1].standard_error * (1.0 - tolerance))
             .unwrap_or(n),
     }
+}
+
+/// The first step i ≥ `first` (1-based) that F rose into (the drop that often follows the
+/// forced terms is not a maximum), after which F rises by no more than `tolerance`, and that
+/// `accept` agrees to.
+fn f_maximum(steps: &[Step], first: usize, tolerance: f64, accept: impl Fn(usize) -> bool) -> Option<usize> {
+    let n = steps.len();
+    (first..=n).find(|&i| {
+        let rising = i == 1 || steps[i - 1].f > steps[i - 2].f;
+        let peak = i == n || steps[i].f <= steps[i - 1].f * (1.0 + tolerance);
+        rising && peak && accept(i)
+    })
 }
 
 impl Selector for Stepwise {
@@ -253,7 +282,12 @@ impl Selector for Stepwise {
                 break Stop::ExactFit { residual_share };
             }
         };
-        let chosen = choose_step(self.step_rule, &steps, pb.forced.len());
+        // At an exact fit the data determine the model: bumps of F before it mean nothing, and
+        // any earlier step would leave a residual the data say is real.
+        let chosen = match stop {
+            Stop::ExactFit { .. } => steps.len(),
+            _ => choose_step(self.step_rule, &steps, pb.forced.len()),
+        };
         let intercept = chosen.checked_sub(1).and_then(|c| steps[c].intercept.clone());
         let pruned = self.prune(pb, &a0, &d, &steps[..chosen], total, n_eff, means, &mut notes);
         let mut selection = Selection {

@@ -242,3 +242,4 @@ fn downsample(t: &Trajectory, every: usize) -> Trajectory {
         derivatives: t.derivatives.iter().map(pick).collect(),
     }
 }
+pub mod oltmann;

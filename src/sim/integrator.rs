@@ -73,7 +73,7 @@ impl Settings {
 }
 
 /// A simulated run, sampled at the output interval.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Default)]
 pub struct Trajectory {
     /// Sample times.
     pub time: Vec<f64>,

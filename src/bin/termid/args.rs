@@ -20,6 +20,8 @@ pub enum Command {
     Identify(IdentifyCommand),
     /// Simulate a model file (the default ship model if none) under a manoeuvre or inputs.
     Simulate(SimulateCommand),
+    /// Reproduce Oltmann (1973) end to end: tables, figures and a report beside the paper's.
+    Reproduce(ReproduceCommand),
 }
 
 /// Output format.
@@ -154,4 +156,21 @@ pub struct SimulateCommand {
     /// Output format of the summary.
     #[arg(long, value_enum, default_value = "text")]
     pub format: Format,
+}
+
+/// `termid reproduce`.
+#[derive(Debug, Args)]
+pub struct ReproduceCommand {
+    /// Output folder (report.md, figures/, tables/, data/, summary.json).
+    #[arg(long, short = 'o', default_value = "termid-out")]
+    pub out: PathBuf,
+    /// Model file with the true coefficients (default: the embedded Oltmann model).
+    #[arg(long)]
+    pub model: Option<PathBuf>,
+    /// Take the "exact" accelerations as the B8 step used them, with δ(t+Δt).
+    #[arg(long)]
+    pub rudder_at_end_of_step: bool,
+    /// Round r and ṙ in rad/s (default: °/s, as the paper printed them).
+    #[arg(long)]
+    pub round_rates_in_radians: bool,
 }

@@ -2,6 +2,7 @@
 
 mod args;
 mod identify;
+mod reproduce;
 mod simulate;
 
 use std::process::ExitCode;
@@ -13,6 +14,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         args::Command::Identify(cmd) => identify::run(cmd),
         args::Command::Simulate(cmd) => simulate::run(cmd),
+        args::Command::Reproduce(cmd) => reproduce::run(cmd),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,80 @@
+//! `termid reproduce`: Oltmann (1973) end to end from the default model, into a folder with
+//! report.md, SVG figures, CSV tables and data, and summary.json; a summary on the terminal.
+
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+use termid::ship::oltmann::{self, data::AccelerationTiming, data::RateUnit, report, Options};
+use termid::ship::Ship;
+
+use crate::args::ReproduceCommand;
+
+pub fn run(cmd: ReproduceCommand) -> Result<()> {
+    let started = Instant::now();
+    let model = crate::simulate::load_model(&cmd.model)?;
+    let options = Options {
+        timing: if cmd.rudder_at_end_of_step {
+            AccelerationTiming::RudderAtTPlusDt
+        } else {
+            AccelerationTiming::RudderAtT
+        },
+        rate_unit: if cmd.round_rates_in_radians { RateUnit::Radians } else { RateUnit::Degrees },
+    };
+    let bar = ProgressBar::new(10);
+    bar.set_style(
+        ProgressStyle::with_template("{elapsed:>4} [{bar:30}] {pos}/{len} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    let mut stage = |msg: &str| {
+        bar.inc(1);
+        bar.set_message(msg.to_string());
+    };
+    let study = oltmann::run(&model, &options, &mut stage).context("reproducing Oltmann (1973)")?;
+    let ship = Ship::new(&model, false)?;
+    let path = report::write(&study, &ship, &cmd.out, &mut stage)
+        .with_context(|| format!("writing {}", cmd.out.display()))?;
+    bar.finish_and_clear();
+
+    println!("Oltmann (1973) reproduced from {} in {:.1} s", model.path, started.elapsed().as_secs_f64());
+    println!("straight run: δ0 = {:.3}°\n", study.delta0_deg);
+    println!(
+        "{:<8} {:>22} {:>22} {:>22}",
+        "", "exact: steps 30/10, Komb", "alt. 5: steps 30/10, Komb", "Komb terms (alt. 5)"
+    );
+    for (e, a) in study.exact.iter().zip(&study.alt5) {
+        println!(
+            "{:<8} {:>22} {:>22}   {}",
+            e.equation,
+            format!("{}, {}", e.runs[3].selection.chosen_step, e.komb.selection.chosen_step),
+            format!("{}, {}", a.runs[3].selection.chosen_step, a.komb.selection.chosen_step),
+            a.komb.selection.terms.iter().map(|t| t.term.as_str()).collect::<Vec<_>>().join(", ")
+        );
+    }
+    println!("\nreplayed zigzags, heading error (max / at 100 s):");
+    for r in &study.resimulations {
+        match &r.failure {
+            Some(f) => println!("  {:<7} {:<18} failed: {f}", r.run, r.coefficients),
+            None => println!(
+                "  {:<7} {:<18} {:>7.2}° / {:>7.2}°",
+                r.run, r.coefficients, r.errors.psi_max_deg, r.errors.psi_final_deg
+            ),
+        }
+    }
+    for d in &study.drift {
+        let at = |v: &[oltmann::Resimulation]| {
+            v.iter().map(|r| format!("{:.1}°", r.errors.psi_final_deg)).collect::<Vec<_>>().join(", ")
+        };
+        println!(
+            "\nheading drift with {} coefficients: {} → {} after adding B0 = {:.5}, C0 = {:.5} (true −0.0000, −0.0014)",
+            d.coefficients,
+            at(&d.before),
+            at(&d.after),
+            d.b0,
+            d.c0
+        );
+    }
+    println!("\nreport: {}", path.display());
+    Ok(())
+}

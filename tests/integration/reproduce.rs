@@ -1,0 +1,174 @@
+//! `termid reproduce` through the library: the paper's conclusions, checked against the
+//! paper's own statements and sets, not against our earlier output.
+
+use std::sync::LazyLock;
+
+use termid::model::Model;
+use termid::ship::oltmann::{self, data::RateUnit, Options, Study};
+
+static STUDY: LazyLock<Study> =
+    LazyLock::new(|| oltmann::run(&Model::default_model(), &Options::default(), &mut |_| {}).unwrap());
+
+#[test]
+fn exact_data_combined_regression_resimulates_the_replayed_zigzags() {
+    for r in STUDY.resimulations.iter().filter(|r| r.coefficients == "exact/Komb") {
+        assert!(r.failure.is_none());
+        assert!(r.errors.psi_max_deg < 1.0, "{}: ψ {}", r.run, r.errors.psi_max_deg);
+        assert!(r.errors.r_max_deg_s < 0.1, "{}: r {}", r.run, r.errors.r_max_deg_s);
+    }
+    assert_eq!(STUDY.resimulations.iter().filter(|r| r.coefficients == "exact/Komb").count(), 2);
+}
+
+#[test]
+fn alternative_five_selects_the_papers_surge_terms() {
+    let u = &STUDY.alt5[0];
+    assert_eq!(u.equation, "u_dot");
+    let mut got: Vec<&str> = u.komb.selection.terms.iter().map(|t| t.term.as_str()).collect();
+    got.sort();
+    // Table 4, Komb. Daten: r², u²δ², u·Δu, v², u·v
+    let mut want = ["r^2", "u^2*δ^2", "u*Δu", "v^2", "u*v"];
+    want.sort();
+    assert_eq!(got, want);
+}
+
+#[test]
+fn heading_drift_without_b0_c0_and_its_cure() {
+    let komb = STUDY.drift.iter().find(|d| d.coefficients == "alt5/Komb").unwrap();
+    for r in &komb.before {
+        assert!(r.errors.psi_final_deg.abs() > 15.0, "{}: drift {}", r.run, r.errors.psi_final_deg);
+    }
+    for r in &komb.after {
+        assert!(r.errors.psi_final_deg.abs() < 5.0, "{}: drift {}", r.run, r.errors.psi_final_deg);
+    }
+    // C0 estimated near the true −0.0014
+    assert!((komb.c0 - -0.0014).abs() < 0.0004, "C0 = {}", komb.c0);
+}
+
+#[test]
+fn exact_data_recover_the_true_coefficients() {
+    for t in &STUDY.exact {
+        let truth = |term: &str| t.rows.iter().find(|r| r.term == term).map_or(0.0, |r| r.truth);
+        for ft in &t.komb.selection.terms {
+            let w = truth(&ft.term);
+            if w == 0.0 {
+                // a zero term that entered before the exact fit: statistically nothing
+                assert!(ft.t.abs() < 3.0, "{} {}: t = {}", t.equation, ft.term, ft.t);
+            } else {
+                // far inside the 4 decimals the paper printed
+                assert!(
+                    (ft.coefficient - w).abs() < 1e-5 * w.abs().max(1.0),
+                    "{} {}: {} vs {w}",
+                    t.equation,
+                    ft.term,
+                    ft.coefficient
+                );
+            }
+        }
+        for row in t.rows.iter().filter(|r| r.truth != 0.0) {
+            assert!(row.komb.is_some(), "{}: true term `{}` missing", t.equation, row.term);
+        }
+        // where the stop is decided by round-off, the selection says so
+        let notes = &t.komb.selection.notes;
+        assert!(notes.iter().any(|n| n.contains("round-off")), "{}: {notes:?}", t.equation);
+    }
+}
+
+#[test]
+fn rounding_units_change_the_coarse_data() {
+    let deg = STUDY
+        .alternatives
+        .iter()
+        .filter(|p| p.rate_unit == RateUnit::Degrees && p.equation == "r_dot" && p.alternative == 5)
+        .count();
+    assert_eq!(deg, 1);
+    let se = |u: RateUnit| {
+        STUDY
+            .alternatives
+            .iter()
+            .find(|p| p.rate_unit == u && p.equation == "r_dot" && p.alternative == 5)
+            .unwrap()
+            .standard_error
+    };
+    // 2 decimals of rad/s are 57 times coarser than 2 decimals of °/s
+    assert!(se(RateUnit::Radians) > 3.0 * se(RateUnit::Degrees));
+    // F falls and the standard error rises from exact to rounded-and-differentiated data
+    for eq in oltmann::EQUATIONS {
+        let p = |a: usize| {
+            STUDY
+                .alternatives
+                .iter()
+                .find(|p| p.rate_unit == RateUnit::Degrees && p.equation == eq && p.alternative == a)
+                .unwrap()
+        };
+        assert!(p(5).standard_error > p(1).standard_error, "{eq}");
+    }
+}
+
+#[test]
+fn deterministic_and_independent_of_candidate_order() {
+    let text = termid::model::DEFAULT_MODEL;
+    // reverse the order of every candidate list
+    let mut reversed = String::new();
+    let mut in_list = false;
+    let mut items: Vec<String> = Vec::new();
+    for line in text.lines() {
+        if line.starts_with("candidates = [") {
+            in_list = true;
+            items.clear();
+            continue;
+        }
+        if in_list {
+            if line.starts_with(']') {
+                items.reverse();
+                reversed.push_str(&format!("candidates = [{}]\n", items.join(", ")));
+                in_list = false;
+            } else {
+                items.extend(line.split(',').map(str::trim).filter(|s| !s.is_empty()).map(str::to_string));
+            }
+            continue;
+        }
+        reversed.push_str(line);
+        reversed.push('\n');
+    }
+    let model = Model::parse(&reversed, "reversed.toml").unwrap();
+    assert_ne!(
+        model.equation("v_dot").unwrap().candidates,
+        Model::default_model().equation("v_dot").unwrap().candidates
+    );
+    let other = oltmann::run(&model, &Options::default(), &mut |_| {}).unwrap();
+    let again = oltmann::run(&Model::default_model(), &Options::default(), &mut |_| {}).unwrap();
+    for (a, (b, c)) in STUDY.alt5.iter().zip(other.alt5.iter().zip(&again.alt5)) {
+        let set = |t: &oltmann::tables::EquationTable| {
+            let mut v: Vec<(String, String)> = t
+                .komb
+                .selection
+                .terms
+                .iter()
+                .map(|x| (x.term.clone(), format!("{:.12e}", x.coefficient)))
+                .collect();
+            v.sort();
+            v
+        };
+        assert_eq!(set(a), set(b), "{}: order changed the selection", a.equation);
+        assert_eq!(set(a), set(c), "{}: not deterministic", a.equation);
+    }
+}
+
+#[test]
+fn report_is_written() {
+    let dir = std::env::temp_dir().join(format!("termid-reproduce-{}", std::process::id()));
+    let ship = termid::ship::Ship::new(&Model::default_model(), false).unwrap();
+    let path = oltmann::report::write(&STUDY, &ship, &dir, &mut |_| {}).unwrap();
+    let md = std::fs::read_to_string(&path).unwrap();
+    for needle in ["Table 1", "Table 6", "Fig. 5", "heading drift", "sample state", "round-off"] {
+        assert!(md.contains(needle), "report lacks {needle}");
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert!(summary["exact"]["r_dot"]["komb_chosen_step"].is_number());
+    assert!(summary["resimulations"][0]["errors"]["psi_rms_deg"].is_number());
+    for f in ["fig2_steps_u_dot.svg", "fig5_alternatives.svg", "drift_alt5_Komb.svg", "predict_spiral.svg"] {
+        assert!(dir.join("figures").join(f).exists(), "{f}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
