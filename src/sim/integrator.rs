@@ -148,21 +148,29 @@ pub fn simulate(
         inputs: vec![Vec::with_capacity(cap); m],
         derivatives: vec![Vec::with_capacity(cap); n],
     };
-    let mut f = vec![0.0; n];
-    let mut record =
-        |t: f64, x: &[f64], u: &[f64], out: &mut Trajectory, ws: &mut super::system::Workspace| {
-            system.derivatives(x, u, ws, &mut f);
-            out.time.push(t);
-            for i in 0..n {
-                out.states[i].push(x[i]);
-                out.derivatives[i].push(f[i]);
+    // A sample's derivative f(x(t), input(t)) is filled in by the next step when that step
+    // evaluates the same thing (always for RK4's first stage; for B8 when the input is at rest,
+    // δ(t+Δt) = δ(t)), else evaluated on its own: it saves an evaluation per sample.
+    let record = |t: f64, x: &[f64], u: &[f64], out: &mut Trajectory| {
+        out.time.push(t);
+        for i in 0..n {
+            out.states[i].push(x[i]);
+            out.derivatives[i].push(f64::NAN);
+        }
+        for k in 0..m {
+            out.inputs[k].push(u[k]);
+        }
+    };
+    let fill = |d: &[f64], out: &mut Trajectory| {
+        for i in 0..n {
+            if let Some(last) = out.derivatives[i].last_mut() {
+                *last = d[i];
             }
-            for k in 0..m {
-                out.inputs[k].push(u[k]);
-            }
-        };
+        }
+    };
     check(system, 0.0, &x, x0)?;
-    record(0.0, &x, &u_now, &mut out, &mut ws);
+    record(0.0, &x, &u_now, &mut out);
+    let mut pending = true;
     let mut k = [vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]];
     let mut tmp = vec![0.0; n];
     let mut u_mid = vec![0.0; m];
@@ -175,6 +183,15 @@ pub fn simulate(
             Integrator::ModifiedEuler => {
                 // eq. (B8): rudder at the end of the step
                 system.derivatives(&x, &u_next, &mut ws, &mut k[0]);
+                if pending {
+                    if u_next == u_now {
+                        fill(&k[0], &mut out);
+                    } else {
+                        system.derivatives(&x, &u_now, &mut ws, &mut tmp);
+                        fill(&tmp, &mut out);
+                    }
+                    pending = false;
+                }
                 for i in 0..n {
                     x[i] += dt * k[0][i];
                 }
@@ -184,6 +201,10 @@ pub fn simulate(
                     u_mid[j] = 0.5 * (u_now[j] + u_next[j]);
                 }
                 system.derivatives(&x, &u_now, &mut ws, &mut k[0]);
+                if pending {
+                    fill(&k[0], &mut out);
+                    pending = false;
+                }
                 for i in 0..n {
                     tmp[i] = x[i] + 0.5 * dt * k[0][i];
                 }
@@ -205,11 +226,16 @@ pub fn simulate(
         std::mem::swap(&mut u_now, &mut u_next);
         let done = controller.done(t1, &x);
         if step % every == 0 || done {
-            record(t1, &x, &u_now, &mut out, &mut ws);
+            record(t1, &x, &u_now, &mut out);
+            pending = true;
         }
         if done {
             break;
         }
+    }
+    if pending {
+        system.derivatives(&x, &u_now, &mut ws, &mut tmp);
+        fill(&tmp, &mut out);
     }
     Ok(out)
 }

@@ -55,6 +55,88 @@ pub struct Library {
     ops: Vec<Op>,
     outputs: Vec<usize>,
     terms: Vec<Term>,
+    rows: RowProgram,
+}
+
+/// The same program for one row, levelised: operations grouped by dependency depth and by
+/// kind, so that each group runs as one tight loop instead of one dispatch per operation
+/// (the simulator evaluates a row at every step; dispatch dominated there).
+#[derive(Clone, Debug, Default)]
+struct RowProgram {
+    constants: Vec<(usize, f64)>,
+    inputs: Vec<(u32, u32)>,
+    groups: Vec<Group>,
+    lin: Vec<(f64, u32)>,
+}
+
+#[derive(Clone, Debug)]
+enum Group {
+    Mul(Vec<(u32, u32, u32)>),
+    Recip(Vec<(u32, u32)>),
+    Call(Vec<(usize, usize, Vec<usize>)>),
+    /// (destination, start, length) into `RowProgram::lin`.
+    Lin(Vec<(u32, u32, u32)>),
+}
+
+impl Group {
+    fn is_empty(&self) -> bool {
+        match self {
+            Group::Mul(v) | Group::Lin(v) => v.is_empty(),
+            Group::Recip(v) => v.is_empty(),
+            Group::Call(v) => v.is_empty(),
+        }
+    }
+}
+
+impl RowProgram {
+    fn new(ops: &[Op]) -> RowProgram {
+        let mut level = vec![0usize; ops.len()];
+        for (i, op) in ops.iter().enumerate() {
+            let deps: Vec<usize> = match op {
+                Op::Input(_) | Op::Const(_) => vec![],
+                Op::Mul(a, b) => vec![*a, *b],
+                Op::Recip(a) => vec![*a],
+                Op::Call(_, args) => args.clone(),
+                Op::Lin(parts) => parts.iter().map(|p| p.1).collect(),
+            };
+            level[i] = deps.iter().map(|&d| level[d] + 1).max().unwrap_or(0);
+        }
+        let mut prog = RowProgram::default();
+        let depth = level.iter().copied().max().unwrap_or(0);
+        let n = |i: usize| i as u32;
+        for l in 1..=depth {
+            let idx: Vec<usize> = (0..ops.len()).filter(|i| level[*i] == l).collect();
+            let mut muls = Vec::new();
+            let mut recips = Vec::new();
+            let mut calls = Vec::new();
+            let mut lins = Vec::new();
+            for &i in &idx {
+                match &ops[i] {
+                    Op::Mul(a, b) => muls.push((n(i), n(*a), n(*b))),
+                    Op::Recip(a) => recips.push((n(i), n(*a))),
+                    Op::Call(f, a) => calls.push((i, *f, a.clone())),
+                    Op::Lin(parts) => {
+                        lins.push((n(i), n(prog.lin.len()), n(parts.len())));
+                        prog.lin.extend(parts.iter().map(|(c, k)| (*c, n(*k))));
+                    }
+                    Op::Input(_) | Op::Const(_) => {}
+                }
+            }
+            for g in [Group::Mul(muls), Group::Recip(recips), Group::Call(calls), Group::Lin(lins)] {
+                if !g.is_empty() {
+                    prog.groups.push(g);
+                }
+            }
+        }
+        for (i, op) in ops.iter().enumerate() {
+            match op {
+                Op::Input(j) => prog.inputs.push((n(i), n(*j))),
+                Op::Const(c) => prog.constants.push((i, *c)),
+                _ => {}
+            }
+        }
+        prog
+    }
 }
 
 struct Builder<'v> {
@@ -189,7 +271,11 @@ impl Library {
             pending: Vec::new(),
         };
         let outputs = terms.iter().map(|t| b.term(t)).collect::<Result<Vec<_>, _>>()?;
-        Ok(Library { inputs: b.inputs, ops: b.ops, outputs, terms: terms.to_vec() })
+        if b.ops.len() > u32::MAX as usize {
+            return Err(TermError::Declaration("the terms compile to more than 2³² operations".into()));
+        }
+        let rows = RowProgram::new(&b.ops);
+        Ok(Library { inputs: b.inputs, ops: b.ops, outputs, terms: terms.to_vec(), rows })
     }
 
     /// Names of the base variables and parameters the program reads, in input order.
@@ -217,24 +303,60 @@ impl Library {
         self.ops.len()
     }
 
-    /// Scratch space for row evaluation.
+    /// The program, one operation per line (for inspection and tuning).
+    pub fn describe(&self) -> String {
+        self.ops.iter().enumerate().map(|(i, op)| format!("{i:>4}: {op:?}\n")).collect()
+    }
+
+    /// Scratch space for row evaluation (constants already in place).
     pub fn scratch(&self) -> RowScratch {
-        RowScratch(vec![0.0; self.ops.len()])
+        let mut s = vec![0.0; self.ops.len()];
+        for &(i, c) in &self.rows.constants {
+            s[i] = c;
+        }
+        RowScratch(s)
     }
 
     /// Evaluates every term on one row; `inputs` is aligned with [`Library::inputs`].
     #[inline]
     pub fn eval_row(&self, inputs: &[f64], scratch: &mut RowScratch, out: &mut [f64]) {
-        let s = &mut scratch.0;
-        for (i, op) in self.ops.iter().enumerate() {
-            s[i] = match op {
-                Op::Input(j) => inputs[*j],
-                Op::Const(c) => *c,
-                Op::Mul(a, b) => s[*a] * s[*b],
-                Op::Recip(a) => 1.0 / s[*a],
-                Op::Call(f, args) => call_scalar(*f, args, s),
-                Op::Lin(parts) => parts.iter().map(|(c, k)| c * s[*k]).sum(),
-            };
+        let s = scratch.0.as_mut_slice();
+        // These two checks make every index below valid: the program's slot indices are all
+        // < ops.len() and its input indices < inputs.len() by construction (Builder).
+        assert!(s.len() == self.ops.len(), "scratch of another library");
+        assert!(inputs.len() >= self.inputs.len(), "too few inputs");
+        let p = &self.rows;
+        let u = |i: u32| i as usize;
+        // SAFETY: see the asserts above.
+        unsafe {
+            for &(i, j) in &p.inputs {
+                *s.get_unchecked_mut(u(i)) = *inputs.get_unchecked(u(j));
+            }
+            for g in &p.groups {
+                match g {
+                    Group::Mul(v) => {
+                        for &(i, a, b) in v {
+                            *s.get_unchecked_mut(u(i)) = *s.get_unchecked(u(a)) * *s.get_unchecked(u(b));
+                        }
+                    }
+                    Group::Recip(v) => {
+                        for &(i, a) in v {
+                            *s.get_unchecked_mut(u(i)) = 1.0 / *s.get_unchecked(u(a));
+                        }
+                    }
+                    Group::Call(v) => {
+                        for (i, f, args) in v {
+                            *s.get_unchecked_mut(*i) = call_scalar(*f, args, s);
+                        }
+                    }
+                    Group::Lin(v) => {
+                        for &(i, start, len) in v {
+                            let parts = p.lin.get_unchecked(u(start)..u(start) + u(len));
+                            *s.get_unchecked_mut(u(i)) = lin_sum_unchecked(parts, s);
+                        }
+                    }
+                }
+            }
         }
         for (o, &slot) in out.iter_mut().zip(&self.outputs) {
             *o = s[slot];
@@ -339,6 +461,28 @@ impl Library {
             }
         }
     }
+}
+
+/// Σ c·s[k] with four independent partial sums: one running sum is a chain of dependent
+/// additions, and an equation's right-hand side is a long one. No bounds checks.
+///
+/// # Safety
+/// Every slot index in `parts` must be < `s.len()`.
+#[inline]
+unsafe fn lin_sum_unchecked(parts: &[(f64, u32)], s: &[f64]) -> f64 {
+    let mut acc = [0.0f64; 4];
+    let chunks = parts.chunks_exact(4);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for l in 0..4 {
+            acc[l] += c[l].0 * *s.get_unchecked(c[l].1 as usize);
+        }
+    }
+    let mut tail = 0.0;
+    for (c, k) in rest {
+        tail += c * *s.get_unchecked(*k as usize);
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
 fn call_scalar(f: usize, args: &[usize], s: &[f64]) -> f64 {
