@@ -127,6 +127,8 @@ pub struct Identification<'a> {
     pub differentiator: &'a dyn Differentiator,
     /// Fit an intercept.
     pub intercept: bool,
+    /// A column of row weights (weighted least squares), if any.
+    pub weights: Option<String>,
 }
 
 /// A fitted equation with its candidates.
@@ -172,6 +174,21 @@ impl Identification<'_> {
         let y = self.target(target, frame)?;
         let params = self.run_parameters(frame)?;
         let sources = library.bind(&|n| frame.column(n), &|n| params.get(n).copied())?;
+        let weights = match &self.weights {
+            Some(col) => {
+                let w = frame.require(col)?;
+                if let Some(i) = w.iter().position(|w| *w < 0.0) {
+                    return Err(IdentifyError::Setup(format!(
+                        "{}: row {}: weight `{col}` = {} is negative",
+                        frame.origin(),
+                        i + 1,
+                        w[i]
+                    )));
+                }
+                Some(w)
+            }
+            None => None,
+        };
         let mut acc = Accumulator::new(library.len());
         let mut bad: Option<IdentifyError> = None;
         library.for_each_block(&sources, frame.len(), |start, rows, block| {
@@ -187,7 +204,7 @@ impl Identification<'_> {
                 });
                 return;
             }
-            acc.push(block, &y[start..start + rows], None);
+            acc.push(block, &y[start..start + rows], weights.map(|w| &w[start..start + rows]));
         });
         match bad {
             Some(e) => Err(e),
@@ -265,8 +282,13 @@ pub fn fit_equation(
         }
     });
     let rules = model.parameter_rules();
-    let identification =
-        Identification { vocabulary: &model.vocabulary, parameters: &rules, differentiator, intercept };
+    let identification = Identification {
+        vocabulary: &model.vocabulary,
+        parameters: &rules,
+        differentiator,
+        intercept,
+        weights: None,
+    };
     let backend = eq.backend.build()?;
     identification.fit(&target, &eq.candidates, &eq.forced, &eq.excluded, frames, backend.as_ref())
 }

@@ -91,3 +91,62 @@ fn identify_text_and_errors() {
     assert!(!ok);
     assert!(err.contains("duplicate"), "{err}");
 }
+
+#[test]
+fn integer_weights_equal_repeated_rows() {
+    let dir = std::env::temp_dir().join(format!("termid-weights-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let rows = [
+        (1.0, 2.0, 3.1, 1),
+        (2.0, 1.0, 4.2, 2),
+        (3.0, 5.0, 9.0, 1),
+        (4.0, 3.0, 8.7, 3),
+        (5.0, 4.0, 11.2, 1),
+        (6.0, 7.0, 15.1, 2),
+    ];
+    let mut weighted = String::from("x,z,y,w\n");
+    let mut repeated = String::from("x,z,y\n");
+    for (x, z, y, w) in rows {
+        weighted += &format!("{x},{z},{y},{w}\n");
+        for _ in 0..w {
+            repeated += &format!("{x},{z},{y}\n");
+        }
+    }
+    let (a, b) = (dir.join("weighted.csv"), dir.join("repeated.csv"));
+    std::fs::write(&a, weighted).unwrap();
+    std::fs::write(&b, repeated).unwrap();
+    let fit = |file: &std::path::Path, extra: &[&str]| {
+        let mut args = vec![
+            "identify",
+            "--data",
+            file.to_str().unwrap(),
+            "--no-time",
+            "--target",
+            "y",
+            "--terms",
+            "x",
+            "z",
+            "--step-rule",
+            "last",
+            "--format",
+            "json",
+        ];
+        args.extend_from_slice(extra);
+        let (ok, out, err) = termid(&args);
+        assert!(ok, "{err}");
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        v["terms"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|t| (t["term"].as_str().unwrap().to_string(), t["coefficient"].as_f64().unwrap()))
+            .collect::<Vec<_>>()
+    };
+    let (w, r) = (fit(&a, &["--weight", "w"]), fit(&b, &[]));
+    assert_eq!(w.len(), 2);
+    for ((tw, cw), (tr, cr)) in w.iter().zip(&r) {
+        assert_eq!(tw, tr);
+        assert!((cw - cr).abs() < 1e-12 * cr.abs().max(1.0), "{tw}: {cw} vs {cr}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -99,6 +99,9 @@ pub struct IdentifyCommand {
     /// Fit without an intercept b0.
     #[arg(long)]
     pub no_intercept: bool,
+    /// Weighted least squares with the row weights in this column.
+    #[arg(long, conflicts_with = "model")]
+    pub weight: Option<String>,
     /// Stepwise: stop when the next term's share of the total sum of squares is below this.
     #[arg(long, default_value_t = 0.0)]
     pub min_proportion: f64,

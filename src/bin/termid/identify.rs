@@ -82,6 +82,7 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
         parameters: &params,
         differentiator: diff.as_ref(),
         intercept: !cmd.no_intercept,
+        weights: cmd.weight.clone(),
     };
     let fit = identification.fit(&target, &candidates, &forced, &excluded, &frames, selector.as_ref())?;
     match cmd.format {
