@@ -5,11 +5,10 @@
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion};
 use nalgebra::{DMatrix, DMatrixView, Dyn};
 use termid::select::{Accumulator, Problem, Selector, StepRule, Stepwise};
-use termid::term::{parse_terms, Library, Vocabulary};
+use termid::term::{parse_terms, Library};
 
-#[path = "term_eval.rs"]
-#[allow(dead_code)]
-mod term_eval;
+mod common;
+use common::{bind, signals, vocab, TERMS_29};
 
 fn lcg(seed: &mut u64) -> f64 {
     *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
@@ -46,42 +45,22 @@ fn bench(c: &mut Criterion) {
 
     // STPRG on 2 505 × 29 including the design (the paper's Komb. Daten size)
     let rows = 2505;
-    let t: Vec<f64> = (0..rows).map(|i| i as f64 * 0.2).collect();
-    let u: Vec<f64> = t.iter().map(|t| 1.9 + 0.1 * (0.05 * t).cos()).collect();
-    let v: Vec<f64> = t.iter().map(|t| 0.1 * (0.11 * t).sin()).collect();
-    let r: Vec<f64> = t.iter().map(|t| 0.05 * (0.13 * t).sin()).collect();
-    let d: Vec<f64> = t.iter().map(|t| 0.3 * (0.07 * t).sin()).collect();
+    let sig = signals(rows, 0.2);
+    let [u, v, r, d] = &sig;
     let target: Vec<f64> = (0..rows)
         .map(|i| {
             -0.28 * u[i] * r[i] - 0.18 * u[i] * v[i] + 0.03 * u[i] * u[i] * d[i] + 1e-3 * (i as f64).sin()
         })
         .collect();
-    let mut vocab = Vocabulary::new();
-    for n in ["u", "v", "r", "δ"] {
-        vocab.variable(n).unwrap();
-    }
-    vocab.parameter("u0").unwrap();
-    vocab.derive("Δu", "u - u0").unwrap();
-    vocab.alias("du", "Δu").unwrap().alias("delta", "δ").unwrap();
-    let terms = parse_terms(&term_eval::TERMS_29, &vocab).unwrap();
+    let vocab = vocab();
+    let terms = parse_terms(&TERMS_29, &vocab).unwrap();
     let lib = Library::compile(&terms, &vocab).unwrap();
     let names: Vec<String> = terms.iter().map(|t| t.to_string()).collect();
     let stepwise = Stepwise { step_rule: StepRule::Last, ..Stepwise::default() };
     let mut g = c.benchmark_group("stepwise");
     g.bench_with_input(BenchmarkId::new("design_and_stprg", rows), &rows, |b, &rows| {
         b.iter(|| {
-            let sources = lib
-                .bind(
-                    &|name| match name {
-                        "u" => Some(u.as_slice()),
-                        "v" => Some(v.as_slice()),
-                        "r" => Some(r.as_slice()),
-                        "δ" => Some(d.as_slice()),
-                        _ => None,
-                    },
-                    &|name| (name == "u0").then_some(2.01),
-                )
-                .unwrap();
+            let sources = bind(&lib, &sig);
             let mut acc = Accumulator::new(lib.len());
             lib.for_each_block(&sources, rows, |start, len, block| {
                 acc.push(block, &target[start..start + len], None)
@@ -93,18 +72,7 @@ fn bench(c: &mut Criterion) {
         })
     });
     // where the time goes
-    let sources = lib
-        .bind(
-            &|name| match name {
-                "u" => Some(u.as_slice()),
-                "v" => Some(v.as_slice()),
-                "r" => Some(r.as_slice()),
-                "δ" => Some(d.as_slice()),
-                _ => None,
-            },
-            &|name| (name == "u0").then_some(2.01),
-        )
-        .unwrap();
+    let sources = bind(&lib, &sig);
     let mut design = vec![0.0; rows * lib.len()];
     g.bench_function("design_only_2505", |b| {
         b.iter(|| lib.fill(black_box(&sources), rows, black_box(&mut design)))

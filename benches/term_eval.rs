@@ -2,60 +2,10 @@
 //! termid's compiled library against a hand-written Rust loop computing the same columns.
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use termid::term::{parse_terms, Library, Vocabulary};
+use termid::term::{parse_terms, Library};
 
-pub const TERMS_29: [&str; 29] = [
-    "u^2",
-    "u*v",
-    "u*r",
-    "u^2*delta",
-    "v^3/u",
-    "v^2*r/u",
-    "v*r^2/u",
-    "r^3/u",
-    "v^2*delta",
-    "u*v*delta^2",
-    "r^2*delta",
-    "u*r*delta^2",
-    "u^2*delta^3",
-    "v*du",
-    "r*du",
-    "u*du*delta",
-    "v*du^2/u",
-    "r*du^2/u",
-    "delta*du^2",
-    "v*r*delta",
-    "v*r",
-    "v^2",
-    "r^2",
-    "u^2*delta^2",
-    "u*v*delta",
-    "u*r*delta",
-    "v*r*du/u",
-    "r*du*delta",
-    "v*du*delta",
-];
-
-fn vocab() -> Vocabulary {
-    let mut v = Vocabulary::new();
-    for n in ["u", "v", "r", "δ"] {
-        v.variable(n).unwrap();
-    }
-    v.parameter("u0").unwrap();
-    v.derive("Δu", "u - u0").unwrap();
-    v.alias("du", "Δu").unwrap().alias("delta", "δ").unwrap();
-    v
-}
-
-fn signals(n: usize) -> [Vec<f64>; 4] {
-    let t: Vec<f64> = (0..n).map(|i| i as f64 * 0.01).collect();
-    [
-        t.iter().map(|t| 1.9 + 0.1 * (0.05 * t).cos()).collect(),
-        t.iter().map(|t| 0.1 * (0.11 * t).sin()).collect(),
-        t.iter().map(|t| 0.05 * (0.13 * t).sin()).collect(),
-        t.iter().map(|t| 0.3 * (0.07 * t).sin()).collect(),
-    ]
-}
+mod common;
+use common::{bind, signals, vocab, TERMS_29, U0};
 
 /// The hand-written reference: one pass, all 29 columns per row.
 fn hand(u: &[f64], v: &[f64], r: &[f64], d: &[f64], u0: f64, out: &mut [f64]) {
@@ -103,27 +53,17 @@ fn hand(u: &[f64], v: &[f64], r: &[f64], d: &[f64], u0: f64, out: &mut [f64]) {
 
 fn bench(c: &mut Criterion) {
     let n = 1_000_000;
-    let [u, v, r, d] = signals(n);
+    let sig = signals(n, 0.01);
+    let [u, v, r, d] = &sig;
     let vocab = vocab();
     let terms = parse_terms(&TERMS_29, &vocab).unwrap();
     let lib = Library::compile(&terms, &vocab).unwrap();
-    let sources = lib
-        .bind(
-            &|name| match name {
-                "u" => Some(u.as_slice()),
-                "v" => Some(v.as_slice()),
-                "r" => Some(r.as_slice()),
-                "δ" => Some(d.as_slice()),
-                _ => None,
-            },
-            &|name| (name == "u0").then_some(2.01),
-        )
-        .unwrap();
+    let sources = bind(&lib, &sig);
     let mut out = vec![0.0; n * 29];
     // the two must agree before their speed is compared
     let mut check = vec![0.0; n * 29];
     lib.fill(&sources, n, &mut out);
-    hand(&u, &v, &r, &d, 2.01, &mut check);
+    hand(u, v, r, d, U0, &mut check);
     for (j, t) in terms.iter().enumerate() {
         let k = TERMS_29.iter().position(|s| vocab.parse(s).unwrap() == *t).unwrap();
         for i in (0..n).step_by(9973) {
@@ -138,7 +78,7 @@ fn bench(c: &mut Criterion) {
         b.iter(|| lib.fill(black_box(&sources), n, black_box(&mut out)))
     });
     g.bench_with_input(BenchmarkId::new("hand_written_loop", n), &n, |b, _| {
-        b.iter(|| hand(black_box(&u), black_box(&v), black_box(&r), black_box(&d), 2.01, black_box(&mut out)))
+        b.iter(|| hand(black_box(u), black_box(v), black_box(r), black_box(d), U0, black_box(&mut out)))
     });
     g.finish();
 

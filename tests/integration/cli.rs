@@ -1,15 +1,6 @@
 //! The `termid` binary end to end.
 
-use std::process::Command;
-
-fn termid(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_termid")).args(args).output().expect("run termid");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}
+use crate::common::termid;
 
 #[test]
 fn identify_hald_json() {

@@ -2,12 +2,13 @@
 //! simulated and identified with the same code and commands.
 
 use std::collections::BTreeMap;
-use std::process::Command;
 
 use termid::data::{CentralDifference, Frame};
 use termid::identify::{fit_equation, Target};
 use termid::model::Model;
 use termid::sim::{simulate, Constant, Integrator, Replay, Settings, System};
+
+use crate::common::termid;
 
 fn lorenz_run() -> (Model, Frame) {
     let m = Model::load(std::path::Path::new("models/lorenz.toml")).unwrap();
@@ -68,15 +69,6 @@ fn duffing_with_replayed_forcing() {
         assert_eq!(name, wn);
         assert!((g - w).abs() < 1e-6, "{name}: {g}");
     }
-}
-
-fn termid(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_termid")).args(args).output().expect("run termid");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
 }
 
 #[test]
