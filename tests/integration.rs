@@ -25,3 +25,6 @@ mod generic;
 // The paper end to end (`termid reproduce`) through the library.
 #[path = "integration/reproduce.rs"]
 mod reproduce;
+// Every back-end through one suite; best subset against brute force.
+#[path = "integration/selectors.rs"]
+mod selectors;

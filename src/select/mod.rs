@@ -3,13 +3,18 @@
 //! ([`Moments`]) and implements [`Selector`]; [`Backend`] picks one by name for the CLI and
 //! model files. A new back-end is one new file and one row in [`Backend`].
 
+mod best_subset;
+mod efroymson;
 #[doc(hidden)]
 pub mod gram;
 mod moments;
-mod stepwise;
+pub(crate) mod stepwise;
+mod subset;
 
 use serde::{Deserialize, Serialize};
 
+pub use best_subset::{BestSubset, Criterion};
+pub use efroymson::Efroymson;
 pub use moments::{Accumulator, Moments};
 pub use stepwise::{StepRule, Stepwise};
 
@@ -81,8 +86,13 @@ pub struct Step {
     pub standard_error_adjusted: f64,
     /// F-value (A8); infinite at an exact fit.
     pub f: f64,
-    /// Coefficients of the terms in, in order of entry (A11); the terms are those of steps
-    /// 1..=step. [`Selection::terms_at`] pairs them with names, standard errors and t.
+    /// Whether this step removed `term` (Efroymson) rather than entering it.
+    #[serde(default)]
+    pub removed: bool,
+    /// The candidate columns in the equation after this step, aligned with `coefficients`.
+    pub set: Vec<usize>,
+    /// Coefficients of the terms in `set` (A11). [`Selection::terms_at`] pairs them with
+    /// names, standard errors and t.
     pub coefficients: Vec<f64>,
     /// Standard errors of those coefficients (A13).
     pub std_errors: Vec<f64>,
@@ -123,6 +133,8 @@ pub struct Selection {
     pub backend: String,
     /// Rows used.
     pub rows: usize,
+    /// The candidates' names by column.
+    pub candidates: Vec<String>,
     /// Every step taken (empty for back-ends without steps).
     pub steps: Vec<Step>,
     /// The chosen step (1-based; 0 if nothing entered).
@@ -138,15 +150,15 @@ pub struct Selection {
 }
 
 impl Selection {
-    /// The fitted terms after step `k` (1-based), in order of entry.
+    /// The fitted terms after step `k` (1-based).
     pub fn terms_at(&self, k: usize) -> Vec<FittedTerm> {
         let Some(step) = k.checked_sub(1).and_then(|i| self.steps.get(i)) else { return vec![] };
-        self.steps[..k]
+        step.set
             .iter()
             .zip(step.coefficients.iter().zip(&step.std_errors))
-            .map(|(s, (&coefficient, &std_error))| FittedTerm {
-                term: s.term.clone(),
-                index: s.index,
+            .map(|(&index, (&coefficient, &std_error))| FittedTerm {
+                term: self.candidates[index].clone(),
+                index,
                 coefficient,
                 std_error,
                 t: coefficient / std_error,
@@ -229,6 +241,10 @@ pub trait Selector: Send + Sync {
 pub enum Backend {
     /// The IBM SSP forward stepwise regression (STPRG) the paper used.
     Stepwise(Stepwise),
+    /// Efroymson's stepwise with F-to-enter and F-to-remove (MATLAB `stepwisefit`).
+    Efroymson(Efroymson),
+    /// Exact best subset by branch and bound, size by a criterion.
+    BestSubset(BestSubset),
 }
 
 impl Default for Backend {
@@ -239,12 +255,14 @@ impl Default for Backend {
 
 impl Backend {
     /// The names of all back-ends.
-    pub const NAMES: &'static [&'static str] = &["stepwise"];
+    pub const NAMES: &'static [&'static str] = &["stepwise", "efroymson", "best-subset"];
 
     /// A back-end with default settings, by name.
     pub fn by_name(name: &str) -> Result<Backend, SelectError> {
         match name {
             "stepwise" | "stprg" => Ok(Backend::Stepwise(Stepwise::default())),
+            "efroymson" => Ok(Backend::Efroymson(Efroymson::default())),
+            "best-subset" => Ok(Backend::BestSubset(BestSubset::default())),
             other => Err(SelectError::Config(format!(
                 "unknown back-end `{other}` (known: {})",
                 Backend::NAMES.join(", ")
@@ -258,6 +276,18 @@ impl Backend {
             Backend::Stepwise(s) => {
                 s.validate()?;
                 Ok(Box::new(s.clone()))
+            }
+            Backend::Efroymson(e) => {
+                e.validate()?;
+                Ok(Box::new(e.clone()))
+            }
+            Backend::BestSubset(b) => {
+                if b.node_limit == 0 || b.time_limit.is_nan() || b.time_limit <= 0.0 {
+                    return Err(SelectError::Config(
+                        "best-subset node_limit and time_limit must be positive".into(),
+                    ));
+                }
+                Ok(Box::new(b.clone()))
             }
         }
     }

@@ -11,7 +11,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{Estimate, Problem, SelectError, Selection, Selector, Step, Stop};
+use super::{FittedTerm, Problem, SelectError, Selection, Selector, Step, Stop};
 
 /// How the step whose coefficients are reported is chosen (Oltmann 1973, Figs. 2-4).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -129,26 +129,7 @@ impl Stepwise {
     }
 }
 
-/// Goodnight's sweep of a symmetric matrix (row-major, size m) on pivot k.
-fn sweep(a: &mut [f64], m: usize, k: usize) {
-    let d = a[k * m + k];
-    let mut pivot_row: Vec<f64> = a[k * m..(k + 1) * m].iter().map(|x| x / d).collect();
-    for (i, row) in a.chunks_exact_mut(m).enumerate() {
-        if i == k {
-            continue;
-        }
-        let b = row[k];
-        if b == 0.0 {
-            continue;
-        }
-        for (x, p) in row.iter_mut().zip(&pivot_row) {
-            *x -= b * p;
-        }
-        row[k] = -b / d;
-    }
-    pivot_row[k] = 1.0 / d;
-    a[k * m..(k + 1) * m].copy_from_slice(&pivot_row);
-}
+use super::subset::{sweep, Scaled};
 
 /// Chooses the reported step (1-based) from the steps taken.
 pub(crate) fn choose_step(rule: StepRule, steps: &[Step], n_forced: usize) -> usize {
@@ -192,30 +173,10 @@ impl Selector for Stepwise {
     }
 
     fn select(&self, pb: &Problem<'_>) -> Result<Selection, SelectError> {
-        pb.validate()?;
         self.validate()?;
-        let mo = pb.moments;
-        let p = mo.regressors();
-        let m = p + 1;
-        let n = mo.count();
-        let cross = |i: usize, j: usize| if pb.intercept { mo.corrected(i, j) } else { mo.raw(i, j) };
-        let total = cross(p, p);
-        if total.is_nan() || total <= 0.0 {
-            return Err(SelectError::NoVariance);
-        }
-        // correlation scaling: pivots become shares of variance, comparable across terms
-        let d: Vec<f64> = (0..m).map(|i| cross(i, i).max(0.0).sqrt()).collect();
-        let mut a = vec![0.0; m * m];
-        for i in 0..m {
-            for j in 0..m {
-                if d[i] > 0.0 && d[j] > 0.0 {
-                    a[i * m + j] = cross(i, j) / (d[i] * d[j]);
-                }
-            }
-        }
-        let a0 = a.clone();
-        let means = mo.means();
-        let n_eff = if pb.intercept { n as f64 - 1.0 } else { n as f64 };
+        let sc = Scaled::new(pb)?;
+        let (p, m, n) = (sc.p, sc.m, sc.n);
+        let mut a = sc.a.clone();
         let mut entered: Vec<usize> = Vec::new();
         let mut refused: Vec<usize> = Vec::new();
         let mut notes = Vec::new();
@@ -264,8 +225,7 @@ impl Selector for Stepwise {
                 };
             }
             let k = entered.len() + 1;
-            let dof = n_eff - k as f64;
-            if dof < 1.0 {
+            if sc.n_eff - (k as f64) < 1.0 {
                 if forcing {
                     return Err(SelectError::TooFewRows { rows: n, terms: k, intercept: pb.intercept });
                 }
@@ -273,8 +233,12 @@ impl Selector for Stepwise {
             }
             sweep(&mut a, m, j);
             entered.push(j);
-            steps.push(self.statistics(pb, &a, &d, &entered, j, share, total, dof, n_eff, forcing, means));
-            let residual_share = a[p * m + p];
+            let mut step = sc.step(&a, &entered, pb.names, j, false, forcing);
+            step.step = k;
+            step.reduction = share * sc.total; // eq. (A2)
+            step.proportion = share; // eq. (A3)
+            steps.push(step);
+            let residual_share = sc.residual_share(&a);
             if residual_share <= self.exact_fit {
                 notes.push(format!(
                     "exact fit after step {k} (1 − R² = {residual_share:.1e}): further steps would be chosen by round-off, so stepping stopped"
@@ -289,10 +253,11 @@ impl Selector for Stepwise {
             _ => choose_step(self.step_rule, &steps, pb.forced.len()),
         };
         let intercept = chosen.checked_sub(1).and_then(|c| steps[c].intercept.clone());
-        let pruned = self.prune(pb, &a0, &d, &steps[..chosen], total, n_eff, means, &mut notes);
+        let pruned = self.prune(pb, &sc, &steps[..chosen], &mut notes);
         let mut selection = Selection {
             backend: self.name().into(),
             rows: n,
+            candidates: pb.names.to_vec(),
             steps,
             chosen_step: chosen,
             terms: vec![],
@@ -302,11 +267,11 @@ impl Selector for Stepwise {
         };
         selection.terms = selection.terms_at(chosen);
         if let Some(fit) = pruned {
-            let kept: Vec<usize> = fit.0;
-            selection.terms = kept
+            selection.terms = fit
+                .set
                 .iter()
-                .zip(fit.1.coefficients.iter().zip(&fit.1.std_errors))
-                .map(|(&i, (&coefficient, &std_error))| super::FittedTerm {
+                .zip(fit.coefficients.iter().zip(&fit.std_errors))
+                .map(|(&i, (&coefficient, &std_error))| FittedTerm {
                     term: pb.names[i].clone(),
                     index: i,
                     coefficient,
@@ -314,7 +279,7 @@ impl Selector for Stepwise {
                     t: coefficient / std_error,
                 })
                 .collect();
-            selection.intercept = fit.1.intercept;
+            selection.intercept = fit.intercept;
         }
         Ok(selection)
     }
@@ -323,33 +288,16 @@ impl Selector for Stepwise {
 impl Stepwise {
     /// The backward pass of `prune_t` / `prune_beta` on the chosen step's terms: refits by
     /// sweeping a fresh copy of the scaled matrix on the terms kept. None if nothing goes.
-    #[allow(clippy::too_many_arguments)]
-    fn prune(
-        &self,
-        pb: &Problem<'_>,
-        a0: &[f64],
-        d: &[f64],
-        chosen: &[Step],
-        total: f64,
-        n_eff: f64,
-        means: &[f64],
-        notes: &mut Vec<String>,
-    ) -> Option<(Vec<usize>, Step)> {
+    fn prune(&self, pb: &Problem<'_>, sc: &Scaled, chosen: &[Step], notes: &mut Vec<String>) -> Option<Step> {
         if (self.prune_t == 0.0 && self.prune_beta == 0.0) || chosen.is_empty() {
             return None;
         }
-        let p = pb.moments.regressors();
-        let m = p + 1;
+        let (p, m) = (sc.p, sc.m);
         let mut kept: Vec<usize> = chosen.iter().map(|s| s.index).collect();
         let mut removed_any = false;
         loop {
-            let mut a = a0.to_vec();
-            for &j in &kept {
-                sweep(&mut a, m, j);
-            }
-            let dof = n_eff - kept.len() as f64;
-            let last = *kept.last()?;
-            let fit = self.statistics(pb, &a, d, &kept, last, f64::NAN, total, dof, n_eff, false, means);
+            let a = sc.swept(&kept, 0.0).ok()?;
+            let fit = sc.step(&a, &kept, pb.names, *kept.last()?, false, false);
             // standardised coefficient = coefficient in correlation units, |a[j][y]|
             let worst = kept
                 .iter()
@@ -367,63 +315,8 @@ impl Stepwise {
                     kept.remove(k);
                     removed_any = true;
                 }
-                _ => return removed_any.then_some((kept, fit)),
+                _ => return removed_any.then_some(fit),
             }
-        }
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn statistics(
-        &self,
-        pb: &Problem<'_>,
-        a: &[f64],
-        d: &[f64],
-        entered: &[usize],
-        j: usize,
-        share: f64,
-        total: f64,
-        dof: f64,
-        n_eff: f64,
-        forced: bool,
-        means: &[f64],
-    ) -> Step {
-        let p = pb.moments.regressors();
-        let m = p + 1;
-        let k = entered.len() as f64;
-        let residual = (a[p * m + p] * total).max(0.0);
-        let r2 = 1.0 - a[p * m + p];
-        let s = (residual / dof).sqrt(); // eq. (A7)
-                                         // eq. (A11), unscaled from correlation units; eq. (A13)
-        let coefficients: Vec<f64> = entered.iter().map(|&i| a[i * m + p] * d[p] / d[i]).collect();
-        let std_errors: Vec<f64> = entered.iter().map(|&i| s * a[i * m + i].max(0.0).sqrt() / d[i]).collect();
-        let intercept = pb.intercept.then(|| {
-            // eq. (A12)
-            let value = means[p] - entered.iter().zip(&coefficients).map(|(&i, b)| b * means[i]).sum::<f64>();
-            let mut q = 1.0 / pb.moments.weight();
-            for &i in entered {
-                for &l in entered {
-                    q += means[i] * means[l] * a[i * m + l] / (d[i] * d[l]);
-                }
-            }
-            let std_error = s * q.max(0.0).sqrt();
-            Estimate { value, std_error, t: value / std_error }
-        });
-        Step {
-            step: entered.len(),
-            term: pb.names[j].clone(),
-            index: j,
-            forced,
-            reduction: share * total,
-            proportion: share,
-            r2,
-            r: r2.max(0.0).sqrt(),
-            r_adjusted: (1.0 - (1.0 - r2) * n_eff / (n_eff + 1.0 - k)).max(0.0).sqrt(),
-            standard_error: s,
-            standard_error_adjusted: s * (n_eff / (n_eff + 1.0 - k)).sqrt(),
-            f: (r2 * total / k) / (residual / dof), // eq. (A8)
-            coefficients,
-            std_errors,
-            intercept,
         }
     }
 }

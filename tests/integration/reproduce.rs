@@ -172,3 +172,60 @@ fn report_is_written() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Issue 5 §7: on exact data the true support is recoverable, and best subset with its
+/// default criterion finds it: no false terms, coefficients to 1e-6.
+#[test]
+fn best_subset_finds_the_exact_support_on_exact_data() {
+    let model = Model::default_model();
+    let frames: Vec<termid::data::Frame> = STUDY.recorded.iter().map(|r| r.frame.clone()).collect();
+    for eq in oltmann::EQUATIONS {
+        let e = model.equation(eq).unwrap();
+        let rules = model.parameter_rules();
+        let id = termid::identify::Identification {
+            vocabulary: &model.vocabulary,
+            parameters: &rules,
+            differentiator: &termid::data::CentralDifference,
+            intercept: true,
+            weights: None,
+        };
+        let target = termid::identify::Target::Column(format!("{}_dot", e.state));
+        let fit = id
+            .fit(
+                &target,
+                &e.candidates,
+                &e.forced,
+                &e.excluded,
+                &frames,
+                &termid::select::BestSubset::default(),
+            )
+            .unwrap();
+        let truth = |t: &str| e.coefficients.iter().find(|(c, _, _)| c.to_string() == t).map_or(0.0, |c| c.1);
+        for ft in &fit.selection.terms {
+            let w = truth(&ft.term);
+            let forced = e.forced.iter().any(|f| f.to_string() == ft.term);
+            if w == 0.0 {
+                assert!(forced, "{eq}: false term `{}` ({})", ft.term, ft.coefficient);
+                assert!(
+                    ft.coefficient.abs() < 1e-6,
+                    "{eq}: forced zero term `{}` = {}",
+                    ft.term,
+                    ft.coefficient
+                );
+            } else {
+                assert!(
+                    (ft.coefficient - w).abs() <= 1e-6 * w.abs(),
+                    "{eq} {}: {} vs {w}",
+                    ft.term,
+                    ft.coefficient
+                );
+            }
+        }
+        for (t, c, _) in e.coefficients.iter().filter(|(_, c, _)| *c != 0.0) {
+            assert!(
+                fit.selection.terms.iter().any(|ft| ft.term == t.to_string()),
+                "{eq}: `{t}` ({c}) missing"
+            );
+        }
+    }
+}

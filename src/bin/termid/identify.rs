@@ -94,15 +94,14 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
 
 fn configure_backend(cmd: &IdentifyCommand) -> Result<Backend> {
     let mut backend = Backend::by_name(&cmd.backend)?;
-    match &mut backend {
-        Backend::Stepwise(s) => {
-            s.min_proportion = cmd.min_proportion;
-            s.step_rule = match cmd.step_rule {
-                RuleName::FMax => StepRule::FirstFMaximum { tolerance: cmd.step_tolerance },
-                RuleName::SePlateau => StepRule::StandardErrorPlateau { tolerance: cmd.step_tolerance },
-                RuleName::Last => StepRule::Last,
-            };
-        }
+    // the stepwise stop and step-rule options do not apply to the other back-ends
+    if let Backend::Stepwise(s) = &mut backend {
+        s.min_proportion = cmd.min_proportion;
+        s.step_rule = match cmd.step_rule {
+            RuleName::FMax => StepRule::FirstFMaximum { tolerance: cmd.step_tolerance },
+            RuleName::SePlateau => StepRule::StandardErrorPlateau { tolerance: cmd.step_tolerance },
+            RuleName::Last => StepRule::Last,
+        };
     }
     Ok(backend)
 }

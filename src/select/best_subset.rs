@@ -1,0 +1,243 @@
+//! Exact best-subset regression by branch and bound in the manner of Furnival & Wilson's
+//! "leaps and bounds" (Technometrics 16, 1974): for every model size the subset with the
+//! smallest residual sum of squares, forced terms always in, then the size chosen by a named
+//! criterion. A node of the search is (terms in, terms undecided); every completion's RSS is
+//! at least the RSS with all undecided terms in, so a node whose bound cannot beat the best
+//! of any size it could still reach is pruned. Excluding a term is one sweep of the parent's
+//! matrix (the sweep is its own inverse), so a node costs O(p²).
+
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use super::stepwise::Stepwise;
+use super::subset::{sweep, Scaled};
+use super::{Problem, SelectError, Selection, Selector, Step, Stop};
+
+/// How the model size is chosen.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Criterion {
+    /// Bayesian information criterion n·ln(RSS/n) + k·ln(n).
+    Bic,
+    /// Akaike's n·ln(RSS/n) + 2k.
+    Aic,
+    /// Mallows' Cp = RSS/σ̂² − n + 2k, σ̂² from the largest model searched.
+    Cp,
+    /// Largest adjusted R².
+    AdjustedR2,
+}
+
+/// Settings.
+///
+/// | setting | default | meaning |
+/// |---|---|---|
+/// | `criterion` | `bic` | chooses the size |
+/// | `max_size` | all | largest model size searched (terms, forced included) |
+/// | `node_limit` | 20 000 000 | stop the search after this many nodes, with a caveat |
+/// | `time_limit` | 60 s | likewise for time |
+/// | `pivot_tolerance` | 1e-10 | collinear candidates are left out |
+///
+/// An exact fit (RSS zero to round-off) breaks log-likelihood criteria, so RSS is floored at
+/// 1e-13 of the total sum of squares (the same round-off level at which STPRG stops): among
+/// exact fits the smallest wins.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BestSubset {
+    /// Size criterion.
+    pub criterion: Criterion,
+    /// Largest size searched.
+    pub max_size: Option<usize>,
+    /// Node limit.
+    pub node_limit: u64,
+    /// Time limit in seconds.
+    pub time_limit: f64,
+    /// Pivot tolerance.
+    pub pivot_tolerance: f64,
+}
+
+impl Default for BestSubset {
+    fn default() -> Self {
+        BestSubset {
+            criterion: Criterion::Bic,
+            max_size: None,
+            node_limit: 20_000_000,
+            time_limit: 60.0,
+            pivot_tolerance: 1e-10,
+        }
+    }
+}
+
+const RSS_FLOOR: f64 = 1e-13;
+
+struct Search<'a> {
+    sc: &'a Scaled,
+    kmax: usize,
+    best: Vec<(f64, Vec<usize>)>,
+    nodes: u64,
+    limit: u64,
+    deadline: Instant,
+    stopped: bool,
+}
+
+impl Search<'_> {
+    fn record(&mut self, rss: f64, set: &[usize]) {
+        let k = set.len();
+        if k <= self.kmax && rss < self.best[k].0 {
+            let mut s = set.to_vec();
+            s.sort_unstable();
+            self.best[k] = (rss, s);
+        }
+    }
+
+    /// `a` is swept on `inn ∪ undecided`.
+    fn visit(&mut self, a: &[f64], inn: &mut Vec<usize>, undecided: &[usize]) {
+        self.nodes += 1;
+        if self.nodes >= self.limit || (self.nodes.is_multiple_of(4096) && Instant::now() > self.deadline) {
+            self.stopped = true;
+        }
+        if self.stopped {
+            return;
+        }
+        let rss = self.sc.residual_share(a).max(RSS_FLOOR);
+        let full: Vec<usize> = inn.iter().chain(undecided).copied().collect();
+        self.record(rss, &full);
+        if undecided.is_empty() {
+            return;
+        }
+        // every subset between inn and inn ∪ undecided has RSS ≥ rss
+        let lo = inn.len();
+        let hi = (lo + undecided.len() - 1).min(self.kmax);
+        if lo > hi || (lo..=hi).all(|k| rss >= self.best[k].0) {
+            return;
+        }
+        let (u, rest) = (undecided[0], &undecided[1..]);
+        // exclude u: one sweep takes it out
+        let mut b = a.to_vec();
+        sweep(&mut b, self.sc.m, u);
+        self.visit(&b, inn, rest);
+        // include u: same fitted set as this node, u decided in
+        inn.push(u);
+        self.visit(a, inn, rest);
+        inn.pop();
+    }
+}
+
+impl Selector for BestSubset {
+    fn name(&self) -> &'static str {
+        "best-subset"
+    }
+
+    fn select(&self, pb: &Problem<'_>) -> Result<Selection, SelectError> {
+        let sc = Scaled::new(pb)?;
+        let m = sc.m;
+        let mut notes = Vec::new();
+        // candidates: forced first; the others that are not collinear with everything else
+        let mut free: Vec<usize> =
+            (0..sc.p).filter(|j| !pb.forced.contains(j) && !pb.excluded.contains(j)).collect();
+        let forced: Vec<usize> = pb.forced.to_vec();
+        let mut a = sc.swept(&forced, self.pivot_tolerance).map_err(|j| SelectError::ForcedCollinear {
+            term: pb.names[j].clone(),
+            pivot: f64::NAN,
+            tolerance: self.pivot_tolerance,
+        })?;
+        // order: most important last, so excluding it (the first branch) comes deep in the tree
+        // and strong small models are found early; refuse terms collinear with the rest
+        let mut kept = Vec::new();
+        free.sort_by(|&x, &y| {
+            let r = |j: usize| a[j * m + sc.p].powi(2) / a[j * m + j].max(1e-300);
+            r(x).total_cmp(&r(y))
+        });
+        for j in free.drain(..) {
+            let pivot = a[j * m + j];
+            if pivot.is_nan() || pivot <= self.pivot_tolerance {
+                notes.push(format!(
+                    "`{}` left out: collinear with the terms before it (pivot {pivot:.2e})",
+                    pb.names[j]
+                ));
+                continue;
+            }
+            sweep(&mut a, m, j);
+            kept.push(j);
+        }
+        let max_rows = (sc.n_eff as usize).saturating_sub(1);
+        let kmax = self.max_size.unwrap_or(usize::MAX).min(forced.len() + kept.len()).min(max_rows);
+        if kmax < forced.len() {
+            return Err(SelectError::TooFewRows { rows: sc.n, terms: forced.len(), intercept: pb.intercept });
+        }
+        // first bounds: the forward stepwise path
+        let mut search = Search {
+            sc: &sc,
+            kmax,
+            best: vec![(f64::INFINITY, vec![]); kmax + 1],
+            nodes: 0,
+            limit: self.node_limit,
+            deadline: Instant::now() + std::time::Duration::from_secs_f64(self.time_limit.max(0.0)),
+            stopped: false,
+        };
+        if let Ok(path) = (Stepwise { step_rule: super::StepRule::Last, ..Stepwise::default() }).select(pb) {
+            for st in &path.steps {
+                search.record((1.0 - st.r2).max(RSS_FLOOR), &st.set);
+            }
+        }
+        let mut inn = forced.clone();
+        search.visit(&a, &mut inn, &kept);
+        if search.stopped {
+            notes.push(format!(
+                "search stopped at its limit after {} nodes: the subsets reported are the best found, not proven best",
+                search.nodes
+            ));
+        } else {
+            notes.push(format!("exact: {} nodes searched", search.nodes));
+        }
+        // one step per size, chosen by the criterion
+        let n = sc.n as f64;
+        let full_rss = search.best.iter().rev().find(|b| b.0.is_finite()).map_or(1.0, |b| b.0);
+        let sigma2 = full_rss / (sc.n_eff - kmax as f64).max(1.0);
+        let mut steps = Vec::new();
+        let mut scores = Vec::new();
+        for (k, (rss, set)) in search.best.iter().enumerate() {
+            if !rss.is_finite() || set.len() != k || k < forced.len().max(1) {
+                continue;
+            }
+            let Ok(sw) = sc.swept(set, 0.0) else { continue };
+            let newest = set
+                .iter()
+                .copied()
+                .find(|j| !steps.last().is_some_and(|s: &Step| s.set.contains(j)))
+                .unwrap_or(0);
+            let mut st = sc.step(&sw, set, pb.names, newest, false, forced.contains(&newest));
+            st.step = k;
+            let kk = k as f64 + if sc.intercept { 1.0 } else { 0.0 };
+            let score = match self.criterion {
+                Criterion::Bic => n * (rss * sc.total / n).ln() + kk * n.ln(),
+                Criterion::Aic => n * (rss * sc.total / n).ln() + 2.0 * kk,
+                Criterion::Cp => rss / sigma2 - sc.n_eff + 2.0 * kk,
+                Criterion::AdjustedR2 => -(1.0 - rss * sc.n_eff / (sc.n_eff - k as f64).max(1e-300)),
+            };
+            scores.push(score);
+            steps.push(st);
+        }
+        let chosen = scores
+            .iter()
+            .enumerate()
+            .min_by(|a, b| a.1.total_cmp(b.1).then(a.0.cmp(&b.0)))
+            .map_or(0, |(i, _)| i + 1);
+        for (i, st) in steps.iter_mut().enumerate() {
+            st.step = i + 1;
+        }
+        let mut selection = Selection {
+            backend: self.name().into(),
+            rows: sc.n,
+            candidates: pb.names.to_vec(),
+            chosen_step: chosen,
+            terms: vec![],
+            intercept: chosen.checked_sub(1).and_then(|c| steps[c].intercept.clone()),
+            steps,
+            stop: if search.stopped { Stop::Converged } else { Stop::AllEntered },
+            notes,
+        };
+        selection.terms = selection.terms_at(chosen);
+        Ok(selection)
+    }
+}

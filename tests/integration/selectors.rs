@@ -1,0 +1,188 @@
+//! One suite, every back-end (pysindy's parametrised optimizer tests): a planted support on
+//! noise-free data, forced terms kept, too few rows refused, determinism. Then what is
+//! particular to each: best subset against brute force, Efroymson against MATLAB's example.
+
+use proptest::prelude::*;
+use termid::select::{Backend, BestSubset, Efroymson, Problem, SelectError, Selector};
+
+use crate::common::{moments_of, qr_fit, Lcg};
+
+fn backends() -> Vec<(String, Box<dyn Selector>)> {
+    Backend::NAMES.iter().map(|n| (n.to_string(), Backend::by_name(n).unwrap().build().unwrap())).collect()
+}
+
+fn names(p: usize) -> Vec<String> {
+    (1..=p).map(|i| format!("x{i}")).collect()
+}
+
+/// Random columns, y = Σ true coefficients × columns (+ noise).
+fn planted(seed: u64, n: usize, p: usize, truth: &[(usize, f64)], noise: f64) -> (Vec<Vec<f64>>, Vec<f64>) {
+    let mut g = Lcg(seed);
+    let cols: Vec<Vec<f64>> = (0..p).map(|_| (0..n).map(|_| g.normal()).collect()).collect();
+    let y = (0..n)
+        .map(|i| 0.5 + truth.iter().map(|(j, b)| b * cols[*j][i]).sum::<f64>() + noise * g.normal())
+        .collect();
+    (cols, y)
+}
+
+#[test]
+fn every_backend_recovers_a_planted_support() {
+    let truth = [(1, 2.0), (4, -1.5), (6, 0.75)];
+    let (cols, y) = planted(11, 80, 8, &truth, 0.0);
+    let m = moments_of(&cols, &y);
+    let names = names(8);
+    let pb = Problem { moments: &m, names: &names, forced: &[], excluded: &[], intercept: true };
+    for (name, b) in backends() {
+        let s = b.select(&pb).unwrap();
+        let mut got: Vec<(usize, f64)> = s.terms.iter().map(|t| (t.index, t.coefficient)).collect();
+        got.sort_by_key(|x| x.0);
+        assert_eq!(got.iter().map(|x| x.0).collect::<Vec<_>>(), [1, 4, 6], "{name}: {:?}", s.notes);
+        for ((_, g), (_, w)) in got.iter().zip(truth) {
+            assert!((g - w).abs() < 1e-9, "{name}: {g} vs {w}");
+        }
+        assert!((s.intercept.unwrap().value - 0.5).abs() < 1e-9, "{name}");
+    }
+}
+
+#[test]
+fn every_backend_keeps_forced_terms() {
+    let (cols, y) = planted(12, 60, 6, &[(0, 1.0), (3, 2.0)], 0.1);
+    let m = moments_of(&cols, &y);
+    let names = names(6);
+    let pb = Problem { moments: &m, names: &names, forced: &[5], excluded: &[0], intercept: true };
+    for (name, b) in backends() {
+        let s = b.select(&pb).unwrap();
+        assert!(s.terms.iter().any(|t| t.index == 5), "{name}: forced term dropped");
+        assert!(s.terms.iter().all(|t| t.index != 0), "{name}: excluded term entered");
+        assert!(s.terms.iter().any(|t| t.index == 3), "{name}");
+    }
+}
+
+#[test]
+fn every_backend_refuses_fewer_rows_than_terms() {
+    let (cols, y) = planted(13, 4, 6, &[(0, 1.0)], 0.1);
+    let m = moments_of(&cols, &y);
+    let names = names(6);
+    let pb = Problem { moments: &m, names: &names, forced: &[0, 1, 2, 3], excluded: &[], intercept: true };
+    for (name, b) in backends() {
+        let e = b.select(&pb).unwrap_err();
+        assert!(matches!(e, SelectError::TooFewRows { rows: 4, .. }), "{name}: {e}");
+        assert!(e.to_string().contains("4 rows cannot determine"), "{name}: {e}");
+    }
+}
+
+#[test]
+fn every_backend_is_deterministic() {
+    let (cols, y) = planted(14, 50, 9, &[(2, 1.0), (7, -1.0)], 0.3);
+    let m = moments_of(&cols, &y);
+    let names = names(9);
+    let pb = Problem { moments: &m, names: &names, forced: &[], excluded: &[], intercept: true };
+    for (name, b) in backends() {
+        // Debug text: steps of non-STPRG back-ends carry NaN (no A2 reduction), and NaN ≠ NaN
+        assert_eq!(
+            format!("{:?}", b.select(&pb).unwrap()),
+            format!("{:?}", b.select(&pb).unwrap()),
+            "{name}"
+        );
+    }
+}
+
+/// MATLAB's `stepwisefit` documentation runs the Hald data with the default p-values:
+/// "Step 1, added column 4, p=0.000576232; Step 2, added column 1, p=1.10528e-06;
+/// Final columns included: 1 4", coefficients 1.4400 and −0.6140.
+#[test]
+fn efroymson_matches_matlabs_hald_example() {
+    let f = termid::data::Frame::read_csv_untimed(std::path::Path::new("tests/data/hald.csv")).unwrap();
+    let cols: Vec<Vec<f64>> =
+        ["x1", "x2", "x3", "x4"].iter().map(|c| f.require(c).unwrap().to_vec()).collect();
+    let m = moments_of(&cols, f.require("y").unwrap());
+    let names = names(4);
+    let pb = Problem { moments: &m, names: &names, forced: &[], excluded: &[], intercept: true };
+    let s = Efroymson::default().select(&pb).unwrap();
+    let order: Vec<&str> = s.steps.iter().map(|st| st.term.as_str()).collect();
+    assert_eq!(order, ["x4", "x1"]);
+    let mut coef: Vec<(usize, f64)> = s.terms.iter().map(|t| (t.index, t.coefficient)).collect();
+    coef.sort_by_key(|c| c.0);
+    assert!((coef[0].1 - 1.4400).abs() < 5e-5 && (coef[1].1 - -0.6140).abs() < 5e-5, "{coef:?}");
+    // the p-values MATLAB prints, from the steps' F (1 and n − k − 1 degrees of freedom)
+    let p1 = fdist_upper(s.steps[0].f, 1.0, 11.0);
+    // MATLAB prints 6 significant digits
+    assert!((p1 / 0.000576232 - 1.0).abs() < 1e-5, "{p1}");
+    let t = s.terms.iter().find(|t| t.term == "x1").unwrap().t;
+    let p2 = fdist_upper(t * t, 1.0, 10.0);
+    assert!((p2 / 1.10528e-06 - 1.0).abs() < 1e-5, "{p2}");
+}
+
+/// Upper tail of F(d1, d2) by numerical integration of the density (independent of the
+/// library's continued fraction): P(F > f) = 1 − ∫₀^x Beta(d1/2, d2/2) with x = d1 f / (d1 f + d2).
+fn fdist_upper(f: f64, d1: f64, d2: f64) -> f64 {
+    let (a, b) = (d1 / 2.0, d2 / 2.0);
+    let x = d1 * f / (d1 * f + d2);
+    // ∫ₓ¹ t^(a−1) (1−t)^(b−1) dt / B(a, b), with t = 1 − s², removing the end singularities
+    let dens = |t: f64| t.powf(a - 1.0) * (1.0 - t).powf(b - 1.0);
+    let simpson = |lo: f64, hi: f64, k: usize, g: &dyn Fn(f64) -> f64| {
+        let h = (hi - lo) / k as f64;
+        (0..=k)
+            .map(|i| {
+                g(lo + i as f64 * h)
+                    * if i == 0 || i == k {
+                        1.0
+                    } else if i % 2 == 1 {
+                        4.0
+                    } else {
+                        2.0
+                    }
+            })
+            .sum::<f64>()
+            * h
+            / 3.0
+    };
+    // substitute t = 1 − u² on [x, 1] (b ≥ 1 here, so the integrand is smooth in u)
+    let upper = simpson(0.0, (1.0 - x).sqrt(), 20000, &|u: f64| dens(1.0 - u * u) * 2.0 * u);
+    // B(a, b) with a = 1/2: substitute t = s² on [0, 1]
+    let total = simpson(0.0, 1.0, 200000, &|s: f64| {
+        if s == 0.0 {
+            0.0
+        } else {
+            2.0 * s.powf(2.0 * a - 1.0) * (1.0 - s * s).powf(b - 1.0)
+        }
+    });
+    upper / total
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    #[test]
+    fn best_subset_equals_brute_force(p in 2usize..=14, seed in any::<u64>(), forced_first in any::<bool>()) {
+        let n = 40;
+        let mut g = Lcg(seed);
+        let cols: Vec<Vec<f64>> = (0..p).map(|_| (0..n).map(|_| g.normal()).collect()).collect();
+        let y: Vec<f64> = (0..n).map(|i| cols.iter().enumerate().map(|(j, c)| c[i] * ((j % 3) as f64 - 1.0)).sum::<f64>() + g.normal()).collect();
+        let m = moments_of(&cols, &y);
+        let names = names(p);
+        let forced: Vec<usize> = if forced_first { vec![0] } else { vec![] };
+        let pb = Problem { moments: &m, names: &names, forced: &forced, excluded: &[], intercept: true };
+        let s = BestSubset::default().select(&pb).unwrap();
+        prop_assert!(s.notes.iter().any(|n| n.starts_with("exact")), "{:?}", s.notes);
+        // brute force: every subset (containing the forced term) by QR
+        let mut best = vec![f64::INFINITY; p + 1];
+        for mask in 0u32..(1 << p) {
+            if forced_first && mask & 1 == 0 {
+                continue;
+            }
+            let set: Vec<usize> = (0..p).filter(|j| mask >> j & 1 == 1).collect();
+            let sub: Vec<Vec<f64>> = set.iter().map(|&j| cols[j].clone()).collect();
+            let (b0, b) = qr_fit(&sub, &y, true);
+            let rss: f64 = (0..n).map(|i| { let f = b0.unwrap() + set.iter().zip(&b).map(|(&j, bj)| bj * cols[j][i]).sum::<f64>(); (y[i] - f).powi(2) }).sum();
+            best[set.len()] = best[set.len()].min(rss);
+        }
+        let ybar = y.iter().sum::<f64>() / n as f64;
+        let tss: f64 = y.iter().map(|v| (v - ybar).powi(2)).sum();
+        for st in &s.steps {
+            let k = st.set.len();
+            let rss = (1.0 - st.r2) * tss;
+            prop_assert!((rss - best[k]).abs() <= 1e-8 * tss, "size {}: {} vs brute force {}", k, rss, best[k]);
+        }
+    }
+}
