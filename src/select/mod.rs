@@ -8,6 +8,7 @@ mod efroymson;
 #[doc(hidden)]
 pub mod gram;
 mod moments;
+mod sparse;
 pub(crate) mod stepwise;
 mod subset;
 
@@ -16,6 +17,7 @@ use serde::{Deserialize, Serialize};
 pub use best_subset::{BestSubset, Criterion};
 pub use efroymson::Efroymson;
 pub use moments::{Accumulator, Moments};
+pub use sparse::{Equality, SparseFit};
 pub use stepwise::{StepRule, Stepwise};
 
 /// What a back-end is asked to do.
@@ -197,6 +199,9 @@ pub enum SelectError {
     /// Settings out of range.
     #[error("invalid setting: {0}")]
     Config(String),
+    /// The QP solver (Clarabel) ended with a status other than Solved.
+    #[error("the sparse fit's QP solver stopped with status {0}")]
+    Solver(String),
     /// Index out of range or names not matching the statistics.
     #[error("problem does not fit together: {0}")]
     Shape(String),
@@ -245,6 +250,8 @@ pub enum Backend {
     Efroymson(Efroymson),
     /// Exact best subset by branch and bound, size by a criterion.
     BestSubset(BestSubset),
+    /// LASSO path (Clarabel QP) with least-squares refit and constraints.
+    Sparse(SparseFit),
 }
 
 impl Default for Backend {
@@ -255,7 +262,7 @@ impl Default for Backend {
 
 impl Backend {
     /// The names of all back-ends.
-    pub const NAMES: &'static [&'static str] = &["stepwise", "efroymson", "best-subset"];
+    pub const NAMES: &'static [&'static str] = &["stepwise", "efroymson", "best-subset", "sparse"];
 
     /// A back-end with default settings, by name.
     pub fn by_name(name: &str) -> Result<Backend, SelectError> {
@@ -263,6 +270,7 @@ impl Backend {
             "stepwise" | "stprg" => Ok(Backend::Stepwise(Stepwise::default())),
             "efroymson" => Ok(Backend::Efroymson(Efroymson::default())),
             "best-subset" => Ok(Backend::BestSubset(BestSubset::default())),
+            "sparse" => Ok(Backend::Sparse(SparseFit::default())),
             other => Err(SelectError::Config(format!(
                 "unknown back-end `{other}` (known: {})",
                 Backend::NAMES.join(", ")
@@ -288,6 +296,10 @@ impl Backend {
                     ));
                 }
                 Ok(Box::new(b.clone()))
+            }
+            Backend::Sparse(s) => {
+                s.validate()?;
+                Ok(Box::new(s.clone()))
             }
         }
     }

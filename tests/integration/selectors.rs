@@ -186,3 +186,83 @@ proptest! {
         }
     }
 }
+
+/// Coordinate-descent LASSO on the correlation matrix, written independently of the library:
+/// minimise ½βᵀRβ − rᵀβ + λ Σ|βⱼ| (Friedman, Hastie & Tibshirani 2010, covariance updates).
+fn coordinate_descent(r: &[Vec<f64>], ry: &[f64], lambda: f64) -> Vec<f64> {
+    let p = ry.len();
+    let mut b = vec![0.0; p];
+    for _ in 0..100_000 {
+        let mut change: f64 = 0.0;
+        for j in 0..p {
+            let z = ry[j] - (0..p).filter(|&k| k != j).map(|k| r[j][k] * b[k]).sum::<f64>();
+            let new = z.signum() * (z.abs() - lambda).max(0.0) / r[j][j];
+            change = change.max((new - b[j]).abs());
+            b[j] = new;
+        }
+        if change < 1e-15 {
+            break;
+        }
+    }
+    b
+}
+
+#[test]
+fn sparse_fit_equals_coordinate_descent() {
+    use termid::select::SparseFit;
+    let (cols, y) = planted(21, 60, 7, &[(0, 1.0), (2, -0.5), (5, 0.25)], 0.3);
+    let m = moments_of(&cols, &y);
+    let names = names(7);
+    let pb = Problem { moments: &m, names: &names, forced: &[], excluded: &[], intercept: true };
+    // correlations from the data, independently of the library
+    let all: Vec<&Vec<f64>> = cols.iter().chain(std::iter::once(&y)).collect();
+    let centred: Vec<Vec<f64>> = all
+        .iter()
+        .map(|c| {
+            let mu = c.iter().sum::<f64>() / c.len() as f64;
+            c.iter().map(|v| v - mu).collect()
+        })
+        .collect();
+    let norm: Vec<f64> = centred.iter().map(|c| c.iter().map(|v| v * v).sum::<f64>().sqrt()).collect();
+    let corr = |i: usize, j: usize| {
+        centred[i].iter().zip(&centred[j]).map(|(a, b)| a * b).sum::<f64>() / (norm[i] * norm[j])
+    };
+    let r: Vec<Vec<f64>> = (0..7).map(|i| (0..7).map(|j| corr(i, j)).collect()).collect();
+    let ry: Vec<f64> = (0..7).map(|j| corr(j, 7)).collect();
+    for lambda in [0.3, 0.05, 0.005] {
+        let got = SparseFit::default().lasso(&pb, lambda).unwrap();
+        let want = coordinate_descent(&r, &ry, lambda);
+        for (g, w) in got.iter().zip(&want) {
+            assert!((g - w).abs() < 1e-6, "λ = {lambda}: {got:?} vs {want:?}");
+        }
+    }
+}
+
+#[test]
+fn sparse_fit_honours_constraints_and_reports_solver_failure() {
+    use termid::select::{Equality, SparseFit};
+    let (cols, y) = planted(22, 60, 5, &[(0, 1.0), (1, 0.5), (3, -0.7)], 0.2);
+    let m = moments_of(&cols, &y);
+    let names = names(5);
+    let pb = Problem { moments: &m, names: &names, forced: &[], excluded: &[], intercept: true };
+    let sd = |c: &Vec<f64>| {
+        let mu = c.iter().sum::<f64>() / c.len() as f64;
+        c.iter().map(|v| (v - mu).powi(2)).sum::<f64>().sqrt()
+    };
+    let to_raw = |j: usize, beta: f64| beta * sd(&y) / sd(&cols[j]);
+    // a coefficient fixed to a raw value
+    let fixed = SparseFit { fixed: vec![(1, 0.8)], ..SparseFit::default() }.lasso(&pb, 0.01).unwrap();
+    assert!((to_raw(1, fixed[1]) - 0.8).abs() < 1e-7, "{}", to_raw(1, fixed[1]));
+    // a sign constraint against the data
+    let signed = SparseFit { signs: vec![(3, 1.0)], ..SparseFit::default() }.lasso(&pb, 0.01).unwrap();
+    assert!(signed[3] >= -1e-9, "{}", signed[3]);
+    // b0 = b1 (raw units)
+    let eq = Equality { terms: vec![(0, 1.0), (1, -1.0)], value: 0.0 };
+    let tied = SparseFit { equalities: vec![eq], ..SparseFit::default() }.lasso(&pb, 0.01).unwrap();
+    assert!((to_raw(0, tied[0]) - to_raw(1, tied[1])).abs() < 1e-7);
+    // contradictory constraints: a typed error, not a number
+    let bad = SparseFit { fixed: vec![(2, 1.0)], signs: vec![(2, -1.0)], ..SparseFit::default() };
+    let e = bad.lasso(&pb, 0.01).unwrap_err();
+    assert!(matches!(e, SelectError::Solver(_)), "{e}");
+    assert!(e.to_string().contains("Infeasible"), "{e}");
+}
