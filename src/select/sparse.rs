@@ -109,8 +109,12 @@ impl SparseFit {
                     pb.names[j]
                 ))
             })?;
-            for &j in &all {
-                w[j] = 1.0 / a[j * sc.m + sc.p].abs().max(1e-12);
+            // weights 1/|β_ols|, capped at 1e6 × the smallest: on exact data the zero terms'
+            // β_ols is round-off, and weights of 1e12 wreck the QP's scaling
+            let beta: Vec<f64> = all.iter().map(|&j| a[j * sc.m + sc.p].abs()).collect();
+            let floor = beta.iter().fold(0.0f64, |m, b| m.max(*b)) * 1e-6;
+            for (&j, b) in all.iter().zip(&beta) {
+                w[j] = 1.0 / b.max(floor).max(1e-300);
             }
         }
         for &j in pb.forced {

@@ -177,6 +177,21 @@ fn report_is_written() {
 /// default criterion finds it: no false terms, coefficients to 1e-6.
 #[test]
 fn best_subset_finds_the_exact_support_on_exact_data() {
+    exact_support(&termid::select::BestSubset::default());
+}
+
+/// The sparse fit gets there too with adaptive weights and a λ path down to 1e-10 λ_max.
+#[test]
+fn adaptive_sparse_fit_finds_the_exact_support_on_exact_data() {
+    exact_support(&termid::select::SparseFit {
+        adaptive: true,
+        lambda_ratio: 1e-10,
+        path: 80,
+        ..Default::default()
+    });
+}
+
+fn exact_support(backend: &dyn termid::select::Selector) {
     let model = Model::default_model();
     let frames: Vec<termid::data::Frame> = STUDY.recorded.iter().map(|r| r.frame.clone()).collect();
     for eq in oltmann::EQUATIONS {
@@ -190,16 +205,7 @@ fn best_subset_finds_the_exact_support_on_exact_data() {
             weights: None,
         };
         let target = termid::identify::Target::Column(format!("{}_dot", e.state));
-        let fit = id
-            .fit(
-                &target,
-                &e.candidates,
-                &e.forced,
-                &e.excluded,
-                &frames,
-                &termid::select::BestSubset::default(),
-            )
-            .unwrap();
+        let fit = id.fit(&target, &e.candidates, &e.forced, &e.excluded, &frames, backend).unwrap();
         let truth = |t: &str| e.coefficients.iter().find(|(c, _, _)| c.to_string() == t).map_or(0.0, |c| c.1);
         for ft in &fit.selection.terms {
             let w = truth(&ft.term);
