@@ -141,3 +141,50 @@ fn integer_weights_equal_repeated_rows() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn compare_runs_every_backend() {
+    let dir = std::env::temp_dir().join(format!("termid-compare-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("lorenz.csv");
+    let (ok, _, err) = termid(&[
+        "simulate",
+        "--model",
+        "models/lorenz.toml",
+        "--integrator",
+        "rk4",
+        "--dt",
+        "0.001",
+        "--sample",
+        "0.001",
+        "--duration",
+        "3",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let (ok, out, err) = termid(&[
+        "compare",
+        "--model",
+        "models/lorenz.toml",
+        "--data",
+        csv.to_str().unwrap(),
+        "--no-intercept",
+        "--replay",
+        csv.to_str().unwrap(),
+        "--dt",
+        "0.001",
+        "--format",
+        "json",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let names: Vec<&str> = v.as_array().unwrap().iter().map(|e| e["backend"].as_str().unwrap()).collect();
+    assert_eq!(names, ["stepwise", "efroymson", "best-subset", "sparse"]);
+    for e in v.as_array().unwrap() {
+        assert_eq!(e["equations"].as_array().unwrap().len(), 3);
+        assert!(e["equations"][0]["time_ms"].as_f64().unwrap() >= 0.0);
+        assert!(e["replay"].is_array(), "{}", e["replay"]);
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

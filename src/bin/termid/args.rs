@@ -22,6 +22,8 @@ pub enum Command {
     Simulate(SimulateCommand),
     /// Reproduce Oltmann (1973) end to end: tables, figures and a report beside the paper's.
     Reproduce(ReproduceCommand),
+    /// Run every back-end on the same data and equations and show them side by side.
+    Compare(CompareCommand),
 }
 
 /// Output format.
@@ -176,4 +178,33 @@ pub struct ReproduceCommand {
     /// Round r and ṙ in rad/s (default: °/s, as the paper printed them).
     #[arg(long)]
     pub round_rates_in_radians: bool,
+}
+
+/// `termid compare`.
+#[derive(Debug, Args)]
+pub struct CompareCommand {
+    /// Model file with the candidates (default: the embedded Oltmann model).
+    #[arg(long)]
+    pub model: Option<PathBuf>,
+    /// Runs (CSV), combined.
+    #[arg(long = "data", short = 'd', required = true, num_args = 1..)]
+    pub data: Vec<PathBuf>,
+    /// Equations to compare (default: all identifiable ones).
+    #[arg(long, num_args = 1..)]
+    pub equation: Vec<String>,
+    /// A recorded run to re-simulate with each back-end's model (its inputs replayed).
+    #[arg(long)]
+    pub replay: Option<PathBuf>,
+    /// Integration step for the re-simulation, s.
+    #[arg(long, default_value_t = 0.04)]
+    pub dt: f64,
+    /// Derivative method where a state's derivative is the target.
+    #[arg(long, default_value = "central")]
+    pub derivative: String,
+    /// Fit without an intercept.
+    #[arg(long)]
+    pub no_intercept: bool,
+    /// Output format.
+    #[arg(long, value_enum, default_value = "text")]
+    pub format: Format,
 }

@@ -1,6 +1,7 @@
 //! The `termid` command: a thin layer over the library; `anyhow` lives only here.
 
 mod args;
+mod compare;
 mod identify;
 mod reproduce;
 mod simulate;
@@ -15,6 +16,7 @@ fn main() -> ExitCode {
         args::Command::Identify(cmd) => identify::run(cmd),
         args::Command::Simulate(cmd) => simulate::run(cmd),
         args::Command::Reproduce(cmd) => reproduce::run(cmd),
+        args::Command::Compare(cmd) => compare::run(cmd),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,200 @@
+//! `termid compare`: every back-end on the same runs and equations, side by side: the terms
+//! chosen, coefficients, R², standard error and time; with `--replay`, each back-end's model
+//! re-simulated against a recorded run (any model: the recorded inputs are replayed).
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use termid::data::{differentiator, Frame};
+use termid::identify::{coefficients_of, fit_equation, Fit};
+use termid::select::Backend;
+use termid::sim::{simulate, Integrator, Replay, Settings, System};
+
+use crate::args::{CompareCommand, Format};
+use crate::identify::num;
+
+/// (state, RMS error, max error) of a re-simulation.
+type StateErrors = Vec<(String, f64, f64)>;
+
+struct Entry {
+    backend: String,
+    fits: Vec<(String, Fit, f64)>,
+    replay: Option<Result<StateErrors, String>>,
+}
+
+pub fn run(cmd: CompareCommand) -> Result<()> {
+    let model = crate::simulate::load_model(&cmd.model)?;
+    let time = model.spec.model.time.clone();
+    let frames = cmd.data.iter().map(|p| Frame::read_csv(p, &time)).collect::<Result<Vec<_>, _>>()?;
+    let equations: Vec<String> = if cmd.equation.is_empty() {
+        model
+            .equations
+            .iter()
+            .filter(|e| e.identify && !e.candidates.is_empty())
+            .map(|e| e.name.clone())
+            .collect()
+    } else {
+        cmd.equation.clone()
+    };
+    let diff = differentiator(&cmd.derivative)?;
+    let replay = cmd.replay.as_ref().map(|p| Frame::read_csv(p, &time)).transpose()?;
+    let mut entries = Vec::new();
+    for name in Backend::NAMES {
+        let mut m = model.clone();
+        let mut fits = Vec::new();
+        for eq in &equations {
+            let e = m
+                .equations
+                .iter_mut()
+                .find(|e| &e.name == eq)
+                .with_context(|| format!("no equation `{eq}`"))?;
+            // the model file's own settings for its back-end, defaults for the others
+            if e.backend != Backend::by_name(name)? && !same_kind(&e.backend, name) {
+                e.backend = Backend::by_name(name)?;
+            }
+            let started = Instant::now();
+            let fit = fit_equation(&m, eq, &frames, diff.as_ref(), !cmd.no_intercept, None)
+                .with_context(|| format!("{name} on `{eq}`"))?;
+            let ms = started.elapsed().as_secs_f64() * 1e3;
+            let coefs = coefficients_of(&fit, &m.vocabulary)?;
+            m.set_coefficients(eq, coefs, None);
+            fits.push((eq.clone(), fit, ms));
+        }
+        let replay = replay.as_ref().map(|run| resimulate(&m, run, cmd.dt).map_err(|e| format!("{e:#}")));
+        entries.push(Entry { backend: name.to_string(), fits, replay });
+    }
+    match cmd.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&json(&entries))?),
+        Format::Text => print!("{}", text(&entries, &equations)),
+    }
+    Ok(())
+}
+
+fn same_kind(b: &Backend, name: &str) -> bool {
+    matches!(
+        (b, name),
+        (Backend::Stepwise(_), "stepwise")
+            | (Backend::Efroymson(_), "efroymson")
+            | (Backend::BestSubset(_), "best-subset")
+            | (Backend::Sparse(_), "sparse")
+    )
+}
+
+/// Replays the recorded inputs from the recorded initial state; RMS and max error per state.
+fn resimulate(model: &termid::model::Model, run: &Frame, dt: f64) -> Result<StateErrors> {
+    let system = System::new(model, &BTreeMap::new(), false)?;
+    let x0 = system.states.iter().map(|s| run.require(s).map(|c| c[0])).collect::<Result<Vec<_>, _>>()?;
+    let t = run.time();
+    let (t0, t1) = (t[0], t[t.len() - 1]);
+    let sample = t[1] - t0;
+    let every = (sample / dt).round().max(1.0);
+    let settings =
+        Settings { integrator: Integrator::ModifiedEuler, dt: sample / every, duration: t1 - t0, sample };
+    let mut replay = Replay::new(run, &system.inputs)?;
+    let sim = simulate(&system, &x0, &mut replay, &settings)?;
+    Ok(system
+        .states
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| {
+            let rec = run.column(s)?;
+            let n = rec.len().min(sim.time.len());
+            let d: Vec<f64> = (0..n).map(|k| sim.states[i][k] - rec[k]).collect();
+            let rms = (d.iter().map(|v| v * v).sum::<f64>() / n as f64).sqrt();
+            let max = d.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            Some((s.clone(), rms, max))
+        })
+        .collect())
+}
+
+fn text(entries: &[Entry], equations: &[String]) -> String {
+    let mut out = String::new();
+    for (k, eq) in equations.iter().enumerate() {
+        out += &format!(
+            "== {eq} ==\n{:<12} {:>6} {:>12} {:>12} {:>10}\n",
+            "back-end", "terms", "R²", "std. error", "time [ms]"
+        );
+        for e in entries {
+            let (_, fit, ms) = &e.fits[k];
+            let s = &fit.selection;
+            let st = s.chosen_step.checked_sub(1).and_then(|i| s.steps.get(i));
+            out += &format!(
+                "{:<12} {:>6} {:>12.8} {:>12} {:>10.3}\n",
+                e.backend,
+                s.terms.len(),
+                st.map_or(f64::NAN, |st| st.r2),
+                st.map_or("--".into(), |st| num(st.standard_error)),
+                ms
+            );
+        }
+        let mut terms: Vec<String> = Vec::new();
+        for e in entries {
+            for t in &e.fits[k].1.selection.terms {
+                if !terms.contains(&t.term) {
+                    terms.push(t.term.clone());
+                }
+            }
+        }
+        out += &format!("\n{:<18}", "coefficients");
+        for e in entries {
+            out += &format!(" {:>13}", e.backend);
+        }
+        out += "\n";
+        for t in &terms {
+            out += &format!("{t:<18}");
+            for e in entries {
+                let c = e.fits[k]
+                    .1
+                    .selection
+                    .terms
+                    .iter()
+                    .find(|x| &x.term == t)
+                    .map_or("--".to_string(), |x| num(x.coefficient));
+                out += &format!(" {c:>13}");
+            }
+            out += "\n";
+        }
+        out += "\n";
+    }
+    if entries.iter().any(|e| e.replay.is_some()) {
+        out += "re-simulation of the recorded run (RMS / max error per state):\n";
+        for e in entries {
+            match &e.replay {
+                Some(Ok(errs)) => {
+                    let cells: Vec<String> =
+                        errs.iter().map(|(s, r, m)| format!("{s} {} / {}", num(*r), num(*m))).collect();
+                    out += &format!("{:<12} {}\n", e.backend, cells.join(", "));
+                }
+                Some(Err(msg)) => out += &format!("{:<12} failed: {msg}\n", e.backend),
+                None => {}
+            }
+        }
+    }
+    out
+}
+
+fn json(entries: &[Entry]) -> serde_json::Value {
+    serde_json::Value::Array(
+        entries
+            .iter()
+            .map(|e| {
+                serde_json::json!({
+                    "backend": e.backend,
+                    "equations": e.fits.iter().map(|(eq, f, ms)| serde_json::json!({
+                        "equation": eq,
+                        "time_ms": ms,
+                        "terms": f.selection.terms,
+                        "intercept": f.selection.intercept,
+                        "notes": f.selection.notes,
+                    })).collect::<Vec<_>>(),
+                    "replay": match &e.replay {
+                        Some(Ok(v)) => serde_json::json!(v.iter().map(|(s, r, m)| serde_json::json!({"state": s, "rms": r, "max": m})).collect::<Vec<_>>()),
+                        Some(Err(m)) => serde_json::json!({"error": m}),
+                        None => serde_json::Value::Null,
+                    },
+                })
+            })
+            .collect(),
+    )
+}
