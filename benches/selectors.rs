@@ -4,7 +4,7 @@
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion};
 use nalgebra::{DMatrix, DMatrixView, Dyn};
-use termid::select::{Accumulator, Problem, Selector, StepRule, Stepwise};
+use termid::select::{Accumulator, Backend, Problem, Selector, StepRule, Stepwise};
 use termid::term::{parse_terms, Library};
 
 mod common;
@@ -74,6 +74,8 @@ fn bench(c: &mut Criterion) {
     // where the time goes
     let sources = bind(&lib, &sig);
     let mut design = vec![0.0; rows * lib.len()];
+    // filled here, not only inside a bench: a filtered run may skip that bench
+    lib.fill(&sources, rows, &mut design);
     g.bench_function("design_only_2505", |b| {
         b.iter(|| lib.fill(black_box(&sources), rows, black_box(&mut design)))
     });
@@ -98,6 +100,61 @@ fn bench(c: &mut Criterion) {
             let pb =
                 Problem { moments: &m, names: &names, forced: &[1, 2, 3], excluded: &[], intercept: true };
             black_box(stepwise.select(&pb).unwrap())
+        })
+    });
+    g.finish();
+
+    // every back-end on the paper's combined-data size (statistics already accumulated)
+    let mut g = c.benchmark_group("backends_2505x29");
+    for name in Backend::NAMES {
+        let backend = Backend::by_name(name).unwrap().build().unwrap();
+        g.bench_function(*name, |b| {
+            b.iter(|| {
+                let pb = Problem {
+                    moments: &m,
+                    names: &names,
+                    forced: &[1, 2, 3],
+                    excluded: &[],
+                    intercept: true,
+                };
+                black_box(backend.select(&pb).unwrap())
+            })
+        });
+    }
+    g.finish();
+
+    // the large problem: 10⁶ rows × 100 candidates, the pass over the rows included
+    let (n, p) = (1_000_000usize, 100usize);
+    let mut seed = 7;
+    let x: Vec<f64> = (0..n * p).map(|_| lcg(&mut seed)).collect();
+    let y: Vec<f64> = (0..n)
+        .map(|i| 2.0 * x[i] - 1.0 * x[3 * n + i] + 0.5 * x[50 * n + i] + 0.1 * lcg(&mut seed))
+        .collect();
+    let big_names: Vec<String> = (0..p).map(|j| format!("x{j}")).collect();
+    let mut g = c.benchmark_group("backends_1e6x100");
+    g.sample_size(10);
+    for name in ["stepwise", "sparse"] {
+        let backend = Backend::by_name(name).unwrap().build().unwrap();
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                let mut acc = Accumulator::new(p);
+                acc.push(black_box(&x), &y, None);
+                let m = acc.finish();
+                let pb =
+                    Problem { moments: &m, names: &big_names, forced: &[], excluded: &[], intercept: true };
+                black_box(backend.select(&pb).unwrap())
+            })
+        });
+    }
+    let mut z = x.clone();
+    z.extend_from_slice(&y);
+    g.bench_function("nalgebra_gemm_xtx", |b| {
+        b.iter(|| {
+            let zv = DMatrixView::from_slice(&z, n, p + 1);
+            let zt = DMatrixView::from_slice_with_strides_generic(&z, Dyn(p + 1), Dyn(n), Dyn(n), Dyn(1));
+            let mut cmat = DMatrix::<f64>::zeros(p + 1, p + 1);
+            cmat.gemm(1.0, &zt, &zv, 0.0);
+            black_box(cmat)
         })
     });
     g.finish();
