@@ -28,3 +28,6 @@ mod reproduce;
 // Every back-end through one suite; best subset against brute force.
 #[path = "integration/selectors.rs"]
 mod selectors;
+// No panic on any user input (model files, CSV, manoeuvre strings).
+#[path = "integration/robustness.rs"]
+mod robustness;
