@@ -171,6 +171,19 @@ impl Identification<'_> {
         target: &Target,
         frame: &Frame,
     ) -> Result<Moments, IdentifyError> {
+        let mut acc = Accumulator::new(library.len());
+        self.accumulate(library, target, frame, &mut acc)?;
+        Ok(acc.finish())
+    }
+
+    /// Adds one run's rows to an accumulator (runs simply add up: "Komb. Daten").
+    pub fn accumulate(
+        &self,
+        library: &Library,
+        target: &Target,
+        frame: &Frame,
+        acc: &mut Accumulator,
+    ) -> Result<(), IdentifyError> {
         let y = self.target(target, frame)?;
         let params = self.run_parameters(frame)?;
         let sources = library.bind(&|n| frame.column(n), &|n| params.get(n).copied())?;
@@ -189,7 +202,6 @@ impl Identification<'_> {
             }
             None => None,
         };
-        let mut acc = Accumulator::new(library.len());
         let mut bad: Option<IdentifyError> = None;
         library.for_each_block(&sources, frame.len(), |start, rows, block| {
             if bad.is_some() {
@@ -208,7 +220,7 @@ impl Identification<'_> {
         });
         match bad {
             Some(e) => Err(e),
-            None => Ok(acc.finish()),
+            None => Ok(()),
         }
     }
 
@@ -226,15 +238,11 @@ impl Identification<'_> {
             return Err(IdentifyError::Setup("no data: give at least one run".into()));
         }
         let library = Library::compile(candidates, self.vocabulary)?;
-        let mut total: Option<Moments> = None;
+        let mut acc = Accumulator::new(candidates.len());
         for f in frames {
-            let m = self.moments(&library, target, f)?;
-            match total.as_mut() {
-                Some(t) => t.merge(&m),
-                None => total = Some(m),
-            }
+            self.accumulate(&library, target, f, &mut acc)?;
         }
-        let moments = total.unwrap_or_else(|| Moments::new(candidates.len()));
+        let moments = acc.finish();
         let names: Vec<String> = candidates.iter().map(Term::to_string).collect();
         let index_of = |t: &Term, role: &str| {
             candidates

@@ -6,7 +6,9 @@
 //! Chan, Golub & LeVeque (1979). Statistics of several files simply [`Moments::merge`].
 
 /// Most rows per chunk handed to the Gram kernel (the buffer grows to this as rows come).
-const CHUNK: usize = 2048;
+/// 512 rows of 30 columns stay below glibc's mmap threshold (128 KiB): larger chunks were
+/// mapped and unmapped on every fit, and the page faults cost more than the products.
+const CHUNK: usize = 512;
 
 /// Means and corrected cross-products of `p` regressors and one target.
 #[derive(Clone, Debug, PartialEq)]

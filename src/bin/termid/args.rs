@@ -198,6 +198,9 @@ pub struct CompareCommand {
     /// Integration step for the re-simulation, s.
     #[arg(long, default_value_t = 0.04)]
     pub dt: f64,
+    /// Time each fit as the median of this many repetitions after one warm-up fit.
+    #[arg(long, default_value_t = 5)]
+    pub repeat: usize,
     /// Derivative method where a state's derivative is the target.
     #[arg(long, default_value = "central")]
     pub derivative: String,

@@ -53,10 +53,20 @@ pub fn run(cmd: CompareCommand) -> Result<()> {
             if e.backend != Backend::by_name(name)? && !same_kind(&e.backend, name) {
                 e.backend = Backend::by_name(name)?;
             }
-            let started = Instant::now();
+            // one warm-up fit, then the median of `repeat` timed fits (data already loaded)
             let fit = fit_equation(&m, eq, &frames, diff.as_ref(), !cmd.no_intercept, None)
                 .with_context(|| format!("{name} on `{eq}`"))?;
-            let ms = started.elapsed().as_secs_f64() * 1e3;
+            let mut times: Vec<f64> = (0..cmd.repeat.max(1))
+                .map(|_| {
+                    let started = Instant::now();
+                    let again = fit_equation(&m, eq, &frames, diff.as_ref(), !cmd.no_intercept, None);
+                    let t = started.elapsed().as_secs_f64() * 1e3;
+                    drop(again);
+                    t
+                })
+                .collect();
+            times.sort_by(f64::total_cmp);
+            let ms = times[times.len() / 2];
             let coefs = coefficients_of(&fit, &m.vocabulary)?;
             m.set_coefficients(eq, coefs, None);
             fits.push((eq.clone(), fit, ms));

@@ -1,0 +1,147 @@
+"""Time termid's back-ends and the peers on the same data, the same way: each fit in its own
+language's process, data already loaded, median of repeated fits after one warm-up.
+
+Data: the default model's five exact zigzags (written by `termid reproduce`), the 29
+candidate terms of v-dot and r-dot (Oltmann 1973), combined (2 505 rows); and a 10^6 x 100
+synthetic problem for the pass over the rows. Prints a Markdown table.
+"""
+import argparse
+import glob
+import json
+import os
+import platform
+import statistics
+import subprocess
+import time
+
+import numpy as np
+
+TERMS = ["u^2", "u*v", "u*r", "u^2*delta", "v^3/u", "v^2*r/u", "v*r^2/u", "r^3/u", "v^2*delta",
+         "u*v*delta^2", "r^2*delta", "u*r*delta^2", "u^2*delta^3", "v*du", "r*du", "u*du*delta",
+         "v*du^2/u", "r*du^2/u", "delta*du^2", "v*r*delta", "v*r", "v^2", "r^2", "u^2*delta^2",
+         "u*v*delta", "u*r*delta", "v*r*du/u", "r*du*delta", "v*du*delta"]
+
+
+def design(files):
+    cols, ys = [], {"v_dot": [], "r_dot": []}
+    for f in sorted(files):
+        d = np.genfromtxt(f, delimiter=",", names=True, encoding="utf-8", comments="#")
+        u, v, r, delta = d["u"], d["v"], d["r"], d["δ"] if "δ" in d.dtype.names else d["delta"]
+        du = u - u[0]
+        env = {"u": u, "v": v, "r": r, "delta": delta, "du": du}
+        cols.append(np.column_stack([eval(t.replace("^", "**"), {}, env) for t in TERMS]))
+        ys["v_dot"].append(d["v_dot"])
+        ys["r_dot"].append(d["r_dot"])
+    return np.vstack(cols), {k: np.concatenate(v) for k, v in ys.items()}
+
+
+def timed(fn, repeat):
+    fn()
+    times = []
+    out = None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times), out
+
+
+def numpy_stepwise(X, y):
+    """The same forward stepwise (STPRG) in numpy: corrected cross-products, sweeps."""
+    Z = np.column_stack([X, y])
+    Z = Z - Z.mean(axis=0)
+    A = Z.T @ Z
+    d = np.sqrt(np.diag(A))
+    A = A / np.outer(d, d)
+    p = X.shape[1]
+    entered = []
+    for _ in range(p):
+        cand = [j for j in range(p) if j not in entered and A[j, j] > 1e-10]
+        if not cand:
+            break
+        j = max(cand, key=lambda j: A[j, p] ** 2 / A[j, j])
+        # Goodnight's sweep on j
+        piv = A[j, j]
+        row = A[j] / piv
+        col = A[:, j].copy()
+        A = A - np.outer(col, row)
+        A[:, j] = -col / piv
+        A[j] = row
+        A[j, j] = 1.0 / piv
+        entered.append(j)
+        if A[p, p] < 1e-13:
+            break
+    return entered
+
+
+def peers(X, y, repeat, slow_repeat):
+    import pysindy as ps
+    import statsmodels.api as sm
+    from abess.linear import LinearRegression
+    from sklearn.linear_model import LassoCV
+
+    rows = []
+    t, sel = timed(lambda: numpy_stepwise(X, y), repeat)
+    rows.append(("numpy forward stepwise", t, len(sel)))
+    Xc = sm.add_constant(X)
+    t, _ = timed(lambda: sm.OLS(y, Xc).fit(), repeat)
+    rows.append(("statsmodels OLS (all terms)", t, X.shape[1]))
+    opt = lambda: ps.STLSQ(threshold=1e-6, normalize_columns=True).fit(X, y)
+    t, o = timed(opt, repeat)
+    rows.append(("pysindy STLSQ", t, int(np.count_nonzero(o.coef_))))
+    t, o = timed(lambda: LinearRegression().fit(X, y), slow_repeat)
+    rows.append(("abess best subset", t, int(np.count_nonzero(o.coef_))))
+    t, o = timed(lambda: LassoCV(cv=5, max_iter=100000).fit(X, y), slow_repeat)
+    rows.append(("scikit-learn LassoCV", t, int(np.count_nonzero(o.coef_))))
+    return rows
+
+
+def termid_times(binary, files, repeat):
+    out = subprocess.run([binary, "compare", "--equation", "v_dot", "r_dot", "--repeat", str(repeat),
+                          "--format", "json", "--data", *sorted(files)], check=True, capture_output=True, text=True)
+    res = {}
+    for e in json.loads(out.stdout):
+        for eq in e["equations"]:
+            res[(e["backend"], eq["equation"])] = (eq["time_ms"] / 1e3, len(eq["terms"]))
+    return res
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--termid", required=True)
+    ap.add_argument("--data", required=True)
+    ap.add_argument("--repeat", type=int, default=21)
+    ap.add_argument("--quick", action="store_true", help="skip the 10^6 x 100 problem")
+    a = ap.parse_args()
+    files = [f for f in glob.glob(os.path.join(a.data, "z*.csv")) if "alt5" not in f]
+    X, ys = design(files)
+    ours = termid_times(a.termid, files, a.repeat)
+    print(f"# termid and its peers ({platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+          f"numpy {np.__version__})\n")
+    print(f"Combined data of the five zigzags: {X.shape[0]} rows x {X.shape[1]} candidates. "
+          "termid's times include evaluating the terms and the one-pass statistics; the peers get the "
+          "finished 29-column matrix. Median of repeated fits after a warm-up.\n")
+    for eq in ["v_dot", "r_dot"]:
+        print(f"## {eq}\n\n| method | time [ms] | terms | ratio to numpy stepwise |\n|---|---|---|---|")
+        rows = peers(X, ys[eq], a.repeat, max(3, a.repeat // 7))
+        base = rows[0][1]
+        for name in ["stepwise", "efroymson", "best-subset", "sparse"]:
+            t, k = ours[(name, eq)]
+            print(f"| termid {name} | {t * 1e3:.3f} | {k} | {base / t:.1f}x faster |")
+        for name, t, k in rows:
+            print(f"| {name} | {t * 1e3:.3f} | {k} | {base / t:.2f} |")
+        print()
+    if not a.quick:
+        rng = np.random.default_rng(7)
+        n, p = 1_000_000, 100
+        Xl = rng.random((n, p)) - 0.5
+        yl = 2 * Xl[:, 0] - Xl[:, 3] + 0.5 * Xl[:, 50] + 0.1 * (rng.random(n) - 0.5)
+        t_xtx, _ = timed(lambda: Xl.T @ Xl, 3)
+        t_sw, _ = timed(lambda: numpy_stepwise(Xl, yl), 3)
+        print("## 10^6 x 100 synthetic\n\n| method | time [ms] |\n|---|---|")
+        print(f"| numpy X'X | {t_xtx * 1e3:.1f} |\n| numpy forward stepwise | {t_sw * 1e3:.1f} |")
+        print("\ntermid on the same size: `cargo bench --bench selectors -- backends_1e6x100` (criterion).")
+
+
+if __name__ == "__main__":
+    main()
