@@ -3,6 +3,7 @@
 
 #![allow(dead_code)]
 
+use nalgebra::{DMatrix, DMatrixView, Dyn};
 use termid::term::{Library, Source, Vocabulary};
 
 /// The 29 candidates of v̇ and ṙ (Oltmann 1973 §3).
@@ -77,4 +78,14 @@ pub fn bind<'a>(lib: &Library, s: &'a [Vec<f64>; 4]) -> Vec<Source<'a>> {
         &|name| (name == "u0").then_some(U0),
     )
     .unwrap()
+}
+
+/// The BLAS-class reference XᵀX of [X | y] (n rows, p + 1 columns, column-major): nalgebra's
+/// gemm through a transposed view, which reaches matrixmultiply's packed kernel.
+pub fn gemm_xtx(z: &[f64], n: usize, cols: usize) -> DMatrix<f64> {
+    let zv = DMatrixView::from_slice(z, n, cols);
+    let zt = DMatrixView::from_slice_with_strides_generic(z, Dyn(cols), Dyn(n), Dyn(n), Dyn(1));
+    let mut c = DMatrix::<f64>::zeros(cols, cols);
+    c.gemm(1.0, &zt, &zv, 0.0);
+    c
 }

@@ -292,6 +292,15 @@ impl Model {
         Ok(Model { path: file.into(), spec, vocabulary: vocab, equations })
     }
 
+    /// The names of the equations `identify` fits (identifiable, with candidates).
+    pub fn identifiable(&self) -> Vec<String> {
+        self.equations
+            .iter()
+            .filter(|e| e.identify && !e.candidates.is_empty())
+            .map(|e| e.name.clone())
+            .collect()
+    }
+
     /// An equation by name.
     pub fn equation(&self, name: &str) -> Option<&Equation> {
         self.equations.iter().find(|e| e.name == name)

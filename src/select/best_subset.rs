@@ -226,18 +226,7 @@ impl Selector for BestSubset {
         for (i, st) in steps.iter_mut().enumerate() {
             st.step = i + 1;
         }
-        let mut selection = Selection {
-            backend: self.name().into(),
-            rows: sc.n,
-            candidates: pb.names.to_vec(),
-            chosen_step: chosen,
-            terms: vec![],
-            intercept: chosen.checked_sub(1).and_then(|c| steps[c].intercept.clone()),
-            steps,
-            stop: if search.stopped { Stop::Converged } else { Stop::AllEntered },
-            notes,
-        };
-        selection.terms = selection.terms_at(chosen);
-        Ok(selection)
+        let stop = if search.stopped { Stop::Converged } else { Stop::AllEntered };
+        Ok(Selection::from_steps(self.name(), sc.n, pb.names, steps, chosen, stop, notes))
     }
 }

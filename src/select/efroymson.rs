@@ -146,18 +146,6 @@ impl Selector for Efroymson {
             }
         };
         let chosen = steps.len();
-        let mut selection = Selection {
-            backend: self.name().into(),
-            rows: sc.n,
-            candidates: pb.names.to_vec(),
-            chosen_step: chosen,
-            terms: vec![],
-            intercept: steps.last().and_then(|s| s.intercept.clone()),
-            steps,
-            stop,
-            notes,
-        };
-        selection.terms = selection.terms_at(chosen);
-        Ok(selection)
+        Ok(Selection::from_steps(self.name(), sc.n, pb.names, steps, chosen, stop, notes))
     }
 }

@@ -152,6 +152,33 @@ pub struct Selection {
 }
 
 impl Selection {
+    /// A selection reporting step `chosen` (1-based; 0 for none) of `steps`: its terms and
+    /// intercept become the equation.
+    pub fn from_steps(
+        backend: &str,
+        rows: usize,
+        candidates: &[String],
+        steps: Vec<Step>,
+        chosen: usize,
+        stop: Stop,
+        notes: Vec<String>,
+    ) -> Selection {
+        let intercept = chosen.checked_sub(1).and_then(|c| steps.get(c)).and_then(|s| s.intercept.clone());
+        let mut selection = Selection {
+            backend: backend.into(),
+            rows,
+            candidates: candidates.to_vec(),
+            steps,
+            chosen_step: chosen,
+            terms: vec![],
+            intercept,
+            stop,
+            notes,
+        };
+        selection.terms = selection.terms_at(chosen);
+        selection
+    }
+
     /// The fitted terms after step `k` (1-based).
     pub fn terms_at(&self, k: usize) -> Vec<FittedTerm> {
         let Some(step) = k.checked_sub(1).and_then(|i| self.steps.get(i)) else { return vec![] };

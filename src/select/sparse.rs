@@ -293,18 +293,6 @@ impl Selector for SparseFit {
             steps[best].reduction,
             shrunk_raw.join(", ")
         ));
-        let mut selection = Selection {
-            backend: self.name().into(),
-            rows: sc.n,
-            candidates: pb.names.to_vec(),
-            chosen_step: chosen,
-            terms: vec![],
-            intercept: steps[best].intercept.clone(),
-            steps,
-            stop: Stop::Converged,
-            notes,
-        };
-        selection.terms = selection.terms_at(chosen);
-        Ok(selection)
+        Ok(Selection::from_steps(self.name(), sc.n, pb.names, steps, chosen, Stop::Converged, notes))
     }
 }

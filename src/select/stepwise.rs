@@ -252,20 +252,8 @@ impl Selector for Stepwise {
             Stop::ExactFit { .. } => steps.len(),
             _ => choose_step(self.step_rule, &steps, pb.forced.len()),
         };
-        let intercept = chosen.checked_sub(1).and_then(|c| steps[c].intercept.clone());
         let pruned = self.prune(pb, &sc, &steps[..chosen], &mut notes);
-        let mut selection = Selection {
-            backend: self.name().into(),
-            rows: n,
-            candidates: pb.names.to_vec(),
-            steps,
-            chosen_step: chosen,
-            terms: vec![],
-            intercept,
-            stop,
-            notes,
-        };
-        selection.terms = selection.terms_at(chosen);
+        let mut selection = Selection::from_steps(self.name(), n, pb.names, steps, chosen, stop, notes);
         if let Some(fit) = pruned {
             selection.terms = fit
                 .set

@@ -146,23 +146,7 @@ fn integer_weights_equal_repeated_rows() {
 fn compare_runs_every_backend() {
     let dir = std::env::temp_dir().join(format!("termid-compare-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let csv = dir.join("lorenz.csv");
-    let (ok, _, err) = termid(&[
-        "simulate",
-        "--model",
-        "models/lorenz.toml",
-        "--integrator",
-        "rk4",
-        "--dt",
-        "0.001",
-        "--sample",
-        "0.001",
-        "--duration",
-        "3",
-        "--out",
-        csv.to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
+    let csv = crate::common::lorenz_csv(&dir, "3");
     let (ok, out, err) = termid(&[
         "compare",
         "--model",

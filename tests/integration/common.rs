@@ -62,3 +62,25 @@ pub fn termid(args: &[&str]) -> (bool, String, String) {
         String::from_utf8_lossy(&out.stderr).into(),
     )
 }
+
+/// Simulates the Lorenz model with `termid simulate` (RK4, Δt = 0.001) into `dir/lorenz.csv`.
+pub fn lorenz_csv(dir: &std::path::Path, duration: &str) -> std::path::PathBuf {
+    let csv = dir.join("lorenz.csv");
+    let (ok, _, err) = termid(&[
+        "simulate",
+        "--model",
+        "models/lorenz.toml",
+        "--integrator",
+        "rk4",
+        "--dt",
+        "0.001",
+        "--sample",
+        "0.001",
+        "--duration",
+        duration,
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    csv
+}

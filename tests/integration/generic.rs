@@ -75,24 +75,8 @@ fn duffing_with_replayed_forcing() {
 fn same_commands_for_lorenz_and_the_ship() {
     let dir = std::env::temp_dir().join(format!("termid-generic-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let csv = dir.join("lorenz.csv");
+    let csv = crate::common::lorenz_csv(&dir, "5");
     let out = dir.join("lorenz-identified.toml");
-    let (ok, _, err) = termid(&[
-        "simulate",
-        "--model",
-        "models/lorenz.toml",
-        "--integrator",
-        "rk4",
-        "--dt",
-        "0.001",
-        "--sample",
-        "0.001",
-        "--duration",
-        "5",
-        "--out",
-        csv.to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
     let (ok, _, err) = termid(&[
         "identify",
         "--model",

@@ -27,16 +27,8 @@ pub fn run(cmd: CompareCommand) -> Result<()> {
     let model = crate::simulate::load_model(&cmd.model)?;
     let time = model.spec.model.time.clone();
     let frames = cmd.data.iter().map(|p| Frame::read_csv(p, &time)).collect::<Result<Vec<_>, _>>()?;
-    let equations: Vec<String> = if cmd.equation.is_empty() {
-        model
-            .equations
-            .iter()
-            .filter(|e| e.identify && !e.candidates.is_empty())
-            .map(|e| e.name.clone())
-            .collect()
-    } else {
-        cmd.equation.clone()
-    };
+    let equations: Vec<String> =
+        if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };
     let diff = differentiator(&cmd.derivative)?;
     let replay = cmd.replay.as_ref().map(|p| Frame::read_csv(p, &time)).transpose()?;
     let mut entries = Vec::new();

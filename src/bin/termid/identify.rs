@@ -113,16 +113,8 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
     let mut model = termid::model::Model::load(&path)?;
     let time = model.spec.model.time.clone();
     let frames = cmd.data.iter().map(|p| Frame::read_csv(p, &time)).collect::<Result<Vec<_>, _>>()?;
-    let names: Vec<String> = if cmd.equation.is_empty() {
-        model
-            .equations
-            .iter()
-            .filter(|e| e.identify && !e.candidates.is_empty())
-            .map(|e| e.name.clone())
-            .collect()
-    } else {
-        cmd.equation.clone()
-    };
+    let names: Vec<String> =
+        if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };
     if cmd.target.is_some() && names.len() != 1 {
         bail!("--target applies to one equation: name it with --equation");
     }
