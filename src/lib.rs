@@ -4,6 +4,7 @@
 #![warn(missing_docs)]
 
 pub mod data;
+pub mod diagnose;
 pub mod identify;
 pub mod model;
 pub mod plot;

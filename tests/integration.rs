@@ -31,3 +31,6 @@ mod selectors;
 // No panic on any user input (model files, CSV, manoeuvre strings).
 #[path = "integration/robustness.rs"]
 mod robustness;
+// The discrepancy workflow on data with hidden effects, and a negative control.
+#[path = "integration/diagnose.rs"]
+mod diagnose;

@@ -24,6 +24,8 @@ pub enum Command {
     Reproduce(ReproduceCommand),
     /// Run every back-end on the same data and equations and show them side by side.
     Compare(CompareCommand),
+    /// Find where model and measurements disagree, name the missing effect, add it.
+    Diagnose(DiagnoseCommand),
 }
 
 /// Output format.
@@ -207,6 +209,26 @@ pub struct CompareCommand {
     /// Fit without an intercept.
     #[arg(long)]
     pub no_intercept: bool,
+    /// Output format.
+    #[arg(long, value_enum, default_value = "text")]
+    pub format: Format,
+}
+
+/// `termid diagnose`.
+#[derive(Debug, Args)]
+pub struct DiagnoseCommand {
+    /// The model to check (default: the embedded Oltmann model).
+    #[arg(long)]
+    pub model: Option<PathBuf>,
+    /// Measured runs (CSV with the time, the inputs and some states).
+    #[arg(long = "data", short = 'd', required = true, num_args = 1..)]
+    pub data: Vec<PathBuf>,
+    /// Write the model with the winning effect added (the original stays as it is).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Integration step, s.
+    #[arg(long, default_value_t = 0.04)]
+    pub dt: f64,
     /// Output format.
     #[arg(long, value_enum, default_value = "text")]
     pub format: Format,

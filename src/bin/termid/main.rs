@@ -2,6 +2,7 @@
 
 mod args;
 mod compare;
+mod diagnose;
 mod identify;
 mod reproduce;
 mod simulate;
@@ -17,6 +18,7 @@ fn main() -> ExitCode {
         args::Command::Simulate(cmd) => simulate::run(cmd),
         args::Command::Reproduce(cmd) => reproduce::run(cmd),
         args::Command::Compare(cmd) => compare::run(cmd),
+        args::Command::Diagnose(cmd) => diagnose::run(cmd),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

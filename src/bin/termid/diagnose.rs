@@ -1,0 +1,96 @@
+//! `termid diagnose`: where model and measurement disagree, which effect explains it, the
+//! model with the effect added, and the gap before and after.
+
+use anyhow::{Context, Result};
+use termid::data::Frame;
+use termid::diagnose::{diagnose, generic_hypotheses, Diagnosis, Settings};
+
+use crate::args::{DiagnoseCommand, Format};
+use crate::identify::num;
+
+pub fn run(cmd: DiagnoseCommand) -> Result<()> {
+    let model = crate::simulate::load_model(&cmd.model)?;
+    let time = model.spec.model.time.clone();
+    let runs = cmd.data.iter().map(|p| Frame::read_csv(p, &time)).collect::<Result<Vec<_>, _>>()?;
+    let hypotheses = if model.spec.ship.is_some() {
+        termid::ship::hypotheses::hypotheses(&model)
+    } else {
+        generic_hypotheses(&model)
+    };
+    let settings = Settings { dt: cmd.dt, ..Settings::default() };
+    let d = diagnose(&model, &runs, &hypotheses, &settings).context("diagnosing")?;
+    if let (Some(out), Some(m)) = (&cmd.out, &d.model) {
+        std::fs::write(out, m.to_toml()).with_context(|| format!("writing {}", out.display()))?;
+    }
+    match cmd.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&json(&d))?),
+        Format::Text => print!("{}", text(&d, cmd.out.as_deref(), hypotheses.len())),
+    }
+    Ok(())
+}
+
+fn json(d: &Diagnosis) -> serde_json::Value {
+    serde_json::json!({
+        "location": d.location,
+        "effect": d.winner.map(|w| {
+            let c = &d.candidates[w];
+            serde_json::json!({"name": c.name, "terms": c.effect, "coefficients": c.estimate, "std_errors": c.std_error,
+                               "explained": c.explained, "delta_bic": c.delta_bic})
+        }),
+        "gap_before": d.gap_before,
+        "gap_after": d.gap_after,
+        "candidates": d.candidates,
+    })
+}
+
+fn text(d: &Diagnosis, out: Option<&std::path::Path>, tested: usize) -> String {
+    let mut s = format!("where: {}\n\n", d.location.words);
+    s += &format!("{tested} hypotheses tested (output error, recorded inputs replayed); best first:\n");
+    s += &format!("{:<58} {:>10} {:>12}  estimate ± std. error\n", "hypothesis", "explained", "ΔBIC");
+    for c in d.candidates.iter().take(8) {
+        let est: Vec<String> = c
+            .estimate
+            .iter()
+            .zip(&c.std_error)
+            .map(|(e, se)| format!("{} ± {}", num(*e), num(*se)))
+            .collect();
+        s += &format!(
+            "{:<58} {:>9.1}% {:>12.1}  {}\n",
+            c.name,
+            100.0 * c.explained,
+            c.delta_bic,
+            est.join(", ")
+        );
+    }
+    s += "\n";
+    match d.winner {
+        Some(w) => {
+            let c = &d.candidates[w];
+            s += &format!("verdict: {} explains {:.0} % of the gap", c.name, 100.0 * c.explained);
+            if let Some(r) = d.candidates.get(w + 1) {
+                s += &format!(" (runner-up: {}, {:.0} %)", r.name, 100.0 * r.explained);
+            }
+            s += ".\n";
+        }
+        None => s += "verdict: no hypothesis explains the gap significantly; the model is left unchanged.\n",
+    }
+    s += &format!(
+        "\n{:<8} {:>16} {:>16} {:>16} {:>16}\n",
+        "state", "RMS before", "RMS after", "max before", "max after"
+    );
+    for (b, a) in d.gap_before.states.iter().zip(&d.gap_after.states) {
+        s += &format!(
+            "{:<8} {:>16} {:>16} {:>16} {:>16}  [{}]\n",
+            b.0,
+            num(b.2),
+            num(a.2),
+            num(b.3),
+            num(a.3),
+            b.1
+        );
+    }
+    if let (Some(p), Some(_)) = (out, &d.model) {
+        s += &format!("\nwrote {} (the original is unchanged)\n", p.display());
+    }
+    s
+}

@@ -1,0 +1,394 @@
+//! Output error: simulate the measured runs with their recorded inputs from their recorded
+//! initial states, compare every measured state (each scaled by its spread in the data), and
+//! fit a hypothesis's parameters by Gauss-Newton / Levenberg-Marquardt on those residuals.
+
+use nalgebra::{DMatrix, DVector};
+
+use super::hypotheses::{Effect, Hypothesis};
+use super::{DiagnoseError, Gap, Location};
+use crate::data::Frame;
+use crate::model::Model;
+use crate::sim::{simulate, Controller, Integrator, Replay, Settings, SimError, System, Trajectory};
+
+/// The measured runs prepared for re-simulation.
+pub struct Runs {
+    frames: Vec<Frame>,
+    /// (state index in the system, measured column) for the compared states.
+    states: Vec<(usize, String)>,
+    scale: Vec<f64>,
+    units: Vec<String>,
+    x0: Vec<Vec<f64>>,
+    settings: Vec<Settings>,
+}
+
+/// Recorded inputs with an offset and a factor applied.
+struct Transformed {
+    replay: Replay,
+    offset: Vec<f64>,
+    factor: Vec<f64>,
+}
+
+impl Controller for Transformed {
+    fn input(&mut self, t: f64, x: &[f64], out: &mut [f64]) {
+        self.replay.input(t, x, out);
+        for ((o, a), b) in out.iter_mut().zip(&self.offset).zip(&self.factor) {
+            *o = *o * b + a;
+        }
+    }
+}
+
+/// Simulates every run of `runs` with `model` (for scripts and tests).
+pub fn simulate_runs(runs: &Runs, model: &Model) -> Result<Vec<Trajectory>, SimError> {
+    runs.simulate(model, &[], &[])
+}
+
+impl Runs {
+    /// Prepares runs: every state the model has and the data have is compared.
+    pub fn new(model: &Model, frames: &[Frame], dt: f64) -> Result<Runs, DiagnoseError> {
+        if frames.is_empty() {
+            return Err(DiagnoseError::Setup("no measured runs".into()));
+        }
+        let system = System::new(model, &Default::default(), false)?;
+        let states: Vec<(usize, String)> = system
+            .states
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| frames.iter().all(|f| f.column(s).is_some()))
+            .map(|(i, s)| (i, s.clone()))
+            .collect();
+        if states.is_empty() {
+            return Err(DiagnoseError::Setup(format!(
+                "the runs have none of the model's states ({}) as columns",
+                system.states.join(", ")
+            )));
+        }
+        for f in frames {
+            for i in &system.inputs {
+                f.require(i)?;
+            }
+        }
+        let scale = states
+            .iter()
+            .map(|(_, s)| {
+                let all: Vec<f64> =
+                    frames.iter().flat_map(|f| f.column(s).unwrap_or(&[]).iter().copied()).collect();
+                let mean = all.iter().sum::<f64>() / all.len() as f64;
+                let sd = (all.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / all.len() as f64).sqrt();
+                if sd > 0.0 {
+                    sd
+                } else {
+                    1.0
+                }
+            })
+            .collect();
+        let units = states
+            .iter()
+            .map(|(_, s)| {
+                model.spec.states.iter().find(|t| &t.name == s).map_or(String::new(), |t| t.unit.clone())
+            })
+            .collect();
+        let x0 = frames
+            .iter()
+            .map(|f| {
+                system
+                    .states
+                    .iter()
+                    .map(|s| {
+                        f.column(s).map_or_else(
+                            || model.spec.states.iter().find(|t| &t.name == s).map_or(0.0, |t| t.initial),
+                            |c| c[0],
+                        )
+                    })
+                    .collect()
+            })
+            .collect();
+        let settings = frames
+            .iter()
+            .map(|f| {
+                let t = f.time();
+                let sample = if t.len() > 1 { t[1] - t[0] } else { dt };
+                let sub = (sample / dt).round().max(1.0);
+                Settings {
+                    integrator: Integrator::ModifiedEuler,
+                    dt: sample / sub,
+                    duration: t[t.len() - 1] - t[0],
+                    sample,
+                }
+            })
+            .collect();
+        Ok(Runs { frames: frames.to_vec(), states, scale, units, x0, settings })
+    }
+
+    /// Number of compared values.
+    pub fn residual_count(&self) -> usize {
+        self.frames.iter().map(|f| f.len()).sum::<usize>() * self.states.len()
+    }
+
+    /// Simulates every run; `offsets` and `factors` by input index.
+    pub fn simulate(
+        &self,
+        model: &Model,
+        offsets: &[(usize, f64)],
+        factors: &[(usize, f64)],
+    ) -> Result<Vec<Trajectory>, SimError> {
+        let system = System::new(model, &Default::default(), false)?;
+        let m = system.inputs.len();
+        self.frames
+            .iter()
+            .zip(&self.x0)
+            .zip(&self.settings)
+            .map(|((f, x0), s)| {
+                let mut c = Transformed {
+                    replay: Replay::new(f, &system.inputs)?,
+                    offset: vec![0.0; m],
+                    factor: vec![1.0; m],
+                };
+                for &(i, v) in offsets {
+                    c.offset[i] = v;
+                }
+                for &(i, v) in factors {
+                    c.factor[i] = v;
+                }
+                simulate(&system, x0, &mut c, s)
+            })
+            .collect()
+    }
+
+    /// Scaled residuals (sim − measured) of every compared state, run by run.
+    pub fn residuals(&self, sims: &[Trajectory]) -> Vec<f64> {
+        let mut r = Vec::with_capacity(self.residual_count());
+        for (f, sim) in self.frames.iter().zip(sims) {
+            for ((i, name), sc) in self.states.iter().zip(&self.scale) {
+                let meas = f.column(name).unwrap_or(&[]);
+                for (k, m) in meas.iter().enumerate() {
+                    let s = sim.states[*i].get(k).copied().unwrap_or(f64::NAN);
+                    r.push((s - m) / sc);
+                }
+            }
+        }
+        r
+    }
+
+    /// RMS and max per state, in the state's unit.
+    pub fn gap(&self, sims: &[Trajectory]) -> Gap {
+        let mut states = Vec::new();
+        for (((i, name), unit), _) in self.states.iter().zip(&self.units).zip(&self.scale) {
+            let mut sq = 0.0;
+            let mut n = 0usize;
+            let mut max = 0.0f64;
+            for (f, sim) in self.frames.iter().zip(sims) {
+                for (k, m) in f.column(name).unwrap_or(&[]).iter().enumerate() {
+                    let d = sim.states[*i].get(k).copied().unwrap_or(f64::NAN) - m;
+                    sq += d * d;
+                    n += 1;
+                    max = max.max(d.abs());
+                }
+            }
+            states.push((name.clone(), unit.clone(), (sq / n.max(1) as f64).sqrt(), max));
+        }
+        let cost = self.residuals(sims).iter().map(|r| r * r).sum();
+        Gap { states, cost }
+    }
+
+    /// Where the gap is: leading state, onset, growth, and what it goes with.
+    pub fn locate(&self, sims: &[Trajectory]) -> Location {
+        let scaled_rms: Vec<f64> = self
+            .states
+            .iter()
+            .zip(&self.scale)
+            .map(|((i, name), sc)| {
+                let (mut sq, mut n) = (0.0, 0usize);
+                for (f, sim) in self.frames.iter().zip(sims) {
+                    for (k, m) in f.column(name).unwrap_or(&[]).iter().enumerate() {
+                        sq += ((sim.states[*i][k.min(sim.states[*i].len() - 1)] - m) / sc).powi(2);
+                        n += 1;
+                    }
+                }
+                (sq / n.max(1) as f64).sqrt()
+            })
+            .collect();
+        let lead = scaled_rms.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1)).map_or(0, |x| x.0);
+        let (li, lname) = &self.states[lead];
+        let mut onset = Vec::new();
+        let (mut first, mut second) = (0.0, 0.0);
+        // growth rate of the gap against the magnitude of every measured column
+        let mut rates: Vec<f64> = Vec::new();
+        let mut columns: Vec<(String, Vec<f64>)> =
+            self.frames[0].names().iter().skip(1).map(|n| (n.clone(), Vec::new())).collect();
+        for (f, sim) in self.frames.iter().zip(sims) {
+            let meas = f.column(lname).unwrap_or(&[]);
+            let t = f.time();
+            let e: Vec<f64> = meas
+                .iter()
+                .enumerate()
+                .map(|(k, m)| sim.states[*li][k.min(sim.states[*li].len() - 1)] - m)
+                .collect();
+            let emax = e.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+            let k0 = e.iter().position(|v| v.abs() > 0.1 * emax).unwrap_or(0);
+            onset.push((f.origin().to_string(), t[k0] - t[0]));
+            let half = e.len() / 2;
+            first += e[..half].iter().map(|v| v * v).sum::<f64>();
+            second += e[half..].iter().map(|v| v * v).sum::<f64>();
+            for k in 1..e.len() {
+                rates.push(((e[k] - e[k - 1]) / (t[k] - t[k - 1])).abs());
+                for (name, col) in columns.iter_mut() {
+                    col.push(f.column(name).map_or(f64::NAN, |c| c[k].abs()));
+                }
+            }
+        }
+        let growth = (second / first.max(1e-300)).sqrt();
+        let regime = columns
+            .iter()
+            .filter(|(n, _)| n != lname && !n.ends_with("_dot"))
+            .map(|(n, c)| (n.clone(), correlation(&rates, c)))
+            .filter(|(_, r)| r.is_finite())
+            .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+            .unwrap_or_default();
+        let earliest = onset.iter().map(|o| o.1).fold(f64::INFINITY, f64::min);
+        let words = format!(
+            "The gap is led by {lname}; it is visible from t = {earliest:.1} s on; {}; it grows fastest where |{}| is {} (correlation {:.2}).",
+            if growth > 1.5 {
+                format!("it keeps growing (second half {growth:.1}× the first): an effect that accumulates")
+            } else {
+                format!("it does not grow much (second half {growth:.1}× the first)")
+            },
+            regime.0,
+            if regime.1 >= 0.0 { "large" } else { "small" },
+            regime.1
+        );
+        Location { leading_state: lname.clone(), onset, growth, regime, words }
+    }
+}
+
+fn correlation(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len()) as f64;
+    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for (x, y) in a.iter().zip(b) {
+        sab += (x - ma) * (y - mb);
+        saa += (x - ma).powi(2);
+        sbb += (y - mb).powi(2);
+    }
+    sab / (saa * sbb).sqrt()
+}
+
+/// The model with a hypothesis's term coefficients added (inputs are changed in simulation).
+pub fn apply(model: &Model, h: &Hypothesis, theta: &[f64]) -> Result<Model, String> {
+    let mut m = model.clone();
+    if let Effect::Terms { terms } = &h.effect {
+        for ((eq, text), value) in terms.iter().zip(theta) {
+            let term = m.vocabulary.parse(text).map_err(|e| e.to_string())?;
+            let e = m.equation(eq).ok_or_else(|| format!("no equation {eq}"))?.clone();
+            let mut coefs = e.coefficients.clone();
+            match coefs.iter_mut().find(|(t, _, _)| *t == term) {
+                Some(c) => c.1 += value,
+                None => coefs.push((term, *value, None)),
+            }
+            m.set_coefficients(eq, coefs, e.intercept);
+        }
+    }
+    Ok(m)
+}
+
+fn residuals(data: &Runs, model: &Model, h: &Hypothesis, theta: &[f64]) -> Option<Vec<f64>> {
+    let m = apply(model, h, theta).ok()?;
+    let sims = data.simulate(&m, &h.input_offsets(theta, model), &h.input_scales(theta, model)).ok()?;
+    let r = data.residuals(&sims);
+    r.iter().all(|v| v.is_finite()).then_some(r)
+}
+
+fn jacobian(data: &Runs, model: &Model, h: &Hypothesis, theta: &[f64]) -> Option<(Vec<f64>, DMatrix<f64>)> {
+    let r0 = residuals(data, model, h, theta)?;
+    let mut jac = DMatrix::<f64>::zeros(r0.len(), theta.len());
+    for j in 0..theta.len() {
+        let step = 1e-6 * theta[j].abs().max(1e-3);
+        let (mut up, mut down) = (theta.to_vec(), theta.to_vec());
+        up[j] += step;
+        down[j] -= step;
+        let (ru, rd) = (residuals(data, model, h, &up)?, residuals(data, model, h, &down)?);
+        for (i, (a, b)) in ru.iter().zip(&rd).enumerate() {
+            jac[(i, j)] = (a - b) / (2.0 * step);
+        }
+    }
+    Some((r0, jac))
+}
+
+fn cost(r: &[f64]) -> f64 {
+    r.iter().map(|v| v * v).sum()
+}
+
+/// `iterations` Gauss-Newton steps from θ = 0; (θ, cost).
+pub fn gauss_newton(
+    data: &Runs,
+    model: &Model,
+    h: &Hypothesis,
+    iterations: usize,
+) -> Result<(Vec<f64>, f64), String> {
+    let mut theta = vec![0.0; h.parameters()];
+    let mut best = cost(&residuals(data, model, h, &theta).ok_or("the unchanged model diverges")?);
+    for _ in 0..iterations {
+        let (r, j) = jacobian(data, model, h, &theta).ok_or("diverges near the start")?;
+        let jt = j.transpose();
+        let step = (&jt * &j).lu().solve(&(&jt * DVector::from_vec(r))).ok_or("singular")?;
+        let trial: Vec<f64> = theta.iter().zip(step.iter()).map(|(t, d)| t - d).collect();
+        match residuals(data, model, h, &trial) {
+            Some(rt) if cost(&rt) < best => {
+                best = cost(&rt);
+                theta = trial;
+            }
+            _ => break,
+        }
+    }
+    Ok((theta, best))
+}
+
+/// Levenberg-Marquardt from θ0; (θ, cost, standard errors).
+pub fn levenberg_marquardt(
+    data: &Runs,
+    model: &Model,
+    h: &Hypothesis,
+    theta0: Vec<f64>,
+) -> Result<(Vec<f64>, f64, Vec<f64>), String> {
+    let mut theta = theta0;
+    let (mut r, mut j) = jacobian(data, model, h, &theta).ok_or("diverges at the start")?;
+    let mut c = cost(&r);
+    let mut lambda = 1e-3;
+    for _ in 0..30 {
+        let jt = j.transpose();
+        let jtj = &jt * &j;
+        let g = &jt * DVector::from_vec(r.clone());
+        let mut a = jtj.clone();
+        for k in 0..a.nrows() {
+            a[(k, k)] += lambda * jtj[(k, k)].max(1e-300);
+        }
+        let Some(step) = a.lu().solve(&g) else { break };
+        let trial: Vec<f64> = theta.iter().zip(step.iter()).map(|(t, d)| t - d).collect();
+        match residuals(data, model, h, &trial) {
+            Some(rt) if cost(&rt) < c => {
+                let improvement = (c - cost(&rt)) / c.max(1e-300);
+                theta = trial;
+                (r, j) = jacobian(data, model, h, &theta).ok_or("diverges")?;
+                c = cost(&r);
+                lambda = (lambda / 10.0).max(1e-12);
+                if improvement < 1e-10 {
+                    break;
+                }
+            }
+            _ => {
+                lambda *= 10.0;
+                if lambda > 1e10 {
+                    break;
+                }
+            }
+        }
+    }
+    let n = r.len() as f64;
+    let k = theta.len() as f64;
+    let sigma2 = c / (n - k).max(1.0);
+    let jt = j.transpose();
+    let se = match (&jt * &j).try_inverse() {
+        Some(inv) => (0..theta.len()).map(|i| (sigma2 * inv[(i, i)]).max(0.0).sqrt()).collect(),
+        None => vec![f64::NAN; theta.len()],
+    };
+    Ok((theta, c, se))
+}

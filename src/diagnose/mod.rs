@@ -1,0 +1,200 @@
+//! The discrepancy workflow (`termid diagnose`): re-simulate measured runs with their
+//! recorded inputs, find where model and measurement part, test a library of candidate
+//! effects against the gap by output error (each hypothesis's few new parameters fitted by
+//! Levenberg-Marquardt with the rest of the model held), rank them by the error left and an
+//! information criterion, add the winner to a new model, and show the gap shrink. Generic:
+//! the library holds constants, missing candidate terms and input offsets and scales; a
+//! plug-in (the ship's) adds named hypotheses.
+
+mod fit;
+mod hypotheses;
+
+use serde::Serialize;
+
+pub use fit::{simulate_runs, Runs};
+pub use hypotheses::{generic_hypotheses, Effect, Hypothesis};
+
+use crate::data::{DataError, Frame};
+use crate::model::Model;
+use crate::sim::SimError;
+
+/// Why a diagnosis failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum DiagnoseError {
+    /// Data.
+    #[error(transparent)]
+    Data(#[from] DataError),
+    /// Simulation of the unchanged model.
+    #[error(transparent)]
+    Sim(#[from] SimError),
+    /// Setup.
+    #[error("{0}")]
+    Setup(String),
+}
+
+/// The gap between simulation and measurement, per state: RMS and max of (sim − meas).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Gap {
+    /// (state, unit, RMS, max |·|) over all runs.
+    pub states: Vec<(String, String, f64, f64)>,
+    /// Scaled sum of squares (each state by its spread in the data) over all runs and samples.
+    pub cost: f64,
+}
+
+/// Where the disagreement is.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Location {
+    /// The state with the largest scaled gap.
+    pub leading_state: String,
+    /// First time its gap exceeds 10 % of its largest value, per run.
+    pub onset: Vec<(String, f64)>,
+    /// Ratio of the gap's RMS in the second half of the runs to the first half (> 1: it grows).
+    pub growth: f64,
+    /// The measured quantity whose magnitude goes with the gap's growth rate most, and the
+    /// correlation (where the gap grows fastest).
+    pub regime: (String, f64),
+    /// The same in words.
+    pub words: String,
+}
+
+/// One tested hypothesis.
+#[derive(Clone, Debug, Serialize)]
+pub struct Candidate {
+    /// Its name.
+    pub name: String,
+    /// What it adds.
+    pub effect: Effect,
+    /// Estimated parameters (coefficients; input offsets in the input's unit; scales as factors).
+    pub estimate: Vec<f64>,
+    /// Their standard errors (from the Gauss-Newton approximation at the optimum).
+    pub std_error: Vec<f64>,
+    /// Scaled cost left.
+    pub cost: f64,
+    /// Share of the gap's cost it removes.
+    pub explained: f64,
+    /// BIC change against the unchanged model (negative: better).
+    pub delta_bic: f64,
+    /// Made of declared candidate terms (see [`Hypothesis::declared`]).
+    pub declared: bool,
+}
+
+/// Settings.
+#[derive(Clone, Debug, Serialize)]
+pub struct Settings {
+    /// Integration step (B8).
+    pub dt: f64,
+    /// Hypotheses refined by Levenberg-Marquardt after screening (the rest keep one step).
+    pub refine: usize,
+    /// An effect is significant if it removes at least this share of the gap …
+    pub min_explained: f64,
+    /// … and lowers BIC by at least this much.
+    pub min_bic_drop: f64,
+    /// Hypotheses within this share of the best one's explained gap count as tied; among them
+    /// those made of the model's declared candidate terms come first.
+    pub tie: f64,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings { dt: 0.04, refine: 8, min_explained: 0.3, min_bic_drop: 10.0, tie: 0.01 }
+    }
+}
+
+/// What `diagnose` found.
+#[derive(Clone, Debug, Serialize)]
+pub struct Diagnosis {
+    /// Where.
+    pub location: Location,
+    /// The gap with the model as it is.
+    pub gap_before: Gap,
+    /// With the winner added (equal to before when nothing is significant).
+    pub gap_after: Gap,
+    /// Every hypothesis, best first.
+    pub candidates: Vec<Candidate>,
+    /// Index of the significant winner in `candidates`, if any.
+    pub winner: Option<usize>,
+    /// The model with the winner added.
+    #[serde(skip)]
+    pub model: Option<Model>,
+}
+
+/// Runs the workflow on measured runs (time column = the model's; states and inputs by name).
+pub fn diagnose(
+    model: &Model,
+    runs: &[Frame],
+    hypotheses: &[Hypothesis],
+    settings: &Settings,
+) -> Result<Diagnosis, DiagnoseError> {
+    let data = Runs::new(model, runs, settings.dt)?;
+    let base = data.simulate(model, &[], &[])?;
+    let gap_before = data.gap(&base);
+    let location = data.locate(&base);
+    let n = data.residual_count() as f64;
+    let mut candidates: Vec<Candidate> = Vec::new();
+    // screening: one Gauss-Newton step from zero for every hypothesis
+    let mut screened: Vec<(usize, Vec<f64>, f64)> = Vec::new();
+    for (i, h) in hypotheses.iter().enumerate() {
+        if let Ok((theta, cost)) = fit::gauss_newton(&data, model, h, 1) {
+            screened.push((i, theta, cost));
+        }
+    }
+    screened.sort_by(|a, b| a.2.total_cmp(&b.2));
+    for (rank, (i, theta, cost)) in screened.into_iter().enumerate() {
+        let h = &hypotheses[i];
+        let (theta, cost, se) = if rank < settings.refine {
+            match fit::levenberg_marquardt(&data, model, h, theta.clone()) {
+                Ok(r) => r,
+                Err(_) => (theta, cost, vec![f64::NAN; h.parameters()]),
+            }
+        } else {
+            (theta, cost, vec![f64::NAN; h.parameters()])
+        };
+        let k = h.parameters() as f64;
+        let delta_bic = n * (cost.max(1e-300) / gap_before.cost.max(1e-300)).ln() + k * n.ln();
+        candidates.push(Candidate {
+            name: h.name.clone(),
+            effect: h.effect.clone(),
+            estimate: h.natural(&theta),
+            std_error: se,
+            cost,
+            explained: 1.0 - cost / gap_before.cost.max(1e-300),
+            delta_bic,
+            declared: h.declared(model),
+        });
+    }
+    candidates.sort_by(|a, b| a.delta_bic.total_cmp(&b.delta_bic).then(a.cost.total_cmp(&b.cost)));
+    // a catch-all (a constant, an input error) that only ties with the model's own physics
+    // does not win: among near-ties, declared candidate terms come first
+    if let Some(best) = candidates.first().map(|c| c.explained) {
+        let tied = candidates.iter().take_while(|c| best - c.explained <= settings.tie).count();
+        candidates[..tied]
+            .sort_by(|a, b| b.declared.cmp(&a.declared).then(a.delta_bic.total_cmp(&b.delta_bic)));
+    }
+    let winner = candidates
+        .first()
+        .filter(|c| c.explained >= settings.min_explained && c.delta_bic <= -settings.min_bic_drop)
+        .map(|_| 0);
+    let (gap_after, new_model) = match winner {
+        Some(w) => {
+            let h = hypotheses
+                .iter()
+                .find(|h| h.name == candidates[w].name)
+                .ok_or_else(|| DiagnoseError::Setup("lost hypothesis".into()))?;
+            let theta = h.internal(&candidates[w].estimate);
+            let m = fit::apply(model, h, &theta).map_err(DiagnoseError::Setup)?;
+            let after = data.simulate(&m, &h.input_offsets(&theta, model), &h.input_scales(&theta, model))?;
+            let mut m = m;
+            m.spec.model.notes.push(format!(
+                "termid diagnose added {} ({}), explaining {:.0} % of the gap (ΔBIC {:.1})",
+                candidates[w].name,
+                candidates[w].estimate.iter().map(|v| format!("{v:.6}")).collect::<Vec<_>>().join(", "),
+                100.0 * candidates[w].explained,
+                candidates[w].delta_bic
+            ));
+            (data.gap(&after), Some(m))
+        }
+        None => (gap_before.clone(), None),
+    };
+    Ok(Diagnosis { location, gap_before, gap_after, candidates, winner, model: new_model })
+}

@@ -1,0 +1,172 @@
+//! `termid diagnose` on data in which an effect is hidden, each made by the test itself:
+//! the paper's missing B0·u², C0·u²; a rudder zero offset; a missing cubic term; a rudder
+//! scale error; the offset again under measurement noise; and a negative control.
+
+use std::sync::LazyLock;
+
+use termid::data::Frame;
+use termid::diagnose::{diagnose, Diagnosis, Effect, Settings};
+use termid::model::Model;
+use termid::ship::oltmann::{self, data, resim, Options};
+use termid::sim::{simulate, Controller, Integrator, Replay, System};
+
+use crate::common::Lcg;
+
+static STUDY: LazyLock<oltmann::Study> =
+    LazyLock::new(|| oltmann::run(&Model::default_model(), &Options::default(), &mut |_| {}).unwrap());
+
+/// The 30°/10° and 20°/20° runs of the true model, as recorded (0.2 s samples).
+fn recorded() -> Vec<Frame> {
+    STUDY
+        .recorded
+        .iter()
+        .filter(|r| r.name == "z30_10" || r.name == "z20_20")
+        .map(|r| r.frame.clone())
+        .collect()
+}
+
+/// The recorded rudder, altered on its way to the "real" ship.
+struct Altered {
+    replay: Replay,
+    offset: f64,
+    factor: f64,
+}
+
+impl Controller for Altered {
+    fn input(&mut self, t: f64, x: &[f64], out: &mut [f64]) {
+        self.replay.input(t, x, out);
+        out[0] = out[0] * self.factor + self.offset;
+    }
+}
+
+/// Runs of the true model whose real rudder is `factor`·δ + `offset` while the file records
+/// δ; `noise` adds basin-like measurement noise (0.1° heading, 0.02 m/s, 0.05 °/s, 0.02 m).
+fn hidden_rudder_error(offset: f64, factor: f64, noise: bool) -> Vec<Frame> {
+    let model = Model::default_model();
+    let system = System::new(&model, &Default::default(), false).unwrap();
+    let mut g = Lcg(99);
+    recorded()
+        .iter()
+        .map(|f| {
+            let x0: Vec<f64> = system.states.iter().map(|s| f.require(s).unwrap()[0]).collect();
+            let mut c = Altered { replay: Replay::new(f, &system.inputs).unwrap(), offset, factor };
+            let s = termid::sim::Settings {
+                integrator: Integrator::ModifiedEuler,
+                dt: 0.04,
+                duration: 100.0,
+                sample: 0.2,
+            };
+            let t = simulate(&system, &x0, &mut c, &s).unwrap();
+            let mut out = Frame::new(f.origin(), "t", t.time.clone()).unwrap();
+            for (k, name) in system.states.iter().enumerate() {
+                let sd = match name.as_str() {
+                    "ψ" => 0.1f64.to_radians(),
+                    "u" | "v" => 0.02,
+                    "r" => 0.05f64.to_radians(),
+                    _ => 0.02,
+                };
+                let values =
+                    t.states[k].iter().map(|v| if noise { v + sd * g.normal() } else { *v }).collect();
+                out.push(name, values).unwrap();
+            }
+            out.push("δ", f.require("δ").unwrap().to_vec()).unwrap();
+            out
+        })
+        .collect()
+}
+
+fn run(model: &Model, runs: &[Frame]) -> Diagnosis {
+    diagnose(model, runs, &termid::ship::hypotheses::hypotheses(model), &Settings::default()).unwrap()
+}
+
+fn heading_shrink(d: &Diagnosis) -> f64 {
+    let rms = |g: &termid::diagnose::Gap| g.states.iter().find(|s| s.0 == "ψ").unwrap().2;
+    1.0 - rms(&d.gap_after) / rms(&d.gap_before)
+}
+
+#[test]
+fn names_the_papers_missing_asymmetry() {
+    let model = resim::identified_model(&Model::default_model(), &STUDY.alt5, resim::Column::Komb);
+    // all five zigzags, as the paper (and the issue) did
+    let runs: Vec<Frame> = STUDY
+        .recorded
+        .iter()
+        .map(|r| {
+            data::degrade(&r.frame, data::Alternative::RoundedDifferentiated, data::RateUnit::Degrees)
+                .unwrap()
+        })
+        .collect();
+    let d = run(&model, &runs);
+    let w = &d.candidates[d.winner.expect("an effect")];
+    assert!(w.name.contains("asymmetry"), "{}", w.name);
+    let Effect::Terms { terms } = &w.effect else { panic!("{:?}", w.effect) };
+    let c0 = terms
+        .iter()
+        .zip(&w.estimate)
+        .find(|((eq, t), _)| eq == "r_dot" && t == "u^2")
+        .map(|(_, v)| *v)
+        .unwrap();
+    assert!((c0 - -0.0014).abs() < 0.0006, "C0 = {c0}");
+    assert!(heading_shrink(&d) >= 0.8, "heading gap shrank by {}", heading_shrink(&d));
+    // the new model carries the effect and says where it came from
+    let m = d.model.as_ref().unwrap();
+    assert!(m.spec.model.notes.iter().any(|n| n.contains("termid diagnose added")));
+    assert_ne!(m.equation("r_dot").unwrap().coefficients, model.equation("r_dot").unwrap().coefficients);
+}
+
+#[test]
+fn names_a_rudder_zero_offset() {
+    let d = run(&Model::default_model(), &hidden_rudder_error(1.5f64.to_radians(), 1.0, false));
+    let w = &d.candidates[d.winner.expect("an effect")];
+    assert_eq!(w.name, "rudder zero offset");
+    assert!((w.estimate[0].to_degrees() - 1.5).abs() < 0.05, "{}°", w.estimate[0].to_degrees());
+    assert!(heading_shrink(&d) >= 0.7);
+}
+
+#[test]
+fn names_a_rudder_scale_error() {
+    let d = run(&Model::default_model(), &hidden_rudder_error(0.0, 1.1, false));
+    let w = &d.candidates[d.winner.expect("an effect")];
+    assert_eq!(w.name, "rudder angle scale error");
+    assert!((w.estimate[0] - 1.1).abs() < 0.01, "{}", w.estimate[0]);
+    assert!(heading_shrink(&d) >= 0.7);
+}
+
+#[test]
+fn names_a_missing_cubic_term() {
+    let mut model = Model::default_model();
+    let cubic = model.vocabulary.parse("v^3/u").unwrap();
+    let eq = model.equation("r_dot").unwrap().clone();
+    model.set_coefficients(
+        "r_dot",
+        eq.coefficients.into_iter().filter(|(t, _, _)| *t != cubic).collect(),
+        None,
+    );
+    let d = run(&model, &recorded());
+    let w = &d.candidates[d.winner.expect("an effect")];
+    assert!(w.name.contains("v^3/u") && w.name.contains("r_dot"), "{}", w.name);
+    assert!((w.estimate[0] - -1.1812).abs() < 0.05, "{}", w.estimate[0]);
+    let shrink = 1.0 - d.gap_after.cost / d.gap_before.cost;
+    assert!(shrink >= 0.7, "{shrink}");
+}
+
+#[test]
+fn noise_does_not_change_the_verdict() {
+    let d = run(&Model::default_model(), &hidden_rudder_error(1.5f64.to_radians(), 1.0, true));
+    let w = &d.candidates[d.winner.expect("an effect")];
+    assert_eq!(w.name, "rudder zero offset");
+    assert!((w.estimate[0].to_degrees() - 1.5).abs() < 0.2, "{}°", w.estimate[0].to_degrees());
+}
+
+#[test]
+fn negative_control_changes_nothing() {
+    let model = Model::default_model();
+    let d = run(&model, &hidden_rudder_error(0.0, 1.0, true));
+    assert!(
+        d.winner.is_none(),
+        "found {:?}",
+        d.candidates.first().map(|c| (&c.name, c.explained, c.delta_bic))
+    );
+    assert!(d.model.is_none());
+    assert_eq!(d.gap_after, d.gap_before);
+}
