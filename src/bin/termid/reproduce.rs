@@ -21,7 +21,7 @@ pub fn run(cmd: ReproduceCommand) -> Result<()> {
         },
         rate_unit: if cmd.round_rates_in_radians { RateUnit::Radians } else { RateUnit::Degrees },
     };
-    let bar = ProgressBar::new(10);
+    let bar = ProgressBar::new(11);
     bar.set_style(
         ProgressStyle::with_template("{elapsed:>4} [{bar:30}] {pos}/{len} {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_bar())
@@ -74,6 +74,17 @@ pub fn run(cmd: ReproduceCommand) -> Result<()> {
             d.b0,
             d.c0
         );
+    }
+    if let Some(d) = &study.diagnosis {
+        match d.winner {
+            Some(w) => println!(
+                "\ntermid diagnose on the alternative-5 model: {} ({}), explains {:.1} % of the gap",
+                d.candidates[w].name,
+                d.candidates[w].estimate.iter().map(|v| format!("{v:.5}")).collect::<Vec<_>>().join(", "),
+                100.0 * d.candidates[w].explained
+            ),
+            None => println!("\ntermid diagnose on the alternative-5 model: no significant effect"),
+        }
     }
     println!("\nreport: {}", path.display());
     Ok(())

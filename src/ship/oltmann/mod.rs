@@ -143,6 +143,8 @@ pub struct Study {
     pub predictions: Vec<Prediction>,
     /// The B0/C0 story.
     pub drift: Vec<DriftCure>,
+    /// termid's own discrepancy workflow on the alternative-5 Komb. model and the five runs.
+    pub diagnosis: Option<crate::diagnose::Diagnosis>,
 }
 
 fn tables_for(
@@ -293,7 +295,17 @@ pub fn run(
             after: resimulate(&ship, &format!("{name} + B0, C0"), &cured, &recorded, &[3, 4])?,
         });
     }
+    progress("termid diagnose on the alternative-5 model");
+    let diagnosis = sets.iter().find(|(n, _)| *n == "alt5/Komb").and_then(|(_, m)| {
+        let runs: Vec<crate::data::Frame> = recorded
+            .iter()
+            .filter_map(|r| degrade(&r.frame, Alternative::RoundedDifferentiated, options.rate_unit).ok())
+            .collect();
+        let hypotheses = crate::ship::hypotheses::hypotheses(m);
+        crate::diagnose::diagnose(m, &runs, &hypotheses, &crate::diagnose::Settings::default()).ok()
+    });
     Ok(Study {
+        diagnosis,
         options: options.clone(),
         delta0_deg,
         recorded,

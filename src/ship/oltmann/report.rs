@@ -421,6 +421,12 @@ pub fn summary(study: &Study) -> serde_json::Value {
         "fig5": study.alternatives,
         "resimulations": study.resimulations,
         "predictions": study.predictions,
+        "diagnosis": study.diagnosis.as_ref().map(|d| json!({
+            "winner": d.winner.map(|w| &d.candidates[w]),
+            "gap_before": d.gap_before,
+            "gap_after": d.gap_after,
+            "location": d.location,
+        })),
         "drift": study.drift.iter().map(|d| json!({
             "coefficients": d.coefficients, "b0": d.b0, "c0": d.c0,
             "before": d.before, "after": d.after,
@@ -513,8 +519,48 @@ fn markdown(study: &Study) -> String {
         s += &resim_rows(&[d.before.clone(), d.after.clone()].concat());
         let _ = writeln!(s, "\n![drift](figures/drift_{}.svg)\n", d.coefficients.replace('/', "_"));
     }
-    s += "termid's own discrepancy workflow (`termid diagnose`) is not built yet; when it is, this section will show its verdict beside the paper's way.\n\n";
+    s += &diagnosis_md(study);
     s += &remarks_sample();
+    s
+}
+
+fn diagnosis_md(study: &Study) -> String {
+    let Some(d) = &study.diagnosis else {
+        return "termid's discrepancy workflow did not run (the alternative-5 model could not be simulated).\n\n".into();
+    };
+    let mut s = String::from("**termid's own way** (`termid diagnose`, the alt5/Komb model against the five rounded runs, every hypothesis fitted by output error):\n\n");
+    s +=
+        &format!("{}\n\n| hypothesis | explained | ΔBIC | estimate |\n|---|---|---|---|\n", d.location.words);
+    for c in d.candidates.iter().take(5) {
+        let est: Vec<String> = c.estimate.iter().map(|v| format!("{v:.5}")).collect();
+        s += &format!(
+            "| {} | {:.1} % | {:.0} | {} |\n",
+            c.name,
+            100.0 * c.explained,
+            c.delta_bic,
+            est.join(", ")
+        );
+    }
+    match d.winner {
+        Some(w) => {
+            s += &format!(
+                "\nVerdict: **{}**, explaining {:.1} % of the gap.",
+                d.candidates[w].name,
+                100.0 * d.candidates[w].explained
+            );
+        }
+        None => s += "\nVerdict: no hypothesis explains the gap significantly.",
+    }
+    s += " Gap before → after (RMS): ";
+    let cells: Vec<String> = d
+        .gap_before
+        .states
+        .iter()
+        .zip(&d.gap_after.states)
+        .map(|(b, a)| format!("{} {} → {} {}", b.0, fmt(b.2), fmt(a.2), b.1))
+        .collect();
+    s += &cells.join(", ");
+    s += ".\n\n";
     s
 }
 
