@@ -114,7 +114,8 @@ pub struct PlotError {
 
 /// Axis numbers without trailing noise: 0.25, 30, 1e-4.
 fn short(v: f64) -> String {
-    if v == 0.0 {
+    // tick positions computed as sums carry round-off: 1e-17 is a zero
+    if v.abs() < 1e-12 {
         "0".into()
     } else if v.abs() >= 1e-3 && v.abs() < 1e5 {
         let s = format!("{v:.3}");

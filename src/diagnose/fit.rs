@@ -44,7 +44,12 @@ pub fn simulate_runs(runs: &Runs, model: &Model) -> Result<Vec<Trajectory>, SimE
 
 impl Runs {
     /// Prepares runs: every state the model has and the data have is compared.
-    pub fn new(model: &Model, frames: &[Frame], dt: f64) -> Result<Runs, DiagnoseError> {
+    pub fn new(
+        model: &Model,
+        frames: &[Frame],
+        dt: f64,
+        integrator: Integrator,
+    ) -> Result<Runs, DiagnoseError> {
         if frames.is_empty() {
             return Err(DiagnoseError::Setup("no measured runs".into()));
         }
@@ -108,12 +113,7 @@ impl Runs {
                 let t = f.time();
                 let sample = if t.len() > 1 { t[1] - t[0] } else { dt };
                 let sub = (sample / dt).round().max(1.0);
-                Settings {
-                    integrator: Integrator::ModifiedEuler,
-                    dt: sample / sub,
-                    duration: t[t.len() - 1] - t[0],
-                    sample,
-                }
+                Settings { integrator, dt: sample / sub, duration: t[t.len() - 1] - t[0], sample }
             })
             .collect();
         Ok(Runs { frames: frames.to_vec(), states, scale, units, x0, settings })
@@ -187,7 +187,29 @@ impl Runs {
             states.push((name.clone(), unit.clone(), (sq / n.max(1) as f64).sqrt(), max));
         }
         let cost = self.residuals(sims).iter().map(|r| r * r).sum();
-        Gap { states, cost }
+        let runs = self
+            .frames
+            .iter()
+            .zip(sims)
+            .map(|(f, sim)| {
+                let per = self
+                    .states
+                    .iter()
+                    .map(|(i, name)| {
+                        let meas = f.column(name).unwrap_or(&[]);
+                        let d: Vec<f64> = meas
+                            .iter()
+                            .enumerate()
+                            .map(|(k, m)| sim.states[*i].get(k).copied().unwrap_or(f64::NAN) - m)
+                            .collect();
+                        let rms = (d.iter().map(|v| v * v).sum::<f64>() / d.len().max(1) as f64).sqrt();
+                        (name.clone(), rms, d.iter().fold(0.0f64, |a, b| a.max(b.abs())))
+                    })
+                    .collect();
+                (f.origin().to_string(), per)
+            })
+            .collect();
+        Gap { states, runs, cost }
     }
 
     /// Where the gap is: leading state, onset, growth, and what it goes with.

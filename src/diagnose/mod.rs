@@ -12,6 +12,62 @@ mod hypotheses;
 use serde::Serialize;
 
 pub use fit::{simulate_runs, Runs};
+
+/// Figures of a diagnosis, one per run: each measured state against the simulation before
+/// (and after) the winning effect, and the residual.
+pub fn figures(d: &Diagnosis, runs: &[crate::data::Frame]) -> Vec<(String, crate::plot::Figure)> {
+    use crate::plot::{Figure, Panel, Series};
+    runs.iter()
+        .enumerate()
+        .filter_map(|(k, f)| {
+            let before = d.before.get(k)?;
+            let mut panels = Vec::new();
+            for (i, name) in before.state_names.iter().enumerate() {
+                let Some(meas) = f.column(name) else { continue };
+                let t = f.time().to_vec();
+                let n = meas.len().min(before.states[i].len());
+                let mut series = vec![
+                    Series::line("measured", t[..n].to_vec(), meas[..n].to_vec()),
+                    Series::dashed("model", t[..n].to_vec(), before.states[i][..n].to_vec()),
+                ];
+                let mut residual = vec![Series::line(
+                    "model − measured",
+                    t[..n].to_vec(),
+                    (0..n).map(|j| before.states[i][j] - meas[j]).collect(),
+                )];
+                if let Some(after) = d.after.get(k) {
+                    series.push(Series::dashed(
+                        "with the effect",
+                        t[..n].to_vec(),
+                        after.states[i][..n].to_vec(),
+                    ));
+                    residual.push(Series::line(
+                        "with the effect − measured",
+                        t[..n].to_vec(),
+                        (0..n).map(|j| after.states[i][j] - meas[j]).collect(),
+                    ));
+                }
+                panels.push(Panel {
+                    title: name.clone(),
+                    x_label: "t".into(),
+                    y_label: name.clone(),
+                    series,
+                    ..Panel::default()
+                });
+                panels.push(Panel {
+                    title: format!("{name}: residual"),
+                    x_label: "t".into(),
+                    y_label: "Δ".into(),
+                    series: residual,
+                    ..Panel::default()
+                });
+            }
+            let mut fig = Figure::new(&format!("diagnose: {}", f.origin()), panels);
+            fig.panel_height = 170;
+            Some((f.origin().to_string(), fig))
+        })
+        .collect()
+}
 pub use hypotheses::{generic_hypotheses, Effect, Hypothesis};
 
 use crate::data::{DataError, Frame};
@@ -38,9 +94,14 @@ pub enum DiagnoseError {
 pub struct Gap {
     /// (state, unit, RMS, max |·|) over all runs.
     pub states: Vec<(String, String, f64, f64)>,
+    /// The same per run.
+    pub runs: Vec<RunGap>,
     /// Scaled sum of squares (each state by its spread in the data) over all runs and samples.
     pub cost: f64,
 }
+
+/// One run's gap: (run, [(state, RMS, max |·|)]).
+pub type RunGap = (String, Vec<(String, f64, f64)>);
 
 /// Where the disagreement is.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -82,8 +143,10 @@ pub struct Candidate {
 /// Settings.
 #[derive(Clone, Debug, Serialize)]
 pub struct Settings {
-    /// Integration step (B8).
+    /// Integration step.
     pub dt: f64,
+    /// Integrator of the re-simulations (use the one the model is meant for).
+    pub integrator: crate::sim::Integrator,
     /// Hypotheses refined by Levenberg-Marquardt after screening (the rest keep one step).
     pub refine: usize,
     /// An effect is significant if it removes at least this share of the gap …
@@ -97,7 +160,14 @@ pub struct Settings {
 
 impl Default for Settings {
     fn default() -> Self {
-        Settings { dt: 0.04, refine: 8, min_explained: 0.3, min_bic_drop: 10.0, tie: 0.01 }
+        Settings {
+            dt: 0.04,
+            integrator: crate::sim::Integrator::ModifiedEuler,
+            refine: 8,
+            min_explained: 0.3,
+            min_bic_drop: 10.0,
+            tie: 0.01,
+        }
     }
 }
 
@@ -117,6 +187,12 @@ pub struct Diagnosis {
     /// The model with the winner added.
     #[serde(skip)]
     pub model: Option<Model>,
+    /// The re-simulations before (and after) the winner, for figures.
+    #[serde(skip)]
+    pub before: Vec<crate::sim::Trajectory>,
+    /// After.
+    #[serde(skip)]
+    pub after: Vec<crate::sim::Trajectory>,
 }
 
 /// Runs the workflow on measured runs (time column = the model's; states and inputs by name).
@@ -126,7 +202,7 @@ pub fn diagnose(
     hypotheses: &[Hypothesis],
     settings: &Settings,
 ) -> Result<Diagnosis, DiagnoseError> {
-    let data = Runs::new(model, runs, settings.dt)?;
+    let data = Runs::new(model, runs, settings.dt, settings.integrator)?;
     let base = data.simulate(model, &[], &[])?;
     let gap_before = data.gap(&base);
     let location = data.locate(&base);
@@ -175,6 +251,7 @@ pub fn diagnose(
         .first()
         .filter(|c| c.explained >= settings.min_explained && c.delta_bic <= -settings.min_bic_drop)
         .map(|_| 0);
+    let mut after_sims = Vec::new();
     let (gap_after, new_model) = match winner {
         Some(w) => {
             let h = hypotheses
@@ -192,9 +269,20 @@ pub fn diagnose(
                 100.0 * candidates[w].explained,
                 candidates[w].delta_bic
             ));
-            (data.gap(&after), Some(m))
+            let gap = data.gap(&after);
+            after_sims = after;
+            (gap, Some(m))
         }
         None => (gap_before.clone(), None),
     };
-    Ok(Diagnosis { location, gap_before, gap_after, candidates, winner, model: new_model })
+    Ok(Diagnosis {
+        location,
+        gap_before,
+        gap_after,
+        candidates,
+        winner,
+        model: new_model,
+        before: base,
+        after: after_sims,
+    })
 }

@@ -170,3 +170,63 @@ fn negative_control_changes_nothing() {
     assert!(d.model.is_none());
     assert_eq!(d.gap_after, d.gap_before);
 }
+
+/// The command on a non-ship model: a Duffing oscillator whose forcing input is recorded
+/// 0.3 too low. JSON keys, one figure per run, the corrected model written, the original kept.
+#[test]
+fn command_on_a_generic_model() {
+    let dir = std::env::temp_dir().join(format!("termid-diagnose-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let model = Model::load(std::path::Path::new("models/duffing.toml")).unwrap();
+    let system = System::new(&model, &Default::default(), false).unwrap();
+    let t: Vec<f64> = (0..=3000).map(|i| i as f64 * 0.01).collect();
+    let mut files = Vec::new();
+    for (k, w) in [0.7, 1.3].iter().enumerate() {
+        let forcing: Vec<f64> = t.iter().map(|t| 0.8 * (w * t).sin()).collect();
+        let mut rec = Frame::new("forcing", "t", t.clone()).unwrap();
+        rec.push("F", forcing.clone()).unwrap();
+        // the real forcing is 0.3 higher than recorded
+        let mut real = Frame::new("real", "t", t.clone()).unwrap();
+        real.push("F", forcing.iter().map(|f| f + 0.3).collect()).unwrap();
+        let mut c = Replay::new(&real, &system.inputs).unwrap();
+        let s = termid::sim::Settings { integrator: Integrator::Rk4, dt: 0.01, duration: 30.0, sample: 0.01 };
+        let run = simulate(&system, &[0.0, 0.0], &mut c, &s).unwrap();
+        let mut out = run.to_frame("run", "t").unwrap();
+        out.set("F", forcing).unwrap();
+        let path = dir.join(format!("run{k}.csv"));
+        out.write_csv(&path).unwrap();
+        files.push(path);
+    }
+    let new_model = dir.join("duffing-cured.toml");
+    let svg = dir.join("figs");
+    let mut args = vec![
+        "diagnose",
+        "--model",
+        "models/duffing.toml",
+        "--dt",
+        "0.01",
+        "--integrator",
+        "rk4",
+        "--format",
+        "json",
+    ];
+    args.extend(["--out", new_model.to_str().unwrap(), "--svg", svg.to_str().unwrap(), "--data"]);
+    let names: Vec<String> = files.iter().map(|f| f.to_str().unwrap().to_string()).collect();
+    args.extend(names.iter().map(String::as_str));
+    let (ok, out, err) = crate::common::termid(&args);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    // with F entering v̇ with coefficient 1, an offset on F and a constant force are one effect
+    let name = v["effect"]["name"].as_str().unwrap();
+    assert!(name == "offset on input F" || name == "constant in v_dot", "{name}");
+    assert!((v["effect"]["coefficients"][0].as_f64().unwrap() - 0.3).abs() < 1e-3);
+    for key in ["gap_before", "gap_after", "candidates", "location"] {
+        assert!(!v[key].is_null(), "{key}");
+    }
+    assert!(v["gap_after"]["cost"].as_f64().unwrap() < 0.01 * v["gap_before"]["cost"].as_f64().unwrap());
+    assert!(svg.join("diagnose_run0.svg").exists() && svg.join("diagnose_run1.svg").exists());
+    assert!(Model::load(&new_model).is_ok());
+    // the original is untouched: it still has no offset and reloads as before
+    assert_eq!(Model::load(std::path::Path::new("models/duffing.toml")).unwrap().spec, model.spec);
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -226,6 +226,12 @@ pub struct DiagnoseCommand {
     /// Write the model with the winning effect added (the original stays as it is).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Write one figure per run (measured, simulated, residual) into this folder.
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
+    /// Integrator of the re-simulations: b8 (the paper's, default) or rk4.
+    #[arg(long, default_value = "b8")]
+    pub integrator: String,
     /// Integration step, s.
     #[arg(long, default_value_t = 0.04)]
     pub dt: f64,

@@ -17,8 +17,21 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
     } else {
         generic_hypotheses(&model)
     };
-    let settings = Settings { dt: cmd.dt, ..Settings::default() };
+    let settings = Settings {
+        dt: cmd.dt,
+        integrator: termid::sim::Integrator::by_name(&cmd.integrator)?,
+        ..Settings::default()
+    };
     let d = diagnose(&model, &runs, &hypotheses, &settings).context("diagnosing")?;
+    if let Some(dir) = &cmd.svg {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        for (k, (name, fig)) in termid::diagnose::figures(&d, &runs).into_iter().enumerate() {
+            let stem = std::path::Path::new(&name)
+                .file_stem()
+                .map_or(format!("run{k}"), |s| s.to_string_lossy().into_owned());
+            fig.write_svg(&dir.join(format!("diagnose_{stem}.svg")))?;
+        }
+    }
     if let (Some(out), Some(m)) = (&cmd.out, &d.model) {
         std::fs::write(out, m.to_toml()).with_context(|| format!("writing {}", out.display()))?;
     }
@@ -88,6 +101,12 @@ fn text(d: &Diagnosis, out: Option<&std::path::Path>, tested: usize) -> String {
             num(a.3),
             b.1
         );
+    }
+    s += "\nper run (RMS before → after):\n";
+    for ((run, b), (_, a)) in d.gap_before.runs.iter().zip(&d.gap_after.runs) {
+        let cells: Vec<String> =
+            b.iter().zip(a).map(|(x, y)| format!("{} {} → {}", x.0, num(x.1), num(y.1))).collect();
+        s += &format!("  {run}: {}\n", cells.join(", "));
     }
     if let (Some(p), Some(_)) = (out, &d.model) {
         s += &format!("\nwrote {} (the original is unchanged)\n", p.display());
