@@ -238,11 +238,13 @@ impl Identification<'_> {
             return Err(IdentifyError::Setup("no data: give at least one run".into()));
         }
         let library = Library::compile(candidates, self.vocabulary)?;
-        let mut acc = Accumulator::new(candidates.len());
-        for f in frames {
-            self.accumulate(&library, target, f, &mut acc)?;
+        // per run, for the back-ends that cross-validate; together they are "Komb. Daten"
+        let folds =
+            frames.iter().map(|f| self.moments(&library, target, f)).collect::<Result<Vec<_>, _>>()?;
+        let mut moments = Moments::new(candidates.len());
+        for f in &folds {
+            moments.merge(f);
         }
-        let moments = acc.finish();
         let names: Vec<String> = candidates.iter().map(Term::to_string).collect();
         let index_of = |t: &Term, role: &str| {
             candidates
@@ -259,7 +261,7 @@ impl Identification<'_> {
             excluded: &excluded,
             intercept: self.intercept,
         };
-        let selection = backend.select(&problem)?;
+        let selection = backend.select_with_folds(&problem, &folds)?;
         Ok(Fit { target: target.to_string(), candidates: names, selection })
     }
 }

@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 
 use super::stepwise::Stepwise;
 use super::subset::{sweep, Scaled};
-use super::{Problem, SelectError, Selection, Selector, Step, Stop};
+use super::{Moments, Problem, SelectError, Selection, Selector, Step, Stop};
 
 /// How the model size is chosen.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -26,6 +26,9 @@ pub enum Criterion {
     Cp,
     /// Largest adjusted R².
     AdjustedR2,
+    /// Smallest leave-one-run-out prediction error (each run predicted from the others;
+    /// needs two runs or more).
+    LeaveOneRunOut,
 }
 
 /// Settings.
@@ -129,6 +132,16 @@ impl Selector for BestSubset {
     }
 
     fn select(&self, pb: &Problem<'_>) -> Result<Selection, SelectError> {
+        self.search(pb, &[])
+    }
+
+    fn select_with_folds(&self, pb: &Problem<'_>, folds: &[Moments]) -> Result<Selection, SelectError> {
+        self.search(pb, folds)
+    }
+}
+
+impl BestSubset {
+    fn search(&self, pb: &Problem<'_>, folds: &[Moments]) -> Result<Selection, SelectError> {
         let sc = Scaled::new(pb)?;
         let m = sc.m;
         let mut notes = Vec::new();
@@ -214,6 +227,7 @@ impl Selector for BestSubset {
                 Criterion::Aic => n * (rss * sc.total / n).ln() + 2.0 * kk,
                 Criterion::Cp => rss / sigma2 - sc.n_eff + 2.0 * kk,
                 Criterion::AdjustedR2 => -(1.0 - rss * sc.n_eff / (sc.n_eff - k as f64).max(1e-300)),
+                Criterion::LeaveOneRunOut => super::cross_validation_error(pb, folds, set)?,
             };
             scores.push(score);
             steps.push(st);

@@ -17,7 +17,7 @@ use serde::{Deserialize, Serialize};
 pub use best_subset::{BestSubset, Criterion};
 pub use efroymson::Efroymson;
 pub use moments::{Accumulator, Moments};
-pub use sparse::{Equality, SparseFit};
+pub use sparse::{Equality, LambdaChoice, SparseFit};
 pub use stepwise::{StepRule, Stepwise};
 
 /// What a back-end is asked to do.
@@ -265,6 +265,41 @@ pub trait Selector: Send + Sync {
     fn name(&self) -> &'static str;
     /// Chooses terms and fits their coefficients.
     fn select(&self, problem: &Problem<'_>) -> Result<Selection, SelectError>;
+    /// The same with the statistics of each run (folds) for cross-validation; back-ends that
+    /// do not cross-validate ignore them.
+    fn select_with_folds(&self, problem: &Problem<'_>, _folds: &[Moments]) -> Result<Selection, SelectError> {
+        self.select(problem)
+    }
+}
+
+/// Leave-one-run-out squared prediction error of the least-squares fit on `set`: each run
+/// predicted by the fit on all the others, from sufficient statistics alone.
+pub fn cross_validation_error(
+    problem: &Problem<'_>,
+    folds: &[Moments],
+    set: &[usize],
+) -> Result<f64, SelectError> {
+    if folds.len() < 2 {
+        return Err(SelectError::Config(format!(
+            "cross-validation needs at least two runs, has {}",
+            folds.len()
+        )));
+    }
+    let mut total = 0.0;
+    for fold in folds {
+        let train = problem.moments.without(fold);
+        let pb = Problem { moments: &train, ..*problem };
+        let sc = subset::Scaled::new(&pb)?;
+        let Ok(a) = sc.swept(set, 1e-12) else { return Ok(f64::INFINITY) };
+        let b: Vec<f64> = set.iter().map(|&j| a[j * sc.m + sc.p] * sc.d[sc.p] / sc.d[j]).collect();
+        let b0 = if pb.intercept {
+            train.means()[sc.p] - set.iter().zip(&b).map(|(&j, bj)| bj * train.means()[j]).sum::<f64>()
+        } else {
+            0.0
+        };
+        total += fold.squared_error(set, &b, b0);
+    }
+    Ok(total)
 }
 
 /// Back-end settings as written in model files and chosen on the CLI, by `method` name.

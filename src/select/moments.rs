@@ -82,6 +82,51 @@ impl Moments {
     }
 }
 
+impl Moments {
+    /// The statistics of all rows except those of `part` (which must be among them): the
+    /// inverse of [`Moments::merge`], for leaving one run out.
+    pub fn without(&self, part: &Moments) -> Moments {
+        assert_eq!(self.p, part.p, "moments of different regressor sets");
+        let m = self.p + 1;
+        let rest_w = self.weight - part.weight;
+        let mut rest = Moments::new(self.p);
+        rest.count = self.count.saturating_sub(part.count);
+        rest.weight = rest_w;
+        if rest_w <= 0.0 {
+            return rest;
+        }
+        for j in 0..m {
+            rest.mean[j] = (self.weight * self.mean[j] - part.weight * part.mean[j]) / rest_w;
+        }
+        let f = rest_w * part.weight / self.weight;
+        for j in 0..m {
+            for i in 0..m {
+                let (di, dj) = (part.mean[i] - rest.mean[i], part.mean[j] - rest.mean[j]);
+                rest.comoment[i + j * m] = self.comoment[i + j * m] - part.comoment[i + j * m] - f * di * dj;
+            }
+        }
+        rest
+    }
+
+    /// Σ w (y − b0 − Σ bⱼ xⱼ)² over these rows for a given linear predictor (`set` columns,
+    /// `coefficients` aligned): the squared error of a model fitted elsewhere.
+    pub fn squared_error(&self, set: &[usize], coefficients: &[f64], intercept: f64) -> f64 {
+        let p = self.p;
+        let c = |i: usize, j: usize| self.corrected(i, j);
+        let mut sse = c(p, p);
+        for (a, &i) in set.iter().enumerate() {
+            sse -= 2.0 * coefficients[a] * c(i, p);
+            for (b, &j) in set.iter().enumerate() {
+                sse += coefficients[a] * coefficients[b] * c(i, j);
+            }
+        }
+        let bias = self.mean[p]
+            - intercept
+            - set.iter().zip(coefficients).map(|(&i, b)| b * self.mean[i]).sum::<f64>();
+        (sse + self.weight * bias * bias).max(0.0)
+    }
+}
+
 /// Σ x with four independent partial sums: a single running sum is a dependent chain of
 /// additions (latency-bound, ~4× slower), and the compiler may not reorder it itself.
 fn sum4(x: &[f64]) -> f64 {
@@ -265,6 +310,33 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn without_is_the_inverse_of_merge_and_squared_error_is_direct() {
+        let x: Vec<f64> = (0..60).map(|i| ((i * 37 % 11) as f64) * 0.3 + 1.0).collect();
+        let y: Vec<f64> = (0..30).map(|i| (i as f64 * 0.7).sin() * 3.0 + 5.0).collect();
+        let cols = |r: std::ops::Range<usize>| -> Vec<f64> {
+            (0..2).flat_map(|j| x[j * 30 + r.start..j * 30 + r.end].to_vec()).collect()
+        };
+        let (mut a, mut b, mut all) = (Accumulator::new(2), Accumulator::new(2), Accumulator::new(2));
+        a.push(&cols(0..12), &y[..12], None);
+        b.push(&cols(12..30), &y[12..], None);
+        all.push(&x, &y, None);
+        let (a, b, all) = (a.finish(), b.finish(), all.finish());
+        let rest = all.without(&a);
+        for i in 0..3 {
+            assert!((rest.means()[i] - b.means()[i]).abs() < 1e-12);
+            for j in 0..3 {
+                assert!(
+                    (rest.corrected(i, j) - b.corrected(i, j)).abs()
+                        < 1e-9 * b.corrected(i, j).abs().max(1.0)
+                );
+            }
+        }
+        // squared error of y ≈ 0.5 + 0.3 x1 − 0.2 x2 on rows 12..30, directly
+        let direct: f64 = (12..30).map(|r| (y[r] - 0.5 - 0.3 * x[r] + 0.2 * x[30 + r]).powi(2)).sum();
+        assert!((b.squared_error(&[0, 1], &[0.3, -0.2], 0.5) - direct).abs() < 1e-9 * direct);
     }
 
     #[test]

@@ -16,7 +16,7 @@ use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, S
 use serde::{Deserialize, Serialize};
 
 use super::subset::Scaled;
-use super::{Problem, SelectError, Selection, Selector, Step, Stop};
+use super::{Moments, Problem, SelectError, Selection, Selector, Step, Stop};
 
 /// A linear equality between coefficients: Σ coefficient × b[term] = value (raw units).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -28,10 +28,22 @@ pub struct Equality {
     pub value: f64,
 }
 
+/// How λ is chosen on the path.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum LambdaChoice {
+    /// BIC of the least-squares refit.
+    #[default]
+    Bic,
+    /// Leave-one-run-out prediction error of the refit (needs two runs or more).
+    LeaveOneRunOut,
+}
+
 /// Settings.
 ///
 /// | setting | default | meaning |
 /// |---|---|---|
+/// | `choice` | `bic` | how λ is chosen: `bic` or `leave-one-run-out` |
 /// | `path` | 40 | number of λ on the path, log-spaced from λ_max to λ_max·`lambda_ratio` |
 /// | `lambda_ratio` | 1e-5 | smallest λ over λ_max |
 /// | `lambda` | none | a single λ instead of the path (standardised units) |
@@ -44,6 +56,8 @@ pub struct Equality {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SparseFit {
+    /// How λ is chosen.
+    pub choice: LambdaChoice,
     /// λ values on the path.
     pub path: usize,
     /// λ_min / λ_max.
@@ -67,6 +81,7 @@ pub struct SparseFit {
 impl Default for SparseFit {
     fn default() -> Self {
         SparseFit {
+            choice: LambdaChoice::Bic,
             path: 40,
             lambda_ratio: 1e-5,
             lambda: None,
@@ -223,6 +238,16 @@ impl Selector for SparseFit {
     }
 
     fn select(&self, pb: &Problem<'_>) -> Result<Selection, SelectError> {
+        self.path_fit(pb, &[])
+    }
+
+    fn select_with_folds(&self, pb: &Problem<'_>, folds: &[Moments]) -> Result<Selection, SelectError> {
+        self.path_fit(pb, folds)
+    }
+}
+
+impl SparseFit {
+    fn path_fit(&self, pb: &Problem<'_>, folds: &[Moments]) -> Result<Selection, SelectError> {
         self.validate()?;
         let sc = Scaled::new(pb)?;
         let (p, m) = (sc.p, sc.m);
@@ -270,7 +295,10 @@ impl Selector for SparseFit {
             st.reduction = lambda; // the path's λ (standardised units), for the report
             let rss = sc.residual_share(&a).max(1e-13); // exact fits: see best_subset
             let k = support.len() as f64 + if sc.intercept { 1.0 } else { 0.0 };
-            scores.push(n * (rss * sc.total / n).ln() + k * n.ln());
+            scores.push(match self.choice {
+                LambdaChoice::Bic => n * (rss * sc.total / n).ln() + k * n.ln(),
+                LambdaChoice::LeaveOneRunOut => super::cross_validation_error(pb, folds, &support)?,
+            });
             shrunk.push(beta);
             steps.push(st);
         }
@@ -289,8 +317,12 @@ impl Selector for SparseFit {
             .map(|&j| format!("{} {:.6e}", pb.names[j], shrunk[best][j] * sc.d[p] / sc.d[j]))
             .collect();
         notes.push(format!(
-            "λ = {:.3e} chosen by BIC of the least-squares refit; LASSO (shrunk) coefficients there: {}",
+            "λ = {:.3e} chosen by {} of the least-squares refit; LASSO (shrunk) coefficients there: {}",
             steps[best].reduction,
+            match self.choice {
+                LambdaChoice::Bic => "BIC",
+                LambdaChoice::LeaveOneRunOut => "leave-one-run-out error",
+            },
             shrunk_raw.join(", ")
         ));
         Ok(Selection::from_steps(self.name(), sc.n, pb.names, steps, chosen, Stop::Converged, notes))

@@ -266,3 +266,73 @@ fn sparse_fit_honours_constraints_and_reports_solver_failure() {
     assert!(matches!(e, SelectError::Solver(_)), "{e}");
     assert!(e.to_string().contains("Infeasible"), "{e}");
 }
+
+/// Three runs of one planted problem: each run's columns and target, their statistics per
+/// run, and all together.
+struct ThreeRuns {
+    cols: Vec<Vec<Vec<f64>>>,
+    ys: Vec<Vec<f64>>,
+    folds: Vec<termid::select::Moments>,
+    total: termid::select::Moments,
+}
+
+fn three_runs(seed: u64, noise: f64) -> ThreeRuns {
+    let truth = [(1, 2.0), (4, -1.5), (6, 0.75)];
+    let mut cols = Vec::new();
+    let mut ys = Vec::new();
+    let mut folds = Vec::new();
+    for k in 0..3 {
+        let (c, y) = planted(seed + k, 40, 8, &truth, noise);
+        folds.push(moments_of(&c, &y));
+        cols.push(c);
+        ys.push(y);
+    }
+    let mut total = folds[0].clone();
+    total.merge(&folds[1]);
+    total.merge(&folds[2]);
+    ThreeRuns { cols, ys, folds, total }
+}
+
+#[test]
+fn leave_one_run_out_error_equals_direct_computation() {
+    let ThreeRuns { cols, ys, folds, total } = three_runs(31, 0.2);
+    let names = names(8);
+    let pb = Problem { moments: &total, names: &names, forced: &[], excluded: &[], intercept: true };
+    let set = [1usize, 4, 5];
+    let got = termid::select::cross_validation_error(&pb, &folds, &set).unwrap();
+    // directly: fit on the raw rows of the other two runs by QR, predict the third
+    let mut want = 0.0;
+    for out in 0..3 {
+        let train: Vec<usize> = (0..3).filter(|k| *k != out).collect();
+        let sub: Vec<Vec<f64>> =
+            set.iter().map(|&j| train.iter().flat_map(|&k| cols[k][j].clone()).collect()).collect();
+        let y: Vec<f64> = train.iter().flat_map(|&k| ys[k].clone()).collect();
+        let (b0, b) = qr_fit(&sub, &y, true);
+        for i in 0..ys[out].len() {
+            let f = b0.unwrap() + set.iter().zip(&b).map(|(&j, bj)| bj * cols[out][j][i]).sum::<f64>();
+            want += (ys[out][i] - f).powi(2);
+        }
+    }
+    assert!((got - want).abs() < 1e-9 * want, "{got} vs {want}");
+}
+
+#[test]
+fn cross_validated_choices_recover_the_support() {
+    use termid::select::{Criterion, LambdaChoice, SparseFit};
+    let ThreeRuns { folds, total, .. } = three_runs(41, 0.05);
+    let names = names(8);
+    let pb = Problem { moments: &total, names: &names, forced: &[], excluded: &[], intercept: true };
+    let bs = BestSubset { criterion: Criterion::LeaveOneRunOut, ..BestSubset::default() };
+    let sp = SparseFit { choice: LambdaChoice::LeaveOneRunOut, ..SparseFit::default() };
+    for (name, s) in
+        [("best subset", bs.select_with_folds(&pb, &folds)), ("sparse", sp.select_with_folds(&pb, &folds))]
+    {
+        let s = s.unwrap();
+        let mut got: Vec<usize> = s.terms.iter().map(|t| t.index).collect();
+        got.sort();
+        assert_eq!(got, [1, 4, 6], "{name}: {:?}", s.notes);
+    }
+    // without runs to leave out, a clear error
+    let e = bs.select(&pb).unwrap_err();
+    assert!(e.to_string().contains("cross-validation needs at least two runs"), "{e}");
+}
