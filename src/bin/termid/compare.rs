@@ -46,8 +46,10 @@ pub fn run(cmd: CompareCommand) -> Result<()> {
                 e.backend = Backend::by_name(name)?;
             }
             // one warm-up fit, then the median of `repeat` timed fits (data already loaded)
-            let fit = fit_equation(&m, eq, &frames, diff.as_ref(), !cmd.no_intercept, None)
-                .with_context(|| format!("{name} on `{eq}`"))?;
+            let fit = crate::progress::with_spinner(&format!("{name} on {eq}"), || {
+                fit_equation(&m, eq, &frames, diff.as_ref(), !cmd.no_intercept, None)
+            })
+            .with_context(|| format!("{name} on `{eq}`"))?;
             let mut times: Vec<f64> = (0..cmd.repeat.max(1))
                 .map(|_| {
                     let started = Instant::now();

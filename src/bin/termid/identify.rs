@@ -84,7 +84,9 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
         intercept: !cmd.no_intercept,
         weights: cmd.weight.clone(),
     };
-    let fit = identification.fit(&target, &candidates, &forced, &excluded, &frames, selector.as_ref())?;
+    let fit = crate::progress::with_spinner(&format!("{} on {}", selector.name(), target), || {
+        identification.fit(&target, &candidates, &forced, &excluded, &frames, selector.as_ref())
+    })?;
     match cmd.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&json(&fit))?),
         Format::Text => print!("{}", text(&fit)),
@@ -121,14 +123,16 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
     let diff = differentiator(&cmd.derivative)?;
     let mut fits = Vec::new();
     for name in &names {
-        let fit = termid::identify::fit_equation(
-            &model,
-            name,
-            &frames,
-            diff.as_ref(),
-            !cmd.no_intercept,
-            cmd.target.as_deref().map(Target::parse),
-        )
+        let fit = crate::progress::with_spinner(&format!("identifying {name}"), || {
+            termid::identify::fit_equation(
+                &model,
+                name,
+                &frames,
+                diff.as_ref(),
+                !cmd.no_intercept,
+                cmd.target.as_deref().map(Target::parse),
+            )
+        })
         .with_context(|| format!("identifying `{name}`"))?;
         let coefficients = termid::identify::coefficients_of(&fit, &model.vocabulary)?;
         model.set_coefficients(name, coefficients, fit.selection.intercept.as_ref().map(|b| b.value));

@@ -4,6 +4,7 @@ mod args;
 mod compare;
 mod diagnose;
 mod identify;
+mod progress;
 mod reproduce;
 mod simulate;
 
