@@ -240,7 +240,17 @@ pub fn simulate(
     Ok(out)
 }
 
+#[inline]
 fn check(system: &System, t: f64, x: &[f64], prev: &[f64]) -> Result<(), SimError> {
+    // one branch in the common case: NaN fails both comparisons
+    if x.iter().zip(&system.bounds).all(|(v, (lo, hi))| *v >= *lo && *v <= *hi && v.is_finite()) {
+        return Ok(());
+    }
+    report(system, t, x, prev)
+}
+
+#[cold]
+fn report(system: &System, t: f64, x: &[f64], prev: &[f64]) -> Result<(), SimError> {
     for (i, &v) in x.iter().enumerate() {
         let (lo, hi) = system.bounds[i];
         let why = if !v.is_finite() {

@@ -93,20 +93,22 @@ impl System {
 
     /// Scratch space for [`System::derivatives`].
     pub fn workspace(&self) -> Workspace {
-        Workspace { args: vec![0.0; self.map.len()], scratch: self.rhs.scratch() }
+        Workspace { scratch: self.rhs.scratch() }
     }
 
     /// ẋ = f(x, input).
     #[inline]
     pub fn derivatives(&self, x: &[f64], input: &[f64], ws: &mut Workspace, dx: &mut [f64]) {
-        for (a, slot) in ws.args.iter_mut().zip(&self.map) {
-            *a = match *slot {
+        let params = &self.params;
+        self.rhs.eval_row_with(
+            |j| match self.map[j] {
                 Slot::State(i) => x[i],
                 Slot::Input(i) => input[i],
-                Slot::Param(i) => self.params[i],
-            };
-        }
-        self.rhs.eval_row(&ws.args, &mut ws.scratch, dx);
+                Slot::Param(i) => params[i],
+            },
+            &mut ws.scratch,
+            dx,
+        );
     }
 
     /// Index of a state by name.
@@ -123,6 +125,5 @@ impl System {
 /// Per-thread scratch of a [`System`].
 #[derive(Clone, Debug)]
 pub struct Workspace {
-    args: Vec<f64>,
     scratch: RowScratch,
 }

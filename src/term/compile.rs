@@ -320,18 +320,25 @@ impl Library {
     /// Evaluates every term on one row; `inputs` is aligned with [`Library::inputs`].
     #[inline]
     pub fn eval_row(&self, inputs: &[f64], scratch: &mut RowScratch, out: &mut [f64]) {
-        let s = scratch.0.as_mut_slice();
-        // These two checks make every index below valid: the program's slot indices are all
-        // < ops.len() and its input indices < inputs.len() by construction (Builder).
-        assert!(s.len() == self.ops.len(), "scratch of another library");
         assert!(inputs.len() >= self.inputs.len(), "too few inputs");
+        self.eval_row_with(|j| inputs[j], scratch, out)
+    }
+
+    /// Like [`Library::eval_row`], input `j` fetched by `fetch(j)` (no intermediate buffer:
+    /// the simulator reads states and inputs where they are).
+    #[inline]
+    pub fn eval_row_with(&self, fetch: impl Fn(usize) -> f64, scratch: &mut RowScratch, out: &mut [f64]) {
+        let s = scratch.0.as_mut_slice();
+        // This check makes every slot index below valid: the program's slot indices are all
+        // < ops.len() by construction (Builder).
+        assert!(s.len() == self.ops.len(), "scratch of another library");
         let p = &self.rows;
         let u = |i: u32| i as usize;
-        // SAFETY: see the asserts above.
+        for &(i, j) in &p.inputs {
+            s[u(i)] = fetch(u(j));
+        }
+        // SAFETY: see the assert above.
         unsafe {
-            for &(i, j) in &p.inputs {
-                *s.get_unchecked_mut(u(i)) = *inputs.get_unchecked(u(j));
-            }
             for g in &p.groups {
                 match g {
                     Group::Mul(v) => {
