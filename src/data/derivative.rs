@@ -62,7 +62,10 @@ impl Differentiator for CentralDifference {
 pub type MakeDifferentiator = fn() -> Box<dyn Differentiator>;
 
 /// The derivative methods by name.
-pub static DIFFERENTIATORS: &[(&str, MakeDifferentiator)] = &[("central", || Box::new(CentralDifference))];
+pub static DIFFERENTIATORS: &[(&str, MakeDifferentiator)] = &[
+    ("central", || Box::new(CentralDifference)),
+    ("savitzky-golay", || Box::new(super::SavitzkyGolay::default())),
+];
 
 /// A derivative method by name.
 pub fn differentiator(name: &str) -> Result<Box<dyn Differentiator>, DataError> {

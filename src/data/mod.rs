@@ -4,8 +4,10 @@
 
 mod csv_io;
 mod derivative;
+mod savitzky_golay;
 
 pub use derivative::{differentiator, CentralDifference, Differentiator, DIFFERENTIATORS};
+pub use savitzky_golay::SavitzkyGolay;
 
 /// Something wrong with a data set. Every variant names where.
 #[derive(Debug, thiserror::Error)]
