@@ -3,9 +3,11 @@
 //! the [`Differentiator`] interface.
 
 mod csv_io;
+mod dataset;
 mod derivative;
 mod savitzky_golay;
 
+pub use dataset::{Dataset, Delimiter, RunSpec};
 pub use derivative::{differentiator, CentralDifference, Differentiator, DIFFERENTIATORS};
 pub use savitzky_golay::SavitzkyGolay;
 
@@ -118,6 +120,18 @@ pub enum DataError {
         needed: usize,
         /// What needed them.
         what: String,
+    },
+    /// A unit that is unknown or contradicted by the values.
+    #[error("{file}: row {row}, column `{column}`: {message}")]
+    Unit {
+        /// The file.
+        file: String,
+        /// 1-based data row (0: the declaration).
+        row: usize,
+        /// The column.
+        column: String,
+        /// What is wrong.
+        message: String,
     },
     /// Unknown derivative method.
     #[error("unknown derivative method `{0}` (known: {1})")]

@@ -172,3 +172,57 @@ fn compare_runs_every_backend() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Issue 7 §1: runs with the basin's own column names, units and layout, via a dataset file.
+#[test]
+fn identify_from_a_dataset_file() {
+    let dir = std::env::temp_dir().join(format!("termid-dataset-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = crate::common::lorenz_csv(&dir, "4");
+    // rewrite as a whitespace log with other names, a preamble, and time in milliseconds
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut log = String::from("lorenz rig\nrecorded by hand\nms X Y Z\n");
+    for line in text.lines().skip(1) {
+        let f: Vec<f64> = line.split(',').map(|v| v.parse().unwrap()).collect();
+        log += &format!("{} {} {} {}\n", f[0] * 1000.0, f[1], f[2], f[3]);
+    }
+    std::fs::write(dir.join("rig.log"), log).unwrap();
+    std::fs::write(
+        dir.join("set.toml"),
+        "[columns]\nt = \"ms [fortnight]\"\nx = \"X\"\ny = \"Y\"\nz = \"Z\"\n\n[[runs]]\nfile = \"rig.log\"\ndelimiter = \"whitespace\"\nskip = 2\n",
+    )
+    .unwrap();
+    // an unknown unit: a clear error naming it
+    let set = dir.join("set.toml");
+    let (ok, _, err) = termid(&[
+        "identify",
+        "--model",
+        "models/lorenz.toml",
+        "--dataset",
+        set.to_str().unwrap(),
+        "--no-intercept",
+    ]);
+    assert!(!ok && err.contains("unknown unit [fortnight]"), "{err}");
+    std::fs::write(&set, std::fs::read_to_string(&set).unwrap().replace("[fortnight]", "[ms]")).unwrap();
+    let (ok, out, err) = termid(&[
+        "identify",
+        "--model",
+        "models/lorenz.toml",
+        "--dataset",
+        set.to_str().unwrap(),
+        "--no-intercept",
+        "--derivative",
+        "savitzky-golay",
+        "--format",
+        "json",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    // time declared in ms, converted to s: σ = 10 comes back
+    let x = &v["x_dot"]["terms"];
+    assert_eq!(x.as_array().unwrap().len(), 2, "{x}");
+    for t in x.as_array().unwrap() {
+        assert!((t["coefficient"].as_f64().unwrap().abs() - 10.0).abs() < 1e-3, "{t}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -52,8 +52,11 @@ pub enum RuleName {
 #[derive(Debug, Args)]
 pub struct IdentifyCommand {
     /// CSV files with a header row; several are combined (the paper's "Komb. Daten").
-    #[arg(long = "data", short = 'd', required = true, num_args = 1..)]
+    #[arg(long = "data", short = 'd', num_args = 1.., required_unless_present = "dataset")]
     pub data: Vec<PathBuf>,
+    /// A dataset file (TOML): runs with their own column names and units.
+    #[arg(long)]
+    pub dataset: Option<PathBuf>,
     /// Name of the time column.
     #[arg(long, default_value = "t")]
     pub time: String,
@@ -189,8 +192,11 @@ pub struct CompareCommand {
     #[arg(long)]
     pub model: Option<PathBuf>,
     /// Runs (CSV), combined.
-    #[arg(long = "data", short = 'd', required = true, num_args = 1..)]
+    #[arg(long = "data", short = 'd', num_args = 1.., required_unless_present = "dataset")]
     pub data: Vec<PathBuf>,
+    /// A dataset file (TOML): runs with their own column names and units.
+    #[arg(long)]
+    pub dataset: Option<PathBuf>,
     /// Equations to compare (default: all identifiable ones).
     #[arg(long, num_args = 1..)]
     pub equation: Vec<String>,
@@ -221,8 +227,11 @@ pub struct DiagnoseCommand {
     #[arg(long)]
     pub model: Option<PathBuf>,
     /// Measured runs (CSV with the time, the inputs and some states).
-    #[arg(long = "data", short = 'd', required = true, num_args = 1..)]
+    #[arg(long = "data", short = 'd', num_args = 1.., required_unless_present = "dataset")]
     pub data: Vec<PathBuf>,
+    /// A dataset file (TOML): runs with their own column names and units.
+    #[arg(long)]
+    pub dataset: Option<PathBuf>,
     /// Write the model with the winning effect added (the original stays as it is).
     #[arg(long)]
     pub out: Option<PathBuf>,

@@ -2,7 +2,6 @@
 //! model with the effect added, and the gap before and after.
 
 use anyhow::{Context, Result};
-use termid::data::Frame;
 use termid::diagnose::{diagnose, generic_hypotheses, Diagnosis, Settings};
 
 use crate::args::{DiagnoseCommand, Format};
@@ -11,7 +10,7 @@ use crate::identify::num;
 pub fn run(cmd: DiagnoseCommand) -> Result<()> {
     let model = crate::simulate::load_model(&cmd.model)?;
     let time = model.spec.model.time.clone();
-    let runs = cmd.data.iter().map(|p| Frame::read_csv(p, &time)).collect::<Result<Vec<_>, _>>()?;
+    let runs = crate::runs::load(&cmd.data, cmd.dataset.as_deref(), &time)?;
     let hypotheses = if model.spec.ship.is_some() {
         termid::ship::hypotheses::hypotheses(&model)
     } else {

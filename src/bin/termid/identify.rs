@@ -25,6 +25,10 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
         .iter()
         .map(|p| if cmd.no_time { Frame::read_csv_untimed(p) } else { Frame::read_csv(p, &cmd.time) })
         .collect::<Result<Vec<_>, _>>()?;
+    let mut frames = frames;
+    if let Some(ds) = &cmd.dataset {
+        frames.extend(crate::runs::load(&[], Some(ds), &cmd.time)?);
+    }
     let mut vocab = Vocabulary::new();
     let mut params = BTreeMap::new();
     for p in &cmd.params {
@@ -114,7 +118,7 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
     let path = cmd.model.clone().context("--model")?;
     let mut model = termid::model::Model::load(&path)?;
     let time = model.spec.model.time.clone();
-    let frames = cmd.data.iter().map(|p| Frame::read_csv(p, &time)).collect::<Result<Vec<_>, _>>()?;
+    let frames = crate::runs::load(&cmd.data, cmd.dataset.as_deref(), &time)?;
     let names: Vec<String> =
         if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };
     if cmd.target.is_some() && names.len() != 1 {

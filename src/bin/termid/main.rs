@@ -6,6 +6,7 @@ mod diagnose;
 mod identify;
 mod progress;
 mod reproduce;
+mod runs;
 mod simulate;
 
 use std::process::ExitCode;
