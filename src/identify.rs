@@ -56,9 +56,14 @@ impl ParamValue {
         match self {
             ParamValue::Value(_) => Ok(()),
             ParamValue::Rule(rule) => match rule.split_once(':') {
-                Some(("first" | "mean", col)) if !col.is_empty() => Ok(()),
+                Some(("first", col)) if !col.is_empty() => Ok(()),
+                Some(("mean", rest)) if !rest.is_empty() => match rest.split_once(':') {
+                    Some((c, secs)) if !c.is_empty() && secs.parse::<f64>().is_ok_and(|s| s > 0.0) => Ok(()),
+                    Some(_) => Err(format!("parameter `{name}`: `{rule}`: write mean:COLUMN:SECONDS with SECONDS > 0")),
+                    None => Ok(()),
+                },
                 _ => Err(format!(
-                    "parameter `{name}`: `{rule}` is neither a number nor `first:COLUMN` / `mean:COLUMN`"
+                    "parameter `{name}`: `{rule}` is neither a number nor `first:COLUMN`, `mean:COLUMN` or `mean:COLUMN:SECONDS`"
                 )),
             },
         }
@@ -70,12 +75,19 @@ impl ParamValue {
             ParamValue::Value(v) => Ok(*v),
             ParamValue::Rule(rule) => match rule.split_once(':') {
                 Some(("first", col)) => Ok(frame.require(col)?[0]),
-                Some(("mean", col)) => {
+                Some(("mean", rest)) => {
+                    // `mean:u` over the run, `mean:u:2` over its first 2 time units (the approach)
+                    let (col, span) = match rest.split_once(':') {
+                        Some((c, secs)) => (c, secs.parse::<f64>().ok().filter(|s| *s > 0.0)),
+                        None => (rest, None),
+                    };
                     let c = frame.require(col)?;
-                    Ok(c.iter().sum::<f64>() / c.len() as f64)
+                    let t = frame.time();
+                    let n = span.map_or(c.len(), |s| t.iter().take_while(|ti| **ti - t[0] <= s).count().max(1));
+                    Ok(c[..n].iter().sum::<f64>() / n as f64)
                 }
                 _ => Err(IdentifyError::Parameter(format!(
-                    "parameter `{name}`: `{rule}` is neither a number nor `first:COLUMN` / `mean:COLUMN`"
+                    "parameter `{name}`: `{rule}` is neither a number nor `first:COLUMN`, `mean:COLUMN` or `mean:COLUMN:SECONDS`"
                 ))),
             },
         }
@@ -318,6 +330,16 @@ pub fn coefficients_of(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn mean_over_the_first_seconds() {
+        let mut f = Frame::new("run", "t", vec![0.0, 1.0, 2.0, 3.0, 4.0]).unwrap();
+        f.push("u", vec![2.0, 2.2, 2.4, 1.0, 1.0]).unwrap();
+        let v = ParamValue::Rule("mean:u:2".into()).resolve("u0", &f).unwrap();
+        assert!((v - 2.2).abs() < 1e-15);
+        assert!(ParamValue::Rule("mean:u:-1".into()).check_rule("u0").is_err());
+        assert!(ParamValue::Rule("mean:u".into()).check_rule("u0").is_ok());
+    }
 
     #[test]
     fn target_syntax() {

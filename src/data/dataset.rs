@@ -46,6 +46,12 @@ pub struct RunSpec {
     /// Lines before the header.
     #[serde(default)]
     pub skip: usize,
+    /// Keep only samples at or after this time (file's time unit converted to s).
+    #[serde(default)]
+    pub from: Option<f64>,
+    /// Keep only samples at or before this time.
+    #[serde(default)]
+    pub to: Option<f64>,
 }
 
 /// Column separators.
@@ -151,6 +157,27 @@ impl Dataset {
                 }
                 frame.push(var, values.iter().map(|v| v * f).collect())?;
             }
+            if run.from.is_some() || run.to.is_some() {
+                let t = frame.time();
+                let lo = run.from.map_or(0, |a| t.iter().position(|v| *v >= a).unwrap_or(t.len()));
+                let hi = run.to.map_or(t.len(), |b| t.iter().rposition(|v| *v <= b).map_or(0, |i| i + 1));
+                if hi <= lo + 2 {
+                    return Err(DataError::TooShort {
+                        file: origin.clone(),
+                        rows: hi.saturating_sub(lo),
+                        needed: 3,
+                        what: "the trimmed window".into(),
+                    });
+                }
+                notes.push(format!(
+                    "{origin}: trimmed to {} ≤ t ≤ {} ({} of {} samples)",
+                    t[lo],
+                    t[hi - 1],
+                    hi - lo,
+                    t.len()
+                ));
+                frame = frame.slice(lo..hi);
+            }
             frames.push(frame);
         }
         Ok((frames, notes))
@@ -199,6 +226,11 @@ mod tests {
         assert!((f.require("r").unwrap()[0] - 0.5f64.to_radians()).abs() < 1e-15);
         assert!((f.require("u").unwrap()[1] - 1.0).abs() < 1e-15);
         assert_eq!(notes.len(), 3, "{notes:?}");
+        // a time window
+        write(&dir, "set4.toml", "[columns]\nt = \"time [s]\"\n\"δ\" = \"delta [deg]\"\n\n[[runs]]\nfile = \"run4.csv\"\nfrom = 0.15\nto = 0.45\n");
+        write(&dir, "run4.csv", "time,delta\n0,1\n0.1,2\n0.2,3\n0.3,4\n0.4,5\n0.5,6\n");
+        let (fr, _) = Dataset::load(&dir.join("set4.toml")).unwrap().read(&dir, "t").unwrap();
+        assert_eq!(fr[0].time(), &[0.2, 0.3, 0.4]);
         // degrees declared as radians: refused with file, row and column
         write(
             &dir,
