@@ -16,11 +16,22 @@ pub use fit::{simulate_runs, Runs};
 /// Figures of a diagnosis, one per run: each measured state against the simulation before
 /// (and after) the winning effect, and the residual.
 pub fn figures(d: &Diagnosis, runs: &[crate::data::Frame]) -> Vec<(String, crate::plot::Figure)> {
+    comparison_figures(runs, &d.before, &d.after, "diagnose")
+}
+
+/// One figure per run: every measured state with the model's simulation (and a second
+/// simulation, if given), and their residuals.
+pub fn comparison_figures(
+    runs: &[crate::data::Frame],
+    model: &[crate::sim::Trajectory],
+    other: &[crate::sim::Trajectory],
+    title: &str,
+) -> Vec<(String, crate::plot::Figure)> {
     use crate::plot::{Figure, Panel, Series};
     runs.iter()
         .enumerate()
         .filter_map(|(k, f)| {
-            let before = d.before.get(k)?;
+            let before = model.get(k)?;
             let mut panels = Vec::new();
             for (i, name) in before.state_names.iter().enumerate() {
                 let Some(meas) = f.column(name) else { continue };
@@ -35,7 +46,7 @@ pub fn figures(d: &Diagnosis, runs: &[crate::data::Frame]) -> Vec<(String, crate
                     t[..n].to_vec(),
                     (0..n).map(|j| before.states[i][j] - meas[j]).collect(),
                 )];
-                if let Some(after) = d.after.get(k) {
+                if let Some(after) = other.get(k) {
                     series.push(Series::dashed(
                         "with the effect",
                         t[..n].to_vec(),
@@ -62,12 +73,13 @@ pub fn figures(d: &Diagnosis, runs: &[crate::data::Frame]) -> Vec<(String, crate
                     ..Panel::default()
                 });
             }
-            let mut fig = Figure::new(&format!("diagnose: {}", f.origin()), panels);
+            let mut fig = Figure::new(&format!("{title}: {}", f.origin()), panels);
             fig.panel_height = 170;
             Some((f.origin().to_string(), fig))
         })
         .collect()
 }
+
 pub use hypotheses::{generic_hypotheses, Effect, Hypothesis};
 
 use crate::data::{DataError, Frame};

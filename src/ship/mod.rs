@@ -6,6 +6,7 @@
 pub mod figure;
 pub mod hypotheses;
 pub mod manoeuvre;
+pub mod observed;
 
 use std::collections::BTreeMap;
 

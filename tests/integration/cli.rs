@@ -226,3 +226,38 @@ fn identify_from_a_dataset_file() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Issue 7 §4: a model validated on held-out runs: errors per run, metrics side by side.
+#[test]
+fn validate_sets_model_and_measurement_side_by_side() {
+    let dir = std::env::temp_dir().join(format!("termid-validate-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = dir.join("z.csv");
+    let (ok, _, err) = termid(&["simulate", "-m", "zigzag:20/20", "--out", run.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let svg = dir.join("figs");
+    let (ok, out, err) = termid(&[
+        "validate",
+        "--data",
+        run.to_str().unwrap(),
+        "--svg",
+        svg.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    // the true model against its own run: the gap is only what replaying the rudder from
+    // 0.2 s samples (linear between them, the kinks fall between) costs
+    let psi = v["gap"]["states"].as_array().unwrap().iter().find(|s| s[0] == "ψ").unwrap().clone();
+    assert!(psi[2].as_f64().unwrap() < 1e-3, "{psi}");
+    let m = &v["metrics"][0];
+    assert!(
+        (m["measured"]["first_overshoot_deg"].as_f64().unwrap()
+            - m["simulated"]["first_overshoot_deg"].as_f64().unwrap())
+        .abs()
+            < 0.05
+    );
+    assert!(svg.join("validate_z.svg").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}

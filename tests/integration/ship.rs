@@ -188,3 +188,45 @@ fn divergence_stops_with_time_and_state() {
     let msg = err.to_string();
     assert!(msg.contains("diverged at t =") && msg.contains("state was u ="), "{msg}");
 }
+
+/// Metrics read off sampled trajectories (what `termid validate` sets side by side) agree
+/// with the ones the manoeuvre computed from its own switching, to within the sampling.
+#[test]
+fn observed_metrics_match_the_manoeuvres_own() {
+    use termid::ship::observed::observe;
+    let ship = Ship::new(&Model::default_model(), false).unwrap();
+    let r = ship.roles;
+    // 0.2 s samples: the switching heading is reconstructed between samples
+    for (text, tol) in [("zigzag:30/10", 0.3), ("zigzag:20/20", 0.3)] {
+        let run = ship
+            .run(
+                &Manoeuvre::parse(text).unwrap(),
+                &Settings { integrator: Integrator::ModifiedEuler, dt: 0.04, duration: 100.0, sample: 0.2 },
+            )
+            .unwrap();
+        let t = &run.trajectory;
+        let o = observe(&t.time, &t.states[r.psi], &t.inputs[r.rudder], &t.states[r.x0], &t.states[r.y0]);
+        let Metrics::ZigZag(m) = &run.metrics else { unreachable!() };
+        assert!(
+            (o.first_overshoot_deg.unwrap() - m.first_overshoot_deg.unwrap()).abs() < tol,
+            "{text}: {o:?} vs {m:?}"
+        );
+        assert!((o.second_overshoot_deg.unwrap() - m.second_overshoot_deg.unwrap()).abs() < tol, "{text}");
+    }
+    let run = ship
+        .run(
+            &Manoeuvre::parse("turning:-35").unwrap(),
+            &Settings { integrator: Integrator::ModifiedEuler, dt: 0.04, duration: 200.0, sample: 0.2 },
+        )
+        .unwrap();
+    let t = &run.trajectory;
+    let o = observe(&t.time, &t.states[r.psi], &t.inputs[r.rudder], &t.states[r.x0], &t.states[r.y0]);
+    let Metrics::Turning(m) = &run.metrics else { unreachable!() };
+    for (a, b) in [
+        (o.advance_m, m.advance_m),
+        (o.transfer_m, m.transfer_m),
+        (o.tactical_diameter_m, m.tactical_diameter_m),
+    ] {
+        assert!((a.unwrap() - b.unwrap()).abs() < 0.05, "{a:?} vs {b:?}");
+    }
+}

@@ -26,6 +26,8 @@ pub enum Command {
     Compare(CompareCommand),
     /// Find where model and measurements disagree, name the missing effect, add it.
     Diagnose(DiagnoseCommand),
+    /// Check a model against held-out runs: errors per run, manoeuvre metrics side by side.
+    Validate(ValidateCommand),
 }
 
 /// Output format.
@@ -239,6 +241,32 @@ pub struct DiagnoseCommand {
     #[arg(long)]
     pub svg: Option<PathBuf>,
     /// Integrator of the re-simulations: b8 (the paper's, default) or rk4.
+    #[arg(long, default_value = "b8")]
+    pub integrator: String,
+    /// Integration step, s.
+    #[arg(long, default_value_t = 0.04)]
+    pub dt: f64,
+    /// Output format.
+    #[arg(long, value_enum, default_value = "text")]
+    pub format: Format,
+}
+
+/// `termid validate`.
+#[derive(Debug, Args)]
+pub struct ValidateCommand {
+    /// The model (default: the embedded Oltmann model).
+    #[arg(long)]
+    pub model: Option<PathBuf>,
+    /// Held-out runs (CSV with time, inputs and measured states).
+    #[arg(long = "data", short = 'd', num_args = 1.., required_unless_present = "dataset")]
+    pub data: Vec<PathBuf>,
+    /// A dataset file (TOML): runs with their own column names and units.
+    #[arg(long)]
+    pub dataset: Option<PathBuf>,
+    /// One figure per run (measured, simulated, residual) into this folder.
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
+    /// Integrator: b8 (default) or rk4.
     #[arg(long, default_value = "b8")]
     pub integrator: String,
     /// Integration step, s.

@@ -8,6 +8,7 @@ mod progress;
 mod reproduce;
 mod runs;
 mod simulate;
+mod validate;
 
 use std::process::ExitCode;
 
@@ -21,6 +22,7 @@ fn main() -> ExitCode {
         args::Command::Reproduce(cmd) => reproduce::run(cmd),
         args::Command::Compare(cmd) => compare::run(cmd),
         args::Command::Diagnose(cmd) => diagnose::run(cmd),
+        args::Command::Validate(cmd) => validate::run(cmd),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -5,7 +5,7 @@
 mod pullout;
 mod replay;
 mod spiral;
-mod turning;
+pub(crate) mod turning;
 mod zigzag;
 
 use serde::Serialize;

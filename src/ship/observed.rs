@@ -1,0 +1,97 @@
+//! Manoeuvre metrics read off any trajectory, measured or simulated, without knowing the
+//! commands that made it: zigzag overshoots from the rudder's reversals (the heading when the
+//! rudder starts back is the switching heading), turning-circle advance, transfer and tactical
+//! diameter from the track. Used to set a model's predictions beside a measurement.
+
+use serde::Serialize;
+
+use super::manoeuvre::turning::at_level;
+
+/// What a trajectory shows.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Observed {
+    /// Rudder reversals found.
+    pub reversals: usize,
+    /// First overshoot beyond the switching heading, degrees (zigzags).
+    pub first_overshoot_deg: Option<f64>,
+    /// Second overshoot, degrees.
+    pub second_overshoot_deg: Option<f64>,
+    /// Distance along the initial course at 90° heading change, m (turns).
+    pub advance_m: Option<f64>,
+    /// Distance across at 90°, m.
+    pub transfer_m: Option<f64>,
+    /// Distance across at 180°, m.
+    pub tactical_diameter_m: Option<f64>,
+}
+
+/// When the rudder left its extreme at sample `k` (its last sample there): extrapolated back
+/// from the next two samples at the rate it then moves.
+fn switch_time(t: &[f64], delta: &[f64], k: usize) -> f64 {
+    if k + 2 >= t.len().min(delta.len()) {
+        return t[k.min(t.len() - 1)];
+    }
+    let rate = (delta[k + 2] - delta[k + 1]) / (t[k + 2] - t[k + 1]);
+    if rate == 0.0 {
+        return t[k];
+    }
+    (t[k + 1] - (delta[k + 1] - delta[k]) / rate).clamp(t[k], t[k + 1])
+}
+
+/// Metrics from samples of time, heading ψ (rad), rudder δ (rad) and position (x0, y0).
+pub fn observe(t: &[f64], psi: &[f64], delta: &[f64], x0: &[f64], y0: &[f64]) -> Observed {
+    let n = t.len().min(psi.len()).min(delta.len());
+    // a reversal: the rudder's motion changes direction after moving at least 1° one way; the
+    // switch itself lies between the last sample at the rudder's extreme and the next one
+    let mut rev: Vec<f64> = Vec::new(); // switch times
+    let mut dir = 0.0f64;
+    let mut anchor = (delta.first().copied().unwrap_or(0.0), 0usize);
+    for k in 1..n {
+        if (delta[k] - anchor.0).abs() < 1e-9 || (dir != 0.0 && (delta[k] - anchor.0) * dir > 0.0) {
+            anchor = (delta[k], k);
+            continue;
+        }
+        if (delta[k] - anchor.0).abs() > 1f64.to_radians() {
+            let d = (delta[k] - anchor.0).signum();
+            if dir != 0.0 && d != dir {
+                rev.push(switch_time(t, delta, anchor.1));
+            }
+            dir = d;
+            anchor = (delta[k], k);
+        }
+    }
+    let at = |ts: f64, v: &[f64]| -> f64 {
+        let i = t[..n].iter().position(|x| *x >= ts).unwrap_or(n - 1).max(1);
+        let w = ((ts - t[i - 1]) / (t[i] - t[i - 1])).clamp(0.0, 1.0);
+        v[i - 1] + w * (v[i] - v[i - 1])
+    };
+    let mut out = Observed { reversals: rev.len(), ..Observed::default() };
+    let overshoot = |i: usize| -> Option<f64> {
+        let ts = *rev.get(i)?;
+        let te = rev.get(i + 1).copied().unwrap_or(t[n - 1]);
+        let h = at(ts, psi);
+        // the turn continues the way the heading was going at the switch
+        let way = (h - at(ts - 1.0, psi)).signum();
+        let extreme = (0..n)
+            .filter(|&k| t[k] >= ts && t[k] <= te)
+            .map(|k| (psi[k] - h) * way)
+            .fold(f64::NEG_INFINITY, f64::max);
+        Some(extreme.to_degrees())
+    };
+    if rev.len() >= 2 {
+        out.first_overshoot_deg = overshoot(0);
+        out.second_overshoot_deg = overshoot(1);
+    }
+    if n > 1 {
+        let sign = if psi[n - 1] >= psi[0] { 1.0 } else { -1.0 };
+        let turned: Vec<f64> = psi[..n].iter().map(|p| sign * (p - psi[0]).to_degrees()).collect();
+        let x: Vec<f64> = x0[..n].iter().map(|v| v - x0[0]).collect();
+        let y: Vec<f64> = y0[..n].iter().map(|v| (v - y0[0]).abs()).collect();
+        if rev.is_empty() {
+            // a turn: no reversal
+            out.advance_m = at_level(&turned, &x, 90.0);
+            out.transfer_m = at_level(&turned, &y, 90.0);
+            out.tactical_diameter_m = at_level(&turned, &y, 180.0);
+        }
+    }
+    out
+}
