@@ -228,24 +228,15 @@ pub struct DiagnoseCommand {
     /// The model to check (default: the embedded Oltmann model).
     #[arg(long)]
     pub model: Option<PathBuf>,
-    /// Measured runs (CSV with the time, the inputs and some states).
-    #[arg(long = "data", short = 'd', num_args = 1.., required_unless_present = "dataset")]
-    pub data: Vec<PathBuf>,
-    /// A dataset file (TOML): runs with their own column names and units.
-    #[arg(long)]
-    pub dataset: Option<PathBuf>,
+    /// Measured runs.
+    #[command(flatten)]
+    pub runs: RunsArgs,
     /// Write the model with the winning effect added (the original stays as it is).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Write one figure per run (measured, simulated, residual) into this folder.
-    #[arg(long)]
-    pub svg: Option<PathBuf>,
-    /// Integrator of the re-simulations: b8 (the paper's, default) or rk4.
-    #[arg(long, default_value = "b8")]
-    pub integrator: String,
-    /// Integration step, s.
-    #[arg(long, default_value_t = 0.04)]
-    pub dt: f64,
+    /// Re-simulation settings.
+    #[command(flatten)]
+    pub resim: ResimArgs,
     /// Output format.
     #[arg(long, value_enum, default_value = "text")]
     pub format: Format,
@@ -257,22 +248,38 @@ pub struct ValidateCommand {
     /// The model (default: the embedded Oltmann model).
     #[arg(long)]
     pub model: Option<PathBuf>,
-    /// Held-out runs (CSV with time, inputs and measured states).
+    /// Held-out runs.
+    #[command(flatten)]
+    pub runs: RunsArgs,
+    /// Re-simulation settings.
+    #[command(flatten)]
+    pub resim: ResimArgs,
+    /// Output format.
+    #[arg(long, value_enum, default_value = "text")]
+    pub format: Format,
+}
+
+/// Measured runs: CSV files with the model's names in SI, and/or a dataset file.
+#[derive(Debug, Args)]
+pub struct RunsArgs {
+    /// Runs (CSV with the time, the inputs and measured states).
     #[arg(long = "data", short = 'd', num_args = 1.., required_unless_present = "dataset")]
     pub data: Vec<PathBuf>,
     /// A dataset file (TOML): runs with their own column names and units.
     #[arg(long)]
     pub dataset: Option<PathBuf>,
-    /// One figure per run (measured, simulated, residual) into this folder.
-    #[arg(long)]
-    pub svg: Option<PathBuf>,
-    /// Integrator: b8 (default) or rk4.
+}
+
+/// How measured runs are re-simulated, and where the figures go.
+#[derive(Debug, Args)]
+pub struct ResimArgs {
+    /// Integrator: b8 (the paper's modified Euler, default) or rk4.
     #[arg(long, default_value = "b8")]
     pub integrator: String,
     /// Integration step, s.
     #[arg(long, default_value_t = 0.04)]
     pub dt: f64,
-    /// Output format.
-    #[arg(long, value_enum, default_value = "text")]
-    pub format: Format,
+    /// One figure per run (measured, simulated, residual) into this folder.
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
 }

@@ -10,19 +10,19 @@ use crate::identify::num;
 pub fn run(cmd: DiagnoseCommand) -> Result<()> {
     let model = crate::simulate::load_model(&cmd.model)?;
     let time = model.spec.model.time.clone();
-    let runs = crate::runs::load(&cmd.data, cmd.dataset.as_deref(), &time)?;
+    let runs = crate::runs::load(&cmd.runs.data, cmd.runs.dataset.as_deref(), &time)?;
     let hypotheses = if model.spec.ship.is_some() {
         termid::ship::hypotheses::hypotheses(&model)
     } else {
         generic_hypotheses(&model)
     };
     let settings = Settings {
-        dt: cmd.dt,
-        integrator: termid::sim::Integrator::by_name(&cmd.integrator)?,
+        dt: cmd.resim.dt,
+        integrator: termid::sim::Integrator::by_name(&cmd.resim.integrator)?,
         ..Settings::default()
     };
     let d = diagnose(&model, &runs, &hypotheses, &settings).context("diagnosing")?;
-    if let Some(dir) = &cmd.svg {
+    if let Some(dir) = &cmd.resim.svg {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         for (k, (name, fig)) in termid::diagnose::figures(&d, &runs).into_iter().enumerate() {
             let stem = std::path::Path::new(&name)

@@ -13,8 +13,8 @@ use crate::identify::num;
 pub fn run(cmd: ValidateCommand) -> Result<()> {
     let model = crate::simulate::load_model(&cmd.model)?;
     let time = model.spec.model.time.clone();
-    let runs = crate::runs::load(&cmd.data, cmd.dataset.as_deref(), &time)?;
-    let data = Runs::new(&model, &runs, cmd.dt, Integrator::by_name(&cmd.integrator)?)?;
+    let runs = crate::runs::load(&cmd.runs.data, cmd.runs.dataset.as_deref(), &time)?;
+    let data = Runs::new(&model, &runs, cmd.resim.dt, Integrator::by_name(&cmd.resim.integrator)?)?;
     let sims = data.simulate(&model, &[], &[])?;
     let gap = data.gap(&sims);
     // ship models: metrics read off measurement and simulation alike
@@ -38,7 +38,7 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
         }
         None => vec![None; runs.len()],
     };
-    if let Some(dir) = &cmd.svg {
+    if let Some(dir) = &cmd.resim.svg {
         std::fs::create_dir_all(dir)?;
         for (k, (name, fig)) in comparison_figures(&runs, &sims, &[], "validate").into_iter().enumerate() {
             let stem = std::path::Path::new(&name)
