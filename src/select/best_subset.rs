@@ -240,7 +240,7 @@ impl BestSubset {
         for (i, st) in steps.iter_mut().enumerate() {
             st.step = i + 1;
         }
-        let stop = if search.stopped { Stop::Converged } else { Stop::AllEntered };
+        let stop = if search.stopped { Stop::Limit { nodes: search.nodes } } else { Stop::AllEntered };
         Ok(Selection::from_steps(self.name(), sc.n, pb.names, steps, chosen, stop, notes))
     }
 }

@@ -126,6 +126,11 @@ pub enum Stop {
     NoDegreesOfFreedom,
     /// The back-end finished by its own rule.
     Converged,
+    /// A search hit its node or time limit: the result is the best found, not proven best.
+    Limit {
+        /// Nodes searched.
+        nodes: u64,
+    },
 }
 
 /// What a back-end returns: the chosen equation plus everything a report needs.
