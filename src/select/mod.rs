@@ -331,6 +331,16 @@ impl Backend {
     /// The names of all back-ends.
     pub const NAMES: &'static [&'static str] = &["stepwise", "efroymson", "best-subset", "sparse"];
 
+    /// The back-end's name (as in [`Backend::NAMES`]).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Backend::Stepwise(_) => "stepwise",
+            Backend::Efroymson(_) => "efroymson",
+            Backend::BestSubset(_) => "best-subset",
+            Backend::Sparse(_) => "sparse",
+        }
+    }
+
     /// A back-end with default settings, by name.
     pub fn by_name(name: &str) -> Result<Backend, SelectError> {
         match name {
@@ -368,6 +378,18 @@ impl Backend {
                 s.validate()?;
                 Ok(Box::new(s.clone()))
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip_through_the_registry() {
+        for name in Backend::NAMES {
+            assert_eq!(Backend::by_name(name).unwrap().name(), *name);
         }
     }
 }

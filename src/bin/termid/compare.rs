@@ -42,7 +42,7 @@ pub fn run(cmd: CompareCommand) -> Result<()> {
                 .find(|e| &e.name == eq)
                 .with_context(|| format!("no equation `{eq}`"))?;
             // the model file's own settings for its back-end, defaults for the others
-            if e.backend != Backend::by_name(name)? && !same_kind(&e.backend, name) {
+            if e.backend.name() != *name {
                 e.backend = Backend::by_name(name)?;
             }
             // one warm-up fit, then the median of `repeat` timed fits (data already loaded)
@@ -73,16 +73,6 @@ pub fn run(cmd: CompareCommand) -> Result<()> {
         Format::Text => print!("{}", text(&entries, &equations)),
     }
     Ok(())
-}
-
-fn same_kind(b: &Backend, name: &str) -> bool {
-    matches!(
-        (b, name),
-        (Backend::Stepwise(_), "stepwise")
-            | (Backend::Efroymson(_), "efroymson")
-            | (Backend::BestSubset(_), "best-subset")
-            | (Backend::Sparse(_), "sparse")
-    )
 }
 
 /// Replays the recorded inputs from the recorded initial state; RMS and max error per state.

@@ -147,6 +147,13 @@ pub struct Study {
     pub diagnosis: Option<crate::diagnose::Diagnosis>,
 }
 
+impl Study {
+    /// The original run `name` (`z30_10`) at the analysed samples.
+    pub fn original(&self, name: &str) -> Option<Trajectory> {
+        self.recorded.iter().find(|r| r.name == name).map(original_samples)
+    }
+}
+
 fn tables_for(
     model: &Model,
     frames: &[crate::data::Frame],

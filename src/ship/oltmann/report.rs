@@ -6,7 +6,7 @@ use std::path::Path;
 
 use serde_json::json;
 
-use super::data::{Alternative, RateUnit, MANOEUVRES};
+use super::data::{Alternative, RateUnit};
 use super::tables::{EquationTable, Row, MEAN_MAX_RATIO, MEAN_MIN_RUNS};
 use super::Resimulation;
 use super::{ReproduceError, Study};
@@ -302,9 +302,7 @@ pub fn write(
     }
     fig("fig5_alternatives.svg", fig5(study))?;
     for r in study.resimulations.iter().filter(|r| r.failure.is_none()) {
-        let orig = super::resim::original_samples(
-            &study.recorded[MANOEUVRES.iter().position(|m| m.0 == r.run).unwrap_or(3)],
-        );
+        let Some(orig) = study.original(&r.run) else { continue };
         let name = format!("resim_{}_{}.svg", r.run, r.coefficients.replace('/', "_"));
         fig(
             &name,
@@ -361,9 +359,7 @@ pub fn write(
         let mut series = Vec::new();
         for (label, list) in [("without B0, C0", &d.before), ("with B0, C0", &d.after)] {
             for r in list.iter().filter(|r| r.failure.is_none()) {
-                let orig = super::resim::original_samples(
-                    &study.recorded[MANOEUVRES.iter().position(|m| m.0 == r.run).unwrap_or(3)],
-                );
+                let Some(orig) = study.original(&r.run) else { continue };
                 let dpsi: Vec<f64> = orig.states[ship.roles.psi]
                     .iter()
                     .zip(&r.trajectory.states[ship.roles.psi])
