@@ -85,8 +85,7 @@ fn identify_text_and_errors() {
 
 #[test]
 fn integer_weights_equal_repeated_rows() {
-    let dir = std::env::temp_dir().join(format!("termid-weights-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::common::Scratch::new("weights");
     let rows = [
         (1.0, 2.0, 3.1, 1),
         (2.0, 1.0, 4.2, 2),
@@ -139,13 +138,11 @@ fn integer_weights_equal_repeated_rows() {
         assert_eq!(tw, tr);
         assert!((cw - cr).abs() < 1e-12 * cr.abs().max(1.0), "{tw}: {cw} vs {cr}");
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn compare_runs_every_backend() {
-    let dir = std::env::temp_dir().join(format!("termid-compare-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::common::Scratch::new("compare");
     let csv = crate::common::lorenz_csv(&dir, "3");
     let (ok, out, err) = termid(&[
         "compare",
@@ -170,14 +167,12 @@ fn compare_runs_every_backend() {
         assert!(e["equations"][0]["time_ms"].as_f64().unwrap() >= 0.0);
         assert!(e["replay"].is_array(), "{}", e["replay"]);
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// Issue 7 §1: runs with the basin's own column names, units and layout, via a dataset file.
 #[test]
 fn identify_from_a_dataset_file() {
-    let dir = std::env::temp_dir().join(format!("termid-dataset-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::common::Scratch::new("dataset-cli");
     let csv = crate::common::lorenz_csv(&dir, "4");
     // rewrite as a whitespace log with other names, a preamble, and time in milliseconds
     let text = std::fs::read_to_string(&csv).unwrap();
@@ -224,14 +219,12 @@ fn identify_from_a_dataset_file() {
     for t in x.as_array().unwrap() {
         assert!((t["coefficient"].as_f64().unwrap().abs() - 10.0).abs() < 1e-3, "{t}");
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// Issue 7 §4: a model validated on held-out runs: errors per run, metrics side by side.
 #[test]
 fn validate_sets_model_and_measurement_side_by_side() {
-    let dir = std::env::temp_dir().join(format!("termid-validate-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::common::Scratch::new("validate");
     let run = dir.join("z.csv");
     let (ok, _, err) = termid(&["simulate", "-m", "zigzag:20/20", "--out", run.to_str().unwrap()]);
     assert!(ok, "{err}");
@@ -259,5 +252,4 @@ fn validate_sets_model_and_measurement_side_by_side() {
             < 0.05
     );
     assert!(svg.join("validate_z.svg").exists());
-    std::fs::remove_dir_all(&dir).ok();
 }

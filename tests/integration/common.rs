@@ -52,6 +52,30 @@ impl Lcg {
     }
 }
 
+/// A scratch folder for one test, unique to this process, removed when it goes out of scope.
+pub struct Scratch(std::path::PathBuf);
+
+impl Scratch {
+    pub fn new(name: &str) -> Scratch {
+        let dir = std::env::temp_dir().join(format!("termid-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        Scratch(dir)
+    }
+}
+
+impl std::ops::Deref for Scratch {
+    type Target = std::path::Path;
+    fn deref(&self) -> &std::path::Path {
+        &self.0
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        std::fs::remove_dir_all(&self.0).ok();
+    }
+}
+
 /// Runs the `termid` binary: (success, stdout, stderr).
 pub fn termid(args: &[&str]) -> (bool, String, String) {
     let out =

@@ -175,8 +175,7 @@ fn negative_control_changes_nothing() {
 /// 0.3 too low. JSON keys, one figure per run, the corrected model written, the original kept.
 #[test]
 fn command_on_a_generic_model() {
-    let dir = std::env::temp_dir().join(format!("termid-diagnose-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::common::Scratch::new("diagnose");
     let model = Model::load(std::path::Path::new("models/duffing.toml")).unwrap();
     let system = System::new(&model, &Default::default(), false).unwrap();
     let t: Vec<f64> = (0..=3000).map(|i| i as f64 * 0.01).collect();
@@ -228,5 +227,4 @@ fn command_on_a_generic_model() {
     assert!(Model::load(&new_model).is_ok());
     // the original is untouched: it still has no offset and reloads as before
     assert_eq!(Model::load(std::path::Path::new("models/duffing.toml")).unwrap().spec, model.spec);
-    std::fs::remove_dir_all(&dir).ok();
 }

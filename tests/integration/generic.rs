@@ -73,8 +73,7 @@ fn duffing_with_replayed_forcing() {
 
 #[test]
 fn same_commands_for_lorenz_and_the_ship() {
-    let dir = std::env::temp_dir().join(format!("termid-generic-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::common::Scratch::new("generic");
     let csv = crate::common::lorenz_csv(&dir, "5");
     let out = dir.join("lorenz-identified.toml");
     let (ok, _, err) = termid(&[
@@ -138,5 +137,4 @@ fn same_commands_for_lorenz_and_the_ship() {
     assert!(!ok);
     assert!(err.contains("diverged at t =") && err.contains("outside its bounds"), "{err}");
     assert!(!never.exists());
-    std::fs::remove_dir_all(&dir).ok();
 }

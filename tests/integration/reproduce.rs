@@ -156,7 +156,9 @@ fn deterministic_and_independent_of_candidate_order() {
 
 #[test]
 fn report_is_written() {
-    let dir = std::env::temp_dir().join(format!("termid-reproduce-{}", std::process::id()));
+    let scratch = crate::common::Scratch::new("reproduce");
+    // a folder that does not exist yet: the report makes it
+    let dir = scratch.join("report");
     let ship = termid::ship::Ship::new(&Model::default_model(), false).unwrap();
     let path = oltmann::report::write(&STUDY, &ship, &dir, &mut |_| {}).unwrap();
     let md = std::fs::read_to_string(&path).unwrap();
@@ -170,7 +172,6 @@ fn report_is_written() {
     for f in ["fig2_steps_u_dot.svg", "fig5_alternatives.svg", "drift_alt5_Komb.svg", "predict_spiral.svg"] {
         assert!(dir.join("figures").join(f).exists(), "{f}");
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// Issue 5 §7: on exact data the true support is recoverable, and best subset with its
