@@ -172,15 +172,14 @@ fn tables_for(
 fn resimulate(
     ship: &Ship,
     set: &str,
-    model: &Model,
+    identified: &Ship,
     recorded: &[Recorded],
     runs: &[usize],
 ) -> Result<Vec<Resimulation>, ReproduceError> {
-    let identified = Ship::new(model, false)?;
     runs.iter()
         .map(|&k| {
             let orig = original_samples(&recorded[k]);
-            let (errors, failure, trajectory) = match replay(&identified, &recorded[k]) {
+            let (errors, failure, trajectory) = match replay(identified, &recorded[k]) {
                 Ok(t) => (errors(ship, &orig, &t), None, t),
                 Err(e) => (Errors::default(), Some(e.to_string()), Trajectory::default()),
             };
@@ -253,18 +252,17 @@ pub fn run(
         ("alt5/Mittelwert", identified_model(model, &alt5, Column::Mittelwert)),
         ("alt5/Komb", identified_model(model, &alt5, Column::Komb)),
     ];
+    let ships = sets.iter().map(|(_, m)| Ship::new(m, false)).collect::<Result<Vec<_>, _>>()?;
     let mut resimulations = Vec::new();
-    for (name, m) in &sets {
-        resimulations.extend(resimulate(&ship, name, m, &recorded, &[3, 4])?);
+    for ((name, _), s) in sets.iter().zip(&ships) {
+        resimulations.extend(resimulate(&ship, name, s, &recorded, &[3, 4])?);
     }
 
     progress("spiral, turning circles and ordinary zigzags");
     let mut predictions = Vec::new();
     let manoeuvres = ["zigzag:30/10", "zigzag:20/20", "turning:20", "turning:-35", "spiral:20/2/100"];
-    for (name, m) in
-        std::iter::once(&("true", model.clone())).chain(sets.iter().filter(|(n, _)| n.ends_with("Komb")))
-    {
-        let s = Ship::new(m, false)?;
+    let komb = sets.iter().zip(&ships).filter(|((n, _), _)| n.ends_with("Komb")).map(|((n, _), s)| (*n, s));
+    for (name, s) in std::iter::once(("true", &ship)).chain(komb) {
         for text in manoeuvres {
             let man = Manoeuvre::parse(text)?;
             let settings = Settings {
@@ -298,8 +296,15 @@ pub fn run(
             coefficients: name.to_string(),
             b0,
             c0,
-            before: resimulate(&ship, name, m, &recorded, &[3, 4])?,
-            after: resimulate(&ship, &format!("{name} + B0, C0"), &cured, &recorded, &[3, 4])?,
+            // the uncorrected re-simulations are those of the section above
+            before: resimulations.iter().filter(|r| r.coefficients == *name).cloned().collect(),
+            after: resimulate(
+                &ship,
+                &format!("{name} + B0, C0"),
+                &Ship::new(&cured, false)?,
+                &recorded,
+                &[3, 4],
+            )?,
         });
     }
     progress("termid diagnose on the alternative-5 model");
