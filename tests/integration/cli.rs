@@ -169,6 +169,34 @@ fn compare_runs_every_backend() {
     }
 }
 
+/// A replay file of a single sample is a degenerate run, not a crash.
+#[test]
+fn compare_replays_a_one_sample_run_without_panic() {
+    let dir = crate::common::Scratch::new("compare-one");
+    let csv = crate::common::lorenz_csv(&dir, "1");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let one = dir.join("one.csv");
+    std::fs::write(&one, text.lines().take(2).collect::<Vec<_>>().join("\n")).unwrap();
+    let (ok, out, err) = termid(&[
+        "compare",
+        "--model",
+        "models/lorenz.toml",
+        "--data",
+        csv.to_str().unwrap(),
+        "--no-intercept",
+        "--replay",
+        one.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    assert!(ok, "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    for e in v.as_array().unwrap() {
+        assert_eq!(e["replay"][0]["rms"], 0.0, "{}", e["replay"]);
+    }
+}
+
 /// Issue 7 §1: runs with the basin's own column names, units and layout, via a dataset file.
 #[test]
 fn identify_from_a_dataset_file() {

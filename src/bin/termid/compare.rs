@@ -2,14 +2,14 @@
 //! chosen, coefficients, R², standard error and time; with `--replay`, each back-end's model
 //! re-simulated against a recorded run (any model: the recorded inputs are replayed).
 
-use std::collections::BTreeMap;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
 use termid::data::{differentiator, Frame};
+use termid::diagnose::{simulate_runs, Runs};
 use termid::identify::{coefficients_of, fit_equation, Fit};
 use termid::select::Backend;
-use termid::sim::{simulate, Integrator, Replay, Settings, System};
+use termid::sim::Integrator;
 
 use crate::args::{CompareCommand, Format};
 use crate::identify::num;
@@ -77,29 +77,13 @@ pub fn run(cmd: CompareCommand) -> Result<()> {
 
 /// Replays the recorded inputs from the recorded initial state; RMS and max error per state.
 fn resimulate(model: &termid::model::Model, run: &Frame, dt: f64) -> Result<StateErrors> {
-    let system = System::new(model, &BTreeMap::new(), false)?;
-    let x0 = system.states.iter().map(|s| run.require(s).map(|c| c[0])).collect::<Result<Vec<_>, _>>()?;
-    let t = run.time();
-    let (t0, t1) = (t[0], t[t.len() - 1]);
-    let sample = t[1] - t0;
-    let every = (sample / dt).round().max(1.0);
-    let settings =
-        Settings { integrator: Integrator::ModifiedEuler, dt: sample / every, duration: t1 - t0, sample };
-    let mut replay = Replay::new(run, &system.inputs)?;
-    let sim = simulate(&system, &x0, &mut replay, &settings)?;
-    Ok(system
-        .states
-        .iter()
-        .enumerate()
-        .filter_map(|(i, s)| {
-            let rec = run.column(s)?;
-            let n = rec.len().min(sim.time.len());
-            let d: Vec<f64> = (0..n).map(|k| sim.states[i][k] - rec[k]).collect();
-            let rms = (d.iter().map(|v| v * v).sum::<f64>() / n as f64).sqrt();
-            let max = d.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            Some((s.clone(), rms, max))
-        })
-        .collect())
+    // the replay starts from the recorded state, so every state must have been measured
+    for s in &model.spec.states {
+        run.require(&s.name)?;
+    }
+    let runs = Runs::new(model, std::slice::from_ref(run), dt, Integrator::ModifiedEuler)?;
+    let gap = runs.gap(&simulate_runs(&runs, model)?);
+    Ok(gap.runs.into_iter().flat_map(|(_, states)| states).collect())
 }
 
 fn text(entries: &[Entry], equations: &[String]) -> String {
