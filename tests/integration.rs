@@ -34,3 +34,6 @@ mod robustness;
 // The discrepancy workflow on data with hidden effects, and a negative control.
 #[path = "integration/diagnose.rs"]
 mod diagnose;
+// Measured runs from a synthetic basin: identify, validate, and the refusals of bad files.
+#[path = "integration/basin.rs"]
+mod basin;

@@ -129,6 +129,8 @@ impl Dataset {
                 .join("\n");
             let (time_col, time_unit) = split_spec(self.columns.get(time).map_or(time, String::as_str));
             let raw = Frame::parse_csv(&csv, &origin, &time_col)?;
+            // a logging dropout would be differentiated across as if it were one step
+            super::check_gaps(&raw, 3.0)?;
             let time_factor = factor(time_unit.as_deref(), &origin, time)?;
             let mut frame = Frame::new(&origin, time, raw.time().iter().map(|t| t * time_factor).collect())?;
             for (var, spec) in self.columns.iter().filter(|(v, _)| v.as_str() != time) {

@@ -4,12 +4,26 @@
 
 use super::DataError;
 
+/// A signal as a smoothing method sees it: its value and its rate at every sample.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Smoothed {
+    /// The smoothed signal (the measured one for methods that only differentiate).
+    pub value: Vec<f64>,
+    /// d/dt of the signal.
+    pub rate: Vec<f64>,
+}
+
 /// Differentiates one signal sampled at strictly increasing times.
 pub trait Differentiator: Send + Sync {
     /// Stable name used on the CLI and in model files.
     fn name(&self) -> &'static str;
     /// dx/dt at every sample.
     fn differentiate(&self, t: &[f64], x: &[f64]) -> Result<Vec<f64>, DataError>;
+    /// The signal as the method estimates it, with its rate. Methods that smooth (spline,
+    /// Kalman) return their smoothed curve, so the regressors can be the smoothed states too.
+    fn smooth(&self, t: &[f64], x: &[f64]) -> Result<Smoothed, DataError> {
+        Ok(Smoothed { value: x.to_vec(), rate: self.differentiate(t, x)? })
+    }
 }
 
 /// Second-order central differences, exact for quadratics also on uneven spacing; the
@@ -58,21 +72,43 @@ impl Differentiator for CentralDifference {
     }
 }
 
-/// Makes a differentiator with default settings.
-pub type MakeDifferentiator = fn() -> Box<dyn Differentiator>;
+/// Makes a differentiator from its options (the `:`-separated words after its name).
+pub type MakeDifferentiator = fn(&[f64]) -> Option<Box<dyn Differentiator>>;
 
-/// The derivative methods by name.
-pub static DIFFERENTIATORS: &[(&str, MakeDifferentiator)] = &[
-    ("central", || Box::new(CentralDifference)),
-    ("savitzky-golay", || Box::new(super::SavitzkyGolay::default())),
+/// The derivative methods by name, with the options each takes.
+pub static DIFFERENTIATORS: &[(&str, &str, MakeDifferentiator)] = &[
+    ("central", "", |o| o.is_empty().then(|| Box::new(CentralDifference) as Box<dyn Differentiator>)),
+    ("savitzky-golay", "[:WINDOW:ORDER] (default 11:3)", |o| match o {
+        [] => Some(Box::new(super::SavitzkyGolay::default())),
+        [w, q] if w.fract() == 0.0 && q.fract() == 0.0 && *w >= 1.0 && *q >= 1.0 => {
+            Some(Box::new(super::SavitzkyGolay { window: *w as usize, order: *q as usize }))
+        }
+        _ => None,
+    }),
+    ("spline", "[:ALPHA] (default: chosen by GCV)", |o| match o {
+        [] => Some(Box::new(super::SmoothingSpline { alpha: None })),
+        [a] => Some(Box::new(super::SmoothingSpline { alpha: Some(*a) })),
+        _ => None,
+    }),
+    ("kalman", "[:RATIO] (default: maximum likelihood)", |o| match o {
+        [] => Some(Box::new(super::KalmanSmoother { ratio: None })),
+        [r] => Some(Box::new(super::KalmanSmoother { ratio: Some(*r) })),
+        _ => None,
+    }),
 ];
 
-/// A derivative method by name.
-pub fn differentiator(name: &str) -> Result<Box<dyn Differentiator>, DataError> {
-    DIFFERENTIATORS.iter().find(|(n, _)| *n == name).map(|(_, make)| make()).ok_or_else(|| {
-        let known: Vec<_> = DIFFERENTIATORS.iter().map(|(n, _)| *n).collect();
-        DataError::UnknownMethod(name.into(), known.join(", "))
-    })
+/// A derivative method from `NAME[:OPTION…]`, e.g. `savitzky-golay:21:3`, `spline`, `kalman`.
+pub fn differentiator(spec: &str) -> Result<Box<dyn Differentiator>, DataError> {
+    let mut words = spec.split(':');
+    let name = words.next().unwrap_or("");
+    let known = || DIFFERENTIATORS.iter().map(|(n, o, _)| format!("{n}{o}")).collect::<Vec<_>>().join(", ");
+    let Some((_, _, make)) = DIFFERENTIATORS.iter().find(|(n, _, _)| *n == name) else {
+        return Err(DataError::UnknownMethod(spec.into(), known()));
+    };
+    let options: Option<Vec<f64>> = words.map(|w| w.trim().parse::<f64>().ok()).collect();
+    options
+        .and_then(|o| make(&o))
+        .ok_or_else(|| DataError::UnknownMethod(spec.into(), format!("options are: {}", known())))
 }
 
 #[cfg(test)]
@@ -88,5 +124,26 @@ mod tests {
             assert!((di - (6.0 * ti - 2.0)).abs() < 1e-12, "{ti}: {di}");
         }
         assert!(CentralDifference.differentiate(&t[..2], &x[..2]).is_err());
+    }
+
+    #[test]
+    fn methods_by_name_with_options() {
+        for ok in [
+            "central",
+            "savitzky-golay",
+            "savitzky-golay:21:3",
+            "spline",
+            "spline:1e4",
+            "kalman",
+            "kalman:1e-3",
+        ] {
+            assert!(differentiator(ok).is_ok(), "{ok}");
+        }
+        for bad in
+            ["centra", "central:3", "savitzky-golay:21", "savitzky-golay:2.5:1", "spline:x", "kalman:1:2"]
+        {
+            let e = differentiator(bad).err().map(|e| e.to_string()).unwrap_or_default();
+            assert!(e.contains(bad) && e.contains("savitzky-golay[:WINDOW:ORDER]"), "{bad}: {e}");
+        }
     }
 }

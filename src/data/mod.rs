@@ -5,11 +5,19 @@
 mod csv_io;
 mod dataset;
 mod derivative;
+mod kalman;
+mod prepare;
+mod resample;
 mod savitzky_golay;
+mod smoothing_spline;
 
 pub use dataset::{Dataset, Delimiter, RunSpec};
-pub use derivative::{differentiator, CentralDifference, Differentiator, DIFFERENTIATORS};
+pub use derivative::{differentiator, CentralDifference, Differentiator, Smoothed, DIFFERENTIATORS};
+pub use kalman::KalmanSmoother;
+pub use prepare::{prepare, prepared_figure, Preparation};
+pub use resample::{check_gaps, median_step, resample};
 pub use savitzky_golay::SavitzkyGolay;
+pub use smoothing_spline::SmoothingSpline;
 
 /// Something wrong with a data set. Every variant names where.
 #[derive(Debug, thiserror::Error)]
@@ -132,6 +140,20 @@ pub enum DataError {
         column: String,
         /// What is wrong.
         message: String,
+    },
+    /// A step in time far beyond the run's usual spacing.
+    #[error("{file}: row {row}, column `{column}`: time jumps by {step:.4} (usual step {median:.4}): a gap in the record")]
+    TimeGap {
+        /// The file.
+        file: String,
+        /// 1-based data row after the gap.
+        row: usize,
+        /// The time column.
+        column: String,
+        /// The step.
+        step: f64,
+        /// The median step.
+        median: f64,
     },
     /// Unknown derivative method.
     #[error("unknown derivative method `{0}` (known: {1})")]

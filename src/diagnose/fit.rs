@@ -6,7 +6,10 @@ use nalgebra::{DMatrix, DVector};
 
 use super::hypotheses::{Effect, Hypothesis};
 use super::{DiagnoseError, Gap, Location};
+use std::collections::BTreeMap;
+
 use crate::data::Frame;
+use crate::identify::ParamValue;
 use crate::model::Model;
 use crate::sim::{simulate, Controller, Integrator, Replay, Settings, SimError, System, Trajectory};
 
@@ -18,7 +21,10 @@ pub struct Runs {
     scale: Vec<f64>,
     units: Vec<String>,
     x0: Vec<Vec<f64>>,
+    /// Each run's own parameters (the model's per-run rules, e.g. u0 = the run's start speed).
+    params: Vec<BTreeMap<String, f64>>,
     settings: Vec<Settings>,
+    intercepts: bool,
 }
 
 /// Recorded inputs with an offset and a factor applied.
@@ -116,7 +122,28 @@ impl Runs {
                 Settings { integrator, dt: sample / sub, duration: t[t.len() - 1] - t[0], sample }
             })
             .collect();
-        Ok(Runs { frames: frames.to_vec(), states, scale, units, x0, settings })
+        // a run is simulated at its own parameters, as it was identified (Δu = u − u0 of that run)
+        let rules = model.parameter_rules();
+        let params = frames
+            .iter()
+            .map(|f| {
+                rules
+                    .iter()
+                    .filter(|(_, r)| matches!(r, ParamValue::Rule(_)))
+                    .map(|(n, r)| {
+                        Ok((n.clone(), r.resolve(n, f).map_err(|e| DiagnoseError::Setup(e.to_string()))?))
+                    })
+                    .collect::<Result<BTreeMap<_, _>, DiagnoseError>>()
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Runs { frames: frames.to_vec(), states, scale, units, x0, params, settings, intercepts: false })
+    }
+
+    /// Simulate with the equations' intercepts b0 (off by default: the paper re-simulates
+    /// without them, and its B0, C0 stand for effects it did not model, §8).
+    pub fn with_intercepts(mut self, yes: bool) -> Runs {
+        self.intercepts = yes;
+        self
     }
 
     /// Number of compared values.
@@ -131,13 +158,15 @@ impl Runs {
         offsets: &[(usize, f64)],
         factors: &[(usize, f64)],
     ) -> Result<Vec<Trajectory>, SimError> {
-        let system = System::new(model, &Default::default(), false)?;
+        let system = System::new(model, &Default::default(), self.intercepts)?;
         let m = system.inputs.len();
         self.frames
             .iter()
             .zip(&self.x0)
             .zip(&self.settings)
-            .map(|((f, x0), s)| {
+            .zip(&self.params)
+            .map(|(((f, x0), s), p)| {
+                let system = system.with_parameters(p)?;
                 let mut c = Transformed {
                     replay: Replay::new(f, &system.inputs)?,
                     offset: vec![0.0; m],

@@ -168,6 +168,8 @@ pub struct Settings {
     /// Hypotheses within this share of the best one's explained gap count as tied; among them
     /// those made of the model's declared candidate terms come first.
     pub tie: f64,
+    /// Simulate with the equations' stored intercepts b0.
+    pub with_intercepts: bool,
 }
 
 impl Default for Settings {
@@ -179,6 +181,7 @@ impl Default for Settings {
             min_explained: 0.3,
             min_bic_drop: 10.0,
             tie: 0.01,
+            with_intercepts: false,
         }
     }
 }
@@ -214,7 +217,8 @@ pub fn diagnose(
     hypotheses: &[Hypothesis],
     settings: &Settings,
 ) -> Result<Diagnosis, DiagnoseError> {
-    let data = Runs::new(model, runs, settings.dt, settings.integrator)?;
+    let data =
+        Runs::new(model, runs, settings.dt, settings.integrator)?.with_intercepts(settings.with_intercepts);
     let base = data.simulate(model, &[], &[])?;
     let gap_before = data.gap(&base);
     let location = data.locate(&base);

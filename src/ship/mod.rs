@@ -3,6 +3,7 @@
 //! of the generic simulator, and their metrics as naval architects define them (IMO
 //! MSC.137(76), ITTC 7.5-04-02-01). Angles are radians inside, degrees in metrics.
 
+pub mod basin;
 pub mod figure;
 pub mod hypotheses;
 pub mod manoeuvre;

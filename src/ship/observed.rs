@@ -53,7 +53,12 @@ pub fn observe(t: &[f64], psi: &[f64], delta: &[f64], x0: &[f64], y0: &[f64]) ->
         if (delta[k] - anchor.0).abs() > 1f64.to_radians() {
             let d = (delta[k] - anchor.0).signum();
             if dir != 0.0 && d != dir {
-                rev.push(switch_time(t, delta, anchor.1));
+                // a measured rudder jitters at its extreme: the highest sample is anywhere in
+                // the hold; it left the extreme at the last sample still within 0.2° of it
+                let level = 0.2f64.to_radians();
+                let left =
+                    (anchor.1..k).rev().find(|&j| (delta[j] - anchor.0).abs() <= level).unwrap_or(anchor.1);
+                rev.push(switch_time(t, delta, left));
             }
             dir = d;
             anchor = (delta[k], k);

@@ -18,6 +18,7 @@ pub struct System {
     rhs: Library,
     /// For each library input: where its value comes from.
     map: Vec<Slot>,
+    param_names: Vec<String>,
     params: Vec<f64>,
 }
 
@@ -83,7 +84,19 @@ impl System {
                 )
             })
             .collect();
-        Ok(System { states, inputs, bounds, rhs, map, params: values.into_values().collect() })
+        Ok(System { states, inputs, bounds, rhs, map, param_names, params: values.into_values().collect() })
+    }
+
+    /// The same system with some parameters changed (e.g. a run's own approach speed u0).
+    pub fn with_parameters(&self, parameters: &BTreeMap<String, f64>) -> Result<System, SimError> {
+        let mut out = self.clone();
+        for (name, value) in parameters {
+            let i = self.param_names.iter().position(|n| n == name).ok_or_else(|| {
+                SimError::Settings(format!("`{name}` is not a parameter ({})", self.param_names.join(", ")))
+            })?;
+            out.params[i] = *value;
+        }
+        Ok(out)
     }
 
     /// Number of states.

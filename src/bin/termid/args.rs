@@ -17,7 +17,7 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Select terms and fit coefficients of one equation from one or several runs.
-    Identify(IdentifyCommand),
+    Identify(Box<IdentifyCommand>),
     /// Simulate a model file (the default ship model if none) under a manoeuvre or inputs.
     Simulate(SimulateCommand),
     /// Reproduce Oltmann (1973) end to end: tables, figures and a report beside the paper's.
@@ -102,9 +102,21 @@ pub struct IdentifyCommand {
     /// Regression back-end.
     #[arg(long, default_value = "stepwise")]
     pub backend: String,
-    /// Derivative method for `dX/dt` targets.
+    /// Derivative method for `dX/dt` targets: central, savitzky-golay[:WINDOW:ORDER],
+    /// spline[:ALPHA] (GCV by default), kalman[:RATIO] (maximum likelihood by default).
     #[arg(long, default_value = "central")]
     pub derivative: String,
+    /// Resample every run to this interval [s] before differentiating (low-pass filtered
+    /// first when coarser than the data, so noise does not alias).
+    #[arg(long)]
+    pub resample: Option<f64>,
+    /// Replace each differentiated signal by the derivative method's smoothed estimate
+    /// (spline, kalman), so the regressors are smoothed as well as the targets.
+    #[arg(long)]
+    pub smooth: bool,
+    /// Write a figure of the raw and prepared signals of every run into this folder.
+    #[arg(long)]
+    pub prepared_svg: Option<PathBuf>,
     /// Fit without an intercept b0.
     #[arg(long)]
     pub no_intercept: bool,
@@ -282,4 +294,7 @@ pub struct ResimArgs {
     /// One figure per run (measured, simulated, residual) into this folder.
     #[arg(long)]
     pub svg: Option<PathBuf>,
+    /// Include each equation's stored intercept b0 in the simulation.
+    #[arg(long)]
+    pub with_intercept: bool,
 }

@@ -19,6 +19,7 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
     let settings = Settings {
         dt: cmd.resim.dt,
         integrator: termid::sim::Integrator::by_name(&cmd.resim.integrator)?,
+        with_intercepts: cmd.resim.with_intercept,
         ..Settings::default()
     };
     let d = diagnose(&model, &runs, &hypotheses, &settings).context("diagnosing")?;

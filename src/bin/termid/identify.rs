@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 
 use anyhow::{bail, Context, Result};
-use termid::data::{differentiator, Frame};
+use termid::data::{differentiator, prepare, prepared_figure, Frame, Preparation};
 use termid::identify::{Fit, Identification, ParamValue, Target};
 use termid::select::{Backend, StepRule};
 use termid::term::{parse_terms, Vocabulary};
@@ -29,6 +29,10 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     if let Some(ds) = &cmd.dataset {
         frames.extend(crate::runs::load(&[], Some(ds), &cmd.time)?);
     }
+    let target = Target::parse(cmd.target.as_deref().unwrap_or_default());
+    if let Target::Derivative(state) = &target {
+        frames = prepare_runs(&cmd, frames, std::slice::from_ref(state), &|_| (1.0, String::new()))?;
+    }
     let mut vocab = Vocabulary::new();
     let mut params = BTreeMap::new();
     for p in &cmd.params {
@@ -39,7 +43,6 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
         };
         params.insert(name.to_string(), value);
     }
-    let target = Target::parse(cmd.target.as_deref().unwrap_or_default());
     if cmd.no_time && matches!(target, Target::Derivative(_)) {
         bail!("--no-time data have no time axis, so `{target}` cannot be differentiated");
     }
@@ -98,6 +101,38 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     Ok(())
 }
 
+/// Resampling and smoothing of the runs where asked for: each differentiated signal gets its
+/// rate as `<signal>_dot` (which identification then takes as the target), and a figure.
+fn prepare_runs(
+    cmd: &IdentifyCommand,
+    frames: Vec<Frame>,
+    signals: &[String],
+    scale: &dyn Fn(&str) -> (f64, String),
+) -> Result<Vec<Frame>> {
+    if cmd.resample.is_none() && !cmd.smooth && cmd.prepared_svg.is_none() {
+        return Ok(frames);
+    }
+    let method = differentiator(&cmd.derivative)?;
+    let how = Preparation {
+        resample: cmd.resample,
+        method: method.as_ref(),
+        signals: signals.to_vec(),
+        smooth: cmd.smooth,
+    };
+    let prepared = frames.iter().map(|f| prepare(f, &how)).collect::<Result<Vec<_>, _>>()?;
+    if let Some(dir) = &cmd.prepared_svg {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        for (k, (raw, p)) in frames.iter().zip(&prepared).enumerate() {
+            let stem = std::path::Path::new(raw.origin())
+                .file_stem()
+                .map_or(format!("run{k}"), |s| s.to_string_lossy().into_owned());
+            let path = dir.join(format!("prepared_{k}_{stem}.svg"));
+            prepared_figure(raw, p, signals, scale).write_svg(&path)?;
+        }
+    }
+    Ok(prepared)
+}
+
 fn configure_backend(cmd: &IdentifyCommand) -> Result<Backend> {
     let mut backend = Backend::by_name(&cmd.backend)?;
     // the stepwise stop and step-rule options do not apply to the other back-ends
@@ -121,6 +156,18 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
     let frames = crate::runs::load(&cmd.data, cmd.dataset.as_deref(), &time)?;
     let names: Vec<String> =
         if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };
+    let states: Vec<String> =
+        names.iter().filter_map(|n| model.equation(n).map(|e| e.state.clone())).collect();
+    let units: BTreeMap<String, String> =
+        model.spec.states.iter().map(|s| (s.name.clone(), s.unit.clone())).collect();
+    let frames = prepare_runs(&cmd, frames, &states, &|name| {
+        let unit = units.get(name).cloned().unwrap_or_default();
+        // angles are read in degrees
+        match unit.strip_prefix("rad") {
+            Some(rest) => (180.0 / std::f64::consts::PI, format!("deg{rest}")),
+            None => (1.0, unit),
+        }
+    })?;
     if cmd.target.is_some() && names.len() != 1 {
         bail!("--target applies to one equation: name it with --equation");
     }

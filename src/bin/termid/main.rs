@@ -17,7 +17,7 @@ use clap::Parser;
 fn main() -> ExitCode {
     let cli = args::Cli::parse();
     let result = match cli.command {
-        args::Command::Identify(cmd) => identify::run(cmd),
+        args::Command::Identify(cmd) => identify::run(*cmd),
         args::Command::Simulate(cmd) => simulate::run(cmd),
         args::Command::Reproduce(cmd) => reproduce::run(cmd),
         args::Command::Compare(cmd) => compare::run(cmd),

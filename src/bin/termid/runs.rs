@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use termid::data::{Dataset, Frame};
+use termid::data::{check_gaps, Dataset, Frame};
 
 pub fn load(data: &[PathBuf], dataset: Option<&Path>, time: &str) -> Result<Vec<Frame>> {
     let mut frames = data.iter().map(|p| Frame::read_csv(p, time)).collect::<Result<Vec<_>, _>>()?;
@@ -17,6 +17,10 @@ pub fn load(data: &[PathBuf], dataset: Option<&Path>, time: &str) -> Result<Vec<
             eprintln!("unit: {n}");
         }
         frames.extend(more);
+    }
+    for f in &frames {
+        // a logging dropout would be differentiated across as if it were one step
+        check_gaps(f, 3.0)?;
     }
     if frames.is_empty() {
         bail!("no runs: give --data FILE… or --dataset FILE");

@@ -14,7 +14,8 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
     let model = crate::simulate::load_model(&cmd.model)?;
     let time = model.spec.model.time.clone();
     let runs = crate::runs::load(&cmd.runs.data, cmd.runs.dataset.as_deref(), &time)?;
-    let data = Runs::new(&model, &runs, cmd.resim.dt, Integrator::by_name(&cmd.resim.integrator)?)?;
+    let data = Runs::new(&model, &runs, cmd.resim.dt, Integrator::by_name(&cmd.resim.integrator)?)?
+        .with_intercepts(cmd.resim.with_intercept);
     let sims = data.simulate(&model, &[], &[])?;
     let gap = data.gap(&sims);
     // ship models: metrics read off measurement and simulation alike

@@ -1,0 +1,216 @@
+//! Kalman filter with Rauch-Tung-Striebel smoother on a kinematic model of one signal: value,
+//! rate and acceleration, driven by white jerk (the "Wiener-process acceleration" model of
+//! Bar-Shalom et al. 2001, §6.2.3). The ratio of jerk intensity to measurement noise, which
+//! sets how much the signal is smoothed, is chosen by maximum likelihood of the innovations
+//! unless given; the noise level itself is concentrated out of the likelihood.
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::derivative::{Differentiator, Smoothed};
+use super::DataError;
+
+/// Kalman/RTS smoothing and differentiation.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct KalmanSmoother {
+    /// Jerk intensity / measurement variance, time in mean sample spacings; `None` = maximum
+    /// likelihood.
+    pub ratio: Option<f64>,
+}
+
+/// Filter and smoother of one signal at one noise ratio (measurement variance 1).
+struct Pass {
+    /// Smoothed states.
+    states: Vec<Vector3<f64>>,
+    /// −2 log likelihood with the measurement variance concentrated out.
+    deviance: f64,
+}
+
+fn transition(dt: f64) -> Matrix3<f64> {
+    Matrix3::new(1.0, dt, 0.5 * dt * dt, 0.0, 1.0, dt, 0.0, 0.0, 1.0)
+}
+
+fn process_noise(dt: f64, q: f64) -> Matrix3<f64> {
+    let (d2, d3) = (dt * dt, dt * dt * dt);
+    let (d4, d5) = (d2 * d2, d2 * d3);
+    q * Matrix3::new(d5 / 20.0, d4 / 8.0, d3 / 6.0, d4 / 8.0, d3 / 3.0, d2 / 2.0, d3 / 6.0, d2 / 2.0, dt)
+}
+
+/// Runs filter and (if `smooth`) smoother on `y` over the scaled steps `h`.
+fn pass(h: &[f64], y: &[f64], q: f64, smooth: bool) -> Option<Pass> {
+    let n = y.len();
+    // exact start instead of a numerically fragile diffuse prior: the parabola through the
+    // first three samples gives the state at sample 2 and, with unit measurement variance,
+    // its covariance J Jᵀ
+    let (t0, t1) = (-(h[0] + h[1]), -h[1]);
+    let v = Matrix3::new(1.0, t0, 0.5 * t0 * t0, 1.0, t1, 0.5 * t1 * t1, 1.0, 0.0, 0.0);
+    let j = v.try_inverse()?;
+    let mut x = j * Vector3::new(y[0], y[1], y[2]);
+    let mut p = j * j.transpose();
+    let (mut filtered, mut predicted) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    filtered.push((x, p));
+    predicted.push((x, p));
+    let (mut sum_log_s, mut sum_v2) = (0.0, 0.0);
+    for k in 3..n {
+        let f = transition(h[k - 1]);
+        x = f * x;
+        p = f * p * f.transpose() + process_noise(h[k - 1], q);
+        predicted.push((x, p));
+        let s = p[(0, 0)] + 1.0;
+        let v = y[k] - x[0];
+        let gain = p.column(0) / s;
+        x += gain * v;
+        p -= gain * p.row(0);
+        p = 0.5 * (p + p.transpose());
+        sum_log_s += s.ln();
+        sum_v2 += v * v / s;
+        filtered.push((x, p));
+    }
+    let m = (n - 3) as f64;
+    // −∞ for data the model fits exactly (no noise at all): the best possible score
+    let deviance = sum_log_s + m * (sum_v2 / m).ln();
+    if deviance.is_nan() || states_blew_up(&filtered) {
+        return None;
+    }
+    // filtered[i] is sample i + 2
+    let mut states: Vec<Vector3<f64>> = filtered.iter().map(|(x, _)| *x).collect();
+    if smooth {
+        for i in (0..states.len() - 1).rev() {
+            let (xf, pf) = filtered[i];
+            let (xp, pp) = predicted[i + 1];
+            let c = pf * transition(h[i + 2]).transpose() * pp.try_inverse()?;
+            states[i] = xf + c * (states[i + 1] - xp);
+        }
+    }
+    // samples 0 and 1: the state at sample 2 carried back along the kinematic model
+    let first = states[0];
+    let back = |dt: f64| transition(-dt) * first;
+    let mut all = vec![back(h[0] + h[1]), back(h[1])];
+    all.extend(states);
+    Some(Pass { states: all, deviance })
+}
+
+fn states_blew_up(filtered: &[(Vector3<f64>, Matrix3<f64>)]) -> bool {
+    filtered.iter().any(|(x, _)| !x.iter().all(|v| v.is_finite()))
+}
+
+impl KalmanSmoother {
+    /// The smoothed signal and its rate, and the noise ratio used.
+    pub fn fit(&self, t: &[f64], x: &[f64]) -> Result<(Smoothed, f64), DataError> {
+        let n = t.len().min(x.len());
+        if n < 8 {
+            return Err(DataError::TooShort {
+                file: "signal".into(),
+                rows: n,
+                needed: 8,
+                what: "a Kalman smoother".into(),
+            });
+        }
+        let (t, x) = (&t[..n], &x[..n]);
+        let scale = (t[n - 1] - t[0]) / (n - 1) as f64;
+        let h: Vec<f64> = t.windows(2).map(|w| (w[1] - w[0]) / scale).collect();
+        let ratio = match self.ratio {
+            Some(r) if r > 0.0 && r.is_finite() => r,
+            Some(r) => {
+                return Err(DataError::UnknownMethod(
+                    format!("kalman:{r}"),
+                    "a noise ratio > 0, or none for maximum likelihood".into(),
+                ))
+            }
+            None => most_likely_ratio(&h, x),
+        };
+        let fail = || DataError::UnknownMethod(format!("kalman:{ratio}"), "the smoother diverged".into());
+        let p = pass(&h, x, ratio, true)
+            .filter(|p| p.states.iter().all(|s| s.iter().all(|v| v.is_finite())))
+            .ok_or_else(fail)?;
+        Ok((
+            Smoothed {
+                value: p.states.iter().map(|s| s[0]).collect(),
+                rate: p.states.iter().map(|s| s[1] / scale).collect(),
+            },
+            ratio,
+        ))
+    }
+}
+
+/// Ratio maximising the likelihood: a grid in decades, then golden section in log ratio.
+fn most_likely_ratio(h: &[f64], y: &[f64]) -> f64 {
+    let score = |p: f64| pass(h, y, 10f64.powf(p), false).map_or(f64::INFINITY, |s| s.deviance);
+    let grid: Vec<f64> = (-16..=6).map(f64::from).collect();
+    let scores: Vec<f64> = grid.iter().map(|&p| score(p)).collect();
+    let best = (0..grid.len()).min_by(|&a, &b| scores[a].total_cmp(&scores[b])).unwrap_or(0);
+    let (mut a, mut b) = (grid[best.saturating_sub(1)], grid[(best + 1).min(grid.len() - 1)]);
+    let phi = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut c, mut d) = (b - phi * (b - a), a + phi * (b - a));
+    let (mut fc, mut fd) = (score(c), score(d));
+    while b - a > 0.01 {
+        if fc < fd {
+            (b, d, fd) = (d, c, fc);
+            c = b - phi * (b - a);
+            fc = score(c);
+        } else {
+            (a, c, fc) = (c, d, fd);
+            d = a + phi * (b - a);
+            fd = score(d);
+        }
+    }
+    10f64.powf(0.5 * (a + b))
+}
+
+impl Differentiator for KalmanSmoother {
+    fn name(&self) -> &'static str {
+        "kalman"
+    }
+
+    fn differentiate(&self, t: &[f64], x: &[f64]) -> Result<Vec<f64>, DataError> {
+        Ok(self.fit(t, x)?.0.rate)
+    }
+
+    fn smooth(&self, t: &[f64], x: &[f64]) -> Result<Smoothed, DataError> {
+        Ok(self.fit(t, x)?.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn noise(seed: &mut u64) -> f64 {
+        *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (*seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    }
+
+    #[test]
+    fn exact_on_quadratics_without_noise() {
+        let t: Vec<f64> = (0..50).map(|i| i as f64 * 0.1).collect();
+        let x: Vec<f64> = t.iter().map(|t| 1.0 + 2.0 * t - 0.5 * t * t).collect();
+        let (s, _) = KalmanSmoother { ratio: Some(1e-6) }.fit(&t, &x).unwrap();
+        for (i, t) in t.iter().enumerate() {
+            assert!((s.rate[i] - (2.0 - t)).abs() < 1e-5, "{t}: {}", s.rate[i]);
+            assert!((s.value[i] - x[i]).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn maximum_likelihood_smoothing_beats_central_differences() {
+        let t: Vec<f64> = (0..2000).map(|i| i as f64 * 0.05).collect();
+        let mut seed = 3u64;
+        let x: Vec<f64> = t.iter().map(|t| (0.3 * t).sin() + 0.02 * noise(&mut seed)).collect();
+        let err = |d: &[f64]| {
+            (d.iter()
+                .zip(&t)
+                .skip(20)
+                .take(1960)
+                .map(|(d, t)| (d - 0.3 * (0.3 * t).cos()).powi(2))
+                .sum::<f64>()
+                / 1960.0)
+                .sqrt()
+        };
+        let (s, _) = KalmanSmoother::default().fit(&t, &x).unwrap();
+        let cd = crate::data::CentralDifference.differentiate(&t, &x).unwrap();
+        assert!(err(&s.rate) < err(&cd) / 10.0, "kalman {} vs central {}", err(&s.rate), err(&cd));
+        let value_err =
+            (s.value.iter().zip(&t).map(|(v, t)| (v - (0.3 * t).sin()).powi(2)).sum::<f64>() / 2000.0).sqrt();
+        assert!(value_err < 0.02 / 12f64.sqrt() / 2.0, "smoothed value error {value_err}");
+        assert!(KalmanSmoother { ratio: Some(0.0) }.fit(&t, &x).is_err());
+    }
+}

@@ -1,0 +1,289 @@
+//! A synthetic model basin: free-running runs of a known model recorded as a basin records
+//! them — a straight approach at the run's own speed, then the manoeuvre; sampled at the
+//! logging rate with Gaussian sensor noise; written with the basin's own column names, angles
+//! in degrees, whitespace-separated with a file header. The truth is kept beside the
+//! recording, so identification from the files can be judged against it (what the paper did
+//! by rounding, §8, with realistic measurement errors instead).
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::{Manoeuvre, Metrics, Ship, ShipError};
+use crate::data::Frame;
+use crate::model::Model;
+use crate::sim::{Integrator, Settings};
+
+/// Standard deviations of the sensors' noise.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Noise {
+    /// Surge and sway speed, m/s.
+    pub speed_m_s: f64,
+    /// Yaw rate, °/s.
+    pub yaw_rate_deg_s: f64,
+    /// Heading, °.
+    pub heading_deg: f64,
+    /// Position, m.
+    pub position_m: f64,
+    /// Rudder angle, °.
+    pub rudder_deg: f64,
+}
+
+impl Default for Noise {
+    /// Sizes typical of a model basin's carriage-free tracking and gyro (issue 7's figures).
+    fn default() -> Self {
+        Noise { speed_m_s: 0.02, yaw_rate_deg_s: 0.05, heading_deg: 0.1, position_m: 0.02, rudder_deg: 0.05 }
+    }
+}
+
+/// How runs are recorded.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Basin {
+    /// Logging rate, Hz.
+    pub rate_hz: f64,
+    /// Straight approach before the rudder is put over, s.
+    pub approach_s: f64,
+    /// Sensor noise.
+    pub noise: Noise,
+    /// Integration step of the truth (RK4), s.
+    pub dt: f64,
+}
+
+impl Default for Basin {
+    fn default() -> Self {
+        Basin { rate_hz: 20.0, approach_s: 5.0, noise: Noise::default(), dt: 0.01 }
+    }
+}
+
+/// One recorded run.
+#[derive(Clone, Debug)]
+pub struct Recording {
+    /// Noise-free states and inputs (SI, radians, model names), time from the start of the approach.
+    pub truth: Frame,
+    /// The same with sensor noise.
+    pub measured: Frame,
+    /// The manoeuvre's metrics from the noise-free run.
+    pub metrics: Metrics,
+    /// The run's approach speed, m/s.
+    pub u0: f64,
+}
+
+/// The basin's column names and units for the ship's roles, as a dataset file maps them.
+pub const COLUMNS: [(&str, &str); 8] = [
+    ("t", "time [s]"),
+    ("u", "u_log [m/s]"),
+    ("v", "v_log [m/s]"),
+    ("r", "yaw_rate [deg/s]"),
+    ("ψ", "heading [deg]"),
+    ("x0", "x_track [m]"),
+    ("y0", "y_track [m]"),
+    ("δ", "rudder [deg]"),
+];
+
+/// The model run at another approach speed: the ship's u0 and every parameter taken from the
+/// run's surge speed in identification (`first:u`, `mean:u…`), so that Δu = u − u0 is
+/// measured from this run's own speed, as it is in identification.
+pub fn at_approach_speed(model: &Model, u0: f64) -> Model {
+    let mut m = model.clone();
+    let surge = m.spec.ship.as_ref().map(|s| s.names.u.clone()).unwrap_or_else(|| "u".into());
+    if let Some(ship) = m.spec.ship.as_mut() {
+        ship.u0 = u0;
+    }
+    for p in m.spec.parameters.values_mut() {
+        let reads_surge =
+            p.per_run.as_deref().is_some_and(|rule| rule.split(':').nth(1) == Some(surge.as_str()));
+        if reads_surge {
+            p.value = u0;
+        }
+    }
+    m
+}
+
+/// Gaussian numbers from a seeded SplitMix64 (Box-Muller): the same seed, the same run.
+struct Gauss(u64);
+
+impl Gauss {
+    fn uniform(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        ((z >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    }
+
+    fn next(&mut self) -> f64 {
+        let (a, b) = (self.uniform(), self.uniform());
+        (-2.0 * a.ln()).sqrt() * (2.0 * std::f64::consts::PI * b).cos()
+    }
+}
+
+impl Basin {
+    /// Runs `manoeuvre` with `model` at approach speed `u0` for `duration` s after the
+    /// approach, and records it; `seed` fixes the noise.
+    pub fn record(
+        &self,
+        model: &Model,
+        manoeuvre: &Manoeuvre,
+        u0: f64,
+        duration: f64,
+        seed: u64,
+        origin: &str,
+    ) -> Result<Recording, ShipError> {
+        let model = at_approach_speed(model, u0);
+        let ship = Ship::new(&model, false)?;
+        let sample = 1.0 / self.rate_hz;
+        let settings = Settings { integrator: Integrator::Rk4, dt: self.dt, duration, sample };
+        let run = ship.run(manoeuvre, &settings)?;
+        let tr = &run.trajectory;
+        let r = &ship.roles;
+        // the approach: steady straight running (ψ = 0) at the straight run's u0, v0, δ0
+        let before = (self.approach_s * self.rate_hz).round() as usize;
+        let mut time: Vec<f64> = (0..before).map(|i| i as f64 * sample).collect();
+        let shift = before as f64 * sample;
+        time.extend(tr.time.iter().map(|t| t + shift));
+        let states: Vec<Vec<f64>> = (0..tr.states.len())
+            .map(|i| {
+                let (x, rate) = match i {
+                    _ if i == r.x0 => (run.start.x[i], run.start.x[r.u]),
+                    _ if i == r.y0 => (run.start.x[i], run.start.x[r.v]),
+                    _ => (run.start.x[i], 0.0),
+                };
+                let mut c: Vec<f64> = (0..before).map(|k| x + rate * (k as f64 * sample - shift)).collect();
+                c.extend(&tr.states[i]);
+                c
+            })
+            .collect();
+        let inputs: Vec<Vec<f64>> = (0..tr.inputs.len())
+            .map(|i| {
+                let mut c = vec![run.start.input[i]; before];
+                c.extend(&tr.inputs[i]);
+                c
+            })
+            .collect();
+        // the track continues from where the approach ended: put the origin at its start
+        let (ox, oy) = (states[r.x0][0], states[r.y0][0]);
+        let mut truth = Frame::new(origin, "t", time)?;
+        let mut measured = truth.clone();
+        let mut gauss = Gauss(seed);
+        let n = &self.noise;
+        for (i, name) in tr.state_names.iter().enumerate() {
+            let (offset, sd) = match i {
+                _ if i == r.u || i == r.v => (0.0, n.speed_m_s),
+                _ if i == r.r => (0.0, n.yaw_rate_deg_s.to_radians()),
+                _ if i == r.psi => (0.0, n.heading_deg.to_radians()),
+                _ if i == r.x0 => (ox, n.position_m),
+                _ if i == r.y0 => (oy, n.position_m),
+                _ => (0.0, 0.0),
+            };
+            let clean: Vec<f64> = states[i].iter().map(|v| v - offset).collect();
+            measured.push(name, clean.iter().map(|v| v + sd * gauss.next()).collect())?;
+            truth.push(name, clean)?;
+        }
+        for (i, name) in tr.input_names.iter().enumerate() {
+            let sd = if i == r.rudder { n.rudder_deg.to_radians() } else { 0.0 };
+            measured.push(name, inputs[i].iter().map(|v| v + sd * gauss.next()).collect())?;
+            truth.push(name, inputs[i].clone())?;
+        }
+        Ok(Recording { truth, measured, metrics: run.metrics, u0 })
+    }
+
+    /// Writes the measured run as the basin's data file: three header lines, then the
+    /// columns of [`COLUMNS`] separated by spaces, angles in degrees.
+    pub fn write(&self, rec: &Recording, model: &Model, path: &Path) -> std::io::Result<()> {
+        let canon = |n: &str| model.vocabulary.canonical(n).unwrap_or_else(|| n.to_string());
+        let mut text = format!(
+            "# synthetic basin run {}\n# logged at {} Hz; approach {} s at u0 = {:.4} m/s\n# noise sd: speed {} m/s, yaw rate {} deg/s, heading {} deg, position {} m, rudder {} deg\n",
+            rec.measured.origin(),
+            self.rate_hz,
+            self.approach_s,
+            rec.u0,
+            self.noise.speed_m_s,
+            self.noise.yaw_rate_deg_s,
+            self.noise.heading_deg,
+            self.noise.position_m,
+            self.noise.rudder_deg
+        );
+        let header: Vec<&str> = COLUMNS.iter().map(|(_, c)| c.split(" [").next().unwrap_or(c)).collect();
+        text += &header.join(" ");
+        text.push('\n');
+        let cols: Vec<(&[f64], bool)> = COLUMNS
+            .iter()
+            .map(|(var, spec)| {
+                let c =
+                    if *var == "t" { Some(rec.measured.time()) } else { rec.measured.column(&canon(var)) };
+                (c.unwrap_or(&[]), spec.contains("[deg"))
+            })
+            .collect();
+        for k in 0..rec.measured.len() {
+            let row: Vec<String> = cols
+                .iter()
+                .map(|(c, deg)| {
+                    let v = c.get(k).copied().unwrap_or(f64::NAN);
+                    format!("{:.6}", if *deg { v.to_degrees() } else { v })
+                })
+                .collect();
+            let _ = writeln!(text, "{}", row.join(" "));
+        }
+        std::fs::write(path, text)
+    }
+}
+
+/// A dataset file (see [`crate::data::Dataset`]) listing basin files written by [`Basin::write`].
+pub fn dataset_toml(files: &[&str]) -> String {
+    let mut s = String::from("# runs from the synthetic basin\n[columns]\n");
+    for (var, spec) in COLUMNS {
+        let _ = writeln!(s, "\"{var}\" = \"{spec}\"");
+    }
+    for f in files {
+        let _ = write!(s, "\n[[runs]]\nfile = \"{f}\"\ndelimiter = \"whitespace\"\nskip = 3\n");
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn noise_has_the_declared_size_and_the_approach_is_straight() {
+        let model = Model::default_model();
+        let basin = Basin::default();
+        let m = Manoeuvre::parse("zigzag:20/20").unwrap();
+        let rec = basin.record(&model, &m, 1.95, 40.0, 1, "zz.dat").unwrap();
+        let (t, mp) = (rec.truth.column("ψ").unwrap(), rec.measured.column("ψ").unwrap());
+        let sd = (t.iter().zip(mp).map(|(a, b)| (a - b).powi(2)).sum::<f64>() / t.len() as f64).sqrt();
+        assert!((sd.to_degrees() / 0.1 - 1.0).abs() < 0.1, "heading noise {}°", sd.to_degrees());
+        let u = rec.truth.column("u").unwrap();
+        assert!((u[0] - 1.95).abs() < 1e-12 && (u[99] - 1.95).abs() < 1e-12);
+        assert_eq!(rec.truth.len(), 100 + 801);
+        assert!((rec.truth.time()[100] - 5.0).abs() < 1e-12);
+        // Δu = u − u0 is zero on the approach at this run's speed: the surge balance holds
+        let faster = at_approach_speed(&model, 1.95);
+        assert_eq!(faster.parameter_values()["u0"], 1.95);
+    }
+
+    /// Overshoots read off a noisy record (rudder jittering at its extremes) are those of the
+    /// noise-free run, up to the heading noise's maximum.
+    #[test]
+    fn metrics_read_off_a_noisy_record_match_the_truth() {
+        let model = Model::default_model();
+        let m = Manoeuvre::parse("zigzag:25/10").unwrap();
+        for seed in [11, 99] {
+            let rec = Basin::default().record(&model, &m, 1.97, 100.0, seed, "zz.dat").unwrap();
+            let o = |f: &Frame| {
+                let c = |n: &str| f.column(n).unwrap();
+                crate::ship::observed::observe(f.time(), c("ψ"), c("δ"), c("x0"), c("y0"))
+            };
+            let Metrics::ZigZag(z) = &rec.metrics else { panic!("a zigzag") };
+            let (truth, measured) = (o(&rec.truth), o(&rec.measured));
+            for (a, b) in [
+                (z.first_overshoot_deg, measured.first_overshoot_deg),
+                (z.second_overshoot_deg, measured.second_overshoot_deg),
+                (z.first_overshoot_deg, truth.first_overshoot_deg),
+            ] {
+                let (a, b) = (a.unwrap(), b.unwrap());
+                assert!((a - b).abs() < 0.4, "seed {seed}: {a}° vs {b}°");
+            }
+        }
+    }
+}

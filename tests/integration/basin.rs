@@ -1,0 +1,214 @@
+//! Issue 7's synthetic basin: the default model's zigzags recorded at 20 Hz with realistic
+//! sensor noise, per-run approach speeds, degrees and the basin's own column names; identified
+//! through the CLI from four runs, validated on the fifth and on turning circles against the
+//! noise-free truth. Also the bad-file cases of measured runs.
+
+use termid::model::Model;
+use termid::ship::basin::{dataset_toml, Basin};
+use termid::ship::{Manoeuvre, Metrics};
+
+use crate::common::{termid, Scratch};
+
+/// (manoeuvre, approach speed / nominal u0): the paper's five zigzags (NOTES.md §4).
+const TRAIN: [(&str, f64); 4] = [
+    ("zigzag:15/10", 0.97),
+    ("zigzag:20/10:port", 1.02),
+    ("zigzag:30/10", 0.99),
+    ("zigzag:20/20:port", 1.03),
+];
+const HELD_OUT: (&str, f64) = ("zigzag:25/10", 0.98);
+
+fn json(text: &str) -> serde_json::Value {
+    serde_json::from_str(text).unwrap_or_else(|e| panic!("{e}: {text}"))
+}
+
+fn tactical(model: Option<&str>, delta: f64) -> f64 {
+    let turn = format!("turning:{delta}");
+    let mut args = vec![
+        "simulate",
+        "--manoeuvre",
+        &turn,
+        "--integrator",
+        "rk4",
+        "--dt",
+        "0.01",
+        "--duration",
+        "250",
+        "--format",
+        "json",
+    ];
+    if let Some(m) = model {
+        args.extend(["--model", m]);
+    }
+    let (ok, out, err) = termid(&args);
+    assert!(ok, "{err}");
+    json(&out)["metrics"]["tactical_diameter_m"].as_f64().expect("a tactical diameter")
+}
+
+#[test]
+fn identified_from_noisy_basin_runs_the_model_predicts_within_the_targets() {
+    let dir = Scratch::new("basin");
+    let truth = Model::default_model();
+    let basin = Basin::default();
+    let mut held_overshoot = f64::NAN;
+    let mut names = Vec::new();
+    for (k, (m, f)) in TRAIN.iter().chain([&HELD_OUT]).enumerate() {
+        let name = format!("run{k}.dat");
+        let rec = basin
+            .record(&truth, &Manoeuvre::parse(m).unwrap(), f * 2.010, 100.0, 7 + k as u64, &name)
+            .unwrap();
+        basin.write(&rec, &truth, &dir.join(&name)).unwrap();
+        if let Metrics::ZigZag(z) = &rec.metrics {
+            held_overshoot = z.first_overshoot_deg.unwrap();
+        }
+        names.push(name);
+    }
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    std::fs::write(dir.join("train.toml"), dataset_toml(&names[..4])).unwrap();
+    std::fs::write(dir.join("held.toml"), dataset_toml(&names[4..])).unwrap();
+    // measured runs: u0 is each run's approach speed, the mean over its straight approach
+    let text = std::fs::read_to_string("models/oltmann1973.toml").unwrap();
+    assert!(text.contains("per_run = \"first:u\""));
+    std::fs::write(dir.join("m.toml"), text.replace("per_run = \"first:u\"", "per_run = \"mean:u:4\""))
+        .unwrap();
+    let p = |f: &str| dir.join(f).display().to_string();
+
+    let (ok, out, err) = termid(&[
+        "identify",
+        "--model",
+        &p("m.toml"),
+        "--dataset",
+        &p("train.toml"),
+        "--derivative",
+        "kalman",
+        "--smooth",
+        // no intercept: the model's u² terms already carry the constant asymmetry (B0, C0),
+        // and at u ≈ u0 they and an intercept are nearly the same column
+        "--no-intercept",
+        "--out",
+        &p("id.toml"),
+        "--prepared-svg",
+        &p("prepared"),
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("wrote"), "{out}");
+    // every conversion is stated: degrees of the basin's columns to radians
+    assert!(err.contains("`heading` [deg] → ψ") && err.contains("`yaw_rate` [deg/s] → r"), "{err}");
+    let figures = std::fs::read_dir(dir.join("prepared")).unwrap().count();
+    assert_eq!(figures, 4);
+
+    // the fifth run: simulated from its own start with its recorded rudder
+    let (ok, out, err) = termid(&[
+        "validate",
+        "--model",
+        &p("id.toml"),
+        "--dataset",
+        &p("held.toml"),
+        "--integrator",
+        "rk4",
+        "--dt",
+        "0.01",
+        "--svg",
+        &p("validate"),
+        "--format",
+        "json",
+    ]);
+    assert!(ok, "{err}");
+    let v = json(&out);
+    let predicted = v["metrics"][0]["simulated"]["first_overshoot_deg"].as_f64().unwrap();
+    assert!(
+        (predicted - held_overshoot).abs() < 1.5,
+        "first overshoot {predicted}° vs true {held_overshoot}°: {out}"
+    );
+    let heading_rms =
+        v["gap"]["states"].as_array().unwrap().iter().find(|s| s[0] == "ψ").unwrap()[2].as_f64().unwrap();
+    assert!(heading_rms.to_degrees() < 3.0, "held-out heading RMS {}°", heading_rms.to_degrees());
+
+    // turning circles over the rudder range the zigzags covered (±20°, ±30°); README gives ±35°
+    for delta in [20.0, -20.0, 30.0, -30.0] {
+        let (t, m) = (tactical(None, delta), tactical(Some(&p("id.toml")), delta));
+        assert!((m / t - 1.0).abs() < 0.05, "δ = {delta}°: tactical diameter {m} m vs true {t} m");
+    }
+}
+
+#[test]
+fn preparation_resamples_and_refuses_what_it_cannot_do() {
+    let dir = Scratch::new("basin-prepare");
+    let truth = Model::default_model();
+    let basin = Basin { rate_hz: 50.0, ..Basin::default() };
+    let rec =
+        basin.record(&truth, &Manoeuvre::parse("zigzag:20/20").unwrap(), 2.0, 60.0, 3, "zz.dat").unwrap();
+    basin.write(&rec, &truth, &dir.join("zz.dat")).unwrap();
+    std::fs::write(dir.join("set.toml"), dataset_toml(&["zz.dat"])).unwrap();
+    let p = |f: &str| dir.join(f).display().to_string();
+    let set = p("set.toml");
+    let identify = |extra: &[&str]| {
+        let mut args = vec!["identify", "--model", "models/oltmann1973.toml", "--dataset", &set];
+        args.extend(extra);
+        termid(&args)
+    };
+    // 50 Hz decimated to 10 Hz: the fit sees 10 Hz rows
+    let (ok, out, err) =
+        identify(&["--resample", "0.1", "--derivative", "spline", "--smooth", "--format", "json"]);
+    assert!(ok, "{err}");
+    let rows = json(&out)["u_dot"]["rows"].as_u64().unwrap();
+    assert_eq!(rows, 651, "{out}");
+    let (ok, _, err) = identify(&["--resample", "0"]);
+    assert!(!ok && err.contains("zz.dat") && err.contains("resampling"), "{err}");
+    let (ok, _, err) = identify(&["--derivative", "savitzky-golay:2:1", "--smooth"]);
+    assert!(!ok && err.contains("savitzky-golay"), "{err}");
+    let (ok, _, err) = identify(&["--derivative", "kalmann"]);
+    assert!(!ok && err.contains("kalman[:RATIO]"), "{err}");
+    // a run shorter than the derivative window names its file and signal
+    let short: String = std::fs::read_to_string(dir.join("zz.dat"))
+        .unwrap()
+        .lines()
+        .take(4 + 9)
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(dir.join("short.dat"), short).unwrap();
+    std::fs::write(dir.join("short.toml"), dataset_toml(&["short.dat"])).unwrap();
+    let (ok, _, err) = termid(&[
+        "identify",
+        "--model",
+        "models/oltmann1973.toml",
+        "--dataset",
+        &p("short.toml"),
+        "--derivative",
+        "savitzky-golay:21:3",
+        "--smooth",
+    ]);
+    assert!(!ok && err.contains("short.dat") && err.contains("window of 21") && err.contains("`u`"), "{err}");
+}
+
+#[test]
+fn gaps_and_repeated_time_stamps_are_refused_with_their_row() {
+    let dir = Scratch::new("basin-gaps");
+    let truth = Model::default_model();
+    let basin = Basin::default();
+    let rec =
+        basin.record(&truth, &Manoeuvre::parse("zigzag:20/20").unwrap(), 2.0, 30.0, 3, "zz.dat").unwrap();
+    basin.write(&rec, &truth, &dir.join("zz.dat")).unwrap();
+    let lines: Vec<String> =
+        std::fs::read_to_string(dir.join("zz.dat")).unwrap().lines().map(String::from).collect();
+    // data row 101 (file line 4 + 101) missing a second of record; data row 51 repeated
+    let gap: Vec<String> = lines
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| !(4 + 100..4 + 120).contains(i))
+        .map(|(_, l)| l.clone())
+        .collect();
+    std::fs::write(dir.join("gap.dat"), gap.join("\n")).unwrap();
+    let mut dup = lines.clone();
+    dup.insert(4 + 51, lines[4 + 50].clone());
+    std::fs::write(dir.join("dup.dat"), dup.join("\n")).unwrap();
+    for (file, row, what) in [("gap.dat", "row 101", "gap"), ("dup.dat", "row 52", "does not increase")] {
+        std::fs::write(dir.join("set.toml"), dataset_toml(&[file])).unwrap();
+        let set = dir.join("set.toml").display().to_string();
+        let (ok, _, err) = termid(&["validate", "--model", "models/oltmann1973.toml", "--dataset", &set]);
+        assert!(
+            !ok && err.contains(file) && err.contains(row) && err.contains(what) && err.contains("`time`"),
+            "{err}"
+        );
+    }
+}
