@@ -152,6 +152,41 @@ pub struct Fit {
     pub candidates: Vec<String>,
     /// The back-end's result.
     pub selection: Selection,
+    /// Covariance of the chosen coefficients (in the order of `selection.terms`),
+    /// s²·(X'X)⁻¹ of the least-squares fit on the chosen terms; `None` when it is undefined
+    /// (no terms, no residual degrees of freedom, or a singular cross-product matrix).
+    #[serde(default)]
+    pub covariance: Option<Vec<Vec<f64>>>,
+    /// Integrated autocorrelation time of the residuals, in rows (1 for independent rows).
+    /// The covariance assumes independent rows; residuals of a sampled time series are not,
+    /// and the effective number of rows is `rows / correlation_time`, so honest standard
+    /// errors are √τ times the reported ones.
+    #[serde(default)]
+    pub correlation_time: Option<f64>,
+}
+
+/// s²·S⁻¹ of the chosen terms, S their (centred when there is an intercept) cross products:
+/// the covariance whose diagonal gives the standard errors the back-ends report (eq. A12).
+fn covariance_of(moments: &Moments, selection: &Selection) -> Option<Vec<Vec<f64>>> {
+    let set: Vec<usize> = selection.terms.iter().map(|t| t.index).collect();
+    let k = set.len();
+    let intercept = selection.intercept.as_ref().map(|b| b.value);
+    let dof = moments.count() as f64 - k as f64 - f64::from(u8::from(intercept.is_some()));
+    if k == 0 || dof <= 0.0 {
+        return None;
+    }
+    let coefficients: Vec<f64> = selection.terms.iter().map(|t| t.coefficient).collect();
+    let s2 = moments.squared_error(&set, &coefficients, intercept.unwrap_or(0.0)).max(0.0) / dof;
+    let cross = nalgebra::DMatrix::from_fn(k, k, |i, j| {
+        if intercept.is_some() {
+            moments.corrected(set[i], set[j])
+        } else {
+            moments.raw(set[i], set[j])
+        }
+    });
+    let inverse = cross.cholesky()?.inverse();
+    let cov: Vec<Vec<f64>> = (0..k).map(|i| (0..k).map(|j| s2 * inverse[(i, j)]).collect()).collect();
+    cov.iter().flatten().all(|v| v.is_finite()).then_some(cov)
 }
 
 impl Identification<'_> {
@@ -274,7 +309,71 @@ impl Identification<'_> {
             intercept: self.intercept,
         };
         let selection = backend.select_with_folds(&problem, &folds)?;
-        Ok(Fit { target: target.to_string(), candidates: names, selection })
+        let covariance = covariance_of(&moments, &selection);
+        // the residual pass for τ is left to the caller (`correlation_time`): selection itself
+        // needs only the sufficient statistics, and is timed against the peers without it
+        Ok(Fit {
+            target: target.to_string(),
+            candidates: names,
+            selection,
+            covariance,
+            correlation_time: None,
+        })
+    }
+
+    /// τ = 1 + 2 Σ ρₖ of the chosen equation's residuals, the autocorrelations ρₖ pooled over
+    /// the runs and summed up to the first lag where they fall below zero (Geyer's initial
+    /// positive sequence, simplified; at most 1000 lags); `None` with no terms, row weights or
+    /// a run too short. One more pass over the rows.
+    pub fn correlation_time(
+        &self,
+        target: &Target,
+        candidates: &[Term],
+        frames: &[Frame],
+        selection: &Selection,
+    ) -> Result<Option<f64>, IdentifyError> {
+        if selection.terms.is_empty() || self.weights.is_some() {
+            return Ok(None);
+        }
+        let chosen: Vec<Term> = selection.terms.iter().map(|t| candidates[t.index].clone()).collect();
+        let library = Library::compile(&chosen, self.vocabulary)?;
+        let b0 = selection.intercept.as_ref().map_or(0.0, |b| b.value);
+        let mut residuals: Vec<Vec<f64>> = Vec::new();
+        for frame in frames {
+            let y = self.target(target, frame)?;
+            let params = self.run_parameters(frame)?;
+            let sources = library.bind(&|n| frame.column(n), &|n| params.get(n).copied())?;
+            let mut e = y.iter().map(|y| y - b0).collect::<Vec<f64>>();
+            library.for_each_block(&sources, frame.len(), |start, rows, block| {
+                for (j, t) in selection.terms.iter().enumerate() {
+                    for r in 0..rows {
+                        e[start + r] -= t.coefficient * block[j * rows + r];
+                    }
+                }
+            });
+            residuals.push(e);
+        }
+        let lag = |k: usize| -> f64 {
+            residuals
+                .iter()
+                .filter(|e| e.len() > k)
+                .map(|e| e.iter().zip(&e[k..]).map(|(a, b)| a * b).sum::<f64>())
+                .sum()
+        };
+        let c0 = lag(0);
+        let longest = residuals.iter().map(Vec::len).max().unwrap_or(0);
+        if c0 <= 0.0 || !c0.is_finite() || longest < 4 {
+            return Ok(None);
+        }
+        let mut tau = 1.0;
+        for k in 1..(longest / 2).min(1000) {
+            let rho = lag(k) / c0;
+            if rho <= 0.0 {
+                break;
+            }
+            tau += 2.0 * rho;
+        }
+        Ok(Some(tau))
     }
 }
 
@@ -315,6 +414,27 @@ pub fn fit_equation(
     identification.fit(&target, &eq.candidates, &eq.forced, &eq.excluded, frames, backend.as_ref())
 }
 
+/// [`Identification::correlation_time`] of an equation fitted by [`fit_equation`], with the
+/// same runs and derivative method.
+pub fn correlation_time_of(
+    model: &crate::model::Model,
+    frames: &[Frame],
+    differentiator: &dyn Differentiator,
+    fit: &Fit,
+) -> Result<Option<f64>, IdentifyError> {
+    let rules = model.parameter_rules();
+    let identification = Identification {
+        vocabulary: &model.vocabulary,
+        parameters: &rules,
+        differentiator,
+        intercept: true,
+        weights: None,
+    };
+    let candidates: Vec<Term> =
+        fit.candidates.iter().map(|c| model.vocabulary.parse(c)).collect::<Result<_, _>>()?;
+    identification.correlation_time(&Target::parse(&fit.target), &candidates, frames, &fit.selection)
+}
+
 /// The identified coefficients of a fit, as a model stores them (term, value, std. error).
 pub fn coefficients_of(
     fit: &Fit,
@@ -339,6 +459,74 @@ mod tests {
         assert!((v - 2.2).abs() < 1e-15);
         assert!(ParamValue::Rule("mean:u:-1".into()).check_rule("u0").is_err());
         assert!(ParamValue::Rule("mean:u".into()).check_rule("u0").is_ok());
+    }
+
+    /// The covariance's diagonal is the standard errors STPRG reports (its own formula, A12),
+    /// with and without an intercept; off-diagonals are those of (X'X)⁻¹ from a direct solve.
+    #[test]
+    fn covariance_matches_the_reported_standard_errors() {
+        use crate::select::{StepRule, Stepwise};
+        let n = 60;
+        let t: Vec<f64> = (0..n).map(f64::from).collect();
+        let x1: Vec<f64> = t.iter().map(|t| (0.3 * t).sin() + 0.05 * t).collect();
+        let x2: Vec<f64> = t.iter().map(|t| (0.17 * t).cos() * 2.0).collect();
+        let y: Vec<f64> = (0..n as usize)
+            .map(|i| 1.5 + 2.0 * x1[i] - 0.7 * x2[i] + 0.1 * ((i * 7919) % 13) as f64 / 13.0)
+            .collect();
+        let mut f = Frame::new("run", "t", t).unwrap();
+        f.push("x1", x1.clone()).unwrap();
+        f.push("x2", x2.clone()).unwrap();
+        f.push("y", y.clone()).unwrap();
+        let mut vocab = Vocabulary::new();
+        for v in ["t", "x1", "x2", "y"] {
+            vocab.variable(v).unwrap();
+        }
+        let terms = vec![vocab.parse("x1").unwrap(), vocab.parse("x2").unwrap()];
+        let stepwise = Stepwise { step_rule: StepRule::Last, ..Stepwise::default() };
+        let central = crate::data::CentralDifference;
+        for intercept in [true, false] {
+            let params = BTreeMap::new();
+            let id = Identification {
+                vocabulary: &vocab,
+                parameters: &params,
+                differentiator: &central,
+                intercept,
+                weights: None,
+            };
+            let fit = id.fit(&Target::Column("y".into()), &terms, &[], &[], &[f.clone()], &stepwise).unwrap();
+            let cov = fit.covariance.as_ref().expect("a covariance");
+            for (i, term) in fit.selection.terms.iter().enumerate() {
+                let se = cov[i][i].sqrt();
+                assert!(
+                    (se / term.std_error - 1.0).abs() < 1e-9,
+                    "{}: {se} vs {}",
+                    term.term,
+                    term.std_error
+                );
+            }
+            // off-diagonal: s²(X'X)⁻¹ directly, columns in the order the terms entered
+            let cols: Vec<&Vec<f64>> =
+                fit.selection.terms.iter().map(|t| if t.term == "x1" { &x1 } else { &x2 }).collect();
+            let width = cols.len() + usize::from(intercept);
+            let x = nalgebra::DMatrix::from_fn(n as usize, width, |r, c| {
+                if intercept && c == 0 {
+                    1.0
+                } else {
+                    cols[c - usize::from(intercept)][r]
+                }
+            });
+            let xtx_inv = (x.transpose() * &x).try_inverse().unwrap();
+            let b = &xtx_inv * x.transpose() * nalgebra::DVector::from_vec(y.clone());
+            let resid = nalgebra::DVector::from_vec(y.clone()) - &x * &b;
+            let s2 = resid.norm_squared() / (n as f64 - width as f64);
+            let o = usize::from(intercept);
+            assert!(
+                (cov[0][1] / (s2 * xtx_inv[(o, o + 1)]) - 1.0).abs() < 1e-8,
+                "{} vs {}",
+                cov[0][1],
+                s2 * xtx_inv[(o, o + 1)]
+            );
+        }
     }
 
     #[test]

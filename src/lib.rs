@@ -12,3 +12,4 @@ pub mod select;
 pub mod ship;
 pub mod sim;
 pub mod term;
+pub mod uncertainty;

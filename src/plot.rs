@@ -15,6 +15,8 @@ pub enum Style {
     Dashed,
     /// Markers only.
     Points,
+    /// A shaded band between `y` (lower) and `upper`.
+    Band,
 }
 
 /// One curve.
@@ -28,20 +30,26 @@ pub struct Series {
     pub y: Vec<f64>,
     /// Drawing style.
     pub style: Style,
+    /// Upper edge of a band (empty for other styles).
+    pub upper: Vec<f64>,
 }
 
 impl Series {
     /// A solid line.
     pub fn line(name: &str, x: Vec<f64>, y: Vec<f64>) -> Series {
-        Series { name: name.into(), x, y, style: Style::Line }
+        Series { name: name.into(), x, y, style: Style::Line, upper: vec![] }
     }
     /// A dashed line.
     pub fn dashed(name: &str, x: Vec<f64>, y: Vec<f64>) -> Series {
-        Series { name: name.into(), x, y, style: Style::Dashed }
+        Series { name: name.into(), x, y, style: Style::Dashed, upper: vec![] }
     }
     /// Markers.
     pub fn points(name: &str, x: Vec<f64>, y: Vec<f64>) -> Series {
-        Series { name: name.into(), x, y, style: Style::Points }
+        Series { name: name.into(), x, y, style: Style::Points, upper: vec![] }
+    }
+    /// A shaded band from `lower` to `upper` (e.g. a 90 % prediction band).
+    pub fn band(name: &str, x: Vec<f64>, lower: Vec<f64>, upper: Vec<f64>) -> Series {
+        Series { name: name.into(), x, y: lower, style: Style::Band, upper }
     }
 }
 
@@ -160,7 +168,8 @@ impl Figure {
         area: &DrawingArea<DB, plotters::coord::Shift>,
     ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
         let (mut x0, mut x1) = range(panel.series.iter().flat_map(|s| s.x.iter().copied()), false);
-        let (mut y0, mut y1) = range(panel.series.iter().flat_map(|s| s.y.iter().copied()), panel.log_y);
+        let (mut y0, mut y1) =
+            range(panel.series.iter().flat_map(|s| s.y.iter().chain(&s.upper).copied()), panel.log_y);
         if panel.equal_axes {
             let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
             let half = (x1 - x0).max(y1 - y0) / 2.0;
@@ -233,9 +242,23 @@ fn draw_series<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate<
             Style::Points => {
                 chart.draw_series(pts.into_iter().map(move |p| Circle::new(p, 3, color.filled())))?
             }
+            Style::Band => {
+                // lower edge forward, upper edge back: one closed polygon
+                let mut outline: Vec<(f64, f64)> = pts.clone();
+                outline.extend(
+                    s.x.iter()
+                        .zip(&s.upper)
+                        .filter(|(x, y)| x.is_finite() && y.is_finite())
+                        .map(|(x, y)| (*x, *y))
+                        .rev(),
+                );
+                chart.draw_series(std::iter::once(Polygon::new(outline, color.mix(0.25).filled())))?
+            }
         };
-        anno.label(s.name.clone())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2)));
+        if !s.name.is_empty() {
+            anno.label(s.name.clone())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2)));
+        }
     }
     if panel.series.len() > 1 {
         chart

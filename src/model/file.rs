@@ -141,6 +141,28 @@ pub struct EquationSpec {
     /// Coefficients by term.
     #[serde(default)]
     pub coefficients: BTreeMap<String, CoefficientSpec>,
+    /// Covariance of the identified coefficients (for Monte-Carlo prediction bands).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub covariance: Option<CovarianceSpec>,
+}
+
+/// `[equations.NAME.covariance]`: the coefficients' covariance matrix, rows and columns in
+/// the order of `terms` (each a term of `coefficients`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CovarianceSpec {
+    /// The terms, in matrix order.
+    pub terms: Vec<String>,
+    /// Symmetric positive semi-definite matrix, one row per term (s²(X'X)⁻¹: independent rows).
+    pub matrix: Vec<Vec<f64>>,
+    /// The residuals' integrated autocorrelation time in rows (≥ 1): Monte-Carlo draws use
+    /// `matrix` × this, since correlated rows carry less information than their number says.
+    #[serde(default = "one")]
+    pub correlation_time: f64,
+}
+
+fn one() -> f64 {
+    1.0
 }
 
 fn yes() -> bool {

@@ -7,7 +7,8 @@
 mod file;
 
 pub use file::{
-    CoefficientSpec, EquationSpec, InputSpec, Meta, ModelFile, ParameterSpec, ShipSpec, StateSpec,
+    CoefficientSpec, CovarianceSpec, EquationSpec, InputSpec, Meta, ModelFile, ParameterSpec, ShipSpec,
+    StateSpec,
 };
 
 use std::collections::BTreeMap;
@@ -89,6 +90,19 @@ pub struct Equation {
     pub intercept: Option<f64>,
     /// Whether `termid identify` fits it (kinematic equations are fixed).
     pub identify: bool,
+    /// Covariance of the coefficients, if stored.
+    pub covariance: Option<Covariance>,
+}
+
+/// The covariance of an equation's coefficients.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Covariance {
+    /// The terms (each one of the equation's coefficients), in matrix order.
+    pub terms: Vec<Term>,
+    /// s²(X'X)⁻¹, row-major; symmetric and positive semi-definite.
+    pub matrix: Vec<Vec<f64>>,
+    /// Residual autocorrelation time in rows (≥ 1); the effective covariance is matrix × this.
+    pub correlation_time: f64,
 }
 
 impl Equation {
@@ -262,6 +276,36 @@ impl Model {
                 }
                 coefficients.push((t, value, se));
             }
+            let covariance = match &eq.covariance {
+                None => None,
+                Some(c) => {
+                    let key = format!("equations.{name}.covariance");
+                    let bad = |m: String| key_err(&key, &format!("[equations.{name}.covariance]"), m);
+                    let mut terms = Vec::new();
+                    for text in &c.terms {
+                        let t = vocab.parse(text).map_err(|e| ModelError::Term {
+                            source: Box::new(e),
+                            file: file.into(),
+                            line: line_of(&format!("[equations.{name}.covariance]")),
+                            key: format!("{key}.terms"),
+                        })?;
+                        if !coefficients.iter().any(|(o, _, _)| *o == t) || terms.contains(&t) {
+                            return Err(bad(format!(
+                                "term `{text}` is not a coefficient of the equation, or repeated"
+                            )));
+                        }
+                        terms.push(t);
+                    }
+                    check_covariance(&c.matrix, terms.len()).map_err(bad)?;
+                    if !(c.correlation_time >= 1.0 && c.correlation_time.is_finite()) {
+                        return Err(bad(format!(
+                            "correlation_time {} must be a number ≥ 1",
+                            c.correlation_time
+                        )));
+                    }
+                    Some(Covariance { terms, matrix: c.matrix.clone(), correlation_time: c.correlation_time })
+                }
+            };
             let backend = eq.backend.clone().unwrap_or_default();
             backend
                 .build()
@@ -276,6 +320,7 @@ impl Model {
                 coefficients,
                 intercept: eq.intercept,
                 identify: eq.identify,
+                covariance,
             });
         }
         // integrate in the order the states are declared
@@ -342,6 +387,8 @@ impl Model {
         if let Some(eq) = self.equations.iter_mut().find(|e| e.name == equation) {
             eq.coefficients = coefficients;
             eq.intercept = intercept;
+            // a covariance belongs to the coefficients it was estimated with
+            eq.covariance = None;
         }
         if let Some(spec) = self.spec.equations.get_mut(equation) {
             let eq = self.equations.iter().find(|e| e.name == equation).expect("same names");
@@ -357,7 +404,35 @@ impl Model {
                 })
                 .collect();
             spec.intercept = intercept;
+            spec.covariance = None;
         }
+    }
+
+    /// Stores the covariance of an equation's coefficients. Refused unless every term is a
+    /// coefficient, the matrix a covariance matrix and the correlation time ≥ 1.
+    pub fn set_covariance(&mut self, equation: &str, covariance: Covariance) -> Result<(), String> {
+        let Covariance { terms, matrix, correlation_time } = covariance;
+        if !(correlation_time >= 1.0 && correlation_time.is_finite()) {
+            return Err(format!("correlation time {correlation_time} must be a number ≥ 1"));
+        }
+        let eq = self
+            .equations
+            .iter_mut()
+            .find(|e| e.name == equation)
+            .ok_or(format!("no equation `{equation}`"))?;
+        if let Some(t) = terms.iter().find(|t| !eq.coefficients.iter().any(|(o, _, _)| o == *t)) {
+            return Err(format!("`{t}` is not a coefficient of `{equation}`"));
+        }
+        check_covariance(&matrix, terms.len())?;
+        if let Some(spec) = self.spec.equations.get_mut(equation) {
+            spec.covariance = Some(CovarianceSpec {
+                terms: terms.iter().map(Term::to_string).collect(),
+                matrix: matrix.clone(),
+                correlation_time,
+            });
+        }
+        eq.covariance = Some(Covariance { terms, matrix, correlation_time });
+        Ok(())
     }
 
     /// The model as TOML text (what `identify --out` writes and `simulate` reads back).
@@ -366,6 +441,33 @@ impl Model {
             toml::to_string_pretty(&self.spec).unwrap_or_else(|e| format!("# could not serialise: {e}\n"));
         format!("# written by termid {}\n{body}", env!("CARGO_PKG_VERSION"))
     }
+}
+
+/// A covariance matrix must be k×k, finite, symmetric and positive semi-definite.
+fn check_covariance(m: &[Vec<f64>], k: usize) -> Result<(), String> {
+    if m.len() != k || m.iter().any(|r| r.len() != k) {
+        return Err(format!("`matrix` must be {k}×{k}, one row per term"));
+    }
+    if m.iter().flatten().any(|v| !v.is_finite()) {
+        return Err("`matrix` has a value that is not finite".into());
+    }
+    for i in 0..k {
+        for j in 0..i {
+            if (m[i][j] - m[j][i]).abs() > 1e-9 * (m[i][i] * m[j][j]).sqrt().max(f64::MIN_POSITIVE) {
+                return Err(format!(
+                    "`matrix` is not symmetric: [{i}][{j}] = {} but [{j}][{i}] = {}",
+                    m[i][j], m[j][i]
+                ));
+            }
+        }
+    }
+    let a = nalgebra::DMatrix::from_fn(k, k, |i, j| m[i][j]);
+    let smallest = a.symmetric_eigenvalues().iter().copied().fold(f64::INFINITY, f64::min);
+    let largest = m.iter().enumerate().map(|(i, r)| r[i]).fold(0.0, f64::max);
+    if k > 0 && smallest < -1e-9 * largest {
+        return Err(format!("`matrix` is not positive semi-definite (eigenvalue {smallest:e})"));
+    }
+    Ok(())
 }
 
 /// 1-based line of the first occurrence of `needle` in `text` (0 if absent).

@@ -12,6 +12,7 @@ use super::{Manoeuvre, Metrics, Ship, ShipError};
 use crate::data::Frame;
 use crate::model::Model;
 use crate::sim::{Integrator, Settings};
+use crate::uncertainty::Normal;
 
 /// Standard deviations of the sensors' noise.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -98,25 +99,6 @@ pub fn at_approach_speed(model: &Model, u0: f64) -> Model {
     m
 }
 
-/// Gaussian numbers from a seeded SplitMix64 (Box-Muller): the same seed, the same run.
-struct Gauss(u64);
-
-impl Gauss {
-    fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        ((z >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-
-    fn next(&mut self) -> f64 {
-        let (a, b) = (self.uniform(), self.uniform());
-        (-2.0 * a.ln()).sqrt() * (2.0 * std::f64::consts::PI * b).cos()
-    }
-}
-
 impl Basin {
     /// Runs `manoeuvre` with `model` at approach speed `u0` for `duration` s after the
     /// approach, and records it; `seed` fixes the noise.
@@ -164,7 +146,7 @@ impl Basin {
         let (ox, oy) = (states[r.x0][0], states[r.y0][0]);
         let mut truth = Frame::new(origin, "t", time)?;
         let mut measured = truth.clone();
-        let mut gauss = Gauss(seed);
+        let mut gauss = Normal::new(seed);
         let n = &self.noise;
         for (i, name) in tr.state_names.iter().enumerate() {
             let (offset, sd) = match i {
@@ -176,12 +158,12 @@ impl Basin {
                 _ => (0.0, 0.0),
             };
             let clean: Vec<f64> = states[i].iter().map(|v| v - offset).collect();
-            measured.push(name, clean.iter().map(|v| v + sd * gauss.next()).collect())?;
+            measured.push(name, clean.iter().map(|v| v + sd * gauss.sample()).collect())?;
             truth.push(name, clean)?;
         }
         for (i, name) in tr.input_names.iter().enumerate() {
             let sd = if i == r.rudder { n.rudder_deg.to_radians() } else { 0.0 };
-            measured.push(name, inputs[i].iter().map(|v| v + sd * gauss.next()).collect())?;
+            measured.push(name, inputs[i].iter().map(|v| v + sd * gauss.sample()).collect())?;
             truth.push(name, inputs[i].clone())?;
         }
         Ok(Recording { truth, measured, metrics: run.metrics, u0 })

@@ -129,6 +129,75 @@ fn identified_from_noisy_basin_runs_the_model_predicts_within_the_targets() {
         let (t, m) = (tactical(None, delta), tactical(Some(&p("id.toml")), delta));
         assert!((m / t - 1.0).abs() < 0.05, "δ = {delta}°: tactical diameter {m} m vs true {t} m");
     }
+
+    // uncertainty: identify stored covariances and correlation times; draws give a band
+    let id = Model::load(&dir.join("id.toml")).unwrap();
+    for eq in ["u_dot", "v_dot", "r_dot"] {
+        let c = id.equation(eq).unwrap().covariance.clone().expect("a stored covariance");
+        // 20 Hz smoothed records: residuals correlated over many rows
+        assert!(c.correlation_time > 5.0, "{eq}: τ = {}", c.correlation_time);
+    }
+    let svg = p("mc.svg");
+    let (ok, out, err) = termid(&[
+        "simulate",
+        "--model",
+        &p("id.toml"),
+        "--manoeuvre",
+        "turning:30",
+        "--duration",
+        "200",
+        "--monte-carlo",
+        "40",
+        "--seed",
+        "3",
+        "--svg",
+        &svg,
+        "--format",
+        "json",
+    ]);
+    assert!(ok, "{err}");
+    let v = json(&out);
+    let mc = &v["monte_carlo"];
+    assert_eq!(mc["draws"], 40);
+    let s = &mc["spread"]["tactical_diameter_m"];
+    let nominal = v["metrics"]["tactical_diameter_m"].as_f64().unwrap();
+    let (lo, hi) = (s["p05"].as_f64().unwrap(), s["p95"].as_f64().unwrap());
+    assert!(lo < nominal && nominal < hi && hi - lo < 0.1 * nominal, "{lo} … {hi} around {nominal}");
+    assert!(std::fs::read_to_string(&svg).unwrap().contains("90 % band"));
+    // the same seed gives the same draws
+    let (_, again, _) = termid(&[
+        "simulate",
+        "--model",
+        &p("id.toml"),
+        "--manoeuvre",
+        "turning:30",
+        "--duration",
+        "200",
+        "--monte-carlo",
+        "40",
+        "--seed",
+        "3",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(json(&again)["monte_carlo"], v["monte_carlo"]);
+    let (ok, out, err) = termid(&[
+        "validate",
+        "--model",
+        &p("id.toml"),
+        "--dataset",
+        &p("held.toml"),
+        "--monte-carlo",
+        "20",
+        "--format",
+        "json",
+    ]);
+    assert!(ok, "{err}");
+    let s = &json(&out)["metrics"][0]["monte_carlo"]["spread"]["first_overshoot_deg"];
+    assert!(s["p05"].as_f64().unwrap() <= s["p95"].as_f64().unwrap(), "{s}");
+    // a model without a covariance has nothing to draw from
+    let (ok, _, err) = termid(&["simulate", "--manoeuvre", "zigzag:20/20", "--monte-carlo", "5"]);
+    assert!(!ok && err.contains("no coefficient covariance"), "{err}");
 }
 
 #[test]

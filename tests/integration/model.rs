@@ -1,6 +1,7 @@
 //! Model files: the default model against the paper, errors that point at file/line/key,
 //! and the identify → write → read round trip.
 
+use termid::model::Covariance;
 use termid::model::{Model, ModelError};
 use termid::term::Term;
 
@@ -99,4 +100,47 @@ fn written_model_reads_back_unchanged() {
     assert_eq!(eq.intercept, Some(1e-4));
     // and once more: a fixed point
     assert_eq!(Model::parse(&back.to_toml(), "again.toml").unwrap().spec, back.spec);
+}
+
+#[test]
+fn covariances_are_checked_and_read_back() {
+    let mut m = Model::default_model();
+    let (uv, ur) = (m.vocabulary.parse("u*v").unwrap(), m.vocabulary.parse("u*r").unwrap());
+    let matrix = vec![vec![4e-6, 1e-6], vec![1e-6, 9e-6]];
+    let cov = |matrix: Vec<Vec<f64>>, tau: f64| Covariance {
+        terms: vec![uv.clone(), ur.clone()],
+        matrix,
+        correlation_time: tau,
+    };
+    m.set_covariance("v_dot", cov(matrix.clone(), 12.5)).unwrap();
+    let back = Model::parse(&m.to_toml(), "written.toml").unwrap();
+    assert_eq!(back.equation("v_dot").unwrap().covariance, Some(cov(matrix.clone(), 12.5)));
+    // refused: not symmetric, not positive semi-definite, τ < 1, a term without coefficient
+    for (bad, what) in [
+        (cov(vec![vec![4e-6, 1e-6], vec![2e-6, 9e-6]], 1.0), "not symmetric"),
+        (cov(vec![vec![4e-6, 9e-6], vec![9e-6, 4e-6]], 1.0), "positive semi-definite"),
+        (cov(matrix.clone(), 0.5), "≥ 1"),
+        (
+            Covariance {
+                terms: vec![uv.clone(), m.vocabulary.parse("r^3/u").unwrap()],
+                ..cov(matrix.clone(), 1.0)
+            },
+            "not a coefficient",
+        ),
+    ] {
+        let e = m.clone().set_covariance("v_dot", bad).unwrap_err();
+        assert!(e.contains(what), "{e}");
+    }
+    // and in a file: the key is named
+    let mut asym = m.clone();
+    asym.spec.equations.get_mut("v_dot").unwrap().covariance.as_mut().unwrap().matrix[0][1] = 2e-6;
+    let e = Model::parse(&asym.to_toml(), "cov.toml").err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(
+        e.contains("cov.toml") && e.contains("equations.v_dot.covariance") && e.contains("not symmetric"),
+        "{e}"
+    );
+    // new coefficients void the old covariance
+    m.set_coefficients("v_dot", vec![(uv, -0.18, None)], None);
+    assert_eq!(m.equation("v_dot").unwrap().covariance, None);
+    assert!(!m.to_toml().contains("covariance"));
 }

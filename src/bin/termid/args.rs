@@ -177,6 +177,8 @@ pub struct SimulateCommand {
     /// Include each equation's stored intercept b0 in the right-hand side.
     #[arg(long)]
     pub with_intercept: bool,
+    #[command(flatten)]
+    pub monte_carlo: MonteCarloArgs,
     /// Output format of the summary.
     #[arg(long, value_enum, default_value = "text")]
     pub format: Format,
@@ -266,9 +268,23 @@ pub struct ValidateCommand {
     /// Re-simulation settings.
     #[command(flatten)]
     pub resim: ResimArgs,
+    #[command(flatten)]
+    pub monte_carlo: MonteCarloArgs,
     /// Output format.
     #[arg(long, value_enum, default_value = "text")]
     pub format: Format,
+}
+
+/// Prediction uncertainty from the coefficients' covariance.
+#[derive(Debug, Args)]
+pub struct MonteCarloArgs {
+    /// Also simulate this many models drawn from the identified coefficients' covariance
+    /// (stored by `identify --out`): a 90 % band in the figure and the spread of each metric.
+    #[arg(long, default_value_t = 0)]
+    pub monte_carlo: usize,
+    /// Seed of the draws.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
 }
 
 /// Measured runs: CSV files with the model's names in SI, and/or a dataset file.

@@ -5,6 +5,7 @@ use std::collections::BTreeMap;
 use anyhow::{bail, Context, Result};
 use termid::data::{differentiator, prepare, prepared_figure, Frame, Preparation};
 use termid::identify::{Fit, Identification, ParamValue, Target};
+use termid::model::Covariance;
 use termid::select::{Backend, StepRule};
 use termid::term::{parse_terms, Vocabulary};
 
@@ -91,9 +92,14 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
         intercept: !cmd.no_intercept,
         weights: cmd.weight.clone(),
     };
-    let fit = crate::progress::with_spinner(&format!("{} on {}", selector.name(), target), || {
+    let mut fit = crate::progress::with_spinner(&format!("{} on {}", selector.name(), target), || {
         identification.fit(&target, &candidates, &forced, &excluded, &frames, selector.as_ref())
     })?;
+    if !cmd.no_time {
+        // rows of a time series are not independent; rows without time have no order to test
+        fit.correlation_time =
+            identification.correlation_time(&target, &candidates, &frames, &fit.selection)?;
+    }
     match cmd.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&json(&fit))?),
         Format::Text => print!("{}", text(&fit)),
@@ -186,7 +192,19 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
         })
         .with_context(|| format!("identifying `{name}`"))?;
         let coefficients = termid::identify::coefficients_of(&fit, &model.vocabulary)?;
+        let terms: Vec<_> = coefficients.iter().map(|(t, _, _)| t.clone()).collect();
         model.set_coefficients(name, coefficients, fit.selection.intercept.as_ref().map(|b| b.value));
+        let mut fit = fit;
+        fit.correlation_time = termid::identify::correlation_time_of(&model, &frames, diff.as_ref(), &fit)?;
+        if let Some(matrix) = &fit.covariance {
+            // kept for Monte-Carlo prediction bands (`simulate --monte-carlo`)
+            let covariance = Covariance {
+                terms,
+                matrix: matrix.clone(),
+                correlation_time: fit.correlation_time.unwrap_or(1.0).max(1.0),
+            };
+            model.set_covariance(name, covariance).map_err(anyhow::Error::msg)?;
+        }
         fits.push((name.clone(), fit));
     }
     if let Some(out) = &cmd.out {
@@ -280,6 +298,12 @@ fn text(fit: &Fit) -> String {
         out += &format!("{:<22} {:>12} {:>12} {:>9.2}\n", t.term, num(t.coefficient), num(t.std_error), t.t);
     }
     out += &format!("\nstopped: {:?}\n", s.stop);
+    if let Some(tau) = fit.correlation_time.filter(|t| *t > 1.5) {
+        out += &format!(
+            "note: the residuals are correlated over τ = {tau:.1} rows; the standard errors above assume independent rows, honest ones are about √τ = {:.1} times larger\n",
+            tau.sqrt()
+        );
+    }
     for n in &s.notes {
         out += &format!("note: {n}\n");
     }
@@ -313,5 +337,7 @@ fn json(fit: &Fit) -> serde_json::Value {
         "intercept_std_error": s.intercept.as_ref().map(|b| b.std_error),
         "stop": s.stop,
         "notes": s.notes,
+        "correlation_time": fit.correlation_time,
+        "covariance": fit.covariance,
     })
 }

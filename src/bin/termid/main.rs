@@ -4,6 +4,7 @@ mod args;
 mod compare;
 mod diagnose;
 mod identify;
+mod monte_carlo;
 mod progress;
 mod reproduce;
 mod runs;

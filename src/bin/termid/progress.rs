@@ -29,3 +29,15 @@ pub fn with_spinner<T: Send>(label: &str, work: impl FnOnce() -> T + Send) -> T 
         result
     })
 }
+
+/// A counting progress bar on standard error for `len` items of repeated work (drawn only
+/// when standard error is a terminal).
+pub fn counter(len: u64, what: &str) -> ProgressBar {
+    let bar = ProgressBar::new(len);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:30} {pos}/{len} {msg} {elapsed:>4}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar.set_message(what.to_string());
+    bar
+}

@@ -7,10 +7,14 @@ use anyhow::{bail, Context, Result};
 use termid::data::Frame;
 use termid::model::Model;
 use termid::plot::{Figure, Panel, Series};
-use termid::ship::{figure::manoeuvre_figure, Manoeuvre, Ship};
+use termid::ship::{
+    figure::{add_bands, manoeuvre_figure},
+    Manoeuvre, Ship,
+};
 use termid::sim::{simulate, Constant, Controller, Integrator, Replay, Settings};
 
 use crate::args::{Format, SimulateCommand};
+use crate::monte_carlo::Draws;
 
 pub fn load_model(path: &Option<std::path::PathBuf>) -> Result<Model> {
     Ok(match path {
@@ -42,6 +46,13 @@ fn ship_run(cmd: &SimulateCommand, model: &Model, text: &str, integrator: Integr
     };
     let run = ship.run(&manoeuvre, &settings)?;
     let frame = ship.frame(&run.trajectory, "simulation")?;
+    let mc = match cmd.monte_carlo.monte_carlo {
+        0 => None,
+        n => Some(Draws::run(model, n, cmd.monte_carlo.seed, |m| {
+            let drawn = Ship::new(m, cmd.with_intercept)?.run(&manoeuvre, &settings)?;
+            Ok((serde_json::to_value(&drawn.metrics)?, drawn.trajectory))
+        })?),
+    };
     if let Some(out) = &cmd.out {
         frame.write_csv(out)?;
     }
@@ -49,7 +60,14 @@ fn ship_run(cmd: &SimulateCommand, model: &Model, text: &str, integrator: Integr
         let title = format!("{}: {}", model.spec.model.name, manoeuvre.label());
         let fig = match &run.metrics {
             termid::ship::Metrics::Spiral(s) => spiral_figure(&title, s),
-            _ => manoeuvre_figure(&ship, &title, &[("simulation", &run.trajectory)], true),
+            _ => {
+                let mut fig = manoeuvre_figure(&ship, &title, &[("simulation", &run.trajectory)], true);
+                if let Some(mc) = &mc {
+                    let tracks: Vec<_> = mc.results.iter().map(|(_, t)| t.clone()).collect();
+                    add_bands(&mut fig, &ship, &tracks);
+                }
+                fig
+            }
         };
         fig.write_svg(svg)?;
     }
@@ -64,6 +82,7 @@ fn ship_run(cmd: &SimulateCommand, model: &Model, text: &str, integrator: Integr
                 "delta0_deg": run.start.delta0_deg,
                 "v0": run.start.v0,
                 "metrics": run.metrics,
+                "monte_carlo": mc.as_ref().map(|mc| mc.summary(&mc.spread(|r| vec![r.0.clone()]))),
             }))?
         ),
         Format::Text => {
@@ -93,6 +112,12 @@ fn ship_run(cmd: &SimulateCommand, model: &Model, text: &str, integrator: Integr
                 for p in &s.points {
                     println!("  {:>8.1} {:>10.4} {:>6}", p.rudder_deg, p.yaw_rate_deg_s, p.branch);
                 }
+            }
+            if let Some(mc) = &mc {
+                print!(
+                    "{}",
+                    mc.text(&mc.spread(|r| vec![r.0.clone()]), &serde_json::to_value(&run.metrics)?)
+                );
             }
             if let Some(out) = &cmd.out {
                 println!("wrote {} ({} rows; SI units, angles in rad)", out.display(), frame.len());

@@ -7,8 +7,12 @@ use termid::diagnose::{comparison_figures, Runs};
 use termid::ship::observed::{observe, Observed};
 use termid::sim::{Integrator, Trajectory};
 
+use termid::plot::{Figure, Series};
+use termid::uncertainty::band;
+
 use crate::args::{Format, ValidateCommand};
 use crate::identify::num;
+use crate::monte_carlo::Draws;
 
 pub fn run(cmd: ValidateCommand) -> Result<()> {
     let model = crate::simulate::load_model(&cmd.model)?;
@@ -19,29 +23,52 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
     let sims = data.simulate(&model, &[], &[])?;
     let gap = data.gap(&sims);
     // ship models: metrics read off measurement and simulation alike
-    let metrics: Vec<Option<(Observed, Observed)>> = match &model.spec.ship {
-        Some(ship) => {
-            let names = &ship.names;
-            let canon = |n: &str| model.vocabulary.canonical(n).unwrap_or_else(|| n.to_string());
-            let (psi, rudder, x0, y0) =
-                (canon(&names.psi), canon(&names.rudder), canon(&names.x0), canon(&names.y0));
-            runs.iter()
-                .zip(&sims)
-                .map(|(f, s)| {
-                    let col = |n: &str| f.column(n);
-                    let state = |t: &Trajectory, n: &str| t.state(n).map(<[f64]>::to_vec);
-                    let (mp, md, mx, my) = (col(&psi)?, col(&rudder)?, col(&x0)?, col(&y0)?);
-                    let measured = observe(f.time(), mp, md, mx, my);
-                    let simulated = observe(&s.time, &state(s, &psi)?, md, &state(s, &x0)?, &state(s, &y0)?);
-                    Some((measured, simulated))
-                })
-                .collect()
-        }
-        None => vec![None; runs.len()],
+    let observed = |sims: &[Trajectory]| -> Vec<Option<(Observed, Observed)>> {
+        let Some(ship) = &model.spec.ship else { return vec![None; runs.len()] };
+        let names = &ship.names;
+        let canon = |n: &str| model.vocabulary.canonical(n).unwrap_or_else(|| n.to_string());
+        let (psi, rudder, x0, y0) =
+            (canon(&names.psi), canon(&names.rudder), canon(&names.x0), canon(&names.y0));
+        runs.iter()
+            .zip(sims)
+            .map(|(f, s)| {
+                let col = |n: &str| f.column(n);
+                let state = |t: &Trajectory, n: &str| t.state(n).map(<[f64]>::to_vec);
+                let (mp, md, mx, my) = (col(&psi)?, col(&rudder)?, col(&x0)?, col(&y0)?);
+                let measured = observe(f.time(), mp, md, mx, my);
+                let simulated = observe(&s.time, &state(s, &psi)?, md, &state(s, &x0)?, &state(s, &y0)?);
+                Some((measured, simulated))
+            })
+            .collect()
     };
+    let metrics = observed(&sims);
+    // Monte Carlo: every run simulated with each drawn model
+    let mc = match cmd.monte_carlo.monte_carlo {
+        0 => None,
+        n => Some(Draws::run(&model, n, cmd.monte_carlo.seed, |m| Ok(data.simulate(m, &[], &[])?))?),
+    };
+    let spreads: Vec<_> = (0..runs.len())
+        .map(|k| {
+            mc.as_ref().map(|mc| {
+                mc.spread(|sims| {
+                    observed(sims)
+                        .get(k)
+                        .cloned()
+                        .flatten()
+                        .map(|(_, s)| serde_json::to_value(s).unwrap_or_default())
+                        .into_iter()
+                        .collect()
+                })
+            })
+        })
+        .collect();
     if let Some(dir) = &cmd.resim.svg {
         std::fs::create_dir_all(dir)?;
-        for (k, (name, fig)) in comparison_figures(&runs, &sims, &[], "validate").into_iter().enumerate() {
+        for (k, (name, mut fig)) in comparison_figures(&runs, &sims, &[], "validate").into_iter().enumerate()
+        {
+            if let Some(mc) = &mc {
+                add_bands(&mut fig, k, runs[k].time(), &mc.results);
+            }
             let stem = std::path::Path::new(&name)
                 .file_stem()
                 .map_or(format!("run{k}"), |s| s.to_string_lossy().into_owned());
@@ -53,10 +80,11 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({
                 "gap": gap,
-                "metrics": metrics.iter().zip(&runs).map(|(m, f)| serde_json::json!({
+                "metrics": metrics.iter().zip(&runs).zip(&spreads).map(|((m, f), s)| serde_json::json!({
                     "run": f.origin(),
                     "measured": m.as_ref().map(|m| &m.0),
                     "simulated": m.as_ref().map(|m| &m.1),
+                    "monte_carlo": mc.as_ref().zip(s.as_ref()).map(|(mc, s)| mc.summary(s)),
                 })).collect::<Vec<_>>(),
             }))?
         ),
@@ -71,13 +99,25 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
                     per.iter().map(|(s, r, m)| format!("{s} {} / {}", num(*r), num(*m))).collect();
                 println!("  {run}: {}", cells.join(", "));
             }
-            for (m, f) in metrics.iter().zip(&runs) {
+            for ((m, f), s) in metrics.iter().zip(&runs).zip(&spreads) {
                 let Some((a, b)) = m else { continue };
-                println!("\n{}: metric, measured, model", f.origin());
+                let band = if s.is_some() { "   model 5 % … 95 %" } else { "" };
+                println!("\n{}: metric, measured, model{band}", f.origin());
                 let row = |name: &str, x: Option<f64>, y: Option<f64>| {
                     if x.is_some() || y.is_some() {
                         let f = |v: Option<f64>| v.map_or("--".to_string(), num);
-                        println!("  {name:<24} {:>12} {:>12}", f(x), f(y));
+                        let key = match name.split(" [").next().unwrap_or(name) {
+                            "1st overshoot" => "first_overshoot_deg",
+                            "2nd overshoot" => "second_overshoot_deg",
+                            "advance" => "advance_m",
+                            "transfer" => "transfer_m",
+                            _ => "tactical_diameter_m",
+                        };
+                        let spread = s
+                            .as_ref()
+                            .and_then(|s| s.get(key))
+                            .map_or(String::new(), |sp| format!("   {} … {}", num(sp.p05), num(sp.p95)));
+                        println!("  {name:<24} {:>12} {:>12}{spread}", f(x), f(y));
                     }
                 };
                 row("1st overshoot [°]", a.first_overshoot_deg, b.first_overshoot_deg);
@@ -86,7 +126,37 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
                 row("transfer [m]", a.transfer_m, b.transfer_m);
                 row("tactical diameter [m]", a.tactical_diameter_m, b.tactical_diameter_m);
             }
+            if let Some(mc) = &mc {
+                println!(
+                    "\nMonte Carlo: {} models drawn from the covariance × correlation time of {} (seed {}); {} ran, {} failed",
+                    mc.draws,
+                    mc.equations.join(", "),
+                    mc.seed,
+                    mc.results.len(),
+                    mc.failed
+                );
+            }
         }
     }
     Ok(())
+}
+
+/// Adds the draws' pointwise 5-95 % band of each state to run `k`'s comparison figure.
+/// The band is drawn over the measured run's times, sample by sample, as the figure's
+/// simulation is.
+fn add_bands(fig: &mut Figure, k: usize, time: &[f64], draws: &[Vec<Trajectory>]) {
+    let Some(first) = draws.first().and_then(|d| d.get(k)) else { return };
+    for (i, name) in first.state_names.iter().enumerate() {
+        let Some(panel) = fig.panels.iter_mut().find(|p| &p.title == name) else { continue };
+        let signals: Vec<Vec<f64>> =
+            draws.iter().filter_map(|d| d.get(k)).map(|t| t.states[i].clone()).collect();
+        let (lo, hi) = band(&signals);
+        let n = lo.len().min(time.len());
+        panel.series.push(Series::band(
+            &format!("model 90 % band ({} draws)", signals.len()),
+            time[..n].to_vec(),
+            lo[..n].to_vec(),
+            hi[..n].to_vec(),
+        ));
+    }
 }

@@ -1,0 +1,222 @@
+//! Uncertainty of a prediction from the uncertainty of the identified coefficients: models
+//! drawn from each equation's stored covariance (Monte Carlo), the spread of any numbers
+//! computed from them, and pointwise bands of simulated signals. Generic; the ship plug-in
+//! and the CLI decide what to simulate with each draw.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use crate::model::Model;
+
+/// Seeded standard normal numbers (SplitMix64, Box-Muller): the same seed, the same draws.
+#[derive(Clone, Debug)]
+pub struct Normal(u64);
+
+impl Normal {
+    /// A generator from a seed.
+    pub fn new(seed: u64) -> Normal {
+        Normal(seed)
+    }
+
+    fn uniform(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        ((z >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    }
+
+    /// The next standard normal number.
+    pub fn sample(&mut self) -> f64 {
+        let (a, b) = (self.uniform(), self.uniform());
+        (-2.0 * a.ln()).sqrt() * (2.0 * std::f64::consts::PI * b).cos()
+    }
+}
+
+/// Which equations a draw can perturb: those with a stored covariance.
+pub fn uncertain_equations(model: &Model) -> Vec<String> {
+    model.equations.iter().filter(|e| e.covariance.is_some()).map(|e| e.name.clone()).collect()
+}
+
+/// A model whose coefficients are drawn from N(b, τΣ) equation by equation (b the stored
+/// coefficients, Σ their covariance, τ the residual correlation time); equations without a
+/// covariance keep their values.
+pub fn draw(model: &Model, normal: &mut Normal) -> Model {
+    let mut out = model.clone();
+    for eq in &model.equations {
+        let Some(c) = &eq.covariance else { continue };
+        let (terms, k) = (&c.terms, c.terms.len());
+        // rows of a time series are not independent: the effective covariance is τ times s²(X'X)⁻¹
+        let sigma = nalgebra::DMatrix::from_fn(k, k, |i, j| c.matrix[i][j] * c.correlation_time);
+        // semi-definite matrices (an exact fit, a term with zero error) have no Cholesky
+        // factor: a symmetric square root from the eigen-decomposition serves for both
+        let eig = sigma.symmetric_eigen();
+        let root = &eig.eigenvectors
+            * nalgebra::DMatrix::from_diagonal(&eig.eigenvalues.map(|l| l.max(0.0).sqrt()))
+            * eig.eigenvectors.transpose();
+        let z = nalgebra::DVector::from_fn(k, |_, _| normal.sample());
+        let shift = root * z;
+        let coefficients = eq
+            .coefficients
+            .iter()
+            .map(|(t, v, se)| {
+                let d = terms.iter().position(|u| u == t).map_or(0.0, |i| shift[i]);
+                (t.clone(), v + d, *se)
+            })
+            .collect();
+        out.set_coefficients(&eq.name, coefficients, eq.intercept);
+    }
+    out
+}
+
+/// The spread of one number over the draws.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Spread {
+    /// Draws that gave a value.
+    pub count: usize,
+    /// Mean.
+    pub mean: f64,
+    /// Standard deviation.
+    pub sd: f64,
+    /// 5th percentile.
+    pub p05: f64,
+    /// 95th percentile.
+    pub p95: f64,
+}
+
+/// Linear-interpolated percentile of sorted values.
+fn percentile(sorted: &[f64], p: f64) -> f64 {
+    let x = p * (sorted.len() - 1) as f64;
+    let (i, w) = (x.floor() as usize, x - x.floor());
+    if i + 1 < sorted.len() {
+        sorted[i] * (1.0 - w) + sorted[i + 1] * w
+    } else {
+        sorted[i]
+    }
+}
+
+/// The spread of a set of values (`None` for none).
+pub fn spread_of(values: &[f64]) -> Option<Spread> {
+    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    let sd = if v.len() > 1 {
+        (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+    } else {
+        0.0
+    };
+    Some(Spread { count: v.len(), mean, sd, p05: percentile(&v, 0.05), p95: percentile(&v, 0.95) })
+}
+
+/// The spread of every number in a set of like JSON records (e.g. manoeuvre metrics), by
+/// its dotted path; arrays are left out.
+pub fn spread(records: &[serde_json::Value]) -> BTreeMap<String, Spread> {
+    fn leaves(prefix: &str, v: &serde_json::Value, out: &mut BTreeMap<String, Vec<f64>>) {
+        match v {
+            serde_json::Value::Object(map) => {
+                for (k, x) in map {
+                    let key = if prefix.is_empty() { k.clone() } else { format!("{prefix}.{k}") };
+                    leaves(&key, x, out);
+                }
+            }
+            serde_json::Value::Number(n) => out.entry(prefix.to_string()).or_default().extend(n.as_f64()),
+            _ => {}
+        }
+    }
+    let mut all = BTreeMap::new();
+    for r in records {
+        leaves("", r, &mut all);
+    }
+    all.into_iter().filter_map(|(k, v)| spread_of(&v).map(|s| (k, s))).collect()
+}
+
+/// Pointwise 5 % and 95 % curves of several signals sampled at the same times (shorter
+/// signals, e.g. from runs that stopped, count where they have values).
+pub fn band(signals: &[Vec<f64>]) -> (Vec<f64>, Vec<f64>) {
+    let n = signals.iter().map(Vec::len).max().unwrap_or(0);
+    (0..n)
+        .map(|i| {
+            let mut at: Vec<f64> =
+                signals.iter().filter_map(|s| s.get(i).copied()).filter(|v| v.is_finite()).collect();
+            at.sort_by(f64::total_cmp);
+            if at.is_empty() {
+                (f64::NAN, f64::NAN)
+            } else {
+                (percentile(&at, 0.05), percentile(&at, 0.95))
+            }
+        })
+        .unzip()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn normal_numbers_have_unit_variance() {
+        let mut g = Normal::new(5);
+        let v: Vec<f64> = (0..20000).map(|_| g.sample()).collect();
+        let s = spread_of(&v).unwrap();
+        assert!(s.mean.abs() < 0.03 && (s.sd - 1.0).abs() < 0.03, "{s:?}");
+        assert!((s.p95 - 1.645).abs() < 0.05 && (s.p05 + 1.645).abs() < 0.05, "{s:?}");
+    }
+
+    /// Draws reproduce the stored covariance, correlations included.
+    #[test]
+    fn draws_have_the_stored_covariance() {
+        let mut model = Model::default_model();
+        let eq = model.equation("u_dot").unwrap().clone();
+        let terms: Vec<_> = eq.coefficients.iter().take(2).map(|c| c.0.clone()).collect();
+        let cov = [[4e-6, -3e-6], [-3e-6, 9e-6]];
+        let c = crate::model::Covariance {
+            terms: terms.clone(),
+            matrix: cov.iter().map(|r| r.iter().map(|v| v / 4.0).collect()).collect(),
+            correlation_time: 4.0,
+        };
+        model.set_covariance("u_dot", c).unwrap();
+        let mut g = Normal::new(1);
+        let base: Vec<f64> = terms.iter().map(|t| model.equation("u_dot").unwrap().coefficient(t)).collect();
+        let n = 20000;
+        let mut d = vec![[0.0; 2]; n];
+        for row in d.iter_mut() {
+            let m = draw(&model, &mut g);
+            let e = m.equation("u_dot").unwrap();
+            for (k, t) in terms.iter().enumerate() {
+                row[k] = e.coefficient(t) - base[k];
+            }
+            // the other equations are untouched
+            assert_eq!(
+                m.equation("r_dot").unwrap().coefficients,
+                model.equation("r_dot").unwrap().coefficients
+            );
+        }
+        let c = |a: usize, b: usize| d.iter().map(|r| r[a] * r[b]).sum::<f64>() / n as f64;
+        for (a, b) in [(0, 0), (0, 1), (1, 1)] {
+            assert!((c(a, b) - cov[a][b]).abs() < 0.05 * 9e-6, "[{a}][{b}]: {} vs {}", c(a, b), cov[a][b]);
+        }
+        assert_eq!(uncertain_equations(&model), vec!["u_dot".to_string()]);
+    }
+
+    #[test]
+    fn spreads_and_bands() {
+        let records: Vec<serde_json::Value> = (0..=10)
+            .map(|i| serde_json::json!({"a": i as f64, "b": {"c": 2.0}, "d": null, "e": [1, 2]}))
+            .collect();
+        let s = spread(&records);
+        assert_eq!(s.keys().collect::<Vec<_>>(), ["a", "b.c"]);
+        assert!(
+            (s["a"].mean - 5.0).abs() < 1e-12
+                && (s["a"].p05 - 0.5).abs() < 1e-12
+                && (s["a"].p95 - 9.5).abs() < 1e-12
+        );
+        let (lo, hi) = band(&[vec![0.0, 1.0], vec![2.0, 3.0], vec![4.0]]);
+        assert_eq!(lo.len(), 2);
+        assert!((lo[0] - 0.2).abs() < 1e-12 && (hi[0] - 3.8).abs() < 1e-12 && (hi[1] - 2.9).abs() < 1e-12);
+    }
+}
