@@ -23,6 +23,8 @@ struct Pass {
     states: Vec<Vector3<f64>>,
     /// −2 log likelihood with the measurement variance concentrated out.
     deviance: f64,
+    /// The measurement variance that maximises the likelihood (data units²).
+    variance: f64,
 }
 
 fn transition(dt: f64) -> Matrix3<f64> {
@@ -88,14 +90,49 @@ fn pass(h: &[f64], y: &[f64], q: f64, smooth: bool) -> Option<Pass> {
     let back = |dt: f64| transition(-dt) * first;
     let mut all = vec![back(h[0] + h[1]), back(h[1])];
     all.extend(states);
-    Some(Pass { states: all, deviance })
+    Some(Pass { states: all, deviance, variance: sum_v2 / m })
 }
 
 fn states_blew_up(filtered: &[(Vector3<f64>, Matrix3<f64>)]) -> bool {
     filtered.iter().any(|(x, _)| !x.iter().all(|v| v.is_finite()))
 }
 
+/// What the likelihood says about a signal's noise: its measurement variance and the
+/// intensity (power spectral density) of the white jerk that drives it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NoiseModel {
+    /// Measurement noise variance, signal units².
+    pub measurement_variance: f64,
+    /// Jerk intensity q, signal units² / s⁵.
+    pub jerk_intensity: f64,
+}
+
 impl KalmanSmoother {
+    /// The maximum-likelihood noise model of a signal (time in seconds); models that fuse
+    /// several signals (the ship plug-in's tracking) take their noise levels from here.
+    pub fn noise_model(t: &[f64], x: &[f64]) -> Result<NoiseModel, DataError> {
+        let n = t.len().min(x.len());
+        if n < 8 {
+            return Err(DataError::TooShort {
+                file: "signal".into(),
+                rows: n,
+                needed: 8,
+                what: "a noise model".into(),
+            });
+        }
+        let scale = (t[n - 1] - t[0]) / (n - 1) as f64;
+        let h: Vec<f64> = t[..n].windows(2).map(|w| (w[1] - w[0]) / scale).collect();
+        let ratio = most_likely_ratio(&h, &x[..n]);
+        let p = pass(&h, &x[..n], ratio, false).ok_or_else(|| {
+            DataError::UnknownMethod(format!("kalman:{ratio}"), "the filter diverged".into())
+        })?;
+        // q in scaled time is ratio·σ²; Δ⁵ scaling takes it to seconds
+        Ok(NoiseModel {
+            measurement_variance: p.variance,
+            jerk_intensity: ratio * p.variance / scale.powi(5),
+        })
+    }
+
     /// The smoothed signal and its rate, and the noise ratio used.
     pub fn fit(&self, t: &[f64], x: &[f64]) -> Result<(Smoothed, f64), DataError> {
         let n = t.len().min(x.len());
@@ -230,5 +267,9 @@ mod tests {
             (s.value.iter().zip(&t).map(|(v, t)| (v - (0.3 * t).sin()).powi(2)).sum::<f64>() / 2000.0).sqrt();
         assert!(value_err < 0.02 / 12f64.sqrt() / 2.0, "smoothed value error {value_err}");
         assert!(KalmanSmoother { ratio: Some(0.0) }.fit(&t, &x).is_err());
+        // the noise level is estimated: uniform noise of width 0.02 has variance 0.02²/12
+        let nm = KalmanSmoother::noise_model(&t, &x).unwrap();
+        let sd = nm.measurement_variance.sqrt();
+        assert!((sd / (0.02 / 12f64.sqrt()) - 1.0).abs() < 0.1, "noise sd {sd}");
     }
 }

@@ -13,7 +13,7 @@ mod smoothing_spline;
 
 pub use dataset::{Dataset, Delimiter, RunSpec};
 pub use derivative::{differentiator, CentralDifference, Differentiator, Smoothed, DIFFERENTIATORS};
-pub use kalman::KalmanSmoother;
+pub use kalman::{KalmanSmoother, NoiseModel};
 pub use prepare::{prepare, prepared_figure, Preparation};
 pub use resample::{check_gaps, median_step, resample};
 pub use savitzky_golay::SavitzkyGolay;

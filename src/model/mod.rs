@@ -7,8 +7,8 @@
 mod file;
 
 pub use file::{
-    CoefficientSpec, CovarianceSpec, EquationSpec, InputSpec, Meta, ModelFile, ParameterSpec, ShipSpec,
-    StateSpec,
+    CoefficientSpec, CovarianceSpec, EquationSpec, InputSpec, Meta, ModelFile, ParameterSpec, ShipNames,
+    ShipSpec, StateSpec,
 };
 
 use std::collections::BTreeMap;

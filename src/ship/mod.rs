@@ -8,6 +8,7 @@ pub mod figure;
 pub mod hypotheses;
 pub mod manoeuvre;
 pub mod observed;
+pub mod tracking;
 
 use std::collections::BTreeMap;
 

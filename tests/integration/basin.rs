@@ -73,62 +73,87 @@ fn identified_from_noisy_basin_runs_the_model_predicts_within_the_targets() {
         .unwrap();
     let p = |f: &str| dir.join(f).display().to_string();
 
-    let (ok, out, err) = termid(&[
+    // per-signal Kalman smoothing and the ship's tracking filter (kinematics coupled)
+    for method in ["kalman", "kinematic"] {
+        let model = p(&format!("id_{method}.toml"));
+        let prepared = p(&format!("prepared_{method}"));
+        let (ok, out, err) = termid(&[
+            "identify",
+            "--model",
+            &p("m.toml"),
+            "--dataset",
+            &p("train.toml"),
+            "--derivative",
+            method,
+            "--smooth",
+            // no intercept: the model's u² terms already carry the constant asymmetry (B0, C0),
+            // and at u ≈ u0 they and an intercept are nearly the same column
+            "--no-intercept",
+            "--out",
+            &model,
+            "--prepared-svg",
+            &prepared,
+        ]);
+        assert!(ok, "{method}: {err}");
+        assert!(out.contains("wrote"), "{out}");
+        // every conversion is stated: degrees of the basin's columns to radians
+        assert!(err.contains("`heading` [deg] → ψ") && err.contains("`yaw_rate` [deg/s] → r"), "{err}");
+        assert_eq!(std::fs::read_dir(&prepared).unwrap().count(), 4);
+
+        // the fifth run: simulated from its own start with its recorded rudder
+        let (ok, out, err) = termid(&[
+            "validate",
+            "--model",
+            &model,
+            "--dataset",
+            &p("held.toml"),
+            "--integrator",
+            "rk4",
+            "--dt",
+            "0.01",
+            "--svg",
+            &p("validate"),
+            "--format",
+            "json",
+        ]);
+        assert!(ok, "{err}");
+        let v = json(&out);
+        let predicted = v["metrics"][0]["simulated"]["first_overshoot_deg"].as_f64().unwrap();
+        assert!(
+            (predicted - held_overshoot).abs() < 1.5,
+            "{method}: first overshoot {predicted}° vs true {held_overshoot}°"
+        );
+        let heading_rms =
+            v["gap"]["states"].as_array().unwrap().iter().find(|s| s[0] == "ψ").unwrap()[2].as_f64().unwrap();
+        assert!(
+            heading_rms.to_degrees() < 3.0,
+            "{method}: held-out heading RMS {}°",
+            heading_rms.to_degrees()
+        );
+
+        // turning circles over the rudder range the zigzags covered (±20°, ±30°); README gives ±35°
+        for delta in [20.0, -20.0, 30.0, -30.0] {
+            let (t, m) = (tactical(None, delta), tactical(Some(&model), delta));
+            assert!(
+                (m / t - 1.0).abs() < 0.05,
+                "{method}, δ = {delta}°: tactical diameter {m} m vs true {t} m"
+            );
+        }
+    }
+    std::fs::copy(dir.join("id_kalman.toml"), dir.join("id.toml")).unwrap();
+    // the tracking filter is the ship plug-in's: refused without a ship
+    let (ok, _, err) = termid(&[
         "identify",
-        "--model",
-        &p("m.toml"),
         "--dataset",
         &p("train.toml"),
+        "--target",
+        "du/dt",
+        "--terms",
+        "u",
         "--derivative",
-        "kalman",
-        "--smooth",
-        // no intercept: the model's u² terms already carry the constant asymmetry (B0, C0),
-        // and at u ≈ u0 they and an intercept are nearly the same column
-        "--no-intercept",
-        "--out",
-        &p("id.toml"),
-        "--prepared-svg",
-        &p("prepared"),
+        "kinematic",
     ]);
-    assert!(ok, "{err}");
-    assert!(out.contains("wrote"), "{out}");
-    // every conversion is stated: degrees of the basin's columns to radians
-    assert!(err.contains("`heading` [deg] → ψ") && err.contains("`yaw_rate` [deg/s] → r"), "{err}");
-    let figures = std::fs::read_dir(dir.join("prepared")).unwrap().count();
-    assert_eq!(figures, 4);
-
-    // the fifth run: simulated from its own start with its recorded rudder
-    let (ok, out, err) = termid(&[
-        "validate",
-        "--model",
-        &p("id.toml"),
-        "--dataset",
-        &p("held.toml"),
-        "--integrator",
-        "rk4",
-        "--dt",
-        "0.01",
-        "--svg",
-        &p("validate"),
-        "--format",
-        "json",
-    ]);
-    assert!(ok, "{err}");
-    let v = json(&out);
-    let predicted = v["metrics"][0]["simulated"]["first_overshoot_deg"].as_f64().unwrap();
-    assert!(
-        (predicted - held_overshoot).abs() < 1.5,
-        "first overshoot {predicted}° vs true {held_overshoot}°: {out}"
-    );
-    let heading_rms =
-        v["gap"]["states"].as_array().unwrap().iter().find(|s| s[0] == "ψ").unwrap()[2].as_f64().unwrap();
-    assert!(heading_rms.to_degrees() < 3.0, "held-out heading RMS {}°", heading_rms.to_degrees());
-
-    // turning circles over the rudder range the zigzags covered (±20°, ±30°); README gives ±35°
-    for delta in [20.0, -20.0, 30.0, -30.0] {
-        let (t, m) = (tactical(None, delta), tactical(Some(&p("id.toml")), delta));
-        assert!((m / t - 1.0).abs() < 0.05, "δ = {delta}°: tactical diameter {m} m vs true {t} m");
-    }
+    assert!(!ok && err.contains("[ship]"), "{err}");
 
     // uncertainty: identify stored covariances and correlation times; draws give a band
     let id = Model::load(&dir.join("id.toml")).unwrap();

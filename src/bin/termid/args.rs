@@ -103,7 +103,8 @@ pub struct IdentifyCommand {
     #[arg(long, default_value = "stepwise")]
     pub backend: String,
     /// Derivative method for `dX/dt` targets: central, savitzky-golay[:WINDOW:ORDER],
-    /// spline[:ALPHA] (GCV by default), kalman[:RATIO] (maximum likelihood by default).
+    /// spline[:ALPHA] (GCV by default), kalman[:RATIO] (maximum likelihood by default), or for
+    /// ship models `kinematic`: the tracking filter fusing track, heading, log and gyro.
     #[arg(long, default_value = "central")]
     pub derivative: String,
     /// Resample every run to this interval [s] before differentiating (low-pass filtered

@@ -3,10 +3,12 @@
 use std::collections::BTreeMap;
 
 use anyhow::{bail, Context, Result};
-use termid::data::{differentiator, prepare, prepared_figure, Frame, Preparation};
+use termid::data::{differentiator, prepare, prepared_figure, resample, Frame, Preparation};
 use termid::identify::{Fit, Identification, ParamValue, Target};
 use termid::model::Covariance;
+use termid::model::ShipSpec;
 use termid::select::{Backend, StepRule};
+use termid::ship::tracking::track;
 use termid::term::{parse_terms, Vocabulary};
 
 use crate::args::{Format, IdentifyCommand, RuleName};
@@ -32,7 +34,7 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     }
     let target = Target::parse(cmd.target.as_deref().unwrap_or_default());
     if let Target::Derivative(state) = &target {
-        frames = prepare_runs(&cmd, frames, std::slice::from_ref(state), &|_| (1.0, String::new()))?;
+        frames = prepare_runs(&cmd, frames, std::slice::from_ref(state), None, &|_| (1.0, String::new()))?;
     }
     let mut vocab = Vocabulary::new();
     let mut params = BTreeMap::new();
@@ -113,19 +115,38 @@ fn prepare_runs(
     cmd: &IdentifyCommand,
     frames: Vec<Frame>,
     signals: &[String],
+    ship: Option<&ShipSpec>,
     scale: &dyn Fn(&str) -> (f64, String),
 ) -> Result<Vec<Frame>> {
-    if cmd.resample.is_none() && !cmd.smooth && cmd.prepared_svg.is_none() {
+    let kinematic = cmd.derivative == "kinematic";
+    if cmd.resample.is_none() && !cmd.smooth && cmd.prepared_svg.is_none() && !kinematic {
         return Ok(frames);
     }
-    let method = differentiator(&cmd.derivative)?;
-    let how = Preparation {
-        resample: cmd.resample,
-        method: method.as_ref(),
-        signals: signals.to_vec(),
-        smooth: cmd.smooth,
+    let prepared = if kinematic {
+        // the ship plug-in's tracking filter: all states of a run at once, kinematics coupled
+        let Some(ship) = ship else {
+            bail!("--derivative kinematic is the ship plug-in's tracking filter: it needs a --model with a [ship] section");
+        };
+        frames
+            .iter()
+            .map(|f| {
+                let f = match cmd.resample {
+                    Some(dt) => resample(f, dt)?,
+                    None => f.clone(),
+                };
+                track(&f, ship, cmd.smooth)
+            })
+            .collect::<Result<Vec<_>, _>>()?
+    } else {
+        let method = differentiator(&cmd.derivative)?;
+        let how = Preparation {
+            resample: cmd.resample,
+            method: method.as_ref(),
+            signals: signals.to_vec(),
+            smooth: cmd.smooth,
+        };
+        frames.iter().map(|f| prepare(f, &how)).collect::<Result<Vec<_>, _>>()?
     };
-    let prepared = frames.iter().map(|f| prepare(f, &how)).collect::<Result<Vec<_>, _>>()?;
     if let Some(dir) = &cmd.prepared_svg {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         for (k, (raw, p)) in frames.iter().zip(&prepared).enumerate() {
@@ -166,7 +187,24 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
         names.iter().filter_map(|n| model.equation(n).map(|e| e.state.clone())).collect();
     let units: BTreeMap<String, String> =
         model.spec.states.iter().map(|s| (s.name.clone(), s.unit.clone())).collect();
-    let frames = prepare_runs(&cmd, frames, &states, &|name| {
+    // the ship's roles under the names the frames use
+    let ship = model.spec.ship.clone().map(|mut s| {
+        let canon = |n: &mut String| *n = model.vocabulary.canonical(n).unwrap_or_else(|| n.clone());
+        let names = &mut s.names;
+        for n in [
+            &mut names.u,
+            &mut names.v,
+            &mut names.r,
+            &mut names.psi,
+            &mut names.x0,
+            &mut names.y0,
+            &mut names.rudder,
+        ] {
+            canon(n);
+        }
+        s
+    });
+    let frames = prepare_runs(&cmd, frames, &states, ship.as_ref(), &|name| {
         let unit = units.get(name).cloned().unwrap_or_default();
         // angles are read in degrees
         match unit.strip_prefix("rad") {
@@ -177,7 +215,12 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
     if cmd.target.is_some() && names.len() != 1 {
         bail!("--target applies to one equation: name it with --equation");
     }
-    let diff = differentiator(&cmd.derivative)?;
+    // the tracking filter writes every rate as a column; nothing is left to differentiate
+    let diff: Box<dyn termid::data::Differentiator> = if cmd.derivative == "kinematic" {
+        Box::new(termid::data::CentralDifference)
+    } else {
+        differentiator(&cmd.derivative)?
+    };
     let mut fits = Vec::new();
     for name in &names {
         let fit = crate::progress::with_spinner(&format!("identifying {name}"), || {
