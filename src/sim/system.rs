@@ -18,6 +18,10 @@ pub struct System {
     rhs: Library,
     /// For each library input: where its value comes from.
     map: Vec<Slot>,
+    /// (scratch slot, state index) and (scratch slot, input index) of the library inputs
+    /// that change from row to row; parameters sit in the workspace from its creation.
+    state_slots: Vec<(usize, usize)>,
+    input_slots: Vec<(usize, usize)>,
     param_names: Vec<String>,
     params: Vec<f64>,
 }
@@ -84,7 +88,28 @@ impl System {
                 )
             })
             .collect();
-        Ok(System { states, inputs, bounds, rhs, map, param_names, params: values.into_values().collect() })
+        let slot =
+            |j: usize| rhs.input_slot(j).ok_or_else(|| SimError::Settings(format!("input {j} has no slot")));
+        let mut state_slots = Vec::new();
+        let mut input_slots = Vec::new();
+        for (j, m) in map.iter().enumerate() {
+            match m {
+                Slot::State(i) => state_slots.push((slot(j)?, *i)),
+                Slot::Input(i) => input_slots.push((slot(j)?, *i)),
+                Slot::Param(_) => {}
+            }
+        }
+        Ok(System {
+            states,
+            inputs,
+            bounds,
+            rhs,
+            map,
+            state_slots,
+            input_slots,
+            param_names,
+            params: values.into_values().collect(),
+        })
     }
 
     /// The same system with some parameters changed (e.g. a run's own approach speed u0).
@@ -104,24 +129,27 @@ impl System {
         self.states.len()
     }
 
-    /// Scratch space for [`System::derivatives`].
+    /// Scratch space for [`System::derivatives`], with the parameters in place.
     pub fn workspace(&self) -> Workspace {
-        Workspace { scratch: self.rhs.scratch() }
+        let mut scratch = self.rhs.scratch();
+        for (j, m) in self.map.iter().enumerate() {
+            if let (Slot::Param(i), Some(slot)) = (m, self.rhs.input_slot(j)) {
+                self.rhs.set_input(&mut scratch, slot, self.params[*i]);
+            }
+        }
+        Workspace { scratch }
     }
 
     /// ẋ = f(x, input).
     #[inline]
     pub fn derivatives(&self, x: &[f64], input: &[f64], ws: &mut Workspace, dx: &mut [f64]) {
-        let params = &self.params;
-        self.rhs.eval_row_with(
-            |j| match self.map[j] {
-                Slot::State(i) => x[i],
-                Slot::Input(i) => input[i],
-                Slot::Param(i) => params[i],
-            },
-            &mut ws.scratch,
-            dx,
-        );
+        for &(slot, i) in &self.state_slots {
+            self.rhs.set_input(&mut ws.scratch, slot, x[i]);
+        }
+        for &(slot, i) in &self.input_slots {
+            self.rhs.set_input(&mut ws.scratch, slot, input[i]);
+        }
+        self.rhs.eval_row_prepared(&mut ws.scratch, dx);
     }
 
     /// Index of a state by name.

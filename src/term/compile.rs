@@ -74,6 +74,9 @@ enum Group {
     Mul(Vec<(u32, u32, u32)>),
     Recip(Vec<(u32, u32)>),
     Call(Vec<(usize, usize, Vec<usize>)>),
+    /// (sine destination, cosine destination, argument): sin and cos of one argument share
+    /// their argument reduction (a ship's track needs both of ψ at every step).
+    SinCos(Vec<(u32, u32, u32)>),
     /// (destination, start, length) into `RowProgram::lin`.
     Lin(Vec<(u32, u32, u32)>),
 }
@@ -84,6 +87,7 @@ impl Group {
             Group::Mul(v) | Group::Lin(v) => v.is_empty(),
             Group::Recip(v) => v.is_empty(),
             Group::Call(v) => v.is_empty(),
+            Group::SinCos(v) => v.is_empty(),
         }
     }
 }
@@ -122,7 +126,14 @@ impl RowProgram {
                     Op::Input(_) | Op::Const(_) => {}
                 }
             }
-            for g in [Group::Mul(muls), Group::Recip(recips), Group::Call(calls), Group::Lin(lins)] {
+            let sincos = pair_sin_cos(&mut calls);
+            for g in [
+                Group::Mul(muls),
+                Group::Recip(recips),
+                Group::Call(calls),
+                Group::SinCos(sincos),
+                Group::Lin(lins),
+            ] {
                 if !g.is_empty() {
                     prog.groups.push(g);
                 }
@@ -137,6 +148,33 @@ impl RowProgram {
         }
         prog
     }
+}
+
+/// Takes the pairs sin(a), cos(a) of one argument out of a level's calls.
+fn pair_sin_cos(calls: &mut Vec<(usize, usize, Vec<usize>)>) -> Vec<(u32, u32, u32)> {
+    let id = |name: &str| super::functions::FUNCTIONS.iter().position(|f| f.name == name);
+    let (Some(sin), Some(cos)) = (id("sin"), id("cos")) else { return vec![] };
+    let mut pairs = Vec::new();
+    let mut k = 0;
+    while k < calls.len() {
+        let (i, f, args) = &calls[k];
+        let partner = (*f == sin && args.len() == 1)
+            .then(|| calls.iter().position(|(_, g, b)| *g == cos && *b == *args))
+            .flatten();
+        match partner {
+            Some(j) => {
+                let (i_sin, arg) = (*i as u32, args[0] as u32);
+                let i_cos = calls[j].0 as u32;
+                pairs.push((i_sin, i_cos, arg));
+                let (hi, lo) = (k.max(j), k.min(j));
+                calls.remove(hi);
+                calls.remove(lo);
+                k = 0;
+            }
+            None => k += 1,
+        }
+    }
+    pairs
 }
 
 struct Builder<'v> {
@@ -328,15 +366,34 @@ impl Library {
     /// the simulator reads states and inputs where they are).
     #[inline]
     pub fn eval_row_with(&self, fetch: impl Fn(usize) -> f64, scratch: &mut RowScratch, out: &mut [f64]) {
+        for &(i, j) in &self.rows.inputs {
+            scratch.0[i as usize] = fetch(j as usize);
+        }
+        self.eval_row_prepared(scratch, out);
+    }
+
+    /// The scratch slot that holds input `j` (for callers that keep some inputs, e.g. the
+    /// parameters of a simulation, in place between rows).
+    pub fn input_slot(&self, j: usize) -> Option<usize> {
+        self.rows.inputs.iter().find(|(_, k)| *k as usize == j).map(|(i, _)| *i as usize)
+    }
+
+    /// Sets input `j`'s value in a scratch (see [`Library::input_slot`]).
+    #[inline]
+    pub fn set_input(&self, scratch: &mut RowScratch, slot: usize, value: f64) {
+        scratch.0[slot] = value;
+    }
+
+    /// Evaluates every term on the inputs already in `scratch` (set by
+    /// [`Library::set_input`]).
+    #[inline]
+    pub fn eval_row_prepared(&self, scratch: &mut RowScratch, out: &mut [f64]) {
         let s = scratch.0.as_mut_slice();
         // This check makes every slot index below valid: the program's slot indices are all
         // < ops.len() by construction (Builder).
         assert!(s.len() == self.ops.len(), "scratch of another library");
         let p = &self.rows;
         let u = |i: u32| i as usize;
-        for &(i, j) in &p.inputs {
-            s[u(i)] = fetch(u(j));
-        }
         // SAFETY: see the assert above.
         unsafe {
             for g in &p.groups {
@@ -354,6 +411,13 @@ impl Library {
                     Group::Call(v) => {
                         for (i, f, args) in v {
                             *s.get_unchecked_mut(*i) = call_scalar(*f, args, s);
+                        }
+                    }
+                    Group::SinCos(v) => {
+                        for &(i_sin, i_cos, a) in v {
+                            let (sin, cos) = libm::sincos(*s.get_unchecked(u(a)));
+                            *s.get_unchecked_mut(u(i_sin)) = sin;
+                            *s.get_unchecked_mut(u(i_cos)) = cos;
                         }
                     }
                     Group::Lin(v) => {

@@ -70,6 +70,7 @@ impl Servo {
     }
 
     /// Moves towards `command` over the time since the last call.
+    #[inline]
     pub fn step(&mut self, t: f64, command: f64) -> f64 {
         let target = command.clamp(-self.limit, self.limit);
         let max = self.rate * (t - self.last_t).max(0.0);

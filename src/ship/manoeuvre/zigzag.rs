@@ -43,6 +43,7 @@ struct Switch {
 
 impl Switch {
     /// Updates the direction from the heading change `h`; true when it reversed.
+    #[inline]
     fn update(&mut self, h: f64) -> bool {
         if (self.dir > 0.0 && h >= self.limit) || (self.dir < 0.0 && h <= -self.limit) {
             self.dir = -self.dir;
@@ -65,8 +66,8 @@ pub struct ZigZagControl {
 }
 
 impl Controller for ZigZagControl {
+    #[inline]
     fn input(&mut self, t: f64, x: &[f64], out: &mut [f64]) {
-        out.fill(0.0);
         self.switch.update(x[self.psi] - self.psi0);
         // rudder for a turn in direction `dir` (+ = starboard): sign from ∂ṙ/∂δ
         let command = self.delta0 + self.turn_sign * self.switch.dir * self.amplitude;
