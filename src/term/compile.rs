@@ -589,4 +589,28 @@ mod tests {
             assert!((got - want).abs() <= 1e-15 * want, "{got} vs {want}");
         }
     }
+
+    /// sin and cos of the same argument are evaluated as one pair (the ship's track needs
+    /// both of ψ); a lone sin or a cos of another argument stays a plain call.
+    #[test]
+    fn pairs_sine_and_cosine_of_one_argument() {
+        let v = Vocabulary::open();
+        let texts = ["u*cos(p)", "v*sin(p)", "sin(p)", "cos(2*p)", "sin(u)"];
+        let terms: Vec<Term> = texts.iter().map(|t| v.parse(t).unwrap()).collect();
+        let lib = Library::compile(&terms, &v).unwrap();
+        let pairs: usize =
+            lib.rows.groups.iter().map(|g| if let Group::SinCos(p) = g { p.len() } else { 0 }).sum();
+        assert_eq!(pairs, 1);
+        let (p, u, w) = (40.3, 1.7, -0.4);
+        let mut inp = vec![0.0; lib.inputs().len()];
+        for (n, val) in [("p", p), ("u", u), ("v", w)] {
+            inp[lib.inputs().iter().position(|i| i == n).unwrap()] = val;
+        }
+        let mut out = vec![0.0; texts.len()];
+        lib.eval_row(&inp, &mut lib.scratch(), &mut out);
+        let want = [u * p.cos(), w * p.sin(), p.sin(), (2.0 * p).cos(), u.sin()];
+        for (got, want) in out.iter().zip(want) {
+            assert!((got - want).abs() <= 4e-16 * want.abs().max(1.0), "{got} vs {want}");
+        }
+    }
 }
