@@ -460,8 +460,13 @@ impl Library {
         mut visit: impl FnMut(usize, usize, &[f64]),
     ) {
         let p = self.outputs.len();
-        let mut slots = vec![0.0; self.ops.len() * BLOCK];
-        let mut block = vec![0.0; p * BLOCK];
+        // every slot row is written before it is read, so reused buffers need no clearing
+        let (mut slots, mut block) = BLOCK_SPARE.with(|s| std::mem::take(&mut *s.borrow_mut()));
+        for (buf, len) in [(&mut slots, self.ops.len() * BLOCK), (&mut block, p * BLOCK)] {
+            if buf.len() < len {
+                buf.resize(len, 0.0);
+            }
+        }
         let mut start = 0;
         while start < n {
             let len = BLOCK.min(n - start);
@@ -472,6 +477,7 @@ impl Library {
             visit(start, len, &block[..p * len]);
             start += len;
         }
+        BLOCK_SPARE.with(|s| *s.borrow_mut() = (slots, block));
     }
 
     /// Fills a column-major `n × len()` design matrix.
@@ -532,6 +538,14 @@ impl Library {
             }
         }
     }
+}
+
+thread_local! {
+    /// The block evaluator's slot and output buffers, kept between calls on this thread:
+    /// identification evaluates run after run, and fresh buffers of this size came back
+    /// from the system as fresh pages every time.
+    static BLOCK_SPARE: std::cell::RefCell<(Vec<f64>, Vec<f64>)> =
+        const { std::cell::RefCell::new((Vec::new(), Vec::new())) };
 }
 
 /// Σ c·s[k] with four independent partial sums: one running sum is a chain of dependent
