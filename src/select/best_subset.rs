@@ -81,6 +81,22 @@ struct Search<'a> {
     limit: u64,
     deadline: Instant,
     stopped: bool,
+    /// One matrix per depth of the tree, reused: a node's exclude branch sweeps into it.
+    stack: Vec<Vec<f64>>,
+}
+
+/// `b` = `a` swept on pivot `u`, but only the entries among `rest` and the target `t`: all
+/// that the subtree below reads (its pivots come from `rest`, its RSS is the target's
+/// diagonal). A node then costs (|rest| + 1)² instead of m², and nothing is allocated.
+fn sweep_out(a: &[f64], b: &mut [f64], m: usize, u: usize, rest: &[usize], t: usize) {
+    let d = a[u * m + u];
+    let row_u = &a[u * m..(u + 1) * m];
+    for &i in rest.iter().chain(std::iter::once(&t)) {
+        let f = a[i * m + u] / d;
+        for &j in rest.iter().chain(std::iter::once(&t)) {
+            b[i * m + j] = a[i * m + j] - f * row_u[j];
+        }
+    }
 }
 
 impl Search<'_> {
@@ -103,8 +119,11 @@ impl Search<'_> {
             return;
         }
         let rss = self.sc.residual_share(a).max(RSS_FLOOR);
-        let full: Vec<usize> = inn.iter().chain(undecided).copied().collect();
-        self.record(rss, &full);
+        let size = inn.len() + undecided.len();
+        if size <= self.kmax && rss < self.best[size].0 {
+            let full: Vec<usize> = inn.iter().chain(undecided).copied().collect();
+            self.record(rss, &full);
+        }
         if undecided.is_empty() {
             return;
         }
@@ -115,10 +134,19 @@ impl Search<'_> {
             return;
         }
         let (u, rest) = (undecided[0], &undecided[1..]);
-        // exclude u: one sweep takes it out
-        let mut b = a.to_vec();
-        sweep(&mut b, self.sc.m, u);
-        self.visit(&b, inn, rest);
+        // exclude u: the RSS rises by b_u²/c_uu (coefficient and inverse diagonal, both in
+        // the swept matrix), so a hopeless subtree is known before its sweep is paid for
+        let (m, t) = (self.sc.m, self.sc.p);
+        let child = (rss + a[u * m + t].powi(2) / a[u * m + u]).max(RSS_FLOOR);
+        let top = (lo + rest.len()).min(self.kmax);
+        if lo <= top && !(lo..=top).all(|k| child >= self.best[k].0) {
+            // one sweep takes u out (into this depth's buffer)
+            let depth = rest.len();
+            let mut b = std::mem::take(&mut self.stack[depth]);
+            sweep_out(a, &mut b, m, u, rest, t);
+            self.visit(&b, inn, rest);
+            self.stack[depth] = b;
+        }
         // include u: same fitted set as this node, u decided in
         inn.push(u);
         self.visit(a, inn, rest);
@@ -187,6 +215,7 @@ impl BestSubset {
             limit: self.node_limit,
             deadline: Instant::now() + std::time::Duration::from_secs_f64(self.time_limit.max(0.0)),
             stopped: false,
+            stack: vec![vec![0.0; m * m]; kept.len() + 1],
         };
         if let Ok(path) = (Stepwise { step_rule: super::StepRule::Last, ..Stepwise::default() }).select(pb) {
             for st in &path.steps {
