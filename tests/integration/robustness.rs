@@ -39,4 +39,41 @@ proptest! {
     fn manoeuvre_strings_never_panic(text in "[a-z:/0-9.\\-]{0,20}") {
         let _ = termid::ship::Manoeuvre::parse(&text);
     }
+
+    /// Derivative methods and resampling on any signal (constant, stepped, huge, uneven in
+    /// time) and any `--derivative`/`--resample` text: an error or finite numbers, no panic.
+    #[test]
+    fn preparation_never_panics(
+        steps in prop::collection::vec(1e-3f64..1.0, 1..60),
+        values in prop::collection::vec(prop_oneof![Just(0.0), Just(1.0), -1e6f64..1e6], 60),
+        spec in "(central|savitzky-golay|spline|kalman|kinematic|x)(:[0-9.e\\-]{0,6}){0,3}",
+        dt in -1.0f64..5.0,
+    ) {
+        let mut t = vec![0.0];
+        for s in &steps {
+            t.push(t[t.len() - 1] + s);
+        }
+        let x = &values[..t.len()];
+        if let Ok(method) = termid::data::differentiator(&spec) {
+            if let Ok(s) = method.smooth(&t, x) {
+                prop_assert!(s.rate.iter().chain(&s.value).all(|v| v.is_finite()), "{spec}: {s:?}");
+            }
+        }
+        let mut f = Frame::new("run.csv", "t", t.clone()).unwrap();
+        f.push("x", x.to_vec()).unwrap();
+        if let Ok(r) = termid::data::resample(&f, dt) {
+            prop_assert!(r.column("x").unwrap().iter().all(|v| v.is_finite()));
+        }
+        // the ship's tracking filter on the same signal in every channel
+        let ship = Model::default_model().spec.ship.unwrap();
+        let mut run = Frame::new("run.csv", "t", t.clone()).unwrap();
+        for (k, name) in ["u", "v", "r", "ψ", "x0", "y0"].iter().enumerate() {
+            run.push(name, x.iter().map(|v| v * (k + 1) as f64).collect()).unwrap();
+        }
+        if let Ok(tracked) = termid::ship::tracking::track(&run, &ship, true) {
+            for name in ["u_dot", "v_dot", "r_dot", "ψ"] {
+                prop_assert!(tracked.column(name).unwrap().iter().all(|v| v.is_finite()), "{name}");
+            }
+        }
+    }
 }
