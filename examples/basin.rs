@@ -16,20 +16,12 @@ use termid::diagnose::Runs;
 use termid::identify::{coefficients_of, fit_equation, Identification, Target};
 use termid::model::Model;
 use termid::select::{Backend, Moments};
-use termid::ship::basin::{at_approach_speed, dataset_toml, Basin, Recording};
+use termid::ship::basin::{at_approach_speed, dataset_toml, Basin, Recording, PAPER_RUNS};
 use termid::ship::tracking::track;
 use termid::ship::{Manoeuvre, Metrics, Ship};
 use termid::sim::{Integrator, Settings};
 use termid::term::Library;
 
-/// (manoeuvre, approach speed as a fraction of the nominal u0)
-const TRAIN: [(&str, f64); 4] = [
-    ("zigzag:15/10", 0.97),
-    ("zigzag:20/10:port", 1.02),
-    ("zigzag:30/10", 0.99),
-    ("zigzag:20/20:port", 1.03),
-];
-const HELD_OUT: (&str, f64) = ("zigzag:25/10", 0.98);
 const TURNS: [f64; 6] = [20.0, -20.0, 30.0, -30.0, 35.0, -35.0];
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -61,12 +53,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         };
     // BASIN_SEED varies the noise, to see how much of a result is luck
     let seed: u64 = std::env::var("BASIN_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or(0);
-    let train: Vec<(String, Recording)> = TRAIN
+    let train: Vec<(String, Recording)> = PAPER_RUNS[..4]
         .iter()
         .enumerate()
         .map(|(k, r)| record(*r, 11 + k as u64 + 100 * seed))
         .collect::<Result<_, _>>()?;
-    let held = record(HELD_OUT, 99 + 100 * seed)?;
+    let held = record(PAPER_RUNS[4], 99 + 100 * seed)?;
     let names: Vec<&str> = train.iter().map(|(n, _)| n.as_str()).collect();
     std::fs::write(dir.join("train.toml"), dataset_toml(&names))?;
     std::fs::write(dir.join("held_out.toml"), dataset_toml(&[held.0.as_str()]))?;
@@ -95,7 +87,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     println!(
         "truth: held-out {} first overshoot {:.2}°, tactical diameters {:?} m",
-        HELD_OUT.0, true_overshoot, true_tactical
+        PAPER_RUNS[4].0, true_overshoot, true_tactical
     );
     println!();
     let turn_heads: Vec<String> = TURNS
@@ -203,7 +195,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let gap = runs.gap(&runs.simulate(&identified, &[], &[])?);
         let psi = gap.states.iter().find(|s| s.0 == "ψ").map_or(f64::NAN, |s| s.2.to_degrees());
         let held_run = Ship::new(&at_approach_speed(&identified, held.1.u0), true)?
-            .run(&Manoeuvre::parse(HELD_OUT.0)?, &settings)?;
+            .run(&Manoeuvre::parse(PAPER_RUNS[4].0)?, &settings)?;
         let tact: Vec<String> = TURNS
             .iter()
             .zip(&true_tactical)

@@ -107,21 +107,21 @@ pub struct NoiseModel {
     pub jerk_intensity: f64,
 }
 
+/// Steps in units of the mean spacing (the filter is set up in those), and the spacing.
+fn scaled_steps(t: &[f64], x: &[f64], what: &str) -> Result<(usize, f64, Vec<f64>), DataError> {
+    let n = t.len().min(x.len());
+    if n < 8 {
+        return Err(DataError::TooShort { file: "signal".into(), rows: n, needed: 8, what: what.into() });
+    }
+    let scale = (t[n - 1] - t[0]) / (n - 1) as f64;
+    Ok((n, scale, t[..n].windows(2).map(|w| (w[1] - w[0]) / scale).collect()))
+}
+
 impl KalmanSmoother {
     /// The maximum-likelihood noise model of a signal (time in seconds); models that fuse
     /// several signals (the ship plug-in's tracking) take their noise levels from here.
     pub fn noise_model(t: &[f64], x: &[f64]) -> Result<NoiseModel, DataError> {
-        let n = t.len().min(x.len());
-        if n < 8 {
-            return Err(DataError::TooShort {
-                file: "signal".into(),
-                rows: n,
-                needed: 8,
-                what: "a noise model".into(),
-            });
-        }
-        let scale = (t[n - 1] - t[0]) / (n - 1) as f64;
-        let h: Vec<f64> = t[..n].windows(2).map(|w| (w[1] - w[0]) / scale).collect();
+        let (n, scale, h) = scaled_steps(t, x, "a noise model")?;
         let ratio = most_likely_ratio(&h, &x[..n]);
         let p = pass(&h, &x[..n], ratio, false).ok_or_else(|| {
             DataError::UnknownMethod(format!("kalman:{ratio}"), "the filter diverged".into())
@@ -135,18 +135,8 @@ impl KalmanSmoother {
 
     /// The smoothed signal and its rate, and the noise ratio used.
     pub fn fit(&self, t: &[f64], x: &[f64]) -> Result<(Smoothed, f64), DataError> {
-        let n = t.len().min(x.len());
-        if n < 8 {
-            return Err(DataError::TooShort {
-                file: "signal".into(),
-                rows: n,
-                needed: 8,
-                what: "a Kalman smoother".into(),
-            });
-        }
-        let (t, x) = (&t[..n], &x[..n]);
-        let scale = (t[n - 1] - t[0]) / (n - 1) as f64;
-        let h: Vec<f64> = t.windows(2).map(|w| (w[1] - w[0]) / scale).collect();
+        let (n, scale, h) = scaled_steps(t, x, "a Kalman smoother")?;
+        let x = &x[..n];
         let ratio = match self.ratio {
             Some(r) if r > 0.0 && r.is_finite() => r,
             Some(r) => {
@@ -173,26 +163,11 @@ impl KalmanSmoother {
 
 /// Ratio maximising the likelihood: a grid in decades, then golden section in log ratio.
 fn most_likely_ratio(h: &[f64], y: &[f64]) -> f64 {
-    let score = |p: f64| pass(h, y, 10f64.powf(p), false).map_or(f64::INFINITY, |s| s.deviance);
     let grid: Vec<f64> = (-16..=6).map(f64::from).collect();
-    let scores: Vec<f64> = grid.iter().map(|&p| score(p)).collect();
-    let best = (0..grid.len()).min_by(|&a, &b| scores[a].total_cmp(&scores[b])).unwrap_or(0);
-    let (mut a, mut b) = (grid[best.saturating_sub(1)], grid[(best + 1).min(grid.len() - 1)]);
-    let phi = 0.5 * (5f64.sqrt() - 1.0);
-    let (mut c, mut d) = (b - phi * (b - a), a + phi * (b - a));
-    let (mut fc, mut fd) = (score(c), score(d));
-    while b - a > 0.01 {
-        if fc < fd {
-            (b, d, fd) = (d, c, fc);
-            c = b - phi * (b - a);
-            fc = score(c);
-        } else {
-            (a, c, fc) = (c, d, fd);
-            d = a + phi * (b - a);
-            fd = score(d);
-        }
-    }
-    10f64.powf(0.5 * (a + b))
+    let best = super::search::minimise(&grid, 0.01, |p| {
+        pass(h, y, 10f64.powf(p), false).map_or(f64::INFINITY, |s| s.deviance)
+    });
+    10f64.powf(best)
 }
 
 impl Differentiator for KalmanSmoother {
@@ -212,11 +187,7 @@ impl Differentiator for KalmanSmoother {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn noise(seed: &mut u64) -> f64 {
-        *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (*seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    }
+    use crate::data::test_noise as noise;
 
     #[test]
     fn exact_on_quadratics_without_noise() {

@@ -9,6 +9,7 @@ mod kalman;
 mod prepare;
 mod resample;
 mod savitzky_golay;
+mod search;
 mod smoothing_spline;
 
 pub use dataset::{Dataset, Delimiter, RunSpec};
@@ -18,6 +19,13 @@ pub use prepare::{prepare, prepared_figure, Preparation};
 pub use resample::{check_gaps, median_step, resample};
 pub use savitzky_golay::SavitzkyGolay;
 pub use smoothing_spline::SmoothingSpline;
+
+#[cfg(test)]
+/// Uniform noise in [−½, ½) from a seeded LCG, for the tests of the derivative methods.
+pub(crate) fn test_noise(seed: &mut u64) -> f64 {
+    *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+    (*seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+}
 
 /// Something wrong with a data set. Every variant names where.
 #[derive(Debug, thiserror::Error)]

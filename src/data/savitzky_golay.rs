@@ -84,11 +84,8 @@ mod tests {
     fn less_noisy_than_central_differences() {
         let t: Vec<f64> = (0..2000).map(|i| i as f64 * 0.05).collect();
         let mut seed = 3u64;
-        let mut noise = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.02
-        };
-        let x: Vec<f64> = t.iter().map(|t| (0.3 * t).sin() + noise()).collect();
+        let x: Vec<f64> =
+            t.iter().map(|t| (0.3 * t).sin() + 0.02 * crate::data::test_noise(&mut seed)).collect();
         let err = |d: Vec<f64>| {
             (d.iter()
                 .zip(&t)

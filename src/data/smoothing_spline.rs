@@ -195,32 +195,7 @@ impl SmoothingSpline {
 fn gcv_alpha(band: &Banded, x: &[f64], n: usize) -> f64 {
     let top = 4.0 * ((n as f64 / 2.0).min(2000.0)).log10();
     let grid: Vec<f64> = (0..=((top + 2.0) * 2.0) as usize).map(|i| -2.0 + 0.5 * i as f64).collect();
-    let score = |p: f64| {
-        let g = band.fit(x, 10f64.powf(p)).gcv;
-        if g.is_finite() {
-            g
-        } else {
-            f64::INFINITY
-        }
-    };
-    let scores: Vec<f64> = grid.iter().map(|&p| score(p)).collect();
-    let best = (0..grid.len()).min_by(|&a, &b| scores[a].total_cmp(&scores[b])).unwrap_or(0);
-    let (mut a, mut b) = (grid[best.saturating_sub(1)], grid[(best + 1).min(grid.len() - 1)]);
-    let phi = 0.5 * (5f64.sqrt() - 1.0);
-    let (mut c, mut d) = (b - phi * (b - a), a + phi * (b - a));
-    let (mut fc, mut fd) = (score(c), score(d));
-    while b - a > 0.01 {
-        if fc < fd {
-            (b, d, fd) = (d, c, fc);
-            c = b - phi * (b - a);
-            fc = score(c);
-        } else {
-            (a, c, fc) = (c, d, fd);
-            d = a + phi * (b - a);
-            fd = score(d);
-        }
-    }
-    10f64.powf(0.5 * (a + b))
+    10f64.powf(super::search::minimise(&grid, 0.01, |p| band.fit(x, 10f64.powf(p)).gcv))
 }
 
 impl Differentiator for SmoothingSpline {
@@ -240,12 +215,8 @@ impl Differentiator for SmoothingSpline {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::data::test_noise as noise;
     use nalgebra::{DMatrix, DVector};
-
-    fn noise(seed: &mut u64) -> f64 {
-        *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (*seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    }
 
     /// The same minimiser from dense linear algebra: (I + αQR⁻¹Qᵀ)g = y.
     #[test]

@@ -68,6 +68,17 @@ pub struct Recording {
     pub u0: f64,
 }
 
+/// The paper's five Z-manoeuvres (NOTES.md §4), each with the approach speed (× the nominal
+/// u0) the synthetic-basin study gives it; the study identifies from the first four and
+/// holds the last out.
+pub const PAPER_RUNS: [(&str, f64); 5] = [
+    ("zigzag:15/10", 0.97),
+    ("zigzag:20/10:port", 1.02),
+    ("zigzag:30/10", 0.99),
+    ("zigzag:20/20:port", 1.03),
+    ("zigzag:25/10", 0.98),
+];
+
 /// The basin's column names and units for the ship's roles, as a dataset file maps them.
 pub const COLUMNS: [(&str, &str); 8] = [
     ("t", "time [s]"),

@@ -4,19 +4,10 @@
 //! noise-free truth. Also the bad-file cases of measured runs.
 
 use termid::model::Model;
-use termid::ship::basin::{dataset_toml, Basin};
+use termid::ship::basin::{dataset_toml, Basin, PAPER_RUNS};
 use termid::ship::{Manoeuvre, Metrics};
 
 use crate::common::{termid, Scratch};
-
-/// (manoeuvre, approach speed / nominal u0): the paper's five zigzags (NOTES.md §4).
-const TRAIN: [(&str, f64); 4] = [
-    ("zigzag:15/10", 0.97),
-    ("zigzag:20/10:port", 1.02),
-    ("zigzag:30/10", 0.99),
-    ("zigzag:20/20:port", 1.03),
-];
-const HELD_OUT: (&str, f64) = ("zigzag:25/10", 0.98);
 
 fn json(text: &str) -> serde_json::Value {
     serde_json::from_str(text).unwrap_or_else(|e| panic!("{e}: {text}"))
@@ -52,7 +43,7 @@ fn identified_from_noisy_basin_runs_the_model_predicts_within_the_targets() {
     let basin = Basin::default();
     let mut held_overshoot = f64::NAN;
     let mut names = Vec::new();
-    for (k, (m, f)) in TRAIN.iter().chain([&HELD_OUT]).enumerate() {
+    for (k, (m, f)) in PAPER_RUNS.iter().enumerate() {
         let name = format!("run{k}.dat");
         let rec = basin
             .record(&truth, &Manoeuvre::parse(m).unwrap(), f * 2.010, 100.0, 7 + k as u64, &name)
@@ -163,23 +154,27 @@ fn identified_from_noisy_basin_runs_the_model_predicts_within_the_targets() {
         assert!(c.correlation_time > 5.0, "{eq}: τ = {}", c.correlation_time);
     }
     let svg = p("mc.svg");
-    let (ok, out, err) = termid(&[
-        "simulate",
-        "--model",
-        &p("id.toml"),
-        "--manoeuvre",
-        "turning:30",
-        "--duration",
-        "200",
-        "--monte-carlo",
-        "40",
-        "--seed",
-        "3",
-        "--svg",
-        &svg,
-        "--format",
-        "json",
-    ]);
+    let (id, seed) = (p("id.toml"), "3");
+    let monte_carlo = |extra: &[&str]| {
+        let mut args = vec![
+            "simulate",
+            "--model",
+            &id,
+            "--manoeuvre",
+            "turning:30",
+            "--duration",
+            "200",
+            "--monte-carlo",
+            "40",
+            "--seed",
+            seed,
+            "--format",
+            "json",
+        ];
+        args.extend(extra);
+        termid(&args)
+    };
+    let (ok, out, err) = monte_carlo(&["--svg", &svg]);
     assert!(ok, "{err}");
     let v = json(&out);
     let mc = &v["monte_carlo"];
@@ -190,21 +185,7 @@ fn identified_from_noisy_basin_runs_the_model_predicts_within_the_targets() {
     assert!(lo < nominal && nominal < hi && hi - lo < 0.1 * nominal, "{lo} … {hi} around {nominal}");
     assert!(std::fs::read_to_string(&svg).unwrap().contains("90 % band"));
     // the same seed gives the same draws
-    let (_, again, _) = termid(&[
-        "simulate",
-        "--model",
-        &p("id.toml"),
-        "--manoeuvre",
-        "turning:30",
-        "--duration",
-        "200",
-        "--monte-carlo",
-        "40",
-        "--seed",
-        "3",
-        "--format",
-        "json",
-    ]);
+    let (_, again, _) = monte_carlo(&[]);
     assert_eq!(json(&again)["monte_carlo"], v["monte_carlo"]);
     let (ok, out, err) = termid(&[
         "validate",

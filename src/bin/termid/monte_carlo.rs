@@ -74,16 +74,21 @@ impl<T> Draws<T> {
         })
     }
 
-    /// A table of each metric: nominal value, mean, sd and the 5-95 % range over the draws.
-    pub fn text(&self, spread: &BTreeMap<String, Spread>, nominal: &serde_json::Value) -> String {
-        let mut out = format!(
-            "\nMonte Carlo: {} models with {} coefficients drawn from their covariance × correlation time (seed {}); {} ran, {} failed\n",
+    /// One line: how many models were drawn from what, how many ran.
+    pub fn headline(&self) -> String {
+        format!(
+            "Monte Carlo: {} models with {} coefficients drawn from their covariance × correlation time (seed {}); {} ran, {} failed",
             self.draws,
             self.equations.join(", "),
             self.seed,
             self.results.len(),
             self.failed
-        );
+        )
+    }
+
+    /// A table of each metric: nominal value, mean, sd and the 5-95 % range over the draws.
+    pub fn text(&self, spread: &BTreeMap<String, Spread>, nominal: &serde_json::Value) -> String {
+        let mut out = format!("\n{}\n", self.headline());
         if let Some(why) = &self.first_failure {
             out += &format!("  first failure: {why}\n");
         }

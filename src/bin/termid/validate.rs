@@ -127,14 +127,7 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
                 row("tactical diameter [m]", a.tactical_diameter_m, b.tactical_diameter_m);
             }
             if let Some(mc) = &mc {
-                println!(
-                    "\nMonte Carlo: {} models drawn from the covariance × correlation time of {} (seed {}); {} ran, {} failed",
-                    mc.draws,
-                    mc.equations.join(", "),
-                    mc.seed,
-                    mc.results.len(),
-                    mc.failed
-                );
+                println!("\n{}", mc.headline());
             }
         }
     }
