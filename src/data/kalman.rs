@@ -221,16 +221,7 @@ mod tests {
         let t: Vec<f64> = (0..2000).map(|i| i as f64 * 0.05).collect();
         let mut seed = 3u64;
         let x: Vec<f64> = t.iter().map(|t| (0.3 * t).sin() + 0.02 * noise(&mut seed)).collect();
-        let err = |d: &[f64]| {
-            (d.iter()
-                .zip(&t)
-                .skip(20)
-                .take(1960)
-                .map(|(d, t)| (d - 0.3 * (0.3 * t).cos()).powi(2))
-                .sum::<f64>()
-                / 1960.0)
-                .sqrt()
-        };
+        let err = |d: &[f64]| crate::data::sine_rate_error(&t, d);
         let (s, _) = KalmanSmoother::default().fit(&t, &x).unwrap();
         let cd = crate::data::CentralDifference.differentiate(&t, &x).unwrap();
         assert!(err(&s.rate) < err(&cd) / 10.0, "kalman {} vs central {}", err(&s.rate), err(&cd));

@@ -27,6 +27,14 @@ pub(crate) fn test_noise(seed: &mut u64) -> f64 {
     (*seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
 }
 
+#[cfg(test)]
+/// RMS error of a rate estimate of sin(0.3 t) over samples 20..1980 (ends left out), the
+/// shared yardstick of the derivative methods' noise tests.
+pub(crate) fn sine_rate_error(t: &[f64], d: &[f64]) -> f64 {
+    let sq: f64 = d.iter().zip(t).skip(20).take(1960).map(|(d, t)| (d - 0.3 * (0.3 * t).cos()).powi(2)).sum();
+    (sq / 1960.0).sqrt()
+}
+
 /// Something wrong with a data set. Every variant names where.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]

@@ -86,16 +86,7 @@ mod tests {
         let mut seed = 3u64;
         let x: Vec<f64> =
             t.iter().map(|t| (0.3 * t).sin() + 0.02 * crate::data::test_noise(&mut seed)).collect();
-        let err = |d: Vec<f64>| {
-            (d.iter()
-                .zip(&t)
-                .skip(20)
-                .take(1960)
-                .map(|(d, t)| (d - 0.3 * (0.3 * t).cos()).powi(2))
-                .sum::<f64>()
-                / 1960.0)
-                .sqrt()
-        };
+        let err = |d: Vec<f64>| crate::data::sine_rate_error(&t, &d);
         let sg = err(SavitzkyGolay { window: 21, order: 3 }.differentiate(&t, &x).unwrap());
         let cd = err(CentralDifference.differentiate(&t, &x).unwrap());
         assert!(sg < cd / 5.0, "Savitzky-Golay {sg} vs central {cd}");
