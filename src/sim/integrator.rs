@@ -242,7 +242,7 @@ pub fn simulate(
     Ok(out)
 }
 
-#[inline]
+#[inline(always)]
 fn check(system: &System, t: f64, x: &[f64], prev: &[f64]) -> Result<(), SimError> {
     // one branch for all states, not three per state (`&` where `&&` would branch);
     // v·0 is NaN exactly when v is ±∞ or NaN, and costs less than is_finite here
