@@ -147,6 +147,7 @@ impl SparseFit {
         previous: (f64, &[f64]),
         w: &[f64],
         always: &[bool],
+        cache: &mut Option<(Vec<usize>, DefaultSolver<f64>)>,
     ) -> Result<Vec<f64>, SelectError> {
         let (p, m) = (sc.p, sc.m);
         let correlation = |b: &[f64], j: usize| -> f64 {
@@ -169,7 +170,7 @@ impl SparseFit {
             })
             .collect();
         loop {
-            let beta = self.solve(sc, lambda, w, &active)?;
+            let beta = self.solve_with(sc, lambda, w, &active, cache)?;
             let violators: Vec<usize> = candidates
                 .iter()
                 .copied()
@@ -212,8 +213,22 @@ impl SparseFit {
 
     /// The LASSO QP on the columns `active` (the others held at zero): variables b and the
     /// bounds t ≥ |b| of the active columns; standardised coefficients, one per candidate.
-    #[allow(non_snake_case)]
     fn solve(&self, sc: &Scaled, lambda: f64, w: &[f64], active: &[usize]) -> Result<Vec<f64>, SelectError> {
+        self.solve_with(sc, lambda, w, active, &mut None)
+    }
+
+    /// [`SparseFit::solve`], reusing the solver of the previous λ when it had the same
+    /// columns: only q depends on λ, so its data are updated in place and the setup
+    /// (equilibration, symbolic factorisation, allocation) is skipped.
+    #[allow(non_snake_case)]
+    fn solve_with(
+        &self,
+        sc: &Scaled,
+        lambda: f64,
+        w: &[f64],
+        active: &[usize],
+        cache: &mut Option<(Vec<usize>, DefaultSolver<f64>)>,
+    ) -> Result<Vec<f64>, SelectError> {
         let (p, m) = (sc.p, sc.m);
         let k = active.len();
         let n = 2 * k;
@@ -309,10 +324,21 @@ impl SparseFit {
             tol_gap_abs: 1e-12,
             tol_gap_rel: 1e-12,
             tol_feas: 1e-12,
+            // data updates along the path need the problem as given
+            presolve_enable: false,
+            input_sparse_dropzeros: false,
             ..DefaultSettings::default()
         };
-        let mut solver = DefaultSolver::new(&P, &q, &A, &b, &cones, settings)
-            .map_err(|e| SelectError::Config(format!("clarabel refused the problem: {e}")))?;
+        let reuse = cache
+            .as_mut()
+            .filter(|(cols, _)| cols == active)
+            .is_some_and(|(_, solver)| solver.update_q(&q).is_ok());
+        if !reuse {
+            let solver = DefaultSolver::new(&P, &q, &A, &b, &cones, settings)
+                .map_err(|e| SelectError::Config(format!("clarabel refused the problem: {e}")))?;
+            *cache = Some((active.to_vec(), solver));
+        }
+        let Some((_, solver)) = cache.as_mut() else { unreachable!("just stored") };
         solver.solve();
         match solver.solution.status {
             SolverStatus::Solved => {
@@ -365,8 +391,10 @@ impl SparseFit {
         let mut notes = Vec::new();
         let always = self.always_active(pb, &w);
         let mut previous = (lambda_max, vec![0.0; p]);
+        let mut cache = None;
         for &lambda in &lambdas {
-            let beta = self.solve_screened(&sc, pb, lambda, (previous.0, &previous.1), &w, &always)?;
+            let beta =
+                self.solve_screened(&sc, pb, lambda, (previous.0, &previous.1), &w, &always, &mut cache)?;
             previous = (lambda, beta.clone());
             let mut support: Vec<usize> = (0..p)
                 .filter(|&j| beta[j].abs() > self.support_tolerance || pb.forced.contains(&j))
@@ -472,10 +500,12 @@ mod tests {
                 .map(|j| sc.a[j * sc.m + p].abs() / w[j])
                 .fold(0.0, f64::max);
             let mut previous = (lambda_max, vec![0.0; p]);
+            let mut cache = None;
             for k in 0..12 {
                 let lambda = lambda_max * 1e-4f64.powf(k as f64 / 11.0);
-                let screened =
-                    fit.solve_screened(&sc, &pb, lambda, (previous.0, &previous.1), &w, &always).unwrap();
+                let screened = fit
+                    .solve_screened(&sc, &pb, lambda, (previous.0, &previous.1), &w, &always, &mut cache)
+                    .unwrap();
                 let full = fit.solve(&sc, lambda, &w, &all).unwrap();
                 for j in 0..p {
                     assert!(
