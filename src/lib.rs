@@ -1,6 +1,9 @@
 //! termid identifies equations of motion from time series. Candidate terms are written as
-//! text in a small language ([`term`]), evaluated on data ([`data`]), and a regression
-//! back-end ([`select`]) chooses the terms that matter ([`identify`]).
+//! text in a small language ([`term`]), evaluated on data ([`data`]: frames, units,
+//! resampling, derivative methods), and a regression back-end ([`select`]) chooses the terms
+//! that matter ([`identify`]). Identified models ([`model`]) are simulated ([`sim`]), checked
+//! against runs ([`diagnose`]) and drawn from their coefficients' covariance
+//! ([`uncertainty`]); ship manoeuvring is the first plug-in ([`ship`]).
 #![warn(missing_docs)]
 
 pub mod data;
