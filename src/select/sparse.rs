@@ -18,7 +18,7 @@ use serde::{Deserialize, Serialize};
 use super::subset::Scaled;
 use super::{Moments, Problem, SelectError, Selection, Selector, Step, Stop};
 
-/// A linear equality between coefficients: Σ coefficient × b[term] = value (raw units).
+/// A linear equality between coefficients: Σ coefficient × b(term) = value (raw units).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Equality {

@@ -98,7 +98,7 @@ pub struct EquationTable {
     pub equation: String,
     /// The data alternative.
     pub alternative: Alternative,
-    /// Each manoeuvre alone, in [`MANOEUVRES`] order.
+    /// Each manoeuvre alone, in [`MANOEUVRES`](super::data::MANOEUVRES) order.
     pub runs: Vec<Fit>,
     /// All five together.
     pub komb: Fit,
