@@ -117,6 +117,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ("stepwise", "kalman*0.1", true, false),
         ("stepwise", "kalman*10", true, false),
         ("stepwise", "kinematic", true, false),
+        ("stepwise, u²δ² forced", "kalman", true, false),
+        ("stepwise, u²δ² forced", "kinematic", true, false),
         ("true-terms", "kalman", true, false),
         ("efroymson", "kalman", true, false),
         ("best-subset", "kalman", true, false),
@@ -133,6 +135,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 e.candidates = terms.clone();
                 e.forced = terms;
                 e.excluded.clear();
+            } else if backend == "stepwise, u²δ² forced" {
+                // the propeller's asymmetry in the rudder angle, forced in v̇ and ṙ as the
+                // paper forces it in u̇ (a single-screw ship has it)
+                let t = model.vocabulary.parse("u^2*δ^2")?;
+                if e.name != "u_dot" && e.candidates.contains(&t) && !e.forced.contains(&t) {
+                    e.forced.push(t);
+                }
             } else {
                 e.backend = Backend::by_name(backend)?;
             }
