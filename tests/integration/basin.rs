@@ -287,3 +287,28 @@ fn gaps_and_repeated_time_stamps_are_refused_with_their_row() {
         );
     }
 }
+
+/// A run at its own approach speed is re-simulated at that speed: with the true model and
+/// the run's u0 taken from its approach, the replay of a noise-free record matches it.
+#[test]
+fn runs_are_resimulated_at_their_own_approach_speed() {
+    use termid::diagnose::Runs;
+    use termid::sim::Integrator;
+    let basin = Basin::default();
+    let mut model = Model::default_model();
+    let rec = basin
+        .record(&model, &Manoeuvre::parse("zigzag:20/20").unwrap(), 0.95 * 2.010, 60.0, 1, "slow")
+        .unwrap();
+    let surge_rms = |model: &Model| {
+        let runs = Runs::new(model, std::slice::from_ref(&rec.truth), 0.01, Integrator::Rk4).unwrap();
+        let gap = runs.gap(&runs.simulate(model, &[], &[]).unwrap());
+        gap.states.iter().find(|s| s.0 == "u").unwrap().2
+    };
+    // the file's u0 (2.010) for a run that approached at 1.91 m/s: the surge balance is off
+    model.spec.parameters.get_mut("u0").unwrap().per_run = None;
+    let fixed = surge_rms(&model);
+    model.spec.parameters.get_mut("u0").unwrap().per_run = Some("mean:u:4".into());
+    let own = surge_rms(&model);
+    // what remains is the replay of a rudder sampled at 20 Hz
+    assert!(own < 1e-3 && fixed > 100.0 * own, "u RMS {own} at the run's u0, {fixed} at the file's");
+}
