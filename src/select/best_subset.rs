@@ -100,13 +100,21 @@ fn sweep_out(a: &[f64], b: &mut [f64], m: usize, u: usize, rest: &[usize], t: us
 }
 
 impl Search<'_> {
-    fn record(&mut self, rss: f64, set: &[usize]) {
-        let k = set.len();
+    /// Keeps the set made of `parts` if it is the best of its size so far (the set is only
+    /// assembled then: most nodes do not improve on anything).
+    fn record(&mut self, rss: f64, parts: &[&[usize]]) {
+        let k = parts.iter().map(|p| p.len()).sum::<usize>();
         if k <= self.kmax && rss < self.best[k].0 {
-            let mut s = set.to_vec();
+            let mut s: Vec<usize> = parts.concat();
             s.sort_unstable();
             self.best[k] = (rss, s);
         }
+    }
+
+    /// No size in `lo..=hi` (capped at the largest searched) can improve with RSS ≥ `rss`.
+    fn hopeless(&self, lo: usize, hi: usize, rss: f64) -> bool {
+        let hi = hi.min(self.kmax);
+        lo > hi || (lo..=hi).all(|k| rss >= self.best[k].0)
     }
 
     /// `a` is swept on `inn ∪ undecided`.
@@ -119,18 +127,13 @@ impl Search<'_> {
             return;
         }
         let rss = self.sc.residual_share(a).max(RSS_FLOOR);
-        let size = inn.len() + undecided.len();
-        if size <= self.kmax && rss < self.best[size].0 {
-            let full: Vec<usize> = inn.iter().chain(undecided).copied().collect();
-            self.record(rss, &full);
-        }
+        self.record(rss, &[inn, undecided]);
         if undecided.is_empty() {
             return;
         }
         // every subset between inn and inn ∪ undecided has RSS ≥ rss
         let lo = inn.len();
-        let hi = (lo + undecided.len() - 1).min(self.kmax);
-        if lo > hi || (lo..=hi).all(|k| rss >= self.best[k].0) {
+        if self.hopeless(lo, lo + undecided.len() - 1, rss) {
             return;
         }
         let (u, rest) = (undecided[0], &undecided[1..]);
@@ -138,8 +141,7 @@ impl Search<'_> {
         // the swept matrix), so a hopeless subtree is known before its sweep is paid for
         let (m, t) = (self.sc.m, self.sc.p);
         let child = (rss + a[u * m + t].powi(2) / a[u * m + u]).max(RSS_FLOOR);
-        let top = (lo + rest.len()).min(self.kmax);
-        if lo <= top && !(lo..=top).all(|k| child >= self.best[k].0) {
+        if !self.hopeless(lo, lo + rest.len(), child) {
             // one sweep takes u out (into this depth's buffer)
             let depth = rest.len();
             let mut b = std::mem::take(&mut self.stack[depth]);
@@ -219,7 +221,7 @@ impl BestSubset {
         };
         if let Ok(path) = (Stepwise { step_rule: super::StepRule::Last, ..Stepwise::default() }).select(pb) {
             for st in &path.steps {
-                search.record((1.0 - st.r2).max(RSS_FLOOR), &st.set);
+                search.record((1.0 - st.r2).max(RSS_FLOOR), &[&st.set]);
             }
         }
         let mut inn = forced.clone();
