@@ -5,24 +5,31 @@
 
 use super::{DataError, Frame};
 
-/// Linear interpolation of (t, x) at `at` (clamped to the ends).
+/// The value of (t, x) at time `s` by linear interpolation, held at the ends. `cursor` is
+/// where the last lookup ended: a sweep of increasing times costs one pass (it restarts from
+/// the front when `s` goes back). Shared by resampling and the simulator's input replay.
+pub fn interpolate_at(t: &[f64], x: &[f64], s: f64, cursor: &mut usize) -> f64 {
+    if s <= t[0] {
+        return x[0];
+    }
+    if s >= t[t.len() - 1] {
+        return x[t.len() - 1];
+    }
+    if t[*cursor] > s {
+        *cursor = 0;
+    }
+    while t[*cursor + 1] < s {
+        *cursor += 1;
+    }
+    let i = *cursor;
+    let w = (s - t[i]) / (t[i + 1] - t[i]);
+    x[i] + w * (x[i + 1] - x[i])
+}
+
+/// (t, x) interpolated at every time of `at`.
 fn interpolate(t: &[f64], x: &[f64], at: &[f64]) -> Vec<f64> {
-    let mut j = 0;
-    at.iter()
-        .map(|&s| {
-            while j + 2 < t.len() && t[j + 1] < s {
-                j += 1;
-            }
-            if t.len() == 1 || s <= t[0] {
-                return x[0];
-            }
-            if s >= t[t.len() - 1] {
-                return x[t.len() - 1];
-            }
-            let w = (s - t[j]) / (t[j + 1] - t[j]);
-            x[j] + w * (x[j + 1] - x[j])
-        })
-        .collect()
+    let mut cursor = 0;
+    at.iter().map(|&s| interpolate_at(t, x, s, &mut cursor)).collect()
 }
 
 /// Low-pass FIR taps: cut-off `fc` and transition `width`, both in cycles per sample.
@@ -108,18 +115,19 @@ pub fn resample(frame: &Frame, dt: f64) -> Result<Frame, DataError> {
     let coarse = grid(dt);
     let h = median_step(t);
     let factor = (dt / h * (1.0 - 1e-9)).ceil() as usize;
+    // decimation: a uniform fine grid with dt an exact multiple of its step, one filter for
+    // every column, keep every factor-th sample
+    let fine = (factor > 1)
+        .then(|| (grid(dt / factor as f64), low_pass(0.8 * 0.5 / factor as f64, 0.2 * 0.5 / factor as f64)));
     let mut out = Frame::new(frame.origin(), frame.time_name(), coarse.clone())?;
-    for (name, x) in frame.names().iter().zip(frame.names().iter().map(|n| frame.column(n))).skip(1) {
-        let Some(x) = x else { continue };
-        let values = if factor <= 1 {
-            interpolate(t, x, &coarse)
-        } else {
-            // uniform fine grid with dt an exact multiple of its step, filter, keep every factor-th
-            let fine_t = grid(dt / factor as f64);
-            let fine = interpolate(t, x, &fine_t);
-            let taps = low_pass(0.8 * 0.5 / factor as f64, 0.2 * 0.5 / factor as f64);
-            let smooth = filter(&fine, &taps);
-            (0..coarse.len()).map(|i| smooth[(i * factor).min(smooth.len() - 1)]).collect()
+    for name in &frame.names()[1..] {
+        let x = frame.require(name)?;
+        let values = match &fine {
+            None => interpolate(t, x, &coarse),
+            Some((fine_t, taps)) => {
+                let smooth = filter(&interpolate(t, x, fine_t), taps);
+                (0..coarse.len()).map(|i| smooth[(i * factor).min(smooth.len() - 1)]).collect()
+            }
         };
         out.push(name, values)?;
     }

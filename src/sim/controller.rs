@@ -42,22 +42,7 @@ impl Replay {
 
     /// The recorded value of input `k` at time `t`.
     pub fn at(&mut self, k: usize, t: f64) -> f64 {
-        let ts = &self.time;
-        if t <= ts[0] {
-            return self.columns[k][0];
-        }
-        if t >= ts[ts.len() - 1] {
-            return self.columns[k][ts.len() - 1];
-        }
-        if ts[self.cursor] > t {
-            self.cursor = 0;
-        }
-        while ts[self.cursor + 1] < t {
-            self.cursor += 1;
-        }
-        let (i, c) = (self.cursor, &self.columns[k]);
-        let w = (t - ts[i]) / (ts[i + 1] - ts[i]);
-        c[i] + w * (c[i + 1] - c[i])
+        crate::data::interpolate_at(&self.time, &self.columns[k], t, &mut self.cursor)
     }
 }
 
