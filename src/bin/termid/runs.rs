@@ -8,6 +8,11 @@ use termid::data::{check_gaps, Dataset, Frame};
 
 pub fn load(data: &[PathBuf], dataset: Option<&Path>, time: &str) -> Result<Vec<Frame>> {
     let mut frames = data.iter().map(|p| Frame::read_csv(p, time)).collect::<Result<Vec<_>, _>>()?;
+    for f in &frames {
+        // a logging dropout would be differentiated across as if it were one step (dataset
+        // files are checked as they are read, in their own column names)
+        check_gaps(f, 3.0)?;
+    }
     if let Some(path) = dataset {
         let ds = Dataset::load(path)?;
         let base = path.parent().unwrap_or(Path::new("."));
@@ -17,10 +22,6 @@ pub fn load(data: &[PathBuf], dataset: Option<&Path>, time: &str) -> Result<Vec<
             eprintln!("unit: {n}");
         }
         frames.extend(more);
-    }
-    for f in &frames {
-        // a logging dropout would be differentiated across as if it were one step
-        check_gaps(f, 3.0)?;
     }
     if frames.is_empty() {
         bail!("no runs: give --data FILE… or --dataset FILE");
