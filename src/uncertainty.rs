@@ -40,35 +40,59 @@ pub fn uncertain_equations(model: &Model) -> Vec<String> {
     model.equations.iter().filter(|e| e.covariance.is_some()).map(|e| e.name.clone()).collect()
 }
 
-/// A model whose coefficients are drawn from N(b, τΣ) equation by equation (b the stored
+/// Draws models whose coefficients come from N(b, τΣ) equation by equation (b the stored
 /// coefficients, Σ their covariance, τ the residual correlation time); equations without a
-/// covariance keep their values.
-pub fn draw(model: &Model, normal: &mut Normal) -> Model {
-    let mut out = model.clone();
-    for eq in &model.equations {
-        let Some(c) = &eq.covariance else { continue };
-        let (terms, k) = (&c.terms, c.terms.len());
-        // rows of a time series are not independent: the effective covariance is τ times s²(X'X)⁻¹
-        let sigma = nalgebra::DMatrix::from_fn(k, k, |i, j| c.matrix[i][j] * c.correlation_time);
-        // semi-definite matrices (an exact fit, a term with zero error) have no Cholesky
-        // factor: a symmetric square root from the eigen-decomposition serves for both
-        let eig = sigma.symmetric_eigen();
-        let root = &eig.eigenvectors
-            * nalgebra::DMatrix::from_diagonal(&eig.eigenvalues.map(|l| l.max(0.0).sqrt()))
-            * eig.eigenvectors.transpose();
-        let z = nalgebra::DVector::from_fn(k, |_, _| normal.sample());
-        let shift = root * z;
-        let coefficients = eq
-            .coefficients
+/// covariance keep their values. The square roots of the covariances are taken once, here.
+pub struct Sampler<'m> {
+    model: &'m Model,
+    /// (equation, its covariance's terms, a square root of τΣ).
+    roots: Vec<(String, Vec<crate::term::Term>, nalgebra::DMatrix<f64>)>,
+}
+
+impl<'m> Sampler<'m> {
+    /// Prepares draws from `model`'s stored covariances.
+    pub fn new(model: &'m Model) -> Sampler<'m> {
+        let roots = model
+            .equations
             .iter()
-            .map(|(t, v, se)| {
-                let d = terms.iter().position(|u| u == t).map_or(0.0, |i| shift[i]);
-                (t.clone(), v + d, *se)
+            .filter_map(|eq| {
+                let c = eq.covariance.as_ref()?;
+                let k = c.terms.len();
+                // rows of a time series are not independent: the effective covariance is τ
+                // times s²(X'X)⁻¹
+                let sigma = nalgebra::DMatrix::from_fn(k, k, |i, j| c.matrix[i][j] * c.correlation_time);
+                // semi-definite matrices (an exact fit, a term with zero error) have no
+                // Cholesky factor: a symmetric square root from the eigen-decomposition
+                // serves for both
+                let eig = sigma.symmetric_eigen();
+                let root = &eig.eigenvectors
+                    * nalgebra::DMatrix::from_diagonal(&eig.eigenvalues.map(|l| l.max(0.0).sqrt()))
+                    * eig.eigenvectors.transpose();
+                Some((eq.name.clone(), c.terms.clone(), root))
             })
             .collect();
-        out.set_coefficients(&eq.name, coefficients, eq.intercept);
+        Sampler { model, roots }
     }
-    out
+
+    /// One drawn model.
+    pub fn draw(&self, normal: &mut Normal) -> Model {
+        let mut out = self.model.clone();
+        for (name, terms, root) in &self.roots {
+            let Some(eq) = self.model.equation(name) else { continue };
+            let z = nalgebra::DVector::from_fn(terms.len(), |_, _| normal.sample());
+            let shift = root * z;
+            let coefficients = eq
+                .coefficients
+                .iter()
+                .map(|(t, v, se)| {
+                    let d = terms.iter().position(|u| u == t).map_or(0.0, |i| shift[i]);
+                    (t.clone(), v + d, *se)
+                })
+                .collect();
+            out.set_coefficients(name, coefficients, eq.intercept);
+        }
+        out
+    }
 }
 
 /// The spread of one number over the draws.
@@ -181,11 +205,12 @@ mod tests {
         };
         model.set_covariance("u_dot", c).unwrap();
         let mut g = Normal::new(1);
+        let sampler = Sampler::new(&model);
         let base: Vec<f64> = terms.iter().map(|t| model.equation("u_dot").unwrap().coefficient(t)).collect();
         let n = 20000;
         let mut d = vec![[0.0; 2]; n];
         for row in d.iter_mut() {
-            let m = draw(&model, &mut g);
+            let m = sampler.draw(&mut g);
             let e = m.equation("u_dot").unwrap();
             for (k, t) in terms.iter().enumerate() {
                 row[k] = e.coefficient(t) - base[k];

@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 
 use anyhow::{bail, Result};
 use termid::model::Model;
-use termid::uncertainty::{draw, spread, uncertain_equations, Normal, Spread};
+use termid::uncertainty::{spread, uncertain_equations, Normal, Sampler, Spread};
 
 /// The results of simulating drawn models.
 pub struct Draws<T> {
@@ -41,10 +41,11 @@ impl<T> Draws<T> {
             );
         }
         let mut normal = Normal::new(seed);
+        let sampler = Sampler::new(model);
         let mut out = Draws { draws: n, seed, equations, results: vec![], failed: 0, first_failure: None };
         let bar = crate::progress::counter(n as u64, "Monte-Carlo draws");
         for _ in 0..n {
-            match simulate(&draw(model, &mut normal)) {
+            match simulate(&sampler.draw(&mut normal)) {
                 Ok(r) => out.results.push(r),
                 Err(e) => {
                     out.failed += 1;
