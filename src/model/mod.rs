@@ -281,29 +281,22 @@ impl Model {
                 Some(c) => {
                     let key = format!("equations.{name}.covariance");
                     let bad = |m: String| key_err(&key, &format!("[equations.{name}.covariance]"), m);
-                    let mut terms = Vec::new();
-                    for text in &c.terms {
-                        let t = vocab.parse(text).map_err(|e| ModelError::Term {
-                            source: Box::new(e),
-                            file: file.into(),
-                            line: line_of(&format!("[equations.{name}.covariance]")),
-                            key: format!("{key}.terms"),
-                        })?;
-                        if !coefficients.iter().any(|(o, _, _)| *o == t) || terms.contains(&t) {
-                            return Err(bad(format!(
-                                "term `{text}` is not a coefficient of the equation, or repeated"
-                            )));
-                        }
-                        terms.push(t);
-                    }
-                    check_covariance(&c.matrix, terms.len()).map_err(bad)?;
-                    if !(c.correlation_time >= 1.0 && c.correlation_time.is_finite()) {
-                        return Err(bad(format!(
-                            "correlation_time {} must be a number ≥ 1",
-                            c.correlation_time
-                        )));
-                    }
-                    Some(Covariance { terms, matrix: c.matrix.clone(), correlation_time: c.correlation_time })
+                    let terms = c
+                        .terms
+                        .iter()
+                        .map(|text| {
+                            vocab.parse(text).map_err(|e| ModelError::Term {
+                                source: Box::new(e),
+                                file: file.into(),
+                                line: line_of(&format!("[equations.{name}.covariance]")),
+                                key: format!("{key}.terms"),
+                            })
+                        })
+                        .collect::<Result<Vec<_>, _>>()?;
+                    let c =
+                        Covariance { terms, matrix: c.matrix.clone(), correlation_time: c.correlation_time };
+                    check_covariance(&coefficients, &c).map_err(bad)?;
+                    Some(c)
                 }
             };
             let backend = eq.backend.clone().unwrap_or_default();
@@ -411,27 +404,20 @@ impl Model {
     /// Stores the covariance of an equation's coefficients. Refused unless every term is a
     /// coefficient, the matrix a covariance matrix and the correlation time ≥ 1.
     pub fn set_covariance(&mut self, equation: &str, covariance: Covariance) -> Result<(), String> {
-        let Covariance { terms, matrix, correlation_time } = covariance;
-        if !(correlation_time >= 1.0 && correlation_time.is_finite()) {
-            return Err(format!("correlation time {correlation_time} must be a number ≥ 1"));
-        }
         let eq = self
             .equations
             .iter_mut()
             .find(|e| e.name == equation)
             .ok_or(format!("no equation `{equation}`"))?;
-        if let Some(t) = terms.iter().find(|t| !eq.coefficients.iter().any(|(o, _, _)| o == *t)) {
-            return Err(format!("`{t}` is not a coefficient of `{equation}`"));
-        }
-        check_covariance(&matrix, terms.len())?;
+        check_covariance(&eq.coefficients, &covariance)?;
         if let Some(spec) = self.spec.equations.get_mut(equation) {
             spec.covariance = Some(CovarianceSpec {
-                terms: terms.iter().map(Term::to_string).collect(),
-                matrix: matrix.clone(),
-                correlation_time,
+                terms: covariance.terms.iter().map(Term::to_string).collect(),
+                matrix: covariance.matrix.clone(),
+                correlation_time: covariance.correlation_time,
             });
         }
-        eq.covariance = Some(Covariance { terms, matrix, correlation_time });
+        eq.covariance = Some(covariance);
         Ok(())
     }
 
@@ -443,8 +429,22 @@ impl Model {
     }
 }
 
-/// A covariance matrix must be k×k, finite, symmetric and positive semi-definite.
-fn check_covariance(m: &[Vec<f64>], k: usize) -> Result<(), String> {
+/// A covariance fits its equation: τ ≥ 1, every term one of the equation's coefficients and
+/// named once, the matrix k×k, finite, symmetric and positive semi-definite. The one check for
+/// model files and for `set_covariance`.
+fn check_covariance(coefficients: &[(Term, f64, Option<f64>)], c: &Covariance) -> Result<(), String> {
+    if !(c.correlation_time >= 1.0 && c.correlation_time.is_finite()) {
+        return Err(format!("correlation time {} must be a number ≥ 1", c.correlation_time));
+    }
+    for (i, t) in c.terms.iter().enumerate() {
+        if !coefficients.iter().any(|(o, _, _)| o == t) {
+            return Err(format!("`{t}` is not a coefficient of the equation"));
+        }
+        if c.terms[..i].contains(t) {
+            return Err(format!("`{t}` appears twice in the covariance's terms"));
+        }
+    }
+    let (m, k) = (&c.matrix, c.terms.len());
     if m.len() != k || m.iter().any(|r| r.len() != k) {
         return Err(format!("`matrix` must be {k}×{k}, one row per term"));
     }
