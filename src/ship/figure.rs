@@ -60,27 +60,29 @@ pub fn manoeuvre_figure(ship: &Ship, title: &str, runs: &[(&str, &Trajectory)], 
 
 /// Adds Monte-Carlo prediction bands (pointwise 5-95 %) of ψ, U/U0, β and r to a figure made
 /// by [`manoeuvre_figure`], and up to ten of the drawn tracks.
-pub fn add_bands(fig: &mut Figure, ship: &Ship, draws: &[Trajectory]) {
+pub fn add_bands(fig: &mut Figure, ship: &Ship, draws: &[&Trajectory]) {
     let Some(first) = draws.first() else { return };
     let r = &ship.roles;
     let time = draws.iter().max_by_key(|t| t.time.len()).map_or(first.time.clone(), |t| t.time.clone());
     let deg = |v: &[f64]| v.iter().map(|x| x.to_degrees()).collect::<Vec<f64>>();
-    let signal = |f: &dyn Fn(&Trajectory) -> Vec<f64>| {
-        crate::uncertainty::band(&draws.iter().map(f).collect::<Vec<_>>())
+    let signal = |f: &dyn Fn(usize) -> Vec<f64>| {
+        crate::uncertainty::band(&(0..draws.len()).map(f).collect::<Vec<_>>())
     };
     let series = |name: &str, (lo, hi): (Vec<f64>, Vec<f64>)| Series::band(name, time.clone(), lo, hi);
     let label = format!("90 % band ({} draws)", draws.len());
+    // U and β of each draw, once
+    let speed_drift: Vec<(Vec<f64>, Vec<f64>)> = draws.iter().map(|t| ship.speed_and_drift(t)).collect();
     let bands: [(usize, Series); 4] = [
-        (0, series(&format!("ψ {label}"), signal(&|t| deg(&t.states[r.psi])))),
+        (0, series(&format!("ψ {label}"), signal(&|k| deg(&draws[k].states[r.psi])))),
         (
             1,
             series(
                 &format!("U/U0 {label}"),
-                signal(&|t| ship.speed_and_drift(t).0.iter().map(|u| u / ship.spec.u0).collect()),
+                signal(&|k| speed_drift[k].0.iter().map(|u| u / ship.spec.u0).collect()),
             ),
         ),
-        (2, series(&format!("β {label}"), signal(&|t| deg(&ship.speed_and_drift(t).1)))),
-        (2, series(&format!("r {label}"), signal(&|t| deg(&t.states[r.r])))),
+        (2, series(&format!("β {label}"), signal(&|k| deg(&speed_drift[k].1)))),
+        (2, series(&format!("r {label}"), signal(&|k| deg(&draws[k].states[r.r])))),
     ];
     for (panel, band) in bands {
         if let Some(p) = fig.panels.get_mut(panel) {

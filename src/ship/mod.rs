@@ -15,7 +15,7 @@ use std::collections::BTreeMap;
 pub use manoeuvre::{Manoeuvre, Metrics};
 
 use crate::data::{DataError, Frame};
-use crate::model::{Model, ShipSpec};
+use crate::model::{Model, ShipNames, ShipSpec};
 use crate::sim::{self, simulate, Settings, SimError, SteadyProblem, System, Trajectory, Unknown};
 
 /// Why a ship run failed.
@@ -100,6 +100,19 @@ pub struct Run {
     pub trajectory: Trajectory,
     /// Metrics (from the run at full step resolution).
     pub metrics: Metrics,
+}
+
+/// The model's `[ship]` section with its role names as frames and systems spell them
+/// (aliases resolved: `psi` → `ψ`, `delta` → `δ`); `None` for a model without one.
+pub fn canonical_spec(model: &Model) -> Option<ShipSpec> {
+    let mut spec = model.spec.ship.clone()?;
+    let ShipNames { u, v, r, psi, x0, y0, rudder } = &mut spec.names;
+    for n in [u, v, r, psi, x0, y0, rudder] {
+        if let Some(c) = model.vocabulary.canonical(n) {
+            *n = c;
+        }
+    }
+    Some(spec)
 }
 
 impl Ship {

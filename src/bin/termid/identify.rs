@@ -188,22 +188,7 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
     let units: BTreeMap<String, String> =
         model.spec.states.iter().map(|s| (s.name.clone(), s.unit.clone())).collect();
     // the ship's roles under the names the frames use
-    let ship = model.spec.ship.clone().map(|mut s| {
-        let canon = |n: &mut String| *n = model.vocabulary.canonical(n).unwrap_or_else(|| n.clone());
-        let names = &mut s.names;
-        for n in [
-            &mut names.u,
-            &mut names.v,
-            &mut names.r,
-            &mut names.psi,
-            &mut names.x0,
-            &mut names.y0,
-            &mut names.rudder,
-        ] {
-            canon(n);
-        }
-        s
-    });
+    let ship = termid::ship::canonical_spec(&model);
     let frames = prepare_runs(&cmd, frames, &states, ship.as_ref(), &|name| {
         let unit = units.get(name).cloned().unwrap_or_default();
         // angles are read in degrees

@@ -63,7 +63,7 @@ fn ship_run(cmd: &SimulateCommand, model: &Model, text: &str, integrator: Integr
             _ => {
                 let mut fig = manoeuvre_figure(&ship, &title, &[("simulation", &run.trajectory)], true);
                 if let Some(mc) = &mc {
-                    let tracks: Vec<_> = mc.results.iter().map(|(_, t)| t.clone()).collect();
+                    let tracks: Vec<&_> = mc.results.iter().map(|(_, t)| t).collect();
                     add_bands(&mut fig, &ship, &tracks);
                 }
                 fig

@@ -23,51 +23,42 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
     let sims = data.simulate(&model, &[], &[])?;
     let gap = data.gap(&sims);
     // ship models: metrics read off measurement and simulation alike
-    let observed = |sims: &[Trajectory]| -> Vec<Option<(Observed, Observed)>> {
-        let Some(ship) = &model.spec.ship else { return vec![None; runs.len()] };
-        let names = &ship.names;
-        let canon = |n: &str| model.vocabulary.canonical(n).unwrap_or_else(|| n.to_string());
-        let (psi, rudder, x0, y0) =
-            (canon(&names.psi), canon(&names.rudder), canon(&names.x0), canon(&names.y0));
-        runs.iter()
-            .zip(sims)
-            .map(|(f, s)| {
-                let col = |n: &str| f.column(n);
-                let state = |t: &Trajectory, n: &str| t.state(n).map(<[f64]>::to_vec);
-                let (mp, md, mx, my) = (col(&psi)?, col(&rudder)?, col(&x0)?, col(&y0)?);
-                let measured = observe(f.time(), mp, md, mx, my);
-                let simulated = observe(&s.time, &state(s, &psi)?, md, &state(s, &x0)?, &state(s, &y0)?);
-                Some((measured, simulated))
-            })
-            .collect()
+    let ship = termid::ship::canonical_spec(&model);
+    let names = ship.as_ref().map(|s| &s.names);
+    let measured = |f: &termid::data::Frame| -> Option<Observed> {
+        let (n, col) = (names?, |c: &str| f.column(c));
+        Some(observe(f.time(), col(&n.psi)?, col(&n.rudder)?, col(&n.x0)?, col(&n.y0)?))
     };
-    let metrics = observed(&sims);
-    // Monte Carlo: every run simulated with each drawn model
+    // the simulation's track with the rudder it was given, the measured one
+    let simulated = |f: &termid::data::Frame, s: &Trajectory| -> Option<Observed> {
+        let (n, state) = (names?, |c: &str| s.state(c));
+        Some(observe(&s.time, state(&n.psi)?, f.column(&n.rudder)?, state(&n.x0)?, state(&n.y0)?))
+    };
+    let metrics: Vec<Option<(Observed, Observed)>> =
+        runs.iter().zip(&sims).map(|(f, s)| Some((measured(f)?, simulated(f, s)?))).collect();
+    // Monte Carlo: every run simulated with each drawn model, its metrics read once per draw
     let mc = match cmd.monte_carlo.monte_carlo {
         0 => None,
-        n => Some(Draws::run(&model, n, cmd.monte_carlo.seed, |m| Ok(data.simulate(m, &[], &[])?))?),
+        n => Some(Draws::run(&model, n, cmd.monte_carlo.seed, |m| {
+            let sims = data.simulate(m, &[], &[])?;
+            let seen: Vec<Option<serde_json::Value>> = runs
+                .iter()
+                .zip(&sims)
+                .map(|(f, s)| simulated(f, s).map(|o| serde_json::to_value(o).unwrap_or_default()))
+                .collect();
+            Ok((sims, seen))
+        })?),
     };
     let spreads: Vec<_> = (0..runs.len())
-        .map(|k| {
-            mc.as_ref().map(|mc| {
-                mc.spread(|sims| {
-                    observed(sims)
-                        .get(k)
-                        .cloned()
-                        .flatten()
-                        .map(|(_, s)| serde_json::to_value(s).unwrap_or_default())
-                        .into_iter()
-                        .collect()
-                })
-            })
-        })
+        .map(|k| mc.as_ref().map(|mc| mc.spread(|(_, seen)| seen[k].iter().cloned().collect())))
         .collect();
     if let Some(dir) = &cmd.resim.svg {
         std::fs::create_dir_all(dir)?;
         for (k, (name, mut fig)) in comparison_figures(&runs, &sims, &[], "validate").into_iter().enumerate()
         {
             if let Some(mc) = &mc {
-                add_bands(&mut fig, k, runs[k].time(), &mc.results);
+                let draws: Vec<&[Trajectory]> = mc.results.iter().map(|(sims, _)| sims.as_slice()).collect();
+                add_bands(&mut fig, k, runs[k].time(), &draws);
             }
             let stem = std::path::Path::new(&name)
                 .file_stem()
@@ -103,16 +94,9 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
                 let Some((a, b)) = m else { continue };
                 let band = if s.is_some() { "   model 5 % … 95 %" } else { "" };
                 println!("\n{}: metric, measured, model{band}", f.origin());
-                let row = |name: &str, x: Option<f64>, y: Option<f64>| {
+                let row = |name: &str, key: &str, x: Option<f64>, y: Option<f64>| {
                     if x.is_some() || y.is_some() {
                         let f = |v: Option<f64>| v.map_or("--".to_string(), num);
-                        let key = match name.split(" [").next().unwrap_or(name) {
-                            "1st overshoot" => "first_overshoot_deg",
-                            "2nd overshoot" => "second_overshoot_deg",
-                            "advance" => "advance_m",
-                            "transfer" => "transfer_m",
-                            _ => "tactical_diameter_m",
-                        };
                         let spread = s
                             .as_ref()
                             .and_then(|s| s.get(key))
@@ -120,11 +104,21 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
                         println!("  {name:<24} {:>12} {:>12}{spread}", f(x), f(y));
                     }
                 };
-                row("1st overshoot [°]", a.first_overshoot_deg, b.first_overshoot_deg);
-                row("2nd overshoot [°]", a.second_overshoot_deg, b.second_overshoot_deg);
-                row("advance [m]", a.advance_m, b.advance_m);
-                row("transfer [m]", a.transfer_m, b.transfer_m);
-                row("tactical diameter [m]", a.tactical_diameter_m, b.tactical_diameter_m);
+                row("1st overshoot [°]", "first_overshoot_deg", a.first_overshoot_deg, b.first_overshoot_deg);
+                row(
+                    "2nd overshoot [°]",
+                    "second_overshoot_deg",
+                    a.second_overshoot_deg,
+                    b.second_overshoot_deg,
+                );
+                row("advance [m]", "advance_m", a.advance_m, b.advance_m);
+                row("transfer [m]", "transfer_m", a.transfer_m, b.transfer_m);
+                row(
+                    "tactical diameter [m]",
+                    "tactical_diameter_m",
+                    a.tactical_diameter_m,
+                    b.tactical_diameter_m,
+                );
             }
             if let Some(mc) = &mc {
                 println!("\n{}", mc.headline());
@@ -137,7 +131,7 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
 /// Adds the draws' pointwise 5-95 % band of each state to run `k`'s comparison figure.
 /// The band is drawn over the measured run's times, sample by sample, as the figure's
 /// simulation is.
-fn add_bands(fig: &mut Figure, k: usize, time: &[f64], draws: &[Vec<Trajectory>]) {
+fn add_bands(fig: &mut Figure, k: usize, time: &[f64], draws: &[&[Trajectory]]) {
     let Some(first) = draws.first().and_then(|d| d.get(k)) else { return };
     for (i, name) in first.state_names.iter().enumerate() {
         let Some(panel) = fig.panels.iter_mut().find(|p| &p.title == name) else { continue };
