@@ -201,12 +201,9 @@ impl Identification<'_> {
             Target::Column(c) => frame.require(c)?.to_vec(),
             Target::Derivative(s) => {
                 let x = frame.require(s)?;
-                self.differentiator.differentiate(frame.time(), x).map_err(|e| match e {
-                    DataError::TooShort { rows, needed, what, .. } => {
-                        DataError::TooShort { file: frame.origin().into(), rows, needed, what }
-                    }
-                    e => e,
-                })?
+                self.differentiator
+                    .differentiate(frame.time(), x)
+                    .map_err(|e| e.in_run(frame.origin(), None))?
             }
         })
     }

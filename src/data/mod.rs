@@ -176,6 +176,25 @@ pub enum DataError {
     UnknownMethod(String, String),
 }
 
+impl DataError {
+    /// A signal-level "too short" said of a run: the file, and the signal when given (the
+    /// derivative methods see bare signals and do not know where they came from).
+    pub fn in_run(self, file: &str, signal: Option<&str>) -> DataError {
+        match self {
+            DataError::TooShort { rows, needed, what, .. } => DataError::TooShort {
+                file: file.into(),
+                rows,
+                needed,
+                what: match signal {
+                    Some(s) => format!("{what} of `{s}`"),
+                    None => what,
+                },
+            },
+            e => e,
+        }
+    }
+}
+
 /// Named f64 columns over a strictly increasing time column.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Frame {

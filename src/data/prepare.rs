@@ -28,15 +28,7 @@ pub fn prepare(frame: &Frame, how: &Preparation) -> Result<Frame, DataError> {
     };
     for name in &how.signals {
         let x = out.require(name)?.to_vec();
-        let s = how.method.smooth(out.time(), &x).map_err(|e| match e {
-            DataError::TooShort { rows, needed, what, .. } => DataError::TooShort {
-                file: frame.origin().into(),
-                rows,
-                needed,
-                what: format!("{what} of `{name}`"),
-            },
-            e => e,
-        })?;
+        let s = how.method.smooth(out.time(), &x).map_err(|e| e.in_run(frame.origin(), Some(name)))?;
         if how.smooth {
             out.set(name, s.value)?;
         }

@@ -110,17 +110,7 @@ pub fn track(frame: &Frame, ship: &ShipSpec, smooth: bool) -> Result<Frame, Data
     let models = data
         .iter()
         .zip(&chans)
-        .map(|(x, (_, c))| {
-            KalmanSmoother::noise_model(t, x).map_err(|e| match e {
-                DataError::TooShort { rows, needed, what, .. } => DataError::TooShort {
-                    file: frame.origin().into(),
-                    rows,
-                    needed,
-                    what: format!("{what} of `{c}`"),
-                },
-                e => e,
-            })
-        })
+        .map(|(x, (_, c))| KalmanSmoother::noise_model(t, x).map_err(|e| e.in_run(frame.origin(), Some(c))))
         .collect::<Result<Vec<_>, _>>()?;
     let variance: Vec<f64> = models.iter().map(|m| m.measurement_variance.max(f64::MIN_POSITIVE)).collect();
     let q = [models[3].jerk_intensity, models[4].jerk_intensity, models[5].jerk_intensity];
