@@ -466,10 +466,7 @@ mod tests {
     fn screened_path_equals_the_full_problem() {
         let (n, p) = (300, 40);
         let mut seed = 17u64;
-        let mut next = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut next = || crate::data::test_noise(&mut seed);
         let mut x = vec![0.0; n * p];
         for v in x.iter_mut() {
             *v = next();
