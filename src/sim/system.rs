@@ -16,12 +16,12 @@ pub struct System {
     /// Lower and upper bounds per state (±∞ when not declared).
     pub bounds: Vec<(f64, f64)>,
     rhs: Library,
-    /// For each library input: where its value comes from.
-    map: Vec<Slot>,
     /// (scratch slot, state index) and (scratch slot, input index) of the library inputs
-    /// that change from row to row; parameters sit in the workspace from its creation.
+    /// that change from row to row; parameters (scratch slot, parameter index) sit in the
+    /// workspace from its creation.
     state_slots: Vec<(usize, usize)>,
     input_slots: Vec<(usize, usize)>,
+    param_slots: Vec<(usize, usize)>,
     param_names: Vec<String>,
     params: Vec<f64>,
 }
@@ -90,13 +90,12 @@ impl System {
             .collect();
         let slot =
             |j: usize| rhs.input_slot(j).ok_or_else(|| SimError::Settings(format!("input {j} has no slot")));
-        let mut state_slots = Vec::new();
-        let mut input_slots = Vec::new();
+        let (mut state_slots, mut input_slots, mut param_slots) = (Vec::new(), Vec::new(), Vec::new());
         for (j, m) in map.iter().enumerate() {
             match m {
                 Slot::State(i) => state_slots.push((slot(j)?, *i)),
                 Slot::Input(i) => input_slots.push((slot(j)?, *i)),
-                Slot::Param(_) => {}
+                Slot::Param(i) => param_slots.push((slot(j)?, *i)),
             }
         }
         Ok(System {
@@ -104,9 +103,9 @@ impl System {
             inputs,
             bounds,
             rhs,
-            map,
             state_slots,
             input_slots,
+            param_slots,
             param_names,
             params: values.into_values().collect(),
         })
@@ -132,10 +131,8 @@ impl System {
     /// Scratch space for [`System::derivatives`], with the parameters in place.
     pub fn workspace(&self) -> Workspace {
         let mut scratch = self.rhs.scratch();
-        for (j, m) in self.map.iter().enumerate() {
-            if let (Slot::Param(i), Some(slot)) = (m, self.rhs.input_slot(j)) {
-                self.rhs.set_input(&mut scratch, slot, self.params[*i]);
-            }
+        for &(slot, i) in &self.param_slots {
+            self.rhs.set_input(&mut scratch, slot, self.params[i]);
         }
         Workspace { scratch }
     }
