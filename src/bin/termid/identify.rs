@@ -3,7 +3,9 @@
 use std::collections::BTreeMap;
 
 use anyhow::{bail, Context, Result};
-use termid::data::{differentiator, prepare, prepared_figure, resample, Frame, Preparation};
+use termid::data::{
+    differentiator, prepare, prepared_figure, resample, CentralDifference, Differentiator, Frame, Preparation,
+};
 use termid::identify::{Fit, Identification, ParamValue, Target};
 use termid::model::Covariance;
 use termid::model::ShipSpec;
@@ -33,8 +35,14 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
         frames.extend(crate::runs::load(&[], Some(ds), &cmd.time)?);
     }
     let target = Target::parse(cmd.target.as_deref().unwrap_or_default());
+    if cmd.derivative == KINEMATIC {
+        bail!("--derivative kinematic is the ship plug-in's tracking filter: it needs a --model with a [ship] section");
+    }
+    let diff = derivative_method(&cmd)?;
     if let Target::Derivative(state) = &target {
-        frames = prepare_runs(&cmd, frames, std::slice::from_ref(state), None, &|_| (1.0, String::new()))?;
+        frames = prepare_runs(&cmd, frames, std::slice::from_ref(state), None, diff.as_ref(), &|_| {
+            (1.0, String::new())
+        })?;
     }
     let mut vocab = Vocabulary::new();
     let mut params = BTreeMap::new();
@@ -86,7 +94,6 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     let excluded = parse_terms(&cmd.exclude, &vocab)?;
     let backend = configure_backend(&cmd)?;
     let selector = backend.build()?;
-    let diff = differentiator(&cmd.derivative)?;
     let identification = Identification {
         vocabulary: &vocab,
         parameters: &params,
@@ -109,6 +116,19 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     Ok(())
 }
 
+/// `--derivative kinematic` is the ship's tracking filter, which writes every rate as a column
+/// in `prepare_runs`; nothing is left to differentiate then.
+const KINEMATIC: &str = "kinematic";
+
+/// The `--derivative` method (central differences stand in for `kinematic`, see above).
+fn derivative_method(cmd: &IdentifyCommand) -> Result<Box<dyn Differentiator>> {
+    Ok(if cmd.derivative == KINEMATIC {
+        Box::new(CentralDifference)
+    } else {
+        differentiator(&cmd.derivative)?
+    })
+}
+
 /// Resampling and smoothing of the runs where asked for: each differentiated signal gets its
 /// rate as `<signal>_dot` (which identification then takes as the target), and a figure.
 fn prepare_runs(
@@ -116,16 +136,20 @@ fn prepare_runs(
     frames: Vec<Frame>,
     signals: &[String],
     ship: Option<&ShipSpec>,
+    method: &dyn Differentiator,
     scale: &dyn Fn(&str) -> (f64, String),
 ) -> Result<Vec<Frame>> {
-    let kinematic = cmd.derivative == "kinematic";
+    let kinematic = cmd.derivative == KINEMATIC;
     if cmd.resample.is_none() && !cmd.smooth && cmd.prepared_svg.is_none() && !kinematic {
         return Ok(frames);
     }
     let prepared = if kinematic {
         // the ship plug-in's tracking filter: all states of a run at once, kinematics coupled
         let Some(ship) = ship else {
-            bail!("--derivative kinematic is the ship plug-in's tracking filter: it needs a --model with a [ship] section");
+            bail!(
+                "--derivative kinematic is the ship plug-in's tracking filter: {} has no [ship] section",
+                cmd.model.as_ref().map_or("the model".into(), |p| p.display().to_string())
+            );
         };
         frames
             .iter()
@@ -138,13 +162,8 @@ fn prepare_runs(
             })
             .collect::<Result<Vec<_>, _>>()?
     } else {
-        let method = differentiator(&cmd.derivative)?;
-        let how = Preparation {
-            resample: cmd.resample,
-            method: method.as_ref(),
-            signals: signals.to_vec(),
-            smooth: cmd.smooth,
-        };
+        let how =
+            Preparation { resample: cmd.resample, method, signals: signals.to_vec(), smooth: cmd.smooth };
         frames.iter().map(|f| prepare(f, &how)).collect::<Result<Vec<_>, _>>()?
     };
     if let Some(dir) = &cmd.prepared_svg {
@@ -189,7 +208,8 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
         model.spec.states.iter().map(|s| (s.name.clone(), s.unit.clone())).collect();
     // the ship's roles under the names the frames use
     let ship = termid::ship::canonical_spec(&model);
-    let frames = prepare_runs(&cmd, frames, &states, ship.as_ref(), &|name| {
+    let diff = derivative_method(&cmd)?;
+    let frames = prepare_runs(&cmd, frames, &states, ship.as_ref(), diff.as_ref(), &|name| {
         let unit = units.get(name).cloned().unwrap_or_default();
         // angles are read in degrees
         match unit.strip_prefix("rad") {
@@ -200,12 +220,6 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
     if cmd.target.is_some() && names.len() != 1 {
         bail!("--target applies to one equation: name it with --equation");
     }
-    // the tracking filter writes every rate as a column; nothing is left to differentiate
-    let diff: Box<dyn termid::data::Differentiator> = if cmd.derivative == "kinematic" {
-        Box::new(termid::data::CentralDifference)
-    } else {
-        differentiator(&cmd.derivative)?
-    };
     let mut fits = Vec::new();
     for name in &names {
         let fit = crate::progress::with_spinner(&format!("identifying {name}"), || {
