@@ -3,7 +3,7 @@
 //! paper's combined-data size (2 505 rows × 29 candidates) including the design.
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion};
-use termid::select::{Accumulator, Backend, Problem, Selector, StepRule, Stepwise};
+use termid::select::{Accumulator, Backend, Moments, Problem, Selector, StepRule, Stepwise};
 use termid::term::{parse_terms, Library};
 
 mod common;
@@ -29,6 +29,9 @@ fn bench(c: &mut Criterion) {
             black_box(acc.finish())
         })
     });
+    g.bench_function("termid_parallel", |b| {
+        b.iter(|| black_box(Moments::of_columns(black_box(&x), &y, None)))
+    });
     let mut z = x.clone();
     z.extend_from_slice(&y);
     g.bench_function("nalgebra_gemm_xtx", |b| b.iter(|| black_box(gemm_xtx(&z, n, p + 1))));
@@ -53,8 +56,8 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             let sources = bind(&lib, &sig);
             let mut acc = Accumulator::new(lib.len());
-            lib.for_each_block(&sources, rows, |start, len, block| {
-                acc.push(block, &target[start..start + len], None)
+            lib.for_each_block(&sources, 0..rows, |start, columns| {
+                acc.push_columns(columns, &target[start..start + columns[0].len()], None)
             });
             let m = acc.finish();
             let pb =
@@ -128,9 +131,7 @@ fn bench(c: &mut Criterion) {
         let backend = Backend::by_name(name).unwrap().build().unwrap();
         g.bench_function(name, |b| {
             b.iter(|| {
-                let mut acc = Accumulator::new(p);
-                acc.push(black_box(&x), &y, None);
-                let m = acc.finish();
+                let m = Moments::of_columns(black_box(&x), &y, None);
                 let pb =
                     Problem { moments: &m, names: &big_names, forced: &[], excluded: &[], intercept: true };
                 black_box(backend.select(&pb).unwrap())

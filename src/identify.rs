@@ -8,8 +8,8 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 use crate::data::{DataError, Differentiator, Frame};
-use crate::select::{Accumulator, Moments, Problem, SelectError, Selection, Selector};
-use crate::term::{Library, Term, TermError, Vocabulary};
+use crate::select::{gather, Accumulator, Moments, Problem, SelectError, Selection, Selector};
+use crate::term::{Library, Source, Term, TermError, Vocabulary};
 
 /// What the equation explains.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -165,6 +165,56 @@ pub struct Fit {
     pub correlation_time: Option<f64>,
 }
 
+/// One run bound to a compiled library (see `Identification::bind`).
+struct BoundRun<'a> {
+    frame: &'a Frame,
+    y: Vec<f64>,
+    sources: Vec<Source<'a>>,
+    weights: Option<&'a [f64]>,
+}
+
+impl BoundRun<'_> {
+    /// Evaluates the terms on `rows` and adds them to `acc`; a value that is not finite is
+    /// refused with its row and term.
+    fn push(
+        &self,
+        library: &Library,
+        rows: std::ops::Range<usize>,
+        acc: &mut Accumulator,
+    ) -> Result<(), IdentifyError> {
+        let mut bad: Option<IdentifyError> = None;
+        library.for_each_block(&self.sources, rows, |start, columns| {
+            if bad.is_some() {
+                return;
+            }
+            let len = columns.first().map_or(0, |c| c.len());
+            let rows = start..start + len;
+            let y = &self.y[rows.clone()];
+            acc.push_columns(columns, y, self.weights.map(|w| &w[rows]));
+            // the accumulator notices a value that is not finite in passing; find it only then
+            if let Some(j) = acc.not_finite() {
+                let (values, term) = match columns.get(j) {
+                    Some(c) => (*c, library.terms()[j].to_string()),
+                    None => (y, "the target".to_string()),
+                };
+                // no such value: the sum overflowed; name the largest
+                let i = values.iter().position(|v| !v.is_finite()).unwrap_or_else(|| {
+                    (0..values.len())
+                        .max_by(|&a, &b| values[a].abs().total_cmp(&values[b].abs()))
+                        .unwrap_or(0)
+                });
+                bad = Some(IdentifyError::NonFinite {
+                    file: self.frame.origin().into(),
+                    row: start + i + 1,
+                    term,
+                    value: values.get(i).copied().unwrap_or(f64::NAN),
+                });
+            }
+        });
+        bad.map_or(Ok(()), Err)
+    }
+}
+
 /// s²·S⁻¹ of the chosen terms, S their (centred when there is an intercept) cross products:
 /// the covariance whose diagonal gives the standard errors the back-ends report (eq. A12).
 fn covariance_of(moments: &Moments, selection: &Selection) -> Option<Vec<Vec<f64>>> {
@@ -177,15 +227,20 @@ fn covariance_of(moments: &Moments, selection: &Selection) -> Option<Vec<Vec<f64
     }
     let coefficients: Vec<f64> = selection.terms.iter().map(|t| t.coefficient).collect();
     let s2 = moments.squared_error(&set, &coefficients, intercept.unwrap_or(0.0)).max(0.0) / dof;
-    let cross = nalgebra::DMatrix::from_fn(k, k, |i, j| {
-        if intercept.is_some() {
-            moments.corrected(set[i], set[j])
-        } else {
-            moments.raw(set[i], set[j])
+    let cross_product =
+        |i: usize, j: usize| if intercept.is_some() { moments.corrected(i, j) } else { moments.raw(i, j) };
+    // sweeping every pivot of a positive definite matrix leaves its inverse; a pivot that is
+    // not clearly positive means the cross products are singular on this set
+    let mut inverse: Vec<f64> = (0..k * k).map(|e| cross_product(set[e / k], set[e % k])).collect();
+    for j in 0..k {
+        let scale = cross_product(set[j], set[j]).abs();
+        if inverse[j * k + j].is_nan() || inverse[j * k + j] <= 1e-14 * scale {
+            return None;
         }
-    });
-    let inverse = cross.cholesky()?.inverse();
-    let cov: Vec<Vec<f64>> = (0..k).map(|i| (0..k).map(|j| s2 * inverse[(i, j)]).collect()).collect();
+        crate::select::sweep(&mut inverse, k, j);
+    }
+    let cov: Vec<Vec<f64>> =
+        inverse.chunks_exact(k).map(|row| row.iter().map(|v| s2 * v).collect()).collect();
     cov.iter().flatten().all(|v| v.is_finite()).then_some(cov)
 }
 
@@ -215,19 +270,29 @@ impl Identification<'_> {
         target: &Target,
         frame: &Frame,
     ) -> Result<Moments, IdentifyError> {
-        let mut acc = Accumulator::new(library.len());
-        self.accumulate(library, target, frame, &mut acc)?;
-        Ok(acc.finish())
+        Ok(self.moments_of_runs(library, target, std::slice::from_ref(frame))?.remove(0))
     }
 
-    /// Adds one run's rows to an accumulator (runs simply add up: "Komb. Daten").
-    pub fn accumulate(
+    /// The statistics of each run, gathered in parallel (parts of runs on all threads).
+    fn moments_of_runs(
         &self,
         library: &Library,
         target: &Target,
-        frame: &Frame,
-        acc: &mut Accumulator,
-    ) -> Result<(), IdentifyError> {
+        frames: &[Frame],
+    ) -> Result<Vec<Moments>, IdentifyError> {
+        let runs = frames.iter().map(|f| self.bind(library, target, f)).collect::<Result<Vec<_>, _>>()?;
+        let rows: Vec<usize> = frames.iter().map(Frame::len).collect();
+        gather(library.len(), &rows, |k, part, acc| runs[k].push(library, part, acc))
+    }
+
+    /// A run made ready for accumulation: its target, its inputs with its own parameters, and
+    /// its row weights.
+    fn bind<'a>(
+        &self,
+        library: &Library,
+        target: &Target,
+        frame: &'a Frame,
+    ) -> Result<BoundRun<'a>, IdentifyError> {
         let y = self.target(target, frame)?;
         let params = self.run_parameters(frame)?;
         let sources = library.bind(&|n| frame.column(n), &|n| params.get(n).copied())?;
@@ -246,26 +311,7 @@ impl Identification<'_> {
             }
             None => None,
         };
-        let mut bad: Option<IdentifyError> = None;
-        library.for_each_block(&sources, frame.len(), |start, rows, block| {
-            if bad.is_some() {
-                return;
-            }
-            if let Some(i) = block.iter().position(|v| !v.is_finite()) {
-                bad = Some(IdentifyError::NonFinite {
-                    file: frame.origin().into(),
-                    row: start + i % rows + 1,
-                    term: library.terms()[i / rows].to_string(),
-                    value: block[i],
-                });
-                return;
-            }
-            acc.push(block, &y[start..start + rows], weights.map(|w| &w[start..start + rows]));
-        });
-        match bad {
-            Some(e) => Err(e),
-            None => Ok(()),
-        }
+        Ok(BoundRun { frame, y, sources, weights })
     }
 
     /// Identifies one equation from all runs together ("Komb. Daten").
@@ -283,8 +329,7 @@ impl Identification<'_> {
         }
         let library = Library::compile(candidates, self.vocabulary)?;
         // per run, for the back-ends that cross-validate; together they are "Komb. Daten"
-        let folds =
-            frames.iter().map(|f| self.moments(&library, target, f)).collect::<Result<Vec<_>, _>>()?;
+        let folds = self.moments_of_runs(&library, target, frames)?;
         let mut moments = Moments::new(candidates.len());
         for f in &folds {
             moments.merge(f);
@@ -341,10 +386,10 @@ impl Identification<'_> {
             let params = self.run_parameters(frame)?;
             let sources = library.bind(&|n| frame.column(n), &|n| params.get(n).copied())?;
             let mut e = y.iter().map(|y| y - b0).collect::<Vec<f64>>();
-            library.for_each_block(&sources, frame.len(), |start, rows, block| {
-                for (j, t) in selection.terms.iter().enumerate() {
-                    for r in 0..rows {
-                        e[start + r] -= t.coefficient * block[j * rows + r];
+            library.for_each_block(&sources, 0..frame.len(), |start, columns| {
+                for (t, column) in selection.terms.iter().zip(columns) {
+                    for (e, x) in e[start..].iter_mut().zip(*column) {
+                        *e -= t.coefficient * x;
                     }
                 }
             });
@@ -456,6 +501,44 @@ mod tests {
         assert!((v - 2.2).abs() < 1e-15);
         assert!(ParamValue::Rule("mean:u:-1".into()).check_rule("u0").is_err());
         assert!(ParamValue::Rule("mean:u".into()).check_rule("u0").is_ok());
+    }
+
+    /// A term that is not finite on some row is refused with the run, the row and the term,
+    /// wherever in the run (and in whichever part of it, when gathered in parallel) it is.
+    #[test]
+    fn a_term_that_is_not_finite_names_run_row_and_term() {
+        let n = 1000;
+        let t: Vec<f64> = (0..n).map(|i| i as f64).collect();
+        let mut vocab = Vocabulary::new();
+        for v in ["t", "x", "y"] {
+            vocab.variable(v).unwrap();
+        }
+        let terms = vec![vocab.parse("x").unwrap(), vocab.parse("y/x").unwrap()];
+        let params = BTreeMap::new();
+        let central = crate::data::CentralDifference;
+        let id = Identification {
+            vocabulary: &vocab,
+            parameters: &params,
+            differentiator: &central,
+            intercept: true,
+            weights: None,
+        };
+        for zero_at in [0usize, 3, 700, 999] {
+            let x: Vec<f64> = (0..n).map(|i| if i == zero_at { 0.0 } else { 1.0 + i as f64 }).collect();
+            let mut f = Frame::new("run7.csv", "t", t.clone()).unwrap();
+            f.push("x", x).unwrap();
+            f.push("y", t.iter().map(|t| t.sin() + 2.0).collect()).unwrap();
+            let err = id
+                .fit(&Target::Column("y".into()), &terms, &[], &[], &[f], &crate::select::Stepwise::default())
+                .unwrap_err();
+            match err {
+                IdentifyError::NonFinite { file, row, term, value } => {
+                    assert_eq!((file.as_str(), row, term.as_str()), ("run7.csv", zero_at + 1, "y/x"));
+                    assert!(value.is_infinite());
+                }
+                e => panic!("{e}"),
+            }
+        }
     }
 
     /// The covariance's diagonal is the standard errors STPRG reports (its own formula, A12),

@@ -16,9 +16,10 @@ use serde::{Deserialize, Serialize};
 
 pub use best_subset::{BestSubset, Criterion};
 pub use efroymson::Efroymson;
-pub use moments::{Accumulator, Moments};
+pub use moments::{gather, Accumulator, Moments};
 pub use sparse::{Equality, LambdaChoice, SparseFit};
 pub use stepwise::{StepRule, Stepwise};
+pub(crate) use subset::sweep;
 
 /// What a back-end is asked to do.
 #[derive(Clone, Copy, Debug)]

@@ -5,6 +5,8 @@
 //! through nalgebra on a transposed view), and chunks are merged with the pairwise update of
 //! Chan, Golub & LeVeque (1979). Statistics of several files simply [`Moments::merge`].
 
+use std::ops::Range;
+
 /// Most rows per chunk handed to the Gram kernel (the buffer grows to this as rows come).
 /// 512 rows of 30 columns stay below glibc's mmap threshold (128 KiB): larger chunks were
 /// mapped and unmapped on every fit, and the page faults cost more than the products.
@@ -65,17 +67,26 @@ impl Moments {
             self.count += other.count;
             return;
         }
+        if self.weight == 0.0 {
+            let count = self.count + other.count;
+            self.clone_from(other);
+            self.count = count;
+            return;
+        }
         let m = self.p + 1;
         let total = self.weight + other.weight;
         let f = self.weight * other.weight / total;
-        let delta: Vec<f64> = other.mean.iter().zip(&self.mean).map(|(b, a)| b - a).collect();
+        let (a, b) = (&self.mean, &other.mean);
         for j in 0..m {
-            for i in 0..m {
-                self.comoment[i + j * m] += other.comoment[i + j * m] + f * delta[i] * delta[j];
+            let fdj = f * (b[j] - a[j]);
+            let (mine, theirs) =
+                (&mut self.comoment[j * m..(j + 1) * m], &other.comoment[j * m..(j + 1) * m]);
+            for ((c, o), (bi, ai)) in mine.iter_mut().zip(theirs).zip(b.iter().zip(a)) {
+                *c += o + fdj * (bi - ai);
             }
         }
-        for (mu, d) in self.mean.iter_mut().zip(&delta) {
-            *mu += d * other.weight / total;
+        for (mu, o) in self.mean.iter_mut().zip(&other.mean) {
+            *mu += (o - *mu) * other.weight / total;
         }
         self.weight = total;
         self.count += other.count;
@@ -127,43 +138,50 @@ impl Moments {
     }
 }
 
-/// Σ x with four independent partial sums: a single running sum is a dependent chain of
-/// additions (latency-bound, ~4× slower), and the compiler may not reorder it itself.
-fn sum4(x: &[f64]) -> f64 {
+/// Copies `src − c` into `dst` and returns Σ (src − c), four partial sums: a single running
+/// sum is a chain of dependent additions (latency-bound, ~4× slower).
+fn shift_copy(src: &[f64], dst: &mut [f64], c: f64) -> f64 {
     let mut lanes = [0.0f64; 4];
-    let chunks = x.chunks_exact(4);
-    let rest: f64 = chunks.remainder().iter().sum();
-    for c in chunks {
-        for l in 0..4 {
-            lanes[l] += c[l];
-        }
+    let mut rest = 0.0;
+    let (s4, d4) = (src.chunks_exact(4), dst.chunks_exact_mut(4));
+    for (x, d) in s4.remainder().iter().zip(d4.into_remainder()) {
+        *d = x - c;
+        rest += *d;
     }
-    (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + rest
-}
-
-/// Σ x·w, four partial sums (see [`sum4`]).
-fn dot4(x: &[f64], w: &[f64]) -> f64 {
-    let mut lanes = [0.0f64; 4];
-    let (xc, wc) = (x.chunks_exact(4), w.chunks_exact(4));
-    let rest: f64 = xc.remainder().iter().zip(wc.remainder()).map(|(a, b)| a * b).sum();
-    for (a, b) in xc.zip(wc) {
+    for (x, d) in src.chunks_exact(4).zip(dst.chunks_exact_mut(4)) {
         for l in 0..4 {
-            lanes[l] += a[l] * b[l];
+            d[l] = x[l] - c;
+            lanes[l] += d[l];
         }
     }
     (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + rest
 }
 
 /// Accumulates [`Moments`] from blocks of rows without keeping them.
+///
+/// Each chunk of rows is shifted by its first row as it is copied in (the sums of the shifted
+/// values are taken in the same pass), its cross-products formed by [`super::gram::gram`],
+/// and corrected to the chunk mean, G − s sᵀ/W: the shifted-data algorithm, as accurate as
+/// centring on the mean when the shift is a value of the data, with one pass fewer.
 #[derive(Debug)]
 pub struct Accumulator {
     moments: Moments,
-    /// Chunk buffer, (p+1) columns of `ld` rows, column-major.
+    /// The statistics of the chunk being flushed (kept: a fresh one per chunk cost more in
+    /// allocation than its merge).
+    chunk: Moments,
+    /// Chunk buffer, (p+1) columns of `ld` rows, column-major: (z − shift)·√w.
     buf: Vec<f64>,
     ld: usize,
-    w: Vec<f64>,
+    /// Per column, the chunk's shift and Σ w (z − shift) of the rows in the chunk.
+    shift: Vec<f64>,
+    sums: Vec<f64>,
+    /// Σ w of the rows in the chunk.
+    wsum: f64,
+    /// √w of the rows being copied.
+    root_w: Vec<f64>,
     filled: usize,
-    weighted: bool,
+    /// The first column (p = target) whose sum was not finite.
+    not_finite: Option<usize>,
 }
 
 impl Accumulator {
@@ -171,39 +189,82 @@ impl Accumulator {
     pub fn new(p: usize) -> Accumulator {
         Accumulator {
             moments: Moments::new(p),
+            chunk: Moments::new(p),
             buf: Vec::new(),
             ld: 0,
-            w: Vec::new(),
+            shift: vec![0.0; p + 1],
+            sums: vec![0.0; p + 1],
+            wsum: 0.0,
+            root_w: Vec::new(),
             filled: 0,
-            weighted: false,
+            not_finite: None,
         }
     }
 
     /// Adds `rows` rows: `x` column-major `rows × p`, target `y`, optional weights.
     pub fn push(&mut self, x: &[f64], y: &[f64], weights: Option<&[f64]>) {
+        let rows = y.len();
+        assert_eq!(x.len(), rows * self.moments.p, "block must hold rows × p values");
+        if rows == 0 {
+            return;
+        }
+        let columns: Vec<&[f64]> = x.chunks_exact(rows).take(self.moments.p).collect();
+        self.push_columns(&columns, y, weights);
+    }
+
+    /// Adds `y.len()` rows given as one slice per regressor (each as long as `y`): the rows
+    /// of a part of a larger column-major matrix, or a block of evaluated terms, without
+    /// first copying them together.
+    pub fn push_columns(&mut self, columns: &[&[f64]], y: &[f64], weights: Option<&[f64]>) {
         let p = self.moments.p;
         let rows = y.len();
-        assert_eq!(x.len(), rows * p, "block must hold rows × p values");
+        assert!(
+            columns.len() == p && columns.iter().all(|c| c.len() == rows),
+            "push_columns: p columns of y.len() rows"
+        );
+        assert!(weights.is_none_or(|w| w.len() == rows), "push_columns: one weight per row");
         let mut done = 0;
         while done < rows {
             if self.filled == self.ld && self.ld < CHUNK {
                 self.grow(CHUNK);
             }
-            let ld = self.ld;
-            let take = (ld - self.filled).min(rows - done);
-            for j in 0..p {
-                let src = &x[j * rows + done..j * rows + done + take];
-                self.buf[j * ld + self.filled..j * ld + self.filled + take].copy_from_slice(src);
-            }
-            self.buf[p * ld + self.filled..p * ld + self.filled + take]
-                .copy_from_slice(&y[done..done + take]);
-            let w = &mut self.w[self.filled..self.filled + take];
-            match weights {
-                Some(ws) => {
-                    self.weighted = true;
-                    w.copy_from_slice(&ws[done..done + take]);
+            let (ld, at) = (self.ld, self.filled);
+            let take = (ld - at).min(rows - done);
+            let part = done..done + take;
+            if at == 0 {
+                for (j, col) in columns.iter().chain(std::iter::once(&y)).enumerate() {
+                    let c = col[done];
+                    self.shift[j] = if c.is_finite() { c } else { 0.0 };
                 }
-                None => w.fill(1.0),
+                self.sums.fill(0.0);
+                self.wsum = 0.0;
+            }
+            if let Some(ws) = weights {
+                let ws = &ws[part.clone()];
+                self.root_w.clear();
+                self.root_w.extend(ws.iter().map(|w| w.sqrt()));
+                self.wsum += ws.iter().sum::<f64>();
+            } else {
+                self.wsum += take as f64;
+            }
+            for (j, col) in columns.iter().chain(std::iter::once(&y)).enumerate() {
+                let dst = &mut self.buf[j * ld + at..j * ld + at + take];
+                let src = &col[part.clone()];
+                let sum = if weights.is_some() {
+                    // (z − c)·√w into the buffer, Σ w (z − c) = Σ (z − c)·√w·√w beside it
+                    let mut sum = 0.0;
+                    for ((d, x), r) in dst.iter_mut().zip(src).zip(&self.root_w) {
+                        *d = (x - self.shift[j]) * r;
+                        sum += *d * r;
+                    }
+                    sum
+                } else {
+                    shift_copy(src, dst, self.shift[j])
+                };
+                if !sum.is_finite() && self.not_finite.is_none() {
+                    self.not_finite = Some(j);
+                }
+                self.sums[j] += sum;
             }
             self.filled += take;
             done += take;
@@ -211,6 +272,12 @@ impl Accumulator {
                 self.flush();
             }
         }
+    }
+
+    /// The first column (index p is the target) in which a value pushed so far was not finite
+    /// or a sum overflowed; such statistics are meaningless.
+    pub fn not_finite(&self) -> Option<usize> {
+        self.not_finite
     }
 
     /// Re-lays the chunk buffer out for `ld` rows per column, in the thread's spare buffer
@@ -229,7 +296,6 @@ impl Accumulator {
                 .copy_from_slice(&self.buf[j * self.ld..j * self.ld + self.filled]);
         }
         self.buf = buf;
-        self.w.resize(ld, 0.0);
         self.ld = ld;
     }
 
@@ -238,37 +304,95 @@ impl Accumulator {
         if n == 0 {
             return;
         }
+        self.filled = 0;
         let m = self.moments.p + 1;
-        let w = &self.w[..n];
-        let wsum: f64 = w.iter().sum();
-        let mut chunk = Moments::new(self.moments.p);
+        let chunk = &mut self.chunk;
         chunk.count = n;
-        chunk.weight = wsum;
-        // centre each column on the chunk mean, scale rows by √w
-        let ld = self.ld;
-        for j in 0..m {
-            let col = &mut self.buf[j * ld..j * ld + n];
-            let mean = if self.weighted { dot4(col, w) / wsum } else { sum4(col) / n as f64 };
-            chunk.mean[j] = mean;
-            if self.weighted {
-                for (x, w) in col.iter_mut().zip(w) {
-                    *x = (*x - mean) * w.sqrt();
+        chunk.weight = self.wsum;
+        if self.wsum > 0.0 {
+            super::gram::gram(&self.buf, self.ld, n, m, &mut chunk.comoment);
+            let inv = 1.0 / self.wsum;
+            for j in 0..m {
+                let sj = self.sums[j] * inv;
+                chunk.mean[j] = self.shift[j] + sj;
+                for (c, si) in chunk.comoment[j * m..(j + 1) * m].iter_mut().zip(&self.sums) {
+                    *c -= si * sj;
                 }
-            } else {
-                col.iter_mut().for_each(|x| *x -= mean);
             }
         }
-        if wsum > 0.0 {
-            super::gram::gram(&self.buf, ld, n, m, &mut chunk.comoment);
+        if self.moments.weight == 0.0 && self.wsum > 0.0 {
+            // the first chunk simply becomes the statistics
+            let count = self.moments.count + n;
+            std::mem::swap(&mut self.moments, chunk);
+            self.moments.count = count;
+        } else {
+            self.moments.merge(chunk);
         }
-        self.moments.merge(&chunk);
-        self.filled = 0;
     }
 
     /// The statistics of all rows pushed.
     pub fn finish(mut self) -> Moments {
         self.flush();
         std::mem::replace(&mut self.moments, Moments::new(0))
+    }
+}
+
+/// Rows per part when statistics are gathered in parallel from a run of `rows` rows: about
+/// 200 rows or more, at most 64 parts a run. It depends on the row count alone, so the result,
+/// round-off included, is the same however many threads there are.
+fn part_rows(rows: usize) -> usize {
+    let parts = (rows / 200).clamp(1, 64);
+    rows.div_ceil(parts).max(1)
+}
+
+/// The statistics of several runs (`runs[k]` rows each), gathered in parallel: the rows are
+/// cut into parts, `feed(run, rows, accumulator)` pushes the rows of one part, and the parts
+/// are merged in row order. The first error, in run and row order, is returned.
+pub fn gather<E: Send>(
+    p: usize,
+    runs: &[usize],
+    feed: impl Fn(usize, Range<usize>, &mut Accumulator) -> Result<(), E> + Sync,
+) -> Result<Vec<Moments>, E> {
+    use rayon::prelude::*;
+    let jobs: Vec<(usize, Range<usize>)> = runs
+        .iter()
+        .enumerate()
+        .flat_map(|(k, &n)| {
+            let step = part_rows(n);
+            (0..n).step_by(step).map(move |s| (k, s..(s + step).min(n)))
+        })
+        .collect();
+    let parts: Vec<Result<Moments, E>> = jobs
+        .par_iter()
+        .map(|(k, rows)| {
+            let mut acc = Accumulator::new(p);
+            feed(*k, rows.clone(), &mut acc)?;
+            Ok(acc.finish())
+        })
+        .collect();
+    let mut out: Vec<Moments> = runs.iter().map(|_| Moments::new(p)).collect();
+    for ((k, _), part) in jobs.iter().zip(parts) {
+        out[*k].merge(&part?);
+    }
+    Ok(out)
+}
+
+impl Moments {
+    /// The statistics of a column-major `n × p` matrix `x` (n = `y.len()`) against `y`,
+    /// gathered in parallel (see [`gather`]).
+    pub fn of_columns(x: &[f64], y: &[f64], weights: Option<&[f64]>) -> Moments {
+        let n = y.len();
+        assert!(n > 0 && x.len().is_multiple_of(n), "of_columns: x must hold whole columns of y.len() rows");
+        let p = x.len() / n;
+        let parts = gather(p, &[n], |_, rows, acc| {
+            let columns: Vec<&[f64]> = x.chunks_exact(n).map(|c| &c[rows.clone()]).collect();
+            acc.push_columns(&columns, &y[rows.clone()], weights.map(|w| &w[rows]));
+            Ok::<(), std::convert::Infallible>(())
+        });
+        match parts {
+            Ok(mut m) => m.remove(0),
+            Err(never) => match never {},
+        }
     }
 }
 
@@ -362,6 +486,52 @@ mod tests {
         // squared error of y ≈ 0.5 + 0.3 x1 − 0.2 x2 on rows 12..30, directly
         let direct: f64 = (12..30).map(|r| (y[r] - 0.5 - 0.3 * x[r] + 0.2 * x[30 + r]).powi(2)).sum();
         assert!((b.squared_error(&[0, 1], &[0.3, -0.2], 0.5) - direct).abs() < 1e-9 * direct);
+    }
+
+    #[test]
+    fn parts_gathered_in_parallel_equal_one_pass_and_the_two_pass_formula() {
+        // 100 000 rows: 64 parts; a large mean and a small spread, where shifting matters
+        let n = 100_000;
+        let x: Vec<f64> = (0..n * 3).map(|i| 1e5 + ((i * 7919) % 1009) as f64 * 1e-3).collect();
+        let y: Vec<f64> = (0..n).map(|i| (i as f64 * 0.01).sin() + 3.0).collect();
+        let w: Vec<f64> = (0..n).map(|i| 0.5 + (i % 3) as f64).collect();
+        for weights in [None, Some(&w[..])] {
+            let parallel = Moments::of_columns(&x, &y, weights);
+            let mut acc = Accumulator::new(3);
+            acc.push(&x, &y, weights);
+            let serial = acc.finish();
+            let col = |j: usize| if j < 3 { &x[j * n..(j + 1) * n] } else { &y[..] };
+            let wt = |r: usize| weights.map_or(1.0, |w| w[r]);
+            let total: f64 = (0..n).map(wt).sum();
+            for i in 0..4 {
+                let mi = (0..n).map(|r| wt(r) * col(i)[r]).sum::<f64>() / total;
+                assert!((parallel.means()[i] - mi).abs() < 1e-12 * mi.abs());
+                for j in 0..4 {
+                    let mj = (0..n).map(|r| wt(r) * col(j)[r]).sum::<f64>() / total;
+                    let c: f64 = (0..n).map(|r| wt(r) * (col(i)[r] - mi) * (col(j)[r] - mj)).sum();
+                    let tol = 1e-9 * (parallel.corrected(i, i) * parallel.corrected(j, j)).sqrt();
+                    assert!(
+                        (parallel.corrected(i, j) - c).abs() < tol,
+                        "{i}{j}: {} vs {c}",
+                        parallel.corrected(i, j)
+                    );
+                    assert!((serial.corrected(i, j) - c).abs() < tol);
+                }
+            }
+            assert_eq!(parallel.count(), n);
+        }
+    }
+
+    #[test]
+    fn a_value_that_is_not_finite_is_noticed_with_its_column() {
+        let mut acc = Accumulator::new(2);
+        acc.push(&[1.0, 2.0, 3.0, 4.0], &[1.0, 2.0], None);
+        assert_eq!(acc.not_finite(), None);
+        acc.push(&[1.0, 2.0, 3.0, f64::NAN], &[1.0, 2.0], None);
+        assert_eq!(acc.not_finite(), Some(1));
+        let mut acc = Accumulator::new(1);
+        acc.push(&[1.0], &[f64::INFINITY], None);
+        assert_eq!(acc.not_finite(), Some(1), "the target is column p");
     }
 
     #[test]

@@ -8,22 +8,22 @@ use super::{Estimate, Problem, SelectError, Step};
 /// is its own inverse: sweeping k again takes the term out.
 pub(crate) fn sweep(a: &mut [f64], m: usize, k: usize) {
     let d = a[k * m + k];
-    let mut pivot_row: Vec<f64> = a[k * m..(k + 1) * m].iter().map(|x| x / d).collect();
-    for (i, row) in a.chunks_exact_mut(m).enumerate() {
-        if i == k {
-            continue;
-        }
+    for x in &mut a[k * m..(k + 1) * m] {
+        *x /= d;
+    }
+    let (before, rest) = a.split_at_mut(k * m);
+    let (pivot_row, after) = rest.split_at_mut(m);
+    for row in before.chunks_exact_mut(m).chain(after.chunks_exact_mut(m)) {
         let b = row[k];
         if b == 0.0 {
             continue;
         }
-        for (x, p) in row.iter_mut().zip(&pivot_row) {
+        for (x, p) in row.iter_mut().zip(pivot_row.iter()) {
             *x -= b * p;
         }
         row[k] = -b / d;
     }
     pivot_row[k] = 1.0 / d;
-    a[k * m..(k + 1) * m].copy_from_slice(&pivot_row);
 }
 
 /// The problem's cross-product matrix in correlation scale, target last.
@@ -121,18 +121,21 @@ impl Scaled {
         let share = self.residual_share(a).max(0.0);
         let residual = share * self.total;
         let r2 = 1.0 - share;
-        let s = (residual / dof).sqrt();
+        // below m·ε the residual share is round-off of the sweeps, not resolved: at an exact
+        // fit the standard errors stay at that level instead of 0 (t = ±∞ for round-off terms)
+        let s = (share.max(m as f64 * f64::EPSILON) * self.total / dof).sqrt();
         let coefficients: Vec<f64> = set.iter().map(|&i| a[i * m + p] * self.d[p] / self.d[i]).collect();
         let std_errors: Vec<f64> =
             set.iter().map(|&i| s * a[i * m + i].max(0.0).sqrt() / self.d[i]).collect();
         let intercept = self.intercept.then(|| {
             let means = &self.means;
             let value = means[p] - set.iter().zip(&coefficients).map(|(&i, b)| b * means[i]).sum::<f64>();
+            // q = 1/W + x̄ᵀ S⁻¹ x̄ over the set, S⁻¹ in correlation scale: x̄ᵢ/dᵢ
+            let g: Vec<f64> = set.iter().map(|&i| means[i] / self.d[i]).collect();
             let mut q = 1.0 / self.weight;
-            for &i in set {
-                for &l in set {
-                    q += means[i] * means[l] * a[i * m + l] / (self.d[i] * self.d[l]);
-                }
+            for (&i, gi) in set.iter().zip(&g) {
+                let row = &a[i * m..(i + 1) * m];
+                q += gi * set.iter().zip(&g).map(|(&l, gl)| gl * row[l]).sum::<f64>();
             }
             let std_error = s * q.max(0.0).sqrt();
             Estimate { value, std_error, t: value / std_error }

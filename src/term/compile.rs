@@ -4,7 +4,7 @@
 //! a design matrix block by block (cache-sized blocks, no per-row allocation) and evaluates
 //! one row for the simulator.
 
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 
 use super::canon::{Atom, Monomial, Term};
 use super::error::TermError;
@@ -304,8 +304,8 @@ impl Library {
             vocab,
             inputs: Vec::new(),
             ops: Vec::new(),
-            cache: HashMap::new(),
-            derived: HashMap::new(),
+            cache: HashMap::default(),
+            derived: HashMap::default(),
             pending: Vec::new(),
         };
         let outputs = terms.iter().map(|t| b.term(t)).collect::<Result<Vec<_>, _>>()?;
@@ -451,33 +451,29 @@ impl Library {
             .collect()
     }
 
-    /// Evaluates the terms on rows `0..n` block by block; `visit(first_row, rows, block)`
-    /// gets each block column-major with leading dimension `rows`.
+    /// Evaluates the terms on `rows` block by block; `visit(first_row, block)` gets each
+    /// block's columns, one slice per term, all of the block's length.
     pub fn for_each_block(
         &self,
         sources: &[Source<'_>],
-        n: usize,
-        mut visit: impl FnMut(usize, usize, &[f64]),
+        rows: std::ops::Range<usize>,
+        mut visit: impl FnMut(usize, &[&[f64]]),
     ) {
-        let p = self.outputs.len();
-        // every slot row is written before it is read, so reused buffers need no clearing
-        let (mut slots, mut block) = BLOCK_SPARE.with(|s| std::mem::take(&mut *s.borrow_mut()));
-        for (buf, len) in [(&mut slots, self.ops.len() * BLOCK), (&mut block, p * BLOCK)] {
-            if buf.len() < len {
-                buf.resize(len, 0.0);
-            }
+        // every slot row is written before it is read, so a reused buffer needs no clearing
+        let mut slots = BLOCK_SPARE.with(|s| std::mem::take(&mut *s.borrow_mut()));
+        if slots.len() < self.ops.len() * BLOCK {
+            slots.resize(self.ops.len() * BLOCK, 0.0);
         }
-        let mut start = 0;
-        while start < n {
-            let len = BLOCK.min(n - start);
+        let mut start = rows.start;
+        while start < rows.end {
+            let len = BLOCK.min(rows.end - start);
             self.eval_block(sources, start, len, &mut slots);
-            for (j, &slot) in self.outputs.iter().enumerate() {
-                block[j * len..(j + 1) * len].copy_from_slice(&slots[slot * BLOCK..slot * BLOCK + len]);
-            }
-            visit(start, len, &block[..p * len]);
+            let columns: Vec<&[f64]> =
+                self.outputs.iter().map(|&slot| &slots[slot * BLOCK..slot * BLOCK + len]).collect();
+            visit(start, &columns);
             start += len;
         }
-        BLOCK_SPARE.with(|s| *s.borrow_mut() = (slots, block));
+        BLOCK_SPARE.with(|s| *s.borrow_mut() = slots);
     }
 
     /// Fills a column-major `n × len()` design matrix.
@@ -541,11 +537,10 @@ impl Library {
 }
 
 thread_local! {
-    /// The block evaluator's slot and output buffers, kept between calls on this thread:
-    /// identification evaluates run after run, and fresh buffers of this size came back
-    /// from the system as fresh pages every time.
-    static BLOCK_SPARE: std::cell::RefCell<(Vec<f64>, Vec<f64>)> =
-        const { std::cell::RefCell::new((Vec::new(), Vec::new())) };
+    /// The block evaluator's slot buffer, kept between calls on this thread: identification
+    /// evaluates run after run, and a fresh buffer of this size came back from the system as
+    /// fresh pages every time.
+    static BLOCK_SPARE: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// Σ c·s[k] with four independent partial sums: one running sum is a chain of dependent

@@ -75,10 +75,55 @@ fn rename(rule: &Rule) -> String {
 
 /// Parses a term's text into a spanned expression (syntax only).
 pub fn parse_expr(input: &str) -> Result<Expr, TermError> {
+    check_size(input)?;
     let mut pairs = TermParser::parse(Rule::term, input)
         .map_err(|e| TermError::Invalid(Box::new(e.renamed_rules(rename))))?;
     let expr = pairs.next().ok_or_else(|| TermError::at(input, 0, 0, "expected a term"))?;
     build(expr.into_inner(), input)
+}
+
+/// Deepest nesting of parentheses and calls in one term.
+pub const MAX_DEPTH: usize = 32;
+/// Most operators (`+ - * / ^ ,`) in one term.
+pub const MAX_OPERATORS: usize = 256;
+
+/// Refuses a term nested deeper than [`MAX_DEPTH`] or with more than [`MAX_OPERATORS`]
+/// operators before it is parsed: parsing and every later pass over the tree recurse, and a
+/// pathological text would otherwise exhaust the stack (an abort, not an error). No candidate
+/// regressor comes near either limit.
+fn check_size(input: &str) -> Result<(), TermError> {
+    let (mut depth, mut operators) = (0usize, 0usize);
+    for (i, c) in input.char_indices() {
+        match c {
+            '(' => {
+                depth += 1;
+                if depth > MAX_DEPTH {
+                    return Err(TermError::at(
+                        input,
+                        i,
+                        i + 1,
+                        format!("nested more than {MAX_DEPTH} deep: write the term more simply"),
+                    ));
+                }
+            }
+            ')' => depth = depth.saturating_sub(1),
+            '+' | '-' | '*' | '/' | '^' | ',' => {
+                operators += 1;
+                if operators > MAX_OPERATORS {
+                    return Err(TermError::at(
+                        input,
+                        i,
+                        i + 1,
+                        format!(
+                            "more than {MAX_OPERATORS} operators in one term: split it into several terms"
+                        ),
+                    ));
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
 }
 
 fn build(pairs: Pairs<'_, Rule>, input: &str) -> Result<Expr, TermError> {
@@ -167,6 +212,32 @@ mod tests {
         assert!(parse_expr("u^(-2)").is_ok());
         assert!(parse_expr("Δu*δ^3").is_ok());
         assert!(parse_expr("∆u").is_ok());
+    }
+
+    #[test]
+    fn pathological_nesting_and_length_are_refused_on_a_small_stack() {
+        // run where a rayon worker would (2 MiB): these used to overflow the stack
+        std::thread::Builder::new()
+            .stack_size(2 << 20)
+            .spawn(|| {
+                let deep = format!("{}u{}", "(".repeat(5000), ")".repeat(5000));
+                let err = parse_expr(&deep).unwrap_err();
+                assert_eq!(err.line_col(), Some((1, MAX_DEPTH + 1)), "{err}");
+                assert!(err.to_string().contains("nested more than"), "{err}");
+                let calls = format!("{}u{}", "sin(".repeat(5000), ")".repeat(5000));
+                assert!(parse_expr(&calls).is_err());
+                for long in [format!("u{}", "*u".repeat(5000)), format!("{}u", "-".repeat(5000))] {
+                    let err = parse_expr(&long).unwrap_err();
+                    assert!(err.to_string().contains("operators in one term"), "{err}");
+                }
+                // at the limits a term still parses
+                let ok = format!("{}u{}", "(".repeat(MAX_DEPTH), ")".repeat(MAX_DEPTH));
+                assert!(parse_expr(&ok).is_ok());
+                assert!(parse_expr(&format!("u{}", "*u".repeat(MAX_OPERATORS))).is_ok());
+            })
+            .unwrap()
+            .join()
+            .unwrap();
     }
 
     #[test]
