@@ -159,6 +159,9 @@ impl SparseFit {
                     .sum::<f64>()
         };
         let (lambda_prev, b_prev) = previous;
+        if let Some(beta) = self.closed_form(sc, pb, lambda, b_prev, w) {
+            return Ok(beta);
+        }
         let candidates: Vec<usize> = (0..p).filter(|j| !pb.excluded.contains(j)).collect();
         let mut active: Vec<usize> = candidates
             .iter()
@@ -185,6 +188,54 @@ impl SparseFit {
             active.extend(violators);
             active.sort_unstable();
         }
+    }
+
+    /// The plain LASSO at λ when its active set and signs are those of the neighbouring λ's
+    /// solution `b_prev`, as they mostly are along a fine path: then b_S = R_SS⁻¹ (c_S − λ w_S∘s_S)
+    /// in closed form, and it is the solution exactly when its signs hold and every other
+    /// column satisfies the optimality condition |c_j − (R b)_j| ≤ λ w_j. `None` when either
+    /// fails (the active set changed: the QP decides), or with fixed values, signs or
+    /// equalities, which the closed form does not know.
+    fn closed_form(
+        &self,
+        sc: &Scaled,
+        pb: &Problem<'_>,
+        lambda: f64,
+        b_prev: &[f64],
+        w: &[f64],
+    ) -> Option<Vec<f64>> {
+        if !(self.fixed.is_empty() && self.signs.is_empty() && self.equalities.is_empty()) {
+            return None;
+        }
+        let (p, m) = (sc.p, sc.m);
+        let set: Vec<usize> = (0..p)
+            .filter(|&j| {
+                !pb.excluded.contains(&j) && (w[j] == 0.0 || b_prev[j].abs() > self.support_tolerance)
+            })
+            .collect();
+        if set.is_empty() {
+            return None;
+        }
+        let k = set.len();
+        let r = nalgebra::DMatrix::from_fn(k, k, |a, b| sc.a[set[a] * m + set[b]]);
+        let rhs = nalgebra::DVector::from_fn(k, |a, _| {
+            let j = set[a];
+            sc.a[j * m + p] - lambda * w[j] * b_prev[j].signum()
+        });
+        let b_set = r.cholesky()?.solve(&rhs);
+        let mut beta = vec![0.0; p];
+        for (a, &j) in set.iter().enumerate() {
+            // a penalised coefficient that would change sign (or vanish) leaves the set
+            if w[j] > 0.0 && b_set[a] * b_prev[j] <= 0.0 {
+                return None;
+            }
+            beta[j] = b_set[a];
+        }
+        let kkt = (0..p).filter(|j| !pb.excluded.contains(j) && set.binary_search(j).is_err()).all(|j| {
+            let c = sc.a[j * m + p] - set.iter().map(|&i| sc.a[j * m + i] * beta[i]).sum::<f64>();
+            c.abs() <= lambda * w[j]
+        });
+        kkt.then_some(beta)
     }
 
     fn weights(&self, sc: &Scaled, pb: &Problem<'_>) -> Result<Vec<f64>, SelectError> {
@@ -390,12 +441,33 @@ impl SparseFit {
         let mut shrunk = Vec::new();
         let mut notes = Vec::new();
         let always = self.always_active(pb, &w);
-        let mut previous = (lambda_max, vec![0.0; p]);
-        let mut cache = None;
-        for &lambda in &lambdas {
-            let beta =
-                self.solve_screened(&sc, pb, lambda, (previous.0, &previous.1), &w, &always, &mut cache)?;
-            previous = (lambda, beta.clone());
+        // Two chains along the path, every other λ each, solved in parallel: each screens and
+        // starts from its own previous λ (screening stays exact with the wider gap). The split
+        // is fixed, so the result does not depend on the number of threads.
+        let chain = |first: usize| {
+            let mut previous = (lambda_max, vec![0.0; p]);
+            let mut cache = None;
+            let mut out = Vec::new();
+            for &lambda in lambdas.iter().skip(first).step_by(2) {
+                let beta =
+                    self.solve_screened(&sc, pb, lambda, (previous.0, &previous.1), &w, &always, &mut cache);
+                let failed = beta.is_err();
+                if let Ok(b) = &beta {
+                    previous = (lambda, b.clone());
+                }
+                out.push(beta);
+                if failed {
+                    break;
+                }
+            }
+            out.into_iter()
+        };
+        let (mut even, mut odd) = rayon::join(|| chain(0), || chain(1));
+        for (i, &lambda) in lambdas.iter().enumerate() {
+            let next = if i % 2 == 0 { even.next() } else { odd.next() };
+            // a chain stops at its first failure, which the loop meets before any later λ
+            let Some(beta) = next else { break };
+            let beta = beta?;
             let mut support: Vec<usize> = (0..p)
                 .filter(|&j| beta[j].abs() > self.support_tolerance || pb.forced.contains(&j))
                 .collect();
@@ -459,6 +531,62 @@ impl SparseFit {
 mod tests {
     use super::*;
     use crate::select::Accumulator;
+
+    /// Where the active set stays, the closed form is the QP's solution; where it changes,
+    /// the closed form declines.
+    #[test]
+    fn closed_form_is_the_qp_solution_or_declines() {
+        let (n, p) = (400, 12);
+        let mut seed = 5u64;
+        let mut next = || crate::data::test_noise(&mut seed);
+        let x: Vec<f64> = (0..n * p).map(|_| next()).collect();
+        let y: Vec<f64> =
+            (0..n).map(|i| 2.0 * x[i] - x[3 * n + i] + 0.5 * x[7 * n + i] + 0.05 * next()).collect();
+        let mut acc = Accumulator::new(p);
+        acc.push(&x, &y, None);
+        let m = acc.finish();
+        let names: Vec<String> = (0..p).map(|j| format!("x{j}")).collect();
+        let pb = Problem { moments: &m, names: &names, forced: &[], excluded: &[], intercept: true };
+        let fit = SparseFit::default();
+        let sc = Scaled::new(&pb).unwrap();
+        let w = fit.weights(&sc, &pb).unwrap();
+        let all: Vec<usize> = (0..p).collect();
+        let (mut hits, mut declined) = (0, 0);
+        let mut lambda = 0.5;
+        let mut previous = fit.solve(&sc, lambda, &w, &all).unwrap();
+        while lambda > 1e-4 {
+            lambda *= 0.8;
+            let qp = fit.solve(&sc, lambda, &w, &all).unwrap();
+            match fit.closed_form(&sc, &pb, lambda, &previous, &w) {
+                Some(b) => {
+                    hits += 1;
+                    // the objective ½bᵀRb − cᵀb + λ‖b‖₁: the closed form (exact when it answers)
+                    // is never worse than the interior-point solution, and agrees with it up to
+                    // the QP's accuracy in the coefficients
+                    let f = |b: &[f64]| {
+                        let mut v = 0.0;
+                        for i in 0..p {
+                            v -= sc.a[i * sc.m + p] * b[i] - lambda * b[i].abs();
+                            for j in 0..p {
+                                v += 0.5 * b[i] * sc.a[i * sc.m + j] * b[j];
+                            }
+                        }
+                        v
+                    };
+                    assert!(f(&b) <= f(&qp) + 1e-14, "λ {lambda}: {} vs {}", f(&b), f(&qp));
+                    for j in 0..p {
+                        assert!((b[j] - qp[j]).abs() < 1e-5, "λ {lambda}: {j}: {} vs {}", b[j], qp[j]);
+                    }
+                }
+                None => declined += 1,
+            }
+            previous = qp;
+        }
+        assert!(hits > 5 && declined > 0, "{hits} closed-form solutions, {declined} declined");
+        // constraints the closed form does not know: always the QP
+        let signed = SparseFit { signs: vec![(3, -1.0)], ..SparseFit::default() };
+        assert!(signed.closed_form(&sc, &pb, lambda, &previous, &w).is_none());
+    }
 
     /// Screening changes which QPs are solved, not their answers: at every λ of a path the
     /// screened solution is the one over all columns.
