@@ -12,7 +12,7 @@ use termid::data::{
     differentiator, prepare, CentralDifference, DataError, Dataset, Differentiator, Frame, KalmanSmoother,
     Preparation, Smoothed,
 };
-use termid::diagnose::Runs;
+use termid::diagnose::{refine, Runs};
 use termid::identify::{coefficients_of, fit_equation, Identification, Target};
 use termid::model::Model;
 use termid::select::{Backend, Moments};
@@ -114,6 +114,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ("stepwise", "spline", true, false),
         ("stepwise", "kalman", false, false),
         ("stepwise", "kalman", true, false),
+        ("stepwise + output error", "kalman", true, false),
         ("stepwise", "kalman*0.1", true, false),
         ("stepwise", "kalman*10", true, false),
         ("stepwise", "kinematic", true, false),
@@ -143,7 +144,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     e.forced.push(t);
                 }
             } else {
-                e.backend = Backend::by_name(backend)?;
+                e.backend = Backend::by_name(backend.trim_end_matches(" + output error"))?;
             }
         }
         let frames: Vec<Frame> =
@@ -166,10 +167,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             frames.iter().map(|f| prepare(f, &how)).collect::<Result<_, _>>()?
         };
         let mut identified = model.clone();
-        let mut errors = Vec::new();
         for eq in model.identifiable() {
             let fit = fit_equation(&model, &eq, &prepared, method.as_ref(), intercept, None)?;
             let coefficients = coefficients_of(&fit, &model.vocabulary)?;
+            identified.set_coefficients(&eq, coefficients, fit.selection.intercept.as_ref().map(|b| b.value));
+        }
+        if backend.ends_with("+ output error") {
+            // all coefficients refined together on the training runs as prepared (smoothed
+            // initial states), comparing velocities and heading (`identify --refine u,v,r,ψ`)
+            let states: Vec<String> = ["u", "v", "r", "ψ"].map(String::from).to_vec();
+            let training = Runs::new(&identified, &prepared, 0.05, Integrator::Rk4)?
+                .with_intercepts(intercept)
+                .comparing(&states)?;
+            identified = refine(&identified, &training)?.model;
+        }
+        let mut errors = Vec::new();
+        for eq in model.identifiable() {
+            let coefficients = identified.equation(&eq).map(|e| e.coefficients.clone()).unwrap_or_default();
             let reference = truth.equation(&eq).map(|e| e.coefficients.clone()).unwrap_or_default();
             let mut union: BTreeMap<String, (f64, f64)> = BTreeMap::new();
             for (t, v, _) in &reference {
@@ -198,7 +212,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let num: f64 = union.values().zip(&rms).map(|((a, b), s)| ((a - b) * s).powi(2)).sum();
             let den: f64 = union.values().zip(&rms).map(|((_, b), s)| (b * s).powi(2)).sum();
             errors.push(format!("{:.0} %", 100.0 * (num / den).sqrt()));
-            identified.set_coefficients(&eq, coefficients, fit.selection.intercept.as_ref().map(|b| b.value));
         }
         let runs = Runs::new(&identified, &held_frames, 0.01, Integrator::Rk4)?.with_intercepts(intercept);
         let gap = runs.gap(&runs.simulate(&identified, &[], &[])?);

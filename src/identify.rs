@@ -395,27 +395,7 @@ impl Identification<'_> {
             });
             residuals.push(e);
         }
-        let lag = |k: usize| -> f64 {
-            residuals
-                .iter()
-                .filter(|e| e.len() > k)
-                .map(|e| e.iter().zip(&e[k..]).map(|(a, b)| a * b).sum::<f64>())
-                .sum()
-        };
-        let c0 = lag(0);
-        let longest = residuals.iter().map(Vec::len).max().unwrap_or(0);
-        if c0 <= 0.0 || !c0.is_finite() || longest < 4 {
-            return Ok(None);
-        }
-        let mut tau = 1.0;
-        for k in 1..(longest / 2).min(1000) {
-            let rho = lag(k) / c0;
-            if rho <= 0.0 {
-                break;
-            }
-            tau += 2.0 * rho;
-        }
-        Ok(Some(tau))
+        Ok(crate::uncertainty::correlation_time(&residuals))
     }
 }
 

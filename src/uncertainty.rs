@@ -178,6 +178,35 @@ pub fn band(signals: &[Vec<f64>]) -> (Vec<f64>, Vec<f64>) {
         .unzip()
 }
 
+/// Integrated autocorrelation time τ = 1 + 2 Σ ρₖ of residual series (pooled over the series),
+/// summed up to the first lag where ρₖ falls to zero or below (Geyer's initial positive
+/// sequence, simplified; at most 1000 lags), in samples. `None` without variance or with
+/// series shorter than 4 samples. Independent residuals give τ ≈ 1; the effective number of
+/// samples is n/τ.
+pub fn correlation_time(residuals: &[Vec<f64>]) -> Option<f64> {
+    let lag = |k: usize| -> f64 {
+        residuals
+            .iter()
+            .filter(|e| e.len() > k)
+            .map(|e| e.iter().zip(&e[k..]).map(|(a, b)| a * b).sum::<f64>())
+            .sum()
+    };
+    let c0 = lag(0);
+    let longest = residuals.iter().map(Vec::len).max().unwrap_or(0);
+    if c0 <= 0.0 || !c0.is_finite() || longest < 4 {
+        return None;
+    }
+    let mut tau = 1.0;
+    for k in 1..(longest / 2).min(1000) {
+        let rho = lag(k) / c0;
+        if rho <= 0.0 {
+            break;
+        }
+        tau += 2.0 * rho;
+    }
+    Some(tau)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -139,6 +139,28 @@ impl Runs {
         Ok(Runs { frames: frames.to_vec(), states, scale, units, x0, params, settings, intercepts: false })
     }
 
+    /// Compares only the named states (all must be compared ones); the others are still
+    /// simulated from their recorded initial values.
+    pub fn comparing(mut self, names: &[String]) -> Result<Runs, DiagnoseError> {
+        for n in names {
+            if !self.states.iter().any(|(_, s)| s == n) {
+                let have: Vec<&str> = self.states.iter().map(|(_, s)| s.as_str()).collect();
+                return Err(DiagnoseError::Setup(format!(
+                    "cannot compare `{n}`: the model's states the runs have are {}",
+                    have.join(", ")
+                )));
+            }
+        }
+        let keep: Vec<bool> = self.states.iter().map(|(_, s)| names.contains(s)).collect();
+        let mut k = keep.iter();
+        self.states.retain(|_| *k.next().unwrap_or(&false));
+        let mut k = keep.iter();
+        self.scale.retain(|_| *k.next().unwrap_or(&false));
+        let mut k = keep.iter();
+        self.units.retain(|_| *k.next().unwrap_or(&false));
+        Ok(self)
+    }
+
     /// Simulate with the equations' intercepts b0 (off by default: the paper re-simulates
     /// without them, and its B0, C0 stand for effects it did not model, §8).
     pub fn with_intercepts(mut self, yes: bool) -> Runs {
@@ -181,6 +203,20 @@ impl Runs {
                 simulate(&system, x0, &mut c, s)
             })
             .collect()
+    }
+
+    /// [`Runs::residuals`] cut into their series, one per run and compared state.
+    pub fn series(&self, residuals: &[f64]) -> Vec<Vec<f64>> {
+        let mut out = Vec::new();
+        let mut at = 0;
+        for f in &self.frames {
+            for _ in &self.states {
+                let end = (at + f.len()).min(residuals.len());
+                out.push(residuals[at..end].to_vec());
+                at = end;
+            }
+        }
+        out
     }
 
     /// Scaled residuals (sim − measured) of every compared state, run by run.
@@ -350,16 +386,22 @@ fn residuals(data: &Runs, model: &Model, h: &Hypothesis, theta: &[f64]) -> Optio
 
 fn jacobian(data: &Runs, model: &Model, h: &Hypothesis, theta: &[f64]) -> Option<(Vec<f64>, DMatrix<f64>)> {
     let r0 = residuals(data, model, h, theta)?;
+    use rayon::prelude::*;
+    // the columns are independent re-simulations: all threads take them
+    let columns: Vec<Option<Vec<f64>>> = (0..theta.len())
+        .into_par_iter()
+        .map(|j| {
+            let step = 1e-6 * theta[j].abs().max(1e-3);
+            let (mut up, mut down) = (theta.to_vec(), theta.to_vec());
+            up[j] += step;
+            down[j] -= step;
+            let (ru, rd) = (residuals(data, model, h, &up)?, residuals(data, model, h, &down)?);
+            Some(ru.iter().zip(&rd).map(|(a, b)| (a - b) / (2.0 * step)).collect())
+        })
+        .collect();
     let mut jac = DMatrix::<f64>::zeros(r0.len(), theta.len());
-    for j in 0..theta.len() {
-        let step = 1e-6 * theta[j].abs().max(1e-3);
-        let (mut up, mut down) = (theta.to_vec(), theta.to_vec());
-        up[j] += step;
-        down[j] -= step;
-        let (ru, rd) = (residuals(data, model, h, &up)?, residuals(data, model, h, &down)?);
-        for (i, (a, b)) in ru.iter().zip(&rd).enumerate() {
-            jac[(i, j)] = (a - b) / (2.0 * step);
-        }
+    for (j, column) in columns.into_iter().enumerate() {
+        jac.set_column(j, &DVector::from_vec(column?));
     }
     Some((r0, jac))
 }
@@ -393,13 +435,36 @@ pub fn gauss_newton(
     Ok((theta, best))
 }
 
-/// Levenberg-Marquardt from θ0; (θ, cost, standard errors).
+/// A Levenberg-Marquardt fit of a hypothesis's parameters.
+pub struct Estimated {
+    /// The parameters.
+    pub theta: Vec<f64>,
+    /// Scaled sum of squares at θ.
+    pub cost: f64,
+    /// σ²(JᵀJ)⁻¹ with σ² = cost / (residuals − parameters), if JᵀJ is invertible (it
+    /// assumes independent residuals).
+    pub covariance: Option<DMatrix<f64>>,
+    /// The scaled residuals at θ, run by run and state by state ([`Runs::residuals`]).
+    pub residuals: Vec<f64>,
+}
+
+impl Estimated {
+    /// √ of the covariance's diagonal (NaN without one).
+    pub fn std_errors(&self) -> Vec<f64> {
+        match &self.covariance {
+            Some(c) => (0..self.theta.len()).map(|i| c[(i, i)].max(0.0).sqrt()).collect(),
+            None => vec![f64::NAN; self.theta.len()],
+        }
+    }
+}
+
+/// Levenberg-Marquardt from θ0.
 pub fn levenberg_marquardt(
     data: &Runs,
     model: &Model,
     h: &Hypothesis,
     theta0: Vec<f64>,
-) -> Result<(Vec<f64>, f64, Vec<f64>), String> {
+) -> Result<Estimated, String> {
     let mut theta = theta0;
     let (mut r, mut j) = jacobian(data, model, h, &theta).ok_or("diverges at the start")?;
     let mut c = cost(&r);
@@ -436,10 +501,6 @@ pub fn levenberg_marquardt(
     let n = r.len() as f64;
     let k = theta.len() as f64;
     let sigma2 = c / (n - k).max(1.0);
-    let jt = j.transpose();
-    let se = match (&jt * &j).try_inverse() {
-        Some(inv) => (0..theta.len()).map(|i| (sigma2 * inv[(i, i)]).max(0.0).sqrt()).collect(),
-        None => vec![f64::NAN; theta.len()],
-    };
-    Ok((theta, c, se))
+    let covariance = (j.transpose() * &j).try_inverse().map(|inv| inv * sigma2);
+    Ok(Estimated { theta, cost: c, covariance, residuals: r })
 }

@@ -8,10 +8,12 @@
 
 mod fit;
 mod hypotheses;
+mod refine;
 
 use serde::Serialize;
 
 pub use fit::{simulate_runs, Runs};
+pub use refine::{refine, Refined};
 
 /// Figures of a diagnosis, one per run: each measured state against the simulation before
 /// (and after) the winning effect, and the residual.
@@ -236,7 +238,10 @@ pub fn diagnose(
         let h = &hypotheses[i];
         let (theta, cost, se) = if rank < settings.refine {
             match fit::levenberg_marquardt(&data, model, h, theta.clone()) {
-                Ok(r) => r,
+                Ok(e) => {
+                    let se = e.std_errors();
+                    (e.theta, e.cost, se)
+                }
                 Err(_) => (theta, cost, vec![f64::NAN; h.parameters()]),
             }
         } else {

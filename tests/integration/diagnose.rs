@@ -5,7 +5,7 @@
 use std::sync::LazyLock;
 
 use termid::data::Frame;
-use termid::diagnose::{diagnose, Diagnosis, Effect, Settings};
+use termid::diagnose::{diagnose, Diagnosis, Effect, Runs, Settings};
 use termid::model::Model;
 use termid::ship::oltmann::{self, data, resim, Options};
 use termid::sim::{simulate, Controller, Integrator, Replay, System};
@@ -231,4 +231,54 @@ fn command_on_a_generic_model() {
     assert!(Model::load(&new_model).is_ok());
     // the original is untouched: it still has no offset and reloads as before
     assert_eq!(Model::load(std::path::Path::new("models/duffing.toml")).unwrap().spec, model.spec);
+}
+
+/// Output-error refinement on a generic model: coefficients 20 % off (as a regression on
+/// noisy regressors leaves them) come back to the truth from noisy runs.
+#[test]
+fn output_error_refinement_recovers_the_true_coefficients() {
+    let truth = Model::load(std::path::Path::new("models/duffing.toml")).unwrap();
+    let system = System::new(&truth, &Default::default(), false).unwrap();
+    let t: Vec<f64> = (0..=600).map(|i| i as f64 * 0.05).collect();
+    let mut g = Lcg(5);
+    let runs: Vec<Frame> = [0.7, 1.3]
+        .iter()
+        .map(|w| {
+            let mut rec = Frame::new("forcing", "t", t.clone()).unwrap();
+            rec.push("F", t.iter().map(|t| 0.8 * (w * t).sin()).collect()).unwrap();
+            let mut c = Replay::new(&rec, &system.inputs).unwrap();
+            let s =
+                termid::sim::Settings { integrator: Integrator::Rk4, dt: 0.01, duration: 30.0, sample: 0.05 };
+            let run = simulate(&system, &[0.3, 0.0], &mut c, &s).unwrap();
+            let mut out = Frame::new("run", "t", run.time.clone()).unwrap();
+            for (k, name) in system.states.iter().enumerate() {
+                out.push(name, run.states[k].iter().map(|v| v + 0.01 * g.normal()).collect()).unwrap();
+            }
+            out.push("F", rec.require("F").unwrap().to_vec()).unwrap();
+            out
+        })
+        .collect();
+    let mut off = truth.clone();
+    let true_coefficients = truth.equation("v_dot").unwrap().coefficients.clone();
+    let biased = true_coefficients.iter().map(|(t, v, _)| (t.clone(), v * 1.2, None)).collect();
+    off.set_coefficients("v_dot", biased, None);
+    let data = Runs::new(&off, &runs, 0.05, Integrator::Rk4).unwrap();
+    let refined = termid::diagnose::refine(&off, &data).unwrap();
+    assert!(
+        refined.cost_after < 0.1 * refined.cost_before,
+        "{} → {}",
+        refined.cost_before,
+        refined.cost_after
+    );
+    for (term, value, _) in &true_coefficients {
+        let got = refined.model.equation("v_dot").unwrap().coefficient(term);
+        assert!((got / value - 1.0).abs() < 0.02, "{term}: {got} vs true {value}");
+    }
+    // standard errors and a covariance come with the refined coefficients
+    let eq = refined.model.equation("v_dot").unwrap();
+    assert!(eq.coefficients.iter().all(|c| c.2.is_some_and(|s| s > 0.0 && s.is_finite())));
+    assert!(eq.covariance.as_ref().is_some_and(|c| c.correlation_time >= 1.0));
+    // comparing a state the runs do not have is refused by name
+    let err = Runs::new(&off, &runs, 0.05, Integrator::Rk4).unwrap().comparing(&["y".into()]).err().unwrap();
+    assert!(err.to_string().contains("cannot compare `y`"), "{err}");
 }

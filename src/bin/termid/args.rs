@@ -118,6 +118,12 @@ pub struct IdentifyCommand {
     /// Write a figure of the raw and prepared signals of every run into this folder.
     #[arg(long)]
     pub prepared_svg: Option<PathBuf>,
+    /// After the regression, refine all identified coefficients together by output error:
+    /// re-simulate the (prepared) runs from their initial states with their recorded inputs
+    /// and fit these states, comma-separated model names (e.g. `u,v,r,ψ`), or `all`. Compare
+    /// velocities and heading; positions integrate every earlier error and dominate the fit.
+    #[arg(long, value_name = "STATES")]
+    pub refine: Option<String>,
     /// Fit without an intercept b0.
     #[arg(long)]
     pub no_intercept: bool,

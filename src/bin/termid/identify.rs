@@ -249,6 +249,16 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
         }
         fits.push((name.clone(), fit));
     }
+    let refined = match &cmd.refine {
+        Some(states) => {
+            let r = crate::progress::with_spinner("refining by output error", || {
+                refine_by_output_error(&model, &frames, states, !cmd.no_intercept)
+            })?;
+            model = r.model.clone();
+            Some(r)
+        }
+        None => None,
+    };
     if let Some(out) = &cmd.out {
         model.spec.model.provenance = format!(
             "identified by termid from {} ({})",
@@ -259,8 +269,11 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
     }
     match cmd.format {
         Format::Json => {
-            let all: serde_json::Map<String, serde_json::Value> =
+            let mut all: serde_json::Map<String, serde_json::Value> =
                 fits.iter().map(|(n, f)| (n.clone(), json(f))).collect();
+            if let Some(r) = &refined {
+                all.insert("output_error_refinement".into(), serde_json::to_value(r)?);
+            }
             println!("{}", serde_json::to_string_pretty(&all)?);
         }
         Format::Text => {
@@ -269,12 +282,63 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
                 print!("{}", text(fit));
                 println!();
             }
+            if let Some(r) = &refined {
+                print!("{}", refinement_text(r));
+            }
             if let Some(out) = &cmd.out {
                 println!("wrote {}", out.display());
             }
         }
     }
     Ok(())
+}
+
+/// `identify --refine`: every identified coefficient refined by output error on the runs as
+/// they were prepared for the regression (smoothed initial states: a noisy first sample of a
+/// rate would otherwise drift through its integral).
+fn refine_by_output_error(
+    model: &termid::model::Model,
+    frames: &[Frame],
+    states: &str,
+    intercept: bool,
+) -> Result<termid::diagnose::Refined> {
+    let sample = frames.iter().map(|f| termid::data::median_step(f.time())).fold(f64::INFINITY, f64::min);
+    // one RK4 step per sample: the recorded input is known only at the samples
+    let runs = termid::diagnose::Runs::new(model, frames, sample, termid::sim::Integrator::Rk4)?
+        .with_intercepts(intercept);
+    let runs = if states.trim() == "all" {
+        runs
+    } else {
+        let names: Vec<String> =
+            states.split(',').map(|s| s.trim().to_string()).filter(|s| !s.is_empty()).collect();
+        runs.comparing(&names)?
+    };
+    Ok(termid::diagnose::refine(model, &runs)?)
+}
+
+fn refinement_text(r: &termid::diagnose::Refined) -> String {
+    let mut out = format!(
+        "== output-error refinement ==\nre-simulation cost (scaled sum of squares) {} → {}; residual correlation time {} samples\n{:<8} {:<18} {:>13} {:>13} {:>12} {:>8}\n",
+        num(r.cost_before),
+        num(r.cost_after),
+        r.correlation_time.map_or("--".into(), |t| format!("{t:.0}")),
+        "equation",
+        "term",
+        "regression",
+        "refined",
+        "std. error",
+        "change"
+    );
+    for (eq, term, before, after, se) in &r.coefficients {
+        out += &format!(
+            "{eq:<8} {term:<18} {:>13} {:>13} {:>12} {:>7.1}%\n",
+            num(*before),
+            num(*after),
+            num(*se),
+            100.0 * (after / before - 1.0)
+        );
+    }
+    out + "\n"
 }
 
 /// Significant-figure formatting that stays fixed-point where a reader expects it.

@@ -1,0 +1,91 @@
+//! Output-error refinement of identified coefficients: all of them adjusted together by
+//! Levenberg-Marquardt so that the runs, re-simulated from their initial states with their
+//! recorded inputs, match the measured states. The regression (equation error) is biased
+//! when its regressors are noisy measured states; the simulation takes only the inputs and
+//! the initial state from the data, so this fit is not. The terms stay those the back-end
+//! chose. Which states are compared matters: integrals such as positions add the drift of
+//! every error before them, and a noisy initial state then dominates them.
+
+use serde::Serialize;
+
+use super::fit::{apply, levenberg_marquardt};
+use super::{DiagnoseError, Effect, Hypothesis, Runs};
+use crate::model::{Covariance, Model};
+
+/// An output-error refinement's result.
+#[derive(Clone, Debug, Serialize)]
+pub struct Refined {
+    /// The model with the refined coefficients, their standard errors and covariance (per
+    /// equation, from the refinement's Jacobian, with the residuals' correlation time).
+    #[serde(skip)]
+    pub model: Model,
+    /// Scaled sum of squares of the re-simulation over all runs, before.
+    pub cost_before: f64,
+    /// The same after.
+    pub cost_after: f64,
+    /// Integrated autocorrelation time of the re-simulation residuals, in samples.
+    pub correlation_time: Option<f64>,
+    /// Per coefficient: equation, term, regression value, refined value, standard error
+    /// (√τ-corrected).
+    pub coefficients: Vec<(String, String, f64, f64, f64)>,
+}
+
+/// Refines every coefficient of the model's identified equations against `runs`.
+pub fn refine(model: &Model, runs: &Runs) -> Result<Refined, DiagnoseError> {
+    let entries: Vec<(String, String, f64)> = model
+        .equations
+        .iter()
+        .filter(|e| e.identify)
+        .flat_map(|e| e.coefficients.iter().map(|(t, v, _)| (e.name.clone(), t.to_string(), *v)))
+        .collect();
+    if entries.is_empty() {
+        return Err(DiagnoseError::Setup("no identified coefficients to refine".into()));
+    }
+    let hypothesis = Hypothesis {
+        name: "output-error refinement".into(),
+        effect: Effect::Terms { terms: entries.iter().map(|(e, t, _)| (e.clone(), t.clone())).collect() },
+    };
+    let before = runs.gap(&runs.simulate(model, &[], &[])?).cost;
+    let fit = levenberg_marquardt(runs, model, &hypothesis, vec![0.0; entries.len()])
+        .map_err(|e| DiagnoseError::Setup(format!("output-error refinement: the re-simulation {e}")))?;
+    let mut refined = apply(model, &hypothesis, &fit.theta).map_err(DiagnoseError::Setup)?;
+    // σ²(JᵀJ)⁻¹ assumes independent residuals; re-simulation residuals are strongly
+    // correlated in time, so the covariance is widened by their correlation time τ
+    let tau = crate::uncertainty::correlation_time(&runs.series(&fit.residuals));
+    let widen = tau.unwrap_or(1.0).max(1.0);
+    let std_errors: Vec<f64> = fit.std_errors().iter().map(|s| s * widen.sqrt()).collect();
+    let mut k = 0;
+    for e in model.equations.iter().filter(|e| e.identify) {
+        let first = k;
+        let eq = refined.equation(&e.name).cloned().ok_or_else(|| DiagnoseError::Setup(e.name.clone()))?;
+        let coefficients: Vec<_> = eq
+            .coefficients
+            .iter()
+            .map(|(t, v, _)| {
+                let se = std_errors[k];
+                k += 1;
+                (t.clone(), *v, se.is_finite().then_some(se))
+            })
+            .collect();
+        let terms = coefficients.iter().map(|c| c.0.clone()).collect();
+        refined.set_coefficients(&e.name, coefficients, eq.intercept);
+        if let Some(c) = &fit.covariance {
+            let matrix =
+                (first..k).map(|i| (first..k).map(|j| 0.5 * (c[(i, j)] + c[(j, i)])).collect()).collect();
+            // a singular direction (a term the runs do not excite) leaves no usable covariance
+            let _ = refined.set_covariance(&e.name, Covariance { terms, matrix, correlation_time: widen });
+        }
+    }
+    let coefficients = entries
+        .iter()
+        .zip(fit.theta.iter().zip(&std_errors))
+        .map(|((e, t, v), (d, se))| (e.clone(), t.clone(), *v, v + d, *se))
+        .collect();
+    Ok(Refined {
+        model: refined,
+        cost_before: before,
+        cost_after: fit.cost,
+        correlation_time: tau,
+        coefficients,
+    })
+}
