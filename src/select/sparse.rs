@@ -52,6 +52,7 @@ pub enum LambdaChoice {
 /// | `signs` | none | (column, +1 or −1): coefficient ≥ 0 or ≤ 0 |
 /// | `equalities` | none | linear equalities between coefficients |
 /// | `support_tolerance` | 1e-6 | \|β\| below this (standardised) is zero |
+/// | `active_set` | true | a plain-LASSO λ is first solved from its optimality conditions (active set and signs from the neighbouring λ, updated while they fail; accepted only when all hold, so exact), Clarabel where that fails and for every constrained fit; false: Clarabel at every λ |
 /// | `verbose` | false | let Clarabel print its iterations |
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -74,6 +75,8 @@ pub struct SparseFit {
     pub equalities: Vec<Equality>,
     /// Zero threshold for a standardised coefficient.
     pub support_tolerance: f64,
+    /// Solve plain-LASSO λ from their optimality conditions where they can be verified.
+    pub active_set: bool,
     /// Solver output.
     pub verbose: bool,
 }
@@ -90,6 +93,7 @@ impl Default for SparseFit {
             signs: vec![],
             equalities: vec![],
             support_tolerance: 1e-6,
+            active_set: true,
             verbose: false,
         }
     }
@@ -167,8 +171,10 @@ impl SparseFit {
             .iter()
             .copied()
             .filter(|&j| {
+                // an interior-point solution is never exactly zero: below the support
+                // tolerance a coefficient counts as out (the optimality check below keeps this exact)
                 always[j]
-                    || b_prev[j] != 0.0
+                    || b_prev[j].abs() > self.support_tolerance
                     || correlation(b_prev, j).abs() >= w[j] * (2.0 * lambda - lambda_prev)
             })
             .collect();
@@ -190,12 +196,14 @@ impl SparseFit {
         }
     }
 
-    /// The plain LASSO at λ when its active set and signs are those of the neighbouring λ's
-    /// solution `b_prev`, as they mostly are along a fine path: then b_S = R_SS⁻¹ (c_S − λ w_S∘s_S)
-    /// in closed form, and it is the solution exactly when its signs hold and every other
-    /// column satisfies the optimality condition |c_j − (R b)_j| ≤ λ w_j. `None` when either
-    /// fails (the active set changed: the QP decides), or with fixed values, signs or
-    /// equalities, which the closed form does not know.
+    /// The plain LASSO at λ by its optimality conditions, starting from the active set and
+    /// signs of the neighbouring λ's solution `b_prev` (along a fine path they mostly stay):
+    /// b_S = R_SS⁻¹ (c_S − λ w_S∘s_S) in closed form is the solution exactly when its signs
+    /// hold and every other column satisfies |c_j − (R b)_j| ≤ λ w_j. Where either fails, the
+    /// set is updated (columns that violate the condition enter with the sign of their
+    /// correlation, coefficients that would change sign leave) and tried again, at most once
+    /// per column. `None` if no set passes (the QP decides), with `active_set` off, or with
+    /// fixed values, signs or equalities, which the closed form does not know.
     fn closed_form(
         &self,
         sc: &Scaled,
@@ -204,38 +212,60 @@ impl SparseFit {
         b_prev: &[f64],
         w: &[f64],
     ) -> Option<Vec<f64>> {
-        if !(self.fixed.is_empty() && self.signs.is_empty() && self.equalities.is_empty()) {
+        if !(self.active_set && self.fixed.is_empty() && self.signs.is_empty() && self.equalities.is_empty())
+        {
             return None;
         }
         let (p, m) = (sc.p, sc.m);
-        let set: Vec<usize> = (0..p)
-            .filter(|&j| {
-                !pb.excluded.contains(&j) && (w[j] == 0.0 || b_prev[j].abs() > self.support_tolerance)
-            })
-            .collect();
-        if set.is_empty() {
-            return None;
-        }
-        let k = set.len();
-        let r = nalgebra::DMatrix::from_fn(k, k, |a, b| sc.a[set[a] * m + set[b]]);
-        let rhs = nalgebra::DVector::from_fn(k, |a, _| {
-            let j = set[a];
-            sc.a[j * m + p] - lambda * w[j] * b_prev[j].signum()
-        });
-        let b_set = r.cholesky()?.solve(&rhs);
-        let mut beta = vec![0.0; p];
-        for (a, &j) in set.iter().enumerate() {
-            // a penalised coefficient that would change sign (or vanish) leaves the set
-            if w[j] > 0.0 && b_set[a] * b_prev[j] <= 0.0 {
+        let open: Vec<bool> = (0..p).map(|j| !pb.excluded.contains(&j)).collect();
+        // sign of each penalised coefficient in the set (0: out); unpenalised ones are always in
+        let mut sign: Vec<f64> =
+            (0..p)
+                .map(|j| {
+                    if open[j] && b_prev[j].abs() > self.support_tolerance {
+                        b_prev[j].signum()
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
+        let in_set = |j: usize, sign: &[f64]| open[j] && (w[j] == 0.0 || sign[j] != 0.0);
+        // each update moves at least one column in or out: as many as there are columns
+        for _ in 0..=p {
+            let set: Vec<usize> = (0..p).filter(|&j| in_set(j, &sign)).collect();
+            if set.is_empty() {
                 return None;
             }
-            beta[j] = b_set[a];
+            let k = set.len();
+            let r = nalgebra::DMatrix::from_fn(k, k, |a, b| sc.a[set[a] * m + set[b]]);
+            let rhs = nalgebra::DVector::from_fn(k, |a, _| {
+                let j = set[a];
+                sc.a[j * m + p] - lambda * w[j] * sign[j]
+            });
+            let b_set = r.cholesky()?.solve(&rhs);
+            let mut beta = vec![0.0; p];
+            for (a, &j) in set.iter().enumerate() {
+                beta[j] = b_set[a];
+            }
+            let mut changed = false;
+            for &j in &set {
+                if w[j] > 0.0 && beta[j] * sign[j] <= 0.0 {
+                    sign[j] = 0.0;
+                    changed = true;
+                }
+            }
+            for j in (0..p).filter(|&j| open[j] && !set.contains(&j)) {
+                let c = sc.a[j * m + p] - set.iter().map(|&i| sc.a[j * m + i] * beta[i]).sum::<f64>();
+                if c.abs() > lambda * w[j] {
+                    sign[j] = c.signum();
+                    changed = true;
+                }
+            }
+            if !changed {
+                return Some(beta);
+            }
         }
-        let kkt = (0..p).filter(|j| !pb.excluded.contains(j) && set.binary_search(j).is_err()).all(|j| {
-            let c = sc.a[j * m + p] - set.iter().map(|&i| sc.a[j * m + i] * beta[i]).sum::<f64>();
-            c.abs() <= lambda * w[j]
-        });
-        kkt.then_some(beta)
+        None
     }
 
     fn weights(&self, sc: &Scaled, pb: &Problem<'_>) -> Result<Vec<f64>, SelectError> {
@@ -532,8 +562,9 @@ mod tests {
     use super::*;
     use crate::select::Accumulator;
 
-    /// Where the active set stays, the closed form is the QP's solution; where it changes,
-    /// the closed form declines.
+    /// Whenever the optimality conditions give an answer it is the QP's solution, from the
+    /// neighbouring λ's solution and from far away (every column starting out); off, or with
+    /// constraints, they give none.
     #[test]
     fn closed_form_is_the_qp_solution_or_declines() {
         let (n, p) = (400, 12);
@@ -557,35 +588,59 @@ mod tests {
         while lambda > 1e-4 {
             lambda *= 0.8;
             let qp = fit.solve(&sc, lambda, &w, &all).unwrap();
-            match fit.closed_form(&sc, &pb, lambda, &previous, &w) {
-                Some(b) => {
-                    hits += 1;
-                    // the objective ½bᵀRb − cᵀb + λ‖b‖₁: the closed form (exact when it answers)
-                    // is never worse than the interior-point solution, and agrees with it up to
-                    // the QP's accuracy in the coefficients
-                    let f = |b: &[f64]| {
-                        let mut v = 0.0;
-                        for i in 0..p {
-                            v -= sc.a[i * sc.m + p] * b[i] - lambda * b[i].abs();
-                            for j in 0..p {
-                                v += 0.5 * b[i] * sc.a[i * sc.m + j] * b[j];
+            for start in [previous.clone(), vec![0.0; p]] {
+                match fit.closed_form(&sc, &pb, lambda, &start, &w) {
+                    Some(b) => {
+                        hits += 1;
+                        // the objective ½bᵀRb − cᵀb + λ‖b‖₁: the closed form (exact when it answers)
+                        // is never worse than the interior-point solution, and agrees with it up to
+                        // the QP's accuracy in the coefficients
+                        let f = |b: &[f64]| {
+                            let mut v = 0.0;
+                            for i in 0..p {
+                                v -= sc.a[i * sc.m + p] * b[i] - lambda * b[i].abs();
+                                for j in 0..p {
+                                    v += 0.5 * b[i] * sc.a[i * sc.m + j] * b[j];
+                                }
                             }
+                            v
+                        };
+                        assert!(f(&b) <= f(&qp) + 1e-14, "λ {lambda}: {} vs {}", f(&b), f(&qp));
+                        for j in 0..p {
+                            assert!((b[j] - qp[j]).abs() < 1e-5, "λ {lambda}: {j}: {} vs {}", b[j], qp[j]);
                         }
-                        v
-                    };
-                    assert!(f(&b) <= f(&qp) + 1e-14, "λ {lambda}: {} vs {}", f(&b), f(&qp));
-                    for j in 0..p {
-                        assert!((b[j] - qp[j]).abs() < 1e-5, "λ {lambda}: {j}: {} vs {}", b[j], qp[j]);
                     }
+                    None => declined += 1,
                 }
-                None => declined += 1,
             }
             previous = qp;
         }
-        assert!(hits > 5 && declined > 0, "{hits} closed-form solutions, {declined} declined");
-        // constraints the closed form does not know: always the QP
+        assert!(hits > 20, "{hits} closed-form solutions, {declined} declined");
+        // constraints the closed form does not know, or the setting off: always the QP
         let signed = SparseFit { signs: vec![(3, -1.0)], ..SparseFit::default() };
         assert!(signed.closed_form(&sc, &pb, lambda, &previous, &w).is_none());
+        let qp_only = SparseFit { active_set: false, ..SparseFit::default() };
+        assert!(qp_only.closed_form(&sc, &pb, lambda, &previous, &w).is_none());
+        // the whole path either way: the same selection
+        for choice in [LambdaChoice::Bic, LambdaChoice::LeaveOneRunOut] {
+            let fast = SparseFit { choice, ..SparseFit::default() };
+            let slow = SparseFit { choice, active_set: false, ..SparseFit::default() };
+            let half = |r: std::ops::Range<usize>| {
+                let cols: Vec<&[f64]> = x.chunks_exact(n).map(|c| &c[r.clone()]).collect();
+                let mut acc = Accumulator::new(p);
+                acc.push_columns(&cols, &y[r], None);
+                acc.finish()
+            };
+            let folds = [half(0..n / 2), half(n / 2..n)];
+            let (a, b) =
+                (fast.select_with_folds(&pb, &folds).unwrap(), slow.select_with_folds(&pb, &folds).unwrap());
+            assert_eq!(a.chosen_step, b.chosen_step);
+            let set = |s: &Selection| s.terms.iter().map(|t| (t.index, t.coefficient)).collect::<Vec<_>>();
+            for ((i, x), (j, y)) in set(&a).into_iter().zip(set(&b)) {
+                assert!(i == j && (x - y).abs() < 1e-9 * x.abs().max(1.0), "{i} {x} / {j} {y}");
+            }
+            assert_eq!(a.terms.len(), b.terms.len());
+        }
     }
 
     /// Screening changes which QPs are solved, not their answers: at every λ of a path the
