@@ -101,8 +101,9 @@ def relative(base, t):
     return f"{base / t:.1f}x faster" if t <= base else f"{t / base:.1f}x slower"
 
 
-def termid_times(binary, files, repeat):
-    out = subprocess.run([binary, "compare", "--equation", "v_dot", "r_dot", "--repeat", str(repeat),
+def termid_times(binary, files, repeat, model=None):
+    extra = ["--model", model] if model else []
+    out = subprocess.run([binary, "compare", *extra, "--equation", "v_dot", "r_dot", "--repeat", str(repeat),
                           "--format", "json", "--data", *sorted(files)], check=True, capture_output=True, text=True)
     res = {}
     for e in json.loads(out.stdout):
@@ -121,6 +122,17 @@ def main():
     files = [f for f in glob.glob(os.path.join(a.data, "z*.csv")) if "alt5" not in f]
     X, ys = design(files)
     ours = termid_times(a.termid, files, a.repeat)
+    # the sparse path with λ chosen by cross-validation (leave one run out), as LassoCV does
+    here = os.path.dirname(os.path.abspath(__file__))
+    with open(os.path.join(here, "..", "..", "models", "oltmann1973.toml"), encoding="utf-8") as f:
+        text = f.read().replace('backend = { method = "stepwise" }',
+                                'backend = { method = "sparse", choice = "leave-one-run-out" }')
+    cv_model = os.path.join(here, "work", "sparse_cv.toml")
+    with open(cv_model, "w", encoding="utf-8") as f:
+        f.write(text)
+    cv = termid_times(a.termid, files, a.repeat, cv_model)
+    for eq in ["v_dot", "r_dot"]:
+        ours[("sparse-cv", eq)] = cv[("sparse", eq)]
     print(f"# termid and its peers ({platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
           f"numpy {np.__version__})\n")
     print(f"Combined data of the five zigzags: {X.shape[0]} rows x {X.shape[1]} candidates. "
@@ -130,9 +142,10 @@ def main():
         print(f"## {eq}\n\n| method | time [ms] | terms | ratio to numpy stepwise |\n|---|---|---|---|")
         rows = peers(X, ys[eq], a.repeat, max(3, a.repeat // 7))
         base = rows[0][1]
-        for name in ["stepwise", "efroymson", "best-subset", "sparse"]:
+        labels = {"sparse": "sparse (λ by BIC)", "sparse-cv": "sparse (λ by leave-one-run-out CV)"}
+        for name in ["stepwise", "efroymson", "best-subset", "sparse", "sparse-cv"]:
             t, k = ours[(name, eq)]
-            print(f"| termid {name} | {t * 1e3:.3f} | {k} | {relative(base, t)} |")
+            print(f"| termid {labels.get(name, name)} | {t * 1e3:.3f} | {k} | {relative(base, t)} |")
         for name, t, k in rows:
             print(f"| {name} | {t * 1e3:.3f} | {k} | {relative(base, t)} |")
         print()

@@ -240,6 +240,10 @@ impl BestSubset {
         let sigma2 = full_rss / (sc.n_eff - kmax as f64).max(1.0);
         let mut steps = Vec::new();
         let mut scores = Vec::new();
+        let validation = match self.criterion {
+            Criterion::LeaveOneRunOut => Some(super::CrossValidation::new(pb, folds)?),
+            _ => None,
+        };
         for (k, (rss, set)) in search.best.iter().enumerate() {
             if !rss.is_finite() || set.len() != k || k < forced.len().max(1) {
                 continue;
@@ -258,7 +262,7 @@ impl BestSubset {
                 Criterion::Aic => n * (rss * sc.total / n).ln() + 2.0 * kk,
                 Criterion::Cp => rss / sigma2 - sc.n_eff + 2.0 * kk,
                 Criterion::AdjustedR2 => -(1.0 - rss * sc.n_eff / (sc.n_eff - k as f64).max(1e-300)),
-                Criterion::LeaveOneRunOut => super::cross_validation_error(pb, folds, set)?,
+                Criterion::LeaveOneRunOut => validation.as_ref().map_or(f64::INFINITY, |cv| cv.error(set)),
             };
             scores.push(score);
             steps.push(st);

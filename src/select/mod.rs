@@ -285,27 +285,89 @@ pub fn cross_validation_error(
     folds: &[Moments],
     set: &[usize],
 ) -> Result<f64, SelectError> {
-    if folds.len() < 2 {
-        return Err(SelectError::Config(format!(
-            "cross-validation needs at least two runs, has {}",
-            folds.len()
-        )));
+    Ok(CrossValidation::new(problem, folds)?.error(set))
+}
+
+/// Leave-one-run-out cross-validation of many subsets on the same runs: the statistics of
+/// all runs but one are formed once per run, and each subset's fit on them is a k × k solve.
+pub struct CrossValidation<'a> {
+    folds: &'a [Moments],
+    /// Per fold, the statistics of the other runs.
+    rest: Vec<Moments>,
+    intercept: bool,
+}
+
+impl<'a> CrossValidation<'a> {
+    /// Prepares the folds; at least two are needed.
+    pub fn new(problem: &Problem<'_>, folds: &'a [Moments]) -> Result<CrossValidation<'a>, SelectError> {
+        if folds.len() < 2 {
+            return Err(SelectError::Config(format!(
+                "cross-validation needs at least two runs, has {}",
+                folds.len()
+            )));
+        }
+        let rest = folds.iter().map(|f| problem.moments.without(f)).collect();
+        Ok(CrossValidation { folds, rest, intercept: problem.intercept })
     }
-    let mut total = 0.0;
-    for fold in folds {
-        let train = problem.moments.without(fold);
-        let pb = Problem { moments: &train, ..*problem };
-        let sc = subset::Scaled::new(&pb)?;
-        let Ok(a) = sc.swept(set, 1e-12) else { return Ok(f64::INFINITY) };
-        let b: Vec<f64> = set.iter().map(|&j| a[j * sc.m + sc.p] * sc.d[sc.p] / sc.d[j]).collect();
-        let b0 = if pb.intercept {
-            train.means()[sc.p] - set.iter().zip(&b).map(|(&j, bj)| bj * train.means()[j]).sum::<f64>()
-        } else {
-            0.0
-        };
-        total += fold.squared_error(set, &b, b0);
+
+    /// The summed squared error of each run predicted by the least-squares fit on `set` over
+    /// the others; ∞ when the set is collinear on some training part (a pivot of its
+    /// correlation matrix at most 1e-12, as the sweeps refuse).
+    pub fn error(&self, set: &[usize]) -> f64 {
+        let k = set.len();
+        let mut total = 0.0;
+        let mut l = vec![0.0; k * k];
+        let mut b = vec![0.0; k];
+        for (fold, train) in self.folds.iter().zip(&self.rest) {
+            let p = train.regressors();
+            let cross =
+                |i: usize, j: usize| if self.intercept { train.corrected(i, j) } else { train.raw(i, j) };
+            let d: Vec<f64> = set.iter().map(|&j| cross(j, j).max(0.0).sqrt()).collect();
+            if d.contains(&0.0) {
+                return f64::INFINITY;
+            }
+            // Cholesky of the correlation matrix R = LLᵀ, then L Lᵀ b' = r_y, b = b'/d
+            for c in 0..k {
+                for r in c..k {
+                    let mut v = cross(set[r], set[c]) / (d[r] * d[c]);
+                    for q in 0..c {
+                        v -= l[r * k + q] * l[c * k + q];
+                    }
+                    if r == c {
+                        if v.is_nan() || v <= 1e-12 {
+                            return f64::INFINITY;
+                        }
+                        l[c * k + c] = v.sqrt();
+                    } else {
+                        l[r * k + c] = v / l[c * k + c];
+                    }
+                }
+            }
+            for r in 0..k {
+                let mut v = cross(set[r], p) / d[r];
+                for q in 0..r {
+                    v -= l[r * k + q] * b[q];
+                }
+                b[r] = v / l[r * k + r];
+            }
+            for r in (0..k).rev() {
+                let mut v = b[r];
+                for q in r + 1..k {
+                    v -= l[q * k + r] * b[q];
+                }
+                b[r] = v / l[r * k + r];
+            }
+            let coefficients: Vec<f64> = b.iter().zip(&d).map(|(b, d)| b / d).collect();
+            let means = train.means();
+            let b0 = if self.intercept {
+                means[p] - set.iter().zip(&coefficients).map(|(&j, bj)| bj * means[j]).sum::<f64>()
+            } else {
+                0.0
+            };
+            total += fold.squared_error(set, &coefficients, b0);
+        }
+        total
     }
-    Ok(total)
 }
 
 /// Back-end settings as written in model files and chosen on the CLI, by `method` name.

@@ -471,6 +471,10 @@ impl SparseFit {
         let mut shrunk = Vec::new();
         let mut notes = Vec::new();
         let always = self.always_active(pb, &w);
+        let validation = match self.choice {
+            LambdaChoice::LeaveOneRunOut => Some(super::CrossValidation::new(pb, folds)?),
+            LambdaChoice::Bic => None,
+        };
         // Two chains along the path, every other λ each, solved in parallel: each screens and
         // starts from its own previous λ (screening stays exact with the wider gap). The split
         // is fixed, so the result does not depend on the number of threads.
@@ -525,7 +529,9 @@ impl SparseFit {
             let k = support.len() as f64 + if sc.intercept { 1.0 } else { 0.0 };
             scores.push(match self.choice {
                 LambdaChoice::Bic => n * (rss * sc.total / n).ln() + k * n.ln(),
-                LambdaChoice::LeaveOneRunOut => super::cross_validation_error(pb, folds, &support)?,
+                LambdaChoice::LeaveOneRunOut => {
+                    validation.as_ref().map_or(f64::INFINITY, |cv| cv.error(&support))
+                }
             });
             shrunk.push(beta);
             steps.push(st);
