@@ -16,6 +16,13 @@ use std::process::ExitCode;
 use clap::Parser;
 
 fn main() -> ExitCode {
+    // a closed pipe (`termid … | head`) ends the process quietly, as it does other Unix
+    // tools, instead of a panic in the next `println!`
+    #[cfg(unix)]
+    // SAFETY: restoring the default disposition of one signal before any thread starts
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = args::Cli::parse();
     let command = move || match cli.command {
         args::Command::Identify(cmd) => identify::run(*cmd),
