@@ -178,17 +178,21 @@ impl Selector for Stepwise {
         let (p, m, n) = (sc.p, sc.m, sc.n);
         let mut a = sc.a.clone();
         let mut entered: Vec<usize> = Vec::new();
-        let mut refused: Vec<usize> = Vec::new();
         let mut notes = Vec::new();
         let mut steps: Vec<Step> = Vec::new();
+        // a candidate is open until it is entered, refused or excluded
+        let mut open: Vec<bool> = (0..p).map(|j| !pb.excluded.contains(&j)).collect();
+        let mut pool: Vec<usize> = Vec::with_capacity(p);
         let stop = loop {
             if self.max_steps.is_some_and(|k| entered.len() >= k) {
                 break Stop::Converged;
             }
-            let open = |j: &usize| !entered.contains(j) && !refused.contains(j) && !pb.excluded.contains(j);
-            let forced_left: Vec<usize> = pb.forced.iter().copied().filter(open).collect();
-            let forcing = !forced_left.is_empty();
-            let pool: Vec<usize> = if forcing { forced_left } else { (0..p).filter(open).collect() };
+            pool.clear();
+            pool.extend(pb.forced.iter().copied().filter(|&j| open[j]));
+            let forcing = !pool.is_empty();
+            if !forcing {
+                pool.extend((0..p).filter(|&j| open[j]));
+            }
             if pool.is_empty() {
                 break Stop::AllEntered;
             }
@@ -204,7 +208,7 @@ impl Selector for Stepwise {
                             tolerance: self.pivot_tolerance,
                         });
                     }
-                    refused.push(j);
+                    open[j] = false;
                     notes.push(format!(
                         "`{}` refused: collinear with the terms in (pivot {pivot:.3e} ≤ {:.0e})",
                         pb.names[j], self.pivot_tolerance
@@ -233,6 +237,7 @@ impl Selector for Stepwise {
             }
             sweep(&mut a, m, j);
             entered.push(j);
+            open[j] = false;
             let mut step = sc.step(&a, &entered, pb.names, j, false, forcing);
             step.step = k;
             step.reduction = share * sc.total; // eq. (A2)
