@@ -1,31 +1,34 @@
-//! A spinner for work that may take long (an exact best-subset search): the work runs on a
-//! worker thread; if it is not done within a second, an indicatif spinner shows what is being
-//! done and for how long. The library itself never prints.
+//! A spinner for work that may take long (an exact best-subset search): the work runs on
+//! the calling thread (a worker of the thread pool, so the library's parallel passes start at
+//! once); if it is not done within a second, an indicatif spinner shows what is being done and
+//! for how long. The library itself never prints.
 
-use std::sync::mpsc;
+use std::sync::mpsc::{self, RecvTimeoutError};
 use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
 
 /// Runs `work`, with a spinner labelled `label` once it has taken more than a second.
-pub fn with_spinner<T: Send>(label: &str, work: impl FnOnce() -> T + Send) -> T {
+pub fn with_spinner<T>(label: &str, work: impl FnOnce() -> T) -> T {
+    let (done, finished) = mpsc::channel::<()>();
     std::thread::scope(|scope| {
-        let (tx, rx) = mpsc::channel();
         scope.spawn(move || {
-            let _ = tx.send(work());
+            // the work ended (sent or, on a panic, dropped the sender) within the second
+            if !matches!(finished.recv_timeout(Duration::from_secs(1)), Err(RecvTimeoutError::Timeout)) {
+                return;
+            }
+            let bar = ProgressBar::new_spinner();
+            bar.set_style(
+                ProgressStyle::with_template("{spinner} {elapsed:>4} {msg}")
+                    .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+            );
+            bar.set_message(label.to_string());
+            bar.enable_steady_tick(Duration::from_millis(120));
+            let _ = finished.recv();
+            bar.finish_and_clear();
         });
-        if let Ok(done) = rx.recv_timeout(Duration::from_secs(1)) {
-            return done;
-        }
-        let bar = ProgressBar::new_spinner();
-        bar.set_style(
-            ProgressStyle::with_template("{spinner} {elapsed:>4} {msg}")
-                .unwrap_or_else(|_| ProgressStyle::default_spinner()),
-        );
-        bar.set_message(label.to_string());
-        bar.enable_steady_tick(Duration::from_millis(120));
-        let result = rx.recv().expect("the worker thread sends its result");
-        bar.finish_and_clear();
+        let result = work();
+        let _ = done.send(());
         result
     })
 }
