@@ -67,6 +67,20 @@ fn identify_text_and_errors() {
         termid(&["identify", "--data", "tests/data/hald.csv", "--no-time", "--target", "z", "--terms", "x1"]);
     assert!(!ok);
     assert!(err.contains("hald.csv") && err.contains("`z`"), "{err}");
+    // output-error refinement re-simulates a model's equations: no model, no refinement
+    let (ok, _, err) = termid(&[
+        "identify",
+        "--data",
+        "tests/data/hald.csv",
+        "--no-time",
+        "--target",
+        "y",
+        "--terms",
+        "x1",
+        "--refine",
+        "y",
+    ]);
+    assert!(!ok && err.contains("--refine") && err.contains("--model"), "{err}");
     let (ok, _, err) = termid(&[
         "identify",
         "--data",

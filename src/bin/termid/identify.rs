@@ -25,6 +25,9 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     if cmd.model.is_some() {
         return run_model(cmd);
     }
+    if cmd.refine.is_some() {
+        bail!("--refine re-simulates the identified equations: it needs a --model that declares them");
+    }
     let frames = cmd
         .data
         .iter()
