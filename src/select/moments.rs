@@ -380,6 +380,9 @@ pub fn gather<E: Send>(
 impl Moments {
     /// The statistics of a column-major `n × p` matrix `x` (n = `y.len()`) against `y`,
     /// gathered in parallel (see [`gather`]).
+    ///
+    /// # Panics
+    /// If `y` is empty or `x` is not whole columns of `y.len()` rows.
     pub fn of_columns(x: &[f64], y: &[f64], weights: Option<&[f64]>) -> Moments {
         let n = y.len();
         assert!(n > 0 && x.len().is_multiple_of(n), "of_columns: x must hold whole columns of y.len() rows");

@@ -579,9 +579,7 @@ mod tests {
         let x: Vec<f64> = (0..n * p).map(|_| next()).collect();
         let y: Vec<f64> =
             (0..n).map(|i| 2.0 * x[i] - x[3 * n + i] + 0.5 * x[7 * n + i] + 0.05 * next()).collect();
-        let mut acc = Accumulator::new(p);
-        acc.push(&x, &y, None);
-        let m = acc.finish();
+        let m = Moments::of_columns(&x, &y, None);
         let names: Vec<String> = (0..p).map(|j| format!("x{j}")).collect();
         let pb = Problem { moments: &m, names: &names, forced: &[], excluded: &[], intercept: true };
         let fit = SparseFit::default();
@@ -668,9 +666,7 @@ mod tests {
         }
         let y: Vec<f64> =
             (0..n).map(|i| 2.0 * x[i] - x[3 * n + i] + 0.5 * x[10 * n + i] + 0.1 * next()).collect();
-        let mut acc = Accumulator::new(p);
-        acc.push(&x, &y, None);
-        let m = acc.finish();
+        let m = Moments::of_columns(&x, &y, None);
         let names: Vec<String> = (0..p).map(|j| format!("x{j}")).collect();
         let pb = Problem { moments: &m, names: &names, forced: &[7], excluded: &[5], intercept: true };
         for fit in [
