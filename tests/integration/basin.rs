@@ -149,6 +149,21 @@ fn identified_from_noisy_basin_runs_the_model_predicts_within_the_targets() {
             );
         }
     }
+    // a state the model does not have is refused before any work, and nothing is written
+    let never = p("never.toml");
+    let (ok, _, err) = termid(&[
+        "identify",
+        "--model",
+        &p("m.toml"),
+        "--dataset",
+        &p("train.toml"),
+        "--refine",
+        "u,psi",
+        "--out",
+        &never,
+    ]);
+    assert!(!ok && err.contains("`psi` is not a state of the model"), "{err}");
+    assert!(!std::path::Path::new(&never).exists());
     std::fs::copy(dir.join("id_kalman.toml"), dir.join("id.toml")).unwrap();
     // the tracking filter is the ship plug-in's: refused without a ship
     let (ok, _, err) = termid(&[

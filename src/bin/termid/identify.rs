@@ -220,6 +220,14 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
             None => (1.0, unit),
         }
     })?;
+    if let Some(list) = cmd.refine.as_deref().filter(|l| l.trim() != "all") {
+        let known: Vec<&str> = model.spec.states.iter().map(|s| s.name.as_str()).collect();
+        for name in list.split(',').map(str::trim).filter(|n| !n.is_empty()) {
+            if !known.contains(&name) {
+                bail!("--refine {list}: `{name}` is not a state of the model ({})", known.join(", "));
+            }
+        }
+    }
     if cmd.target.is_some() && names.len() != 1 {
         bail!("--target applies to one equation: name it with --equation");
     }
@@ -252,15 +260,19 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
         }
         fits.push((name.clone(), fit));
     }
-    let refined = match &cmd.refine {
-        Some(states) => {
-            let r = crate::progress::with_spinner("refining by output error", || {
-                refine_by_output_error(&model, &frames, states, !cmd.no_intercept)
-            })?;
-            model = r.model.clone();
-            Some(r)
-        }
-        None => None,
+    // a refinement that fails loses nothing: the regression's model is still written, and
+    // the command ends with the refinement's error
+    let (refined, refine_error) = match &cmd.refine {
+        Some(states) => match crate::progress::with_spinner("refining by output error", || {
+            refine_by_output_error(&model, &frames, states, !cmd.no_intercept)
+        }) {
+            Ok(r) => {
+                model = r.model.clone();
+                (Some(r), None)
+            }
+            Err(e) => (None, Some(e)),
+        },
+        None => (None, None),
     };
     if let Some(out) = &cmd.out {
         model.spec.model.provenance = format!(
@@ -269,6 +281,13 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
             model.spec.model.provenance
         );
         std::fs::write(out, model.to_toml()).with_context(|| format!("writing {}", out.display()))?;
+    }
+    if let Some(e) = refine_error {
+        let kept = cmd
+            .out
+            .as_ref()
+            .map_or(String::new(), |o| format!("; {} holds the regression's model", o.display()));
+        return Err(e.context(format!("output-error refinement failed{kept}")));
     }
     match cmd.format {
         Format::Json => {
