@@ -112,6 +112,35 @@ def termid_times(binary, files, repeat, model=None):
     return res
 
 
+def finished_matrix(binary, X, ys, repeat, work):
+    """termid's stepwise on the peers' own finished matrix: a generic model whose 29
+    candidates are the matrix's columns, so that no term is evaluated (like for like)."""
+    n, p = X.shape
+    model = os.path.join(work, "finished_matrix.toml")
+    with open(model, "w", encoding="utf-8") as f:
+        f.write('[model]\nname = "the peers\' finished 29-column matrix"\n'
+                'provenance = "benches/peers/peers.py"\ntime = "t"\n\n'
+                '[[states]]\nname = "s"\nunit = "-"\ninitial = 0.0\n\n')
+        for j in range(p):
+            f.write(f'[[inputs]]\nname = "c{j}"\nunit = "-"\ninitial = 0.0\n\n')
+        f.write('[equations.s_dot]\nstate = "s"\ncandidates = [' + ", ".join(f'"c{j}"' for j in range(p)) +
+                ']\nbackend = { method = "stepwise" }\n')
+    out = {}
+    for eq, y in ys.items():
+        path = os.path.join(work, f"finished_{eq}.csv")
+        with open(path, "w", encoding="utf-8") as f:
+            f.write("t,s_dot," + ",".join(f"c{j}" for j in range(p)) + "\n")
+            for i in range(n):
+                f.write(f"{0.2 * i:.1f},{float(y[i])!r}," + ",".join(repr(float(v)) for v in X[i]) + "\n")
+        res = subprocess.run([binary, "compare", "--model", model, "--equation", "s_dot", "--repeat", str(repeat),
+                              "--format", "json", "--data", path], check=True, capture_output=True, text=True)
+        for e in json.loads(res.stdout):
+            if e["backend"] == "stepwise":
+                q = e["equations"][0]
+                out[eq] = (q["time_ms"] / 1e3, len(q["terms"]))
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--termid", required=True)
@@ -133,17 +162,22 @@ def main():
     cv = termid_times(a.termid, files, a.repeat, cv_model)
     for eq in ["v_dot", "r_dot"]:
         ours[("sparse-cv", eq)] = cv[("sparse", eq)]
+    for eq, r in finished_matrix(a.termid, X, ys, a.repeat, os.path.join(here, "work")).items():
+        ours[("stepwise-matrix", eq)] = r
     print(f"# termid and its peers ({platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
           f"numpy {np.__version__})\n")
     print(f"Combined data of the five zigzags: {X.shape[0]} rows x {X.shape[1]} candidates. "
           "termid's times include evaluating the terms and the one-pass statistics; the peers get the "
-          "finished 29-column matrix. Median of repeated fits after a warm-up.\n")
+          "finished 29-column matrix (termid's stepwise is also timed on that matrix, as a model whose "
+          "candidates are its columns). Median of repeated fits after a warm-up.\n")
     for eq in ["v_dot", "r_dot"]:
         print(f"## {eq}\n\n| method | time [ms] | terms | ratio to numpy stepwise |\n|---|---|---|---|")
         rows = peers(X, ys[eq], a.repeat, max(3, a.repeat // 7))
         base = rows[0][1]
-        labels = {"sparse": "sparse (λ by BIC)", "sparse-cv": "sparse (λ by leave-one-run-out CV)"}
-        for name in ["stepwise", "efroymson", "best-subset", "sparse", "sparse-cv"]:
+        labels = {"sparse": "sparse (λ by BIC)", "sparse-cv": "sparse (λ by leave-one-run-out CV)",
+                  "stepwise": "stepwise (terms evaluated from the runs)",
+                  "stepwise-matrix": "stepwise (the peers' finished matrix)"}
+        for name in ["stepwise", "stepwise-matrix", "efroymson", "best-subset", "sparse", "sparse-cv"]:
             t, k = ours[(name, eq)]
             print(f"| termid {labels.get(name, name)} | {t * 1e3:.3f} | {k} | {relative(base, t)} |")
         for name, t, k in rows:
