@@ -179,6 +179,7 @@ impl BoundRun<'_> {
     fn push(
         &self,
         library: &Library,
+        terms: &[Term],
         rows: std::ops::Range<usize>,
         acc: &mut Accumulator,
     ) -> Result<(), IdentifyError> {
@@ -194,7 +195,7 @@ impl BoundRun<'_> {
             // the accumulator notices a value that is not finite in passing; find it only then
             if let Some(j) = acc.not_finite() {
                 let (values, term) = match columns.get(j) {
-                    Some(c) => (*c, library.terms()[j].to_string()),
+                    Some(c) => (*c, terms.get(j).map_or_else(|| format!("term {}", j + 1), Term::to_string)),
                     None => (y, "the target".to_string()),
                 };
                 // no such value: the sum overflowed; name the largest
@@ -270,19 +271,21 @@ impl Identification<'_> {
         target: &Target,
         frame: &Frame,
     ) -> Result<Moments, IdentifyError> {
-        Ok(self.moments_of_runs(library, target, std::slice::from_ref(frame))?.remove(0))
+        // without the terms at hand, a term that is not finite is named by its column
+        Ok(self.moments_of_runs(library, &[], target, std::slice::from_ref(frame))?.remove(0))
     }
 
     /// The statistics of each run, gathered in parallel (parts of runs on all threads).
     fn moments_of_runs(
         &self,
         library: &Library,
+        terms: &[Term],
         target: &Target,
         frames: &[Frame],
     ) -> Result<Vec<Moments>, IdentifyError> {
         let runs = frames.iter().map(|f| self.bind(library, target, f)).collect::<Result<Vec<_>, _>>()?;
         let rows: Vec<usize> = frames.iter().map(Frame::len).collect();
-        gather(library.len(), &rows, |k, part, acc| runs[k].push(library, part, acc))
+        gather(library.len(), &rows, |k, part, acc| runs[k].push(library, terms, part, acc))
     }
 
     /// A run made ready for accumulation: its target, its inputs with its own parameters, and
@@ -334,7 +337,7 @@ impl Identification<'_> {
         }
         let library = Library::compile(candidates, self.vocabulary)?;
         // per run, for the back-ends that cross-validate; together they are "Komb. Daten"
-        let folds = self.moments_of_runs(&library, target, frames)?;
+        let folds = self.moments_of_runs(&library, candidates, target, frames)?;
         let mut moments = Moments::new(candidates.len());
         for f in &folds {
             moments.merge(f);

@@ -35,8 +35,13 @@ def design(files):
     return np.vstack(cols), {k: np.concatenate(v) for k, v in ys.items()}
 
 
-def timed(fn, repeat):
+def timed(fn, repeat, warm_up=0.3):
+    """Median of `repeat` calls after warming up for `warm_up` seconds (at least one call),
+    the same protocol as `termid compare --warm-up`."""
+    started = time.perf_counter()
     fn()
+    while time.perf_counter() - started < warm_up:
+        fn()
     times = []
     out = None
     for _ in range(repeat):

@@ -54,7 +54,6 @@ pub struct Library {
     inputs: Vec<String>,
     ops: Vec<Op>,
     outputs: Vec<usize>,
-    terms: Vec<Term>,
     rows: RowProgram,
 }
 
@@ -313,17 +312,13 @@ impl Library {
             return Err(TermError::Declaration("the terms compile to more than 2³² operations".into()));
         }
         let rows = RowProgram::new(&b.ops);
-        Ok(Library { inputs: b.inputs, ops: b.ops, outputs, terms: terms.to_vec(), rows })
+        // the terms themselves are not kept: their caller has them, in the columns' order
+        Ok(Library { inputs: b.inputs, ops: b.ops, outputs, rows })
     }
 
     /// Names of the base variables and parameters the program reads, in input order.
     pub fn inputs(&self) -> &[String] {
         &self.inputs
-    }
-
-    /// The compiled terms.
-    pub fn terms(&self) -> &[Term] {
-        &self.terms
     }
 
     /// Number of terms (columns).

@@ -229,9 +229,13 @@ pub struct CompareCommand {
     /// Integration step for the re-simulation, s.
     #[arg(long, default_value_t = 0.04)]
     pub dt: f64,
-    /// Time each fit as the median of this many repetitions after one warm-up fit.
+    /// Time each fit as the median of this many repetitions after the warm-up.
     #[arg(long, default_value_t = 5)]
     pub repeat: usize,
+    /// Warm up by fitting for at least this long (s; at least one fit) before timing: a core
+    /// that was idle runs slowly for the first ~0.1 s of work.
+    #[arg(long, default_value_t = 0.3)]
+    pub warm_up: f64,
     /// Derivative method where a state's derivative is the target.
     #[arg(long, default_value = "central")]
     pub derivative: String,

@@ -45,11 +45,16 @@ pub fn run(cmd: CompareCommand) -> Result<()> {
             if e.backend.name() != *name {
                 e.backend = Backend::by_name(name)?;
             }
-            // one warm-up fit, then the median of `repeat` timed fits (data already loaded)
+            // warm-up fits for `warm_up` seconds (at least one), then the median of `repeat`
+            // timed fits (data already loaded)
             let fit = crate::progress::with_spinner(&format!("{name} on {eq}"), || {
                 fit_equation(&m, eq, &frames, diff.as_ref(), !cmd.no_intercept, None)
             })
             .with_context(|| format!("{name} on `{eq}`"))?;
+            let warming = Instant::now();
+            while warming.elapsed().as_secs_f64() < cmd.warm_up {
+                drop(fit_equation(&m, eq, &frames, diff.as_ref(), !cmd.no_intercept, None));
+            }
             let mut times: Vec<f64> = (0..cmd.repeat.max(1))
                 .map(|_| {
                     let started = Instant::now();
