@@ -6,6 +6,7 @@
 //! of any size it could still reach is pruned. Excluding a term is one sweep of the parent's
 //! matrix (the sweep is its own inverse), so a node costs O(p²).
 
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
@@ -73,17 +74,33 @@ impl Default for BestSubset {
 
 const RSS_FLOOR: f64 = 1e-13;
 
+/// Per model size, the smallest relative RSS found and its set (sorted).
+type Best = Vec<(f64, Vec<usize>)>;
+
+/// One search over a region of the tree (the whole tree, or the subtree below a fixed choice
+/// of the first terms, searched beside the others).
 struct Search<'a> {
     sc: &'a Scaled,
     kmax: usize,
-    best: Vec<(f64, Vec<usize>)>,
+    best: Best,
+    /// Nodes visited here and not yet added to `limits`.
     nodes: u64,
-    limit: u64,
-    deadline: Instant,
+    limits: &'a Limits,
     stopped: bool,
     /// One matrix per depth of the tree, reused: a node's exclude branch sweeps into it.
     stack: Vec<Vec<f64>>,
 }
+
+/// The node and time limits, shared by the regions searched in parallel.
+struct Limits {
+    nodes: AtomicU64,
+    node_limit: u64,
+    deadline: Instant,
+    stopped: AtomicBool,
+}
+
+/// Nodes a region visits between looks at the shared limits.
+const CHECK_EVERY: u64 = 4096;
 
 /// `b` = `a` swept on pivot `u`, but only the entries among `rest` and the target `t`: all
 /// that the subtree below reads (its pivots come from `rest`, its RSS is the target's
@@ -111,6 +128,17 @@ impl Search<'_> {
         }
     }
 
+    /// Adds the nodes visited to the shared count and stops when a limit is reached (here or
+    /// in another region).
+    fn report(&mut self) {
+        let total = self.limits.nodes.fetch_add(self.nodes, Ordering::Relaxed) + self.nodes;
+        self.nodes = 0;
+        if total >= self.limits.node_limit || Instant::now() > self.limits.deadline {
+            self.limits.stopped.store(true, Ordering::Relaxed);
+        }
+        self.stopped = self.limits.stopped.load(Ordering::Relaxed);
+    }
+
     /// No size in `lo..=hi` (capped at the largest searched) can improve with RSS ≥ `rss`.
     fn hopeless(&self, lo: usize, hi: usize, rss: f64) -> bool {
         let hi = hi.min(self.kmax);
@@ -120,8 +148,8 @@ impl Search<'_> {
     /// `a` is swept on `inn ∪ undecided`.
     fn visit(&mut self, a: &[f64], inn: &mut Vec<usize>, undecided: &[usize]) {
         self.nodes += 1;
-        if self.nodes >= self.limit || (self.nodes.is_multiple_of(4096) && Instant::now() > self.deadline) {
-            self.stopped = true;
+        if self.nodes == CHECK_EVERY {
+            self.report();
         }
         if self.stopped {
             return;
@@ -154,6 +182,30 @@ impl Search<'_> {
         self.visit(a, inn, rest);
         inn.pop();
     }
+}
+
+/// The roots of the subtrees below every choice (out, then in: the order one search visits
+/// them) of the first `depth` undecided terms: (matrix swept on inn ∪ undecided, inn,
+/// undecided). Depth 0 is the whole tree.
+fn regions(
+    sc: &Scaled,
+    a: &[f64],
+    inn: &[usize],
+    undecided: &[usize],
+    depth: usize,
+) -> Vec<(Vec<f64>, Vec<usize>, Vec<usize>)> {
+    if depth == 0 || undecided.is_empty() {
+        return vec![(a.to_vec(), inn.to_vec(), undecided.to_vec())];
+    }
+    let (u, rest) = (undecided[0], &undecided[1..]);
+    let (m, t) = (sc.m, sc.p);
+    let mut out_of = vec![0.0; m * m];
+    sweep_out(a, &mut out_of, m, u, rest, t);
+    let mut all = regions(sc, &out_of, inn, rest, depth - 1);
+    let mut with_u = inn.to_vec();
+    with_u.push(u);
+    all.extend(regions(sc, a, &with_u, rest, depth - 1));
+    all
 }
 
 impl Selector for BestSubset {
@@ -209,34 +261,68 @@ impl BestSubset {
             return Err(SelectError::TooFewRows { rows: sc.n, terms: forced.len(), intercept: pb.intercept });
         }
         // first bounds: the forward stepwise path
-        let mut search = Search {
-            sc: &sc,
-            kmax,
-            best: vec![(f64::INFINITY, vec![]); kmax + 1],
-            nodes: 0,
-            limit: self.node_limit,
-            deadline: Instant::now() + std::time::Duration::from_secs_f64(self.time_limit.max(0.0)),
-            stopped: false,
-            stack: vec![vec![0.0; m * m]; kept.len() + 1],
-        };
+        let mut best = vec![(f64::INFINITY, vec![]); kmax + 1];
         if let Ok(path) = (Stepwise { step_rule: super::StepRule::Last, ..Stepwise::default() }).select(pb) {
             for st in &path.steps {
-                search.record((1.0 - st.r2).max(RSS_FLOOR), &[&st.set]);
+                let k = st.set.len();
+                let rss = (1.0 - st.r2).max(RSS_FLOOR);
+                if k <= kmax && rss < best[k].0 {
+                    let mut set = st.set.clone();
+                    set.sort_unstable();
+                    best[k] = (rss, set);
+                }
             }
         }
-        let mut inn = forced.clone();
-        search.visit(&a, &mut inn, &kept);
-        if search.stopped {
+        let limits = Limits {
+            nodes: AtomicU64::new(0),
+            node_limit: self.node_limit,
+            deadline: Instant::now() + std::time::Duration::from_secs_f64(self.time_limit.max(0.0)),
+            stopped: AtomicBool::new(false),
+        };
+        // the subtrees below each choice of the first few terms are searched in parallel, each
+        // pruning against its own best sets; merged in the order one search would have met
+        // them (an earlier region keeps a tie), the result is the sequential search's
+        let split = if kept.len() > 10 { 3 } else { 0 };
+        let regions = regions(&sc, &a, &forced, &kept, split);
+        use rayon::prelude::*;
+        let found: Vec<(Best, bool)> = regions
+            .par_iter()
+            .map(|(a, inn, undecided)| {
+                let mut search = Search {
+                    sc: &sc,
+                    kmax,
+                    best: best.clone(),
+                    nodes: 0,
+                    limits: &limits,
+                    stopped: false,
+                    stack: vec![vec![0.0; m * m]; undecided.len() + 1],
+                };
+                let mut inn = inn.clone();
+                search.visit(a, &mut inn, undecided);
+                search.report();
+                (search.best, search.stopped)
+            })
+            .collect();
+        let mut stopped = false;
+        for (region, s) in found {
+            stopped |= s;
+            for (b, r) in best.iter_mut().zip(region) {
+                if r.0 < b.0 {
+                    *b = r;
+                }
+            }
+        }
+        let nodes = limits.nodes.load(Ordering::Relaxed);
+        if stopped {
             notes.push(format!(
-                "search stopped at its limit after {} nodes: the subsets reported are the best found, not proven best",
-                search.nodes
+                "search stopped at its limit after {nodes} nodes: the subsets reported are the best found, not proven best"
             ));
         } else {
-            notes.push(format!("exact: {} nodes searched", search.nodes));
+            notes.push(format!("exact: {nodes} nodes searched"));
         }
         // one step per size, chosen by the criterion
         let n = sc.n as f64;
-        let full_rss = search.best.iter().rev().find(|b| b.0.is_finite()).map_or(1.0, |b| b.0);
+        let full_rss = best.iter().rev().find(|b| b.0.is_finite()).map_or(1.0, |b| b.0);
         let sigma2 = full_rss / (sc.n_eff - kmax as f64).max(1.0);
         let mut steps = Vec::new();
         let mut scores = Vec::new();
@@ -244,7 +330,7 @@ impl BestSubset {
             Criterion::LeaveOneRunOut => Some(super::CrossValidation::new(pb, folds)?),
             _ => None,
         };
-        for (k, (rss, set)) in search.best.iter().enumerate() {
+        for (k, (rss, set)) in best.iter().enumerate() {
             if !rss.is_finite() || set.len() != k || k < forced.len().max(1) {
                 continue;
             }
@@ -275,7 +361,7 @@ impl BestSubset {
         for (i, st) in steps.iter_mut().enumerate() {
             st.step = i + 1;
         }
-        let stop = if search.stopped { Stop::Limit { nodes: search.nodes } } else { Stop::AllEntered };
+        let stop = if stopped { Stop::Limit { nodes } } else { Stop::AllEntered };
         Ok(Selection::from_steps(self.name(), sc.n, pb.names, steps, chosen, stop, notes))
     }
 }
