@@ -91,8 +91,10 @@ struct Search<'a> {
     stack: Vec<Vec<f64>>,
 }
 
-/// The node and time limits, shared by the regions searched in parallel.
+/// What the regions searched in parallel share: the limits, and per size the smallest RSS
+/// any region has found (f64 bits; for non-negative floats their order is the integers').
 struct Limits {
+    found: Vec<AtomicU64>,
     nodes: AtomicU64,
     node_limit: u64,
     deadline: Instant,
@@ -125,6 +127,7 @@ impl Search<'_> {
             let mut s: Vec<usize> = parts.concat();
             s.sort_unstable();
             self.best[k] = (rss, s);
+            self.limits.found[k].fetch_min(rss.to_bits(), Ordering::Relaxed);
         }
     }
 
@@ -139,10 +142,16 @@ impl Search<'_> {
         self.stopped = self.limits.stopped.load(Ordering::Relaxed);
     }
 
-    /// No size in `lo..=hi` (capped at the largest searched) can improve with RSS ≥ `rss`.
+    /// No size in `lo..=hi` (capped at the largest searched) can improve with RSS ≥ `rss`
+    /// on this region's best, or with RSS > another region's: a tie with another region is
+    /// still searched, so that the merge can keep the one a single search would have met
+    /// first whatever the timing.
     fn hopeless(&self, lo: usize, hi: usize, rss: f64) -> bool {
         let hi = hi.min(self.kmax);
-        lo > hi || (lo..=hi).all(|k| rss >= self.best[k].0)
+        lo > hi
+            || (lo..=hi).all(|k| {
+                rss >= self.best[k].0 || rss > f64::from_bits(self.limits.found[k].load(Ordering::Relaxed))
+            })
     }
 
     /// `a` is swept on `inn ∪ undecided`.
@@ -274,6 +283,7 @@ impl BestSubset {
             }
         }
         let limits = Limits {
+            found: best.iter().map(|b| AtomicU64::new(b.0.to_bits())).collect(),
             nodes: AtomicU64::new(0),
             node_limit: self.node_limit,
             deadline: Instant::now() + std::time::Duration::from_secs_f64(self.time_limit.max(0.0)),
