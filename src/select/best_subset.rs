@@ -7,6 +7,8 @@
 //! matrix (the sweep is its own inverse), so a node costs O(p²).
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+
+use rayon::prelude::*;
 use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
@@ -289,12 +291,12 @@ impl BestSubset {
             deadline: Instant::now() + std::time::Duration::from_secs_f64(self.time_limit.max(0.0)),
             stopped: AtomicBool::new(false),
         };
-        // the subtrees below each choice of the first few terms are searched in parallel, each
-        // pruning against its own best sets; merged in the order one search would have met
-        // them (an earlier region keeps a tie), the result is the sequential search's
+        // the subtrees below each choice of the first three terms are searched in parallel,
+        // each pruning on its own best sets and, strictly, on the others' (`hopeless`); merged
+        // in the order one search would have met them (an earlier region keeps a tie), the
+        // result is the sequential search's
         let split = if kept.len() > 10 { 3 } else { 0 };
         let regions = regions(&sc, &a, &forced, &kept, split);
-        use rayon::prelude::*;
         let found: Vec<(Best, bool)> = regions
             .par_iter()
             .map(|(a, inn, undecided)| {
