@@ -4,7 +4,9 @@
 //! criterion. A node of the search is (terms in, terms undecided); every completion's RSS is
 //! at least the RSS with all undecided terms in, so a node whose bound cannot beat the best
 //! of any size it could still reach is pruned. Excluding a term is one sweep of the parent's
-//! matrix (the sweep is its own inverse), so a node costs O(p²).
+//! matrix (the sweep is its own inverse), so a node costs O(p²). The subtrees below the
+//! choices of the first three terms are searched in parallel and merged so that the result
+//! is exactly the sequential search's.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
