@@ -81,6 +81,19 @@ const RSS_FLOOR: f64 = 1e-13;
 /// Per model size, the smallest relative RSS found and its set (sorted).
 type Best = Vec<(f64, Vec<usize>)>;
 
+/// Keeps the set made of `parts` if it is the best of its size (at most `kmax`) so far; the
+/// size if kept. The set is only assembled then: most candidates do not improve on anything.
+fn keep_if_better(best: &mut Best, kmax: usize, rss: f64, parts: &[&[usize]]) -> Option<usize> {
+    let k = parts.iter().map(|p| p.len()).sum::<usize>();
+    if k > kmax || rss >= best[k].0 {
+        return None;
+    }
+    let mut set: Vec<usize> = parts.concat();
+    set.sort_unstable();
+    best[k] = (rss, set);
+    Some(k)
+}
+
 /// One search over a region of the tree (the whole tree, or the subtree below a fixed choice
 /// of the first terms, searched beside the others).
 struct Search<'a> {
@@ -123,14 +136,10 @@ fn sweep_out(a: &[f64], b: &mut [f64], m: usize, u: usize, rest: &[usize], t: us
 }
 
 impl Search<'_> {
-    /// Keeps the set made of `parts` if it is the best of its size so far (the set is only
-    /// assembled then: most nodes do not improve on anything).
+    /// Keeps the set made of `parts` if it is this region's best of its size so far, and
+    /// tells the other regions its RSS.
     fn record(&mut self, rss: f64, parts: &[&[usize]]) {
-        let k = parts.iter().map(|p| p.len()).sum::<usize>();
-        if k <= self.kmax && rss < self.best[k].0 {
-            let mut s: Vec<usize> = parts.concat();
-            s.sort_unstable();
-            self.best[k] = (rss, s);
+        if let Some(k) = keep_if_better(&mut self.best, self.kmax, rss, parts) {
             self.limits.found[k].fetch_min(rss.to_bits(), Ordering::Relaxed);
         }
     }
@@ -277,13 +286,7 @@ impl BestSubset {
         let mut best = vec![(f64::INFINITY, vec![]); kmax + 1];
         if let Ok(path) = (Stepwise { step_rule: super::StepRule::Last, ..Stepwise::default() }).select(pb) {
             for st in &path.steps {
-                let k = st.set.len();
-                let rss = (1.0 - st.r2).max(RSS_FLOOR);
-                if k <= kmax && rss < best[k].0 {
-                    let mut set = st.set.clone();
-                    set.sort_unstable();
-                    best[k] = (rss, set);
-                }
+                keep_if_better(&mut best, kmax, (1.0 - st.r2).max(RSS_FLOOR), &[&st.set]);
             }
         }
         let limits = Limits {
