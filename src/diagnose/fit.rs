@@ -3,6 +3,7 @@
 //! fit a hypothesis's parameters by Gauss-Newton / Levenberg-Marquardt on those residuals.
 
 use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 
 use super::hypotheses::{Effect, Hypothesis};
 use super::{DiagnoseError, Gap, Location};
@@ -151,13 +152,14 @@ impl Runs {
                 )));
             }
         }
+        // states, scales and units are parallel lists
+        fn kept<T>(v: Vec<T>, keep: &[bool]) -> Vec<T> {
+            v.into_iter().zip(keep).filter(|(_, k)| **k).map(|(x, _)| x).collect()
+        }
         let keep: Vec<bool> = self.states.iter().map(|(_, s)| names.contains(s)).collect();
-        let mut k = keep.iter();
-        self.states.retain(|_| *k.next().unwrap_or(&false));
-        let mut k = keep.iter();
-        self.scale.retain(|_| *k.next().unwrap_or(&false));
-        let mut k = keep.iter();
-        self.units.retain(|_| *k.next().unwrap_or(&false));
+        self.states = kept(self.states, &keep);
+        self.scale = kept(self.scale, &keep);
+        self.units = kept(self.units, &keep);
         Ok(self)
     }
 
@@ -386,7 +388,6 @@ fn residuals(data: &Runs, model: &Model, h: &Hypothesis, theta: &[f64]) -> Optio
 
 fn jacobian(data: &Runs, model: &Model, h: &Hypothesis, theta: &[f64]) -> Option<(Vec<f64>, DMatrix<f64>)> {
     let r0 = residuals(data, model, h, theta)?;
-    use rayon::prelude::*;
     // the columns are independent re-simulations: all threads take them
     let columns: Vec<Option<Vec<f64>>> = (0..theta.len())
         .into_par_iter()
