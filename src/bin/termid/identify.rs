@@ -201,6 +201,7 @@ fn configure_backend(cmd: &IdentifyCommand) -> Result<Backend> {
 fn run_model(cmd: IdentifyCommand) -> Result<()> {
     let path = cmd.model.clone().context("--model")?;
     let mut model = termid::model::Model::load(&path)?;
+    let refine = cmd.refine.as_deref().map(|list| refine_states(list, &model)).transpose()?;
     let time = model.spec.model.time.clone();
     let frames = crate::runs::load(&cmd.data, cmd.dataset.as_deref(), &time)?;
     let names: Vec<String> =
@@ -220,14 +221,6 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
             None => (1.0, unit),
         }
     })?;
-    if let Some(list) = cmd.refine.as_deref().filter(|l| l.trim() != "all") {
-        let known: Vec<&str> = model.spec.states.iter().map(|s| s.name.as_str()).collect();
-        for name in list.split(',').map(str::trim).filter(|n| !n.is_empty()) {
-            if !known.contains(&name) {
-                bail!("--refine {list}: `{name}` is not a state of the model ({})", known.join(", "));
-            }
-        }
-    }
     if cmd.target.is_some() && names.len() != 1 {
         bail!("--target applies to one equation: name it with --equation");
     }
@@ -262,9 +255,9 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
     }
     // a refinement that fails loses nothing: the regression's model is still written, and
     // the command ends with the refinement's error
-    let (refined, refine_error) = match &cmd.refine {
+    let (refined, refine_error) = match &refine {
         Some(states) => match crate::progress::with_spinner("refining by output error", || {
-            refine_by_output_error(&model, &frames, states, !cmd.no_intercept)
+            refine_by_output_error(&model, &frames, states.as_deref(), !cmd.no_intercept)
         }) {
             Ok(r) => {
                 model = r.model.clone();
@@ -318,22 +311,33 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
 /// `identify --refine`: every identified coefficient refined by output error on the runs as
 /// they were prepared for the regression (smoothed initial states: a noisy first sample of a
 /// rate would otherwise drift through its integral).
+/// The states `--refine` names (`None`: all), each checked to be one of the model's.
+fn refine_states(list: &str, model: &termid::model::Model) -> Result<Option<Vec<String>>> {
+    if list.trim() == "all" {
+        return Ok(None);
+    }
+    let known: Vec<&str> = model.spec.states.iter().map(|s| s.name.as_str()).collect();
+    let names: Vec<String> =
+        list.split(',').map(str::trim).filter(|n| !n.is_empty()).map(String::from).collect();
+    if let Some(name) = names.iter().find(|n| !known.contains(&n.as_str())) {
+        bail!("--refine {list}: `{name}` is not a state of the model ({})", known.join(", "));
+    }
+    Ok(Some(names))
+}
+
 fn refine_by_output_error(
     model: &termid::model::Model,
     frames: &[Frame],
-    states: &str,
+    states: Option<&[String]>,
     intercept: bool,
 ) -> Result<termid::diagnose::Refined> {
     let sample = frames.iter().map(|f| termid::data::median_step(f.time())).fold(f64::INFINITY, f64::min);
     // one RK4 step per sample: the recorded input is known only at the samples
     let runs = termid::diagnose::Runs::new(model, frames, sample, termid::sim::Integrator::Rk4)?
         .with_intercepts(intercept);
-    let runs = if states.trim() == "all" {
-        runs
-    } else {
-        let names: Vec<String> =
-            states.split(',').map(|s| s.trim().to_string()).filter(|s| !s.is_empty()).collect();
-        runs.comparing(&names)?
+    let runs = match states {
+        Some(names) => runs.comparing(names)?,
+        None => runs,
     };
     Ok(termid::diagnose::refine(model, &runs)?)
 }
