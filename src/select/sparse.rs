@@ -99,6 +99,14 @@ impl Default for SparseFit {
     }
 }
 
+/// c_j − (R b)_j: column j's correlation with the residual of the standardised coefficients
+/// `b` (the LASSO's optimality conditions and the screening rule are about it).
+fn residual_correlation(sc: &Scaled, b: &[f64], j: usize) -> f64 {
+    let (p, m) = (sc.p, sc.m);
+    sc.a[j * m + p]
+        - b.iter().enumerate().filter(|(_, v)| **v != 0.0).map(|(i, v)| sc.a[j * m + i] * v).sum::<f64>()
+}
+
 impl SparseFit {
     /// Checks the settings.
     pub fn validate(&self) -> Result<(), SelectError> {
@@ -153,15 +161,8 @@ impl SparseFit {
         always: &[bool],
         cache: &mut Option<(Vec<usize>, DefaultSolver<f64>)>,
     ) -> Result<Vec<f64>, SelectError> {
-        let (p, m) = (sc.p, sc.m);
-        let correlation = |b: &[f64], j: usize| -> f64 {
-            sc.a[j * m + p]
-                - b.iter()
-                    .enumerate()
-                    .filter(|(_, v)| **v != 0.0)
-                    .map(|(i, v)| sc.a[j * m + i] * v)
-                    .sum::<f64>()
-        };
+        let p = sc.p;
+        let correlation = |b: &[f64], j: usize| residual_correlation(sc, b, j);
         let (lambda_prev, b_prev) = previous;
         if let Some(beta) = self.closed_form(sc, pb, lambda, b_prev, w) {
             return Ok(beta);
@@ -255,7 +256,7 @@ impl SparseFit {
                 }
             }
             for j in (0..p).filter(|&j| open[j] && !set.contains(&j)) {
-                let c = sc.a[j * m + p] - set.iter().map(|&i| sc.a[j * m + i] * beta[i]).sum::<f64>();
+                let c = residual_correlation(sc, &beta, j);
                 if c.abs() > lambda * w[j] {
                     sign[j] = c.signum();
                     changed = true;
