@@ -169,9 +169,9 @@ pub struct Accumulator {
     /// The statistics of the chunk being flushed (kept: a fresh one per chunk cost more in
     /// allocation than its merge).
     chunk: Moments,
-    /// Chunk buffer, (p+1) columns of `ld` rows, column-major: (z − shift)·√w.
+    /// Chunk buffer, (p+1) columns of [`CHUNK`] rows, column-major: (z − shift)·√w; empty
+    /// until the first rows arrive.
     buf: Vec<f64>,
-    ld: usize,
     /// Per column, the chunk's shift and Σ w (z − shift) of the rows in the chunk.
     shift: Vec<f64>,
     sums: Vec<f64>,
@@ -191,7 +191,6 @@ impl Accumulator {
             moments: Moments::new(p),
             chunk: Moments::new(p),
             buf: Vec::new(),
-            ld: 0,
             shift: vec![0.0; p + 1],
             sums: vec![0.0; p + 1],
             wsum: 0.0,
@@ -225,10 +224,10 @@ impl Accumulator {
         assert!(weights.is_none_or(|w| w.len() == rows), "push_columns: one weight per row");
         let mut done = 0;
         while done < rows {
-            if self.filled == self.ld && self.ld < CHUNK {
-                self.grow(CHUNK);
+            if self.buf.is_empty() {
+                self.take_buffer();
             }
-            let (ld, at) = (self.ld, self.filled);
+            let (ld, at) = (CHUNK, self.filled);
             let take = (ld - at).min(rows - done);
             let part = done..done + take;
             if at == 0 {
@@ -280,23 +279,17 @@ impl Accumulator {
         self.not_finite
     }
 
-    /// Re-lays the chunk buffer out for `ld` rows per column, in the thread's spare buffer
-    /// when there is one (its old contents need no clearing: rows are written before they
-    /// are read).
-    fn grow(&mut self, ld: usize) {
-        let m = self.moments.p + 1;
+    /// The chunk buffer, from the thread's spare buffer when there is one (its old contents
+    /// need no clearing: rows are written before they are read).
+    fn take_buffer(&mut self) {
+        let len = (self.moments.p + 1) * CHUNK;
         let mut buf = SPARE.with(|s| std::mem::take(&mut *s.borrow_mut()));
-        if buf.len() >= m * ld {
-            buf.truncate(m * ld);
+        if buf.len() >= len {
+            buf.truncate(len);
         } else {
-            buf.resize(m * ld, 0.0);
-        }
-        for j in 0..m {
-            buf[j * ld..j * ld + self.filled]
-                .copy_from_slice(&self.buf[j * self.ld..j * self.ld + self.filled]);
+            buf.resize(len, 0.0);
         }
         self.buf = buf;
-        self.ld = ld;
     }
 
     fn flush(&mut self) {
@@ -310,7 +303,7 @@ impl Accumulator {
         chunk.count = n;
         chunk.weight = self.wsum;
         if self.wsum > 0.0 {
-            super::gram::gram(&self.buf, self.ld, n, m, &mut chunk.comoment);
+            super::gram::gram(&self.buf, CHUNK, n, m, &mut chunk.comoment);
             let inv = 1.0 / self.wsum;
             for j in 0..m {
                 let sj = self.sums[j] * inv;
