@@ -474,17 +474,11 @@ impl Library {
     /// Fills a column-major `n × len()` design matrix.
     pub fn fill(&self, sources: &[Source<'_>], n: usize, out: &mut [f64]) {
         assert_eq!(out.len(), n * self.len(), "design buffer must hold n × terms values");
-        let mut slots = vec![0.0; self.ops.len() * BLOCK];
-        let mut start = 0;
-        while start < n {
-            let len = BLOCK.min(n - start);
-            self.eval_block(sources, start, len, &mut slots);
-            for (j, &slot) in self.outputs.iter().enumerate() {
-                out[j * n + start..j * n + start + len]
-                    .copy_from_slice(&slots[slot * BLOCK..slot * BLOCK + len]);
+        self.for_each_block(sources, 0..n, |start, columns| {
+            for (j, column) in columns.iter().enumerate() {
+                out[j * n + start..j * n + start + column.len()].copy_from_slice(column);
             }
-            start += len;
-        }
+        });
     }
 
     fn eval_block(&self, sources: &[Source<'_>], start: usize, len: usize, slots: &mut [f64]) {
