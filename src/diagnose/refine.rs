@@ -57,7 +57,8 @@ pub fn refine(model: &Model, runs: &Runs) -> Result<Refined, DiagnoseError> {
     let mut k = 0;
     for e in model.equations.iter().filter(|e| e.identify) {
         let first = k;
-        let eq = refined.equation(&e.name).cloned().ok_or_else(|| DiagnoseError::Setup(e.name.clone()))?;
+        let eq = refined.equation(&e.name).ok_or_else(|| DiagnoseError::Setup(e.name.clone()))?;
+        let intercept = eq.intercept;
         let coefficients: Vec<_> = eq
             .coefficients
             .iter()
@@ -68,7 +69,7 @@ pub fn refine(model: &Model, runs: &Runs) -> Result<Refined, DiagnoseError> {
             })
             .collect();
         let terms = coefficients.iter().map(|c| c.0.clone()).collect();
-        refined.set_coefficients(&e.name, coefficients, eq.intercept);
+        refined.set_coefficients(&e.name, coefficients, intercept);
         if let Some(c) = &fit.covariance {
             let matrix =
                 (first..k).map(|i| (first..k).map(|j| 0.5 * (c[(i, j)] + c[(j, i)])).collect()).collect();
