@@ -1,15 +1,17 @@
 //! Sufficient statistics of a linear regression: the weighted means and the corrected sums
 //! of cross-products a_jk = Σ w (z_j − z̄_j)(z_k − z̄_k) of the regressors and the target
 //! (target last), accumulated in one pass over the rows. Rows arrive in blocks; each chunk
-//! is centred on its own mean, its cross-products formed by a BLAS-class product (matrixmultiply
-//! through nalgebra on a transposed view), and chunks are merged with the pairwise update of
-//! Chan, Golub & LeVeque (1979). Statistics of several files simply [`Moments::merge`].
+//! is shifted by its first row, its cross-products formed by the register-tiled kernel of
+//! [`super::gram`] straight from the caller's columns, and chunks are merged with the pairwise
+//! update of Chan, Golub & LeVeque (1979). Statistics of several files simply
+//! [`Moments::merge`].
 
 use std::ops::Range;
 
-/// Most rows per chunk handed to the Gram kernel (the buffer grows to this as rows come).
-/// 512 rows of 30 columns stay below glibc's mmap threshold (128 KiB): larger chunks were
-/// mapped and unmapped on every fit, and the page faults cost more than the products.
+/// Most rows per chunk, i.e. per shift: the data's drift within a chunk stays small beside
+/// the shifted values. For weighted rows it is also the scratch block's height: 512 rows of 30
+/// columns stay below glibc's mmap threshold (128 KiB), above which every fit had paid page
+/// faults.
 const CHUNK: usize = 512;
 
 /// Means and corrected cross-products of `p` regressors and one target.
@@ -138,48 +140,34 @@ impl Moments {
     }
 }
 
-/// Copies `src − c` into `dst` and returns Σ (src − c), four partial sums: a single running
-/// sum is a chain of dependent additions (latency-bound, ~4× slower).
-fn shift_copy(src: &[f64], dst: &mut [f64], c: f64) -> f64 {
-    let mut lanes = [0.0f64; 4];
-    let mut rest = 0.0;
-    let (s4, d4) = (src.chunks_exact(4), dst.chunks_exact_mut(4));
-    for (x, d) in s4.remainder().iter().zip(d4.into_remainder()) {
-        *d = x - c;
-        rest += *d;
-    }
-    for (x, d) in src.chunks_exact(4).zip(dst.chunks_exact_mut(4)) {
-        for l in 0..4 {
-            d[l] = x[l] - c;
-            lanes[l] += d[l];
-        }
-    }
-    (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + rest
-}
-
 /// Accumulates [`Moments`] from blocks of rows without keeping them.
 ///
-/// Each chunk of rows is shifted by its first row as it is copied in (the sums of the shifted
-/// values are taken in the same pass), its cross-products formed by [`super::gram::gram`],
-/// and corrected to the chunk mean, G − s sᵀ/W: the shifted-data algorithm, as accurate as
-/// centring on the mean when the shift is a value of the data, with one pass fewer.
+/// Each chunk of rows is shifted by its first row, its cross-products formed by
+/// [`super::gram::gram_add`] straight from the caller's columns (shifted in registers) and
+/// the sums of the shifted values in a pass beside it, then corrected to the chunk mean,
+/// G − s sᵀ/W: the shifted-data algorithm, as accurate as centring on the mean when the shift
+/// is a value of the data, with one pass fewer. Weighted rows are first copied as
+/// (z − shift)·√w into a scratch block.
 #[derive(Debug)]
 pub struct Accumulator {
     moments: Moments,
-    /// The statistics of the chunk being flushed (kept: a fresh one per chunk cost more in
-    /// allocation than its merge).
+    /// The statistics of the chunk being gathered; its comoment collects the lower triangle
+    /// of the shifted cross-products until the chunk is flushed.
     chunk: Moments,
-    /// Chunk buffer, (p+1) columns of [`CHUNK`] rows, column-major: (z − shift)·√w; empty
-    /// until the first rows arrive.
-    buf: Vec<f64>,
     /// Per column, the chunk's shift and Σ w (z − shift) of the rows in the chunk.
     shift: Vec<f64>,
     sums: Vec<f64>,
     /// Σ w of the rows in the chunk.
     wsum: f64,
-    /// √w of the rows being copied.
-    root_w: Vec<f64>,
+    /// Rows in the chunk.
     filled: usize,
+    /// Weighted rows only: (z − shift)·√w, (p+1) columns of the piece's rows, from the
+    /// thread's spare buffer; √w of the rows; zero shifts for the kernel and room for the
+    /// kernel's sums, which are not the weighted ones.
+    scratch: Vec<f64>,
+    root_w: Vec<f64>,
+    zeros: Vec<f64>,
+    unused: Vec<f64>,
     /// The first column (p = target) whose sum was not finite.
     not_finite: Option<usize>,
 }
@@ -190,12 +178,14 @@ impl Accumulator {
         Accumulator {
             moments: Moments::new(p),
             chunk: Moments::new(p),
-            buf: Vec::new(),
             shift: vec![0.0; p + 1],
             sums: vec![0.0; p + 1],
             wsum: 0.0,
-            root_w: Vec::new(),
             filled: 0,
+            scratch: Vec::new(),
+            root_w: Vec::new(),
+            zeros: Vec::new(),
+            unused: Vec::new(),
             not_finite: None,
         }
     }
@@ -212,8 +202,8 @@ impl Accumulator {
     }
 
     /// Adds `y.len()` rows given as one slice per regressor (each as long as `y`): the rows
-    /// of a part of a larger column-major matrix, or a block of evaluated terms, without
-    /// first copying them together.
+    /// of a part of a larger column-major matrix, or a block of evaluated terms, read where
+    /// they are.
     pub fn push_columns(&mut self, columns: &[&[f64]], y: &[f64], weights: Option<&[f64]>) {
         let p = self.moments.p;
         let rows = y.len();
@@ -222,48 +212,53 @@ impl Accumulator {
             "push_columns: p columns of y.len() rows"
         );
         assert!(weights.is_none_or(|w| w.len() == rows), "push_columns: one weight per row");
+        let all = || columns.iter().copied().chain(std::iter::once(y));
+        let mut piece: Vec<&[f64]> = Vec::with_capacity(p + 1);
         let mut done = 0;
         while done < rows {
-            if self.buf.is_empty() {
-                self.take_buffer();
-            }
-            let (ld, at) = (CHUNK, self.filled);
-            let take = (ld - at).min(rows - done);
-            let part = done..done + take;
-            if at == 0 {
-                for (j, col) in columns.iter().chain(std::iter::once(&y)).enumerate() {
+            if self.filled == 0 {
+                for (j, col) in all().enumerate() {
                     let c = col[done];
                     self.shift[j] = if c.is_finite() { c } else { 0.0 };
                 }
                 self.sums.fill(0.0);
                 self.wsum = 0.0;
+                self.chunk.comoment.fill(0.0);
             }
-            if let Some(ws) = weights {
-                let ws = &ws[part.clone()];
-                self.root_w.clear();
-                self.root_w.extend(ws.iter().map(|w| w.sqrt()));
-                self.wsum += ws.iter().sum::<f64>();
-            } else {
-                self.wsum += take as f64;
-            }
-            for (j, col) in columns.iter().chain(std::iter::once(&y)).enumerate() {
-                let dst = &mut self.buf[j * ld + at..j * ld + at + take];
-                let src = &col[part.clone()];
-                let sum = if weights.is_some() {
-                    // (z − c)·√w into the buffer, Σ w (z − c) = Σ (z − c)·√w·√w beside it
-                    let mut sum = 0.0;
-                    for ((d, x), r) in dst.iter_mut().zip(src).zip(&self.root_w) {
-                        *d = (x - self.shift[j]) * r;
-                        sum += *d * r;
-                    }
-                    sum
-                } else {
-                    shift_copy(src, dst, self.shift[j])
-                };
-                if !sum.is_finite() && self.not_finite.is_none() {
-                    self.not_finite = Some(j);
+            let take = (CHUNK - self.filled).min(rows - done);
+            let part = done..done + take;
+            piece.clear();
+            match weights {
+                None => {
+                    self.wsum += take as f64;
+                    piece.extend(all().map(|col| &col[part.clone()]));
+                    super::gram::gram_add(&piece, &self.shift, &mut self.chunk.comoment, &mut self.sums);
                 }
-                self.sums[j] += sum;
+                Some(ws) => {
+                    let ws = &ws[part.clone()];
+                    self.root_w.clear();
+                    self.root_w.extend(ws.iter().map(|w| w.sqrt()));
+                    self.wsum += ws.iter().sum::<f64>();
+                    self.take_scratch(take);
+                    for (j, col) in all().enumerate() {
+                        // (z − c)·√w into the scratch block, Σ w (z − c) = Σ (z − c)·√w·√w
+                        let dst = &mut self.scratch[j * take..(j + 1) * take];
+                        let mut sum = 0.0;
+                        for ((d, x), r) in dst.iter_mut().zip(&col[part.clone()]).zip(&self.root_w) {
+                            *d = (x - self.shift[j]) * r;
+                            sum += *d * r;
+                        }
+                        self.sums[j] += sum;
+                    }
+                    self.zeros.resize(p + 1, 0.0);
+                    self.unused.resize(p + 1, 0.0);
+                    let scaled: Vec<&[f64]> = self.scratch.chunks_exact(take).collect();
+                    // the kernel's own sums of these values, Σ (z − c)·√w, are not needed
+                    super::gram::gram_add(&scaled, &self.zeros, &mut self.chunk.comoment, &mut self.unused);
+                }
+            }
+            if self.not_finite.is_none() {
+                self.not_finite = self.sums.iter().position(|s| !s.is_finite());
             }
             self.filled += take;
             done += take;
@@ -279,17 +274,18 @@ impl Accumulator {
         self.not_finite
     }
 
-    /// The chunk buffer, from the thread's spare buffer when there is one (its old contents
-    /// need no clearing: rows are written before they are read).
-    fn take_buffer(&mut self) {
-        let len = (self.moments.p + 1) * CHUNK;
-        let mut buf = SPARE.with(|s| std::mem::take(&mut *s.borrow_mut()));
-        if buf.len() >= len {
-            buf.truncate(len);
-        } else {
-            buf.resize(len, 0.0);
+    /// A scratch block of (p+1) × `rows`, from the thread's spare buffer when there is one
+    /// (its old contents need no clearing: every value is written before it is read).
+    fn take_scratch(&mut self, rows: usize) {
+        let len = (self.moments.p + 1) * rows;
+        if self.scratch.is_empty() {
+            self.scratch = SPARE.with(|s| std::mem::take(&mut *s.borrow_mut()));
         }
-        self.buf = buf;
+        if self.scratch.len() >= len {
+            self.scratch.truncate(len);
+        } else {
+            self.scratch.resize(len, 0.0);
+        }
     }
 
     fn flush(&mut self) {
@@ -303,7 +299,7 @@ impl Accumulator {
         chunk.count = n;
         chunk.weight = self.wsum;
         if self.wsum > 0.0 {
-            super::gram::gram(&self.buf, CHUNK, n, m, &mut chunk.comoment);
+            super::gram::mirror(&mut chunk.comoment, m);
             let inv = 1.0 / self.wsum;
             for j in 0..m {
                 let sj = self.sums[j] * inv;
@@ -341,6 +337,9 @@ fn part_rows(rows: usize) -> usize {
 /// The statistics of several runs (`runs[k]` rows each), gathered in parallel: the rows are
 /// cut into parts, `feed(run, rows, accumulator)` pushes the rows of one part, and the parts
 /// are merged in row order. The first error, in run and row order, is returned.
+///
+/// (A fixed binary tree of `rayon::join`s that also merged the parts in parallel was tried:
+/// 3 % slower per 2 505-row fit, the second thread joining later.)
 pub fn gather<E: Send>(
     p: usize,
     runs: &[usize],
@@ -393,15 +392,15 @@ impl Moments {
 }
 
 thread_local! {
-    /// The last chunk buffer, kept for the next accumulator on this thread: a fit accumulates
-    /// run after run, and a fresh 100 kB buffer each time came back from the system as fresh
-    /// pages — page faults cost more than the products (half of a 2 505-row fit).
+    /// The last scratch block of weighted rows, kept for the next accumulator on this thread:
+    /// a fit accumulates run after run, and a fresh 100 kB buffer each time came back from the
+    /// system as fresh pages — page faults cost more than the products.
     static SPARE: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 impl Drop for Accumulator {
     fn drop(&mut self) {
-        let buf = std::mem::take(&mut self.buf);
+        let buf = std::mem::take(&mut self.scratch);
         SPARE.with(|s| {
             let mut spare = s.borrow_mut();
             if buf.capacity() > spare.capacity() {

@@ -464,7 +464,7 @@ impl Library {
             let len = BLOCK.min(rows.end - start);
             self.eval_block(sources, start, len, &mut slots);
             let columns: Vec<&[f64]> =
-                self.outputs.iter().map(|&slot| &slots[slot * BLOCK..slot * BLOCK + len]).collect();
+                self.outputs.iter().map(|&slot| self.operand(sources, &slots, slot, start, len)).collect();
             visit(start, &columns);
             start += len;
         }
@@ -481,33 +481,55 @@ impl Library {
         });
     }
 
+    /// The values of `slot` on rows `start..start + len` of the block: an input column is read
+    /// where it is (copying it into its slot had cost a tenth of the evaluation, and all of it
+    /// for a finished design matrix), any other slot from the block's buffer.
+    fn operand<'a>(
+        &self,
+        sources: &[Source<'a>],
+        done: &'a [f64],
+        slot: usize,
+        start: usize,
+        len: usize,
+    ) -> &'a [f64] {
+        match self.ops[slot] {
+            Op::Input(j) => match sources[j] {
+                Source::Column(c) => &c[start..start + len],
+                Source::Constant(_) => &done[slot * BLOCK..slot * BLOCK + len],
+            },
+            _ => &done[slot * BLOCK..slot * BLOCK + len],
+        }
+    }
+
     fn eval_block(&self, sources: &[Source<'_>], start: usize, len: usize, slots: &mut [f64]) {
         for (i, op) in self.ops.iter().enumerate() {
             let (done, rest) = slots.split_at_mut(i * BLOCK);
+            let done = &*done;
             let dst = &mut rest[..len];
+            let at = |a: usize| self.operand(sources, done, a, start, len);
             match op {
                 Op::Input(j) => match sources[*j] {
-                    Source::Column(c) => dst.copy_from_slice(&c[start..start + len]),
+                    Source::Column(_) => {} // read in place by `operand`
                     Source::Constant(v) => dst.fill(v),
                 },
                 Op::Const(c) => dst.fill(*c),
                 Op::Mul(a, b) => {
-                    let (a, b) = (&done[a * BLOCK..a * BLOCK + len], &done[b * BLOCK..b * BLOCK + len]);
-                    for ((d, x), y) in dst.iter_mut().zip(a).zip(b) {
+                    for ((d, x), y) in dst.iter_mut().zip(at(*a)).zip(at(*b)) {
                         *d = x * y;
                     }
                 }
                 Op::Recip(a) => {
-                    for (d, x) in dst.iter_mut().zip(&done[a * BLOCK..a * BLOCK + len]) {
+                    for (d, x) in dst.iter_mut().zip(at(*a)) {
                         *d = 1.0 / x;
                     }
                 }
                 Op::Call(f, args) => {
                     let func = super::functions::FUNCTIONS[*f].eval;
+                    let columns: Vec<&[f64]> = args.iter().map(|&a| at(a)).collect();
                     let mut buf = vec![0.0; args.len()];
                     for (r, d) in dst.iter_mut().enumerate() {
-                        for (b, &a) in buf.iter_mut().zip(args) {
-                            *b = done[a * BLOCK + r];
+                        for (b, column) in buf.iter_mut().zip(&columns) {
+                            *b = column[r];
                         }
                         *d = func(&buf);
                     }
@@ -515,7 +537,7 @@ impl Library {
                 Op::Lin(parts) => {
                     dst.fill(0.0);
                     for &(c, k) in parts {
-                        for (d, x) in dst.iter_mut().zip(&done[k * BLOCK..k * BLOCK + len]) {
+                        for (d, x) in dst.iter_mut().zip(at(k)) {
                             *d += c * x;
                         }
                     }
