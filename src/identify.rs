@@ -165,6 +165,37 @@ pub struct Fit {
     pub correlation_time: Option<f64>,
 }
 
+/// An equation's candidate terms compiled for evaluation, with their names: all of a fit that
+/// does not depend on the runs. Build it once to fit the same candidates to many sets of runs
+/// (repeated timings, resampling); [`Identification::fit`] builds one per call.
+#[derive(Clone, Debug)]
+pub struct Design {
+    candidates: Vec<Term>,
+    library: Library,
+    names: Vec<String>,
+}
+
+impl Design {
+    /// Compiles `candidates` with the vocabulary they were parsed with.
+    pub fn new(candidates: &[Term], vocabulary: &Vocabulary) -> Result<Design, IdentifyError> {
+        Ok(Design {
+            candidates: candidates.to_vec(),
+            library: Library::compile(candidates, vocabulary)?,
+            names: candidates.iter().map(Term::to_string).collect(),
+        })
+    }
+
+    /// The candidate terms, in column order.
+    pub fn candidates(&self) -> &[Term] {
+        &self.candidates
+    }
+
+    /// Their canonical text.
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+}
+
 /// One run bound to a compiled library (see `Identification::bind`).
 struct BoundRun<'a> {
     frame: &'a Frame,
@@ -327,22 +358,39 @@ impl Identification<'_> {
         frames: &[Frame],
         backend: &dyn Selector,
     ) -> Result<Fit, IdentifyError> {
+        // compiling overlaps with the worker's waking
+        self.wake_a_worker();
+        let design = Design::new(candidates, self.vocabulary)?;
+        self.fit_woken(target, &design, forced, excluded, frames, backend)
+    }
+
+    /// [`Identification::fit`] with the candidates already compiled.
+    pub fn fit_design(
+        &self,
+        target: &Target,
+        design: &Design,
+        forced: &[Term],
+        excluded: &[Term],
+        frames: &[Frame],
+        backend: &dyn Selector,
+    ) -> Result<Fit, IdentifyError> {
+        self.wake_a_worker();
+        self.fit_woken(target, design, forced, excluded, frames, backend)
+    }
+
+    fn fit_woken(
+        &self,
+        target: &Target,
+        design: &Design,
+        forced: &[Term],
+        excluded: &[Term],
+        frames: &[Frame],
+        backend: &dyn Selector,
+    ) -> Result<Fit, IdentifyError> {
         if frames.is_empty() {
             return Err(IdentifyError::Setup("no data: give at least one run".into()));
         }
-        // wake a sleeping worker now, so that it is looking for work when the rows are
-        // gathered after the terms are compiled (waking it then cost ~25 µs of a 0.1 ms fit)
-        if rayon::current_num_threads() > 1 {
-            rayon::spawn(|| {});
-        }
-        let library = Library::compile(candidates, self.vocabulary)?;
-        // per run, for the back-ends that cross-validate; together they are "Komb. Daten"
-        let folds = self.moments_of_runs(&library, candidates, target, frames)?;
-        let mut moments = Moments::new(candidates.len());
-        for f in &folds {
-            moments.merge(f);
-        }
-        let names: Vec<String> = candidates.iter().map(Term::to_string).collect();
+        let candidates = design.candidates();
         let index_of = |t: &Term, role: &str| {
             candidates
                 .iter()
@@ -351,9 +399,15 @@ impl Identification<'_> {
         };
         let forced = forced.iter().map(|t| index_of(t, "forced")).collect::<Result<Vec<_>, _>>()?;
         let excluded = excluded.iter().map(|t| index_of(t, "excluded")).collect::<Result<Vec<_>, _>>()?;
+        // per run, for the back-ends that cross-validate; together they are "Komb. Daten"
+        let folds = self.moments_of_runs(&design.library, candidates, target, frames)?;
+        let mut moments = Moments::new(candidates.len());
+        for f in &folds {
+            moments.merge(f);
+        }
         let problem = Problem {
             moments: &moments,
-            names: &names,
+            names: design.names(),
             forced: &forced,
             excluded: &excluded,
             intercept: self.intercept,
@@ -364,11 +418,20 @@ impl Identification<'_> {
         // needs only the sufficient statistics, and is timed against the peers without it
         Ok(Fit {
             target: target.to_string(),
-            candidates: names,
+            candidates: design.names().to_vec(),
             selection,
             covariance,
             correlation_time: None,
         })
+    }
+
+    /// Wakes a sleeping worker, so that it is looking for work by the time the rows are
+    /// gathered (waking it only then cost ~25 µs of a 0.1 ms fit); a second call while it is
+    /// awake costs a queued empty job.
+    fn wake_a_worker(&self) {
+        if rayon::current_num_threads() > 1 {
+            rayon::spawn(|| {});
+        }
     }
 
     /// τ = 1 + 2 Σ ρₖ of the chosen equation's residuals, the autocorrelations ρₖ pooled over
@@ -418,12 +481,27 @@ pub fn fit_equation(
     intercept: bool,
     target: Option<Target>,
 ) -> Result<Fit, IdentifyError> {
-    let eq = model
-        .equation(equation)
-        .ok_or_else(|| IdentifyError::Setup(format!("{}: no equation `{equation}`", model.path)))?;
-    if eq.candidates.is_empty() {
-        return Err(IdentifyError::Setup(format!("{}: equation `{equation}` has no candidates", model.path)));
-    }
+    fit_equation_design(model, equation, None, frames, differentiator, intercept, target)
+}
+
+/// The compiled candidates of a model's equation, for [`fit_equation_design`].
+pub fn equation_design(model: &crate::model::Model, equation: &str) -> Result<Design, IdentifyError> {
+    let eq = model_equation(model, equation)?;
+    Design::new(&eq.candidates, &model.vocabulary)
+}
+
+/// [`fit_equation`] with the equation's candidates compiled beforehand by [`equation_design`]
+/// (`None`: compiled here).
+pub fn fit_equation_design(
+    model: &crate::model::Model,
+    equation: &str,
+    design: Option<&Design>,
+    frames: &[Frame],
+    differentiator: &dyn Differentiator,
+    intercept: bool,
+    target: Option<Target>,
+) -> Result<Fit, IdentifyError> {
+    let eq = model_equation(model, equation)?;
     let target = target.unwrap_or_else(|| {
         let column = format!("{}_dot", eq.state);
         if frames.iter().all(|f| f.column(&column).is_some()) {
@@ -441,7 +519,30 @@ pub fn fit_equation(
         weights: None,
     };
     let backend = eq.backend.build()?;
-    identification.fit(&target, &eq.candidates, &eq.forced, &eq.excluded, frames, backend.as_ref())
+    match design {
+        Some(d) if d.candidates() != eq.candidates.as_slice() => Err(IdentifyError::Setup(format!(
+            "{}: the compiled design given for `{equation}` is of other candidates",
+            model.path
+        ))),
+        Some(d) => identification.fit_design(&target, d, &eq.forced, &eq.excluded, frames, backend.as_ref()),
+        None => {
+            identification.fit(&target, &eq.candidates, &eq.forced, &eq.excluded, frames, backend.as_ref())
+        }
+    }
+}
+
+/// The model's equation `equation`, which must have candidates.
+fn model_equation<'m>(
+    model: &'m crate::model::Model,
+    equation: &str,
+) -> Result<&'m crate::model::Equation, IdentifyError> {
+    let eq = model
+        .equation(equation)
+        .ok_or_else(|| IdentifyError::Setup(format!("{}: no equation `{equation}`", model.path)))?;
+    if eq.candidates.is_empty() {
+        return Err(IdentifyError::Setup(format!("{}: equation `{equation}` has no candidates", model.path)));
+    }
+    Ok(eq)
 }
 
 /// [`Identification::correlation_time`] of an equation fitted by [`fit_equation`], with the

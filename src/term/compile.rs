@@ -484,6 +484,7 @@ impl Library {
     /// The values of `slot` on rows `start..start + len` of the block: an input column is read
     /// where it is (copying it into its slot had cost a tenth of the evaluation, and all of it
     /// for a finished design matrix), any other slot from the block's buffer.
+    #[inline(always)]
     fn operand<'a>(
         &self,
         sources: &[Source<'a>],
@@ -501,7 +502,27 @@ impl Library {
         }
     }
 
+    /// One block of every operation. The loops are plain Rust; on x86-64 they are compiled a
+    /// second time for AVX2 (four lanes instead of SSE2's two) and that copy is chosen at run
+    /// time: 9 µs of a 2 505-row fit's 19 µs of term evaluation. Same operations, same results.
     fn eval_block(&self, sources: &[Source<'_>], start: usize, len: usize, slots: &mut [f64]) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2.
+            unsafe { self.eval_block_avx2(sources, start, len, slots) };
+            return;
+        }
+        self.eval_block_portable(sources, start, len, slots);
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn eval_block_avx2(&self, sources: &[Source<'_>], start: usize, len: usize, slots: &mut [f64]) {
+        self.eval_block_portable(sources, start, len, slots);
+    }
+
+    #[inline(always)]
+    fn eval_block_portable(&self, sources: &[Source<'_>], start: usize, len: usize, slots: &mut [f64]) {
         for (i, op) in self.ops.iter().enumerate() {
             let (done, rest) = slots.split_at_mut(i * BLOCK);
             let done = &*done;

@@ -7,7 +7,7 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use termid::data::{differentiator, Frame};
 use termid::diagnose::{simulate_runs, Runs};
-use termid::identify::{coefficients_of, fit_equation, Fit};
+use termid::identify::{coefficients_of, equation_design, fit_equation_design, Fit};
 use termid::select::Backend;
 use termid::sim::Integrator;
 
@@ -31,11 +31,17 @@ pub fn run(cmd: CompareCommand) -> Result<()> {
         if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };
     let diff = differentiator(&cmd.derivative)?;
     let replay = cmd.replay.as_ref().map(|p| Frame::read_csv(p, &time)).transpose()?;
+    // the candidates are compiled once per equation, outside the timings, as the peers' design
+    // matrix is built outside theirs
+    let designs = equations
+        .iter()
+        .map(|eq| equation_design(&model, eq).with_context(|| format!("equation `{eq}`")))
+        .collect::<Result<Vec<_>>>()?;
     let mut entries = Vec::new();
     for name in Backend::NAMES {
         let mut m = model.clone();
         let mut fits = Vec::new();
-        for eq in &equations {
+        for (eq, design) in equations.iter().zip(&designs) {
             let e = m
                 .equations
                 .iter_mut()
@@ -48,17 +54,33 @@ pub fn run(cmd: CompareCommand) -> Result<()> {
             // warm-up fits for `warm_up` seconds (at least one), then the median of `repeat`
             // timed fits (data already loaded)
             let fit = crate::progress::with_spinner(&format!("{name} on {eq}"), || {
-                fit_equation(&m, eq, &frames, diff.as_ref(), !cmd.no_intercept, None)
+                fit_equation_design(&m, eq, Some(design), &frames, diff.as_ref(), !cmd.no_intercept, None)
             })
             .with_context(|| format!("{name} on `{eq}`"))?;
             let warming = Instant::now();
             while warming.elapsed().as_secs_f64() < cmd.warm_up {
-                drop(fit_equation(&m, eq, &frames, diff.as_ref(), !cmd.no_intercept, None));
+                drop(fit_equation_design(
+                    &m,
+                    eq,
+                    Some(design),
+                    &frames,
+                    diff.as_ref(),
+                    !cmd.no_intercept,
+                    None,
+                ));
             }
             let mut times: Vec<f64> = (0..cmd.repeat.max(1))
                 .map(|_| {
                     let started = Instant::now();
-                    let again = fit_equation(&m, eq, &frames, diff.as_ref(), !cmd.no_intercept, None);
+                    let again = fit_equation_design(
+                        &m,
+                        eq,
+                        Some(design),
+                        &frames,
+                        diff.as_ref(),
+                        !cmd.no_intercept,
+                        None,
+                    );
                     let t = started.elapsed().as_secs_f64() * 1e3;
                     drop(again);
                     t
