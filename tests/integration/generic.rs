@@ -4,7 +4,7 @@
 use std::collections::BTreeMap;
 
 use termid::data::{CentralDifference, Frame};
-use termid::identify::{fit_equation, Target};
+use termid::identify::{equation_design, fit_equation, fit_equation_design, Design, Target};
 use termid::model::Model;
 use termid::sim::{simulate, Constant, Integrator, Replay, Settings, System};
 
@@ -41,6 +41,28 @@ fn check(m: &Model, frames: &[Frame], target: fn(&str) -> Option<Target>, rel: f
 fn lorenz_identified_exactly_from_exact_derivatives() {
     let (m, f) = lorenz_run();
     check(&m, &[f], |_| None, 1e-6);
+}
+
+/// A design compiled once fits exactly as a fresh compilation does, and one compiled from
+/// other candidates is refused instead of fitting the wrong candidates.
+#[test]
+fn a_compiled_design_fits_as_a_fresh_one_and_only_its_own_equation() {
+    let (m, f) = lorenz_run();
+    let frames = [f];
+    for eq in &m.equations {
+        let design = equation_design(&m, &eq.name).unwrap();
+        let fresh = fit_equation(&m, &eq.name, &frames, &CentralDifference, false, None).unwrap();
+        let again =
+            fit_equation_design(&m, &eq.name, Some(&design), &frames, &CentralDifference, false, None)
+                .unwrap();
+        assert_eq!(fresh.selection, again.selection, "{}", eq.name);
+        assert_eq!(fresh.candidates, again.candidates);
+    }
+    let eq = &m.equations[0];
+    let fewer = Design::new(&eq.candidates[..3], &m.vocabulary).unwrap();
+    let err = fit_equation_design(&m, &eq.name, Some(&fewer), &frames, &CentralDifference, false, None)
+        .unwrap_err();
+    assert!(err.to_string().contains("other candidates"), "{err}");
 }
 
 #[test]
