@@ -175,9 +175,12 @@ pub struct Accumulator {
 impl Accumulator {
     /// An accumulator for `p` regressors.
     pub fn new(p: usize) -> Accumulator {
+        // both allocated when first needed: a part of a run is often a single chunk, which
+        // then simply becomes the statistics (allocating and zeroing them was a tenth of a fit)
+        let unallocated = || Moments { p, count: 0, weight: 0.0, mean: Vec::new(), comoment: Vec::new() };
         Accumulator {
-            moments: Moments::new(p),
-            chunk: Moments::new(p),
+            moments: unallocated(),
+            chunk: unallocated(),
             shift: vec![0.0; p + 1],
             sums: vec![0.0; p + 1],
             wsum: 0.0,
@@ -223,7 +226,11 @@ impl Accumulator {
                 }
                 self.sums.fill(0.0);
                 self.wsum = 0.0;
-                self.chunk.comoment.fill(0.0);
+                if self.chunk.comoment.len() == (p + 1) * (p + 1) {
+                    self.chunk.comoment.fill(0.0);
+                } else {
+                    self.chunk = Moments::new(p);
+                }
             }
             let take = (CHUNK - self.filled).min(rows - done);
             let part = done..done + take;
@@ -322,7 +329,18 @@ impl Accumulator {
     /// The statistics of all rows pushed.
     pub fn finish(mut self) -> Moments {
         self.flush();
-        std::mem::replace(&mut self.moments, Moments::new(0))
+        let p = self.moments.p;
+        let mut moments = std::mem::replace(
+            &mut self.moments,
+            Moments { p, count: 0, weight: 0.0, mean: Vec::new(), comoment: Vec::new() },
+        );
+        if moments.mean.len() != p + 1 {
+            // no row with weight
+            let count = moments.count;
+            moments = Moments::new(p);
+            moments.count = count;
+        }
+        moments
     }
 }
 
@@ -362,11 +380,16 @@ pub fn gather<E: Send>(
             Ok(acc.finish())
         })
         .collect();
-    let mut out: Vec<Moments> = runs.iter().map(|_| Moments::new(p)).collect();
+    // a run's first part becomes its statistics, the others are merged into it
+    let mut out: Vec<Option<Moments>> = runs.iter().map(|_| None).collect();
     for ((k, _), part) in jobs.iter().zip(parts) {
-        out[*k].merge(&part?);
+        let part = part?;
+        match &mut out[*k] {
+            Some(m) => m.merge(&part),
+            none => *none = Some(part),
+        }
     }
-    Ok(out)
+    Ok(out.into_iter().map(|m| m.unwrap_or_else(|| Moments::new(p))).collect())
 }
 
 impl Moments {

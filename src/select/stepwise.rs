@@ -174,9 +174,11 @@ impl Selector for Stepwise {
 
     fn select(&self, pb: &Problem<'_>) -> Result<Selection, SelectError> {
         self.validate()?;
-        let sc = Scaled::new(pb)?;
+        let mut sc = Scaled::new(pb)?;
         let (p, m, n) = (sc.p, sc.m, sc.n);
-        let mut a = sc.a.clone();
+        // the unswept matrix is needed again only to prune
+        let pruning = self.prune_t != 0.0 || self.prune_beta != 0.0;
+        let mut a = if pruning { sc.a.clone() } else { std::mem::take(&mut sc.a) };
         let mut entered: Vec<usize> = Vec::new();
         let mut notes = Vec::new();
         let mut steps: Vec<Step> = Vec::new();
