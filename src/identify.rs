@@ -359,7 +359,7 @@ impl Identification<'_> {
         backend: &dyn Selector,
     ) -> Result<Fit, IdentifyError> {
         // compiling overlaps with the worker's waking
-        self.wake_a_worker();
+        wake_a_worker();
         let design = Design::new(candidates, self.vocabulary)?;
         self.fit_woken(target, &design, forced, excluded, frames, backend)
     }
@@ -374,7 +374,7 @@ impl Identification<'_> {
         frames: &[Frame],
         backend: &dyn Selector,
     ) -> Result<Fit, IdentifyError> {
-        self.wake_a_worker();
+        wake_a_worker();
         self.fit_woken(target, design, forced, excluded, frames, backend)
     }
 
@@ -425,15 +425,6 @@ impl Identification<'_> {
         })
     }
 
-    /// Wakes a sleeping worker, so that it is looking for work by the time the rows are
-    /// gathered (waking it only then cost ~25 µs of a 0.1 ms fit); a second call while it is
-    /// awake costs a queued empty job.
-    fn wake_a_worker(&self) {
-        if rayon::current_num_threads() > 1 {
-            rayon::spawn(|| {});
-        }
-    }
-
     /// τ = 1 + 2 Σ ρₖ of the chosen equation's residuals, the autocorrelations ρₖ pooled over
     /// the runs and summed up to the first lag where they fall below zero (Geyer's initial
     /// positive sequence, simplified; at most 1000 lags); `None` with no terms, row weights or
@@ -467,6 +458,15 @@ impl Identification<'_> {
             residuals.push(e);
         }
         Ok(crate::uncertainty::correlation_time(&residuals))
+    }
+}
+
+/// Wakes a sleeping worker, so that it is looking for work by the time the rows are gathered
+/// (waking it only then cost ~25 µs of a 0.1 ms fit); a second call while it is awake costs a
+/// queued empty job.
+fn wake_a_worker() {
+    if rayon::current_num_threads() > 1 {
+        rayon::spawn(|| {});
     }
 }
 

@@ -1,9 +1,9 @@
 //! (Z − 1cᵀ)ᵀ(Z − 1cᵀ) for a tall, narrow block of columns Z shifted by a constant per column:
 //! the cross-products of the shifted-data algorithm ([`super::Accumulator`]). The columns are
 //! read where they are (the term evaluator's output, a user's matrix) and shifted in registers,
-//! not copied first: the copy had cost a quarter of a 2 505-row fit. Only the lower triangle
-//! is computed (half the flops of a general product, as BLAS dsyrk) and [`mirror`]ed at the
-//! end. On x86-64 register-tiled kernels with explicit intrinsics (AVX2+FMA, and the same with
+//! not copied first (the copy had cost ~6 % of a 2 505-row fit). Only the lower triangle is
+//! computed (half the flops of a general product, as BLAS dsyrk); [`mirror`] completes it where
+//! a full matrix is wanted. On x86-64 register-tiled kernels with explicit intrinsics (AVX2+FMA, and the same with
 //! AVX-512VL's 32 registers, checked at run time); elsewhere a portable one.
 
 const LANES: usize = 4;

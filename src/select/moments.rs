@@ -15,14 +15,33 @@ use std::ops::Range;
 const CHUNK: usize = 512;
 
 /// Means and corrected cross-products of `p` regressors and one target.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct Moments {
     p: usize,
     count: usize,
     weight: f64,
     mean: Vec<f64>,
-    /// (p+1)² column-major, symmetric.
+    /// (p+1)² column-major; only the lower triangle (row ≥ column) is kept up to date: the
+    /// matrix is symmetric, and mirroring every chunk's products cost more than reading
+    /// (i, j) as (j, i).
     comoment: Vec<f64>,
+}
+
+impl PartialEq for Moments {
+    fn eq(&self, other: &Moments) -> bool {
+        let m = self.p + 1;
+        let lower = |c: &[f64]| -> Vec<f64> {
+            (0..m.min(c.len()))
+                .flat_map(|j| (j..m).map(move |i| (i, j)))
+                .filter_map(|(i, j)| c.get(i + j * m).copied())
+                .collect()
+        };
+        self.p == other.p
+            && self.count == other.count
+            && self.weight == other.weight
+            && self.mean == other.mean
+            && lower(&self.comoment) == lower(&other.comoment)
+    }
 }
 
 impl Moments {
@@ -54,6 +73,7 @@ impl Moments {
 
     /// Corrected cross-product of variables `i` and `j` (index `p` is the target).
     pub fn corrected(&self, i: usize, j: usize) -> f64 {
+        let (i, j) = if i >= j { (i, j) } else { (j, i) };
         self.comoment[i + j * (self.p + 1)]
     }
 
@@ -81,9 +101,9 @@ impl Moments {
         let (a, b) = (&self.mean, &other.mean);
         for j in 0..m {
             let fdj = f * (b[j] - a[j]);
-            let (mine, theirs) =
-                (&mut self.comoment[j * m..(j + 1) * m], &other.comoment[j * m..(j + 1) * m]);
-            for ((c, o), (bi, ai)) in mine.iter_mut().zip(theirs).zip(b.iter().zip(a)) {
+            let lower = j * m + j..(j + 1) * m;
+            let (mine, theirs) = (&mut self.comoment[lower.clone()], &other.comoment[lower]);
+            for ((c, o), (bi, ai)) in mine.iter_mut().zip(theirs).zip(b[j..].iter().zip(&a[j..])) {
                 *c += o + fdj * (bi - ai);
             }
         }
@@ -113,7 +133,7 @@ impl Moments {
         }
         let f = rest_w * part.weight / self.weight;
         for j in 0..m {
-            for i in 0..m {
+            for i in j..m {
                 let (di, dj) = (part.mean[i] - rest.mean[i], part.mean[j] - rest.mean[j]);
                 rest.comoment[i + j * m] = self.comoment[i + j * m] - part.comoment[i + j * m] - f * di * dj;
             }
@@ -152,7 +172,8 @@ impl Moments {
 pub struct Accumulator {
     moments: Moments,
     /// The statistics of the chunk being gathered; its comoment collects the lower triangle
-    /// of the shifted cross-products until the chunk is flushed.
+    /// of the shifted cross-products until the chunk is flushed (the kernel's entries above
+    /// the diagonal are never read).
     chunk: Moments,
     /// Per column, the chunk's shift and Σ w (z − shift) of the rows in the chunk.
     shift: Vec<f64>,
@@ -306,12 +327,11 @@ impl Accumulator {
         chunk.count = n;
         chunk.weight = self.wsum;
         if self.wsum > 0.0 {
-            super::gram::mirror(&mut chunk.comoment, m);
             let inv = 1.0 / self.wsum;
             for j in 0..m {
                 let sj = self.sums[j] * inv;
                 chunk.mean[j] = self.shift[j] + sj;
-                for (c, si) in chunk.comoment[j * m..(j + 1) * m].iter_mut().zip(&self.sums) {
+                for (c, si) in chunk.comoment[j * m + j..(j + 1) * m].iter_mut().zip(&self.sums[j..]) {
                     *c -= si * sj;
                 }
             }
