@@ -6,7 +6,28 @@ use super::{Estimate, Problem, SelectError, Step};
 
 /// Goodnight's sweep of a symmetric matrix (row-major, size m) on pivot k. In this form it
 /// is its own inverse: sweeping k again takes the term out.
+///
+/// The loops are plain Rust; on x86-64 they are compiled a second time for AVX2 (four lanes
+/// instead of SSE2's two, a third of a stepwise selection's time) and that copy is chosen at
+/// run time. Same operations, same results.
 pub(crate) fn sweep(a: &mut [f64], m: usize, k: usize) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2.
+        unsafe { sweep_avx2(a, m, k) };
+        return;
+    }
+    sweep_portable(a, m, k);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn sweep_avx2(a: &mut [f64], m: usize, k: usize) {
+    sweep_portable(a, m, k);
+}
+
+#[inline(always)]
+fn sweep_portable(a: &mut [f64], m: usize, k: usize) {
     let d = a[k * m + k];
     for x in &mut a[k * m..(k + 1) * m] {
         *x /= d;
@@ -135,7 +156,17 @@ impl Scaled {
             let mut q = 1.0 / self.weight;
             for (&i, gi) in set.iter().zip(&g) {
                 let row = &a[i * m..(i + 1) * m];
-                q += gi * set.iter().zip(&g).map(|(&l, gl)| gl * row[l]).sum::<f64>();
+                // four partial sums: one running sum is a chain of dependent additions, and
+                // this O(k²) loop was a fifth of a selection
+                let mut lanes = [0.0f64; 4];
+                let (sets, gs) = (set.chunks_exact(4), g.chunks_exact(4));
+                let tail: f64 = sets.remainder().iter().zip(gs.remainder()).map(|(&l, gl)| gl * row[l]).sum();
+                for (ls, gl) in sets.zip(gs) {
+                    for j in 0..4 {
+                        lanes[j] += gl[j] * row[ls[j]];
+                    }
+                }
+                q += gi * ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail);
             }
             let std_error = s * q.max(0.0).sqrt();
             Estimate { value, std_error, t: value / std_error }
