@@ -3,8 +3,8 @@
 //! read where they are (the term evaluator's output, a user's matrix) and shifted in registers,
 //! not copied first (the copy had cost ~6 % of a 2 505-row fit). Only the lower triangle is
 //! computed (half the flops of a general product, as BLAS dsyrk); [`mirror`] completes it where
-//! a full matrix is wanted. On x86-64 register-tiled kernels with explicit intrinsics (AVX2+FMA, and the same with
-//! AVX-512VL's 32 registers, checked at run time); elsewhere a portable one.
+//! a full matrix is wanted. On x86-64 register-tiled kernels with explicit intrinsics (AVX-512, else AVX2+FMA, checked at
+//! run time); elsewhere a portable one.
 
 const LANES: usize = 4;
 
@@ -36,8 +36,8 @@ pub fn gram_add(columns: &[&[f64]], shift: &[f64], c: &mut [f64], sums: &mut [f6
             // SAFETY: the CPU supports the features each function is compiled for; every
             // pointer is to a column of n values.
             unsafe {
-                if has!("avx512f") && has!("avx512vl") {
-                    gram_avx512vl(&ptrs, n, shift, c, sums);
+                if has!("avx512f") {
+                    gram_avx512(&ptrs, n, shift, c, sums);
                 } else {
                     gram_avx2(&ptrs, n, shift, c, sums);
                 }
@@ -64,10 +64,9 @@ pub fn mirror(c: &mut [f64], m: usize) {
 #[cfg(target_arch = "x86_64")]
 const PANEL: usize = 256;
 
-/// One kernel, compiled twice: with AVX2+FMA's 16 vector registers, and with AVX-512VL's 32.
-/// 3 × 3 output tiles: 9 accumulators + 3 loaded columns + 1; the six broadcast shifts fit
-/// beside them only in 32 registers (with 16 they are re-read from L1, which the load ports
-/// absorb). The shift subtractions run on the FP add ports, so the FMAs stay the bottleneck.
+/// The AVX2+FMA kernel. 3 × 3 output tiles: 9 accumulators + 3 loaded columns + 1 in the 16
+/// vector registers; the six broadcast shifts do not fit beside them and are re-read from L1,
+/// which the load ports absorb. The shift subtractions run on the FP add ports, so the FMAs stay the bottleneck.
 #[cfg(target_arch = "x86_64")]
 macro_rules! gram_kernel {
     ($name:ident, $features:literal) => {
@@ -190,8 +189,133 @@ macro_rules! gram_kernel {
 
 #[cfg(target_arch = "x86_64")]
 gram_kernel!(gram_avx2, "avx2,fma");
+
+/// The same 3 × 3 tiles eight lanes wide in AVX-512's 32 registers: on cores with full-width
+/// 512-bit FMA units (AMD Zen 5, Intel server cores) twice the products per cycle of the
+/// AVX2 kernel; on Zen 4, which splits them in two, as fast. A panel's last rows are taken
+/// with masked loads and shifts (the masked-off lanes are zero), so there is no scalar tail.
 #[cfg(target_arch = "x86_64")]
-gram_kernel!(gram_avx512vl, "avx2,fma,avx512f,avx512vl");
+#[target_feature(enable = "avx512f")]
+unsafe fn gram_avx512(z: &[*const f64], n: usize, shift: &[f64], c: &mut [f64], sums: &mut [f64]) {
+    use std::arch::x86_64::*;
+    let m = z.len();
+    // rows r..r1 as a lane mask (all eight but at a panel's end)
+    let mask = |r: usize, r1: usize| -> __mmask8 {
+        if r1 - r >= 8 {
+            0xff
+        } else {
+            (1u8 << (r1 - r)) - 1
+        }
+    };
+    let mut r0 = 0;
+    while r0 < n {
+        let r1 = (r0 + PANEL).min(n);
+        let mut j0 = 0;
+        while j0 < m {
+            let mut i0 = j0;
+            while i0 < m {
+                if m - j0 >= 3 && m - i0 >= 3 {
+                    let xi = [z[i0], z[i0 + 1], z[i0 + 2]];
+                    let xj = [z[j0], z[j0 + 1], z[j0 + 2]];
+                    let si = [
+                        _mm512_set1_pd(shift[i0]),
+                        _mm512_set1_pd(shift[i0 + 1]),
+                        _mm512_set1_pd(shift[i0 + 2]),
+                    ];
+                    let sj = [
+                        _mm512_set1_pd(shift[j0]),
+                        _mm512_set1_pd(shift[j0 + 1]),
+                        _mm512_set1_pd(shift[j0 + 2]),
+                    ];
+                    let load = |x: *const f64, s: __m512d, r: usize, k: __mmask8| {
+                        _mm512_maskz_sub_pd(k, _mm512_maskz_loadu_pd(k, x.add(r)), s)
+                    };
+                    let full =
+                        |x: *const f64, s: __m512d, r: usize| _mm512_sub_pd(_mm512_loadu_pd(x.add(r)), s);
+                    let mut acc = [[_mm512_setzero_pd(); 3]; 3];
+                    let mut r = r0;
+                    if i0 == j0 {
+                        let mut sum = [_mm512_setzero_pd(); 3];
+                        while r < r1 {
+                            let k = mask(r, r1);
+                            let a = if k == 0xff {
+                                [full(xi[0], si[0], r), full(xi[1], si[1], r), full(xi[2], si[2], r)]
+                            } else {
+                                [load(xi[0], si[0], r, k), load(xi[1], si[1], r, k), load(xi[2], si[2], r, k)]
+                            };
+                            for ai in 0..3 {
+                                sum[ai] = _mm512_add_pd(sum[ai], a[ai]);
+                                for bj in 0..3 {
+                                    acc[ai][bj] = _mm512_fmadd_pd(a[ai], a[bj], acc[ai][bj]);
+                                }
+                            }
+                            r += 8;
+                        }
+                        for (ai, v) in sum.iter().enumerate() {
+                            sums[i0 + ai] += _mm512_reduce_add_pd(*v);
+                        }
+                    } else {
+                        let whole = r0 + (r1 - r0) / 8 * 8;
+                        while r < whole {
+                            let a = [full(xi[0], si[0], r), full(xi[1], si[1], r), full(xi[2], si[2], r)];
+                            for bj in 0..3 {
+                                let b = full(xj[bj], sj[bj], r);
+                                for ai in 0..3 {
+                                    acc[ai][bj] = _mm512_fmadd_pd(a[ai], b, acc[ai][bj]);
+                                }
+                            }
+                            r += 8;
+                        }
+                        if r < r1 {
+                            let k = mask(r, r1);
+                            let a = [
+                                load(xi[0], si[0], r, k),
+                                load(xi[1], si[1], r, k),
+                                load(xi[2], si[2], r, k),
+                            ];
+                            for bj in 0..3 {
+                                let b = load(xj[bj], sj[bj], r, k);
+                                for ai in 0..3 {
+                                    acc[ai][bj] = _mm512_fmadd_pd(a[ai], b, acc[ai][bj]);
+                                }
+                            }
+                        }
+                    }
+                    for (ai, row) in acc.iter().enumerate() {
+                        for (bj, v) in row.iter().enumerate() {
+                            c[(i0 + ai) + (j0 + bj) * m] += _mm512_reduce_add_pd(*v);
+                        }
+                    }
+                } else {
+                    // edge tiles: one output at a time, still eight lanes wide
+                    for a in i0..m.min(i0 + 3) {
+                        for b in j0..m.min(j0 + 3) {
+                            let (x, y) = (z[a], z[b]);
+                            let (sx, sy) = (_mm512_set1_pd(shift[a]), _mm512_set1_pd(shift[b]));
+                            let (mut acc, mut sum) = (_mm512_setzero_pd(), _mm512_setzero_pd());
+                            let mut r = r0;
+                            while r < r1 {
+                                let k = mask(r, r1);
+                                let dx = _mm512_maskz_sub_pd(k, _mm512_maskz_loadu_pd(k, x.add(r)), sx);
+                                sum = _mm512_add_pd(sum, dx);
+                                let dy = _mm512_maskz_sub_pd(k, _mm512_maskz_loadu_pd(k, y.add(r)), sy);
+                                acc = _mm512_fmadd_pd(dx, dy, acc);
+                                r += 8;
+                            }
+                            c[a + b * m] += _mm512_reduce_add_pd(acc);
+                            if a == b {
+                                sums[a] += _mm512_reduce_add_pd(sum);
+                            }
+                        }
+                    }
+                }
+                i0 += 3;
+            }
+            j0 += 3;
+        }
+        r0 = r1;
+    }
+}
 
 /// The portable kernel: lower triangle, four independent partial sums per output.
 fn gram_tiles(z: &[&[f64]], n: usize, shift: &[f64], c: &mut [f64], sums: &mut [f64]) {
