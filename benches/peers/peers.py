@@ -1,5 +1,6 @@
 """Time termid's back-ends and the peers on the same data, the same way: each fit in its own
-language's process, data already loaded, median of repeated fits after one warm-up.
+language's process, data already loaded, median of repeated fits (101 by default) after a
+warm-up.
 
 Data: the default model's five exact zigzags (written by `termid reproduce`), the 29
 candidate terms of v-dot and r-dot (Oltmann 1973), combined (2 505 rows); and a 10^6 x 100
@@ -150,7 +151,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--termid", required=True)
     ap.add_argument("--data", required=True)
-    ap.add_argument("--repeat", type=int, default=21)
+    ap.add_argument("--repeat", type=int, default=101)
     ap.add_argument("--quick", action="store_true", help="skip the 10^6 x 100 problem")
     a = ap.parse_args()
     files = [f for f in glob.glob(os.path.join(a.data, "z*.csv")) if "alt5" not in f]
@@ -172,7 +173,8 @@ def main():
     print(f"# termid and its peers ({platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
           f"numpy {np.__version__})\n")
     print(f"Combined data of the five zigzags: {X.shape[0]} rows x {X.shape[1]} candidates. "
-          "termid's times include evaluating the terms and the one-pass statistics; the peers get the "
+          "termid's times include evaluating the terms and the one-pass statistics (the terms are "
+          "compiled once per equation beforehand, as the peers' matrix is built beforehand); the peers get the "
           "finished 29-column matrix (termid's stepwise is also timed on that matrix, as a model whose "
           "candidates are its columns). Median of repeated fits after a warm-up.\n")
     for eq in ["v_dot", "r_dot"]:
