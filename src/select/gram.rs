@@ -64,257 +64,171 @@ pub fn mirror(c: &mut [f64], m: usize) {
 #[cfg(target_arch = "x86_64")]
 const PANEL: usize = 256;
 
-/// The AVX2+FMA kernel. 3 × 3 output tiles: 9 accumulators + 3 loaded columns + 1 in the 16
-/// vector registers; the six broadcast shifts do not fit beside them and are re-read from L1,
-/// which the load ports absorb. The shift subtractions run on the FP add ports, so the FMAs stay the bottleneck.
+/// The x86-64 kernels: one tile loop, written once in [`tile_kernel`] over the vector
+/// operations each kernel defines, instantiated for AVX2's four lanes and AVX-512's eight.
+/// (A generic function over a trait of vector operations was tried: its intrinsics were not
+/// inlined into the feature-enabled kernels, 50× slower.)
+///
+/// 3 × 3 output tiles: 9 accumulators + 3 loaded columns + 1 register, and the six broadcast
+/// shifts where there is room (AVX-512's 32 registers; with AVX2's 16 they are re-read from
+/// L1, which the load ports absorb). The shift subtractions and the diagonal tiles' column sums
+/// run on the FP add ports, so the FMAs stay the bottleneck. A panel's last rows are taken as a
+/// partial vector (lanes beyond them zero), so there is no scalar tail.
 #[cfg(target_arch = "x86_64")]
-macro_rules! gram_kernel {
-    ($name:ident, $features:literal) => {
-        #[target_feature(enable = $features)]
-        unsafe fn $name(z: &[*const f64], n: usize, shift: &[f64], c: &mut [f64], sums: &mut [f64]) {
-            use std::arch::x86_64::*;
-            #[inline(always)]
-            unsafe fn hsum(v: __m256d) -> f64 {
-                let mut lanes = [0.0f64; 4];
-                _mm256_storeu_pd(lanes.as_mut_ptr(), v);
-                (lanes[0] + lanes[1]) + (lanes[2] + lanes[3])
-            }
-            let m = z.len();
-            let nq = n / 4 * 4;
-            let mut r0 = 0;
-            while r0 < nq {
-                let r1 = (r0 + PANEL).min(nq);
-                let mut j0 = 0;
-                while j0 < m {
-                    let mut i0 = j0;
-                    while i0 < m {
-                        if m - j0 >= 3 && m - i0 >= 3 {
-                            let xi = [z[i0], z[i0 + 1], z[i0 + 2]];
-                            let xj = [z[j0], z[j0 + 1], z[j0 + 2]];
-                            let si = [
-                                _mm256_set1_pd(shift[i0]),
-                                _mm256_set1_pd(shift[i0 + 1]),
-                                _mm256_set1_pd(shift[i0 + 2]),
-                            ];
-                            let sj = [
-                                _mm256_set1_pd(shift[j0]),
-                                _mm256_set1_pd(shift[j0 + 1]),
-                                _mm256_set1_pd(shift[j0 + 2]),
-                            ];
-                            let mut acc = [[_mm256_setzero_pd(); 3]; 3];
-                            let mut r = r0;
-                            if i0 == j0 {
-                                let mut sum = [_mm256_setzero_pd(); 3];
-                                while r < r1 {
-                                    let a = [
-                                        _mm256_sub_pd(_mm256_loadu_pd(xi[0].add(r)), si[0]),
-                                        _mm256_sub_pd(_mm256_loadu_pd(xi[1].add(r)), si[1]),
-                                        _mm256_sub_pd(_mm256_loadu_pd(xi[2].add(r)), si[2]),
-                                    ];
-                                    for ai in 0..3 {
-                                        sum[ai] = _mm256_add_pd(sum[ai], a[ai]);
-                                        for bj in 0..3 {
-                                            acc[ai][bj] = _mm256_fmadd_pd(a[ai], a[bj], acc[ai][bj]);
-                                        }
-                                    }
-                                    r += 4;
-                                }
-                                for (ai, v) in sum.iter().enumerate() {
-                                    sums[i0 + ai] += hsum(*v);
-                                }
-                            } else {
-                                while r < r1 {
-                                    let a = [
-                                        _mm256_sub_pd(_mm256_loadu_pd(xi[0].add(r)), si[0]),
-                                        _mm256_sub_pd(_mm256_loadu_pd(xi[1].add(r)), si[1]),
-                                        _mm256_sub_pd(_mm256_loadu_pd(xi[2].add(r)), si[2]),
-                                    ];
+macro_rules! tile_kernel {
+    ($z:ident, $n:ident, $shift:ident, $c:ident, $sums:ident, lanes: $lanes:expr,
+     splat: $splat:expr, zero: $zero:expr, shifted: $shifted:expr, part: $part:expr,
+     add: $add:expr, fmadd: $fmadd:expr, sum: $sum:expr) => {{
+        let (z, n, shift, c, sums) = ($z, $n, $shift, $c, $sums);
+        let (splat, zero, shifted, part, add, fmadd, sum) =
+            ($splat, $zero, $shifted, $part, $add, $fmadd, $sum);
+        let m = z.len();
+        let mut r0 = 0;
+        while r0 < n {
+            let r1 = (r0 + PANEL).min(n);
+            let whole = r0 + (r1 - r0) / $lanes * $lanes;
+            // x[r..] − s as a vector: whole, or the panel's last rows
+            let load = |x: *const f64, s, r: usize| {
+                if r < whole {
+                    shifted(x.add(r), s)
+                } else {
+                    part(x.add(r), s, r1 - r)
+                }
+            };
+            let mut j0 = 0;
+            while j0 < m {
+                let mut i0 = j0;
+                while i0 < m {
+                    if m - j0 >= 3 && m - i0 >= 3 {
+                        let xi = [z[i0], z[i0 + 1], z[i0 + 2]];
+                        let xj = [z[j0], z[j0 + 1], z[j0 + 2]];
+                        let si = [splat(shift[i0]), splat(shift[i0 + 1]), splat(shift[i0 + 2])];
+                        let sj = [splat(shift[j0]), splat(shift[j0 + 1]), splat(shift[j0 + 2])];
+                        let mut acc = [[zero(); 3]; 3];
+                        let mut r = r0;
+                        if i0 == j0 {
+                            let mut s3 = [zero(); 3];
+                            let mut products = |a: [_; 3]| {
+                                for ai in 0..3 {
+                                    s3[ai] = add(s3[ai], a[ai]);
                                     for bj in 0..3 {
-                                        let b = _mm256_sub_pd(_mm256_loadu_pd(xj[bj].add(r)), sj[bj]);
-                                        for ai in 0..3 {
-                                            acc[ai][bj] = _mm256_fmadd_pd(a[ai], b, acc[ai][bj]);
-                                        }
+                                        acc[ai][bj] = fmadd(a[ai], a[bj], acc[ai][bj]);
                                     }
-                                    r += 4;
                                 }
+                            };
+                            while r < whole {
+                                products([
+                                    shifted(xi[0].add(r), si[0]),
+                                    shifted(xi[1].add(r), si[1]),
+                                    shifted(xi[2].add(r), si[2]),
+                                ]);
+                                r += $lanes;
                             }
-                            for (ai, row) in acc.iter().enumerate() {
-                                for (bj, v) in row.iter().enumerate() {
-                                    c[(i0 + ai) + (j0 + bj) * m] += hsum(*v);
-                                }
+                            if r < r1 {
+                                products([
+                                    load(xi[0], si[0], r),
+                                    load(xi[1], si[1], r),
+                                    load(xi[2], si[2], r),
+                                ]);
+                            }
+                            for (ai, v) in s3.iter().enumerate() {
+                                sums[i0 + ai] += sum(*v);
                             }
                         } else {
-                            // edge tiles: one output at a time, still four lanes wide
-                            for a in i0..m.min(i0 + 3) {
-                                for b in j0..m.min(j0 + 3) {
-                                    let (x, y) = (z[a], z[b]);
-                                    let (sx, sy) = (_mm256_set1_pd(shift[a]), _mm256_set1_pd(shift[b]));
-                                    let (mut acc, mut sum) = (_mm256_setzero_pd(), _mm256_setzero_pd());
-                                    let mut r = r0;
-                                    while r < r1 {
-                                        let dx = _mm256_sub_pd(_mm256_loadu_pd(x.add(r)), sx);
-                                        sum = _mm256_add_pd(sum, dx);
-                                        let dy = _mm256_sub_pd(_mm256_loadu_pd(y.add(r)), sy);
-                                        acc = _mm256_fmadd_pd(dx, dy, acc);
-                                        r += 4;
+                            let mut products = |a: [_; 3], b: [_; 3]| {
+                                for bj in 0..3 {
+                                    for ai in 0..3 {
+                                        acc[ai][bj] = fmadd(a[ai], b[bj], acc[ai][bj]);
                                     }
-                                    c[a + b * m] += hsum(acc);
-                                    if a == b {
-                                        sums[a] += hsum(sum);
-                                    }
+                                }
+                            };
+                            while r < whole {
+                                let column = |x: *const f64, s| shifted(x.add(r), s);
+                                products(
+                                    [column(xi[0], si[0]), column(xi[1], si[1]), column(xi[2], si[2])],
+                                    [column(xj[0], sj[0]), column(xj[1], sj[1]), column(xj[2], sj[2])],
+                                );
+                                r += $lanes;
+                            }
+                            if r < r1 {
+                                products(
+                                    [load(xi[0], si[0], r), load(xi[1], si[1], r), load(xi[2], si[2], r)],
+                                    [load(xj[0], sj[0], r), load(xj[1], sj[1], r), load(xj[2], sj[2], r)],
+                                );
+                            }
+                        }
+                        for (ai, row) in acc.iter().enumerate() {
+                            for (bj, v) in row.iter().enumerate() {
+                                c[(i0 + ai) + (j0 + bj) * m] += sum(*v);
+                            }
+                        }
+                    } else {
+                        // edge tiles: one output at a time, still a vector wide
+                        for a in i0..m.min(i0 + 3) {
+                            for b in j0..m.min(j0 + 3) {
+                                let (sx, sy) = (splat(shift[a]), splat(shift[b]));
+                                let (mut acc, mut s1) = (zero(), zero());
+                                let mut r = r0;
+                                while r < r1 {
+                                    let (dx, dy) = (load(z[a], sx, r), load(z[b], sy, r));
+                                    s1 = add(s1, dx);
+                                    acc = fmadd(dx, dy, acc);
+                                    r += $lanes;
+                                }
+                                c[a + b * m] += sum(acc);
+                                if a == b {
+                                    sums[a] += sum(s1);
                                 }
                             }
                         }
-                        i0 += 3;
                     }
-                    j0 += 3;
+                    i0 += 3;
                 }
-                r0 = r1;
+                j0 += 3;
             }
-            for j in 0..m {
-                for i in j..m {
-                    let (x, y) = (z[i], z[j]);
-                    for r in nq..n {
-                        let (dx, dy) = (*x.add(r) - shift[i], *y.add(r) - shift[j]);
-                        c[i + j * m] = dx.mul_add(dy, c[i + j * m]);
-                    }
-                }
-                for r in nq..n {
-                    sums[j] += *z[j].add(r) - shift[j];
-                }
-            }
+            r0 = r1;
         }
-    };
+    }};
 }
 
 #[cfg(target_arch = "x86_64")]
-gram_kernel!(gram_avx2, "avx2,fma");
+#[target_feature(enable = "avx2,fma")]
+unsafe fn gram_avx2(z: &[*const f64], n: usize, shift: &[f64], c: &mut [f64], sums: &mut [f64]) {
+    use std::arch::x86_64::*;
+    tile_kernel!(z, n, shift, c, sums, lanes: 4,
+    splat: |x: f64| _mm256_set1_pd(x),
+    zero: || _mm256_setzero_pd(),
+    shifted: |x: *const f64, s: __m256d| _mm256_sub_pd(_mm256_loadu_pd(x), s),
+    part: |x: *const f64, s: __m256d, left: usize| {
+        let on = _mm256_cmpgt_epi64(_mm256_set1_epi64x(left as i64), _mm256_setr_epi64x(0, 1, 2, 3));
+        _mm256_and_pd(_mm256_sub_pd(_mm256_maskload_pd(x, on), s), _mm256_castsi256_pd(on))
+    },
+    add: |a: __m256d, b: __m256d| _mm256_add_pd(a, b),
+    fmadd: |a: __m256d, b: __m256d, acc: __m256d| _mm256_fmadd_pd(a, b, acc),
+    sum: |v: __m256d| {
+        let mut lanes = [0.0f64; 4];
+        _mm256_storeu_pd(lanes.as_mut_ptr(), v);
+        (lanes[0] + lanes[1]) + (lanes[2] + lanes[3])
+    })
+}
 
-/// The same 3 × 3 tiles eight lanes wide in AVX-512's 32 registers: on cores with full-width
-/// 512-bit FMA units (AMD Zen 5, Intel server cores) twice the products per cycle of the
-/// AVX2 kernel; on Zen 4, which splits them in two, as fast. A panel's last rows are taken
-/// with masked loads and shifts (the masked-off lanes are zero), so there is no scalar tail.
+/// On cores with full-width 512-bit FMA units (AMD Zen 5, Intel server cores) twice the
+/// products per cycle of AVX2; on Zen 4, which splits them in two, as fast.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
 unsafe fn gram_avx512(z: &[*const f64], n: usize, shift: &[f64], c: &mut [f64], sums: &mut [f64]) {
     use std::arch::x86_64::*;
-    let m = z.len();
-    // rows r..r1 as a lane mask (all eight but at a panel's end)
-    let mask = |r: usize, r1: usize| -> __mmask8 {
-        if r1 - r >= 8 {
-            0xff
-        } else {
-            (1u8 << (r1 - r)) - 1
-        }
-    };
-    let mut r0 = 0;
-    while r0 < n {
-        let r1 = (r0 + PANEL).min(n);
-        let mut j0 = 0;
-        while j0 < m {
-            let mut i0 = j0;
-            while i0 < m {
-                if m - j0 >= 3 && m - i0 >= 3 {
-                    let xi = [z[i0], z[i0 + 1], z[i0 + 2]];
-                    let xj = [z[j0], z[j0 + 1], z[j0 + 2]];
-                    let si = [
-                        _mm512_set1_pd(shift[i0]),
-                        _mm512_set1_pd(shift[i0 + 1]),
-                        _mm512_set1_pd(shift[i0 + 2]),
-                    ];
-                    let sj = [
-                        _mm512_set1_pd(shift[j0]),
-                        _mm512_set1_pd(shift[j0 + 1]),
-                        _mm512_set1_pd(shift[j0 + 2]),
-                    ];
-                    let load = |x: *const f64, s: __m512d, r: usize, k: __mmask8| {
-                        _mm512_maskz_sub_pd(k, _mm512_maskz_loadu_pd(k, x.add(r)), s)
-                    };
-                    let full =
-                        |x: *const f64, s: __m512d, r: usize| _mm512_sub_pd(_mm512_loadu_pd(x.add(r)), s);
-                    let mut acc = [[_mm512_setzero_pd(); 3]; 3];
-                    let mut r = r0;
-                    if i0 == j0 {
-                        let mut sum = [_mm512_setzero_pd(); 3];
-                        while r < r1 {
-                            let k = mask(r, r1);
-                            let a = if k == 0xff {
-                                [full(xi[0], si[0], r), full(xi[1], si[1], r), full(xi[2], si[2], r)]
-                            } else {
-                                [load(xi[0], si[0], r, k), load(xi[1], si[1], r, k), load(xi[2], si[2], r, k)]
-                            };
-                            for ai in 0..3 {
-                                sum[ai] = _mm512_add_pd(sum[ai], a[ai]);
-                                for bj in 0..3 {
-                                    acc[ai][bj] = _mm512_fmadd_pd(a[ai], a[bj], acc[ai][bj]);
-                                }
-                            }
-                            r += 8;
-                        }
-                        for (ai, v) in sum.iter().enumerate() {
-                            sums[i0 + ai] += _mm512_reduce_add_pd(*v);
-                        }
-                    } else {
-                        let whole = r0 + (r1 - r0) / 8 * 8;
-                        while r < whole {
-                            let a = [full(xi[0], si[0], r), full(xi[1], si[1], r), full(xi[2], si[2], r)];
-                            for bj in 0..3 {
-                                let b = full(xj[bj], sj[bj], r);
-                                for ai in 0..3 {
-                                    acc[ai][bj] = _mm512_fmadd_pd(a[ai], b, acc[ai][bj]);
-                                }
-                            }
-                            r += 8;
-                        }
-                        if r < r1 {
-                            let k = mask(r, r1);
-                            let a = [
-                                load(xi[0], si[0], r, k),
-                                load(xi[1], si[1], r, k),
-                                load(xi[2], si[2], r, k),
-                            ];
-                            for bj in 0..3 {
-                                let b = load(xj[bj], sj[bj], r, k);
-                                for ai in 0..3 {
-                                    acc[ai][bj] = _mm512_fmadd_pd(a[ai], b, acc[ai][bj]);
-                                }
-                            }
-                        }
-                    }
-                    for (ai, row) in acc.iter().enumerate() {
-                        for (bj, v) in row.iter().enumerate() {
-                            c[(i0 + ai) + (j0 + bj) * m] += _mm512_reduce_add_pd(*v);
-                        }
-                    }
-                } else {
-                    // edge tiles: one output at a time, still eight lanes wide
-                    for a in i0..m.min(i0 + 3) {
-                        for b in j0..m.min(j0 + 3) {
-                            let (x, y) = (z[a], z[b]);
-                            let (sx, sy) = (_mm512_set1_pd(shift[a]), _mm512_set1_pd(shift[b]));
-                            let (mut acc, mut sum) = (_mm512_setzero_pd(), _mm512_setzero_pd());
-                            let mut r = r0;
-                            while r < r1 {
-                                let k = mask(r, r1);
-                                let dx = _mm512_maskz_sub_pd(k, _mm512_maskz_loadu_pd(k, x.add(r)), sx);
-                                sum = _mm512_add_pd(sum, dx);
-                                let dy = _mm512_maskz_sub_pd(k, _mm512_maskz_loadu_pd(k, y.add(r)), sy);
-                                acc = _mm512_fmadd_pd(dx, dy, acc);
-                                r += 8;
-                            }
-                            c[a + b * m] += _mm512_reduce_add_pd(acc);
-                            if a == b {
-                                sums[a] += _mm512_reduce_add_pd(sum);
-                            }
-                        }
-                    }
-                }
-                i0 += 3;
-            }
-            j0 += 3;
-        }
-        r0 = r1;
-    }
+    tile_kernel!(z, n, shift, c, sums, lanes: 8,
+        splat: |x: f64| _mm512_set1_pd(x),
+        zero: || _mm512_setzero_pd(),
+        shifted: |x: *const f64, s: __m512d| _mm512_sub_pd(_mm512_loadu_pd(x), s),
+        part: |x: *const f64, s: __m512d, left: usize| {
+            let on: __mmask8 = (1u8 << left) - 1;
+            _mm512_maskz_sub_pd(on, _mm512_maskz_loadu_pd(on, x), s)
+        },
+        add: |a: __m512d, b: __m512d| _mm512_add_pd(a, b),
+        fmadd: |a: __m512d, b: __m512d, acc: __m512d| _mm512_fmadd_pd(a, b, acc),
+        sum: |v: __m512d| _mm512_reduce_add_pd(v))
 }
 
 /// The portable kernel: lower triangle, four independent partial sums per output.

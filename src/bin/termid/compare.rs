@@ -53,34 +53,18 @@ pub fn run(cmd: CompareCommand) -> Result<()> {
             }
             // warm-up fits for `warm_up` seconds (at least one), then the median of `repeat`
             // timed fits (data already loaded)
-            let fit = crate::progress::with_spinner(&format!("{name} on {eq}"), || {
-                fit_equation_design(&m, eq, Some(design), &frames, diff.as_ref(), !cmd.no_intercept, None)
-            })
-            .with_context(|| format!("{name} on `{eq}`"))?;
+            let fit_once =
+                || fit_equation_design(&m, eq, Some(design), &frames, diff.as_ref(), !cmd.no_intercept, None);
+            let fit = crate::progress::with_spinner(&format!("{name} on {eq}"), fit_once)
+                .with_context(|| format!("{name} on `{eq}`"))?;
             let warming = Instant::now();
             while warming.elapsed().as_secs_f64() < cmd.warm_up {
-                drop(fit_equation_design(
-                    &m,
-                    eq,
-                    Some(design),
-                    &frames,
-                    diff.as_ref(),
-                    !cmd.no_intercept,
-                    None,
-                ));
+                drop(fit_once());
             }
             let mut times: Vec<f64> = (0..cmd.repeat.max(1))
                 .map(|_| {
                     let started = Instant::now();
-                    let again = fit_equation_design(
-                        &m,
-                        eq,
-                        Some(design),
-                        &frames,
-                        diff.as_ref(),
-                        !cmd.no_intercept,
-                        None,
-                    );
+                    let again = fit_once();
                     let t = started.elapsed().as_secs_f64() * 1e3;
                     drop(again);
                     t
