@@ -69,9 +69,9 @@ const PANEL: usize = 256;
 /// (A generic function over a trait of vector operations was tried: its intrinsics were not
 /// inlined into the feature-enabled kernels, 50× slower.)
 ///
-/// 3 × 3 output tiles: 9 accumulators + 3 loaded columns + 1 register, and the six broadcast
-/// shifts where there is room (AVX-512's 32 registers; with AVX2's 16 they are re-read from
-/// L1, which the load ports absorb). The shift subtractions and the diagonal tiles' column sums
+/// 3 × 3 output tiles: 9 accumulators and the 6 loaded columns, and the six broadcast shifts
+/// where there is room (AVX-512's 32 registers; with AVX2's 16 they are re-read from L1, which
+/// the load ports absorb). The shift subtractions and the diagonal tiles' column sums
 /// run on the FP add ports, so the FMAs stay the bottleneck. A panel's last rows are taken as a
 /// partial vector (lanes beyond them zero), so there is no scalar tail.
 #[cfg(target_arch = "x86_64")]
