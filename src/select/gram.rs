@@ -219,16 +219,24 @@ unsafe fn gram_avx2(z: &[*const f64], n: usize, shift: &[f64], c: &mut [f64], su
 unsafe fn gram_avx512(z: &[*const f64], n: usize, shift: &[f64], c: &mut [f64], sums: &mut [f64]) {
     use std::arch::x86_64::*;
     tile_kernel!(z, n, shift, c, sums, lanes: 8,
-        splat: |x: f64| _mm512_set1_pd(x),
-        zero: || _mm512_setzero_pd(),
-        shifted: |x: *const f64, s: __m512d| _mm512_sub_pd(_mm512_loadu_pd(x), s),
-        part: |x: *const f64, s: __m512d, left: usize| {
-            let on: __mmask8 = (1u8 << left) - 1;
-            _mm512_maskz_sub_pd(on, _mm512_maskz_loadu_pd(on, x), s)
-        },
-        add: |a: __m512d, b: __m512d| _mm512_add_pd(a, b),
-        fmadd: |a: __m512d, b: __m512d, acc: __m512d| _mm512_fmadd_pd(a, b, acc),
-        sum: |v: __m512d| _mm512_reduce_add_pd(v))
+    splat: |x: f64| _mm512_set1_pd(x),
+    zero: || _mm512_setzero_pd(),
+    shifted: |x: *const f64, s: __m512d| _mm512_sub_pd(_mm512_loadu_pd(x), s),
+    part: |x: *const f64, s: __m512d, left: usize| {
+        let on: __mmask8 = (1u8 << left) - 1;
+        _mm512_maskz_sub_pd(on, _mm512_maskz_loadu_pd(on, x), s)
+    },
+    add: |a: __m512d, b: __m512d| _mm512_add_pd(a, b),
+    fmadd: |a: __m512d, b: __m512d, acc: __m512d| _mm512_fmadd_pd(a, b, acc),
+    // halves added, then as AVX2's sum: a fixed order (`_mm512_reduce_add_pd` is an
+    // unordered reduction, whose rounding changed with a column's place in its tile and so
+    // with the order of the candidates)
+    sum: |v: __m512d| {
+        let half = _mm256_add_pd(_mm512_castpd512_pd256(v), _mm512_extractf64x4_pd::<1>(v));
+        let mut lanes = [0.0f64; 4];
+        _mm256_storeu_pd(lanes.as_mut_ptr(), half);
+        (lanes[0] + lanes[1]) + (lanes[2] + lanes[3])
+    })
 }
 
 /// The portable kernel: lower triangle, four independent partial sums per output.
