@@ -3,7 +3,7 @@
 //! paper's combined-data size (2 505 rows × 29 candidates) including the design.
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion};
-use termid::select::{Accumulator, Backend, Moments, Problem, Selector, StepRule, Stepwise};
+use termid::select::{Accumulator, Backend, BestSubset, Moments, Problem, Selector, StepRule, Stepwise};
 use termid::term::{parse_terms, Library};
 
 mod common;
@@ -127,9 +127,16 @@ fn bench(c: &mut Criterion) {
     let big_names: Vec<String> = (0..p).map(|j| format!("x{j}")).collect();
     let mut g = c.benchmark_group("backends_1e6x100");
     g.sample_size(10);
-    for name in ["stepwise", "sparse"] {
-        let backend = Backend::by_name(name).unwrap().build().unwrap();
-        g.bench_function(name, |b| {
+    // every back-end; best subset searched exactly up to five terms (all 2¹⁰⁰ subsets are out of
+    // reach of any exact method)
+    let backends: Vec<(&str, Box<dyn Selector>)> = vec![
+        ("stepwise", Backend::by_name("stepwise").unwrap().build().unwrap()),
+        ("efroymson", Backend::by_name("efroymson").unwrap().build().unwrap()),
+        ("best-subset_max5", Box::new(BestSubset { max_size: Some(5), ..BestSubset::default() })),
+        ("sparse", Backend::by_name("sparse").unwrap().build().unwrap()),
+    ];
+    for (name, backend) in &backends {
+        g.bench_function(*name, |b| {
             b.iter(|| {
                 let m = Moments::of_columns(black_box(&x), &y, None);
                 let pb =
