@@ -358,10 +358,10 @@ impl Identification<'_> {
         frames: &[Frame],
         backend: &dyn Selector,
     ) -> Result<Fit, IdentifyError> {
-        // compiling overlaps with the worker's waking
+        // compiling overlaps with the worker's waking (fit_design's second call is cheap)
         wake_a_worker();
         let design = Design::new(candidates, self.vocabulary)?;
-        self.fit_woken(target, &design, forced, excluded, frames, backend)
+        self.fit_design(target, &design, forced, excluded, frames, backend)
     }
 
     /// [`Identification::fit`] with the candidates already compiled.
@@ -375,18 +375,6 @@ impl Identification<'_> {
         backend: &dyn Selector,
     ) -> Result<Fit, IdentifyError> {
         wake_a_worker();
-        self.fit_woken(target, design, forced, excluded, frames, backend)
-    }
-
-    fn fit_woken(
-        &self,
-        target: &Target,
-        design: &Design,
-        forced: &[Term],
-        excluded: &[Term],
-        frames: &[Frame],
-        backend: &dyn Selector,
-    ) -> Result<Fit, IdentifyError> {
         if frames.is_empty() {
             return Err(IdentifyError::Setup("no data: give at least one run".into()));
         }
