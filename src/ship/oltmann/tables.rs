@@ -5,7 +5,7 @@ use serde::Serialize;
 
 use super::data::Alternative;
 use crate::data::{CentralDifference, Frame};
-use crate::identify::{fit_equation, Fit, IdentifyError, Target};
+use crate::identify::{equation_design, fit_equation_design, Fit, IdentifyError, Target};
 use crate::model::Model;
 use crate::term::Vocabulary;
 
@@ -138,7 +138,11 @@ pub fn equation_table(
     } else {
         Target::Column(format!("{}_dot", eq.state))
     };
-    let fit = |f: &[Frame]| fit_equation(model, equation, f, &CentralDifference, true, Some(target.clone()));
+    // six fits of one equation (each run, then all together): its terms compiled once
+    let design = equation_design(model, equation)?;
+    let fit = |f: &[Frame]| {
+        fit_equation_design(model, equation, Some(&design), f, &CentralDifference, true, Some(target.clone()))
+    };
     let runs = frames.iter().map(|f| fit(std::slice::from_ref(f))).collect::<Result<Vec<_>, _>>()?;
     let komb = fit(frames)?;
     // rows: every term selected anywhere, every term with a true value, every printed row
