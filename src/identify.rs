@@ -432,11 +432,9 @@ impl Identification<'_> {
         let b0 = selection.intercept.as_ref().map_or(0.0, |b| b.value);
         let mut residuals: Vec<Vec<f64>> = Vec::new();
         for frame in frames {
-            let y = self.target(target, frame)?;
-            let params = self.run_parameters(frame)?;
-            let sources = library.bind(&|n| frame.column(n), &|n| params.get(n).copied())?;
-            let mut e = y.iter().map(|y| y - b0).collect::<Vec<f64>>();
-            library.for_each_block(&sources, 0..frame.len(), |start, columns| {
+            let run = self.bind(&library, target, frame)?;
+            let mut e = run.y.iter().map(|y| y - b0).collect::<Vec<f64>>();
+            library.for_each_block(&run.sources, 0..frame.len(), |start, columns| {
                 for (t, column) in selection.terms.iter().zip(columns) {
                     for (e, x) in e[start..].iter_mut().zip(*column) {
                         *e -= t.coefficient * x;
