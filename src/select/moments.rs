@@ -51,6 +51,12 @@ impl Moments {
         Moments { p, count: 0, weight: 0.0, mean: vec![0.0; m], comoment: vec![0.0; m * m] }
     }
 
+    /// Empty statistics whose vectors are not allocated yet (an accumulator's, until its first
+    /// chunk).
+    fn unallocated(p: usize) -> Moments {
+        Moments { p, count: 0, weight: 0.0, mean: Vec::new(), comoment: Vec::new() }
+    }
+
     /// Number of regressors.
     pub fn regressors(&self) -> usize {
         self.p
@@ -162,9 +168,9 @@ impl Moments {
 
 /// Accumulates [`Moments`] from blocks of rows without keeping them.
 ///
-/// Each chunk of rows is shifted by its first row, its cross-products formed by
-/// [`super::gram::gram_add`] straight from the caller's columns (shifted in registers) and
-/// the sums of the shifted values in a pass beside it, then corrected to the chunk mean,
+/// Each chunk of rows is shifted by its first row, its cross-products and the sums of the
+/// shifted values formed by [`super::gram::gram_add`] straight from the caller's columns
+/// (shifted in registers), then corrected to the chunk mean,
 /// G − s sᵀ/W: the shifted-data algorithm, as accurate as centring on the mean when the shift
 /// is a value of the data, with one pass fewer. Weighted rows are first copied as
 /// (z − shift)·√w into a scratch block.
@@ -198,10 +204,9 @@ impl Accumulator {
     pub fn new(p: usize) -> Accumulator {
         // both allocated when first needed: a part of a run is often a single chunk, which
         // then simply becomes the statistics (allocating and zeroing them was a tenth of a fit)
-        let unallocated = || Moments { p, count: 0, weight: 0.0, mean: Vec::new(), comoment: Vec::new() };
         Accumulator {
-            moments: unallocated(),
-            chunk: unallocated(),
+            moments: Moments::unallocated(p),
+            chunk: Moments::unallocated(p),
             shift: vec![0.0; p + 1],
             sums: vec![0.0; p + 1],
             wsum: 0.0,
@@ -350,10 +355,7 @@ impl Accumulator {
     pub fn finish(mut self) -> Moments {
         self.flush();
         let p = self.moments.p;
-        let mut moments = std::mem::replace(
-            &mut self.moments,
-            Moments { p, count: 0, weight: 0.0, mean: Vec::new(), comoment: Vec::new() },
-        );
+        let mut moments = std::mem::replace(&mut self.moments, Moments::unallocated(p));
         if moments.mean.len() != p + 1 {
             // no row with weight
             let count = moments.count;
