@@ -177,8 +177,7 @@ impl Selector for Stepwise {
         let mut sc = Scaled::new(pb)?;
         let (p, m, n) = (sc.p, sc.m, sc.n);
         // the unswept matrix is needed again only to prune
-        let pruning = self.prune_t != 0.0 || self.prune_beta != 0.0;
-        let mut a = if pruning { sc.a.clone() } else { std::mem::take(&mut sc.a) };
+        let mut a = if self.prunes() { sc.a.clone() } else { std::mem::take(&mut sc.a) };
         let mut entered: Vec<usize> = Vec::new();
         let mut notes = Vec::new();
         let mut steps: Vec<Step> = Vec::new();
@@ -281,10 +280,15 @@ impl Selector for Stepwise {
 }
 
 impl Stepwise {
+    /// Whether a prune rule is on.
+    fn prunes(&self) -> bool {
+        self.prune_t != 0.0 || self.prune_beta != 0.0
+    }
+
     /// The backward pass of `prune_t` / `prune_beta` on the chosen step's terms: refits by
     /// sweeping a fresh copy of the scaled matrix on the terms kept. None if nothing goes.
     fn prune(&self, pb: &Problem<'_>, sc: &Scaled, chosen: &[Step], notes: &mut Vec<String>) -> Option<Step> {
-        if (self.prune_t == 0.0 && self.prune_beta == 0.0) || chosen.is_empty() {
+        if !self.prunes() || chosen.is_empty() {
             return None;
         }
         let (p, m) = (sc.p, sc.m);
