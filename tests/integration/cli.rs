@@ -2,13 +2,16 @@
 
 use crate::common::termid;
 
+/// `termid identify` on the Hald cement data (no time column) with `args` after it.
+fn identify_hald(args: &[&str]) -> (bool, String, String) {
+    let all: Vec<&str> =
+        ["identify", "--data", "tests/data/hald.csv", "--no-time"].iter().chain(args).copied().collect();
+    termid(&all)
+}
+
 #[test]
 fn identify_hald_json() {
-    let (ok, out, err) = termid(&[
-        "identify",
-        "--data",
-        "tests/data/hald.csv",
-        "--no-time",
+    let (ok, out, err) = identify_hald(&[
         "--target",
         "y",
         "--terms",
@@ -36,63 +39,19 @@ fn identify_hald_json() {
 
 #[test]
 fn identify_text_and_errors() {
-    let (ok, out, _) = termid(&[
-        "identify",
-        "--data",
-        "tests/data/hald.csv",
-        "--no-time",
-        "--target",
-        "y",
-        "--terms",
-        "x1",
-        "x2",
-        "x4",
-    ]);
+    let (ok, out, _) = identify_hald(&["--target", "y", "--terms", "x1", "x2", "x4"]);
     assert!(ok);
     assert!(out.contains("term entered") && out.contains("← chosen"), "{out}");
-    let (ok, _, err) = termid(&[
-        "identify",
-        "--data",
-        "tests/data/hald.csv",
-        "--no-time",
-        "--target",
-        "y",
-        "--terms",
-        "x1",
-        "x2**x4",
-    ]);
+    let (ok, _, err) = identify_hald(&["--target", "y", "--terms", "x1", "x2**x4"]);
     assert!(!ok);
     assert!(err.contains("1:4") && err.contains('^'), "{err}");
-    let (ok, _, err) =
-        termid(&["identify", "--data", "tests/data/hald.csv", "--no-time", "--target", "z", "--terms", "x1"]);
+    let (ok, _, err) = identify_hald(&["--target", "z", "--terms", "x1"]);
     assert!(!ok);
     assert!(err.contains("hald.csv") && err.contains("`z`"), "{err}");
     // output-error refinement re-simulates a model's equations: no model, no refinement
-    let (ok, _, err) = termid(&[
-        "identify",
-        "--data",
-        "tests/data/hald.csv",
-        "--no-time",
-        "--target",
-        "y",
-        "--terms",
-        "x1",
-        "--refine",
-        "y",
-    ]);
+    let (ok, _, err) = identify_hald(&["--target", "y", "--terms", "x1", "--refine", "y"]);
     assert!(!ok && err.contains("--refine") && err.contains("--model"), "{err}");
-    let (ok, _, err) = termid(&[
-        "identify",
-        "--data",
-        "tests/data/hald.csv",
-        "--no-time",
-        "--target",
-        "y",
-        "--terms",
-        "x1",
-        "x2*x1",
-        "x1*x2",
-    ]);
+    let (ok, _, err) = identify_hald(&["--target", "y", "--terms", "x1", "x2*x1", "x1*x2"]);
     assert!(!ok);
     assert!(err.contains("duplicate"), "{err}");
 }
