@@ -3,8 +3,8 @@
 //! read where they are (the term evaluator's output, a user's matrix) and shifted in registers,
 //! not copied first (the copy had cost ~6 % of a 2 505-row fit). Only the lower triangle is
 //! computed (half the flops of a general product, as BLAS dsyrk); [`mirror`] completes it where
-//! a full matrix is wanted. On x86-64 register-tiled kernels with explicit intrinsics (AVX-512, else AVX2+FMA, checked at
-//! run time); elsewhere a portable one.
+//! a full matrix is wanted. On x86-64 register-tiled kernels with explicit intrinsics
+//! (AVX-512, else AVX2+FMA, checked at run time); elsewhere a portable one.
 
 const LANES: usize = 4;
 

