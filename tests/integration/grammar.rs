@@ -1,7 +1,7 @@
 //! The term language through the public API.
 
 use proptest::prelude::*;
-use termid::term::{parse_expr, parse_terms, Library, Source, Term, TermError, Vocabulary};
+use termid::term::{parse_expr, parse_terms, Expr, Library, Source, Term, TermError, Vocabulary};
 
 fn ship() -> Vocabulary {
     let mut v = Vocabulary::new();
@@ -107,6 +107,26 @@ fn values(u: f64, v: f64, r: f64, d: f64, u0: f64) -> impl Fn(&str) -> f64 {
     }
 }
 
+/// Whether the term is so ill-conditioned at this point that two evaluation orders need not
+/// agree to the law's tolerance: a relative nudge of 1e-12 to any one input (u, v, r, δ, u0)
+/// moves the value by more than 1e-7 relative, i.e. a condition number above 1e5, at which a
+/// few ulps of rounding inside (Δu = u − u0 near zero, sin of 1/Δu³) exceed 1e-9. Such points
+/// come from random constants and parameters (poles at `1.75 - u`, Δu → 0), not from the
+/// compiler, and are skipped; the well-conditioned rest of each case is checked.
+fn ill_conditioned(vocab: &Vocabulary, expr: &Expr, x: [f64; 5], want: f64) -> bool {
+    if !want.is_finite() {
+        return false;
+    }
+    (0..5).any(|k| {
+        [1.0 + 1e-12, 1.0 - 1e-12].iter().any(|s| {
+            let mut y = x;
+            y[k] *= s;
+            let moved = vocab.interpret(expr, &values(y[0], y[1], y[2], y[3], y[4]));
+            !moved.is_finite() || (moved - want).abs() > 1e-7 * want.abs().max(1.0)
+        })
+    })
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 400, ..ProptestConfig::default() })]
 
@@ -123,8 +143,8 @@ proptest! {
     #[test]
     fn compiled_equals_interpreter(
         text in term_text(),
-        // magnitudes kept ≥ 0.3: near a pole, sin(1/r^3/δ) is so ill-conditioned that no two
-        // evaluation orders agree, and that is not what this law is about
+        // magnitudes kept ≥ 0.3 so that most rows are well-conditioned; the poles left (Δu → 0,
+        // random constants) are skipped row by row by `ill_conditioned`
         rows in prop::collection::vec((1.0f64..3.0, away_from_zero(), away_from_zero(), away_from_zero()), 1..40),
         u0 in 1.5f64..2.5,
     ) {
@@ -144,12 +164,18 @@ proptest! {
         for (i, row) in rows.iter().enumerate() {
             let env = values(row.0, row.1, row.2, row.3, u0);
             let want = vocab.interpret(&expr, &env);
+            if ill_conditioned(&vocab, &expr, [row.0, row.1, row.2, row.3, u0], want) {
+                continue;
+            }
             let canon = term.eval(&|n| vocab.value_of(n, &env));
             let inputs: Vec<f64> = lib.inputs().iter().map(|n| env(n)).collect();
             let mut one = [0.0];
             lib.eval_row(&inputs, &mut scratch, &mut one);
+            // a division by zero is non-finite in every order, but which non-finite value
+            // (±inf or NaN) depends on how the canonical form distributed it: (v+r)/0 = -inf is
+            // r/0 + v/0 = NaN; such a column is refused as data either way
             for got in [design[i], one[0], canon] {
-                let ok = (got.is_nan() && want.is_nan())
+                let ok = (!got.is_finite() && !want.is_finite())
                     || got == want
                     || (got - want).abs() <= 1e-9 * want.abs().max(1.0);
                 prop_assert!(ok, "{}: got {} want {} (canonical {})", text, got, want, term);
