@@ -96,7 +96,8 @@ fn away_from_zero() -> impl Strategy<Value = f64> {
     (0.3f64..1.0, any::<bool>()).prop_map(|(x, neg)| if neg { -x } else { x })
 }
 
-fn values(u: f64, v: f64, r: f64, d: f64, u0: f64) -> impl Fn(&str) -> f64 {
+/// The values of u, v, r, δ and u0, in that order, by name.
+fn values([u, v, r, d, u0]: [f64; 5]) -> impl Fn(&str) -> f64 {
     move |n| match n {
         "u" => u,
         "v" => v,
@@ -121,7 +122,7 @@ fn ill_conditioned(vocab: &Vocabulary, expr: &Expr, x: [f64; 5], want: f64) -> b
         [1.0 + 1e-12, 1.0 - 1e-12].iter().any(|s| {
             let mut y = x;
             y[k] *= s;
-            let moved = vocab.interpret(expr, &values(y[0], y[1], y[2], y[3], y[4]));
+            let moved = vocab.interpret(expr, &values(y));
             !moved.is_finite() || (moved - want).abs() > 1e-7 * want.abs().max(1.0)
         })
     })
@@ -162,9 +163,10 @@ proptest! {
         lib.fill(&sources, rows.len(), &mut design);
         let mut scratch = lib.scratch();
         for (i, row) in rows.iter().enumerate() {
-            let env = values(row.0, row.1, row.2, row.3, u0);
+            let x = [row.0, row.1, row.2, row.3, u0];
+            let env = values(x);
             let want = vocab.interpret(&expr, &env);
-            if ill_conditioned(&vocab, &expr, [row.0, row.1, row.2, row.3, u0], want) {
+            if ill_conditioned(&vocab, &expr, x, want) {
                 continue;
             }
             let canon = term.eval(&|n| vocab.value_of(n, &env));
