@@ -271,8 +271,11 @@ fn covariance_of(moments: &Moments, selection: &Selection) -> Option<Vec<Vec<f64
         }
         crate::select::sweep(&mut inverse, k, j);
     }
-    let cov: Vec<Vec<f64>> =
-        inverse.chunks_exact(k).map(|row| row.iter().map(|v| s2 * v).collect()).collect();
+    // the sweep's round-off leaves the inverse symmetric only to ~1e-8 relative on
+    // ill-conditioned sets; a covariance is symmetric by definition, so take the mean
+    let cov: Vec<Vec<f64>> = (0..k)
+        .map(|i| (0..k).map(|j| s2 * 0.5 * (inverse[i * k + j] + inverse[j * k + i])).collect())
+        .collect();
     cov.iter().flatten().all(|v| v.is_finite()).then_some(cov)
 }
 

@@ -6,10 +6,12 @@
 //! ([`uncertainty`]); ship manoeuvring is the first plug-in ([`ship`]).
 #![warn(missing_docs)]
 
+pub mod budget;
 pub mod data;
 pub mod diagnose;
 pub mod identify;
 pub mod model;
+pub mod output;
 pub mod plot;
 pub mod select;
 pub mod ship;

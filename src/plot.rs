@@ -139,27 +139,36 @@ impl Figure {
         Figure { title: title.into(), panels, width: 760, panel_height: 240 }
     }
 
-    /// Writes the figure as SVG.
+    /// Writes the figure as SVG (atomically: the old file stays until the new one is whole).
     pub fn write_svg(&self, path: &Path) -> Result<(), PlotError> {
         let file = path.display().to_string();
-        let err = |e: &dyn std::fmt::Display| PlotError { file: file.clone(), message: e.to_string() };
+        let svg = self.to_svg().map_err(|message| PlotError { file: file.clone(), message })?;
+        crate::output::write_file(path, svg.as_bytes()).map_err(|e| PlotError { file, message: e.reason() })
+    }
+
+    /// The figure as SVG text.
+    pub fn to_svg(&self) -> Result<String, String> {
+        let err = |e: &dyn std::fmt::Display| e.to_string();
         let title_h = if self.title.is_empty() { 0 } else { 30 };
         let height = title_h + self.panel_height * self.panels.len().max(1) as u32;
-        let root = SVGBackend::new(path, (self.width, height)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| err(&e))?;
-        let body = if title_h > 0 {
-            let (top, body) = root.split_vertically(title_h);
-            top.titled(&self.title, ("sans-serif", 18)).map_err(|e| err(&e))?;
-            body
-        } else {
-            root.clone()
-        };
-        let areas = body.split_evenly((self.panels.len().max(1), 1));
-        for (panel, area) in self.panels.iter().zip(areas) {
-            self.draw_panel(panel, &area).map_err(|e| err(&e))?;
+        let mut svg = String::new();
+        {
+            let root = SVGBackend::with_string(&mut svg, (self.width, height)).into_drawing_area();
+            root.fill(&WHITE).map_err(|e| err(&e))?;
+            let body = if title_h > 0 {
+                let (top, body) = root.split_vertically(title_h);
+                top.titled(&self.title, ("sans-serif", 18)).map_err(|e| err(&e))?;
+                body
+            } else {
+                root.clone()
+            };
+            let areas = body.split_evenly((self.panels.len().max(1), 1));
+            for (panel, area) in self.panels.iter().zip(areas) {
+                self.draw_panel(panel, &area).map_err(|e| err(&e))?;
+            }
+            root.present().map_err(|e| err(&e))?;
         }
-        root.present().map_err(|e| err(&e))?;
-        Ok(())
+        Ok(svg)
     }
 
     fn draw_panel<DB: DrawingBackend>(

@@ -92,10 +92,11 @@ impl Frame {
         Ok(frame)
     }
 
-    /// Writes the frame as CSV (time first), numbers in shortest round-trip form.
+    /// Writes the frame as CSV (time first), numbers in shortest round-trip form; atomically
+    /// (the old file stays until the new one is whole).
     pub fn write_csv(&self, path: &Path) -> Result<(), DataError> {
-        std::fs::write(path, self.to_csv())
-            .map_err(|e| DataError::Io { file: path.display().to_string(), message: e.to_string() })
+        crate::output::write_file(path, self.to_csv().as_bytes())
+            .map_err(|e| DataError::Io { file: path.display().to_string(), message: e.reason() })
     }
 
     /// The frame as CSV text.

@@ -171,6 +171,17 @@ pub enum DataError {
         /// The median step.
         median: f64,
     },
+    /// A setting out of its range (a resampling interval of 0 s).
+    #[error("{0}")]
+    Setting(String),
+    /// Work too large for memory, refused before it started.
+    #[error("{file}: {size}")]
+    TooLarge {
+        /// The file.
+        file: String,
+        /// How large (in the message, so not also a source that would print twice).
+        size: crate::budget::TooLarge,
+    },
     /// Unknown derivative method.
     #[error("unknown derivative method `{0}` (known: {1})")]
     UnknownMethod(String, String),

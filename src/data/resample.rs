@@ -100,7 +100,27 @@ pub fn check_gaps(frame: &Frame, factor: f64) -> Result<(), DataError> {
 pub fn resample(frame: &Frame, dt: f64) -> Result<Frame, DataError> {
     let t = frame.time();
     let span = t[t.len() - 1] - t[0];
-    if !(dt > 0.0 && dt.is_finite()) || dt > span / 2.0 {
+    if !(dt > 0.0 && dt.is_finite()) {
+        return Err(DataError::Setting(format!(
+            "the resampling interval must be a positive number of seconds, not {dt}"
+        )));
+    }
+    // the fine grid of the decimation is never coarser than the run's own median step
+    let rows = span / dt.min(median_step(t)) + 1.0;
+    crate::budget::check_values(
+        rows * frame.names().len() as f64,
+        || {
+            format!(
+                "resampling {} rows over {span} s at {dt} s: {} rows × {} columns",
+                t.len(),
+                crate::budget::count(rows),
+                frame.names().len()
+            )
+        },
+        "choose a coarser --resample",
+    )
+    .map_err(|size| DataError::TooLarge { file: frame.origin().into(), size })?;
+    if dt > span / 2.0 {
         return Err(DataError::TooShort {
             file: frame.origin().into(),
             rows: t.len(),

@@ -5,6 +5,7 @@
 //! caret inside it.
 
 mod file;
+mod locate;
 
 pub use file::{
     CoefficientSpec, CovarianceSpec, EquationSpec, InputSpec, Meta, ModelFile, ParameterSpec, ShipNames,
@@ -15,7 +16,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use crate::identify::ParamValue;
-use crate::select::Backend;
+use crate::select::{Backend, Candidate};
 use crate::term::{Library, Term, TermError, Vocabulary};
 
 /// The default model: HSVA model 1512 as identified by Oltmann (1973), true coefficients.
@@ -56,7 +57,7 @@ pub enum ModelError {
         message: String,
     },
     /// A term inside a key.
-    #[error("{file}:{line}: `{key}`:\n{source}")]
+    #[error("{file}:{line}: `{key}`:\n{term}")]
     Term {
         /// The file.
         file: String,
@@ -64,8 +65,9 @@ pub enum ModelError {
         line: usize,
         /// The key.
         key: String,
-        /// The term error with its caret.
-        source: Box<TermError>,
+        /// The term error with its caret (in the message, so not also a source that would
+        /// print the caret block twice).
+        term: Box<TermError>,
     },
 }
 
@@ -158,53 +160,43 @@ impl Model {
 
     /// Checks a parsed file and resolves its terms.
     pub fn from_spec(spec: ModelFile, text: &str, file: &str) -> Result<Model, ModelError> {
-        let line_of = |key: &str| locate(text, key);
-        let key_err = |key: &str, line_key: &str, message: String| ModelError::Key {
+        let line_of = |key: &str| locate::line_of_key(text, key);
+        let key_err = |key: &str, message: String| ModelError::Key {
             file: file.into(),
-            line: line_of(line_key),
+            line: line_of(key),
             key: key.into(),
             message,
         };
         let mut vocab = Vocabulary::new();
         for (i, s) in spec.states.iter().enumerate() {
-            vocab
-                .variable(&s.name)
-                .map_err(|e| key_err(&format!("states[{i}].name"), &s.name, e.to_string()))?;
+            vocab.variable(&s.name).map_err(|e| key_err(&format!("states[{i}].name"), e.to_string()))?;
             if let (Some(lo), Some(hi)) = (s.min, s.max) {
                 if lo >= hi {
-                    return Err(key_err(
-                        &format!("states[{i}]"),
-                        &s.name,
-                        format!("min {lo} is not below max {hi}"),
-                    ));
+                    return Err(key_err(&format!("states[{i}]"), format!("min {lo} is not below max {hi}")));
                 }
             }
         }
         for (i, s) in spec.inputs.iter().enumerate() {
-            vocab
-                .variable(&s.name)
-                .map_err(|e| key_err(&format!("inputs[{i}].name"), &s.name, e.to_string()))?;
+            vocab.variable(&s.name).map_err(|e| key_err(&format!("inputs[{i}].name"), e.to_string()))?;
         }
         for (name, p) in &spec.parameters {
-            vocab.parameter(name).map_err(|e| key_err(&format!("parameters.{name}"), name, e.to_string()))?;
+            vocab.parameter(name).map_err(|e| key_err(&format!("parameters.{name}"), e.to_string()))?;
             if let Some(rule) = &p.per_run {
                 ParamValue::Rule(rule.clone())
                     .check_rule(name)
-                    .map_err(|m| key_err(&format!("parameters.{name}.per_run"), rule, m))?;
+                    .map_err(|m| key_err(&format!("parameters.{name}.per_run"), m))?;
             }
         }
         for (i, d) in spec.derived.iter().enumerate() {
             vocab.derive(&d.name, &d.definition).map_err(|e| ModelError::Term {
-                source: Box::new(e),
+                term: Box::new(e),
                 file: file.into(),
-                line: line_of(&d.definition),
+                line: line_of(&format!("derived[{i}].definition")),
                 key: format!("derived[{i}].definition"),
             })?;
         }
         for (alias, target) in &spec.aliases {
-            vocab
-                .alias(alias, target)
-                .map_err(|e| key_err(&format!("aliases.{alias}"), alias, e.to_string()))?;
+            vocab.alias(alias, target).map_err(|e| key_err(&format!("aliases.{alias}"), e.to_string()))?;
         }
         let mut equations = Vec::new();
         for (name, eq) in &spec.equations {
@@ -212,7 +204,6 @@ impl Model {
             let Some(state) = state.filter(|s| spec.states.iter().any(|st| &st.name == s)) else {
                 return Err(key_err(
                     &format!("equations.{name}.state"),
-                    &format!("[equations.{name}]"),
                     format!("`{}` is not a declared state", eq.state),
                 ));
             };
@@ -220,15 +211,14 @@ impl Model {
                 let mut out: Vec<Term> = Vec::new();
                 for (i, text) in list.iter().enumerate() {
                     let t = vocab.parse(text).map_err(|e| ModelError::Term {
-                        source: Box::new(e),
+                        term: Box::new(e),
                         file: file.into(),
-                        line: line_of(&format!("\"{text}\"")),
+                        line: line_of(&format!("equations.{name}.{what}[{i}]")),
                         key: format!("equations.{name}.{what}[{i}]"),
                     })?;
                     if let Some(j) = out.iter().position(|o| *o == t) {
                         return Err(key_err(
                             &format!("equations.{name}.{what}[{i}]"),
-                            &format!("\"{text}\""),
                             format!("`{text}` is the same term as `{}` (both `{t}`)", list[j]),
                         ));
                     }
@@ -239,13 +229,10 @@ impl Model {
             let candidates = parse_list(&eq.candidates, "candidates")?;
             let forced = parse_list(&eq.forced, "forced")?;
             let excluded = parse_list(&eq.excluded, "excluded")?;
-            for (what, list, texts) in
-                [("forced", &forced, &eq.forced), ("excluded", &excluded, &eq.excluded)]
-            {
-                if let Some((t, text)) = list.iter().zip(texts).find(|(t, _)| !candidates.contains(t)) {
+            for (what, list) in [("forced", &forced), ("excluded", &excluded)] {
+                if let Some((i, t)) = list.iter().enumerate().find(|(_, t)| !candidates.contains(t)) {
                     return Err(key_err(
-                        &format!("equations.{name}.{what}"),
-                        &format!("\"{text}\""),
+                        &format!("equations.{name}.{what}[{i}]"),
                         format!("`{t}` is not among the candidates"),
                     ));
                 }
@@ -254,25 +241,17 @@ impl Model {
             for (text, c) in &eq.coefficients {
                 let key = format!("equations.{name}.coefficients.\"{text}\"");
                 let t = vocab.parse(text).map_err(|e| ModelError::Term {
-                    source: Box::new(e),
+                    term: Box::new(e),
                     file: file.into(),
-                    line: line_of(&format!("\"{text}\"")),
+                    line: line_of(&key),
                     key: key.clone(),
                 })?;
                 let (value, se) = c.value_and_error();
                 if !value.is_finite() || se.is_some_and(|s| !s.is_finite() || s < 0.0) {
-                    return Err(key_err(
-                        &key,
-                        &format!("\"{text}\""),
-                        "value and std_error must be finite (std_error ≥ 0)".into(),
-                    ));
+                    return Err(key_err(&key, "value and std_error must be finite (std_error ≥ 0)".into()));
                 }
                 if coefficients.iter().any(|(o, _, _)| *o == t) {
-                    return Err(key_err(
-                        &key,
-                        &format!("\"{text}\""),
-                        format!("term `{t}` has two coefficients"),
-                    ));
+                    return Err(key_err(&key, format!("term `{t}` has two coefficients")));
                 }
                 coefficients.push((t, value, se));
             }
@@ -280,15 +259,15 @@ impl Model {
                 None => None,
                 Some(c) => {
                     let key = format!("equations.{name}.covariance");
-                    let bad = |m: String| key_err(&key, &format!("[equations.{name}.covariance]"), m);
+                    let bad = |m: String| key_err(&key, m);
                     let terms = c
                         .terms
                         .iter()
                         .map(|text| {
                             vocab.parse(text).map_err(|e| ModelError::Term {
-                                source: Box::new(e),
+                                term: Box::new(e),
                                 file: file.into(),
-                                line: line_of(&format!("[equations.{name}.covariance]")),
+                                line: line_of(&format!("{key}.terms")),
                                 key: format!("{key}.terms"),
                             })
                         })
@@ -299,10 +278,53 @@ impl Model {
                     Some(c)
                 }
             };
-            let backend = eq.backend.clone().unwrap_or_default();
-            backend
-                .build()
-                .map_err(|e| key_err(&format!("equations.{name}.backend"), "backend", e.to_string()))?;
+            let mut backend = eq.backend.clone().unwrap_or_default();
+            backend.build().map_err(|e| key_err(&format!("equations.{name}.backend"), e.to_string()))?;
+            if let Backend::Sparse(fit) = &mut backend {
+                // constraints name candidates: each must be one, and is kept by its canonical text
+                let key = format!("equations.{name}.backend");
+                let canonical = |c: &mut Candidate, at: String| -> Result<(), ModelError> {
+                    let term = match &*c {
+                        Candidate::Column(j) => candidates.get(*j).cloned(),
+                        Candidate::Term(text) => {
+                            let t = vocab.parse(text).map_err(|e| ModelError::Term {
+                                term: Box::new(e),
+                                file: file.into(),
+                                line: line_of(&at),
+                                key: at.clone(),
+                            })?;
+                            candidates.contains(&t).then_some(t)
+                        }
+                    };
+                    let term = term.ok_or_else(|| {
+                        key_err(
+                            &at,
+                            format!(
+                                "{c} is not one of the {} candidates of `{name}` (name the term as in `candidates`)",
+                                candidates.len()
+                            ),
+                        )
+                    })?;
+                    *c = Candidate::Term(term.to_string());
+                    Ok(())
+                };
+                for (i, (c, _)) in fit.fixed.iter_mut().enumerate() {
+                    canonical(c, format!("{key}.fixed[{i}]"))?;
+                }
+                for (i, (c, _)) in fit.signs.iter_mut().enumerate() {
+                    canonical(c, format!("{key}.signs[{i}]"))?;
+                }
+                for (i, e) in fit.equalities.iter_mut().enumerate() {
+                    for (k, (c, _)) in e.terms.iter_mut().enumerate() {
+                        canonical(c, format!("{key}.equalities[{i}].terms[{k}]"))?;
+                    }
+                }
+                for (c, _) in fit.fixed.iter().chain(&fit.signs) {
+                    if excluded.iter().any(|t| Candidate::Term(t.to_string()) == *c) {
+                        return Err(key_err(&key, format!("a constraint names {c}, which is excluded")));
+                    }
+                }
+            }
             equations.push(Equation {
                 name: name.clone(),
                 state,
@@ -322,7 +344,6 @@ impl Model {
             if w[0].state == w[1].state {
                 return Err(key_err(
                     &format!("equations.{}.state", w[1].name),
-                    &format!("[equations.{}]", w[1].name),
                     format!("state `{}` already has equation `{}`", w[1].state, w[0].name),
                 ));
             }
@@ -468,11 +489,6 @@ fn check_covariance(coefficients: &[(Term, f64, Option<f64>)], c: &Covariance) -
         return Err(format!("`matrix` is not positive semi-definite (eigenvalue {smallest:e})"));
     }
     Ok(())
-}
-
-/// 1-based line of the first occurrence of `needle` in `text` (0 if absent).
-fn locate(text: &str, needle: &str) -> usize {
-    text.find(needle).map_or(0, |i| text[..i].matches('\n').count() + 1)
 }
 
 #[cfg(test)]

@@ -17,7 +17,7 @@ use serde::{Deserialize, Serialize};
 pub use best_subset::{BestSubset, Criterion};
 pub use efroymson::Efroymson;
 pub use moments::{gather, Accumulator, Moments};
-pub use sparse::{Equality, LambdaChoice, SparseFit};
+pub use sparse::{Candidate, Equality, LambdaChoice, SparseFit};
 pub use stepwise::{StepRule, Stepwise};
 pub(crate) use subset::sweep;
 
@@ -235,6 +235,12 @@ pub enum SelectError {
     /// The QP solver (Clarabel) ended with a status other than Solved.
     #[error("the sparse fit's QP solver stopped with status {0}")]
     Solver(String),
+    /// The sparse fit's constraints admit no coefficients.
+    #[error("the sparse fit's constraints conflict: no coefficients satisfy {constraints} together (with the forced terms and the target's scale); drop or loosen one")]
+    Infeasible {
+        /// The constraints, as a person reads them.
+        constraints: String,
+    },
     /// Index out of range or names not matching the statistics.
     #[error("problem does not fit together: {0}")]
     Shape(String),

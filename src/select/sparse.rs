@@ -18,14 +18,79 @@ use serde::{Deserialize, Serialize};
 use super::subset::Scaled;
 use super::{Moments, Problem, SelectError, Selection, Selector, Step, Stop};
 
-/// A linear equality between coefficients: Σ coefficient × b(term) = value (raw units).
+/// A candidate named in a constraint: its term as model files write it (`"u*δ"`, matched
+/// against the candidates' canonical texts; a model file's are canonicalised when it is read)
+/// or its 0-based column among the candidates.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Candidate {
+    /// Column index.
+    Column(usize),
+    /// Term text.
+    Term(String),
+}
+
+impl std::fmt::Display for Candidate {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Candidate::Column(j) => write!(f, "column {j}"),
+            Candidate::Term(t) => write!(f, "`{t}`"),
+        }
+    }
+}
+
+impl From<usize> for Candidate {
+    fn from(j: usize) -> Candidate {
+        Candidate::Column(j)
+    }
+}
+
+impl From<&str> for Candidate {
+    fn from(t: &str) -> Candidate {
+        Candidate::Term(t.into())
+    }
+}
+
+impl Candidate {
+    /// The column it names among `names`, or an error that lists them.
+    pub fn column(&self, names: &[String]) -> Result<usize, SelectError> {
+        let found = match self {
+            Candidate::Column(j) => Some(*j).filter(|j| *j < names.len()),
+            Candidate::Term(t) => names.iter().position(|n| n == t),
+        };
+        found.ok_or_else(|| {
+            SelectError::Config(format!(
+                "a sparse constraint names {self}, which is not a candidate (candidates: {})",
+                names.join(", ")
+            ))
+        })
+    }
+}
+
+/// A linear equality between coefficients: Σ factor × b(term) = value (raw units).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Equality {
-    /// (candidate column, factor).
-    pub terms: Vec<(usize, f64)>,
+    /// (candidate, factor).
+    pub terms: Vec<(Candidate, f64)>,
     /// Right-hand side.
     pub value: f64,
+}
+
+/// The constraints with every candidate resolved to its column (checked against the problem).
+#[derive(Clone, Debug, Default)]
+struct Columns {
+    fixed: Vec<(usize, f64)>,
+    signs: Vec<(usize, f64)>,
+    equalities: Vec<(Vec<(usize, f64)>, f64)>,
+    /// The constraints as a person reads them (`x3 = 1, x3 ≤ 0`), for the error when they conflict.
+    text: String,
+}
+
+impl Columns {
+    fn is_empty(&self) -> bool {
+        self.fixed.is_empty() && self.signs.is_empty() && self.equalities.is_empty()
+    }
 }
 
 /// How λ is chosen on the path.
@@ -48,8 +113,8 @@ pub enum LambdaChoice {
 /// | `lambda_ratio` | 1e-5 | smallest λ over λ_max |
 /// | `lambda` | none | a single λ instead of the path (standardised units) |
 /// | `adaptive` | false | weights 1/\|β_ols\| (adaptive LASSO, Zou 2006) |
-/// | `fixed` | none | (column, value): coefficient fixed, raw units |
-/// | `signs` | none | (column, +1 or −1): coefficient ≥ 0 or ≤ 0 |
+/// | `fixed` | none | (term, value): coefficient fixed, raw units |
+/// | `signs` | none | (term, +1 or −1): coefficient ≥ 0 or ≤ 0 |
 /// | `equalities` | none | linear equalities between coefficients |
 /// | `support_tolerance` | 1e-6 | \|β\| below this (standardised) is zero |
 /// | `active_set` | true | a plain-LASSO λ is first solved from its optimality conditions (active set and signs from the neighbouring λ, updated while they fail; accepted only when all hold, so exact), Clarabel where that fails and for every constrained fit; false: Clarabel at every λ |
@@ -67,10 +132,10 @@ pub struct SparseFit {
     pub lambda: Option<f64>,
     /// Adaptive weights.
     pub adaptive: bool,
-    /// Fixed coefficients (column, raw value).
-    pub fixed: Vec<(usize, f64)>,
-    /// Sign constraints (column, ±1).
-    pub signs: Vec<(usize, f64)>,
+    /// Fixed coefficients (term, raw value).
+    pub fixed: Vec<(Candidate, f64)>,
+    /// Sign constraints (term, ±1).
+    pub signs: Vec<(Candidate, f64)>,
     /// Linear equalities.
     pub equalities: Vec<Equality>,
     /// Zero threshold for a standardised coefficient.
@@ -116,26 +181,87 @@ impl SparseFit {
         if self.lambda.is_some_and(|l| l.is_nan() || l < 0.0) || self.signs.iter().any(|s| s.1.abs() != 1.0) {
             return Err(SelectError::Config("sparse lambda must be ≥ 0 and signs ±1".into()));
         }
+        let values = self.fixed.iter().map(|f| f.1).chain(
+            self.equalities.iter().flat_map(|e| e.terms.iter().map(|t| t.1).chain(std::iter::once(e.value))),
+        );
+        if values.into_iter().any(|v| !v.is_finite()) {
+            return Err(SelectError::Config("sparse fixed values and equalities must be finite".into()));
+        }
         Ok(())
+    }
+
+    /// The constraints on the problem's columns: every named candidate must be one, and a
+    /// candidate may be fixed or signed once.
+    fn columns(&self, pb: &Problem<'_>) -> Result<Columns, SelectError> {
+        let col = |c: &Candidate| c.column(pb.names);
+        let pairs = |list: &[(Candidate, f64)], what: &str| -> Result<Vec<(usize, f64)>, SelectError> {
+            let mut out: Vec<(usize, f64)> = Vec::new();
+            for (c, v) in list {
+                let j = col(c)?;
+                if out.iter().any(|(i, _)| *i == j) {
+                    return Err(SelectError::Config(format!(
+                        "sparse `{what}` names `{}` twice",
+                        pb.names[j]
+                    )));
+                }
+                out.push((j, *v));
+            }
+            Ok(out)
+        };
+        let mut equalities = Vec::new();
+        for e in &self.equalities {
+            let terms =
+                e.terms.iter().map(|(c, f)| Ok((col(c)?, *f))).collect::<Result<Vec<_>, SelectError>>()?;
+            equalities.push((terms, e.value));
+        }
+        let (fixed, signs) = (pairs(&self.fixed, "fixed")?, pairs(&self.signs, "signs")?);
+        let name = |j: usize| pb.names[j].as_str();
+        let text = fixed
+            .iter()
+            .map(|&(j, v)| format!("{} = {v}", name(j)))
+            .chain(signs.iter().map(|&(j, s)| format!("{} {} 0", name(j), if s > 0.0 { "≥" } else { "≤" })))
+            .chain(equalities.iter().map(|(terms, v)| {
+                let lhs: Vec<String> = terms.iter().map(|&(j, f)| format!("{f}·{}", name(j))).collect();
+                format!("{} = {v}", lhs.join(" + "))
+            }))
+            .collect::<Vec<_>>()
+            .join(", ");
+        let columns = Columns { fixed, signs, equalities, text };
+        for &j in columns
+            .fixed
+            .iter()
+            .map(|(j, _)| j)
+            .chain(columns.equalities.iter().flat_map(|e| e.0.iter().map(|(j, _)| j)))
+        {
+            if pb.excluded.contains(&j) {
+                return Err(SelectError::Config(format!(
+                    "sparse constraint on `{}`, which is excluded",
+                    pb.names[j]
+                )));
+            }
+        }
+        Ok(columns)
     }
 
     /// The LASSO solution at one λ, standardised coefficients (one per candidate).
     pub fn lasso(&self, pb: &Problem<'_>, lambda: f64) -> Result<Vec<f64>, SelectError> {
+        self.validate()?;
+        let c = self.columns(pb)?;
         let sc = Scaled::new(pb)?;
         let w = self.weights(&sc, pb)?;
         let all: Vec<usize> = (0..sc.p).filter(|j| !pb.excluded.contains(j)).collect();
-        self.solve(&sc, lambda, &w, &all)
+        self.solve(&sc, lambda, &w, &all, &c)
     }
 
     /// Columns the QP must always carry: unpenalised (forced) ones and those a fixed value
     /// or an equality names.
-    fn always_active(&self, pb: &Problem<'_>, w: &[f64]) -> Vec<bool> {
+    fn always_active(&self, pb: &Problem<'_>, w: &[f64], c: &Columns) -> Vec<bool> {
         let mut keep: Vec<bool> = w.iter().map(|w| *w == 0.0).collect();
-        for &(j, _) in &self.fixed {
+        for &(j, _) in &c.fixed {
             keep[j] = true;
         }
-        for e in &self.equalities {
-            for &(j, _) in &e.terms {
+        for e in &c.equalities {
+            for &(j, _) in &e.0 {
                 keep[j] = true;
             }
         }
@@ -160,11 +286,12 @@ impl SparseFit {
         w: &[f64],
         always: &[bool],
         cache: &mut Option<(Vec<usize>, DefaultSolver<f64>)>,
+        c: &Columns,
     ) -> Result<Vec<f64>, SelectError> {
         let p = sc.p;
         let correlation = |b: &[f64], j: usize| residual_correlation(sc, b, j);
         let (lambda_prev, b_prev) = previous;
-        if let Some(beta) = self.closed_form(sc, pb, lambda, b_prev, w) {
+        if let Some(beta) = self.closed_form(sc, pb, lambda, b_prev, w, c) {
             return Ok(beta);
         }
         let candidates: Vec<usize> = (0..p).filter(|j| !pb.excluded.contains(j)).collect();
@@ -180,7 +307,7 @@ impl SparseFit {
             })
             .collect();
         loop {
-            let beta = self.solve_with(sc, lambda, w, &active, cache)?;
+            let beta = self.solve_with(sc, lambda, w, &active, cache, c)?;
             let violators: Vec<usize> = candidates
                 .iter()
                 .copied()
@@ -212,9 +339,9 @@ impl SparseFit {
         lambda: f64,
         b_prev: &[f64],
         w: &[f64],
+        c: &Columns,
     ) -> Option<Vec<f64>> {
-        if !(self.active_set && self.fixed.is_empty() && self.signs.is_empty() && self.equalities.is_empty())
-        {
+        if !(self.active_set && c.is_empty()) {
             return None;
         }
         let (p, m) = (sc.p, sc.m);
@@ -295,8 +422,15 @@ impl SparseFit {
 
     /// The LASSO QP on the columns `active` (the others held at zero): variables b and the
     /// bounds t ≥ |b| of the active columns; standardised coefficients, one per candidate.
-    fn solve(&self, sc: &Scaled, lambda: f64, w: &[f64], active: &[usize]) -> Result<Vec<f64>, SelectError> {
-        self.solve_with(sc, lambda, w, active, &mut None)
+    fn solve(
+        &self,
+        sc: &Scaled,
+        lambda: f64,
+        w: &[f64],
+        active: &[usize],
+        c: &Columns,
+    ) -> Result<Vec<f64>, SelectError> {
+        self.solve_with(sc, lambda, w, active, &mut None, c)
     }
 
     /// [`SparseFit::solve`], reusing the solver of the previous λ when it had the same
@@ -310,6 +444,7 @@ impl SparseFit {
         w: &[f64],
         active: &[usize],
         cache: &mut Option<(Vec<usize>, DefaultSolver<f64>)>,
+        c: &Columns,
     ) -> Result<Vec<f64>, SelectError> {
         let (p, m) = (sc.p, sc.m);
         let k = active.len();
@@ -343,17 +478,16 @@ impl SparseFit {
         // constraint rows (dense, then to CSC): equalities first (zero cone), then inequalities
         let to_std = |j: usize| sc.d[j] / sc.d[p]; // β = b·d_j/d_y
         let mut eq_rows: Vec<(Vec<(usize, f64)>, f64)> = Vec::new();
-        for &(j, v) in &self.fixed {
+        for &(j, v) in &c.fixed {
             eq_rows.push((vec![(at(j)?, 1.0)], v * to_std(j)));
         }
-        for e in &self.equalities {
+        for (terms, value) in &c.equalities {
             // Σ f·b = v with b = β·d_y/d_j
-            let entries = e
-                .terms
+            let entries = terms
                 .iter()
                 .map(|&(j, f)| Ok((at(j)?, f / to_std(j))))
                 .collect::<Result<_, SelectError>>()?;
-            eq_rows.push((entries, e.value));
+            eq_rows.push((entries, *value));
         }
         let mut ineq_rows: Vec<Vec<(usize, f64)>> = Vec::new();
         for (a, &j) in active.iter().enumerate() {
@@ -366,7 +500,7 @@ impl SparseFit {
             ineq_rows.push(vec![(a, 1.0), (k + a, -1.0)]);
             ineq_rows.push(vec![(a, -1.0), (k + a, -1.0)]);
         }
-        for &(j, sgn) in &self.signs {
+        for &(j, sgn) in &c.signs {
             // a column left out is zero, which every sign allows
             if let Ok(a) = at(j) {
                 ineq_rows.push(vec![(a, -sgn)]);
@@ -430,6 +564,9 @@ impl SparseFit {
                 }
                 Ok(beta)
             }
+            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
+                Err(SelectError::Infeasible { constraints: c.text.clone() })
+            }
             status => Err(SelectError::Solver(format!("{status:?}"))),
         }
     }
@@ -452,6 +589,7 @@ impl Selector for SparseFit {
 impl SparseFit {
     fn path_fit(&self, pb: &Problem<'_>, folds: &[Moments]) -> Result<Selection, SelectError> {
         self.validate()?;
+        let c = self.columns(pb)?;
         let sc = Scaled::new(pb)?;
         let (p, m) = (sc.p, sc.m);
         let w = self.weights(&sc, pb)?;
@@ -471,7 +609,7 @@ impl SparseFit {
         let mut scores = Vec::new();
         let mut shrunk = Vec::new();
         let mut notes = Vec::new();
-        let always = self.always_active(pb, &w);
+        let always = self.always_active(pb, &w, &c);
         let validation = match self.choice {
             LambdaChoice::LeaveOneRunOut => Some(super::CrossValidation::new(pb, folds)?),
             LambdaChoice::Bic => None,
@@ -484,8 +622,16 @@ impl SparseFit {
             let mut cache = None;
             let mut out = Vec::new();
             for &lambda in lambdas.iter().skip(first).step_by(2) {
-                let beta =
-                    self.solve_screened(&sc, pb, lambda, (previous.0, &previous.1), &w, &always, &mut cache);
+                let beta = self.solve_screened(
+                    &sc,
+                    pb,
+                    lambda,
+                    (previous.0, &previous.1),
+                    &w,
+                    &always,
+                    &mut cache,
+                    &c,
+                );
                 let failed = beta.is_err();
                 if let Ok(b) = &beta {
                     previous = (lambda, b.clone());
@@ -589,12 +735,13 @@ mod tests {
         let all: Vec<usize> = (0..p).collect();
         let (mut hits, mut declined) = (0, 0);
         let mut lambda = 0.5;
-        let mut previous = fit.solve(&sc, lambda, &w, &all).unwrap();
+        let none = Columns::default();
+        let mut previous = fit.solve(&sc, lambda, &w, &all, &none).unwrap();
         while lambda > 1e-4 {
             lambda *= 0.8;
-            let qp = fit.solve(&sc, lambda, &w, &all).unwrap();
+            let qp = fit.solve(&sc, lambda, &w, &all, &none).unwrap();
             for start in [previous.clone(), vec![0.0; p]] {
-                match fit.closed_form(&sc, &pb, lambda, &start, &w) {
+                match fit.closed_form(&sc, &pb, lambda, &start, &w, &none) {
                     Some(b) => {
                         hits += 1;
                         // the objective ½bᵀRb − cᵀb + λ‖b‖₁: the closed form (exact when it answers)
@@ -622,10 +769,11 @@ mod tests {
         }
         assert!(hits > 20, "{hits} closed-form solutions, {declined} declined");
         // constraints the closed form does not know, or the setting off: always the QP
-        let signed = SparseFit { signs: vec![(3, -1.0)], ..SparseFit::default() };
-        assert!(signed.closed_form(&sc, &pb, lambda, &previous, &w).is_none());
+        let signed = SparseFit { signs: vec![(3.into(), -1.0)], ..SparseFit::default() };
+        let c = signed.columns(&pb).unwrap();
+        assert!(signed.closed_form(&sc, &pb, lambda, &previous, &w, &c).is_none());
         let qp_only = SparseFit { active_set: false, ..SparseFit::default() };
-        assert!(qp_only.closed_form(&sc, &pb, lambda, &previous, &w).is_none());
+        assert!(qp_only.closed_form(&sc, &pb, lambda, &previous, &w, &none).is_none());
         // the whole path either way: the same selection
         for choice in [LambdaChoice::Bic, LambdaChoice::LeaveOneRunOut] {
             let fast = SparseFit { choice, ..SparseFit::default() };
@@ -672,11 +820,12 @@ mod tests {
         let pb = Problem { moments: &m, names: &names, forced: &[7], excluded: &[5], intercept: true };
         for fit in [
             SparseFit::default(),
-            SparseFit { adaptive: true, signs: vec![(3, -1.0)], ..SparseFit::default() },
+            SparseFit { adaptive: true, signs: vec![("x3".into(), -1.0)], ..SparseFit::default() },
         ] {
             let sc = Scaled::new(&pb).unwrap();
             let w = fit.weights(&sc, &pb).unwrap();
-            let always = fit.always_active(&pb, &w);
+            let c = fit.columns(&pb).unwrap();
+            let always = fit.always_active(&pb, &w, &c);
             let all: Vec<usize> = (0..p).filter(|j| *j != 5).collect();
             let lambda_max = (0..p)
                 .filter(|j| w[*j] > 0.0 && *j != 5)
@@ -687,9 +836,9 @@ mod tests {
             for k in 0..12 {
                 let lambda = lambda_max * 1e-4f64.powf(k as f64 / 11.0);
                 let screened = fit
-                    .solve_screened(&sc, &pb, lambda, (previous.0, &previous.1), &w, &always, &mut cache)
+                    .solve_screened(&sc, &pb, lambda, (previous.0, &previous.1), &w, &always, &mut cache, &c)
                     .unwrap();
-                let full = fit.solve(&sc, lambda, &w, &all).unwrap();
+                let full = fit.solve(&sc, lambda, &w, &all, &c).unwrap();
                 for j in 0..p {
                     assert!(
                         (screened[j] - full[j]).abs() < 1e-7,

@@ -49,6 +49,27 @@ pub struct Settings {
 }
 
 impl Settings {
+    /// Checks the settings for a run that keeps `columns` values per output sample; returns
+    /// (steps, steps per sample). A run whose output would not fit in memory is refused here,
+    /// before anything is allocated.
+    pub fn check(&self, columns: usize) -> Result<(usize, usize), SimError> {
+        let (steps, every) = self.validate()?;
+        let samples = (steps / every + 2) as f64;
+        crate::budget::check_values(
+            samples * columns as f64,
+            || {
+                format!(
+                    "a run of {} samples × {columns} columns ({} s every {} s)",
+                    crate::budget::count(samples),
+                    self.duration,
+                    self.sample
+                )
+            },
+            "shorten the duration or sample less often",
+        )?;
+        Ok((steps, every))
+    }
+
     fn validate(&self) -> Result<(usize, usize), SimError> {
         let bad = |m: String| Err(SimError::Settings(m));
         if self.dt.is_nan() || self.dt <= 0.0 || self.dt.is_infinite() {
@@ -128,8 +149,9 @@ pub fn simulate(
     controller: &mut dyn Controller,
     settings: &Settings,
 ) -> Result<Trajectory, SimError> {
-    let (steps, every) = settings.validate()?;
     let (n, m) = (system.dim(), system.inputs.len());
+    // time, states, inputs and derivatives per sample
+    let (steps, every) = settings.check(1 + 2 * n + m)?;
     if x0.len() != n {
         return Err(SimError::Settings(format!("{} initial values for {n} states", x0.len())));
     }

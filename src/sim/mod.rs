@@ -39,6 +39,9 @@ pub enum SimError {
     /// Replay data missing a column or too short.
     #[error(transparent)]
     Data(#[from] crate::data::DataError),
+    /// A run too large for memory, refused before it started.
+    #[error(transparent)]
+    TooLarge(#[from] crate::budget::TooLarge),
     /// A steady state that could not be found.
     #[error("no steady state found: {0}")]
     NoSteadyState(String),

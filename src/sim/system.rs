@@ -57,7 +57,16 @@ impl System {
         }
         let inputs: Vec<String> = model.spec.inputs.iter().map(|i| i.name.clone()).collect();
         let mut values = model.parameter_values();
-        values.extend(parameters.iter().map(|(k, v)| (k.clone(), *v)));
+        for (name, value) in parameters {
+            let Some(slot) = values.get_mut(name) else {
+                return Err(SimError::Settings(format!(
+                    "{}: `{name}` is not a parameter of the model ({})",
+                    model.path,
+                    model.parameter_values().keys().cloned().collect::<Vec<_>>().join(", ")
+                )));
+            };
+            *slot = *value;
+        }
         let param_names: Vec<String> = values.keys().cloned().collect();
         let rhs = model.compile_rhs(with_intercept)?;
         let map = rhs

@@ -251,20 +251,39 @@ fn sparse_fit_honours_constraints_and_reports_solver_failure() {
     };
     let to_raw = |j: usize, beta: f64| beta * sd(&y) / sd(&cols[j]);
     // a coefficient fixed to a raw value
-    let fixed = SparseFit { fixed: vec![(1, 0.8)], ..SparseFit::default() }.lasso(&pb, 0.01).unwrap();
+    let fixed =
+        SparseFit { fixed: vec![("x2".into(), 0.8)], ..SparseFit::default() }.lasso(&pb, 0.01).unwrap();
     assert!((to_raw(1, fixed[1]) - 0.8).abs() < 1e-7, "{}", to_raw(1, fixed[1]));
     // a sign constraint against the data
-    let signed = SparseFit { signs: vec![(3, 1.0)], ..SparseFit::default() }.lasso(&pb, 0.01).unwrap();
+    let signed = SparseFit { signs: vec![(3.into(), 1.0)], ..SparseFit::default() }.lasso(&pb, 0.01).unwrap();
     assert!(signed[3] >= -1e-9, "{}", signed[3]);
     // b0 = b1 (raw units)
-    let eq = Equality { terms: vec![(0, 1.0), (1, -1.0)], value: 0.0 };
+    let eq = Equality { terms: vec![("x1".into(), 1.0), (1.into(), -1.0)], value: 0.0 };
     let tied = SparseFit { equalities: vec![eq], ..SparseFit::default() }.lasso(&pb, 0.01).unwrap();
     assert!((to_raw(0, tied[0]) - to_raw(1, tied[1])).abs() < 1e-7);
     // contradictory constraints: a typed error, not a number
-    let bad = SparseFit { fixed: vec![(2, 1.0)], signs: vec![(2, -1.0)], ..SparseFit::default() };
+    let bad = SparseFit {
+        fixed: vec![("x3".into(), 1.0)],
+        signs: vec![("x3".into(), -1.0)],
+        ..SparseFit::default()
+    };
     let e = bad.lasso(&pb, 0.01).unwrap_err();
-    assert!(matches!(e, SelectError::Solver(_)), "{e}");
-    assert!(e.to_string().contains("Infeasible"), "{e}");
+    assert!(matches!(e, SelectError::Infeasible { .. }), "{e}");
+    assert!(e.to_string().contains("x3 = 1, x3 ≤ 0"), "{e}");
+    // a candidate that is not there, by text or by column: an error naming it, not a panic
+    for bad in [
+        SparseFit { fixed: vec![(99.into(), 2.0)], ..SparseFit::default() },
+        SparseFit { signs: vec![(5.into(), 1.0)], ..SparseFit::default() },
+        SparseFit {
+            equalities: vec![Equality { terms: vec![("x9".into(), 1.0)], value: 0.0 }],
+            ..SparseFit::default()
+        },
+    ] {
+        let e = bad.lasso(&pb, 0.01).unwrap_err().to_string();
+        assert!(e.contains("not a candidate") && e.contains("x1, x2"), "{e}");
+        let e = bad.select(&pb).unwrap_err().to_string();
+        assert!(e.contains("not a candidate"), "{e}");
+    }
 }
 
 /// Three runs of one planted problem: each run's columns and target, their statistics per

@@ -249,7 +249,9 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
                 matrix: matrix.clone(),
                 correlation_time: fit.correlation_time.unwrap_or(1.0).max(1.0),
             };
-            model.set_covariance(name, covariance).map_err(anyhow::Error::msg)?;
+            model
+                .set_covariance(name, covariance)
+                .map_err(|e| anyhow::anyhow!("identifying `{name}`: its coefficients' covariance {e}"))?;
         }
         fits.push((name.clone(), fit));
     }

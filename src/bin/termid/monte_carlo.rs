@@ -26,13 +26,26 @@ pub struct Draws<T> {
 }
 
 impl<T> Draws<T> {
-    /// Simulates `n` models drawn from `model`'s covariance (seeded) with `simulate`.
+    /// Simulates `n` models drawn from `model`'s covariance (seeded) with `simulate`, each
+    /// keeping about `values` numbers (refused before the first draw if all would not fit).
     pub fn run(
         model: &Model,
         n: usize,
         seed: u64,
+        values: usize,
         simulate: impl Fn(&Model) -> Result<T>,
     ) -> Result<Draws<T>> {
+        termid::budget::check_values(
+            n as f64 * values as f64,
+            || {
+                format!(
+                    "{} Monte-Carlo draws of {} values each",
+                    termid::budget::count(n as f64),
+                    termid::budget::count(values as f64)
+                )
+            },
+            "ask for fewer draws (a few hundred give a 90 % band)",
+        )?;
         let equations = uncertain_equations(model);
         if equations.is_empty() {
             bail!(

@@ -11,7 +11,10 @@ use indicatif::{ProgressBar, ProgressStyle};
 /// Runs `work`, with a spinner labelled `label` once it has taken more than a second.
 pub fn with_spinner<T>(label: &str, work: impl FnOnce() -> T) -> T {
     let (done, finished) = mpsc::channel::<()>();
-    std::thread::scope(|scope| {
+    // `done` moves into the scope: a panic in `work` drops it while unwinding, which ends the
+    // spinner thread, so the scope's join does not wait for ever
+    std::thread::scope(move |scope| {
+        let done = done;
         scope.spawn(move || {
             // the work ended (sent or, on a panic, dropped the sender) within the second
             if !matches!(finished.recv_timeout(Duration::from_secs(1)), Err(RecvTimeoutError::Timeout)) {

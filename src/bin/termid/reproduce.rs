@@ -31,10 +31,19 @@ pub fn run(cmd: ReproduceCommand) -> Result<()> {
         bar.inc(1);
         bar.set_message(msg.to_string());
     };
+    // a folder that will not take the output is refused before the work
+    termid::output::check_folder(&cmd.out)?;
     let study = oltmann::run(&model, &options, &mut stage).context("reproducing Oltmann (1973)")?;
     let ship = Ship::new(&model, false)?;
-    let path = report::write(&study, &ship, &cmd.out, &mut stage)
-        .with_context(|| format!("writing {}", cmd.out.display()))?;
+    // built beside the target and swapped in whole: a failure, or another run at the same
+    // time, never leaves a folder of mixed or partial files
+    let ours = |dir: &std::path::Path| dir.join("summary.json").is_file() && dir.join("report.md").is_file();
+    termid::output::replace_folder(&cmd.out, ours, |dir| -> Result<()> {
+        report::write(&study, &ship, dir, &mut stage)
+            .with_context(|| format!("writing {}", cmd.out.display()))?;
+        Ok(())
+    })?;
+    let path = cmd.out.join("report.md");
     bar.finish_and_clear();
 
     println!("Oltmann (1973) reproduced from {} in {:.1} s", model.path, started.elapsed().as_secs_f64());

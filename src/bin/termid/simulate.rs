@@ -24,15 +24,69 @@ pub fn load_model(path: &Option<std::path::PathBuf>) -> Result<Model> {
 }
 
 pub fn run(cmd: SimulateCommand) -> Result<()> {
-    let model = load_model(&cmd.model)?;
+    // outputs that cannot be written are refused before any work
+    for path in cmd.out.iter().chain(&cmd.svg) {
+        termid::output::check_file(path)?;
+    }
+    let mut model = load_model(&cmd.model)?;
+    set_parameters(&mut model, &cmd.params)?;
     let integrator = Integrator::by_name(&cmd.integrator)?;
     match (&cmd.manoeuvre, model.spec.ship.is_some()) {
-        (Some(m), true) => ship_run(&cmd, &model, m, integrator),
+        (Some(m), true) => {
+            // a manoeuvre starts from the straight approach and drives the rudder itself
+            if !cmd.initial.is_empty() {
+                bail!("--initial does not apply to a ship manoeuvre: it starts from the straight approach at u0 (set it with --param u0=…), v and δ of the straight run, r = ψ = 0");
+            }
+            if !cmd.inputs.is_empty() {
+                bail!("--input does not apply to a ship manoeuvre: the manoeuvre drives the rudder; for recorded inputs use --manoeuvre replay:FILE.csv");
+            }
+            ship_run(&cmd, &model, m, integrator)
+        }
         (Some(m), false) if !m.starts_with("replay:") => {
             bail!("{} has no [ship] section, so `{m}` does not apply; use --input NAME=VALUE or --manoeuvre replay:FILE.csv", model.path)
         }
         _ => generic_run(&cmd, &model, integrator),
     }
+}
+
+/// `--param NAME=VALUE`: a parameter of the model; for a ship model `u0` is also the
+/// approach speed of the `[ship]` section. Unknown names are refused.
+fn set_parameters(model: &mut Model, params: &[String]) -> Result<()> {
+    for p in params {
+        let (name, value) = p.split_once('=').with_context(|| format!("--param `{p}` must be NAME=VALUE"))?;
+        let (name, text) = (name.trim(), value.trim());
+        let value = finite(text, || format!("--param `{p}`"))?;
+        let mut known = false;
+        if let Some(spec) = model.spec.parameters.get_mut(name) {
+            spec.value = value;
+            known = true;
+        }
+        if let Some(ship) = model.spec.ship.as_mut().filter(|_| name == "u0") {
+            if value <= 0.0 {
+                bail!("--param u0={text}: the approach speed must be positive");
+            }
+            ship.u0 = value;
+            known = true;
+        }
+        if !known {
+            let names: Vec<&str> = model.spec.parameters.keys().map(String::as_str).collect();
+            bail!(
+                "--param {name}: not a parameter of {} (parameters: {})",
+                model.path,
+                if names.is_empty() { "none".into() } else { names.join(", ") }
+            );
+        }
+    }
+    Ok(())
+}
+
+/// A finite number from the command line (`nan` and `inf` parse as f64 but are no values).
+fn finite(text: &str, what: impl FnOnce() -> String) -> Result<f64> {
+    let text = text.trim();
+    text.parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite())
+        .with_context(|| format!("{}: `{text}` is not a finite number", what()))
 }
 
 fn ship_run(cmd: &SimulateCommand, model: &Model, text: &str, integrator: Integrator) -> Result<()> {
@@ -48,13 +102,14 @@ fn ship_run(cmd: &SimulateCommand, model: &Model, text: &str, integrator: Integr
     let frame = ship.frame(&run.trajectory, "simulation")?;
     let mc = match cmd.monte_carlo.monte_carlo {
         0 => None,
-        n => Some(Draws::run(model, n, cmd.monte_carlo.seed, |m| {
+        n => Some(Draws::run(model, n, cmd.monte_carlo.seed, trajectory_values(&run.trajectory), |m| {
             let drawn = Ship::new(m, cmd.with_intercept)?.run(&manoeuvre, &settings)?;
             Ok((serde_json::to_value(&drawn.metrics)?, drawn.trajectory))
         })?),
     };
+    let mut outputs = termid::output::Outputs::new();
     if let Some(out) = &cmd.out {
-        frame.write_csv(out)?;
+        outputs.file(out, frame.to_csv().as_bytes())?;
     }
     if let Some(svg) = &cmd.svg {
         let title = format!("{}: {}", model.spec.model.name, manoeuvre.label());
@@ -69,8 +124,9 @@ fn ship_run(cmd: &SimulateCommand, model: &Model, text: &str, integrator: Integr
                 fig
             }
         };
-        fig.write_svg(svg)?;
+        outputs.file(svg, fig.to_svg().map_err(anyhow::Error::msg)?.as_bytes())?;
     }
+    outputs.commit()?;
     match cmd.format {
         Format::Json => println!(
             "{}",
@@ -127,6 +183,12 @@ fn ship_run(cmd: &SimulateCommand, model: &Model, text: &str, integrator: Integr
     Ok(())
 }
 
+/// The values a trajectory holds (time, states, inputs, derivatives), for the memory check of
+/// Monte-Carlo draws that keep one each.
+pub fn trajectory_values(t: &termid::sim::Trajectory) -> usize {
+    t.time.len() * (1 + t.states.len() + t.inputs.len() + t.derivatives.len())
+}
+
 fn format_value(v: &serde_json::Value) -> String {
     match v.as_f64() {
         Some(x) => format!("{x:.4}"),
@@ -153,15 +215,7 @@ fn spiral_figure(title: &str, s: &termid::ship::manoeuvre::SpiralMetrics) -> Fig
 }
 
 fn generic_run(cmd: &SimulateCommand, model: &Model, integrator: Integrator) -> Result<()> {
-    let mut params = BTreeMap::new();
-    for p in &cmd.params {
-        let (k, v) = p.split_once('=').with_context(|| format!("--param `{p}` must be NAME=VALUE"))?;
-        params.insert(
-            k.trim().to_string(),
-            v.trim().parse::<f64>().with_context(|| format!("--param `{p}`: not a number"))?,
-        );
-    }
-    let system = termid::sim::System::new(model, &params, cmd.with_intercept)?;
+    let system = termid::sim::System::new(model, &BTreeMap::new(), cmd.with_intercept)?;
     let mut x0: Vec<f64> = system
         .states
         .iter()
@@ -171,29 +225,36 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, integrator: Integrator) -> 
         let (k, v) = p.split_once('=').with_context(|| format!("--initial `{p}` must be NAME=VALUE"))?;
         let name = model.vocabulary.canonical(k.trim()).unwrap_or_else(|| k.trim().to_string());
         let i = system.state_index(&name).with_context(|| format!("--initial: `{k}` is not a state"))?;
-        x0[i] = v.trim().parse().with_context(|| format!("--initial `{p}`: not a number"))?;
+        x0[i] = finite(v, || format!("--initial `{p}`"))?;
     }
     let mut inputs: Vec<f64> = model.spec.inputs.iter().map(|i| i.initial).collect();
     for p in &cmd.inputs {
         let (k, v) = p.split_once('=').with_context(|| format!("--input `{p}` must be NAME=VALUE"))?;
         let name = model.vocabulary.canonical(k.trim()).unwrap_or_else(|| k.trim().to_string());
         let i = system.input_index(&name).with_context(|| format!("--input: `{k}` is not an input"))?;
-        inputs[i] = v.trim().parse().with_context(|| format!("--input `{p}`: not a number"))?;
+        inputs[i] = finite(v, || format!("--input `{p}`"))?;
     }
+    let mut replayed = None;
     let mut controller: Box<dyn Controller> =
         match cmd.manoeuvre.as_deref().and_then(|m| m.strip_prefix("replay:")) {
             Some(file) => {
                 let frame = Frame::read_csv(std::path::Path::new(file), &model.spec.model.time)?;
+                let t = frame.time();
+                replayed = Some(t[t.len() - 1] - t[0]);
                 Box::new(Replay::new(&frame, &system.inputs)?)
             }
             None => Box::new(Constant(inputs)),
         };
-    let duration = cmd.duration.context("give --duration for a model without a manoeuvre")?;
+    // a replay lasts as long as its recording; constant inputs have no natural end
+    let duration = cmd.duration.or(replayed).context(
+        "give --duration SECONDS: with constant inputs the model has no natural end (a ship model's manoeuvre, or a replay, has)",
+    )?;
     let settings = Settings { integrator, dt: cmd.dt, duration, sample: cmd.sample };
     let traj = simulate(&system, &x0, controller.as_mut(), &settings)?;
     let frame = traj.to_frame("simulation", &model.spec.model.time)?;
+    let mut outputs = termid::output::Outputs::new();
     if let Some(out) = &cmd.out {
-        frame.write_csv(out)?;
+        outputs.file(out, frame.to_csv().as_bytes())?;
     }
     if let Some(svg) = &cmd.svg {
         let panels = system
@@ -213,8 +274,10 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, integrator: Integrator) -> 
                 ..Panel::default()
             })
             .collect();
-        Figure::new(&model.spec.model.name, panels).write_svg(svg)?;
+        let svg_text = Figure::new(&model.spec.model.name, panels).to_svg().map_err(anyhow::Error::msg)?;
+        outputs.file(svg, svg_text.as_bytes())?;
     }
+    outputs.commit()?;
     let last = traj.last_state();
     match cmd.format {
         Format::Json => println!(

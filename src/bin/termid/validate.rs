@@ -39,15 +39,21 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
     // Monte Carlo: every run simulated with each drawn model, its metrics read once per draw
     let mc = match cmd.monte_carlo.monte_carlo {
         0 => None,
-        n => Some(Draws::run(&model, n, cmd.monte_carlo.seed, |m| {
-            let sims = data.simulate(m, &[], &[])?;
-            let seen: Vec<Option<serde_json::Value>> = runs
-                .iter()
-                .zip(&sims)
-                .map(|(f, s)| simulated(f, s).map(|o| serde_json::to_value(o).unwrap_or_default()))
-                .collect();
-            Ok((sims, seen))
-        })?),
+        n => Some(Draws::run(
+            &model,
+            n,
+            cmd.monte_carlo.seed,
+            sims.iter().map(crate::simulate::trajectory_values).sum(),
+            |m| {
+                let sims = data.simulate(m, &[], &[])?;
+                let seen: Vec<Option<serde_json::Value>> = runs
+                    .iter()
+                    .zip(&sims)
+                    .map(|(f, s)| simulated(f, s).map(|o| serde_json::to_value(o).unwrap_or_default()))
+                    .collect();
+                Ok((sims, seen))
+            },
+        )?),
     };
     let spreads: Vec<_> = (0..runs.len())
         .map(|k| mc.as_ref().map(|mc| mc.spread(|(_, seen)| seen[k].iter().cloned().collect())))

@@ -186,6 +186,32 @@ impl Manoeuvre {
         }
     }
 
+    /// The largest rudder angle the manoeuvre commands, ° (none for a replay).
+    pub fn largest_rudder_deg(&self) -> Option<f64> {
+        match self {
+            Manoeuvre::ZigZag(z) => Some(z.rudder_deg),
+            Manoeuvre::Turning(t) => Some(t.rudder_deg.abs()),
+            Manoeuvre::Spiral(s) => Some(s.max_deg),
+            Manoeuvre::PullOut(p) => Some(p.rudder_deg.abs()),
+            Manoeuvre::Replay(_) => None,
+        }
+    }
+
+    /// Refuses a rudder angle beyond the ship's limit: the servo would clamp it, and the run
+    /// would be labelled with an angle the rudder never reached.
+    pub fn check(&self, ship: &Ship) -> Result<(), ShipError> {
+        match self.largest_rudder_deg() {
+            Some(d) if d > ship.spec.rudder_limit => Err(ShipError::Manoeuvre {
+                text: self.label(),
+                message: format!(
+                    "rudder angle {d}° is beyond the ship's rudder limit of {}° (`rudder_limit` in [ship])",
+                    ship.spec.rudder_limit
+                ),
+            }),
+            _ => Ok(()),
+        }
+    }
+
     /// The manoeuvre's controller, for benchmarks and custom integration loops.
     pub fn controller_for_bench(
         &self,
