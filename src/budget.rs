@@ -28,6 +28,82 @@ pub fn check_values(count: f64, what: impl FnOnce() -> String, advice: &str) -> 
     Err(TooLarge { what: what(), bytes, advice: advice.into() })
 }
 
+/// The longest line a text input may have (a CSV row, a model file line): 1 MiB.
+pub const MAX_LINE: usize = 1 << 20;
+
+/// A text input that could not be read within bounds.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ReadError {
+    /// The system refused.
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+    /// A NUL byte: a binary file or a device, not text.
+    #[error("byte {offset} is NUL: this is not a text file")]
+    Binary {
+        /// Its offset.
+        offset: usize,
+    },
+    /// A line beyond [`MAX_LINE`].
+    #[error("line {line} is longer than {} (is this a text file?)", size(MAX_LINE as f64))]
+    LongLine {
+        /// 1-based line.
+        line: usize,
+    },
+    /// More than the memory limit.
+    #[error("the file is larger than {}: too large to read whole", size(MEMORY_LIMIT))]
+    TooLarge,
+    /// Not UTF-8.
+    #[error("line {line} is not UTF-8 text")]
+    NotUtf8 {
+        /// 1-based line.
+        line: usize,
+    },
+}
+
+/// Reads a text file with bounds: at most [`MEMORY_LIMIT`] bytes, lines of at most
+/// [`MAX_LINE`], no NUL byte; so `/dev/zero`, a binary file or an endless pipe is an error
+/// after a few reads instead of memory that grows without bound.
+pub fn read_text(path: &std::path::Path) -> Result<String, ReadError> {
+    use std::io::Read;
+    let mut file = std::fs::File::open(path)?;
+    if file.metadata().is_ok_and(|m| m.is_file() && m.len() as f64 > MEMORY_LIMIT) {
+        return Err(ReadError::TooLarge);
+    }
+    let mut bytes = Vec::new();
+    let mut chunk = vec![0u8; 1 << 16];
+    let (mut line, mut line_start) = (1usize, 0usize);
+    loop {
+        let n = match file.read(&mut chunk) {
+            Ok(0) => break,
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(e.into()),
+        };
+        let base = bytes.len();
+        for (i, &b) in chunk[..n].iter().enumerate() {
+            match b {
+                0 => return Err(ReadError::Binary { offset: base + i }),
+                b'\n' => {
+                    line += 1;
+                    line_start = base + i + 1;
+                }
+                _ if base + i - line_start >= MAX_LINE => return Err(ReadError::LongLine { line }),
+                _ => {}
+            }
+        }
+        if (base + n) as f64 > MEMORY_LIMIT {
+            return Err(ReadError::TooLarge);
+        }
+        bytes.extend_from_slice(&chunk[..n]);
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let line = e.as_bytes()[..at].iter().filter(|b| **b == b'\n').count() + 1;
+        ReadError::NotUtf8 { line }
+    })
+}
+
 /// A byte count as a person reads it: 7.8 GB, 512 MB.
 pub fn size(bytes: f64) -> String {
     match bytes {
@@ -70,5 +146,21 @@ mod tests {
         assert!(check_values(f64::NAN, String::new, "").is_err());
         assert_eq!(count(975e6), "975 000 000");
         assert_eq!(count(12.0), "12");
+    }
+
+    #[test]
+    fn endless_and_binary_inputs_are_refused() {
+        let e = read_text(std::path::Path::new("/dev/zero")).unwrap_err();
+        assert!(matches!(e, ReadError::Binary { offset: 0 }), "{e}");
+        let dir = std::env::temp_dir().join(format!("termid-budget-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let long = dir.join("long.csv");
+        std::fs::write(&long, format!("t,u\n0,{}\n", "1".repeat(MAX_LINE + 10))).unwrap();
+        assert!(matches!(read_text(&long), Err(ReadError::LongLine { line: 2 })));
+        std::fs::write(&long, b"t,u\n0,\xff\n").unwrap();
+        assert!(matches!(read_text(&long), Err(ReadError::NotUtf8 { line: 2 })));
+        std::fs::write(&long, "t,u\n0,1\n").unwrap();
+        assert_eq!(read_text(&long).unwrap(), "t,u\n0,1\n");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -51,6 +51,21 @@ pub enum ParamValue {
 }
 
 impl ParamValue {
+    /// A value as written on the command line or in a file: a finite number, or a rule that
+    /// [`ParamValue::check_rule`] accepts.
+    pub fn from_text(name: &str, text: &str) -> Result<ParamValue, String> {
+        let text = text.trim();
+        match text.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(ParamValue::Value(v)),
+            Ok(v) => Err(format!("parameter `{name}`: {v} is not a finite number")),
+            Err(_) => {
+                let rule = ParamValue::Rule(text.to_string());
+                rule.check_rule(name)?;
+                Ok(rule)
+            }
+        }
+    }
+
     /// Checks a rule's syntax without data.
     pub fn check_rule(&self, name: &str) -> Result<(), String> {
         match self {
@@ -74,6 +89,9 @@ impl ParamValue {
         match self {
             ParamValue::Value(v) => Ok(*v),
             ParamValue::Rule(rule) => match rule.split_once(':') {
+                _ if self.check_rule(name).is_err() => Err(IdentifyError::Parameter(
+                    self.check_rule(name).err().unwrap_or_default(),
+                )),
                 Some(("first", col)) => Ok(frame.require(col)?[0]),
                 Some(("mean", rest)) => {
                     // `mean:u` over the run, `mean:u:2` over its first 2 time units (the approach)

@@ -8,7 +8,7 @@ impl Frame {
     /// Reads a CSV file whose header names the columns; `time` names the time column.
     pub fn read_csv(path: &Path, time: &str) -> Result<Frame, DataError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path)
+        let text = crate::budget::read_text(path)
             .map_err(|e| DataError::Io { file: file.clone(), message: e.to_string() })?;
         Frame::parse_csv(&text, &file, time)
     }
@@ -17,72 +17,33 @@ impl Frame {
     /// a column `row` numbered 1..n stands in for time.
     pub fn read_csv_untimed(path: &Path) -> Result<Frame, DataError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path)
+        let text = crate::budget::read_text(path)
             .map_err(|e| DataError::Io { file: file.clone(), message: e.to_string() })?;
         Frame::parse_csv_untimed(&text, &file)
     }
 
     /// Parses CSV text without a time column (rows numbered 1..n in a column `row`).
     pub fn parse_csv_untimed(text: &str, origin: &str) -> Result<Frame, DataError> {
-        let mut numbered = String::with_capacity(text.len() + 8 * text.lines().count());
-        let mut row = 0usize;
-        for line in text.lines() {
-            if line.trim().is_empty() || line.trim_start().starts_with('#') {
-                continue;
-            }
-            if row == 0 {
-                numbered.push_str("row,");
-            } else {
-                numbered.push_str(&format!("{row},"));
-            }
-            numbered.push_str(line);
-            numbered.push('\n');
-            row += 1;
+        let (header, columns) = parse_table(text, origin)?;
+        if header.iter().any(|h| h == "row") {
+            return Err(DataError::DuplicateColumn { file: origin.into(), column: "row".into() });
         }
-        Frame::parse_csv(&numbered, origin, "row")
+        let rows = columns.first().map_or(0, Vec::len);
+        let mut frame = Frame::new(origin, "row", (1..=rows).map(|r| r as f64).collect())?;
+        for (name, values) in header.iter().zip(columns) {
+            frame.push(name, values)?;
+        }
+        Ok(frame)
     }
 
     /// Parses CSV text; `origin` names it in errors.
     pub fn parse_csv(text: &str, origin: &str, time: &str) -> Result<Frame, DataError> {
-        let io = |e: csv::Error| DataError::Io { file: origin.into(), message: e.to_string() };
-        let mut reader = csv::ReaderBuilder::new()
-            .trim(csv::Trim::All)
-            .flexible(true)
-            .comment(Some(b'#'))
-            .from_reader(text.as_bytes());
-        let header: Vec<String> = reader.headers().map_err(io)?.iter().map(str::to_string).collect();
-        for (i, h) in header.iter().enumerate() {
-            if header[..i].contains(h) {
-                return Err(DataError::DuplicateColumn { file: origin.into(), column: h.clone() });
-            }
-        }
+        let (header, mut columns) = parse_table(text, origin)?;
         let time_index = header.iter().position(|h| h == time).ok_or_else(|| DataError::MissingColumn {
             file: origin.into(),
             column: time.into(),
             available: header.join(", "),
         })?;
-        let mut columns: Vec<Vec<f64>> = vec![Vec::new(); header.len()];
-        for (r, record) in reader.records().enumerate() {
-            let record = record.map_err(io)?;
-            let row = r + 1;
-            if record.len() != header.len() {
-                return Err(DataError::Ragged {
-                    file: origin.into(),
-                    row,
-                    expected: header.len(),
-                    found: record.len(),
-                });
-            }
-            for (c, cell) in record.iter().enumerate() {
-                let v: f64 = cell.parse().map_err(|_| DataError::NotNumeric {
-                    file: origin.into(),
-                    row,
-                    column: header[c].clone(),
-                    cell: cell.into(),
-                })?;
-                columns[c].push(v);
-            }
-        }
         let mut frame = Frame::new(origin, time, std::mem::take(&mut columns[time_index]))?;
         for (name, values) in header.iter().zip(columns) {
             if name != time {
@@ -113,6 +74,48 @@ impl Frame {
     }
 }
 
+/// The header and the numeric columns of CSV text, every cell checked.
+fn parse_table(text: &str, origin: &str) -> Result<(Vec<String>, Vec<Vec<f64>>), DataError> {
+    let io = |e: csv::Error| DataError::Io { file: origin.into(), message: e.to_string() };
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .flexible(true)
+        .comment(Some(b'#'))
+        .from_reader(text.as_bytes());
+    let header: Vec<String> = reader.headers().map_err(io)?.iter().map(str::to_string).collect();
+    if header.iter().all(String::is_empty) {
+        return Err(DataError::NoHeader { file: origin.into() });
+    }
+    for (i, h) in header.iter().enumerate() {
+        if header[..i].contains(h) {
+            return Err(DataError::DuplicateColumn { file: origin.into(), column: h.clone() });
+        }
+    }
+    let mut columns: Vec<Vec<f64>> = vec![Vec::new(); header.len()];
+    for (r, record) in reader.records().enumerate() {
+        let record = record.map_err(io)?;
+        let row = r + 1;
+        if record.len() != header.len() {
+            return Err(DataError::Ragged {
+                file: origin.into(),
+                row,
+                expected: header.len(),
+                found: record.len(),
+            });
+        }
+        for (c, cell) in record.iter().enumerate() {
+            let v: f64 = cell.parse().map_err(|_| DataError::NotNumeric {
+                file: origin.into(),
+                row,
+                column: header[c].clone(),
+                cell: cell.into(),
+            })?;
+            columns[c].push(v);
+        }
+    }
+    Ok((header, columns))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -128,7 +131,13 @@ mod tests {
         let e = Frame::parse_csv("t,u\n0,1\n0,2\n", "a.csv", "t").unwrap_err().to_string();
         assert!(e.contains("row 2") && e.contains("does not increase"), "{e}");
         assert!(matches!(Frame::parse_csv("t,u\n", "a.csv", "t"), Err(DataError::Empty { .. })));
-        assert!(matches!(Frame::parse_csv("", "a.csv", "t"), Err(DataError::MissingColumn { .. })));
+        assert!(matches!(Frame::parse_csv("", "a.csv", "t"), Err(DataError::NoHeader { .. })));
+        // without time: the file's own cells counted, no column of termid's own named
+        let e = Frame::parse_csv_untimed("x,y\n1,2\n3\n", "h.csv").unwrap_err().to_string();
+        assert_eq!(e, "h.csv: row 2 has 1 cells, the header has 2");
+        let f = Frame::parse_csv_untimed("# c\nx,y\n1,2\n\n3,4\n", "h.csv").unwrap();
+        assert_eq!(f.column("row").unwrap(), [1.0, 2.0]);
+        assert_eq!(f.column("y").unwrap(), [2.0, 4.0]);
         assert!(matches!(
             Frame::parse_csv("time,u\n0,1\n", "a.csv", "t"),
             Err(DataError::MissingColumn { .. })

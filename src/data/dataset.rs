@@ -102,7 +102,7 @@ impl Dataset {
     /// Reads a dataset file.
     pub fn load(path: &Path) -> Result<Dataset, DataError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path)
+        let text = crate::budget::read_text(path)
             .map_err(|e| DataError::Io { file: file.clone(), message: e.to_string() })?;
         toml::from_str(&text).map_err(|e| DataError::Io { file, message: e.to_string() })
     }
@@ -115,7 +115,7 @@ impl Dataset {
         for run in &self.runs {
             let path = base.join(&run.file);
             let origin = path.display().to_string();
-            let text = std::fs::read_to_string(&path)
+            let text = crate::budget::read_text(&path)
                 .map_err(|e| DataError::Io { file: origin.clone(), message: e.to_string() })?;
             let body: Vec<&str> = text.lines().skip(run.skip).collect();
             let csv: String = body

@@ -47,6 +47,14 @@ pub enum DataError {
         /// What the system said.
         message: String,
     },
+    /// Nothing at all, not even a header.
+    #[error(
+        "{file}: the file is empty: a CSV file needs a header row naming its columns, then rows of numbers"
+    )]
+    NoHeader {
+        /// The file.
+        file: String,
+    },
     /// No data rows.
     #[error("{file}: no data rows")]
     Empty {

@@ -141,7 +141,7 @@ impl Model {
     /// Reads and checks a model file.
     pub fn load(path: &Path) -> Result<Model, ModelError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path)
+        let text = crate::budget::read_text(path)
             .map_err(|e| ModelError::Io { file: file.clone(), message: e.to_string() })?;
         Model::parse(&text, &file)
     }
@@ -440,6 +440,67 @@ impl Model {
         }
         eq.covariance = Some(covariance);
         Ok(())
+    }
+
+    /// Checks measured runs against the model's known kinematics: where an equation that is
+    /// not identified says ẋ = c·y for a state x and a variable y (ψ̇ = r), the run's own dx/dt
+    /// must match c·y. A ratio near π/180 or 180/π means one of the two columns is in degrees
+    /// where radians were declared (or assumed), which would otherwise pass silently and
+    /// give coefficients in mixed units.
+    pub fn check_kinematics(&self, frame: &crate::data::Frame) -> Result<(), crate::data::DataError> {
+        for eq in self.equations.iter().filter(|e| !e.identify && e.coefficients.len() == 1) {
+            let (term, c, _) = &eq.coefficients[0];
+            let names = term.variables();
+            let [y] = names.as_slice() else { continue };
+            if *term != Term::var(y) || *c == 0.0 {
+                continue;
+            }
+            let (Some(x), Some(yv)) = (frame.column(&eq.state), frame.column(y)) else { continue };
+            let t = frame.time();
+            if t.len() < 3 {
+                continue;
+            }
+            // central differences against c·y at the inner samples: k = Σ ẋ·cy / Σ (cy)²
+            let (mut num, mut den) = (0.0, 0.0);
+            for i in 1..t.len() - 1 {
+                let dx = (x[i + 1] - x[i - 1]) / (t[i + 1] - t[i - 1]);
+                let cy = c * yv[i];
+                num += dx * cy;
+                den += cy * cy;
+            }
+            if !(den > 0.0 && num.is_finite()) {
+                continue;
+            }
+            let k = num / den;
+            let degree = 180.0 / std::f64::consts::PI;
+            let near = |target: f64| (k / target - 1.0).abs() < 0.3;
+            let message = if near(1.0 / degree) {
+                format!("`{}` rises {k:.4} × as fast as `{y}` says ({} = {c}·{y}): `{y}` looks like degrees (per s) where `{}` is in radians; give both in radians (a dataset file converts: [deg/s])", eq.state, eq.name, eq.state)
+            } else if near(degree) {
+                format!("`{}` rises {k:.1} × as fast as `{y}` says ({} = {c}·{y}): `{}` looks like degrees where `{y}` is in radians; give both in radians (a dataset file converts: [deg])", eq.state, eq.name, eq.state)
+            } else {
+                continue;
+            };
+            return Err(crate::data::DataError::Unit {
+                file: frame.origin().into(),
+                row: 0,
+                column: y.clone(),
+                message,
+            });
+        }
+        Ok(())
+    }
+
+    /// The names a data column may carry for this model: its states, inputs, parameters,
+    /// derived variables and aliases, and `<state>_dot` for measured rates.
+    pub fn data_names(&self) -> Vec<String> {
+        let mut names: Vec<String> = self.vocabulary.variables().to_vec();
+        names.extend(self.vocabulary.parameters().iter().cloned());
+        names.extend(self.spec.derived.iter().map(|d| d.name.clone()));
+        names.extend(self.spec.aliases.keys().cloned());
+        names.extend(self.spec.states.iter().map(|s| format!("{}_dot", s.name)));
+        names.push(self.spec.model.time.clone());
+        names
     }
 
     /// The model as TOML text (what `identify --out` writes and `simulate` reads back).

@@ -276,8 +276,15 @@ impl BestSubset {
         for j in free.drain(..) {
             let pivot = a[j * m + j];
             if pivot.is_nan() || pivot <= self.pivot_tolerance {
+                let before: Vec<String> =
+                    forced.iter().chain(&kept).map(|&i| format!("`{}`", pb.names[i])).collect();
+                let with = match before.len() {
+                    0 => "it does not vary".to_string(),
+                    1..=4 => format!("collinear with {}", before.join(", ")),
+                    n => format!("collinear with {} and {} more terms", before[..3].join(", "), n - 3),
+                };
                 notes.push(format!(
-                    "`{}` left out: collinear with the terms before it (pivot {pivot:.2e})",
+                    "`{}` left out of the search: {with} (pivot {pivot:.2e}); the search uses the others",
                     pb.names[j]
                 ));
                 continue;
@@ -293,7 +300,9 @@ impl BestSubset {
         // first bounds: the forward stepwise path
         let mut best = vec![(f64::INFINITY, vec![]); kmax + 1];
         if let Ok(path) = (Stepwise { step_rule: super::StepRule::Last, ..Stepwise::default() }).select(pb) {
-            for st in &path.steps {
+            // only sets the search itself could reach: not one with a term it left out
+            let allowed = |j: &usize| forced.contains(j) || kept.contains(j);
+            for st in path.steps.iter().filter(|st| st.set.iter().all(allowed)) {
                 keep_if_better(&mut best, kmax, (1.0 - st.r2).max(RSS_FLOOR), &[&st.set]);
             }
         }

@@ -684,7 +684,10 @@ impl SparseFit {
             steps.push(st);
         }
         if steps.is_empty() {
-            return Err(SelectError::Config("the λ path produced no usable support".into()));
+            return Err(SelectError::Config(format!(
+                "no λ of the path gave a set of terms that can be fitted: every support was collinear{} — leave out candidates that are multiples or sums of others (`termid identify --backend stepwise` lists which)",
+                if notes.iter().any(|n| n.contains("more terms than rows")) { " or had more terms than rows" } else { "" }
+            )));
         }
         let best = scores
             .iter()

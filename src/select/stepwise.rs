@@ -210,10 +210,17 @@ impl Selector for Stepwise {
                         });
                     }
                     open[j] = false;
-                    notes.push(format!(
-                        "`{}` refused: collinear with the terms in (pivot {pivot:.3e} ≤ {:.0e})",
-                        pb.names[j], self.pivot_tolerance
-                    ));
+                    // a column that does not vary at all (constant, or under/overflowed to one
+                    // value) is said as such, not as collinearity with the others
+                    let flat = spread(pb, j) <= 0.0;
+                    notes.push(if flat {
+                        format!("`{}` refused: it has one value on every row (constant, or over- or underflowed), so it explains nothing", pb.names[j])
+                    } else {
+                        format!(
+                            "`{}` refused: collinear with the terms in (pivot {pivot:.3e} ≤ {:.0e})",
+                            pb.names[j], self.pivot_tolerance
+                        )
+                    });
                     continue;
                 }
                 let c = a[j * m + p] * a[j * m + p] / pivot; // eq. (A2), as a share of D
@@ -317,6 +324,16 @@ impl Stepwise {
                 _ => return removed_any.then_some(fit),
             }
         }
+    }
+}
+
+/// The spread of candidate `j` about its mean (or its raw sum of squares without an
+/// intercept): zero for a column with one value on every row.
+fn spread(pb: &Problem<'_>, j: usize) -> f64 {
+    if pb.intercept {
+        pb.moments.corrected(j, j)
+    } else {
+        pb.moments.raw(j, j)
     }
 }
 

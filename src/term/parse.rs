@@ -76,11 +76,53 @@ fn rename(rule: &Rule) -> String {
 /// Parses a term's text into a spanned expression (syntax only).
 pub fn parse_expr(input: &str) -> Result<Expr, TermError> {
     check_size(input)?;
-    let mut pairs = TermParser::parse(Rule::term, input)
-        .map_err(|e| TermError::Invalid(Box::new(e.renamed_rules(rename))))?;
+    let mut pairs = TermParser::parse(Rule::term, input).map_err(|e| syntax_error(input, e))?;
     let expr = pairs.next().ok_or_else(|| TermError::at(input, 0, 0, "expected a term"))?;
     build(expr.into_inner(), input)
 }
+
+/// pest's error made readable: an exponent that is not an integer says so; expected rules
+/// that read the same (the four operators) are listed once.
+fn syntax_error(input: &str, mut e: pest::error::Error<Rule>) -> TermError {
+    let at = match e.location {
+        pest::error::InputLocation::Pos(p) => p,
+        pest::error::InputLocation::Span((p, _)) => p,
+    };
+    // `u^1.5`, `u^v`, `u^(1/2)`: the failure is at or just after the exponent
+    let before = &input[..at.min(input.len())];
+    if let Some(caret) = before.rfind('^') {
+        let exponent = &input[caret + 1..];
+        let end = if exponent.trim_start().starts_with('(') {
+            exponent.find(')').map_or(exponent.len(), |i| i + 1)
+        } else {
+            exponent.find(|c: char| c.is_whitespace() || "*/+".contains(c)).unwrap_or(exponent.len())
+        };
+        if before[caret + 1..].chars().all(|c| c.is_ascii_digit() || "-( ".contains(c)) {
+            return TermError::at(
+                input,
+                caret + 1,
+                caret + 1 + end,
+                format!(
+                    "exponents are integers (`u^2`, `u^-1`), not `{}`: for a root write `sqrt(u)` or `u*sqrt(u)`",
+                    &exponent[..end]
+                ),
+            );
+        }
+    }
+    if let pest::error::ErrorVariant::ParsingError { positives, .. } = &mut e.variant {
+        let mut seen = Vec::new();
+        positives.retain(|r| {
+            let name = rename(r);
+            let new = !seen.contains(&name);
+            seen.push(name);
+            new
+        });
+    }
+    TermError::Invalid(Box::new(e.renamed_rules(rename)))
+}
+
+/// Longest term text, in characters (a caret block echoes the term; no regressor is longer).
+pub const MAX_LENGTH: usize = 1000;
 
 /// Deepest nesting of parentheses and calls in one term.
 pub const MAX_DEPTH: usize = 32;
@@ -122,6 +164,13 @@ fn check_size(input: &str) -> Result<(), TermError> {
             }
             _ => {}
         }
+    }
+    let length = input.chars().count();
+    if length > MAX_LENGTH {
+        let start: String = input.chars().take(40).collect();
+        return Err(TermError::Declaration(format!(
+            "a term of {length} characters (`{start}…`) is longer than the {MAX_LENGTH} a term may have"
+        )));
     }
     Ok(())
 }
@@ -234,6 +283,9 @@ mod tests {
                 let ok = format!("{}u{}", "(".repeat(MAX_DEPTH), ")".repeat(MAX_DEPTH));
                 assert!(parse_expr(&ok).is_ok());
                 assert!(parse_expr(&format!("u{}", "*u".repeat(MAX_OPERATORS))).is_ok());
+                // a long term is refused without echoing it whole
+                let err = parse_expr(&"u".repeat(100_000)).unwrap_err().to_string();
+                assert!(err.contains("100000 characters") && err.len() < 200, "{err}");
             })
             .unwrap()
             .join()

@@ -57,7 +57,9 @@ fn caret_messages() {
         ("u*w", "1:3", "unknown variable `w`"),
         ("sqr(u)", "1:1", "unknown function `sqr`; known: abs, sign, sqrt"),
         ("abs(u, v)", "1:1", "function `abs` takes 1 argument, found 2"),
-        ("u^1.5", "1:4", "expected end of term"),
+        ("u^1.5", "1:3", "exponents are integers (`u^2`, `u^-1`), not `1.5`"),
+        ("u^v", "1:3", "exponents are integers"),
+        ("u v", "1:3", "expected end of term or an operator (+ - * /)"),
         ("abs*u", "1:1", "`abs` is a function"),
     ];
     for (text, pos, msg) in cases {

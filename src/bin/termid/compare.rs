@@ -26,7 +26,7 @@ struct Entry {
 pub fn run(cmd: CompareCommand) -> Result<()> {
     let model = crate::simulate::load_model(&cmd.model)?;
     let time = model.spec.model.time.clone();
-    let frames = crate::runs::load(&cmd.data, cmd.dataset.as_deref(), &time)?;
+    let frames = crate::runs::load_for(&model, &cmd.data, cmd.dataset.as_deref())?;
     let equations: Vec<String> =
         if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };
     let diff = differentiator(&cmd.derivative)?;

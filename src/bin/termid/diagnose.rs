@@ -8,9 +8,15 @@ use crate::args::{DiagnoseCommand, Format};
 use crate::identify::num;
 
 pub fn run(cmd: DiagnoseCommand) -> Result<()> {
+    // outputs that cannot be written are refused before any work
+    if let Some(out) = &cmd.out {
+        termid::output::check_file(out)?;
+    }
+    if let Some(dir) = &cmd.resim.svg {
+        termid::output::check_folder(dir)?;
+    }
     let model = crate::simulate::load_model(&cmd.model)?;
-    let time = model.spec.model.time.clone();
-    let runs = crate::runs::load(&cmd.runs.data, cmd.runs.dataset.as_deref(), &time)?;
+    let runs = crate::runs::load_for(&model, &cmd.runs.data, cmd.runs.dataset.as_deref())?;
     let hypotheses = if model.spec.ship.is_some() {
         termid::ship::hypotheses::hypotheses(&model)
     } else {
@@ -23,18 +29,21 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
         ..Settings::default()
     };
     let d = diagnose(&model, &runs, &hypotheses, &settings).context("diagnosing")?;
+    let mut outputs = termid::output::Outputs::new();
     if let Some(dir) = &cmd.resim.svg {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        outputs.folder(dir)?;
         for (k, (name, fig)) in termid::diagnose::figures(&d, &runs).into_iter().enumerate() {
             let stem = std::path::Path::new(&name)
                 .file_stem()
                 .map_or(format!("run{k}"), |s| s.to_string_lossy().into_owned());
-            fig.write_svg(&dir.join(format!("diagnose_{stem}.svg")))?;
+            let svg = fig.to_svg().map_err(anyhow::Error::msg)?;
+            outputs.file(&dir.join(format!("diagnose_{stem}.svg")), svg.as_bytes())?;
         }
     }
     if let (Some(out), Some(m)) = (&cmd.out, &d.model) {
-        std::fs::write(out, m.to_toml()).with_context(|| format!("writing {}", out.display()))?;
+        outputs.file(out, m.to_toml().as_bytes())?;
     }
+    outputs.commit()?;
     match cmd.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&json(&d))?),
         Format::Text => print!("{}", text(&d, cmd.out.as_deref(), hypotheses.len())),

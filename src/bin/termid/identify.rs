@@ -22,21 +22,26 @@ fn split_pair<'a>(text: &'a str, what: &str) -> Result<(&'a str, &'a str)> {
 }
 
 pub fn run(cmd: IdentifyCommand) -> Result<()> {
+    if let Some(dir) = &cmd.prepared_svg {
+        termid::output::check_folder(dir)?;
+    }
     if cmd.model.is_some() {
         return run_model(cmd);
     }
     if cmd.refine.is_some() {
         bail!("--refine re-simulates the identified equations: it needs a --model that declares them");
     }
-    let frames = cmd
-        .data
-        .iter()
-        .map(|p| if cmd.no_time { Frame::read_csv_untimed(p) } else { Frame::read_csv(p, &cmd.time) })
-        .collect::<Result<Vec<_>, _>>()?;
-    let mut frames = frames;
-    if let Some(ds) = &cmd.dataset {
-        frames.extend(crate::runs::load(&[], Some(ds), &cmd.time)?);
-    }
+    let mut frames = if cmd.no_time {
+        let mut frames =
+            cmd.data.iter().map(|p| Frame::read_csv_untimed(p)).collect::<Result<Vec<_>, _>>()?;
+        if let Some(ds) = &cmd.dataset {
+            frames.extend(crate::runs::load(&[], Some(ds), &cmd.time)?);
+        }
+        frames
+    } else {
+        // the same reading (and check for gaps in time) as every other command
+        crate::runs::load(&cmd.data, cmd.dataset.as_deref(), &cmd.time)?
+    };
     let target = Target::parse(cmd.target.as_deref().unwrap_or_default());
     if cmd.derivative == KINEMATIC {
         bail!("--derivative kinematic is the ship plug-in's tracking filter: it needs a --model with a [ship] section");
@@ -51,10 +56,7 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     let mut params = BTreeMap::new();
     for p in &cmd.params {
         let (name, value) = split_pair(p, "parameter")?;
-        let value = match value.parse::<f64>() {
-            Ok(v) => ParamValue::Value(v),
-            Err(_) => ParamValue::Rule(value.to_string()),
-        };
+        let value = ParamValue::from_text(name, value).map_err(|m| anyhow::anyhow!("--param {p}: {m}"))?;
         params.insert(name.to_string(), value);
     }
     if cmd.no_time && matches!(target, Target::Derivative(_)) {
@@ -81,13 +83,16 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     }
     let mut texts = cmd.terms.clone();
     if let Some(path) = &cmd.terms_file {
-        let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-        texts.extend(
-            text.lines()
-                .map(|l| l.split('#').next().unwrap_or("").trim())
-                .filter(|l| !l.is_empty())
-                .map(str::to_string),
-        );
+        let text = termid::budget::read_text(path).with_context(|| format!("reading {}", path.display()))?;
+        for (k, line) in text.lines().enumerate() {
+            let term = line.split('#').next().unwrap_or("").trim();
+            if term.is_empty() {
+                continue;
+            }
+            // each line checked here, so an error names the file and line
+            vocab.parse(term).map_err(|e| anyhow::anyhow!("{}:{}:\n{e}", path.display(), k + 1))?;
+            texts.push(term.to_string());
+        }
     }
     if texts.is_empty() {
         bail!("no candidate terms: give --terms or --terms-file");
@@ -170,14 +175,17 @@ fn prepare_runs(
         frames.iter().map(|f| prepare(f, &how)).collect::<Result<Vec<_>, _>>()?
     };
     if let Some(dir) = &cmd.prepared_svg {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        let mut outputs = termid::output::Outputs::new();
+        outputs.folder(dir)?;
         for (k, (raw, p)) in frames.iter().zip(&prepared).enumerate() {
             let stem = std::path::Path::new(raw.origin())
                 .file_stem()
                 .map_or(format!("run{k}"), |s| s.to_string_lossy().into_owned());
             let path = dir.join(format!("prepared_{k}_{stem}.svg"));
-            prepared_figure(raw, p, signals, scale).write_svg(&path)?;
+            let svg = prepared_figure(raw, p, signals, scale).to_svg().map_err(anyhow::Error::msg)?;
+            outputs.file(&path, svg.as_bytes())?;
         }
+        outputs.commit()?;
     }
     Ok(prepared)
 }
@@ -200,10 +208,13 @@ fn configure_backend(cmd: &IdentifyCommand) -> Result<Backend> {
 /// with the model's candidates, forced terms and back-end; optionally written back.
 fn run_model(cmd: IdentifyCommand) -> Result<()> {
     let path = cmd.model.clone().context("--model")?;
+    // outputs that cannot be written are refused before any work
+    if let Some(out) = &cmd.out {
+        termid::output::check_file(out)?;
+    }
     let mut model = termid::model::Model::load(&path)?;
     let refine = cmd.refine.as_deref().map(|list| refine_states(list, &model)).transpose()?;
-    let time = model.spec.model.time.clone();
-    let frames = crate::runs::load(&cmd.data, cmd.dataset.as_deref(), &time)?;
+    let frames = crate::runs::load_for(&model, &cmd.data, cmd.dataset.as_deref())?;
     let names: Vec<String> =
         if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };
     let states: Vec<String> =
@@ -275,7 +286,7 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
             cmd.data.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "),
             model.spec.model.provenance
         );
-        std::fs::write(out, model.to_toml()).with_context(|| format!("writing {}", out.display()))?;
+        termid::output::write_file(out, model.to_toml().as_bytes())?;
     }
     if let Some(e) = refine_error {
         let kept = cmd
@@ -321,6 +332,9 @@ fn refine_states(list: &str, model: &termid::model::Model) -> Result<Option<Vec<
     let known: Vec<&str> = model.spec.states.iter().map(|s| s.name.as_str()).collect();
     let names: Vec<String> =
         list.split(',').map(str::trim).filter(|n| !n.is_empty()).map(String::from).collect();
+    if names.is_empty() {
+        bail!("--refine `{list}` names no state: list the states to compare, e.g. --refine u,v,r, or `all`");
+    }
     if let Some(name) = names.iter().find(|n| !known.contains(&n.as_str())) {
         bail!("--refine {list}: `{name}` is not a state of the model ({})", known.join(", "));
     }

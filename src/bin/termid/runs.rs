@@ -5,6 +5,29 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use termid::data::{check_gaps, Dataset, Frame};
+use termid::model::Model;
+
+/// The runs of a command with a model: as [`load`], then each dataset mapping checked to name
+/// one of the model's variables and each run checked against the model's known kinematics.
+pub fn load_for(model: &Model, data: &[PathBuf], dataset: Option<&Path>) -> Result<Vec<Frame>> {
+    if let Some(path) = dataset {
+        let ds = Dataset::load(path)?;
+        let known = model.data_names();
+        if let Some(var) = ds.columns.keys().find(|v| !known.contains(v)) {
+            bail!(
+                "{}: `columns.{var}` maps a column onto `{var}`, which is not a variable of {} (states, inputs, parameters: {})",
+                path.display(),
+                model.path,
+                model.vocabulary.variables().iter().chain(model.vocabulary.parameters()).cloned().collect::<Vec<_>>().join(", ")
+            );
+        }
+    }
+    let frames = load(data, dataset, &model.spec.model.time)?;
+    for f in &frames {
+        model.check_kinematics(f)?;
+    }
+    Ok(frames)
+}
 
 pub fn load(data: &[PathBuf], dataset: Option<&Path>, time: &str) -> Result<Vec<Frame>> {
     let mut frames = data.iter().map(|p| Frame::read_csv(p, time)).collect::<Result<Vec<_>, _>>()?;

@@ -15,9 +15,11 @@ use crate::identify::num;
 use crate::monte_carlo::Draws;
 
 pub fn run(cmd: ValidateCommand) -> Result<()> {
+    if let Some(dir) = &cmd.resim.svg {
+        termid::output::check_folder(dir)?;
+    }
     let model = crate::simulate::load_model(&cmd.model)?;
-    let time = model.spec.model.time.clone();
-    let runs = crate::runs::load(&cmd.runs.data, cmd.runs.dataset.as_deref(), &time)?;
+    let runs = crate::runs::load_for(&model, &cmd.runs.data, cmd.runs.dataset.as_deref())?;
     let data = Runs::new(&model, &runs, cmd.resim.dt, Integrator::by_name(&cmd.resim.integrator)?)?
         .with_intercepts(cmd.resim.with_intercept);
     let sims = data.simulate(&model, &[], &[])?;
@@ -59,7 +61,8 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
         .map(|k| mc.as_ref().map(|mc| mc.spread(|(_, seen)| seen[k].iter().cloned().collect())))
         .collect();
     if let Some(dir) = &cmd.resim.svg {
-        std::fs::create_dir_all(dir)?;
+        let mut outputs = termid::output::Outputs::new();
+        outputs.folder(dir)?;
         for (k, (name, mut fig)) in comparison_figures(&runs, &sims, &[], "validate").into_iter().enumerate()
         {
             if let Some(mc) = &mc {
@@ -69,8 +72,10 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
             let stem = std::path::Path::new(&name)
                 .file_stem()
                 .map_or(format!("run{k}"), |s| s.to_string_lossy().into_owned());
-            fig.write_svg(&dir.join(format!("validate_{stem}.svg")))?;
+            let svg = fig.to_svg().map_err(anyhow::Error::msg)?;
+            outputs.file(&dir.join(format!("validate_{stem}.svg")), svg.as_bytes())?;
         }
+        outputs.commit()?;
     }
     match cmd.format {
         Format::Json => println!(
