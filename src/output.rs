@@ -112,6 +112,9 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
 pub struct Outputs {
     /// (temporary file, target), in the order staged.
     staged: Vec<(PathBuf, PathBuf)>,
+    /// Targets that are not regular files (`/dev/stdout`, a pipe): written in place on commit,
+    /// since renaming over them would replace the device rather than write to it.
+    streams: Vec<(PathBuf, Vec<u8>)>,
     /// Folders this transaction created (removed again if it does not commit).
     made: Vec<PathBuf>,
 }
@@ -150,6 +153,15 @@ impl Outputs {
     /// place on commit).
     pub fn file(&mut self, path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
         check_file(path)?;
+        // a link is followed: the file it points to is replaced, the link stays
+        let path = &match std::fs::symlink_metadata(path) {
+            Ok(m) if m.file_type().is_symlink() => std::fs::canonicalize(path).map_err(io_error(path))?,
+            _ => path.to_path_buf(),
+        };
+        if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
+            self.streams.push((path.clone(), bytes.to_vec()));
+            return Ok(());
+        }
         let temp = sibling(path, "tmp");
         // recorded first, so that a failed write is removed by Drop
         self.staged.push((temp.clone(), path.to_path_buf()));
@@ -171,6 +183,9 @@ impl Outputs {
             }
         }
         self.made.clear();
+        for (target, bytes) in std::mem::take(&mut self.streams) {
+            std::fs::write(&target, bytes).map_err(io_error(&target))?;
+        }
         Ok(())
     }
 }
@@ -278,6 +293,21 @@ mod tests {
         out.commit().unwrap();
         assert_eq!(std::fs::read_to_string(d.join("a.csv")).unwrap(), "new");
         assert_eq!(entries(&d), ["a.csv"]);
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    #[test]
+    fn links_are_followed_and_devices_written_in_place() {
+        let d = scratch("links");
+        std::fs::write(d.join("real.csv"), "old").unwrap();
+        std::os::unix::fs::symlink(d.join("real.csv"), d.join("link.csv")).unwrap();
+        write_file(&d.join("link.csv"), b"new").unwrap();
+        assert!(std::fs::symlink_metadata(d.join("link.csv")).unwrap().file_type().is_symlink());
+        assert_eq!(std::fs::read_to_string(d.join("real.csv")).unwrap(), "new");
+        // a device is written to, not replaced
+        write_file(Path::new("/dev/null"), b"x").unwrap();
+        assert!(!std::fs::metadata("/dev/null").unwrap().is_file());
+        assert_eq!(entries(&d), ["link.csv", "real.csv"]);
         let _ = std::fs::remove_dir_all(&d);
     }
 

@@ -37,3 +37,6 @@ mod diagnose;
 // Measured runs from a synthetic basin: identify, validate, and the refusals of bad files.
 #[path = "integration/basin.rs"]
 mod basin;
+// Hostile inputs through the CLI: no hang, no half-written file, no silent surprise.
+#[path = "integration/hostile.rs"]
+mod hostile;

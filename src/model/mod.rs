@@ -172,7 +172,10 @@ impl Model {
             vocab.variable(&s.name).map_err(|e| key_err(&format!("states[{i}].name"), e.to_string()))?;
             if let (Some(lo), Some(hi)) = (s.min, s.max) {
                 if lo >= hi {
-                    return Err(key_err(&format!("states[{i}]"), format!("min {lo} is not below max {hi}")));
+                    return Err(key_err(
+                        &format!("states[{i}].min"),
+                        format!("min {lo} is not below max {hi}"),
+                    ));
                 }
             }
         }

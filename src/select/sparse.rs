@@ -587,6 +587,49 @@ impl Selector for SparseFit {
 }
 
 impl SparseFit {
+    /// Least squares on `support` under the constraints, written into the step: its
+    /// coefficients, intercept and fit; a fixed coefficient's standard error is 0 (it is not
+    /// estimated), the others keep the unconstrained fit's. Returns the residual share 1 − R².
+    fn constrained_refit(
+        &self,
+        sc: &Scaled,
+        w: &[f64],
+        support: &[usize],
+        c: &Columns,
+        st: &mut Step,
+    ) -> Result<f64, SelectError> {
+        let (p, m) = (sc.p, sc.m);
+        let beta = self.solve(sc, 0.0, w, support, c)?;
+        // 1 − R² = 1 − 2 rᵀβ + βᵀRβ in correlation scale
+        let mut rss = 1.0;
+        for &i in support {
+            rss -= 2.0 * sc.a[i * m + p] * beta[i];
+            for &j in support {
+                rss += beta[i] * sc.a[i * m + j] * beta[j];
+            }
+        }
+        let rss = rss.max(0.0);
+        st.coefficients = support.iter().map(|&j| beta[j] * sc.d[p] / sc.d[j]).collect();
+        for (k, &j) in support.iter().enumerate() {
+            if c.fixed.iter().any(|(f, _)| *f == j) {
+                st.std_errors[k] = 0.0;
+            }
+        }
+        if let Some(b0) = st.intercept.as_mut() {
+            let means = &sc.means;
+            b0.value =
+                means[p] - support.iter().zip(&st.coefficients).map(|(&j, b)| b * means[j]).sum::<f64>();
+            b0.t = b0.value / b0.std_error;
+        }
+        let r2 = 1.0 - rss;
+        let dof = sc.n_eff - support.len() as f64;
+        st.r2 = r2;
+        st.r = r2.max(0.0).sqrt();
+        st.standard_error = (rss * sc.total / dof.max(1.0)).sqrt();
+        st.f = if rss > 0.0 { r2 / support.len() as f64 / (rss / dof.max(1.0)) } else { f64::INFINITY };
+        Ok(rss)
+    }
+
     fn path_fit(&self, pb: &Problem<'_>, folds: &[Moments]) -> Result<Selection, SelectError> {
         self.validate()?;
         let c = self.columns(pb)?;
@@ -672,7 +715,13 @@ impl SparseFit {
             let mut st = sc.step(&a, &support, pb.names, newest, false, pb.forced.contains(&newest));
             st.step = steps.len() + 1;
             st.reduction = lambda; // the path's λ (standardised units), for the report
-            let rss = sc.residual_share(&a).max(1e-13); // exact fits: see best_subset
+            let mut rss = sc.residual_share(&a);
+            if !c.is_empty() {
+                // the refit keeps the constraints: least squares on the support subject to
+                // them (the QP at λ = 0), else a fixed coefficient would come back free
+                rss = self.constrained_refit(&sc, &w, &support, &c, &mut st)?;
+            }
+            let rss = rss.max(1e-13); // exact fits: see best_subset
             let k = support.len() as f64 + if sc.intercept { 1.0 } else { 0.0 };
             scores.push(match self.choice {
                 LambdaChoice::Bic => n * (rss * sc.total / n).ln() + k * n.ln(),

@@ -87,7 +87,10 @@ impl Settings {
         }
         let steps = (self.duration / self.dt).round();
         if steps > 1e9 {
-            return bad(format!("{steps} steps are too many"));
+            return bad(format!(
+                "{:.3e} steps of {} s are too many (at most 1e9): shorten the duration or take longer steps",
+                steps, self.dt
+            ));
         }
         Ok((steps as usize, every as usize))
     }

@@ -251,9 +251,13 @@ fn sparse_fit_honours_constraints_and_reports_solver_failure() {
     };
     let to_raw = |j: usize, beta: f64| beta * sd(&y) / sd(&cols[j]);
     // a coefficient fixed to a raw value
-    let fixed =
-        SparseFit { fixed: vec![("x2".into(), 0.8)], ..SparseFit::default() }.lasso(&pb, 0.01).unwrap();
+    let fixing = SparseFit { fixed: vec![("x2".into(), 0.8)], ..SparseFit::default() };
+    let fixed = fixing.lasso(&pb, 0.01).unwrap();
     assert!((to_raw(1, fixed[1]) - 0.8).abs() < 1e-7, "{}", to_raw(1, fixed[1]));
+    // the least-squares refit the path reports keeps it fixed too
+    let selection = fixing.select(&pb).unwrap();
+    let x2 = selection.terms.iter().find(|t| t.term == "x2").expect("a fixed term is in");
+    assert!((x2.coefficient - 0.8).abs() < 1e-7 && x2.std_error == 0.0, "{x2:?}");
     // a sign constraint against the data
     let signed = SparseFit { signs: vec![(3.into(), 1.0)], ..SparseFit::default() }.lasso(&pb, 0.01).unwrap();
     assert!(signed[3] >= -1e-9, "{}", signed[3]);

@@ -443,7 +443,10 @@ fn text(fit: &Fit) -> String {
             &format!("{:<22} {:>12} {:>12} {:>9.2}\n", "(intercept)", num(b0.value), num(b0.std_error), b0.t);
     }
     for t in &s.terms {
-        out += &format!("{:<22} {:>12} {:>12} {:>9.2}\n", t.term, num(t.coefficient), num(t.std_error), t.t);
+        // a coefficient the back-end was told to hold (sparse `fixed`) is not estimated
+        let t_value = if t.std_error == 0.0 { "fixed".to_string() } else { format!("{:.2}", t.t) };
+        out +=
+            &format!("{:<22} {:>12} {:>12} {:>9}\n", t.term, num(t.coefficient), num(t.std_error), t_value);
     }
     out += &format!("\nstopped: {:?}\n", s.stop);
     if let Some(tau) = fit.correlation_time.filter(|t| *t > 1.5) {

@@ -30,6 +30,10 @@ pub fn with_spinner<T>(label: &str, work: impl FnOnce() -> T) -> T {
             let _ = finished.recv();
             bar.finish_and_clear();
         });
+        // the crash path's regression test makes the work panic (tests/integration/hostile.rs)
+        if std::env::var_os("TERMID_TEST_PANIC").is_some() {
+            panic!("TERMID_TEST_PANIC is set");
+        }
         let result = work();
         let _ = done.send(());
         result
