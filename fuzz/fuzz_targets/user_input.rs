@@ -1,5 +1,6 @@
 //! Every text a user hands termid, from one fuzzer input: the first byte picks the reader,
-//! the rest is the text. Any error is fine; a panic is a bug.
+//! the rest is the text. Any error is fine; a panic is a bug. Kind 6 is a model file's
+//! back-end table (`backend = …`), loaded and then fitted on a short Lorenz run.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -11,7 +12,7 @@ use termid::term::Vocabulary;
 fuzz_target!(|data: &[u8]| {
     let Some((&kind, rest)) = data.split_first() else { return };
     let Ok(text) = std::str::from_utf8(rest) else { return };
-    match kind % 6 {
+    match kind % 7 {
         0 => {
             // a candidate term in the ship's vocabulary
             let mut v = Vocabulary::new();
@@ -44,8 +45,37 @@ fuzz_target!(|data: &[u8]| {
                 let _ = d.smooth(&t, &x);
             }
         }
-        _ => {
+        5 => {
             let _ = toml::from_str::<Dataset>(text);
+        }
+        _ => {
+            let lorenz = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../models/lorenz.toml"))
+                .expect("models/lorenz.toml");
+            let line = lorenz.lines().find(|l| l.starts_with("backend = ")).expect("a backend line");
+            let text = lorenz.replacen(line, &format!("backend = {text}"), 1);
+            if let Ok(model) = Model::parse(&text, "fuzz.toml") {
+                let frames = [lorenz_run(&model)];
+                for eq in model.identifiable() {
+                    let _ = termid::identify::fit_equation(
+                        &model,
+                        &eq,
+                        &frames,
+                        &termid::data::CentralDifference,
+                        true,
+                        None,
+                    );
+                }
+            }
         }
     }
 });
+
+/// One second of the Lorenz system at 0.01 s, with its derivative columns.
+fn lorenz_run(model: &Model) -> Frame {
+    let system = termid::sim::System::new(model, &Default::default(), false).expect("lorenz compiles");
+    let settings =
+        termid::sim::Settings { integrator: termid::sim::Integrator::Rk4, dt: 0.01, duration: 1.0, sample: 0.01 };
+    let x0: Vec<f64> = model.spec.states.iter().map(|s| s.initial).collect();
+    let traj = termid::sim::simulate(&system, &x0, &mut termid::sim::Constant(vec![]), &settings).expect("runs");
+    traj.to_frame("lorenz", "t").expect("a frame")
+}

@@ -220,8 +220,9 @@ impl Ship {
         settings: &Settings,
         start: StraightRun,
     ) -> Result<Run, ShipError> {
-        // the output interval is checked as asked for, although every step is kept for the metrics
-        settings.check(1)?;
+        // the output interval is checked as asked for, although every step is kept for the
+        // metrics (that run's memory is checked by `simulate`)
+        settings.check(0)?;
         manoeuvre.check(self)?;
         let fine = Settings { sample: settings.dt, ..*settings };
         let mut controller = manoeuvre.controller(self, &start)?;
