@@ -22,13 +22,12 @@ pub enum OutputError {
         reason: String,
     },
     /// The system refused a write, a rename or a lock.
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     Io {
         /// The path written.
         path: String,
-        /// What the system said.
-        #[source]
-        source: std::io::Error,
+        /// What the system said (in the message, so not also a source that would print twice).
+        error: std::io::Error,
     },
 }
 
@@ -37,13 +36,13 @@ impl OutputError {
     pub fn reason(&self) -> String {
         match self {
             OutputError::Unwritable { reason, .. } => reason.clone(),
-            OutputError::Io { source, .. } => source.to_string(),
+            OutputError::Io { error, .. } => error.to_string(),
         }
     }
 }
 
 fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> OutputError + '_ {
-    move |source| OutputError::Io { path: path.display().to_string(), source }
+    move |error| OutputError::Io { path: path.display().to_string(), error }
 }
 
 /// A name beside `target` that no other process or call uses: `.NAME.termid-PID-N.tmp`.
