@@ -40,77 +40,7 @@ impl std::fmt::Display for Target {
     }
 }
 
-/// Where a parameter's value comes from in each run.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
-pub enum ParamValue {
-    /// The same value for every run.
-    Value(f64),
-    /// A rule evaluated on each run: `first:u` is the run's first value of `u`.
-    Rule(String),
-}
-
-impl ParamValue {
-    /// A value as written on the command line or in a file: a finite number, or a rule that
-    /// [`ParamValue::check_rule`] accepts.
-    pub fn from_text(name: &str, text: &str) -> Result<ParamValue, String> {
-        let text = text.trim();
-        match text.parse::<f64>() {
-            Ok(v) if v.is_finite() => Ok(ParamValue::Value(v)),
-            Ok(v) => Err(format!("parameter `{name}`: {v} is not a finite number")),
-            Err(_) => {
-                let rule = ParamValue::Rule(text.to_string());
-                rule.check_rule(name)?;
-                Ok(rule)
-            }
-        }
-    }
-
-    /// Checks a rule's syntax without data.
-    pub fn check_rule(&self, name: &str) -> Result<(), String> {
-        match self {
-            ParamValue::Value(_) => Ok(()),
-            ParamValue::Rule(rule) => match rule.split_once(':') {
-                Some(("first", col)) if !col.is_empty() => Ok(()),
-                Some(("mean", rest)) if !rest.is_empty() => match rest.split_once(':') {
-                    Some((c, secs)) if !c.is_empty() && secs.parse::<f64>().is_ok_and(|s| s > 0.0) => Ok(()),
-                    Some(_) => Err(format!("parameter `{name}`: `{rule}`: write mean:COLUMN:SECONDS with SECONDS > 0")),
-                    None => Ok(()),
-                },
-                _ => Err(format!(
-                    "parameter `{name}`: `{rule}` is neither a number nor `first:COLUMN`, `mean:COLUMN` or `mean:COLUMN:SECONDS`"
-                )),
-            },
-        }
-    }
-
-    /// The value in one run.
-    pub fn resolve(&self, name: &str, frame: &Frame) -> Result<f64, IdentifyError> {
-        match self {
-            ParamValue::Value(v) => Ok(*v),
-            ParamValue::Rule(rule) => match rule.split_once(':') {
-                _ if self.check_rule(name).is_err() => Err(IdentifyError::Parameter(
-                    self.check_rule(name).err().unwrap_or_default(),
-                )),
-                Some(("first", col)) => Ok(frame.require(col)?[0]),
-                Some(("mean", rest)) => {
-                    // `mean:u` over the run, `mean:u:2` over its first 2 time units (the approach)
-                    let (col, span) = match rest.split_once(':') {
-                        Some((c, secs)) => (c, secs.parse::<f64>().ok().filter(|s| *s > 0.0)),
-                        None => (rest, None),
-                    };
-                    let c = frame.require(col)?;
-                    let t = frame.time();
-                    let n = span.map_or(c.len(), |s| t.iter().take_while(|ti| **ti - t[0] <= s).count().max(1));
-                    Ok(c[..n].iter().sum::<f64>() / n as f64)
-                }
-                _ => Err(IdentifyError::Parameter(format!(
-                    "parameter `{name}`: `{rule}` is neither a number nor `first:COLUMN`, `mean:COLUMN` or `mean:COLUMN:SECONDS`"
-                ))),
-            },
-        }
-    }
-}
+pub use crate::model::ParamValue;
 
 /// Why identification failed.
 #[derive(Debug, thiserror::Error)]
@@ -139,9 +69,6 @@ pub enum IdentifyError {
         /// Its value.
         value: f64,
     },
-    /// A parameter could not be set.
-    #[error("{0}")]
-    Parameter(String),
     /// Something the caller asked for does not fit together.
     #[error("{0}")]
     Setup(String),

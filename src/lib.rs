@@ -12,6 +12,7 @@ pub mod diagnose;
 pub mod identify;
 pub mod model;
 pub mod output;
+#[cfg(feature = "plot")]
 pub mod plot;
 pub mod select;
 pub mod ship;

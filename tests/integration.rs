@@ -40,3 +40,6 @@ mod basin;
 // Hostile inputs through the CLI: no hang, no half-written file, no silent surprise.
 #[path = "integration/hostile.rs"]
 mod hostile;
+// The library's layers run one way (a table checked against the `crate::` paths).
+#[path = "integration/layers.rs"]
+mod layers;

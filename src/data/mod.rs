@@ -15,7 +15,7 @@ mod smoothing_spline;
 pub use dataset::{Dataset, Delimiter, RunSpec};
 pub use derivative::{differentiator, CentralDifference, Differentiator, Smoothed, DIFFERENTIATORS};
 pub use kalman::{KalmanSmoother, NoiseModel};
-pub use prepare::{prepare, prepared_figure, Preparation};
+pub use prepare::{prepare, Preparation};
 pub use resample::{check_gaps, interpolate_at, median_step, resample};
 pub use savitzky_golay::SavitzkyGolay;
 pub use smoothing_spline::SmoothingSpline;

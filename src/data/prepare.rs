@@ -6,7 +6,6 @@
 use super::derivative::Differentiator;
 use super::resample::resample;
 use super::{DataError, Frame};
-use crate::plot::{Figure, Panel, Series};
 
 /// What to do to each run.
 pub struct Preparation<'a> {
@@ -37,48 +36,6 @@ pub fn prepare(frame: &Frame, how: &Preparation) -> Result<Frame, DataError> {
     Ok(out)
 }
 
-/// Raw and prepared signals over time, two panels per signal (its value, and its rate beside
-/// the central differences of the raw record, which show the noise the method took out);
-/// `scale` gives a display factor and unit per signal (e.g. rad → deg).
-pub fn prepared_figure(
-    raw: &Frame,
-    prepared: &Frame,
-    signals: &[String],
-    scale: &dyn Fn(&str) -> (f64, String),
-) -> Figure {
-    let mut panels = Vec::new();
-    let times = |f: &Frame| f.time().to_vec();
-    for name in signals {
-        let (k, unit) = scale(name);
-        let line = |v: &[f64]| v.iter().map(|v| v * k).collect::<Vec<_>>();
-        let (Some(r), Some(p)) = (raw.column(name), prepared.column(name)) else { continue };
-        panels.push(Panel {
-            title: name.clone(),
-            x_label: format!("{} [s]", raw.time_name()),
-            y_label: format!("{name} [{unit}]"),
-            series: vec![
-                Series::points("raw", times(raw), line(r)),
-                Series::line("prepared", times(prepared), line(p)),
-            ],
-            ..Panel::default()
-        });
-        let Some(d) = prepared.column(&format!("{name}_dot")) else { continue };
-        let mut series = Vec::new();
-        if let Ok(cd) = super::CentralDifference.differentiate(raw.time(), r) {
-            series.push(Series::points("central differences of raw", times(raw), line(&cd)));
-        }
-        series.push(Series::line("prepared rate", times(prepared), line(d)));
-        panels.push(Panel {
-            title: format!("d{name}/dt"),
-            x_label: format!("{} [s]", raw.time_name()),
-            y_label: format!("d{name}/dt [{unit}/s]"),
-            series,
-            ..Panel::default()
-        });
-    }
-    Figure::new(&format!("{}: raw and prepared signals", raw.origin()), panels)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -99,8 +56,6 @@ mod tests {
             let t = p.time()[i];
             assert!((u[i] - t * t).abs() < 1e-3 && (du[i] - 2.0 * t).abs() < 1e-2, "{t}: {} {}", u[i], du[i]);
         }
-        let fig = prepared_figure(&f, &p, &how.signals, &|_| (1.0, "m/s".into()));
-        assert_eq!(fig.panels.len(), 2);
         let short = Frame::new("short.csv", "t", vec![0.0, 1.0, 2.0]).unwrap();
         let mut short2 = short.clone();
         short2.push("u", vec![0.0; 3]).unwrap();

@@ -6,6 +6,9 @@
 
 mod file;
 mod locate;
+mod param;
+
+pub use param::ParamValue;
 
 pub use file::{
     CoefficientSpec, CovarianceSpec, EquationSpec, InputSpec, Meta, ModelFile, ParameterSpec, ShipNames,
@@ -15,7 +18,6 @@ pub use file::{
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use crate::identify::ParamValue;
 use crate::select::{Backend, Candidate};
 use crate::term::{Library, Term, TermError, Vocabulary};
 
@@ -511,6 +513,55 @@ impl Model {
         let body =
             toml::to_string_pretty(&self.spec).unwrap_or_else(|e| format!("# could not serialise: {e}\n"));
         format!("# written by termid {}\n{body}", env!("CARGO_PKG_VERSION"))
+    }
+}
+
+/// A model file is what the simulator integrates: its equations' coefficients times their
+/// terms are ẋ.
+impl crate::sim::RightHandSide for Model {
+    fn origin(&self) -> &str {
+        &self.path
+    }
+
+    fn states(&self) -> Result<Vec<(String, f64, f64)>, crate::sim::SimError> {
+        let missing: Vec<&str> = self
+            .spec
+            .states
+            .iter()
+            .map(|s| s.name.as_str())
+            .filter(|s| !self.equations.iter().any(|e| e.state == *s))
+            .collect();
+        if !missing.is_empty() {
+            return Err(crate::sim::SimError::Settings(format!(
+                "{}: state(s) {} have no equation, so the model cannot be simulated",
+                self.path,
+                missing.join(", ")
+            )));
+        }
+        Ok(self
+            .equations
+            .iter()
+            .map(|e| {
+                let spec = self.spec.states.iter().find(|t| t.name == e.state);
+                (
+                    e.state.clone(),
+                    spec.and_then(|t| t.min).unwrap_or(f64::NEG_INFINITY),
+                    spec.and_then(|t| t.max).unwrap_or(f64::INFINITY),
+                )
+            })
+            .collect())
+    }
+
+    fn inputs(&self) -> Vec<String> {
+        self.spec.inputs.iter().map(|i| i.name.clone()).collect()
+    }
+
+    fn parameters(&self) -> BTreeMap<String, f64> {
+        self.parameter_values()
+    }
+
+    fn compile(&self, with_intercept: bool) -> Result<Library, crate::sim::SimError> {
+        Ok(self.compile_rhs(with_intercept)?)
     }
 }
 

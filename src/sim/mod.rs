@@ -1,4 +1,5 @@
-//! Simulation of identified equations: a [`System`] (any model's equations, compiled once),
+//! Simulation of identified equations: a [`System`] (any [`RightHandSide`], e.g. a model
+//! file's equations, compiled once),
 //! a [`Controller`] that sets the inputs, and a fixed-step [`Integrator`]. Nothing here knows
 //! about ships; the manoeuvres of the ship plug-in are controllers.
 
@@ -10,7 +11,7 @@ mod system;
 pub use controller::{Constant, Controller, Replay};
 pub use integrator::{simulate, Integrator, Settings, Trajectory};
 pub use steady::{solve_steady, SteadyProblem, Unknown};
-pub use system::{System, Workspace};
+pub use system::{RightHandSide, System, Workspace};
 
 /// Why a simulation stopped.
 #[derive(Debug, thiserror::Error)]

@@ -3,7 +3,6 @@
 use std::collections::BTreeMap;
 
 use super::SimError;
-use crate::model::Model;
 use crate::term::{Library, RowScratch};
 
 /// The compiled right-hand side of a model with its states, inputs and parameters.
@@ -33,42 +32,48 @@ enum Slot {
     Param(usize),
 }
 
+/// What the simulator needs of a model: its states (in integration order, with bounds), inputs,
+/// parameters and the compiled right-hand side. A model file implements it; so can anything
+/// else that yields ẋ = f(x, input; parameters) as terms, so the simulator depends on neither
+/// model files nor the regression back-ends.
+pub trait RightHandSide {
+    /// Where it comes from, for messages (a model file's path).
+    fn origin(&self) -> &str;
+    /// State names in integration order with their (lower, upper) bounds (±∞ if none).
+    fn states(&self) -> Result<Vec<(String, f64, f64)>, SimError>;
+    /// Input names.
+    fn inputs(&self) -> Vec<String>;
+    /// Parameter values by name.
+    fn parameters(&self) -> BTreeMap<String, f64>;
+    /// ẋ of each state as one compiled library, one output per state in `states` order;
+    /// with `with_intercept` each equation's stored constant b0 included.
+    fn compile(&self, with_intercept: bool) -> Result<Library, SimError>;
+}
+
 impl System {
-    /// Compiles a model's equations. `parameters` override the file's values.
-    pub fn new(
-        model: &Model,
+    /// Compiles a right-hand side (a model). `parameters` override its values.
+    pub fn new<R: RightHandSide + ?Sized>(
+        model: &R,
         parameters: &BTreeMap<String, f64>,
         with_intercept: bool,
     ) -> Result<System, SimError> {
-        let states: Vec<String> = model.equations.iter().map(|e| e.state.clone()).collect();
-        let missing: Vec<&str> = model
-            .spec
-            .states
-            .iter()
-            .map(|s| s.name.as_str())
-            .filter(|s| !states.iter().any(|t| t == s))
-            .collect();
-        if !missing.is_empty() {
-            return Err(SimError::Settings(format!(
-                "{}: state(s) {} have no equation, so the model cannot be simulated",
-                model.path,
-                missing.join(", ")
-            )));
-        }
-        let inputs: Vec<String> = model.spec.inputs.iter().map(|i| i.name.clone()).collect();
-        let mut values = model.parameter_values();
+        let declared = model.states()?;
+        let states: Vec<String> = declared.iter().map(|(n, _, _)| n.clone()).collect();
+        let bounds: Vec<(f64, f64)> = declared.iter().map(|(_, lo, hi)| (*lo, *hi)).collect();
+        let inputs = model.inputs();
+        let mut values = model.parameters();
         for (name, value) in parameters {
             let Some(slot) = values.get_mut(name) else {
                 return Err(SimError::Settings(format!(
                     "{}: `{name}` is not a parameter of the model ({})",
-                    model.path,
-                    model.parameter_values().keys().cloned().collect::<Vec<_>>().join(", ")
+                    model.origin(),
+                    model.parameters().keys().cloned().collect::<Vec<_>>().join(", ")
                 )));
             };
             *slot = *value;
         }
         let param_names: Vec<String> = values.keys().cloned().collect();
-        let rhs = model.compile_rhs(with_intercept)?;
+        let rhs = model.compile(with_intercept)?;
         let map = rhs
             .inputs()
             .iter()
@@ -82,21 +87,11 @@ impl System {
                     .ok_or_else(|| {
                         SimError::Settings(format!(
                             "{}: `{n}` is neither a state, an input nor a parameter",
-                            model.path
+                            model.origin()
                         ))
                     })
             })
             .collect::<Result<Vec<_>, _>>()?;
-        let bounds = states
-            .iter()
-            .map(|s| {
-                let spec = model.spec.states.iter().find(|t| &t.name == s);
-                (
-                    spec.and_then(|t| t.min).unwrap_or(f64::NEG_INFINITY),
-                    spec.and_then(|t| t.max).unwrap_or(f64::INFINITY),
-                )
-            })
-            .collect();
         let slot =
             |j: usize| rhs.input_slot(j).ok_or_else(|| SimError::Settings(format!("input {j} has no slot")));
         let (mut state_slots, mut input_slots, mut param_slots) = (Vec::new(), Vec::new(), Vec::new());

@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 
 use anyhow::{bail, Context, Result};
 use termid::data::{
-    differentiator, prepare, prepared_figure, resample, CentralDifference, Differentiator, Frame, Preparation,
+    differentiator, prepare, resample, CentralDifference, Differentiator, Frame, Preparation,
 };
 use termid::identify::{Fit, Identification, ParamValue, Target};
 use termid::model::Covariance;
@@ -182,7 +182,8 @@ fn prepare_runs(
                 .file_stem()
                 .map_or(format!("run{k}"), |s| s.to_string_lossy().into_owned());
             let path = dir.join(format!("prepared_{k}_{stem}.svg"));
-            let svg = prepared_figure(raw, p, signals, scale).to_svg().map_err(anyhow::Error::msg)?;
+            let svg =
+                termid::plot::prepared_figure(raw, p, signals, scale).to_svg().map_err(anyhow::Error::msg)?;
             outputs.file(&path, svg.as_bytes())?;
         }
         outputs.commit()?;

@@ -3,7 +3,8 @@
 //! ship models the manoeuvre metrics of measurement and model side by side; a figure per run.
 
 use anyhow::Result;
-use termid::diagnose::{comparison_figures, Runs};
+use termid::diagnose::Runs;
+use termid::plot::comparison_figures;
 use termid::ship::observed::{observe, Observed};
 use termid::sim::{Integrator, Trajectory};
 

@@ -4,6 +4,7 @@
 //! everything into a [`Study`]; [`report`] writes it as Markdown, SVG, CSV and JSON.
 
 pub mod data;
+#[cfg(feature = "plot")]
 pub mod report;
 pub mod resim;
 pub mod tables;

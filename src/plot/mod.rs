@@ -1,6 +1,13 @@
 //! Figures as SVG (plotters, no fonts needed): a figure is a column of panels, each with
-//! named line or point series. Generic; the ship plug-in and the reproduction choose what to
-//! put in them.
+//! named line or point series. Generic; the core's figures (a run's preparation, runs beside
+//! their simulations) are here, the ship plug-in draws its own with the same types. Behind
+//! the `plot` feature.
+
+mod comparison;
+mod prepared;
+
+pub use comparison::{comparison_figures, diagnosis_figures};
+pub use prepared::prepared_figure;
 
 use std::path::Path;
 

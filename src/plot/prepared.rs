@@ -1,0 +1,68 @@
+//! The figure of a run's preparation for identification: raw and prepared signals, and the
+//! rates beside the raw record's central differences.
+
+use super::{Figure, Panel, Series};
+use crate::data::{CentralDifference, Differentiator, Frame};
+
+/// Raw and prepared signals over time, two panels per signal (its value, and its rate beside
+/// the central differences of the raw record, which show the noise the method took out);
+/// `scale` gives a display factor and unit per signal (e.g. rad → deg).
+pub fn prepared_figure(
+    raw: &Frame,
+    prepared: &Frame,
+    signals: &[String],
+    scale: &dyn Fn(&str) -> (f64, String),
+) -> Figure {
+    let mut panels = Vec::new();
+    let times = |f: &Frame| f.time().to_vec();
+    for name in signals {
+        let (k, unit) = scale(name);
+        let line = |v: &[f64]| v.iter().map(|v| v * k).collect::<Vec<_>>();
+        let (Some(r), Some(p)) = (raw.column(name), prepared.column(name)) else { continue };
+        panels.push(Panel {
+            title: name.clone(),
+            x_label: format!("{} [s]", raw.time_name()),
+            y_label: format!("{name} [{unit}]"),
+            series: vec![
+                Series::points("raw", times(raw), line(r)),
+                Series::line("prepared", times(prepared), line(p)),
+            ],
+            ..Panel::default()
+        });
+        let Some(d) = prepared.column(&format!("{name}_dot")) else { continue };
+        let mut series = Vec::new();
+        if let Ok(cd) = CentralDifference.differentiate(raw.time(), r) {
+            series.push(Series::points("central differences of raw", times(raw), line(&cd)));
+        }
+        series.push(Series::line("prepared rate", times(prepared), line(d)));
+        panels.push(Panel {
+            title: format!("d{name}/dt"),
+            x_label: format!("{} [s]", raw.time_name()),
+            y_label: format!("d{name}/dt [{unit}/s]"),
+            series,
+            ..Panel::default()
+        });
+    }
+    Figure::new(&format!("{}: raw and prepared signals", raw.origin()), panels)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::{prepare, Preparation, SmoothingSpline};
+
+    #[test]
+    fn two_panels_per_signal() {
+        let t: Vec<f64> = (0..400).map(|i| i as f64 * 0.01).collect();
+        let mut f = Frame::new("run.csv", "t", t.clone()).unwrap();
+        f.push("u", t.iter().map(|t| t * t).collect()).unwrap();
+        let spline = SmoothingSpline { alpha: Some(1.0) };
+        let how =
+            Preparation { resample: Some(0.02), method: &spline, signals: vec!["u".into()], smooth: true };
+        let p = prepare(&f, &how).unwrap();
+        let fig = prepared_figure(&f, &p, &how.signals, &|_| (1.0, "m/s".into()));
+        assert_eq!(fig.panels.len(), 2);
+        assert_eq!(fig.panels[1].title, "du/dt");
+        assert!(fig.to_svg().unwrap().contains("</svg>"));
+    }
+}
