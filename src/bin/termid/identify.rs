@@ -7,7 +7,6 @@ use termid::data::{
     differentiator, prepare, resample, CentralDifference, Differentiator, Frame, Preparation,
 };
 use termid::identify::{Fit, Identification, ParamValue, Target};
-use termid::model::Covariance;
 use termid::model::ShipSpec;
 use termid::select::{Backend, StepRule};
 use termid::ship::tracking::track;
@@ -236,37 +235,18 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
     if cmd.target.is_some() && names.len() != 1 {
         bail!("--target applies to one equation: name it with --equation");
     }
-    let mut fits = Vec::new();
-    for name in &names {
-        let fit = crate::progress::with_spinner(&format!("identifying {name}"), || {
-            termid::identify::fit_equation(
-                &model,
-                name,
-                &frames,
-                diff.as_ref(),
-                !cmd.no_intercept,
-                cmd.target.as_deref().map(Target::parse),
-            )
-        })
-        .with_context(|| format!("identifying `{name}`"))?;
-        let coefficients = termid::identify::coefficients_of(&fit, &model.vocabulary)?;
-        let terms: Vec<_> = coefficients.iter().map(|(t, _, _)| t.clone()).collect();
-        model.set_coefficients(name, coefficients, fit.selection.intercept.as_ref().map(|b| b.value));
-        let mut fit = fit;
-        fit.correlation_time = termid::identify::correlation_time_of(&model, &frames, diff.as_ref(), &fit)?;
-        if let Some(matrix) = &fit.covariance {
-            // kept for Monte-Carlo prediction bands (`simulate --monte-carlo`)
-            let covariance = Covariance {
-                terms,
-                matrix: matrix.clone(),
-                correlation_time: fit.correlation_time.unwrap_or(1.0).max(1.0),
-            };
-            model
-                .set_covariance(name, covariance)
-                .map_err(|e| anyhow::anyhow!("identifying `{name}`: its coefficients' covariance {e}"))?;
-        }
-        fits.push((name.clone(), fit));
-    }
+    let label = format!("identifying {}", names.join(", "));
+    let how = termid::identify::ModelIdentification {
+        equations: names,
+        differentiator: diff.as_ref(),
+        intercept: !cmd.no_intercept,
+        target: cmd.target.as_deref().map(Target::parse),
+    };
+    let identified = crate::progress::with_spinner(&label, || {
+        termid::identify::identify_model(&model, &frames, &how, &mut |_| {})
+    })?;
+    let fits = identified.fits;
+    model = identified.model;
     // a refinement that fails loses nothing: the regression's model is still written, and
     // the command ends with the refinement's error
     let (refined, refine_error) = match &refine {

@@ -42,6 +42,13 @@ impl std::fmt::Display for Target {
 
 pub use crate::model::ParamValue;
 
+mod model;
+
+pub use model::{
+    coefficients_of, correlation_time_of, equation_design, fit_equation, fit_equation_design, identify_model,
+    IdentifiedModel, ModelIdentification,
+};
+
 /// Why identification failed.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -72,6 +79,21 @@ pub enum IdentifyError {
     /// Something the caller asked for does not fit together.
     #[error("{0}")]
     Setup(String),
+    /// Any of the above, in a model's equation.
+    #[error("identifying `{equation}`: {error}")]
+    InEquation {
+        /// The equation's name.
+        equation: String,
+        /// What went wrong (in the message, so not also a source that would print twice).
+        error: Box<IdentifyError>,
+    },
+}
+
+impl IdentifyError {
+    /// The error said of a model's equation.
+    pub fn in_equation(self, equation: &str) -> IdentifyError {
+        IdentifyError::InEquation { equation: equation.into(), error: Box::new(self) }
+    }
 }
 
 /// The settings shared by the equations of one identification.
@@ -402,114 +424,6 @@ fn wake_a_worker() {
     if rayon::current_num_threads() > 1 {
         rayon::spawn(|| {});
     }
-}
-
-/// Identifies one equation of a model from runs: candidates, forced and excluded terms and
-/// the back-end come from the model file; the target is the column `<state>_dot` where every
-/// run has it, else the derivative of the state.
-pub fn fit_equation(
-    model: &crate::model::Model,
-    equation: &str,
-    frames: &[Frame],
-    differentiator: &dyn Differentiator,
-    intercept: bool,
-    target: Option<Target>,
-) -> Result<Fit, IdentifyError> {
-    fit_equation_design(model, equation, None, frames, differentiator, intercept, target)
-}
-
-/// The compiled candidates of a model's equation, for [`fit_equation_design`].
-pub fn equation_design(model: &crate::model::Model, equation: &str) -> Result<Design, IdentifyError> {
-    let eq = model_equation(model, equation)?;
-    Design::new(&eq.candidates, &model.vocabulary)
-}
-
-/// [`fit_equation`] with the equation's candidates compiled beforehand by [`equation_design`]
-/// (`None`: compiled here).
-pub fn fit_equation_design(
-    model: &crate::model::Model,
-    equation: &str,
-    design: Option<&Design>,
-    frames: &[Frame],
-    differentiator: &dyn Differentiator,
-    intercept: bool,
-    target: Option<Target>,
-) -> Result<Fit, IdentifyError> {
-    let eq = model_equation(model, equation)?;
-    let target = target.unwrap_or_else(|| {
-        let column = format!("{}_dot", eq.state);
-        if frames.iter().all(|f| f.column(&column).is_some()) {
-            Target::Column(column)
-        } else {
-            Target::Derivative(eq.state.clone())
-        }
-    });
-    let rules = model.parameter_rules();
-    let identification = Identification {
-        vocabulary: &model.vocabulary,
-        parameters: &rules,
-        differentiator,
-        intercept,
-        weights: None,
-    };
-    let backend = eq.backend.build()?;
-    match design {
-        Some(d) if d.candidates() != eq.candidates.as_slice() => Err(IdentifyError::Setup(format!(
-            "{}: the compiled design given for `{equation}` is of other candidates",
-            model.path
-        ))),
-        Some(d) => identification.fit_design(&target, d, &eq.forced, &eq.excluded, frames, backend.as_ref()),
-        None => {
-            identification.fit(&target, &eq.candidates, &eq.forced, &eq.excluded, frames, backend.as_ref())
-        }
-    }
-}
-
-/// The model's equation `equation`, which must have candidates.
-fn model_equation<'m>(
-    model: &'m crate::model::Model,
-    equation: &str,
-) -> Result<&'m crate::model::Equation, IdentifyError> {
-    let eq = model
-        .equation(equation)
-        .ok_or_else(|| IdentifyError::Setup(format!("{}: no equation `{equation}`", model.path)))?;
-    if eq.candidates.is_empty() {
-        return Err(IdentifyError::Setup(format!("{}: equation `{equation}` has no candidates", model.path)));
-    }
-    Ok(eq)
-}
-
-/// [`Identification::correlation_time`] of an equation fitted by [`fit_equation`], with the
-/// same runs and derivative method.
-pub fn correlation_time_of(
-    model: &crate::model::Model,
-    frames: &[Frame],
-    differentiator: &dyn Differentiator,
-    fit: &Fit,
-) -> Result<Option<f64>, IdentifyError> {
-    let rules = model.parameter_rules();
-    let identification = Identification {
-        vocabulary: &model.vocabulary,
-        parameters: &rules,
-        differentiator,
-        intercept: true,
-        weights: None,
-    };
-    let candidates: Vec<Term> =
-        fit.candidates.iter().map(|c| model.vocabulary.parse(c)).collect::<Result<_, _>>()?;
-    identification.correlation_time(&Target::parse(&fit.target), &candidates, frames, &fit.selection)
-}
-
-/// The identified coefficients of a fit, as a model stores them (term, value, std. error).
-pub fn coefficients_of(
-    fit: &Fit,
-    vocabulary: &Vocabulary,
-) -> Result<Vec<(Term, f64, Option<f64>)>, IdentifyError> {
-    fit.selection
-        .terms
-        .iter()
-        .map(|t| Ok((vocabulary.parse(&t.term)?, t.coefficient, Some(t.std_error))))
-        .collect()
 }
 
 #[cfg(test)]

@@ -1,0 +1,179 @@
+//! A model's equations identified from runs: each equation's candidates, forced and excluded
+//! terms and back-end come from the model file; [`identify_model`] fits them all and returns
+//! the model with coefficients, intercepts, covariances and correlation times stored — what
+//! `termid identify --model … --out …` writes, for any caller.
+
+use super::{Design, Fit, Identification, IdentifyError, Target};
+use crate::data::{Differentiator, Frame};
+use crate::model::{Covariance, Equation, Model};
+use crate::term::{Term, Vocabulary};
+
+/// How a model's equations are identified.
+pub struct ModelIdentification<'a> {
+    /// The equations to fit (empty: every identifiable one).
+    pub equations: Vec<String>,
+    /// Derivatives of the states where a run has no `<state>_dot` column.
+    pub differentiator: &'a dyn Differentiator,
+    /// Fit an intercept b0 (stored; simulated with `--with-intercept`).
+    pub intercept: bool,
+    /// What to explain instead of each equation's state derivative (one equation only).
+    pub target: Option<Target>,
+}
+
+/// A model identified from runs.
+#[derive(Clone, Debug)]
+pub struct IdentifiedModel {
+    /// The model with the identified coefficients, intercepts and covariances.
+    pub model: Model,
+    /// Each equation's fit (with its residuals' correlation time), in the order fitted.
+    pub fits: Vec<(String, Fit)>,
+}
+
+/// Fits the chosen equations of `model` to `frames` and stores each in a copy of the model:
+/// the chosen terms' coefficients (with standard errors) and intercept, and the coefficients'
+/// covariance widened by the residuals' correlation time (for Monte-Carlo prediction bands).
+/// `progress` is told which equation is being fitted.
+pub fn identify_model(
+    model: &Model,
+    frames: &[Frame],
+    how: &ModelIdentification<'_>,
+    progress: &mut dyn FnMut(&str),
+) -> Result<IdentifiedModel, IdentifyError> {
+    let names = if how.equations.is_empty() { model.identifiable() } else { how.equations.clone() };
+    if how.target.is_some() && names.len() != 1 {
+        return Err(IdentifyError::Setup(
+            "a target other than the state's derivative applies to one equation: name it".into(),
+        ));
+    }
+    let mut identified = model.clone();
+    let mut fits = Vec::new();
+    for name in &names {
+        progress(name);
+        let in_equation = |e: IdentifyError| e.in_equation(name);
+        let mut fit =
+            fit_equation(model, name, frames, how.differentiator, how.intercept, how.target.clone())
+                .map_err(in_equation)?;
+        let coefficients = coefficients_of(&fit, &model.vocabulary).map_err(in_equation)?;
+        let terms: Vec<Term> = coefficients.iter().map(|(t, _, _)| t.clone()).collect();
+        identified.set_coefficients(name, coefficients, fit.selection.intercept.as_ref().map(|b| b.value));
+        fit.correlation_time =
+            correlation_time_of(&identified, frames, how.differentiator, &fit).map_err(in_equation)?;
+        if let Some(matrix) = &fit.covariance {
+            let covariance = Covariance {
+                terms,
+                matrix: matrix.clone(),
+                correlation_time: fit.correlation_time.unwrap_or(1.0).max(1.0),
+            };
+            identified
+                .set_covariance(name, covariance)
+                .map_err(|e| IdentifyError::Setup(format!("`{name}`: its coefficients' covariance {e}")))?;
+        }
+        fits.push((name.clone(), fit));
+    }
+    Ok(IdentifiedModel { model: identified, fits })
+}
+
+/// Identifies one equation of a model from runs: candidates, forced and excluded terms and
+/// the back-end come from the model file; the target is the column `<state>_dot` where every
+/// run has it, else the derivative of the state.
+pub fn fit_equation(
+    model: &Model,
+    equation: &str,
+    frames: &[Frame],
+    differentiator: &dyn Differentiator,
+    intercept: bool,
+    target: Option<Target>,
+) -> Result<Fit, IdentifyError> {
+    fit_equation_design(model, equation, None, frames, differentiator, intercept, target)
+}
+
+/// The compiled candidates of a model's equation, for [`fit_equation_design`].
+pub fn equation_design(model: &Model, equation: &str) -> Result<Design, IdentifyError> {
+    let eq = model_equation(model, equation)?;
+    Design::new(&eq.candidates, &model.vocabulary)
+}
+
+/// [`fit_equation`] with the equation's candidates compiled beforehand by [`equation_design`]
+/// (`None`: compiled here).
+pub fn fit_equation_design(
+    model: &Model,
+    equation: &str,
+    design: Option<&Design>,
+    frames: &[Frame],
+    differentiator: &dyn Differentiator,
+    intercept: bool,
+    target: Option<Target>,
+) -> Result<Fit, IdentifyError> {
+    let eq = model_equation(model, equation)?;
+    let target = target.unwrap_or_else(|| {
+        let column = format!("{}_dot", eq.state);
+        if frames.iter().all(|f| f.column(&column).is_some()) {
+            Target::Column(column)
+        } else {
+            Target::Derivative(eq.state.clone())
+        }
+    });
+    let rules = model.parameter_rules();
+    let identification = Identification {
+        vocabulary: &model.vocabulary,
+        parameters: &rules,
+        differentiator,
+        intercept,
+        weights: None,
+    };
+    let backend = eq.backend.build()?;
+    match design {
+        Some(d) if d.candidates() != eq.candidates.as_slice() => Err(IdentifyError::Setup(format!(
+            "{}: the compiled design given for `{equation}` is of other candidates",
+            model.path
+        ))),
+        Some(d) => identification.fit_design(&target, d, &eq.forced, &eq.excluded, frames, backend.as_ref()),
+        None => {
+            identification.fit(&target, &eq.candidates, &eq.forced, &eq.excluded, frames, backend.as_ref())
+        }
+    }
+}
+
+/// The model's equation `equation`, which must have candidates.
+fn model_equation<'m>(model: &'m Model, equation: &str) -> Result<&'m Equation, IdentifyError> {
+    let eq = model
+        .equation(equation)
+        .ok_or_else(|| IdentifyError::Setup(format!("{}: no equation `{equation}`", model.path)))?;
+    if eq.candidates.is_empty() {
+        return Err(IdentifyError::Setup(format!("{}: equation `{equation}` has no candidates", model.path)));
+    }
+    Ok(eq)
+}
+
+/// [`Identification::correlation_time`] of an equation fitted by [`fit_equation`], with the
+/// same runs and derivative method.
+pub fn correlation_time_of(
+    model: &Model,
+    frames: &[Frame],
+    differentiator: &dyn Differentiator,
+    fit: &Fit,
+) -> Result<Option<f64>, IdentifyError> {
+    let rules = model.parameter_rules();
+    let identification = Identification {
+        vocabulary: &model.vocabulary,
+        parameters: &rules,
+        differentiator,
+        intercept: true,
+        weights: None,
+    };
+    let candidates: Vec<Term> =
+        fit.candidates.iter().map(|c| model.vocabulary.parse(c)).collect::<Result<_, _>>()?;
+    identification.correlation_time(&Target::parse(&fit.target), &candidates, frames, &fit.selection)
+}
+
+/// The identified coefficients of a fit, as a model stores them (term, value, std. error).
+pub fn coefficients_of(
+    fit: &Fit,
+    vocabulary: &Vocabulary,
+) -> Result<Vec<(Term, f64, Option<f64>)>, IdentifyError> {
+    fit.selection
+        .terms
+        .iter()
+        .map(|t| Ok((vocabulary.parse(&t.term)?, t.coefficient, Some(t.std_error))))
+        .collect()
+}
