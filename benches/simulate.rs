@@ -2,12 +2,11 @@
 //! step) with the default model, as `termid simulate` runs it; and one right-hand side.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use termid::model::Model;
 use termid::ship::{Manoeuvre, Ship};
 use termid::sim::{simulate, Integrator, Settings};
 
 fn bench(c: &mut Criterion) {
-    let ship = Ship::new(&Model::default_model(), false).unwrap();
+    let ship = Ship::new(&termid::ship::default_model(), false).unwrap();
     let start = ship.straight_run().unwrap();
     let zigzag = Manoeuvre::parse("zigzag:20/20").unwrap();
     let mut g = c.benchmark_group("simulate");

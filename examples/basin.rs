@@ -28,8 +28,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let dir =
         std::env::args().nth(1).map_or_else(|| std::env::temp_dir().join("termid-basin"), PathBuf::from);
     std::fs::create_dir_all(&dir)?;
-    let truth = Model::default_model();
-    let u0 = truth.spec.ship.as_ref().map_or(2.01, |s| s.u0);
+    let truth = termid::ship::default_model();
+    let u0 = termid::ship::ShipSpec::of(&truth)?.map_or(2.01, |s| s.u0);
     let mut basin = Basin::default();
     // BASIN_NOISE scales every sensor's noise (1 = issue 7's sizes)
     if let Some(k) = std::env::var("BASIN_NOISE").ok().and_then(|s| s.parse::<f64>().ok()) {
@@ -161,7 +161,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             smooth,
         };
         let prepared: Vec<Frame> = if spec == "kinematic" {
-            let ship = model.spec.ship.clone().ok_or("a ship model")?;
+            let ship = termid::ship::ShipSpec::of(&model)?.ok_or("a ship model")?;
             frames.iter().map(|f| track(f, &ship, smooth)).collect::<Result<_, _>>()?
         } else {
             frames.iter().map(|f| prepare(f, &how)).collect::<Result<_, _>>()?

@@ -3,7 +3,8 @@
 //! resampling, derivative methods), and a regression back-end ([`select`]) chooses the terms
 //! that matter ([`identify`]). Identified models ([`model`]) are simulated ([`sim`]), checked
 //! against runs ([`diagnose`]) and drawn from their coefficients' covariance
-//! ([`uncertainty`]); ship manoeuvring is the first plug-in ([`ship`]).
+//! ([`uncertainty`]); fields add to the core through [`plugin`]s, ship manoeuvring
+//! ([`ship`]) the first.
 #![warn(missing_docs)]
 
 pub mod budget;
@@ -14,6 +15,8 @@ pub mod model;
 pub mod output;
 #[cfg(feature = "plot")]
 pub mod plot;
+pub mod plugin;
+pub mod plugins;
 pub mod select;
 pub mod ship;
 pub mod sim;

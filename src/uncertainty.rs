@@ -223,7 +223,22 @@ mod tests {
     /// Draws reproduce the stored covariance, correlations included.
     #[test]
     fn draws_have_the_stored_covariance() {
-        let mut model = Model::default_model();
+        // two equations, each with two coefficients (a generic model: no plug-in needed)
+        let text = r#"
+[model]
+name = "two"
+[[states]]
+name = "u"
+[[states]]
+name = "r"
+[equations.u_dot]
+state = "u"
+coefficients = { "u" = -0.4, "u^2" = 0.1 }
+[equations.r_dot]
+state = "r"
+coefficients = { "r" = -1.0, "u*r" = 0.3 }
+"#;
+        let mut model = Model::parse(text, "two.toml").unwrap();
         let eq = model.equation("u_dot").unwrap().clone();
         let terms: Vec<_> = eq.coefficients.iter().take(2).map(|c| c.0.clone()).collect();
         let cov = [[4e-6, -3e-6], [-3e-6, 9e-6]];

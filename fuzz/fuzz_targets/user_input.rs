@@ -33,7 +33,7 @@ fuzz_target!(|data: &[u8]| {
             }
         }
         2 => {
-            let _ = Model::parse(text, "fuzz.toml");
+            let _ = termid::plugins::parse(text, "fuzz.toml");
         }
         3 => {
             let _ = Manoeuvre::parse(text);
@@ -53,7 +53,7 @@ fuzz_target!(|data: &[u8]| {
                 .expect("models/lorenz.toml");
             let line = lorenz.lines().find(|l| l.starts_with("backend = ")).expect("a backend line");
             let text = lorenz.replacen(line, &format!("backend = {text}"), 1);
-            if let Ok(model) = Model::parse(&text, "fuzz.toml") {
+            if let Ok(model) = termid::plugins::parse(&text, "fuzz.toml") {
                 let frames = [lorenz_run(&model)];
                 for eq in model.identifiable() {
                     let _ = termid::identify::fit_equation(

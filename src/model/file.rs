@@ -6,9 +6,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::select::Backend;
 
-/// A whole model file.
+/// A whole model file. Tables the core does not know (`[ship]`) are kept as data for the
+/// plug-in that reads them (`crate::plugin` checks that one does).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct ModelFile {
     /// Name and provenance.
     pub model: Meta,
@@ -30,9 +30,9 @@ pub struct ModelFile {
     /// Equations by name.
     #[serde(default)]
     pub equations: BTreeMap<String, EquationSpec>,
-    /// The ship plug-in's particulars (only for ship models).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub ship: Option<ShipSpec>,
+    /// Plug-ins' tables by name (`ship`), as written; the core hands them on unread.
+    #[serde(flatten)]
+    pub plugins: BTreeMap<String, toml::Value>,
 }
 
 /// `[model]`.
@@ -190,66 +190,6 @@ impl CoefficientSpec {
         match self {
             CoefficientSpec::Value(v) => (*v, None),
             CoefficientSpec::WithError { value, std_error } => (*value, Some(*std_error)),
-        }
-    }
-}
-
-/// `[ship]`: particulars for the manoeuvring plug-in. Lengths in m, angles in degrees.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ShipSpec {
-    /// Length between perpendiculars, m.
-    pub lpp: f64,
-    /// Beam, m.
-    #[serde(default)]
-    pub beam: f64,
-    /// Draught, m.
-    #[serde(default)]
-    pub draught: f64,
-    /// Displacement volume, m³.
-    #[serde(default)]
-    pub displacement: f64,
-    /// Rudder rate, °/s.
-    pub rudder_rate: f64,
-    /// Largest rudder angle, °.
-    pub rudder_limit: f64,
-    /// Approach speed, m/s.
-    pub u0: f64,
-    /// State names the plug-in reads (defaults: u, v, r, ψ, x0, y0) and the rudder input (δ).
-    #[serde(default)]
-    pub names: ShipNames,
-}
-
-/// Which model names play the ship's roles.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct ShipNames {
-    /// Surge velocity.
-    pub u: String,
-    /// Sway velocity.
-    pub v: String,
-    /// Yaw rate.
-    pub r: String,
-    /// Heading.
-    pub psi: String,
-    /// North (initial course) position.
-    pub x0: String,
-    /// East position.
-    pub y0: String,
-    /// Rudder angle.
-    pub rudder: String,
-}
-
-impl Default for ShipNames {
-    fn default() -> Self {
-        ShipNames {
-            u: "u".into(),
-            v: "v".into(),
-            r: "r".into(),
-            psi: "ψ".into(),
-            x0: "x0".into(),
-            y0: "y0".into(),
-            rudder: "δ".into(),
         }
     }
 }

@@ -47,7 +47,7 @@ fn steps(key: &str) -> Vec<Step> {
 }
 
 /// The 1-based line of the deepest part of `key` found in `text` (0 if none is).
-pub(super) fn line_of_key(text: &str, key: &str) -> usize {
+pub fn line_of_key(text: &str, key: &str) -> usize {
     let Ok(doc) = ImDocument::parse(text) else { return 0 };
     let mut item: &Item = doc.as_item();
     let mut at = None;

@@ -11,20 +11,15 @@ mod param;
 pub use param::ParamValue;
 
 pub use file::{
-    CoefficientSpec, CovarianceSpec, EquationSpec, InputSpec, Meta, ModelFile, ParameterSpec, ShipNames,
-    ShipSpec, StateSpec,
+    CoefficientSpec, CovarianceSpec, EquationSpec, InputSpec, Meta, ModelFile, ParameterSpec, StateSpec,
 };
+pub use locate::line_of_key;
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
 use crate::select::{Backend, Candidate};
 use crate::term::{Library, Term, TermError, Vocabulary};
-
-/// The default model: HSVA model 1512 as identified by Oltmann (1973), true coefficients.
-pub const DEFAULT_MODEL: &str = include_str!("../../models/oltmann1973.toml");
-/// The name the default model reports as its file.
-pub const DEFAULT_MODEL_PATH: &str = "models/oltmann1973.toml";
 
 /// A model file that could not be used.
 #[derive(Debug, thiserror::Error)]
@@ -140,17 +135,13 @@ pub struct Model {
 }
 
 impl Model {
-    /// Reads and checks a model file.
+    /// Reads and checks a model file. Plug-in tables (`[ship]`) are kept unread:
+    /// `crate::plugins::load` also checks them.
     pub fn load(path: &Path) -> Result<Model, ModelError> {
         let file = path.display().to_string();
         let text = crate::budget::read_text(path)
             .map_err(|e| ModelError::Io { file: file.clone(), message: e.to_string() })?;
         Model::parse(&text, &file)
-    }
-
-    /// The default model (embedded in the binary).
-    pub fn default_model() -> Model {
-        Model::parse(DEFAULT_MODEL, DEFAULT_MODEL_PATH).expect("the embedded default model is valid (tested)")
     }
 
     /// Parses and checks model text; `file` names it in errors.
@@ -169,6 +160,15 @@ impl Model {
             key: key.into(),
             message,
         };
+        // other tables belong to plug-ins (`crate::plugin` checks that one reads each)
+        for (name, value) in &spec.plugins {
+            if !value.is_table() {
+                return Err(key_err(
+                    name,
+                    "not a key of a model file (a plug-in's settings are a table)".into(),
+                ));
+            }
+        }
         let mut vocab = Vocabulary::new();
         for (i, s) in spec.states.iter().enumerate() {
             vocab.variable(&s.name).map_err(|e| key_err(&format!("states[{i}].name"), e.to_string()))?;
@@ -610,13 +610,32 @@ fn check_covariance(coefficients: &[(Term, f64, Option<f64>)], c: &Covariance) -
 mod tests {
     use super::*;
 
+    const DECAY: &str = r#"
+[model]
+name = "decay"
+[[states]]
+name = "x"
+[equations.x_dot]
+state = "x"
+candidates = ["x", "x^2"]
+coefficients = { "x" = -0.5 }
+[vehicle]
+mass = 2.0
+"#;
+
     #[test]
-    fn default_model_loads() {
-        let m = Model::default_model();
-        let names: Vec<&str> = m.equations.iter().map(|e| e.name.as_str()).collect();
-        assert_eq!(&names[..3], ["u_dot", "v_dot", "r_dot"]);
-        assert_eq!(m.equation("u_dot").unwrap().candidates.len(), 18);
-        assert_eq!(m.equation("v_dot").unwrap().candidates.len(), 29);
-        assert_eq!(m.equation("r_dot").unwrap().candidates.len(), 29);
+    fn plug_in_tables_are_kept_as_data_and_written_back() {
+        let m = Model::parse(DECAY, "decay.toml").unwrap();
+        assert_eq!(m.spec.plugins["vehicle"]["mass"].as_float(), Some(2.0));
+        let again = Model::parse(&m.to_toml(), "again.toml").unwrap();
+        assert_eq!(again.spec, m.spec);
+        assert_eq!(m.equation("x_dot").unwrap().candidates.len(), 2);
+    }
+
+    #[test]
+    fn a_top_level_value_that_is_no_table_is_refused_with_its_line() {
+        let text = format!("mass = 2.0\n{DECAY}");
+        let e = Model::parse(&text, "decay.toml").unwrap_err().to_string();
+        assert!(e.starts_with("decay.toml:1: `mass`: not a key"), "{e}");
     }
 }

@@ -96,9 +96,11 @@ pub const COLUMNS: [(&str, &str); 8] = [
 /// measured from this run's own speed, as it is in identification.
 pub fn at_approach_speed(model: &Model, u0: f64) -> Model {
     let mut m = model.clone();
-    let surge = m.spec.ship.as_ref().map(|s| s.names.u.clone()).unwrap_or_else(|| "u".into());
-    if let Some(ship) = m.spec.ship.as_mut() {
+    let ship = super::ShipSpec::of(&m).ok().flatten();
+    let surge = ship.as_ref().map(|s| s.names.u.clone()).unwrap_or_else(|| "u".into());
+    if let Some(mut ship) = ship {
         ship.u0 = u0;
+        ship.store(&mut m);
     }
     for p in m.spec.parameters.values_mut() {
         let reads_surge =
@@ -239,7 +241,7 @@ mod tests {
 
     #[test]
     fn noise_has_the_declared_size_and_the_approach_is_straight() {
-        let model = Model::default_model();
+        let model = crate::ship::default_model();
         let basin = Basin::default();
         let m = Manoeuvre::parse("zigzag:20/20").unwrap();
         let rec = basin.record(&model, &m, 1.95, 40.0, 1, "zz.dat").unwrap();
@@ -259,7 +261,7 @@ mod tests {
     /// noise-free run, up to the heading noise's maximum.
     #[test]
     fn metrics_read_off_a_noisy_record_match_the_truth() {
-        let model = Model::default_model();
+        let model = crate::ship::default_model();
         let m = Manoeuvre::parse("zigzag:25/10").unwrap();
         for seed in [11, 99] {
             let rec = Basin::default().record(&model, &m, 1.97, 100.0, seed, "zz.dat").unwrap();

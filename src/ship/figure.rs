@@ -96,3 +96,28 @@ pub fn add_bands(fig: &mut Figure, ship: &Ship, draws: &[&Trajectory]) {
         }
     }
 }
+
+/// The spiral test: steady yaw rate against rudder angle, the branch from +δ down and the one
+/// back from −δ, from the metrics' `points` (`rudder_deg`, `yaw_rate_deg_s`, `branch`).
+pub fn spiral_figure(title: &str, metrics: &serde_json::Value) -> Figure {
+    let points = metrics.get("points").and_then(|p| p.as_array()).cloned().unwrap_or_default();
+    let branch = |b: &str| -> (Vec<f64>, Vec<f64>) {
+        points
+            .iter()
+            .filter(|p| p.get("branch").and_then(|v| v.as_str()) == Some(b))
+            .filter_map(|p| Some((p.get("rudder_deg")?.as_f64()?, p.get("yaw_rate_deg_s")?.as_f64()?)))
+            .unzip()
+    };
+    let (dx, dy) = branch("down");
+    let (ux, uy) = branch("up");
+    Figure::new(
+        title,
+        vec![Panel {
+            title: "spiral: steady yaw rate against rudder angle".into(),
+            x_label: "δ [°]".into(),
+            y_label: "r [°/s]".into(),
+            series: vec![Series::line("from +δ", dx, dy), Series::points("back from −δ", ux, uy)],
+            ..Panel::default()
+        }],
+    )
+}

@@ -6,11 +6,7 @@ use crate::model::Model;
 
 /// The generic library, renamed where a ship name exists, plus the ship's own.
 pub fn hypotheses(model: &Model) -> Vec<Hypothesis> {
-    let rudder = model
-        .spec
-        .ship
-        .as_ref()
-        .map(|s| model.vocabulary.canonical(&s.names.rudder).unwrap_or_else(|| s.names.rudder.clone()));
+    let rudder = super::canonical_spec(model).map(|s| s.names.rudder);
     let mut out: Vec<Hypothesis> = generic_hypotheses(model)
         .into_iter()
         .map(|mut h| {

@@ -9,14 +9,17 @@ pub mod figure;
 pub mod hypotheses;
 pub mod manoeuvre;
 pub mod observed;
+pub mod plugin;
+pub mod spec;
 pub mod tracking;
 
 use std::collections::BTreeMap;
 
 pub use manoeuvre::{Manoeuvre, Metrics};
+pub use spec::{default_model, ShipNames, ShipSpec, DEFAULT_MODEL, DEFAULT_MODEL_PATH};
 
 use crate::data::{DataError, Frame};
-use crate::model::{Model, ShipNames, ShipSpec};
+use crate::model::Model;
 use crate::sim::{self, simulate, Settings, SimError, SteadyProblem, System, Trajectory, Unknown};
 
 /// Why a ship run failed.
@@ -104,9 +107,10 @@ pub struct Run {
 }
 
 /// The model's `[ship]` section with its role names as frames and systems spell them
-/// (aliases resolved: `psi` → `ψ`, `delta` → `δ`); `None` for a model without one.
+/// (aliases resolved: `psi` → `ψ`, `delta` → `δ`); `None` for a model without one (or with
+/// one that does not read: [`ShipSpec::of`] says why).
 pub fn canonical_spec(model: &Model) -> Option<ShipSpec> {
-    let mut spec = model.spec.ship.clone()?;
+    let mut spec = ShipSpec::of(model).ok().flatten()?;
     let ShipNames { u, v, r, psi, x0, y0, rudder } = &mut spec.names;
     for n in [u, v, r, psi, x0, y0, rudder] {
         if let Some(c) = model.vocabulary.canonical(n) {
@@ -119,7 +123,7 @@ pub fn canonical_spec(model: &Model) -> Option<ShipSpec> {
 impl Ship {
     /// A ship from a model with a `[ship]` section.
     pub fn new(model: &Model, with_intercept: bool) -> Result<Ship, ShipError> {
-        let spec = model.spec.ship.clone().ok_or_else(|| {
+        let spec = ShipSpec::of(model)?.ok_or_else(|| {
             ShipError::Model(format!("{}: no [ship] section: not a ship model", model.path))
         })?;
         let system = System::new(model, &BTreeMap::new(), with_intercept)?;

@@ -80,7 +80,7 @@ fn process_noise(dt: f64, q: [f64; 3]) -> Cov {
 }
 
 /// The measured channels: state index and column name.
-fn channels(names: &crate::model::ShipNames) -> [(usize, String); 6] {
+fn channels(names: &super::ShipNames) -> [(usize, String); 6] {
     [
         (X0, names.x0.clone()),
         (Y0, names.y0.clone()),
@@ -185,7 +185,6 @@ pub fn track(frame: &Frame, ship: &ShipSpec, smooth: bool) -> Result<Frame, Data
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::Model;
     use crate::ship::basin::Basin;
     use crate::ship::Manoeuvre;
 
@@ -193,8 +192,8 @@ mod tests {
     /// per-signal smoother's, and its heading closer than the gyro-free record.
     #[test]
     fn fuses_track_heading_and_speeds() {
-        let model = Model::default_model();
-        let spec = model.spec.ship.clone().unwrap();
+        let model = crate::ship::default_model();
+        let spec = crate::ship::ShipSpec::of(&model).unwrap().unwrap();
         let rec = Basin::default()
             .record(&model, &Manoeuvre::parse("zigzag:20/20").unwrap(), 2.0, 60.0, 4, "zz")
             .unwrap();

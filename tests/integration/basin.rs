@@ -39,7 +39,7 @@ fn tactical(model: Option<&str>, delta: f64) -> f64 {
 #[test]
 fn identified_from_noisy_basin_runs_the_model_predicts_within_the_targets() {
     let dir = Scratch::new("basin");
-    let truth = Model::default_model();
+    let truth = termid::ship::default_model();
     let basin = Basin::default();
     let mut held_overshoot = f64::NAN;
     let mut names = Vec::new();
@@ -180,7 +180,7 @@ fn identified_from_noisy_basin_runs_the_model_predicts_within_the_targets() {
     assert!(!ok && err.contains("[ship]"), "{err}");
 
     // uncertainty: identify stored covariances and correlation times; draws give a band
-    let id = Model::load(&dir.join("id.toml")).unwrap();
+    let id = termid::plugins::load(&dir.join("id.toml")).unwrap();
     for eq in ["u_dot", "v_dot", "r_dot"] {
         let c = id.equation(eq).unwrap().covariance.clone().expect("a stored covariance");
         // 20 Hz smoothed records: residuals correlated over many rows
@@ -242,7 +242,7 @@ fn identified_from_noisy_basin_runs_the_model_predicts_within_the_targets() {
 #[test]
 fn preparation_resamples_and_refuses_what_it_cannot_do() {
     let dir = Scratch::new("basin-prepare");
-    let truth = Model::default_model();
+    let truth = termid::ship::default_model();
     let basin = Basin { rate_hz: 50.0, ..Basin::default() };
     let rec =
         basin.record(&truth, &Manoeuvre::parse("zigzag:20/20").unwrap(), 2.0, 60.0, 3, "zz.dat").unwrap();
@@ -292,7 +292,7 @@ fn preparation_resamples_and_refuses_what_it_cannot_do() {
 #[test]
 fn gaps_and_repeated_time_stamps_are_refused_with_their_row() {
     let dir = Scratch::new("basin-gaps");
-    let truth = Model::default_model();
+    let truth = termid::ship::default_model();
     let basin = Basin::default();
     let rec =
         basin.record(&truth, &Manoeuvre::parse("zigzag:20/20").unwrap(), 2.0, 30.0, 3, "zz.dat").unwrap();
@@ -328,7 +328,7 @@ fn runs_are_resimulated_at_their_own_approach_speed() {
     use termid::diagnose::Runs;
     use termid::sim::Integrator;
     let basin = Basin::default();
-    let mut model = Model::default_model();
+    let mut model = termid::ship::default_model();
     let rec = basin
         .record(&model, &Manoeuvre::parse("zigzag:20/20").unwrap(), 0.95 * 2.010, 60.0, 1, "slow")
         .unwrap();

@@ -13,7 +13,7 @@ use termid::sim::{simulate, Controller, Integrator, Replay, System};
 use crate::common::Lcg;
 
 static STUDY: LazyLock<oltmann::Study> =
-    LazyLock::new(|| oltmann::run(&Model::default_model(), &Options::default(), &mut |_| {}).unwrap());
+    LazyLock::new(|| oltmann::run(&termid::ship::default_model(), &Options::default(), &mut |_| {}).unwrap());
 
 /// The 30°/10° and 20°/20° runs of the true model, as recorded (0.2 s samples).
 fn recorded() -> Vec<Frame> {
@@ -42,7 +42,7 @@ impl Controller for Altered {
 /// Runs of the true model whose real rudder is `factor`·δ + `offset` while the file records
 /// δ; `noise` adds basin-like measurement noise (0.1° heading, 0.02 m/s, 0.05 °/s, 0.02 m).
 fn hidden_rudder_error(offset: f64, factor: f64, noise: bool) -> Vec<Frame> {
-    let model = Model::default_model();
+    let model = termid::ship::default_model();
     let system = System::new(&model, &Default::default(), false).unwrap();
     let mut g = Lcg(99);
     recorded()
@@ -86,7 +86,7 @@ fn heading_shrink(d: &Diagnosis) -> f64 {
 
 #[test]
 fn names_the_papers_missing_asymmetry() {
-    let model = resim::identified_model(&Model::default_model(), &STUDY.alt5, resim::Column::Komb);
+    let model = resim::identified_model(&termid::ship::default_model(), &STUDY.alt5, resim::Column::Komb);
     // all five zigzags, as the paper (and the issue) did
     let runs: Vec<Frame> = STUDY
         .recorded
@@ -116,7 +116,7 @@ fn names_the_papers_missing_asymmetry() {
 
 #[test]
 fn names_a_rudder_zero_offset() {
-    let d = run(&Model::default_model(), &hidden_rudder_error(1.5f64.to_radians(), 1.0, false));
+    let d = run(&termid::ship::default_model(), &hidden_rudder_error(1.5f64.to_radians(), 1.0, false));
     let w = &d.candidates[d.winner.expect("an effect")];
     assert_eq!(w.name, "rudder zero offset");
     assert!((w.estimate[0].to_degrees() - 1.5).abs() < 0.05, "{}°", w.estimate[0].to_degrees());
@@ -125,7 +125,7 @@ fn names_a_rudder_zero_offset() {
 
 #[test]
 fn names_a_rudder_scale_error() {
-    let d = run(&Model::default_model(), &hidden_rudder_error(0.0, 1.1, false));
+    let d = run(&termid::ship::default_model(), &hidden_rudder_error(0.0, 1.1, false));
     let w = &d.candidates[d.winner.expect("an effect")];
     assert_eq!(w.name, "rudder angle scale error");
     assert!((w.estimate[0] - 1.1).abs() < 0.01, "{}", w.estimate[0]);
@@ -134,7 +134,7 @@ fn names_a_rudder_scale_error() {
 
 #[test]
 fn names_a_missing_cubic_term() {
-    let mut model = Model::default_model();
+    let mut model = termid::ship::default_model();
     let cubic = model.vocabulary.parse("v^3/u").unwrap();
     let eq = model.equation("r_dot").unwrap().clone();
     model.set_coefficients(
@@ -154,7 +154,7 @@ fn names_a_missing_cubic_term() {
 fn noise_does_not_change_the_verdict() {
     // each run is simulated at its own u0; from noisy records that is the mean over the first
     // seconds, not the first (noisy) sample the paper's exact data allow
-    let mut model = Model::default_model();
+    let mut model = termid::ship::default_model();
     model.spec.parameters.get_mut("u0").unwrap().per_run = Some("mean:u:2".into());
     let d = run(&model, &hidden_rudder_error(1.5f64.to_radians(), 1.0, true));
     let w = &d.candidates[d.winner.expect("an effect")];
@@ -164,7 +164,7 @@ fn noise_does_not_change_the_verdict() {
 
 #[test]
 fn negative_control_changes_nothing() {
-    let model = Model::default_model();
+    let model = termid::ship::default_model();
     let d = run(&model, &hidden_rudder_error(0.0, 1.0, true));
     assert!(
         d.winner.is_none(),
@@ -180,7 +180,7 @@ fn negative_control_changes_nothing() {
 #[test]
 fn command_on_a_generic_model() {
     let dir = crate::common::Scratch::new("diagnose");
-    let model = Model::load(std::path::Path::new("models/duffing.toml")).unwrap();
+    let model = termid::plugins::load(std::path::Path::new("models/duffing.toml")).unwrap();
     let system = System::new(&model, &Default::default(), false).unwrap();
     let t: Vec<f64> = (0..=3000).map(|i| i as f64 * 0.01).collect();
     let mut files = Vec::new();
@@ -228,16 +228,16 @@ fn command_on_a_generic_model() {
     }
     assert!(v["gap_after"]["cost"].as_f64().unwrap() < 0.01 * v["gap_before"]["cost"].as_f64().unwrap());
     assert!(svg.join("diagnose_run0.svg").exists() && svg.join("diagnose_run1.svg").exists());
-    assert!(Model::load(&new_model).is_ok());
+    assert!(termid::plugins::load(&new_model).is_ok());
     // the original is untouched: it still has no offset and reloads as before
-    assert_eq!(Model::load(std::path::Path::new("models/duffing.toml")).unwrap().spec, model.spec);
+    assert_eq!(termid::plugins::load(std::path::Path::new("models/duffing.toml")).unwrap().spec, model.spec);
 }
 
 /// Output-error refinement on a generic model: coefficients 20 % off (as a regression on
 /// noisy regressors leaves them) come back to the truth from noisy runs.
 #[test]
 fn output_error_refinement_recovers_the_true_coefficients() {
-    let truth = Model::load(std::path::Path::new("models/duffing.toml")).unwrap();
+    let truth = termid::plugins::load(std::path::Path::new("models/duffing.toml")).unwrap();
     let system = System::new(&truth, &Default::default(), false).unwrap();
     let t: Vec<f64> = (0..=600).map(|i| i as f64 * 0.05).collect();
     let mut g = Lcg(5);

@@ -11,7 +11,7 @@ use termid::sim::{simulate, Constant, Integrator, Replay, Settings, System};
 use crate::common::termid;
 
 fn lorenz_run() -> (Model, Frame) {
-    let m = Model::load(std::path::Path::new("models/lorenz.toml")).unwrap();
+    let m = termid::plugins::load(std::path::Path::new("models/lorenz.toml")).unwrap();
     let system = System::new(&m, &BTreeMap::new(), false).unwrap();
     let x0: Vec<f64> = m.spec.states.iter().map(|s| s.initial).collect();
     let s = Settings { integrator: Integrator::Rk4, dt: 0.001, duration: 10.0, sample: 0.001 };
@@ -73,7 +73,7 @@ fn lorenz_identified_to_one_percent_from_central_differences() {
 
 #[test]
 fn duffing_with_replayed_forcing() {
-    let m = Model::load(std::path::Path::new("models/duffing.toml")).unwrap();
+    let m = termid::plugins::load(std::path::Path::new("models/duffing.toml")).unwrap();
     let system = System::new(&m, &BTreeMap::new(), false).unwrap();
     let t: Vec<f64> = (0..=4000).map(|i| i as f64 * 0.01).collect();
     let mut forcing = Frame::new("forcing", "t", t.clone()).unwrap();
@@ -109,7 +109,7 @@ fn same_commands_for_lorenz_and_the_ship() {
         out.to_str().unwrap(),
     ]);
     assert!(ok, "{err}");
-    let back = Model::load(&out).unwrap();
+    let back = termid::plugins::load(&out).unwrap();
     assert_eq!(back.equation("y_dot").unwrap().coefficients.len(), 3);
     let (ok, stdout, err) =
         termid(&["simulate", "--model", out.to_str().unwrap(), "--duration", "1", "--format", "json"]);

@@ -219,7 +219,7 @@ fn a_single_noise_free_run_identifies() {
         std::fs::write(&part, lines.join("\n")).unwrap();
         let m = dir.join(format!("m{rows}.toml"));
         succeeds(&["identify", "--model", "models/oltmann1973.toml", "--data", s(&part), "--out", s(&m)]);
-        assert!(termid::model::Model::load(&m).is_ok());
+        assert!(termid::plugins::load(&m).is_ok());
     }
 }
 

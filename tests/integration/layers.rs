@@ -5,7 +5,7 @@
 use std::path::Path;
 
 /// Bottom to top. The simulator sits below the model files (it integrates any
-/// `sim::RightHandSide`), the regression back-ends below both; the ship plug-in is on top.
+/// `sim::RightHandSide`), the regression back-ends below both; the ship plug-in and the registry of plug-ins are on top.
 const LAYERS: &[&str] = &[
     "budget",
     "output",
@@ -18,7 +18,9 @@ const LAYERS: &[&str] = &[
     "identify",
     "diagnose",
     "plot",
+    "plugin",
     "ship",
+    "plugins",
 ];
 
 /// Every `.rs` file under `dir`.

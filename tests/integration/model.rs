@@ -2,7 +2,7 @@
 //! and the identify → write → read round trip.
 
 use termid::model::Covariance;
-use termid::model::{Model, ModelError};
+use termid::model::ModelError;
 use termid::term::Term;
 
 /// The paper's sample state (NOTES.md §3) evaluated with the printed true coefficients.
@@ -11,7 +11,7 @@ use termid::term::Term;
 /// printed −0.02364, −0.04247 m/s² and 0.87020 °/s². The model file and README report this.
 #[test]
 fn sample_state_accelerations() {
-    let m = Model::default_model();
+    let m = termid::ship::default_model();
     let lib = m.compile_rhs(false).unwrap();
     let value = |n: &str| match n {
         "u" => 1.88895,
@@ -37,7 +37,7 @@ fn sample_state_accelerations() {
 
 #[test]
 fn default_model_has_the_papers_sets() {
-    let m = Model::default_model();
+    let m = termid::ship::default_model();
     let u = m.equation("u_dot").unwrap();
     let forced: Vec<String> = u.forced.iter().map(Term::to_string).collect();
     assert_eq!(forced, ["u*Δu", "v^2", "r^2", "u^2*δ^2"]);
@@ -51,7 +51,7 @@ fn default_model_has_the_papers_sets() {
 }
 
 fn with(original: &str, replacement: &str) -> String {
-    let text = termid::model::DEFAULT_MODEL;
+    let text = termid::ship::DEFAULT_MODEL;
     assert!(text.contains(original), "fixture drifted: {original}");
     text.replacen(original, replacement, 1)
 }
@@ -59,28 +59,34 @@ fn with(original: &str, replacement: &str) -> String {
 #[test]
 fn errors_name_file_line_and_key() {
     let text = with("\"u*r\", \"u*r*delta\",", "\"u*r\", \"u*r**delta\",");
-    let e = Model::parse(&text, "ship.toml").unwrap_err();
+    let e = termid::plugins::parse(&text, "ship.toml").unwrap_err();
     let msg = e.to_string();
     let line = text.lines().position(|l| l.contains("u*r**delta")).unwrap() + 1;
     assert!(matches!(e, ModelError::Term { .. }));
     assert!(msg.starts_with(&format!("ship.toml:{line}: `equations.u_dot.candidates[")), "{msg}");
     assert!(msg.contains('^') && msg.contains("1:5"), "{msg}");
 
-    let e = Model::parse(&with("rudder_rate = 12.65", "rudder_rate = \"fast\""), "ship.toml").unwrap_err();
+    let e = termid::plugins::parse(&with("rudder_rate = 12.65", "rudder_rate = \"fast\""), "ship.toml")
+        .unwrap_err();
     assert!(e.to_string().contains("ship.toml") && e.to_string().contains("rudder_rate"), "{e}");
 
-    let e = Model::parse(&with("lpp = 4.572", "lpp = 4.572\nlength = 5.0"), "ship.toml").unwrap_err();
+    let e =
+        termid::plugins::parse(&with("lpp = 4.572", "lpp = 4.572\nlength = 5.0"), "ship.toml").unwrap_err();
     assert!(e.to_string().contains("unknown field `length`"), "{e}");
 
-    let e = Model::parse(&with("state = \"r\"", "state = \"w\""), "ship.toml").unwrap_err();
+    let e = termid::plugins::parse(&with("state = \"r\"", "state = \"w\""), "ship.toml").unwrap_err();
     assert!(e.to_string().contains("`equations.r_dot.state`") && e.to_string().contains("`w`"), "{e}");
 
-    let e = Model::parse(&with("\"v*r\", \"u*v\", \"u*r\",", "\"v*r\", \"r*v\", \"u*r\","), "ship.toml")
-        .unwrap_err();
+    let e = termid::plugins::parse(
+        &with("\"v*r\", \"u*v\", \"u*r\",", "\"v*r\", \"r*v\", \"u*r\","),
+        "ship.toml",
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("same term"), "{e}");
 
-    let e = Model::parse(&with("\"du^2\" = -0.1429", "\"du^2\" = -0.1429\n\"u*w\" = 1.0"), "ship.toml")
-        .unwrap_err();
+    let e =
+        termid::plugins::parse(&with("\"du^2\" = -0.1429", "\"du^2\" = -0.1429\n\"u*w\" = 1.0"), "ship.toml")
+            .unwrap_err();
     assert!(
         e.to_string().contains("coefficients.\"u*w\"") && e.to_string().contains("unknown variable `w`"),
         "{e}"
@@ -89,22 +95,22 @@ fn errors_name_file_line_and_key() {
 
 #[test]
 fn written_model_reads_back_unchanged() {
-    let mut m = Model::default_model();
+    let mut m = termid::ship::default_model();
     let t = m.vocabulary.parse("u*v").unwrap();
     m.set_coefficients("v_dot", vec![(t.clone(), -0.18312345678901234, Some(1.5e-3))], Some(1e-4));
     let text = m.to_toml();
-    let back = Model::parse(&text, "written.toml").unwrap();
+    let back = termid::plugins::parse(&text, "written.toml").unwrap();
     assert_eq!(back.spec, m.spec);
     let eq = back.equation("v_dot").unwrap();
     assert_eq!(eq.coefficients, vec![(t, -0.18312345678901234, Some(1.5e-3))]);
     assert_eq!(eq.intercept, Some(1e-4));
     // and once more: a fixed point
-    assert_eq!(Model::parse(&back.to_toml(), "again.toml").unwrap().spec, back.spec);
+    assert_eq!(termid::plugins::parse(&back.to_toml(), "again.toml").unwrap().spec, back.spec);
 }
 
 #[test]
 fn covariances_are_checked_and_read_back() {
-    let mut m = Model::default_model();
+    let mut m = termid::ship::default_model();
     let (uv, ur) = (m.vocabulary.parse("u*v").unwrap(), m.vocabulary.parse("u*r").unwrap());
     let matrix = vec![vec![4e-6, 1e-6], vec![1e-6, 9e-6]];
     let cov = |matrix: Vec<Vec<f64>>, tau: f64| Covariance {
@@ -113,7 +119,7 @@ fn covariances_are_checked_and_read_back() {
         correlation_time: tau,
     };
     m.set_covariance("v_dot", cov(matrix.clone(), 12.5)).unwrap();
-    let back = Model::parse(&m.to_toml(), "written.toml").unwrap();
+    let back = termid::plugins::parse(&m.to_toml(), "written.toml").unwrap();
     assert_eq!(back.equation("v_dot").unwrap().covariance, Some(cov(matrix.clone(), 12.5)));
     // refused: not symmetric, not positive semi-definite, τ < 1, a term without coefficient
     for (bad, what) in [
@@ -134,7 +140,8 @@ fn covariances_are_checked_and_read_back() {
     // and in a file: the key is named
     let mut asym = m.clone();
     asym.spec.equations.get_mut("v_dot").unwrap().covariance.as_mut().unwrap().matrix[0][1] = 2e-6;
-    let e = Model::parse(&asym.to_toml(), "cov.toml").err().map(|e| e.to_string()).unwrap_or_default();
+    let e =
+        termid::plugins::parse(&asym.to_toml(), "cov.toml").err().map(|e| e.to_string()).unwrap_or_default();
     assert!(
         e.contains("cov.toml") && e.contains("equations.v_dot.covariance") && e.contains("not symmetric"),
         "{e}"
@@ -143,4 +150,32 @@ fn covariances_are_checked_and_read_back() {
     m.set_coefficients("v_dot", vec![(uv, -0.18, None)], None);
     assert_eq!(m.equation("v_dot").unwrap().covariance, None);
     assert!(!m.to_toml().contains("covariance"));
+}
+
+#[test]
+fn plug_in_tables_are_checked_by_the_registry() {
+    // a table no plug-in reads: kept by the core, refused (located) by the registry
+    let text = format!("{}\n[shipp]\nlpp = 4.0\n", termid::ship::DEFAULT_MODEL);
+    assert!(termid::model::Model::parse(&text, "m.toml").is_ok());
+    let e = termid::plugins::parse(&text, "m.toml").unwrap_err().to_string();
+    let line = text.lines().position(|l| l == "[shipp]").unwrap() + 1;
+    assert!(e.starts_with(&format!("m.toml:{line}: `shipp`: no plug-in reads this table")), "{e}");
+    assert!(e.contains("[ship]"), "{e}");
+    // the ship plug-in's own checks, located
+    let e = termid::plugins::parse(&with("rudder_limit = 35.0", "rudder_limit = -35.0"), "m.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("`ship.rudder_limit`: must be a positive number"), "{e}");
+    let e = termid::plugins::parse(
+        &with("u0 = 2.010\n", "u0 = 2.010\nnames = { rudder = \"rudder\" }\n"),
+        "m.toml",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("`ship.names.rudder`") && e.contains("not a state or input"), "{e}");
+    // the registry finds the model's plug-in and the one with a derivative method
+    let m = termid::plugins::default_model();
+    assert_eq!(termid::plugins::of(&m).map(|p| p.table()), Some("ship"));
+    assert_eq!(termid::plugins::with_derivative("kinematic").map(|p| p.table()), Some("ship"));
+    assert!(termid::plugins::with_derivative("spline").is_none());
 }

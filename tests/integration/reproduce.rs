@@ -7,7 +7,7 @@ use termid::model::Model;
 use termid::ship::oltmann::{self, data::RateUnit, Options, Study};
 
 static STUDY: LazyLock<Study> =
-    LazyLock::new(|| oltmann::run(&Model::default_model(), &Options::default(), &mut |_| {}).unwrap());
+    LazyLock::new(|| oltmann::run(&termid::ship::default_model(), &Options::default(), &mut |_| {}).unwrap());
 
 #[test]
 fn exact_data_combined_regression_resimulates_the_replayed_zigzags() {
@@ -106,7 +106,7 @@ fn rounding_units_change_the_coarse_data() {
 
 #[test]
 fn deterministic_and_independent_of_candidate_order() {
-    let text = termid::model::DEFAULT_MODEL;
+    let text = termid::ship::DEFAULT_MODEL;
     // reverse the order of every candidate list
     let mut reversed = String::new();
     let mut in_list = false;
@@ -133,10 +133,10 @@ fn deterministic_and_independent_of_candidate_order() {
     let model = Model::parse(&reversed, "reversed.toml").unwrap();
     assert_ne!(
         model.equation("v_dot").unwrap().candidates,
-        Model::default_model().equation("v_dot").unwrap().candidates
+        termid::ship::default_model().equation("v_dot").unwrap().candidates
     );
     let other = oltmann::run(&model, &Options::default(), &mut |_| {}).unwrap();
-    let again = oltmann::run(&Model::default_model(), &Options::default(), &mut |_| {}).unwrap();
+    let again = oltmann::run(&termid::ship::default_model(), &Options::default(), &mut |_| {}).unwrap();
     for (a, (b, c)) in STUDY.alt5.iter().zip(other.alt5.iter().zip(&again.alt5)) {
         let set = |t: &oltmann::tables::EquationTable| {
             let mut v: Vec<(String, String)> = t
@@ -159,7 +159,7 @@ fn report_is_written() {
     let scratch = crate::common::Scratch::new("reproduce");
     // a folder that does not exist yet: the report makes it
     let dir = scratch.join("report");
-    let ship = termid::ship::Ship::new(&Model::default_model(), false).unwrap();
+    let ship = termid::ship::Ship::new(&termid::ship::default_model(), false).unwrap();
     let path = oltmann::report::write(&STUDY, &ship, &dir, &mut |_| {}).unwrap();
     let md = std::fs::read_to_string(&path).unwrap();
     for needle in ["Table 1", "Table 6", "Fig. 5", "heading drift", "sample state", "round-off"] {
@@ -193,7 +193,7 @@ fn adaptive_sparse_fit_finds_the_exact_support_on_exact_data() {
 }
 
 fn exact_support(backend: &dyn termid::select::Selector) {
-    let model = Model::default_model();
+    let model = termid::ship::default_model();
     let frames: Vec<termid::data::Frame> = STUDY.recorded.iter().map(|r| r.frame.clone()).collect();
     for eq in oltmann::EQUATIONS {
         let e = model.equation(eq).unwrap();

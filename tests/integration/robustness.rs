@@ -2,7 +2,8 @@
 
 use proptest::prelude::*;
 use termid::data::Frame;
-use termid::model::{Model, DEFAULT_MODEL};
+use termid::model::Model;
+use termid::ship::DEFAULT_MODEL;
 
 proptest! {
     #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
@@ -18,7 +19,7 @@ proptest! {
             _ => { let l = lines[k].clone(); lines.insert(k, l); }
         }
         let text = lines.join("\n");
-        if let Ok(m) = Model::parse(&text, "mutated.toml") {
+        if let Ok(m) = termid::plugins::parse(&text, "mutated.toml") {
             // a model that loads must also compile or refuse cleanly
             let _ = m.compile_rhs(false);
             let _ = termid::ship::Ship::new(&m, false).and_then(|s| s.straight_run());
@@ -54,7 +55,7 @@ proptest! {
         let lorenz = std::fs::read_to_string("models/lorenz.toml").unwrap();
         let line = lorenz.lines().find(|l| l.starts_with("backend = ")).unwrap();
         let text = lorenz.replacen(line, &format!("backend = {{ {} }}", settings.join(", ")), 1);
-        match Model::parse(&text, "fuzzed.toml") {
+        match termid::plugins::parse(&text, "fuzzed.toml") {
             Err(e) => prop_assert!(e.to_string().contains("fuzzed.toml"), "{e}"),
             Ok(model) => {
                 let frames = [lorenz_run(&model)];
@@ -107,7 +108,7 @@ proptest! {
             prop_assert!(r.column("x").unwrap().iter().all(|v| v.is_finite()));
         }
         // the ship's tracking filter on the same signal in every channel
-        let ship = Model::default_model().spec.ship.unwrap();
+        let ship = termid::ship::ShipSpec::of(&termid::ship::default_model()).unwrap().unwrap();
         let mut run = Frame::new("run.csv", "t", t.clone()).unwrap();
         for (k, name) in ["u", "v", "r", "ψ", "x0", "y0"].iter().enumerate() {
             run.push(name, x.iter().map(|v| v * (k + 1) as f64).collect()).unwrap();

@@ -25,7 +25,7 @@ fn odd_degree(t: &Term) -> i32 {
 }
 
 fn mirror_symmetric_model() -> Model {
-    let mut m = Model::default_model();
+    let mut m = termid::ship::default_model();
     for (name, keep_parity) in [("u_dot", 0), ("v_dot", 1), ("r_dot", 1)] {
         let eq = m.equation(name).unwrap().clone();
         let kept = eq
@@ -76,7 +76,7 @@ fn end_state(ship: &Ship, integrator: Integrator, dt: f64) -> Vec<f64> {
 
 #[test]
 fn integrator_orders() {
-    let ship = Ship::new(&Model::default_model(), false).unwrap();
+    let ship = Ship::new(&termid::ship::default_model(), false).unwrap();
     let reference = end_state(&ship, Integrator::Rk4, 0.00125);
     let err = |integrator, dt| {
         let x = end_state(&ship, integrator, dt);
@@ -91,7 +91,7 @@ fn integrator_orders() {
 
 #[test]
 fn steady_turning_equals_the_roots_of_the_equations() {
-    let model = Model::default_model();
+    let model = termid::ship::default_model();
     let ship = Ship::new(&model, false).unwrap();
     let run = ship
         .run(
@@ -124,7 +124,7 @@ fn steady_turning_equals_the_roots_of_the_equations() {
 
 #[test]
 fn default_model_manoeuvres_look_like_the_papers_ship() {
-    let ship = Ship::new(&Model::default_model(), false).unwrap();
+    let ship = Ship::new(&termid::ship::default_model(), false).unwrap();
     let start = ship.straight_run().unwrap();
     assert!((start.delta0_deg - -0.8).abs() < 0.05, "δ0 = {}", start.delta0_deg); // NOTES.md §5: about −0.8°
     let s = settings(Integrator::ModifiedEuler, 0.04, 100.0);
@@ -149,7 +149,7 @@ fn default_model_manoeuvres_look_like_the_papers_ship() {
 
 #[test]
 fn zigzag_overshoot_is_measured_beyond_the_switching_heading() {
-    let ship = Ship::new(&Model::default_model(), false).unwrap();
+    let ship = Ship::new(&termid::ship::default_model(), false).unwrap();
     let run = ship
         .run(&Manoeuvre::parse("zigzag:20/10").unwrap(), &settings(Integrator::ModifiedEuler, 0.04, 100.0))
         .unwrap();
@@ -170,7 +170,7 @@ fn zigzag_overshoot_is_measured_beyond_the_switching_heading() {
 
 #[test]
 fn divergence_stops_with_time_and_state() {
-    let mut m = Model::default_model();
+    let mut m = termid::ship::default_model();
     let t = m.vocabulary.parse("u*r").unwrap();
     let mut coefs = m.equation("r_dot").unwrap().coefficients.clone();
     coefs.retain(|(c, _, _)| *c != t);
@@ -194,7 +194,7 @@ fn divergence_stops_with_time_and_state() {
 #[test]
 fn observed_metrics_match_the_manoeuvres_own() {
     use termid::ship::observed::observe;
-    let ship = Ship::new(&Model::default_model(), false).unwrap();
+    let ship = Ship::new(&termid::ship::default_model(), false).unwrap();
     let r = ship.roles;
     // 0.2 s samples: the switching heading is reconstructed between samples
     for (text, tol) in [("zigzag:30/10", 0.3), ("zigzag:20/20", 0.3)] {

@@ -17,11 +17,9 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
     }
     let model = crate::simulate::load_model(&cmd.model)?;
     let runs = crate::runs::load_for(&model, &cmd.runs.data, cmd.runs.dataset.as_deref())?;
-    let hypotheses = if model.spec.ship.is_some() {
-        termid::ship::hypotheses::hypotheses(&model)
-    } else {
-        generic_hypotheses(&model)
-    };
+    let hypotheses = termid::plugins::of(&model)
+        .and_then(|p| p.hypotheses(&model))
+        .unwrap_or_else(|| generic_hypotheses(&model));
     let settings = Settings {
         dt: cmd.resim.dt,
         integrator: termid::sim::Integrator::by_name(&cmd.resim.integrator)?,

@@ -7,9 +7,7 @@ use termid::data::{
     differentiator, prepare, resample, CentralDifference, Differentiator, Frame, Preparation,
 };
 use termid::identify::{Fit, Identification, ParamValue, Target};
-use termid::model::ShipSpec;
 use termid::select::{Backend, StepRule};
-use termid::ship::tracking::track;
 use termid::term::{parse_terms, Vocabulary};
 
 use crate::args::{Format, IdentifyCommand, RuleName};
@@ -42,8 +40,13 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
         crate::runs::load(&cmd.data, cmd.dataset.as_deref(), &cmd.time)?
     };
     let target = Target::parse(cmd.target.as_deref().unwrap_or_default());
-    if cmd.derivative == KINEMATIC {
-        bail!("--derivative kinematic is the ship plug-in's tracking filter: it needs a --model with a [ship] section");
+    if let Some(plugin) = termid::plugins::with_derivative(&cmd.derivative) {
+        bail!(
+            "--derivative {} is the {} plug-in's: it needs a --model with a [{}] section",
+            cmd.derivative,
+            plugin.table(),
+            plugin.table()
+        );
     }
     let diff = derivative_method(&cmd)?;
     if let Target::Derivative(state) = &target {
@@ -123,13 +126,11 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     Ok(())
 }
 
-/// `--derivative kinematic` is the ship's tracking filter, which writes every rate as a column
-/// in `prepare_runs`; nothing is left to differentiate then.
-const KINEMATIC: &str = "kinematic";
-
-/// The `--derivative` method (central differences stand in for `kinematic`, see above).
+/// The `--derivative` method. A plug-in's method (the ship's `kinematic` tracking filter)
+/// writes every rate as a column in `prepare_runs`, so central differences stand in for it:
+/// nothing is left to differentiate then.
 fn derivative_method(cmd: &IdentifyCommand) -> Result<Box<dyn Differentiator>> {
-    Ok(if cmd.derivative == KINEMATIC {
+    Ok(if termid::plugins::with_derivative(&cmd.derivative).is_some() {
         Box::new(CentralDifference)
     } else {
         differentiator(&cmd.derivative)?
@@ -142,21 +143,18 @@ fn prepare_runs(
     cmd: &IdentifyCommand,
     frames: Vec<Frame>,
     signals: &[String],
-    ship: Option<&ShipSpec>,
+    model: Option<&termid::model::Model>,
     method: &dyn Differentiator,
     scale: &dyn Fn(&str) -> (f64, String),
 ) -> Result<Vec<Frame>> {
-    let kinematic = cmd.derivative == KINEMATIC;
-    if cmd.resample.is_none() && !cmd.smooth && cmd.prepared_svg.is_none() && !kinematic {
+    let plugin = termid::plugins::with_derivative(&cmd.derivative);
+    if cmd.resample.is_none() && !cmd.smooth && cmd.prepared_svg.is_none() && plugin.is_none() {
         return Ok(frames);
     }
-    let prepared = if kinematic {
-        // the ship plug-in's tracking filter: all states of a run at once, kinematics coupled
-        let Some(ship) = ship else {
-            bail!(
-                "--derivative kinematic is the ship plug-in's tracking filter: {} has no [ship] section",
-                cmd.model.as_ref().map_or("the model".into(), |p| p.display().to_string())
-            );
+    let prepared = if let Some(plugin) = plugin {
+        // a plug-in's preparation (the ship's tracking filter: all states of a run at once)
+        let Some(model) = model else {
+            bail!("--derivative {} needs a --model", cmd.derivative);
         };
         frames
             .iter()
@@ -165,9 +163,9 @@ fn prepare_runs(
                     Some(dt) => resample(f, dt)?,
                     None => f.clone(),
                 };
-                track(&f, ship, cmd.smooth)
+                Ok(plugin.prepare(&cmd.derivative, model, &f, cmd.smooth)?)
             })
-            .collect::<Result<Vec<_>, _>>()?
+            .collect::<Result<Vec<_>>>()?
     } else {
         let how =
             Preparation { resample: cmd.resample, method, signals: signals.to_vec(), smooth: cmd.smooth };
@@ -212,7 +210,7 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
     if let Some(out) = &cmd.out {
         termid::output::check_file(out)?;
     }
-    let mut model = termid::model::Model::load(&path)?;
+    let mut model = termid::plugins::load(&path)?;
     let refine = cmd.refine.as_deref().map(|list| refine_states(list, &model)).transpose()?;
     let frames = crate::runs::load_for(&model, &cmd.data, cmd.dataset.as_deref())?;
     let names: Vec<String> =
@@ -221,10 +219,8 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
         names.iter().filter_map(|n| model.equation(n).map(|e| e.state.clone())).collect();
     let units: BTreeMap<String, String> =
         model.spec.states.iter().map(|s| (s.name.clone(), s.unit.clone())).collect();
-    // the ship's roles under the names the frames use
-    let ship = termid::ship::canonical_spec(&model);
     let diff = derivative_method(&cmd)?;
-    let frames = prepare_runs(&cmd, frames, &states, ship.as_ref(), diff.as_ref(), &|name| {
+    let frames = prepare_runs(&cmd, frames, &states, Some(&model), diff.as_ref(), &|name| {
         let unit = units.get(name).cloned().unwrap_or_default();
         // angles are read in degrees
         match unit.strip_prefix("rad") {

@@ -7,10 +7,7 @@ use anyhow::{bail, Context, Result};
 use termid::data::Frame;
 use termid::model::Model;
 use termid::plot::{Figure, Panel, Series};
-use termid::ship::{
-    figure::{add_bands, manoeuvre_figure},
-    Manoeuvre, Ship,
-};
+use termid::plugin::{Plugin, ScenarioRequest};
 use termid::sim::{simulate, Constant, Controller, Integrator, Replay, Settings};
 
 use crate::args::{Format, SimulateCommand};
@@ -18,8 +15,8 @@ use crate::monte_carlo::Draws;
 
 pub fn load_model(path: &Option<std::path::PathBuf>) -> Result<Model> {
     Ok(match path {
-        Some(p) => Model::load(p)?,
-        None => Model::default_model(),
+        Some(p) => termid::plugins::load(p)?,
+        None => termid::plugins::default_model(),
     })
 }
 
@@ -31,26 +28,23 @@ pub fn run(cmd: SimulateCommand) -> Result<()> {
     let mut model = load_model(&cmd.model)?;
     set_parameters(&mut model, &cmd.params)?;
     let integrator = Integrator::by_name(&cmd.integrator)?;
-    match (&cmd.manoeuvre, model.spec.ship.is_some()) {
-        (Some(m), true) => {
-            // a manoeuvre starts from the straight approach and drives the rudder itself
-            if !cmd.initial.is_empty() {
-                bail!("--initial does not apply to a ship manoeuvre: it starts from the straight approach at u0 (set it with --param u0=…), v and δ of the straight run, r = ψ = 0");
-            }
-            if !cmd.inputs.is_empty() {
-                bail!("--input does not apply to a ship manoeuvre: the manoeuvre drives the rudder; for recorded inputs use --manoeuvre replay:FILE.csv");
-            }
-            ship_run(&cmd, &model, m, integrator)
-        }
-        (Some(m), false) if !m.starts_with("replay:") => {
-            bail!("{} has no [ship] section, so `{m}` does not apply; use --input NAME=VALUE or --manoeuvre replay:FILE.csv", model.path)
+    match (&cmd.manoeuvre, termid::plugins::of(&model)) {
+        (Some(m), Some(plugin)) => scenario_run(&cmd, &model, plugin, m, integrator),
+        (Some(m), None) if !m.starts_with("replay:") => {
+            let tables: Vec<String> =
+                termid::plugins::PLUGINS.iter().map(|p| format!("[{}]", p.table())).collect();
+            bail!(
+                "{} has no plug-in table ({}), so `{m}` does not apply; use --input NAME=VALUE or --manoeuvre replay:FILE.csv",
+                model.path,
+                tables.join(", ")
+            )
         }
         _ => generic_run(&cmd, &model, integrator),
     }
 }
 
-/// `--param NAME=VALUE`: a parameter of the model; for a ship model `u0` is also the
-/// approach speed of the `[ship]` section. Unknown names are refused.
+/// `--param NAME=VALUE`: a parameter of the model, or a value of its plug-in's table (a
+/// ship's `u0` is both). Unknown names are refused.
 fn set_parameters(model: &mut Model, params: &[String]) -> Result<()> {
     for p in params {
         let (name, value) = p.split_once('=').with_context(|| format!("--param `{p}` must be NAME=VALUE"))?;
@@ -61,12 +55,8 @@ fn set_parameters(model: &mut Model, params: &[String]) -> Result<()> {
             spec.value = value;
             known = true;
         }
-        if let Some(ship) = model.spec.ship.as_mut().filter(|_| name == "u0") {
-            if value <= 0.0 {
-                bail!("--param u0={text}: the approach speed must be positive");
-            }
-            ship.u0 = value;
-            known = true;
+        if let Some(plugin) = termid::plugins::of(model) {
+            known |= plugin.set_parameter(model, name, value)?;
         }
         if !known {
             let names: Vec<&str> = model.spec.parameters.keys().map(String::as_str).collect();
@@ -89,94 +79,72 @@ fn finite(text: &str, what: impl FnOnce() -> String) -> Result<f64> {
         .with_context(|| format!("{}: `{text}` is not a finite number", what()))
 }
 
-fn ship_run(cmd: &SimulateCommand, model: &Model, text: &str, integrator: Integrator) -> Result<()> {
-    let ship = Ship::new(model, cmd.with_intercept)?;
-    let manoeuvre = Manoeuvre::parse(text)?;
+/// A plug-in's scenario (a ship manoeuvre): the nominal run, Monte-Carlo draws on request,
+/// the CSV and figure, and the plug-in's report.
+fn scenario_run(
+    cmd: &SimulateCommand,
+    model: &Model,
+    plugin: &dyn Plugin,
+    text: &str,
+    integrator: Integrator,
+) -> Result<()> {
+    let request = ScenarioRequest {
+        text,
+        with_intercept: cmd.with_intercept,
+        initial_given: !cmd.initial.is_empty(),
+        inputs_given: !cmd.inputs.is_empty(),
+    };
+    let scenario = plugin.scenario(model, &request)?;
     let settings = Settings {
         integrator,
         dt: cmd.dt,
-        duration: cmd.duration.unwrap_or_else(|| manoeuvre.default_duration()),
+        duration: cmd.duration.unwrap_or_else(|| scenario.default_duration()),
         sample: cmd.sample,
     };
-    let run = ship.run(&manoeuvre, &settings)?;
-    let frame = ship.frame(&run.trajectory, "simulation")?;
+    let run = scenario.run(model, &settings)?;
     let mc = match cmd.monte_carlo.monte_carlo {
         0 => None,
         n => Some(Draws::run(model, n, cmd.monte_carlo.seed, trajectory_values(&run.trajectory), |m| {
-            let drawn = Ship::new(m, cmd.with_intercept)?.run(&manoeuvre, &settings)?;
-            Ok((serde_json::to_value(&drawn.metrics)?, drawn.trajectory))
+            let drawn = scenario.run(m, &settings)?;
+            Ok((drawn.metrics, drawn.trajectory))
         })?),
     };
     let mut outputs = termid::output::Outputs::new();
     if let Some(out) = &cmd.out {
-        outputs.file(out, frame.to_csv().as_bytes())?;
+        outputs.file(out, run.frame.to_csv().as_bytes())?;
     }
     if let Some(svg) = &cmd.svg {
-        let title = format!("{}: {}", model.spec.model.name, manoeuvre.label());
-        let fig = match &run.metrics {
-            termid::ship::Metrics::Spiral(s) => spiral_figure(&title, s),
-            _ => {
-                let mut fig = manoeuvre_figure(&ship, &title, &[("simulation", &run.trajectory)], true);
-                if let Some(mc) = &mc {
-                    let tracks: Vec<&_> = mc.results.iter().map(|(_, t)| t).collect();
-                    add_bands(&mut fig, &ship, &tracks);
-                }
-                fig
-            }
-        };
+        let title = format!("{}: {}", model.spec.model.name, scenario.label());
+        let draws: Vec<&_> = mc.iter().flat_map(|mc| mc.results.iter().map(|(_, t)| t)).collect();
+        let fig = scenario.figure(&title, &run, &draws);
         outputs.file(svg, fig.to_svg().map_err(anyhow::Error::msg)?.as_bytes())?;
     }
     outputs.commit()?;
     match cmd.format {
-        Format::Json => println!(
-            "{}",
-            serde_json::to_string_pretty(&serde_json::json!({
-                "model": model.path,
-                "manoeuvre": manoeuvre.label(),
-                "integrator": cmd.integrator,
-                "dt": cmd.dt,
-                "delta0_deg": run.start.delta0_deg,
-                "v0": run.start.v0,
-                "metrics": run.metrics,
-                "monte_carlo": mc.as_ref().map(|mc| mc.summary(&mc.spread(|r| vec![r.0.clone()]))),
-            }))?
-        ),
-        Format::Text => {
-            println!("{} — {}", model.spec.model.name, manoeuvre.label());
-            println!(
-                "straight run: δ0 = {:.3}°, v0 = {:.5} m/s (u̇ residual {:.2e} m/s²); {} steps of {} s",
-                run.start.delta0_deg,
-                run.start.v0,
-                run.start.surge_residual,
-                (settings.duration / settings.dt).round(),
-                settings.dt
+        Format::Json => {
+            let mut report = serde_json::Map::new();
+            report.insert("model".into(), model.path.clone().into());
+            report.insert("manoeuvre".into(), scenario.label().into());
+            report.insert("integrator".into(), cmd.integrator.clone().into());
+            report.insert("dt".into(), cmd.dt.into());
+            report.extend(run.start.clone());
+            report.insert("metrics".into(), run.metrics.clone());
+            report.insert(
+                "monte_carlo".into(),
+                serde_json::to_value(mc.as_ref().map(|mc| mc.summary(&mc.spread(|r| vec![r.0.clone()]))))?,
             );
-            let json = serde_json::to_value(&run.metrics)?;
-            if let Some(map) = json.as_object() {
-                for (k, v) in map {
-                    if k == "manoeuvre" || k == "points" || k == "reversals_s" {
-                        continue;
-                    }
-                    println!(
-                        "  {k:<28} {}",
-                        if v.is_null() { "not reached (run longer?)".to_string() } else { format_value(v) }
-                    );
-                }
-            }
-            if let termid::ship::Metrics::Spiral(s) = &run.metrics {
-                println!("  {:>8} {:>10} {:>6}", "δ [°]", "r [°/s]", "branch");
-                for p in &s.points {
-                    println!("  {:>8.1} {:>10.4} {:>6}", p.rudder_deg, p.yaw_rate_deg_s, p.branch);
-                }
+            println!("{}", serde_json::to_string_pretty(&report)?)
+        }
+        Format::Text => {
+            println!("{} — {}", model.spec.model.name, scenario.label());
+            for line in &run.text {
+                println!("{line}");
             }
             if let Some(mc) = &mc {
-                print!(
-                    "{}",
-                    mc.text(&mc.spread(|r| vec![r.0.clone()]), &serde_json::to_value(&run.metrics)?)
-                );
+                print!("{}", mc.text(&mc.spread(|r| vec![r.0.clone()]), &run.metrics));
             }
             if let Some(out) = &cmd.out {
-                println!("wrote {} ({} rows; SI units, angles in rad)", out.display(), frame.len());
+                println!("wrote {} ({} rows; SI units, angles in rad)", out.display(), run.frame.len());
             }
         }
     }
@@ -187,31 +155,6 @@ fn ship_run(cmd: &SimulateCommand, model: &Model, text: &str, integrator: Integr
 /// Monte-Carlo draws that keep one each.
 pub fn trajectory_values(t: &termid::sim::Trajectory) -> usize {
     t.time.len() * (1 + t.states.len() + t.inputs.len() + t.derivatives.len())
-}
-
-fn format_value(v: &serde_json::Value) -> String {
-    match v.as_f64() {
-        Some(x) => format!("{x:.4}"),
-        None => v.to_string(),
-    }
-}
-
-fn spiral_figure(title: &str, s: &termid::ship::manoeuvre::SpiralMetrics) -> Figure {
-    let branch = |b: &str| -> (Vec<f64>, Vec<f64>) {
-        s.points.iter().filter(|p| p.branch == b).map(|p| (p.rudder_deg, p.yaw_rate_deg_s)).unzip()
-    };
-    let (dx, dy) = branch("down");
-    let (ux, uy) = branch("up");
-    Figure::new(
-        title,
-        vec![Panel {
-            title: "spiral: steady yaw rate against rudder angle".into(),
-            x_label: "δ [°]".into(),
-            y_label: "r [°/s]".into(),
-            series: vec![Series::line("from +δ", dx, dy), Series::points("back from −δ", ux, uy)],
-            ..Panel::default()
-        }],
-    )
 }
 
 fn generic_run(cmd: &SimulateCommand, model: &Model, integrator: Integrator) -> Result<()> {

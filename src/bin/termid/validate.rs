@@ -1,11 +1,11 @@
 //! `termid validate`: a model against held-out runs. Each run is simulated from its recorded
 //! initial state with its recorded inputs; per run the error of every measured state, and for
-//! ship models the manoeuvre metrics of measurement and model side by side; a figure per run.
+//! a plug-in's models (ships) its metrics of measurement and model side by side; a figure per run.
 
 use anyhow::Result;
 use termid::diagnose::Runs;
 use termid::plot::comparison_figures;
-use termid::ship::observed::{observe, Observed};
+use termid::plugin::Observation;
 use termid::sim::{Integrator, Trajectory};
 
 use termid::plot::{Figure, Series};
@@ -25,20 +25,11 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
         .with_intercepts(cmd.resim.with_intercept);
     let sims = data.simulate(&model, &[], &[])?;
     let gap = data.gap(&sims);
-    // ship models: metrics read off measurement and simulation alike
-    let ship = termid::ship::canonical_spec(&model);
-    let names = ship.as_ref().map(|s| &s.names);
-    let measured = |f: &termid::data::Frame| -> Option<Observed> {
-        let (n, col) = (names?, |c: &str| f.column(c));
-        Some(observe(f.time(), col(&n.psi)?, col(&n.rudder)?, col(&n.x0)?, col(&n.y0)?))
-    };
-    // the simulation's track with the rudder it was given, the measured one
-    let simulated = |f: &termid::data::Frame, s: &Trajectory| -> Option<Observed> {
-        let (n, state) = (names?, |c: &str| s.state(c));
-        Some(observe(&s.time, state(&n.psi)?, f.column(&n.rudder)?, state(&n.x0)?, state(&n.y0)?))
-    };
-    let metrics: Vec<Option<(Observed, Observed)>> =
-        runs.iter().zip(&sims).map(|(f, s)| Some((measured(f)?, simulated(f, s)?))).collect();
+    // a plug-in's models: its metrics read off measurement and simulation alike
+    let plugin = termid::plugins::of(&model);
+    let observe = |f: &termid::data::Frame, s: Option<&Trajectory>| plugin?.observe(&model, f, s);
+    let metrics: Vec<Option<(Observation, Observation)>> =
+        runs.iter().zip(&sims).map(|(f, s)| Some((observe(f, None)?, observe(f, Some(s))?))).collect();
     // Monte Carlo: every run simulated with each drawn model, its metrics read once per draw
     let mc = match cmd.monte_carlo.monte_carlo {
         0 => None,
@@ -49,11 +40,8 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
             sims.iter().map(crate::simulate::trajectory_values).sum(),
             |m| {
                 let sims = data.simulate(m, &[], &[])?;
-                let seen: Vec<Option<serde_json::Value>> = runs
-                    .iter()
-                    .zip(&sims)
-                    .map(|(f, s)| simulated(f, s).map(|o| serde_json::to_value(o).unwrap_or_default()))
-                    .collect();
+                let seen: Vec<Option<serde_json::Value>> =
+                    runs.iter().zip(&sims).map(|(f, s)| observe(f, Some(s)).map(|o| o.json)).collect();
                 Ok((sims, seen))
             },
         )?),
@@ -85,8 +73,8 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
                 "gap": gap,
                 "metrics": metrics.iter().zip(&runs).zip(&spreads).map(|((m, f), s)| serde_json::json!({
                     "run": f.origin(),
-                    "measured": m.as_ref().map(|m| &m.0),
-                    "simulated": m.as_ref().map(|m| &m.1),
+                    "measured": m.as_ref().map(|m| &m.0.json),
+                    "simulated": m.as_ref().map(|m| &m.1.json),
                     "monte_carlo": mc.as_ref().zip(s.as_ref()).map(|(mc, s)| mc.summary(s)),
                 })).collect::<Vec<_>>(),
             }))?
@@ -116,21 +104,9 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
                         println!("  {name:<24} {:>12} {:>12}{spread}", f(x), f(y));
                     }
                 };
-                row("1st overshoot [°]", "first_overshoot_deg", a.first_overshoot_deg, b.first_overshoot_deg);
-                row(
-                    "2nd overshoot [°]",
-                    "second_overshoot_deg",
-                    a.second_overshoot_deg,
-                    b.second_overshoot_deg,
-                );
-                row("advance [m]", "advance_m", a.advance_m, b.advance_m);
-                row("transfer [m]", "transfer_m", a.transfer_m, b.transfer_m);
-                row(
-                    "tactical diameter [m]",
-                    "tactical_diameter_m",
-                    a.tactical_diameter_m,
-                    b.tactical_diameter_m,
-                );
+                for ((label, key, x), (_, _, y)) in a.rows.iter().zip(&b.rows) {
+                    row(label, key, *x, *y);
+                }
             }
             if let Some(mc) = &mc {
                 println!("\n{}", mc.headline());

@@ -1,0 +1,130 @@
+//! What a plug-in is: what a field adds to the generic core (ship manoeuvring is the first).
+//! A plug-in owns one table of the model file, which the core keeps as data; it checks that
+//! table, may bring a default model, derivative preparations, diagnosis hypotheses, metrics of
+//! recorded runs and named scenarios to simulate. `crate::plugins` registers them.
+
+use crate::data::Frame;
+use crate::diagnose::Hypothesis;
+use crate::model::{Model, ModelError};
+use crate::sim::{Settings, Trajectory};
+
+/// Why a plug-in could not do what was asked.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum PluginError {
+    /// An option or request that does not apply (the message says what to do instead).
+    #[error("{0}")]
+    Refused(String),
+    /// The work failed; the plug-in's own error says why.
+    #[error(transparent)]
+    Failed(Box<dyn std::error::Error + Send + Sync>),
+}
+
+impl PluginError {
+    /// Wraps a plug-in's own error.
+    pub fn failed(e: impl std::error::Error + Send + Sync + 'static) -> PluginError {
+        PluginError::Failed(Box::new(e))
+    }
+}
+
+/// A field's extension of the core.
+pub trait Plugin: Sync {
+    /// The model-file table it owns (`ship`); a model with that table is this plug-in's.
+    fn table(&self) -> &'static str;
+    /// Checks its table of `model`, read from `text` (errors located by key, as the core's).
+    fn check(&self, model: &Model, text: &str) -> Result<(), ModelError>;
+    /// Its default model, if it has one (the first plug-in's is termid's default).
+    fn default_model(&self) -> Option<Model> {
+        None
+    }
+    /// Sets a value the plug-in's table holds (`u0` of a ship), besides the model's parameter
+    /// of that name; `Ok(false)`: not one of its values.
+    fn set_parameter(&self, _model: &mut Model, _name: &str, _value: f64) -> Result<bool, PluginError> {
+        Ok(false)
+    }
+    /// The derivative preparations it adds (`kinematic`), by `--derivative` name.
+    fn derivative_methods(&self) -> &'static [&'static str] {
+        &[]
+    }
+    /// A run prepared by one of [`Plugin::derivative_methods`]: states smoothed and their
+    /// derivatives added as `<state>_dot` columns.
+    fn prepare(
+        &self,
+        method: &str,
+        _model: &Model,
+        _frame: &Frame,
+        _smooth: bool,
+    ) -> Result<Frame, PluginError> {
+        Err(PluginError::Refused(format!("no derivative method `{method}`")))
+    }
+    /// The effects `diagnose` tries for a model of this field (`None`: the generic ones).
+    fn hypotheses(&self, _model: &Model) -> Option<Vec<Hypothesis>> {
+        None
+    }
+    /// The field's metrics of a recorded run (`simulated`: of the simulation of that run, with
+    /// the run's recorded inputs); `None` where the run has none.
+    fn observe(
+        &self,
+        _model: &Model,
+        _frame: &Frame,
+        _simulated: Option<&Trajectory>,
+    ) -> Option<Observation> {
+        None
+    }
+    /// A named scenario of this field (`zigzag:20/20`) to simulate `model` under.
+    fn scenario(
+        &self,
+        model: &Model,
+        request: &ScenarioRequest<'_>,
+    ) -> Result<Box<dyn Scenario>, PluginError>;
+}
+
+/// What `simulate` asks of a plug-in's scenario.
+#[derive(Clone, Debug)]
+pub struct ScenarioRequest<'a> {
+    /// The scenario as the user wrote it.
+    pub text: &'a str,
+    /// Simulate the stored intercepts too.
+    pub with_intercept: bool,
+    /// Initial states were given (a scenario that sets its own refuses them).
+    pub initial_given: bool,
+    /// Constant inputs were given (a scenario that drives its inputs refuses them).
+    pub inputs_given: bool,
+}
+
+/// A scenario ready to run on a model and its drawn variants.
+pub trait Scenario {
+    /// How a title names it (`zigzag 20°/20°`).
+    fn label(&self) -> String;
+    /// How long it runs unless told otherwise, s.
+    fn default_duration(&self) -> f64;
+    /// Runs it on `model` (the nominal model or one drawn from its covariance).
+    fn run(&self, model: &Model, settings: &Settings) -> Result<Outcome, PluginError>;
+    /// Its figure: the nominal outcome, with the 90 % band of the drawn models' trajectories.
+    #[cfg(feature = "plot")]
+    fn figure(&self, title: &str, nominal: &Outcome, draws: &[&Trajectory]) -> crate::plot::Figure;
+}
+
+/// What a scenario produced.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// The simulation, at the output sampling.
+    pub trajectory: Trajectory,
+    /// The same as a frame of named columns (what `--out` writes).
+    pub frame: Frame,
+    /// Its metrics (a JSON object of numbers, `null` where not reached).
+    pub metrics: serde_json::Value,
+    /// Values that describe the start, for the JSON report (`delta0_deg`, `v0`).
+    pub start: serde_json::Map<String, serde_json::Value>,
+    /// The report a person reads, one line each, metrics included.
+    pub text: Vec<String>,
+}
+
+/// A field's metrics of one run.
+#[derive(Clone, Debug)]
+pub struct Observation {
+    /// Every metric, as the JSON report gives it.
+    pub json: serde_json::Value,
+    /// The ones a table shows: label with unit, key in `json`, value (`None`: not reached).
+    pub rows: Vec<(String, String, Option<f64>)>,
+}

@@ -1,0 +1,51 @@
+//! The registry of plug-ins: [`PLUGINS`] is the one place a plug-in is named; the CLI and the
+//! loaders here iterate it. Load model files through [`load`] / [`parse`] to have every
+//! plug-in table checked (the core's `Model::load` keeps them unread).
+
+use crate::model::{line_of_key, Model, ModelError};
+use crate::plugin::Plugin;
+
+/// Every plug-in termid knows. A new one is a module and one line here.
+pub static PLUGINS: &[&dyn Plugin] = &[&crate::ship::plugin::Manoeuvring];
+
+/// The plug-in whose table `model` has.
+pub fn of(model: &Model) -> Option<&'static dyn Plugin> {
+    PLUGINS.iter().copied().find(|p| model.spec.plugins.contains_key(p.table()))
+}
+
+/// The plug-in that adds derivative method `name`.
+pub fn with_derivative(name: &str) -> Option<&'static dyn Plugin> {
+    PLUGINS.iter().copied().find(|p| p.derivative_methods().contains(&name))
+}
+
+/// termid's default model: the first plug-in's (the Oltmann ship).
+pub fn default_model() -> Model {
+    PLUGINS.iter().find_map(|p| p.default_model()).expect("the first plug-in brings the default model")
+}
+
+/// Parses model text and checks its plug-in tables: each must be a registered plug-in's, and
+/// pass that plug-in's checks. `file` names it in errors.
+pub fn parse(text: &str, file: &str) -> Result<Model, ModelError> {
+    let model = Model::parse(text, file)?;
+    for table in model.spec.plugins.keys() {
+        let Some(plugin) = PLUGINS.iter().find(|p| p.table() == table) else {
+            let known: Vec<String> = PLUGINS.iter().map(|p| format!("[{}]", p.table())).collect();
+            return Err(ModelError::Key {
+                file: file.into(),
+                line: line_of_key(text, table),
+                key: table.clone(),
+                message: format!("no plug-in reads this table (tables of plug-ins: {})", known.join(", ")),
+            });
+        };
+        plugin.check(&model, text)?;
+    }
+    Ok(model)
+}
+
+/// Reads a model file and checks it as [`parse`] does.
+pub fn load(path: &std::path::Path) -> Result<Model, ModelError> {
+    let file = path.display().to_string();
+    let text = crate::budget::read_text(path)
+        .map_err(|e| ModelError::Io { file: file.clone(), message: e.to_string() })?;
+    parse(&text, &file)
+}

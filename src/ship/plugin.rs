@@ -1,0 +1,190 @@
+//! The manoeuvring plug-in as the core sees it: the `[ship]` table, the default ship, the
+//! tracking filter as a derivative method, the ship's diagnosis hypotheses, manoeuvre metrics
+//! of recorded runs and the standard manoeuvres as scenarios (registered in `crate::plugin`).
+
+use super::observed::observe;
+use super::{canonical_spec, Manoeuvre, Metrics, Ship, ShipError, ShipSpec};
+use crate::data::Frame;
+use crate::diagnose::Hypothesis;
+use crate::model::{Model, ModelError};
+use crate::plugin::{Observation, Outcome, Plugin, PluginError, Scenario, ScenarioRequest};
+use crate::sim::{Settings, Trajectory};
+
+/// Ship manoeuvring (Oltmann 1973; IMO MSC.137(76)).
+pub struct Manoeuvring;
+
+/// `--derivative kinematic`: the ship's tracking filter (all states of a run at once).
+const KINEMATIC: &str = "kinematic";
+
+impl From<ShipError> for PluginError {
+    fn from(e: ShipError) -> Self {
+        PluginError::failed(e)
+    }
+}
+
+impl Plugin for Manoeuvring {
+    fn table(&self) -> &'static str {
+        super::spec::TABLE
+    }
+
+    fn check(&self, model: &Model, text: &str) -> Result<(), ModelError> {
+        ShipSpec::check(model, text)
+    }
+
+    fn default_model(&self) -> Option<Model> {
+        Some(super::default_model())
+    }
+
+    fn set_parameter(&self, model: &mut Model, name: &str, value: f64) -> Result<bool, PluginError> {
+        let Some(mut ship) = ShipSpec::of(model)?.filter(|_| name == "u0") else { return Ok(false) };
+        if value <= 0.0 {
+            return Err(PluginError::Refused(format!(
+                "--param u0={value}: the approach speed must be positive"
+            )));
+        }
+        ship.u0 = value;
+        ship.store(model);
+        Ok(true)
+    }
+
+    fn derivative_methods(&self) -> &'static [&'static str] {
+        &[KINEMATIC]
+    }
+
+    fn prepare(
+        &self,
+        method: &str,
+        model: &Model,
+        frame: &Frame,
+        smooth: bool,
+    ) -> Result<Frame, PluginError> {
+        if method != KINEMATIC {
+            return Err(PluginError::Refused(format!("no derivative method `{method}`")));
+        }
+        let ship = canonical_spec(model).ok_or_else(|| {
+            PluginError::Refused(format!(
+                "--derivative kinematic is the ship plug-in's tracking filter: {} has no [ship] section",
+                model.path
+            ))
+        })?;
+        super::tracking::track(frame, &ship, smooth).map_err(PluginError::failed)
+    }
+
+    fn hypotheses(&self, model: &Model) -> Option<Vec<Hypothesis>> {
+        Some(super::hypotheses::hypotheses(model))
+    }
+
+    fn observe(&self, model: &Model, frame: &Frame, simulated: Option<&Trajectory>) -> Option<Observation> {
+        let ship = canonical_spec(model)?;
+        let n = &ship.names;
+        // a simulation's track with the rudder it was given, the recorded one
+        let seen = match simulated {
+            None => {
+                let col = |c: &str| frame.column(c);
+                observe(frame.time(), col(&n.psi)?, col(&n.rudder)?, col(&n.x0)?, col(&n.y0)?)
+            }
+            Some(s) => {
+                let state = |c: &str| s.state(c);
+                observe(&s.time, state(&n.psi)?, frame.column(&n.rudder)?, state(&n.x0)?, state(&n.y0)?)
+            }
+        };
+        let rows = [
+            ("1st overshoot [°]", "first_overshoot_deg", seen.first_overshoot_deg),
+            ("2nd overshoot [°]", "second_overshoot_deg", seen.second_overshoot_deg),
+            ("advance [m]", "advance_m", seen.advance_m),
+            ("transfer [m]", "transfer_m", seen.transfer_m),
+            ("tactical diameter [m]", "tactical_diameter_m", seen.tactical_diameter_m),
+        ];
+        Some(Observation {
+            json: serde_json::to_value(&seen).unwrap_or_default(),
+            rows: rows.iter().map(|(l, k, v)| (l.to_string(), k.to_string(), *v)).collect(),
+        })
+    }
+
+    fn scenario(
+        &self,
+        model: &Model,
+        request: &ScenarioRequest<'_>,
+    ) -> Result<Box<dyn Scenario>, PluginError> {
+        // a manoeuvre starts from the straight approach and drives the rudder itself
+        if request.initial_given {
+            return Err(PluginError::Refused("--initial does not apply to a ship manoeuvre: it starts from the straight approach at u0 (set it with --param u0=…), v and δ of the straight run, r = ψ = 0".into()));
+        }
+        if request.inputs_given {
+            return Err(PluginError::Refused("--input does not apply to a ship manoeuvre: the manoeuvre drives the rudder; for recorded inputs use --manoeuvre replay:FILE.csv".into()));
+        }
+        let ship = Ship::new(model, request.with_intercept)?;
+        let manoeuvre = Manoeuvre::parse(request.text)?;
+        Ok(Box::new(ShipScenario { ship, manoeuvre, with_intercept: request.with_intercept }))
+    }
+}
+
+/// A standard manoeuvre of a ship model.
+struct ShipScenario {
+    /// The nominal model's ship (its figure's roles).
+    #[cfg_attr(not(feature = "plot"), allow(dead_code))]
+    ship: Ship,
+    manoeuvre: Manoeuvre,
+    with_intercept: bool,
+}
+
+impl Scenario for ShipScenario {
+    fn label(&self) -> String {
+        self.manoeuvre.label()
+    }
+
+    fn default_duration(&self) -> f64 {
+        self.manoeuvre.default_duration()
+    }
+
+    fn run(&self, model: &Model, settings: &Settings) -> Result<Outcome, PluginError> {
+        let ship = Ship::new(model, self.with_intercept)?;
+        let run = ship.run(&self.manoeuvre, settings)?;
+        let frame = ship.frame(&run.trajectory, "simulation").map_err(PluginError::failed)?;
+        let metrics = serde_json::to_value(&run.metrics).map_err(PluginError::failed)?;
+        let mut start = serde_json::Map::new();
+        start.insert("delta0_deg".into(), run.start.delta0_deg.into());
+        start.insert("v0".into(), run.start.v0.into());
+        let mut text = vec![format!(
+            "straight run: δ0 = {:.3}°, v0 = {:.5} m/s (u̇ residual {:.2e} m/s²); {} steps of {} s",
+            run.start.delta0_deg,
+            run.start.v0,
+            run.start.surge_residual,
+            (settings.duration / settings.dt).round(),
+            settings.dt
+        )];
+        if let Some(map) = metrics.as_object() {
+            for (k, v) in map {
+                if k == "manoeuvre" || k == "points" || k == "reversals_s" {
+                    continue;
+                }
+                let value = match (v.is_null(), v.as_f64()) {
+                    (true, _) => "not reached (run longer?)".to_string(),
+                    (false, Some(x)) => format!("{x:.4}"),
+                    (false, None) => v.to_string(),
+                };
+                text.push(format!("  {k:<28} {value}"));
+            }
+        }
+        if let Metrics::Spiral(s) = &run.metrics {
+            text.push(format!("  {:>8} {:>10} {:>6}", "δ [°]", "r [°/s]", "branch"));
+            for p in &s.points {
+                text.push(format!("  {:>8.1} {:>10.4} {:>6}", p.rudder_deg, p.yaw_rate_deg_s, p.branch));
+            }
+        }
+        Ok(Outcome { trajectory: run.trajectory, frame, metrics, start, text })
+    }
+
+    #[cfg(feature = "plot")]
+    fn figure(&self, title: &str, nominal: &Outcome, draws: &[&Trajectory]) -> crate::plot::Figure {
+        use super::figure::{add_bands, manoeuvre_figure, spiral_figure};
+        if let Manoeuvre::Spiral(_) = self.manoeuvre {
+            return spiral_figure(title, &nominal.metrics);
+        }
+        let mut fig = manoeuvre_figure(&self.ship, title, &[("simulation", &nominal.trajectory)], true);
+        if !draws.is_empty() {
+            add_bands(&mut fig, &self.ship, draws);
+        }
+        fig
+    }
+}

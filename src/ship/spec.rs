@@ -1,0 +1,156 @@
+//! The `[ship]` table of a model file: the particulars and role names the manoeuvring
+//! plug-in reads. The core keeps the table as data (`ModelFile::plugins`); this module owns
+//! its schema, its checks and the default ship.
+
+use serde::{Deserialize, Serialize};
+
+use super::ShipError;
+use crate::model::{line_of_key, Model, ModelError};
+
+/// The model-file table this plug-in owns.
+pub const TABLE: &str = "ship";
+
+/// The default model: HSVA model 1512 as identified by Oltmann (1973), true coefficients.
+pub const DEFAULT_MODEL: &str = include_str!("../../models/oltmann1973.toml");
+/// The name the default model reports as its file.
+pub const DEFAULT_MODEL_PATH: &str = "models/oltmann1973.toml";
+
+/// The default model (embedded in the binary).
+pub fn default_model() -> Model {
+    Model::parse(DEFAULT_MODEL, DEFAULT_MODEL_PATH).expect("the embedded default model is valid (tested)")
+}
+
+/// `[ship]`: particulars for the manoeuvring plug-in. Lengths in m, angles in degrees.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShipSpec {
+    /// Length between perpendiculars, m.
+    pub lpp: f64,
+    /// Beam, m.
+    #[serde(default)]
+    pub beam: f64,
+    /// Draught, m.
+    #[serde(default)]
+    pub draught: f64,
+    /// Displacement volume, m³.
+    #[serde(default)]
+    pub displacement: f64,
+    /// Rudder rate, °/s.
+    pub rudder_rate: f64,
+    /// Largest rudder angle, °.
+    pub rudder_limit: f64,
+    /// Approach speed, m/s.
+    pub u0: f64,
+    /// State names the plug-in reads (defaults: u, v, r, ψ, x0, y0) and the rudder input (δ).
+    #[serde(default)]
+    pub names: ShipNames,
+}
+
+/// Which model names play the ship's roles.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ShipNames {
+    /// Surge velocity.
+    pub u: String,
+    /// Sway velocity.
+    pub v: String,
+    /// Yaw rate.
+    pub r: String,
+    /// Heading.
+    pub psi: String,
+    /// North (initial course) position.
+    pub x0: String,
+    /// East position.
+    pub y0: String,
+    /// Rudder angle.
+    pub rudder: String,
+}
+
+impl Default for ShipNames {
+    fn default() -> Self {
+        ShipNames {
+            u: "u".into(),
+            v: "v".into(),
+            r: "r".into(),
+            psi: "ψ".into(),
+            x0: "x0".into(),
+            y0: "y0".into(),
+            rudder: "δ".into(),
+        }
+    }
+}
+
+impl ShipSpec {
+    /// The model's `[ship]` table, as written (`None`: not a ship model).
+    pub fn of(model: &Model) -> Result<Option<ShipSpec>, ShipError> {
+        let Some(table) = model.spec.plugins.get(TABLE) else { return Ok(None) };
+        let spec = ShipSpec::deserialize(table.clone())
+            .map_err(|e| ShipError::Model(format!("{}: [{TABLE}]: {}", model.path, e.message())))?;
+        Ok(Some(spec))
+    }
+
+    /// Writes these particulars back into the model's `[ship]` table.
+    pub fn store(&self, model: &mut Model) {
+        if let Ok(value) = toml::Value::try_from(self) {
+            model.spec.plugins.insert(TABLE.into(), value);
+        }
+    }
+
+    /// Checks the `[ship]` table of a model read from `text`: its schema, positive lengths and
+    /// speeds, and role names the model declares. Errors are located in the file.
+    pub fn check(model: &Model, text: &str) -> Result<(), ModelError> {
+        let key_err = |key: &str, message: String| ModelError::Key {
+            file: model.path.clone(),
+            line: line_of_key(text, key),
+            key: key.into(),
+            message,
+        };
+        if !model.spec.plugins.contains_key(TABLE) {
+            return Ok(());
+        }
+        // read from the text itself, so that toml's message carries the line and column
+        #[derive(Deserialize)]
+        struct Only {
+            ship: ShipSpec,
+        }
+        let spec = toml::from_str::<Only>(text)
+            .map_err(|e| ModelError::Syntax { file: model.path.clone(), message: e.to_string() })?
+            .ship;
+        for (key, value) in [
+            ("lpp", spec.lpp),
+            ("rudder_rate", spec.rudder_rate),
+            ("rudder_limit", spec.rudder_limit),
+            ("u0", spec.u0),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(key_err(
+                    &format!("{TABLE}.{key}"),
+                    format!("must be a positive number, not {value}"),
+                ));
+            }
+        }
+        let n = &spec.names;
+        let declared = |name: &str| {
+            let name = model.vocabulary.canonical(name).unwrap_or_else(|| name.to_string());
+            model.spec.states.iter().any(|s| s.name == name)
+                || model.spec.inputs.iter().any(|i| i.name == name)
+        };
+        for (role, name) in [
+            ("u", &n.u),
+            ("v", &n.v),
+            ("r", &n.r),
+            ("psi", &n.psi),
+            ("x0", &n.x0),
+            ("y0", &n.y0),
+            ("rudder", &n.rudder),
+        ] {
+            if !declared(name) {
+                return Err(key_err(
+                    &format!("{TABLE}.names.{role}"),
+                    format!("`{name}` is not a state or input of the model"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
