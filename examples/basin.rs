@@ -13,11 +13,10 @@ use termid::data::{
     Preparation, Smoothed,
 };
 use termid::diagnose::{refine, Runs};
-use termid::identify::{coefficients_of, fit_equation, Identification, Target};
+use termid::identify::{identify_model, Identification, ModelIdentification, Target};
 use termid::model::Model;
 use termid::select::{Backend, Moments};
 use termid::ship::basin::{at_approach_speed, dataset_toml, Basin, Recording, PAPER_RUNS};
-use termid::ship::tracking::track;
 use termid::ship::{Manoeuvre, Metrics, Ship};
 use termid::sim::{Integrator, Settings};
 use termid::term::Library;
@@ -160,18 +159,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             signals: vec!["u".into(), "v".into(), "r".into()],
             smooth,
         };
-        let prepared: Vec<Frame> = if spec == "kinematic" {
-            let ship = termid::ship::ShipSpec::of(&model)?.ok_or("a ship model")?;
-            frames.iter().map(|f| track(f, &ship, smooth)).collect::<Result<_, _>>()?
+        let prepared: Vec<Frame> = if let Some(plugin) = termid::plugins::with_derivative(spec) {
+            frames.iter().map(|f| plugin.prepare(spec, &model, f, smooth)).collect::<Result<_, _>>()?
         } else {
             frames.iter().map(|f| prepare(f, &how)).collect::<Result<_, _>>()?
         };
-        let mut identified = model.clone();
-        for eq in model.identifiable() {
-            let fit = fit_equation(&model, &eq, &prepared, method.as_ref(), intercept, None)?;
-            let coefficients = coefficients_of(&fit, &model.vocabulary)?;
-            identified.set_coefficients(&eq, coefficients, fit.selection.intercept.as_ref().map(|b| b.value));
-        }
+        let how = ModelIdentification {
+            equations: vec![],
+            differentiator: method.as_ref(),
+            intercept,
+            target: None,
+        };
+        let mut identified = identify_model(&model, &prepared, &how, &mut |_| {})?.model;
         if backend.ends_with("+ output error") {
             // all coefficients refined together on the training runs as prepared (smoothed
             // initial states), comparing velocities and heading (`identify --refine u,v,r,ψ`)

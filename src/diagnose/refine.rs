@@ -90,3 +90,34 @@ pub fn refine(model: &Model, runs: &Runs) -> Result<Refined, DiagnoseError> {
         coefficients,
     })
 }
+
+impl Refined {
+    /// The refinement as a person reads it: the cost before and after and, per coefficient,
+    /// the regression's value, the refined one, its standard error and the change.
+    pub fn text(&self) -> String {
+        let r = self;
+        use crate::identify::num;
+        let mut out = format!(
+        "== output-error refinement ==\nre-simulation cost (scaled sum of squares) {} → {}; residual correlation time {} samples\n{:<8} {:<18} {:>13} {:>13} {:>12} {:>8}\n",
+        num(r.cost_before),
+        num(r.cost_after),
+        r.correlation_time.map_or("--".into(), |t| format!("{t:.0}")),
+        "equation",
+        "term",
+        "regression",
+        "refined",
+        "std. error",
+        "change"
+    );
+        for (eq, term, before, after, se) in &r.coefficients {
+            out += &format!(
+                "{eq:<8} {term:<18} {:>13} {:>13} {:>12} {:>7.1}%\n",
+                num(*before),
+                num(*after),
+                num(*se),
+                100.0 * (after / before - 1.0)
+            );
+        }
+        out + "\n"
+    }
+}

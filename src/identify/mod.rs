@@ -43,11 +43,13 @@ impl std::fmt::Display for Target {
 pub use crate::model::ParamValue;
 
 mod model;
+mod report;
 
 pub use model::{
     coefficients_of, correlation_time_of, equation_design, fit_equation, fit_equation_design, identify_model,
     IdentifiedModel, ModelIdentification,
 };
+pub use report::{num, FitReport, StepReport, TermReport};
 
 /// Why identification failed.
 #[derive(Debug, thiserror::Error)]

@@ -12,7 +12,7 @@ use termid::select::Backend;
 use termid::sim::Integrator;
 
 use crate::args::{CompareCommand, Format};
-use crate::identify::num;
+use termid::identify::num;
 
 /// (state, RMS error, max error) of a re-simulation.
 type StateErrors = Vec<(String, f64, f64)>;

@@ -5,7 +5,7 @@ use anyhow::{Context, Result};
 use termid::diagnose::{diagnose, generic_hypotheses, Diagnosis, Settings};
 
 use crate::args::{DiagnoseCommand, Format};
-use crate::identify::num;
+use termid::identify::num;
 
 pub fn run(cmd: DiagnoseCommand) -> Result<()> {
     // outputs that cannot be written are refused before any work

@@ -6,7 +6,7 @@ use anyhow::{bail, Context, Result};
 use termid::data::{
     differentiator, prepare, resample, CentralDifference, Differentiator, Frame, Preparation,
 };
-use termid::identify::{Fit, Identification, ParamValue, Target};
+use termid::identify::{Identification, ParamValue, Target};
 use termid::select::{Backend, StepRule};
 use termid::term::{parse_terms, Vocabulary};
 
@@ -120,8 +120,8 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
             identification.correlation_time(&target, &candidates, &frames, &fit.selection)?;
     }
     match cmd.format {
-        Format::Json => println!("{}", serde_json::to_string_pretty(&json(&fit))?),
-        Format::Text => print!("{}", text(&fit)),
+        Format::Json => println!("{}", serde_json::to_string_pretty(&serde_json::to_value(fit.report())?)?),
+        Format::Text => print!("{}", fit.text()),
     }
     Ok(())
 }
@@ -274,8 +274,10 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
     }
     match cmd.format {
         Format::Json => {
-            let mut all: serde_json::Map<String, serde_json::Value> =
-                fits.iter().map(|(n, f)| (n.clone(), json(f))).collect();
+            let mut all: serde_json::Map<String, serde_json::Value> = fits
+                .iter()
+                .map(|(n, f)| Ok((n.clone(), serde_json::to_value(f.report())?)))
+                .collect::<Result<_>>()?;
             if let Some(r) = &refined {
                 all.insert("output_error_refinement".into(), serde_json::to_value(r)?);
             }
@@ -284,11 +286,11 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
         Format::Text => {
             for (name, fit) in &fits {
                 println!("== {name} ==");
-                print!("{}", text(fit));
+                print!("{}", fit.text());
                 println!();
             }
             if let Some(r) = &refined {
-                print!("{}", refinement_text(r));
+                print!("{}", r.text());
             }
             if let Some(out) = &cmd.out {
                 println!("wrote {}", out.display());
@@ -333,139 +335,4 @@ fn refine_by_output_error(
         None => runs,
     };
     Ok(termid::diagnose::refine(model, &runs)?)
-}
-
-fn refinement_text(r: &termid::diagnose::Refined) -> String {
-    let mut out = format!(
-        "== output-error refinement ==\nre-simulation cost (scaled sum of squares) {} → {}; residual correlation time {} samples\n{:<8} {:<18} {:>13} {:>13} {:>12} {:>8}\n",
-        num(r.cost_before),
-        num(r.cost_after),
-        r.correlation_time.map_or("--".into(), |t| format!("{t:.0}")),
-        "equation",
-        "term",
-        "regression",
-        "refined",
-        "std. error",
-        "change"
-    );
-    for (eq, term, before, after, se) in &r.coefficients {
-        out += &format!(
-            "{eq:<8} {term:<18} {:>13} {:>13} {:>12} {:>7.1}%\n",
-            num(*before),
-            num(*after),
-            num(*se),
-            100.0 * (after / before - 1.0)
-        );
-    }
-    out + "\n"
-}
-
-/// Significant-figure formatting that stays fixed-point where a reader expects it.
-pub fn num(x: f64) -> String {
-    if x == 0.0 || (1e-4..1e6).contains(&x.abs()) {
-        let digits = (5 - x.abs().log10().floor() as i32).clamp(0, 9) as usize;
-        format!("{x:.digits$}")
-    } else {
-        format!("{x:.4e}")
-    }
-}
-
-fn text(fit: &Fit) -> String {
-    let s = &fit.selection;
-    let mut out = format!(
-        "{} on {} rows, {} candidates, back-end {}\n\n",
-        fit.target,
-        s.rows,
-        fit.candidates.len(),
-        s.backend
-    );
-    if !s.steps.is_empty() {
-        out +=
-            &format!("{:>4}  {:<22} {:>12} {:>12} {:>10}\n", "step", "term entered", "std. error", "F", "R²");
-        for st in &s.steps {
-            let mark = if st.step == s.chosen_step { " ← chosen" } else { "" };
-            let forced = if st.forced { " (forced)" } else { "" };
-            out += &format!(
-                "{:>4}  {:<22} {:>12} {:>12} {:>10.6}{forced}{mark}\n",
-                st.step,
-                st.term,
-                num(st.standard_error),
-                num(st.f),
-                st.r2
-            );
-        }
-        out += "\n";
-    }
-    out += &format!("{} =", fit.target);
-    let mut first = true;
-    if let Some(b0) = &s.intercept {
-        out += &format!(" {}", num(b0.value));
-        first = false;
-    }
-    for t in &s.terms {
-        let sign = if t.coefficient < 0.0 {
-            "-"
-        } else if first {
-            ""
-        } else {
-            "+"
-        };
-        out += &format!("\n    {sign} {}*{}", num(t.coefficient.abs()), t.term);
-        first = false;
-    }
-    out += "\n\n";
-    out += &format!("{:<22} {:>12} {:>12} {:>9}\n", "term", "coefficient", "std. error", "t");
-    if let Some(b0) = &s.intercept {
-        out +=
-            &format!("{:<22} {:>12} {:>12} {:>9.2}\n", "(intercept)", num(b0.value), num(b0.std_error), b0.t);
-    }
-    for t in &s.terms {
-        // a coefficient the back-end was told to hold (sparse `fixed`) is not estimated
-        let t_value = if t.std_error == 0.0 { "fixed".to_string() } else { format!("{:.2}", t.t) };
-        out +=
-            &format!("{:<22} {:>12} {:>12} {:>9}\n", t.term, num(t.coefficient), num(t.std_error), t_value);
-    }
-    out += &format!("\nstopped: {:?}\n", s.stop);
-    if let Some(tau) = fit.correlation_time.filter(|t| *t > 1.5) {
-        out += &format!(
-            "note: the residuals are correlated over τ = {tau:.1} rows; the standard errors above assume independent rows, honest ones are about √τ = {:.1} times larger\n",
-            tau.sqrt()
-        );
-    }
-    for n in &s.notes {
-        out += &format!("note: {n}\n");
-    }
-    out
-}
-
-fn json(fit: &Fit) -> serde_json::Value {
-    let s = &fit.selection;
-    serde_json::json!({
-        "target": fit.target,
-        "backend": s.backend,
-        "rows": s.rows,
-        "candidates": fit.candidates,
-        "steps": s.steps.iter().map(|st| serde_json::json!({
-            "step": st.step,
-            "term": st.term,
-            "forced": st.forced,
-            "standard_error": st.standard_error,
-            "f": st.f,
-            "r2": st.r2,
-            "proportion": st.proportion,
-        })).collect::<Vec<_>>(),
-        "chosen_step": s.chosen_step,
-        "terms": s.terms.iter().map(|t| serde_json::json!({
-            "term": t.term,
-            "coefficient": t.coefficient,
-            "std_error": t.std_error,
-            "t": t.t,
-        })).collect::<Vec<_>>(),
-        "intercept": s.intercept.as_ref().map(|b| b.value),
-        "intercept_std_error": s.intercept.as_ref().map(|b| b.std_error),
-        "stop": s.stop,
-        "notes": s.notes,
-        "correlation_time": fit.correlation_time,
-        "covariance": fit.covariance,
-    })
 }

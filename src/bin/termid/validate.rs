@@ -12,8 +12,8 @@ use termid::plot::{Figure, Series};
 use termid::uncertainty::band;
 
 use crate::args::{Format, ValidateCommand};
-use crate::identify::num;
 use crate::monte_carlo::Draws;
+use termid::identify::num;
 
 pub fn run(cmd: ValidateCommand) -> Result<()> {
     if let Some(dir) = &cmd.resim.svg {

@@ -1,0 +1,207 @@
+//! How a fit reads: the step table, the equation and the coefficient table as text, and the
+//! same numbers as a plain serde record ([`FitReport`]) for JSON. The CLI, the examples and a
+//! binding print fits with these, so every fit reads the same.
+
+use serde::Serialize;
+
+use super::Fit;
+use crate::select::Stop;
+
+/// Significant-figure formatting that stays fixed-point where a reader expects it.
+pub fn num(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e6).contains(&x.abs()) {
+        let digits = (5 - x.abs().log10().floor() as i32).clamp(0, 9) as usize;
+        format!("{x:.digits$}")
+    } else {
+        format!("{x:.4e}")
+    }
+}
+
+/// One step of the table, as reported.
+#[derive(Clone, Debug, Serialize)]
+pub struct StepReport {
+    /// 1-based step number.
+    pub step: usize,
+    /// The term entered (or removed).
+    pub term: String,
+    /// Entered because forced.
+    pub forced: bool,
+    /// Standard error of estimate s (A7).
+    pub standard_error: f64,
+    /// F-value (A8); `null` in JSON at an exact fit.
+    pub f: f64,
+    /// Cumulative share R² (A5).
+    pub r2: f64,
+    /// Its share of the total sum of squares (A3).
+    pub proportion: f64,
+}
+
+/// A chosen term, as reported.
+#[derive(Clone, Debug, Serialize)]
+pub struct TermReport {
+    /// The term's canonical text.
+    pub term: String,
+    /// The coefficient.
+    pub coefficient: f64,
+    /// Its standard error (0: held fixed).
+    pub std_error: f64,
+    /// t-value.
+    pub t: f64,
+}
+
+/// A fit as `identify --format json` reports it.
+#[derive(Clone, Debug, Serialize)]
+pub struct FitReport {
+    /// What was explained.
+    pub target: String,
+    /// The back-end's name.
+    pub backend: String,
+    /// Rows fitted.
+    pub rows: usize,
+    /// The candidates, in column order.
+    pub candidates: Vec<String>,
+    /// The step table (back-ends that take steps).
+    pub steps: Vec<StepReport>,
+    /// The step chosen.
+    pub chosen_step: usize,
+    /// The chosen terms.
+    pub terms: Vec<TermReport>,
+    /// The intercept b0, if fitted.
+    pub intercept: Option<f64>,
+    /// Its standard error.
+    pub intercept_std_error: Option<f64>,
+    /// Why the back-end stopped.
+    pub stop: Stop,
+    /// The back-end's notes.
+    pub notes: Vec<String>,
+    /// The residuals' correlation time, rows.
+    pub correlation_time: Option<f64>,
+    /// The chosen coefficients' covariance.
+    pub covariance: Option<Vec<Vec<f64>>>,
+}
+
+impl Fit {
+    /// The fit as a plain record (for JSON).
+    pub fn report(&self) -> FitReport {
+        let s = &self.selection;
+        FitReport {
+            target: self.target.clone(),
+            backend: s.backend.clone(),
+            rows: s.rows,
+            candidates: self.candidates.clone(),
+            steps: s
+                .steps
+                .iter()
+                .map(|st| StepReport {
+                    step: st.step,
+                    term: st.term.clone(),
+                    forced: st.forced,
+                    standard_error: st.standard_error,
+                    f: st.f,
+                    r2: st.r2,
+                    proportion: st.proportion,
+                })
+                .collect(),
+            chosen_step: s.chosen_step,
+            terms: s
+                .terms
+                .iter()
+                .map(|t| TermReport {
+                    term: t.term.clone(),
+                    coefficient: t.coefficient,
+                    std_error: t.std_error,
+                    t: t.t,
+                })
+                .collect(),
+            intercept: s.intercept.as_ref().map(|b| b.value),
+            intercept_std_error: s.intercept.as_ref().map(|b| b.std_error),
+            stop: s.stop.clone(),
+            notes: s.notes.clone(),
+            correlation_time: self.correlation_time,
+            covariance: self.covariance.clone(),
+        }
+    }
+
+    /// The fit as a person reads it: the step table, the equation, the coefficient table and
+    /// the notes.
+    pub fn text(&self) -> String {
+        let fit = self;
+        let s = &fit.selection;
+        let mut out = format!(
+            "{} on {} rows, {} candidates, back-end {}\n\n",
+            fit.target,
+            s.rows,
+            fit.candidates.len(),
+            s.backend
+        );
+        if !s.steps.is_empty() {
+            out += &format!(
+                "{:>4}  {:<22} {:>12} {:>12} {:>10}\n",
+                "step", "term entered", "std. error", "F", "R²"
+            );
+            for st in &s.steps {
+                let mark = if st.step == s.chosen_step { " ← chosen" } else { "" };
+                let forced = if st.forced { " (forced)" } else { "" };
+                out += &format!(
+                    "{:>4}  {:<22} {:>12} {:>12} {:>10.6}{forced}{mark}\n",
+                    st.step,
+                    st.term,
+                    num(st.standard_error),
+                    num(st.f),
+                    st.r2
+                );
+            }
+            out += "\n";
+        }
+        out += &format!("{} =", fit.target);
+        let mut first = true;
+        if let Some(b0) = &s.intercept {
+            out += &format!(" {}", num(b0.value));
+            first = false;
+        }
+        for t in &s.terms {
+            let sign = if t.coefficient < 0.0 {
+                "-"
+            } else if first {
+                ""
+            } else {
+                "+"
+            };
+            out += &format!("\n    {sign} {}*{}", num(t.coefficient.abs()), t.term);
+            first = false;
+        }
+        out += "\n\n";
+        out += &format!("{:<22} {:>12} {:>12} {:>9}\n", "term", "coefficient", "std. error", "t");
+        if let Some(b0) = &s.intercept {
+            out += &format!(
+                "{:<22} {:>12} {:>12} {:>9.2}\n",
+                "(intercept)",
+                num(b0.value),
+                num(b0.std_error),
+                b0.t
+            );
+        }
+        for t in &s.terms {
+            // a coefficient the back-end was told to hold (sparse `fixed`) is not estimated
+            let t_value = if t.std_error == 0.0 { "fixed".to_string() } else { format!("{:.2}", t.t) };
+            out += &format!(
+                "{:<22} {:>12} {:>12} {:>9}\n",
+                t.term,
+                num(t.coefficient),
+                num(t.std_error),
+                t_value
+            );
+        }
+        out += &format!("\nstopped: {:?}\n", s.stop);
+        if let Some(tau) = fit.correlation_time.filter(|t| *t > 1.5) {
+            out += &format!(
+            "note: the residuals are correlated over τ = {tau:.1} rows; the standard errors above assume independent rows, honest ones are about √τ = {:.1} times larger\n",
+            tau.sqrt()
+        );
+        }
+        for n in &s.notes {
+            out += &format!("note: {n}\n");
+        }
+        out
+    }
+}
