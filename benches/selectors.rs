@@ -101,7 +101,7 @@ fn bench(c: &mut Criterion) {
     // every back-end on the paper's combined-data size (statistics already accumulated)
     let mut g = c.benchmark_group("backends_2505x29");
     for name in Backend::NAMES {
-        let backend = Backend::by_name(name).unwrap().build().unwrap();
+        let backend = Backend::by_name(name).unwrap().build();
         g.bench_function(*name, |b| {
             b.iter(|| {
                 let pb = Problem {
@@ -130,10 +130,10 @@ fn bench(c: &mut Criterion) {
     // every back-end; best subset searched exactly up to five terms (all 2¹⁰⁰ subsets are out of
     // reach of any exact method)
     let backends: Vec<(&str, Box<dyn Selector>)> = vec![
-        ("stepwise", Backend::by_name("stepwise").unwrap().build().unwrap()),
-        ("efroymson", Backend::by_name("efroymson").unwrap().build().unwrap()),
+        ("stepwise", Backend::by_name("stepwise").unwrap().build()),
+        ("efroymson", Backend::by_name("efroymson").unwrap().build()),
         ("best-subset_max5", Box::new(BestSubset { max_size: Some(5), ..BestSubset::default() })),
-        ("sparse", Backend::by_name("sparse").unwrap().build().unwrap()),
+        ("sparse", Backend::by_name("sparse").unwrap().build()),
     ];
     for (name, backend) in &backends {
         g.bench_function(*name, |b| {

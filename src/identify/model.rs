@@ -121,7 +121,7 @@ pub fn fit_equation_design(
         intercept,
         weights: None,
     };
-    let backend = eq.backend.build()?;
+    let backend = eq.backend.build();
     match design {
         Some(d) if d.candidates() != eq.candidates.as_slice() => Err(IdentifyError::Setup(format!(
             "{}: the compiled design given for `{equation}` is of other candidates",

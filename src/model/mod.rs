@@ -284,7 +284,7 @@ impl Model {
                 }
             };
             let mut backend = eq.backend.clone().unwrap_or_default();
-            backend.build().map_err(|e| key_err(&format!("equations.{name}.backend"), e.to_string()))?;
+            backend.validate().map_err(|e| key_err(&format!("equations.{name}.backend"), e.to_string()))?;
             if let Backend::Sparse(fit) = &mut backend {
                 // constraints name candidates: each must be one, and is kept by its canonical text
                 let key = format!("equations.{name}.backend");

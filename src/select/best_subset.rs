@@ -253,7 +253,16 @@ impl Selector for BestSubset {
 }
 
 impl BestSubset {
+    /// Checks the settings: positive node and time limits.
+    pub fn validate(&self) -> Result<(), SelectError> {
+        if self.node_limit == 0 || self.time_limit.is_nan() || self.time_limit <= 0.0 {
+            return Err(SelectError::Config("best-subset node_limit and time_limit must be positive".into()));
+        }
+        Ok(())
+    }
+
     fn search(&self, pb: &Problem<'_>, folds: &[Moments]) -> Result<Selection, SelectError> {
+        self.validate()?;
         let sc = Scaled::new(pb)?;
         let m = sc.m;
         let mut notes = Vec::new();

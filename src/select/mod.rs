@@ -233,8 +233,11 @@ pub enum SelectError {
     #[error("invalid setting: {0}")]
     Config(String),
     /// The QP solver (Clarabel) ended with a status other than Solved.
-    #[error("the sparse fit's QP solver stopped with status {0}")]
-    Solver(String),
+    #[error("the sparse fit's QP solver stopped with status {status:?}")]
+    Solver {
+        /// Clarabel's status.
+        status: clarabel::solver::SolverStatus,
+    },
     /// The sparse fit's constraints admit no coefficients.
     #[error("the sparse fit's constraints conflict: no coefficients satisfy {constraints} together (with the forced terms and the target's scale); drop or loosen one")]
     Infeasible {
@@ -396,6 +399,33 @@ impl Default for Backend {
     }
 }
 
+/// A back-end by name, with its default settings (the command line's `--backend`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+pub enum BackendName {
+    /// Oltmann's stepwise regression (IBM SSP STPRG).
+    #[cfg_attr(feature = "cli", value(alias = "stprg"))]
+    Stepwise,
+    /// Efroymson's stepwise with removal.
+    Efroymson,
+    /// Exact best subset by branch and bound.
+    BestSubset,
+    /// Sparse regression (SR3 / constrained least squares).
+    Sparse,
+}
+
+impl From<BackendName> for Backend {
+    fn from(name: BackendName) -> Backend {
+        match name {
+            BackendName::Stepwise => Backend::Stepwise(Stepwise::default()),
+            BackendName::Efroymson => Backend::Efroymson(Efroymson::default()),
+            BackendName::BestSubset => Backend::BestSubset(BestSubset::default()),
+            BackendName::Sparse => Backend::Sparse(SparseFit::default()),
+        }
+    }
+}
+
 impl Backend {
     /// The names of all back-ends.
     pub const NAMES: &'static [&'static str] = &["stepwise", "efroymson", "best-subset", "sparse"];
@@ -413,10 +443,10 @@ impl Backend {
     /// A back-end with default settings, by name.
     pub fn by_name(name: &str) -> Result<Backend, SelectError> {
         match name {
-            "stepwise" | "stprg" => Ok(Backend::Stepwise(Stepwise::default())),
-            "efroymson" => Ok(Backend::Efroymson(Efroymson::default())),
-            "best-subset" => Ok(Backend::BestSubset(BestSubset::default())),
-            "sparse" => Ok(Backend::Sparse(SparseFit::default())),
+            "stepwise" | "stprg" => Ok(BackendName::Stepwise.into()),
+            "efroymson" => Ok(BackendName::Efroymson.into()),
+            "best-subset" => Ok(BackendName::BestSubset.into()),
+            "sparse" => Ok(BackendName::Sparse.into()),
             other => Err(SelectError::Config(format!(
                 "unknown back-end `{other}` (known: {})",
                 Backend::NAMES.join(", ")
@@ -424,29 +454,25 @@ impl Backend {
         }
     }
 
-    /// Checks the settings and returns the runnable back-end.
-    pub fn build(&self) -> Result<Box<dyn Selector>, SelectError> {
+    /// Checks the settings (a model file's `backend` table is checked when it is read). Each
+    /// back-end's `select` checks its own settings too, once per fit: a back-end used
+    /// directly, without this enum, is checked all the same.
+    pub fn validate(&self) -> Result<(), SelectError> {
         match self {
-            Backend::Stepwise(s) => {
-                s.validate()?;
-                Ok(Box::new(s.clone()))
-            }
-            Backend::Efroymson(e) => {
-                e.validate()?;
-                Ok(Box::new(e.clone()))
-            }
-            Backend::BestSubset(b) => {
-                if b.node_limit == 0 || b.time_limit.is_nan() || b.time_limit <= 0.0 {
-                    return Err(SelectError::Config(
-                        "best-subset node_limit and time_limit must be positive".into(),
-                    ));
-                }
-                Ok(Box::new(b.clone()))
-            }
-            Backend::Sparse(s) => {
-                s.validate()?;
-                Ok(Box::new(s.clone()))
-            }
+            Backend::Stepwise(s) => s.validate(),
+            Backend::Efroymson(e) => e.validate(),
+            Backend::BestSubset(b) => b.validate(),
+            Backend::Sparse(s) => s.validate(),
+        }
+    }
+
+    /// The runnable back-end (its settings are checked when it selects).
+    pub fn build(&self) -> Box<dyn Selector> {
+        match self {
+            Backend::Stepwise(s) => Box::new(s.clone()),
+            Backend::Efroymson(e) => Box::new(e.clone()),
+            Backend::BestSubset(b) => Box::new(b.clone()),
+            Backend::Sparse(s) => Box::new(s.clone()),
         }
     }
 }

@@ -567,7 +567,7 @@ impl SparseFit {
             SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
                 Err(SelectError::Infeasible { constraints: c.text.clone() })
             }
-            status => Err(SelectError::Solver(format!("{status:?}"))),
+            status => Err(SelectError::Solver { status }),
         }
     }
 }

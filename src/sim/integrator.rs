@@ -16,15 +16,25 @@ use crate::data::Frame;
 /// The integration method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Integrator {
     /// Oltmann's modified Euler (eq. B8), first order.
     #[default]
+    #[cfg_attr(feature = "cli", value(name = "b8", alias = "euler", alias = "modified-euler"))]
     ModifiedEuler,
     /// Classical Runge-Kutta, fourth order.
     Rk4,
 }
 
 impl Integrator {
+    /// The name the command line uses (`b8`, `rk4`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Integrator::ModifiedEuler => "b8",
+            Integrator::Rk4 => "rk4",
+        }
+    }
+
     /// By name: `b8` (or `euler`) and `rk4`.
     pub fn by_name(name: &str) -> Result<Integrator, SimError> {
         match name {

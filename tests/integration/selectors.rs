@@ -8,7 +8,7 @@ use termid::select::{Backend, BestSubset, Efroymson, Problem, SelectError, Selec
 use crate::common::{moments_of, qr_fit, Lcg};
 
 fn backends() -> Vec<(String, Box<dyn Selector>)> {
-    Backend::NAMES.iter().map(|n| (n.to_string(), Backend::by_name(n).unwrap().build().unwrap())).collect()
+    Backend::NAMES.iter().map(|n| (n.to_string(), Backend::by_name(n).unwrap().build())).collect()
 }
 
 fn names(p: usize) -> Vec<String> {

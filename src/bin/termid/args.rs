@@ -3,6 +3,8 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use termid::select::BackendName;
+use termid::sim::Integrator;
 
 /// termid: identify equations of motion from time series.
 #[derive(Debug, Parser)]
@@ -99,9 +101,9 @@ pub struct IdentifyCommand {
     /// Aliases: `du=Δu`.
     #[arg(long = "alias", num_args = 1..)]
     pub aliases: Vec<String>,
-    /// Regression back-end.
-    #[arg(long, default_value = "stepwise")]
-    pub backend: String,
+    /// Regression back-end (settings beyond the defaults: a model file's `backend` table).
+    #[arg(long, value_enum, default_value = "stepwise")]
+    pub backend: BackendName,
     /// Derivative method for `dX/dt` targets: central, savitzky-golay[:WINDOW:ORDER],
     /// spline[:ALPHA] (GCV by default), kalman[:RATIO] (maximum likelihood by default), or for
     /// ship models `kinematic`: the tracking filter fusing track, heading, log and gyro.
@@ -155,8 +157,8 @@ pub struct SimulateCommand {
     #[arg(long, short = 'm')]
     pub manoeuvre: Option<String>,
     /// Integrator: b8 (Oltmann's modified Euler, eq. B8) or rk4.
-    #[arg(long, default_value = "b8")]
-    pub integrator: String,
+    #[arg(long, value_enum, default_value = "b8")]
+    pub integrator: Integrator,
     /// Step, s.
     #[arg(long, default_value_t = 0.04)]
     pub dt: f64,
@@ -313,8 +315,8 @@ pub struct RunsArgs {
 #[derive(Debug, Args)]
 pub struct ResimArgs {
     /// Integrator: b8 (the paper's modified Euler, default) or rk4.
-    #[arg(long, default_value = "b8")]
-    pub integrator: String,
+    #[arg(long, value_enum, default_value = "b8")]
+    pub integrator: Integrator,
     /// Integration step, s.
     #[arg(long, default_value_t = 0.04)]
     pub dt: f64,

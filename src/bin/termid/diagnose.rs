@@ -22,7 +22,7 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
         .unwrap_or_else(|| generic_hypotheses(&model));
     let settings = Settings {
         dt: cmd.resim.dt,
-        integrator: termid::sim::Integrator::by_name(&cmd.resim.integrator)?,
+        integrator: cmd.resim.integrator,
         with_intercepts: cmd.resim.with_intercept,
         ..Settings::default()
     };

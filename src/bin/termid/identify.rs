@@ -103,7 +103,7 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     let forced = parse_terms(&cmd.forced, &vocab)?;
     let excluded = parse_terms(&cmd.exclude, &vocab)?;
     let backend = configure_backend(&cmd)?;
-    let selector = backend.build()?;
+    let selector = backend.build();
     let identification = Identification {
         vocabulary: &vocab,
         parameters: &params,
@@ -189,7 +189,7 @@ fn prepare_runs(
 }
 
 fn configure_backend(cmd: &IdentifyCommand) -> Result<Backend> {
-    let mut backend = Backend::by_name(&cmd.backend)?;
+    let mut backend = Backend::from(cmd.backend);
     // the stepwise stop and step-rule options do not apply to the other back-ends
     if let Backend::Stepwise(s) = &mut backend {
         s.min_proportion = cmd.min_proportion;

@@ -27,7 +27,7 @@ pub fn run(cmd: SimulateCommand) -> Result<()> {
     }
     let mut model = load_model(&cmd.model)?;
     set_parameters(&mut model, &cmd.params)?;
-    let integrator = Integrator::by_name(&cmd.integrator)?;
+    let integrator = cmd.integrator;
     match (&cmd.manoeuvre, termid::plugins::of(&model)) {
         (Some(m), Some(plugin)) => scenario_run(&cmd, &model, plugin, m, integrator),
         (Some(m), None) if !m.starts_with("replay:") => {
@@ -125,7 +125,7 @@ fn scenario_run(
             let mut report = serde_json::Map::new();
             report.insert("model".into(), model.path.clone().into());
             report.insert("manoeuvre".into(), scenario.label().into());
-            report.insert("integrator".into(), cmd.integrator.clone().into());
+            report.insert("integrator".into(), cmd.integrator.name().into());
             report.insert("dt".into(), cmd.dt.into());
             report.extend(run.start.clone());
             report.insert("metrics".into(), run.metrics.clone());

@@ -6,7 +6,7 @@ use anyhow::Result;
 use termid::diagnose::Runs;
 use termid::plot::comparison_figures;
 use termid::plugin::Observation;
-use termid::sim::{Integrator, Trajectory};
+use termid::sim::Trajectory;
 
 use termid::plot::{Figure, Series};
 use termid::uncertainty::band;
@@ -21,7 +21,7 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
     }
     let model = crate::simulate::load_model(&cmd.model)?;
     let runs = crate::runs::load_for(&model, &cmd.runs.data, cmd.runs.dataset.as_deref())?;
-    let data = Runs::new(&model, &runs, cmd.resim.dt, Integrator::by_name(&cmd.resim.integrator)?)?
+    let data = Runs::new(&model, &runs, cmd.resim.dt, cmd.resim.integrator)?
         .with_intercepts(cmd.resim.with_intercept);
     let sims = data.simulate(&model, &[], &[])?;
     let gap = data.gap(&sims);
