@@ -4,9 +4,13 @@
 //! documents every key. Errors name the file, the line and the key, and for a bad term the
 //! caret inside it.
 
+mod covariance;
 mod file;
 mod locate;
 mod param;
+mod rhs;
+
+pub use covariance::{Covariance, CovarianceError};
 
 pub use param::ParamValue;
 
@@ -91,17 +95,6 @@ pub struct Equation {
     pub identify: bool,
     /// Covariance of the coefficients, if stored.
     pub covariance: Option<Covariance>,
-}
-
-/// The covariance of an equation's coefficients.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Covariance {
-    /// The terms (each one of the equation's coefficients), in matrix order.
-    pub terms: Vec<Term>,
-    /// s²(X'X)⁻¹, row-major; symmetric and positive semi-definite.
-    pub matrix: Vec<Vec<f64>>,
-    /// Residual autocorrelation time in rows (≥ 1); the effective covariance is matrix × this.
-    pub correlation_time: f64,
 }
 
 impl Equation {
@@ -279,7 +272,7 @@ impl Model {
                         .collect::<Result<Vec<_>, _>>()?;
                     let c =
                         Covariance { terms, matrix: c.matrix.clone(), correlation_time: c.correlation_time };
-                    check_covariance(&coefficients, &c).map_err(bad)?;
+                    covariance::check(&coefficients, &c).map_err(|e| bad(e.to_string()))?;
                     Some(c)
                 }
             };
@@ -427,26 +420,6 @@ impl Model {
         }
     }
 
-    /// Stores the covariance of an equation's coefficients. Refused unless every term is a
-    /// coefficient, the matrix a covariance matrix and the correlation time ≥ 1.
-    pub fn set_covariance(&mut self, equation: &str, covariance: Covariance) -> Result<(), String> {
-        let eq = self
-            .equations
-            .iter_mut()
-            .find(|e| e.name == equation)
-            .ok_or(format!("no equation `{equation}`"))?;
-        check_covariance(&eq.coefficients, &covariance)?;
-        if let Some(spec) = self.spec.equations.get_mut(equation) {
-            spec.covariance = Some(CovarianceSpec {
-                terms: covariance.terms.iter().map(Term::to_string).collect(),
-                matrix: covariance.matrix.clone(),
-                correlation_time: covariance.correlation_time,
-            });
-        }
-        eq.covariance = Some(covariance);
-        Ok(())
-    }
-
     /// Checks measured runs against the model's known kinematics: where an equation that is
     /// not identified says ẋ = c·y for a state x and a variable y (ψ̇ = r), the run's own dx/dt
     /// must match c·y. A ratio near π/180 or 180/π means one of the two columns is in degrees
@@ -514,96 +487,6 @@ impl Model {
             toml::to_string_pretty(&self.spec).unwrap_or_else(|e| format!("# could not serialise: {e}\n"));
         format!("# written by termid {}\n{body}", env!("CARGO_PKG_VERSION"))
     }
-}
-
-/// A model file is what the simulator integrates: its equations' coefficients times their
-/// terms are ẋ.
-impl crate::sim::RightHandSide for Model {
-    fn origin(&self) -> &str {
-        &self.path
-    }
-
-    fn states(&self) -> Result<Vec<(String, f64, f64)>, crate::sim::SimError> {
-        let missing: Vec<&str> = self
-            .spec
-            .states
-            .iter()
-            .map(|s| s.name.as_str())
-            .filter(|s| !self.equations.iter().any(|e| e.state == *s))
-            .collect();
-        if !missing.is_empty() {
-            return Err(crate::sim::SimError::Settings(format!(
-                "{}: state(s) {} have no equation, so the model cannot be simulated",
-                self.path,
-                missing.join(", ")
-            )));
-        }
-        Ok(self
-            .equations
-            .iter()
-            .map(|e| {
-                let spec = self.spec.states.iter().find(|t| t.name == e.state);
-                (
-                    e.state.clone(),
-                    spec.and_then(|t| t.min).unwrap_or(f64::NEG_INFINITY),
-                    spec.and_then(|t| t.max).unwrap_or(f64::INFINITY),
-                )
-            })
-            .collect())
-    }
-
-    fn inputs(&self) -> Vec<String> {
-        self.spec.inputs.iter().map(|i| i.name.clone()).collect()
-    }
-
-    fn parameters(&self) -> BTreeMap<String, f64> {
-        self.parameter_values()
-    }
-
-    fn compile(&self, with_intercept: bool) -> Result<Library, crate::sim::SimError> {
-        Ok(self.compile_rhs(with_intercept)?)
-    }
-}
-
-/// A covariance fits its equation: τ ≥ 1, every term one of the equation's coefficients and
-/// named once, the matrix k×k, finite, symmetric and positive semi-definite. The one check for
-/// model files and for `set_covariance`.
-fn check_covariance(coefficients: &[(Term, f64, Option<f64>)], c: &Covariance) -> Result<(), String> {
-    if !(c.correlation_time >= 1.0 && c.correlation_time.is_finite()) {
-        return Err(format!("correlation time {} must be a number ≥ 1", c.correlation_time));
-    }
-    for (i, t) in c.terms.iter().enumerate() {
-        if !coefficients.iter().any(|(o, _, _)| o == t) {
-            return Err(format!("`{t}` is not a coefficient of the equation"));
-        }
-        if c.terms[..i].contains(t) {
-            return Err(format!("`{t}` appears twice in the covariance's terms"));
-        }
-    }
-    let (m, k) = (&c.matrix, c.terms.len());
-    if m.len() != k || m.iter().any(|r| r.len() != k) {
-        return Err(format!("`matrix` must be {k}×{k}, one row per term"));
-    }
-    if m.iter().flatten().any(|v| !v.is_finite()) {
-        return Err("`matrix` has a value that is not finite".into());
-    }
-    for i in 0..k {
-        for j in 0..i {
-            if (m[i][j] - m[j][i]).abs() > 1e-9 * (m[i][i] * m[j][j]).sqrt().max(f64::MIN_POSITIVE) {
-                return Err(format!(
-                    "`matrix` is not symmetric: [{i}][{j}] = {} but [{j}][{i}] = {}",
-                    m[i][j], m[j][i]
-                ));
-            }
-        }
-    }
-    let a = nalgebra::DMatrix::from_fn(k, k, |i, j| m[i][j]);
-    let smallest = a.symmetric_eigenvalues().iter().copied().fold(f64::INFINITY, f64::min);
-    let largest = m.iter().enumerate().map(|(i, r)| r[i]).fold(0.0, f64::max);
-    if k > 0 && smallest < -1e-9 * largest {
-        return Err(format!("`matrix` is not positive semi-definite (eigenvalue {smallest:e})"));
-    }
-    Ok(())
 }
 
 #[cfg(test)]

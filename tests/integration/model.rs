@@ -135,7 +135,7 @@ fn covariances_are_checked_and_read_back() {
         ),
     ] {
         let e = m.clone().set_covariance("v_dot", bad).unwrap_err();
-        assert!(e.contains(what), "{e}");
+        assert!(e.to_string().contains(what), "{e}");
     }
     // and in a file: the key is named
     let mut asym = m.clone();
