@@ -36,7 +36,7 @@ pub const MAX_LINE: usize = 1 << 20;
 #[non_exhaustive]
 pub enum ReadError {
     /// The system refused.
-    #[error("{0}")]
+    #[error(transparent)]
     Io(#[from] std::io::Error),
     /// A NUL byte: a binary file or a device, not text.
     #[error("byte {offset} is NUL: this is not a text file")]

@@ -45,7 +45,7 @@ pub fn parse(text: &str, file: &str) -> Result<Model, ModelError> {
 /// Reads a model file and checks it as [`parse`] does.
 pub fn load(path: &std::path::Path) -> Result<Model, ModelError> {
     let file = path.display().to_string();
-    let text = crate::budget::read_text(path)
-        .map_err(|e| ModelError::Io { file: file.clone(), message: e.to_string() })?;
+    let text =
+        crate::budget::read_text(path).map_err(|error| ModelError::Io { file: file.clone(), error })?;
     parse(&text, &file)
 }

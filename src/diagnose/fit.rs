@@ -362,12 +362,15 @@ fn correlation(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// The model with a hypothesis's term coefficients added (inputs are changed in simulation).
-pub fn apply(model: &Model, h: &Hypothesis, theta: &[f64]) -> Result<Model, String> {
+pub fn apply(model: &Model, h: &Hypothesis, theta: &[f64]) -> Result<Model, super::DiagnoseError> {
     let mut m = model.clone();
     if let Effect::Terms { terms } = &h.effect {
         for ((eq, text), value) in terms.iter().zip(theta) {
-            let term = m.vocabulary.parse(text).map_err(|e| e.to_string())?;
-            let e = m.equation(eq).ok_or_else(|| format!("no equation {eq}"))?.clone();
+            let term = m.vocabulary.parse(text)?;
+            let e = m
+                .equation(eq)
+                .ok_or_else(|| super::DiagnoseError::Setup(format!("no equation {eq}")))?
+                .clone();
             let mut coefs = e.coefficients.clone();
             match coefs.iter_mut().find(|(t, _, _)| *t == term) {
                 Some(c) => c.1 += value,

@@ -34,6 +34,9 @@ pub enum DiagnoseError {
     /// Setup.
     #[error("{0}")]
     Setup(String),
+    /// A hypothesis's term that does not parse in the model's vocabulary.
+    #[error(transparent)]
+    Term(#[from] crate::term::TermError),
 }
 
 /// The gap between simulation and measurement, per state: RMS and max of (sim − meas).
@@ -213,7 +216,7 @@ pub fn diagnose(
                 .find(|h| h.name == candidates[w].name)
                 .ok_or_else(|| DiagnoseError::Setup("lost hypothesis".into()))?;
             let theta = h.internal(&candidates[w].estimate);
-            let m = fit::apply(model, h, &theta).map_err(DiagnoseError::Setup)?;
+            let m = fit::apply(model, h, &theta)?;
             let after = data.simulate(&m, &h.input_offsets(&theta, model), &h.input_scales(&theta, model))?;
             let mut m = m;
             m.spec.model.notes.push(format!(

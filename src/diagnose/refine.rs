@@ -48,7 +48,7 @@ pub fn refine(model: &Model, runs: &Runs) -> Result<Refined, DiagnoseError> {
     let before = runs.gap(&runs.simulate(model, &[], &[])?).cost;
     let fit = levenberg_marquardt(runs, model, &hypothesis, vec![0.0; entries.len()])
         .map_err(|e| DiagnoseError::Setup(format!("output-error refinement: the re-simulation {e}")))?;
-    let mut refined = apply(model, &hypothesis, &fit.theta).map_err(DiagnoseError::Setup)?;
+    let mut refined = apply(model, &hypothesis, &fit.theta)?;
     // σ²(JᵀJ)⁻¹ assumes independent residuals; re-simulation residuals are strongly
     // correlated in time, so the covariance is widened by their correlation time τ
     let tau = crate::uncertainty::correlation_time(&runs.series(&fit.residuals));

@@ -12,7 +12,7 @@ mod rhs;
 
 pub use covariance::{Covariance, CovarianceError};
 
-pub use param::ParamValue;
+pub use param::{ParamError, ParamValue};
 
 pub use file::{
     CoefficientSpec, CovarianceSpec, EquationSpec, InputSpec, Meta, ModelFile, ParameterSpec, StateSpec,
@@ -29,13 +29,14 @@ use crate::term::{Library, Term, TermError, Vocabulary};
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum ModelError {
-    /// Unreadable file.
-    #[error("{file}: {message}")]
+    /// Unreadable file (the reason is the source: `{:#}` or the chain prints it).
+    #[error("{file}")]
     Io {
         /// The file.
         file: String,
-        /// What the system said.
-        message: String,
+        /// Why it could not be read.
+        #[source]
+        error: crate::budget::ReadError,
     },
     /// TOML syntax or a wrong type (toml's message carries line and column).
     #[error("{file}: {message}")]
@@ -132,8 +133,8 @@ impl Model {
     /// `crate::plugins::load` also checks them.
     pub fn load(path: &Path) -> Result<Model, ModelError> {
         let file = path.display().to_string();
-        let text = crate::budget::read_text(path)
-            .map_err(|e| ModelError::Io { file: file.clone(), message: e.to_string() })?;
+        let text =
+            crate::budget::read_text(path).map_err(|error| ModelError::Io { file: file.clone(), error })?;
         Model::parse(&text, &file)
     }
 
@@ -182,7 +183,7 @@ impl Model {
             if let Some(rule) = &p.per_run {
                 ParamValue::Rule(rule.clone())
                     .check_rule(name)
-                    .map_err(|m| key_err(&format!("parameters.{name}.per_run"), m))?;
+                    .map_err(|m| key_err(&format!("parameters.{name}.per_run"), m.to_string()))?;
             }
         }
         for (i, d) in spec.derived.iter().enumerate() {

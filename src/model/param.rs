@@ -15,14 +15,44 @@ pub enum ParamValue {
     Rule(String),
 }
 
+/// A parameter value or rule that cannot be.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ParamError {
+    /// A number that is not finite.
+    #[error("parameter `{name}`: {value} is not a finite number")]
+    NotFinite {
+        /// The parameter.
+        name: String,
+        /// The value.
+        value: f64,
+    },
+    /// `mean:COLUMN:SECONDS` without a positive number of seconds.
+    #[error("parameter `{name}`: `{rule}`: write mean:COLUMN:SECONDS with SECONDS > 0")]
+    MeanWindow {
+        /// The parameter.
+        name: String,
+        /// The rule as written.
+        rule: String,
+    },
+    /// Neither a number nor a known rule.
+    #[error("parameter `{name}`: `{rule}` is neither a number nor `first:COLUMN`, `mean:COLUMN` or `mean:COLUMN:SECONDS`")]
+    Unknown {
+        /// The parameter.
+        name: String,
+        /// The rule as written.
+        rule: String,
+    },
+}
+
 impl ParamValue {
     /// A value as written on the command line or in a file: a finite number, or a rule that
     /// [`ParamValue::check_rule`] accepts.
-    pub fn from_text(name: &str, text: &str) -> Result<ParamValue, String> {
+    pub fn from_text(name: &str, text: &str) -> Result<ParamValue, ParamError> {
         let text = text.trim();
         match text.parse::<f64>() {
             Ok(v) if v.is_finite() => Ok(ParamValue::Value(v)),
-            Ok(v) => Err(format!("parameter `{name}`: {v} is not a finite number")),
+            Ok(value) => Err(ParamError::NotFinite { name: name.into(), value }),
             Err(_) => {
                 let rule = ParamValue::Rule(text.to_string());
                 rule.check_rule(name)?;
@@ -32,19 +62,17 @@ impl ParamValue {
     }
 
     /// Checks a rule's syntax without data.
-    pub fn check_rule(&self, name: &str) -> Result<(), String> {
+    pub fn check_rule(&self, name: &str) -> Result<(), ParamError> {
         match self {
             ParamValue::Value(_) => Ok(()),
             ParamValue::Rule(rule) => match rule.split_once(':') {
                 Some(("first", col)) if !col.is_empty() => Ok(()),
                 Some(("mean", rest)) if !rest.is_empty() => match rest.split_once(':') {
                     Some((c, secs)) if !c.is_empty() && secs.parse::<f64>().is_ok_and(|s| s > 0.0) => Ok(()),
-                    Some(_) => Err(format!("parameter `{name}`: `{rule}`: write mean:COLUMN:SECONDS with SECONDS > 0")),
+                    Some(_) => Err(ParamError::MeanWindow { name: name.into(), rule: rule.clone() }),
                     None => Ok(()),
                 },
-                _ => Err(format!(
-                    "parameter `{name}`: `{rule}` is neither a number nor `first:COLUMN`, `mean:COLUMN` or `mean:COLUMN:SECONDS`"
-                )),
+                _ => Err(ParamError::Unknown { name: name.into(), rule: rule.clone() }),
             },
         }
     }
@@ -54,9 +82,9 @@ impl ParamValue {
         match self {
             ParamValue::Value(v) => Ok(*v),
             ParamValue::Rule(rule) => match rule.split_once(':') {
-                _ if self.check_rule(name).is_err() => {
-                    Err(DataError::Setting(self.check_rule(name).err().unwrap_or_default()))
-                }
+                _ if self.check_rule(name).is_err() => Err(DataError::Setting(
+                    self.check_rule(name).err().map(|e| e.to_string()).unwrap_or_default(),
+                )),
                 Some(("first", col)) => Ok(frame.require(col)?[0]),
                 Some(("mean", rest)) => {
                     // `mean:u` over the run, `mean:u:2` over its first 2 time units (the approach)

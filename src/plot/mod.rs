@@ -117,14 +117,21 @@ fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
-/// Why a figure could not be written.
+/// Why a figure could not be drawn or written.
 #[derive(Debug, thiserror::Error)]
-#[error("{file}: could not draw the figure: {message}")]
-pub struct PlotError {
-    /// The file.
-    pub file: String,
-    /// What went wrong.
-    pub message: String,
+#[non_exhaustive]
+pub enum PlotError {
+    /// The drawing back-end failed (plotters' message).
+    #[error("could not draw the figure: {0}")]
+    Draw(String),
+    /// Drawn, but not written.
+    #[error("{file}: could not draw the figure: {message}")]
+    File {
+        /// The file.
+        file: String,
+        /// What went wrong.
+        message: String,
+    },
 }
 
 /// Axis numbers without trailing noise: 0.25, 30, 1e-4.
@@ -149,13 +156,15 @@ impl Figure {
     /// Writes the figure as SVG (atomically: the old file stays until the new one is whole).
     pub fn write_svg(&self, path: &Path) -> Result<(), PlotError> {
         let file = path.display().to_string();
-        let svg = self.to_svg().map_err(|message| PlotError { file: file.clone(), message })?;
-        crate::output::write_file(path, svg.as_bytes()).map_err(|e| PlotError { file, message: e.reason() })
+        let svg =
+            self.to_svg().map_err(|e| PlotError::File { file: file.clone(), message: e.to_string() })?;
+        crate::output::write_file(path, svg.as_bytes())
+            .map_err(|e| PlotError::File { file, message: e.reason() })
     }
 
     /// The figure as SVG text.
-    pub fn to_svg(&self) -> Result<String, String> {
-        let err = |e: &dyn std::fmt::Display| e.to_string();
+    pub fn to_svg(&self) -> Result<String, PlotError> {
+        let err = |e: &dyn std::fmt::Display| PlotError::Draw(e.to_string());
         let title_h = if self.title.is_empty() { 0 } else { 30 };
         let height = title_h + self.panel_height * self.panels.len().max(1) as u32;
         let mut svg = String::new();
