@@ -3,6 +3,8 @@
 //! ([`Moments`]) and implements [`Selector`]; [`Backend`] picks one by name for the CLI and
 //! model files. A new back-end is one new file and one row in [`Backend`].
 
+#[macro_use]
+mod registry;
 mod best_subset;
 mod efroymson;
 #[doc(hidden)]
@@ -10,6 +12,7 @@ pub mod gram;
 mod moments;
 mod sparse;
 pub(crate) mod stepwise;
+mod stlsq;
 mod subset;
 
 use serde::{Deserialize, Serialize};
@@ -19,6 +22,7 @@ pub use efroymson::Efroymson;
 pub use moments::{gather, Accumulator, Moments};
 pub use sparse::{Candidate, Equality, LambdaChoice, SparseFit};
 pub use stepwise::{StepRule, Stepwise};
+pub use stlsq::Stlsq;
 pub(crate) use subset::sweep;
 
 /// What a back-end is asked to do.
@@ -379,101 +383,25 @@ impl<'a> CrossValidation<'a> {
     }
 }
 
-/// Back-end settings as written in model files and chosen on the CLI, by `method` name.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "method", rename_all = "kebab-case", deny_unknown_fields)]
-pub enum Backend {
+// The registry of back-ends: one line each (variant, settings type, name and aliases). It
+// makes `Backend` (a model file's `backend` table, tagged by `method`), `BackendName` (the
+// command line's `--backend`) and their names, checks and builders (see `registry.rs`).
+back_ends! {
     /// The IBM SSP forward stepwise regression (STPRG) the paper used.
-    Stepwise(Stepwise),
+    Stepwise(Stepwise) = "stepwise" | "stprg";
     /// Efroymson's stepwise with F-to-enter and F-to-remove (MATLAB `stepwisefit`).
-    Efroymson(Efroymson),
+    Efroymson(Efroymson) = "efroymson";
     /// Exact best subset by branch and bound, size by a criterion.
-    BestSubset(BestSubset),
+    BestSubset(BestSubset) = "best-subset";
     /// LASSO path (Clarabel QP) with least-squares refit and constraints.
-    Sparse(SparseFit),
+    Sparse(SparseFit) = "sparse";
+    /// Sequentially thresholded least squares (SINDy's STLSQ).
+    Stlsq(Stlsq) = "stlsq";
 }
 
 impl Default for Backend {
     fn default() -> Self {
         Backend::Stepwise(Stepwise::default())
-    }
-}
-
-/// A back-end by name, with its default settings (the command line's `--backend`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
-pub enum BackendName {
-    /// Oltmann's stepwise regression (IBM SSP STPRG).
-    #[cfg_attr(feature = "cli", value(alias = "stprg"))]
-    Stepwise,
-    /// Efroymson's stepwise with removal.
-    Efroymson,
-    /// Exact best subset by branch and bound.
-    BestSubset,
-    /// Sparse regression (SR3 / constrained least squares).
-    Sparse,
-}
-
-impl From<BackendName> for Backend {
-    fn from(name: BackendName) -> Backend {
-        match name {
-            BackendName::Stepwise => Backend::Stepwise(Stepwise::default()),
-            BackendName::Efroymson => Backend::Efroymson(Efroymson::default()),
-            BackendName::BestSubset => Backend::BestSubset(BestSubset::default()),
-            BackendName::Sparse => Backend::Sparse(SparseFit::default()),
-        }
-    }
-}
-
-impl Backend {
-    /// The names of all back-ends.
-    pub const NAMES: &'static [&'static str] = &["stepwise", "efroymson", "best-subset", "sparse"];
-
-    /// The back-end's name (as in [`Backend::NAMES`]).
-    pub fn name(&self) -> &'static str {
-        match self {
-            Backend::Stepwise(_) => "stepwise",
-            Backend::Efroymson(_) => "efroymson",
-            Backend::BestSubset(_) => "best-subset",
-            Backend::Sparse(_) => "sparse",
-        }
-    }
-
-    /// A back-end with default settings, by name.
-    pub fn by_name(name: &str) -> Result<Backend, SelectError> {
-        match name {
-            "stepwise" | "stprg" => Ok(BackendName::Stepwise.into()),
-            "efroymson" => Ok(BackendName::Efroymson.into()),
-            "best-subset" => Ok(BackendName::BestSubset.into()),
-            "sparse" => Ok(BackendName::Sparse.into()),
-            other => Err(SelectError::Config(format!(
-                "unknown back-end `{other}` (known: {})",
-                Backend::NAMES.join(", ")
-            ))),
-        }
-    }
-
-    /// Checks the settings (a model file's `backend` table is checked when it is read). Each
-    /// back-end's `select` checks its own settings too, once per fit: a back-end used
-    /// directly, without this enum, is checked all the same.
-    pub fn validate(&self) -> Result<(), SelectError> {
-        match self {
-            Backend::Stepwise(s) => s.validate(),
-            Backend::Efroymson(e) => e.validate(),
-            Backend::BestSubset(b) => b.validate(),
-            Backend::Sparse(s) => s.validate(),
-        }
-    }
-
-    /// The runnable back-end (its settings are checked when it selects).
-    pub fn build(&self) -> Box<dyn Selector> {
-        match self {
-            Backend::Stepwise(s) => Box::new(s.clone()),
-            Backend::Efroymson(e) => Box::new(e.clone()),
-            Backend::BestSubset(b) => Box::new(b.clone()),
-            Backend::Sparse(s) => Box::new(s.clone()),
-        }
     }
 }
 
@@ -484,7 +412,12 @@ mod tests {
     #[test]
     fn names_round_trip_through_the_registry() {
         for name in Backend::NAMES {
-            assert_eq!(Backend::by_name(name).unwrap().name(), *name);
+            let backend = Backend::by_name(name).unwrap();
+            assert_eq!(backend.name(), *name);
+            assert_eq!(backend.build().name(), *name);
+            // a model file's `method` is the same name
+            let table: toml::Value = toml::Value::try_from(&backend).unwrap();
+            assert_eq!(table.get("method").and_then(|m| m.as_str()), Some(*name));
         }
     }
 }

@@ -134,7 +134,7 @@ fn compare_runs_every_backend() {
     assert!(ok, "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     let names: Vec<&str> = v.as_array().unwrap().iter().map(|e| e["backend"].as_str().unwrap()).collect();
-    assert_eq!(names, ["stepwise", "efroymson", "best-subset", "sparse"]);
+    assert_eq!(names, ["stepwise", "efroymson", "best-subset", "sparse", "stlsq"]);
     for e in v.as_array().unwrap() {
         assert_eq!(e["equations"].as_array().unwrap().len(), 3);
         assert!(e["equations"][0]["time_ms"].as_f64().unwrap() >= 0.0);

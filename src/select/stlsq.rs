@@ -1,0 +1,193 @@
+//! Sequentially thresholded least squares (STLSQ; Brunton, Proctor & Kutz 2016, the default
+//! optimiser of SINDy): fit every allowed candidate, drop those whose standardised coefficient
+//! is below a threshold, refit on the rest, until the support settles. Coefficients are
+//! compared in correlation scale (β_j·d_j/d_y), so the threshold does not depend on the
+//! candidates' units. The reported fit is ordinary least squares on the final support,
+//! entered in order of decreasing |β| so the step table shows what each term adds.
+
+use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
+
+use super::subset::{sweep, Scaled};
+use super::{Problem, SelectError, Selection, Selector, Step, Stop};
+
+/// Settings.
+///
+/// | setting | default | meaning |
+/// |---|---|---|
+/// | `threshold` | 0.05 | a term whose standardised coefficient is below this leaves |
+/// | `alpha` | 0 | ridge penalty in correlation scale (0: plain least squares) |
+/// | `max_iterations` | 20 | refits before giving up on a settled support |
+/// | `pivot_tolerance` | 1e-10 | a collinear term is left out of the final fit |
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Stlsq {
+    /// Threshold on |standardised coefficient|.
+    pub threshold: f64,
+    /// Ridge penalty (correlation scale).
+    pub alpha: f64,
+    /// Most refits.
+    pub max_iterations: usize,
+    /// Refusal threshold for a term's pivot (correlation scale).
+    pub pivot_tolerance: f64,
+}
+
+impl Default for Stlsq {
+    fn default() -> Self {
+        Stlsq { threshold: 0.05, alpha: 0.0, max_iterations: 20, pivot_tolerance: 1e-10 }
+    }
+}
+
+impl Stlsq {
+    /// Checks the settings.
+    pub fn validate(&self) -> Result<(), SelectError> {
+        let finite_non_negative = |v: f64| v >= 0.0 && v.is_finite();
+        if !finite_non_negative(self.threshold) || !finite_non_negative(self.alpha) {
+            return Err(SelectError::Config(format!(
+                "stlsq needs a finite threshold ≥ 0 and alpha ≥ 0, has {} and {}",
+                self.threshold, self.alpha
+            )));
+        }
+        if self.max_iterations == 0 {
+            return Err(SelectError::Config("stlsq max_iterations must be ≥ 1".into()));
+        }
+        Ok(())
+    }
+
+    /// Standardised (ridge) least-squares coefficients on `set`, in its order; `None` where
+    /// the system is singular.
+    fn solve(&self, sc: &Scaled, set: &[usize]) -> Option<Vec<f64>> {
+        let (p, m) = (sc.p, sc.m);
+        let k = set.len();
+        let r =
+            DMatrix::from_fn(k, k, |i, j| sc.a[set[i] * m + set[j]] + if i == j { self.alpha } else { 0.0 });
+        let c = DVector::from_fn(k, |i, _| sc.a[set[i] * m + p]);
+        let beta = r.clone().cholesky().map(|ch| ch.solve(&c)).or_else(|| r.lu().solve(&c))?;
+        beta.iter().all(|b| b.is_finite()).then(|| beta.iter().copied().collect())
+    }
+}
+
+impl Selector for Stlsq {
+    fn name(&self) -> &'static str {
+        "stlsq"
+    }
+
+    fn select(&self, pb: &Problem<'_>) -> Result<Selection, SelectError> {
+        self.validate()?;
+        let sc = Scaled::new(pb)?;
+        let (p, m) = (sc.p, sc.m);
+        let mut notes = Vec::new();
+        // columns without variance carry no information (and would make R singular)
+        let mut set: Vec<usize> = (0..p)
+            .filter(|j| !pb.excluded.contains(j) && (sc.d[*j] > 0.0 || pb.forced.contains(j)))
+            .collect();
+        let mut beta = Vec::new();
+        let mut settled = false;
+        for _ in 0..self.max_iterations {
+            beta = match self.solve(&sc, &set) {
+                Some(b) => b,
+                None => {
+                    notes.push("the least-squares system is singular on the candidates: add `alpha` (ridge) or exclude collinear candidates".into());
+                    break;
+                }
+            };
+            let keep: Vec<usize> = set
+                .iter()
+                .zip(&beta)
+                .filter(|(j, b)| pb.forced.contains(j) || b.abs() >= self.threshold)
+                .map(|(j, _)| *j)
+                .collect();
+            if keep.len() == set.len() {
+                settled = true;
+                break;
+            }
+            set = keep;
+        }
+        if !settled {
+            notes.push(format!(
+                "the support had not settled after {} refits (max_iterations)",
+                self.max_iterations
+            ));
+        }
+        // the final fit: forced terms first, then by decreasing |β|
+        let mut order: Vec<(usize, f64)> = set.iter().copied().zip(beta.iter().map(|b| b.abs())).collect();
+        order.sort_by(|x, y| {
+            pb.forced.contains(&y.0).cmp(&pb.forced.contains(&x.0)).then(y.1.total_cmp(&x.1))
+        });
+        let mut a = sc.a.clone();
+        let mut fitted: Vec<usize> = Vec::new();
+        let mut steps: Vec<Step> = Vec::new();
+        for (j, _) in order {
+            let pivot = a[j * m + j];
+            if pivot.is_nan() || pivot <= self.pivot_tolerance {
+                if pb.forced.contains(&j) {
+                    return Err(SelectError::ForcedCollinear {
+                        term: pb.names[j].clone(),
+                        pivot,
+                        tolerance: self.pivot_tolerance,
+                    });
+                }
+                notes.push(format!("`{}` left out: collinear with the terms before it", pb.names[j]));
+                continue;
+            }
+            if sc.n_eff - ((fitted.len() + 1) as f64) < 1.0 {
+                return Err(SelectError::TooFewRows {
+                    rows: sc.n,
+                    terms: fitted.len() + 1,
+                    intercept: pb.intercept,
+                });
+            }
+            sweep(&mut a, m, j);
+            fitted.push(j);
+            let mut st = sc.step(&a, &fitted, pb.names, j, false, pb.forced.contains(&j));
+            st.step = steps.len() + 1;
+            steps.push(st);
+        }
+        let chosen = steps.len();
+        Ok(Selection::from_steps(self.name(), sc.n, pb.names, steps, chosen, Stop::Converged, notes))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::select::Accumulator;
+
+    /// y = 2·x1 − 3·x3 + 0.5 plus a little noise, six candidates: STLSQ keeps x1 and x3 and
+    /// their coefficients are the least-squares ones on that support.
+    #[test]
+    fn keeps_the_true_terms_and_fits_them_by_least_squares() {
+        let n = 300;
+        let (mut cols, mut ys) = (vec![Vec::new(); 6], Vec::new());
+        let mut seed = 7u64;
+        let mut noise = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for i in 0..n {
+            let t = i as f64 / n as f64;
+            let x = [t, (7.0 * t).sin(), (3.0 * t).cos(), t * t, (11.0 * t).sin() * 0.1, noise()];
+            ys.push(2.0 * x[0] - 3.0 * x[2] + 0.5 + 0.01 * noise());
+            for (c, v) in cols.iter_mut().zip(x) {
+                c.push(v);
+            }
+        }
+        let mut acc = Accumulator::new(6);
+        let columns: Vec<&[f64]> = cols.iter().map(Vec::as_slice).collect();
+        acc.push_columns(&columns, &ys, None);
+        let moments = acc.finish();
+        let names: Vec<String> = (1..=6).map(|i| format!("x{i}")).collect();
+        let pb = Problem { moments: &moments, names: &names, forced: &[], excluded: &[], intercept: true };
+        let s = Stlsq::default().select(&pb).unwrap();
+        let mut chosen: Vec<&str> = s.terms.iter().map(|t| t.term.as_str()).collect();
+        chosen.sort();
+        assert_eq!(chosen, ["x1", "x3"]);
+        let b = |name: &str| s.terms.iter().find(|t| t.term == name).unwrap().coefficient;
+        assert!((b("x1") - 2.0).abs() < 0.01 && (b("x3") + 3.0).abs() < 0.01, "{:?}", s.terms);
+        assert!((s.intercept.unwrap().value - 0.5).abs() < 0.01);
+        // a threshold of 0 keeps every candidate with variance
+        let all = Stlsq { threshold: 0.0, ..Stlsq::default() }.select(&pb).unwrap();
+        assert_eq!(all.terms.len(), 6);
+        assert!(Stlsq { threshold: -1.0, ..Stlsq::default() }.validate().is_err());
+    }
+}
