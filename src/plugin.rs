@@ -114,8 +114,9 @@ pub struct Outcome {
     pub frame: Frame,
     /// Its metrics (a JSON object of numbers, `null` where not reached).
     pub metrics: serde_json::Value,
-    /// Values that describe the start, for the JSON report (`delta0_deg`, `v0`).
-    pub start: serde_json::Map<String, serde_json::Value>,
+    /// Further values for the JSON report (a ship's straight run `delta0_deg`, `v0`, and
+    /// its IMO criteria).
+    pub extra: serde_json::Map<String, serde_json::Value>,
     /// The report a person reads, one line each, metrics included.
     pub text: Vec<String>,
 }

@@ -78,6 +78,7 @@ pub type MakeDifferentiator = fn(&[f64]) -> Option<Box<dyn Differentiator>>;
 /// The derivative methods by name, with the options each takes.
 pub static DIFFERENTIATORS: &[(&str, &str, MakeDifferentiator)] = &[
     ("central", "", |o| o.is_empty().then(|| Box::new(CentralDifference) as Box<dyn Differentiator>)),
+    ("five-point", "", |o| o.is_empty().then(|| Box::new(super::FivePoint) as Box<dyn Differentiator>)),
     ("savitzky-golay", "[:WINDOW:ORDER] (default 11:3)", |o| match o {
         [] => Some(Box::new(super::SavitzkyGolay::default())),
         [w, q] if w.fract() == 0.0 && q.fract() == 0.0 && *w >= 1.0 && *q >= 1.0 => {

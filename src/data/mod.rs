@@ -5,6 +5,7 @@
 mod csv_io;
 mod dataset;
 mod derivative;
+mod five_point;
 mod kalman;
 mod prepare;
 mod resample;
@@ -14,6 +15,7 @@ mod smoothing_spline;
 
 pub use dataset::{Dataset, Delimiter, RunSpec};
 pub use derivative::{differentiator, CentralDifference, Differentiator, Smoothed, DIFFERENTIATORS};
+pub use five_point::FivePoint;
 pub use kalman::{KalmanSmoother, NoiseModel};
 pub use prepare::{prepare, Preparation};
 pub use resample::{check_gaps, interpolate_at, median_step, resample};

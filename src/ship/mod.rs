@@ -7,6 +7,7 @@ pub mod basin;
 #[cfg(feature = "plot")]
 pub mod figure;
 pub mod hypotheses;
+pub mod imo;
 pub mod manoeuvre;
 pub mod observed;
 pub mod plugin;

@@ -142,9 +142,9 @@ impl Scenario for ShipScenario {
         let run = ship.run(&self.manoeuvre, settings)?;
         let frame = ship.frame(&run.trajectory, "simulation").map_err(PluginError::failed)?;
         let metrics = serde_json::to_value(&run.metrics).map_err(PluginError::failed)?;
-        let mut start = serde_json::Map::new();
-        start.insert("delta0_deg".into(), run.start.delta0_deg.into());
-        start.insert("v0".into(), run.start.v0.into());
+        let mut extra = serde_json::Map::new();
+        extra.insert("delta0_deg".into(), run.start.delta0_deg.into());
+        extra.insert("v0".into(), run.start.v0.into());
         let mut text = vec![format!(
             "straight run: δ0 = {:.3}°, v0 = {:.5} m/s (u̇ residual {:.2e} m/s²); {} steps of {} s",
             run.start.delta0_deg,
@@ -172,7 +172,29 @@ impl Scenario for ShipScenario {
                 text.push(format!("  {:>8.1} {:>10.4} {:>6}", p.rudder_deg, p.yaw_rate_deg_s, p.branch));
             }
         }
-        Ok(Outcome { trajectory: run.trajectory, frame, metrics, start, text })
+        let imo = super::imo::criteria(&ship.spec, &self.manoeuvre, &run.metrics);
+        if !imo.is_empty() {
+            let lv = super::imo::length_over_speed(&ship.spec);
+            let scale = match ship.spec.full_scale_lpp {
+                Some(full) => format!("L/V = {lv:.1} s of the {full} m ship, Froude-scaled"),
+                None => format!("L/V = {lv:.2} s of this model; set [ship] full_scale_lpp for a ship's"),
+            };
+            text.push(format!("IMO MSC.137(76) ({scale}):"));
+            for c in &imo {
+                let verdict = match c.passed {
+                    Some(true) => "meets",
+                    Some(false) => "FAILS",
+                    None => "not reached",
+                };
+                let value = c.value.map_or("--".to_string(), |v| format!("{v:.2}"));
+                text.push(format!(
+                    "  {:<34} {value:>8} {} (limit {} {})  {verdict}",
+                    c.name, c.unit, c.limit, c.unit
+                ));
+            }
+            extra.insert("imo".into(), serde_json::to_value(&imo).map_err(PluginError::failed)?);
+        }
+        Ok(Outcome { trajectory: run.trajectory, frame, metrics, extra, text })
     }
 
     #[cfg(feature = "plot")]

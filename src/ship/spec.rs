@@ -41,6 +41,10 @@ pub struct ShipSpec {
     pub rudder_limit: f64,
     /// Approach speed, m/s.
     pub u0: f64,
+    /// Length of the full-scale ship a model represents, m (IMO's time-based criteria then
+    /// use its Froude-scaled L/V).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub full_scale_lpp: Option<f64>,
     /// State names the plug-in reads (defaults: u, v, r, ψ, x0, y0) and the rudder input (δ).
     #[serde(default)]
     pub names: ShipNames,
@@ -128,6 +132,12 @@ impl ShipSpec {
                     format!("must be a positive number, not {value}"),
                 ));
             }
+        }
+        if let Some(full) = spec.full_scale_lpp.filter(|v| !(v.is_finite() && *v > 0.0)) {
+            return Err(key_err(
+                &format!("{TABLE}.full_scale_lpp"),
+                format!("must be a positive length, not {full}"),
+            ));
         }
         let n = &spec.names;
         let declared = |name: &str| {

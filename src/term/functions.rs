@@ -23,6 +23,13 @@ pub static FUNCTIONS: &[Function] = &[
     Function { name: "cos", arity: 1, eval: |a| a[0].cos(), doc: "cosine (radians)" },
     Function { name: "tanh", arity: 1, eval: |a| a[0].tanh(), doc: "hyperbolic tangent" },
     Function { name: "exp", arity: 1, eval: |a| a[0].exp(), doc: "exponential" },
+    Function { name: "atan", arity: 1, eval: |a| a[0].atan(), doc: "arc tangent (radians)" },
+    Function {
+        name: "atan2",
+        arity: 2,
+        eval: |a| a[0].atan2(a[1]),
+        doc: "angle of the point (x, y) as atan2(y, x), radians in (−π, π], e.g. atan2(v, u) the drift angle",
+    },
 ];
 
 fn sign(x: f64) -> f64 {

@@ -36,6 +36,8 @@ fn accepts_the_papers_terms_and_canonicalises() {
         ("(u + v)^2/(u + v)", "u + v"),
         ("∆u*u", "u*Δu"),
         ("tanh(2*r)", "tanh(2*r)"),
+        ("atan2(v,u)*r", "r*atan2(v, u)"),
+        ("atan(2*δ)", "atan(2*δ)"),
     ] {
         assert_eq!(v.parse(text).unwrap().to_string(), canonical, "{text}");
     }
@@ -88,8 +90,9 @@ fn term_text() -> impl Strategy<Value = String> {
             (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("({a} - {b})")),
             (inner.clone(), -3i32..4).prop_map(|(a, k)| format!("({a})^{k}")),
             inner.clone().prop_map(|a| format!("-({a})")),
-            (prop::sample::select(vec!["abs", "sin", "cos", "tanh", "sign"]), inner)
+            (prop::sample::select(vec!["abs", "sin", "cos", "tanh", "sign", "atan"]), inner.clone())
                 .prop_map(|(f, a)| format!("{f}({a})")),
+            (inner.clone(), inner).prop_map(|(a, b)| format!("atan2({a}, {b})")),
         ]
     })
 }

@@ -104,7 +104,7 @@ pub struct IdentifyCommand {
     /// Regression back-end (settings beyond the defaults: a model file's `backend` table).
     #[arg(long, value_enum, default_value = "stepwise")]
     pub backend: BackendName,
-    /// Derivative method for `dX/dt` targets: central, savitzky-golay[:WINDOW:ORDER],
+    /// Derivative method for `dX/dt` targets: central, five-point, savitzky-golay[:WINDOW:ORDER],
     /// spline[:ALPHA] (GCV by default), kalman[:RATIO] (maximum likelihood by default), or for
     /// ship models `kinematic`: the tracking filter fusing track, heading, log and gyro.
     #[arg(long, default_value = "central")]
@@ -153,7 +153,8 @@ pub struct SimulateCommand {
     #[arg(long)]
     pub model: Option<PathBuf>,
     /// Ship models: zigzag:20/20[:port], turning:35, spiral[:MAX/STEP/HOLD], pullout:20,
-    /// replay:FILE.csv. Any model: replay:FILE.csv.
+    /// initial-turning[:10/10], replay:FILE.csv (IMO MSC.137(76) criteria are judged where
+    /// they apply). Any model: replay:FILE.csv.
     #[arg(long, short = 'm')]
     pub manoeuvre: Option<String>,
     /// Integrator: b8 (Oltmann's modified Euler, eq. B8) or rk4.

@@ -127,7 +127,7 @@ fn scenario_run(
             report.insert("manoeuvre".into(), scenario.label().into());
             report.insert("integrator".into(), cmd.integrator.name().into());
             report.insert("dt".into(), cmd.dt.into());
-            report.extend(run.start.clone());
+            report.extend(run.extra.clone());
             report.insert("metrics".into(), run.metrics.clone());
             report.insert(
                 "monte_carlo".into(),

@@ -5,7 +5,7 @@
 use serde::Serialize;
 
 use super::zigzag::RudderOnly;
-use super::{Servo, Ship, StraightRun};
+use super::{Servo, Ship, ShipError, StraightRun};
 use crate::sim::{Controller, Trajectory};
 
 /// A pull-out manoeuvre.
@@ -78,5 +78,34 @@ impl PullOut {
             residual_yaw_rate_deg_s: r[r.len() - 1].to_degrees(),
             decay_time_s: decay,
         }
+    }
+}
+
+impl super::Test for PullOut {
+    type Metrics = PullOutMetrics;
+
+    /// `pullout:RUDDER`, e.g. `pullout:20`.
+    fn parse(text: &str, rest: &str) -> Result<Self, ShipError> {
+        Ok(PullOut { rudder_deg: super::parse_num(text, rest, "rudder angle")?, ..PullOut::default() })
+    }
+
+    fn label(&self) -> String {
+        format!("pull-out from δ = {}°", self.rudder_deg)
+    }
+
+    fn default_duration(&self) -> f64 {
+        self.turn_s + self.after_s
+    }
+
+    fn largest_rudder_deg(&self) -> Option<f64> {
+        Some(self.rudder_deg.abs())
+    }
+
+    fn controller(&self, ship: &Ship, start: &StraightRun) -> Result<Box<dyn Controller>, ShipError> {
+        Ok(Box::new(PullOut::controller(self, ship, start)))
+    }
+
+    fn metrics(&self, ship: &Ship, run: &Trajectory) -> PullOutMetrics {
+        PullOut::metrics(self, ship, run)
     }
 }

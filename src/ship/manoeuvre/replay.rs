@@ -30,3 +30,43 @@ impl Replayed {
         Ok(Replay::new(&self.frame, &ship.system.inputs)?)
     }
 }
+
+/// A replay has no metrics of its own (`validate` reads a recording's).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct NoMetrics;
+
+impl super::Test for Replayed {
+    type Metrics = NoMetrics;
+
+    /// `replay:FILE.csv`.
+    fn parse(text: &str, rest: &str) -> Result<Self, ShipError> {
+        if rest.is_empty() {
+            return Err(ShipError::Manoeuvre { text: text.into(), message: "write replay:FILE.csv".into() });
+        }
+        Replayed::read(rest)
+    }
+
+    fn label(&self) -> String {
+        format!("replay of {}", self.frame.origin())
+    }
+
+    fn default_duration(&self) -> f64 {
+        self.duration()
+    }
+
+    fn largest_rudder_deg(&self) -> Option<f64> {
+        None
+    }
+
+    fn controller(
+        &self,
+        ship: &Ship,
+        _start: &super::StraightRun,
+    ) -> Result<Box<dyn crate::sim::Controller>, ShipError> {
+        Ok(Box::new(Replayed::controller(self, ship)?))
+    }
+
+    fn metrics(&self, _ship: &Ship, _run: &crate::sim::Trajectory) -> NoMetrics {
+        NoMetrics
+    }
+}

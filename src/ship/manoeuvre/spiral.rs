@@ -7,7 +7,7 @@
 use serde::Serialize;
 
 use super::zigzag::RudderOnly;
-use super::{Servo, Ship, StraightRun};
+use super::{Servo, Ship, ShipError, StraightRun};
 use crate::sim::{Controller, Trajectory};
 
 /// A spiral test.
@@ -130,5 +130,48 @@ impl Controller for SpiralControl {
     fn input(&mut self, t: f64, _x: &[f64], out: &mut [f64]) {
         let k = ((t / self.hold) as usize).min(self.angles.len() - 1);
         out[0] = self.servo.step(t, self.angles[k]);
+    }
+}
+
+impl super::Test for Spiral {
+    type Metrics = SpiralMetrics;
+
+    /// `spiral` or `spiral:MAX/STEP/HOLD` (largest rudder °, step °, hold s).
+    fn parse(text: &str, rest: &str) -> Result<Self, ShipError> {
+        let bad = |m: &str| ShipError::Manoeuvre { text: text.into(), message: m.into() };
+        let mut s = Spiral::default();
+        if !rest.is_empty() {
+            let v: Vec<&str> = rest.split('/').collect();
+            if v.len() != 3 {
+                return Err(bad("write spiral:MAX/STEP/HOLD, e.g. spiral:20/2/120"));
+            }
+            s.max_deg = super::parse_num(text, v[0], "largest rudder angle")?;
+            s.step_deg = super::parse_num(text, v[1], "rudder step")?;
+            s.hold_s = super::parse_num(text, v[2], "hold time")?;
+            if s.max_deg <= 0.0 || s.step_deg <= 0.0 || s.hold_s <= 0.0 || s.max_deg / s.step_deg > 200.0 {
+                return Err(bad("largest angle, step and hold must be positive, with at most 200 steps"));
+            }
+        }
+        Ok(s)
+    }
+
+    fn label(&self) -> String {
+        format!("spiral ±{}° in {}° steps, {} s each", self.max_deg, self.step_deg, self.hold_s)
+    }
+
+    fn default_duration(&self) -> f64 {
+        self.duration()
+    }
+
+    fn largest_rudder_deg(&self) -> Option<f64> {
+        Some(self.max_deg)
+    }
+
+    fn controller(&self, ship: &Ship, start: &StraightRun) -> Result<Box<dyn Controller>, ShipError> {
+        Ok(Box::new(Spiral::controller(self, ship, start)))
+    }
+
+    fn metrics(&self, ship: &Ship, run: &Trajectory) -> SpiralMetrics {
+        Spiral::metrics(self, ship, run)
     }
 }

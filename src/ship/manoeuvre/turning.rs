@@ -5,7 +5,7 @@
 use serde::Serialize;
 
 use super::zigzag::RudderOnly;
-use super::{Servo, Ship, StraightRun};
+use super::{Servo, Ship, ShipError, StraightRun};
 use crate::sim::{Controller, Trajectory};
 
 /// A turning circle.
@@ -99,5 +99,34 @@ impl TurningCircle {
             yaw_rate_deg_s: r_end.to_degrees(),
             direction: if sign > 0.0 { "starboard".into() } else { "port".into() },
         }
+    }
+}
+
+impl super::Test for TurningCircle {
+    type Metrics = TurningMetrics;
+
+    /// `turning:RUDDER`, e.g. `turning:35` (negative: to the other side).
+    fn parse(text: &str, rest: &str) -> Result<Self, ShipError> {
+        Ok(TurningCircle { rudder_deg: super::parse_num(text, rest, "rudder angle")? })
+    }
+
+    fn label(&self) -> String {
+        format!("turning circle δ = {}°", self.rudder_deg)
+    }
+
+    fn default_duration(&self) -> f64 {
+        200.0
+    }
+
+    fn largest_rudder_deg(&self) -> Option<f64> {
+        Some(self.rudder_deg.abs())
+    }
+
+    fn controller(&self, ship: &Ship, start: &StraightRun) -> Result<Box<dyn Controller>, ShipError> {
+        Ok(Box::new(TurningCircle::controller(self, ship, start)))
+    }
+
+    fn metrics(&self, ship: &Ship, run: &Trajectory) -> TurningMetrics {
+        TurningCircle::metrics(self, ship, run)
     }
 }

@@ -5,7 +5,7 @@
 
 use serde::Serialize;
 
-use super::{Servo, Ship, StraightRun};
+use super::{Servo, Ship, ShipError, StraightRun};
 use crate::sim::{Controller, Trajectory};
 
 /// A zigzag manoeuvre.
@@ -153,5 +153,58 @@ impl<C: Controller> Controller for RudderOnly<C> {
     }
     fn done(&self, t: f64, x: &[f64]) -> bool {
         self.inner.done(t, x)
+    }
+}
+
+impl super::Test for ZigZag {
+    type Metrics = ZigZagMetrics;
+
+    /// `zigzag:RUDDER/HEADING[:port]`, e.g. `zigzag:20/20`, `zigzag:20/10:port`.
+    fn parse(text: &str, rest: &str) -> Result<Self, ShipError> {
+        let bad = |m: &str| ShipError::Manoeuvre { text: text.into(), message: m.into() };
+        let mut parts = rest.split(':');
+        let angles = parts.next().unwrap_or("");
+        let (d, p) =
+            angles.split_once('/').ok_or_else(|| bad("write zigzag:RUDDER/HEADING, e.g. zigzag:20/20"))?;
+        let side = parts.next().unwrap_or("starboard");
+        let starboard_first = match side {
+            "starboard" | "stb" | "s" => true,
+            "port" | "p" => false,
+            _ => return Err(bad("the side is `starboard` or `port`")),
+        };
+        let z = ZigZag {
+            rudder_deg: super::parse_num(text, d, "rudder angle")?,
+            heading_deg: super::parse_num(text, p, "heading change")?,
+            starboard_first,
+        };
+        if z.rudder_deg <= 0.0 || z.heading_deg <= 0.0 {
+            return Err(bad("rudder angle and heading change are positive; choose the side with `:port`"));
+        }
+        Ok(z)
+    }
+
+    fn label(&self) -> String {
+        format!(
+            "zigzag {}°/{}° {}",
+            self.rudder_deg,
+            self.heading_deg,
+            if self.starboard_first { "starboard" } else { "port" }
+        )
+    }
+
+    fn default_duration(&self) -> f64 {
+        100.0
+    }
+
+    fn largest_rudder_deg(&self) -> Option<f64> {
+        Some(self.rudder_deg)
+    }
+
+    fn controller(&self, ship: &Ship, start: &StraightRun) -> Result<Box<dyn Controller>, ShipError> {
+        Ok(Box::new(ZigZag::controller(self, ship, start)))
+    }
+
+    fn metrics(&self, ship: &Ship, run: &Trajectory) -> ZigZagMetrics {
+        ZigZag::metrics(self, ship, run)
     }
 }

@@ -257,7 +257,8 @@ fn metric_line(m: &Metrics) -> String {
                 .join(" / ")
         ),
         Metrics::PullOut(p) => format!("residual yaw rate {:.4} °/s", p.residual_yaw_rate_deg_s),
-        Metrics::Replay => String::new(),
+        // replays and manoeuvres the paper does not run have no line of their own
+        _ => String::new(),
     }
 }
 
