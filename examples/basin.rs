@@ -96,11 +96,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .collect();
     println!("| back-end | derivative method | states smoothed | coefficient error u̇ / v̇ / ṙ | held-out ψ RMS [°] | 1st overshoot [°] (true {true_overshoot:.2}) | {} |", turn_heads.join(" | "));
     println!("|---|---|---|---|---|---|{}", "---|".repeat(TURNS.len()));
-    let mut model = truth.clone();
     // measured runs: u0 from each run's approach, not its first (noisy) sample
-    if let Some(p) = model.spec.parameters.get_mut("u0") {
-        p.per_run = Some("mean:u:4".into());
-    }
+    let model = truth.edit(|file| {
+        if let Some(p) = file.parameters.get_mut("u0") {
+            p.per_run = Some("mean:u:4".into());
+        }
+    })?;
     let text = model.to_toml();
     // no intercept: the model's u² terms carry the constant asymmetry, and at u ≈ u0 an
     // intercept is nearly the same column (with it the fits become ill-conditioned)
@@ -124,28 +125,35 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ("best-subset", "kalman", true, false),
         ("sparse", "kalman", true, false),
     ] {
-        let mut model = Model::parse(&text, "basin model")?;
-        for e in model.equations.iter_mut().filter(|e| e.identify) {
-            if backend == "true-terms" {
-                // the true structure forced in: what noise does to the coefficients alone
-                let terms: Vec<_> = truth
-                    .equation(&e.name)
-                    .map(|t| t.coefficients.iter().map(|c| c.0.clone()).collect())
-                    .unwrap_or_default();
-                e.candidates = terms.clone();
-                e.forced = terms;
-                e.excluded.clear();
-            } else if backend == "stepwise, u²δ² forced" {
-                // the propeller's asymmetry in the rudder angle, forced in v̇ and ṙ as the
-                // paper forces it in u̇ (a single-screw ship has it)
-                let t = model.vocabulary.parse("u^2*δ^2")?;
-                if e.name != "u_dot" && e.candidates.contains(&t) && !e.forced.contains(&t) {
-                    e.forced.push(t);
+        let parsed = Model::parse(&text, "basin model")?;
+        let rudder_asymmetry = parsed.vocabulary.parse("u^2*δ^2")?;
+        let same = |text: &str, t: &termid::term::Term| parsed.vocabulary.parse(text).is_ok_and(|p| p == *t);
+        let model = parsed.edit(|file| {
+            for (name, e) in file.equations.iter_mut().filter(|(_, e)| e.identify) {
+                if backend == "true-terms" {
+                    // the true structure forced in: what noise does to the coefficients alone
+                    let terms: Vec<String> = truth
+                        .equation(name)
+                        .map(|t| t.coefficients.iter().map(|c| c.0.to_string()).collect())
+                        .unwrap_or_default();
+                    e.candidates = terms.clone();
+                    e.forced = terms;
+                    e.excluded.clear();
+                } else if backend == "stepwise, u²δ² forced" {
+                    // the propeller's asymmetry in the rudder angle, forced in v̇ and ṙ as the
+                    // paper forces it in u̇ (a single-screw ship has it)
+                    let t = &rudder_asymmetry;
+                    let candidate = e.candidates.iter().find(|c| same(c, t)).cloned();
+                    if let Some(c) =
+                        candidate.filter(|_| name != "u_dot" && !e.forced.iter().any(|f| same(f, t)))
+                    {
+                        e.forced.push(c);
+                    }
+                } else {
+                    e.backend = Backend::by_name(backend.trim_end_matches(" + output error")).ok();
                 }
-            } else {
-                e.backend = Backend::by_name(backend.trim_end_matches(" + output error"))?;
             }
-        }
+        })?;
         let frames: Vec<Frame> =
             if exact { train.iter().map(|(_, r)| r.truth.clone()).collect() } else { frames.clone() };
         let method: Box<dyn Differentiator> = match spec.strip_prefix("kalman*") {

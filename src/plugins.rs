@@ -10,7 +10,7 @@ pub static PLUGINS: &[&dyn Plugin] = &[&crate::ship::plugin::Manoeuvring];
 
 /// The plug-in whose table `model` has.
 pub fn of(model: &Model) -> Option<&'static dyn Plugin> {
-    PLUGINS.iter().copied().find(|p| model.spec.plugins.contains_key(p.table()))
+    PLUGINS.iter().copied().find(|p| model.spec().plugins.contains_key(p.table()))
 }
 
 /// The plug-in that adds derivative method `name`.
@@ -27,7 +27,7 @@ pub fn default_model() -> Model {
 /// pass that plug-in's checks. `file` names it in errors.
 pub fn parse(text: &str, file: &str) -> Result<Model, ModelError> {
     let model = Model::parse(text, file)?;
-    for table in model.spec.plugins.keys() {
+    for table in model.spec().plugins.keys() {
         let Some(plugin) = PLUGINS.iter().find(|p| p.table() == table) else {
             let known: Vec<String> = PLUGINS.iter().map(|p| format!("[{}]", p.table())).collect();
             return Err(ModelError::Key {

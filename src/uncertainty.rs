@@ -37,7 +37,7 @@ impl Normal {
 
 /// Which equations a draw can perturb: those with a stored covariance.
 pub fn uncertain_equations(model: &Model) -> Vec<String> {
-    model.equations.iter().filter(|e| e.covariance.is_some()).map(|e| e.name.clone()).collect()
+    model.equations().iter().filter(|e| e.covariance.is_some()).map(|e| e.name.clone()).collect()
 }
 
 /// Draws models whose coefficients come from N(b, τΣ) equation by equation (b the stored
@@ -53,7 +53,7 @@ impl<'m> Sampler<'m> {
     /// Prepares draws from `model`'s stored covariances.
     pub fn new(model: &'m Model) -> Sampler<'m> {
         let roots = model
-            .equations
+            .equations()
             .iter()
             .filter_map(|eq| {
                 let c = eq.covariance.as_ref()?;

@@ -75,7 +75,7 @@ fn lorenz_run(model: &Model) -> Frame {
     let system = termid::sim::System::new(model, &Default::default(), false).expect("lorenz compiles");
     let settings =
         termid::sim::Settings { integrator: termid::sim::Integrator::Rk4, dt: 0.01, duration: 1.0, sample: 0.01 };
-    let x0: Vec<f64> = model.spec.states.iter().map(|s| s.initial).collect();
+    let x0: Vec<f64> = model.spec().states.iter().map(|s| s.initial).collect();
     let traj = termid::sim::simulate(&system, &x0, &mut termid::sim::Constant(vec![]), &settings).expect("runs");
     traj.to_frame("lorenz", "t").expect("a frame")
 }

@@ -96,7 +96,7 @@ impl Runs {
         let units = states
             .iter()
             .map(|(_, s)| {
-                model.spec.states.iter().find(|t| &t.name == s).map_or(String::new(), |t| t.unit.clone())
+                model.spec().states.iter().find(|t| &t.name == s).map_or(String::new(), |t| t.unit.clone())
             })
             .collect();
         let x0 = frames
@@ -107,7 +107,7 @@ impl Runs {
                     .iter()
                     .map(|s| {
                         f.column(s).map_or_else(
-                            || model.spec.states.iter().find(|t| &t.name == s).map_or(0.0, |t| t.initial),
+                            || model.spec().states.iter().find(|t| &t.name == s).map_or(0.0, |t| t.initial),
                             |c| c[0],
                         )
                     })

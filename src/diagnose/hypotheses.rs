@@ -97,13 +97,13 @@ impl Hypothesis {
 }
 
 fn input_index(model: &Model, input: &str) -> Option<usize> {
-    model.spec.inputs.iter().position(|i| i.name == input)
+    model.spec().inputs.iter().position(|i| i.name == input)
 }
 
 /// The generic library for a model.
 pub fn generic_hypotheses(model: &Model) -> Vec<Hypothesis> {
     let mut out = Vec::new();
-    for eq in model.equations.iter().filter(|e| e.identify) {
+    for eq in model.equations().iter().filter(|e| e.identify) {
         out.push(Hypothesis {
             name: format!("constant in {}", eq.name),
             effect: Effect::Terms { terms: vec![(eq.name.clone(), "1".into())] },
@@ -117,7 +117,7 @@ pub fn generic_hypotheses(model: &Model) -> Vec<Hypothesis> {
             }
         }
     }
-    for i in &model.spec.inputs {
+    for i in &model.spec().inputs {
         out.push(Hypothesis {
             name: format!("offset on input {}", i.name),
             effect: Effect::InputOffset { input: i.name.clone() },

@@ -219,7 +219,7 @@ pub fn diagnose(
             let m = fit::apply(model, h, &theta)?;
             let after = data.simulate(&m, &h.input_offsets(&theta, model), &h.input_scales(&theta, model))?;
             let mut m = m;
-            m.spec.model.notes.push(format!(
+            m.add_note(format!(
                 "termid diagnose added {} ({}), explaining {:.0} % of the gap (ΔBIC {:.1})",
                 candidates[w].name,
                 candidates[w].estimate.iter().map(|v| format!("{v:.6}")).collect::<Vec<_>>().join(", "),

@@ -33,7 +33,7 @@ pub struct Refined {
 /// Refines every coefficient of the model's identified equations against `runs`.
 pub fn refine(model: &Model, runs: &Runs) -> Result<Refined, DiagnoseError> {
     let entries: Vec<(String, String, f64)> = model
-        .equations
+        .equations()
         .iter()
         .filter(|e| e.identify)
         .flat_map(|e| e.coefficients.iter().map(|(t, v, _)| (e.name.clone(), t.to_string(), *v)))
@@ -55,7 +55,7 @@ pub fn refine(model: &Model, runs: &Runs) -> Result<Refined, DiagnoseError> {
     let widen = tau.unwrap_or(1.0).max(1.0);
     let std_errors: Vec<f64> = fit.std_errors().iter().map(|s| s * widen.sqrt()).collect();
     let mut k = 0;
-    for e in model.equations.iter().filter(|e| e.identify) {
+    for e in model.equations().iter().filter(|e| e.identify) {
         let first = k;
         let eq = refined.equation(&e.name).ok_or_else(|| DiagnoseError::Setup(e.name.clone()))?;
         let intercept = eq.intercept;

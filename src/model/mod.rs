@@ -117,18 +117,69 @@ impl Equation {
 
 /// A loaded, checked model.
 #[derive(Clone, Debug)]
+///
+/// The file ([`Model::spec`]) is the one source of truth; the checked equations are derived
+/// from it when it is read, and every change goes through a method that keeps both in step
+/// ([`Model::set_coefficients`], [`Model::set_covariance`], [`Model::set_parameter`],
+/// [`Model::set_plugin_table`], [`Model::edit`] for anything else).
 pub struct Model {
     /// Where it came from.
     pub path: String,
     /// The parsed file.
-    pub spec: ModelFile,
+    spec: ModelFile,
     /// Names usable in terms.
     pub vocabulary: Vocabulary,
     /// The equations, in the order of the states they integrate.
-    pub equations: Vec<Equation>,
+    equations: Vec<Equation>,
 }
 
 impl Model {
+    /// The model file as read (and as changed through the setters).
+    pub fn spec(&self) -> &ModelFile {
+        &self.spec
+    }
+
+    /// The checked equations, in the order of the states they integrate.
+    pub fn equations(&self) -> &[Equation] {
+        &self.equations
+    }
+
+    /// The model with its file edited by `change` and checked again as a file is (errors
+    /// located in the edited file's text).
+    pub fn edit(&self, change: impl FnOnce(&mut ModelFile)) -> Result<Model, ModelError> {
+        let mut spec = self.spec.clone();
+        change(&mut spec);
+        let text = toml::to_string_pretty(&spec)
+            .map_err(|e| ModelError::Syntax { file: self.path.clone(), message: e.to_string() })?;
+        Model::from_spec(spec, &text, &self.path)
+    }
+
+    /// Sets a parameter's value (`false`: the model has no such parameter).
+    pub fn set_parameter(&mut self, name: &str, value: f64) -> bool {
+        match self.spec.parameters.get_mut(name) {
+            Some(p) => {
+                p.value = value;
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Sets a plug-in's table (the plug-in checks what it reads).
+    pub fn set_plugin_table(&mut self, name: &str, table: toml::Value) {
+        self.spec.plugins.insert(name.into(), table);
+    }
+
+    /// Adds a note to the file's `[model] notes` (kept on write).
+    pub fn add_note(&mut self, note: String) {
+        self.spec.model.notes.push(note);
+    }
+
+    /// Sets the file's provenance line (`[model] provenance`).
+    pub fn set_provenance(&mut self, provenance: String) {
+        self.spec.model.provenance = provenance;
+    }
+
     /// Reads and checks a model file. Plug-in tables (`[ship]`) are kept unread:
     /// `crate::plugins::load` also checks them.
     pub fn load(path: &Path) -> Result<Model, ModelError> {

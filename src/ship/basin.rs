@@ -102,12 +102,17 @@ pub fn at_approach_speed(model: &Model, u0: f64) -> Model {
         ship.u0 = u0;
         ship.store(&mut m);
     }
-    for p in m.spec.parameters.values_mut() {
-        let reads_surge =
-            p.per_run.as_deref().is_some_and(|rule| rule.split(':').nth(1) == Some(surge.as_str()));
-        if reads_surge {
-            p.value = u0;
-        }
+    let reading_surge: Vec<String> = m
+        .spec()
+        .parameters
+        .iter()
+        .filter(|(_, p)| {
+            p.per_run.as_deref().is_some_and(|rule| rule.split(':').nth(1) == Some(surge.as_str()))
+        })
+        .map(|(name, _)| name.clone())
+        .collect();
+    for name in reading_surge {
+        m.set_parameter(&name, u0);
     }
     m
 }

@@ -87,7 +87,7 @@ impl Default for ShipNames {
 impl ShipSpec {
     /// The model's `[ship]` table, as written (`None`: not a ship model).
     pub fn of(model: &Model) -> Result<Option<ShipSpec>, ShipError> {
-        let Some(table) = model.spec.plugins.get(TABLE) else { return Ok(None) };
+        let Some(table) = model.spec().plugins.get(TABLE) else { return Ok(None) };
         let spec = ShipSpec::deserialize(table.clone())
             .map_err(|e| ShipError::Model(format!("{}: [{TABLE}]: {}", model.path, e.message())))?;
         Ok(Some(spec))
@@ -96,7 +96,7 @@ impl ShipSpec {
     /// Writes these particulars back into the model's `[ship]` table.
     pub fn store(&self, model: &mut Model) {
         if let Ok(value) = toml::Value::try_from(self) {
-            model.spec.plugins.insert(TABLE.into(), value);
+            model.set_plugin_table(TABLE, value);
         }
     }
 
@@ -109,7 +109,7 @@ impl ShipSpec {
             key: key.into(),
             message,
         };
-        if !model.spec.plugins.contains_key(TABLE) {
+        if !model.spec().plugins.contains_key(TABLE) {
             return Ok(());
         }
         // read from the text itself, so that toml's message carries the line and column
@@ -142,8 +142,8 @@ impl ShipSpec {
         let n = &spec.names;
         let declared = |name: &str| {
             let name = model.vocabulary.canonical(name).unwrap_or_else(|| name.to_string());
-            model.spec.states.iter().any(|s| s.name == name)
-                || model.spec.inputs.iter().any(|i| i.name == name)
+            model.spec().states.iter().any(|s| s.name == name)
+                || model.spec().inputs.iter().any(|i| i.name == name)
         };
         for (role, name) in [
             ("u", &n.u),

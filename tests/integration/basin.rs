@@ -328,7 +328,7 @@ fn runs_are_resimulated_at_their_own_approach_speed() {
     use termid::diagnose::Runs;
     use termid::sim::Integrator;
     let basin = Basin::default();
-    let mut model = termid::ship::default_model();
+    let model = termid::ship::default_model();
     let rec = basin
         .record(&model, &Manoeuvre::parse("zigzag:20/20").unwrap(), 0.95 * 2.010, 60.0, 1, "slow")
         .unwrap();
@@ -338,10 +338,11 @@ fn runs_are_resimulated_at_their_own_approach_speed() {
         gap.states.iter().find(|s| s.0 == "u").unwrap().2
     };
     // the file's u0 (2.010) for a run that approached at 1.91 m/s: the surge balance is off
-    model.spec.parameters.get_mut("u0").unwrap().per_run = None;
-    let fixed = surge_rms(&model);
-    model.spec.parameters.get_mut("u0").unwrap().per_run = Some("mean:u:4".into());
-    let own = surge_rms(&model);
+    let per_run = |rule: Option<&str>| {
+        model.edit(|file| file.parameters.get_mut("u0").unwrap().per_run = rule.map(String::from)).unwrap()
+    };
+    let fixed = surge_rms(&per_run(None));
+    let own = surge_rms(&per_run(Some("mean:u:4")));
     // what remains is the replay of a rudder sampled at 20 Hz
     assert!(own < 1e-3 && fixed > 100.0 * own, "u RMS {own} at the run's u0, {fixed} at the file's");
 }

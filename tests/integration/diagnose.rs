@@ -110,7 +110,7 @@ fn names_the_papers_missing_asymmetry() {
     assert!(heading_shrink(&d) >= 0.8, "heading gap shrank by {}", heading_shrink(&d));
     // the new model carries the effect and says where it came from
     let m = d.model.as_ref().unwrap();
-    assert!(m.spec.model.notes.iter().any(|n| n.contains("termid diagnose added")));
+    assert!(m.spec().model.notes.iter().any(|n| n.contains("termid diagnose added")));
     assert_ne!(m.equation("r_dot").unwrap().coefficients, model.equation("r_dot").unwrap().coefficients);
 }
 
@@ -154,8 +154,9 @@ fn names_a_missing_cubic_term() {
 fn noise_does_not_change_the_verdict() {
     // each run is simulated at its own u0; from noisy records that is the mean over the first
     // seconds, not the first (noisy) sample the paper's exact data allow
-    let mut model = termid::ship::default_model();
-    model.spec.parameters.get_mut("u0").unwrap().per_run = Some("mean:u:2".into());
+    let model = termid::ship::default_model()
+        .edit(|file| file.parameters.get_mut("u0").unwrap().per_run = Some("mean:u:2".into()))
+        .unwrap();
     let d = run(&model, &hidden_rudder_error(1.5f64.to_radians(), 1.0, true));
     let w = &d.candidates[d.winner.expect("an effect")];
     assert_eq!(w.name, "rudder zero offset");
@@ -230,7 +231,10 @@ fn command_on_a_generic_model() {
     assert!(svg.join("diagnose_run0.svg").exists() && svg.join("diagnose_run1.svg").exists());
     assert!(termid::plugins::load(&new_model).is_ok());
     // the original is untouched: it still has no offset and reloads as before
-    assert_eq!(termid::plugins::load(std::path::Path::new("models/duffing.toml")).unwrap().spec, model.spec);
+    assert_eq!(
+        termid::plugins::load(std::path::Path::new("models/duffing.toml")).unwrap().spec(),
+        model.spec()
+    );
 }
 
 /// Output-error refinement on a generic model: coefficients 20 % off (as a regression on

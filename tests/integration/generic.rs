@@ -13,7 +13,7 @@ use crate::common::termid;
 fn lorenz_run() -> (Model, Frame) {
     let m = termid::plugins::load(std::path::Path::new("models/lorenz.toml")).unwrap();
     let system = System::new(&m, &BTreeMap::new(), false).unwrap();
-    let x0: Vec<f64> = m.spec.states.iter().map(|s| s.initial).collect();
+    let x0: Vec<f64> = m.spec().states.iter().map(|s| s.initial).collect();
     let s = Settings { integrator: Integrator::Rk4, dt: 0.001, duration: 10.0, sample: 0.001 };
     let traj = simulate(&system, &x0, &mut Constant(vec![]), &s).unwrap();
     let f = traj.to_frame("lorenz", "t").unwrap();
@@ -21,7 +21,7 @@ fn lorenz_run() -> (Model, Frame) {
 }
 
 fn check(m: &Model, frames: &[Frame], target: fn(&str) -> Option<Target>, rel: f64) {
-    for eq in &m.equations {
+    for eq in m.equations() {
         let fit = fit_equation(m, &eq.name, frames, &CentralDifference, false, target(&eq.state)).unwrap();
         let mut got: Vec<(String, f64)> =
             fit.selection.terms.iter().map(|t| (t.term.clone(), t.coefficient)).collect();
@@ -49,7 +49,7 @@ fn lorenz_identified_exactly_from_exact_derivatives() {
 fn a_compiled_design_fits_as_a_fresh_one_and_only_its_own_equation() {
     let (m, f) = lorenz_run();
     let frames = [f];
-    for eq in &m.equations {
+    for eq in m.equations() {
         let design = equation_design(&m, &eq.name).unwrap();
         let fresh = fit_equation(&m, &eq.name, &frames, &CentralDifference, false, None).unwrap();
         let again =
@@ -58,7 +58,7 @@ fn a_compiled_design_fits_as_a_fresh_one_and_only_its_own_equation() {
         assert_eq!(fresh.selection, again.selection, "{}", eq.name);
         assert_eq!(fresh.candidates, again.candidates);
     }
-    let eq = &m.equations[0];
+    let eq = &m.equations()[0];
     let fewer = Design::new(&eq.candidates[..3], &m.vocabulary).unwrap();
     let err = fit_equation_design(&m, &eq.name, Some(&fewer), &frames, &CentralDifference, false, None)
         .unwrap_err();

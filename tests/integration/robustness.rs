@@ -130,7 +130,7 @@ fn lorenz_run(model: &Model) -> Frame {
         duration: 2.0,
         sample: 0.01,
     };
-    let x0: Vec<f64> = model.spec.states.iter().map(|s| s.initial).collect();
+    let x0: Vec<f64> = model.spec().states.iter().map(|s| s.initial).collect();
     let traj = termid::sim::simulate(&system, &x0, &mut termid::sim::Constant(vec![]), &settings).unwrap();
     traj.to_frame("lorenz", "t").unwrap()
 }

@@ -25,7 +25,7 @@ struct Entry {
 
 pub fn run(cmd: CompareCommand) -> Result<()> {
     let model = crate::simulate::load_model(&cmd.model)?;
-    let time = model.spec.model.time.clone();
+    let time = model.spec().model.time.clone();
     let frames = crate::runs::load_for(&model, &cmd.data, cmd.dataset.as_deref())?;
     let equations: Vec<String> =
         if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };
@@ -39,18 +39,18 @@ pub fn run(cmd: CompareCommand) -> Result<()> {
         .collect::<Result<Vec<_>>>()?;
     let mut entries = Vec::new();
     for name in Backend::NAMES {
-        let mut m = model.clone();
+        // the model file's own settings for its back-end, defaults for the others
+        let mut m = model.edit(|file| {
+            for eq in &equations {
+                if let Some(e) = file.equations.get_mut(eq) {
+                    if e.backend.as_ref().map_or("stepwise", Backend::name) != *name {
+                        e.backend = Backend::by_name(name).ok();
+                    }
+                }
+            }
+        })?;
         let mut fits = Vec::new();
         for (eq, design) in equations.iter().zip(&designs) {
-            let e = m
-                .equations
-                .iter_mut()
-                .find(|e| &e.name == eq)
-                .with_context(|| format!("no equation `{eq}`"))?;
-            // the model file's own settings for its back-end, defaults for the others
-            if e.backend.name() != *name {
-                e.backend = Backend::by_name(name)?;
-            }
             // warm-up fits for `warm_up` seconds (at least one), then the median of `repeat`
             // timed fits (data already loaded)
             let fit_once =
@@ -89,7 +89,7 @@ pub fn run(cmd: CompareCommand) -> Result<()> {
 /// Replays the recorded inputs from the recorded initial state; RMS and max error per state.
 fn resimulate(model: &termid::model::Model, run: &Frame, dt: f64) -> Result<StateErrors> {
     // the replay starts from the recorded state, so every state must have been measured
-    for s in &model.spec.states {
+    for s in &model.spec().states {
         run.require(&s.name)?;
     }
     let runs = Runs::new(model, std::slice::from_ref(run), dt, Integrator::ModifiedEuler)?;

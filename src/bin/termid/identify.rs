@@ -218,7 +218,7 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
     let states: Vec<String> =
         names.iter().filter_map(|n| model.equation(n).map(|e| e.state.clone())).collect();
     let units: BTreeMap<String, String> =
-        model.spec.states.iter().map(|s| (s.name.clone(), s.unit.clone())).collect();
+        model.spec().states.iter().map(|s| (s.name.clone(), s.unit.clone())).collect();
     let diff = derivative_method(&cmd)?;
     let frames = prepare_runs(&cmd, frames, &states, Some(&model), diff.as_ref(), &|name| {
         let unit = units.get(name).cloned().unwrap_or_default();
@@ -258,11 +258,12 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
         None => (None, None),
     };
     if let Some(out) = &cmd.out {
-        model.spec.model.provenance = format!(
+        let provenance = format!(
             "identified by termid from {} ({})",
             cmd.data.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "),
-            model.spec.model.provenance
+            model.spec().model.provenance
         );
+        model.set_provenance(provenance);
         termid::output::write_file(out, model.to_toml().as_bytes())?;
     }
     if let Some(e) = refine_error {
@@ -308,7 +309,7 @@ fn refine_states(list: &str, model: &termid::model::Model) -> Result<Option<Vec<
     if list.trim() == "all" {
         return Ok(None);
     }
-    let known: Vec<&str> = model.spec.states.iter().map(|s| s.name.as_str()).collect();
+    let known: Vec<&str> = model.spec().states.iter().map(|s| s.name.as_str()).collect();
     let names: Vec<String> =
         list.split(',').map(str::trim).filter(|n| !n.is_empty()).map(String::from).collect();
     if names.is_empty() {

@@ -22,7 +22,7 @@ pub fn load_for(model: &Model, data: &[PathBuf], dataset: Option<&Path>) -> Resu
             );
         }
     }
-    let frames = load(data, dataset, &model.spec.model.time)?;
+    let frames = load(data, dataset, &model.spec().model.time)?;
     for f in &frames {
         model.check_kinematics(f)?;
     }

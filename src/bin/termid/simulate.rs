@@ -50,16 +50,12 @@ fn set_parameters(model: &mut Model, params: &[String]) -> Result<()> {
         let (name, value) = p.split_once('=').with_context(|| format!("--param `{p}` must be NAME=VALUE"))?;
         let (name, text) = (name.trim(), value.trim());
         let value = finite(text, || format!("--param `{p}`"))?;
-        let mut known = false;
-        if let Some(spec) = model.spec.parameters.get_mut(name) {
-            spec.value = value;
-            known = true;
-        }
+        let mut known = model.set_parameter(name, value);
         if let Some(plugin) = termid::plugins::of(model) {
             known |= plugin.set_parameter(model, name, value)?;
         }
         if !known {
-            let names: Vec<&str> = model.spec.parameters.keys().map(String::as_str).collect();
+            let names: Vec<&str> = model.spec().parameters.keys().map(String::as_str).collect();
             bail!(
                 "--param {name}: not a parameter of {} (parameters: {})",
                 model.path,
@@ -114,7 +110,7 @@ fn scenario_run(
         outputs.file(out, run.frame.to_csv().as_bytes())?;
     }
     if let Some(svg) = &cmd.svg {
-        let title = format!("{}: {}", model.spec.model.name, scenario.label());
+        let title = format!("{}: {}", model.spec().model.name, scenario.label());
         let draws: Vec<&_> = mc.iter().flat_map(|mc| mc.results.iter().map(|(_, t)| t)).collect();
         let fig = scenario.figure(&title, &run, &draws);
         outputs.file(svg, fig.to_svg().map_err(anyhow::Error::msg)?.as_bytes())?;
@@ -136,7 +132,7 @@ fn scenario_run(
             println!("{}", serde_json::to_string_pretty(&report)?)
         }
         Format::Text => {
-            println!("{} — {}", model.spec.model.name, scenario.label());
+            println!("{} — {}", model.spec().model.name, scenario.label());
             for line in &run.text {
                 println!("{line}");
             }
@@ -162,7 +158,7 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, integrator: Integrator) -> 
     let mut x0: Vec<f64> = system
         .states
         .iter()
-        .map(|s| model.spec.states.iter().find(|t| &t.name == s).map_or(0.0, |t| t.initial))
+        .map(|s| model.spec().states.iter().find(|t| &t.name == s).map_or(0.0, |t| t.initial))
         .collect();
     for p in &cmd.initial {
         let (k, v) = p.split_once('=').with_context(|| format!("--initial `{p}` must be NAME=VALUE"))?;
@@ -170,7 +166,7 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, integrator: Integrator) -> 
         let i = system.state_index(&name).with_context(|| format!("--initial: `{k}` is not a state"))?;
         x0[i] = finite(v, || format!("--initial `{p}`"))?;
     }
-    let mut inputs: Vec<f64> = model.spec.inputs.iter().map(|i| i.initial).collect();
+    let mut inputs: Vec<f64> = model.spec().inputs.iter().map(|i| i.initial).collect();
     for p in &cmd.inputs {
         let (k, v) = p.split_once('=').with_context(|| format!("--input `{p}` must be NAME=VALUE"))?;
         let name = model.vocabulary.canonical(k.trim()).unwrap_or_else(|| k.trim().to_string());
@@ -181,7 +177,7 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, integrator: Integrator) -> 
     let mut controller: Box<dyn Controller> =
         match cmd.manoeuvre.as_deref().and_then(|m| m.strip_prefix("replay:")) {
             Some(file) => {
-                let frame = Frame::read_csv(std::path::Path::new(file), &model.spec.model.time)?;
+                let frame = Frame::read_csv(std::path::Path::new(file), &model.spec().model.time)?;
                 let t = frame.time();
                 replayed = Some(t[t.len() - 1] - t[0]);
                 Box::new(Replay::new(&frame, &system.inputs)?)
@@ -194,7 +190,7 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, integrator: Integrator) -> 
     )?;
     let settings = Settings { integrator, dt: cmd.dt, duration, sample: cmd.sample };
     let traj = simulate(&system, &x0, controller.as_mut(), &settings)?;
-    let frame = traj.to_frame("simulation", &model.spec.model.time)?;
+    let frame = traj.to_frame("simulation", &model.spec().model.time)?;
     let mut outputs = termid::output::Outputs::new();
     if let Some(out) = &cmd.out {
         outputs.file(out, frame.to_csv().as_bytes())?;
@@ -206,9 +202,9 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, integrator: Integrator) -> 
             .enumerate()
             .map(|(i, s)| Panel {
                 title: s.clone(),
-                x_label: model.spec.model.time.clone(),
+                x_label: model.spec().model.time.clone(),
                 y_label: model
-                    .spec
+                    .spec()
                     .states
                     .iter()
                     .find(|t| &t.name == s)
@@ -217,7 +213,7 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, integrator: Integrator) -> 
                 ..Panel::default()
             })
             .collect();
-        let svg_text = Figure::new(&model.spec.model.name, panels).to_svg().map_err(anyhow::Error::msg)?;
+        let svg_text = Figure::new(&model.spec().model.name, panels).to_svg().map_err(anyhow::Error::msg)?;
         outputs.file(svg, svg_text.as_bytes())?;
     }
     outputs.commit()?;
@@ -234,7 +230,7 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, integrator: Integrator) -> 
         Format::Text => {
             println!(
                 "{}: {} samples to t = {}",
-                model.spec.model.name,
+                model.spec().model.name,
                 traj.time.len(),
                 traj.time.last().copied().unwrap_or(0.0)
             );

@@ -82,7 +82,7 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
         Format::Text => {
             println!(
                 "{} against {} run(s): error of the simulation (model − measured), RMS / max",
-                model.spec.model.name,
+                model.spec().model.name,
                 runs.len()
             );
             for (run, per) in &gap.runs {
