@@ -313,3 +313,101 @@ fn report(system: &System, t: f64, x: &[f64], prev: &[f64]) -> Result<(), SimErr
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use std::collections::BTreeMap;
+
+    use super::*;
+    use crate::sim::{Constant, RightHandSide, SimError};
+    use crate::term::{Library, Vocabulary};
+
+    /// ẋ = u − k·x: a first-order lag, the simplest right-hand side that has a state, an
+    /// input and a parameter (no model file: the simulator needs only the trait).
+    struct Lag {
+        k: f64,
+        bounds: (f64, f64),
+    }
+
+    impl RightHandSide for Lag {
+        fn origin(&self) -> &str {
+            "lag"
+        }
+        fn states(&self) -> Result<Vec<(String, f64, f64)>, SimError> {
+            Ok(vec![("x".into(), self.bounds.0, self.bounds.1)])
+        }
+        fn inputs(&self) -> Vec<String> {
+            vec!["u".into()]
+        }
+        fn parameters(&self) -> BTreeMap<String, f64> {
+            BTreeMap::from([("k".to_string(), self.k)])
+        }
+        fn compile(&self, _with_intercept: bool) -> Result<Library, SimError> {
+            let mut v = Vocabulary::new();
+            v.variable("x")?.variable("u")?.parameter("k")?;
+            Ok(Library::compile(&[v.parse("u - k*x")?], &v)?)
+        }
+    }
+
+    fn final_x(k: f64, u: f64, integrator: Integrator, dt: f64) -> f64 {
+        let system =
+            System::new(&Lag { k, bounds: (f64::NEG_INFINITY, f64::INFINITY) }, &BTreeMap::new(), false)
+                .unwrap();
+        let settings = Settings { integrator, dt, duration: 2.0, sample: dt };
+        let t = simulate(&system, &[1.0], &mut Constant(vec![u]), &settings).unwrap();
+        assert!((t.time.last().unwrap() - 2.0).abs() < 1e-9);
+        *t.states[0].last().unwrap()
+    }
+
+    /// x(t) = u/k + (x0 − u/k)·e^(−kt); RK4 is fourth order, the paper's B8 first order.
+    #[test]
+    fn orders_of_accuracy_on_a_first_order_lag() {
+        let exact = |k: f64, u: f64| u / k + (1.0 - u / k) * (-2.0 * k).exp();
+        let rk4 = |dt| (final_x(0.5, 0.2, Integrator::Rk4, dt) - exact(0.5, 0.2)).abs();
+        let b8 = |dt| (final_x(0.5, 0.0, Integrator::ModifiedEuler, dt) - exact(0.5, 0.0)).abs();
+        assert!(rk4(0.1) < 1e-6, "{}", rk4(0.1));
+        assert!((12.0..20.0).contains(&(rk4(0.1) / rk4(0.05))), "RK4 ratio {}", rk4(0.1) / rk4(0.05));
+        assert!((1.8..2.2).contains(&(b8(0.01) / b8(0.005))), "B8 ratio {}", b8(0.01) / b8(0.005));
+    }
+
+    /// ẋ = +x (k = −1) leaves its bounds: stopped with the time and the state, no NaN.
+    #[test]
+    fn leaving_the_bounds_stops_with_time_and_state() {
+        let system = System::new(&Lag { k: -1.0, bounds: (-10.0, 10.0) }, &BTreeMap::new(), false).unwrap();
+        let settings = Settings { integrator: Integrator::Rk4, dt: 0.01, duration: 5.0, sample: 0.01 };
+        match simulate(&system, &[1.0], &mut Constant(vec![0.0]), &settings) {
+            Err(SimError::Diverged { t, state, value, .. }) => {
+                assert_eq!(state, "x");
+                // e^t = 10 at t = ln 10
+                assert!((t - 10f64.ln()).abs() < 0.02 && value > 10.0, "t = {t}, x = {value}");
+            }
+            other => panic!("expected divergence, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn settings_that_do_not_fit_are_refused() {
+        let system = System::new(&Lag { k: 1.0, bounds: (-1e9, 1e9) }, &BTreeMap::new(), false).unwrap();
+        let run = |dt: f64, duration: f64, sample: f64| {
+            simulate(
+                &system,
+                &[0.0],
+                &mut Constant(vec![0.0]),
+                &Settings { integrator: Integrator::Rk4, dt, duration, sample },
+            )
+        };
+        assert!(run(0.1, 1.0, 0.15).is_err(), "a sample that is no multiple of the step");
+        assert!(
+            run(0.0, 1.0, 0.1).is_err() && run(-0.1, 1.0, 0.1).is_err() && run(f64::NAN, 1.0, 0.1).is_err()
+        );
+        assert!(run(0.1, 1.0, 0.2).is_ok());
+        // unknown parameters are refused by name
+        let e = System::new(
+            &Lag { k: 1.0, bounds: (-1.0, 1.0) },
+            &BTreeMap::from([("q".to_string(), 1.0)]),
+            false,
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("`q` is not a parameter"), "{e}");
+    }
+}

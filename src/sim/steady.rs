@@ -105,3 +105,47 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<(Vec<f64>, Vec<f64>), SimEr
     }
     Ok((x, u))
 }
+
+#[cfg(test)]
+mod tests {
+    use std::collections::BTreeMap;
+
+    use super::*;
+    use crate::model::Model;
+
+    /// ẋ = u − k·x with x held at 2: the input that keeps it there is u = 2k; and ẏ = x·y − 1
+    /// with x = 2: y = ½.
+    #[test]
+    fn newton_finds_the_input_and_the_state_that_hold_still() {
+        let text = r#"
+[model]
+name = "two lags"
+[[states]]
+name = "x"
+[[states]]
+name = "y"
+[[inputs]]
+name = "u"
+[parameters.k]
+value = 0.7
+[equations.x_dot]
+state = "x"
+coefficients = { "u" = 1.0, "k*x" = -1.0 }
+[equations.y_dot]
+state = "y"
+coefficients = { "x*y" = 1.0, "1" = -1.0 }
+"#;
+        let model = Model::parse(text, "lags.toml").unwrap();
+        let system = System::new(&model, &BTreeMap::new(), false).unwrap();
+        let p = SteadyProblem {
+            system: &system,
+            x: vec![2.0, 1.0],
+            input: vec![0.0],
+            unknowns: vec![Unknown::Input(0), Unknown::State(1)],
+            zero: vec![0, 1],
+        };
+        let (x, u) = solve_steady(&p).unwrap();
+        assert!((u[0] - 1.4).abs() < 1e-9 && (x[1] - 0.5).abs() < 1e-9, "u = {u:?}, x = {x:?}");
+        assert_eq!(x[0], 2.0);
+    }
+}
