@@ -414,19 +414,31 @@ fn cost(r: &[f64]) -> f64 {
     r.iter().map(|v| v * v).sum()
 }
 
+/// Why a Gauss-Newton or Levenberg-Marquardt estimate could not be made.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum EstimateError {
+    /// The re-simulation left its bounds or gave a non-finite residual; where it did so.
+    #[error("diverges {0}")]
+    Diverges(&'static str),
+    /// JᵀJ has no inverse (a parameter the runs do not excite).
+    #[error("has singular normal equations")]
+    Singular,
+}
+
 /// `iterations` Gauss-Newton steps from θ = 0; (θ, cost).
 pub fn gauss_newton(
     data: &Runs,
     model: &Model,
     h: &Hypothesis,
     iterations: usize,
-) -> Result<(Vec<f64>, f64), String> {
+) -> Result<(Vec<f64>, f64), EstimateError> {
     let mut theta = vec![0.0; h.parameters()];
-    let mut best = cost(&residuals(data, model, h, &theta).ok_or("the unchanged model diverges")?);
+    let mut best =
+        cost(&residuals(data, model, h, &theta).ok_or(EstimateError::Diverges("with the unchanged model"))?);
     for _ in 0..iterations {
-        let (r, j) = jacobian(data, model, h, &theta).ok_or("diverges near the start")?;
+        let (r, j) = jacobian(data, model, h, &theta).ok_or(EstimateError::Diverges("near the start"))?;
         let jt = j.transpose();
-        let step = (&jt * &j).lu().solve(&(&jt * DVector::from_vec(r))).ok_or("singular")?;
+        let step = (&jt * &j).lu().solve(&(&jt * DVector::from_vec(r))).ok_or(EstimateError::Singular)?;
         let trial: Vec<f64> = theta.iter().zip(step.iter()).map(|(t, d)| t - d).collect();
         match residuals(data, model, h, &trial) {
             Some(rt) if cost(&rt) < best => {
@@ -468,9 +480,9 @@ pub fn levenberg_marquardt(
     model: &Model,
     h: &Hypothesis,
     theta0: Vec<f64>,
-) -> Result<Estimated, String> {
+) -> Result<Estimated, EstimateError> {
     let mut theta = theta0;
-    let (mut r, mut j) = jacobian(data, model, h, &theta).ok_or("diverges at the start")?;
+    let (mut r, mut j) = jacobian(data, model, h, &theta).ok_or(EstimateError::Diverges("at the start"))?;
     let mut c = cost(&r);
     let mut lambda = 1e-3;
     for _ in 0..30 {
@@ -487,7 +499,7 @@ pub fn levenberg_marquardt(
             Some(rt) if cost(&rt) < c => {
                 let improvement = (c - cost(&rt)) / c.max(1e-300);
                 theta = trial;
-                (r, j) = jacobian(data, model, h, &theta).ok_or("diverges")?;
+                (r, j) = jacobian(data, model, h, &theta).ok_or(EstimateError::Diverges("on the way"))?;
                 c = cost(&r);
                 lambda = (lambda / 10.0).max(1e-12);
                 if improvement < 1e-10 {

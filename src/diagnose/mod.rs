@@ -12,7 +12,7 @@ mod refine;
 
 use serde::Serialize;
 
-pub use fit::{simulate_runs, Runs};
+pub use fit::{simulate_runs, EstimateError, Runs};
 pub use refine::{refine, Refined};
 
 pub use hypotheses::{generic_hypotheses, Effect, Hypothesis};
@@ -34,6 +34,10 @@ pub enum DiagnoseError {
     /// Setup.
     #[error("{0}")]
     Setup(String),
+    /// The output-error refinement's estimate failed (the reason is its only content, so it
+    /// is printed here rather than kept as a source that would print it twice).
+    #[error("output-error refinement: the re-simulation {0}")]
+    Refinement(fit::EstimateError),
     /// A hypothesis's term that does not parse in the model's vocabulary.
     #[error(transparent)]
     Term(#[from] crate::term::TermError),

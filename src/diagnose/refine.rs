@@ -47,7 +47,7 @@ pub fn refine(model: &Model, runs: &Runs) -> Result<Refined, DiagnoseError> {
     };
     let before = runs.gap(&runs.simulate(model, &[], &[])?).cost;
     let fit = levenberg_marquardt(runs, model, &hypothesis, vec![0.0; entries.len()])
-        .map_err(|e| DiagnoseError::Setup(format!("output-error refinement: the re-simulation {e}")))?;
+        .map_err(DiagnoseError::Refinement)?;
     let mut refined = apply(model, &hypothesis, &fit.theta)?;
     // σ²(JᵀJ)⁻¹ assumes independent residuals; re-simulation residuals are strongly
     // correlated in time, so the covariance is widened by their correlation time τ
@@ -119,5 +119,71 @@ impl Refined {
             );
         }
         out + "\n"
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::Frame;
+    use crate::sim::Integrator;
+
+    /// ẋ = a·u + b·x: identified as a = 1, b = −0.3; the runs come from a = 1, b = −0.5.
+    fn lag(b: f64) -> Model {
+        let text = format!(
+            r#"
+[model]
+name = "lag"
+[[states]]
+name = "x"
+[[inputs]]
+name = "u"
+[equations.x_dot]
+state = "x"
+candidates = ["u", "x"]
+coefficients = {{ "u" = 1.0, "x" = {b} }}
+"#
+        );
+        Model::parse(&text, "lag.toml").unwrap()
+    }
+
+    /// A step of u = 1 from x = 0: x(t) = (1 − e^(−kt))/k, k = 0.5, in closed form.
+    fn step_response() -> Frame {
+        let t: Vec<f64> = (0..=100).map(|i| 0.1 * i as f64).collect();
+        let x = t.iter().map(|t| (1.0 - (-0.5 * t).exp()) / 0.5).collect();
+        let mut f = Frame::new("step", "t", t.clone()).unwrap();
+        f.push("x", x).unwrap();
+        f.push("u", vec![1.0; t.len()]).unwrap();
+        f
+    }
+
+    #[test]
+    fn refinement_finds_the_coefficients_of_the_closed_form() {
+        let model = lag(-0.3);
+        let runs = Runs::new(&model, &[step_response()], 0.01, Integrator::Rk4).unwrap();
+        let r = refine(&model, &runs).unwrap();
+        let b = r.coefficients.iter().find(|c| c.1 == "x").unwrap().3;
+        let a = r.coefficients.iter().find(|c| c.1 == "u").unwrap().3;
+        assert!((b + 0.5).abs() < 1e-4 && (a - 1.0).abs() < 1e-4, "a = {a}, b = {b}");
+        assert!(r.cost_after < 1e-6 * r.cost_before, "{} → {}", r.cost_before, r.cost_after);
+        assert!(r.text().contains("output-error refinement"));
+    }
+
+    #[test]
+    fn the_true_model_has_no_gap_and_a_wrong_one_has() {
+        let runs = Runs::new(&lag(-0.5), &[step_response()], 0.01, Integrator::Rk4).unwrap();
+        let gap = |b: f64| runs.gap(&runs.simulate(&lag(b), &[], &[]).unwrap());
+        assert!(gap(-0.5).cost < 1e-10, "{:?}", gap(-0.5));
+        let wrong = gap(-0.3);
+        // x(10) is 1.98 for k = 0.5 and 3.17 for k = 0.3: the largest gap is at the end
+        assert!((wrong.states[0].3 - (0.95021 / 0.3 - 0.99326 / 0.5)).abs() < 1e-3, "{wrong:?}");
+    }
+
+    #[test]
+    fn a_model_without_identified_coefficients_is_refused() {
+        let text = "[model]\nname = \"fixed\"\n[[states]]\nname = \"x\"\n[equations.x_dot]\nstate = \"x\"\nidentify = false\ncoefficients = { \"x\" = -1.0 }\n";
+        let model = Model::parse(text, "fixed.toml").unwrap();
+        let runs = Runs::new(&model, &[step_response()], 0.01, Integrator::Rk4).unwrap();
+        assert!(matches!(refine(&model, &runs), Err(DiagnoseError::Setup(_))));
     }
 }

@@ -321,6 +321,38 @@ impl Identification<'_> {
     }
 
     /// Identifies one equation from all runs together ("Komb. Daten").
+    ///
+    /// Hald's cement data (Hald 1952), the classic case of stepwise regression: the heat
+    /// `y` explained by four ingredients; STPRG enters x4, x1, x2, x3 (Draper & Smith).
+    ///
+    /// ```
+    /// use std::collections::BTreeMap;
+    /// use termid::data::{CentralDifference, Frame};
+    /// use termid::identify::{Identification, Target};
+    /// use termid::select::{StepRule, Stepwise};
+    /// use termid::term::{parse_terms, Vocabulary};
+    ///
+    /// let hald = Frame::read_csv_untimed(std::path::Path::new("tests/data/hald.csv"))?;
+    /// let mut vocabulary = Vocabulary::new();
+    /// for x in ["x1", "x2", "x3", "x4"] {
+    ///     vocabulary.variable(x)?;
+    /// }
+    /// let candidates = parse_terms(&["x1", "x2", "x3", "x4"], &vocabulary)?;
+    /// let how = Identification {
+    ///     vocabulary: &vocabulary,
+    ///     parameters: &BTreeMap::new(),
+    ///     differentiator: &CentralDifference,
+    ///     intercept: true,
+    ///     weights: None,
+    /// };
+    /// let backend = Stepwise { step_rule: StepRule::Last, ..Stepwise::default() };
+    /// let fit = how.fit(&Target::Column("y".into()), &candidates, &[], &[], &[hald], &backend)?;
+    /// let order: Vec<&str> = fit.selection.steps.iter().map(|s| s.term.as_str()).collect();
+    /// assert_eq!(order, ["x4", "x1", "x2", "x3"]);
+    /// // y = 117.57 − 0.7382 x4 after the first step (Draper & Smith)
+    /// assert!((fit.selection.terms_at(1)[0].coefficient + 0.738162).abs() < 1e-5);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn fit(
         &self,
         target: &Target,

@@ -44,9 +44,9 @@ pub enum CovarianceError {
         i: usize,
         /// Column.
         j: usize,
-        /// m[i][j].
+        /// m\[i\]\[j\].
         upper: f64,
-        /// m[j][i].
+        /// m\[j\]\[i\].
         lower: f64,
     },
     /// A negative eigenvalue beyond round-off.

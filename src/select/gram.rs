@@ -17,8 +17,8 @@ pub fn gram(z: &[f64], ld: usize, n: usize, m: usize, c: &mut [f64]) {
     mirror(c, m);
 }
 
-/// Adds Σ_r (z_i[r] − c_i)(z_j[r] − c_j) to `c[i + j m]` for i ≥ j (and to the upper entries
-/// of the diagonal 3 × 3 tiles, which [`mirror`] overwrites), and Σ_r (z_i[r] − c_i) to
+/// Adds Σ_r (z_i\[r\] − c_i)(z_j\[r\] − c_j) to `c[i + j m]` for i ≥ j (and to the upper entries
+/// of the diagonal 3 × 3 tiles, which [`mirror`] overwrites), and Σ_r (z_i\[r\] − c_i) to
 /// `sums[i]`: m = `columns.len()`, all columns of one length. The sums come from the diagonal
 /// tiles' loads on the otherwise idle add ports (a pass of their own cost a tenth of a fit).
 pub fn gram_add(columns: &[&[f64]], shift: &[f64], c: &mut [f64], sums: &mut [f64]) {

@@ -156,6 +156,43 @@ impl Trajectory {
 }
 
 /// Integrates `system` from `x0` under `controller`.
+///
+/// A damped oscillator written as a model file, ẍ = −ω²x − 2ζωẋ with ω = 2 rad/s, ζ = 0.1,
+/// released from x = 1: its first minimum comes at t = π/ω_d, ω_d = ω√(1 − ζ²), with
+/// x = −e^(−ζωt).
+///
+/// ```
+/// use std::collections::BTreeMap;
+/// use termid::model::Model;
+/// use termid::sim::{simulate, Constant, Integrator, Settings, System};
+///
+/// let model = Model::parse(r#"
+///     [model]
+///     name = "damped oscillator"
+///     [[states]]
+///     name = "x"
+///     initial = 1.0
+///     [[states]]
+///     name = "w"
+///     [equations.x_dot]
+///     state = "x"
+///     coefficients = { "w" = 1.0 }
+///     [equations.w_dot]
+///     state = "w"
+///     coefficients = { "x" = -4.0, "w" = -0.4 }
+/// "#, "oscillator.toml")?;
+/// let system = System::new(&model, &BTreeMap::new(), false)?;
+/// let settings = Settings { integrator: Integrator::Rk4, dt: 0.001, duration: 5.0, sample: 0.001 };
+/// let run = simulate(&system, &[1.0, 0.0], &mut Constant(vec![]), &settings)?;
+/// let (i, x_min) = run.states[0].iter().enumerate().fold((0, f64::MAX), |m, (i, &x)| {
+///     if x < m.1 { (i, x) } else { m }
+/// });
+/// let omega_d = 2.0 * (1.0f64 - 0.01).sqrt();
+/// let t_min = std::f64::consts::PI / omega_d;
+/// assert!((run.time[i] - t_min).abs() < 2e-3);
+/// assert!((x_min + (-0.2 * t_min).exp()).abs() < 1e-4);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn simulate(
     system: &System,
     x0: &[f64],

@@ -18,6 +18,21 @@ pub use vocabulary::{Derived, Vocabulary};
 
 /// Parses and resolves a list of candidate terms, refusing a duplicate (two spellings of
 /// one canonical term, e.g. `v*r` and `r*v`) with an error that names both.
+///
+/// ```
+/// use termid::term::{parse_terms, Vocabulary};
+///
+/// let mut vocabulary = Vocabulary::new();
+/// vocabulary.variable("u")?.variable("v")?.variable("r")?;
+/// let terms = parse_terms(&["r*v^2/u", "u^2"], &vocabulary)?;
+/// // canonical: the same term however it is spelt
+/// assert_eq!(terms[0], vocabulary.parse("v*v*r/u")?);
+/// // a typo is located with its line, column and a caret
+/// let error = vocabulary.parse("u*w").unwrap_err().to_string();
+/// assert!(error.contains('^') && error.contains('w'), "{error}");
+/// assert!(parse_terms(&["v*r", "r*v"], &vocabulary).is_err());
+/// # Ok::<(), termid::term::TermError>(())
+/// ```
 pub fn parse_terms<S: AsRef<str>>(texts: &[S], vocab: &Vocabulary) -> Result<Vec<Term>, TermError> {
     let mut terms: Vec<Term> = Vec::with_capacity(texts.len());
     for (i, text) in texts.iter().enumerate() {
