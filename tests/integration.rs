@@ -43,3 +43,6 @@ mod hostile;
 // The library's layers run one way (a table checked against the `crate::` paths).
 #[path = "integration/layers.rs"]
 mod layers;
+// The MMG model of KVLCC2 as a model file, against the shipmmg package's numbers.
+#[path = "integration/mmg.rs"]
+mod mmg;
