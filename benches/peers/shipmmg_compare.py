@@ -1,8 +1,9 @@
 """termid's MMG model file (models/mmg_kvlcc2.toml) against the shipmmg package (its KVLCC2 L7
 parameter set), the independent implementation of the same MMG equations.
 
-termid simulates each manoeuvre (RK4, 0.01 s) and writes its run; the rudder angle series of
-that run is given to shipmmg (scipy's RK45 with tight tolerances) from the same initial state,
+termid simulates each manoeuvre (RK4, 0.01 s) from the straight run at the self-propulsion
+point (the propeller's rate that holds u0) and writes its run; the rudder angle and propeller
+rate series of that run are given to shipmmg (scipy's RK45 with tight tolerances) from the same initial state,
 and both trajectories are measured by the same functions here: advance and tactical diameter
 of turning circles, first and second overshoots of zigzags. Python serves only this
 comparison, never the product.
@@ -41,7 +42,6 @@ def kvlcc2_l7():
     return basic, man
 
 
-N_RPS = 17.95
 U0 = 2.29 * 0.512  # shipmmg's approach speed in its test case, m/s
 
 
@@ -50,12 +50,12 @@ def read_run(path):
     names = data.dtype.names
     col = lambda n: np.asarray(data[n], dtype=float)
     return {"t": col("t"), "u": col("u"), "v": col("v"), "r": col("r"), "psi": col(names[4]),
-            "x": col("x0"), "y": col("y0"), "delta": col(names[7])}
+            "x": col("x0"), "y": col("y0"), "delta": col(names[7]), "n": col("n")}
 
 
-def shipmmg_run(t, delta):
+def shipmmg_run(t, delta, n):
     basic, man = kvlcc2_l7()
-    sol = simulate_mmg_3dof(basic, man, t, delta, np.full(len(t), N_RPS), u0=U0,
+    sol = simulate_mmg_3dof(basic, man, t, delta, n, u0=U0,
                             method="RK45", rtol=1e-9, atol=1e-11, max_step=0.05)
     u, v, r, x, y, psi = sol.sol(t)[:6]
     return {"t": t, "u": u, "v": v, "r": r, "psi": psi, "x": x, "y": y, "delta": delta}
@@ -124,7 +124,7 @@ def main():
                         "--dt", "0.01", "--sample", "0.01", "--out", path], check=True,
                        stdout=subprocess.DEVNULL)
         ours = read_run(path)
-        theirs = shipmmg_run(ours["t"], ours["delta"])
+        theirs = shipmmg_run(ours["t"], ours["delta"], ours["n"])
         if heading is None:
             m1, m2 = turning_metrics(ours), turning_metrics(theirs)
             for q in m1:

@@ -63,6 +63,8 @@ pub struct Roles {
     pub y0: usize,
     /// Rudder input.
     pub rudder: usize,
+    /// Propeller rate input, solved for the self-propulsion point in the straight run.
+    pub propeller: Option<usize>,
 }
 
 /// The straight run before a manoeuvre: rudder δ0 and sway v0 that cancel the asymmetry
@@ -92,6 +94,8 @@ pub struct Ship {
     pub roles: Roles,
     /// sign(∂ṙ/∂δ): −1 when positive rudder turns to port (the paper's convention).
     pub turn_sign: f64,
+    /// The inputs' declared values (the model file's `initial`), in the system's order.
+    pub base_input: Vec<f64>,
 }
 
 /// One simulated manoeuvre.
@@ -112,8 +116,8 @@ pub struct Run {
 /// one that does not read: [`ShipSpec::of`] says why).
 pub fn canonical_spec(model: &Model) -> Option<ShipSpec> {
     let mut spec = ShipSpec::of(model).ok().flatten()?;
-    let ShipNames { u, v, r, psi, x0, y0, rudder } = &mut spec.names;
-    for n in [u, v, r, psi, x0, y0, rudder] {
+    let ShipNames { u, v, r, psi, x0, y0, rudder, propeller } = &mut spec.names;
+    for n in [u, v, r, psi, x0, y0, rudder].into_iter().chain(propeller.as_mut()) {
         if let Some(c) = model.vocabulary.canonical(n) {
             *n = c;
         }
@@ -149,8 +153,24 @@ impl Ship {
             rudder: system.input_index(&rudder_name).ok_or_else(|| {
                 ShipError::Model(format!("{}: rudder input `{}` is not declared", model.path, n.rudder))
             })?,
+            propeller: match &n.propeller {
+                None => None,
+                Some(p) => {
+                    let canonical = model.vocabulary.canonical(p).unwrap_or_else(|| p.clone());
+                    Some(system.input_index(&canonical).ok_or_else(|| {
+                        ShipError::Model(format!("{}: propeller input `{p}` is not declared", model.path))
+                    })?)
+                }
+            },
         };
-        let mut ship = Ship { spec, system, roles, turn_sign: -1.0 };
+        // inputs other than the rudder start at their declared values (the propeller's as
+        // the straight run's first guess)
+        let base_input = system
+            .inputs
+            .iter()
+            .map(|name| model.spec().inputs.iter().find(|i| &i.name == name).map_or(0.0, |i| i.initial))
+            .collect();
+        let mut ship = Ship { spec, system, roles, turn_sign: -1.0, base_input };
         ship.turn_sign = ship.rudder_effect()?.signum();
         Ok(ship)
     }
@@ -159,7 +179,7 @@ impl Ship {
         let mut ws = self.system.workspace();
         let mut x = vec![0.0; self.system.dim()];
         x[self.roles.u] = self.spec.u0;
-        let mut input = vec![0.0; self.system.inputs.len()];
+        let mut input = self.base_input.clone();
         let mut d = vec![0.0; x.len()];
         input[self.roles.rudder] = 0.01;
         self.system.derivatives(&x, &input, &mut ws, &mut d);
@@ -173,19 +193,20 @@ impl Ship {
         Ok(effect)
     }
 
-    /// Steady straight running at u0: δ0 and v0 with v̇ = ṙ = 0 (r = 0, heading 0).
+    /// Steady straight running at u0: δ0 and v0 with v̇ = ṙ = 0 (r = 0, heading 0), and
+    /// the propeller's rate with u̇ = 0 where the ship names one.
     pub fn straight_run(&self) -> Result<StraightRun, ShipError> {
         let r = &self.roles;
         let mut x = vec![0.0; self.system.dim()];
         x[r.u] = self.spec.u0;
-        let input = vec![0.0; self.system.inputs.len()];
-        let p = SteadyProblem {
-            system: &self.system,
-            x,
-            input,
-            unknowns: vec![Unknown::State(r.v), Unknown::Input(r.rudder)],
-            zero: vec![r.v, r.r],
-        };
+        let mut input = self.base_input.clone();
+        input[r.rudder] = 0.0;
+        let (mut unknowns, mut zero) = (vec![Unknown::State(r.v), Unknown::Input(r.rudder)], vec![r.v, r.r]);
+        if let Some(p) = r.propeller {
+            unknowns.push(Unknown::Input(p));
+            zero.push(r.u);
+        }
+        let p = SteadyProblem { system: &self.system, x, input, unknowns, zero };
         let (x, input) = sim::solve_steady(&p)?;
         let mut ws = self.system.workspace();
         let mut d = vec![0.0; x.len()];

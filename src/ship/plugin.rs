@@ -153,6 +153,11 @@ impl Scenario for ShipScenario {
             (settings.duration / settings.dt).round(),
             settings.dt
         )];
+        if let Some(p) = ship.roles.propeller {
+            let (name, n) = (&ship.system.inputs[p], run.start.input[p]);
+            extra.insert("propeller".into(), n.into());
+            text[0] += &format!("; self-propulsion point {name} = {n:.4} (holds u0 = {} m/s)", ship.spec.u0);
+        }
         if let Some(map) = metrics.as_object() {
             for (k, v) in map {
                 if k == "manoeuvre" || k == "points" || k == "reversals_s" {

@@ -68,6 +68,11 @@ pub struct ShipNames {
     pub y0: String,
     /// Rudder angle.
     pub rudder: String,
+    /// The propeller's rate of revolution, where the model has it as an input: the straight
+    /// run then solves it for u̇ = 0 at u0 (the self-propulsion point), as a basin sets it
+    /// for each run's approach speed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub propeller: Option<String>,
 }
 
 impl Default for ShipNames {
@@ -80,6 +85,7 @@ impl Default for ShipNames {
             x0: "x0".into(),
             y0: "y0".into(),
             rudder: "δ".into(),
+            propeller: None,
         }
     }
 }
@@ -158,6 +164,15 @@ impl ShipSpec {
                 return Err(key_err(
                     &format!("{TABLE}.names.{role}"),
                     format!("`{name}` is not a state or input of the model"),
+                ));
+            }
+        }
+        if let Some(name) = &n.propeller {
+            let canonical = model.vocabulary.canonical(name).unwrap_or_else(|| name.to_string());
+            if !model.spec().inputs.iter().any(|i| i.name == canonical) {
+                return Err(key_err(
+                    &format!("{TABLE}.names.propeller"),
+                    format!("`{name}` is not an input of the model (the propeller's rate is solved as one)"),
                 ));
             }
         }
