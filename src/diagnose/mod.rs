@@ -6,12 +6,14 @@
 //! the library holds constants, missing candidate terms and input offsets and scales; a
 //! plug-in (the ship's) adds named hypotheses.
 
+mod choose;
 mod fit;
 mod hypotheses;
 mod refine;
 
 use serde::Serialize;
 
+pub use choose::{choose_by_prediction, Chosen, Configuration, Prediction};
 pub use fit::{simulate_runs, EstimateError, Runs};
 pub use refine::{refine, Refined};
 

@@ -254,3 +254,60 @@ fn validate_sets_model_and_measurement_side_by_side() {
     );
     assert!(svg.join("validate_z.svg").exists());
 }
+
+/// With --model, --backend replaces the file's back-ends (it was silently ignored), and
+/// --choose prints the table it chose from and writes the chosen model.
+#[test]
+fn backend_and_choose_with_a_model() {
+    let dir = crate::common::Scratch::new("choose");
+    let csv = crate::common::lorenz_csv(&dir, "3");
+    let half = dir.join("lorenz2.csv");
+    // a second run: the first one's second half, so that one run can be left out
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let mut second = vec![lines[0]];
+    second.extend(&lines[lines.len() / 2..]);
+    std::fs::write(&half, second.join("\n")).unwrap();
+    let (ok, out, err) = termid(&[
+        "identify",
+        "--model",
+        "models/lorenz.toml",
+        "--data",
+        csv.to_str().unwrap(),
+        "--no-intercept",
+        "--backend",
+        "best-subset",
+    ]);
+    assert!(ok, "{err}");
+    assert_eq!(out.matches("back-end best-subset").count(), 3, "{out}");
+    let written = dir.join("chosen.toml");
+    let (ok, out, err) = termid(&[
+        "identify",
+        "--model",
+        "models/lorenz.toml",
+        "--data",
+        csv.to_str().unwrap(),
+        half.to_str().unwrap(),
+        "--no-intercept",
+        "--choose",
+        "stepwise,sparse",
+        "--compare",
+        "x,y,z",
+        "--out",
+        written.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("chosen by prediction") && out.contains("← chosen"), "{out}");
+    assert!(out.contains("\nstepwise") && out.contains("\nsparse"), "{out}");
+    assert!(std::fs::read_to_string(&written).unwrap().contains("x*z"));
+    let (ok, _, err) = termid(&[
+        "identify",
+        "--model",
+        "models/lorenz.toml",
+        "--data",
+        csv.to_str().unwrap(),
+        "--choose",
+        "lasso",
+    ]);
+    assert!(!ok && err.contains("unknown back-end `lasso`"), "{err}");
+}

@@ -160,3 +160,75 @@ fn same_commands_for_lorenz_and_the_ship() {
     assert!(err.contains("diverged at t =") && err.contains("outside its bounds"), "{err}");
     assert!(!never.exists());
 }
+
+/// Forced Duffing runs at three forcing amplitudes, with their exact derivatives.
+fn duffing_runs(m: &Model) -> Vec<Frame> {
+    let system = System::new(m, &BTreeMap::new(), false).unwrap();
+    let t: Vec<f64> = (0..=2000).map(|i| i as f64 * 0.01).collect();
+    [0.3, 0.8, 1.4]
+        .iter()
+        .enumerate()
+        .map(|(k, a)| {
+            let mut forcing = Frame::new("forcing", "t", t.clone()).unwrap();
+            forcing
+                .push("F", t.iter().map(|t| a * (0.7 * t).sin() + 0.3 * (1.9 * t).cos()).collect())
+                .unwrap();
+            let mut replay = Replay::new(&forcing, &system.inputs).unwrap();
+            let s = Settings { integrator: Integrator::Rk4, dt: 0.005, duration: 20.0, sample: 0.01 };
+            let traj = simulate(&system, &[0.2 * k as f64, 0.0], &mut replay, &s).unwrap();
+            traj.to_frame(&format!("run{k}"), "t").unwrap()
+        })
+        .collect()
+}
+
+/// Choosing by prediction: the library with the cubic stiffness predicts the runs it did not
+/// see; a library without it cannot, and the table says so. Each fold's error is the
+/// re-simulation of that run by the model identified on the other two.
+#[test]
+fn choosing_by_prediction_prefers_the_library_that_predicts_held_out_runs() {
+    use termid::diagnose::{choose_by_prediction, Prediction, Runs};
+    use termid::identify::{identify_model, ModelIdentification};
+    let m = termid::plugins::load(std::path::Path::new("models/duffing.toml")).unwrap();
+    let frames = duffing_runs(&m);
+    let linear = m
+        .edit(|file| {
+            let e = file.equations.get_mut("v_dot").unwrap();
+            e.candidates.retain(|c| !c.contains('3') && !c.contains("^2"));
+        })
+        .unwrap();
+    let configurations = vec![("linear".to_string(), linear.clone()), ("cubic".to_string(), m.clone())];
+    let how = ModelIdentification {
+        equations: vec![],
+        differentiator: &CentralDifference,
+        intercept: false,
+        target: None,
+    };
+    let prediction = Prediction::default();
+    let chosen = choose_by_prediction(&configurations, &frames, &how, &prediction, &mut |_| {}).unwrap();
+    assert_eq!(chosen.best, 1, "{}", chosen.text());
+    let (lin, cub) = (&chosen.candidates[0], &chosen.candidates[1]);
+    assert!(cub.score < 1e-6 && lin.score > 1e-3, "{}", chosen.text());
+    assert!(chosen.text().contains("← chosen"));
+    // the first fold of the linear library, computed directly
+    let id = identify_model(&linear, &frames[1..], &how, &mut |_| {}).unwrap();
+    let runs = Runs::new(&id.model, &frames[..1], prediction.dt, prediction.integrator)
+        .unwrap()
+        .comparing(&["v".to_string()])
+        .unwrap();
+    let direct = runs.gap(&runs.simulate(&id.model, &[], &[]).unwrap()).cost;
+    assert!((lin.folds[0].1 - direct).abs() <= 1e-9 * direct, "{} vs {direct}", lin.folds[0].1);
+    assert_eq!(lin.folds[0].0, "run0");
+    // the chosen model is the cubic library identified on all runs: the true coefficients
+    let x3 = chosen
+        .identified
+        .model
+        .equation("v_dot")
+        .unwrap()
+        .coefficients
+        .iter()
+        .find(|c| c.0.to_string() == "x^3")
+        .map(|c| c.1);
+    assert!((x3.unwrap() + 0.2).abs() < 1e-6, "{x3:?}");
+    // too few runs to leave one out
+    assert!(choose_by_prediction(&configurations, &frames[..1], &how, &prediction, &mut |_| {}).is_err());
+}

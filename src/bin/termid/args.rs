@@ -102,8 +102,9 @@ pub struct IdentifyCommand {
     #[arg(long = "alias", num_args = 1..)]
     pub aliases: Vec<String>,
     /// Regression back-end (settings beyond the defaults: a model file's `backend` table).
-    #[arg(long, value_enum, default_value = "stepwise")]
-    pub backend: BackendName,
+    /// Default: stepwise; with --model each equation's own, which this replaces when given.
+    #[arg(long, value_enum)]
+    pub backend: Option<BackendName>,
     /// Derivative method for `dX/dt` targets: central, five-point, savitzky-golay[:WINDOW:ORDER],
     /// spline[:ALPHA] (GCV by default), kalman[:RATIO] (maximum likelihood by default), or for
     /// ship models `kinematic`: the tracking filter fusing track, heading, log and gyro.
@@ -126,6 +127,16 @@ pub struct IdentifyCommand {
     /// velocities and heading; positions integrate every earlier error and dominate the fit.
     #[arg(long, value_name = "STATES")]
     pub refine: Option<String>,
+    /// With --model: choose among these back-ends (comma-separated, or `all`) by what they
+    /// predict: each run is re-simulated by the model identified on the other runs, and the
+    /// back-end with the smallest error on the runs it did not see is identified on all of
+    /// them. The table it chose from is printed.
+    #[arg(long, value_name = "BACKENDS", requires = "model")]
+    pub choose: Option<String>,
+    /// With --choose: the states compared in the held-out runs (default: the states of the
+    /// identified equations), e.g. `u,v,r,ψ`.
+    #[arg(long, value_name = "STATES", requires = "choose")]
+    pub compare: Option<String>,
     /// Fit without an intercept b0.
     #[arg(long)]
     pub no_intercept: bool,

@@ -7,7 +7,7 @@ use termid::data::{
     differentiator, prepare, resample, CentralDifference, Differentiator, Frame, Preparation,
 };
 use termid::identify::{Identification, ParamValue, Target};
-use termid::select::{Backend, StepRule};
+use termid::select::{Backend, BackendName, StepRule};
 use termid::term::{parse_terms, Vocabulary};
 
 use crate::args::{Format, IdentifyCommand, RuleName};
@@ -189,7 +189,7 @@ fn prepare_runs(
 }
 
 fn configure_backend(cmd: &IdentifyCommand) -> Result<Backend> {
-    let mut backend = Backend::from(cmd.backend);
+    let mut backend = Backend::from(cmd.backend.unwrap_or(BackendName::Stepwise));
     // the stepwise stop and step-rule options do not apply to the other back-ends
     if let Backend::Stepwise(s) = &mut backend {
         s.min_proportion = cmd.min_proportion;
@@ -211,6 +211,15 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
         termid::output::check_file(out)?;
     }
     let mut model = termid::plugins::load(&path)?;
+    if cmd.backend.is_some() {
+        // the command line's back-end (with its stepwise options) replaces the file's
+        let backend = configure_backend(&cmd)?;
+        model = model.edit(|file| {
+            for e in file.equations.values_mut().filter(|e| e.identify) {
+                e.backend = Some(backend.clone());
+            }
+        })?;
+    }
     let refine = cmd.refine.as_deref().map(|list| refine_states(list, &model)).transpose()?;
     let frames = crate::runs::load_for(&model, &cmd.data, cmd.dataset.as_deref())?;
     let names: Vec<String> =
@@ -238,9 +247,34 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
         intercept: !cmd.no_intercept,
         target: cmd.target.as_deref().map(Target::parse),
     };
-    let identified = crate::progress::with_spinner(&label, || {
-        termid::identify::identify_model(&model, &frames, &how, &mut |_| {})
-    })?;
+    let identified = match &cmd.choose {
+        None => crate::progress::with_spinner(&label, || {
+            termid::identify::identify_model(&model, &frames, &how, &mut |_| {})
+        })?,
+        Some(list) => {
+            let configurations = backend_variants(&model, list)?;
+            let prediction = termid::diagnose::Prediction {
+                states: match cmd.compare.as_deref().map(|l| refine_states(l, &model)).transpose()? {
+                    Some(Some(states)) => states,
+                    _ => vec![],
+                },
+                ..Default::default()
+            };
+            let chosen = crate::progress::with_spinner("choosing by prediction (leave one run out)", || {
+                termid::diagnose::choose_by_prediction(
+                    &configurations,
+                    &frames,
+                    &how,
+                    &prediction,
+                    &mut |_| {},
+                )
+            })?;
+            if matches!(cmd.format, Format::Text) {
+                print!("{}", chosen.text());
+            }
+            chosen.identified
+        }
+    };
     let fits = identified.fits;
     model = identified.model;
     // a refinement that fails loses nothing: the regression's model is still written, and
@@ -304,6 +338,30 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
 /// `identify --refine`: every identified coefficient refined by output error on the runs as
 /// they were prepared for the regression (smoothed initial states: a noisy first sample of a
 /// rate would otherwise drift through its integral).
+/// `--choose`: the model with each named back-end in every identified equation.
+fn backend_variants(model: &termid::model::Model, list: &str) -> Result<Vec<(String, termid::model::Model)>> {
+    let names: Vec<&str> = if list.trim() == "all" {
+        Backend::NAMES.to_vec()
+    } else {
+        list.split(',').map(str::trim).filter(|n| !n.is_empty()).collect()
+    };
+    if names.is_empty() {
+        bail!("--choose `{list}` names no back-end (known: {})", Backend::NAMES.join(", "));
+    }
+    names
+        .into_iter()
+        .map(|name| {
+            let backend = Backend::by_name(name).map_err(|e| anyhow::anyhow!("--choose: {e}"))?;
+            let variant = model.edit(|file| {
+                for e in file.equations.values_mut().filter(|e| e.identify) {
+                    e.backend = Some(backend.clone());
+                }
+            })?;
+            Ok((name.to_string(), variant))
+        })
+        .collect()
+}
+
 /// The states `--refine` names (`None`: all), each checked to be one of the model's.
 fn refine_states(list: &str, model: &termid::model::Model) -> Result<Option<Vec<String>>> {
     if list.trim() == "all" {
