@@ -5,6 +5,11 @@
 //! identified on all runs. A regression's own fit (R², F) says how well an equation explains
 //! the accelerations it was given; only a simulation of runs it has not seen says how well
 //! the model will predict a manoeuvre, which is what it is for.
+//!
+//! Held-out errors are themselves estimates: configurations whose errors differ by less than
+//! their standard error are not told apart by the runs. Among those within one standard error
+//! of the lowest, the first in the caller's order is chosen (the one-standard-error rule of
+//! Breiman et al. 1984, with the caller's order of preference in place of "the simplest").
 
 use serde::Serialize;
 
@@ -45,6 +50,8 @@ pub struct Configuration {
     /// Mean over the runs of the scaled mean square (each run's cost over its samples and
     /// states): 1 is an error the size of the signals' own spread.
     pub score: f64,
+    /// Standard error of that mean (the spread of the runs' mean squares over √runs).
+    pub standard_error: f64,
     /// Runs whose prediction failed (diverged or could not be identified).
     pub failed: usize,
 }
@@ -54,9 +61,11 @@ pub struct Configuration {
 pub struct Chosen {
     /// Every configuration's record, in the order given.
     pub candidates: Vec<Configuration>,
-    /// Index of the chosen configuration (lowest score among those with no failed run, else
-    /// fewest failures).
+    /// Index of the chosen configuration: the first in the given order whose score is within
+    /// one standard error of the lowest (among those with no failed run, else fewest failures).
     pub best: usize,
+    /// Index of the configuration with the lowest score.
+    pub lowest: usize,
     /// The chosen configuration identified on all runs.
     pub identified: IdentifiedModel,
 }
@@ -96,26 +105,31 @@ pub fn choose_by_prediction(
         }
         let failed = mean_squares.iter().filter(|c| !c.is_finite()).count();
         let finite: Vec<f64> = mean_squares.iter().copied().filter(|c| c.is_finite()).collect();
-        let score = if finite.is_empty() {
-            f64::INFINITY
-        } else if failed > 0 {
-            // a configuration that fails a run ranks after every one that fails none
-            f64::INFINITY
+        // a configuration that fails a run ranks after every one that fails none
+        let (score, standard_error) = if failed > 0 || finite.is_empty() {
+            (f64::INFINITY, f64::INFINITY)
         } else {
-            finite.iter().sum::<f64>() / finite.len() as f64
+            let k = finite.len() as f64;
+            let mean = finite.iter().sum::<f64>() / k;
+            let var = finite.iter().map(|c| (c - mean).powi(2)).sum::<f64>() / (k - 1.0).max(1.0);
+            (mean, (var / k).sqrt())
         };
-        candidates.push(Configuration { label: label.clone(), folds, score, failed });
+        candidates.push(Configuration { label: label.clone(), folds, score, standard_error, failed });
     }
-    let best = (0..candidates.len())
+    let lowest = (0..candidates.len())
         .min_by(|&a, &b| {
             let (x, y) = (&candidates[a], &candidates[b]);
             x.failed.cmp(&y.failed).then(x.score.total_cmp(&y.score))
         })
         .unwrap_or(0);
+    let limit = candidates[lowest].score + candidates[lowest].standard_error;
+    let best = (0..candidates.len())
+        .find(|&i| candidates[i].failed == candidates[lowest].failed && candidates[i].score <= limit)
+        .unwrap_or(lowest);
     progress(&format!("{} on all runs", candidates[best].label));
     let identified = identify_model(&configurations[best].1, frames, how, &mut |_| {})
         .map_err(|e| DiagnoseError::Setup(format!("the chosen `{}`: {e}", candidates[best].label)))?;
-    Ok(Chosen { candidates, best, identified })
+    Ok(Chosen { candidates, best, lowest, identified })
 }
 
 /// The states a prediction compares.
@@ -141,6 +155,11 @@ fn held_out_cost(
     Ok(runs.gap(&sims).cost)
 }
 
+/// A run's file name without its folder (the table's column stays narrow).
+fn file_name(origin: &str) -> String {
+    std::path::Path::new(origin).file_name().map_or(origin.to_string(), |n| n.to_string_lossy().into_owned())
+}
+
 impl Chosen {
     /// The table as a person reads it: per configuration its mean scaled error over the
     /// held-out runs and the worst run, the chosen one marked.
@@ -148,20 +167,35 @@ impl Chosen {
         let mut out = String::from(
             "== chosen by prediction: each run re-simulated by a model identified on the others ==\n",
         );
-        out += &format!(
-            "{:<28} {:>14} {:>14}  {}\n",
-            "configuration", "mean error", "worst run", "(error: mean square of the compared states, each scaled by its spread; 1 = as large as the signal)"
-        );
+        out += "error: mean square of the compared states over a held-out run, each state scaled by its\nspread (1 = as large as the signal), averaged over the runs, ± its standard error\n";
+        out +=
+            &format!("{:<28} {:>14} {:>12} {:>24}\n", "configuration", "mean error", "± s.e.", "worst run");
         for (i, c) in self.candidates.iter().enumerate() {
             let worst = c.folds.iter().max_by(|a, b| a.1.total_cmp(&b.1));
-            let score =
-                if c.failed > 0 { format!("{} failed", c.failed) } else { crate::identify::num(c.score) };
+            let (score, se) = if c.failed > 0 {
+                (format!("{} failed", c.failed), "--".to_string())
+            } else {
+                (crate::identify::num(c.score), crate::identify::num(c.standard_error))
+            };
+            let mark = if i == self.best {
+                "  ← chosen"
+            } else if i == self.lowest {
+                "  (lowest)"
+            } else {
+                ""
+            };
             out += &format!(
-                "{:<28} {:>14} {:>14}{}\n",
+                "{:<28} {:>14} {:>12} {:>24}{mark}\n",
                 c.label,
                 score,
-                worst.map_or("--".to_string(), |w| w.0.clone()),
-                if i == self.best { "  ← chosen" } else { "" }
+                se,
+                worst.map_or("--".to_string(), |w| file_name(&w.0)),
+            );
+        }
+        if self.best != self.lowest {
+            out += &format!(
+                "`{}` is within one standard error of the lowest, `{}`: the runs do not tell them apart, and it comes first in the order given\n",
+                self.candidates[self.best].label, self.candidates[self.lowest].label
             );
         }
         out + "\n"

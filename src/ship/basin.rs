@@ -8,7 +8,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::{Manoeuvre, Metrics, Ship, ShipError};
+use super::{Manoeuvre, Metrics, Ship, ShipError, StraightRun};
 use crate::data::Frame;
 use crate::model::Model;
 use crate::sim::{Integrator, Settings};
@@ -36,6 +36,20 @@ impl Default for Noise {
     }
 }
 
+/// What real records have beyond sensor noise (all off by default, as in the Oltmann basin).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Artefacts {
+    /// The rudder indicator reads this much more than the rudder's hydrodynamic angle, °.
+    pub rudder_offset_deg: f64,
+    /// u and v are not logged but computed from the tracked position (with its noise) and the
+    /// measured heading, by central differences over ± this many samples, as in the SIMMAN
+    /// KVLCC2 files.
+    pub velocities_from_track: Option<usize>,
+    /// The record ends with the rudder back at midship (the straight run's angle) for this
+    /// many seconds after the manoeuvre.
+    pub midship_end_s: f64,
+}
+
 /// How runs are recorded.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Basin {
@@ -47,11 +61,19 @@ pub struct Basin {
     pub noise: Noise,
     /// Integration step of the truth (RK4), s.
     pub dt: f64,
+    /// Artefacts of real records.
+    pub artefacts: Artefacts,
 }
 
 impl Default for Basin {
     fn default() -> Self {
-        Basin { rate_hz: 20.0, approach_s: 5.0, noise: Noise::default(), dt: 0.01 }
+        Basin {
+            rate_hz: 20.0,
+            approach_s: 5.0,
+            noise: Noise::default(),
+            dt: 0.01,
+            artefacts: Artefacts::default(),
+        }
     }
 }
 
@@ -90,6 +112,20 @@ pub const COLUMNS: [(&str, &str); 8] = [
     ("y0", "y_track [m]"),
     ("δ", "rudder [deg]"),
 ];
+
+/// The basin's columns for `model`: [`COLUMNS`] and one per further input (a propeller's
+/// rate), by its own name and unit.
+pub fn columns(model: &Model) -> Vec<(String, String)> {
+    let rudder = super::canonical_spec(model).map_or_else(|| "δ".to_string(), |s| s.names.rudder);
+    COLUMNS
+        .iter()
+        .map(|(v, c)| (v.to_string(), c.to_string()))
+        .chain(model.spec().inputs.iter().filter(|i| i.name != rudder).map(|i| {
+            let unit = if i.unit.is_empty() { "-" } else { i.unit.as_str() };
+            (i.name.clone(), format!("{} [{unit}]", i.name))
+        }))
+        .collect()
+}
 
 /// The model run at another approach speed: the ship's u0 and every parameter taken from the
 /// run's surge speed in identification (`first:u`, `mean:u…`), so that Δu = u − u0 is
@@ -133,7 +169,28 @@ impl Basin {
         let ship = Ship::new(&model, false)?;
         let sample = 1.0 / self.rate_hz;
         let settings = Settings { integrator: Integrator::Rk4, dt: self.dt, duration, sample };
-        let run = ship.run(manoeuvre, &settings)?;
+        let mut run = ship.run(manoeuvre, &settings)?;
+        if self.artefacts.midship_end_s > 0.0 {
+            // the rudder back to the straight run's angle, the record going on
+            let tr = &run.trajectory;
+            let last = |c: &Vec<Vec<f64>>| c.iter().map(|s| s[s.len() - 1]).collect::<Vec<f64>>();
+            let start = StraightRun { x: last(&tr.states), input: last(&tr.inputs), ..run.start.clone() };
+            let back = Manoeuvre::parse(&format!("turning:{}", run.start.delta0_deg))?;
+            let end = Settings { duration: self.artefacts.midship_end_s, ..settings };
+            let more = ship.run_from(&back, &end, start)?.trajectory;
+            let t_end = tr.time[tr.time.len() - 1];
+            let tr = &mut run.trajectory;
+            tr.time.extend(more.time[1..].iter().map(|t| t + t_end));
+            for (a, b) in tr.states.iter_mut().zip(&more.states) {
+                a.extend(&b[1..]);
+            }
+            for (a, b) in tr.inputs.iter_mut().zip(&more.inputs) {
+                a.extend(&b[1..]);
+            }
+            for (a, b) in tr.derivatives.iter_mut().zip(&more.derivatives) {
+                a.extend(&b[1..]);
+            }
+        }
         let tr = &run.trajectory;
         let r = &ship.roles;
         // the approach: steady straight running (ψ = 0) at the straight run's u0, v0, δ0
@@ -166,7 +223,9 @@ impl Basin {
         let mut measured = truth.clone();
         let mut gauss = Normal::new(seed);
         let n = &self.noise;
-        for (i, name) in tr.state_names.iter().enumerate() {
+        let mut clean_states = Vec::with_capacity(tr.state_names.len());
+        let mut noisy_states = Vec::with_capacity(tr.state_names.len());
+        for (i, state) in states.iter().enumerate() {
             let (offset, sd) = match i {
                 _ if i == r.u || i == r.v => (0.0, n.speed_m_s),
                 _ if i == r.r => (0.0, n.yaw_rate_deg_s.to_radians()),
@@ -175,20 +234,38 @@ impl Basin {
                 _ if i == r.y0 => (oy, n.position_m),
                 _ => (0.0, 0.0),
             };
-            let clean: Vec<f64> = states[i].iter().map(|v| v - offset).collect();
-            measured.push(name, clean.iter().map(|v| v + sd * gauss.sample()).collect())?;
+            let clean: Vec<f64> = state.iter().map(|v| v - offset).collect();
+            noisy_states.push(clean.iter().map(|v| v + sd * gauss.sample()).collect::<Vec<f64>>());
+            clean_states.push(clean);
+        }
+        if let Some(half) = self.artefacts.velocities_from_track {
+            let (u, v) = velocities_from_track(
+                truth.time(),
+                &noisy_states[r.x0],
+                &noisy_states[r.y0],
+                &noisy_states[r.psi],
+                half.max(1),
+            );
+            (noisy_states[r.u], noisy_states[r.v]) = (u, v);
+        }
+        for ((name, clean), noisy) in tr.state_names.iter().zip(clean_states).zip(noisy_states) {
+            measured.push(name, noisy)?;
             truth.push(name, clean)?;
         }
         for (i, name) in tr.input_names.iter().enumerate() {
-            let sd = if i == r.rudder { n.rudder_deg.to_radians() } else { 0.0 };
-            measured.push(name, inputs[i].iter().map(|v| v + sd * gauss.sample()).collect())?;
+            let (offset, sd) = if i == r.rudder {
+                (self.artefacts.rudder_offset_deg.to_radians(), n.rudder_deg.to_radians())
+            } else {
+                (0.0, 0.0)
+            };
+            measured.push(name, inputs[i].iter().map(|v| v + offset + sd * gauss.sample()).collect())?;
             truth.push(name, inputs[i].clone())?;
         }
         Ok(Recording { truth, measured, metrics: run.metrics, u0 })
     }
 
     /// Writes the measured run as the basin's data file: three header lines, then the
-    /// columns of [`COLUMNS`] separated by spaces, angles in degrees.
+    /// columns of [`columns`] separated by spaces, angles in degrees.
     pub fn write(&self, rec: &Recording, model: &Model, path: &Path) -> std::io::Result<()> {
         let canon = |n: &str| model.vocabulary.canonical(n).unwrap_or_else(|| n.to_string());
         let mut text = format!(
@@ -203,14 +280,14 @@ impl Basin {
             self.noise.position_m,
             self.noise.rudder_deg
         );
-        let header: Vec<&str> = COLUMNS.iter().map(|(_, c)| c.split(" [").next().unwrap_or(c)).collect();
+        let columns = columns(model);
+        let header: Vec<&str> = columns.iter().map(|(_, c)| c.split(" [").next().unwrap_or(c)).collect();
         text += &header.join(" ");
         text.push('\n');
-        let cols: Vec<(&[f64], bool)> = COLUMNS
+        let cols: Vec<(&[f64], bool)> = columns
             .iter()
             .map(|(var, spec)| {
-                let c =
-                    if *var == "t" { Some(rec.measured.time()) } else { rec.measured.column(&canon(var)) };
+                let c = if var == "t" { Some(rec.measured.time()) } else { rec.measured.column(&canon(var)) };
                 (c.unwrap_or(&[]), spec.contains("[deg"))
             })
             .collect();
@@ -228,16 +305,41 @@ impl Basin {
     }
 }
 
-/// A dataset file (see [`crate::data::Dataset`]) listing basin files written by [`Basin::write`].
+/// A dataset file (see [`crate::data::Dataset`]) listing basin files written by [`Basin::write`]
+/// for a model with no inputs beyond the rudder.
 pub fn dataset_toml(files: &[&str]) -> String {
+    let columns: Vec<(String, String)> =
+        COLUMNS.iter().map(|(v, c)| (v.to_string(), c.to_string())).collect();
+    dataset_file(&columns, files)
+}
+
+/// A dataset file listing basin files written by [`Basin::write`] with `columns` (those of
+/// [`columns`] for the model).
+pub fn dataset_file(columns: &[(String, String)], files: &[&str]) -> String {
     let mut s = String::from("# runs from the synthetic basin\n[columns]\n");
-    for (var, spec) in COLUMNS {
+    for (var, spec) in columns {
         let _ = writeln!(s, "\"{var}\" = \"{spec}\"");
     }
     for f in files {
         let _ = write!(s, "\n[[runs]]\nfile = \"{f}\"\ndelimiter = \"whitespace\"\nskip = 3\n");
     }
     s
+}
+
+/// Surge and sway velocity from a tracked position and heading: the earth-fixed velocity by
+/// central differences over ± `half` samples (one-sided at the ends), turned into the body
+/// frame by the heading (eq. B9 inverted).
+fn velocities_from_track(t: &[f64], x: &[f64], y: &[f64], psi: &[f64], half: usize) -> (Vec<f64>, Vec<f64>) {
+    let n = t.len();
+    (0..n)
+        .map(|k| {
+            let (a, b) = (k.saturating_sub(half), (k + half).min(n - 1));
+            let h = (t[b] - t[a]).max(f64::MIN_POSITIVE);
+            let (xd, yd) = ((x[b] - x[a]) / h, (y[b] - y[a]) / h);
+            let (s, c) = psi[k].sin_cos();
+            (xd * c + yd * s, -xd * s + yd * c)
+        })
+        .unzip()
 }
 
 #[cfg(test)]
@@ -285,5 +387,56 @@ mod tests {
                 assert!((a - b).abs() < 0.4, "seed {seed}: {a}° vs {b}°");
             }
         }
+    }
+
+    /// The artefacts of real records: velocities from the track equal the true ones where the
+    /// track is exact, the rudder indicator reads its offset, the record ends at midship.
+    #[test]
+    fn artefacts_are_recorded_as_declared() {
+        let model = crate::ship::default_model();
+        let basin = Basin {
+            noise: Noise {
+                speed_m_s: 0.0,
+                yaw_rate_deg_s: 0.0,
+                heading_deg: 0.0,
+                position_m: 0.0,
+                rudder_deg: 0.0,
+            },
+            artefacts: Artefacts {
+                rudder_offset_deg: 0.5,
+                velocities_from_track: Some(2),
+                midship_end_s: 6.0,
+            },
+            ..Basin::default()
+        };
+        let rec = basin
+            .record(&model, &Manoeuvre::parse("zigzag:20/20").unwrap(), 2.01, 40.0, 1, "zz.dat")
+            .unwrap();
+        // 5 s of approach, 40 s of zigzag, 6 s back at midship, at 20 Hz
+        assert_eq!(rec.truth.len(), 100 + 801 + 120);
+        let (d, dm) = (rec.truth.column("δ").unwrap(), rec.measured.column("δ").unwrap());
+        assert!(d.iter().zip(dm).all(|(a, b)| (b - a - 0.5f64.to_radians()).abs() < 1e-12));
+        // the straight run's rudder (0 for this symmetric-at-rest ship up to its asymmetry)
+        // is reached at the rudder rate and held to the end
+        let delta0 = d[0];
+        assert!((d[d.len() - 1] - delta0).abs() < 1e-12 && (d[d.len() - 40] - delta0).abs() < 1e-12);
+        // central differences over ±0.1 s of the exact track: u and v to their truncation error
+        for name in ["u", "v"] {
+            let (a, b) = (rec.truth.column(name).unwrap(), rec.measured.column(name).unwrap());
+            let worst = a[2..a.len() - 2].iter().zip(&b[2..]).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+            assert!(worst < 2e-3, "{name}: {worst} m/s");
+        }
+    }
+
+    #[test]
+    fn velocities_from_a_straight_track_are_exact() {
+        let t: Vec<f64> = (0..50).map(|i| i as f64 * 0.05).collect();
+        let psi = vec![0.3; t.len()];
+        // u = 2, v = −0.5 in the body frame, turned by ψ into the earth frame
+        let (xd, yd) = (2.0 * 0.3f64.cos() + 0.5 * 0.3f64.sin(), 2.0 * 0.3f64.sin() - 0.5 * 0.3f64.cos());
+        let x: Vec<f64> = t.iter().map(|t| xd * t).collect();
+        let y: Vec<f64> = t.iter().map(|t| yd * t).collect();
+        let (u, v) = velocities_from_track(&t, &x, &y, &psi, 2);
+        assert!(u.iter().all(|u| (u - 2.0).abs() < 1e-12) && v.iter().all(|v| (v + 0.5).abs() < 1e-12));
     }
 }

@@ -73,3 +73,89 @@ fn a_propeller_that_is_not_an_input_is_refused_with_its_key() {
     let e = termid::plugins::parse(&text, "mmg.toml").unwrap_err().to_string();
     assert!(e.contains("ship.names.propeller") && e.contains("not an input"), "{e}");
 }
+
+/// The recipe for a new ship through the command line, on records of the MMG truth with the
+/// artefacts of real ones (noise, a rudder indicator 0.3° off, u and v from the track, the
+/// rudder back at midship at the end): from eight zigzags, the turning circles of the truth
+/// within 3 % and a held-out zigzag's first overshoot within 1° (README's MMG basin table has
+/// every seed).
+#[test]
+fn the_new_ship_recipe_predicts_turning_circles_it_was_not_trained_on() {
+    use termid::ship::basin::{at_approach_speed, columns, dataset_file, Artefacts, Basin, Noise};
+    let dir = crate::common::Scratch::new("mmg-recipe");
+    let truth = termid::plugins::load(Path::new("models/mmg_kvlcc2.toml")).unwrap();
+    let basin = Basin {
+        noise: Noise {
+            speed_m_s: 0.0,
+            yaw_rate_deg_s: 0.05,
+            heading_deg: 0.05,
+            position_m: 0.002,
+            rudder_deg: 0.05,
+        },
+        artefacts: Artefacts { rudder_offset_deg: 0.3, velocities_from_track: Some(2), midship_end_s: 5.0 },
+        ..Basin::default()
+    };
+    let runs = [
+        ("zigzag:10/10", 0.98),
+        ("zigzag:10/10:port", 1.02),
+        ("zigzag:20/20", 1.01),
+        ("zigzag:20/20:port", 0.97),
+        ("zigzag:15/5", 1.03),
+        ("zigzag:15/5:port", 0.99),
+        ("zigzag:35/5", 1.00),
+        ("zigzag:35/5:port", 1.02),
+    ];
+    let mut files = Vec::new();
+    for (k, (m, f)) in runs.iter().enumerate() {
+        let name = format!("{}.dat", m.replace([':', '/'], "_"));
+        let rec = basin
+            .record(&truth, &Manoeuvre::parse(m).unwrap(), f * 1.17248, 80.0, 101 + k as u64, &name)
+            .unwrap();
+        basin.write(&rec, &truth, &dir.join(&name)).unwrap();
+        files.push(name);
+    }
+    let names: Vec<&str> = files.iter().map(String::as_str).collect();
+    std::fs::write(dir.join("train.toml"), dataset_file(&columns(&truth), &names)).unwrap();
+    let out = dir.join("identified.toml");
+    let (ok, text, err) = crate::common::termid(&[
+        "identify",
+        "--model",
+        "models/new_ship.toml",
+        "--dataset",
+        dir.join("train.toml").to_str().unwrap(),
+        "--derivative",
+        "kinematic",
+        "--smooth",
+        "--no-intercept",
+        "--choose",
+        "sparse,best-subset,efroymson,stepwise",
+        "--compare",
+        "u,v,r,ψ",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(text.contains("← chosen"), "{text}");
+    let mut model = termid::plugins::load(&out).unwrap();
+    let mut spec = termid::ship::ShipSpec::of(&model).unwrap().unwrap();
+    spec.rudder_limit = 36.0;
+    spec.store(&mut model);
+    let truth_ship = ship();
+    let identified = Ship::new(&model, false).unwrap();
+    for rudder in [35.0, -35.0] {
+        let Metrics::Turning(t) = run(&truth_ship, &format!("turning:{rudder}")) else { unreachable!() };
+        // the model's rudder is the indicator's, 0.3° more than the true angle
+        let Metrics::Turning(m) = run(&identified, &format!("turning:{}", rudder + 0.3)) else {
+            unreachable!()
+        };
+        let (a, b) = (m.tactical_diameter_m.unwrap(), t.tactical_diameter_m.unwrap());
+        assert!((a / b - 1.0).abs() < 0.03, "δ = {rudder}°: tactical diameter {a} m, truth {b} m");
+    }
+    let held = |m: &termid::model::Model| {
+        let s = Ship::new(&at_approach_speed(m, 1.17248), false).unwrap();
+        let Metrics::ZigZag(z) = run(&s, "zigzag:25/10") else { unreachable!() };
+        z.first_overshoot_deg.unwrap()
+    };
+    let (a, b) = (held(&model), held(&truth));
+    assert!((a - b).abs() < 1.0, "held-out 25/10: {a}° vs truth {b}°");
+}
