@@ -115,6 +115,9 @@ def main():
     os.makedirs(a.work, exist_ok=True)
     cases = [("turning:35", None), ("turning:-35", None), ("turning:20", None), ("turning:-20", None),
              ("zigzag:10/10", 10.0), ("zigzag:20/20", 20.0)]
+    from importlib.metadata import version
+    print(f"# termid's MMG model file ({a.model}) against shipmmg {version('shipmmg')}\n")
+    print("Same rudder and propeller series, same initial state; both trajectories measured here.\n")
     print("| manoeuvre | quantity | termid | shipmmg | difference |")
     print("|---|---|---:|---:|---:|")
     worst = {"turning": 0.0, "zigzag": 0.0}
