@@ -71,12 +71,42 @@ pub trait Plugin: Sync {
     ) -> Option<Observation> {
         None
     }
+    /// Physical checks of an identified `model` (identified from `runs`), before it is written
+    /// or trusted: what the field knows must hold whatever the data said. Empty: none.
+    fn checks(&self, _model: &Model, _runs: &[Frame]) -> Vec<Check> {
+        vec![]
+    }
     /// A named scenario of this field (`zigzag:20/20`) to simulate `model` under.
     fn scenario(
         &self,
         model: &Model,
         request: &ScenarioRequest<'_>,
     ) -> Result<Box<dyn Scenario>, PluginError>;
+}
+
+/// One physical check of a model and its outcome.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Check {
+    /// What is checked, e.g. `yaw damping ∂ṙ/∂r < 0`.
+    pub name: String,
+    /// Whether the model passes.
+    pub passed: bool,
+    /// Whether failing it refuses the model (else it is flagged: some real hulls fail it).
+    pub refuses: bool,
+    /// The numbers behind the verdict.
+    pub detail: String,
+}
+
+impl Check {
+    /// One line a person reads: `ok`, `FLAG` or `FAIL`, the check and its numbers.
+    pub fn line(&self) -> String {
+        let verdict = match (self.passed, self.refuses) {
+            (true, _) => "ok  ",
+            (false, false) => "FLAG",
+            (false, true) => "FAIL",
+        };
+        format!("{verdict} {}: {}", self.name, self.detail)
+    }
 }
 
 /// What `simulate` asks of a plug-in's scenario.

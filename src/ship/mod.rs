@@ -4,6 +4,7 @@
 //! MSC.137(76), ITTC 7.5-04-02-01). Angles are radians inside, degrees in metrics.
 
 pub mod basin;
+pub mod checks;
 #[cfg(feature = "plot")]
 pub mod figure;
 pub mod hypotheses;

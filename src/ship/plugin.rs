@@ -7,7 +7,7 @@ use super::{canonical_spec, Manoeuvre, Metrics, Ship, ShipError, ShipSpec};
 use crate::data::Frame;
 use crate::diagnose::Hypothesis;
 use crate::model::{Model, ModelError};
-use crate::plugin::{Observation, Outcome, Plugin, PluginError, Scenario, ScenarioRequest};
+use crate::plugin::{Check, Observation, Outcome, Plugin, PluginError, Scenario, ScenarioRequest};
 use crate::sim::{Settings, Trajectory};
 
 /// Ship manoeuvring (Oltmann 1973; IMO MSC.137(76)).
@@ -68,6 +68,27 @@ impl Plugin for Manoeuvring {
             ))
         })?;
         super::tracking::track(frame, &ship, smooth).map_err(PluginError::failed)
+    }
+
+    fn checks(&self, model: &Model, runs: &[Frame]) -> Vec<Check> {
+        let Some(spec) = canonical_spec(model) else { return vec![] };
+        // turning circles at the largest rudder angle the runs used (from each run's start,
+        // its approach), the model's limit when there are no runs
+        let used = runs
+            .iter()
+            .filter_map(|f| f.column(&spec.names.rudder))
+            .map(|d| d.iter().map(|v| (v - d[0]).abs()).fold(0.0, f64::max).to_degrees())
+            .fold(0.0, f64::max);
+        let rudder = if used > 0.0 { used.min(spec.rudder_limit) } else { spec.rudder_limit };
+        match super::checks::physical_checks(model, rudder) {
+            Ok(checks) => checks,
+            Err(e) => vec![Check {
+                name: "the model simulates as a ship".into(),
+                passed: false,
+                refuses: true,
+                detail: e.to_string(),
+            }],
+        }
     }
 
     fn hypotheses(&self, model: &Model) -> Option<Vec<Hypothesis>> {

@@ -27,7 +27,9 @@ pub static FUNCTIONS: &[Function] = &[
     Function {
         name: "atan2",
         arity: 2,
-        eval: |a| a[0].atan2(a[1]),
+        // signed zeros folded to +0: the canonical form may compute a zero as −0 where the
+        // text gives +0 (u − u), and atan2 would then jump from π to −π
+        eval: |a| (a[0] + 0.0).atan2(a[1] + 0.0),
         doc: "angle of the point (x, y) as atan2(y, x), radians in (−π, π], e.g. atan2(v, u) the drift angle",
     },
 ];

@@ -158,4 +158,25 @@ fn the_new_ship_recipe_predicts_turning_circles_it_was_not_trained_on() {
     };
     let (a, b) = (held(&model), held(&truth));
     assert!((a - b).abs() < 1.0, "held-out 25/10: {a}° vs truth {b}°");
+    // the same records with sequentially thresholded least squares: a model whose turning
+    // circles diverge, refused by the physical checks and not written
+    let refused = dir.join("stlsq.toml");
+    let (ok, text, err) = crate::common::termid(&[
+        "identify",
+        "--model",
+        "models/new_ship.toml",
+        "--dataset",
+        dir.join("train.toml").to_str().unwrap(),
+        "--derivative",
+        "kinematic",
+        "--smooth",
+        "--no-intercept",
+        "--backend",
+        "stlsq",
+        "--out",
+        refused.to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("fails physical checks") && err.contains("--keep-unphysical"), "{err}");
+    assert!(text.contains("== physical checks ==") && text.contains("FAIL turning circle"), "{text}");
+    assert!(!refused.exists());
 }

@@ -137,6 +137,10 @@ pub struct IdentifyCommand {
     /// identified equations), e.g. `u,v,r,ψ`.
     #[arg(long, value_name = "STATES", requires = "choose")]
     pub compare: Option<String>,
+    /// Write the model even when it fails a physical check of its plug-in (a ship's: damping
+    /// signs, turning circles that complete, plausible speed loss and drift).
+    #[arg(long, requires = "model")]
+    pub keep_unphysical: bool,
     /// Fit without an intercept b0.
     #[arg(long)]
     pub no_intercept: bool,

@@ -291,7 +291,11 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
         },
         None => (None, None),
     };
-    if let Some(out) = &cmd.out {
+    // what the field knows must hold, checked before anything is written
+    let checks = termid::plugins::of(&model).map(|p| p.checks(&model, &frames)).unwrap_or_default();
+    let refused: Vec<String> = checks.iter().filter(|c| !c.passed && c.refuses).map(|c| c.line()).collect();
+    let write = refused.is_empty() || cmd.keep_unphysical;
+    if let Some(out) = cmd.out.as_ref().filter(|_| write) {
         let provenance = format!(
             "identified by termid from {} ({})",
             cmd.data.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "),
@@ -316,6 +320,9 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
             if let Some(r) = &refined {
                 all.insert("output_error_refinement".into(), serde_json::to_value(r)?);
             }
+            if !checks.is_empty() {
+                all.insert("physical_checks".into(), serde_json::to_value(&checks)?);
+            }
             println!("{}", serde_json::to_string_pretty(&all)?);
         }
         Format::Text => {
@@ -327,10 +334,31 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
             if let Some(r) = &refined {
                 print!("{}", r.text());
             }
-            if let Some(out) = &cmd.out {
+            if !checks.is_empty() {
+                println!("== physical checks ==");
+                for c in &checks {
+                    println!("{}", c.line());
+                }
+                println!();
+            }
+            if let Some(out) = cmd.out.as_ref().filter(|_| write) {
                 println!("wrote {}", out.display());
             }
         }
+    }
+    if !refused.is_empty() {
+        let what = if cmd.keep_unphysical {
+            "written anyway (--keep-unphysical)".to_string()
+        } else {
+            match &cmd.out {
+                Some(out) => format!("not written to {} (--keep-unphysical writes it)", out.display()),
+                None => "refused".to_string(),
+            }
+        };
+        if !cmd.keep_unphysical {
+            bail!("the identified model fails physical checks, {what}:\n  {}", refused.join("\n  "));
+        }
+        eprintln!("warning: the identified model fails physical checks, {what}:\n  {}", refused.join("\n  "));
     }
     Ok(())
 }

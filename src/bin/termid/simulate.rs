@@ -29,7 +29,13 @@ pub fn run(cmd: SimulateCommand) -> Result<()> {
     set_parameters(&mut model, &cmd.params)?;
     let integrator = cmd.integrator;
     match (&cmd.manoeuvre, termid::plugins::of(&model)) {
-        (Some(m), Some(plugin)) => scenario_run(&cmd, &model, plugin, m, integrator),
+        (Some(m), Some(plugin)) => {
+            // a model that fails what its field knows is simulated, but not silently
+            for c in plugin.checks(&model, &[]).iter().filter(|c| !c.passed && c.refuses) {
+                eprintln!("warning: {} fails a physical check: {}", model.path, c.line());
+            }
+            scenario_run(&cmd, &model, plugin, m, integrator)
+        }
         (Some(m), None) if !m.starts_with("replay:") => {
             let tables: Vec<String> =
                 termid::plugins::PLUGINS.iter().map(|p| format!("[{}]", p.table())).collect();

@@ -1,0 +1,152 @@
+//! Physical checks of an identified ship model, made before it is written: the sway and yaw
+//! damping at the straight run have the signs every hull has, turning circles at the rudder
+//! angles the training runs used complete, and in them the ship slows down (but keeps some
+//! speed) and drifts with its bow inside the circle. A regression that fits zigzags well can
+//! still fail these (a model that turns 60° and then turns back), and such a model must not be
+//! written silently. Straight-line stability is reported, not required: some full-form hulls
+//! are course-unstable.
+
+use super::{Manoeuvre, Metrics, Ship, ShipError};
+use crate::model::Model;
+use crate::plugin::Check;
+use crate::sim::{Integrator, Settings};
+
+/// The checks of `model` with turning circles at ± `rudder_deg` from the straight run's rudder.
+pub fn physical_checks(model: &Model, rudder_deg: f64) -> Result<Vec<Check>, ShipError> {
+    let ship = Ship::new(model, false)?;
+    let start = ship.straight_run()?;
+    let r = ship.roles;
+    let mut checks = Vec::new();
+    // the sway-yaw derivatives at the straight run, by central differences
+    let jacobian = {
+        let mut ws = ship.system.workspace();
+        let mut d = vec![0.0; start.x.len()];
+        let mut rate = |state: usize, h: f64| {
+            let mut x = start.x.clone();
+            x[state] += h;
+            ship.system.derivatives(&x, &start.input, &mut ws, &mut d);
+            (d[r.v], d[r.r])
+        };
+        let hv = 1e-4 * ship.spec.u0;
+        let hr = hv / ship.spec.lpp;
+        let (vp, vm) = (rate(r.v, hv), rate(r.v, -hv));
+        let (rp, rm) = (rate(r.r, hr), rate(r.r, -hr));
+        [
+            [(vp.0 - vm.0) / (2.0 * hv), (rp.0 - rm.0) / (2.0 * hr)],
+            [(vp.1 - vm.1) / (2.0 * hv), (rp.1 - rm.1) / (2.0 * hr)],
+        ]
+    };
+    let [[yv, yr], [nv, nr]] = jacobian;
+    checks.push(Check {
+        name: "sway damping ∂v̇/∂v < 0".into(),
+        passed: yv < 0.0,
+        refuses: true,
+        detail: format!("{yv:.4} 1/s at u0 = {} m/s", ship.spec.u0),
+    });
+    checks.push(Check {
+        name: "yaw damping ∂ṙ/∂r < 0".into(),
+        passed: nr < 0.0,
+        refuses: true,
+        detail: format!("{nr:.4} 1/s at u0"),
+    });
+    // the linear sway-yaw system is stable when its trace is negative and its determinant
+    // positive; the determinant's sign is the classical stability criterion
+    let (trace, det) = (yv + nr, yv * nr - yr * nv);
+    let disc = trace * trace / 4.0 - det;
+    let largest = if disc >= 0.0 { trace / 2.0 + disc.sqrt() } else { trace / 2.0 };
+    checks.push(Check {
+        name: "straight-line stability".into(),
+        passed: trace < 0.0 && det > 0.0,
+        refuses: false,
+        detail: if trace < 0.0 && det > 0.0 {
+            format!("stable, slowest eigenvalue {largest:.4} 1/s")
+        } else {
+            format!(
+                "course-unstable: eigenvalue {largest:+.4} 1/s (a disturbance doubles in {:.0} s); a spiral test shows a loop",
+                std::f64::consts::LN_2 / largest.max(1e-12)
+            )
+        },
+    });
+    let duration = (40.0 * ship.spec.lpp / ship.spec.u0).max(60.0);
+    let settings = Settings { integrator: Integrator::Rk4, dt: 0.05, duration, sample: 0.05 };
+    for side in [1.0, -1.0] {
+        let angle =
+            (start.delta0_deg + side * rudder_deg).clamp(-ship.spec.rudder_limit, ship.spec.rudder_limit);
+        let label = format!("turning circle δ = {angle:.1}°");
+        let run = Manoeuvre::parse(&format!("turning:{angle}")).and_then(|m| ship.run(&m, &settings));
+        let (run, t) = match run {
+            Ok(run) => match &run.metrics {
+                Metrics::Turning(t) => {
+                    let t = t.clone();
+                    (run, t)
+                }
+                _ => unreachable!("a turning manoeuvre has turning metrics"),
+            },
+            Err(e) => {
+                checks.push(Check {
+                    name: format!("{label} completes"),
+                    passed: false,
+                    refuses: true,
+                    detail: format!("the simulation fails: {e}"),
+                });
+                continue;
+            }
+        };
+        let psi = &run.trajectory.states[r.psi];
+        let turned = psi.iter().map(|p| (p - psi[0]).abs()).fold(0.0, f64::max).to_degrees();
+        let end = (psi[psi.len() - 1] - psi[0]).abs().to_degrees();
+        checks.push(Check {
+            name: format!("{label} completes"),
+            passed: t.tactical_diameter_m.is_some(),
+            refuses: true,
+            detail: match t.tactical_diameter_m {
+                Some(d) => format!("tactical diameter {d:.2} m = {:.2} L", d / ship.spec.lpp),
+                None if end + 1.0 < turned => {
+                    format!("turns {turned:.0}° and then back to {end:.0}° in {duration:.0} s")
+                }
+                None => format!("turns only {turned:.0}° in {duration:.0} s"),
+            },
+        });
+        if t.tactical_diameter_m.is_none() {
+            continue;
+        }
+        checks.push(Check {
+            name: format!("{label}: speed falls, to more than 15 %"),
+            passed: t.speed_ratio > 0.15 && t.speed_ratio <= 1.0 + 1e-9,
+            refuses: true,
+            detail: format!("steady speed {:.1} % of the approach", 100.0 * t.speed_ratio),
+        });
+        let inward = t.drift_angle_deg * t.yaw_rate_deg_s > 0.0;
+        checks.push(Check {
+            name: format!("{label}: drift with the bow inside the circle, under 35°"),
+            passed: inward && t.drift_angle_deg.abs() < 35.0,
+            refuses: !inward,
+            detail: format!("drift angle {:.1}° at yaw rate {:.2} °/s", t.drift_angle_deg, t.yaw_rate_deg_s),
+        });
+    }
+    Ok(checks)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_papers_ship_passes_and_a_ship_without_yaw_damping_fails() {
+        let model = crate::ship::default_model();
+        let checks = physical_checks(&model, 30.0).unwrap();
+        assert!(checks.iter().all(|c| c.passed || !c.refuses), "{checks:#?}");
+        assert_eq!(checks.iter().filter(|c| c.name.contains("completes")).count(), 2);
+        // the yaw damping of the paper's ṙ (u·r) reversed: the ship spins up
+        let eq = model.equation("r_dot").unwrap().clone();
+        let ur = model.vocabulary.parse("u*r").unwrap();
+        let coefficients =
+            eq.coefficients.iter().map(|(t, v, s)| (t.clone(), if *t == ur { -v } else { *v }, *s)).collect();
+        let mut bad = model.clone();
+        bad.set_coefficients("r_dot", coefficients, None);
+        let checks = physical_checks(&bad, 30.0).unwrap();
+        let yaw = checks.iter().find(|c| c.name.starts_with("yaw damping")).unwrap();
+        assert!(!yaw.passed && yaw.refuses, "{yaw:?}");
+        assert!(checks.iter().any(|c| c.name.contains("completes") && !c.passed), "{checks:#?}");
+    }
+}
