@@ -1,7 +1,10 @@
 //! Manoeuvre metrics read off any trajectory, measured or simulated, without knowing the
 //! commands that made it: zigzag overshoots from the rudder's reversals (the heading when the
 //! rudder starts back is the switching heading), turning-circle advance, transfer and tactical
-//! diameter from the track. Used to set a model's predictions beside a measurement.
+//! diameter from the track, measured from the rudder execute (the last sample before the rudder
+//! leaves its approach angle) along the course at that moment. A record in which the rudder goes
+//! to one side and comes back to midship (a turning circle as basins record it) is a turn, not
+//! a zigzag. Used to set a model's predictions beside a measurement.
 
 use serde::Serialize;
 
@@ -86,17 +89,63 @@ pub fn observe(t: &[f64], psi: &[f64], delta: &[f64], x0: &[f64], y0: &[f64]) ->
         out.first_overshoot_deg = overshoot(0);
         out.second_overshoot_deg = overshoot(1);
     }
-    if n > 1 {
-        let sign = if psi[n - 1] >= psi[0] { 1.0 } else { -1.0 };
-        let turned: Vec<f64> = psi[..n].iter().map(|p| sign * (p - psi[0]).to_degrees()).collect();
-        let x: Vec<f64> = x0[..n].iter().map(|v| v - x0[0]).collect();
-        let y: Vec<f64> = y0[..n].iter().map(|v| (v - y0[0]).abs()).collect();
-        if rev.is_empty() {
-            // a turn: no reversal
-            out.advance_m = at_level(&turned, &x, 90.0);
-            out.transfer_m = at_level(&turned, &y, 90.0);
-            out.tactical_diameter_m = at_level(&turned, &y, 180.0);
-        }
+    // a turn: the rudder never goes more than 1° past its approach angle to the other side
+    // (back at midship at the end of the record is still a turn)
+    let off: Vec<f64> = delta[..n].iter().map(|d| d - delta[0]).collect();
+    let main = off.iter().copied().fold(0.0f64, |m, d| if d.abs() > m.abs() { d } else { m });
+    let turn = off.iter().all(|d| d * main.signum() > -1f64.to_radians());
+    if n > 1 && turn && main.abs() > 1f64.to_radians() {
+        // the execute: the last sample before the rudder leaves its approach angle by 0.5°
+        let e = off.iter().position(|d| d.abs() > 0.5f64.to_radians()).map_or(0, |k| k.saturating_sub(1));
+        let m = n.min(x0.len()).min(y0.len());
+        let (ce, se) = (psi[e].cos(), psi[e].sin());
+        let sign = if psi[m - 1] >= psi[e] { 1.0 } else { -1.0 };
+        let turned: Vec<f64> = psi[e..m].iter().map(|p| sign * (p - psi[e]).to_degrees()).collect();
+        // along and across the course at the execute
+        let x: Vec<f64> = (e..m).map(|k| (x0[k] - x0[e]) * ce + (y0[k] - y0[e]) * se).collect();
+        let y: Vec<f64> = (e..m).map(|k| (-(x0[k] - x0[e]) * se + (y0[k] - y0[e]) * ce).abs()).collect();
+        out.advance_m = at_level(&turned, &x, 90.0);
+        out.transfer_m = at_level(&turned, &y, 90.0);
+        out.tactical_diameter_m = at_level(&turned, &y, 180.0);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ship::basin::{Artefacts, Basin};
+    use crate::ship::{Manoeuvre, Metrics};
+
+    /// A turning circle as a basin records it — an approach, then the turn, the rudder back at
+    /// midship at the end, noise, and an approach course that is not the x axis — reads as
+    /// the manoeuvre's own metrics, measured from the rudder execute.
+    #[test]
+    fn a_recorded_turn_ending_at_midship_is_a_turn_measured_from_the_execute() {
+        let model = crate::ship::default_model();
+        let basin =
+            Basin { artefacts: Artefacts { midship_end_s: 8.0, ..Artefacts::default() }, ..Basin::default() };
+        let rec =
+            basin.record(&model, &Manoeuvre::parse("turning:-35").unwrap(), 2.01, 60.0, 7, "tc.dat").unwrap();
+        let Metrics::Turning(truth) = &rec.metrics else { panic!("a turn") };
+        let f = &rec.measured;
+        let c = |n: &str| f.column(n).unwrap();
+        // the whole record turned by 40°: the approach course is 40° off the x axis
+        let a = 40f64.to_radians();
+        let (x, y) = (c("x0"), c("y0"));
+        let xr: Vec<f64> = x.iter().zip(y).map(|(x, y)| x * a.cos() - y * a.sin()).collect();
+        let yr: Vec<f64> = x.iter().zip(y).map(|(x, y)| x * a.sin() + y * a.cos()).collect();
+        let psi: Vec<f64> = c("ψ").iter().map(|p| p + a).collect();
+        let seen = observe(f.time(), &psi, c("δ"), &xr, &yr);
+        assert_eq!(seen.reversals, 1, "the rudder back to midship is one reversal");
+        for (got, want) in [
+            (seen.advance_m, truth.advance_m),
+            (seen.tactical_diameter_m, truth.tactical_diameter_m),
+            (seen.transfer_m, truth.transfer_m),
+        ] {
+            let (g, w) = (got.expect("read off the record"), want.unwrap());
+            assert!((g - w).abs() < 0.1, "{g} m vs the manoeuvre's {w} m");
+        }
+        assert!(seen.first_overshoot_deg.is_none());
+    }
 }
