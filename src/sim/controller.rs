@@ -33,11 +33,15 @@ pub struct Replay {
 }
 
 impl Replay {
-    /// Replays the named columns of a frame, in the order of the system's inputs.
+    /// Replays the named columns of a frame, in the order of the system's inputs. Time is
+    /// counted from the frame's first sample, as a simulation counts it from its start (a
+    /// record cut with a dataset's `from`, or logged from a clock that did not start at 0,
+    /// was replayed shifted by its start time).
     pub fn new(frame: &Frame, inputs: &[String]) -> Result<Replay, DataError> {
         let columns =
             inputs.iter().map(|n| frame.require(n).map(<[f64]>::to_vec)).collect::<Result<_, _>>()?;
-        Ok(Replay { time: frame.time().to_vec(), columns, cursor: 0 })
+        let t0 = frame.time()[0];
+        Ok(Replay { time: frame.time().iter().map(|t| t - t0).collect(), columns, cursor: 0 })
     }
 
     /// The recorded value of input `k` at time `t`.
@@ -50,6 +54,24 @@ impl Controller for Replay {
     fn input(&mut self, t: f64, _x: &[f64], out: &mut [f64]) {
         for (k, o) in out.iter_mut().enumerate() {
             *o = self.at(k, t);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A record that starts at t = 12 s is replayed from its first sample at simulation time 0.
+    #[test]
+    fn replay_counts_time_from_the_first_sample() {
+        let mut f = Frame::new("late.csv", "t", vec![12.0, 13.0, 14.0]).unwrap();
+        f.push("δ", vec![0.0, 1.0, 3.0]).unwrap();
+        let mut r = Replay::new(&f, &["δ".to_string()]).unwrap();
+        let mut out = [0.0];
+        for (t, want) in [(0.0, 0.0), (0.5, 0.5), (1.5, 2.0), (2.0, 3.0), (9.0, 3.0)] {
+            r.input(t, &[], &mut out);
+            assert_eq!(out[0], want, "t = {t}");
         }
     }
 }
