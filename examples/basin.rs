@@ -12,7 +12,7 @@ use termid::data::{
     differentiator, prepare, CentralDifference, DataError, Dataset, Differentiator, Frame, KalmanSmoother,
     Preparation, Smoothed,
 };
-use termid::diagnose::{refine, Runs};
+use termid::diagnose::{refine, RefineSettings, Runs};
 use termid::identify::{identify_model, Identification, ModelIdentification, Target};
 use termid::model::Model;
 use termid::select::{Backend, Moments};
@@ -186,7 +186,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let training = Runs::new(&identified, &prepared, 0.05, Integrator::Rk4)?
                 .with_intercepts(intercept)
                 .comparing(&states)?;
-            identified = refine(&identified, &training)?.model;
+            let prior = std::env::var("PRIOR").ok().and_then(|v| v.parse().ok()).unwrap_or(1e-4);
+            let r = refine(
+                &identified,
+                &training,
+                &RefineSettings { prior_weight: prior, ..Default::default() },
+            )?;
+            eprintln!("{}", r.stopped);
+            identified = r.model;
         }
         let mut errors = Vec::new();
         for eq in model.identifiable() {

@@ -16,16 +16,16 @@ use crate::sim::{simulate, Controller, Integrator, Replay, Settings, SimError, S
 
 /// The measured runs prepared for re-simulation.
 pub struct Runs {
-    frames: Vec<Frame>,
+    pub(super) frames: Vec<Frame>,
     /// (state index in the system, measured column) for the compared states.
-    states: Vec<(usize, String)>,
-    scale: Vec<f64>,
+    pub(super) states: Vec<(usize, String)>,
+    pub(super) scale: Vec<f64>,
     units: Vec<String>,
-    x0: Vec<Vec<f64>>,
+    pub(super) x0: Vec<Vec<f64>>,
     /// Each run's own parameters (the model's per-run rules, e.g. u0 = the run's start speed).
-    params: Vec<BTreeMap<String, f64>>,
-    settings: Vec<Settings>,
-    intercepts: bool,
+    pub(super) params: Vec<BTreeMap<String, f64>>,
+    pub(super) settings: Vec<Settings>,
+    pub(super) intercepts: bool,
 }
 
 /// Recorded inputs with an offset and a factor applied.
@@ -460,8 +460,6 @@ pub struct Estimated {
     /// σ²(JᵀJ)⁻¹ with σ² = cost / (residuals − parameters), if JᵀJ is invertible (it
     /// assumes independent residuals).
     pub covariance: Option<DMatrix<f64>>,
-    /// The scaled residuals at θ, run by run and state by state ([`Runs::residuals`]).
-    pub residuals: Vec<f64>,
 }
 
 impl Estimated {
@@ -518,5 +516,5 @@ pub fn levenberg_marquardt(
     let k = theta.len() as f64;
     let sigma2 = c / (n - k).max(1.0);
     let covariance = (j.transpose() * &j).try_inverse().map(|inv| inv * sigma2);
-    Ok(Estimated { theta, cost: c, covariance, residuals: r })
+    Ok(Estimated { theta, cost: c, covariance })
 }

@@ -10,12 +10,13 @@ mod choose;
 mod fit;
 mod hypotheses;
 mod refine;
+mod sensitivity;
 
 use serde::Serialize;
 
 pub use choose::{choose_by_prediction, Chosen, Configuration, Prediction};
 pub use fit::{simulate_runs, EstimateError, Runs};
-pub use refine::{refine, Refined};
+pub use refine::{refine, RefineSettings, Refined, RefinedCoefficient};
 
 pub use hypotheses::{generic_hypotheses, Effect, Hypothesis};
 

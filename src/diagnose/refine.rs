@@ -6,11 +6,59 @@
 //! chose. Which states are compared matters: integrals such as positions add the drift of
 //! every error before them, and a noisy initial state then dominates them.
 
+use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
-use super::fit::{apply, levenberg_marquardt};
-use super::{DiagnoseError, Effect, Hypothesis, Runs};
+use super::fit::apply;
+use super::sensitivity::residuals_and_jacobian;
+use super::{DiagnoseError, Effect, EstimateError, Hypothesis, Runs};
 use crate::model::{Covariance, Model};
+use crate::term::Term;
+
+/// How a refinement is held to the regression it starts from.
+#[derive(Clone, Copy)]
+pub struct RefineSettings<'a> {
+    /// Weight of the regression's estimates as a prior: each coefficient is pulled towards its
+    /// regression value with that value's standard error (widened by the residuals'
+    /// correlation time) as the prior's standard deviation; 1 is that prior as it is, 0 none
+    /// (an unbounded refinement, free to wander where the runs do not hold a coefficient).
+    pub prior_weight: f64,
+    /// Runs the refinement does not fit but is stopped by: of its iterates, the one that
+    /// predicts these best is kept.
+    pub validation: Option<&'a Runs>,
+    /// Most Levenberg-Marquardt iterations.
+    pub iterations: usize,
+}
+
+impl Default for RefineSettings<'_> {
+    fn default() -> Self {
+        RefineSettings { prior_weight: 1e-4, validation: None, iterations: 30 }
+    }
+}
+
+/// One refined coefficient.
+#[derive(Clone, Debug, Serialize)]
+pub struct RefinedCoefficient {
+    /// Its equation.
+    pub equation: String,
+    /// Its term.
+    pub term: String,
+    /// The regression's value.
+    pub regression: f64,
+    /// The refined value.
+    pub refined: f64,
+    /// The refined value's standard error (√τ-corrected).
+    pub std_error: f64,
+    /// The prior's standard deviation (the regression's widened standard error).
+    pub prior_sd: f64,
+}
+
+impl RefinedCoefficient {
+    /// The change in units of the prior's standard deviation.
+    pub fn shift(&self) -> f64 {
+        (self.refined - self.regression) / self.prior_sd
+    }
+}
 
 /// An output-error refinement's result.
 #[derive(Clone, Debug, Serialize)]
@@ -23,69 +71,179 @@ pub struct Refined {
     pub cost_before: f64,
     /// The same after.
     pub cost_after: f64,
+    /// The validation runs' scaled sum of squares before and after, where there are any.
+    pub validation: Option<(f64, f64)>,
+    /// Why it stopped.
+    pub stopped: String,
     /// Integrated autocorrelation time of the re-simulation residuals, in samples.
     pub correlation_time: Option<f64>,
-    /// Per coefficient: equation, term, regression value, refined value, standard error
-    /// (√τ-corrected).
-    pub coefficients: Vec<(String, String, f64, f64, f64)>,
+    /// Every refined coefficient.
+    pub coefficients: Vec<RefinedCoefficient>,
 }
 
-/// Refines every coefficient of the model's identified equations against `runs`.
-pub fn refine(model: &Model, runs: &Runs) -> Result<Refined, DiagnoseError> {
-    let entries: Vec<(String, String, f64)> = model
-        .equations()
-        .iter()
-        .filter(|e| e.identify)
-        .flat_map(|e| e.coefficients.iter().map(|(t, v, _)| (e.name.clone(), t.to_string(), *v)))
-        .collect();
+/// Refines every coefficient of the model's identified equations against `runs`: Levenberg-
+/// Marquardt on the re-simulation's scaled residuals, its Jacobian from forward sensitivities,
+/// with the regression's estimates as a prior and, where given, validation runs that stop it.
+pub fn refine(model: &Model, runs: &Runs, settings: &RefineSettings<'_>) -> Result<Refined, DiagnoseError> {
+    // (equation, term, regression value, prior sd)
+    let mut entries: Vec<(String, Term, f64, f64)> = Vec::new();
+    for e in model.equations().iter().filter(|e| e.identify) {
+        let tau = e.covariance.as_ref().map_or(1.0, |c| c.correlation_time.max(1.0));
+        for (t, v, se) in &e.coefficients {
+            // no standard error: a tenth of the value
+            let sd = se.map_or(0.1 * v.abs(), |s| s * tau.sqrt()).max(1e-6 * v.abs()).max(1e-300);
+            entries.push((e.name.clone(), t.clone(), *v, sd));
+        }
+    }
     if entries.is_empty() {
         return Err(DiagnoseError::Setup("no identified coefficients to refine".into()));
     }
+    let terms: Vec<(String, Term)> = entries.iter().map(|(e, t, _, _)| (e.clone(), t.clone())).collect();
     let hypothesis = Hypothesis {
         name: "output-error refinement".into(),
-        effect: Effect::Terms { terms: entries.iter().map(|(e, t, _)| (e.clone(), t.clone())).collect() },
+        effect: Effect::Terms {
+            terms: entries.iter().map(|(e, t, _, _)| (e.clone(), t.to_string())).collect(),
+        },
+    };
+    let k = entries.len();
+    let prior: Vec<f64> = entries.iter().map(|(_, _, _, sd)| settings.prior_weight / (sd * sd)).collect();
+    let prior_cost = |theta: &[f64]| theta.iter().zip(&prior).map(|(t, p)| p * t * t).sum::<f64>();
+    let cost_of = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>();
+    let simulate_cost = |runs: &Runs, theta: &[f64]| -> Option<f64> {
+        let m = apply(model, &hypothesis, theta).ok()?;
+        let r = runs.residuals(&runs.simulate(&m, &[], &[]).ok()?);
+        r.iter().all(|v| v.is_finite()).then(|| cost_of(&r))
     };
     let before = runs.gap(&runs.simulate(model, &[], &[])?).cost;
-    let fit = levenberg_marquardt(runs, model, &hypothesis, vec![0.0; entries.len()])
-        .map_err(DiagnoseError::Refinement)?;
-    let mut refined = apply(model, &hypothesis, &fit.theta)?;
-    // σ²(JᵀJ)⁻¹ assumes independent residuals; re-simulation residuals are strongly
+    let mut theta = vec![0.0; k];
+    let (mut r, mut j) = residuals_and_jacobian(runs, model, &terms)
+        .map_err(|_| DiagnoseError::Refinement(EstimateError::Diverges("at the start")))?;
+    let mut cost = cost_of(&r) + prior_cost(&theta);
+    let validation_before = settings.validation.and_then(|v| simulate_cost(v, &theta));
+    let mut best = (theta.clone(), validation_before.unwrap_or(f64::NAN));
+    let mut rises = 0;
+    let mut lambda = 1e-3;
+    let mut stopped = format!("{} iterations", settings.iterations);
+    for _ in 0..settings.iterations {
+        let jt = j.transpose();
+        let mut a = &jt * &j;
+        let mut g = &jt * DVector::from_vec(r.clone());
+        for i in 0..k {
+            a[(i, i)] += prior[i];
+            g[i] += prior[i] * theta[i];
+        }
+        let mut damped = a.clone();
+        for i in 0..k {
+            damped[(i, i)] += lambda * a[(i, i)].max(1e-300);
+        }
+        let Some(step) = damped.lu().solve(&g) else {
+            stopped = "singular normal equations".into();
+            break;
+        };
+        let trial: Vec<f64> = theta.iter().zip(step.iter()).map(|(t, d)| t - d).collect();
+        match simulate_cost(runs, &trial).map(|c| c + prior_cost(&trial)) {
+            Some(c) if c < cost => {
+                let improvement = (cost - c) / cost.max(1e-300);
+                let applied = apply(model, &hypothesis, &trial)?;
+                let Ok((rt, jt)) = residuals_and_jacobian(runs, &applied, &terms) else {
+                    lambda *= 10.0;
+                    continue;
+                };
+                (theta, r, j, cost) = (trial, rt, jt, c);
+                lambda = (lambda / 10.0).max(1e-12);
+                if let Some(v) = settings.validation {
+                    // the validation runs stop it: keep the iterate that predicts them best
+                    match simulate_cost(v, &theta) {
+                        Some(vc) if best.1.is_nan() || vc < best.1 => {
+                            best = (theta.clone(), vc);
+                            rises = 0;
+                        }
+                        _ => rises += 1,
+                    }
+                    if rises >= 3 {
+                        stopped = "the validation runs' error rose three times".into();
+                        break;
+                    }
+                }
+                if improvement < 1e-10 {
+                    stopped = "converged".into();
+                    break;
+                }
+            }
+            _ => {
+                lambda *= 10.0;
+                if lambda > 1e10 {
+                    stopped = "no step lowers the error".into();
+                    break;
+                }
+            }
+        }
+    }
+    if settings.validation.is_some() && best.0 != theta {
+        theta = best.0.clone();
+        let applied = apply(model, &hypothesis, &theta)?;
+        (r, j) = residuals_and_jacobian(runs, &applied, &terms)
+            .map_err(|_| DiagnoseError::Refinement(EstimateError::Diverges("on the way")))?;
+    }
+    let mut refined = apply(model, &hypothesis, &theta)?;
+    let data_cost = cost_of(&r);
+    // σ²(JᵀJ + P)⁻¹ assumes independent residuals; re-simulation residuals are strongly
     // correlated in time, so the covariance is widened by their correlation time τ
-    let tau = crate::uncertainty::correlation_time(&runs.series(&fit.residuals));
+    let tau = crate::uncertainty::correlation_time(&runs.series(&r));
     let widen = tau.unwrap_or(1.0).max(1.0);
-    let std_errors: Vec<f64> = fit.std_errors().iter().map(|s| s * widen.sqrt()).collect();
-    let mut k = 0;
+    let sigma2 = data_cost / (r.len() as f64 - k as f64).max(1.0);
+    let mut info = j.transpose() * &j;
+    for i in 0..k {
+        info[(i, i)] += prior[i];
+    }
+    let covariance: Option<DMatrix<f64>> = info.try_inverse().map(|inv| inv * sigma2 * widen);
+    let std_errors: Vec<f64> =
+        (0..k).map(|i| covariance.as_ref().map_or(f64::NAN, |c| c[(i, i)].max(0.0).sqrt())).collect();
+    let mut at = 0;
     for e in model.equations().iter().filter(|e| e.identify) {
-        let first = k;
+        let first = at;
         let eq = refined.equation(&e.name).ok_or_else(|| DiagnoseError::Setup(e.name.clone()))?;
         let intercept = eq.intercept;
         let coefficients: Vec<_> = eq
             .coefficients
             .iter()
             .map(|(t, v, _)| {
-                let se = std_errors[k];
-                k += 1;
+                let se = std_errors[at];
+                at += 1;
                 (t.clone(), *v, se.is_finite().then_some(se))
             })
             .collect();
         let terms = coefficients.iter().map(|c| c.0.clone()).collect();
         refined.set_coefficients(&e.name, coefficients, intercept);
-        if let Some(c) = &fit.covariance {
+        if let Some(c) = &covariance {
             let matrix =
-                (first..k).map(|i| (first..k).map(|j| 0.5 * (c[(i, j)] + c[(j, i)])).collect()).collect();
+                (first..at).map(|i| (first..at).map(|j| 0.5 * (c[(i, j)] + c[(j, i)])).collect()).collect();
             // a singular direction (a term the runs do not excite) leaves no usable covariance
             let _ = refined.set_covariance(&e.name, Covariance { terms, matrix, correlation_time: widen });
         }
     }
     let coefficients = entries
         .iter()
-        .zip(fit.theta.iter().zip(&std_errors))
-        .map(|((e, t, v), (d, se))| (e.clone(), t.clone(), *v, v + d, *se))
+        .zip(theta.iter().zip(&std_errors))
+        .map(|((e, t, v, sd), (d, se))| RefinedCoefficient {
+            equation: e.clone(),
+            term: t.to_string(),
+            regression: *v,
+            refined: v + d,
+            std_error: *se,
+            prior_sd: *sd,
+        })
         .collect();
+    let validation = match (validation_before, settings.validation) {
+        (Some(b), Some(v)) => simulate_cost(v, &theta).map(|a| (b, a)),
+        _ => None,
+    };
     Ok(Refined {
         model: refined,
         cost_before: before,
-        cost_after: fit.cost,
+        cost_after: data_cost,
+        validation,
+        stopped,
         correlation_time: tau,
         coefficients,
     })
@@ -93,29 +251,40 @@ pub fn refine(model: &Model, runs: &Runs) -> Result<Refined, DiagnoseError> {
 
 impl Refined {
     /// The refinement as a person reads it: the cost before and after and, per coefficient,
-    /// the regression's value, the refined one, its standard error and the change.
+    /// the regression's value, the refined one, its standard error, the change, and the change
+    /// in units of the prior's standard deviation (where it is large, why).
     pub fn text(&self) -> String {
-        let r = self;
         use crate::identify::num;
+        let r = self;
         let mut out = format!(
-        "== output-error refinement ==\nre-simulation cost (scaled sum of squares) {} → {}; residual correlation time {} samples\n{:<8} {:<18} {:>13} {:>13} {:>12} {:>8}\n",
-        num(r.cost_before),
-        num(r.cost_after),
-        r.correlation_time.map_or("--".into(), |t| format!("{t:.0}")),
-        "equation",
-        "term",
-        "regression",
-        "refined",
-        "std. error",
-        "change"
-    );
-        for (eq, term, before, after, se) in &r.coefficients {
+            "== output-error refinement ==\nre-simulation cost (scaled sum of squares) {} → {}; residual correlation time {} samples; stopped: {}\n",
+            num(r.cost_before),
+            num(r.cost_after),
+            r.correlation_time.map_or("--".into(), |t| format!("{t:.0}")),
+            r.stopped
+        );
+        if let Some((b, a)) = r.validation {
+            out += &format!("validation runs (not fitted): {} → {}\n", num(b), num(a));
+        }
+        out += &format!(
+            "{:<8} {:<18} {:>13} {:>13} {:>12} {:>8} {:>8}\n",
+            "equation", "term", "regression", "refined", "std. error", "change", "shift/σ"
+        );
+        for c in &r.coefficients {
+            let why = if c.shift().abs() > 2.0 {
+                "  the runs pull it beyond 2 σ of the regression: the prior holds it back"
+            } else {
+                ""
+            };
             out += &format!(
-                "{eq:<8} {term:<18} {:>13} {:>13} {:>12} {:>7.1}%\n",
-                num(*before),
-                num(*after),
-                num(*se),
-                100.0 * (after / before - 1.0)
+                "{:<8} {:<18} {:>13} {:>13} {:>12} {:>7.1}% {:>8.2}{why}\n",
+                c.equation,
+                c.term,
+                num(c.regression),
+                num(c.refined),
+                num(c.std_error),
+                100.0 * (c.refined / c.regression - 1.0),
+                c.shift()
             );
         }
         out + "\n"
@@ -161,9 +330,9 @@ coefficients = {{ "u" = 1.0, "x" = {b} }}
     fn refinement_finds_the_coefficients_of_the_closed_form() {
         let model = lag(-0.3);
         let runs = Runs::new(&model, &[step_response()], 0.01, Integrator::Rk4).unwrap();
-        let r = refine(&model, &runs).unwrap();
-        let b = r.coefficients.iter().find(|c| c.1 == "x").unwrap().3;
-        let a = r.coefficients.iter().find(|c| c.1 == "u").unwrap().3;
+        let r = refine(&model, &runs, &RefineSettings { prior_weight: 0.0, ..Default::default() }).unwrap();
+        let b = r.coefficients.iter().find(|c| c.term == "x").unwrap().refined;
+        let a = r.coefficients.iter().find(|c| c.term == "u").unwrap().refined;
         assert!((b + 0.5).abs() < 1e-4 && (a - 1.0).abs() < 1e-4, "a = {a}, b = {b}");
         assert!(r.cost_after < 1e-6 * r.cost_before, "{} → {}", r.cost_before, r.cost_after);
         assert!(r.text().contains("output-error refinement"));
@@ -179,11 +348,34 @@ coefficients = {{ "u" = 1.0, "x" = {b} }}
         assert!((wrong.states[0].3 - (0.95021 / 0.3 - 0.99326 / 0.5)).abs() < 1e-3, "{wrong:?}");
     }
 
+    /// The prior holds: at a huge weight the coefficients stay at the regression's values;
+    /// validation runs keep the iterate that predicts them best.
+    #[test]
+    fn the_prior_holds_and_validation_runs_stop() {
+        let model = lag(-0.3);
+        let runs = Runs::new(&model, &[step_response()], 0.01, Integrator::Rk4).unwrap();
+        let held =
+            refine(&model, &runs, &RefineSettings { prior_weight: 1e12, ..Default::default() }).unwrap();
+        let b = held.coefficients.iter().find(|c| c.term == "x").unwrap();
+        assert!((b.refined + 0.3).abs() < 1e-3, "{b:?}");
+        // validation: the same step response, so the best iterate on it is the converged one
+        let validation = Runs::new(&model, &[step_response()], 0.01, Integrator::Rk4).unwrap();
+        let r = refine(
+            &model,
+            &runs,
+            &RefineSettings { prior_weight: 0.0, validation: Some(&validation), ..Default::default() },
+        )
+        .unwrap();
+        let (before, after) = r.validation.unwrap();
+        assert!(after < 1e-6 * before, "{before} → {after}");
+        assert!(r.text().contains("validation runs (not fitted)"));
+    }
+
     #[test]
     fn a_model_without_identified_coefficients_is_refused() {
         let text = "[model]\nname = \"fixed\"\n[[states]]\nname = \"x\"\n[equations.x_dot]\nstate = \"x\"\nidentify = false\ncoefficients = { \"x\" = -1.0 }\n";
         let model = Model::parse(text, "fixed.toml").unwrap();
         let runs = Runs::new(&model, &[step_response()], 0.01, Integrator::Rk4).unwrap();
-        assert!(matches!(refine(&model, &runs), Err(DiagnoseError::Setup(_))));
+        assert!(matches!(refine(&model, &runs, &RefineSettings::default()), Err(DiagnoseError::Setup(_))));
     }
 }

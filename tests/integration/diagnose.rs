@@ -267,7 +267,8 @@ fn output_error_refinement_recovers_the_true_coefficients() {
     let biased = true_coefficients.iter().map(|(t, v, _)| (t.clone(), v * 1.2, None)).collect();
     off.set_coefficients("v_dot", biased, None);
     let data = Runs::new(&off, &runs, 0.05, Integrator::Rk4).unwrap();
-    let refined = termid::diagnose::refine(&off, &data).unwrap();
+    let refined =
+        termid::diagnose::refine(&off, &data, &termid::diagnose::RefineSettings::default()).unwrap();
     assert!(
         refined.cost_after < 0.1 * refined.cost_before,
         "{} → {}",

@@ -127,6 +127,14 @@ pub struct IdentifyCommand {
     /// velocities and heading; positions integrate every earlier error and dominate the fit.
     #[arg(long, value_name = "STATES")]
     pub refine: Option<String>,
+    /// With --refine: weight of the regression's estimates as a prior (each coefficient held
+    /// to its regression value within its standard error); 0 lets the refinement wander.
+    #[arg(long, value_name = "WEIGHT", default_value_t = 1e-4, requires = "refine")]
+    pub refine_prior: f64,
+    /// With --refine: a dataset file of runs the refinement does not fit but is stopped by
+    /// (of its iterates, the one that predicts these runs best is kept).
+    #[arg(long, value_name = "DATASET", requires = "refine")]
+    pub refine_validation: Option<PathBuf>,
     /// With --model: choose among these back-ends (comma-separated, or `all`) by what they
     /// predict: each run is re-simulated by the model identified on the other runs, and the
     /// back-end with the smallest error on the runs it did not see is identified on all of

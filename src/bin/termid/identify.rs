@@ -229,14 +229,23 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
     let units: BTreeMap<String, String> =
         model.spec().states.iter().map(|s| (s.name.clone(), s.unit.clone())).collect();
     let diff = derivative_method(&cmd)?;
-    let frames = prepare_runs(&cmd, frames, &states, Some(&model), diff.as_ref(), &|name| {
+    let scale = |name: &str| {
         let unit = units.get(name).cloned().unwrap_or_default();
         // angles are read in degrees
         match unit.strip_prefix("rad") {
             Some(rest) => (180.0 / std::f64::consts::PI, format!("deg{rest}")),
             None => (1.0, unit),
         }
-    })?;
+    };
+    let frames = prepare_runs(&cmd, frames, &states, Some(&model), diff.as_ref(), &scale)?;
+    // runs that stop the refinement, prepared as the training runs are
+    let validation = match &cmd.refine_validation {
+        Some(path) => {
+            let held = crate::runs::load_for(&model, &[], Some(path))?;
+            Some(prepare_runs(&cmd, held, &states, Some(&model), diff.as_ref(), &scale)?)
+        }
+        None => None,
+    };
     if cmd.target.is_some() && names.len() != 1 {
         bail!("--target applies to one equation: name it with --equation");
     }
@@ -279,13 +288,44 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
     model = identified.model;
     // a refinement that fails loses nothing: the regression's model is still written, and
     // the command ends with the refinement's error
+    let how_refined = RefineHow {
+        states: refine.clone().flatten(),
+        intercept: !cmd.no_intercept,
+        prior: cmd.refine_prior,
+        validation: validation.as_deref(),
+    };
     let (refined, refine_error) = match &refine {
-        Some(states) => match crate::progress::with_spinner("refining by output error", || {
-            refine_by_output_error(&model, &frames, states.as_deref(), !cmd.no_intercept)
+        Some(_) => match crate::progress::with_spinner("refining by output error", || {
+            refine_by_output_error(&model, &frames, &how_refined)
         }) {
             Ok(r) => {
-                model = r.model.clone();
-                (Some(r), None)
+                // a refinement must not make a model fail what its field knows it passed
+                let plugin = termid::plugins::of(&model);
+                let failing = |m: &termid::model::Model| -> Vec<String> {
+                    plugin.map_or(vec![], |p| {
+                        p.checks(m, &frames)
+                            .into_iter()
+                            .filter(|c| !c.passed && c.refuses)
+                            .map(|c| c.name)
+                            .collect()
+                    })
+                };
+                let before = failing(&model);
+                let lost: Vec<String> =
+                    failing(&r.model).into_iter().filter(|c| !before.contains(c)).collect();
+                if lost.is_empty() {
+                    model = r.model.clone();
+                    (Some(r), None)
+                } else {
+                    if matches!(cmd.format, Format::Text) {
+                        print!("{}", r.text());
+                    }
+                    eprintln!(
+                        "warning: the refinement is rejected: the refined model fails physical checks the regression's passes ({}); the regression's model is kept",
+                        lost.join("; ")
+                    );
+                    (None, None)
+                }
             }
             Err(e) => (None, Some(e)),
         },
@@ -407,19 +447,38 @@ fn refine_states(list: &str, model: &termid::model::Model) -> Result<Option<Vec<
     Ok(Some(names))
 }
 
+/// How `--refine` refines.
+struct RefineHow<'a> {
+    /// The compared states (`None`: all).
+    states: Option<Vec<String>>,
+    intercept: bool,
+    /// Weight of the regression's estimates as a prior.
+    prior: f64,
+    /// Prepared runs that stop it.
+    validation: Option<&'a [Frame]>,
+}
+
 fn refine_by_output_error(
     model: &termid::model::Model,
     frames: &[Frame],
-    states: Option<&[String]>,
-    intercept: bool,
+    how: &RefineHow<'_>,
 ) -> Result<termid::diagnose::Refined> {
-    let sample = frames.iter().map(|f| termid::data::median_step(f.time())).fold(f64::INFINITY, f64::min);
-    // one RK4 step per sample: the recorded input is known only at the samples
-    let runs = termid::diagnose::Runs::new(model, frames, sample, termid::sim::Integrator::Rk4)?
-        .with_intercepts(intercept);
-    let runs = match states {
-        Some(names) => runs.comparing(names)?,
-        None => runs,
+    let runs_of = |frames: &[Frame]| -> Result<termid::diagnose::Runs> {
+        let sample = frames.iter().map(|f| termid::data::median_step(f.time())).fold(f64::INFINITY, f64::min);
+        // one RK4 step per sample: the recorded input is known only at the samples
+        let runs = termid::diagnose::Runs::new(model, frames, sample, termid::sim::Integrator::Rk4)?
+            .with_intercepts(how.intercept);
+        Ok(match &how.states {
+            Some(names) => runs.comparing(names)?,
+            None => runs,
+        })
     };
-    Ok(termid::diagnose::refine(model, &runs)?)
+    let runs = runs_of(frames)?;
+    let validation = how.validation.map(runs_of).transpose()?;
+    let settings = termid::diagnose::RefineSettings {
+        prior_weight: how.prior,
+        validation: validation.as_ref(),
+        ..Default::default()
+    };
+    Ok(termid::diagnose::refine(model, &runs, &settings)?)
 }
