@@ -1,6 +1,6 @@
 //! Forward sensitivities of a re-simulation with respect to the model's coefficients. The
 //! right-hand side is linear in its coefficients, ẋ_i = Σ_j θ_j φ_j(x, u) over the terms of
-//! equation i, so S = ∂x/∂θ obeys Ṡ = A(x, u) S + B(x, u), with A = ∂f/∂x (central
+//! equation i, so S = ∂x/∂θ obeys Ṡ = A(x, u) S + B(x, u), with A = ∂f/∂x (forward
 //! differences of the compiled right-hand side) and B_ij = φ_j(x, u) where term j belongs to
 //! the equation of state i. Integrated beside the state by the same RK4 step, S gives the
 //! whole Jacobian of the output error in one pass per run, instead of one re-simulation per
@@ -8,16 +8,13 @@
 
 use std::collections::BTreeMap;
 
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
 use super::{DiagnoseError, Runs};
 use crate::model::Model;
 use crate::sim::{Controller, Integrator, Replay, RightHandSide, SimError, System};
 use crate::term::{Library, Term};
-
-/// A run's residuals and, per residual, its row of the Jacobian.
-type Residuals = (Vec<f64>, Vec<Vec<f64>>);
 
 /// Per sample of a run: its state and its sensitivities S (row-major, n × K).
 type Rows = (Vec<Vec<f64>>, Vec<Vec<f64>>);
@@ -46,13 +43,72 @@ impl RightHandSide for Regressors<'_> {
     }
 }
 
-/// The scaled residuals of every run (as [`Runs::residuals`] orders them) and their Jacobian
-/// with respect to additive changes of the coefficients `entries` (equation, term).
-pub(super) fn residuals_and_jacobian(
+/// The output error linearised at a model: the scaled residuals of every run (as
+/// [`Runs::residuals`] orders them) and the normal equations' JᵀJ and Jᵀr, J the residuals'
+/// Jacobian with respect to additive changes of the coefficients. J itself, a row per
+/// residual, is never assembled: each run's part is reduced where it is made.
+pub(super) struct Linearised {
+    /// The scaled residuals.
+    pub residuals: Vec<f64>,
+    /// JᵀJ.
+    pub jtj: DMatrix<f64>,
+    /// Jᵀr.
+    pub jtr: DVector<f64>,
+}
+
+/// Linearises the output error of `model` on `runs` in its coefficients `entries` (equation,
+/// term).
+pub(super) fn linearise(
+    runs: &Runs,
+    model: &Model,
+    entries: &[(String, Term)],
+) -> Result<Linearised, DiagnoseError> {
+    let k = entries.len();
+    let mut residuals = Vec::with_capacity(runs.residual_count());
+    let mut jtj = DMatrix::zeros(k, k);
+    let mut jtr = DVector::zeros(k);
+    for part in per_run_jacobians(runs, model, entries, |res, jac| {
+        let jt = jac.transpose();
+        let r = DVector::from_column_slice(&res);
+        let (a, g) = (&jt * &jac, &jt * r);
+        (res, a, g)
+    })? {
+        let (r, a, g) = part;
+        residuals.extend(r);
+        jtj += a;
+        jtr += g;
+    }
+    Ok(Linearised { residuals, jtj, jtr })
+}
+
+/// The residuals of every run and their Jacobian, assembled (for tests and small problems).
+#[cfg(test)]
+fn residuals_and_jacobian(
     runs: &Runs,
     model: &Model,
     entries: &[(String, Term)],
 ) -> Result<(Vec<f64>, DMatrix<f64>), DiagnoseError> {
+    let parts = per_run_jacobians(runs, model, entries, |res, jac| (res, jac))?;
+    let rows: usize = parts.iter().map(|p| p.0.len()).sum();
+    let mut residuals = Vec::with_capacity(rows);
+    let mut jacobian = DMatrix::zeros(rows, entries.len());
+    let mut at = 0;
+    for (r, j) in parts {
+        jacobian.rows_mut(at, r.len()).copy_from(&j);
+        at += r.len();
+        residuals.extend(r);
+    }
+    Ok((residuals, jacobian))
+}
+
+/// Each run's scaled residuals and their Jacobian (a row per residual), handed to `reduce` in
+/// the thread that made them; the runs in parallel.
+fn per_run_jacobians<T: Send>(
+    runs: &Runs,
+    model: &Model,
+    entries: &[(String, Term)],
+    reduce: impl Fn(Vec<f64>, DMatrix<f64>) -> T + Sync,
+) -> Result<Vec<T>, DiagnoseError> {
     let system = System::new(model, &BTreeMap::new(), runs.intercepts)?;
     let regressors = Regressors { model, terms: entries.iter().map(|(_, t)| t.clone()).collect() };
     let phi = System::new(&regressors, &BTreeMap::new(), false)?;
@@ -63,38 +119,35 @@ pub(super) fn residuals_and_jacobian(
             system.state_index(&state).ok_or_else(|| DiagnoseError::Setup(format!("no state for `{eq}`")))
         })
         .collect::<Result<_, _>>()?;
-    // the runs are independent: all threads take them
-    let per_run: Vec<Result<Residuals, DiagnoseError>> = (0..runs.frames.len())
+    let k = owner.len();
+    (0..runs.frames.len())
         .into_par_iter()
         .map(|r| {
             let system = system.with_parameters(&runs.params[r])?;
             let phi = phi.with_parameters(&runs.params[r])?;
             let (x, s) = integrate(&system, &phi, &owner, runs, r)?;
             let frame = &runs.frames[r];
-            let mut res = Vec::new();
-            let mut rows = Vec::new();
+            let rows: usize = runs.states.iter().map(|(_, n)| frame.column(n).map_or(0, <[f64]>::len)).sum();
+            let mut res = Vec::with_capacity(rows);
+            let mut jac = DMatrix::zeros(rows, k);
             for ((i, name), sc) in runs.states.iter().zip(&runs.scale) {
                 let meas = frame.column(name).unwrap_or(&[]);
-                for (k, m) in meas.iter().enumerate() {
-                    let xi = x.get(k).map_or(f64::NAN, |x| x[*i]);
-                    res.push((xi - m) / sc);
-                    rows.push(s.get(k).map_or(vec![f64::NAN; owner.len()], |s| {
-                        s[*i * owner.len()..(*i + 1) * owner.len()].iter().map(|v| v / sc).collect()
-                    }));
+                for (t, m) in meas.iter().enumerate() {
+                    let row = res.len();
+                    res.push(x.get(t).map_or(f64::NAN, |x| x[*i] - m) / sc);
+                    match s.get(t) {
+                        Some(s) => {
+                            for (j, v) in s[*i * k..(*i + 1) * k].iter().enumerate() {
+                                jac[(row, j)] = v / sc;
+                            }
+                        }
+                        None => jac.row_mut(row).fill(f64::NAN),
+                    }
                 }
             }
-            Ok((res, rows))
+            Ok(reduce(res, jac))
         })
-        .collect();
-    let mut residuals = Vec::with_capacity(runs.residual_count());
-    let mut rows = Vec::with_capacity(runs.residual_count());
-    for run in per_run {
-        let (r, j) = run?;
-        residuals.extend(r);
-        rows.extend(j);
-    }
-    let jacobian = DMatrix::from_fn(rows.len(), owner.len(), |a, b| rows[a][b]);
-    Ok((residuals, jacobian))
+        .collect()
 }
 
 /// Run `r` of `runs` with its sensitivities: the state and S (row-major, n × K) at every
@@ -118,7 +171,8 @@ fn integrate(
     let mut wp = phi.workspace();
     let mut fx = vec![0.0; n];
     let mut fp = vec![0.0; n];
-    let mut fm = vec![0.0; n];
+    // ∂f/∂x_c is zero for a state the right-hand side does not read
+    let read: Vec<usize> = (0..n).filter(|&c| system.reads_state(c)).collect();
     let mut terms = vec![0.0; k];
     let mut xs = vec![0.0; n];
     // (ẋ, Ṡ) at (x, S, u)
@@ -130,17 +184,16 @@ fn integrate(
         for (j, &i) in owner.iter().enumerate() {
             ds[i * k + j] = terms[j];
         }
-        // A S by columns of A: ∂f/∂x_c by central differences
+        // A S by columns of A: ∂f/∂x_c by forward differences (the sensitivities need a few
+        // digits, the step's truncation error is 1e-7 relative)
         xs.copy_from_slice(x);
-        for c in 0..n {
-            let h = 1e-6 * (1.0 + x[c].abs());
+        for &c in &read {
+            let h = 1e-7 * (1.0 + x[c].abs());
             xs[c] = x[c] + h;
             system.derivatives(&xs, u, &mut ws, &mut fp);
-            xs[c] = x[c] - h;
-            system.derivatives(&xs, u, &mut ws, &mut fm);
             xs[c] = x[c];
             for i in 0..n {
-                let a = (fp[i] - fm[i]) / (2.0 * h);
+                let a = (fp[i] - fx[i]) / h;
                 if a != 0.0 {
                     for j in 0..k {
                         ds[i * k + j] += a * s[c * k + j];

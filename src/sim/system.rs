@@ -153,6 +153,12 @@ impl System {
         self.rhs.eval_row_prepared(&mut ws.scratch, dx);
     }
 
+    /// Whether the right-hand side reads state `i` at all (positions usually are not read: a
+    /// derivative with respect to them is zero).
+    pub fn reads_state(&self, i: usize) -> bool {
+        self.state_slots.iter().any(|&(_, s)| s == i)
+    }
+
     /// Index of a state by name.
     pub fn state_index(&self, name: &str) -> Option<usize> {
         self.states.iter().position(|s| s == name)
