@@ -76,6 +76,20 @@ pub trait Plugin: Sync {
     fn checks(&self, _model: &Model, _runs: &[Frame]) -> Vec<Check> {
         vec![]
     }
+    /// The reference length, speed and density of a model of this field, for nondimensional
+    /// coefficients (a ship's length, approach speed and water density).
+    fn reference(&self, _model: &Model) -> Option<(f64, f64, f64)> {
+        None
+    }
+    /// The field's name for a coefficient (`Y'_vvr` for the v̇ coefficient of v²r/u).
+    fn coefficient_name(&self, _model: &Model, _equation: &str, _term: &crate::term::Term) -> Option<String> {
+        None
+    }
+    /// Rescales the values of its table when the model is rescaled (lengths × `length`, times
+    /// × `time`, masses × `mass`; `crate::model::dimension::rescaled` does the rest).
+    fn rescale(&self, _model: &mut Model, _length: f64, _time: f64, _mass: f64) -> Result<(), PluginError> {
+        Ok(())
+    }
     /// A named scenario of this field (`zigzag:20/20`) to simulate `model` under.
     fn scenario(
         &self,

@@ -5,6 +5,7 @@
 //! caret inside it.
 
 mod covariance;
+pub mod dimension;
 mod file;
 mod locate;
 mod param;

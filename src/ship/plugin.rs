@@ -70,6 +70,56 @@ impl Plugin for Manoeuvring {
         super::tracking::track(frame, &ship, smooth).map_err(PluginError::failed)
     }
 
+    fn reference(&self, model: &Model) -> Option<(f64, f64, f64)> {
+        let spec = ShipSpec::of(model).ok().flatten()?;
+        Some((spec.lpp, spec.u0, spec.density.unwrap_or(1000.0)))
+    }
+
+    fn coefficient_name(&self, model: &Model, equation: &str, term: &crate::term::Term) -> Option<String> {
+        let spec = canonical_spec(model)?;
+        let n = &spec.names;
+        let state = model.equation(equation)?.state.clone();
+        let letter = if state == n.u {
+            "X"
+        } else if state == n.v {
+            "Y"
+        } else if state == n.r {
+            "N"
+        } else {
+            return None;
+        };
+        // the subscript names the motion variables, each as often as its power (the speed
+        // that makes the term a force, u or U, is the prime system's, not a subscript)
+        let mut sub = String::new();
+        let m = term.monomials().first()?;
+        for (atom, k) in &m.factors {
+            let name = match atom {
+                crate::term::Atom::Var(v) if *v == n.u || v == "U" => continue,
+                crate::term::Atom::Var(v) if *v == n.rudder => "δ".to_string(),
+                crate::term::Atom::Var(v) => v.clone(),
+                crate::term::Atom::Call(f, args) if f == "abs" => format!("|{}|", args.first()?),
+                _ => return None,
+            };
+            for _ in 0..k.unsigned_abs() {
+                sub += &name;
+            }
+        }
+        Some(if sub.is_empty() { format!("{letter}'_0") } else { format!("{letter}'_{sub}") })
+    }
+
+    fn rescale(&self, model: &mut Model, length: f64, time: f64, mass: f64) -> Result<(), PluginError> {
+        let Some(mut spec) = ShipSpec::of(model)? else { return Ok(()) };
+        spec.lpp *= length;
+        spec.beam *= length;
+        spec.draught *= length;
+        // a volume; the mass factor is the volume's at equal density
+        spec.displacement *= mass;
+        spec.u0 *= length / time;
+        spec.rudder_rate /= time;
+        spec.store(model);
+        Ok(())
+    }
+
     fn checks(&self, model: &Model, runs: &[Frame]) -> Vec<Check> {
         let Some(spec) = canonical_spec(model) else { return vec![] };
         // turning circles at the largest rudder angle the runs used (from each run's start,

@@ -41,6 +41,10 @@ pub struct ShipSpec {
     pub rudder_limit: f64,
     /// Approach speed, m/s.
     pub u0: f64,
+    /// Water density, kg/m³ (nondimensional coefficients; 1000 when not given, a basin's fresh
+    /// water).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<f64>,
     /// Length of the full-scale ship a model represents, m (IMO's time-based criteria then
     /// use its Froude-scaled L/V).
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -180,3 +180,55 @@ fn the_new_ship_recipe_predicts_turning_circles_it_was_not_trained_on() {
     assert!(text.contains("== physical checks ==") && text.contains("FAIL turning circle"), "{text}");
     assert!(!refused.exists());
 }
+
+/// `termid scale` takes the 7 m model to the 320 m ship by Froude's law: the turning circle
+/// in ship lengths and the speed loss are the same, the self-propulsion rate √λ times lower.
+#[test]
+fn froude_scaling_to_the_full_scale_ship_keeps_the_manoeuvre_in_ship_lengths() {
+    let dir = crate::common::Scratch::new("mmg-scale");
+    let out = dir.join("full.toml");
+    let lambda: f64 = 320.0 / 7.0;
+    let (ok, text, err) = crate::common::termid(&[
+        "scale",
+        "--model",
+        "models/mmg_kvlcc2.toml",
+        "--factor",
+        &lambda.to_string(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok && text.contains("wrote"), "{err}");
+    let full = Ship::new(&termid::plugins::load(&out).unwrap(), false).unwrap();
+    assert!((full.spec.lpp - 320.0).abs() < 1e-9 && (full.spec.u0 - 1.17248 * lambda.sqrt()).abs() < 1e-9);
+    let s = Settings {
+        integrator: Integrator::Rk4,
+        dt: 0.01 * lambda.sqrt(),
+        duration: 200.0 * lambda.sqrt(),
+        sample: 0.1,
+    };
+    let turn = |ship: &Ship, s: &Settings| match ship
+        .run(&Manoeuvre::parse("turning:35").unwrap(), s)
+        .unwrap()
+        .metrics
+    {
+        Metrics::Turning(t) => t,
+        _ => unreachable!(),
+    };
+    let (a, b) = (
+        turn(&full, &Settings { sample: s.dt, ..s }),
+        turn(&ship(), &Settings { integrator: Integrator::Rk4, dt: 0.01, duration: 200.0, sample: 0.01 }),
+    );
+    assert!((a.tactical_diameter_lpp.unwrap() - b.tactical_diameter_lpp.unwrap()).abs() < 1e-6);
+    assert!((a.speed_ratio - b.speed_ratio).abs() < 1e-9);
+    let (na, nb) = (full.straight_run().unwrap().input[1], ship().straight_run().unwrap().input[1]);
+    assert!((na * lambda.sqrt() / nb - 1.0).abs() < 1e-9, "{na} vs {nb}");
+    let (ok, _, err) = crate::common::termid(&[
+        "scale",
+        "--model",
+        "models/mmg_kvlcc2.toml",
+        "--factor=-2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("positive"), "{err}");
+}

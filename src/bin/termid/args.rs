@@ -30,6 +30,25 @@ pub enum Command {
     Diagnose(DiagnoseCommand),
     /// Check a model against held-out runs: errors per run, manoeuvre metrics side by side.
     Validate(ValidateCommand),
+    /// Rescale a model by Froude's law (a basin's model to its ship, or back).
+    Scale(ScaleCommand),
+}
+
+/// `termid scale`.
+#[derive(Debug, Args)]
+#[command(
+    after_help = "Example: termid scale --model models/mmg_kvlcc2.toml --factor 45.714 --out kvlcc2_full.toml\n(KVLCC2 from L = 7 m to 320 m: lengths × λ, speeds × √λ, times × √λ, masses × λ³; every coefficient by its dimension)"
+)]
+pub struct ScaleCommand {
+    /// The model file.
+    #[arg(long)]
+    pub model: PathBuf,
+    /// Length factor λ (new length / old length; < 1 from ship to model).
+    #[arg(long)]
+    pub factor: f64,
+    /// Write the rescaled model here.
+    #[arg(long)]
+    pub out: PathBuf,
 }
 
 /// Output format.

@@ -285,6 +285,7 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
         }
     };
     let fits = identified.fits;
+    let names_fitted: Vec<String> = fits.iter().map(|(n, _)| n.clone()).collect();
     model = identified.model;
     // a refinement that fails loses nothing: the regression's model is still written, and
     // the command ends with the refinement's error
@@ -331,6 +332,25 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
         },
         None => (None, None),
     };
+    // the coefficients in the field's nondimensional form, where it has reference scales
+    let primes = termid::plugins::of(&model).and_then(|p| {
+        let (length, speed, density) = p.reference(&model)?;
+        let rows = termid::model::dimension::nondimensional(&model, length, speed, density).ok()?;
+        let named: Vec<(String, termid::model::dimension::Nondimensional)> = rows
+            .into_iter()
+            .filter(|c| names_fitted.contains(&c.equation))
+            .map(|c| {
+                let term = model.vocabulary.parse(&c.term).ok();
+                let name = term.and_then(|t| p.coefficient_name(&model, &c.equation, &t)).unwrap_or_default();
+                (name, c)
+            })
+            .collect();
+        let head = format!(
+            "== nondimensional coefficients (prime system: lengths / L, times / (L/U), masses / ρL³ with L = {length} m, U = {speed} m/s, ρ = {density} kg/m³; the equations are accelerations: v̇' = v̇·L/U², ṙ' = ṙ·L²/U²) ==\n{:<10} {:<16} {:<10} {:>14} {:>14}",
+            "equation", "term", "name", "coefficient", "prime"
+        );
+        Some((head, named))
+    });
     // what the field knows must hold, checked before anything is written
     let checks = termid::plugins::of(&model).map(|p| p.checks(&model, &frames)).unwrap_or_default();
     let refused: Vec<String> = checks.iter().filter(|c| !c.passed && c.refuses).map(|c| c.line()).collect();
@@ -363,6 +383,9 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
             if !checks.is_empty() {
                 all.insert("physical_checks".into(), serde_json::to_value(&checks)?);
             }
+            if let Some((_, rows)) = &primes {
+                all.insert("nondimensional".into(), serde_json::to_value(rows)?);
+            }
             println!("{}", serde_json::to_string_pretty(&all)?);
         }
         Format::Text => {
@@ -373,6 +396,20 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
             }
             if let Some(r) = &refined {
                 print!("{}", r.text());
+            }
+            if let Some((head, rows)) = &primes {
+                println!("{head}");
+                for (name, c) in rows {
+                    println!(
+                        "{:<10} {:<16} {:<10} {:>14} {:>14}",
+                        c.equation,
+                        c.term,
+                        name,
+                        termid::identify::num(c.value),
+                        termid::identify::num(c.prime)
+                    );
+                }
+                println!();
             }
             if !checks.is_empty() {
                 println!("== physical checks ==");

@@ -8,6 +8,7 @@ mod monte_carlo;
 mod progress;
 mod reproduce;
 mod runs;
+mod scale;
 mod simulate;
 mod validate;
 
@@ -32,6 +33,7 @@ fn main() -> ExitCode {
         args::Command::Compare(cmd) => compare::run(cmd),
         args::Command::Diagnose(cmd) => diagnose::run(cmd),
         args::Command::Validate(cmd) => validate::run(cmd),
+        args::Command::Scale(cmd) => scale::run(cmd),
     };
     // The command runs on a worker of the thread pool: the library's parallel passes over
     // the rows then start at once, where from outside the pool every pass would wait for a

@@ -1,0 +1,28 @@
+//! `termid scale`: a model rescaled by Froude's law, its plug-in's table included.
+
+use anyhow::{bail, Result};
+
+use crate::args::ScaleCommand;
+
+pub fn run(cmd: ScaleCommand) -> Result<()> {
+    if !(cmd.factor.is_finite() && cmd.factor > 0.0) {
+        bail!("--factor {}: a length factor is a positive number", cmd.factor);
+    }
+    termid::output::check_file(&cmd.out)?;
+    let model = termid::plugins::load(&cmd.model)?;
+    let (length, time, mass) = (cmd.factor, cmd.factor.sqrt(), cmd.factor.powi(3));
+    let mut scaled = termid::model::dimension::rescaled(&model, length, time, mass)?;
+    if let Some(plugin) = termid::plugins::of(&scaled) {
+        plugin.rescale(&mut scaled, length, time, mass)?;
+    }
+    scaled.add_note(format!(
+        "rescaled by Froude's law from {} (lengths × {length}, times × {time:.6}, masses × {mass:.6e})",
+        cmd.model.display()
+    ));
+    termid::output::write_file(&cmd.out, scaled.to_toml().as_bytes())?;
+    println!(
+        "wrote {}: lengths × {length}, speeds and times × {time:.6}, masses × {mass:.6e}",
+        cmd.out.display()
+    );
+    Ok(())
+}
