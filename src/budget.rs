@@ -65,6 +65,26 @@ pub enum ReadError {
 /// [`MAX_LINE`], no NUL byte; so `/dev/zero`, a binary file or an endless pipe is an error
 /// after a few reads instead of memory that grows without bound.
 pub fn read_text(path: &std::path::Path) -> Result<String, ReadError> {
+    let bytes = read_bytes(path)?;
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let line = e.as_bytes()[..at].iter().filter(|b| **b == b'\n').count() + 1;
+        ReadError::NotUtf8 { line }
+    })
+}
+
+/// [`read_text`], with a file that is not UTF-8 read as Latin-1 (Windows-1252's letters and
+/// signs, e.g. a degree sign in a basin's header lines); `true` when it was.
+pub fn read_text_or_latin1(path: &std::path::Path) -> Result<(String, bool), ReadError> {
+    let bytes = read_bytes(path)?;
+    match String::from_utf8(bytes) {
+        Ok(text) => Ok((text, false)),
+        Err(e) => Ok((e.into_bytes().iter().map(|&b| char::from(b)).collect(), true)),
+    }
+}
+
+/// The bytes of a file, with the bounds of [`read_text`].
+fn read_bytes(path: &std::path::Path) -> Result<Vec<u8>, ReadError> {
     use std::io::Read;
     let mut file = std::fs::File::open(path)?;
     if file.metadata().is_ok_and(|m| m.is_file() && m.len() as f64 > MEMORY_LIMIT) {
@@ -97,11 +117,7 @@ pub fn read_text(path: &std::path::Path) -> Result<String, ReadError> {
         }
         bytes.extend_from_slice(&chunk[..n]);
     }
-    String::from_utf8(bytes).map_err(|e| {
-        let at = e.utf8_error().valid_up_to();
-        let line = e.as_bytes()[..at].iter().filter(|b| **b == b'\n').count() + 1;
-        ReadError::NotUtf8 { line }
-    })
+    Ok(bytes)
 }
 
 /// A byte count as a person reads it: 7.8 GB, 512 MB.

@@ -30,8 +30,63 @@ use super::{DataError, Frame};
 pub struct Dataset {
     /// Model variable → "file column [unit]".
     pub columns: BTreeMap<String, String>,
+    /// The files' column names in order, for files with no header row (every run's unless
+    /// it names its own).
+    #[serde(default)]
+    pub header: Option<Vec<String>>,
+    /// Body-frame velocities computed from the track instead of read from columns.
+    #[serde(default)]
+    pub track: Option<Track>,
     /// The runs.
     pub runs: Vec<RunSpec>,
+}
+
+/// `[track]`: surge and sway velocity computed from an earth-fixed track and the heading
+/// (model variables, after the column map), by central differences over ± `half_window`
+/// samples — for records whose logged velocities are missing or not what they say.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Track {
+    /// Position along the x axis.
+    pub x: String,
+    /// Position along the y axis.
+    pub y: String,
+    /// Heading, measured from x towards y.
+    pub heading: String,
+    /// The surge velocity to compute.
+    pub u: String,
+    /// The sway velocity to compute.
+    pub v: String,
+    /// Samples each side of the central difference.
+    #[serde(default = "two")]
+    pub half_window: usize,
+}
+
+fn two() -> usize {
+    2
+}
+
+/// Surge and sway velocity from a track and heading: the earth-fixed velocity by central
+/// differences over ± `half` samples (one-sided at the ends), turned into the body frame by
+/// the heading.
+pub fn velocities_from_track(
+    t: &[f64],
+    x: &[f64],
+    y: &[f64],
+    heading: &[f64],
+    half: usize,
+) -> (Vec<f64>, Vec<f64>) {
+    let n = t.len().min(x.len()).min(y.len()).min(heading.len());
+    let half = half.max(1);
+    (0..n)
+        .map(|k| {
+            let (a, b) = (k.saturating_sub(half), (k + half).min(n - 1));
+            let h = (t[b] - t[a]).max(f64::MIN_POSITIVE);
+            let (xd, yd) = ((x[b] - x[a]) / h, (y[b] - y[a]) / h);
+            let (s, c) = heading[k].sin_cos();
+            (xd * c + yd * s, -xd * s + yd * c)
+        })
+        .unzip()
 }
 
 /// One run of a dataset.
@@ -43,9 +98,12 @@ pub struct RunSpec {
     /// Column separator.
     #[serde(default)]
     pub delimiter: Delimiter,
-    /// Lines before the header.
+    /// Lines before the header (before the data where there is no header row).
     #[serde(default)]
     pub skip: usize,
+    /// The column names in order, for a file with no header row.
+    #[serde(default)]
+    pub header: Option<Vec<String>>,
     /// Keep only samples at or after this time (file's time unit converted to s).
     #[serde(default)]
     pub from: Option<f64>,
@@ -115,16 +173,21 @@ impl Dataset {
         for run in &self.runs {
             let path = base.join(&run.file);
             let origin = path.display().to_string();
-            let text = crate::budget::read_text(&path)
+            let (text, latin1) = crate::budget::read_text_or_latin1(&path)
                 .map_err(|e| DataError::Io { file: origin.clone(), message: e.to_string() })?;
+            if latin1 {
+                notes.push(format!("{origin}: not UTF-8, read as Latin-1 (Windows-1252)"));
+            }
+            let header = run.header.as_ref().or(self.header.as_ref()).map(|h| h.join(","));
             let body: Vec<&str> = text.lines().skip(run.skip).collect();
-            let csv: String = body
+            let csv: String = header
                 .iter()
-                .map(|l| match run.delimiter {
+                .cloned()
+                .chain(body.iter().map(|l| match run.delimiter {
                     Delimiter::Comma => l.to_string(),
                     Delimiter::Semicolon => l.replace(';', ","),
                     Delimiter::Whitespace => l.split_whitespace().collect::<Vec<_>>().join(","),
-                })
+                }))
                 .collect::<Vec<_>>()
                 .join("\n");
             let (time_col, time_unit) = split_spec(self.columns.get(time).map_or(time, String::as_str));
@@ -158,6 +221,22 @@ impl Dataset {
                     ));
                 }
                 frame.push(var, values.iter().map(|v| v * f).collect())?;
+            }
+            if let Some(track) = &self.track {
+                let col = |n: &str| frame.require(n).map(<[f64]>::to_vec);
+                let (u, v) = velocities_from_track(
+                    frame.time(),
+                    &col(&track.x)?,
+                    &col(&track.y)?,
+                    &col(&track.heading)?,
+                    track.half_window,
+                );
+                notes.push(format!(
+                    "{origin}: {} and {} computed from the track ({}, {}) and {} over ±{} samples",
+                    track.u, track.v, track.x, track.y, track.heading, track.half_window
+                ));
+                frame.set(&track.u, u)?;
+                frame.set(&track.v, v)?;
             }
             if run.from.is_some() || run.to.is_some() {
                 let t = frame.time();
@@ -205,6 +284,58 @@ mod tests {
 
     fn write(dir: &Path, name: &str, text: &str) {
         std::fs::write(dir.join(name), text).unwrap();
+    }
+
+    /// A basin file as HSVA writes them: Latin-1 header lines (a degree sign), no row of
+    /// column names, whitespace columns, angles in radians; u and v computed from the track.
+    #[test]
+    fn headerless_latin1_files_with_velocities_from_the_track() {
+        let dir = std::env::temp_dir().join(format!("termid-hsva-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut bytes =
+            b" HSVA, experimental data\n KVLCC2\n Z20\xb0/10\xb0 starting to starboard\n Time series\n"
+                .to_vec();
+        // u = 1.2, v = -0.1 in the body frame, heading 0.2 rad: the track moves accordingly
+        let (c, s) = (0.2f64.cos(), 0.2f64.sin());
+        for k in 0..40 {
+            let t = 0.05 * k as f64;
+            let (x, y) = ((1.2 * c + 0.1 * s) * t, (1.2 * s - 0.1 * c) * t);
+            bytes.extend(format!("  {t:.3}  {x:.9}  {y:.9}  0.2  9.99  9.99  0.001\n").as_bytes());
+        }
+        std::fs::write(dir.join("z.dat"), bytes).unwrap();
+        let text = r#"
+header = ["time", "x0", "y0", "psi", "u", "v", "p"]
+[columns]
+t = "time [s]"
+x0 = "x0 [m]"
+y0 = "y0 [m]"
+"ψ" = "psi [rad]"
+r = "p [rad/s]"
+[track]
+x = "x0"
+y = "y0"
+heading = "ψ"
+u = "u"
+v = "v"
+[[runs]]
+file = "z.dat"
+delimiter = "whitespace"
+skip = 4
+"#;
+        let set: Dataset = toml::from_str(text).unwrap();
+        let (frames, notes) = set.read(&dir, "t").unwrap();
+        assert!(
+            notes.iter().any(|n| n.contains("Latin-1")) && notes.iter().any(|n| n.contains("from the track"))
+        );
+        let f = &frames[0];
+        assert_eq!(f.len(), 40);
+        for k in 0..40 {
+            assert!(
+                (f.column("u").unwrap()[k] - 1.2).abs() < 1e-6
+                    && (f.column("v").unwrap()[k] + 0.1).abs() < 1e-6
+            );
+        }
+        assert_eq!(f.column("r").unwrap()[0], 0.001);
     }
 
     #[test]

@@ -13,7 +13,7 @@ mod savitzky_golay;
 mod search;
 mod smoothing_spline;
 
-pub use dataset::{Dataset, Delimiter, RunSpec};
+pub use dataset::{velocities_from_track, Dataset, Delimiter, RunSpec, Track};
 pub use derivative::{differentiator, CentralDifference, Differentiator, Smoothed, DIFFERENTIATORS};
 pub use five_point::FivePoint;
 pub use kalman::{KalmanSmoother, NoiseModel};

@@ -239,7 +239,7 @@ impl Basin {
             clean_states.push(clean);
         }
         if let Some(half) = self.artefacts.velocities_from_track {
-            let (u, v) = velocities_from_track(
+            let (u, v) = crate::data::velocities_from_track(
                 truth.time(),
                 &noisy_states[r.x0],
                 &noisy_states[r.y0],
@@ -324,22 +324,6 @@ pub fn dataset_file(columns: &[(String, String)], files: &[&str]) -> String {
         let _ = write!(s, "\n[[runs]]\nfile = \"{f}\"\ndelimiter = \"whitespace\"\nskip = 3\n");
     }
     s
-}
-
-/// Surge and sway velocity from a tracked position and heading: the earth-fixed velocity by
-/// central differences over ± `half` samples (one-sided at the ends), turned into the body
-/// frame by the heading (eq. B9 inverted).
-fn velocities_from_track(t: &[f64], x: &[f64], y: &[f64], psi: &[f64], half: usize) -> (Vec<f64>, Vec<f64>) {
-    let n = t.len();
-    (0..n)
-        .map(|k| {
-            let (a, b) = (k.saturating_sub(half), (k + half).min(n - 1));
-            let h = (t[b] - t[a]).max(f64::MIN_POSITIVE);
-            let (xd, yd) = ((x[b] - x[a]) / h, (y[b] - y[a]) / h);
-            let (s, c) = psi[k].sin_cos();
-            (xd * c + yd * s, -xd * s + yd * c)
-        })
-        .unzip()
 }
 
 #[cfg(test)]
@@ -436,7 +420,7 @@ mod tests {
         let (xd, yd) = (2.0 * 0.3f64.cos() + 0.5 * 0.3f64.sin(), 2.0 * 0.3f64.sin() - 0.5 * 0.3f64.cos());
         let x: Vec<f64> = t.iter().map(|t| xd * t).collect();
         let y: Vec<f64> = t.iter().map(|t| yd * t).collect();
-        let (u, v) = velocities_from_track(&t, &x, &y, &psi, 2);
+        let (u, v) = crate::data::velocities_from_track(&t, &x, &y, &psi, 2);
         assert!(u.iter().all(|u| (u - 2.0).abs() < 1e-12) && v.iter().all(|v| (v + 0.5).abs() < 1e-12));
     }
 }
