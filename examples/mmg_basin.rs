@@ -16,21 +16,10 @@ use termid::data::{CentralDifference, Dataset, Frame};
 use termid::diagnose::{choose_by_prediction, Prediction};
 use termid::identify::ModelIdentification;
 use termid::model::Model;
-use termid::ship::basin::{at_approach_speed, columns, dataset_file, Artefacts, Basin, Noise, Recording};
+use termid::ship::basin::{at_approach_speed, columns, dataset_file, Basin, Recording, ZIGZAGS_BOTH_SIDES};
 use termid::ship::{Manoeuvre, Metrics, Ship};
 use termid::sim::{Integrator, Settings};
 
-/// Training zigzags with each run's approach speed (× the nominal u0).
-const TRAIN: [(&str, f64); 8] = [
-    ("zigzag:10/10", 0.98),
-    ("zigzag:10/10:port", 1.02),
-    ("zigzag:20/20", 1.01),
-    ("zigzag:20/20:port", 0.97),
-    ("zigzag:15/5", 1.03),
-    ("zigzag:15/5:port", 0.99),
-    ("zigzag:35/5", 1.00),
-    ("zigzag:35/5:port", 1.02),
-];
 /// Held-out zigzags: identified from none of them.
 const HELD: [(&str, f64); 3] = [("zigzag:25/10", 1.0), ("zigzag:20/10:port", 0.98), ("zigzag:30/5", 1.01)];
 /// Turning circles predicted, rudder in degrees (MMG: positive to starboard).
@@ -51,25 +40,10 @@ fn main() -> Result<(), Error> {
         .ok()
         .map(|s| s.split(',').filter_map(|x| x.trim().parse().ok()).collect())
         .unwrap_or_else(|| vec![0, 1, 2]);
-    let basin = Basin {
-        rate_hz: 20.0,
-        approach_s: 5.0,
-        // optical tracking (2 mm), fibre-optic gyro, rudder potentiometer; the log's noise
-        // does not enter: u and v come from the track
-        noise: Noise {
-            speed_m_s: 0.0,
-            yaw_rate_deg_s: 0.05,
-            heading_deg: 0.05,
-            position_m: 0.002,
-            rudder_deg: 0.05,
-        },
-        dt: 0.01,
-        artefacts: Artefacts {
-            rudder_offset_deg: RUDDER_OFFSET_DEG,
-            velocities_from_track: Some(2),
-            midship_end_s: 5.0,
-        },
-    };
+    // optical tracking (2 mm), gyro, rudder potentiometer, no log: u and v from the track;
+    // the rudder indicator 0.3° off, the rudder back at midship at the end
+    let basin = Basin::tracked();
+    assert_eq!(basin.artefacts.rudder_offset_deg, RUDDER_OFFSET_DEG);
 
     // the truth: turning circles at the nominal speed, held-out zigzags at their own
     let settings = Settings { integrator: Integrator::Rk4, dt: 0.01, duration: 250.0, sample: 0.05 };
@@ -91,7 +65,7 @@ fn main() -> Result<(), Error> {
     println!("{head}\n{rule}");
     let mut summary: Vec<(String, f64, f64, f64)> = Vec::new();
     for seed in seeds {
-        let train = record_all(&basin, &truth, &TRAIN, u0, 1000 * seed + 1, &dir)?;
+        let train = basin.record_all(&truth, &ZIGZAGS_BOTH_SIDES, u0, 80.0, 1000 * seed + 1, Some(&dir))?;
         std::fs::write(dir.join("train.toml"), dataset_file(&columns(&truth), &names(&train)))?;
         let (frames, _) = Dataset::load(&dir.join("train.toml"))?.read(&dir, "t")?;
         // a new ship's recipe: the tracking filter fuses track, heading, gyro and the
@@ -204,25 +178,6 @@ fn pct(a: f64, b: f64) -> f64 {
 
 fn names(runs: &[(String, Recording)]) -> Vec<&str> {
     runs.iter().map(|(n, _)| n.as_str()).collect()
-}
-
-fn record_all(
-    basin: &Basin,
-    truth: &Model,
-    runs: &[(&str, f64)],
-    u0: f64,
-    seed: u64,
-    dir: &Path,
-) -> Result<Vec<(String, Recording)>, Error> {
-    runs.iter()
-        .enumerate()
-        .map(|(k, (m, f))| {
-            let name = format!("{}.dat", m.replace([':', '/'], "_"));
-            let rec = basin.record(truth, &Manoeuvre::parse(m)?, f * u0, 80.0, seed + k as u64, &name)?;
-            basin.write(&rec, truth, &dir.join(&name))?;
-            Ok((name, rec))
-        })
-        .collect()
 }
 
 /// (advance, tactical diameter) in metres of a turning circle at the model's nominal speed.

@@ -77,6 +77,56 @@ impl Default for Basin {
     }
 }
 
+impl Basin {
+    /// A basin with optical tracking, as the MMG basin records: 2 mm on the track, 0.05° on
+    /// heading and rudder, 0.05 °/s on the gyro, no log (u and v from the track), a rudder
+    /// indicator that reads 0.3° more than the true angle, 5 s back at midship at the end.
+    pub fn tracked() -> Basin {
+        Basin {
+            noise: Noise {
+                speed_m_s: 0.0,
+                yaw_rate_deg_s: 0.05,
+                heading_deg: 0.05,
+                position_m: 0.002,
+                rudder_deg: 0.05,
+            },
+            artefacts: Artefacts {
+                rudder_offset_deg: 0.3,
+                velocities_from_track: Some(2),
+                midship_end_s: 5.0,
+            },
+            ..Basin::default()
+        }
+    }
+
+    /// Records `runs` (manoeuvre, approach speed × `u0`) of `model`, each `duration` s after
+    /// its approach, with seeds `seed`, `seed + 1`, …; written into `dir` (when given) as
+    /// `<manoeuvre>.dat`, the names returned with the recordings.
+    pub fn record_all(
+        &self,
+        model: &Model,
+        runs: &[(&str, f64)],
+        u0: f64,
+        duration: f64,
+        seed: u64,
+        dir: Option<&Path>,
+    ) -> Result<Vec<(String, Recording)>, ShipError> {
+        runs.iter()
+            .enumerate()
+            .map(|(k, (m, f))| {
+                let name = format!("{}.dat", m.replace([':', '/'], "_"));
+                let rec =
+                    self.record(model, &Manoeuvre::parse(m)?, f * u0, duration, seed + k as u64, &name)?;
+                if let Some(dir) = dir {
+                    self.write(&rec, model, &dir.join(&name))
+                        .map_err(|e| ShipError::Model(format!("{}: {e}", dir.join(&name).display())))?;
+                }
+                Ok((name, rec))
+            })
+            .collect()
+    }
+}
+
 /// One recorded run.
 #[derive(Clone, Debug)]
 pub struct Recording {
@@ -99,6 +149,19 @@ pub const PAPER_RUNS: [(&str, f64); 5] = [
     ("zigzag:30/10", 0.99),
     ("zigzag:20/20:port", 1.03),
     ("zigzag:25/10", 0.98),
+];
+
+/// Zigzags of several amplitudes to both sides, each with its approach speed (× the nominal
+/// u0): the training set of the MMG basin (`examples/mmg_basin.rs`).
+pub const ZIGZAGS_BOTH_SIDES: [(&str, f64); 8] = [
+    ("zigzag:10/10", 0.98),
+    ("zigzag:10/10:port", 1.02),
+    ("zigzag:20/20", 1.01),
+    ("zigzag:20/20:port", 0.97),
+    ("zigzag:15/5", 1.03),
+    ("zigzag:15/5:port", 0.99),
+    ("zigzag:35/5", 1.00),
+    ("zigzag:35/5:port", 1.02),
 ];
 
 /// The basin's column names and units for the ship's roles, as a dataset file maps them.

@@ -81,52 +81,25 @@ fn a_propeller_that_is_not_an_input_is_refused_with_its_key() {
 /// every seed).
 #[test]
 fn the_new_ship_recipe_predicts_turning_circles_it_was_not_trained_on() {
-    use termid::ship::basin::{at_approach_speed, columns, dataset_file, Artefacts, Basin, Noise};
+    use termid::ship::basin::{at_approach_speed, columns, dataset_file, Basin, ZIGZAGS_BOTH_SIDES};
     let dir = crate::common::Scratch::new("mmg-recipe");
     let truth = termid::plugins::load(Path::new("models/mmg_kvlcc2.toml")).unwrap();
-    let basin = Basin {
-        noise: Noise {
-            speed_m_s: 0.0,
-            yaw_rate_deg_s: 0.05,
-            heading_deg: 0.05,
-            position_m: 0.002,
-            rudder_deg: 0.05,
-        },
-        artefacts: Artefacts { rudder_offset_deg: 0.3, velocities_from_track: Some(2), midship_end_s: 5.0 },
-        ..Basin::default()
-    };
-    let runs = [
-        ("zigzag:10/10", 0.98),
-        ("zigzag:10/10:port", 1.02),
-        ("zigzag:20/20", 1.01),
-        ("zigzag:20/20:port", 0.97),
-        ("zigzag:15/5", 1.03),
-        ("zigzag:15/5:port", 0.99),
-        ("zigzag:35/5", 1.00),
-        ("zigzag:35/5:port", 1.02),
-    ];
-    let mut files = Vec::new();
-    for (k, (m, f)) in runs.iter().enumerate() {
-        let name = format!("{}.dat", m.replace([':', '/'], "_"));
-        let rec = basin
-            .record(&truth, &Manoeuvre::parse(m).unwrap(), f * 1.17248, 80.0, 101 + k as u64, &name)
-            .unwrap();
-        basin.write(&rec, &truth, &dir.join(&name)).unwrap();
-        files.push(name);
-    }
+    let recorded =
+        Basin::tracked().record_all(&truth, &ZIGZAGS_BOTH_SIDES, 1.17248, 80.0, 101, Some(&dir)).unwrap();
+    let files: Vec<String> = recorded.into_iter().map(|(name, _)| name).collect();
     let names: Vec<&str> = files.iter().map(String::as_str).collect();
     std::fs::write(dir.join("train.toml"), dataset_file(&columns(&truth), &names)).unwrap();
     let out = dir.join("identified.toml");
-    let (ok, text, err) = crate::common::termid(&[
-        "identify",
-        "--model",
-        "models/new_ship.toml",
-        "--dataset",
-        dir.join("train.toml").to_str().unwrap(),
-        "--derivative",
-        "kinematic",
-        "--smooth",
-        "--no-intercept",
+    let train = dir.join("train.toml");
+    // the recipe: the tracking filter, smoothed states, no intercept, then what each call adds
+    let identify = |more: &[&str]| {
+        let mut args =
+            vec!["identify", "--model", "models/new_ship.toml", "--dataset", train.to_str().unwrap()];
+        args.extend(["--derivative", "kinematic", "--smooth", "--no-intercept"]);
+        args.extend(more);
+        crate::common::termid(&args)
+    };
+    let (ok, text, err) = identify(&[
         "--choose",
         "sparse,best-subset,efroymson,stepwise",
         "--compare",
@@ -161,21 +134,7 @@ fn the_new_ship_recipe_predicts_turning_circles_it_was_not_trained_on() {
     // the same records with sequentially thresholded least squares: a model whose turning
     // circles diverge, refused by the physical checks and not written
     let refused = dir.join("stlsq.toml");
-    let (ok, text, err) = crate::common::termid(&[
-        "identify",
-        "--model",
-        "models/new_ship.toml",
-        "--dataset",
-        dir.join("train.toml").to_str().unwrap(),
-        "--derivative",
-        "kinematic",
-        "--smooth",
-        "--no-intercept",
-        "--backend",
-        "stlsq",
-        "--out",
-        refused.to_str().unwrap(),
-    ]);
+    let (ok, text, err) = identify(&["--backend", "stlsq", "--out", refused.to_str().unwrap()]);
     assert!(!ok && err.contains("fails physical checks") && err.contains("--keep-unphysical"), "{err}");
     assert!(text.contains("== physical checks ==") && text.contains("FAIL turning circle"), "{text}");
     assert!(!refused.exists());
