@@ -310,4 +310,24 @@ fn backend_and_choose_with_a_model() {
         "lasso",
     ]);
     assert!(!ok && err.contains("unknown back-end `lasso`"), "{err}");
+    // a model file among the configurations: a library without x·z cannot predict y
+    let text = std::fs::read_to_string("models/lorenz.toml").unwrap().replace("\"x*z\", ", "");
+    let poor = dir.join("no_xz.toml");
+    std::fs::write(&poor, text).unwrap();
+    let (ok, out, err) = termid(&[
+        "identify",
+        "--model",
+        "models/lorenz.toml",
+        "--data",
+        csv.to_str().unwrap(),
+        half.to_str().unwrap(),
+        "--no-intercept",
+        "--choose",
+        &format!("{},stepwise", poor.display()),
+        "--compare",
+        "x,y,z",
+    ]);
+    assert!(ok, "{err}");
+    let chosen = out.lines().find(|l| l.contains("← chosen")).unwrap_or_default();
+    assert!(chosen.starts_with("stepwise"), "{out}");
 }

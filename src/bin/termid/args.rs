@@ -154,10 +154,11 @@ pub struct IdentifyCommand {
     /// (of its iterates, the one that predicts these runs best is kept).
     #[arg(long, value_name = "DATASET", requires = "refine")]
     pub refine_validation: Option<PathBuf>,
-    /// With --model: choose among these back-ends (comma-separated, or `all`) by what they
-    /// predict: each run is re-simulated by the model identified on the other runs, and the
-    /// back-end with the smallest error on the runs it did not see is identified on all of
-    /// them. The table it chose from is printed.
+    /// With --model: choose among these back-ends and model files (comma-separated, or `all`
+    /// back-ends; a model file is another candidate library for the same equations) by what
+    /// they predict: each run is re-simulated by the model identified on the other runs; of
+    /// those within one standard error of the smallest error, the first listed is identified
+    /// on all runs. The table it chose from is printed.
     #[arg(long, value_name = "BACKENDS", requires = "model")]
     pub choose: Option<String>,
     /// With --choose: the states compared in the held-out runs (default: the states of the

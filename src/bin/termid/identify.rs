@@ -443,7 +443,9 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
 /// `identify --refine`: every identified coefficient refined by output error on the runs as
 /// they were prepared for the regression (smoothed initial states: a noisy first sample of a
 /// rate would otherwise drift through its integral).
-/// `--choose`: the model with each named back-end in every identified equation.
+/// `--choose`: the configurations to choose from — a back-end's name (the model with that
+/// back-end in every identified equation) or a model file (another candidate library, step
+/// rule or set of forced terms for the same equations).
 fn backend_variants(model: &termid::model::Model, list: &str) -> Result<Vec<(String, termid::model::Model)>> {
     let names: Vec<&str> = if list.trim() == "all" {
         Backend::NAMES.to_vec()
@@ -451,11 +453,20 @@ fn backend_variants(model: &termid::model::Model, list: &str) -> Result<Vec<(Str
         list.split(',').map(str::trim).filter(|n| !n.is_empty()).collect()
     };
     if names.is_empty() {
-        bail!("--choose `{list}` names no back-end (known: {})", Backend::NAMES.join(", "));
+        bail!("--choose `{list}` names no back-end or model file (back-ends: {})", Backend::NAMES.join(", "));
     }
     names
         .into_iter()
         .map(|name| {
+            if name.ends_with(".toml") {
+                let variant = termid::plugins::load(std::path::Path::new(name))?;
+                for e in model.identifiable() {
+                    if variant.equation(&e).is_none() {
+                        bail!("--choose: {name} has no equation `{e}` of {}", model.path);
+                    }
+                }
+                return Ok((name.to_string(), variant));
+            }
             let backend = Backend::by_name(name).map_err(|e| anyhow::anyhow!("--choose: {e}"))?;
             let variant = model.edit(|file| {
                 for e in file.equations.values_mut().filter(|e| e.identify) {
