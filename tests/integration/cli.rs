@@ -268,26 +268,18 @@ fn backend_and_choose_with_a_model() {
     let mut second = vec![lines[0]];
     second.extend(&lines[lines.len() / 2..]);
     std::fs::write(&half, second.join("\n")).unwrap();
-    let (ok, out, err) = termid(&[
-        "identify",
-        "--model",
-        "models/lorenz.toml",
-        "--data",
-        csv.to_str().unwrap(),
-        "--no-intercept",
-        "--backend",
-        "best-subset",
-    ]);
+    let identify = |more: &[&str]| {
+        let mut args = vec!["identify", "--model", "models/lorenz.toml", "--data", csv.to_str().unwrap()];
+        args.extend(more);
+        termid(&args)
+    };
+    let (ok, out, err) = identify(&["--no-intercept", "--backend", "best-subset"]);
     assert!(ok, "{err}");
     assert_eq!(out.matches("back-end best-subset").count(), 3, "{out}");
     let written = dir.join("chosen.toml");
-    let (ok, out, err) = termid(&[
-        "identify",
-        "--model",
-        "models/lorenz.toml",
-        "--data",
-        csv.to_str().unwrap(),
-        half.to_str().unwrap(),
+    let two = half.to_str().unwrap();
+    let (ok, out, err) = identify(&[
+        two,
         "--no-intercept",
         "--choose",
         "stepwise,sparse",
@@ -300,33 +292,14 @@ fn backend_and_choose_with_a_model() {
     assert!(out.contains("chosen by prediction") && out.contains("← chosen"), "{out}");
     assert!(out.contains("\nstepwise") && out.contains("\nsparse"), "{out}");
     assert!(std::fs::read_to_string(&written).unwrap().contains("x*z"));
-    let (ok, _, err) = termid(&[
-        "identify",
-        "--model",
-        "models/lorenz.toml",
-        "--data",
-        csv.to_str().unwrap(),
-        "--choose",
-        "lasso",
-    ]);
+    let (ok, _, err) = identify(&["--choose", "lasso"]);
     assert!(!ok && err.contains("unknown back-end `lasso`"), "{err}");
     // a model file among the configurations: a library without x·z cannot predict y
     let text = std::fs::read_to_string("models/lorenz.toml").unwrap().replace("\"x*z\", ", "");
     let poor = dir.join("no_xz.toml");
     std::fs::write(&poor, text).unwrap();
-    let (ok, out, err) = termid(&[
-        "identify",
-        "--model",
-        "models/lorenz.toml",
-        "--data",
-        csv.to_str().unwrap(),
-        half.to_str().unwrap(),
-        "--no-intercept",
-        "--choose",
-        &format!("{},stepwise", poor.display()),
-        "--compare",
-        "x,y,z",
-    ]);
+    let choice = format!("{},stepwise", poor.display());
+    let (ok, out, err) = identify(&[two, "--no-intercept", "--choose", &choice, "--compare", "x,y,z"]);
     assert!(ok, "{err}");
     let chosen = out.lines().find(|l| l.contains("← chosen")).unwrap_or_default();
     assert!(chosen.starts_with("stepwise"), "{out}");
