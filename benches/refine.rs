@@ -27,11 +27,7 @@ fn bench(c: &mut Criterion) {
     let truth = termid::plugins::load(Path::new("models/mmg_kvlcc2.toml")).unwrap();
     let template = termid::plugins::load(Path::new("models/new_ship.toml"))
         .unwrap()
-        .edit(|file| {
-            for e in file.equations.values_mut().filter(|e| e.identify) {
-                e.backend = Some(Backend::by_name("sparse").unwrap());
-            }
-        })
+        .with_backend(&Backend::by_name("sparse").unwrap())
         .unwrap();
     let plugin = termid::plugins::with_derivative("kinematic").unwrap();
     let runs: Vec<(&str, f64)> = ZIGZAGS_BOTH_SIDES.iter().chain(&MORE).copied().collect();

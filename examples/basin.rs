@@ -186,14 +186,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let training = Runs::new(&identified, &prepared, 0.05, Integrator::Rk4)?
                 .with_intercepts(intercept)
                 .comparing(&states)?;
-            let prior = std::env::var("PRIOR").ok().and_then(|v| v.parse().ok()).unwrap_or(1e-4);
-            let r = refine(
-                &identified,
-                &training,
-                &RefineSettings { prior_weight: prior, ..Default::default() },
-            )?;
-            eprintln!("{}", r.stopped);
-            identified = r.model;
+            identified = refine(&identified, &training, &RefineSettings::default())?.model;
         }
         let mut errors = Vec::new();
         for eq in model.identifiable() {

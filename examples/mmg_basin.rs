@@ -89,12 +89,7 @@ fn main() -> Result<(), Error> {
                 .iter()
                 .map(|name| {
                     let backend = termid::select::Backend::by_name(name)?;
-                    let variant = template.edit(|file| {
-                        for e in file.equations.values_mut().filter(|e| e.identify) {
-                            e.backend = Some(backend.clone());
-                        }
-                    })?;
-                    Ok((name.to_string(), variant))
+                    Ok((name.to_string(), template.with_backend(&backend)?))
                 })
                 .collect::<Result<_, Error>>()?;
         let prediction =

@@ -382,7 +382,9 @@ pub fn apply(model: &Model, h: &Hypothesis, theta: &[f64]) -> Result<Model, supe
     Ok(m)
 }
 
-fn residuals(data: &Runs, model: &Model, h: &Hypothesis, theta: &[f64]) -> Option<Vec<f64>> {
+/// Scaled residuals of the runs re-simulated with the hypothesis at θ; `None` where the
+/// simulation fails or a residual is not finite.
+pub(super) fn residuals(data: &Runs, model: &Model, h: &Hypothesis, theta: &[f64]) -> Option<Vec<f64>> {
     let m = apply(model, h, theta).ok()?;
     let sims = data.simulate(&m, &h.input_offsets(theta, model), &h.input_scales(theta, model)).ok()?;
     let r = data.residuals(&sims);
@@ -410,7 +412,8 @@ fn jacobian(data: &Runs, model: &Model, h: &Hypothesis, theta: &[f64]) -> Option
     Some((r0, jac))
 }
 
-fn cost(r: &[f64]) -> f64 {
+/// Sum of squares.
+pub(super) fn cost(r: &[f64]) -> f64 {
     r.iter().map(|v| v * v).sum()
 }
 

@@ -9,7 +9,7 @@
 use nalgebra::DMatrix;
 use serde::Serialize;
 
-use super::fit::apply;
+use super::fit::{apply, cost as sum_of_squares, residuals};
 use super::sensitivity::{linearise, Linearised};
 use super::{DiagnoseError, Effect, EstimateError, Hypothesis, Runs};
 use crate::model::{Covariance, Model};
@@ -108,17 +108,13 @@ pub fn refine(model: &Model, runs: &Runs, settings: &RefineSettings<'_>) -> Resu
     let k = entries.len();
     let prior: Vec<f64> = entries.iter().map(|(_, _, _, sd)| settings.prior_weight / (sd * sd)).collect();
     let prior_cost = |theta: &[f64]| theta.iter().zip(&prior).map(|(t, p)| p * t * t).sum::<f64>();
-    let cost_of = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>();
-    let simulate_cost = |runs: &Runs, theta: &[f64]| -> Option<f64> {
-        let m = apply(model, &hypothesis, theta).ok()?;
-        let r = runs.residuals(&runs.simulate(&m, &[], &[]).ok()?);
-        r.iter().all(|v| v.is_finite()).then(|| cost_of(&r))
-    };
+    let simulate_cost =
+        |runs: &Runs, theta: &[f64]| residuals(runs, model, &hypothesis, theta).map(|r| sum_of_squares(&r));
     let before = runs.gap(&runs.simulate(model, &[], &[])?).cost;
     let mut theta = vec![0.0; k];
     let mut lin = linearise(runs, model, &terms)
         .map_err(|_| DiagnoseError::Refinement(EstimateError::Diverges("at the start")))?;
-    let mut cost = cost_of(&lin.residuals) + prior_cost(&theta);
+    let mut cost = sum_of_squares(&lin.residuals) + prior_cost(&theta);
     let validation_before = settings.validation.and_then(|v| simulate_cost(v, &theta));
     let mut best = (theta.clone(), validation_before.unwrap_or(f64::NAN));
     let mut rises = 0;
@@ -187,7 +183,7 @@ pub fn refine(model: &Model, runs: &Runs, settings: &RefineSettings<'_>) -> Resu
     }
     let Linearised { residuals: r, jtj, .. } = lin;
     let mut refined = apply(model, &hypothesis, &theta)?;
-    let data_cost = cost_of(&r);
+    let data_cost = sum_of_squares(&r);
     // σ²(JᵀJ + P)⁻¹ assumes independent residuals; re-simulation residuals are strongly
     // correlated in time, so the covariance is widened by their correlation time τ
     let tau = crate::uncertainty::correlation_time(&runs.series(&r));

@@ -145,6 +145,15 @@ impl Model {
         &self.equations
     }
 
+    /// The model with `backend` in every identified equation (the file's back-ends replaced).
+    pub fn with_backend(&self, backend: &Backend) -> Result<Model, ModelError> {
+        self.edit(|file| {
+            for e in file.equations.values_mut().filter(|e| e.identify) {
+                e.backend = Some(backend.clone());
+            }
+        })
+    }
+
     /// The model with its file edited by `change` and checked again as a file is (errors
     /// located in the edited file's text).
     pub fn edit(&self, change: impl FnOnce(&mut ModelFile)) -> Result<Model, ModelError> {

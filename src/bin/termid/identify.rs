@@ -213,12 +213,7 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
     let mut model = termid::plugins::load(&path)?;
     if cmd.backend.is_some() {
         // the command line's back-end (with its stepwise options) replaces the file's
-        let backend = configure_backend(&cmd)?;
-        model = model.edit(|file| {
-            for e in file.equations.values_mut().filter(|e| e.identify) {
-                e.backend = Some(backend.clone());
-            }
-        })?;
+        model = model.with_backend(&configure_backend(&cmd)?)?;
     }
     let refine = cmd.refine.as_deref().map(|list| refine_states(list, &model)).transpose()?;
     let frames = crate::runs::load_for(&model, &cmd.data, cmd.dataset.as_deref())?;
@@ -295,29 +290,29 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
         prior: cmd.refine_prior,
         validation: validation.as_deref(),
     };
+    // what the field knows must hold: the plug-in's physical checks of a model
+    let checks_of =
+        |m: &termid::model::Model| termid::plugins::of(m).map(|p| p.checks(m, &frames)).unwrap_or_default();
+    let failing = |checks: &[termid::plugin::Check]| -> Vec<String> {
+        checks.iter().filter(|c| !c.passed && c.refuses).map(|c| c.name.clone()).collect()
+    };
+    // the checks of the model as it will be written, where the refinement made them already
+    let mut final_checks = None;
     let (refined, refine_error) = match &refine {
         Some(_) => match crate::progress::with_spinner("refining by output error", || {
             refine_by_output_error(&model, &frames, &how_refined)
         }) {
             Ok(r) => {
                 // a refinement must not make a model fail what its field knows it passed
-                let plugin = termid::plugins::of(&model);
-                let failing = |m: &termid::model::Model| -> Vec<String> {
-                    plugin.map_or(vec![], |p| {
-                        p.checks(m, &frames)
-                            .into_iter()
-                            .filter(|c| !c.passed && c.refuses)
-                            .map(|c| c.name)
-                            .collect()
-                    })
-                };
-                let before = failing(&model);
-                let lost: Vec<String> =
-                    failing(&r.model).into_iter().filter(|c| !before.contains(c)).collect();
+                let (before, after) = (checks_of(&model), checks_of(&r.model));
+                let was = failing(&before);
+                let lost: Vec<String> = failing(&after).into_iter().filter(|c| !was.contains(c)).collect();
                 if lost.is_empty() {
                     model = r.model.clone();
+                    final_checks = Some(after);
                     (Some(r), None)
                 } else {
+                    final_checks = Some(before);
                     if matches!(cmd.format, Format::Text) {
                         print!("{}", r.text());
                     }
@@ -351,8 +346,8 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
         );
         Some((head, named))
     });
-    // what the field knows must hold, checked before anything is written
-    let checks = termid::plugins::of(&model).map(|p| p.checks(&model, &frames)).unwrap_or_default();
+    // checked before anything is written
+    let checks = final_checks.unwrap_or_else(|| checks_of(&model));
     let refused: Vec<String> = checks.iter().filter(|c| !c.passed && c.refuses).map(|c| c.line()).collect();
     let write = refused.is_empty() || cmd.keep_unphysical;
     if let Some(out) = cmd.out.as_ref().filter(|_| write) {
@@ -468,12 +463,7 @@ fn backend_variants(model: &termid::model::Model, list: &str) -> Result<Vec<(Str
                 return Ok((name.to_string(), variant));
             }
             let backend = Backend::by_name(name).map_err(|e| anyhow::anyhow!("--choose: {e}"))?;
-            let variant = model.edit(|file| {
-                for e in file.equations.values_mut().filter(|e| e.identify) {
-                    e.backend = Some(backend.clone());
-                }
-            })?;
-            Ok((name.to_string(), variant))
+            Ok((name.to_string(), model.with_backend(&backend)?))
         })
         .collect()
 }
