@@ -75,7 +75,7 @@ impl Frame {
 }
 
 /// The header and the numeric columns of CSV text, every cell checked.
-fn parse_table(text: &str, origin: &str) -> Result<(Vec<String>, Vec<Vec<f64>>), DataError> {
+pub(super) fn parse_table(text: &str, origin: &str) -> Result<(Vec<String>, Vec<Vec<f64>>), DataError> {
     let io = |e: csv::Error| DataError::Io { file: origin.into(), message: e.to_string() };
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)

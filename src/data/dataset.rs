@@ -16,6 +16,9 @@
 //!
 //! termid works in SI and radians inside; every conversion is stated, and a column declared in
 //! radians whose values can only be degrees (beyond 2π) is refused with its file and row.
+//! A leading `-` negates a column (`"δ" = "-delta [deg]"`, for a basin whose sign convention is
+//! not the model's); `froude = λ` reads records of a geosim λ times larger (full scale) at the
+//! model's scale; `regular_time = true` rebuilds time stamps printed with too few digits.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -34,23 +37,49 @@ pub struct Dataset {
     /// it names its own).
     #[serde(default)]
     pub header: Option<Vec<String>>,
+    /// Where the run files are: relative to the dataset file, or absolute (default: the
+    /// dataset file's own folder), `$NAME` / `${NAME}` read from the environment — records
+    /// that stay where the basin put them (`folder = "${SIMMAN}/kvlcc2"`).
+    #[serde(default)]
+    pub folder: Option<PathBuf>,
     /// Body-frame velocities computed from the track instead of read from columns.
     #[serde(default)]
     pub track: Option<Track>,
+    /// The records are of a geosim this many times larger than the model (a full-scale
+    /// ship, a larger model): every column is brought to the model's scale by Froude's law,
+    /// from the dimension of its unit (lengths ÷ λ, times and speeds ÷ √λ, rates × √λ).
+    #[serde(default)]
+    pub froude: Option<f64>,
+    /// Time stamps printed with too few digits (repeated stamps, steps of uneven size) are
+    /// replaced by their least-squares line over the row number: for records sampled at a
+    /// fixed rate. Every run's unless it says otherwise.
+    #[serde(default)]
+    pub regular_time: bool,
     /// The runs.
     pub runs: Vec<RunSpec>,
 }
 
 /// `[track]`: surge and sway velocity computed from an earth-fixed track and the heading
 /// (model variables, after the column map), by central differences over ± `half_window`
-/// samples — for records whose logged velocities are missing or not what they say.
+/// samples — for records whose logged velocities are missing or not what they say; or, with
+/// `x_dot` and `y_dot`, turned into the body frame from logged earth-fixed velocities (for
+/// records whose positions are printed too coarsely to differentiate).
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Track {
     /// Position along the x axis.
-    pub x: String,
+    #[serde(default)]
+    pub x: Option<String>,
     /// Position along the y axis.
-    pub y: String,
+    #[serde(default)]
+    pub y: Option<String>,
+    /// Earth-fixed velocity along the x axis (instead of the positions): a column of the
+    /// file with its unit, as in `[columns]` (`"dx0 [m/s]"`).
+    #[serde(default)]
+    pub x_dot: Option<String>,
+    /// Earth-fixed velocity along the y axis, a column of the file.
+    #[serde(default)]
+    pub y_dot: Option<String>,
     /// Heading, measured from x towards y.
     pub heading: String,
     /// The surge velocity to compute.
@@ -89,6 +118,96 @@ pub fn velocities_from_track(
         .unzip()
 }
 
+/// `$NAME` and `${NAME}` replaced by `lookup(NAME)`; the first name it does not know is the error.
+fn expand_environment(text: &str, lookup: impl Fn(&str) -> Option<String>) -> Result<String, String> {
+    let mut out = String::new();
+    let mut rest = text;
+    while let Some(at) = rest.find('$') {
+        out.push_str(&rest[..at]);
+        let after = &rest[at + 1..];
+        let (name, tail) = match after.strip_prefix('{') {
+            Some(inner) => match inner.find('}') {
+                Some(end) => (&inner[..end], &inner[end + 1..]),
+                None => return Err(format!("{{{inner} (no closing brace)")),
+            },
+            None => {
+                let end = after.find(|c: char| !(c.is_alphanumeric() || c == '_')).unwrap_or(after.len());
+                (&after[..end], &after[end..])
+            }
+        };
+        if name.is_empty() {
+            out.push('$');
+        } else {
+            out.push_str(&lookup(name).ok_or_else(|| name.to_string())?);
+        }
+        rest = tail;
+    }
+    out.push_str(rest);
+    Ok(out)
+}
+
+/// Earth-fixed velocities turned into the body frame by the heading.
+pub fn velocities_from_earth_fixed(x_dot: &[f64], y_dot: &[f64], heading: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    x_dot
+        .iter()
+        .zip(y_dot)
+        .zip(heading)
+        .map(|((xd, yd), h)| {
+            let (s, c) = h.sin_cos();
+            (xd * c + yd * s, -xd * s + yd * c)
+        })
+        .unzip()
+}
+
+/// Time stamps replaced by their least-squares line over the row number. Refused (with the
+/// row) where a stamp lies further from the line than rounding to three significant digits
+/// or two sample intervals explain: a dropout or a change of rate, not rounding.
+pub fn regular_time(t: &[f64], origin: &str, column: &str) -> Result<(Vec<f64>, f64), DataError> {
+    let n = t.len();
+    if n < 3 {
+        return Err(DataError::TooShort {
+            file: origin.into(),
+            rows: n,
+            needed: 3,
+            what: "a regular time".into(),
+        });
+    }
+    let nf = n as f64;
+    let km = (nf - 1.0) / 2.0;
+    let tm = t.iter().sum::<f64>() / nf;
+    let (mut sxy, mut sxx) = (0.0, 0.0);
+    for (k, v) in t.iter().enumerate() {
+        let dk = k as f64 - km;
+        sxy += dk * (v - tm);
+        sxx += dk * dk;
+    }
+    let step = sxy / sxx;
+    let line: Vec<f64> = (0..n).map(|k| tm + step * (k as f64 - km)).collect();
+    if !(step > 0.0 && step.is_finite()) {
+        return Err(DataError::Unit {
+            file: origin.into(),
+            row: 1,
+            column: column.into(),
+            message: "regular_time: the time stamps do not increase along the rows".into(),
+        });
+    }
+    for (k, (v, l)) in t.iter().zip(&line).enumerate() {
+        if (v - l).abs() > 0.005 * v.abs() + 2.0 * step {
+            return Err(DataError::Unit {
+                file: origin.into(),
+                row: k + 1,
+                column: column.into(),
+                message: format!(
+                    "regular_time: the stamp {v} is {:.3} from a regular rate of {step:.6} per row \
+                     (more than rounding explains: a dropout or a change of rate)",
+                    v - l
+                ),
+            });
+        }
+    }
+    Ok((line, step))
+}
+
 /// One run of a dataset.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -104,12 +223,15 @@ pub struct RunSpec {
     /// The column names in order, for a file with no header row.
     #[serde(default)]
     pub header: Option<Vec<String>>,
-    /// Keep only samples at or after this time (file's time unit converted to s).
+    /// Keep only samples at or after this time (the file's time in s, before any Froude scaling).
     #[serde(default)]
     pub from: Option<f64>,
     /// Keep only samples at or before this time.
     #[serde(default)]
     pub to: Option<f64>,
+    /// This run's own `regular_time`.
+    #[serde(default)]
+    pub regular_time: Option<bool>,
 }
 
 /// Column separators.
@@ -125,34 +247,42 @@ pub enum Delimiter {
     Whitespace,
 }
 
-/// Units termid converts to SI and radians: (name, factor to SI).
-const UNITS: &[(&str, f64)] = &[
-    ("s", 1.0),
-    ("ms", 1e-3),
-    ("min", 60.0),
-    ("m", 1.0),
-    ("m/s", 1.0),
-    ("m/s^2", 1.0),
-    ("km/h", 1.0 / 3.6),
-    ("kn", 1852.0 / 3600.0),
-    ("rad", 1.0),
-    ("rad/s", 1.0),
-    ("rad/s^2", 1.0),
-    ("deg", std::f64::consts::PI / 180.0),
-    ("deg/s", std::f64::consts::PI / 180.0),
-    ("deg/s^2", std::f64::consts::PI / 180.0),
-    ("1/min", 1.0 / 60.0),
-    ("1/s", 1.0),
-    ("-", 1.0),
+/// Units termid converts to SI and radians: (name, factor to SI, exponents of length, time
+/// and mass of the SI unit — for Froude scaling).
+const UNITS: &[(&str, f64, [i32; 3])] = &[
+    ("s", 1.0, [0, 1, 0]),
+    ("ms", 1e-3, [0, 1, 0]),
+    ("min", 60.0, [0, 1, 0]),
+    ("m", 1.0, [1, 0, 0]),
+    ("m/s", 1.0, [1, -1, 0]),
+    ("m/s^2", 1.0, [1, -2, 0]),
+    ("km/h", 1.0 / 3.6, [1, -1, 0]),
+    ("kn", 1852.0 / 3600.0, [1, -1, 0]),
+    ("rad", 1.0, [0, 0, 0]),
+    ("rad/s", 1.0, [0, -1, 0]),
+    ("rad/s^2", 1.0, [0, -2, 0]),
+    ("deg", std::f64::consts::PI / 180.0, [0, 0, 0]),
+    ("deg/s", std::f64::consts::PI / 180.0, [0, -1, 0]),
+    ("deg/s^2", std::f64::consts::PI / 180.0, [0, -2, 0]),
+    ("1/min", 1.0 / 60.0, [0, -1, 0]),
+    ("1/s", 1.0, [0, -1, 0]),
+    ("N", 1.0, [1, -2, 1]),
+    ("N m", 1.0, [2, -2, 1]),
+    ("-", 1.0, [0, 0, 0]),
 ];
 
-/// "column [unit]" → (column, unit).
-fn split_spec(spec: &str) -> (String, Option<String>) {
+/// "column [unit]" → (column, unit, sign): a leading `-` negates the column.
+fn split_spec(spec: &str) -> (String, Option<String>, f64) {
+    let spec = spec.trim();
+    let (spec, sign) = match spec.strip_prefix('-') {
+        Some(rest) => (rest.trim_start(), -1.0),
+        None => (spec, 1.0),
+    };
     match spec.rsplit_once('[') {
         Some((col, unit)) if unit.trim_end().ends_with(']') => {
-            (col.trim().to_string(), Some(unit.trim_end().trim_end_matches(']').trim().to_string()))
+            (col.trim().to_string(), Some(unit.trim_end().trim_end_matches(']').trim().to_string()), sign)
         }
-        _ => (spec.trim().to_string(), None),
+        _ => (spec.trim().to_string(), None, sign),
     }
 }
 
@@ -163,6 +293,22 @@ impl Dataset {
         let text = crate::budget::read_text(path)
             .map_err(|e| DataError::Io { file: file.clone(), message: e.to_string() })?;
         toml::from_str(&text).map_err(|e| DataError::Io { file, message: e.to_string() })
+    }
+
+    /// The folder the run files are read from, for a dataset file at `path`.
+    pub fn folder(&self, path: &Path) -> Result<PathBuf, DataError> {
+        let own = path.parent().unwrap_or(Path::new("."));
+        let Some(folder) = &self.folder else { return Ok(own.to_path_buf()) };
+        let text = folder.to_string_lossy();
+        let expanded =
+            expand_environment(&text, |name| std::env::var(name).ok()).map_err(|name| DataError::Io {
+                file: path.display().to_string(),
+                message: format!(
+                    "`folder = \"{text}\"` names the environment variable {name}, which is not set: \
+                     set it to the folder of the records ({name}=/path/to/records termid …)"
+                ),
+            })?;
+        Ok(own.join(expanded))
     }
 
     /// Reads every run into frames named by model variable, in SI units and radians; `time`
@@ -190,14 +336,51 @@ impl Dataset {
                 }))
                 .collect::<Vec<_>>()
                 .join("\n");
-            let (time_col, time_unit) = split_spec(self.columns.get(time).map_or(time, String::as_str));
-            let raw = Frame::parse_csv(&csv, &origin, &time_col)?;
+            let (time_col, time_unit, _) = split_spec(self.columns.get(time).map_or(time, String::as_str));
+            let (names, mut columns) = super::csv_io::parse_table(&csv, &origin)?;
+            let Some(time_index) = names.iter().position(|h| *h == time_col) else {
+                return Err(DataError::MissingColumn {
+                    file: origin.clone(),
+                    column: time_col.clone(),
+                    available: names.join(", "),
+                });
+            };
+            let stamps = std::mem::take(&mut columns[time_index]);
+            let stamps = if run.regular_time.unwrap_or(self.regular_time) {
+                let (line, step) = regular_time(&stamps, &origin, &time_col)?;
+                notes.push(format!(
+                    "{origin}: time stamps replaced by a regular rate of {step:.6} per row (largest change {:.3})",
+                    stamps.iter().zip(&line).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max)
+                ));
+                line
+            } else {
+                stamps
+            };
+            let mut raw = Frame::new(&origin, &time_col, stamps)?;
+            for (name, values) in names.iter().zip(columns).filter(|(n, _)| **n != time_col) {
+                raw.push(name, values)?;
+            }
             // a logging dropout would be differentiated across as if it were one step
             super::check_gaps(&raw, 3.0)?;
+            let scale = |unit: Option<&str>, column: &str| -> Result<f64, DataError> {
+                let Some(lambda) = self.froude else { return Ok(1.0) };
+                froude_factor(lambda, unit, &origin, column)
+            };
             let time_factor = factor(time_unit.as_deref(), &origin, time)?;
-            let mut frame = Frame::new(&origin, time, raw.time().iter().map(|t| t * time_factor).collect())?;
-            for (var, spec) in self.columns.iter().filter(|(v, _)| v.as_str() != time) {
-                let (col, unit) = split_spec(spec);
+            let time_scale = scale(time_unit.as_deref(), &time_col)?;
+            // the file's time in s, for `from` and `to`
+            let file_time: Vec<f64> = raw.time().iter().map(|t| t * time_factor).collect();
+            let mut frame = Frame::new(&origin, time, file_time.iter().map(|t| t * time_scale).collect())?;
+            if let Some(lambda) = self.froude {
+                notes.push(format!(
+                    "{origin}: Froude-scaled from a geosim {lambda} times larger (lengths ÷ {lambda}, times ÷ {:.4}, rates × {:.4})",
+                    lambda.sqrt(),
+                    lambda.sqrt()
+                ));
+            }
+            // one column of the file in SI at the model's scale, with the conversions said
+            let mut convert = |spec: &str, var: &str| -> Result<Vec<f64>, DataError> {
+                let (col, unit, sign) = split_spec(spec);
                 let values = raw.require(&col)?;
                 if unit.as_deref() == Some("rad") {
                     if let Some((i, v)) =
@@ -220,26 +403,49 @@ impl Dataset {
                         unit.as_deref().unwrap_or("")
                     ));
                 }
-                frame.push(var, values.iter().map(|v| v * f).collect())?;
+                if sign < 0.0 {
+                    notes.push(format!("{origin}: `{col}` negated → {var}"));
+                }
+                let f = sign * f * scale(unit.as_deref(), &col)?;
+                Ok(values.iter().map(|v| v * f).collect())
+            };
+            for (var, spec) in self.columns.iter().filter(|(v, _)| v.as_str() != time) {
+                let values = convert(spec, var)?;
+                frame.push(var, values)?;
             }
             if let Some(track) = &self.track {
                 let col = |n: &str| frame.require(n).map(<[f64]>::to_vec);
-                let (u, v) = velocities_from_track(
-                    frame.time(),
-                    &col(&track.x)?,
-                    &col(&track.y)?,
-                    &col(&track.heading)?,
-                    track.half_window,
-                );
-                notes.push(format!(
-                    "{origin}: {} and {} computed from the track ({}, {}) and {} over ±{} samples",
-                    track.u, track.v, track.x, track.y, track.heading, track.half_window
-                ));
+                let heading = col(&track.heading)?;
+                let (u, v) = match (&track.x, &track.y, &track.x_dot, &track.y_dot) {
+                    (Some(x), Some(y), None, None) => {
+                        notes.push(format!(
+                            "{origin}: {} and {} computed from the track ({x}, {y}) and {} over ±{} samples",
+                            track.u, track.v, track.heading, track.half_window
+                        ));
+                        velocities_from_track(frame.time(), &col(x)?, &col(y)?, &heading, track.half_window)
+                    }
+                    (None, None, Some(xd), Some(yd)) => {
+                        let (xd_values, yd_values) = (convert(xd, "ẋ")?, convert(yd, "ẏ")?);
+                        notes.push(format!(
+                            "{origin}: {} and {} turned into the body frame from ({xd}, {yd}) by {}",
+                            track.u, track.v, track.heading
+                        ));
+                        velocities_from_earth_fixed(&xd_values, &yd_values, &heading)
+                    }
+                    _ => {
+                        return Err(DataError::Unit {
+                            file: origin.clone(),
+                            row: 0,
+                            column: track.heading.clone(),
+                            message: "[track] takes either the positions x and y or the earth-fixed velocities x_dot and y_dot".into(),
+                        })
+                    }
+                };
                 frame.set(&track.u, u)?;
                 frame.set(&track.v, v)?;
             }
             if run.from.is_some() || run.to.is_some() {
-                let t = frame.time();
+                let t = &file_time;
                 let lo = run.from.map_or(0, |a| t.iter().position(|v| *v >= a).unwrap_or(t.len()));
                 let hi = run.to.map_or(t.len(), |b| t.iter().rposition(|v| *v <= b).map_or(0, |i| i + 1));
                 if hi <= lo + 2 {
@@ -265,17 +471,48 @@ impl Dataset {
     }
 }
 
-fn factor(unit: Option<&str>, origin: &str, column: &str) -> Result<f64, DataError> {
-    let Some(u) = unit else { return Ok(1.0) };
-    UNITS.iter().find(|(n, _)| *n == u).map(|(_, f)| *f).ok_or_else(|| DataError::Unit {
+fn unit_row(
+    unit: &str,
+    origin: &str,
+    column: &str,
+) -> Result<&'static (&'static str, f64, [i32; 3]), DataError> {
+    UNITS.iter().find(|(n, _, _)| *n == unit).ok_or_else(|| DataError::Unit {
         file: origin.into(),
         row: 0,
         column: column.into(),
         message: format!(
-            "unknown unit [{u}] (known: {})",
-            UNITS.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ")
+            "unknown unit [{unit}] (known: {})",
+            UNITS.iter().map(|(n, _, _)| *n).collect::<Vec<_>>().join(", ")
         ),
     })
+}
+
+fn factor(unit: Option<&str>, origin: &str, column: &str) -> Result<f64, DataError> {
+    let Some(u) = unit else { return Ok(1.0) };
+    Ok(unit_row(u, origin, column)?.1)
+}
+
+/// The factor from a geosim λ times larger to the model, for a column of this unit: Froude's
+/// law keeps u²/(gL) and the density, so lengths go as λ, times as √λ, masses as λ³.
+fn froude_factor(lambda: f64, unit: Option<&str>, origin: &str, column: &str) -> Result<f64, DataError> {
+    if !(lambda > 0.0 && lambda.is_finite()) {
+        return Err(DataError::Unit {
+            file: origin.into(),
+            row: 0,
+            column: column.into(),
+            message: format!("froude = {lambda}: the scale must be a positive number"),
+        });
+    }
+    let Some(u) = unit else {
+        return Err(DataError::Unit {
+            file: origin.into(),
+            row: 0,
+            column: column.into(),
+            message: "Froude scaling needs every column's unit ([-] for a number without one)".into(),
+        });
+    };
+    let [l, t, m] = unit_row(u, origin, column)?.2;
+    Ok(lambda.powi(-l) * lambda.sqrt().powi(-t) * lambda.powi(-3 * m))
 }
 
 #[cfg(test)]
@@ -336,6 +573,99 @@ skip = 4
             );
         }
         assert_eq!(f.column("r").unwrap()[0], 0.001);
+    }
+
+    /// A full-scale record as MARIN prints them (three significant digits: repeated time
+    /// stamps, coarse positions; earth-fixed velocities; rpm; rudder of the other sign) read
+    /// at the model's scale: time rebuilt, Froude's law per unit, u and v in the body frame.
+    #[test]
+    fn full_scale_records_at_model_scale() {
+        let dir = std::env::temp_dir().join(format!("termid-marin-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let lambda: f64 = 49.0; // √λ = 7
+        let heading = (-17.2f64).to_radians(); // printable in three digits
+        let (u, v) = (7.0, 0.7); // full scale, body frame
+        let (xd, yd) = (u * heading.cos() - v * heading.sin(), u * heading.sin() + v * heading.cos());
+        let mut text = String::from("MARIN\nZig-zag\n\n");
+        for k in 0..900 {
+            let t = 0.14 * k as f64;
+            text.push_str(&format!(
+                "{t:.2E}\t{:.2E}\t{:.2E}\t{:.2E}\t{xd:.6E}\t{yd:.6E}\t{:.2E}\t{:.2E}\n",
+                xd * t,
+                yd * t,
+                heading.to_degrees(),
+                0.5,  // yaw rate, deg/s
+                -5.0, // rudder, the basin's sign
+            ));
+        }
+        write(&dir, "zz.dat", &text);
+        let set: Dataset = toml::from_str(
+            r#"
+header = ["time", "x0", "y0", "psi", "dx0", "dy0", "r", "delta"]
+froude = 49.0
+regular_time = true
+folder = "${TERMID_TEST_RECORDS}"
+[columns]
+t = "time [s]"
+x0 = "x0 [m]"
+"ψ" = "psi [deg]"
+r = "r [deg/s]"
+"δ" = "-delta [deg]"
+[track]
+x_dot = "dx0 [m/s]"
+y_dot = "dy0 [m/s]"
+heading = "ψ"
+u = "u"
+v = "v"
+[[runs]]
+file = "zz.dat"
+delimiter = "whitespace"
+skip = 3
+"#,
+        )
+        .unwrap();
+        let set_path = Path::new("/nowhere/set.toml");
+        let e = set.folder(set_path).unwrap_err().to_string();
+        assert!(e.contains("TERMID_TEST_RECORDS") && e.contains("not set"), "{e}");
+        let folder =
+            expand_environment("${TERMID_TEST_RECORDS}", |_| Some(dir.display().to_string())).unwrap();
+        assert_eq!(Path::new(&folder), dir);
+        let (frames, notes) = set.read(&dir, "t").unwrap();
+        let f = &frames[0];
+        // 0.14 s per row at full scale is 0.02 s at the model's; the stamps above 100 s
+        // repeat (1.00E+02 … 1.26E+02) but the rate is rebuilt
+        assert!(notes.iter().any(|n| n.contains("regular rate")), "{notes:?}");
+        for (k, t) in f.time().iter().enumerate() {
+            assert!((t - 0.02 * k as f64).abs() < 1e-3, "row {k}: {t}");
+        }
+        let sq = lambda.sqrt();
+        for k in [0, 450, 899] {
+            assert!((f.column("u").unwrap()[k] - u / sq).abs() < 1e-5);
+            assert!((f.column("v").unwrap()[k] - v / sq).abs() < 1e-5);
+            assert!((f.column("r").unwrap()[k] - 0.5f64.to_radians() * sq).abs() < 1e-9);
+            assert!((f.column("δ").unwrap()[k] - 5f64.to_radians()).abs() < 1e-12);
+            assert!((f.column("ψ").unwrap()[k] - heading).abs() < 1e-12);
+        }
+        // lengths ÷ λ (the positions printed to three digits)
+        let x_full = xd * 0.14 * 899.0;
+        assert!((f.column("x0").unwrap()[899] - x_full / lambda).abs() < 0.01 * x_full / lambda);
+        // a dropout is not rounding: refused with its row
+        let mut t: Vec<f64> = (0..100).map(|k| 0.1 * k as f64).collect();
+        for v in &mut t[60..] {
+            *v += 3.0;
+        }
+        let e = regular_time(&t, "f.dat", "time").unwrap_err().to_string();
+        assert!(e.contains("f.dat") && e.contains("dropout"), "{e}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn environment_in_folders() {
+        let env = |n: &str| (n == "A").then(|| "/data".to_string());
+        assert_eq!(expand_environment("$A/x", env).unwrap(), "/data/x");
+        assert_eq!(expand_environment("${A}x/y", env).unwrap(), "/datax/y");
+        assert_eq!(expand_environment("a$/b", env).unwrap(), "a$/b");
+        assert_eq!(expand_environment("$B/x", env).unwrap_err(), "B");
     }
 
     #[test]

@@ -38,9 +38,9 @@ pub fn load(data: &[PathBuf], dataset: Option<&Path>, time: &str) -> Result<Vec<
     }
     if let Some(path) = dataset {
         let ds = Dataset::load(path)?;
-        let base = path.parent().unwrap_or(Path::new("."));
-        let (more, notes) =
-            ds.read(base, time).with_context(|| format!("reading the runs of {}", path.display()))?;
+        let (more, notes) = ds
+            .read(&ds.folder(path)?, time)
+            .with_context(|| format!("reading the runs of {}", path.display()))?;
         for n in notes {
             eprintln!("unit: {n}");
         }
