@@ -8,7 +8,10 @@
 //! prediction on held-out runs) identifies a model that then predicts the truth's turning
 //! circles and the held-out zigzags. Prints README's table, one row per noise seed.
 //!
-//! `cargo run --release --example mmg_basin [-- OUTPUT_FOLDER]` (seeds: MMG_SEEDS=0,1,2)
+//! `cargo run --release --example mmg_basin [-- OUTPUT_FOLDER]` (seeds: MMG_SEEDS=0,1,2;
+//! MMG_RUNS=simman trains on the SIMMAN HSVA set instead — 13 zigzags from 5°/1° to 35°/5°,
+//! all at one speed and propeller rate, 180 s each; MMG_REFINE=1 adds a row for the chosen
+//! model refined by output error)
 
 use std::path::{Path, PathBuf};
 
@@ -24,6 +27,23 @@ use termid::sim::{Integrator, Settings};
 const HELD: [(&str, f64); 3] = [("zigzag:25/10", 1.0), ("zigzag:20/10:port", 0.98), ("zigzag:30/5", 1.01)];
 /// Turning circles predicted, rudder in degrees (MMG: positive to starboard).
 const TURNS: [f64; 4] = [35.0, -35.0, 20.0, -20.0];
+/// The SIMMAN 2008 KVLCC2 set of HSVA: every zigzag at the approach speed (first rudder to
+/// starboard but where `:port` says).
+const SIMMAN_ZIGZAGS: [(&str, f64); 13] = [
+    ("zigzag:5/1", 1.0),
+    ("zigzag:10/1", 1.0),
+    ("zigzag:10/5", 1.0),
+    ("zigzag:10/10:port", 1.0),
+    ("zigzag:10/10", 1.0),
+    ("zigzag:15/1", 1.0),
+    ("zigzag:15/5", 1.0),
+    ("zigzag:20/5", 1.0),
+    ("zigzag:20/10:port", 1.0),
+    ("zigzag:20/10", 1.0),
+    ("zigzag:25/5", 1.0),
+    ("zigzag:30/5", 1.0),
+    ("zigzag:35/5", 1.0),
+];
 /// What the basin's rudder indicator reads more than the true angle, °.
 const RUDDER_OFFSET_DEG: f64 = 0.3;
 
@@ -65,7 +85,10 @@ fn main() -> Result<(), Error> {
     println!("{head}\n{rule}");
     let mut summary: Vec<(String, f64, f64, f64)> = Vec::new();
     for seed in seeds {
-        let train = basin.record_all(&truth, &ZIGZAGS_BOTH_SIDES, u0, 80.0, 1000 * seed + 1, Some(&dir))?;
+        let simman = std::env::var("MMG_RUNS").is_ok_and(|v| v == "simman");
+        let (set, duration): (&[(&str, f64)], f64) =
+            if simman { (&SIMMAN_ZIGZAGS, 180.0) } else { (&ZIGZAGS_BOTH_SIDES, 80.0) };
+        let train = basin.record_all(&truth, set, u0, duration, 1000 * seed + 1, Some(&dir))?;
         std::fs::write(dir.join("train.toml"), dataset_file(&columns(&truth), &names(&train)))?;
         let (frames, _) = Dataset::load(&dir.join("train.toml"))?.read(&dir, "t")?;
         // a new ship's recipe: the tracking filter fuses track, heading, gyro and the
@@ -100,6 +123,13 @@ fn main() -> Result<(), Error> {
         std::fs::write(dir.join(format!("identified_{seed}.toml")), model.to_toml())?;
         let (cells, _) = predict(&model, &true_turns, &true_held, u0, &settings)?;
         println!("| {seed} | {} |{cells}", chosen.candidates[chosen.best].label);
+        if std::env::var("MMG_REFINE").is_ok_and(|v| v == "1") {
+            let runs = termid::diagnose::Runs::new(&model, &prepared, 0.05, Integrator::Rk4)?
+                .comparing(&["u", "v", "r", "ψ"].map(String::from))?;
+            let refined = termid::diagnose::refine(&model, &runs, &Default::default())?;
+            let (cells, _) = predict(&refined.model, &true_turns, &true_held, u0, &settings)?;
+            println!("| {seed} | {} refined |{cells}", chosen.candidates[chosen.best].label);
+        }
         // every back-end's own model, for the summary: how much the choice matters
         for (k, (label, variant)) in configurations.iter().enumerate() {
             let identified = termid::identify::identify_model(variant, &prepared, &how, &mut |_| {})?.model;

@@ -149,6 +149,45 @@ fn identified_from_noisy_basin_runs_the_model_predicts_within_the_targets() {
             );
         }
     }
+    // several derivative methods are several starts of the refinement: each is identified
+    // and refined, the table shows them all, and the lowest re-simulation cost is kept
+    let (m_toml, train, starts) = (p("m.toml"), p("train.toml"), p("starts.toml"));
+    let multi = |extra: &[&str]| {
+        let mut args = vec![
+            "identify",
+            "--model",
+            &m_toml,
+            "--dataset",
+            &train,
+            "--derivative",
+            "kalman,savitzky-golay",
+            "--smooth",
+            "--no-intercept",
+            "--out",
+            &starts,
+        ];
+        args.extend(extra);
+        termid(&args)
+    };
+    let (ok, _, err) = multi(&[]);
+    assert!(!ok && err.contains("give --refine"), "{err}");
+    let (ok, out, err) = multi(&["--refine", "u,v,r,ψ"]);
+    assert!(ok, "{err}");
+    let rows: Vec<(&str, f64, bool)> = out
+        .lines()
+        .skip_while(|l| !l.starts_with("== starts"))
+        .skip(2)
+        .take(2)
+        .map(|l| {
+            let w: Vec<&str> = l.split_whitespace().collect();
+            (w[0], w[3].parse().unwrap_or(f64::INFINITY), l.contains("← kept"))
+        })
+        .collect();
+    assert_eq!(rows.iter().map(|r| r.0).collect::<Vec<_>>(), ["kalman", "savitzky-golay"], "{out}");
+    let kept = rows.iter().find(|r| r.2).expect("a kept start");
+    assert!(rows.iter().all(|r| kept.1 <= r.1), "{out}");
+    assert!(out.contains("wrote"), "{out}");
+
     // a state the model does not have is refused before any work, and nothing is written
     let never = p("never.toml");
     let (ok, _, err) = termid(&[

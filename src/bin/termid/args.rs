@@ -72,7 +72,7 @@ pub enum RuleName {
 }
 
 /// `termid identify`.
-#[derive(Debug, Args)]
+#[derive(Clone, Debug, Args)]
 pub struct IdentifyCommand {
     /// CSV files with a header row; several are combined (the paper's "Komb. Daten").
     #[arg(long = "data", short = 'd', num_args = 1.., required_unless_present = "dataset")]
@@ -127,6 +127,9 @@ pub struct IdentifyCommand {
     /// Derivative method for `dX/dt` targets: central, five-point, savitzky-golay[:WINDOW:ORDER],
     /// spline[:ALPHA] (GCV by default), kalman[:RATIO] (maximum likelihood by default), or for
     /// ship models `kinematic`: the tracking filter fusing track, heading, log and gyro.
+    /// Several, comma-separated, with --model and --refine: one start each (prepared,
+    /// identified, refined, checked), a table of them, and the one whose refined model
+    /// re-simulates the runs best (the --refine-validation runs where given) is kept.
     #[arg(long, default_value = "central")]
     pub derivative: String,
     /// Resample every run to this interval [s] before differentiating (low-pass filtered
@@ -150,6 +153,9 @@ pub struct IdentifyCommand {
     /// to its regression value within its standard error); 0 lets the refinement wander.
     #[arg(long, value_name = "WEIGHT", default_value_t = 1e-4, requires = "refine")]
     pub refine_prior: f64,
+    /// With --refine: most Levenberg-Marquardt iterations (it stops earlier once converged).
+    #[arg(long, value_name = "N", default_value_t = 30, requires = "refine")]
+    pub refine_iterations: usize,
     /// With --refine: a dataset file of runs the refinement does not fit but is stopped by
     /// (of its iterates, the one that predicts these runs best is kept).
     #[arg(long, value_name = "DATASET", requires = "refine")]

@@ -202,8 +202,49 @@ fn configure_backend(cmd: &IdentifyCommand) -> Result<Backend> {
     Ok(backend)
 }
 
+/// One start of `identify --model`: the runs prepared by one derivative method, the
+/// regression (or the choice among back-ends), the refinement and the physical checks.
+struct Start {
+    /// The derivative method.
+    derivative: String,
+    /// The model as it will be written.
+    model: termid::model::Model,
+    /// The regression's fits, per equation.
+    fits: Vec<(String, termid::identify::Fit)>,
+    /// The table `--choose` chose from.
+    chosen_text: Option<String>,
+    /// The refinement kept.
+    refined: Option<termid::diagnose::Refined>,
+    /// A refinement rejected by the checks, with the checks it lost.
+    rejected: Option<(termid::diagnose::Refined, Vec<String>)>,
+    /// A refinement that failed.
+    refine_error: Option<anyhow::Error>,
+    /// The physical checks of `model`.
+    checks: Vec<termid::plugin::Check>,
+}
+
+impl Start {
+    /// What the start is judged by: the re-simulation cost of the model it keeps, on the
+    /// validation runs where there are any, else on the training runs.
+    fn cost(&self) -> f64 {
+        match (&self.refined, &self.rejected) {
+            (Some(r), _) => r.validation.map_or(r.cost_after, |v| v.1),
+            (None, Some((r, _))) => r.validation.map_or(r.cost_before, |v| v.0),
+            _ => f64::INFINITY,
+        }
+    }
+
+    fn refused(&self) -> usize {
+        self.checks.iter().filter(|c| !c.passed && c.refuses).count()
+    }
+}
+
 /// `identify --model`: every identifiable equation (or the chosen ones) from the runs, each
-/// with the model's candidates, forced terms and back-end; optionally written back.
+/// with the model's candidates, forced terms and back-end; optionally written back. Several
+/// `--derivative` methods (with `--refine`) are several starts: each prepares the runs its
+/// way, is identified and refined, and the one whose refined model re-simulates the runs best
+/// (the validation runs where given) is kept — output error finds different local minima from
+/// different starts.
 fn run_model(cmd: IdentifyCommand) -> Result<()> {
     let path = cmd.model.clone().context("--model")?;
     // outputs that cannot be written are refused before any work
@@ -216,117 +257,53 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
         model = model.with_backend(&configure_backend(&cmd)?)?;
     }
     let refine = cmd.refine.as_deref().map(|list| refine_states(list, &model)).transpose()?;
-    let frames = crate::runs::load_for(&model, &cmd.data, cmd.dataset.as_deref())?;
-    let names: Vec<String> =
-        if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };
-    let states: Vec<String> =
-        names.iter().filter_map(|n| model.equation(n).map(|e| e.state.clone())).collect();
-    let units: BTreeMap<String, String> =
-        model.spec().states.iter().map(|s| (s.name.clone(), s.unit.clone())).collect();
-    let diff = derivative_method(&cmd)?;
-    let scale = |name: &str| {
-        let unit = units.get(name).cloned().unwrap_or_default();
-        // angles are read in degrees
-        match unit.strip_prefix("rad") {
-            Some(rest) => (180.0 / std::f64::consts::PI, format!("deg{rest}")),
-            None => (1.0, unit),
-        }
-    };
-    let frames = prepare_runs(&cmd, frames, &states, Some(&model), diff.as_ref(), &scale)?;
-    // runs that stop the refinement, prepared as the training runs are
-    let validation = match &cmd.refine_validation {
-        Some(path) => {
-            let held = crate::runs::load_for(&model, &[], Some(path))?;
-            Some(prepare_runs(&cmd, held, &states, Some(&model), diff.as_ref(), &scale)?)
-        }
-        None => None,
-    };
-    if cmd.target.is_some() && names.len() != 1 {
-        bail!("--target applies to one equation: name it with --equation");
+    let methods: Vec<String> =
+        cmd.derivative.split(',').map(str::trim).filter(|m| !m.is_empty()).map(String::from).collect();
+    if methods.len() > 1 && refine.is_none() {
+        bail!(
+            "--derivative {}: several derivative methods are several starts of the output-error refinement, judged by its cost: give --refine too",
+            cmd.derivative
+        );
     }
-    let label = format!("identifying {}", names.join(", "));
-    let how = termid::identify::ModelIdentification {
-        equations: names,
-        differentiator: diff.as_ref(),
-        intercept: !cmd.no_intercept,
-        target: cmd.target.as_deref().map(Target::parse),
-    };
-    let identified = match &cmd.choose {
-        None => crate::progress::with_spinner(&label, || {
-            termid::identify::identify_model(&model, &frames, &how, &mut |_| {})
-        })?,
-        Some(list) => {
-            let configurations = backend_variants(&model, list)?;
-            let prediction = termid::diagnose::Prediction {
-                states: match cmd.compare.as_deref().map(|l| refine_states(l, &model)).transpose()? {
-                    Some(Some(states)) => states,
-                    _ => vec![],
-                },
-                ..Default::default()
-            };
-            let chosen = crate::progress::with_spinner("choosing by prediction (leave one run out)", || {
-                termid::diagnose::choose_by_prediction(
-                    &configurations,
-                    &frames,
-                    &how,
-                    &prediction,
-                    &mut |_| {},
-                )
-            })?;
-            if matches!(cmd.format, Format::Text) {
-                print!("{}", chosen.text());
+    let frames = crate::runs::load_for(&model, &cmd.data, cmd.dataset.as_deref())?;
+    let held =
+        cmd.refine_validation.as_ref().map(|p| crate::runs::load_for(&model, &[], Some(p))).transpose()?;
+    let mut starts = Vec::new();
+    for method in &methods {
+        let one = IdentifyCommand { derivative: method.clone(), ..cmd.clone() };
+        match identify_start(&one, &model, &frames, held.as_deref(), refine.as_ref()) {
+            Ok(s) => starts.push(s),
+            Err(e) if methods.len() > 1 => {
+                eprintln!("warning: the start from --derivative {method} fails: {e:#}")
             }
-            chosen.identified
+            Err(e) => return Err(e),
         }
-    };
-    let fits = identified.fits;
+    }
+    let kept = (0..starts.len())
+        .min_by(|&a, &b| {
+            let (x, y) = (&starts[a], &starts[b]);
+            x.refused().cmp(&y.refused()).then(x.cost().total_cmp(&y.cost()))
+        })
+        .context("no start could be identified")?;
+    if starts.len() > 1 && matches!(cmd.format, Format::Text) {
+        print!("{}", starts_table(&starts, kept, held.is_some()));
+    }
+    let Start { model: kept_model, fits, chosen_text, refined, rejected, refine_error, checks, .. } =
+        starts.swap_remove(kept);
+    let mut model = kept_model;
     let names_fitted: Vec<String> = fits.iter().map(|(n, _)| n.clone()).collect();
-    model = identified.model;
-    // a refinement that fails loses nothing: the regression's model is still written, and
-    // the command ends with the refinement's error
-    let how_refined = RefineHow {
-        states: refine.clone().flatten(),
-        intercept: !cmd.no_intercept,
-        prior: cmd.refine_prior,
-        validation: validation.as_deref(),
-    };
-    // what the field knows must hold: the plug-in's physical checks of a model
-    let checks_of =
-        |m: &termid::model::Model| termid::plugins::of(m).map(|p| p.checks(m, &frames)).unwrap_or_default();
-    let failing = |checks: &[termid::plugin::Check]| -> Vec<String> {
-        checks.iter().filter(|c| !c.passed && c.refuses).map(|c| c.name.clone()).collect()
-    };
-    // the checks of the model as it will be written, where the refinement made them already
-    let mut final_checks = None;
-    let (refined, refine_error) = match &refine {
-        Some(_) => match crate::progress::with_spinner("refining by output error", || {
-            refine_by_output_error(&model, &frames, &how_refined)
-        }) {
-            Ok(r) => {
-                // a refinement must not make a model fail what its field knows it passed
-                let (before, after) = (checks_of(&model), checks_of(&r.model));
-                let was = failing(&before);
-                let lost: Vec<String> = failing(&after).into_iter().filter(|c| !was.contains(c)).collect();
-                if lost.is_empty() {
-                    model = r.model.clone();
-                    final_checks = Some(after);
-                    (Some(r), None)
-                } else {
-                    final_checks = Some(before);
-                    if matches!(cmd.format, Format::Text) {
-                        print!("{}", r.text());
-                    }
-                    eprintln!(
-                        "warning: the refinement is rejected: the refined model fails physical checks the regression's passes ({}); the regression's model is kept",
-                        lost.join("; ")
-                    );
-                    (None, None)
-                }
-            }
-            Err(e) => (None, Some(e)),
-        },
-        None => (None, None),
-    };
+    if matches!(cmd.format, Format::Text) {
+        if let Some(text) = &chosen_text {
+            print!("{text}");
+        }
+        if let Some((r, lost)) = &rejected {
+            print!("{}", r.text());
+            eprintln!(
+                "warning: the refinement is rejected: the refined model fails physical checks the regression's passes ({}); the regression's model is kept",
+                lost.join("; ")
+            );
+        }
+    }
     // the coefficients in the field's nondimensional form, where it has reference scales
     let primes = termid::plugins::of(&model).and_then(|p| {
         let (length, speed, density) = p.reference(&model)?;
@@ -347,7 +324,6 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
         Some((head, named))
     });
     // checked before anything is written
-    let checks = final_checks.unwrap_or_else(|| checks_of(&model));
     let refused: Vec<String> = checks.iter().filter(|c| !c.passed && c.refuses).map(|c| c.line()).collect();
     let write = refused.is_empty() || cmd.keep_unphysical;
     if let Some(out) = cmd.out.as_ref().filter(|_| write) {
@@ -435,6 +411,174 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
     Ok(())
 }
 
+/// The table of starts: each derivative method's costs and checks, the kept one marked.
+fn starts_table(starts: &[Start], kept: usize, validation: bool) -> String {
+    let num = termid::identify::num;
+    let mut out = format!(
+        "== starts: one identification per derivative method, each refined; kept: the lowest {} re-simulation cost among those that pass the checks ==\n{:<22} {:>6} {:>16} {:>16} {:>8}\n",
+        if validation { "validation runs'" } else { "training runs'" },
+        "derivative",
+        "terms",
+        "regression cost",
+        "refined cost",
+        "refused"
+    );
+    for (k, s) in starts.iter().enumerate() {
+        let terms: usize =
+            s.model.equations().iter().filter(|e| e.identify).map(|e| e.coefficients.len()).sum();
+        let (before, after) = match (&s.refined, &s.rejected) {
+            (Some(r), _) | (None, Some((r, _))) => match r.validation {
+                Some((b, a)) => (b, a),
+                None => (r.cost_before, r.cost_after),
+            },
+            _ => (f64::INFINITY, f64::INFINITY),
+        };
+        let after = if s.refined.is_some() { num(after) } else { "rejected".into() };
+        let mark = if k == kept { "  ← kept" } else { "" };
+        out += &format!(
+            "{:<22} {terms:>6} {:>16} {after:>16} {:>8}{mark}\n",
+            s.derivative,
+            num(before),
+            s.refused()
+        );
+    }
+    for s in starts {
+        let lines: Vec<String> = s.checks.iter().map(|c| c.line()).collect();
+        out += &format!("{}:\n  {}\n", s.derivative, lines.join("\n  "));
+    }
+    out.push('\n');
+    out
+}
+
+/// One start: the runs prepared with `cmd.derivative`, identified (or chosen among
+/// back-ends), refined where asked, and checked.
+fn identify_start(
+    cmd: &IdentifyCommand,
+    model: &termid::model::Model,
+    frames: &[Frame],
+    held: Option<&[Frame]>,
+    refine: Option<&Option<Vec<String>>>,
+) -> Result<Start> {
+    let names: Vec<String> =
+        if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };
+    let states: Vec<String> =
+        names.iter().filter_map(|n| model.equation(n).map(|e| e.state.clone())).collect();
+    let units: BTreeMap<String, String> =
+        model.spec().states.iter().map(|s| (s.name.clone(), s.unit.clone())).collect();
+    let diff = derivative_method(cmd)?;
+    let scale = |name: &str| {
+        let unit = units.get(name).cloned().unwrap_or_default();
+        // angles are read in degrees
+        match unit.strip_prefix("rad") {
+            Some(rest) => (180.0 / std::f64::consts::PI, format!("deg{rest}")),
+            None => (1.0, unit),
+        }
+    };
+    let frames = prepare_runs(cmd, frames.to_vec(), &states, Some(model), diff.as_ref(), &scale)?;
+    // runs that stop the refinement, prepared as the training runs are
+    let validation = match held {
+        Some(held) => Some(prepare_runs(cmd, held.to_vec(), &states, Some(model), diff.as_ref(), &scale)?),
+        None => None,
+    };
+    if cmd.target.is_some() && names.len() != 1 {
+        bail!("--target applies to one equation: name it with --equation");
+    }
+    let label = format!("identifying {} ({})", names.join(", "), cmd.derivative);
+    let how = termid::identify::ModelIdentification {
+        equations: names,
+        differentiator: diff.as_ref(),
+        intercept: !cmd.no_intercept,
+        target: cmd.target.as_deref().map(Target::parse),
+    };
+    let (identified, chosen_text) = match &cmd.choose {
+        None => (
+            crate::progress::with_spinner(&label, || {
+                termid::identify::identify_model(model, &frames, &how, &mut |_| {})
+            })?,
+            None,
+        ),
+        Some(list) => {
+            let configurations = backend_variants(model, list)?;
+            let prediction = termid::diagnose::Prediction {
+                states: match cmd.compare.as_deref().map(|l| refine_states(l, model)).transpose()? {
+                    Some(Some(states)) => states,
+                    _ => vec![],
+                },
+                ..Default::default()
+            };
+            let chosen = crate::progress::with_spinner(
+                &format!("choosing by prediction (leave one run out; {})", cmd.derivative),
+                || {
+                    termid::diagnose::choose_by_prediction(
+                        &configurations,
+                        &frames,
+                        &how,
+                        &prediction,
+                        &mut |_| {},
+                    )
+                },
+            )?;
+            let text = chosen.text();
+            (chosen.identified, Some(text))
+        }
+    };
+    let fits = identified.fits;
+    let mut model = identified.model;
+    let how_refined = RefineHow {
+        states: refine.cloned().flatten(),
+        intercept: !cmd.no_intercept,
+        prior: cmd.refine_prior,
+        validation: validation.as_deref(),
+        iterations: cmd.refine_iterations,
+    };
+    // what the field knows must hold: the plug-in's physical checks of a model
+    let checks_of =
+        |m: &termid::model::Model| termid::plugins::of(m).map(|p| p.checks(m, &frames)).unwrap_or_default();
+    let failing = |checks: &[termid::plugin::Check]| -> Vec<String> {
+        checks.iter().filter(|c| !c.passed && c.refuses).map(|c| c.name.clone()).collect()
+    };
+    // a refinement that fails loses nothing: the regression's model is still written, and
+    // the command ends with the refinement's error
+    let mut start = Start {
+        derivative: cmd.derivative.clone(),
+        model: model.clone(),
+        fits,
+        chosen_text,
+        refined: None,
+        rejected: None,
+        refine_error: None,
+        checks: vec![],
+    };
+    if refine.is_some() {
+        match crate::progress::with_spinner(&format!("refining by output error ({})", cmd.derivative), || {
+            refine_by_output_error(&model, &frames, &how_refined)
+        }) {
+            Ok(r) => {
+                // a refinement must not make a model fail what its field knows it passed
+                let (before, after) = (checks_of(&model), checks_of(&r.model));
+                let was = failing(&before);
+                let lost: Vec<String> = failing(&after).into_iter().filter(|c| !was.contains(c)).collect();
+                if lost.is_empty() {
+                    model = r.model.clone();
+                    start.checks = after;
+                    start.refined = Some(r);
+                } else {
+                    start.checks = before;
+                    start.rejected = Some((r, lost));
+                }
+            }
+            Err(e) => start.refine_error = Some(e),
+        }
+    } else {
+        start.checks = checks_of(&model);
+    }
+    if start.checks.is_empty() && start.refine_error.is_some() {
+        start.checks = checks_of(&model);
+    }
+    start.model = model;
+    Ok(start)
+}
+
 /// `identify --refine`: every identified coefficient refined by output error on the runs as
 /// they were prepared for the regression (smoothed initial states: a noisy first sample of a
 /// rate would otherwise drift through its integral).
@@ -494,6 +638,8 @@ struct RefineHow<'a> {
     prior: f64,
     /// Prepared runs that stop it.
     validation: Option<&'a [Frame]>,
+    /// Most iterations.
+    iterations: usize,
 }
 
 fn refine_by_output_error(
@@ -516,7 +662,7 @@ fn refine_by_output_error(
     let settings = termid::diagnose::RefineSettings {
         prior_weight: how.prior,
         validation: validation.as_ref(),
-        ..Default::default()
+        iterations: how.iterations,
     };
     Ok(termid::diagnose::refine(model, &runs, &settings)?)
 }
