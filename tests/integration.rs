@@ -46,3 +46,6 @@ mod layers;
 // The MMG model of KVLCC2 as a model file, against the shipmmg package's numbers.
 #[path = "integration/mmg.rs"]
 mod mmg;
+// The SIMMAN case study's dataset files, on records laid out as the basins write them.
+#[path = "integration/simman.rs"]
+mod simman;

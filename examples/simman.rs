@@ -1,0 +1,161 @@
+//! The SIMMAN 2008 KVLCC2 case study (issue 15, README "A real ship: KVLCC2 of SIMMAN
+//! 2008"): a model identified from HSVA's thirteen zigzags (README's `identify` command)
+//! predicts MARIN's four zigzags, which it never saw (full scale, read at the model's scale),
+//! and its turning circles. Prints README's tables and writes two figures.
+//!
+//! `SIMMAN=/path/to/clone cargo run --release --example simman -- IDENTIFIED.toml [OUT_FOLDER]`
+//! (the clone: the public repository martinlarsalbert/System-identification-of-Vessel-
+//! Manoeuvring-Models; its records are read where they are, never copied).
+
+use std::path::{Path, PathBuf};
+
+use termid::data::{Dataset, Frame};
+use termid::diagnose::Runs;
+use termid::plot::{Figure, Panel, Series};
+use termid::ship::{Manoeuvre, Metrics, Ship};
+use termid::sim::{Integrator, Settings, Trajectory};
+
+type Error = Box<dyn std::error::Error>;
+
+/// Turning circles predicted, rudder in degrees (termid's convention: positive to starboard;
+/// MARIN's and HSVA's files count the other way: their `tc_35` is termid's −35°).
+const TURNS: [f64; 4] = [35.0, -35.0, 20.0, -20.0];
+
+fn main() -> Result<(), Error> {
+    let mut args = std::env::args().skip(1);
+    let model_path = PathBuf::from(args.next().ok_or("usage: simman IDENTIFIED.toml [OUT_FOLDER]")?);
+    let out = args.next().map_or_else(|| std::env::temp_dir().join("termid-simman"), PathBuf::from);
+    std::fs::create_dir_all(&out)?;
+    let model = termid::plugins::load(&model_path)?;
+    let marin = Path::new("examples/simman/marin.toml");
+    let set = Dataset::load(marin)?;
+    let (runs, _) = set.read(&set.folder(marin)?, "t")?;
+
+    // MARIN's zigzags re-simulated from their recorded start with their recorded rudder and
+    // propeller rate; overshoots read off record and simulation alike
+    let data = Runs::new(&model, &runs, 0.02, Integrator::Rk4)?;
+    let settings = Settings { integrator: Integrator::Rk4, dt: 0.02, duration: 240.0, sample: 0.2 };
+    let sims = data.simulate(&model, &[], &[])?;
+    let plugin = termid::plugins::of(&model).ok_or("not a ship model")?;
+    // and each zigzag as the model steers it itself: same amplitude and side, from the run's
+    // approach speed (the propeller at the model's self-propulsion point for it)
+    println!("| MARIN run | zigzag (termid) | 1st overshoot measured | predicted | error | 2nd overshoot measured | predicted | error | 1st overshoot, recorded rudder replayed |");
+    println!("|---|---|---|---|---|---|---|---|---|");
+    let mut panels = Vec::new();
+    for (frame, sim) in runs.iter().zip(&sims) {
+        let name =
+            Path::new(frame.origin()).file_stem().map_or(String::new(), |s| s.to_string_lossy().into());
+        let measured = plugin.observe(&model, frame, None).ok_or("no metrics of the record")?.json;
+        let replayed = plugin.observe(&model, frame, Some(sim)).ok_or("no metrics of the simulation")?.json;
+        let manoeuvre = zigzag_of(frame)?;
+        let own = Ship::new(&termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]), false)?
+            .run(&Manoeuvre::parse(&manoeuvre)?, &Settings { duration: 100.0, ..settings })?;
+        let Metrics::ZigZag(z) = &own.metrics else { return Err("not a zigzag".into()) };
+        let mut row = format!("| {name} | {manoeuvre} |");
+        for (key, p) in
+            [("first_overshoot_deg", z.first_overshoot_deg), ("second_overshoot_deg", z.second_overshoot_deg)]
+        {
+            row += &match (measured[key].as_f64(), p) {
+                (Some(m), Some(p)) => format!(" {m:.2}° | {p:.2}° | {:+.2}° |", p - m),
+                _ => " -- | -- | -- |".into(),
+            };
+        }
+        row += &replayed["first_overshoot_deg"].as_f64().map_or(" -- |".into(), |p| format!(" {p:.2}° |"));
+        println!("{row}");
+        panels.push(zigzag_panel(&name, frame, sim)?);
+    }
+    let mut zigzags = Figure::new(
+        "MARIN's KVLCC2 zigzags (model scale), predicted by the model identified from HSVA's",
+        panels,
+    );
+    zigzags.panel_height = 220;
+    zigzags.write_svg(&out.join("simman_zigzags.svg"))?;
+
+    // turning circles at MARIN's approach speed, the propeller at the model's self-propulsion
+    // point for it
+    let u0 = runs.iter().map(|f| f.require("u").map(|u| u[0])).sum::<Result<f64, _>>()? / runs.len() as f64;
+    let ship_model = termid::ship::basin::at_approach_speed(&model, u0);
+    let straight = Ship::new(&ship_model, false)?.straight_run()?;
+    println!(
+        "\nturning circles predicted at u0 = {u0:.3} m/s (MARIN's approach; the model's straight run needs δ0 = {:.2}°):\n",
+        straight.delta0_deg
+    );
+    println!("| δ (termid) | advance | tactical diameter | speed in the turn | drift angle |");
+    println!("|---|---|---|---|---|");
+    let mut tracks = Vec::new();
+    for d in TURNS {
+        let run =
+            Ship::new(&ship_model, false)?.run(&Manoeuvre::parse(&format!("turning:{d}"))?, &settings)?;
+        let Metrics::Turning(t) = &run.metrics else { return Err("not a turning circle".into()) };
+        let lpp = termid::ship::ShipSpec::of(&model)?.map_or(7.0, |s| s.lpp);
+        let m = |v: Option<f64>| v.map_or("--".into(), |v| format!("{v:.2} m ({:.2} L)", v / lpp));
+        println!(
+            "| {d:+}° | {} | {} | {:.0} % of u0 | {:.1}° |",
+            m(t.advance_m),
+            m(t.tactical_diameter_m),
+            100.0 * t.speed_ratio,
+            t.drift_angle_deg
+        );
+        if d.abs() == 35.0 {
+            tracks.push(track(&format!("δ = {d:+}°"), &run.trajectory)?);
+        }
+    }
+    let mut turning = Figure::new(
+        "KVLCC2 (L = 7 m), predicted turning circles",
+        vec![Panel {
+            title: "track of midship".into(),
+            x_label: "y0 [m]".into(),
+            y_label: "x0 [m]".into(),
+            series: tracks,
+            equal_axes: true,
+            ..Default::default()
+        }],
+    );
+    turning.panel_height = 520;
+    turning.width = 560;
+    turning.write_svg(&out.join("simman_turning.svg"))?;
+    println!("\nfigures in {}", out.display());
+    Ok(())
+}
+
+/// Heading measured and predicted, and the rudder, in degrees over the run (every fifth
+/// sample: the figure stays small).
+fn zigzag_panel(name: &str, frame: &Frame, sim: &Trajectory) -> Result<Panel, Error> {
+    let every = |v: &[f64], scale: f64| v.iter().step_by(5).map(|x| x * scale).collect::<Vec<f64>>();
+    let deg = 180.0 / std::f64::consts::PI;
+    let psi = sim.state_names.iter().position(|n| n == "ψ").ok_or("no ψ")?;
+    Ok(Panel {
+        title: name.into(),
+        x_label: "t [s]".into(),
+        y_label: "[°]".into(),
+        series: vec![
+            Series::line("ψ measured", every(frame.time(), 1.0), every(frame.require("ψ")?, deg)),
+            Series::line(
+                "ψ predicted (recorded rudder)",
+                every(&sim.time, 1.0),
+                every(&sim.states[psi], deg),
+            ),
+            Series::line("δ", every(frame.time(), 1.0), every(frame.require("δ")?, deg)),
+        ],
+        ..Default::default()
+    })
+}
+
+/// The zigzag a record is: `zigzag:A/A` with its rudder angle (the largest, to whole 5°: the
+/// indicator overshoots its command a little) and the side its heading first turns to
+/// (MARIN's zigzags switch at the rudder angle).
+fn zigzag_of(frame: &Frame) -> Result<String, Error> {
+    let deg = 180.0 / std::f64::consts::PI;
+    let largest = frame.require("δ")?.iter().fold(0.0f64, |m, d| m.max((d * deg).abs()));
+    let amplitude = 5.0 * (largest / 5.0).round();
+    let psi = frame.require("ψ")?;
+    let first =
+        psi.iter().map(|p| (p - psi[0]) * deg).find(|p| p.abs() > 1.0).ok_or("the heading never turns")?;
+    Ok(format!("zigzag:{amplitude}/{amplitude}{}", if first < 0.0 { ":port" } else { "" }))
+}
+
+/// A run's track, x0 up and y0 across.
+fn track(name: &str, t: &Trajectory) -> Result<Series, Error> {
+    let col = |n: &str| t.state_names.iter().position(|s| s == n).map(|i| t.states[i].clone());
+    Ok(Series::line(name, col("y0").ok_or("no y0")?, col("x0").ok_or("no x0")?))
+}
