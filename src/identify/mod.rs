@@ -44,12 +44,14 @@ pub use crate::model::ParamValue;
 
 mod model;
 mod report;
+mod statistics;
 
 pub use model::{
     coefficients_of, correlation_time_of, equation_design, fit_equation, fit_equation_design, identify_model,
     IdentifiedModel, ModelIdentification,
 };
 pub use report::{num, FitReport, StepReport, TermReport};
+pub use statistics::{EquationMoments, RunMoments};
 
 /// Why identification failed.
 #[derive(Debug, thiserror::Error)]
@@ -279,7 +281,7 @@ impl Identification<'_> {
     }
 
     /// The statistics of each run, gathered in parallel (parts of runs on all threads).
-    fn moments_of_runs(
+    pub(crate) fn moments_of_runs(
         &self,
         library: &Library,
         terms: &[Term],
@@ -393,28 +395,7 @@ impl Identification<'_> {
         let excluded = excluded.iter().map(|t| index_of(t, "excluded")).collect::<Result<Vec<_>, _>>()?;
         // per run, for the back-ends that cross-validate; together they are "Komb. Daten"
         let folds = self.moments_of_runs(&design.library, candidates, target, frames)?;
-        let mut moments = Moments::new(candidates.len());
-        for f in &folds {
-            moments.merge(f);
-        }
-        let problem = Problem {
-            moments: &moments,
-            names: design.names(),
-            forced: &forced,
-            excluded: &excluded,
-            intercept: self.intercept,
-        };
-        let selection = backend.select_with_folds(&problem, &folds)?;
-        let covariance = covariance_of(&moments, &selection);
-        // the residual pass for τ is left to the caller (`correlation_time`): selection itself
-        // needs only the sufficient statistics, and is timed against the peers without it
-        Ok(Fit {
-            target: target.to_string(),
-            candidates: design.names().to_vec(),
-            selection,
-            covariance,
-            correlation_time: None,
-        })
+        fit_folds(&target.to_string(), design.names(), &forced, &excluded, self.intercept, &folds, backend)
     }
 
     /// τ = 1 + 2 Σ ρₖ of the chosen equation's residuals, the autocorrelations ρₖ pooled over
@@ -449,6 +430,35 @@ impl Identification<'_> {
         }
         Ok(crate::uncertainty::correlation_time(&residuals))
     }
+}
+
+/// One equation fitted from its runs' statistics: merged for the selection ("Komb. Daten"),
+/// each run's kept for the back-ends that cross-validate over runs.
+pub(crate) fn fit_folds(
+    target: &str,
+    names: &[String],
+    forced: &[usize],
+    excluded: &[usize],
+    intercept: bool,
+    folds: &[Moments],
+    backend: &dyn Selector,
+) -> Result<Fit, IdentifyError> {
+    let mut moments = Moments::new(names.len());
+    for f in folds {
+        moments.merge(f);
+    }
+    let problem = Problem { moments: &moments, names, forced, excluded, intercept };
+    let selection = backend.select_with_folds(&problem, folds)?;
+    let covariance = covariance_of(&moments, &selection);
+    // the residual pass for τ is left to the caller (`correlation_time`): selection itself
+    // needs only the sufficient statistics, and is timed against the peers without it
+    Ok(Fit {
+        target: target.to_string(),
+        candidates: names.to_vec(),
+        selection,
+        covariance,
+        correlation_time: None,
+    })
 }
 
 /// Wakes a sleeping worker, so that it is looking for work by the time the rows are gathered

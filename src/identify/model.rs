@@ -105,14 +105,7 @@ pub fn fit_equation_design(
     target: Option<Target>,
 ) -> Result<Fit, IdentifyError> {
     let eq = model_equation(model, equation)?;
-    let target = target.unwrap_or_else(|| {
-        let column = format!("{}_dot", eq.state);
-        if frames.iter().all(|f| f.column(&column).is_some()) {
-            Target::Column(column)
-        } else {
-            Target::Derivative(eq.state.clone())
-        }
-    });
+    let target = target.unwrap_or_else(|| default_target(eq, frames));
     let rules = model.parameter_rules();
     let identification = Identification {
         vocabulary: &model.vocabulary,
@@ -134,8 +127,19 @@ pub fn fit_equation_design(
     }
 }
 
+/// An equation's target where none is named: the column `<state>_dot` where every run has
+/// it, else the derivative of the state.
+pub(super) fn default_target(eq: &Equation, frames: &[Frame]) -> Target {
+    let column = format!("{}_dot", eq.state);
+    if frames.iter().all(|f| f.column(&column).is_some()) {
+        Target::Column(column)
+    } else {
+        Target::Derivative(eq.state.clone())
+    }
+}
+
 /// The model's equation `equation`, which must have candidates.
-fn model_equation<'m>(model: &'m Model, equation: &str) -> Result<&'m Equation, IdentifyError> {
+pub(super) fn model_equation<'m>(model: &'m Model, equation: &str) -> Result<&'m Equation, IdentifyError> {
     let eq = model
         .equation(equation)
         .ok_or_else(|| IdentifyError::Setup(format!("{}: no equation `{equation}`", model.path)))?;

@@ -14,8 +14,10 @@ use std::ops::Range;
 /// faults.
 const CHUNK: usize = 512;
 
-/// Means and corrected cross-products of `p` regressors and one target.
-#[derive(Clone, Debug)]
+/// Means and corrected cross-products of `p` regressors and one target. Serializable: the
+/// statistics of a shard of rows are a value to write, send and merge (JSON numbers round-trip
+/// exactly).
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Moments {
     p: usize,
     count: usize,
@@ -55,6 +57,17 @@ impl Moments {
     /// chunk).
     fn unallocated(p: usize) -> Moments {
         Moments { p, count: 0, weight: 0.0, mean: Vec::new(), comoment: Vec::new() }
+    }
+
+    /// Whether the statistics are whole: vectors of their declared size, finite numbers, a
+    /// weight that is not negative (statistics read from a file are checked before use).
+    pub fn is_consistent(&self) -> bool {
+        let m = self.p + 1;
+        self.mean.len() == m
+            && self.comoment.len() == m * m
+            && self.weight >= 0.0
+            && self.weight.is_finite()
+            && self.mean.iter().chain(&self.comoment).all(|v| v.is_finite())
     }
 
     /// Number of regressors.

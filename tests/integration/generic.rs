@@ -232,3 +232,108 @@ fn choosing_by_prediction_prefers_the_library_that_predicts_held_out_runs() {
     // too few runs to leave one out
     assert!(choose_by_prediction(&configurations, &frames[..1], &how, &prediction, &mut |_| {}).is_err());
 }
+
+/// `termid moments` on two shards and `identify --moments` give the model `identify` gives
+/// from the rows together (the coefficients to round-off); statistics of another equation or
+/// a broken file are refused by name.
+#[test]
+fn statistics_of_shards_identify_as_the_rows_together() {
+    let dir = crate::common::Scratch::new("moments");
+    let p = |f: &str| dir.join(f).display().to_string();
+    // two runs of the Lorenz system from different starts, the derivatives from the data
+    for (name, x0) in [("a.csv", "x=-8"), ("b.csv", "x=4")] {
+        let (ok, _, err) = termid(&[
+            "simulate",
+            "--model",
+            "models/lorenz.toml",
+            "--integrator",
+            "rk4",
+            "--dt",
+            "0.001",
+            "--sample",
+            "0.004",
+            "--duration",
+            "3",
+            "--initial",
+            x0,
+            "--out",
+            &p(name),
+        ]);
+        assert!(ok, "{err}");
+        let text = std::fs::read_to_string(p(name)).unwrap();
+        // states only, as a measurement has them
+        let kept: Vec<String> =
+            text.lines().map(|l| l.split(',').take(4).collect::<Vec<_>>().join(",")).collect();
+        std::fs::write(p(name), kept.join("\n")).unwrap();
+    }
+    for eq in ["x_dot", "y_dot", "z_dot"] {
+        for shard in ["a", "b"] {
+            let (ok, out, err) = termid(&[
+                "moments",
+                "--model",
+                "models/lorenz.toml",
+                "--equation",
+                eq,
+                "--data",
+                &p(&format!("{shard}.csv")),
+                "--out",
+                &p(&format!("{shard}_{eq}.moments")),
+            ]);
+            assert!(ok && out.contains("1 run(s)"), "{out}{err}");
+        }
+    }
+    let files: Vec<String> = ["x_dot", "y_dot", "z_dot"]
+        .iter()
+        .flat_map(|eq| ["a", "b"].map(|s| p(&format!("{s}_{eq}.moments"))))
+        .collect();
+    let mut args = vec!["identify", "--model", "models/lorenz.toml", "--out", "MERGED", "--moments"];
+    let merged_out = p("merged.toml");
+    args[4] = &merged_out;
+    args.extend(files.iter().map(String::as_str));
+    let (ok, out, err) = termid(&args);
+    assert!(ok && out.contains("== z_dot =="), "{out}{err}");
+    let rows_out = p("rows.toml");
+    let (ok, _, err) = termid(&[
+        "identify",
+        "--model",
+        "models/lorenz.toml",
+        "--data",
+        &p("a.csv"),
+        &p("b.csv"),
+        "--out",
+        &rows_out,
+    ]);
+    assert!(ok, "{err}");
+    let (merged, rows) = (
+        termid::plugins::load(std::path::Path::new(&merged_out)).unwrap(),
+        termid::plugins::load(std::path::Path::new(&rows_out)).unwrap(),
+    );
+    for eq in ["x_dot", "y_dot", "z_dot"] {
+        let (a, b) = (&merged.equation(eq).unwrap().coefficients, &rows.equation(eq).unwrap().coefficients);
+        assert_eq!(a.len(), b.len(), "{eq}");
+        assert!(!a.is_empty(), "{eq}");
+        for ((ta, ca, _), (tb, cb, _)) in a.iter().zip(b) {
+            assert_eq!(ta, tb);
+            assert!((ca - cb).abs() <= 1e-12 * ca.abs().max(1.0), "{eq} {ta}: {ca} vs {cb}");
+        }
+    }
+    // statistics of other candidates for the same equation do not merge; a damaged file is named
+    let other = std::fs::read_to_string(p("b_x_dot.moments")).unwrap().replacen(
+        "\"candidates\":[\"",
+        "\"candidates\":[\"1*",
+        1,
+    );
+    std::fs::write(p("other.moments"), other).unwrap();
+    let (ok, _, err) = termid(&[
+        "identify",
+        "--model",
+        "models/lorenz.toml",
+        "--moments",
+        &p("a_x_dot.moments"),
+        &p("other.moments"),
+    ]);
+    assert!(!ok && err.contains("other.moments") && err.contains("cannot be merged"), "{err}");
+    std::fs::write(p("bad.moments"), "{\"equation\": \"x_dot\"").unwrap();
+    let (ok, _, err) = termid(&["identify", "--model", "models/lorenz.toml", "--moments", &p("bad.moments")]);
+    assert!(!ok && err.contains("bad.moments"), "{err}");
+}

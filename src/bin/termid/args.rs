@@ -32,6 +32,36 @@ pub enum Command {
     Validate(ValidateCommand),
     /// Rescale a model by Froude's law (a basin's model to its ship, or back).
     Scale(ScaleCommand),
+    /// Write an equation's sufficient statistics over a shard of runs (merged and identified
+    /// by `identify --moments`).
+    Moments(MomentsCommand),
+}
+
+/// `termid moments`.
+#[derive(Debug, Args)]
+#[command(
+    after_help = "Example, two shards identified together as their rows would be:\n  termid moments --model models/lorenz.toml --equation z_dot --data a.csv --out a.moments\n  termid moments --model models/lorenz.toml --equation z_dot --data b.csv --out b.moments\n  termid identify --model models/lorenz.toml --moments a.moments b.moments --out lorenz_id.toml"
+)]
+pub struct MomentsCommand {
+    /// The model file whose equation's candidates are accumulated.
+    #[arg(long)]
+    pub model: PathBuf,
+    /// The equation (e.g. `r_dot`).
+    #[arg(long)]
+    pub equation: String,
+    /// CSV files of runs (model names, SI).
+    #[arg(long = "data", short = 'd', num_args = 1.., required_unless_present = "dataset")]
+    pub data: Vec<PathBuf>,
+    /// A dataset file (TOML): runs with their own column names and units.
+    #[arg(long)]
+    pub dataset: Option<PathBuf>,
+    /// Derivative method where the target is a state's derivative (the runs have no
+    /// `<state>_dot` column): central, five-point, savitzky-golay[:W:Q], spline[:ALPHA], kalman.
+    #[arg(long, default_value = "central")]
+    pub derivative: String,
+    /// Write the statistics here (JSON; numbers round-trip exactly).
+    #[arg(long)]
+    pub out: PathBuf,
 }
 
 /// `termid scale`.
@@ -75,11 +105,15 @@ pub enum RuleName {
 #[derive(Clone, Debug, Args)]
 pub struct IdentifyCommand {
     /// CSV files with a header row; several are combined (the paper's "Komb. Daten").
-    #[arg(long = "data", short = 'd', num_args = 1.., required_unless_present = "dataset")]
+    #[arg(long = "data", short = 'd', num_args = 1.., required_unless_present_any = ["dataset", "moments"])]
     pub data: Vec<PathBuf>,
     /// A dataset file (TOML): runs with their own column names and units.
     #[arg(long)]
     pub dataset: Option<PathBuf>,
+    /// With --model: identify from statistics written by `termid moments` instead of runs
+    /// (several files are merged; each names its equation).
+    #[arg(long, num_args = 1.., requires = "model", conflicts_with_all = ["data", "dataset", "refine", "choose"])]
+    pub moments: Vec<PathBuf>,
     /// Name of the time column.
     #[arg(long, default_value = "t")]
     pub time: String,

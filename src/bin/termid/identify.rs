@@ -22,6 +22,9 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     if let Some(dir) = &cmd.prepared_svg {
         termid::output::check_folder(dir)?;
     }
+    if !cmd.moments.is_empty() {
+        return run_moments(cmd);
+    }
     if cmd.model.is_some() {
         return run_model(cmd);
     }
@@ -200,6 +203,48 @@ fn configure_backend(cmd: &IdentifyCommand) -> Result<Backend> {
         };
     }
     Ok(backend)
+}
+
+/// `identify --model M --moments FILES`: equations identified from merged statistics, as
+/// from the runs they were computed on (no residual pass: no correlation time, no checks).
+fn run_moments(cmd: IdentifyCommand) -> Result<()> {
+    let path = cmd.model.clone().context("--model")?;
+    if let Some(out) = &cmd.out {
+        termid::output::check_file(out)?;
+    }
+    let mut model = termid::plugins::load(&path)?;
+    if cmd.backend.is_some() {
+        model = model.with_backend(&configure_backend(&cmd)?)?;
+    }
+    let (mut model, fits) = crate::moments::identify(&model, &cmd.moments, !cmd.no_intercept)?;
+    if let Some(out) = &cmd.out {
+        let sources = cmd.moments.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
+        model.set_provenance(format!(
+            "identified by termid from the statistics {sources} ({})",
+            model.spec().model.provenance
+        ));
+        termid::output::write_file(out, model.to_toml().as_bytes())?;
+    }
+    match cmd.format {
+        Format::Json => {
+            let all: serde_json::Map<String, serde_json::Value> = fits
+                .iter()
+                .map(|(n, f)| Ok((n.clone(), serde_json::to_value(f.report())?)))
+                .collect::<Result<_>>()?;
+            println!("{}", serde_json::to_string_pretty(&all)?);
+        }
+        Format::Text => {
+            for (name, fit) in &fits {
+                println!("== {name} ==");
+                print!("{}", fit.text());
+                println!();
+            }
+            if let Some(out) = &cmd.out {
+                println!("wrote {}", out.display());
+            }
+        }
+    }
+    Ok(())
 }
 
 /// One start of `identify --model`: the runs prepared by one derivative method, the

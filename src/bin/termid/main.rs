@@ -4,6 +4,7 @@ mod args;
 mod compare;
 mod diagnose;
 mod identify;
+mod moments;
 mod monte_carlo;
 mod progress;
 mod reproduce;
@@ -34,6 +35,7 @@ fn main() -> ExitCode {
         args::Command::Diagnose(cmd) => diagnose::run(cmd),
         args::Command::Validate(cmd) => validate::run(cmd),
         args::Command::Scale(cmd) => scale::run(cmd),
+        args::Command::Moments(cmd) => moments::run(cmd),
     };
     // The command runs on a worker of the thread pool: the library's parallel passes over
     // the rows then start at once, where from outside the pool every pass would wait for a

@@ -1,0 +1,234 @@
+//! An equation's sufficient statistics as a value (issue 16): the candidates' means and
+//! cross-products against the target, per run, for one equation of a model. Computed where
+//! the rows are (`termid moments`, a worker of a distributed engine), written, merged
+//! associatively (runs are appended; merging is concatenation) and identified as the rows
+//! together would be — per-run statistics are kept because back-ends that cross-validate
+//! leave one run out.
+
+use serde::{Deserialize, Serialize};
+
+use super::model::{default_target, model_equation};
+use super::{fit_folds, Design, Fit, Identification, IdentifyError, Target};
+use crate::data::{Differentiator, Frame};
+use crate::model::Model;
+use crate::select::Moments;
+
+/// One run's statistics.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunMoments {
+    /// Where the run came from (its file).
+    pub run: String,
+    /// Its statistics, candidates in the order of [`EquationMoments::candidates`].
+    pub moments: Moments,
+}
+
+/// The statistics of one equation's candidates over a set of runs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EquationMoments {
+    /// The equation of the model file.
+    pub equation: String,
+    /// What is explained (`r_dot`, `dr/dt`).
+    pub target: String,
+    /// The candidate terms, canonical text, in column order.
+    pub candidates: Vec<String>,
+    /// Each run's statistics.
+    pub runs: Vec<RunMoments>,
+}
+
+impl EquationMoments {
+    /// The statistics of `equation` of `model` over `frames` (the target as
+    /// [`super::fit_equation`] takes it).
+    pub fn of_runs(
+        model: &Model,
+        equation: &str,
+        frames: &[Frame],
+        differentiator: &dyn Differentiator,
+        target: Option<Target>,
+    ) -> Result<EquationMoments, IdentifyError> {
+        if frames.is_empty() {
+            return Err(IdentifyError::Setup("no data: give at least one run".into()));
+        }
+        let eq = model_equation(model, equation)?;
+        let target = target.unwrap_or_else(|| default_target(eq, frames));
+        let rules = model.parameter_rules();
+        let how = Identification {
+            vocabulary: &model.vocabulary,
+            parameters: &rules,
+            differentiator,
+            intercept: true,
+            weights: None,
+        };
+        let design = Design::new(&eq.candidates, &model.vocabulary)?;
+        let folds = how.moments_of_runs(&design.library, design.candidates(), &target, frames)?;
+        Ok(EquationMoments {
+            equation: equation.into(),
+            target: target.to_string(),
+            candidates: design.names().to_vec(),
+            runs: frames
+                .iter()
+                .zip(folds)
+                .map(|(f, m)| RunMoments { run: f.origin().into(), moments: m })
+                .collect(),
+        })
+    }
+
+    /// The statistics of both sets of runs: refused where they are of another equation,
+    /// target or candidate list.
+    pub fn merge(mut self, other: EquationMoments) -> Result<EquationMoments, IdentifyError> {
+        if (&self.equation, &self.target, &self.candidates)
+            != (&other.equation, &other.target, &other.candidates)
+        {
+            return Err(IdentifyError::Setup(format!(
+                "statistics of `{}` ({}, {} candidates) cannot be merged with those of `{}` ({}, {} candidates): other equation, target or candidates",
+                self.equation,
+                self.target,
+                self.candidates.len(),
+                other.equation,
+                other.target,
+                other.candidates.len()
+            )));
+        }
+        self.runs.extend(other.runs);
+        Ok(self)
+    }
+
+    /// Reads statistics written as JSON, checked to be whole; `origin` names them in errors.
+    pub fn from_json(text: &str, origin: &str) -> Result<EquationMoments, IdentifyError> {
+        let m: EquationMoments = serde_json::from_str(text).map_err(|e| {
+            IdentifyError::Setup(format!("{origin}: not termid's statistics of an equation: {e}"))
+        })?;
+        if let Some(bad) =
+            m.runs.iter().find(|r| !r.moments.is_consistent() || r.moments.regressors() != m.candidates.len())
+        {
+            return Err(IdentifyError::Setup(format!(
+                "{origin}: the statistics of run `{}` are not whole (sizes or numbers do not fit {} candidates)",
+                bad.run,
+                m.candidates.len()
+            )));
+        }
+        Ok(m)
+    }
+
+    /// The statistics as JSON (every number round-trips exactly).
+    pub fn to_json(&self) -> String {
+        serde_json::to_string(self).unwrap_or_default()
+    }
+
+    /// Identifies the equation from the statistics with the model's forced and excluded terms
+    /// and back-end, as [`super::fit_equation`] would from the rows.
+    pub fn fit(&self, model: &Model, intercept: bool) -> Result<Fit, IdentifyError> {
+        let eq = model_equation(model, &self.equation)?;
+        let design = Design::new(&eq.candidates, &model.vocabulary)?;
+        if design.names() != self.candidates.as_slice() {
+            return Err(IdentifyError::Setup(format!(
+                "{}: the candidates of `{}` are not those the statistics were computed for",
+                model.path, self.equation
+            )));
+        }
+        if self.runs.is_empty() {
+            return Err(IdentifyError::Setup("no data: the statistics hold no run".into()));
+        }
+        let index = |t: &crate::term::Term| design.candidates().iter().position(|c| c == t);
+        let forced: Vec<usize> = eq.forced.iter().filter_map(index).collect();
+        let excluded: Vec<usize> = eq.excluded.iter().filter_map(index).collect();
+        let folds: Vec<Moments> = self.runs.iter().map(|r| r.moments.clone()).collect();
+        fit_folds(
+            &self.target,
+            design.names(),
+            &forced,
+            &excluded,
+            intercept,
+            &folds,
+            eq.backend.build().as_ref(),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::collections::BTreeMap;
+    use std::path::Path;
+
+    use super::*;
+    use crate::data::CentralDifference;
+    use crate::identify::fit_equation;
+    use crate::select::Backend;
+    use crate::sim::{simulate, Constant, Integrator, Settings, System};
+
+    /// Three Lorenz runs with a little noise, as frames of states.
+    fn runs(model: &Model) -> Vec<Frame> {
+        let settings = Settings { integrator: Integrator::Rk4, dt: 0.001, duration: 3.0, sample: 0.005 };
+        let system = System::new(model, &BTreeMap::new(), false).unwrap();
+        [[-8.0, 7.0, 27.0], [1.0, 1.0, 1.0], [10.0, -5.0, 20.0]]
+            .iter()
+            .enumerate()
+            .map(|(k, x0)| {
+                let run = simulate(&system, x0, &mut Constant(vec![]), &settings).unwrap();
+                let mut f = Frame::new(&format!("run{k}"), "t", run.time.clone()).unwrap();
+                for (i, (name, column)) in run.state_names.iter().zip(&run.states).enumerate() {
+                    // a deterministic wiggle, so the fits are not exact
+                    let noisy =
+                        column.iter().enumerate().map(|(j, v)| v + 1e-3 * ((j * (i + 3)) as f64).sin());
+                    f.push(name, noisy.collect()).unwrap();
+                }
+                f
+            })
+            .collect()
+    }
+
+    /// Statistics of shards, written, read, merged in either grouping, fit exactly as the
+    /// rows together — with the paper's stepwise regression and with the sparse fit whose λ
+    /// is chosen by leaving one run out (it needs the per-run statistics).
+    #[test]
+    fn merged_statistics_fit_as_the_rows_together() {
+        let lorenz = Model::load(Path::new("models/lorenz.toml")).unwrap();
+        let frames = runs(&lorenz);
+        for backend in ["stepwise", "sparse"] {
+            let model = lorenz.with_backend(&Backend::by_name(backend).unwrap()).unwrap();
+            for eq in ["x_dot", "z_dot"] {
+                let whole = fit_equation(&model, eq, &frames, &CentralDifference, true, None).unwrap();
+                let shard = |range: std::ops::Range<usize>| {
+                    let m = EquationMoments::of_runs(&model, eq, &frames[range], &CentralDifference, None)
+                        .unwrap();
+                    EquationMoments::from_json(&m.to_json(), "shard").unwrap()
+                };
+                let (a, b, c) = (shard(0..1), shard(1..2), shard(2..3));
+                let left = a.clone().merge(b.clone()).unwrap().merge(c.clone()).unwrap();
+                let right = a.merge(b.merge(c).unwrap()).unwrap();
+                assert_eq!(left, right, "merging is associative");
+                let merged = left.fit(&model, true).unwrap();
+                let (w, m) = (&whole.selection, &merged.selection);
+                assert!(!w.terms.is_empty(), "{backend} {eq}: no terms");
+                assert_eq!(
+                    w.terms.iter().map(|t| &t.term).collect::<Vec<_>>(),
+                    m.terms.iter().map(|t| &t.term).collect::<Vec<_>>(),
+                    "{backend} {eq}"
+                );
+                for (x, y) in w.terms.iter().zip(&m.terms) {
+                    assert!(
+                        (x.coefficient - y.coefficient).abs() <= 1e-12 * x.coefficient.abs().max(1.0),
+                        "{backend} {eq} {}: {} vs {}",
+                        x.term,
+                        x.coefficient,
+                        y.coefficient
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn statistics_of_another_equation_or_broken_are_refused() {
+        let lorenz = Model::load(Path::new("models/lorenz.toml")).unwrap();
+        let frames = runs(&lorenz);
+        let x = EquationMoments::of_runs(&lorenz, "x_dot", &frames[..1], &CentralDifference, None).unwrap();
+        let z = EquationMoments::of_runs(&lorenz, "z_dot", &frames[..1], &CentralDifference, None).unwrap();
+        let e = x.clone().merge(z).unwrap_err().to_string();
+        assert!(e.contains("cannot be merged"), "{e}");
+        let text = x.to_json().replacen("\"mean\":[", "\"mean\":[1.0,", 1);
+        let e = EquationMoments::from_json(&text, "s.moments").unwrap_err().to_string();
+        assert!(e.contains("s.moments") && e.contains("not whole"), "{e}");
+        let e = EquationMoments::from_json("{\"equation\": 3}", "s.moments").unwrap_err().to_string();
+        assert!(e.contains("s.moments"), "{e}");
+    }
+}
