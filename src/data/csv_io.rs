@@ -36,9 +36,26 @@ impl Frame {
         Ok(frame)
     }
 
+    /// Reads a run by its file's extension: Parquet (`.parquet`, `.pq`) and Arrow IPC
+    /// (`.arrow`, `.feather`, `.ipc`) with the `columnar` feature, CSV otherwise.
+    pub fn read(path: &Path, time: &str) -> Result<Frame, DataError> {
+        let (names, columns) = read_table(path)?;
+        Frame::from_table(names, columns, &path.display().to_string(), time)
+    }
+
     /// Parses CSV text; `origin` names it in errors.
     pub fn parse_csv(text: &str, origin: &str, time: &str) -> Result<Frame, DataError> {
-        let (header, mut columns) = parse_table(text, origin)?;
+        let (header, columns) = parse_table(text, origin)?;
+        Frame::from_table(header, columns, origin, time)
+    }
+
+    /// A frame of named columns, `time` among them.
+    fn from_table(
+        header: Vec<String>,
+        mut columns: Vec<Vec<f64>>,
+        origin: &str,
+        time: &str,
+    ) -> Result<Frame, DataError> {
         let time_index = header.iter().position(|h| h == time).ok_or_else(|| DataError::MissingColumn {
             file: origin.into(),
             column: time.into(),
@@ -72,6 +89,24 @@ impl Frame {
         }
         out
     }
+}
+
+/// The names and numeric columns of a file: columnar by its extension, else CSV text.
+pub(super) fn read_table(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), DataError> {
+    let file = path.display().to_string();
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    if matches!(ext.as_deref(), Some("parquet" | "pq" | "arrow" | "feather" | "ipc")) {
+        #[cfg(feature = "columnar")]
+        return super::columnar::read_columns(path);
+        #[cfg(not(feature = "columnar"))]
+        return Err(DataError::Io {
+            file,
+            message: "a columnar file: termid was built without the `columnar` feature".into(),
+        });
+    }
+    let text = crate::budget::read_text(path)
+        .map_err(|e| DataError::Io { file: file.clone(), message: e.to_string() })?;
+    parse_table(&text, &file)
 }
 
 /// The header and the numeric columns of CSV text, every cell checked.

@@ -319,25 +319,34 @@ impl Dataset {
         for run in &self.runs {
             let path = base.join(&run.file);
             let origin = path.display().to_string();
-            let (text, latin1) = crate::budget::read_text_or_latin1(&path)
-                .map_err(|e| DataError::Io { file: origin.clone(), message: e.to_string() })?;
-            if latin1 {
-                notes.push(format!("{origin}: not UTF-8, read as Latin-1 (Windows-1252)"));
-            }
-            let header = run.header.as_ref().or(self.header.as_ref()).map(|h| h.join(","));
-            let body: Vec<&str> = text.lines().skip(run.skip).collect();
-            let csv: String = header
-                .iter()
-                .cloned()
-                .chain(body.iter().map(|l| match run.delimiter {
-                    Delimiter::Comma => l.to_string(),
-                    Delimiter::Semicolon => l.replace(';', ","),
-                    Delimiter::Whitespace => l.split_whitespace().collect::<Vec<_>>().join(","),
-                }))
-                .collect::<Vec<_>>()
-                .join("\n");
+            let columnar = matches!(
+                path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
+                Some("parquet" | "pq" | "arrow" | "feather" | "ipc")
+            );
+            let (names, mut columns) = if columnar {
+                // columnar files name their own columns
+                super::csv_io::read_table(&path)?
+            } else {
+                let (text, latin1) = crate::budget::read_text_or_latin1(&path)
+                    .map_err(|e| DataError::Io { file: origin.clone(), message: e.to_string() })?;
+                if latin1 {
+                    notes.push(format!("{origin}: not UTF-8, read as Latin-1 (Windows-1252)"));
+                }
+                let header = run.header.as_ref().or(self.header.as_ref()).map(|h| h.join(","));
+                let body: Vec<&str> = text.lines().skip(run.skip).collect();
+                let csv: String = header
+                    .iter()
+                    .cloned()
+                    .chain(body.iter().map(|l| match run.delimiter {
+                        Delimiter::Comma => l.to_string(),
+                        Delimiter::Semicolon => l.replace(';', ","),
+                        Delimiter::Whitespace => l.split_whitespace().collect::<Vec<_>>().join(","),
+                    }))
+                    .collect::<Vec<_>>()
+                    .join("\n");
+                super::csv_io::parse_table(&csv, &origin)?
+            };
             let (time_col, time_unit, _) = split_spec(self.columns.get(time).map_or(time, String::as_str));
-            let (names, mut columns) = super::csv_io::parse_table(&csv, &origin)?;
             let Some(time_index) = names.iter().position(|h| *h == time_col) else {
                 return Err(DataError::MissingColumn {
                     file: origin.clone(),

@@ -2,6 +2,8 @@
 //! to CSV with errors that name the file, row and column; and numerical derivatives behind
 //! the [`Differentiator`] interface.
 
+#[cfg(feature = "columnar")]
+mod columnar;
 mod csv_io;
 mod dataset;
 mod derivative;

@@ -337,3 +337,46 @@ fn statistics_of_shards_identify_as_the_rows_together() {
     let (ok, _, err) = termid(&["identify", "--model", "models/lorenz.toml", "--moments", &p("bad.moments")]);
     assert!(!ok && err.contains("bad.moments"), "{err}");
 }
+
+/// `--data` takes Parquet as it takes CSV: the same run in both identifies to the same model.
+#[test]
+fn parquet_runs_identify_as_csv_runs() {
+    use std::sync::Arc;
+    let dir = crate::common::Scratch::new("parquet");
+    let csv = crate::common::lorenz_csv(&dir, "2");
+    let frame = Frame::read(&csv, "t").unwrap();
+    let fields: Vec<arrow_schema::Field> = frame
+        .names()
+        .iter()
+        .map(|n| arrow_schema::Field::new(n, arrow_schema::DataType::Float64, false))
+        .collect();
+    let arrays: Vec<arrow_array::ArrayRef> = frame
+        .names()
+        .iter()
+        .map(|n| Arc::new(arrow_array::Float64Array::from(frame.column(n).unwrap().to_vec())) as _)
+        .collect();
+    let batch =
+        arrow_array::RecordBatch::try_new(Arc::new(arrow_schema::Schema::new(fields)), arrays).unwrap();
+    let pq = dir.join("lorenz.parquet");
+    let mut w =
+        parquet::arrow::ArrowWriter::try_new(std::fs::File::create(&pq).unwrap(), batch.schema(), None)
+            .unwrap();
+    w.write(&batch).unwrap();
+    w.close().unwrap();
+    let fit = |data: &std::path::Path| {
+        let (ok, out, err) = termid(&[
+            "identify",
+            "--model",
+            "models/lorenz.toml",
+            "--data",
+            data.to_str().unwrap(),
+            "--format",
+            "json",
+        ]);
+        assert!(ok, "{err}");
+        out
+    };
+    let (a, b) = (fit(&csv), fit(&pq));
+    assert!(a.contains("\"terms\""), "{a}");
+    assert_eq!(a, b);
+}

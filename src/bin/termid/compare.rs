@@ -30,7 +30,7 @@ pub fn run(cmd: CompareCommand) -> Result<()> {
     let equations: Vec<String> =
         if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };
     let diff = differentiator(&cmd.derivative)?;
-    let replay = cmd.replay.as_ref().map(|p| Frame::read_csv(p, &time)).transpose()?;
+    let replay = cmd.replay.as_ref().map(|p| Frame::read(p, &time)).transpose()?;
     // the candidates are compiled once per equation, outside the timings, as the peers' design
     // matrix is built outside theirs
     let designs = equations

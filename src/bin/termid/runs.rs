@@ -30,7 +30,7 @@ pub fn load_for(model: &Model, data: &[PathBuf], dataset: Option<&Path>) -> Resu
 }
 
 pub fn load(data: &[PathBuf], dataset: Option<&Path>, time: &str) -> Result<Vec<Frame>> {
-    let mut frames = data.iter().map(|p| Frame::read_csv(p, time)).collect::<Result<Vec<_>, _>>()?;
+    let mut frames = data.iter().map(|p| Frame::read(p, time)).collect::<Result<Vec<_>, _>>()?;
     for f in &frames {
         // a logging dropout would be differentiated across as if it were one step (dataset
         // files are checked as they are read, in their own column names)

@@ -183,7 +183,7 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, integrator: Integrator) -> 
     let mut controller: Box<dyn Controller> =
         match cmd.manoeuvre.as_deref().and_then(|m| m.strip_prefix("replay:")) {
             Some(file) => {
-                let frame = Frame::read_csv(std::path::Path::new(file), &model.spec().model.time)?;
+                let frame = Frame::read(std::path::Path::new(file), &model.spec().model.time)?;
                 let t = frame.time();
                 replayed = Some(t[t.len() - 1] - t[0]);
                 Box::new(Replay::new(&frame, &system.inputs)?)

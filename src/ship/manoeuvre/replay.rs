@@ -17,7 +17,7 @@ pub struct Replayed {
 impl Replayed {
     /// Reads a recording.
     pub fn read(path: &str) -> Result<Replayed, ShipError> {
-        Ok(Replayed { frame: Frame::read_csv(std::path::Path::new(path), "t")? })
+        Ok(Replayed { frame: Frame::read(std::path::Path::new(path), "t")? })
     }
 
     /// Length of the recording.
