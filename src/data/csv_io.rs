@@ -112,7 +112,12 @@ pub(super) fn read_table(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), Da
 /// The header and the numeric columns of CSV text, every cell checked.
 pub(super) fn parse_table(text: &str, origin: &str) -> Result<(Vec<String>, Vec<Vec<f64>>), DataError> {
     let io = |e: csv::Error| DataError::Io { file: origin.into(), message: e.to_string() };
+    // a header of semicolons and no comma: a European spreadsheet's CSV, whose numbers may
+    // also have decimal commas
+    let first = text.lines().map(str::trim).find(|l| !l.is_empty() && !l.starts_with('#')).unwrap_or("");
+    let semicolons = first.contains(';') && !first.contains(',');
     let mut reader = csv::ReaderBuilder::new()
+        .delimiter(if semicolons { b';' } else { b',' })
         .trim(csv::Trim::All)
         .flexible(true)
         .comment(Some(b'#'))
@@ -139,7 +144,11 @@ pub(super) fn parse_table(text: &str, origin: &str) -> Result<(Vec<String>, Vec<
             });
         }
         for (c, cell) in record.iter().enumerate() {
-            let v: f64 = cell.parse().map_err(|_| DataError::NotNumeric {
+            let parsed = match cell.parse::<f64>() {
+                Err(_) if semicolons => cell.replace(',', ".").parse::<f64>(),
+                other => other,
+            };
+            let v: f64 = parsed.map_err(|_| DataError::NotNumeric {
                 file: origin.into(),
                 row,
                 column: header[c].clone(),

@@ -291,6 +291,23 @@ impl Frame {
         self.push(name, values)
     }
 
+    /// Gives column `from` the name `to` (the time column too); refused where `to` is taken.
+    pub fn rename(&mut self, from: &str, to: &str) -> Result<(), DataError> {
+        if self.names.iter().any(|n| n == to) {
+            return Err(DataError::DuplicateColumn { file: self.origin.clone(), column: to.into() });
+        }
+        let i = self.names.iter().position(|n| n == from).ok_or_else(|| DataError::MissingColumn {
+            file: self.origin.clone(),
+            column: from.into(),
+            available: self.names.join(", "),
+        })?;
+        if i == 0 {
+            self.time_name = to.into();
+        }
+        self.names[i] = to.into();
+        Ok(())
+    }
+
     /// Where the frame came from (file name), for messages.
     pub fn origin(&self) -> &str {
         &self.origin

@@ -304,3 +304,32 @@ fn backend_and_choose_with_a_model() {
     let chosen = out.lines().find(|l| l.contains("← chosen")).unwrap_or_default();
     assert!(chosen.starts_with("stepwise"), "{out}");
 }
+
+/// A plain CSV as people write it: ASCII `delta` and `psi` (the model file's aliases of δ and
+/// ψ) and a European spreadsheet's semicolons with decimal commas are read as the model's
+/// names; the same run either way gives the same validation.
+#[test]
+fn plain_files_with_aliases_and_semicolons() {
+    let dir = crate::common::Scratch::new("plain");
+    let z = dir.join("z.csv");
+    let (ok, _, err) = termid(&["simulate", "-m", "zigzag:20/20", "--out", z.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let text = std::fs::read_to_string(&z).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().replace('δ', "delta").replace('ψ', "psi");
+    let ascii = dir.join("ascii.csv");
+    std::fs::write(&ascii, format!("{header}\n{}\n", lines.clone().collect::<Vec<_>>().join("\n"))).unwrap();
+    let european = dir.join("european.csv");
+    let body: Vec<String> = lines.map(|l| l.replace(',', ";").replace('.', ",")).collect();
+    std::fs::write(&european, format!("{}\n{}\n", header.replace(',', ";"), body.join("\n"))).unwrap();
+    let validate = |f: &std::path::Path| {
+        let (ok, out, err) = termid(&["validate", "--data", f.to_str().unwrap(), "--format", "json"]);
+        assert!(ok, "{err}");
+        (out, err)
+    };
+    let (a, err) = validate(&ascii);
+    assert!(err.contains("column `delta` read as `δ`"), "{err}");
+    let (b, _) = validate(&european);
+    let strip = |s: &str| s.lines().filter(|l| !l.contains(".csv")).collect::<Vec<_>>().join("\n");
+    assert_eq!(strip(&a), strip(&b));
+}

@@ -22,8 +22,19 @@ pub fn load_for(model: &Model, data: &[PathBuf], dataset: Option<&Path>) -> Resu
             );
         }
     }
-    let frames = load(data, dataset, &model.spec().model.time)?;
-    for f in &frames {
+    let mut frames = load(data, dataset, &model.spec().model.time)?;
+    for f in &mut frames {
+        // a plain file's ASCII names (`delta`, `psi`) are the model's aliases of its names
+        for (alias, name) in &model.spec().aliases {
+            if f.column(alias).is_some() && f.column(name).is_none() {
+                f.rename(alias, name)?;
+                eprintln!(
+                    "unit: {}: column `{alias}` read as `{name}` (an alias in {})",
+                    f.origin(),
+                    model.path
+                );
+            }
+        }
         model.check_kinematics(f)?;
     }
     Ok(frames)
