@@ -333,3 +333,28 @@ fn plain_files_with_aliases_and_semicolons() {
     let strip = |s: &str| s.lines().filter(|l| !l.contains(".csv")).collect::<Vec<_>>().join("\n");
     assert_eq!(strip(&a), strip(&b));
 }
+
+/// Seven rows of one run: an equation that uses up the degrees of freedom is refused with its
+/// numbers, and nothing is written.
+#[test]
+fn a_model_without_degrees_of_freedom_is_not_written() {
+    let dir = crate::common::Scratch::new("dof");
+    let z = dir.join("z.csv");
+    let (ok, _, err) = termid(&["simulate", "-m", "zigzag:20/20", "--out", z.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let text = std::fs::read_to_string(&z).unwrap();
+    let short = dir.join("short.csv");
+    std::fs::write(&short, text.lines().take(8).collect::<Vec<_>>().join("\n")).unwrap();
+    let out = dir.join("id.toml");
+    let (ok, _, err) = termid(&[
+        "identify",
+        "--model",
+        "models/oltmann1973.toml",
+        "--data",
+        short.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("7 rows for") && err.contains("no degrees of freedom are left"), "{err}");
+    assert!(!out.exists());
+}

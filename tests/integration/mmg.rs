@@ -135,7 +135,7 @@ fn the_new_ship_recipe_predicts_turning_circles_it_was_not_trained_on() {
     // circles diverge, refused by the physical checks and not written
     let refused = dir.join("stlsq.toml");
     let (ok, text, err) = identify(&["--backend", "stlsq", "--out", refused.to_str().unwrap()]);
-    assert!(!ok && err.contains("fails physical checks") && err.contains("--keep-unphysical"), "{err}");
+    assert!(!ok && err.contains("fails its checks") && err.contains("--keep-unphysical"), "{err}");
     assert!(text.contains("== physical checks ==") && text.contains("FAIL turning circle"), "{text}");
     assert!(!refused.exists());
 }

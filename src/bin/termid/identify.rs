@@ -368,8 +368,24 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
         );
         Some((head, named))
     });
-    // checked before anything is written
-    let refused: Vec<String> = checks.iter().filter(|c| !c.passed && c.refuses).map(|c| c.line()).collect();
+    // checked before anything is written: an equation that used up the rows' degrees of
+    // freedom interpolates them, whatever it simulates
+    let mut refused: Vec<String> = fits
+        .iter()
+        .filter(|(_, f)| {
+            f.selection.stop == termid::select::Stop::NoDegreesOfFreedom
+                && f.selection.chosen_step == f.selection.steps.len()
+        })
+        .map(|(name, f)| {
+            format!(
+                "FAIL `{name}`: {} rows for {} terms{}: no degrees of freedom are left, the coefficients interpolate the rows (give more or longer runs, or fewer candidates)",
+                f.selection.rows,
+                f.selection.terms.len(),
+                if f.selection.intercept.is_some() { " and an intercept" } else { "" }
+            )
+        })
+        .collect();
+    refused.extend(checks.iter().filter(|c| !c.passed && c.refuses).map(|c| c.line()));
     let write = refused.is_empty() || cmd.keep_unphysical;
     if let Some(out) = cmd.out.as_ref().filter(|_| write) {
         let provenance = format!(
@@ -449,9 +465,9 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
             }
         };
         if !cmd.keep_unphysical {
-            bail!("the identified model fails physical checks, {what}:\n  {}", refused.join("\n  "));
+            bail!("the identified model fails its checks, {what}:\n  {}", refused.join("\n  "));
         }
-        eprintln!("warning: the identified model fails physical checks, {what}:\n  {}", refused.join("\n  "));
+        eprintln!("warning: the identified model fails its checks, {what}:\n  {}", refused.join("\n  "));
     }
     Ok(())
 }
