@@ -332,6 +332,20 @@ fn plain_files_with_aliases_and_semicolons() {
     let (b, _) = validate(&european);
     let strip = |s: &str| s.lines().filter(|l| !l.contains(".csv")).collect::<Vec<_>>().join("\n");
     assert_eq!(strip(&a), strip(&b));
+    // the rudder in degrees in a plain file: refused with its row, pointing to a dataset file
+    let mut rows: Vec<Vec<String>> = text.lines().map(|l| l.split(',').map(String::from).collect()).collect();
+    let d = rows[0].iter().position(|h| h == "δ").unwrap();
+    for r in rows.iter_mut().skip(1) {
+        r[d] = (r[d].parse::<f64>().unwrap().to_degrees()).to_string();
+    }
+    let degrees = dir.join("degrees.csv");
+    std::fs::write(&degrees, rows.iter().map(|r| r.join(",")).collect::<Vec<_>>().join("\n")).unwrap();
+    let (ok, _, err) =
+        termid(&["identify", "--model", "models/oltmann1973.toml", "--data", degrees.to_str().unwrap()]);
+    assert!(
+        !ok && err.contains("degrees.csv: row") && err.contains("`δ`") && err.contains("--dataset"),
+        "{err}"
+    );
 }
 
 /// Seven rows of one run: an equation that uses up the degrees of freedom is refused with its

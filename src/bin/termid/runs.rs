@@ -35,6 +35,22 @@ pub fn load_for(model: &Model, data: &[PathBuf], dataset: Option<&Path>) -> Resu
                 );
             }
         }
+        // an input angle beyond a full turn can only be degrees (a rudder, a flap)
+        for input in model.spec().inputs.iter().filter(|i| i.unit == "rad") {
+            if let Some((row, v)) = f
+                .column(&input.name)
+                .and_then(|c| c.iter().enumerate().find(|(_, v)| v.abs() > 2.0 * std::f64::consts::PI))
+            {
+                bail!(
+                    "{}: row {}, column `{}`: {v} is beyond a full turn, but {} declares `{}` in rad: that can only be degrees; give radians, or map the file with a dataset file (--dataset) that declares the column [deg]",
+                    f.origin(),
+                    row + 1,
+                    input.name,
+                    model.path,
+                    input.name
+                );
+            }
+        }
         model.check_kinematics(f)?;
     }
     Ok(frames)
