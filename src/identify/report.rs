@@ -192,7 +192,7 @@ impl Fit {
                 t_value
             );
         }
-        out += &format!("\nstopped: {:?}\n", s.stop);
+        out += &format!("\nstepping ended: {} (chosen: step {})\n", s.stop, s.chosen_step);
         if let Some(tau) = fit.correlation_time.filter(|t| *t > 1.5) {
             out += &format!(
             "note: the residuals are correlated over τ = {tau:.1} rows; the standard errors above assume independent rows, honest ones are about √τ = {:.1} times larger\n",

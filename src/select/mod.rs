@@ -138,6 +138,27 @@ pub enum Stop {
     },
 }
 
+impl std::fmt::Display for Stop {
+    /// Why the stepping ended, in words (the chosen step may be an earlier one).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Stop::AllEntered => write!(f, "every candidate had entered"),
+            Stop::BelowThreshold { term, proportion, threshold } => write!(
+                f,
+                "the next term, {term}, would explain {:.3} % of the variance, below the threshold of {:.3} %",
+                100.0 * proportion,
+                100.0 * threshold
+            ),
+            Stop::ExactFit { residual_share } => {
+                write!(f, "the fit is exact to round-off (1 − R² = {:.1e})", residual_share.max(0.0))
+            }
+            Stop::NoDegreesOfFreedom => write!(f, "no degrees of freedom were left for another term"),
+            Stop::Converged => write!(f, "the back-end's own rule ended it"),
+            Stop::Limit { nodes } => write!(f, "the search hit its limit after {nodes} nodes: best found, not proven best"),
+        }
+    }
+}
+
 /// What a back-end returns: the chosen equation plus everything a report needs.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Selection {

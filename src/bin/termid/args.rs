@@ -18,7 +18,8 @@ pub struct Cli {
 /// The subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Select terms and fit coefficients of one equation from one or several runs.
+    /// Select terms and fit coefficients of one equation, or of every equation of a --model,
+    /// from one or several runs.
     Identify(Box<IdentifyCommand>),
     /// Simulate a model file (the default ship model if none) under a manoeuvre or inputs.
     Simulate(SimulateCommand),
@@ -103,6 +104,9 @@ pub enum RuleName {
 
 /// `termid identify`.
 #[derive(Clone, Debug, Args)]
+#[command(
+    after_help = "Examples:\n  termid identify --data tests/data/hald.csv --no-time --target y --terms x1 x2 x3 x4\n  termid identify --model models/lorenz.toml --data lorenz.csv --out lorenz_id.toml\n  termid identify --model ship.toml --dataset runs.toml --derivative kinematic,kalman --smooth \\\n      --no-intercept --choose sparse,best-subset --compare u,v,r,ψ --refine u,v,r,ψ --out ship_id.toml\nBack-ends: stepwise (the paper's STPRG), efroymson, best-subset, sparse, stlsq.\nDerivatives: central, five-point, savitzky-golay[:W:Q], spline[:ALPHA], kalman[:RATIO]; kinematic (ship models).\nRuns: CSV (model names, SI; aliases and semicolons read), Parquet, Arrow IPC, or a dataset file (README)."
+)]
 pub struct IdentifyCommand {
     /// CSV files with a header row; several are combined (the paper's "Komb. Daten").
     #[arg(long = "data", short = 'd', num_args = 1.., required_unless_present_any = ["dataset", "moments"])]
@@ -231,6 +235,9 @@ pub struct IdentifyCommand {
 
 /// `termid simulate`.
 #[derive(Debug, Args)]
+#[command(
+    after_help = "Examples:\n  termid simulate -m zigzag:20/20 --svg z.svg --out z.csv\n  termid simulate --model kvlcc2.toml -m turning:-35 --param u0=1.18\n  termid simulate --model models/lorenz.toml --integrator rk4 --dt 0.001 --duration 20\nManoeuvres: zigzag:RUDDER/HEADING[:port], turning:RUDDER, spiral[:MAX/STEP/HOLD], pullout:RUDDER, replay:FILE.\nRudder sign: the model's own (Oltmann's: positive δ turns to port; the MMG and new-ship models: to starboard);\n`port`/`starboard` are read off the heading."
+)]
 pub struct SimulateCommand {
     /// Model file (default: the embedded Oltmann 1973 ship model).
     #[arg(long)]
@@ -296,6 +303,7 @@ pub struct ReproduceCommand {
 
 /// `termid compare`.
 #[derive(Debug, Args)]
+#[command(after_help = "Example:\n  termid compare --model models/oltmann1973.toml --data run1.csv run2.csv")]
 pub struct CompareCommand {
     /// Model file with the candidates (default: the embedded Oltmann model).
     #[arg(long)]
@@ -335,6 +343,9 @@ pub struct CompareCommand {
 
 /// `termid diagnose`.
 #[derive(Debug, Args)]
+#[command(
+    after_help = "Example:\n  termid diagnose --model identified.toml --dataset runs.toml --svg figs/ --out repaired.toml"
+)]
 pub struct DiagnoseCommand {
     /// The model to check (default: the embedded Oltmann model).
     #[arg(long)]
@@ -355,6 +366,9 @@ pub struct DiagnoseCommand {
 
 /// `termid validate`.
 #[derive(Debug, Args)]
+#[command(
+    after_help = "Example:\n  termid validate --model identified.toml --dataset held_out.toml --monte-carlo 100 --svg figs/"
+)]
 pub struct ValidateCommand {
     /// The model (default: the embedded Oltmann model).
     #[arg(long)]
