@@ -1,6 +1,7 @@
 //! Every text a user hands termid, from one fuzzer input: the first byte picks the reader,
-//! the rest is the text. Any error is fine; a panic is a bug. Kind 6 is a model file's
-//! back-end table (`backend = …`), loaded and then fitted on a short Lorenz run.
+//! the rest is the text. Any error is fine; a panic is a bug. Kind 7 is a model file's
+//! back-end table (`backend = …`), loaded and then fitted on a short Lorenz run; kind 6 a
+//! statistics file of `termid moments`.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -12,7 +13,7 @@ use termid::term::Vocabulary;
 fuzz_target!(|data: &[u8]| {
     let Some((&kind, rest)) = data.split_first() else { return };
     let Ok(text) = std::str::from_utf8(rest) else { return };
-    match kind % 7 {
+    match kind % 8 {
         0 => {
             // a candidate term in the ship's vocabulary
             let mut v = Vocabulary::new();
@@ -47,6 +48,18 @@ fuzz_target!(|data: &[u8]| {
         }
         5 => {
             let _ = toml::from_str::<Dataset>(text);
+        }
+        6 => {
+            // an equation's statistics (`identify --moments`), read and fitted with the
+            // Lorenz model's x_dot
+            if let Ok(m) = termid::identify::EquationMoments::from_json(text, "fuzz.moments") {
+                if let Ok(model) = Model::load(std::path::Path::new(concat!(
+                    env!("CARGO_MANIFEST_DIR"),
+                    "/../models/lorenz.toml"
+                ))) {
+                    let _ = m.fit(&model, true);
+                }
+            }
         }
         _ => {
             let lorenz = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../models/lorenz.toml"))
