@@ -65,7 +65,7 @@ fn json(d: &Diagnosis) -> serde_json::Value {
 
 fn text(d: &Diagnosis, out: Option<&std::path::Path>, tested: usize) -> String {
     let mut s = format!("where: {}\n\n", d.location.words);
-    s += &format!("{tested} hypotheses tested (output error, recorded inputs replayed); best first:\n");
+    s += &format!("{tested} hypotheses tested (output error, recorded inputs replayed); best first: by ΔBIC, and among those that explain nearly as much as the best, the model's own candidate terms first:\n");
     s += &format!("{:<58} {:>10} {:>12}  estimate ± std. error\n", "hypothesis", "explained", "ΔBIC");
     for c in d.candidates.iter().take(8) {
         let est: Vec<String> = c
@@ -86,9 +86,9 @@ fn text(d: &Diagnosis, out: Option<&std::path::Path>, tested: usize) -> String {
     match d.winner {
         Some(w) => {
             let c = &d.candidates[w];
-            s += &format!("verdict: {} explains {:.0} % of the gap", c.name, 100.0 * c.explained);
+            s += &format!("verdict: {} explains {:.1} % of the gap", c.name, 100.0 * c.explained);
             if let Some(r) = d.candidates.get(w + 1) {
-                s += &format!(" (runner-up: {}, {:.0} %)", r.name, 100.0 * r.explained);
+                s += &format!(" (runner-up: {}, {:.1} %)", r.name, 100.0 * r.explained);
             }
             s += ".\n";
         }
