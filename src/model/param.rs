@@ -77,6 +77,34 @@ impl ParamValue {
         }
     }
 
+    /// For a `first:COLUMN` rule on a noisy record, why the rule is fragile: its one sample
+    /// carries the noise (σ of the first two time units from their second differences, above
+    /// 10⁻⁴ of the signal), which `mean:COLUMN:SECONDS` averages away. `None` for other rules,
+    /// clean records and runs too short to tell.
+    pub fn noisy_first_sample(&self, name: &str, frame: &Frame) -> Option<String> {
+        let ParamValue::Rule(rule) = self else { return None };
+        let ("first", col) = rule.split_once(':')? else { return None };
+        let x = frame.column(col)?;
+        let t = frame.time();
+        let n = t.iter().take_while(|ti| **ti - t[0] <= 2.0).count();
+        if n < 8 {
+            return None;
+        }
+        let x = &x[..n];
+        // noise from second differences: a smooth start (the ship slowing) hardly shows there
+        let sigma = (x.windows(3).map(|w| (w[2] - 2.0 * w[1] + w[0]).powi(2)).sum::<f64>()
+            / (6.0 * (n - 2) as f64))
+            .sqrt();
+        let mean = x.iter().sum::<f64>() / n as f64;
+        (sigma > 1e-4 * mean.abs().max(1e-12)).then(|| {
+            format!(
+                "{}: `{name} = {rule}` reads one noisy sample ({:.6}; noise σ ≈ {sigma:.2e} from the first 2 s): `mean:{col}:2` averages the approach",
+                frame.origin(),
+                x[0]
+            )
+        })
+    }
+
     /// The value in one run.
     pub fn resolve(&self, name: &str, frame: &Frame) -> Result<f64, DataError> {
         match self {

@@ -329,6 +329,17 @@ fn plain_files_with_aliases_and_semicolons() {
     };
     let (a, err) = validate(&ascii);
     assert!(err.contains("column `delta` read as `δ`"), "{err}");
+    // the model's u0 = first:u on a clean record: no warning; on a noisy one, a warning
+    assert!(!err.contains("noisy sample"), "{err}");
+    let mut rows: Vec<Vec<String>> = text.lines().map(|l| l.split(',').map(String::from).collect()).collect();
+    let u = rows[0].iter().position(|h| h == "u").unwrap();
+    for (k, r) in rows.iter_mut().skip(1).enumerate() {
+        r[u] = (r[u].parse::<f64>().unwrap() + 0.01 * ((k * 7919 % 13) as f64 - 6.0) / 6.0).to_string();
+    }
+    let noisy = dir.join("noisy.csv");
+    std::fs::write(&noisy, rows.iter().map(|r| r.join(",")).collect::<Vec<_>>().join("\n")).unwrap();
+    let (_, err) = validate(&noisy);
+    assert!(err.contains("`u0 = first:u` reads one noisy sample") && err.contains("mean:u:2"), "{err}");
     let (b, _) = validate(&european);
     let strip = |s: &str| s.lines().filter(|l| !l.contains(".csv")).collect::<Vec<_>>().join("\n");
     assert_eq!(strip(&a), strip(&b));

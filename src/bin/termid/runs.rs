@@ -53,6 +53,13 @@ pub fn load_for(model: &Model, data: &[PathBuf], dataset: Option<&Path>) -> Resu
         }
         model.check_kinematics(f)?;
     }
+    // a per-run rule that reads one sample of a noisy record: said once, for the first such run
+    for (name, rule) in model.parameter_rules() {
+        let noisy: Vec<String> = frames.iter().filter_map(|f| rule.noisy_first_sample(&name, f)).collect();
+        if let Some(first) = noisy.first() {
+            eprintln!("warning: {first} ({} of {} runs so)", noisy.len(), frames.len());
+        }
+    }
     Ok(frames)
 }
 
