@@ -85,9 +85,21 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
                 model.spec().model.name,
                 runs.len()
             );
+            // each state in its unit, angles in degrees
+            let unit = |state: &str| {
+                model.spec().states.iter().find(|t| t.name == state).map_or(String::new(), |t| t.unit.clone())
+            };
             for (run, per) in &gap.runs {
-                let cells: Vec<String> =
-                    per.iter().map(|(s, r, m)| format!("{s} {} / {}", num(*r), num(*m))).collect();
+                let cells: Vec<String> = per
+                    .iter()
+                    .map(|(s, r, m)| match unit(s).strip_prefix("rad") {
+                        Some(rest) => {
+                            let d = 180.0 / std::f64::consts::PI;
+                            format!("{s} {} / {} deg{rest}", num(r * d), num(m * d))
+                        }
+                        None => format!("{s} {} / {} {}", num(*r), num(*m), unit(s)),
+                    })
+                    .collect();
                 println!("  {run}: {}", cells.join(", "));
             }
             for ((m, f), s) in metrics.iter().zip(&runs).zip(&spreads) {
