@@ -196,9 +196,15 @@ impl Figure {
         let (mut y0, mut y1) =
             range(panel.series.iter().flat_map(|s| s.y.iter().chain(&s.upper).copied()), panel.log_y);
         if panel.equal_axes {
+            // the same metres per pixel on both axes: the ranges follow the plotting area's
+            // shape (the panel less its caption, label areas and margins below), so a circle
+            // is drawn round
+            let (w, h) = area.dim_in_pixel();
+            let (pw, ph) = ((w as f64 - 60.0 - 16.0).max(10.0), (h as f64 - 34.0 - 16.0 - 22.0).max(10.0));
             let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
-            let half = (x1 - x0).max(y1 - y0) / 2.0;
-            (x0, x1, y0, y1) = (cx - half, cx + half, cy - half, cy + half);
+            let per_pixel = ((x1 - x0) / pw).max((y1 - y0) / ph);
+            (x0, x1) = (cx - per_pixel * pw / 2.0, cx + per_pixel * pw / 2.0);
+            (y0, y1) = (cy - per_pixel * ph / 2.0, cy + per_pixel * ph / 2.0);
         }
         let mut builder = ChartBuilder::on(area);
         builder
