@@ -51,7 +51,7 @@ pub use model::{
     IdentifiedModel, ModelIdentification,
 };
 pub use report::{num, FitReport, StepReport, TermReport};
-pub use statistics::{EquationMoments, RunMoments};
+pub use statistics::{identify_from_moments, EquationMoments, RunMoments};
 
 /// Why identification failed.
 #[derive(Debug, thiserror::Error)]

@@ -144,6 +144,43 @@ impl EquationMoments {
     }
 }
 
+/// Identifies a model's equations from statistics: the parts of each equation are merged in
+/// the order given (shards of runs, from any number of machines), then each equation is
+/// fitted with the model's forced and excluded terms and back-end and stored in a copy of the
+/// model, as [`super::identify_model`] would from the rows. Each part comes with the name an
+/// error calls it by (its file).
+pub fn identify_from_moments(
+    model: &Model,
+    parts: Vec<(String, EquationMoments)>,
+    intercept: bool,
+) -> Result<super::IdentifiedModel, IdentifyError> {
+    let mut merged: Vec<EquationMoments> = Vec::new();
+    for (origin, m) in parts {
+        match merged.iter().position(|e| e.equation == m.equation) {
+            Some(k) => {
+                let old = merged.remove(k);
+                let both = old.merge(m).map_err(|e| IdentifyError::Setup(format!("{origin}: {e}")))?;
+                merged.insert(k, both);
+            }
+            None => merged.push(m),
+        }
+    }
+    let mut identified = model.clone();
+    let mut fits = Vec::new();
+    for m in &merged {
+        let in_equation = |e: IdentifyError| e.in_equation(&m.equation);
+        let fit = m.fit(model, intercept).map_err(in_equation)?;
+        let coefficients = super::coefficients_of(&fit, &model.vocabulary).map_err(in_equation)?;
+        identified.set_coefficients(
+            &m.equation,
+            coefficients,
+            fit.selection.intercept.as_ref().map(|b| b.value),
+        );
+        fits.push((m.equation.clone(), fit));
+    }
+    Ok(super::IdentifiedModel { model: identified, fits })
+}
+
 #[cfg(test)]
 mod tests {
     use std::collections::BTreeMap;

@@ -482,6 +482,44 @@ impl Model {
         }
     }
 
+    /// Makes a measured run fit for this model, the checks every caller of a model needs (the
+    /// CLI, the Python package): a plain file's ASCII column names that are the model's aliases
+    /// (`delta`, `psi`) are read as the names they stand for, an input declared in rad that
+    /// goes beyond a full turn is refused (it can only be degrees), and the run must agree with
+    /// the model's known kinematics ([`Model::check_kinematics`]). Returns what was renamed,
+    /// for the caller to say.
+    pub fn admit(&self, frame: &mut crate::data::Frame) -> Result<Vec<String>, crate::data::DataError> {
+        let mut notes = Vec::new();
+        for (alias, name) in &self.spec.aliases {
+            if frame.column(alias).is_some() && frame.column(name).is_none() {
+                frame.rename(alias, name)?;
+                notes.push(format!(
+                    "{}: column `{alias}` read as `{name}` (an alias in {})",
+                    frame.origin(),
+                    self.path
+                ));
+            }
+        }
+        for input in self.spec.inputs.iter().filter(|i| i.unit == "rad") {
+            let beyond = frame
+                .column(&input.name)
+                .and_then(|c| c.iter().enumerate().find(|(_, v)| v.abs() > 2.0 * std::f64::consts::PI));
+            if let Some((row, v)) = beyond {
+                return Err(crate::data::DataError::Unit {
+                    file: frame.origin().into(),
+                    row: row + 1,
+                    column: input.name.clone(),
+                    message: format!(
+                        "{v} is beyond a full turn, but {} declares `{}` in rad: that can only be degrees; give radians, or map the file with a dataset file (--dataset) that declares the column [deg]",
+                        self.path, input.name
+                    ),
+                });
+            }
+        }
+        self.check_kinematics(frame)?;
+        Ok(notes)
+    }
+
     /// Checks measured runs against the model's known kinematics: where an equation that is
     /// not identified says ẋ = c·y for a state x and a variable y (ψ̇ = r), the run's own dx/dt
     /// must match c·y. A ratio near π/180 or 180/π means one of the two columns is in degrees

@@ -396,6 +396,19 @@ mod tests {
         *t.states[0].last().unwrap()
     }
 
+    /// The right-hand side on a run's rows is u − k·x row by row; a missing column is named.
+    #[test]
+    fn derivatives_on_a_run() {
+        let lag = Lag { k: 2.0, bounds: (f64::NEG_INFINITY, f64::INFINITY) };
+        let system = System::new(&lag, &BTreeMap::from([("k".to_string(), 0.5)]), false).unwrap();
+        let mut frame = crate::data::Frame::new("run.csv", "t", vec![0.0, 1.0, 2.0]).unwrap();
+        frame.push("x", vec![1.0, 2.0, 4.0]).unwrap();
+        let missing = system.derivatives_on(&frame).unwrap_err().to_string();
+        assert!(missing.contains("run.csv") && missing.contains("`u`"), "{missing}");
+        frame.push("u", vec![0.0, 1.0, -1.0]).unwrap();
+        assert_eq!(system.derivatives_on(&frame).unwrap(), vec![vec![-0.5, 0.0, -3.0]]);
+    }
+
     /// x(t) = u/k + (x0 − u/k)·e^(−kt); RK4 is fourth order, the paper's B8 first order.
     #[test]
     fn orders_of_accuracy_on_a_first_order_lag() {

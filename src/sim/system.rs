@@ -153,6 +153,32 @@ impl System {
         self.rhs.eval_row_prepared(&mut ws.scratch, dx);
     }
 
+    /// ẋ on every row of a measured run, one column per state: the states and inputs read
+    /// from the frame's columns by name (the one-step prediction a regression of the
+    /// derivatives is fitted to, where the simulation integrates it).
+    pub fn derivatives_on(&self, frame: &crate::data::Frame) -> Result<Vec<Vec<f64>>, SimError> {
+        let read = |names: &[String]| -> Result<Vec<&[f64]>, SimError> {
+            names.iter().map(|n| Ok(frame.require(n)?)).collect()
+        };
+        let (states, inputs) = (read(&self.states)?, read(&self.inputs)?);
+        let mut ws = self.workspace();
+        let (mut x, mut u, mut dx) =
+            (vec![0.0; states.len()], vec![0.0; inputs.len()], vec![0.0; self.dim()]);
+        let mut out = vec![Vec::with_capacity(frame.len()); self.dim()];
+        for row in 0..frame.len() {
+            x.iter_mut().zip(&states).for_each(|(x, c)| *x = c[row]);
+            u.iter_mut().zip(&inputs).for_each(|(u, c)| *u = c[row]);
+            self.derivatives(&x, &u, &mut ws, &mut dx);
+            out.iter_mut().zip(&dx).for_each(|(o, d)| o.push(*d));
+        }
+        Ok(out)
+    }
+
+    /// State names in integration order.
+    pub fn state_names(&self) -> &[String] {
+        &self.states
+    }
+
     /// Whether the right-hand side reads state `i` at all (positions usually are not read: a
     /// derivative with respect to them is zero).
     pub fn reads_state(&self, i: usize) -> bool {

@@ -26,36 +26,22 @@ pub fn run(cmd: MomentsCommand) -> Result<()> {
     Ok(())
 }
 
-/// `identify --moments`: the statistics files read, merged per equation (in the order given),
-/// each equation identified from them and stored in the model.
+/// `identify --moments`: the statistics files read, then merged per equation (in the order
+/// given) and identified by the library.
 pub fn identify(
     model: &termid::model::Model,
     files: &[std::path::PathBuf],
     intercept: bool,
 ) -> Result<(termid::model::Model, Vec<(String, termid::identify::Fit)>)> {
-    let mut merged: Vec<EquationMoments> = Vec::new();
-    for path in files {
-        let text = termid::budget::read_text(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-        let m = EquationMoments::from_json(&text, &path.display().to_string())?;
-        match merged.iter().position(|e| e.equation == m.equation) {
-            Some(k) => {
-                let old = merged.remove(k);
-                merged.insert(k, old.merge(m).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?);
-            }
-            None => merged.push(m),
-        }
-    }
-    let mut identified = model.clone();
-    let mut fits = Vec::new();
-    for m in &merged {
-        let fit = m.fit(model, intercept).map_err(|e| e.in_equation(&m.equation))?;
-        let coefficients = termid::identify::coefficients_of(&fit, &model.vocabulary)?;
-        identified.set_coefficients(
-            &m.equation,
-            coefficients,
-            fit.selection.intercept.as_ref().map(|b| b.value),
-        );
-        fits.push((m.equation.clone(), fit));
-    }
-    Ok((identified, fits))
+    let parts = files
+        .iter()
+        .map(|path| {
+            let text =
+                termid::budget::read_text(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+            let origin = path.display().to_string();
+            Ok((origin.clone(), EquationMoments::from_json(&text, &origin)?))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let identified = termid::identify::identify_from_moments(model, parts, intercept)?;
+    Ok((identified.model, identified.fits))
 }

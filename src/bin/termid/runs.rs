@@ -24,34 +24,9 @@ pub fn load_for(model: &Model, data: &[PathBuf], dataset: Option<&Path>) -> Resu
     }
     let mut frames = load(data, dataset, &model.spec().model.time)?;
     for f in &mut frames {
-        // a plain file's ASCII names (`delta`, `psi`) are the model's aliases of its names
-        for (alias, name) in &model.spec().aliases {
-            if f.column(alias).is_some() && f.column(name).is_none() {
-                f.rename(alias, name)?;
-                eprintln!(
-                    "unit: {}: column `{alias}` read as `{name}` (an alias in {})",
-                    f.origin(),
-                    model.path
-                );
-            }
+        for note in model.admit(f)? {
+            eprintln!("unit: {note}");
         }
-        // an input angle beyond a full turn can only be degrees (a rudder, a flap)
-        for input in model.spec().inputs.iter().filter(|i| i.unit == "rad") {
-            if let Some((row, v)) = f
-                .column(&input.name)
-                .and_then(|c| c.iter().enumerate().find(|(_, v)| v.abs() > 2.0 * std::f64::consts::PI))
-            {
-                bail!(
-                    "{}: row {}, column `{}`: {v} is beyond a full turn, but {} declares `{}` in rad: that can only be degrees; give radians, or map the file with a dataset file (--dataset) that declares the column [deg]",
-                    f.origin(),
-                    row + 1,
-                    input.name,
-                    model.path,
-                    input.name
-                );
-            }
-        }
-        model.check_kinematics(f)?;
     }
     // a per-run rule that reads one sample of a noisy record: said once, for the first such run
     for (name, rule) in model.parameter_rules() {

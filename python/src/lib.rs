@@ -1,0 +1,739 @@
+//! The native half of the Python package `termid`: thin wrappers that turn numpy arrays into
+//! termid's frames, call the library and hand back plain values (arrays, lists, JSON text).
+//! The pandas and pyarrow conversions and the friendly signatures are in `termid/__init__.py`.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
+use pyo3::exceptions::PyException;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+use termid::data::{differentiator, Frame};
+use termid::identify::{EquationMoments, Fit, Identification, ModelIdentification, Target};
+use termid::model::Model;
+use termid::select::Backend;
+use termid::sim::{Integrator, Settings, System, Trajectory};
+use termid::term::{parse_terms, Library, Source, Term, Vocabulary};
+
+pyo3::create_exception!(
+    _termid,
+    TermidError,
+    PyException,
+    "termid refused the input; the message locates it (file, row, column, or a caret under a term)."
+);
+
+/// An error with its causes, as the command line prints it (`{:#}`).
+fn fail(e: impl std::error::Error) -> PyErr {
+    let mut text = e.to_string();
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        let more = c.to_string();
+        if !text.contains(&more) {
+            text = format!("{text}: {more}");
+        }
+        cause = c.source();
+    }
+    TermidError::new_err(text)
+}
+
+fn refuse(text: impl Into<String>) -> PyErr {
+    TermidError::new_err(text.into())
+}
+
+/// A run handed over from Python: its name, and its columns as float64 arrays.
+type Run<'py> = (String, Bound<'py, PyDict>);
+
+/// One column as a contiguous float64 slice (the Python side makes it so).
+fn column<'py>(origin: &str, name: &str, value: &Bound<'py, PyAny>) -> PyResult<PyReadonlyArray1<'py, f64>> {
+    let array: PyReadonlyArray1<'py, f64> = value
+        .extract()
+        .map_err(|_| refuse(format!("{origin}: column `{name}` is not a one-dimensional float64 array")))?;
+    array.as_slice().map_err(|_| refuse(format!("{origin}: column `{name}` is not contiguous")))?;
+    Ok(array)
+}
+
+/// A run as a frame over its time column `time` (every value checked as a file's would be).
+fn frame_of(origin: &str, time: &str, columns: &Bound<'_, PyDict>) -> PyResult<Frame> {
+    let names: Vec<String> = columns.keys().iter().map(|k| k.extract()).collect::<PyResult<_>>()?;
+    let Some(t) = columns.get_item(time)? else {
+        return Err(refuse(format!("{origin}: no time column `{time}` (columns: {})", names.join(", "))));
+    };
+    let t = column(origin, time, &t)?;
+    let mut frame = Frame::new(origin, time, t.as_slice()?.to_vec()).map_err(fail)?;
+    for (name, value) in names.iter().zip(columns.values().iter()) {
+        if name != time {
+            frame.push(name, column(origin, name, &value)?.as_slice()?.to_vec()).map_err(fail)?;
+        }
+    }
+    Ok(frame)
+}
+
+/// A back-end from its JSON settings (`{"method": "stepwise", "f_in": 4.0}`).
+fn backend_of(json: &str) -> PyResult<Backend> {
+    let backend: Backend = serde_json::from_str(json).map_err(|e| {
+        refuse(format!("back-end settings {json}: {e} (back-ends: {})", Backend::NAMES.join(", ")))
+    })?;
+    backend.validate().map_err(fail)?;
+    Ok(backend)
+}
+
+fn integrator_of(name: &str) -> PyResult<Integrator> {
+    match name {
+        "b8" | "euler" | "modified-euler" => Ok(Integrator::ModifiedEuler),
+        "rk4" => Ok(Integrator::Rk4),
+        other => Err(refuse(format!("unknown integrator `{other}` (known: b8, rk4)"))),
+    }
+}
+
+fn to_json(value: &impl serde::Serialize) -> PyResult<String> {
+    serde_json::to_string(value).map_err(|e| refuse(format!("could not serialise: {e}")))
+}
+
+/// Columns as (name, array) pairs, in order.
+fn arrays<'py>(
+    py: Python<'py>,
+    columns: Vec<(String, Vec<f64>)>,
+) -> Vec<(String, Bound<'py, PyArray1<f64>>)> {
+    columns.into_iter().map(|(n, v)| (n, v.into_pyarray(py))).collect()
+}
+
+/// A frame's columns, time first.
+fn frame_columns(f: &Frame) -> Vec<(String, Vec<f64>)> {
+    f.names().iter().filter_map(|n| f.column(n).map(|c| (n.clone(), c.to_vec()))).collect()
+}
+
+/// A simulated run as columns: time, states, inputs.
+fn trajectory_columns(time: &str, t: Trajectory) -> Vec<(String, Vec<f64>)> {
+    let mut out = vec![(time.to_string(), t.time)];
+    out.extend(t.state_names.into_iter().zip(t.states));
+    out.extend(t.input_names.into_iter().zip(t.inputs));
+    out
+}
+
+/// A model file: states, inputs, parameters and equations, as termid reads and writes it.
+#[pyclass(module = "termid._termid", name = "Model")]
+#[derive(Clone)]
+struct PyModel {
+    inner: Model,
+}
+
+impl PyModel {
+    /// Runs as frames over the model's time column, each admitted by the model (aliases,
+    /// units, kinematics); the notes say what was renamed.
+    fn frames(&self, runs: Vec<Run<'_>>) -> PyResult<Vec<Frame>> {
+        let time = &self.inner.spec().model.time;
+        let mut notes = Vec::new();
+        let mut frames = Vec::with_capacity(runs.len());
+        for (origin, columns) in &runs {
+            let mut frame = frame_of(origin, time, columns)?;
+            notes.extend(self.inner.admit(&mut frame).map_err(fail)?);
+            frames.push(frame);
+        }
+        let Some((_, first)) = runs.first() else {
+            return Err(refuse("no runs: give at least one"));
+        };
+        for (name, rule) in self.inner.parameter_rules() {
+            if let Some(first) = frames.iter().find_map(|f| rule.noisy_first_sample(&name, f)) {
+                notes.push(first);
+            }
+        }
+        // what the command line says on standard error, a notebook shows as warnings
+        let py = first.py();
+        for note in notes {
+            let message = std::ffi::CString::new(note).unwrap_or_default();
+            PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &message, 2)?;
+        }
+        Ok(frames)
+    }
+}
+
+#[pymethods]
+impl PyModel {
+    /// Reads a model file (TOML); errors name the file, line and key.
+    #[staticmethod]
+    fn load(path: PathBuf) -> PyResult<Self> {
+        Ok(PyModel { inner: termid::plugins::load(&path).map_err(fail)? })
+    }
+
+    /// A model from TOML text; `name` stands for the file in messages.
+    #[staticmethod]
+    #[pyo3(signature = (text, name = "<text>"))]
+    fn parse(text: &str, name: &str) -> PyResult<Self> {
+        Ok(PyModel { inner: termid::plugins::parse(text, name).map_err(fail)? })
+    }
+
+    /// The default model: Oltmann's (1973) HSVA 1512 with its Table 2 coefficients.
+    #[staticmethod]
+    fn default_model() -> Self {
+        PyModel { inner: termid::plugins::default_model() }
+    }
+
+    fn to_toml(&self) -> String {
+        self.inner.to_toml()
+    }
+
+    /// Writes the model file (atomically: a file that cannot be written loses nothing).
+    fn save(&self, path: PathBuf) -> PyResult<()> {
+        termid::output::write_file(&path, self.inner.to_toml().as_bytes()).map_err(fail)
+    }
+
+    #[getter]
+    fn name(&self) -> String {
+        self.inner.spec().model.name.clone()
+    }
+
+    #[getter]
+    fn path(&self) -> String {
+        self.inner.path.clone()
+    }
+
+    #[getter]
+    fn time(&self) -> String {
+        self.inner.spec().model.time.clone()
+    }
+
+    #[getter]
+    fn states(&self) -> Vec<String> {
+        self.inner.spec().states.iter().map(|s| s.name.clone()).collect()
+    }
+
+    #[getter]
+    fn inputs(&self) -> Vec<String> {
+        self.inner.spec().inputs.iter().map(|s| s.name.clone()).collect()
+    }
+
+    #[getter]
+    fn equations(&self) -> Vec<String> {
+        self.inner.equations().iter().map(|e| e.name.clone()).collect()
+    }
+
+    #[getter]
+    fn identifiable(&self) -> Vec<String> {
+        self.inner.identifiable()
+    }
+
+    #[getter]
+    fn parameters(&self) -> BTreeMap<String, f64> {
+        self.inner.parameter_values()
+    }
+
+    /// The stored coefficients of an equation: (term, value, standard error).
+    fn coefficients(&self, equation: &str) -> PyResult<Vec<(String, f64, Option<f64>)>> {
+        let eq = self.inner.equation(equation).ok_or_else(|| {
+            refuse(format!(
+                "{}: no equation `{equation}` (equations: {})",
+                self.inner.path,
+                self.equations().join(", ")
+            ))
+        })?;
+        Ok(eq.coefficients.iter().map(|(t, c, s)| (t.to_string(), *c, *s)).collect())
+    }
+
+    fn intercept(&self, equation: &str) -> Option<f64> {
+        self.inner.equation(equation).and_then(|e| e.intercept)
+    }
+
+    /// Sets a parameter, or a value of the plug-in's table (a ship's `u0`); unknown names are
+    /// refused.
+    fn set_parameter(&mut self, name: &str, value: f64) -> PyResult<()> {
+        let mut known = self.inner.set_parameter(name, value);
+        if let Some(plugin) = termid::plugins::of(&self.inner) {
+            known |= plugin.set_parameter(&mut self.inner, name, value).map_err(fail)?;
+        }
+        if !known {
+            return Err(refuse(format!("{}: `{name}` is not a parameter", self.inner.path)));
+        }
+        Ok(())
+    }
+
+    /// Every identifiable equation (or the named ones) from runs; returns the identified model
+    /// and each fit as JSON.
+    #[pyo3(signature = (runs, derivative = "central", equations = vec![], intercept = true, backend = None))]
+    fn identify(
+        &self,
+        runs: Vec<Run<'_>>,
+        derivative: &str,
+        equations: Vec<String>,
+        intercept: bool,
+        backend: Option<&str>,
+    ) -> PyResult<(PyModel, Vec<(String, String)>)> {
+        let model = match backend {
+            Some(json) => self.inner.with_backend(&backend_of(json)?).map_err(fail)?,
+            None => self.inner.clone(),
+        };
+        let frames = self.frames(runs)?;
+        let diff = differentiator(derivative).map_err(fail)?;
+        let how = ModelIdentification { equations, differentiator: diff.as_ref(), intercept, target: None };
+        let identified =
+            termid::identify::identify_model(&model, &frames, &how, &mut |_| {}).map_err(fail)?;
+        let fits = identified
+            .fits
+            .iter()
+            .map(|(n, f)| Ok((n.clone(), to_json(&f.report())?)))
+            .collect::<PyResult<_>>()?;
+        Ok((PyModel { inner: identified.model }, fits))
+    }
+
+    /// The sufficient statistics of one equation over runs (mergeable, picklable).
+    #[pyo3(signature = (equation, runs, derivative = "central"))]
+    fn moments(&self, equation: &str, runs: Vec<Run<'_>>, derivative: &str) -> PyResult<PyMoments> {
+        let frames = self.frames(runs)?;
+        let diff = differentiator(derivative).map_err(fail)?;
+        let inner =
+            EquationMoments::of_runs(&self.inner, equation, &frames, diff.as_ref(), None).map_err(fail)?;
+        Ok(PyMoments { inner })
+    }
+
+    /// The model identified from statistics (merged per equation in the order given).
+    #[pyo3(signature = (moments, intercept = true))]
+    fn identify_from_moments(
+        &self,
+        moments: Vec<PyRef<'_, PyMoments>>,
+        intercept: bool,
+    ) -> PyResult<(PyModel, Vec<(String, String)>)> {
+        let parts = moments
+            .iter()
+            .enumerate()
+            .map(|(k, m)| (format!("statistics {}", k + 1), m.inner.clone()))
+            .collect();
+        let identified =
+            termid::identify::identify_from_moments(&self.inner, parts, intercept).map_err(fail)?;
+        let fits = identified
+            .fits
+            .iter()
+            .map(|(n, f)| Ok((n.clone(), to_json(&f.report())?)))
+            .collect::<PyResult<_>>()?;
+        Ok((PyModel { inner: identified.model }, fits))
+    }
+
+    /// ẋ of every state on every row of a run (the identified equations' one-step prediction).
+    #[pyo3(signature = (run, with_intercept = false))]
+    fn predict<'py>(
+        &self,
+        py: Python<'py>,
+        run: Run<'py>,
+        with_intercept: bool,
+    ) -> PyResult<Vec<(String, Bound<'py, PyArray1<f64>>)>> {
+        let frames = self.frames(vec![run])?;
+        let frame = &frames[0];
+        let mut own = BTreeMap::new();
+        for (name, rule) in self.inner.parameter_rules() {
+            own.insert(name.clone(), rule.resolve(&name, frame).map_err(fail)?);
+        }
+        let system = System::new(&self.inner, &own, with_intercept).map_err(fail)?;
+        let dx = system.derivatives_on(frame).map_err(fail)?;
+        let names = system.state_names().iter().map(|s| format!("{s}_dot"));
+        Ok(arrays(py, names.zip(dx).collect()))
+    }
+
+    /// A plug-in's scenario (`zigzag:20/20`, `turning:35`, `spiral`): the simulated run's
+    /// columns, its metrics (JSON), its label and its report lines.
+    #[pyo3(signature = (scenario, dt = 0.1, duration = None, sample = None, integrator = "b8", with_intercept = false))]
+    #[allow(clippy::too_many_arguments, clippy::type_complexity)]
+    fn simulate<'py>(
+        &self,
+        py: Python<'py>,
+        scenario: &str,
+        dt: f64,
+        duration: Option<f64>,
+        sample: Option<f64>,
+        integrator: &str,
+        with_intercept: bool,
+    ) -> PyResult<(Vec<(String, Bound<'py, PyArray1<f64>>)>, String, String, Vec<String>)> {
+        let plugin = termid::plugins::of(&self.inner).ok_or_else(|| {
+            refuse(format!(
+                "{} has no plug-in table, so `{scenario}` does not apply: use replay",
+                self.inner.path
+            ))
+        })?;
+        let request = termid::plugin::ScenarioRequest {
+            text: scenario,
+            with_intercept,
+            initial_given: false,
+            inputs_given: false,
+        };
+        let scenario = plugin.scenario(&self.inner, &request).map_err(fail)?;
+        let settings = Settings {
+            integrator: integrator_of(integrator)?,
+            dt,
+            duration: duration.unwrap_or_else(|| scenario.default_duration()),
+            sample: sample.unwrap_or(dt),
+        };
+        let outcome = scenario.run(&self.inner, &settings).map_err(fail)?;
+        let frame = &outcome.frame;
+        Ok((arrays(py, frame_columns(frame)), to_json(&outcome.metrics)?, scenario.label(), outcome.text))
+    }
+
+    /// A ship's manoeuvre recorded as a model basin would (termid's synthetic basin): the
+    /// measured run with sensor noise (seeded) and the noise-free truth, both in the model's
+    /// names, SI and radians; the approach speed is `speed` × the model's u0. `tracked`:
+    /// optical tracking (u, v from the track, a rudder offset, the rudder back at midship).
+    #[pyo3(signature = (manoeuvre, speed = 1.0, duration = 100.0, seed = 0, tracked = false))]
+    #[allow(clippy::type_complexity)]
+    fn record<'py>(
+        &self,
+        py: Python<'py>,
+        manoeuvre: &str,
+        speed: f64,
+        duration: f64,
+        seed: u64,
+        tracked: bool,
+    ) -> PyResult<(Vec<(String, Bound<'py, PyArray1<f64>>)>, Vec<(String, Bound<'py, PyArray1<f64>>)>)> {
+        use termid::ship::basin::Basin;
+        let spec = termid::ship::ShipSpec::of(&self.inner).map_err(fail)?.ok_or_else(|| {
+            refuse(format!("{}: no [ship] table: only a ship is recorded in the basin", self.inner.path))
+        })?;
+        let basin = if tracked { Basin::tracked() } else { Basin::default() };
+        let m = termid::ship::Manoeuvre::parse(manoeuvre).map_err(fail)?;
+        let name = format!("{}.dat", manoeuvre.replace([':', '/'], "_"));
+        let rec = py
+            .detach(|| basin.record(&self.inner, &m, speed * spec.u0, duration, seed, &name))
+            .map_err(fail)?;
+        Ok((arrays(py, frame_columns(&rec.measured)), arrays(py, frame_columns(&rec.truth))))
+    }
+
+    /// Each run re-simulated from its recorded initial state with its recorded inputs.
+    #[pyo3(signature = (runs, dt = 0.1, integrator = "b8", with_intercept = false))]
+    #[allow(clippy::type_complexity)]
+    fn replay<'py>(
+        &self,
+        py: Python<'py>,
+        runs: Vec<Run<'py>>,
+        dt: f64,
+        integrator: &str,
+        with_intercept: bool,
+    ) -> PyResult<Vec<Vec<(String, Bound<'py, PyArray1<f64>>)>>> {
+        let frames = self.frames(runs)?;
+        let data = termid::diagnose::Runs::new(&self.inner, &frames, dt, integrator_of(integrator)?)
+            .map_err(fail)?
+            .with_intercepts(with_intercept);
+        let sims = py.detach(|| data.simulate(&self.inner, &[], &[])).map_err(fail)?;
+        let time = self.time();
+        Ok(sims.into_iter().map(|t| arrays(py, trajectory_columns(&time, t))).collect())
+    }
+
+    /// The model against held-out runs: the error of every compared state, and for a
+    /// plug-in's models its metrics measured and simulated (JSON).
+    #[pyo3(signature = (runs, dt = 0.1, integrator = "b8", with_intercept = false))]
+    fn validate(
+        &self,
+        py: Python<'_>,
+        runs: Vec<Run<'_>>,
+        dt: f64,
+        integrator: &str,
+        with_intercept: bool,
+    ) -> PyResult<String> {
+        let frames = self.frames(runs)?;
+        let data = termid::diagnose::Runs::new(&self.inner, &frames, dt, integrator_of(integrator)?)
+            .map_err(fail)?
+            .with_intercepts(with_intercept);
+        let sims = py.detach(|| data.simulate(&self.inner, &[], &[])).map_err(fail)?;
+        let plugin = termid::plugins::of(&self.inner);
+        let observe = |f: &Frame, s: Option<&Trajectory>| {
+            plugin.and_then(|p| p.observe(&self.inner, f, s)).map(|o| o.json)
+        };
+        let metrics: Vec<serde_json::Value> = frames
+            .iter()
+            .zip(&sims)
+            .map(|(f, s)| serde_json::json!({"run": f.origin(), "measured": observe(f, None), "simulated": observe(f, Some(s))}))
+            .collect();
+        to_json(&serde_json::json!({"gap": data.gap(&sims), "metrics": metrics}))
+    }
+
+    /// Where model and runs disagree and which effect explains it (JSON), with the model that
+    /// has the effect added (None when no effect explains enough).
+    #[pyo3(signature = (runs, dt = 0.1, integrator = "b8", with_intercept = false))]
+    fn diagnose(
+        &self,
+        py: Python<'_>,
+        runs: Vec<Run<'_>>,
+        dt: f64,
+        integrator: &str,
+        with_intercept: bool,
+    ) -> PyResult<(String, Option<PyModel>)> {
+        let frames = self.frames(runs)?;
+        let hypotheses = termid::plugins::of(&self.inner)
+            .and_then(|p| p.hypotheses(&self.inner))
+            .unwrap_or_else(|| termid::diagnose::generic_hypotheses(&self.inner));
+        let settings = termid::diagnose::Settings {
+            dt,
+            integrator: integrator_of(integrator)?,
+            with_intercepts: with_intercept,
+            ..Default::default()
+        };
+        let d = py
+            .detach(|| termid::diagnose::diagnose(&self.inner, &frames, &hypotheses, &settings))
+            .map_err(fail)?;
+        let effect = d.winner.map(|w| {
+            let c = &d.candidates[w];
+            serde_json::json!({"name": c.name, "terms": c.effect, "coefficients": c.estimate,
+                               "std_errors": c.std_error, "explained": c.explained, "delta_bic": c.delta_bic})
+        });
+        let json = serde_json::json!({
+            "location": d.location, "effect": effect, "gap_before": d.gap_before,
+            "gap_after": d.gap_after, "candidates": d.candidates,
+        });
+        Ok((to_json(&json)?, d.model.map(|inner| PyModel { inner })))
+    }
+
+    /// The plug-in's physical checks (JSON list: name, passed, refuses, detail).
+    #[pyo3(signature = (runs = vec![]))]
+    fn checks(&self, runs: Vec<Run<'_>>) -> PyResult<String> {
+        let frames = if runs.is_empty() { Vec::new() } else { self.frames(runs)? };
+        let checks =
+            termid::plugins::of(&self.inner).map(|p| p.checks(&self.inner, &frames)).unwrap_or_default();
+        to_json(&checks)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "termid.Model({:?}: {} equations, {} states)",
+            self.name(),
+            self.inner.equations().len(),
+            self.states().len()
+        )
+    }
+}
+
+/// The sufficient statistics of one equation's candidates over runs: merged associatively,
+/// written as JSON, pickled.
+#[pyclass(module = "termid._termid", name = "Moments")]
+#[derive(Clone)]
+struct PyMoments {
+    inner: EquationMoments,
+}
+
+#[pymethods]
+impl PyMoments {
+    #[staticmethod]
+    #[pyo3(signature = (text, origin = "<moments>"))]
+    fn from_json(text: &str, origin: &str) -> PyResult<Self> {
+        Ok(PyMoments { inner: EquationMoments::from_json(text, origin).map_err(fail)? })
+    }
+
+    /// The statistics of `equation` of `model` over runs (a DataFrame, dict of arrays, pyarrow
+    /// Table, or a list of them): one pass over the rows, where the rows are.
+    #[staticmethod]
+    #[pyo3(signature = (data, model, equation, derivative = "central"))]
+    fn from_frame(
+        py: Python<'_>,
+        data: &Bound<'_, PyAny>,
+        model: &Bound<'_, PyAny>,
+        equation: &str,
+        derivative: &str,
+    ) -> PyResult<PyMoments> {
+        // the Python side's conversions (pandas, pyarrow → float64 arrays), and its Model
+        let runs: Vec<Run<'_>> = py.import("termid")?.getattr("_runs")?.call1((data,))?.extract()?;
+        let native = if model.hasattr("_native")? { model.getattr("_native")? } else { model.clone() };
+        let model: PyRef<'_, PyModel> = native.extract()?;
+        model.moments(equation, runs, derivative)
+    }
+
+    fn to_json(&self) -> String {
+        self.inner.to_json()
+    }
+
+    /// The statistics of both (refused for another equation, target or candidate list).
+    fn merge(&self, other: &PyMoments) -> PyResult<PyMoments> {
+        Ok(PyMoments { inner: self.inner.clone().merge(other.inner.clone()).map_err(fail)? })
+    }
+
+    #[getter]
+    fn equation(&self) -> String {
+        self.inner.equation.clone()
+    }
+
+    #[getter]
+    fn target(&self) -> String {
+        self.inner.target.clone()
+    }
+
+    #[getter]
+    fn candidates(&self) -> Vec<String> {
+        self.inner.candidates.clone()
+    }
+
+    #[getter]
+    fn runs(&self) -> Vec<String> {
+        self.inner.runs.iter().map(|r| r.run.clone()).collect()
+    }
+
+    #[getter]
+    fn rows(&self) -> usize {
+        self.inner.runs.iter().map(|r| r.moments.count()).sum()
+    }
+
+    /// Pickling: the exact JSON text (every number round-trips).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let make = py.get_type::<PyMoments>().getattr("from_json")?;
+        Ok((make, PyTuple::new(py, [self.inner.to_json()])?))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "termid.Moments({:?}: {} candidates, {} runs, {} rows)",
+            self.inner.equation,
+            self.inner.candidates.len(),
+            self.inner.runs.len(),
+            self.rows()
+        )
+    }
+}
+
+/// One equation fitted to columns: the back-end's steps and chosen terms (JSON) and the
+/// compiled chosen terms for `predict`.
+#[pyclass(module = "termid._termid", name = "Fit")]
+struct PyFit {
+    fit: Fit,
+    chosen: Library,
+    coefficients: Vec<f64>,
+    intercept: f64,
+    parameters: BTreeMap<String, f64>,
+}
+
+#[pymethods]
+impl PyFit {
+    /// The fit as JSON: target, candidates, the back-end's steps and chosen terms, covariance.
+    fn to_json(&self) -> PyResult<String> {
+        to_json(&self.fit)
+    }
+
+    /// The report's numbers (steps with SSE and F, chosen terms with standard errors) as JSON.
+    fn report_json(&self) -> PyResult<String> {
+        to_json(&self.fit.report())
+    }
+
+    /// Σ cⱼ·termⱼ + b0 on columns (float64 arrays, read in place).
+    fn predict<'py>(
+        &self,
+        py: Python<'py>,
+        columns: &Bound<'py, PyDict>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let mut arrays = Vec::with_capacity(self.chosen.inputs().len());
+        for name in self.chosen.inputs() {
+            match (columns.get_item(name)?, self.parameters.get(name)) {
+                (Some(v), _) => arrays.push(Some(column("predict", name, &v)?)),
+                (None, Some(_)) => arrays.push(None),
+                (None, None) => return Err(refuse(format!("predict: no column `{name}`"))),
+            }
+        }
+        let slices: Vec<Option<&[f64]>> =
+            arrays.iter().map(|a| a.as_ref().and_then(|a| a.as_slice().ok())).collect();
+        let n = slices.iter().flatten().map(|s| s.len()).next().unwrap_or(0);
+        if let Some(bad) = slices.iter().flatten().find(|s| s.len() != n) {
+            return Err(refuse(format!("predict: columns of {} and {n} rows", bad.len())));
+        }
+        let sources: Vec<Source<'_>> = self
+            .chosen
+            .inputs()
+            .iter()
+            .zip(&slices)
+            .map(|(name, s)| s.map_or_else(|| Source::Constant(self.parameters[name]), Source::Column))
+            .collect();
+        let mut out = vec![self.intercept; n];
+        self.chosen.for_each_block(&sources, 0..n, |start, block| {
+            for (c, values) in self.coefficients.iter().zip(block) {
+                for (o, v) in out[start..start + values.len()].iter_mut().zip(*values) {
+                    *o += c * v;
+                }
+            }
+        });
+        Ok(out.into_pyarray(py))
+    }
+}
+
+/// One equation from columns: `target` explained by the candidate `terms` (text in termid's
+/// term language over the column names) with a back-end given as JSON settings.
+#[pyfunction]
+#[pyo3(signature = (target, columns, terms, backend = "{\"method\": \"stepwise\"}", intercept = true, forced = vec![], excluded = vec![], parameters = BTreeMap::new(), weights = None))]
+#[allow(clippy::too_many_arguments)]
+fn fit(
+    py: Python<'_>,
+    target: &str,
+    columns: &Bound<'_, PyDict>,
+    terms: Vec<String>,
+    backend: &str,
+    intercept: bool,
+    forced: Vec<String>,
+    excluded: Vec<String>,
+    parameters: BTreeMap<String, f64>,
+    weights: Option<String>,
+) -> PyResult<PyFit> {
+    let backend = backend_of(backend)?;
+    let names: Vec<String> = columns.keys().iter().map(|k| k.extract()).collect::<PyResult<_>>()?;
+    let first = names.first().ok_or_else(|| refuse("fit: no columns"))?;
+    let n = column("fit", first, &columns.get_item(first)?.expect("listed"))?.len()?;
+    // rows have no time: an index stands for it, as for `identify --no-time`
+    let time = "__row__";
+    let mut frame = Frame::new("data", time, (0..n).map(|i| i as f64).collect()).map_err(fail)?;
+    let mut vocabulary = Vocabulary::new();
+    for (name, value) in names.iter().zip(columns.values().iter()) {
+        frame.push(name, column("data", name, &value)?.as_slice()?.to_vec()).map_err(fail)?;
+        if name != target && Some(name) != weights.as_ref() {
+            vocabulary.variable(name).map_err(fail)?;
+        }
+    }
+    for name in parameters.keys() {
+        vocabulary.parameter(name).map_err(fail)?;
+    }
+    let rules =
+        parameters.iter().map(|(n, v)| (n.clone(), termid::identify::ParamValue::Value(*v))).collect();
+    let parse = |texts: &[String]| parse_terms(texts, &vocabulary).map_err(fail);
+    let (candidates, forced, excluded) = (parse(&terms)?, parse(&forced)?, parse(&excluded)?);
+    let central = termid::data::CentralDifference;
+    let how = Identification {
+        vocabulary: &vocabulary,
+        parameters: &rules,
+        differentiator: &central,
+        intercept,
+        weights,
+    };
+    let selector = backend.build();
+    let frames = [frame];
+    let fit = py
+        .detach(|| {
+            how.fit(
+                &Target::Column(target.into()),
+                &candidates,
+                &forced,
+                &excluded,
+                &frames,
+                selector.as_ref(),
+            )
+        })
+        .map_err(fail)?;
+    let chosen: Vec<Term> = fit.selection.terms.iter().map(|t| candidates[t.index].clone()).collect();
+    Ok(PyFit {
+        chosen: Library::compile(&chosen, &vocabulary).map_err(fail)?,
+        coefficients: fit.selection.terms.iter().map(|t| t.coefficient).collect(),
+        intercept: fit.selection.intercept.as_ref().map_or(0.0, |b| b.value),
+        parameters,
+        fit,
+    })
+}
+
+/// The back-ends by name, the derivative methods with their options.
+#[pyfunction]
+fn methods() -> (Vec<&'static str>, Vec<String>) {
+    let derivatives = termid::data::DIFFERENTIATORS.iter().map(|(n, o, _)| format!("{n}{o}")).collect();
+    (Backend::NAMES.to_vec(), derivatives)
+}
+
+/// The version of termid inside.
+#[pyfunction]
+fn version() -> &'static str {
+    env!("CARGO_PKG_VERSION")
+}
+
+#[pymodule]
+fn _termid(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("TermidError", m.py().get_type::<TermidError>())?;
+    m.add_class::<PyModel>()?;
+    m.add_class::<PyMoments>()?;
+    m.add_class::<PyFit>()?;
+    m.add_function(wrap_pyfunction!(fit, m)?)?;
+    m.add_function(wrap_pyfunction!(methods, m)?)?;
+    m.add_function(wrap_pyfunction!(version, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,353 @@
+"""termid: identify equations of motion from time series.
+
+Candidate terms are written as text (``u*Δu``, ``r*v^2/u``, ``abs(v)*v``); termid compiles
+them, selects the terms that matter with a regression back-end (stepwise as in IBM SSP's
+STPRG, best subset, sparse, Efroymson, ...) and writes the identified model as a file that it
+can simulate. This package calls termid's Rust library in the same process.
+
+    >>> import termid
+    >>> ship = termid.Model.default()            # Oltmann (1973), HSVA 1512
+    >>> run = ship.simulate("zigzag:20/20")      # a pandas DataFrame, SI units
+    >>> fitted = ship.identify([run])            # every equation, from the run
+    >>> fitted.coefficients("r_dot")             # a DataFrame: term, value, std_error
+
+Data is given as pandas DataFrames, dicts of numpy arrays or pyarrow Tables (columns named
+as the model's variables, SI units, angles in radians). Errors are :class:`TermidError`
+carrying termid's located message (file, row, column, or a caret under a term).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import pandas as pd
+
+from . import _termid
+from ._termid import TermidError
+
+__all__ = [
+    "Model",
+    "Moments",
+    "Fit",
+    "Identified",
+    "TermidError",
+    "fit",
+    "backends",
+    "derivatives",
+    "__version__",
+]
+
+__version__ = _termid.version()
+
+#: What a run may be: a DataFrame, a dict of arrays, a pyarrow Table (or anything with
+#: ``to_pandas``).
+Data = Any
+
+
+def _columns(data: Data) -> Dict[str, np.ndarray]:
+    """Columns as contiguous float64 arrays, without copying where the layout allows."""
+    if isinstance(data, pd.DataFrame):
+        items = ((str(c), data[c].to_numpy()) for c in data.columns)
+    elif isinstance(data, Mapping):
+        items = ((str(k), v) for k, v in data.items())
+    elif hasattr(data, "column_names") and hasattr(data, "column"):  # pyarrow Table
+        items = ((n, data.column(n).to_numpy()) for n in data.column_names)
+    elif hasattr(data, "to_pandas"):
+        return _columns(data.to_pandas())
+    else:
+        raise TypeError(
+            f"a run must be a pandas DataFrame, a dict of arrays or a pyarrow Table, not {type(data).__name__}"
+        )
+    return {name: np.ascontiguousarray(values, dtype=np.float64) for name, values in items}
+
+
+def _runs(runs: Union[Data, Sequence[Data]], names: Optional[Sequence[str]] = None) -> List[Tuple[str, Dict[str, np.ndarray]]]:
+    """Runs as (name, columns); one run may be given alone. A DataFrame's ``attrs["name"]``
+    names it in messages, else ``run1``, ``run2``, ..."""
+    if isinstance(runs, (pd.DataFrame, Mapping)) or hasattr(runs, "column_names"):
+        runs = [runs]
+    out = []
+    for k, run in enumerate(runs):
+        name = names[k] if names else getattr(run, "attrs", {}).get("name", f"run{k + 1}")
+        out.append((str(name), _columns(run)))
+    return out
+
+
+def _frame(columns: Sequence[Tuple[str, np.ndarray]]) -> pd.DataFrame:
+    return pd.DataFrame({name: values for name, values in columns})
+
+
+def _backend(backend: Optional[str], settings: Mapping[str, Any]) -> Optional[str]:
+    if backend is None:
+        if settings:
+            raise TypeError(f"back-end settings {sorted(settings)} given without a back-end")
+        return None
+    return json.dumps({"method": backend, **settings})
+
+
+def backends() -> List[str]:
+    """The regression back-ends by name (``stepwise``, ``best-subset``, ``sparse``, ...)."""
+    return list(_termid.methods()[0])
+
+
+def derivatives() -> List[str]:
+    """The derivative methods with their options (``central``, ``savitzky-golay:W:O``, ...)."""
+    return list(_termid.methods()[1])
+
+
+class Fit:
+    """One equation fitted by a back-end: its steps, chosen terms and coefficients.
+
+    ``steps`` is the back-end's table (one row per step: term entered or removed, SSE, F),
+    ``coefficients`` the chosen terms' values with standard errors, ``chosen_step`` the step
+    the back-end stopped at; ``predict`` evaluates the chosen terms, compiled, on new data.
+    """
+
+    def __init__(self, native: Any, target: str):
+        self._native = native
+        self.target = target
+        self.report: Dict[str, Any] = json.loads(native.report_json())
+        self.raw: Dict[str, Any] = json.loads(native.to_json())
+
+    @property
+    def steps(self) -> pd.DataFrame:
+        return pd.DataFrame(self.report.get("steps", []))
+
+    @property
+    def coefficients(self) -> pd.Series:
+        terms = self.report.get("terms", [])
+        return pd.Series({t["term"]: t["coefficient"] for t in terms}, name=self.target, dtype=float)
+
+    @property
+    def standard_errors(self) -> pd.Series:
+        terms = self.report.get("terms", [])
+        return pd.Series({t["term"]: t.get("std_error") for t in terms}, name=self.target, dtype=float)
+
+    @property
+    def intercept(self) -> Optional[float]:
+        b0 = self.raw["selection"].get("intercept")
+        return None if b0 is None else b0["value"]
+
+    @property
+    def chosen_step(self) -> Optional[int]:
+        return self.report.get("chosen_step")
+
+    def predict(self, data: Data) -> np.ndarray:
+        """Σ cⱼ·termⱼ + b0 on data (the compiled evaluator; numpy arrays read in place)."""
+        return self._native.predict(_columns(data))
+
+    def __repr__(self) -> str:
+        return f"termid.Fit({self.target}: {len(self.coefficients)} terms)"
+
+
+def fit(
+    data: Data,
+    target: str,
+    terms: Optional[Sequence[str]] = None,
+    backend: str = "stepwise",
+    *,
+    intercept: bool = True,
+    forced: Sequence[str] = (),
+    excluded: Sequence[str] = (),
+    parameters: Optional[Mapping[str, float]] = None,
+    weights: Optional[str] = None,
+    **settings: Any,
+) -> Fit:
+    """Fits ``target`` (a column of ``data``) by the candidate ``terms`` (text over the other
+    columns; default: every other column) with a back-end and its settings as keywords, e.g.
+    ``fit(df, "y", ["x1", "x2", "x1*x2"], "stepwise", f_in=4.0, f_out=3.9)``."""
+    columns = _columns(data)
+    if target not in columns:
+        raise TermidError(f"no column `{target}` to fit (columns: {', '.join(columns)})")
+    if terms is None:
+        terms = [c for c in columns if c not in (target, weights)]
+    native = _termid.fit(
+        target,
+        columns,
+        list(terms),
+        json.dumps({"method": backend, **settings}),
+        intercept,
+        list(forced),
+        list(excluded),
+        dict(parameters or {}),
+        weights,
+    )
+    return Fit(native, target)
+
+
+class Identified:
+    """What ``Model.identify`` returns: the identified model and each equation's fit report
+    (``steps`` and ``terms`` as DataFrames)."""
+
+    def __init__(self, model: "Model", fits: Sequence[Tuple[str, str]]):
+        self.model = model
+        self.reports: Dict[str, Dict[str, Any]] = {name: json.loads(text) for name, text in fits}
+
+    def steps(self, equation: str) -> pd.DataFrame:
+        return pd.DataFrame(self.reports[equation].get("steps", []))
+
+    def terms(self, equation: str) -> pd.DataFrame:
+        return pd.DataFrame(self.reports[equation].get("terms", []))
+
+    def chosen_step(self, equation: str) -> Optional[int]:
+        return self.reports[equation].get("chosen_step")
+
+    def __repr__(self) -> str:
+        return f"termid.Identified({self.model.name!r}: {', '.join(self.reports)})"
+
+
+class Model:
+    """A termid model file: states, inputs, parameters, derived variables and equations.
+
+    Load one (``Model.load``), take the default ship (``Model.default()``), identify its
+    equations from runs, simulate it and write it back (``save``, ``to_toml``).
+    """
+
+    def __init__(self, native: Any):
+        self._native = native
+
+    # ---- files
+    @staticmethod
+    def load(path: Union[str, os.PathLike]) -> "Model":
+        """Reads a model file; errors name the file, line and key."""
+        return Model(_termid.Model.load(os.fspath(path)))
+
+    @staticmethod
+    def from_toml(text: str, name: str = "<text>") -> "Model":
+        return Model(_termid.Model.parse(text, name))
+
+    @staticmethod
+    def default() -> "Model":
+        """Oltmann's (1973) HSVA 1512 with the coefficients of his Table 2."""
+        return Model(_termid.Model.default_model())
+
+    def to_toml(self) -> str:
+        return self._native.to_toml()
+
+    def save(self, path: Union[str, os.PathLike]) -> None:
+        self._native.save(os.fspath(path))
+
+    # ---- what it is
+    name = property(lambda self: self._native.name)
+    path = property(lambda self: self._native.path)
+    time = property(lambda self: self._native.time)
+    states = property(lambda self: list(self._native.states))
+    inputs = property(lambda self: list(self._native.inputs))
+    equations = property(lambda self: list(self._native.equations))
+    identifiable = property(lambda self: list(self._native.identifiable))
+
+    @property
+    def parameters(self) -> Dict[str, float]:
+        return dict(self._native.parameters)
+
+    def set_parameter(self, name: str, value: float) -> None:
+        self._native.set_parameter(name, float(value))
+
+    def coefficients(self, equation: str) -> pd.DataFrame:
+        """An equation's stored terms with value and standard error."""
+        rows = self._native.coefficients(equation)
+        return pd.DataFrame(rows, columns=["term", "value", "std_error"])
+
+    def intercept(self, equation: str) -> Optional[float]:
+        return self._native.intercept(equation)
+
+    # ---- identification
+    def identify(
+        self,
+        runs: Union[Data, Sequence[Data]],
+        derivative: str = "central",
+        *,
+        equations: Sequence[str] = (),
+        intercept: bool = True,
+        backend: Optional[str] = None,
+        names: Optional[Sequence[str]] = None,
+        **settings: Any,
+    ) -> Identified:
+        """Every identifiable equation (or ``equations``) from the runs, with the model's
+        candidates, forced terms and back-end (or ``backend`` with its settings as keywords)."""
+        native, fits = self._native.identify(
+            _runs(runs, names), derivative, list(equations), intercept, _backend(backend, settings)
+        )
+        return Identified(Model(native), fits)
+
+    def moments(self, equation: str, runs: Union[Data, Sequence[Data]], derivative: str = "central", names: Optional[Sequence[str]] = None) -> "Moments":
+        """The sufficient statistics of ``equation`` over runs (see :class:`Moments`)."""
+        return self._native.moments(equation, _runs(runs, names), derivative)
+
+    def identify_from_moments(self, moments: Union["Moments", Sequence["Moments"]], intercept: bool = True) -> Identified:
+        """The model identified from statistics, merged per equation in the order given:
+        the same model as from the rows together."""
+        if isinstance(moments, _termid.Moments):
+            moments = [moments]
+        native, fits = self._native.identify_from_moments(list(moments), intercept)
+        return Identified(Model(native), fits)
+
+    # ---- prediction and simulation
+    def predict(self, run: Data, with_intercept: bool = False) -> pd.DataFrame:
+        """ẋ of every state on every row of a run (columns ``<state>_dot``)."""
+        return _frame(self._native.predict(_runs(run)[0], with_intercept))
+
+    def simulate(
+        self,
+        scenario: str,
+        *,
+        dt: float = 0.1,
+        duration: Optional[float] = None,
+        sample: Optional[float] = None,
+        integrator: str = "b8",
+        with_intercept: bool = False,
+    ) -> pd.DataFrame:
+        """A plug-in's scenario (``zigzag:20/20``, ``turning:35``, ``spiral``): the run as a
+        DataFrame (SI, radians), its metrics in ``df.attrs["metrics"]``."""
+        columns, metrics, label, text = self._native.simulate(scenario, dt, duration, sample, integrator, with_intercept)
+        frame = _frame(columns)
+        frame.attrs.update(name=label, metrics=json.loads(metrics), report=list(text))
+        return frame
+
+    def record(
+        self,
+        manoeuvre: str,
+        *,
+        speed: float = 1.0,
+        duration: float = 100.0,
+        seed: int = 0,
+        tracked: bool = False,
+        truth: bool = False,
+    ) -> pd.DataFrame:
+        """A ship's manoeuvre recorded as in termid's synthetic basin: 20 Hz, a straight
+        approach, sensor noise fixed by ``seed``, approach speed ``speed`` × u0 (``tracked``:
+        u and v from an optical track, a rudder offset, the rudder back at midship). The
+        measured run, or with ``truth=True`` the noise-free one."""
+        measured, exact = self._native.record(manoeuvre, speed, duration, seed, tracked)
+        frame = _frame(exact if truth else measured)
+        frame.attrs["name"] = f"{manoeuvre}#{seed}"
+        return frame
+
+    def replay(self, runs: Union[Data, Sequence[Data]], *, dt: float = 0.1, integrator: str = "b8", with_intercept: bool = False) -> List[pd.DataFrame]:
+        """Each run re-simulated from its recorded initial state with its recorded inputs."""
+        return [_frame(c) for c in self._native.replay(_runs(runs), dt, integrator, with_intercept)]
+
+    def validate(self, runs: Union[Data, Sequence[Data]], *, dt: float = 0.1, integrator: str = "b8", with_intercept: bool = False) -> Dict[str, Any]:
+        """Held-out runs against the model: per state RMS and largest error, and for a ship
+        the metrics (overshoots, tactical diameter, ...) measured and simulated."""
+        return json.loads(self._native.validate(_runs(runs), dt, integrator, with_intercept))
+
+    def diagnose(self, runs: Union[Data, Sequence[Data]], *, dt: float = 0.1, integrator: str = "b8", with_intercept: bool = False) -> Tuple[Dict[str, Any], Optional["Model"]]:
+        """Where model and runs disagree, which effect explains it, and the model with it."""
+        text, native = self._native.diagnose(_runs(runs), dt, integrator, with_intercept)
+        return json.loads(text), (Model(native) if native is not None else None)
+
+    def checks(self, runs: Union[Data, Sequence[Data], None] = None) -> pd.DataFrame:
+        """The plug-in's physical checks (stability, damping signs, turning circles)."""
+        return pd.DataFrame(json.loads(self._native.checks(_runs(runs) if runs is not None else [])))
+
+    def __repr__(self) -> str:
+        return repr(self._native)
+
+
+#: Sufficient statistics of one equation: ``Moments.from_frame(df, model, "r_dot")``,
+#: ``a.merge(b)``, ``pickle.dumps(m)``, ``model.identify_from_moments([a, b])``.
+Moments = _termid.Moments

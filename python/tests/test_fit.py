@@ -1,0 +1,64 @@
+"""One equation from columns: termid.fit against published numbers and closed forms."""
+import numpy as np
+import pandas as pd
+import pytest
+
+import termid
+
+
+def test_hald_stepwise_follows_draper_and_smith(hald):
+    fit = termid.fit(hald, "y", ["x1", "x2", "x3", "x4"], "stepwise", min_proportion=0.0)
+    # the order in which the terms enter (Draper & Smith, Applied Regression Analysis)
+    assert list(fit.steps["term"]) == ["x4", "x1", "x2", "x3"]
+    first = termid.fit(hald, "y", ["x4"], "stepwise")
+    # y = 117.57 − 0.7382 x4
+    assert first.coefficients["x4"] == pytest.approx(-0.738162, abs=1e-5)
+    assert first.intercept == pytest.approx(117.5679, abs=1e-3)
+
+
+def test_exact_relation_is_recovered_and_predicted():
+    rng = np.random.default_rng(1)
+    x1, x2 = rng.normal(size=200), rng.normal(size=200)
+    df = pd.DataFrame({"x1": x1, "x2": x2, "y": 2.0 + 3.0 * x1 * x2 - 0.5 * x2**3})
+    fit = termid.fit(df, "y", ["x1", "x2", "x1*x2", "x2^3", "x1^2"], "best-subset")
+    coefficients = fit.coefficients
+    assert set(coefficients.index) == {"x1*x2", "x2^3"}
+    assert coefficients["x1*x2"] == pytest.approx(3.0, abs=1e-9)
+    assert coefficients["x2^3"] == pytest.approx(-0.5, abs=1e-9)
+    new = {"x1": np.array([1.0, 2.0]), "x2": np.array([0.5, -1.0])}
+    np.testing.assert_allclose(fit.predict(new), 2.0 + 3.0 * new["x1"] * new["x2"] - 0.5 * new["x2"] ** 3)
+
+
+def test_dict_dataframe_and_arrow_give_the_same_fit(hald):
+    pa = pytest.importorskip("pyarrow")
+    as_frame = termid.fit(hald, "y", backend="stepwise")
+    as_dict = termid.fit({c: hald[c].to_numpy() for c in hald.columns}, "y", backend="stepwise")
+    as_arrow = termid.fit(pa.Table.from_pandas(hald), "y", backend="stepwise")
+    pd.testing.assert_series_equal(as_frame.coefficients, as_dict.coefficients)
+    pd.testing.assert_series_equal(as_frame.coefficients, as_arrow.coefficients)
+
+
+def test_every_back_end_by_name(hald):
+    for name in termid.backends():
+        fit = termid.fit(hald, "y", ["x1", "x2", "x3", "x4"], name)
+        assert len(fit.coefficients) >= 1, name
+
+
+def test_a_typo_in_a_term_shows_a_caret(hald):
+    with pytest.raises(termid.TermidError) as e:
+        termid.fit(hald, "y", ["x1*", "x2"])
+    assert "^" in str(e.value)
+
+
+def test_nan_is_refused_with_its_row(hald):
+    bad = hald.copy()
+    bad.loc[3, "x2"] = np.nan
+    with pytest.raises(termid.TermidError, match=r"row 4.*x2"):
+        termid.fit(bad, "y")
+
+
+def test_unknown_back_end_and_setting_are_refused(hald):
+    with pytest.raises(termid.TermidError, match="stepwise"):
+        termid.fit(hald, "y", backend="lasso-of-dreams")
+    with pytest.raises(termid.TermidError, match="f_in"):
+        termid.fit(hald, "y", backend="stepwise", f_in=4.0)

@@ -1,0 +1,98 @@
+"""Model files from Python: load, write, identify, predict, simulate, validate."""
+import os
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import termid
+
+
+def test_default_ship_round_trips_through_toml(ship, tmp_path):
+    path = tmp_path / "ship.toml"
+    ship.save(path)
+    again = termid.Model.load(path)
+    assert again.equations == ship.equations
+    pd.testing.assert_frame_equal(again.coefficients("r_dot"), ship.coefficients("r_dot"))
+    assert termid.Model.from_toml(ship.to_toml()).states == ["u", "v", "r", "ψ", "x0", "y0"]
+
+
+def test_a_model_file_error_names_file_and_key(ship, tmp_path):
+    text = ship.to_toml().replace('"u*r",', '"u*r*",', 1)
+    path = tmp_path / "typo.toml"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(termid.TermidError) as e:
+        termid.Model.load(path)
+    message = str(e.value)
+    assert "typo.toml" in message and "^" in message
+
+
+def test_identify_from_exact_zigzags_gives_table_2(ship, zigzags):
+    identified = ship.identify(zigzags, "central")
+    # the paper's Table 2 (the default model's own coefficients) comes back from exact runs
+    truth = ship.coefficients("r_dot").set_index("term")["value"]
+    found = identified.model.coefficients("r_dot").set_index("term")["value"]
+    for term in ["r*u", "u*v", "u^2*δ"]:
+        assert found[term] == pytest.approx(truth[term], rel=2e-2), term
+    steps = identified.steps("r_dot")
+    assert {"term", "f", "r2"} <= set(steps.columns)
+
+
+def test_predict_is_the_model_right_hand_side(ship, zigzags):
+    run = zigzags[0]
+    predicted = ship.predict(run)
+    # the simulation's own ẋ columns at its samples (the same equations)
+    np.testing.assert_allclose(predicted["r_dot"], run["r_dot"], atol=1e-12)
+    np.testing.assert_allclose(predicted["v_dot"], run["v_dot"], atol=1e-12)
+
+
+def test_simulate_zigzag_metrics(ship):
+    run = ship.simulate("zigzag:20/20", dt=0.01)
+    assert list(run.columns[:3]) == ["t", "u", "v"]
+    metrics = run.attrs["metrics"]
+    # the first overshoot read off the run's own heading: its largest excursion beyond the
+    # 20° check between the first and the second rudder reversal
+    psi, delta = np.degrees(run["ψ"].to_numpy()), np.degrees(run["δ"].to_numpy())
+    first = np.argmax(psi >= 20.0)
+    second = first + np.argmax(psi[first:] <= -20.0)
+    assert metrics["first_overshoot_deg"] == pytest.approx(psi[first:second].max() - 20.0, abs=0.05)
+    assert np.abs(delta).max() == pytest.approx(20.0, abs=1.0)
+
+
+def test_replay_and_validate_of_the_models_own_run(ship, zigzags):
+    replayed = ship.replay(zigzags[0])[0]
+    np.testing.assert_allclose(replayed["r"].to_numpy(), zigzags[0]["r"].to_numpy(), atol=1e-9)
+    report = ship.validate(zigzags[:1])
+    # per state: name, unit, RMS error, largest error
+    for name, unit, rms, largest in report["gap"]["states"]:
+        assert rms < 1e-9 and largest < 1e-9, name
+
+
+def test_plain_ascii_columns_are_read_as_aliases(ship, zigzags):
+    run = zigzags[0].rename(columns={"δ": "delta", "ψ": "psi"})
+    with pytest.warns(UserWarning, match="alias"):
+        predicted = ship.predict(run)
+    assert "r_dot" in predicted
+
+
+def test_degrees_in_a_radian_column_are_refused(ship, zigzags):
+    run = zigzags[0].copy()
+    run["δ"] = np.degrees(run["δ"]) * 10.0
+    with pytest.raises(termid.TermidError, match="degrees"):
+        ship.predict(run)
+
+
+def test_checks_and_diagnose(ship, zigzags):
+    checks = ship.checks()
+    assert {"name", "passed", "refuses", "detail"} <= set(checks.columns)
+    assert checks["passed"].all()
+    report, improved = ship.diagnose(zigzags[:2])
+    assert "gap_before" in report
+
+
+def test_basin_records_are_noisy_and_seeded(ship):
+    a = ship.record("zigzag:20/20", seed=3, duration=40.0)
+    b = ship.record("zigzag:20/20", seed=3, duration=40.0)
+    exact = ship.record("zigzag:20/20", seed=3, duration=40.0, truth=True)
+    pd.testing.assert_frame_equal(a, b)
+    assert 0 < (a["r"] - exact["r"]).std() < 1e-2

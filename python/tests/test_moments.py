@@ -1,0 +1,38 @@
+"""Mergeable statistics: shards of runs merged give the fit of all rows together."""
+import pickle
+
+import pytest
+
+import termid
+
+
+def test_merged_moments_fit_as_the_rows_do(ship, zigzags):
+    whole = ship.identify(zigzags, "central", equations=["r_dot"])
+    parts = [termid.Moments.from_frame(run, ship, "r_dot") for run in zigzags]
+    merged = parts[0]
+    for p in parts[1:]:
+        merged = merged.merge(p)
+    assert merged.rows == sum(len(r) for r in zigzags)
+    from_moments = ship.identify_from_moments(merged)
+    a = whole.model.coefficients("r_dot").set_index("term")["value"]
+    b = from_moments.model.coefficients("r_dot").set_index("term")["value"]
+    assert list(a.index) == list(b.index)
+    for term in a.index:
+        assert b[term] == pytest.approx(a[term], rel=1e-10, abs=1e-14)
+    # merging is associative: the same statistics in another grouping
+    other = parts[0].merge(parts[1].merge(parts[2]).merge(parts[3])).merge(parts[4])
+    assert other.to_json() == merged.to_json()
+
+
+def test_moments_pickle_exactly(ship, zigzags):
+    m = termid.Moments.from_frame(zigzags[:2], ship, "v_dot")
+    again = pickle.loads(pickle.dumps(m))
+    assert again.to_json() == m.to_json()
+    assert again.runs == m.runs and again.candidates == m.candidates
+
+
+def test_statistics_of_other_equations_do_not_merge(ship, zigzags):
+    a = termid.Moments.from_frame(zigzags[0], ship, "v_dot")
+    b = termid.Moments.from_frame(zigzags[0], ship, "r_dot")
+    with pytest.raises(termid.TermidError, match="cannot be merged"):
+        a.merge(b)
