@@ -24,16 +24,19 @@ TERMS = ["u^2", "u*v", "u*r", "u^2*delta", "v^3/u", "v^2*r/u", "v*r^2/u", "r^3/u
 
 
 def design(files):
-    cols, ys = [], {"v_dot": [], "r_dot": []}
+    """The 29 candidates' matrix, the targets, and the variables the terms are written in."""
+    cols, ys, variables = [], {"v_dot": [], "r_dot": []}, []
     for f in sorted(files):
         d = np.genfromtxt(f, delimiter=",", names=True, encoding="utf-8", comments="#")
         u, v, r, delta = d["u"], d["v"], d["r"], d["δ"] if "δ" in d.dtype.names else d["delta"]
         du = u - u[0]
         env = {"u": u, "v": v, "r": r, "delta": delta, "du": du}
         cols.append(np.column_stack([eval(t.replace("^", "**"), {}, env) for t in TERMS]))
+        variables.append(env)
         ys["v_dot"].append(d["v_dot"])
         ys["r_dot"].append(d["r_dot"])
-    return np.vstack(cols), {k: np.concatenate(v) for k, v in ys.items()}
+    variables = {k: np.concatenate([e[k] for e in variables]) for k in variables[0]}
+    return np.vstack(cols), {k: np.concatenate(v) for k, v in ys.items()}, variables
 
 
 def timed(fn, repeat, warm_up=0.3):
@@ -107,6 +110,27 @@ def relative(base, t):
     return f"{base / t:.1f}x faster" if t <= base else f"{t / base:.1f}x slower"
 
 
+def in_process(X, ys, variables, repeat):
+    """termid called in this Python process (the package in python/): the stepwise from a
+    pandas DataFrame of the finished matrix, timed with the call and the conversion, and
+    `predict` of the 29 terms (compiled, all forced in) on the 2 505 rows of the variables."""
+    import pandas as pd
+    import termid
+
+    names = [f"c{j}" for j in range(X.shape[1])]
+    out = {}
+    for eq, y in ys.items():
+        frame = pd.DataFrame(X, columns=names).assign(y=y)
+        t, fit = timed(lambda: termid.fit(frame, "y", names, "stepwise"), repeat)
+        out[("python-stepwise", eq)] = (t, len(fit.coefficients))
+    data = pd.DataFrame(variables)
+    fit = termid.fit(data.assign(y=ys["r_dot"]), "y", TERMS, "stepwise", forced=TERMS)
+    columns = {k: np.ascontiguousarray(v) for k, v in variables.items()}
+    t_dict, _ = timed(lambda: fit.predict(columns), repeat)
+    t_frame, _ = timed(lambda: fit.predict(data), repeat)
+    return out, (len(fit.coefficients), len(data), t_dict, t_frame)
+
+
 def termid_times(binary, files, repeat, model=None):
     extra = ["--model", model] if model else []
     out = subprocess.run([binary, "compare", *extra, "--equation", "v_dot", "r_dot", "--repeat", str(repeat),
@@ -155,7 +179,7 @@ def main():
     ap.add_argument("--quick", action="store_true", help="skip the 10^6 x 100 problem")
     a = ap.parse_args()
     files = [f for f in glob.glob(os.path.join(a.data, "z*.csv")) if "alt5" not in f]
-    X, ys = design(files)
+    X, ys, variables = design(files)
     ours = termid_times(a.termid, files, a.repeat)
     # the sparse path with λ chosen by cross-validation (leave one run out), as LassoCV does
     here = os.path.dirname(os.path.abspath(__file__))
@@ -170,6 +194,8 @@ def main():
         ours[("sparse-cv", eq)] = cv[("sparse", eq)]
     for eq, r in finished_matrix(a.termid, X, ys, a.repeat, os.path.join(here, "work")).items():
         ours[("stepwise-matrix", eq)] = r
+    python, (n_terms, n_rows, t_dict, t_frame) = in_process(X, ys, variables, a.repeat)
+    ours.update(python)
     print(f"# termid and its peers ({platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
           f"numpy {np.__version__})\n")
     print(f"Combined data of the five zigzags: {X.shape[0]} rows x {X.shape[1]} candidates. "
@@ -184,12 +210,18 @@ def main():
         labels = {"sparse": "sparse (λ by BIC)", "sparse-cv": "sparse (λ by leave-one-run-out CV)",
                   "stepwise": "stepwise (terms evaluated from the runs)",
                   "stepwise-matrix": "stepwise (the peers' finished matrix)"}
-        for name in ["stepwise", "stepwise-matrix", "efroymson", "best-subset", "sparse", "sparse-cv"]:
+        labels["python-stepwise"] = "stepwise from Python: `termid.fit(DataFrame)` in this process, with the conversion"
+        for name in ["stepwise", "stepwise-matrix", "python-stepwise", "efroymson", "best-subset", "sparse",
+                     "sparse-cv"]:
             t, k = ours[(name, eq)]
             print(f"| termid {labels.get(name, name)} | {t * 1e3:.3f} | {k} | {relative(base, t)} |")
         for name, t, k in rows:
             print(f"| {name} | {t * 1e3:.3f} | {k} | {relative(base, t)} |")
         print()
+    print(f"## predict from Python\n\n`Fit.predict` of the {n_terms} terms (compiled; `v^3/u`, `u*du*delta`, ...) "
+          f"on {n_rows} rows, in this process: {t_dict * 1e6:.1f} µs from a dict of numpy arrays, "
+          f"{t_frame * 1e6:.1f} µs from a pandas DataFrame (PySINDy's `predict`: ~5 ms for a similar size, "
+          "its issue #653).\n")
     if not a.quick:
         rng = np.random.default_rng(7)
         n, p = 1_000_000, 100

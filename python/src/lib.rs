@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::PyException;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyTuple};
+use pyo3::types::{PyBytes, PyDict, PyTuple};
 use termid::data::{differentiator, Frame};
 use termid::identify::{EquationMoments, Fit, Identification, ModelIdentification, Target};
 use termid::model::Model;
@@ -230,6 +230,32 @@ impl PyModel {
         Ok(eq.coefficients.iter().map(|(t, c, s)| (t.to_string(), *c, *s)).collect())
     }
 
+    /// Replaces an equation's coefficients: (term text, value, standard error or None) in the
+    /// model's term language, and the intercept b0 (simulated only when asked).
+    #[pyo3(signature = (equation, coefficients, intercept = None))]
+    fn set_coefficients(
+        &mut self,
+        equation: &str,
+        coefficients: Vec<(String, f64, Option<f64>)>,
+        intercept: Option<f64>,
+    ) -> PyResult<()> {
+        if self.inner.equation(equation).is_none() {
+            return Err(refuse(format!(
+                "{}: no equation `{equation}` (equations: {})",
+                self.inner.path,
+                self.equations().join(", ")
+            )));
+        }
+        let texts: Vec<&String> = coefficients.iter().map(|(t, _, _)| t).collect();
+        let terms = parse_terms(&texts, &self.inner.vocabulary).map_err(fail)?;
+        if let Some((t, v, _)) = coefficients.iter().find(|(_, v, _)| !v.is_finite()) {
+            return Err(refuse(format!("`{t}`: coefficient {v} is not finite")));
+        }
+        let values = terms.into_iter().zip(coefficients).map(|(t, (_, v, s))| (t, v, s)).collect();
+        self.inner.set_coefficients(equation, values, intercept);
+        Ok(())
+    }
+
     fn intercept(&self, equation: &str) -> Option<f64> {
         self.inner.equation(equation).and_then(|e| e.intercept)
     }
@@ -275,14 +301,25 @@ impl PyModel {
         Ok((PyModel { inner: identified.model }, fits))
     }
 
-    /// The sufficient statistics of one equation over runs (mergeable, picklable).
-    #[pyo3(signature = (equation, runs, derivative = "central"))]
-    fn moments(&self, equation: &str, runs: Vec<Run<'_>>, derivative: &str) -> PyResult<PyMoments> {
+    /// The sufficient statistics of each of `equations` over runs (mergeable, picklable); the
+    /// runs are read once for all of them.
+    #[pyo3(signature = (equations, runs, derivative = "central"))]
+    fn moments(
+        &self,
+        equations: Vec<String>,
+        runs: Vec<Run<'_>>,
+        derivative: &str,
+    ) -> PyResult<Vec<PyMoments>> {
         let frames = self.frames(runs)?;
         let diff = differentiator(derivative).map_err(fail)?;
-        let inner =
-            EquationMoments::of_runs(&self.inner, equation, &frames, diff.as_ref(), None).map_err(fail)?;
-        Ok(PyMoments { inner })
+        equations
+            .iter()
+            .map(|eq| {
+                let inner =
+                    EquationMoments::of_runs(&self.inner, eq, &frames, diff.as_ref(), None).map_err(fail)?;
+                Ok(PyMoments { inner })
+            })
+            .collect()
     }
 
     /// The model identified from statistics (merged per equation in the order given).
@@ -486,6 +523,12 @@ impl PyModel {
         to_json(&checks)
     }
 
+    /// Pickling (to a worker process): the model file's text and its name.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (String, String))> {
+        let make = py.get_type::<PyModel>().getattr("parse")?;
+        Ok((make, (self.inner.to_toml(), self.inner.path.clone())))
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "termid.Model({:?}: {} equations, {} states)",
@@ -527,7 +570,7 @@ impl PyMoments {
         let runs: Vec<Run<'_>> = py.import("termid")?.getattr("_runs")?.call1((data,))?.extract()?;
         let native = if model.hasattr("_native")? { model.getattr("_native")? } else { model.clone() };
         let model: PyRef<'_, PyModel> = native.extract()?;
-        model.moments(equation, runs, derivative)
+        Ok(model.moments(vec![equation.to_string()], runs, derivative)?.remove(0))
     }
 
     fn to_json(&self) -> String {
@@ -564,10 +607,21 @@ impl PyMoments {
         self.inner.runs.iter().map(|r| r.moments.count()).sum()
     }
 
-    /// Pickling: the exact JSON text (every number round-trips).
+    /// The statistics as compact bytes (exact; what pickling sends).
+    fn to_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
+        PyBytes::new(py, &self.inner.to_bytes())
+    }
+
+    #[staticmethod]
+    #[pyo3(signature = (data, origin = "<moments>"))]
+    fn from_bytes(data: &[u8], origin: &str) -> PyResult<Self> {
+        Ok(PyMoments { inner: EquationMoments::from_bytes(data, origin).map_err(fail)? })
+    }
+
+    /// Pickling: the compact bytes (every number exact).
     fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
-        let make = py.get_type::<PyMoments>().getattr("from_json")?;
-        Ok((make, PyTuple::new(py, [self.inner.to_json()])?))
+        let make = py.get_type::<PyMoments>().getattr("from_bytes")?;
+        Ok((make, PyTuple::new(py, [self.to_bytes(py)])?))
     }
 
     fn __repr__(&self) -> String {

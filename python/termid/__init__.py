@@ -50,6 +50,14 @@ Data = Any
 def _columns(data: Data) -> Dict[str, np.ndarray]:
     """Columns as contiguous float64 arrays, without copying where the layout allows."""
     if isinstance(data, pd.DataFrame):
+        # one column-major copy of the whole frame is faster than a conversion per column
+        # (pandas' column access costs ~15 µs each); its columns are then contiguous views
+        try:
+            block = np.asfortranarray(data.to_numpy(dtype=np.float64))
+        except (TypeError, ValueError):
+            block = None
+        if block is not None:
+            return {str(c): block[:, j] for j, c in enumerate(data.columns)}
         items = ((str(c), data[c].to_numpy()) for c in data.columns)
     elif isinstance(data, Mapping):
         items = ((str(k), v) for k, v in data.items())
@@ -109,8 +117,22 @@ class Fit:
     def __init__(self, native: Any, target: str):
         self._native = native
         self.target = target
-        self.report: Dict[str, Any] = json.loads(native.report_json())
-        self.raw: Dict[str, Any] = json.loads(native.to_json())
+        self._report: Optional[Dict[str, Any]] = None
+        self._raw: Optional[Dict[str, Any]] = None
+
+    @property
+    def report(self) -> Dict[str, Any]:
+        """The fit's report (steps, terms, chosen step, stop) as plain values; read on first use."""
+        if self._report is None:
+            self._report = json.loads(self._native.report_json())
+        return self._report
+
+    @property
+    def raw(self) -> Dict[str, Any]:
+        """The whole fit (selection, candidates, covariance) as plain values."""
+        if self._raw is None:
+            self._raw = json.loads(self._native.to_json())
+        return self._raw
 
     @property
     def steps(self) -> pd.DataFrame:
@@ -254,6 +276,18 @@ class Model:
     def intercept(self, equation: str) -> Optional[float]:
         return self._native.intercept(equation)
 
+    def set_coefficients(
+        self, equation: str, coefficients: Union[Mapping[str, float], pd.Series, pd.DataFrame], intercept: Optional[float] = None
+    ) -> None:
+        """Replaces an equation's terms and coefficients: ``{"u*v": -0.23, ...}``, a Series
+        indexed by term, or a DataFrame like ``coefficients()`` returns."""
+        if isinstance(coefficients, pd.DataFrame):
+            rows = [(str(t), float(v), None if pd.isna(s) else float(s))
+                    for t, v, s in zip(coefficients["term"], coefficients["value"], coefficients.get("std_error", [None] * len(coefficients)))]
+        else:
+            rows = [(str(t), float(v), None) for t, v in dict(coefficients).items()]
+        self._native.set_coefficients(equation, rows, intercept)
+
     # ---- identification
     def identify(
         self,
@@ -273,9 +307,19 @@ class Model:
         )
         return Identified(Model(native), fits)
 
-    def moments(self, equation: str, runs: Union[Data, Sequence[Data]], derivative: str = "central", names: Optional[Sequence[str]] = None) -> "Moments":
-        """The sufficient statistics of ``equation`` over runs (see :class:`Moments`)."""
-        return self._native.moments(equation, _runs(runs, names), derivative)
+    def moments(
+        self,
+        equation: Union[str, Sequence[str]],
+        runs: Union[Data, Sequence[Data]],
+        derivative: str = "central",
+        names: Optional[Sequence[str]] = None,
+    ) -> Any:
+        """The sufficient statistics of ``equation`` over runs (see :class:`Moments`); given a
+        list of equations, a dict of each one's, the runs read once for all."""
+        if isinstance(equation, str):
+            return self._native.moments([equation], _runs(runs, names), derivative)[0]
+        found = self._native.moments(list(equation), _runs(runs, names), derivative)
+        return dict(zip(equation, found))
 
     def identify_from_moments(self, moments: Union["Moments", Sequence["Moments"]], intercept: bool = True) -> Identified:
         """The model identified from statistics, merged per equation in the order given:

@@ -218,6 +218,21 @@ impl DataError {
     }
 }
 
+/// Whether every value is a number (not NaN, not ±∞): v − v is 0 for a number and NaN
+/// otherwise, summed in eight independent lanes so that the compiler vectorises it.
+#[allow(clippy::eq_op)] // v − v on purpose
+fn all_finite(values: &[f64]) -> bool {
+    let mut lanes = [0.0f64; 8];
+    let chunks = values.chunks_exact(8);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for (l, v) in lanes.iter_mut().zip(c) {
+            *l += v - v;
+        }
+    }
+    lanes.iter().sum::<f64>() == 0.0 && rest.iter().all(|v| v.is_finite())
+}
+
 /// Named f64 columns over a strictly increasing time column.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Frame {
@@ -255,7 +270,12 @@ impl Frame {
                 });
             }
         }
-        if let Some((i, &v)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        // v − v is 0 for a number and NaN for NaN/±∞: one sum the compiler vectorises (the
+        // row-by-row search ran at a fifth of the speed); the row only when there is one
+        let finite = all_finite(&values);
+        if let Some((i, &v)) =
+            (!finite).then(|| values.iter().enumerate().find(|(_, v)| !v.is_finite())).flatten()
+        {
             return Err(DataError::NonFinite {
                 file: self.origin.clone(),
                 row: i + 1,

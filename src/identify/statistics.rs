@@ -114,6 +114,72 @@ impl EquationMoments {
         serde_json::to_string(self).unwrap_or_default()
     }
 
+    /// The statistics as bytes: a JSON header (equation, target, candidates, each run's name
+    /// and row count) after its length, then every run's [`Moments::numbers`] as little-endian
+    /// f64 — exact, and several times smaller and faster than the JSON of
+    /// [`EquationMoments::to_json`] (what pickling sends between processes).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let header = serde_json::json!({
+            "equation": self.equation,
+            "target": self.target,
+            "candidates": self.candidates,
+            "runs": self.runs.iter().map(|r| (&r.run, r.moments.count())).collect::<Vec<_>>(),
+        })
+        .to_string();
+        let mut out =
+            Vec::with_capacity(8 + header.len() + self.runs.len() * 8 * (self.candidates.len() + 2).pow(2));
+        out.extend_from_slice(&(header.len() as u64).to_le_bytes());
+        out.extend_from_slice(header.as_bytes());
+        for r in &self.runs {
+            for v in r.moments.numbers() {
+                out.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        out
+    }
+
+    /// Reads [`EquationMoments::to_bytes`], checked to be whole; `origin` names them in errors.
+    pub fn from_bytes(bytes: &[u8], origin: &str) -> Result<EquationMoments, IdentifyError> {
+        let broken = |why: &str| {
+            IdentifyError::Setup(format!("{origin}: not termid's statistics of an equation: {why}"))
+        };
+        let (size, rest) = bytes.split_first_chunk::<8>().ok_or_else(|| broken("too short"))?;
+        let size = usize::try_from(u64::from_le_bytes(*size)).map_err(|_| broken("header size"))?;
+        let (header, mut numbers) = (rest.get(..size), rest.get(size..).unwrap_or_default());
+        #[derive(Deserialize)]
+        struct Header {
+            equation: String,
+            target: String,
+            candidates: Vec<String>,
+            runs: Vec<(String, usize)>,
+        }
+        let header: Header = header
+            .and_then(|h| serde_json::from_slice(h).ok())
+            .ok_or_else(|| broken("the header is not readable"))?;
+        let p = header.candidates.len();
+        let per_run = 1 + (p + 1) + (p + 1) * (p + 2) / 2;
+        if numbers.len() != header.runs.len() * per_run * 8 {
+            return Err(broken("the numbers do not fit the candidates and runs"));
+        }
+        let mut runs = Vec::with_capacity(header.runs.len());
+        for (run, count) in header.runs {
+            let (these, rest) = numbers.split_at(per_run * 8);
+            numbers = rest;
+            let values: Vec<f64> =
+                these.chunks_exact(8).map(|b| f64::from_le_bytes(b.try_into().unwrap_or_default())).collect();
+            let moments = Moments::from_numbers(p, count, &values)
+                .filter(Moments::is_consistent)
+                .ok_or_else(|| broken(&format!("the statistics of run `{run}` are not whole")))?;
+            runs.push(RunMoments { run, moments });
+        }
+        Ok(EquationMoments {
+            equation: header.equation,
+            target: header.target,
+            candidates: header.candidates,
+            runs,
+        })
+    }
+
     /// Identifies the equation from the statistics with the model's forced and excluded terms
     /// and back-end, as [`super::fit_equation`] would from the rows.
     pub fn fit(&self, model: &Model, intercept: bool) -> Result<Fit, IdentifyError> {
@@ -227,7 +293,10 @@ mod tests {
                 let shard = |range: std::ops::Range<usize>| {
                     let m = EquationMoments::of_runs(&model, eq, &frames[range], &CentralDifference, None)
                         .unwrap();
-                    EquationMoments::from_json(&m.to_json(), "shard").unwrap()
+                    let read = EquationMoments::from_json(&m.to_json(), "shard").unwrap();
+                    // the bytes a worker sends carry the same statistics exactly
+                    assert_eq!(EquationMoments::from_bytes(&m.to_bytes(), "shard").unwrap(), read);
+                    read
                 };
                 let (a, b, c) = (shard(0..1), shard(1..2), shard(2..3));
                 let left = a.clone().merge(b.clone()).unwrap().merge(c.clone()).unwrap();
@@ -255,6 +324,23 @@ mod tests {
     }
 
     #[test]
+    fn broken_bytes_are_refused() {
+        let lorenz = Model::load(Path::new("models/lorenz.toml")).unwrap();
+        let frames = runs(&lorenz);
+        let bytes =
+            EquationMoments::of_runs(&lorenz, "x_dot", &frames, &CentralDifference, None).unwrap().to_bytes();
+        for cut in [0, 5, 40, bytes.len() - 8, bytes.len() - 1] {
+            let e = EquationMoments::from_bytes(&bytes[..cut], "x.moments").unwrap_err().to_string();
+            assert!(e.starts_with("x.moments: not termid's statistics"), "{e}");
+        }
+        let mut nan = bytes.clone();
+        let n = nan.len();
+        nan[n - 8..].copy_from_slice(&f64::NAN.to_le_bytes());
+        let e = EquationMoments::from_bytes(&nan, "x.moments").unwrap_err().to_string();
+        assert!(e.contains("not whole"), "{e}");
+    }
+
+    #[test]
     fn statistics_of_another_equation_or_broken_are_refused() {
         let lorenz = Model::load(Path::new("models/lorenz.toml")).unwrap();
         let frames = runs(&lorenz);
@@ -262,9 +348,9 @@ mod tests {
         let z = EquationMoments::of_runs(&lorenz, "z_dot", &frames[..1], &CentralDifference, None).unwrap();
         let e = x.clone().merge(z).unwrap_err().to_string();
         assert!(e.contains("cannot be merged"), "{e}");
-        let text = x.to_json().replacen("\"mean\":[", "\"mean\":[1.0,", 1);
+        let text = x.to_json().replacen("\"numbers\":[", "\"numbers\":[1.0,", 1);
         let e = EquationMoments::from_json(&text, "s.moments").unwrap_err().to_string();
-        assert!(e.contains("s.moments") && e.contains("not whole"), "{e}");
+        assert!(e.contains("s.moments") && e.contains("do not make the statistics of 9 regressors"), "{e}");
         let e = EquationMoments::from_json("{\"equation\": 3}", "s.moments").unwrap_err().to_string();
         assert!(e.contains("s.moments"), "{e}");
     }

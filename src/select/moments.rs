@@ -18,6 +18,7 @@ const CHUNK: usize = 512;
 /// statistics of a shard of rows are a value to write, send and merge (JSON numbers round-trip
 /// exactly).
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[serde(into = "Packed", try_from = "Packed")]
 pub struct Moments {
     p: usize,
     count: usize,
@@ -27,6 +28,30 @@ pub struct Moments {
     /// matrix is symmetric, and mirroring every chunk's products cost more than reading
     /// (i, j) as (j, i).
     comoment: Vec<f64>,
+}
+
+/// How statistics are written: the regressors, the rows, and [`Moments::numbers`] (the lower
+/// triangle only, so the text is canonical and half the size).
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Packed {
+    p: usize,
+    count: usize,
+    numbers: Vec<f64>,
+}
+
+impl From<Moments> for Packed {
+    fn from(m: Moments) -> Packed {
+        Packed { p: m.p, count: m.count, numbers: m.numbers() }
+    }
+}
+
+impl TryFrom<Packed> for Moments {
+    type Error = String;
+    fn try_from(p: Packed) -> Result<Moments, String> {
+        Moments::from_numbers(p.p, p.count, &p.numbers).ok_or_else(|| {
+            format!("{} numbers do not make the statistics of {} regressors", p.numbers.len(), p.p)
+        })
+    }
 }
 
 impl PartialEq for Moments {
@@ -57,6 +82,47 @@ impl Moments {
     /// chunk).
     fn unallocated(p: usize) -> Moments {
         Moments { p, count: 0, weight: 0.0, mean: Vec::new(), comoment: Vec::new() }
+    }
+
+    /// The numbers that determine the statistics, in a fixed order: the weight, the p + 1
+    /// means, then the lower triangle of the comoments column by column ((p+1)(p+2)/2 values;
+    /// the upper one is not kept). With [`Moments::count`] and [`Moments::regressors`] this is
+    /// all [`Moments::from_numbers`] needs: a compact form to send between processes.
+    pub fn numbers(&self) -> Vec<f64> {
+        let m = self.p + 1;
+        let mut out = Vec::with_capacity(1 + m + m * (m + 1) / 2);
+        out.push(self.weight);
+        if self.mean.is_empty() {
+            // not allocated yet: no rows
+            out.resize(1 + m + m * (m + 1) / 2, 0.0);
+            return out;
+        }
+        out.extend_from_slice(&self.mean);
+        for j in 0..m {
+            out.extend_from_slice(&self.comoment[j * m + j..(j + 1) * m]);
+        }
+        out
+    }
+
+    /// Statistics from [`Moments::numbers`]; `None` if there are not as many as `p` needs.
+    pub fn from_numbers(p: usize, count: usize, numbers: &[f64]) -> Option<Moments> {
+        let m = p + 1;
+        if numbers.len() != 1 + m + m * (m + 1) / 2 {
+            return None;
+        }
+        let mut out = Moments::new(p);
+        out.count = count;
+        out.weight = numbers[0];
+        out.mean.copy_from_slice(&numbers[1..1 + m]);
+        let mut k = 1 + m;
+        for j in 0..m {
+            for i in j..m {
+                out.comoment[j * m + i] = numbers[k];
+                out.comoment[i * m + j] = numbers[k];
+                k += 1;
+            }
+        }
+        Some(out)
     }
 
     /// Whether the statistics are whole: vectors of their declared size, finite numbers, a

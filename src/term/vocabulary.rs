@@ -35,7 +35,11 @@ fn normalise_name(name: &str) -> String {
 }
 
 fn is_identifier(name: &str) -> bool {
-    matches!(parse_expr(name), Ok(Expr { kind: ExprKind::Var(_), .. }))
+    // plain ASCII names (`c12`, `x_dot`) are identifiers of the grammar without asking it
+    let mut chars = name.chars();
+    let ascii = chars.next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_');
+    ascii || matches!(parse_expr(name), Ok(Expr { kind: ExprKind::Var(_), .. }))
 }
 
 impl Vocabulary {
@@ -143,6 +147,11 @@ impl Vocabulary {
 
     /// Parses and resolves a term's text.
     pub fn parse(&self, text: &str) -> Result<Term, TermError> {
+        // a declared name alone is that variable (declared names are identifiers, so the
+        // grammar would say the same): a finished matrix's columns skip the parser (~4 µs each)
+        if self.is_declared(text) {
+            return Ok(Term::var(text));
+        }
         let expr = parse_expr(text)?;
         self.resolve(&expr, text)
     }
