@@ -172,4 +172,7 @@ pub struct Observation {
     pub json: serde_json::Value,
     /// The ones a table shows: label with unit, key in `json`, value (`None`: not reached).
     pub rows: Vec<(String, String, Option<f64>)>,
+    /// How the metrics were read, where that differs from how a simulated scenario reports
+    /// them (said once under the table).
+    pub note: Option<String>,
 }

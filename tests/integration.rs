@@ -49,3 +49,6 @@ mod mmg;
 // The SIMMAN case study's dataset files, on records laid out as the basins write them.
 #[path = "integration/simman.rs"]
 mod simman;
+// README as a script: every shell block runs, in order, on the repository's own files.
+#[path = "integration/readme.rs"]
+mod readme;

@@ -230,6 +230,24 @@ impl PyModel {
         Ok(eq.coefficients.iter().map(|(t, c, s)| (t.to_string(), *c, *s)).collect())
     }
 
+    /// How a parameter is set in each run for identification (`first:u`, `mean:u:4`), or
+    /// `None` for its fixed value; checked as a model file's `per_run` is.
+    #[pyo3(signature = (name, rule))]
+    fn set_per_run(&mut self, name: &str, rule: Option<String>) -> PyResult<()> {
+        if !self.inner.spec().parameters.contains_key(name) {
+            return Err(refuse(format!("{}: `{name}` is not a parameter", self.inner.path)));
+        }
+        self.inner = self
+            .inner
+            .edit(|spec| {
+                if let Some(p) = spec.parameters.get_mut(name) {
+                    p.per_run = rule;
+                }
+            })
+            .map_err(fail)?;
+        Ok(())
+    }
+
     /// Replaces an equation's coefficients: (term text, value, standard error or None) in the
     /// model's term language, and the intercept b0 (simulated only when asked).
     #[pyo3(signature = (equation, coefficients, intercept = None))]

@@ -265,8 +265,13 @@ class Model:
     def parameters(self) -> Dict[str, float]:
         return dict(self._native.parameters)
 
-    def set_parameter(self, name: str, value: float) -> None:
-        self._native.set_parameter(name, float(value))
+    def set_parameter(self, name: str, value: Union[float, str]) -> None:
+        """A parameter's value, or as text how each run sets it for identification
+        (``ship.set_parameter("u0", "mean:u:4")``: the mean of u over a record's first 4 s)."""
+        if isinstance(value, str):
+            self._native.set_per_run(name, value)
+        else:
+            self._native.set_parameter(name, float(value))
 
     def coefficients(self, equation: str) -> pd.DataFrame:
         """An equation's stored terms with value and standard error."""

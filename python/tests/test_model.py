@@ -96,3 +96,13 @@ def test_basin_records_are_noisy_and_seeded(ship):
     exact = ship.record("zigzag:20/20", seed=3, duration=40.0, truth=True)
     pd.testing.assert_frame_equal(a, b)
     assert 0 < (a["r"] - exact["r"]).std() < 1e-2
+
+
+def test_per_run_rule_is_set_and_checked(zigzags):
+    ship = termid.Model.default()
+    ship.set_parameter("u0", "mean:u:4")
+    assert 'per_run = "mean:u:4"' in ship.to_toml()
+    with pytest.raises(termid.TermidError, match="per_run"):
+        ship.set_parameter("u0", "middle:u")
+    with pytest.raises(termid.TermidError, match="not a parameter"):
+        ship.set_parameter("w0", 1.0)

@@ -166,9 +166,15 @@ impl Plugin for Manoeuvring {
             ("transfer [m]", "transfer_m", seen.transfer_m),
             ("tactical diameter [m]", "tactical_diameter_m", seen.tactical_diameter_m),
         ];
+        // a record knows no commanded switching heading: the one definition that applies to
+        // measurement and model alike is the heading at the rudder's reversal
+        let note = seen.first_overshoot_deg.is_some().then(|| {
+            "overshoots are read off the samples, beyond the heading at each rudder reversal, for measurement and model alike; `simulate` reports a manoeuvre's beyond its commanded switching heading at every integration step (the heading moves on within the step in which it is reached, so the two differ by up to about a tenth of a degree)".to_string()
+        });
         Some(Observation {
             json: serde_json::to_value(&seen).unwrap_or_default(),
             rows: rows.iter().map(|(l, k, v)| (l.to_string(), k.to_string(), *v)).collect(),
+            note,
         })
     }
 

@@ -253,6 +253,12 @@ fn validate_sets_model_and_measurement_side_by_side() {
             < 0.05
     );
     assert!(svg.join("validate_z.svg").exists());
+    // the text says how its overshoots are read, and how that differs from `simulate`'s
+    let (ok, out, err) = termid(&["validate", "--data", run.to_str().unwrap()]);
+    assert!(
+        ok && out.contains("beyond the heading at each rudder reversal") && out.contains("`simulate`"),
+        "{out}{err}"
+    );
 }
 
 /// With --model, --backend replaces the file's back-ends (it was silently ignored), and

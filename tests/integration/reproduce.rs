@@ -165,6 +165,12 @@ fn report_is_written() {
     for needle in ["Table 1", "Table 6", "Fig. 5", "heading drift", "sample state", "round-off"] {
         assert!(md.contains(needle), "report lacks {needle}");
     }
+    // Table 2's `r*v^2/u` is commented where it stands: the paper's printed true value and its
+    // own positive estimates (tables/table2_vdot.csv)
+    let note = md.lines().find(|l| l.starts_with("`r*v^2/u`: the paper prints")).expect("the r*v^2/u note");
+    for printed in ["-5.4840", "4.9498", "5.7295"] {
+        assert!(note.contains(printed), "{note}");
+    }
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
     assert!(summary["exact"]["r_dot"]["komb_chosen_step"].is_number());

@@ -120,6 +120,9 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
                     row(label, key, *x, *y);
                 }
             }
+            if let Some(note) = metrics.iter().flatten().find_map(|(a, _)| a.note.as_ref()) {
+                println!("\nNote: {note}.");
+            }
             if let Some(mc) = &mc {
                 println!("\n{}", mc.headline());
             }

@@ -1,0 +1,85 @@
+//! README runs as written: every ```sh block, in the order of the file and read from the file
+//! itself (so README and test cannot drift apart), runs with `termid` on PATH in one scratch
+//! folder that sees the repository's `models/`, `examples/` and `tests/`; each must exit 0 and
+//! leave every file or folder it names after `--out`, `--svg` or `--prepared-svg`. A block that
+//! cannot run here says why in an HTML comment on the line before it
+//! (`<!-- readme-test: skip: why -->`), visible to whoever reads the source.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The ```sh blocks of README: (line of the fence, text, the reason given to skip it).
+fn shell_blocks(readme: &str) -> Vec<(usize, String, Option<String>)> {
+    let lines: Vec<&str> = readme.lines().collect();
+    let mut out = Vec::new();
+    let mut k = 0;
+    while k < lines.len() {
+        if lines[k].trim_end() == "```sh" {
+            let skip = k
+                .checked_sub(1)
+                .and_then(|p| lines[p].trim().strip_prefix("<!-- readme-test: skip:"))
+                .map(|r| r.trim_end_matches("-->").trim().to_string());
+            let end = (k + 1..lines.len()).find(|&j| lines[j].trim_end() == "```").expect("a closed block");
+            out.push((k + 1, lines[k + 1..end].join("\n"), skip));
+            k = end;
+        }
+        k += 1;
+    }
+    out
+}
+
+/// The paths a block says it writes.
+fn written(block: &str) -> Vec<String> {
+    let words: Vec<&str> = block.split_whitespace().collect();
+    words
+        .windows(2)
+        .filter(|w| matches!(w[0], "--out" | "--svg" | "--prepared-svg"))
+        .map(|w| w[1].to_string())
+        .collect()
+}
+
+#[test]
+fn blocks_are_found_and_skips_give_a_reason() {
+    let blocks =
+        shell_blocks("text\n<!-- readme-test: skip: needs X -->\n```sh\na --out b.csv\n```\n```sh\nc\n```\n");
+    assert_eq!(blocks.len(), 2);
+    assert_eq!(blocks[0].2.as_deref(), Some("needs X"));
+    assert_eq!(blocks[1], (6, "c".to_string(), None));
+    assert_eq!(written("termid simulate -m x --out z.csv --svg f/"), ["z.csv", "f/"]);
+}
+
+#[test]
+fn every_readme_block_runs_as_written() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let blocks = shell_blocks(&readme);
+    assert!(blocks.iter().filter(|b| b.2.is_none()).count() >= 8, "README lost its shell blocks");
+    let dir = std::env::temp_dir().join(format!("termid-readme-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for shared in ["models", "examples", "tests"] {
+        std::os::unix::fs::symlink(root.join(shared), dir.join(shared)).unwrap();
+    }
+    let bin = Path::new(env!("CARGO_BIN_EXE_termid")).parent().unwrap().to_path_buf();
+    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
+    for (line, block, skip) in &blocks {
+        if skip.is_some() {
+            continue;
+        }
+        let out = Command::new("bash")
+            .args(["-euo", "pipefail", "-c", block])
+            .current_dir(&dir)
+            .env("PATH", &path)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "README.md:{line}: the block failed\n{block}\n--- stderr:\n{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        for file in written(block) {
+            assert!(dir.join(&file).exists(), "README.md:{line}: `{file}` was not written");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
