@@ -16,54 +16,83 @@ use super::DataError;
 
 /// The column names and numeric columns of a Parquet or Arrow IPC file.
 pub fn read_columns(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), DataError> {
-    let file = path.display().to_string();
-    let io = |e: &dyn std::fmt::Display| DataError::Io { file: file.clone(), message: e.to_string() };
-    let handle = std::fs::File::open(path).map_err(|e| io(&e))?;
-    let parquet = matches!(
-        path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
-        Some("parquet" | "pq")
-    );
-    let batches: Box<dyn Iterator<Item = Result<RecordBatch, String>>> = if parquet {
-        let reader = parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder::try_new(handle)
-            .and_then(|b| b.with_batch_size(65_536).build())
-            .map_err(|e| io(&e))?;
-        Box::new(reader.map(|b| b.map_err(|e| e.to_string())))
-    } else {
-        let reader = arrow_ipc::reader::FileReader::try_new(handle, None).map_err(|e| io(&e))?;
-        Box::new(reader.map(|b| b.map_err(|e| e.to_string())))
-    };
-    let mut names: Option<Vec<String>> = None;
-    let mut columns: Vec<Vec<f64>> = Vec::new();
-    let mut rows = 0usize;
-    for batch in batches {
-        let batch = batch
-            .map_err(|m| DataError::Io { file: file.clone(), message: format!("after row {rows}: {m}") })?;
-        let schema = batch.schema();
-        let these: Vec<String> = schema.fields().iter().map(|f| f.name().clone()).collect();
-        match &names {
-            None => {
-                for (i, h) in these.iter().enumerate() {
-                    if these[..i].contains(h) {
-                        return Err(DataError::DuplicateColumn { file: file.clone(), column: h.clone() });
-                    }
-                }
-                columns = vec![Vec::new(); these.len()];
-                names = Some(these);
+    super::stream::read_all(Batches::open(path)?)
+}
+
+/// A Parquet or Arrow IPC file's rows, record batch by record batch.
+pub(super) struct Batches {
+    batches: Box<dyn Iterator<Item = Result<RecordBatch, String>>>,
+    names: Vec<String>,
+    file: String,
+    rows: usize,
+    /// The first batch, read to learn the names.
+    first: Option<RecordBatch>,
+}
+
+impl Batches {
+    pub(super) fn open(path: &Path) -> Result<Batches, DataError> {
+        let file = path.display().to_string();
+        let io = |e: &dyn std::fmt::Display| DataError::Io { file: file.clone(), message: e.to_string() };
+        let handle = std::fs::File::open(path).map_err(|e| io(&e))?;
+        let parquet = matches!(
+            path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
+            Some("parquet" | "pq")
+        );
+        let mut batches: Box<dyn Iterator<Item = Result<RecordBatch, String>>> = if parquet {
+            let reader = parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder::try_new(handle)
+                .and_then(|b| b.with_batch_size(65_536).build())
+                .map_err(|e| io(&e))?;
+            Box::new(reader.map(|b| b.map_err(|e| e.to_string())))
+        } else {
+            let reader = arrow_ipc::reader::FileReader::try_new(handle, None).map_err(|e| io(&e))?;
+            Box::new(reader.map(|b| b.map_err(|e| e.to_string())))
+        };
+        let first =
+            batches.next().ok_or_else(|| DataError::NoHeader { file: file.clone() })?.map_err(|m| io(&m))?;
+        let names: Vec<String> = first.schema().fields().iter().map(|f| f.name().clone()).collect();
+        for (i, h) in names.iter().enumerate() {
+            if names[..i].contains(h) {
+                return Err(DataError::DuplicateColumn { file: file.clone(), column: h.clone() });
             }
-            Some(n) if *n != these => {
-                return Err(io(&format!("the columns change after row {rows}")));
-            }
-            Some(_) => {}
         }
-        for (k, (array, name)) in
-            batch.columns().iter().zip(schema.fields().iter().map(|f| f.name())).enumerate()
-        {
-            append(&mut columns[k], array.as_ref(), &file, name, rows)?;
-        }
-        rows += batch.num_rows();
+        Ok(Batches { batches, names, file, rows: 0, first: Some(first) })
     }
-    let names = names.ok_or_else(|| DataError::NoHeader { file: file.clone() })?;
-    Ok((names, columns))
+}
+
+impl super::stream::RowSource for Batches {
+    fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// Whole record batches until at least `max` rows (or the end).
+    fn read(&mut self, max: usize, columns: &mut [Vec<f64>]) -> Result<usize, DataError> {
+        let mut n = 0;
+        while n < max {
+            let batch = match self.first.take() {
+                Some(b) => b,
+                None => match self.batches.next() {
+                    None => break,
+                    Some(b) => b.map_err(|m| DataError::Io {
+                        file: self.file.clone(),
+                        message: format!("after row {}: {m}", self.rows),
+                    })?,
+                },
+            };
+            let schema = batch.schema();
+            if schema.fields().iter().map(|f| f.name()).ne(self.names.iter()) {
+                return Err(DataError::Io {
+                    file: self.file.clone(),
+                    message: format!("the columns change after row {}", self.rows),
+                });
+            }
+            for (k, (array, name)) in batch.columns().iter().zip(&self.names).enumerate() {
+                append(&mut columns[k], array.as_ref(), &self.file, name, self.rows)?;
+            }
+            self.rows += batch.num_rows();
+            n += batch.num_rows();
+        }
+        Ok(n)
+    }
 }
 
 /// One batch's values of a column as f64, refusing nulls and non-numeric types with the row.

@@ -111,53 +111,7 @@ pub(super) fn read_table(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), Da
 
 /// The header and the numeric columns of CSV text, every cell checked.
 pub(super) fn parse_table(text: &str, origin: &str) -> Result<(Vec<String>, Vec<Vec<f64>>), DataError> {
-    let io = |e: csv::Error| DataError::Io { file: origin.into(), message: e.to_string() };
-    // a header of semicolons and no comma: a European spreadsheet's CSV, whose numbers may
-    // also have decimal commas
-    let first = text.lines().map(str::trim).find(|l| !l.is_empty() && !l.starts_with('#')).unwrap_or("");
-    let semicolons = first.contains(';') && !first.contains(',');
-    let mut reader = csv::ReaderBuilder::new()
-        .delimiter(if semicolons { b';' } else { b',' })
-        .trim(csv::Trim::All)
-        .flexible(true)
-        .comment(Some(b'#'))
-        .from_reader(text.as_bytes());
-    let header: Vec<String> = reader.headers().map_err(io)?.iter().map(str::to_string).collect();
-    if header.iter().all(String::is_empty) {
-        return Err(DataError::NoHeader { file: origin.into() });
-    }
-    for (i, h) in header.iter().enumerate() {
-        if header[..i].contains(h) {
-            return Err(DataError::DuplicateColumn { file: origin.into(), column: h.clone() });
-        }
-    }
-    let mut columns: Vec<Vec<f64>> = vec![Vec::new(); header.len()];
-    for (r, record) in reader.records().enumerate() {
-        let record = record.map_err(io)?;
-        let row = r + 1;
-        if record.len() != header.len() {
-            return Err(DataError::Ragged {
-                file: origin.into(),
-                row,
-                expected: header.len(),
-                found: record.len(),
-            });
-        }
-        for (c, cell) in record.iter().enumerate() {
-            let parsed = match cell.parse::<f64>() {
-                Err(_) if semicolons => cell.replace(',', ".").parse::<f64>(),
-                other => other,
-            };
-            let v: f64 = parsed.map_err(|_| DataError::NotNumeric {
-                file: origin.into(),
-                row,
-                column: header[c].clone(),
-                cell: cell.into(),
-            })?;
-            columns[c].push(v);
-        }
-    }
-    Ok((header, columns))
+    super::stream::read_all(super::stream::CsvRows::new(text.as_bytes(), origin)?)
 }
 
 #[cfg(test)]

@@ -19,6 +19,13 @@ pub trait Differentiator: Send + Sync {
     fn name(&self) -> &'static str;
     /// dx/dt at every sample.
     fn differentiate(&self, t: &[f64], x: &[f64]) -> Result<Vec<f64>, DataError>;
+    /// How many samples on either side a derivative depends on, when that is a fixed number
+    /// (a local stencil): such a method gives the same rates on a run read in pieces with
+    /// that many rows of context ([`super::Chunks`]). `None` (the default): the method needs
+    /// the whole run (a spline, a smoother).
+    fn reach(&self) -> Option<usize> {
+        None
+    }
     /// The signal as the method estimates it, with its rate. Methods that smooth (spline,
     /// Kalman) return their smoothed curve, so the regressors can be the smoothed states too.
     fn smooth(&self, t: &[f64], x: &[f64]) -> Result<Smoothed, DataError> {
@@ -46,6 +53,10 @@ fn three_point(t: &[f64], i0: usize, k: usize) -> [f64; 3] {
 impl Differentiator for CentralDifference {
     fn name(&self) -> &'static str {
         "central"
+    }
+
+    fn reach(&self) -> Option<usize> {
+        Some(1)
     }
 
     fn differentiate(&self, t: &[f64], x: &[f64]) -> Result<Vec<f64>, DataError> {

@@ -30,6 +30,10 @@ impl Differentiator for FivePoint {
         "five-point"
     }
 
+    fn reach(&self) -> Option<usize> {
+        Some(2)
+    }
+
     fn differentiate(&self, t: &[f64], x: &[f64]) -> Result<Vec<f64>, DataError> {
         let n = t.len();
         if n < 5 || x.len() != n {

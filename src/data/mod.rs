@@ -14,6 +14,7 @@ mod resample;
 mod savitzky_golay;
 mod search;
 mod smoothing_spline;
+mod stream;
 
 pub use dataset::{velocities_from_track, Dataset, Delimiter, RunSpec, Track};
 pub use derivative::{differentiator, CentralDifference, Differentiator, Smoothed, DIFFERENTIATORS};
@@ -23,6 +24,7 @@ pub use prepare::{prepare, Preparation};
 pub use resample::{check_gaps, interpolate_at, median_step, resample};
 pub use savitzky_golay::SavitzkyGolay;
 pub use smoothing_spline::SmoothingSpline;
+pub use stream::{Chunk, Chunks, RowSource};
 
 #[cfg(test)]
 /// Uniform noise in [−½, ½) from a seeded LCG, for the tests of the derivative methods.
@@ -200,6 +202,32 @@ pub enum DataError {
 }
 
 impl DataError {
+    /// The error of a piece of a file said of the whole file: its row numbers moved on by
+    /// `rows` (the piece's first row in the file).
+    pub fn shifted(self, rows: usize) -> DataError {
+        match self {
+            DataError::NotNumeric { file, row, column, cell } => {
+                DataError::NotNumeric { file, row: row + rows, column, cell }
+            }
+            DataError::NonFinite { file, row, column, value } => {
+                DataError::NonFinite { file, row: row + rows, column, value }
+            }
+            DataError::Ragged { file, row, expected, found } => {
+                DataError::Ragged { file, row: row + rows, expected, found }
+            }
+            DataError::TimeNotIncreasing { file, row, column, this, previous } => {
+                DataError::TimeNotIncreasing { file, row: row + rows, column, this, previous }
+            }
+            DataError::Unit { file, row, column, message } if row > 0 => {
+                DataError::Unit { file, row: row + rows, column, message }
+            }
+            DataError::TimeGap { file, row, column, step, median } => {
+                DataError::TimeGap { file, row: row + rows, column, step, median }
+            }
+            e => e,
+        }
+    }
+
     /// A signal-level "too short" said of a run: the file, and the signal when given (the
     /// derivative methods see bare signals and do not know where they came from).
     pub fn in_run(self, file: &str, signal: Option<&str>) -> DataError {

@@ -29,6 +29,10 @@ impl Differentiator for SavitzkyGolay {
         "savitzky-golay"
     }
 
+    fn reach(&self) -> Option<usize> {
+        Some(self.window / 2)
+    }
+
     fn differentiate(&self, t: &[f64], x: &[f64]) -> Result<Vec<f64>, DataError> {
         let n = t.len().min(x.len());
         let (w, q) = (self.window, self.order);

@@ -94,6 +94,18 @@ pub enum IdentifyError {
 }
 
 impl IdentifyError {
+    /// The error of a piece of a file said of the whole file: its row numbers moved on by
+    /// `rows` (see [`DataError::shifted`]).
+    pub fn shifted(self, rows: usize) -> IdentifyError {
+        match self {
+            IdentifyError::Data(e) => IdentifyError::Data(e.shifted(rows)),
+            IdentifyError::NonFinite { file, row, term, value } => {
+                IdentifyError::NonFinite { file, row: row + rows, term, value }
+            }
+            e => e,
+        }
+    }
+
     /// The error said of a model's equation.
     pub fn in_equation(self, equation: &str) -> IdentifyError {
         IdentifyError::InEquation { equation: equation.into(), error: Box::new(self) }
@@ -278,6 +290,25 @@ impl Identification<'_> {
     ) -> Result<Moments, IdentifyError> {
         // without the terms at hand, a term that is not finite is named by its column
         Ok(self.moments_of_runs(library, &[], target, std::slice::from_ref(frame))?.remove(0))
+    }
+
+    /// The statistics of rows `rows` of one run: a piece of a run read in chunks, the
+    /// target's derivative taken on the whole piece (its rows and its neighbours'), only its
+    /// own rows counted.
+    pub fn moments_of_rows(
+        &self,
+        library: &Library,
+        terms: &[Term],
+        target: &Target,
+        frame: &Frame,
+        rows: std::ops::Range<usize>,
+    ) -> Result<Moments, IdentifyError> {
+        let run = self.bind(library, target, frame)?;
+        let offset = rows.start;
+        let mut parts = gather(library.len(), &[rows.len()], |_, part, acc| {
+            run.push(library, terms, part.start + offset..part.end + offset, acc)
+        })?;
+        Ok(parts.remove(0))
     }
 
     /// The statistics of each run, gathered in parallel (parts of runs on all threads).

@@ -5,10 +5,12 @@
 //! together would be — per-run statistics are kept because back-ends that cross-validate
 //! leave one run out.
 
+use std::collections::BTreeMap;
+
 use serde::{Deserialize, Serialize};
 
 use super::model::{default_target, model_equation};
-use super::{fit_folds, Design, Fit, Identification, IdentifyError, Target};
+use super::{fit_folds, Design, Fit, Identification, IdentifyError, ParamValue, Target};
 use crate::data::{Differentiator, Frame};
 use crate::model::Model;
 use crate::select::Moments;
@@ -70,6 +72,101 @@ impl EquationMoments {
                 .map(|(f, m)| RunMoments { run: f.origin().into(), moments: m })
                 .collect(),
         })
+    }
+
+    /// The statistics of `equation` over runs read in chunks: one pass, memory bounded by
+    /// the chunk size whatever the files' size. The same as [`EquationMoments::of_runs`] on
+    /// the whole runs to round-off, for a derivative method with a fixed reach (central
+    /// differences, five points, Savitzky-Golay; the chunks must carry at least that many
+    /// rows of context). Each chunk is admitted by the model ([`Model::admit`]) and checked
+    /// for gaps in time; per-run parameters (`first:u`, `mean:u:4`) are read off each run's
+    /// first chunk. Returns the notes of the runs' admission too.
+    pub fn of_chunks(
+        model: &Model,
+        equation: &str,
+        runs: Vec<crate::data::Chunks>,
+        differentiator: &dyn Differentiator,
+    ) -> Result<(EquationMoments, Vec<String>), IdentifyError> {
+        if differentiator.reach().is_none() {
+            return Err(IdentifyError::Setup(format!(
+                "the derivative method `{}` needs whole runs: read in chunks, use central, five-point or savitzky-golay",
+                differentiator.name()
+            )));
+        }
+        if runs.is_empty() {
+            return Err(IdentifyError::Setup("no data: give at least one run".into()));
+        }
+        let eq = model_equation(model, equation)?;
+        let design = Design::new(&eq.candidates, &model.vocabulary)?;
+        let rules = model.parameter_rules();
+        let (mut out, mut notes, mut target) = (Vec::new(), Vec::new(), None);
+        for chunks in runs {
+            let mut run: Option<(String, Moments, BTreeMap<String, ParamValue>)> = None;
+            for chunk in chunks {
+                let mut chunk = chunk?;
+                let shift = |e: IdentifyError| e.shifted(chunk.first_row);
+                let admitted = model.admit(&mut chunk.frame).map_err(|e| shift(e.into()))?;
+                crate::data::check_gaps(&chunk.frame, 3.0).map_err(|e| shift(e.into()))?;
+                if run.is_none() {
+                    notes.extend(admitted);
+                    // a run's own parameters come from its start, which only its first chunk holds
+                    let fixed = rules
+                        .iter()
+                        .map(|(n, r)| Ok((n.clone(), ParamValue::Value(r.resolve(n, &chunk.frame)?))))
+                        .collect::<Result<BTreeMap<_, _>, crate::data::DataError>>()?;
+                    let target =
+                        target.get_or_insert_with(|| default_target(eq, std::slice::from_ref(&chunk.frame)));
+                    let how = Identification {
+                        vocabulary: &model.vocabulary,
+                        parameters: &fixed,
+                        differentiator,
+                        intercept: true,
+                        weights: None,
+                    };
+                    let m = how
+                        .moments_of_rows(
+                            &design.library,
+                            design.candidates(),
+                            target,
+                            &chunk.frame,
+                            chunk.own.clone(),
+                        )
+                        .map_err(shift)?;
+                    run = Some((chunk.frame.origin().to_string(), m, fixed));
+                    continue;
+                }
+                let Some((_, moments, fixed)) = run.as_mut() else { unreachable!() };
+                let how = Identification {
+                    vocabulary: &model.vocabulary,
+                    parameters: fixed,
+                    differentiator,
+                    intercept: true,
+                    weights: None,
+                };
+                let target = target.as_ref().expect("set by the first chunk");
+                let m = how
+                    .moments_of_rows(
+                        &design.library,
+                        design.candidates(),
+                        target,
+                        &chunk.frame,
+                        chunk.own.clone(),
+                    )
+                    .map_err(shift)?;
+                moments.merge(&m);
+            }
+            if let Some((name, moments, _)) = run {
+                out.push(RunMoments { run: name, moments });
+            }
+        }
+        let target = target.ok_or_else(|| IdentifyError::Setup("no data: the runs hold no rows".into()))?;
+        let moments = EquationMoments {
+            equation: equation.into(),
+            target: target.to_string(),
+            candidates: design.names().to_vec(),
+            runs: out,
+        };
+        Ok((moments, notes))
     }
 
     /// The statistics of both sets of runs: refused where they are of another equation,

@@ -380,3 +380,130 @@ fn parquet_runs_identify_as_csv_runs() {
     assert!(a.contains("\"terms\""), "{a}");
     assert_eq!(a, b);
 }
+
+/// Issue 16 §2: `termid moments` reads plain files in pieces (one pass, bounded memory) and
+/// gets the statistics of the whole file to round-off, from CSV and Parquet alike, for the
+/// local derivative methods; errors name the file's own rows; a file of no lines is refused
+/// at once (it grew without bound).
+#[test]
+fn moments_read_in_pieces_equal_the_whole_file() {
+    use std::sync::Arc;
+
+    use arrow_array::{ArrayRef, Float64Array, RecordBatch};
+    let dir = crate::common::Scratch::new("pieces");
+    let p = |f: &str| dir.join(f).display().to_string();
+    let (_, frame) = lorenz_run();
+    // the states only: the target is the derivative, taken piece by piece
+    let keep: Vec<String> = ["t", "x", "y", "z"].iter().map(|s| s.to_string()).collect();
+    let mut text = keep.join(",") + "\n";
+    let cols: Vec<&[f64]> = keep.iter().map(|c| frame.column(c).unwrap()).collect();
+    for r in 0..frame.len() {
+        text += &cols.iter().map(|c| format!("{:?}", c[r])).collect::<Vec<_>>().join(",");
+        text.push('\n');
+    }
+    std::fs::write(p("run.csv"), &text).unwrap();
+    let arrays: Vec<(String, ArrayRef)> = keep
+        .iter()
+        .zip(&cols)
+        .map(|(n, c)| (n.clone(), Arc::new(Float64Array::from(c.to_vec())) as ArrayRef))
+        .collect();
+    let batch = RecordBatch::try_from_iter(arrays).unwrap();
+    let file = std::fs::File::create(p("run.parquet")).unwrap();
+    let mut writer = parquet::arrow::ArrowWriter::try_new(file, batch.schema(), None).unwrap();
+    // several row groups and batches
+    for k in (0..batch.num_rows()).step_by(3000) {
+        writer.write(&batch.slice(k, 3000.min(batch.num_rows() - k))).unwrap();
+        writer.flush().unwrap();
+    }
+    writer.close().unwrap();
+    let numbers = |path: &str| -> (usize, Vec<f64>) {
+        let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+        let m = &v["runs"][0]["moments"];
+        (
+            m["count"].as_u64().unwrap() as usize,
+            m["numbers"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect(),
+        )
+    };
+    for derivative in ["central", "five-point", "savitzky-golay:9:3"] {
+        let run = |data: &str, rows: &str, out: &str| {
+            let (ok, _, err) = termid(&[
+                "moments",
+                "--model",
+                "models/lorenz.toml",
+                "--equation",
+                "y_dot",
+                "--data",
+                data,
+                "--derivative",
+                derivative,
+                "--chunk-rows",
+                rows,
+                "--out",
+                out,
+            ]);
+            assert!(ok, "{err}");
+            numbers(out)
+        };
+        let whole = run(&p("run.csv"), "0", &p("whole.json"));
+        assert_eq!(whole.0, frame.len());
+        for (data, rows) in [(p("run.csv"), "97"), (p("run.csv"), "1000"), (p("run.parquet"), "500")] {
+            let pieces = run(&data, rows, &p("pieces.json"));
+            assert_eq!(pieces.0, whole.0);
+            for (a, b) in whole.1.iter().zip(&pieces.1) {
+                assert!((a - b).abs() <= 1e-10 * a.abs().max(1.0), "{derivative} {data} {rows}: {a} vs {b}");
+            }
+        }
+    }
+    // a smoother needs the whole run: read whole, whatever --chunk-rows says
+    let (ok, _, err) = termid(&[
+        "moments",
+        "--model",
+        "models/lorenz.toml",
+        "--equation",
+        "y_dot",
+        "--data",
+        &p("run.csv"),
+        "--derivative",
+        "spline",
+        "--chunk-rows",
+        "100",
+        "--out",
+        &p("spline.json"),
+    ]);
+    assert!(ok, "{err}");
+    // a bad cell deep in the file: its row in the file, in pieces as whole
+    let mut lines: Vec<&str> = text.lines().collect();
+    let bad = format!("{},1,2,NaN", frame.time()[7000]);
+    lines[7001] = &bad;
+    std::fs::write(p("bad.csv"), lines.join("\n")).unwrap();
+    for rows in ["0", "300"] {
+        let (ok, _, err) = termid(&[
+            "moments",
+            "--model",
+            "models/lorenz.toml",
+            "--equation",
+            "y_dot",
+            "--data",
+            &p("bad.csv"),
+            "--chunk-rows",
+            rows,
+            "--out",
+            &p("bad.json"),
+        ]);
+        assert!(!ok && err.contains("row 7001, column `z`"), "{rows}: {err}");
+    }
+    if std::path::Path::new("/dev/zero").exists() {
+        let (ok, _, err) = termid(&[
+            "moments",
+            "--model",
+            "models/lorenz.toml",
+            "--equation",
+            "y_dot",
+            "--data",
+            "/dev/zero",
+            "--out",
+            &p("zero.json"),
+        ]);
+        assert!(!ok && (err.contains("not a CSV file") || err.contains("not a text file")), "{err}");
+    }
+}

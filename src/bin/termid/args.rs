@@ -63,6 +63,11 @@ pub struct MomentsCommand {
     /// Write the statistics here (JSON; numbers round-trip exactly).
     #[arg(long)]
     pub out: PathBuf,
+    /// Rows per piece when `--data` files are read in pieces (one pass, memory bounded by
+    /// a few pieces, whatever the file's size): with a derivative of fixed reach (central,
+    /// five-point, savitzky-golay) or measured `<state>_dot` columns. 0 reads each file whole.
+    #[arg(long, default_value_t = 262_144)]
+    pub chunk_rows: usize,
 }
 
 /// `termid scale`.

@@ -2,7 +2,7 @@
 //! `identify --moments` to merge (the one pass over the rows done where the rows are).
 
 use anyhow::Result;
-use termid::data::differentiator;
+use termid::data::{differentiator, Chunks};
 use termid::identify::EquationMoments;
 
 use crate::args::MomentsCommand;
@@ -10,9 +10,26 @@ use crate::args::MomentsCommand;
 pub fn run(cmd: MomentsCommand) -> Result<()> {
     termid::output::check_file(&cmd.out)?;
     let model = termid::plugins::load(&cmd.model)?;
-    let frames = crate::runs::load_for(&model, &cmd.data, cmd.dataset.as_deref())?;
     let diff = differentiator(&cmd.derivative)?;
-    let moments = EquationMoments::of_runs(&model, &cmd.equation, &frames, diff.as_ref(), None)?;
+    let moments = match diff.reach() {
+        // plain files with a local derivative: read in pieces, one pass, bounded memory
+        Some(reach) if cmd.chunk_rows > 0 && cmd.dataset.is_none() => {
+            let runs = cmd
+                .data
+                .iter()
+                .map(|p| Chunks::open(p, &model.spec().model.time, cmd.chunk_rows, 2 * reach + 2))
+                .collect::<Result<Vec<_>, _>>()?;
+            let (moments, notes) = EquationMoments::of_chunks(&model, &cmd.equation, runs, diff.as_ref())?;
+            for n in notes {
+                eprintln!("unit: {n}");
+            }
+            moments
+        }
+        _ => {
+            let frames = crate::runs::load_for(&model, &cmd.data, cmd.dataset.as_deref())?;
+            EquationMoments::of_runs(&model, &cmd.equation, &frames, diff.as_ref(), None)?
+        }
+    };
     termid::output::write_file(&cmd.out, moments.to_json().as_bytes())?;
     let rows: usize = moments.runs.iter().map(|r| r.moments.count()).sum();
     println!(

@@ -1,0 +1,381 @@
+//! Runs read in pieces, for one pass over files larger than memory: the rows come in chunks
+//! of a fixed size, each with some rows of its neighbours on either side, so that a local
+//! derivative (central differences, five points, Savitzky-Golay) comes out at every row of a
+//! chunk's own part exactly as on the whole run. Memory stays at a few chunks whatever the
+//! file's size; errors name the file's own rows.
+
+use std::io::{BufRead, BufReader, Read};
+use std::ops::Range;
+use std::path::Path;
+
+use super::{DataError, Frame};
+
+/// Where rows come from: a file's header, then its numeric rows in order.
+pub trait RowSource {
+    /// The column names.
+    fn names(&self) -> &[String];
+    /// Appends up to `max` rows to `columns` (one vector per name); returns how many were
+    /// read, 0 at the end of the file.
+    fn read(&mut self, max: usize, columns: &mut [Vec<f64>]) -> Result<usize, DataError>;
+}
+
+/// A piece of a run.
+#[derive(Clone, Debug)]
+pub struct Chunk {
+    /// The chunk's rows with their neighbours, as a frame (its origin is the file).
+    pub frame: Frame,
+    /// The rows of `frame` that are this chunk's own; the others belong to its neighbours.
+    pub own: Range<usize>,
+    /// The file's row number (0-based, data rows) of the frame's first row.
+    pub first_row: usize,
+}
+
+/// The chunks of one run, in order (an iterator of [`Chunk`]s).
+pub struct Chunks {
+    source: Box<dyn RowSource>,
+    origin: String,
+    time: usize,
+    time_name: String,
+    size: usize,
+    context: usize,
+    /// Rows held, from the file's row `held_from` on.
+    held: Vec<Vec<f64>>,
+    held_from: usize,
+    /// The file's rows before this one are in chunks already given out.
+    given: usize,
+    ended: bool,
+}
+
+impl Chunks {
+    /// The run in `path` (CSV text, or Parquet / Arrow IPC by the extension) in chunks of
+    /// `size` rows, each with `context` rows of its neighbours on either side; `time` names
+    /// the time column.
+    pub fn open(path: &Path, time: &str, size: usize, context: usize) -> Result<Chunks, DataError> {
+        let origin = path.display().to_string();
+        let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        let source: Box<dyn RowSource> =
+            if matches!(ext.as_deref(), Some("parquet" | "pq" | "arrow" | "feather" | "ipc")) {
+                #[cfg(feature = "columnar")]
+                {
+                    Box::new(super::columnar::Batches::open(path)?)
+                }
+                #[cfg(not(feature = "columnar"))]
+                return Err(DataError::Io {
+                    file: origin,
+                    message: "a columnar file: termid was built without the `columnar` feature".into(),
+                });
+            } else {
+                let file = std::fs::File::open(path)
+                    .map_err(|e| DataError::Io { file: origin.clone(), message: e.to_string() })?;
+                Box::new(CsvRows::new(BufReader::new(file), &origin)?)
+            };
+        Chunks::new(source, &origin, time, size, context)
+    }
+
+    /// Chunks of rows from any source.
+    pub fn new(
+        source: Box<dyn RowSource>,
+        origin: &str,
+        time: &str,
+        size: usize,
+        context: usize,
+    ) -> Result<Chunks, DataError> {
+        let names = source.names();
+        let time_index = names.iter().position(|n| n == time).ok_or_else(|| DataError::MissingColumn {
+            file: origin.into(),
+            column: time.into(),
+            available: names.join(", "),
+        })?;
+        let held = vec![Vec::new(); names.len()];
+        Ok(Chunks {
+            source,
+            origin: origin.into(),
+            time: time_index,
+            time_name: time.into(),
+            size: size.max(1),
+            context,
+            held,
+            held_from: 0,
+            given: 0,
+            ended: false,
+        })
+    }
+
+    /// The next chunk, or `None` after the last.
+    fn next_chunk(&mut self) -> Result<Option<Chunk>, DataError> {
+        let held_to = |c: &Chunks| c.held_from + c.held.first().map_or(0, Vec::len);
+        // hold two chunks beyond what was given (and the context after them), so that the
+        // last chunk is never shorter than one chunk: the end formulas of a derivative need
+        // their rows inside it
+        while !self.ended && held_to(self) < self.given + 2 * self.size + self.context {
+            let want = self.given + 2 * self.size + self.context - held_to(self);
+            if self.source.read(want, &mut self.held)? == 0 {
+                self.ended = true;
+            }
+        }
+        let end = held_to(self);
+        if self.given >= end {
+            if self.given == 0 {
+                return Err(DataError::Empty { file: self.origin.clone() });
+            }
+            return Ok(None);
+        }
+        // the rest when it is less than two chunks, else one chunk
+        let own_end =
+            if self.ended && end - self.given < 2 * self.size { end } else { self.given + self.size };
+        let from = self.given.saturating_sub(self.context).max(self.held_from);
+        let to = (own_end + self.context).min(end);
+        let slice = |c: &Vec<f64>| c[from - self.held_from..to - self.held_from].to_vec();
+        let shift = |e: DataError| e.shifted(from);
+        let mut frame =
+            Frame::new(&self.origin, &self.time_name, slice(&self.held[self.time])).map_err(shift)?;
+        for (k, name) in self.source.names().iter().enumerate() {
+            if k != self.time {
+                frame.push(name, slice(&self.held[k])).map_err(shift)?;
+            }
+        }
+        // a chunk's first row must come after the previous chunk's last (the frame checks only
+        // its own rows)
+        let chunk = Chunk { frame, own: self.given - from..own_end - from, first_row: from };
+        self.given = own_end;
+        // keep only what the next chunk's context needs
+        let keep_from = self.given.saturating_sub(self.context).max(self.held_from);
+        for c in &mut self.held {
+            c.drain(..keep_from - self.held_from);
+        }
+        self.held_from = keep_from;
+        Ok(Some(chunk))
+    }
+}
+
+impl Iterator for Chunks {
+    type Item = Result<Chunk, DataError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        match self.next_chunk() {
+            Ok(Some(c)) => Some(Ok(c)),
+            Ok(None) => None,
+            Err(e) => {
+                // an error ends the run
+                self.ended = true;
+                self.given = usize::MAX / 2;
+                self.held.iter_mut().for_each(Vec::clear);
+                self.held_from = self.given;
+                Some(Err(e))
+            }
+        }
+    }
+}
+
+/// A line longer than this is no CSV row (`/dev/zero`, a binary file): refused, not buffered.
+const LONGEST_LINE: usize = 1 << 20;
+
+/// Refuses a line longer than [`LONGEST_LINE`] bytes as it passes.
+struct LineLimit<R> {
+    inner: R,
+    since_newline: usize,
+}
+
+impl<R: Read> Read for LineLimit<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        for &b in &buf[..n] {
+            self.since_newline = if b == b'\n' { 0 } else { self.since_newline + 1 };
+            if self.since_newline > LONGEST_LINE {
+                return Err(std::io::Error::other(format!(
+                    "a line longer than {} MiB without a line break: not a CSV file",
+                    LONGEST_LINE >> 20
+                )));
+            }
+        }
+        Ok(n)
+    }
+}
+
+/// CSV rows read as they are needed: the one CSV reader of termid (a whole file is all its
+/// rows), so a file reads the same in one piece or in chunks.
+pub(super) struct CsvRows<'a> {
+    reader: csv::Reader<LineLimit<Box<dyn Read + 'a>>>,
+    names: Vec<String>,
+    origin: String,
+    semicolons: bool,
+    row: usize,
+    record: csv::StringRecord,
+}
+
+impl<'a> CsvRows<'a> {
+    /// Reads the header. A header of semicolons and no comma is a European spreadsheet's
+    /// CSV, whose numbers may also have decimal commas.
+    pub(super) fn new(mut input: impl BufRead + 'a, origin: &str) -> Result<CsvRows<'a>, DataError> {
+        let io = |e: &dyn std::fmt::Display| DataError::Io { file: origin.into(), message: e.to_string() };
+        // the first line that is neither empty nor a comment decides the delimiter
+        let mut peeked = Vec::new();
+        let semicolons = loop {
+            let mut line = Vec::new();
+            let n = (&mut input)
+                .take(LONGEST_LINE as u64 + 1)
+                .read_until(b'\n', &mut line)
+                .map_err(|e| io(&e))?;
+            if n > LONGEST_LINE {
+                return Err(io(&format!(
+                    "a line longer than {} MiB without a line break: not a CSV file",
+                    LONGEST_LINE >> 20
+                )));
+            }
+            peeked.extend_from_slice(&line);
+            let text = String::from_utf8_lossy(&line);
+            let text = text.trim();
+            if n == 0 || (!text.is_empty() && !text.starts_with('#')) {
+                break text.contains(';') && !text.contains(',');
+            }
+        };
+        let rest: Box<dyn Read + 'a> = Box::new(std::io::Cursor::new(peeked).chain(input));
+        let mut reader = csv::ReaderBuilder::new()
+            .delimiter(if semicolons { b';' } else { b',' })
+            .trim(csv::Trim::All)
+            .flexible(true)
+            .comment(Some(b'#'))
+            .from_reader(LineLimit { inner: rest, since_newline: 0 });
+        let names: Vec<String> = reader.headers().map_err(|e| io(&e))?.iter().map(str::to_string).collect();
+        if names.iter().all(String::is_empty) {
+            return Err(DataError::NoHeader { file: origin.into() });
+        }
+        for (i, h) in names.iter().enumerate() {
+            if names[..i].contains(h) {
+                return Err(DataError::DuplicateColumn { file: origin.into(), column: h.clone() });
+            }
+        }
+        Ok(CsvRows {
+            reader,
+            names,
+            origin: origin.into(),
+            semicolons,
+            row: 0,
+            record: csv::StringRecord::new(),
+        })
+    }
+}
+
+impl RowSource for CsvRows<'_> {
+    fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    fn read(&mut self, max: usize, columns: &mut [Vec<f64>]) -> Result<usize, DataError> {
+        let mut n = 0;
+        while n < max {
+            let more = self
+                .reader
+                .read_record(&mut self.record)
+                .map_err(|e| DataError::Io { file: self.origin.clone(), message: e.to_string() })?;
+            if !more {
+                break;
+            }
+            self.row += 1;
+            if self.record.len() != self.names.len() {
+                return Err(DataError::Ragged {
+                    file: self.origin.clone(),
+                    row: self.row,
+                    expected: self.names.len(),
+                    found: self.record.len(),
+                });
+            }
+            for (c, cell) in self.record.iter().enumerate() {
+                let parsed = match cell.parse::<f64>() {
+                    Err(_) if self.semicolons => cell.replace(',', ".").parse::<f64>(),
+                    other => other,
+                };
+                let v = parsed.map_err(|_| DataError::NotNumeric {
+                    file: self.origin.clone(),
+                    row: self.row,
+                    column: self.names[c].clone(),
+                    cell: cell.into(),
+                })?;
+                columns[c].push(v);
+            }
+            n += 1;
+        }
+        Ok(n)
+    }
+}
+
+/// Every row of a source, as whole columns.
+pub(super) fn read_all(mut source: impl RowSource) -> Result<(Vec<String>, Vec<Vec<f64>>), DataError> {
+    let mut columns = vec![Vec::new(); source.names().len()];
+    while source.read(65_536, &mut columns)? > 0 {}
+    Ok((source.names().to_vec(), columns))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn csv(rows: usize) -> String {
+        let mut s = String::from("t,x\n");
+        for i in 0..rows {
+            s += &format!("{},{}\n", i as f64 * 0.1, (i as f64 * 0.3).sin());
+        }
+        s
+    }
+
+    fn chunks(text: &'static str, size: usize, context: usize) -> Chunks {
+        let rows = CsvRows::new(text.as_bytes(), "a.csv").unwrap();
+        Chunks::new(Box::new(rows), "a.csv", "t", size, context).unwrap()
+    }
+
+    /// Every row is in exactly one chunk's own part, in order, with its context around it,
+    /// and the last chunk is never shorter than one chunk.
+    #[test]
+    fn chunks_cover_every_row_once_with_context() {
+        let text: &'static str = Box::leak(csv(1003).into_boxed_str());
+        for (size, context) in [(100, 2), (7, 3), (1000, 1), (5000, 4)] {
+            let mut next = 0;
+            let mut sizes = Vec::new();
+            for c in chunks(text, size, context) {
+                let c = c.unwrap();
+                let t = c.frame.time();
+                assert_eq!(c.first_row + c.own.start, next);
+                assert!(c.own.start >= context.min(next) && t.len() - c.own.end <= context);
+                for (k, row) in c.own.clone().enumerate() {
+                    assert!((t[row] - (next + k) as f64 * 0.1).abs() < 1e-9);
+                }
+                next += c.own.len();
+                sizes.push(c.own.len());
+            }
+            assert_eq!(next, 1003, "size {size}");
+            assert!(sizes.len() == 1 || *sizes.last().unwrap() >= size, "{sizes:?}");
+        }
+    }
+
+    /// A bad cell or time is named by its row in the file, not in its chunk.
+    #[test]
+    fn errors_name_the_files_row() {
+        let mut lines: Vec<String> = csv(500).lines().map(String::from).collect();
+        lines[303] = lines[303].replacen(',', "x,", 1);
+        let text: &'static str = Box::leak(lines.join("\n").into_boxed_str());
+        let e = chunks(text, 50, 2).find_map(Result::err).unwrap().to_string();
+        assert!(e.starts_with("a.csv: row 303, column `t`"), "{e}");
+        // a value that parses but is not finite: found by the chunk's frame, said of the file
+        let time = lines[303].split(',').next().unwrap().trim_end_matches('x').to_string();
+        lines[303] = format!("{time},inf");
+        let text: &'static str = Box::leak(lines.join("\n").into_boxed_str());
+        let e = chunks(text, 50, 2).find_map(Result::err).unwrap().to_string();
+        assert!(e.starts_with("a.csv: row 303, column `x`") && e.contains("not finite"), "{e}");
+        let e = chunks("t,x\n0,1\n0,2\n", 50, 2).find_map(Result::err).unwrap().to_string();
+        assert!(e.contains("row 2") && e.contains("does not increase"), "{e}");
+        assert!(matches!(chunks("t,x\n", 50, 2).next(), Some(Err(DataError::Empty { .. }))));
+    }
+
+    #[test]
+    fn a_line_without_end_is_refused_not_buffered() {
+        let zeros = std::io::BufReader::new(std::io::repeat(b'0').take(3 << 20));
+        let e = CsvRows::new(zeros, "/dev/zero").err().unwrap().to_string();
+        assert!(e.contains("longer than 1 MiB"), "{e}");
+        let mut text = String::from("t,x\n0,1\n");
+        text.push_str(&"9".repeat(2 << 20));
+        let mut rows = CsvRows::new(text.as_bytes(), "long.csv").unwrap();
+        let mut columns = vec![Vec::new(); 2];
+        let e = rows.read(10, &mut columns).unwrap_err().to_string();
+        assert!(e.contains("longer than 1 MiB"), "{e}");
+    }
+}
