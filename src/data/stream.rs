@@ -179,15 +179,22 @@ struct LineLimit<R> {
 impl<R: Read> Read for LineLimit<R> {
     fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
         let n = self.inner.read(buf)?;
-        for &b in &buf[..n] {
-            self.since_newline = if b == b'\n' { 0 } else { self.since_newline + 1 };
-            if self.since_newline > LONGEST_LINE {
-                return Err(std::io::Error::other(format!(
-                    "a line longer than {} MiB without a line break: not a CSV file",
-                    LONGEST_LINE >> 20
-                )));
+        let (longest, last) = match buf[..n].iter().position(|&b| b == b'\n') {
+            // only the first line can continue the previous one, only the last go on
+            Some(first) => {
+                let last = buf[..n].iter().rposition(|&b| b == b'\n').unwrap_or(first);
+                (self.since_newline + first, n - 1 - last)
             }
+            None => (self.since_newline + n, self.since_newline + n),
+        };
+        // a line inside the buffer, between two breaks, is shorter than the buffer
+        if longest.max(last) > LONGEST_LINE {
+            return Err(std::io::Error::other(format!(
+                "a line longer than {} MiB without a line break: not a CSV file",
+                LONGEST_LINE >> 20
+            )));
         }
+        self.since_newline = last;
         Ok(n)
     }
 }
