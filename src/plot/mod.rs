@@ -135,6 +135,55 @@ pub enum PlotError {
 }
 
 /// Axis numbers without trailing noise: 0.25, 30, 1e-4.
+fn style_is(a: Style, b: Style) -> bool {
+    std::mem::discriminant(&a) == std::mem::discriminant(&b)
+}
+
+/// Whether every x value of the panel is a whole number (steps, alternatives) over a short
+/// range, so that its axis is labelled at whole numbers only.
+fn integer_axis(panel: &Panel) -> bool {
+    let mut xs = panel.series.iter().flat_map(|s| s.x.iter()).filter(|x| x.is_finite()).peekable();
+    xs.peek().is_some() && xs.all(|x| x.fract() == 0.0 && x.abs() < 1e6)
+}
+
+/// A tick of a counted axis: the whole number, no label between two.
+fn whole(v: f64) -> String {
+    if (v - v.round()).abs() < 1e-9 {
+        format!("{}", v.round() as i64)
+    } else {
+        String::new()
+    }
+}
+
+/// The corner of the plotting area where the legend covers the fewest data points (a box of
+/// a third of the width and `rows` legend lines high in each corner), in the order upper
+/// right, upper left, lower right, lower left on ties.
+fn legend_corner(panel: &Panel, x: (f64, f64), y: (f64, f64), rows: usize) -> SeriesLabelPosition {
+    // on a logarithmic axis the box is a share of the decades
+    let scale = |v: f64| if panel.log_y { v.max(1e-300).log10() } else { v };
+    let y = (scale(y.0), scale(y.1));
+    let (w, h) = ((x.1 - x.0) / 3.0, (y.1 - y.0) * (0.1 * rows as f64 + 0.08).min(0.6));
+    let corners = [
+        (SeriesLabelPosition::UpperRight, x.1 - w, y.1 - h),
+        (SeriesLabelPosition::UpperLeft, x.0, y.1 - h),
+        (SeriesLabelPosition::LowerRight, x.1 - w, y.0),
+        (SeriesLabelPosition::LowerLeft, x.0, y.0),
+    ];
+    let inside = |cx: f64, cy: f64| {
+        panel
+            .series
+            .iter()
+            .flat_map(|s| s.x.iter().zip(s.y.iter().chain(s.upper.iter())))
+            .map(|(px, py)| (*px, scale(*py)))
+            .filter(|(px, py)| *px >= cx && *px <= cx + w && *py >= cy && *py <= cy + h)
+            .count()
+    };
+    corners
+        .into_iter()
+        .min_by_key(|(_, cx, cy)| inside(*cx, *cy))
+        .map_or(SeriesLabelPosition::UpperRight, |(p, _, _)| p)
+}
+
 fn short(v: f64) -> String {
     // tick positions computed as sums carry round-off: 1e-17 is a zero
     if v.abs() < 1e-12 {
@@ -214,23 +263,27 @@ impl Figure {
             .y_label_area_size(60);
         if panel.log_y {
             let mut chart = builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale())?;
+            let counted = integer_axis(panel);
             chart
                 .configure_mesh()
                 .x_desc(&panel.x_label)
                 .y_desc(&panel.y_label)
+                .x_label_formatter(&|v| if counted { whole(*v) } else { short(*v) })
                 .y_label_formatter(&|v| format!("{v:.0e}"))
                 .draw()?;
-            draw_series(&mut chart, panel, y0, y1)?;
+            draw_series(&mut chart, panel, x0..x1, y0, y1)?;
         } else {
             let mut chart = builder.build_cartesian_2d(x0..x1, y0..y1)?;
+            // steps and alternatives are counted: their axis is labelled at whole numbers only
+            let counted = integer_axis(panel);
             chart
                 .configure_mesh()
                 .x_desc(&panel.x_label)
                 .y_desc(&panel.y_label)
-                .x_label_formatter(&|v| short(*v))
+                .x_label_formatter(&|v| if counted { whole(*v) } else { short(*v) })
                 .y_label_formatter(&|v| short(*v))
                 .draw()?;
-            draw_series(&mut chart, panel, y0, y1)?;
+            draw_series(&mut chart, panel, x0..x1, y0, y1)?;
         }
         Ok(())
     }
@@ -239,17 +292,22 @@ impl Figure {
 fn draw_series<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate<From = (f64, f64)>>(
     chart: &mut ChartContext<'a, DB, CT>,
     panel: &Panel,
+    x_range: std::ops::Range<f64>,
     y0: f64,
     y1: f64,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
-    for (x, label) in &panel.markers {
+    for (k, (x, label)) in panel.markers.iter().enumerate() {
         chart.draw_series(std::iter::once(PathElement::new(
             vec![(*x, y0), (*x, y1)],
             PALETTE[4].stroke_width(1),
         )))?;
+        // each label a line lower than the one before, so that two close markers' labels
+        // do not print over each other
+        let share = 0.08 * k as f64;
+        let at = if panel.log_y { y1 * (y0 / y1).powf(share) } else { y1 - share * (y1 - y0) };
         chart.draw_series(std::iter::once(Text::new(
             label.clone(),
-            (*x, y1),
+            (*x, at),
             ("sans-serif", 11).into_font(),
         )))?;
     }
@@ -287,17 +345,81 @@ fn draw_series<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate<
             }
         };
         if !s.name.is_empty() {
-            anno.label(s.name.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2)));
+            // one element type for every entry (plotters needs one), its parts shown or not:
+            // a line, dashes, a marker or a shaded band, as the series is drawn
+            let show = |yes: bool| if yes { 1.0 } else { 0.0 };
+            let (line, dashes, marker, band) = (
+                show(style_is(s.style, Style::Line)),
+                show(matches!(s.style, Style::Line | Style::Dashed)),
+                show(style_is(s.style, Style::Points)),
+                show(style_is(s.style, Style::Band)),
+            );
+            anno.label(s.name.clone()).legend(move |(x, y)| {
+                EmptyElement::at((x, y))
+                    + Rectangle::new([(0, -5), (18, 5)], color.mix(0.25 * band).filled())
+                    + PathElement::new(vec![(0, 0), (7, 0)], color.mix(dashes).stroke_width(2))
+                    + PathElement::new(vec![(7, 0), (11, 0)], color.mix(line).stroke_width(2))
+                    + PathElement::new(vec![(11, 0), (18, 0)], color.mix(dashes).stroke_width(2))
+                    + Circle::new((9, 0), 3, color.mix(marker).filled())
+            });
         }
     }
-    if panel.series.len() > 1 {
+    let named = panel.series.iter().filter(|s| !s.name.is_empty()).count();
+    if panel.series.len() > 1 && named > 0 {
         chart
             .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
+            .position(legend_corner(panel, (x_range.start, x_range.end), (y0, y1), named))
+            .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .label_font(("sans-serif", 11))
             .draw()?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn steps_panel() -> Panel {
+        let x: Vec<f64> = (1..=18).map(f64::from).collect();
+        // the data fill the top of the panel and its right half: the lower left is free
+        let high: Vec<f64> = x.iter().map(|s| 10.0 - 0.1 * s).collect();
+        let right: Vec<f64> = x.iter().map(|s| if *s > 9.0 { 1.0 } else { 9.5 }).collect();
+        Panel {
+            title: "steps".into(),
+            x_label: "step".into(),
+            y_label: "F".into(),
+            series: vec![Series::line("a", x.clone(), high), Series::points("b", x, right)],
+            markers: vec![(12.0, "chosen 12".into()), (13.0, "chosen 13".into())],
+            ..Panel::default()
+        }
+    }
+
+    /// Read off the SVG as a person would: a counted axis is labelled 2, 4, … (not 2.0, 2.5),
+    /// the legend goes where the data are not, two close markers' labels stand apart.
+    #[test]
+    fn counted_axes_legend_off_the_data_labels_apart() {
+        let panel = steps_panel();
+        assert!(integer_axis(&panel));
+        assert_eq!((whole(4.0), whole(4.5)), ("4".to_string(), String::new()));
+        assert!(matches!(legend_corner(&panel, (0.0, 19.0), (0.0, 10.5), 2), SeriesLabelPosition::LowerLeft));
+        let svg = Figure::new("t", vec![panel]).to_svg().unwrap();
+        let texts: Vec<&str> = svg
+            .split("<text")
+            .skip(1)
+            .filter_map(|t| Some(t.split('>').nth(1)?.split('<').next()?.trim()))
+            .collect();
+        assert!(texts.contains(&"4") && !texts.iter().any(|t| *t == "4.0" || *t == "2.5"), "{texts:?}");
+        let y_of = |label: &str| -> f64 {
+            let at = svg.find(label).unwrap();
+            let tag = &svg[svg[..at].rfind("<text").unwrap()..at];
+            let y = tag.split(" y=\"").nth(1).unwrap().split('"').next().unwrap();
+            y.parse().unwrap()
+        };
+        assert!((y_of("chosen 13") - y_of("chosen 12")).abs() >= 10.0, "marker labels overlap");
+        let mut times = steps_panel();
+        times.series[0].x[0] = 0.5;
+        assert!(!integer_axis(&times));
+    }
 }
