@@ -148,6 +148,26 @@ impl PyModel {
     }
 }
 
+impl PyModel {
+    /// Runs re-simulated from their recorded initial states with their recorded inputs:
+    /// the runs, their comparison and the simulations (replay, validate).
+    fn resimulate(
+        &self,
+        py: Python<'_>,
+        runs: Vec<Run<'_>>,
+        dt: f64,
+        integrator: &str,
+        with_intercept: bool,
+    ) -> PyResult<(Vec<Frame>, termid::diagnose::Runs, Vec<Trajectory>)> {
+        let frames = self.frames(runs)?;
+        let data = termid::diagnose::Runs::new(&self.inner, &frames, dt, integrator_of(integrator)?)
+            .map_err(fail)?
+            .with_intercepts(with_intercept);
+        let sims = py.detach(|| data.simulate(&self.inner, &[], &[])).map_err(fail)?;
+        Ok((frames, data, sims))
+    }
+}
+
 #[pymethods]
 impl PyModel {
     /// Reads a model file (TOML); errors name the file, line and key.
@@ -459,11 +479,7 @@ impl PyModel {
         integrator: &str,
         with_intercept: bool,
     ) -> PyResult<Vec<Vec<(String, Bound<'py, PyArray1<f64>>)>>> {
-        let frames = self.frames(runs)?;
-        let data = termid::diagnose::Runs::new(&self.inner, &frames, dt, integrator_of(integrator)?)
-            .map_err(fail)?
-            .with_intercepts(with_intercept);
-        let sims = py.detach(|| data.simulate(&self.inner, &[], &[])).map_err(fail)?;
+        let (_, _, sims) = self.resimulate(py, runs, dt, integrator, with_intercept)?;
         let time = self.time();
         Ok(sims.into_iter().map(|t| arrays(py, trajectory_columns(&time, t))).collect())
     }
@@ -479,11 +495,7 @@ impl PyModel {
         integrator: &str,
         with_intercept: bool,
     ) -> PyResult<String> {
-        let frames = self.frames(runs)?;
-        let data = termid::diagnose::Runs::new(&self.inner, &frames, dt, integrator_of(integrator)?)
-            .map_err(fail)?
-            .with_intercepts(with_intercept);
-        let sims = py.detach(|| data.simulate(&self.inner, &[], &[])).map_err(fail)?;
+        let (frames, data, sims) = self.resimulate(py, runs, dt, integrator, with_intercept)?;
         let plugin = termid::plugins::of(&self.inner);
         let observe = |f: &Frame, s: Option<&Trajectory>| {
             plugin.and_then(|p| p.observe(&self.inner, f, s)).map(|o| o.json)

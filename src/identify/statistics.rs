@@ -101,7 +101,7 @@ impl EquationMoments {
         let rules = model.parameter_rules();
         let (mut out, mut notes, mut target) = (Vec::new(), Vec::new(), None);
         for chunks in runs {
-            let mut run: Option<(String, Moments, BTreeMap<String, ParamValue>)> = None;
+            let mut run: Option<(String, Option<Moments>, BTreeMap<String, ParamValue>)> = None;
             for chunk in chunks {
                 let mut chunk = chunk?;
                 let shift = |e: IdentifyError| e.shifted(chunk.first_row);
@@ -114,28 +114,12 @@ impl EquationMoments {
                         .iter()
                         .map(|(n, r)| Ok((n.clone(), ParamValue::Value(r.resolve(n, &chunk.frame)?))))
                         .collect::<Result<BTreeMap<_, _>, crate::data::DataError>>()?;
-                    let target =
-                        target.get_or_insert_with(|| default_target(eq, std::slice::from_ref(&chunk.frame)));
-                    let how = Identification {
-                        vocabulary: &model.vocabulary,
-                        parameters: &fixed,
-                        differentiator,
-                        intercept: true,
-                        weights: None,
-                    };
-                    let m = how
-                        .moments_of_rows(
-                            &design.library,
-                            design.candidates(),
-                            target,
-                            &chunk.frame,
-                            chunk.own.clone(),
-                        )
-                        .map_err(shift)?;
-                    run = Some((chunk.frame.origin().to_string(), m, fixed));
-                    continue;
+                    target.get_or_insert_with(|| default_target(eq, std::slice::from_ref(&chunk.frame)));
+                    run = Some((chunk.frame.origin().to_string(), None, fixed));
                 }
-                let Some((_, moments, fixed)) = run.as_mut() else { unreachable!() };
+                let (Some((_, moments, fixed)), Some(target)) = (run.as_mut(), target.as_ref()) else {
+                    unreachable!("set by the run's first chunk")
+                };
                 let how = Identification {
                     vocabulary: &model.vocabulary,
                     parameters: fixed,
@@ -143,7 +127,6 @@ impl EquationMoments {
                     intercept: true,
                     weights: None,
                 };
-                let target = target.as_ref().expect("set by the first chunk");
                 let m = how
                     .moments_of_rows(
                         &design.library,
@@ -153,9 +136,12 @@ impl EquationMoments {
                         chunk.own.clone(),
                     )
                     .map_err(shift)?;
-                moments.merge(&m);
+                match moments {
+                    Some(all) => all.merge(&m),
+                    none => *none = Some(m),
+                }
             }
-            if let Some((name, moments, _)) = run {
+            if let Some((name, Some(moments), _)) = run {
                 out.push(RunMoments { run: name, moments });
             }
         }
