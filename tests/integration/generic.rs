@@ -424,23 +424,28 @@ fn moments_read_in_pieces_equal_the_whole_file() {
             m["numbers"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect(),
         )
     };
+    // `termid moments` of y_dot: (succeeded, stderr)
+    let moments = |data: &str, derivative: &str, rows: &str, out: &str| {
+        let (ok, _, err) = termid(&[
+            "moments",
+            "--model",
+            "models/lorenz.toml",
+            "--equation",
+            "y_dot",
+            "--data",
+            data,
+            "--derivative",
+            derivative,
+            "--chunk-rows",
+            rows,
+            "--out",
+            out,
+        ]);
+        (ok, err)
+    };
     for derivative in ["central", "five-point", "savitzky-golay:9:3"] {
         let run = |data: &str, rows: &str, out: &str| {
-            let (ok, _, err) = termid(&[
-                "moments",
-                "--model",
-                "models/lorenz.toml",
-                "--equation",
-                "y_dot",
-                "--data",
-                data,
-                "--derivative",
-                derivative,
-                "--chunk-rows",
-                rows,
-                "--out",
-                out,
-            ]);
+            let (ok, err) = moments(data, derivative, rows, out);
             assert!(ok, "{err}");
             numbers(out)
         };
@@ -455,21 +460,7 @@ fn moments_read_in_pieces_equal_the_whole_file() {
         }
     }
     // a smoother needs the whole run: read whole, whatever --chunk-rows says
-    let (ok, _, err) = termid(&[
-        "moments",
-        "--model",
-        "models/lorenz.toml",
-        "--equation",
-        "y_dot",
-        "--data",
-        &p("run.csv"),
-        "--derivative",
-        "spline",
-        "--chunk-rows",
-        "100",
-        "--out",
-        &p("spline.json"),
-    ]);
+    let (ok, err) = moments(&p("run.csv"), "spline", "100", &p("spline.json"));
     assert!(ok, "{err}");
     // a bad cell deep in the file: its row in the file, in pieces as whole
     let mut lines: Vec<&str> = text.lines().collect();
@@ -477,33 +468,11 @@ fn moments_read_in_pieces_equal_the_whole_file() {
     lines[7001] = &bad;
     std::fs::write(p("bad.csv"), lines.join("\n")).unwrap();
     for rows in ["0", "300"] {
-        let (ok, _, err) = termid(&[
-            "moments",
-            "--model",
-            "models/lorenz.toml",
-            "--equation",
-            "y_dot",
-            "--data",
-            &p("bad.csv"),
-            "--chunk-rows",
-            rows,
-            "--out",
-            &p("bad.json"),
-        ]);
+        let (ok, err) = moments(&p("bad.csv"), "central", rows, &p("bad.json"));
         assert!(!ok && err.contains("row 7001, column `z`"), "{rows}: {err}");
     }
     if std::path::Path::new("/dev/zero").exists() {
-        let (ok, _, err) = termid(&[
-            "moments",
-            "--model",
-            "models/lorenz.toml",
-            "--equation",
-            "y_dot",
-            "--data",
-            "/dev/zero",
-            "--out",
-            &p("zero.json"),
-        ]);
+        let (ok, err) = moments("/dev/zero", "central", "262144", &p("zero.json"));
         assert!(!ok && (err.contains("not a CSV file") || err.contains("not a text file")), "{err}");
     }
 }
