@@ -52,3 +52,6 @@ mod simman;
 // README as a script: every shell block runs, in order, on the repository's own files.
 #[path = "integration/readme.rs"]
 mod readme;
+// Every figure kind, read off its SVG as a person would look at it.
+#[path = "integration/figures.rs"]
+mod figures;

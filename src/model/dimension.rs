@@ -8,6 +8,16 @@ use std::collections::BTreeMap;
 use super::Model;
 use crate::term::{Atom, Term};
 
+/// How a quantity in `unit` is shown to a person: angles in degrees (a unit that begins with
+/// rad: rad, rad/s, rad/s^2 become °, °/s, °/s^2), anything else as it is. The factor from
+/// the model's unit, and the unit shown.
+pub fn shown(unit: &str) -> (f64, String) {
+    match unit.strip_prefix("rad") {
+        Some(rest) => (180.0 / std::f64::consts::PI, format!("°{rest}")),
+        None => (1.0, unit.to_string()),
+    }
+}
+
 /// Exponents of length, time and mass.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Dimension {
@@ -303,6 +313,15 @@ pub fn nondimensional(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn angles_shown_in_degrees_other_units_as_they_are() {
+        let (f, u) = shown("rad/s");
+        assert!((f - 57.29577951308232).abs() < 1e-12);
+        assert_eq!(u, "°/s");
+        assert_eq!(shown("rad").1, "°");
+        assert_eq!(shown("m/s"), (1.0, "m/s".to_string()));
+    }
 
     /// Froude scaling of the paper's ship to a 20× larger one: a zigzag's overshoots and
     /// the track in ship lengths are the same, its period √20 times longer.

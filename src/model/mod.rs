@@ -411,6 +411,19 @@ impl Model {
         Ok(Model { path: file.into(), spec, vocabulary: vocab, equations })
     }
 
+    /// The unit the file declares for a state, input or parameter (empty where none or
+    /// unknown).
+    pub fn unit(&self, name: &str) -> &str {
+        let s = &self.spec;
+        s.states
+            .iter()
+            .map(|x| (&x.name, &x.unit))
+            .chain(s.inputs.iter().map(|x| (&x.name, &x.unit)))
+            .chain(s.parameters.iter().map(|(n, x)| (n, &x.unit)))
+            .find(|(n, _)| *n == name)
+            .map_or("", |(_, u)| u.as_str())
+    }
+
     /// The names of the equations `identify` fits (identifiable, with candidates).
     pub fn identifiable(&self) -> Vec<String> {
         self.equations

@@ -12,6 +12,7 @@ pub use prepared::prepared_figure;
 use std::path::Path;
 
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 /// How a series is drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -22,6 +23,9 @@ pub enum Style {
     Dashed,
     /// Markers only.
     Points,
+    /// Larger open rings (a reference, e.g. the true values, that markers drawn over it
+    /// leave visible).
+    Rings,
     /// A shaded band between `y` (lower) and `upper`.
     Band,
 }
@@ -39,24 +43,36 @@ pub struct Series {
     pub style: Style,
     /// Upper edge of a band (empty for other styles).
     pub upper: Vec<f64>,
+    /// The palette colour, where it is not the series' place in its panel (a residual in
+    /// the colour of the simulation it belongs to).
+    pub color: Option<usize>,
 }
 
 impl Series {
+    /// The same series in palette colour `k`.
+    pub fn colored(mut self, k: usize) -> Series {
+        self.color = Some(k);
+        self
+    }
     /// A solid line.
     pub fn line(name: &str, x: Vec<f64>, y: Vec<f64>) -> Series {
-        Series { name: name.into(), x, y, style: Style::Line, upper: vec![] }
+        Series { name: name.into(), x, y, style: Style::Line, upper: vec![], color: None }
     }
     /// A dashed line.
     pub fn dashed(name: &str, x: Vec<f64>, y: Vec<f64>) -> Series {
-        Series { name: name.into(), x, y, style: Style::Dashed, upper: vec![] }
+        Series { name: name.into(), x, y, style: Style::Dashed, upper: vec![], color: None }
     }
     /// Markers.
     pub fn points(name: &str, x: Vec<f64>, y: Vec<f64>) -> Series {
-        Series { name: name.into(), x, y, style: Style::Points, upper: vec![] }
+        Series { name: name.into(), x, y, style: Style::Points, upper: vec![], color: None }
+    }
+    /// Open rings.
+    pub fn rings(name: &str, x: Vec<f64>, y: Vec<f64>) -> Series {
+        Series { name: name.into(), x, y, style: Style::Rings, upper: vec![], color: None }
     }
     /// A shaded band from `lower` to `upper` (e.g. a 90 % prediction band).
     pub fn band(name: &str, x: Vec<f64>, lower: Vec<f64>, upper: Vec<f64>) -> Series {
-        Series { name: name.into(), x, y: lower, style: Style::Band, upper }
+        Series { name: name.into(), x, y: lower, style: Style::Band, upper, color: None }
     }
 }
 
@@ -75,21 +91,32 @@ pub struct Panel {
     pub markers: Vec<(f64, String)>,
     /// Same scale on both axes (tracks).
     pub equal_axes: bool,
+    /// Both axes labelled at every whole unit where the range allows (a track in ship
+    /// lengths: a tick per length, as in the paper's track plots).
+    pub unit_ticks: bool,
     /// Logarithmic y axis.
     pub log_y: bool,
+    /// Height in pixels where it differs from the figure's `panel_height` (a track in a
+    /// one-column figure, drawn near square).
+    pub height: Option<u32>,
 }
 
-/// A column of panels.
+/// Panels in rows of `columns` (one column unless set).
 #[derive(Clone, Debug, Default)]
 pub struct Figure {
     /// Title of the whole figure.
     pub title: String,
-    /// Panels from top to bottom.
+    /// Panels row by row, left to right, top to bottom.
     pub panels: Vec<Panel>,
     /// Width in pixels.
     pub width: u32,
-    /// Height of one panel in pixels.
+    /// Height of one row of panels in pixels.
     pub panel_height: u32,
+    /// Panels side by side in a row.
+    pub columns: usize,
+    /// One legend for the whole figure, under its title, in place of each panel's own (panels
+    /// that show the same series: a run's states beside their simulations).
+    pub shared_legend: bool,
 }
 
 const PALETTE: [RGBColor; 6] = [
@@ -134,7 +161,15 @@ pub enum PlotError {
     },
 }
 
-/// Axis numbers without trailing noise: 0.25, 30, 1e-4.
+/// An axis label: `name [unit]`, or the bare name where there is no unit.
+pub(crate) fn labelled(name: &str, unit: &str) -> String {
+    if unit.is_empty() {
+        name.to_string()
+    } else {
+        format!("{name} [{unit}]")
+    }
+}
+
 fn style_is(a: Style, b: Style) -> bool {
     std::mem::discriminant(&a) == std::mem::discriminant(&b)
 }
@@ -155,35 +190,95 @@ fn whole(v: f64) -> String {
     }
 }
 
-/// The corner of the plotting area where the legend covers the fewest data points (a box of
-/// a third of the width and `rows` legend lines high in each corner), in the order upper
-/// right, upper left, lower right, lower left on ties.
-fn legend_corner(panel: &Panel, x: (f64, f64), y: (f64, f64), rows: usize) -> SeriesLabelPosition {
+/// The legend's size in pixels as plotters lays it out for `panel` (11 px text, about 5 px a
+/// character, a 30 px glyph column, 10 px margins), 5 px from the plotting area's edge, and
+/// a few pixels more: its own estimate of a text's width is not ours (Greek letters).
+fn legend_px(panel: &Panel) -> (f64, f64) {
+    let named = panel.series.iter().filter(|s| !s.name.is_empty());
+    let (rows, chars) = named.fold((0usize, 0usize), |(n, c), s| (n + 1, c.max(s.name.chars().count())));
+    (5.5 * chars as f64 + 65.0, 14.0 * rows as f64 + 30.0)
+}
+
+/// The plotting area's size in pixels in a panel of `(w, h)`: less the label areas (60 px
+/// left, 34 px below), the margins (8 px each side) and the caption.
+fn plot_px((w, h): (u32, u32)) -> (f64, f64) {
+    ((w as f64 - 60.0 - 16.0).max(10.0), (h as f64 - 34.0 - 16.0 - 22.0).max(10.0))
+}
+
+/// The corner of the plotting area where the legend covers the fewest data points, and how
+/// many it covers, in the order upper right, upper left, lower right, lower left on ties.
+/// `px` is the plotting area's size in pixels, which sizes the legend's box in data units.
+fn legend_corner(
+    panel: &Panel,
+    x: (f64, f64),
+    y: (f64, f64),
+    px: (f64, f64),
+) -> (SeriesLabelPosition, usize) {
     // on a logarithmic axis the box is a share of the decades
     let scale = |v: f64| if panel.log_y { v.max(1e-300).log10() } else { v };
     let y = (scale(y.0), scale(y.1));
-    let (w, h) = ((x.1 - x.0) / 3.0, (y.1 - y.0) * (0.1 * rows as f64 + 0.08).min(0.6));
+    let (lw, lh) = legend_px(panel);
+    let (w, h) = ((x.1 - x.0) * (lw / px.0).min(1.0), (y.1 - y.0) * (lh / px.1).min(1.0));
     let corners = [
         (SeriesLabelPosition::UpperRight, x.1 - w, y.1 - h),
         (SeriesLabelPosition::UpperLeft, x.0, y.1 - h),
         (SeriesLabelPosition::LowerRight, x.1 - w, y.0),
         (SeriesLabelPosition::LowerLeft, x.0, y.0),
     ];
+    // a marker is a line over the whole height, and its label (11 px text, 5.5 px a
+    // character) to the right of it near the top, a line lower for each marker before it
+    let per_px = (x.1 - x.0) / px.0;
+    let marks: Vec<(f64, f64)> = panel
+        .markers
+        .iter()
+        .enumerate()
+        .flat_map(|(k, (mx, label))| {
+            let line = (0..=20).map(move |i| (*mx, y.0 + (y.1 - y.0) * f64::from(i) / 20.0));
+            let at = y.1 - 0.08 * k as f64 * (y.1 - y.0);
+            let text = (0..label.chars().count()).map(move |c| (*mx + 5.5 * c as f64 * per_px, at));
+            line.chain(text)
+        })
+        .collect();
+    // the points of every line and band edge, and four between each two (a line from one
+    // point outside the box to the next can cross it)
+    let edge = |s: &Series, ys: &[f64]| -> Vec<(f64, f64)> {
+        let p: Vec<(f64, f64)> = s.x.iter().zip(ys).map(|(a, b)| (*a, scale(*b))).collect();
+        let between = !matches!(s.style, Style::Points | Style::Rings);
+        let mut out = p.clone();
+        if between {
+            for pair in p.windows(2) {
+                let ((a, b), (c, d)) = (pair[0], pair[1]);
+                out.extend((1..5).map(|i| {
+                    let f = f64::from(i) / 5.0;
+                    (a + f * (c - a), b + f * (d - b))
+                }));
+            }
+        }
+        out
+    };
+    let points: Vec<(f64, f64)> = panel
+        .series
+        .iter()
+        .flat_map(|s| edge(s, &s.y).into_iter().chain(edge(s, &s.upper)))
+        .chain(marks)
+        .filter(|(a, b)| a.is_finite() && b.is_finite())
+        .collect();
     let inside = |cx: f64, cy: f64| {
-        panel
-            .series
-            .iter()
-            .flat_map(|s| s.x.iter().zip(s.y.iter().chain(s.upper.iter())))
-            .map(|(px, py)| (*px, scale(*py)))
-            .filter(|(px, py)| *px >= cx && *px <= cx + w && *py >= cy && *py <= cy + h)
-            .count()
+        points.iter().filter(|(px, py)| *px >= cx && *px <= cx + w && *py >= cy && *py <= cy + h).count()
     };
     corners
         .into_iter()
-        .min_by_key(|(_, cx, cy)| inside(*cx, *cy))
-        .map_or(SeriesLabelPosition::UpperRight, |(p, _, _)| p)
+        .map(|(p, cx, cy)| (p, inside(cx, cy)))
+        .min_by_key(|(_, n)| *n)
+        .unwrap_or((SeriesLabelPosition::UpperRight, 0))
 }
 
+/// Whether a panel draws a legend of its own.
+fn has_legend(panel: &Panel) -> bool {
+    panel.series.len() > 1 && panel.series.iter().any(|s| !s.name.is_empty())
+}
+
+/// Axis numbers without trailing noise: 0.25, 30, 1e-4.
 fn short(v: f64) -> String {
     // tick positions computed as sums carry round-off: 1e-17 is a zero
     if v.abs() < 1e-12 {
@@ -199,7 +294,19 @@ fn short(v: f64) -> String {
 impl Figure {
     /// A figure of the given panels, 760 px wide, 240 px per panel.
     pub fn new(title: &str, panels: Vec<Panel>) -> Figure {
-        Figure { title: title.into(), panels, width: 760, panel_height: 240 }
+        Figure {
+            title: title.into(),
+            panels,
+            width: 760,
+            panel_height: 240,
+            columns: 1,
+            shared_legend: false,
+        }
+    }
+
+    /// Rows of panels the figure takes.
+    fn rows(&self) -> usize {
+        self.panels.len().max(1).div_ceil(self.columns.max(1))
     }
 
     /// Writes the figure as SVG (atomically: the old file stays until the new one is whole).
@@ -215,7 +322,14 @@ impl Figure {
     pub fn to_svg(&self) -> Result<String, PlotError> {
         let err = |e: &dyn std::fmt::Display| PlotError::Draw(e.to_string());
         let title_h = if self.title.is_empty() { 0 } else { 30 };
-        let height = title_h + self.panel_height * self.panels.len().max(1) as u32;
+        let legend_h = if self.shared_legend { 24 } else { 0 };
+        // a one-column figure's panels may each have their own height; a grid's rows are even
+        let heights: Vec<u32> = if self.columns <= 1 {
+            self.panels.iter().map(|p| p.height.unwrap_or(self.panel_height)).collect()
+        } else {
+            vec![self.panel_height; self.rows()]
+        };
+        let height = title_h + legend_h + heights.iter().sum::<u32>().max(self.panel_height);
         let mut svg = String::new();
         {
             let root = SVGBackend::with_string(&mut svg, (self.width, height)).into_drawing_area();
@@ -227,7 +341,25 @@ impl Figure {
             } else {
                 root.clone()
             };
-            let areas = body.split_evenly((self.panels.len().max(1), 1));
+            let body = if legend_h > 0 {
+                let (row, body) = body.split_vertically(legend_h);
+                legend_row(&self.panels, &row).map_err(|e| err(&e))?;
+                body
+            } else {
+                body
+            };
+            let areas = if self.columns <= 1 {
+                let mut rest = body;
+                let mut areas = Vec::new();
+                for h in &heights {
+                    let (area, below) = rest.split_vertically(*h);
+                    areas.push(area);
+                    rest = below;
+                }
+                areas
+            } else {
+                body.split_evenly((self.rows(), self.columns))
+            };
             for (panel, area) in self.panels.iter().zip(areas) {
                 self.draw_panel(panel, &area).map_err(|e| err(&e))?;
             }
@@ -244,17 +376,36 @@ impl Figure {
         let (mut x0, mut x1) = range(panel.series.iter().flat_map(|s| s.x.iter().copied()), false);
         let (mut y0, mut y1) =
             range(panel.series.iter().flat_map(|s| s.y.iter().chain(&s.upper).copied()), panel.log_y);
+        let px = plot_px(area.dim_in_pixel());
         if panel.equal_axes {
             // the same metres per pixel on both axes: the ranges follow the plotting area's
-            // shape (the panel less its caption, label areas and margins below), so a circle
-            // is drawn round
-            let (w, h) = area.dim_in_pixel();
-            let (pw, ph) = ((w as f64 - 60.0 - 16.0).max(10.0), (h as f64 - 34.0 - 16.0 - 22.0).max(10.0));
+            // shape, so a circle is drawn round
             let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
-            let per_pixel = ((x1 - x0) / pw).max((y1 - y0) / ph);
-            (x0, x1) = (cx - per_pixel * pw / 2.0, cx + per_pixel * pw / 2.0);
-            (y0, y1) = (cy - per_pixel * ph / 2.0, cy + per_pixel * ph / 2.0);
+            let per_pixel = ((x1 - x0) / px.0).max((y1 - y0) / px.1);
+            (x0, x1) = (cx - per_pixel * px.0 / 2.0, cx + per_pixel * px.0 / 2.0);
+            (y0, y1) = (cy - per_pixel * px.1 / 2.0, cy + per_pixel * px.1 / 2.0);
         }
+        let own_legend = has_legend(panel) && !self.shared_legend;
+        let mut corner = legend_corner(panel, (x0, x1), (y0, y1), px);
+        if own_legend && corner.1 > 0 && !panel.equal_axes {
+            // every corner has data under the legend: room beside the data (a tall legend of
+            // many entries) or above them (a wide one), whichever takes less of the panel,
+            // so that it covers none
+            let (lw, lh) = legend_px(panel);
+            let (wide, high) = ((lw + 4.0) / px.0, (lh + 4.0) / px.1);
+            if wide < high && wide < 0.5 && !panel.log_y {
+                x1 = x0 + (x1 - x0) / (1.0 - wide);
+            } else {
+                let room = 1.0 / (1.0 - high).max(1.0 / 3.0);
+                if panel.log_y {
+                    y1 = y0 * (y1 / y0).powf(room);
+                } else {
+                    y1 = y0 + (y1 - y0) * room;
+                }
+            }
+            corner = legend_corner(panel, (x0, x1), (y0, y1), px);
+        }
+        let legend = own_legend.then_some(corner.0);
         let mut builder = ChartBuilder::on(area);
         builder
             .caption(&panel.title, ("sans-serif", 14))
@@ -271,28 +422,96 @@ impl Figure {
                 .x_label_formatter(&|v| if counted { whole(*v) } else { short(*v) })
                 .y_label_formatter(&|v| format!("{v:.0e}"))
                 .draw()?;
-            draw_series(&mut chart, panel, x0..x1, y0, y1)?;
+            draw_series(&mut chart, panel, legend, y0, y1)?;
         } else {
             let mut chart = builder.build_cartesian_2d(x0..x1, y0..y1)?;
             // steps and alternatives are counted: their axis is labelled at whole numbers only
             let counted = integer_axis(panel);
+            // plotters labels at the finest of 1, 2, 5 × 10ᵏ that gives at most this many
+            // labels: one more than the whole units in the range gives a label per unit
+            // labels, as many as fit at 40 px apart across and 25 px up
+            let per_unit = |lo: f64, hi: f64, fit: f64| {
+                if panel.unit_ticks {
+                    ((hi - lo).floor() + 1.0).min(fit).max(2.0) as usize
+                } else {
+                    10
+                }
+            };
             chart
                 .configure_mesh()
+                .x_labels(per_unit(x0, x1, px.0 / 40.0))
+                .y_labels(per_unit(y0, y1, px.1 / 25.0))
                 .x_desc(&panel.x_label)
                 .y_desc(&panel.y_label)
                 .x_label_formatter(&|v| if counted { whole(*v) } else { short(*v) })
                 .y_label_formatter(&|v| short(*v))
                 .draw()?;
-            draw_series(&mut chart, panel, x0..x1, y0, y1)?;
+            draw_series(&mut chart, panel, legend, y0, y1)?;
         }
         Ok(())
     }
 }
 
+/// A legend entry's picture, 18 px wide from `at`: one element type for every style
+/// (plotters needs one), its parts shown or not: a line, dashes, a marker, a ring or a band.
+/// A macro, not a function: plotters takes legend pictures as elements of a type free of the
+/// drawing back-end, which a generic function cannot name.
+macro_rules! glyph {
+    ($at:expr, $style:expr, $color:expr) => {{
+        let (style, color): (Style, RGBColor) = ($style, $color);
+        let show = |yes: bool| if yes { 1.0 } else { 0.0 };
+        let (line, dashes, marker, ring, band) = (
+            show(style_is(style, Style::Line)),
+            show(matches!(style, Style::Line | Style::Dashed)),
+            show(style_is(style, Style::Points)),
+            show(style_is(style, Style::Rings)),
+            show(style_is(style, Style::Band)),
+        );
+        EmptyElement::at($at)
+            + Rectangle::new([(0, -5), (18, 5)], color.mix(0.25 * band).filled())
+            + PathElement::new(vec![(0, 0), (7, 0)], color.mix(dashes).stroke_width(2))
+            + PathElement::new(vec![(7, 0), (11, 0)], color.mix(line).stroke_width(2))
+            + PathElement::new(vec![(11, 0), (18, 0)], color.mix(dashes).stroke_width(2))
+            + Circle::new((9, 0), 3, color.mix(marker).filled())
+            + Circle::new((9, 0), 5, color.mix(ring).stroke_width(2))
+    }};
+}
+
+/// The figure's legend in one row under its title (a shared legend): every named series
+/// once, by name, in its colour and style as its first panel draws it.
+fn legend_row<DB: DrawingBackend>(
+    panels: &[Panel],
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let mut seen: Vec<(String, Style, RGBColor)> = Vec::new();
+    for panel in panels {
+        for (k, s) in panel.series.iter().enumerate() {
+            if !s.name.is_empty() && !seen.iter().any(|(n, _, _)| *n == s.name) {
+                seen.push((s.name.clone(), s.style, PALETTE[s.color.unwrap_or(k) % PALETTE.len()]));
+            }
+        }
+    }
+    // each entry: its picture, 6 px, its text (5 px a character at 11 px), 18 px to the next
+    let widths: Vec<i32> = seen.iter().map(|(n, _, _)| 18 + 6 + 5 * n.chars().count() as i32 + 18).collect();
+    let (w, h) = area.dim_in_pixel();
+    let mut x = ((w as i32 - widths.iter().sum::<i32>()) / 2).max(4);
+    let y = h as i32 / 2;
+    for ((name, style, color), width) in seen.iter().zip(&widths) {
+        area.draw(&glyph!((x, y), *style, *color))?;
+        area.draw(&Text::new(
+            name.clone(),
+            (x + 24, y),
+            TextStyle::from(("sans-serif", 11).into_font()).pos(Pos::new(HPos::Left, VPos::Center)),
+        ))?;
+        x += width;
+    }
+    Ok(())
+}
+
 fn draw_series<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate<From = (f64, f64)>>(
     chart: &mut ChartContext<'a, DB, CT>,
     panel: &Panel,
-    x_range: std::ops::Range<f64>,
+    legend: Option<SeriesLabelPosition>,
     y0: f64,
     y1: f64,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
@@ -312,7 +531,7 @@ fn draw_series<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate<
         )))?;
     }
     for (k, s) in panel.series.iter().enumerate() {
-        let color = PALETTE[k % PALETTE.len()];
+        let color = PALETTE[s.color.unwrap_or(k) % PALETTE.len()];
         let pts: Vec<(f64, f64)> =
             s.x.iter()
                 .zip(&s.y)
@@ -321,15 +540,13 @@ fn draw_series<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate<
                 .collect();
         let anno = match s.style {
             Style::Line => chart.draw_series(LineSeries::new(pts, color.stroke_width(2)))?,
-            Style::Dashed => {
-                let segments: Vec<Vec<(f64, f64)>> =
-                    pts.chunks(2).step_by(2).map(|c| c.to_vec()).filter(|c| c.len() == 2).collect();
-                chart.draw_series(
-                    segments.into_iter().map(move |seg| PathElement::new(seg, color.stroke_width(2))),
-                )?
-            }
+            // dashes measured in pixels, whatever the sampling
+            Style::Dashed => chart.draw_series(DashedLineSeries::new(pts, 7, 4, color.stroke_width(2)))?,
             Style::Points => {
                 chart.draw_series(pts.into_iter().map(move |p| Circle::new(p, 3, color.filled())))?
+            }
+            Style::Rings => {
+                chart.draw_series(pts.into_iter().map(move |p| Circle::new(p, 6, color.stroke_width(2))))?
             }
             Style::Band => {
                 // lower edge forward, upper edge back: one closed polygon
@@ -345,30 +562,14 @@ fn draw_series<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate<
             }
         };
         if !s.name.is_empty() {
-            // one element type for every entry (plotters needs one), its parts shown or not:
-            // a line, dashes, a marker or a shaded band, as the series is drawn
-            let show = |yes: bool| if yes { 1.0 } else { 0.0 };
-            let (line, dashes, marker, band) = (
-                show(style_is(s.style, Style::Line)),
-                show(matches!(s.style, Style::Line | Style::Dashed)),
-                show(style_is(s.style, Style::Points)),
-                show(style_is(s.style, Style::Band)),
-            );
-            anno.label(s.name.clone()).legend(move |(x, y)| {
-                EmptyElement::at((x, y))
-                    + Rectangle::new([(0, -5), (18, 5)], color.mix(0.25 * band).filled())
-                    + PathElement::new(vec![(0, 0), (7, 0)], color.mix(dashes).stroke_width(2))
-                    + PathElement::new(vec![(7, 0), (11, 0)], color.mix(line).stroke_width(2))
-                    + PathElement::new(vec![(11, 0), (18, 0)], color.mix(dashes).stroke_width(2))
-                    + Circle::new((9, 0), 3, color.mix(marker).filled())
-            });
+            let style = s.style;
+            anno.label(s.name.clone()).legend(move |at| glyph!(at, style, color));
         }
     }
-    let named = panel.series.iter().filter(|s| !s.name.is_empty()).count();
-    if panel.series.len() > 1 && named > 0 {
+    if let Some(position) = legend {
         chart
             .configure_series_labels()
-            .position(legend_corner(panel, (x_range.start, x_range.end), (y0, y1), named))
+            .position(position)
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .label_font(("sans-serif", 11))
@@ -403,7 +604,10 @@ mod tests {
         let panel = steps_panel();
         assert!(integer_axis(&panel));
         assert_eq!((whole(4.0), whole(4.5)), ("4".to_string(), String::new()));
-        assert!(matches!(legend_corner(&panel, (0.0, 19.0), (0.0, 10.5), 2), SeriesLabelPosition::LowerLeft));
+        assert!(matches!(
+            legend_corner(&panel, (0.0, 19.0), (0.0, 10.5), (684.0, 168.0)).0,
+            SeriesLabelPosition::LowerLeft
+        ));
         let svg = Figure::new("t", vec![panel]).to_svg().unwrap();
         let texts: Vec<&str> = svg
             .split("<text")

@@ -1,7 +1,7 @@
 //! The figure of a run's preparation for identification: raw and prepared signals, and the
 //! rates beside the raw record's central differences.
 
-use super::{Figure, Panel, Series};
+use super::{labelled, Figure, Panel, Series};
 use crate::data::{CentralDifference, Differentiator, Frame};
 
 /// Raw and prepared signals over time, two panels per signal (its value, and its rate beside
@@ -14,6 +14,7 @@ pub fn prepared_figure(
     scale: &dyn Fn(&str) -> (f64, String),
 ) -> Figure {
     let mut panels = Vec::new();
+    let mut every_rate = true;
     let times = |f: &Frame| f.time().to_vec();
     for name in signals {
         let (k, unit) = scale(name);
@@ -22,14 +23,17 @@ pub fn prepared_figure(
         panels.push(Panel {
             title: name.clone(),
             x_label: format!("{} [s]", raw.time_name()),
-            y_label: format!("{name} [{unit}]"),
+            y_label: labelled(name, &unit),
             series: vec![
                 Series::points("raw", times(raw), line(r)),
                 Series::line("prepared", times(prepared), line(p)),
             ],
             ..Panel::default()
         });
-        let Some(d) = prepared.column(&format!("{name}_dot")) else { continue };
+        let Some(d) = prepared.column(&format!("{name}_dot")) else {
+            every_rate = false;
+            continue;
+        };
         let mut series = Vec::new();
         if let Ok(cd) = CentralDifference.differentiate(raw.time(), r) {
             series.push(Series::points("central differences of raw", times(raw), line(&cd)));
@@ -38,12 +42,29 @@ pub fn prepared_figure(
         panels.push(Panel {
             title: format!("d{name}/dt"),
             x_label: format!("{} [s]", raw.time_name()),
-            y_label: format!("d{name}/dt [{unit}/s]"),
+            y_label: labelled(&format!("d{name}/dt"), &per_second(&unit)),
             series,
             ..Panel::default()
         });
     }
-    Figure::new(&format!("{}: raw and prepared signals", raw.origin()), panels)
+    // a signal a row, its value beside its rate, where every signal has its rate
+    let mut fig = Figure::new(&format!("{}: raw and prepared signals", raw.origin()), panels);
+    if every_rate {
+        fig.columns = 2;
+        fig.width = 1100;
+        fig.panel_height = 220;
+    }
+    fig.shared_legend = true;
+    fig
+}
+
+/// A rate's unit: m/s → m/s², ° → °/s, nothing → 1/s.
+fn per_second(unit: &str) -> String {
+    match unit {
+        "" => "1/s".into(),
+        u if u.ends_with("/s") => format!("{u}²"),
+        u => format!("{u}/s"),
+    }
 }
 
 #[cfg(test)]

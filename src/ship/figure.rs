@@ -1,37 +1,56 @@
-//! Figures in the paper's layout: δ, ψ and U/U0 over time; β and r over time; the track.
+//! Figures in the paper's layout: δ and ψ over time, U/U0, β and r, and the track in ship
+//! lengths; the spiral test's steady yaw rate against the rudder angle.
 
 use crate::plot::{Figure, Panel, Series};
 use crate::sim::Trajectory;
 
 use super::Ship;
 
-/// One curve set per run: (legend, trajectory).
+const RUDDER_HEADING: &str = "rudder δ and heading ψ";
+const RUDDER: &str = "rudder δ";
+const HEADING: &str = "heading ψ";
+const SPEED: &str = "speed U/U0";
+const DRIFT: &str = "drift angle β and yaw rate r";
+const TRACK: &str = "track";
+
+/// One curve set per run: (legend, trajectory). As in the paper, δ and ψ share a panel over
+/// time, β and r another, U/U0 a third, and the track (in ship lengths, equal scale) the last;
+/// where the heading runs far beyond the rudder angle (a turning circle's ψ reaches 1000°
+/// and more, which would flatten δ to a line) δ and ψ get a panel each.
 pub fn manoeuvre_figure(ship: &Ship, title: &str, runs: &[(&str, &Trajectory)], track: bool) -> Figure {
     let r = &ship.roles;
     let deg = |v: &[f64]| v.iter().map(|x| x.to_degrees()).collect::<Vec<f64>>();
-    let mut top = Panel {
-        title: "rudder δ and heading ψ".into(),
+    let span = |v: &[f64]| {
+        let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
+        if hi >= lo {
+            hi - lo
+        } else {
+            0.0
+        }
+    };
+    let (rudder_span, heading_span) = runs.iter().fold((0f64, 0f64), |(a, b), (_, t)| {
+        (a.max(span(&t.inputs[r.rudder])), b.max(span(&t.states[r.psi])))
+    });
+    let apart = heading_span > 4.0 * rudder_span.max(1f64.to_radians());
+    let panel = |title: &str, y_label: &str| Panel {
+        title: title.into(),
         x_label: "t [s]".into(),
-        y_label: "[°]".into(),
+        y_label: y_label.into(),
         ..Panel::default()
     };
-    let mut speed = Panel {
-        title: "speed U/U0".into(),
-        x_label: "t [s]".into(),
-        y_label: "U/U0 [-]".into(),
-        ..Panel::default()
-    };
-    let mut drift = Panel {
-        title: "drift angle β and yaw rate r".into(),
-        x_label: "t [s]".into(),
-        y_label: "β [°], r [°/s]".into(),
-        ..Panel::default()
-    };
+    let mut rudder =
+        panel(if apart { RUDDER } else { RUDDER_HEADING }, if apart { "δ [°]" } else { "δ, ψ [°]" });
+    let mut heading = panel(HEADING, "ψ [°]");
+    let mut speed = panel(SPEED, "U/U0 [-]");
+    let mut drift = panel(DRIFT, "β [°], r [°/s]");
+    let lpp = ship.spec.lpp;
     let mut path = Panel {
-        title: "track".into(),
-        x_label: "y0 [m] (starboard)".into(),
-        y_label: "x0 [m] (initial course)".into(),
+        title: format!("{TRACK} (L = {lpp} m)"),
+        x_label: "y0/L [-] (starboard)".into(),
+        y_label: "x0/L [-] (initial course)".into(),
         equal_axes: true,
+        unit_ticks: true,
+        height: Some(460),
         ..Panel::default()
     };
     for (k, (name, t)) in runs.iter().enumerate() {
@@ -44,14 +63,25 @@ pub fn manoeuvre_figure(ship: &Ship, title: &str, runs: &[(&str, &Trajectory)], 
             }
         };
         let (speed_v, drift_v) = ship.speed_and_drift(t);
-        top.series.push(mk("δ", deg(&t.inputs[r.rudder])));
-        top.series.push(mk("ψ", deg(&t.states[r.psi])));
+        rudder.series.push(mk("δ", deg(&t.inputs[r.rudder])));
+        let psi = mk("ψ", deg(&t.states[r.psi]));
+        if apart {
+            heading.series.push(psi);
+        } else {
+            rudder.series.push(psi);
+        }
         speed.series.push(mk("U/U0", speed_v.iter().map(|u| u / ship.spec.u0).collect()));
         drift.series.push(mk("β", deg(&drift_v)));
         drift.series.push(mk("r", deg(&t.states[r.r])));
-        path.series.push(Series::line(name, t.states[r.y0].clone(), t.states[r.x0].clone()));
+        let in_lengths = |v: &[f64]| v.iter().map(|x| x / lpp).collect::<Vec<f64>>();
+        path.series
+            .push(Series::line(name, in_lengths(&t.states[r.y0]), in_lengths(&t.states[r.x0])).colored(k));
     }
-    let mut panels = vec![top, speed, drift];
+    let mut panels = vec![rudder];
+    if apart {
+        panels.push(heading);
+    }
+    panels.extend([speed, drift]);
     if track {
         panels.push(path);
     }
@@ -72,27 +102,37 @@ pub fn add_bands(fig: &mut Figure, ship: &Ship, draws: &[&Trajectory]) {
     let label = format!("90 % band ({} draws)", draws.len());
     // U and β of each draw, once
     let speed_drift: Vec<(Vec<f64>, Vec<f64>)> = draws.iter().map(|t| ship.speed_and_drift(t)).collect();
-    let bands: [(usize, Series); 4] = [
-        (0, series(&format!("ψ {label}"), signal(&|k| deg(&draws[k].states[r.psi])))),
+    let bands: [(&[&str], Series); 4] = [
         (
-            1,
+            &[HEADING, RUDDER_HEADING],
+            series(&format!("ψ {label}"), signal(&|k| deg(&draws[k].states[r.psi]))),
+        ),
+        (
+            &[SPEED],
             series(
                 &format!("U/U0 {label}"),
                 signal(&|k| speed_drift[k].0.iter().map(|u| u / ship.spec.u0).collect()),
             ),
         ),
-        (2, series(&format!("β {label}"), signal(&|k| deg(&speed_drift[k].1)))),
-        (2, series(&format!("r {label}"), signal(&|k| deg(&draws[k].states[r.r])))),
+        (&[DRIFT], series(&format!("β {label}"), signal(&|k| deg(&speed_drift[k].1)))),
+        (&[DRIFT], series(&format!("r {label}"), signal(&|k| deg(&draws[k].states[r.r])))),
     ];
-    for (panel, band) in bands {
-        if let Some(p) = fig.panels.get_mut(panel) {
+    for (titles, band) in bands {
+        if let Some(p) = fig.panels.iter_mut().find(|p| titles.contains(&p.title.as_str())) {
             p.series.push(band);
         }
     }
-    if let Some(track) = fig.panels.get_mut(3) {
+    if let Some(track) = fig.panels.iter_mut().find(|p| p.title.starts_with(TRACK)) {
+        let lpp = ship.spec.lpp;
+        let in_lengths = |v: &[f64]| v.iter().map(|x| x / lpp).collect::<Vec<f64>>();
         for (k, t) in draws.iter().take(10).enumerate() {
             let name = if k == 0 { "drawn models".to_string() } else { String::new() };
-            track.series.push(Series::dashed(&name, t.states[r.y0].clone(), t.states[r.x0].clone()));
+            // one colour for every drawn model, the one its legend entry shows; under the
+            // nominal track, which stays in sight
+            track.series.insert(
+                k,
+                Series::dashed(&name, in_lengths(&t.states[r.y0]), in_lengths(&t.states[r.x0])).colored(2),
+            );
         }
     }
 }

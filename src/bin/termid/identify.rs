@@ -524,17 +524,9 @@ fn identify_start(
         if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };
     let states: Vec<String> =
         names.iter().filter_map(|n| model.equation(n).map(|e| e.state.clone())).collect();
-    let units: BTreeMap<String, String> =
-        model.spec().states.iter().map(|s| (s.name.clone(), s.unit.clone())).collect();
     let diff = derivative_method(cmd)?;
-    let scale = |name: &str| {
-        let unit = units.get(name).cloned().unwrap_or_default();
-        // angles are read in degrees
-        match unit.strip_prefix("rad") {
-            Some(rest) => (180.0 / std::f64::consts::PI, format!("deg{rest}")),
-            None => (1.0, unit),
-        }
-    };
+    // angles are read in degrees
+    let scale = |name: &str| termid::model::dimension::shown(model.unit(name));
     let frames = prepare_runs(cmd, frames.to_vec(), &states, Some(model), diff.as_ref(), &scale)?;
     // runs that stop the refinement, prepared as the training runs are
     let validation = match held {

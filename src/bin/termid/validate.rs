@@ -8,8 +8,7 @@ use termid::plot::comparison_figures;
 use termid::plugin::Observation;
 use termid::sim::Trajectory;
 
-use termid::plot::{Figure, Series};
-use termid::uncertainty::band;
+use termid::model::dimension::shown;
 
 use crate::args::{Format, ValidateCommand};
 use crate::monte_carlo::Draws;
@@ -52,12 +51,11 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
     if let Some(dir) = &cmd.resim.svg {
         let mut outputs = termid::output::Outputs::new();
         outputs.folder(dir)?;
-        for (k, (name, mut fig)) in comparison_figures(&runs, &sims, &[], "validate").into_iter().enumerate()
+        let draws: Vec<&[Trajectory]> =
+            mc.iter().flat_map(|mc| mc.results.iter().map(|(sims, _)| sims.as_slice())).collect();
+        for (k, (name, fig)) in
+            comparison_figures(&model, &runs, &sims, &[], &draws, "validate").into_iter().enumerate()
         {
-            if let Some(mc) = &mc {
-                let draws: Vec<&[Trajectory]> = mc.results.iter().map(|(sims, _)| sims.as_slice()).collect();
-                add_bands(&mut fig, k, runs[k].time(), &draws);
-            }
             let stem = std::path::Path::new(&name)
                 .file_stem()
                 .map_or(format!("run{k}"), |s| s.to_string_lossy().into_owned());
@@ -86,18 +84,12 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
                 runs.len()
             );
             // each state in its unit, angles in degrees
-            let unit = |state: &str| {
-                model.spec().states.iter().find(|t| t.name == state).map_or(String::new(), |t| t.unit.clone())
-            };
             for (run, per) in &gap.runs {
                 let cells: Vec<String> = per
                     .iter()
-                    .map(|(s, r, m)| match unit(s).strip_prefix("rad") {
-                        Some(rest) => {
-                            let d = 180.0 / std::f64::consts::PI;
-                            format!("{s} {} / {} deg{rest}", num(r * d), num(m * d))
-                        }
-                        None => format!("{s} {} / {} {}", num(*r), num(*m), unit(s)),
+                    .map(|(s, r, m)| {
+                        let (factor, unit) = shown(model.unit(s));
+                        format!("{s} {} / {} {unit}", num(r * factor), num(m * factor))
                     })
                     .collect();
                 println!("  {run}: {}", cells.join(", "));
@@ -129,24 +121,4 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// Adds the draws' pointwise 5-95 % band of each state to run `k`'s comparison figure.
-/// The band is drawn over the measured run's times, sample by sample, as the figure's
-/// simulation is.
-fn add_bands(fig: &mut Figure, k: usize, time: &[f64], draws: &[&[Trajectory]]) {
-    let Some(first) = draws.first().and_then(|d| d.get(k)) else { return };
-    for (i, name) in first.state_names.iter().enumerate() {
-        let Some(panel) = fig.panels.iter_mut().find(|p| &p.title == name) else { continue };
-        let signals: Vec<Vec<f64>> =
-            draws.iter().filter_map(|d| d.get(k)).map(|t| t.states[i].clone()).collect();
-        let (lo, hi) = band(&signals);
-        let n = lo.len().min(time.len());
-        panel.series.push(Series::band(
-            &format!("model 90 % band ({} draws)", signals.len()),
-            time[..n].to_vec(),
-            lo[..n].to_vec(),
-            hi[..n].to_vec(),
-        ));
-    }
 }

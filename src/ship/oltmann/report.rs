@@ -152,6 +152,9 @@ fn coefficient_errors(t: &EquationTable) -> serde_json::Value {
     })
 }
 
+/// The unit of each equation's acceleration, as its standard error has it.
+const UNITS: [&str; 3] = ["m/s²", "m/s²", "rad/s²"];
+
 fn steps_figure(study: &Study, k: usize) -> Figure {
     let t = &study.exact[k];
     let o = &study.exact_other_timing[k];
@@ -172,7 +175,7 @@ fn steps_figure(study: &Study, k: usize) -> Figure {
             Panel {
                 title: "standard error of estimate".into(),
                 x_label: "step".into(),
-                y_label: "s [m/s² or rad/s²]".into(),
+                y_label: format!("s [{}]", UNITS[k]),
                 series: vec![Series::line(a, xs(sel), se(sel)), Series::points(b, xs(other), se(other))],
                 markers: marker.clone(),
                 log_y: true,
@@ -181,7 +184,7 @@ fn steps_figure(study: &Study, k: usize) -> Figure {
             Panel {
                 title: "F value".into(),
                 x_label: "step".into(),
-                y_label: "F".into(),
+                y_label: "F [-]".into(),
                 series: vec![Series::line(a, xs(sel), f(sel)), Series::points(b, xs(other), f(other))],
                 markers: marker,
                 log_y: true,
@@ -218,7 +221,7 @@ fn fig5(study: &Study) -> Figure {
             panels.push(Panel {
                 title: format!("{}: {what} at the chosen step", TITLES[k]),
                 x_label: "data alternative (1 exact … 5 rounded, differentiated)".into(),
-                y_label: what.into(),
+                y_label: if what == "F" { "F [-]".into() } else { format!("s [{}]", UNITS[k]) },
                 series,
                 log_y: true,
                 ..Panel::default()
@@ -357,32 +360,46 @@ pub fn write(
         );
         fig(&format!("predict_{}.svg", text.replace([':', '/'], "_")), f)?;
     }
-    let spiral: Vec<Series> = study
-        .predictions
-        .iter()
-        .filter(|p| p.manoeuvre.starts_with("spiral"))
-        .filter_map(|p| match &p.metrics {
-            Ok(Metrics::Spiral(s)) => Some(Series::points(
-                &p.coefficients,
-                s.points.iter().map(|q| q.rudder_deg).collect(),
-                s.points.iter().map(|q| q.yaw_rate_deg_s).collect(),
-            )),
-            _ => None,
-        })
-        .collect();
-    fig(
-        "predict_spiral.svg",
-        Figure::new(
-            "Spiral test: steady yaw rate against rudder angle",
-            vec![Panel {
-                title: "r(δ), both directions".into(),
-                x_label: "δ [°]".into(),
-                y_label: "r [°/s]".into(),
-                series: spiral,
-                ..Panel::default()
-            }],
-        ),
-    )?;
+    // a panel per branch (the rudder stepped down from +δ, then back up from −δ), the true
+    // model as rings that the identified models' markers leave visible
+    let branch = |name: &str, title: &str| {
+        let series: Vec<Series> = study
+            .predictions
+            .iter()
+            .filter(|p| p.manoeuvre.starts_with("spiral"))
+            .filter_map(|p| match &p.metrics {
+                Ok(Metrics::Spiral(s)) => {
+                    let (x, y) = s
+                        .points
+                        .iter()
+                        .filter(|q| q.branch == name)
+                        .map(|q| (q.rudder_deg, q.yaw_rate_deg_s))
+                        .unzip();
+                    Some(if p.coefficients == "true" {
+                        Series::rings(&p.coefficients, x, y)
+                    } else {
+                        Series::points(&p.coefficients, x, y)
+                    })
+                }
+                _ => None,
+            })
+            .collect();
+        Panel {
+            title: title.into(),
+            x_label: "δ [°]".into(),
+            y_label: "r [°/s]".into(),
+            series,
+            ..Panel::default()
+        }
+    };
+    let mut spiral = Figure::new(
+        "Spiral test: steady yaw rate against rudder angle",
+        vec![branch("down", "from +δ down to −δ"), branch("up", "back from −δ up to +δ")],
+    );
+    spiral.columns = 2;
+    spiral.width = 1100;
+    spiral.panel_height = 360;
+    fig("predict_spiral.svg", spiral)?;
     for d in &study.drift {
         let mut series = Vec::new();
         for (label, list) in [("without B0, C0", &d.before), ("with B0, C0", &d.after)] {
