@@ -81,7 +81,7 @@ pub fn run(cmd: CompareCommand) -> Result<()> {
     }
     match cmd.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&json(&entries))?),
-        Format::Text => print!("{}", text(&entries, &equations)),
+        Format::Text => print!("{}", text(&model, &entries, &equations)),
     }
     Ok(())
 }
@@ -97,7 +97,7 @@ fn resimulate(model: &termid::model::Model, run: &Frame, dt: f64) -> Result<Stat
     Ok(gap.runs.into_iter().flat_map(|(_, states)| states).collect())
 }
 
-fn text(entries: &[Entry], equations: &[String]) -> String {
+fn text(model: &termid::model::Model, entries: &[Entry], equations: &[String]) -> String {
     let mut out = String::new();
     for (k, eq) in equations.iter().enumerate() {
         out += &format!(
@@ -151,8 +151,10 @@ fn text(entries: &[Entry], equations: &[String]) -> String {
         for e in entries {
             match &e.replay {
                 Some(Ok(errs)) => {
-                    let cells: Vec<String> =
-                        errs.iter().map(|(s, r, m)| format!("{s} {} / {}", num(*r), num(*m))).collect();
+                    let cells: Vec<String> = errs
+                        .iter()
+                        .map(|(s, r, m)| crate::validate::error_cell(s, *r, *m, model.unit(s)))
+                        .collect();
                     out += &format!("{:<12} {}\n", e.backend, cells.join(", "));
                 }
                 Some(Err(msg)) => out += &format!("{:<12} failed: {msg}\n", e.backend),

@@ -6,6 +6,7 @@ use termid::diagnose::{diagnose, generic_hypotheses, Diagnosis, Settings};
 
 use crate::args::{DiagnoseCommand, Format};
 use termid::identify::num;
+use termid::model::dimension::shown;
 
 pub fn run(cmd: DiagnoseCommand) -> Result<()> {
     // outputs that cannot be written are refused before any work
@@ -98,21 +99,32 @@ fn text(d: &Diagnosis, out: Option<&std::path::Path>, tested: usize) -> String {
         "\n{:<8} {:>16} {:>16} {:>16} {:>16}\n",
         "state", "RMS before", "RMS after", "max before", "max after"
     );
+    // each state in its unit, angles in degrees
+    let unit_of = |state: &str| {
+        let unit = d.gap_before.states.iter().find(|x| x.0 == state).map_or("", |x| x.1.as_str());
+        shown(unit)
+    };
     for (b, a) in d.gap_before.states.iter().zip(&d.gap_after.states) {
+        let (f, unit) = unit_of(&b.0);
         s += &format!(
-            "{:<8} {:>16} {:>16} {:>16} {:>16}  [{}]\n",
+            "{:<8} {:>16} {:>16} {:>16} {:>16}  [{unit}]\n",
             b.0,
-            num(b.2),
-            num(a.2),
-            num(b.3),
-            num(a.3),
-            b.1
+            num(b.2 * f),
+            num(a.2 * f),
+            num(b.3 * f),
+            num(a.3 * f),
         );
     }
     s += "\nper run (RMS before → after):\n";
     for ((run, b), (_, a)) in d.gap_before.runs.iter().zip(&d.gap_after.runs) {
-        let cells: Vec<String> =
-            b.iter().zip(a).map(|(x, y)| format!("{} {} → {}", x.0, num(x.1), num(y.1))).collect();
+        let cells: Vec<String> = b
+            .iter()
+            .zip(a)
+            .map(|(x, y)| {
+                let (f, unit) = unit_of(&x.0);
+                format!("{} {} → {} {unit}", x.0, num(x.1 * f), num(y.1 * f))
+            })
+            .collect();
         s += &format!("  {run}: {}\n", cells.join(", "));
     }
     if let (Some(p), Some(_)) = (out, &d.model) {

@@ -85,13 +85,8 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
             );
             // each state in its unit, angles in degrees
             for (run, per) in &gap.runs {
-                let cells: Vec<String> = per
-                    .iter()
-                    .map(|(s, r, m)| {
-                        let (factor, unit) = shown(model.unit(s));
-                        format!("{s} {} / {} {unit}", num(r * factor), num(m * factor))
-                    })
-                    .collect();
+                let cells: Vec<String> =
+                    per.iter().map(|(s, r, m)| error_cell(s, *r, *m, model.unit(s))).collect();
                 println!("  {run}: {}", cells.join(", "));
             }
             for ((m, f), s) in metrics.iter().zip(&runs).zip(&spreads) {
@@ -121,4 +116,10 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// One state's error, RMS / max, in its unit with angles in degrees: `ψ 1.55 / 2.74 °`.
+pub fn error_cell(state: &str, rms: f64, max: f64, unit: &str) -> String {
+    let (factor, unit) = shown(unit);
+    format!("{state} {} / {} {unit}", num(rms * factor), num(max * factor))
 }
