@@ -90,7 +90,9 @@ fn read_bytes(path: &std::path::Path) -> Result<Vec<u8>, ReadError> {
     if file.metadata().is_ok_and(|m| m.is_file() && m.len() as f64 > MEMORY_LIMIT) {
         return Err(ReadError::TooLarge);
     }
-    let mut bytes = Vec::new();
+    // the file's own size up front: no copies as the buffer grows
+    let size = file.metadata().map_or(0, |m| m.len() as usize);
+    let mut bytes = Vec::with_capacity(size.min(MEMORY_LIMIT as usize) + 1);
     let mut chunk = vec![0u8; 1 << 16];
     let (mut line, mut line_start) = (1usize, 0usize);
     loop {
@@ -101,21 +103,26 @@ fn read_bytes(path: &std::path::Path) -> Result<Vec<u8>, ReadError> {
             Err(e) => return Err(e.into()),
         };
         let base = bytes.len();
-        for (i, &b) in chunk[..n].iter().enumerate() {
-            match b {
-                0 => return Err(ReadError::Binary { offset: base + i }),
-                b'\n' => {
-                    line += 1;
-                    line_start = base + i + 1;
-                }
-                _ if base + i - line_start >= MAX_LINE => return Err(ReadError::LongLine { line }),
-                _ => {}
+        let part = &chunk[..n];
+        if let Some(i) = memchr::memchr(0, part) {
+            return Err(ReadError::Binary { offset: base + i });
+        }
+        // every line break of the piece; a line too long is one whose break is too far
+        // from the one before (or from the start of the line the piece goes on)
+        for i in memchr::memchr_iter(b'\n', part) {
+            if base + i - line_start > MAX_LINE {
+                return Err(ReadError::LongLine { line });
             }
+            line += 1;
+            line_start = base + i + 1;
+        }
+        if base + n - line_start > MAX_LINE {
+            return Err(ReadError::LongLine { line });
         }
         if (base + n) as f64 > MEMORY_LIMIT {
             return Err(ReadError::TooLarge);
         }
-        bytes.extend_from_slice(&chunk[..n]);
+        bytes.extend_from_slice(part);
     }
     Ok(bytes)
 }

@@ -37,6 +37,10 @@ pub struct EquationMoments {
     pub runs: Vec<RunMoments>,
 }
 
+/// A run read in pieces, as far as it has been read: its name, its own parameters (from its
+/// first piece) and each equation's statistics so far.
+type RunSoFar = (String, BTreeMap<String, ParamValue>, Vec<Option<Moments>>);
+
 impl EquationMoments {
     /// The statistics of `equation` of `model` over `frames` (the target as
     /// [`super::fit_equation`] takes it).
@@ -87,6 +91,19 @@ impl EquationMoments {
         runs: Vec<crate::data::Chunks>,
         differentiator: &dyn Differentiator,
     ) -> Result<(EquationMoments, Vec<String>), IdentifyError> {
+        let (mut all, notes) = Self::of_chunks_each(model, &[equation.to_string()], runs, differentiator)?;
+        Ok((all.remove(0), notes))
+    }
+
+    /// [`EquationMoments::of_chunks`] for several equations in the same pass over the rows
+    /// (each chunk read, admitted and checked once): one statistics value per equation, in
+    /// the order given.
+    pub fn of_chunks_each(
+        model: &Model,
+        equations: &[String],
+        runs: Vec<crate::data::Chunks>,
+        differentiator: &dyn Differentiator,
+    ) -> Result<(Vec<EquationMoments>, Vec<String>), IdentifyError> {
         if differentiator.reach().is_none() {
             return Err(IdentifyError::Setup(format!(
                 "the derivative method `{}` needs whole runs: read in chunks, use central, five-point or savitzky-golay",
@@ -96,12 +113,16 @@ impl EquationMoments {
         if runs.is_empty() {
             return Err(IdentifyError::Setup("no data: give at least one run".into()));
         }
-        let eq = model_equation(model, equation)?;
-        let design = Design::new(&eq.candidates, &model.vocabulary)?;
+        let eqs = equations.iter().map(|e| model_equation(model, e)).collect::<Result<Vec<_>, _>>()?;
+        let designs = eqs
+            .iter()
+            .map(|eq| Design::new(&eq.candidates, &model.vocabulary))
+            .collect::<Result<Vec<_>, _>>()?;
         let rules = model.parameter_rules();
-        let (mut out, mut notes, mut target) = (Vec::new(), Vec::new(), None);
+        let (mut out, mut notes) = (vec![Vec::new(); eqs.len()], Vec::new());
+        let mut targets: Option<Vec<Target>> = None;
         for chunks in runs {
-            let mut run: Option<(String, Option<Moments>, BTreeMap<String, ParamValue>)> = None;
+            let mut run: Option<RunSoFar> = None;
             for chunk in chunks {
                 let mut chunk = chunk?;
                 let shift = |e: IdentifyError| e.shifted(chunk.first_row);
@@ -114,10 +135,12 @@ impl EquationMoments {
                         .iter()
                         .map(|(n, r)| Ok((n.clone(), ParamValue::Value(r.resolve(n, &chunk.frame)?))))
                         .collect::<Result<BTreeMap<_, _>, crate::data::DataError>>()?;
-                    target.get_or_insert_with(|| default_target(eq, std::slice::from_ref(&chunk.frame)));
-                    run = Some((chunk.frame.origin().to_string(), None, fixed));
+                    targets.get_or_insert_with(|| {
+                        eqs.iter().map(|eq| default_target(eq, std::slice::from_ref(&chunk.frame))).collect()
+                    });
+                    run = Some((chunk.frame.origin().to_string(), fixed, vec![None; eqs.len()]));
                 }
-                let (Some((_, moments, fixed)), Some(target)) = (run.as_mut(), target.as_ref()) else {
+                let (Some((_, fixed, moments)), Some(targets)) = (run.as_mut(), targets.as_ref()) else {
                     unreachable!("set by the run's first chunk")
                 };
                 let how = Identification {
@@ -127,32 +150,44 @@ impl EquationMoments {
                     intercept: true,
                     weights: None,
                 };
-                let m = how
-                    .moments_of_rows(
-                        &design.library,
-                        design.candidates(),
-                        target,
-                        &chunk.frame,
-                        chunk.own.clone(),
-                    )
-                    .map_err(shift)?;
-                match moments {
-                    Some(all) => all.merge(&m),
-                    none => *none = Some(m),
+                for ((design, target), so_far) in designs.iter().zip(targets).zip(moments.iter_mut()) {
+                    let m = how
+                        .moments_of_rows(
+                            &design.library,
+                            design.candidates(),
+                            target,
+                            &chunk.frame,
+                            chunk.own.clone(),
+                        )
+                        .map_err(shift)?;
+                    match so_far {
+                        Some(all) => all.merge(&m),
+                        none => *none = Some(m),
+                    }
                 }
             }
-            if let Some((name, Some(moments), _)) = run {
-                out.push(RunMoments { run: name, moments });
+            if let Some((name, _, moments)) = run {
+                for (list, m) in out.iter_mut().zip(moments) {
+                    if let Some(moments) = m {
+                        list.push(RunMoments { run: name.clone(), moments });
+                    }
+                }
             }
         }
-        let target = target.ok_or_else(|| IdentifyError::Setup("no data: the runs hold no rows".into()))?;
-        let moments = EquationMoments {
-            equation: equation.into(),
-            target: target.to_string(),
-            candidates: design.names().to_vec(),
-            runs: out,
-        };
-        Ok((moments, notes))
+        let targets = targets.ok_or_else(|| IdentifyError::Setup("no data: the runs hold no rows".into()))?;
+        let all = equations
+            .iter()
+            .zip(targets)
+            .zip(designs)
+            .zip(out)
+            .map(|(((equation, target), design), runs)| EquationMoments {
+                equation: equation.clone(),
+                target: target.to_string(),
+                candidates: design.names().to_vec(),
+                runs,
+            })
+            .collect();
+        Ok((all, notes))
     }
 
     /// The statistics of both sets of runs: refused where they are of another equation,

@@ -304,19 +304,52 @@ fn statistics_of_shards_identify_as_the_rows_together() {
         &rows_out,
     ]);
     assert!(ok, "{err}");
-    let (merged, rows) = (
+    // the same runs read in pieces by identify itself (one pass, bounded memory)
+    let pieces_out = p("pieces.toml");
+    let (ok, out, err) = termid(&[
+        "identify",
+        "--model",
+        "models/lorenz.toml",
+        "--data",
+        &p("a.csv"),
+        &p("b.csv"),
+        "--chunk-rows",
+        "97",
+        "--out",
+        &pieces_out,
+    ]);
+    assert!(ok && out.contains("== z_dot =="), "{out}{err}");
+    let (merged, rows, pieces) = (
         termid::plugins::load(std::path::Path::new(&merged_out)).unwrap(),
         termid::plugins::load(std::path::Path::new(&rows_out)).unwrap(),
+        termid::plugins::load(std::path::Path::new(&pieces_out)).unwrap(),
     );
     for eq in ["x_dot", "y_dot", "z_dot"] {
-        let (a, b) = (&merged.equation(eq).unwrap().coefficients, &rows.equation(eq).unwrap().coefficients);
-        assert_eq!(a.len(), b.len(), "{eq}");
-        assert!(!a.is_empty(), "{eq}");
-        for ((ta, ca, _), (tb, cb, _)) in a.iter().zip(b) {
-            assert_eq!(ta, tb);
-            assert!((ca - cb).abs() <= 1e-12 * ca.abs().max(1.0), "{eq} {ta}: {ca} vs {cb}");
+        let b = &rows.equation(eq).unwrap().coefficients;
+        assert!(!b.is_empty(), "{eq}");
+        for (other, tol) in [(&merged, 1e-12), (&pieces, 1e-10)] {
+            let a = &other.equation(eq).unwrap().coefficients;
+            assert_eq!(a.len(), b.len(), "{eq}");
+            for ((ta, ca, _), (tb, cb, _)) in a.iter().zip(b) {
+                assert_eq!(ta, tb);
+                assert!((ca - cb).abs() <= tol * ca.abs().max(1.0), "{eq} {ta}: {ca} vs {cb}");
+            }
         }
     }
+    // what needs whole runs is refused with --chunk-rows, by name
+    let (ok, _, err) = termid(&[
+        "identify",
+        "--model",
+        "models/lorenz.toml",
+        "--data",
+        &p("a.csv"),
+        "--chunk-rows",
+        "97",
+        "--derivative",
+        "spline",
+        "--smooth",
+    ]);
+    assert!(!ok && err.contains("--smooth") && err.contains("whole runs"), "{err}");
     // statistics of other candidates for the same equation do not merge; a damaged file is named
     let other = std::fs::read_to_string(p("b_x_dot.moments")).unwrap().replacen(
         "\"candidates\":[\"",

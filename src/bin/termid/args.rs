@@ -218,6 +218,14 @@ pub struct IdentifyCommand {
     /// signs, turning circles that complete, plausible speed loss and drift).
     #[arg(long, requires = "model")]
     pub keep_unphysical: bool,
+    /// With --model and plain --data files: read them in pieces of this many rows, one pass
+    /// and bounded memory whatever their size (statistics merged as `termid moments` and
+    /// `identify --moments` would). Needs a derivative of fixed reach (central, five-point,
+    /// savitzky-golay) and none of --dataset, --resample, --smooth, --prepared-svg, --refine,
+    /// --choose, --target. Default: in pieces of 262144 rows when the files together exceed
+    /// 256 MiB and these hold; 0 reads them whole.
+    #[arg(long, value_name = "ROWS", requires = "model")]
+    pub chunk_rows: Option<usize>,
     /// Fit without an intercept b0.
     #[arg(long)]
     pub no_intercept: bool,

@@ -247,6 +247,86 @@ fn run_moments(cmd: IdentifyCommand) -> Result<()> {
     Ok(())
 }
 
+/// Files together larger than this are read in pieces by `identify --model` where they can be.
+const WHOLE_LIMIT: u64 = 256 << 20;
+
+/// Rows a piece when `--chunk-rows` is not given.
+const PIECE_ROWS: usize = 262_144;
+
+/// Whether `identify --model` reads its runs in pieces, and in how many rows: asked for with
+/// `--chunk-rows`, or files beyond [`WHOLE_LIMIT`] where nothing needs whole runs.
+fn in_pieces(cmd: &IdentifyCommand, refine: bool) -> Result<Option<usize>> {
+    let local = differentiator(&cmd.derivative).ok().and_then(|d| d.reach()).is_some();
+    let whole_runs_needed = [
+        (cmd.dataset.is_some(), "--dataset"),
+        (cmd.resample.is_some(), "--resample"),
+        (cmd.smooth, "--smooth"),
+        (cmd.prepared_svg.is_some(), "--prepared-svg"),
+        (refine, "--refine"),
+        (cmd.choose.is_some(), "--choose"),
+        (cmd.target.is_some(), "--target"),
+        (!local, "a --derivative that needs whole runs"),
+    ];
+    let needs: Vec<&str> = whole_runs_needed.iter().filter(|(yes, _)| *yes).map(|(_, what)| *what).collect();
+    match cmd.chunk_rows {
+        Some(0) => Ok(None),
+        Some(_) if !needs.is_empty() => bail!(
+            "--chunk-rows reads runs in pieces, which {} cannot work on: leave it out",
+            needs.join(", ")
+        ),
+        Some(rows) => Ok(Some(rows)),
+        None => {
+            let size: u64 = cmd.data.iter().filter_map(|p| std::fs::metadata(p).ok()).map(|m| m.len()).sum();
+            if size > WHOLE_LIMIT && needs.is_empty() {
+                eprintln!(
+                    "note: the runs are {} MiB together: read in pieces of {PIECE_ROWS} rows (bounded memory; --chunk-rows 0 reads them whole)",
+                    size >> 20
+                );
+                Ok(Some(PIECE_ROWS))
+            } else {
+                Ok(None)
+            }
+        }
+    }
+}
+
+/// `identify --model` on runs read in pieces: each equation's statistics in one pass over
+/// the files (as `termid moments` writes them), identified as `identify --moments` would, and
+/// checked (the physical checks at the model's rudder limit: the runs are not kept).
+fn identify_in_pieces(cmd: &IdentifyCommand, model: &termid::model::Model, rows: usize) -> Result<Start> {
+    let diff = differentiator(&cmd.derivative)?;
+    let reach = diff.reach().context("a derivative of fixed reach")?;
+    let names: Vec<String> =
+        if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };
+    let runs = cmd
+        .data
+        .iter()
+        .map(|p| termid::data::Chunks::open(p, &model.spec().model.time, rows.max(1), 2 * reach + 2))
+        .collect::<Result<Vec<_>, _>>()?;
+    let label = format!("statistics of {} in pieces of {rows} rows ({})", names.join(", "), cmd.derivative);
+    let (all, notes) = crate::progress::with_spinner(&label, || {
+        termid::identify::EquationMoments::of_chunks_each(model, &names, runs, diff.as_ref())
+    })?;
+    for n in notes {
+        eprintln!("unit: {n}");
+    }
+    let origin = cmd.data.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
+    let parts = all.into_iter().map(|m| (origin.clone(), m)).collect();
+    let identified = termid::identify::identify_from_moments(model, parts, !cmd.no_intercept)?;
+    let checks =
+        termid::plugins::of(&identified.model).map(|p| p.checks(&identified.model, &[])).unwrap_or_default();
+    Ok(Start {
+        derivative: cmd.derivative.clone(),
+        model: identified.model,
+        fits: identified.fits,
+        chosen_text: None,
+        refined: None,
+        rejected: None,
+        refine_error: None,
+        checks,
+    })
+}
+
 /// One start of `identify --model`: the runs prepared by one derivative method, the
 /// regression (or the choice among back-ends), the refinement and the physical checks.
 struct Start {
@@ -310,11 +390,22 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
             cmd.derivative
         );
     }
-    let frames = crate::runs::load_for(&model, &cmd.data, cmd.dataset.as_deref())?;
-    let held =
-        cmd.refine_validation.as_ref().map(|p| crate::runs::load_for(&model, &[], Some(p))).transpose()?;
     let mut starts = Vec::new();
-    for method in &methods {
+    let streamed = in_pieces(&cmd, refine.is_some())?;
+    let (frames, held) = if streamed.is_some() {
+        (Vec::new(), None)
+    } else {
+        let held = cmd
+            .refine_validation
+            .as_ref()
+            .map(|p| crate::runs::load_for(&model, &[], Some(p)))
+            .transpose()?;
+        (crate::runs::load_for(&model, &cmd.data, cmd.dataset.as_deref())?, held)
+    };
+    if let Some(rows) = streamed {
+        starts.push(identify_in_pieces(&cmd, &model, rows)?);
+    }
+    for method in methods.iter().filter(|_| streamed.is_none()) {
         let one = IdentifyCommand { derivative: method.clone(), ..cmd.clone() };
         match identify_start(&one, &model, &frames, held.as_deref(), refine.as_ref()) {
             Ok(s) => starts.push(s),
