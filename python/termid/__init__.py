@@ -18,6 +18,7 @@ carrying termid's located message (file, row, column, or a caret under a term).
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
@@ -47,9 +48,41 @@ __version__ = _termid.version()
 Data = Any
 
 
+_F64 = np.dtype(np.float64)
+
+
+def _frame_in_place(data: pd.DataFrame) -> Optional[Dict[str, np.ndarray]]:
+    """A DataFrame's float64 columns where they lie, without copying: pandas keeps the
+    columns of one type in 2-D blocks (``_mgr.blocks``, each with the positions of its
+    columns, ``mgr_locs``), one column a row of the block. These are pandas' internals
+    (stable since 1.x); where they are not as expected, or a column is not float64, None, and
+    the public conversion serves."""
+    blocks = getattr(getattr(data, "_mgr", None), "blocks", None)
+    if blocks is None:
+        return None
+    arrays: List[Any] = [None] * data.shape[1]
+    found = 0
+    try:
+        for block in blocks:
+            values = block.values
+            if type(values) is not np.ndarray or values.dtype != _F64 or values.ndim != 2:
+                return None
+            for at, column in zip(block.mgr_locs.as_array.tolist(), values):
+                arrays[at] = column
+                found += 1
+    except (AttributeError, IndexError, TypeError):
+        return None
+    if found != len(arrays):
+        return None
+    return dict(zip(map(str, data.columns.tolist()), arrays))
+
+
 def _columns(data: Data) -> Dict[str, np.ndarray]:
     """Columns as contiguous float64 arrays, without copying where the layout allows."""
     if isinstance(data, pd.DataFrame):
+        in_place = _frame_in_place(data)
+        if in_place is not None:
+            return in_place
         # one column-major copy of the whole frame is faster than a conversion per column
         # (pandas' column access costs ~15 µs each); its columns are then contiguous views
         try:
@@ -165,6 +198,20 @@ class Fit:
         return f"termid.Fit({self.target}: {len(self.coefficients)} terms)"
 
 
+@functools.lru_cache(maxsize=64)
+def _settings_cached(backend: str, items: Tuple[Tuple[str, Any], ...]) -> str:
+    return json.dumps({"method": backend, **dict(items)})
+
+
+def _settings_text(backend: str, settings: Mapping[str, Any]) -> str:
+    """A back-end and its settings as the JSON the native side reads (the same settings,
+    once: repeated fits pass the same text)."""
+    try:
+        return _settings_cached(backend, tuple(settings.items()))
+    except TypeError:  # a setting that cannot be hashed (a list)
+        return json.dumps({"method": backend, **settings})
+
+
 def fit(
     data: Data,
     target: str,
@@ -190,7 +237,7 @@ def fit(
         target,
         columns,
         list(terms),
-        json.dumps({"method": backend, **settings}),
+        _settings_text(backend, settings),
         intercept,
         list(forced),
         list(excluded),

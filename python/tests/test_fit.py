@@ -62,3 +62,17 @@ def test_unknown_back_end_and_setting_are_refused(hald):
         termid.fit(hald, "y", backend="lasso-of-dreams")
     with pytest.raises(termid.TermidError, match="f_in"):
         termid.fit(hald, "y", backend="stepwise", f_in=4.0)
+
+
+def test_frame_columns_are_read_in_place_and_mixed_types_converted(hald):
+    frame = hald.astype("float64")
+    columns = termid._columns(frame)
+    assert list(columns) == [str(c) for c in frame.columns]
+    # float64 columns are the frame's own memory, not copies
+    assert all(np.shares_memory(columns[str(c)], frame[c].to_numpy()) for c in frame.columns)
+    mixed = frame.assign(x1=frame["x1"].astype("int64"))
+    converted = termid._columns(mixed)
+    assert converted["x1"].dtype == np.float64
+    a = termid.fit(frame, "y", ["x1", "x2", "x3", "x4"])
+    b = termid.fit(mixed, "y", ["x1", "x2", "x3", "x4"])
+    pd.testing.assert_series_equal(a.coefficients, b.coefficients)

@@ -177,11 +177,24 @@ impl Design {
     pub fn names(&self) -> &[String] {
         &self.names
     }
+
+    /// The columns of `terms` among the candidates; one that is not among them is refused,
+    /// called by its `role` (forced, excluded).
+    fn columns_of(&self, terms: &[Term], role: &str) -> Result<Vec<usize>, IdentifyError> {
+        terms
+            .iter()
+            .map(|t| {
+                self.candidates.iter().position(|c| c == t).ok_or_else(|| {
+                    IdentifyError::Setup(format!("{role} term `{t}` is not among the candidates"))
+                })
+            })
+            .collect()
+    }
 }
 
 /// One run bound to a compiled library (see `Identification::bind`).
 struct BoundRun<'a> {
-    frame: &'a Frame,
+    origin: &'a str,
     y: Vec<f64>,
     sources: Vec<Source<'a>>,
     weights: Option<&'a [f64]>,
@@ -219,7 +232,7 @@ impl BoundRun<'_> {
                         .unwrap_or(0)
                 });
                 bad = Some(IdentifyError::NonFinite {
-                    file: self.frame.origin().into(),
+                    file: self.origin.into(),
                     row: start + i + 1,
                     term,
                     value: values.get(i).copied().unwrap_or(f64::NAN),
@@ -227,6 +240,18 @@ impl BoundRun<'_> {
             }
         });
         bad.map_or(Ok(()), Err)
+    }
+}
+
+/// Row weights, refused where one is negative.
+fn checked_weights<'a>(origin: &str, column: &str, w: &'a [f64]) -> Result<&'a [f64], IdentifyError> {
+    match w.iter().position(|w| *w < 0.0) {
+        Some(i) => Err(IdentifyError::Setup(format!(
+            "{origin}: row {}: weight `{column}` = {} is negative",
+            i + 1,
+            w[i]
+        ))),
+        None => Ok(w),
     }
 }
 
@@ -336,21 +361,78 @@ impl Identification<'_> {
         let params = self.run_parameters(frame)?;
         let sources = library.bind(&|n| frame.column(n), &|n| params.get(n).copied())?;
         let weights = match &self.weights {
-            Some(col) => {
-                let w = frame.require(col)?;
-                if let Some(i) = w.iter().position(|w| *w < 0.0) {
-                    return Err(IdentifyError::Setup(format!(
-                        "{}: row {}: weight `{col}` = {} is negative",
-                        frame.origin(),
-                        i + 1,
-                        w[i]
-                    )));
-                }
-                Some(w)
-            }
+            Some(col) => Some(checked_weights(frame.origin(), col, frame.require(col)?)?),
             None => None,
         };
-        Ok(BoundRun { frame, y, sources, weights })
+        Ok(BoundRun { origin: frame.origin(), y, sources, weights })
+    }
+
+    /// Identifies one equation, `target` explained by the candidates of `design`, from rows
+    /// given as borrowed columns of equal length — an embedding's arrays (numpy, Arrow) used
+    /// where they lie, with no copy into a [`Frame`]. The rows are one run, not a time series
+    /// (no derivative targets, no per-run rules: parameters are values); a value that is not
+    /// finite is refused with its row and term as from a frame. `origin` names the rows in
+    /// errors.
+    #[allow(clippy::too_many_arguments)]
+    pub fn fit_columns(
+        &self,
+        origin: &str,
+        columns: &[(&str, &[f64])],
+        target: &str,
+        design: &Design,
+        forced: &[Term],
+        excluded: &[Term],
+        backend: &dyn Selector,
+    ) -> Result<Fit, IdentifyError> {
+        let column = |name: &str| columns.iter().find(|(n, _)| *n == name).map(|(_, c)| *c);
+        let rows = columns.first().map_or(0, |(_, c)| c.len());
+        if let Some((name, c)) = columns.iter().find(|(_, c)| c.len() != rows) {
+            return Err(crate::data::DataError::Length {
+                file: origin.into(),
+                column: (*name).into(),
+                expected: rows,
+                found: c.len(),
+            }
+            .into());
+        }
+        if rows == 0 {
+            return Err(crate::data::DataError::Empty { file: origin.into() }.into());
+        }
+        let y = column(target).ok_or_else(|| crate::data::DataError::MissingColumn {
+            file: origin.into(),
+            column: target.into(),
+            available: columns.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", "),
+        })?;
+        let params = self
+            .parameters
+            .iter()
+            .map(|(n, v)| match v {
+                ParamValue::Value(v) => Ok((n.clone(), *v)),
+                ParamValue::Rule(r) => Err(IdentifyError::Setup(format!(
+                    "parameter `{n}` = `{r}`: a rule per run needs runs; give its value"
+                ))),
+            })
+            .collect::<Result<BTreeMap<_, _>, _>>()?;
+        let library = &design.library;
+        let sources = library.bind(&column, &|n| params.get(n).copied())?;
+        let weights = match &self.weights {
+            Some(col) => Some(checked_weights(
+                origin,
+                col,
+                column(col).ok_or_else(|| crate::data::DataError::MissingColumn {
+                    file: origin.into(),
+                    column: col.clone(),
+                    available: columns.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", "),
+                })?,
+            )?),
+            None => None,
+        };
+        let run = BoundRun { origin, y: y.to_vec(), sources, weights };
+        let (forced, excluded) =
+            (design.columns_of(forced, "forced")?, design.columns_of(excluded, "excluded")?);
+        let folds =
+            gather(library.len(), &[rows], |_, part, acc| run.push(library, design.candidates(), part, acc))?;
+        fit_folds(target, design.names(), &forced, &excluded, self.intercept, &folds, backend)
     }
 
     /// Identifies one equation from all runs together ("Komb. Daten").
@@ -396,7 +478,7 @@ impl Identification<'_> {
         backend: &dyn Selector,
     ) -> Result<Fit, IdentifyError> {
         // compiling overlaps with the worker's waking (fit_design's second call is cheap)
-        wake_a_worker();
+        wake_a_worker(frames, candidates.len());
         let design = Design::new(candidates, self.vocabulary)?;
         self.fit_design(target, &design, forced, excluded, frames, backend)
     }
@@ -411,19 +493,13 @@ impl Identification<'_> {
         frames: &[Frame],
         backend: &dyn Selector,
     ) -> Result<Fit, IdentifyError> {
-        wake_a_worker();
+        wake_a_worker(frames, design.candidates().len());
         if frames.is_empty() {
             return Err(IdentifyError::Setup("no data: give at least one run".into()));
         }
         let candidates = design.candidates();
-        let index_of = |t: &Term, role: &str| {
-            candidates
-                .iter()
-                .position(|c| c == t)
-                .ok_or_else(|| IdentifyError::Setup(format!("{role} term `{t}` is not among the candidates")))
-        };
-        let forced = forced.iter().map(|t| index_of(t, "forced")).collect::<Result<Vec<_>, _>>()?;
-        let excluded = excluded.iter().map(|t| index_of(t, "excluded")).collect::<Result<Vec<_>, _>>()?;
+        let (forced, excluded) =
+            (design.columns_of(forced, "forced")?, design.columns_of(excluded, "excluded")?);
         // per run, for the back-ends that cross-validate; together they are "Komb. Daten"
         let folds = self.moments_of_runs(&design.library, candidates, target, frames)?;
         fit_folds(&target.to_string(), design.names(), &forced, &excluded, self.intercept, &folds, backend)
@@ -492,11 +568,11 @@ pub(crate) fn fit_folds(
     })
 }
 
-/// Wakes a sleeping worker, so that it is looking for work by the time the rows are gathered
-/// (waking it only then cost ~25 µs of a 0.1 ms fit); a second call while it is awake costs a
-/// queued empty job.
-fn wake_a_worker() {
-    if rayon::current_num_threads() > 1 {
+/// Wakes a sleeping worker where the rows of `frames` will be gathered in parallel, so that
+/// it is looking for work by the time they are (waking it only then cost ~25 µs of a 0.1 ms
+/// fit); a second call while it is awake costs a queued empty job.
+fn wake_a_worker(frames: &[Frame], p: usize) {
+    if crate::select::in_parallel(frames.iter().map(Frame::len).sum(), p) {
         rayon::spawn(|| {});
     }
 }

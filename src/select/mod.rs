@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 
 pub use best_subset::{BestSubset, Criterion};
 pub use efroymson::Efroymson;
-pub use moments::{gather, Accumulator, Moments};
+pub use moments::{gather, in_parallel, Accumulator, Moments};
 pub use sparse::{Candidate, Equality, LambdaChoice, SparseFit};
 pub use stepwise::{StepRule, Stepwise};
 pub use stlsq::Stlsq;

@@ -197,3 +197,61 @@ proptest! {
         prop_assert_eq!(s1.chosen_step, s2.chosen_step);
     }
 }
+
+/// Rows as borrowed columns (an embedding's arrays) fit as the same rows in a frame: Hald's
+/// order and Draper & Smith's last step, bit for bit; a NaN named by row and term; columns of
+/// unequal length and per-run rules refused.
+#[test]
+fn borrowed_columns_fit_as_a_frame() {
+    use std::collections::BTreeMap;
+    use termid::data::CentralDifference;
+    use termid::identify::{Design, Identification, ParamValue, Target};
+    use termid::term::{parse_terms, Vocabulary};
+
+    let f = Frame::read_csv_untimed(std::path::Path::new("tests/data/hald.csv")).unwrap();
+    let mut vocabulary = Vocabulary::new();
+    for x in ["x1", "x2", "x3", "x4"] {
+        vocabulary.variable(x).unwrap();
+    }
+    let candidates = parse_terms(&["x1", "x2", "x3", "x4", "x1*x4"], &vocabulary).unwrap();
+    let design = Design::new(&candidates, &vocabulary).unwrap();
+    let none = BTreeMap::new();
+    let how = Identification {
+        vocabulary: &vocabulary,
+        parameters: &none,
+        differentiator: &CentralDifference,
+        intercept: true,
+        weights: None,
+    };
+    let stepwise = Stepwise { step_rule: StepRule::Last, ..Stepwise::default() };
+    let framed = how
+        .fit_design(&Target::Column("y".into()), &design, &[], &[], std::slice::from_ref(&f), &stepwise)
+        .unwrap();
+    let columns: Vec<(&str, &[f64])> =
+        ["x1", "x2", "x3", "x4", "y"].iter().map(|c| (*c, f.require(c).unwrap())).collect();
+    let borrowed = how.fit_columns("hald", &columns, "y", &design, &[], &[], &stepwise).unwrap();
+    let order =
+        |f: &termid::identify::Fit| f.selection.steps.iter().map(|s| s.term.clone()).collect::<Vec<_>>();
+    assert_eq!(order(&borrowed)[..3], ["x4", "x1", "x2"]); // Draper & Smith's first three
+    assert_eq!(order(&borrowed), order(&framed));
+    assert_eq!(borrowed.selection.terms.len(), framed.selection.terms.len());
+    for (a, b) in borrowed.selection.terms.iter().zip(&framed.selection.terms) {
+        assert_eq!((a.index, a.coefficient.to_bits()), (b.index, b.coefficient.to_bits()));
+    }
+    // a NaN in x2 at row 4: named by its row and the terms it enters
+    let mut x2 = f.require("x2").unwrap().to_vec();
+    x2[3] = f64::NAN;
+    let mut bad = columns.clone();
+    bad[1] = ("x2", &x2);
+    let e = how.fit_columns("hald", &bad, "y", &design, &[], &[], &stepwise).unwrap_err().to_string();
+    assert!(e.contains("hald") && e.contains("row 4") && e.contains("x2"), "{e}");
+    let short = &x2[..5];
+    bad[1] = ("x2", short);
+    let e = how.fit_columns("hald", &bad, "y", &design, &[], &[], &stepwise).unwrap_err().to_string();
+    assert!(e.contains("x2") && e.contains('5'), "{e}");
+    let rules = BTreeMap::from([("c".to_string(), ParamValue::Rule("first:x1".into()))]);
+    let with_rule = Identification { parameters: &rules, ..how };
+    let e =
+        with_rule.fit_columns("hald", &columns, "y", &design, &[], &[], &stepwise).unwrap_err().to_string();
+    assert!(e.contains("`c`") && e.contains("rule"), "{e}");
+}
