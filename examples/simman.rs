@@ -97,17 +97,18 @@ fn main() -> Result<(), Error> {
             t.drift_angle_deg
         );
         if d.abs() == 35.0 {
-            tracks.push(track(&format!("δ = {d:+}°"), &run.trajectory)?);
+            tracks.push(track(&format!("δ = {d:+}°"), &run.trajectory, lpp)?);
         }
     }
     let mut turning = Figure::new(
         "KVLCC2 (L = 7 m), predicted turning circles",
         vec![Panel {
             title: "track of midship".into(),
-            x_label: "y0 [m]".into(),
-            y_label: "x0 [m]".into(),
+            x_label: "y0/L [-]".into(),
+            y_label: "x0/L [-]".into(),
             series: tracks,
             equal_axes: true,
+            unit_ticks: true,
             ..Default::default()
         }],
     );
@@ -155,7 +156,10 @@ fn zigzag_of(frame: &Frame) -> Result<String, Error> {
 }
 
 /// A run's track, x0 up and y0 across.
-fn track(name: &str, t: &Trajectory) -> Result<Series, Error> {
-    let col = |n: &str| t.state_names.iter().position(|s| s == n).map(|i| t.states[i].clone());
+fn track(name: &str, t: &Trajectory, lpp: f64) -> Result<Series, Error> {
+    // in ship lengths, as the paper draws tracks
+    let col = |n: &str| {
+        t.state_names.iter().position(|s| s == n).map(|i| t.states[i].iter().map(|v| v / lpp).collect())
+    };
     Ok(Series::line(name, col("y0").ok_or("no y0")?, col("x0").ok_or("no x0")?))
 }
