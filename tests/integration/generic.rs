@@ -292,32 +292,19 @@ fn statistics_of_shards_identify_as_the_rows_together() {
     args.extend(files.iter().map(String::as_str));
     let (ok, out, err) = termid(&args);
     assert!(ok && out.contains("== z_dot =="), "{out}{err}");
+    // `identify --model lorenz --data …`
+    let identify = |more: &[&str]| {
+        let mut args = vec!["identify", "--model", "models/lorenz.toml", "--data"];
+        args.extend(more);
+        termid(&args)
+    };
+    let (a, b) = (p("a.csv"), p("b.csv"));
     let rows_out = p("rows.toml");
-    let (ok, _, err) = termid(&[
-        "identify",
-        "--model",
-        "models/lorenz.toml",
-        "--data",
-        &p("a.csv"),
-        &p("b.csv"),
-        "--out",
-        &rows_out,
-    ]);
+    let (ok, _, err) = identify(&[&a, &b, "--out", &rows_out]);
     assert!(ok, "{err}");
     // the same runs read in pieces by identify itself (one pass, bounded memory)
     let pieces_out = p("pieces.toml");
-    let (ok, out, err) = termid(&[
-        "identify",
-        "--model",
-        "models/lorenz.toml",
-        "--data",
-        &p("a.csv"),
-        &p("b.csv"),
-        "--chunk-rows",
-        "97",
-        "--out",
-        &pieces_out,
-    ]);
+    let (ok, out, err) = identify(&[&a, &b, "--chunk-rows", "97", "--out", &pieces_out]);
     assert!(ok && out.contains("== z_dot =="), "{out}{err}");
     let (merged, rows, pieces) = (
         termid::plugins::load(std::path::Path::new(&merged_out)).unwrap(),
@@ -337,18 +324,7 @@ fn statistics_of_shards_identify_as_the_rows_together() {
         }
     }
     // what needs whole runs is refused with --chunk-rows, by name
-    let (ok, _, err) = termid(&[
-        "identify",
-        "--model",
-        "models/lorenz.toml",
-        "--data",
-        &p("a.csv"),
-        "--chunk-rows",
-        "97",
-        "--derivative",
-        "spline",
-        "--smooth",
-    ]);
+    let (ok, _, err) = identify(&[&a, "--chunk-rows", "97", "--derivative", "spline", "--smooth"]);
     assert!(!ok && err.contains("--smooth") && err.contains("whole runs"), "{err}");
     // statistics of other candidates for the same equation do not merge; a damaged file is named
     let other = std::fs::read_to_string(p("b_x_dot.moments")).unwrap().replacen(
