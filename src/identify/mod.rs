@@ -398,11 +398,14 @@ impl Identification<'_> {
         if rows == 0 {
             return Err(crate::data::DataError::Empty { file: origin.into() }.into());
         }
-        let y = column(target).ok_or_else(|| crate::data::DataError::MissingColumn {
-            file: origin.into(),
-            column: target.into(),
-            available: columns.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", "),
-        })?;
+        let require = |name: &str| {
+            column(name).ok_or_else(|| crate::data::DataError::MissingColumn {
+                file: origin.into(),
+                column: name.into(),
+                available: columns.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", "),
+            })
+        };
+        let y = require(target)?;
         let params = self
             .parameters
             .iter()
@@ -416,15 +419,7 @@ impl Identification<'_> {
         let library = &design.library;
         let sources = library.bind(&column, &|n| params.get(n).copied())?;
         let weights = match &self.weights {
-            Some(col) => Some(checked_weights(
-                origin,
-                col,
-                column(col).ok_or_else(|| crate::data::DataError::MissingColumn {
-                    file: origin.into(),
-                    column: col.clone(),
-                    available: columns.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", "),
-                })?,
-            )?),
+            Some(col) => Some(checked_weights(origin, col, require(col)?)?),
             None => None,
         };
         let run = BoundRun { origin, y: y.to_vec(), sources, weights };

@@ -391,30 +391,31 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
         );
     }
     let mut starts = Vec::new();
-    let streamed = in_pieces(&cmd, refine.is_some())?;
-    let (frames, held) = if streamed.is_some() {
-        (Vec::new(), None)
-    } else {
-        let held = cmd
-            .refine_validation
-            .as_ref()
-            .map(|p| crate::runs::load_for(&model, &[], Some(p)))
-            .transpose()?;
-        (crate::runs::load_for(&model, &cmd.data, cmd.dataset.as_deref())?, held)
-    };
-    if let Some(rows) = streamed {
-        starts.push(identify_in_pieces(&cmd, &model, rows)?);
-    }
-    for method in methods.iter().filter(|_| streamed.is_none()) {
-        let one = IdentifyCommand { derivative: method.clone(), ..cmd.clone() };
-        match identify_start(&one, &model, &frames, held.as_deref(), refine.as_ref()) {
-            Ok(s) => starts.push(s),
-            Err(e) if methods.len() > 1 => {
-                eprintln!("warning: the start from --derivative {method} fails: {e:#}")
-            }
-            Err(e) => return Err(e),
+    let held = match in_pieces(&cmd, refine.is_some())? {
+        Some(rows) => {
+            starts.push(identify_in_pieces(&cmd, &model, rows)?);
+            None
         }
-    }
+        None => {
+            let frames = crate::runs::load_for(&model, &cmd.data, cmd.dataset.as_deref())?;
+            let held = cmd
+                .refine_validation
+                .as_ref()
+                .map(|p| crate::runs::load_for(&model, &[], Some(p)))
+                .transpose()?;
+            for method in &methods {
+                let one = IdentifyCommand { derivative: method.clone(), ..cmd.clone() };
+                match identify_start(&one, &model, &frames, held.as_deref(), refine.as_ref()) {
+                    Ok(s) => starts.push(s),
+                    Err(e) if methods.len() > 1 => {
+                        eprintln!("warning: the start from --derivative {method} fails: {e:#}")
+                    }
+                    Err(e) => return Err(e),
+                }
+            }
+            held
+        }
+    };
     let kept = (0..starts.len())
         .min_by(|&a, &b| {
             let (x, y) = (&starts[a], &starts[b]);
