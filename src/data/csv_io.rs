@@ -104,9 +104,11 @@ pub(super) fn read_table(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), Da
             message: "a columnar file: termid was built without the `columnar` feature".into(),
         });
     }
-    let text = crate::budget::read_text(path)
-        .map_err(|e| DataError::Io { file: file.clone(), message: e.to_string() })?;
-    parse_table(&text, &file)
+    // read as it is parsed: the numbers in memory, not the text as well
+    if std::fs::metadata(path).is_ok_and(|m| m.is_file() && m.len() as f64 > crate::budget::MEMORY_LIMIT) {
+        return Err(DataError::Io { file, message: crate::budget::ReadError::TooLarge.to_string() });
+    }
+    super::stream::read_all(super::stream::csv_rows(path)?)
 }
 
 /// The header and the numeric columns of CSV text, every cell checked.

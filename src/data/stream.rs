@@ -65,9 +65,7 @@ impl Chunks {
                     message: "a columnar file: termid was built without the `columnar` feature".into(),
                 });
             } else {
-                let file = std::fs::File::open(path)
-                    .map_err(|e| DataError::Io { file: origin.clone(), message: e.to_string() })?;
-                Box::new(CsvRows::new(BufReader::new(file), &origin)?)
+                Box::new(csv_rows(path)?)
             };
         Chunks::new(source, &origin, time, size, context)
     }
@@ -170,19 +168,32 @@ impl Iterator for Chunks {
 /// A line longer than this is no CSV row (`/dev/zero`, a binary file): refused, not buffered.
 const LONGEST_LINE: usize = 1 << 20;
 
-/// Refuses a line longer than [`LONGEST_LINE`] bytes as it passes.
+/// Refuses a line longer than [`LONGEST_LINE`] bytes, and a NUL byte (a binary file), as
+/// they pass.
 struct LineLimit<R> {
     inner: R,
     since_newline: usize,
+    /// Bytes passed before this read.
+    offset: usize,
+}
+
+/// The message for a NUL byte at `offset`: the file is not text.
+fn nul_at(offset: usize) -> String {
+    format!("byte {offset} is NUL: this is not a text file")
 }
 
 impl<R: Read> Read for LineLimit<R> {
     fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
         let n = self.inner.read(buf)?;
-        let (longest, last) = match buf[..n].iter().position(|&b| b == b'\n') {
+        let part = &buf[..n];
+        if let Some(i) = memchr::memchr(0, part) {
+            return Err(std::io::Error::other(nul_at(self.offset + i)));
+        }
+        self.offset += n;
+        let (longest, last) = match memchr::memchr(b'\n', part) {
             // only the first line can continue the previous one, only the last go on
             Some(first) => {
-                let last = buf[..n].iter().rposition(|&b| b == b'\n').unwrap_or(first);
+                let last = memchr::memrchr(b'\n', part).unwrap_or(first);
                 (self.since_newline + first, n - 1 - last)
             }
             None => (self.since_newline + n, self.since_newline + n),
@@ -197,6 +208,14 @@ impl<R: Read> Read for LineLimit<R> {
         self.since_newline = last;
         Ok(n)
     }
+}
+
+/// The CSV rows of the file at `path`, read as they are needed.
+pub(super) fn csv_rows(path: &Path) -> Result<CsvRows<'static>, DataError> {
+    let origin = path.display().to_string();
+    let file = std::fs::File::open(path)
+        .map_err(|e| DataError::Io { file: origin.clone(), message: e.to_string() })?;
+    CsvRows::new(BufReader::with_capacity(1 << 18, file), &origin)
 }
 
 /// CSV rows read as they are needed: the one CSV reader of termid (a whole file is all its
@@ -223,6 +242,9 @@ impl<'a> CsvRows<'a> {
                 .take(LONGEST_LINE as u64 + 1)
                 .read_until(b'\n', &mut line)
                 .map_err(|e| io(&e))?;
+            if let Some(i) = memchr::memchr(0, &line) {
+                return Err(io(&nul_at(peeked.len() + i)));
+            }
             if n > LONGEST_LINE {
                 return Err(io(&format!(
                     "a line longer than {} MiB without a line break: not a CSV file",
@@ -243,7 +265,7 @@ impl<'a> CsvRows<'a> {
             .trim(csv::Trim::Headers)
             .flexible(true)
             .comment(Some(b'#'))
-            .from_reader(LineLimit { inner: rest, since_newline: 0 });
+            .from_reader(LineLimit { inner: rest, since_newline: 0, offset: 0 });
         let names: Vec<String> = reader.headers().map_err(|e| io(&e))?.iter().map(str::to_string).collect();
         if names.iter().all(String::is_empty) {
             return Err(DataError::NoHeader { file: origin.into() });
@@ -431,5 +453,25 @@ mod tests {
         let mut columns = vec![Vec::new(); 2];
         let e = rows.read(10, &mut columns).unwrap_err().to_string();
         assert!(e.contains("longer than 1 MiB"), "{e}");
+    }
+
+    /// A NUL byte is a binary file, in the header or anywhere after it, read whole (a file
+    /// read as it is parsed) or in chunks: refused with its offset.
+    #[test]
+    fn a_nul_byte_is_not_text() {
+        let e = CsvRows::new(&b"t,\0x\n0,1\n"[..], "bin.csv").err().unwrap().to_string();
+        assert!(e.contains("byte 2 is NUL") && e.contains("not a text file"), "{e}");
+        let dir = std::env::temp_dir().join(format!("termid-nul-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("late.csv");
+        let mut text = csv(5000).into_bytes();
+        let at = text.len() - 10;
+        text[at] = 0;
+        std::fs::write(&path, &text).unwrap();
+        let e = Frame::read(&path, "t").unwrap_err().to_string();
+        assert!(e.contains(&format!("byte {at} is NUL")) && e.contains("late.csv"), "{e}");
+        let e = Chunks::open(&path, "t", 100, 2).unwrap().find_map(Result::err).unwrap().to_string();
+        assert!(e.contains(&format!("byte {at} is NUL")), "{e}");
+        std::fs::remove_dir_all(&dir).ok();
     }
 }
