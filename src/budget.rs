@@ -83,16 +83,23 @@ pub fn read_text_or_latin1(path: &std::path::Path) -> Result<(String, bool), Rea
     }
 }
 
+/// The size of the file at `path` (0 for a device or a pipe, whose size is not known ahead),
+/// refused beyond [`MEMORY_LIMIT`]: a file to be read whole.
+pub fn file_size(path: &std::path::Path) -> Result<u64, ReadError> {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_file() && m.len() as f64 > MEMORY_LIMIT => Err(ReadError::TooLarge),
+        Ok(m) if m.is_file() => Ok(m.len()),
+        _ => Ok(0),
+    }
+}
+
 /// The bytes of a file, with the bounds of [`read_text`].
 fn read_bytes(path: &std::path::Path) -> Result<Vec<u8>, ReadError> {
     use std::io::Read;
     let mut file = std::fs::File::open(path)?;
-    if file.metadata().is_ok_and(|m| m.is_file() && m.len() as f64 > MEMORY_LIMIT) {
-        return Err(ReadError::TooLarge);
-    }
     // the file's own size up front: no copies as the buffer grows
-    let size = file.metadata().map_or(0, |m| m.len() as usize);
-    let mut bytes = Vec::with_capacity(size.min(MEMORY_LIMIT as usize) + 1);
+    let size = file_size(path)?;
+    let mut bytes = Vec::with_capacity(size as usize + 1);
     let mut chunk = vec![0u8; 1 << 16];
     let (mut line, mut line_start) = (1usize, 0usize);
     loop {

@@ -105,9 +105,7 @@ pub(super) fn read_table(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), Da
         });
     }
     // read as it is parsed: the numbers in memory, not the text as well
-    if std::fs::metadata(path).is_ok_and(|m| m.is_file() && m.len() as f64 > crate::budget::MEMORY_LIMIT) {
-        return Err(DataError::Io { file, message: crate::budget::ReadError::TooLarge.to_string() });
-    }
+    crate::budget::file_size(path).map_err(|e| DataError::Io { file, message: e.to_string() })?;
     super::stream::read_all(super::stream::csv_rows(path)?)
 }
 

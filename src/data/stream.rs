@@ -177,6 +177,11 @@ struct LineLimit<R> {
     offset: usize,
 }
 
+/// The message for a line beyond [`LONGEST_LINE`]: the file is not CSV.
+fn too_long() -> String {
+    format!("a line longer than {} MiB without a line break: not a CSV file", LONGEST_LINE >> 20)
+}
+
 /// The message for a NUL byte at `offset`: the file is not text.
 fn nul_at(offset: usize) -> String {
     format!("byte {offset} is NUL: this is not a text file")
@@ -200,10 +205,7 @@ impl<R: Read> Read for LineLimit<R> {
         };
         // a line inside the buffer, between two breaks, is shorter than the buffer
         if longest.max(last) > LONGEST_LINE {
-            return Err(std::io::Error::other(format!(
-                "a line longer than {} MiB without a line break: not a CSV file",
-                LONGEST_LINE >> 20
-            )));
+            return Err(std::io::Error::other(too_long()));
         }
         self.since_newline = last;
         Ok(n)
@@ -246,10 +248,7 @@ impl<'a> CsvRows<'a> {
                 return Err(io(&nul_at(peeked.len() + i)));
             }
             if n > LONGEST_LINE {
-                return Err(io(&format!(
-                    "a line longer than {} MiB without a line break: not a CSV file",
-                    LONGEST_LINE >> 20
-                )));
+                return Err(io(&too_long()));
             }
             peeked.extend_from_slice(&line);
             let text = String::from_utf8_lossy(&line);

@@ -386,7 +386,11 @@ impl Figure {
             (y0, y1) = (cy - per_pixel * px.1 / 2.0, cy + per_pixel * px.1 / 2.0);
         }
         let own_legend = has_legend(panel) && !self.shared_legend;
-        let mut corner = legend_corner(panel, (x0, x1), (y0, y1), px);
+        let mut corner = if own_legend {
+            legend_corner(panel, (x0, x1), (y0, y1), px)
+        } else {
+            (SeriesLabelPosition::UpperRight, 0)
+        };
         if own_legend && corner.1 > 0 && !panel.equal_axes {
             // every corner has data under the legend: room beside the data (a tall legend of
             // many entries) or above them (a wide one), whichever takes less of the panel,
@@ -428,8 +432,8 @@ impl Figure {
             // steps and alternatives are counted: their axis is labelled at whole numbers only
             let counted = integer_axis(panel);
             // plotters labels at the finest of 1, 2, 5 × 10ᵏ that gives at most this many
-            // labels: one more than the whole units in the range gives a label per unit
-            // labels, as many as fit at 40 px apart across and 25 px up
+            // labels: one more than the whole units in the range gives a label per unit, as
+            // many as fit at 40 px apart across and 25 px up
             let per_unit = |lo: f64, hi: f64, fit: f64| {
                 if panel.unit_ticks {
                     ((hi - lo).floor() + 1.0).min(fit).max(2.0) as usize

@@ -447,7 +447,7 @@ impl Accumulator {
 
 /// Rows per part when statistics are gathered from a run of `rows` rows of `p` columns: about
 /// 10⁶ multiply-adds (rows × (p+1)²) a part, at least 200 rows, at most 64 parts a run. A part
-/// costs an accumulator and a merge (12 parts of 2 505 rows × 29 terms took 96 µs, 3 parts
+/// costs an accumulator and a merge (12 parts of 2 505 rows × 29 terms took 96 µs, 2 parts
 /// 86 µs); smaller parts would not pay for themselves on the pool either. It depends on the
 /// row and column counts alone, so the result, round-off included, is the same however many
 /// threads there are.

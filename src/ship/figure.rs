@@ -73,9 +73,8 @@ pub fn manoeuvre_figure(ship: &Ship, title: &str, runs: &[(&str, &Trajectory)], 
         speed.series.push(mk("U/U0", speed_v.iter().map(|u| u / ship.spec.u0).collect()));
         drift.series.push(mk("β", deg(&drift_v)));
         drift.series.push(mk("r", deg(&t.states[r.r])));
-        let in_lengths = |v: &[f64]| v.iter().map(|x| x / lpp).collect::<Vec<f64>>();
-        path.series
-            .push(Series::line(name, in_lengths(&t.states[r.y0]), in_lengths(&t.states[r.x0])).colored(k));
+        let (y, x) = track_in_lengths(ship, t);
+        path.series.push(Series::line(name, y, x).colored(k));
     }
     let mut panels = vec![rudder];
     if apart {
@@ -86,6 +85,14 @@ pub fn manoeuvre_figure(ship: &Ship, title: &str, runs: &[(&str, &Trajectory)], 
         panels.push(path);
     }
     Figure::new(title, panels)
+}
+
+/// A run's track in ship lengths: (y0/L, x0/L), across and up as the figures draw it.
+fn track_in_lengths(ship: &Ship, t: &Trajectory) -> (Vec<f64>, Vec<f64>) {
+    let lpp = ship.spec.lpp;
+    let r = &ship.roles;
+    let in_lengths = |v: &[f64]| v.iter().map(|x| x / lpp).collect();
+    (in_lengths(&t.states[r.y0]), in_lengths(&t.states[r.x0]))
 }
 
 /// Adds Monte-Carlo prediction bands (pointwise 5-95 %) of ψ, U/U0, β and r to a figure made
@@ -123,16 +130,14 @@ pub fn add_bands(fig: &mut Figure, ship: &Ship, draws: &[&Trajectory]) {
         }
     }
     if let Some(track) = fig.panels.iter_mut().find(|p| p.title.starts_with(TRACK)) {
-        let lpp = ship.spec.lpp;
-        let in_lengths = |v: &[f64]| v.iter().map(|x| x / lpp).collect::<Vec<f64>>();
         for (k, t) in draws.iter().take(10).enumerate() {
             let name = if k == 0 { "drawn models".to_string() } else { String::new() };
             // one colour for every drawn model, the one its legend entry shows; under the
             // nominal track, which stays in sight
-            track.series.insert(
-                k,
-                Series::dashed(&name, in_lengths(&t.states[r.y0]), in_lengths(&t.states[r.x0])).colored(2),
-            );
+            track.series.insert(k, {
+                let (y, x) = track_in_lengths(ship, t);
+                Series::dashed(&name, y, x).colored(2)
+            });
         }
     }
 }
