@@ -6,26 +6,58 @@
 /// take: 4 GiB, a sixth of this project's 24 GiB machines.
 pub const MEMORY_LIMIT: f64 = 4.0 * (1u64 << 30) as f64;
 
-/// Work that would not fit in [`MEMORY_LIMIT`].
+/// Work that would not fit in [`memory_limit`].
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("{what} would take {} of memory (the limit is {}); {advice}", size(*.bytes), size(MEMORY_LIMIT))]
+#[error("{what} would take {} of memory (the limit is {}{}); {advice}", size(*.bytes), size(.limit.0), .limit.1)]
 pub struct TooLarge {
     /// What would be built, with its count ("a run of 975 000 000 samples × 16 columns").
     pub what: String,
     /// Its size in bytes.
     pub bytes: f64,
+    /// The limit in bytes, and why it is that (empty, or ", half of the address space left
+    /// under this process's limit").
+    pub limit: (f64, &'static str),
     /// What the user can change.
     pub advice: String,
 }
 
+/// The memory one product may take: [`MEMORY_LIMIT`], or less where the process runs under
+/// an address-space limit (`ulimit -v`, a container's): half of what that limit leaves, so a
+/// refused size is an error here and not an abort in the allocator. With the reason shown.
+pub fn memory_limit() -> (f64, &'static str) {
+    static LIMIT: std::sync::OnceLock<(f64, &'static str)> = std::sync::OnceLock::new();
+    *LIMIT.get_or_init(|| match address_space_left() {
+        Some(left) if left / 2.0 < MEMORY_LIMIT => {
+            (left / 2.0, ", half of the address space this process's limit (ulimit -v) leaves")
+        }
+        _ => (MEMORY_LIMIT, ""),
+    })
+}
+
+/// The soft address-space limit less what the process already maps (Linux's /proc), if set.
+fn address_space_left() -> Option<f64> {
+    let limits = std::fs::read_to_string("/proc/self/limits").ok()?;
+    let line = limits.lines().find(|l| l.starts_with("Max address space"))?;
+    let soft: f64 = line["Max address space".len()..].split_whitespace().next()?.parse().ok()?;
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let used_kb: f64 =
+        status.lines().find(|l| l.starts_with("VmSize:"))?.split_whitespace().nth(1)?.parse().ok()?;
+    Some((soft - 1024.0 * used_kb).max(0.0))
+}
+
 /// Refuses `count` values of 8 bytes beyond the limit.
 pub fn check_values(count: f64, what: impl FnOnce() -> String, advice: &str) -> Result<(), TooLarge> {
-    let bytes = 8.0 * count;
+    check_bytes(8.0 * count, what, advice)
+}
+
+/// Refuses `bytes` beyond the limit.
+pub fn check_bytes(bytes: f64, what: impl FnOnce() -> String, advice: &str) -> Result<(), TooLarge> {
+    let limit = memory_limit();
     // NaN counts (from NaN settings) are refused too
-    if bytes <= MEMORY_LIMIT {
+    if bytes <= limit.0 {
         return Ok(());
     }
-    Err(TooLarge { what: what(), bytes, advice: advice.into() })
+    Err(TooLarge { what: what(), bytes, limit, advice: advice.into() })
 }
 
 /// The longest line a text input may have (a CSV row, a model file line): 1 MiB.
@@ -65,7 +97,16 @@ pub enum ReadError {
 /// [`MAX_LINE`], no NUL byte; so `/dev/zero`, a binary file or an endless pipe is an error
 /// after a few reads instead of memory that grows without bound.
 pub fn read_text(path: &std::path::Path) -> Result<String, ReadError> {
-    let bytes = read_bytes(path)?;
+    utf8(read_bytes(path, MAX_LINE)?)
+}
+
+/// [`read_text`] without the line limit, for text termid writes on one line whatever its
+/// size (statistics files as JSON): still bounded by [`MEMORY_LIMIT`] and refused at a NUL.
+pub fn read_json(path: &std::path::Path) -> Result<String, ReadError> {
+    utf8(read_bytes(path, usize::MAX)?)
+}
+
+fn utf8(bytes: Vec<u8>) -> Result<String, ReadError> {
     String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         let line = e.as_bytes()[..at].iter().filter(|b| **b == b'\n').count() + 1;
@@ -76,7 +117,7 @@ pub fn read_text(path: &std::path::Path) -> Result<String, ReadError> {
 /// [`read_text`], with a file that is not UTF-8 read as Latin-1 (Windows-1252's letters and
 /// signs, e.g. a degree sign in a basin's header lines); `true` when it was.
 pub fn read_text_or_latin1(path: &std::path::Path) -> Result<(String, bool), ReadError> {
-    let bytes = read_bytes(path)?;
+    let bytes = read_bytes(path, MAX_LINE)?;
     match String::from_utf8(bytes) {
         Ok(text) => Ok((text, false)),
         Err(e) => Ok((e.into_bytes().iter().map(|&b| char::from(b)).collect(), true)),
@@ -94,7 +135,7 @@ pub fn file_size(path: &std::path::Path) -> Result<u64, ReadError> {
 }
 
 /// The bytes of a file, with the bounds of [`read_text`].
-fn read_bytes(path: &std::path::Path) -> Result<Vec<u8>, ReadError> {
+fn read_bytes(path: &std::path::Path, max_line: usize) -> Result<Vec<u8>, ReadError> {
     use std::io::Read;
     let mut file = std::fs::File::open(path)?;
     // the file's own size up front: no copies as the buffer grows
@@ -117,13 +158,13 @@ fn read_bytes(path: &std::path::Path) -> Result<Vec<u8>, ReadError> {
         // every line break of the piece; a line too long is one whose break is too far
         // from the one before (or from the start of the line the piece goes on)
         for i in memchr::memchr_iter(b'\n', part) {
-            if base + i - line_start > MAX_LINE {
+            if base + i - line_start > max_line {
                 return Err(ReadError::LongLine { line });
             }
             line += 1;
             line_start = base + i + 1;
         }
-        if base + n - line_start > MAX_LINE {
+        if base + n - line_start > max_line {
             return Err(ReadError::LongLine { line });
         }
         if (base + n) as f64 > MEMORY_LIMIT {

@@ -8,6 +8,7 @@
 #![warn(missing_docs)]
 
 pub mod budget;
+pub mod contain;
 pub mod data;
 pub mod diagnose;
 pub mod identify;

@@ -96,6 +96,60 @@ pub fn check_folder(dir: &Path) -> Result<(), OutputError> {
     Ok(())
 }
 
+/// The identity of an existing file (device and inode), so that two names of one file (a
+/// link, `./d.csv` and `d.csv`) are seen as one.
+fn identity(path: &Path) -> Option<(u64, u64)> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        std::fs::metadata(path).ok().map(|m| (m.dev(), m.ino()))
+    }
+    #[cfg(not(unix))]
+    {
+        std::fs::canonicalize(path).ok().map(|p| (0, p.to_string_lossy().len() as u64))
+    }
+}
+
+/// Whether two paths name one existing file (by identity).
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    identity(a).is_some_and(|x| identity(b) == Some(x))
+}
+
+/// A path as it will be once written: its folder made absolute and resolved, its name kept
+/// (for outputs that do not exist yet).
+fn resolved(path: &Path) -> Option<PathBuf> {
+    Some(std::fs::canonicalize(folder_of(path)).ok()?.join(path.file_name()?))
+}
+
+/// Refuses, before any work, outputs that are one of the command's inputs (by identity, not
+/// by name: a link or another spelling of the same file counts) or that are one another: a
+/// command would read its input and then replace it, or write two outputs over each other.
+/// `outputs` and `inputs` are (what, path), e.g. ("--out", …), ("--data", …).
+pub fn check_distinct(outputs: &[(&str, &Path)], inputs: &[(&str, &Path)]) -> Result<(), OutputError> {
+    let same = |a: &Path, b: &Path| match (identity(a), identity(b)) {
+        (Some(x), Some(y)) => x == y,
+        _ => resolved(a).is_some_and(|a| resolved(b).is_some_and(|b| a == b)),
+    };
+    for (k, (what, out)) in outputs.iter().enumerate() {
+        // a device or pipe (/dev/stdout) is no file to lose
+        if std::fs::metadata(out).is_ok_and(|m| !m.is_file()) {
+            continue;
+        }
+        let clash = |reason: String| Err(OutputError::Unwritable { path: out.display().to_string(), reason });
+        if let Some((input, _)) = inputs.iter().find(|(_, i)| identity(i).is_some() && same(out, i)) {
+            return clash(format!(
+                "{what} names the same file as {input}: termid never overwrites its own input; write elsewhere"
+            ));
+        }
+        if let Some((other, _)) = outputs[..k].iter().find(|(_, o)| same(out, o)) {
+            return clash(format!(
+                "{what} and {other} name the same file: one output would replace the other"
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Writes one file atomically: to a temporary file beside it, flushed to disk, then renamed
 /// over `path`. On any failure `path` is as it was and the temporary file is gone.
 pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
@@ -152,15 +206,18 @@ impl Outputs {
     /// place on commit).
     pub fn file(&mut self, path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
         check_file(path)?;
-        // a link is followed: the file it points to is replaced, the link stays
+        // a device or pipe, also behind a link (/dev/stdout → /proc/self/fd/1 → pipe:[…],
+        // which has no path to resolve; /dev/fd/63 of a process substitution): written in
+        // place through the name given
+        if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
+            self.streams.push((path.to_path_buf(), bytes.to_vec()));
+            return Ok(());
+        }
+        // a link to a file is followed: the file it points to is replaced, the link stays
         let path = &match std::fs::symlink_metadata(path) {
             Ok(m) if m.file_type().is_symlink() => std::fs::canonicalize(path).map_err(io_error(path))?,
             _ => path.to_path_buf(),
         };
-        if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
-            self.streams.push((path.clone(), bytes.to_vec()));
-            return Ok(());
-        }
         let temp = sibling(path, "tmp");
         // recorded first, so that a failed write is removed by Drop
         self.staged.push((temp.clone(), path.to_path_buf()));
@@ -201,29 +258,116 @@ impl Drop for Outputs {
     }
 }
 
-/// Builds a whole output folder with `build` in a fresh folder beside `target`, then swaps it
-/// in under a lock on the parent folder, so two runs at once each leave a complete folder and
-/// the last one wins. A `target` that exists must be a folder `looks_ours` accepts (e.g. one
-/// holding `summary.json`): a user's other folder is never replaced.
-pub fn replace_folder<E: From<OutputError>>(
-    target: &Path,
-    looks_ours: impl Fn(&Path) -> bool,
-    build: impl FnOnce(&Path) -> Result<(), E>,
-) -> Result<(), E> {
-    let unwritable = |reason: String| OutputError::Unwritable { path: target.display().to_string(), reason };
-    if target.exists() {
-        let empty = std::fs::read_dir(target).map(|mut d| d.next().is_none()).unwrap_or(false);
-        if !target.is_dir() {
-            return Err(unwritable("exists and is not a folder".into()).into());
-        }
-        if !empty && !looks_ours(target) {
-            return Err(unwritable(
-                "exists and holds other files; name a new or empty folder (termid replaces its output folder whole)".into(),
-            )
-            .into());
+/// The file in a folder termid built that lists what it wrote there: a line per file
+/// (`<size> <FNV-1a 64 of its bytes> <path>`) and per folder (`- - <path>/`), paths relative
+/// to the folder. Only a folder whose every entry is listed, unchanged, is termid's to replace.
+pub const MANIFEST: &str = ".termid-files";
+
+/// FNV-1a (64 bit) of a file's bytes: enough to tell an edited file from the one written.
+fn fingerprint(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ u64::from(*b)).wrapping_mul(0x100_0000_01b3))
+}
+
+/// Every entry under `dir` (not following links), relative, sorted; folders end in `/`.
+fn entries_under(dir: &Path) -> std::io::Result<Vec<String>> {
+    let mut out = Vec::new();
+    let mut stack = vec![PathBuf::new()];
+    while let Some(rel) = stack.pop() {
+        for e in std::fs::read_dir(dir.join(&rel))? {
+            let e = e?;
+            let path = rel.join(e.file_name());
+            let text = path.to_string_lossy().into_owned();
+            if e.file_type()?.is_dir() {
+                out.push(format!("{text}/"));
+                stack.push(path);
+            } else {
+                out.push(text);
+            }
         }
     }
-    check_folder(target)?;
+    out.sort();
+    Ok(out)
+}
+
+/// The manifest of folder `dir` as it is now (without the manifest itself).
+fn manifest_of(dir: &Path) -> std::io::Result<String> {
+    let mut text = String::new();
+    for e in entries_under(dir)? {
+        if e == MANIFEST {
+            continue;
+        }
+        if e.ends_with('/') {
+            text.push_str(&format!("- - {e}\n"));
+        } else {
+            let bytes = std::fs::read(dir.join(&e))?;
+            text.push_str(&format!("{} {:016x} {e}\n", bytes.len(), fingerprint(&bytes)));
+        }
+    }
+    Ok(text)
+}
+
+/// Checks, before any work, that [`replace_folder`] may replace `target`: it does not exist,
+/// is an empty folder, or holds exactly what termid wrote there last time (its
+/// [`MANIFEST`]), unchanged. A file or folder of anyone else's, or one edited since, is named
+/// in the error and nothing is touched.
+pub fn check_replaceable(target: &Path) -> Result<(), OutputError> {
+    let unwritable = |reason: String| OutputError::Unwritable { path: target.display().to_string(), reason };
+    if !target.exists() {
+        return check_folder(target);
+    }
+    if !target.is_dir() {
+        return Err(unwritable("exists and is not a folder".into()));
+    }
+    let entries = entries_under(target).map_err(io_error(target))?;
+    if entries.is_empty() {
+        return Ok(());
+    }
+    let advice = "termid replaces only a folder it wrote itself, unchanged; move your files elsewhere or name a new or empty folder";
+    let Ok(recorded) = std::fs::read_to_string(target.join(MANIFEST)) else {
+        return Err(unwritable(format!(
+            "holds files termid did not write (no {MANIFEST} of termid's, e.g. `{}`); {advice}",
+            entries[0]
+        )));
+    };
+    let now = manifest_of(target).map_err(io_error(target))?;
+    if now == recorded {
+        return Ok(());
+    }
+    let listed: Vec<&str> = recorded.lines().collect();
+    // the first difference, named: a foreign entry, or one of termid's changed or gone
+    let first = now
+        .lines()
+        .find(|l| !listed.contains(l))
+        .map(|l| {
+            let name = l.splitn(3, ' ').nth(2).unwrap_or(l);
+            let ours = listed.iter().any(|r| r.splitn(3, ' ').nth(2) == Some(name));
+            if ours {
+                format!("`{name}` was changed since termid wrote it")
+            } else {
+                format!("`{name}` is not termid's")
+            }
+        })
+        .or_else(|| {
+            let present: Vec<&str> = now.lines().filter_map(|l| l.splitn(3, ' ').nth(2)).collect();
+            listed
+                .iter()
+                .filter_map(|l| l.splitn(3, ' ').nth(2))
+                .find(|name| !present.contains(name))
+                .map(|name| format!("`{name}`, which termid wrote, was removed or moved"))
+        })
+        .unwrap_or_else(|| "its files differ from those termid wrote".into());
+    Err(unwritable(format!("{first}; {advice}")))
+}
+
+/// Builds a whole output folder with `build` in a fresh folder beside `target`, then swaps it
+/// in under a lock on the parent folder, so two runs at once each leave a complete folder and
+/// the last one wins. A `target` that exists must pass [`check_replaceable`] (checked first and
+/// again under the lock, just before the swap): termid never deletes a file it did not write.
+pub fn replace_folder<E: From<OutputError>>(
+    target: &Path,
+    build: impl FnOnce(&Path) -> Result<(), E>,
+) -> Result<(), E> {
+    check_replaceable(target)?;
     let fresh = sibling(target, "new");
     std::fs::create_dir(&fresh).map_err(io_error(&fresh))?;
     // removes the fresh folder on any failure below
@@ -235,9 +379,13 @@ pub fn replace_folder<E: From<OutputError>>(
     }
     let fresh_guard = Remove(fresh.clone());
     build(&fresh)?;
+    let manifest = manifest_of(&fresh).map_err(io_error(&fresh))?;
+    std::fs::write(fresh.join(MANIFEST), manifest).map_err(io_error(&fresh))?;
     let parent = folder_of(target);
     let lock = File::open(parent).map_err(io_error(parent))?;
     lock.lock().map_err(io_error(parent))?;
+    // what the user may have put there while the folder was built
+    check_replaceable(target)?;
     let old = sibling(target, "old");
     if target.exists() {
         std::fs::rename(target, &old).map_err(io_error(target))?;
@@ -327,18 +475,19 @@ mod tests {
     fn folders_are_swapped_whole_and_foreign_ones_refused() {
         let d = scratch("swap");
         let target = d.join("out");
-        let ours = |p: &Path| p.join("summary.json").exists();
         let build = |text: &'static str| {
             move |dir: &Path| -> Result<(), OutputError> {
                 std::fs::write(dir.join("summary.json"), text).unwrap();
+                std::fs::create_dir(dir.join("data")).unwrap();
+                std::fs::write(dir.join("data/a.csv"), text).unwrap();
                 Ok(())
             }
         };
-        replace_folder(&target, ours, build("1")).unwrap();
-        replace_folder(&target, ours, build("2")).unwrap();
+        replace_folder(&target, build("1")).unwrap();
+        replace_folder(&target, build("2")).unwrap();
         assert_eq!(std::fs::read_to_string(target.join("summary.json")).unwrap(), "2");
         // a failing build leaves the old folder and no sibling
-        let failed = replace_folder(&target, ours, |dir: &Path| {
+        let failed = replace_folder(&target, |dir: &Path| {
             std::fs::write(dir.join("summary.json"), "3").unwrap();
             Err(OutputError::Unwritable { path: "x".into(), reason: "disk full".into() })
         });
@@ -348,8 +497,33 @@ mod tests {
         // a folder of the user's is not replaced
         std::fs::create_dir(d.join("mine")).unwrap();
         std::fs::write(d.join("mine/thesis.tex"), "").unwrap();
-        assert!(replace_folder(&d.join("mine"), ours, build("4")).is_err());
+        assert!(replace_folder(&d.join("mine"), build("4")).is_err());
         assert!(d.join("mine/thesis.tex").exists());
+        // nor termid's own folder once anything was added, edited or put in a subfolder
+        for (what, add) in [
+            (
+                "precious.txt",
+                Box::new(|t: &Path| std::fs::write(t.join("precious.txt"), "x").unwrap())
+                    as Box<dyn Fn(&Path)>,
+            ),
+            ("data/mine.csv", Box::new(|t: &Path| std::fs::write(t.join("data/mine.csv"), "x").unwrap())),
+            ("sub/", Box::new(|t: &Path| std::fs::create_dir(t.join("sub")).unwrap())),
+            ("summary.json", Box::new(|t: &Path| std::fs::write(t.join("summary.json"), "edited").unwrap())),
+        ] {
+            add(&target);
+            let e = replace_folder(&target, build("5")).unwrap_err().to_string();
+            assert!(e.contains(&format!("`{what}`")), "{e}");
+            assert_ne!(std::fs::read_to_string(target.join("summary.json")).unwrap(), "5");
+            let path = target.join(what.trim_end_matches('/'));
+            if path.is_dir() {
+                std::fs::remove_dir(&path).unwrap();
+            } else if what == "summary.json" {
+                std::fs::write(&path, "2").unwrap();
+            } else {
+                std::fs::remove_file(&path).unwrap();
+            }
+            replace_folder(&target, build("2")).unwrap();
+        }
         let _ = std::fs::remove_dir_all(&d);
     }
 }

@@ -40,6 +40,9 @@ mod basin;
 // Hostile inputs through the CLI: no hang, no half-written file, no silent surprise.
 #[path = "integration/hostile.rs"]
 mod hostile;
+// The second hostile sweep: nothing of the user's lost, no panic, nothing silently ignored.
+#[path = "integration/hostile2.rs"]
+mod hostile2;
 // The library's layers run one way (a table checked against the `crate::` paths).
 #[path = "integration/layers.rs"]
 mod layers;

@@ -1,7 +1,9 @@
-//! Every text a user hands termid, from one fuzzer input: the first byte picks the reader,
-//! the rest is the text. Any error is fine; a panic is a bug. Kind 7 is a model file's
+//! Every text and file a user hands termid, from one fuzzer input: the first byte picks the
+//! reader, the rest is the text. Any error is fine; a panic is a bug. Kind 7 is a model file's
 //! back-end table (`backend = …`), loaded and then fitted on a short Lorenz run; kind 6 a
-//! statistics file of `termid moments`.
+//! statistics file of `termid moments`. Kinds 8-10 are binary files seeded from valid ones:
+//! a valid Arrow IPC file, Parquet file or statistics bytes (`EquationMoments::to_bytes`),
+//! the input's bytes laid over it (pairs of position and XOR mask), read whole and in pieces.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -12,6 +14,9 @@ use termid::term::Vocabulary;
 
 fuzz_target!(|data: &[u8]| {
     let Some((&kind, rest)) = data.split_first() else { return };
+    if kind % 11 >= 8 {
+        return damaged_file(kind % 11, rest);
+    }
     let Ok(text) = std::str::from_utf8(rest) else { return };
     match kind % 8 {
         0 => {
@@ -91,4 +96,75 @@ fn lorenz_run(model: &Model) -> Frame {
     let x0: Vec<f64> = model.spec().states.iter().map(|s| s.initial).collect();
     let traj = termid::sim::simulate(&system, &x0, &mut termid::sim::Constant(vec![]), &settings).expect("runs");
     traj.to_frame("lorenz", "t").expect("a frame")
+}
+
+/// A valid file of `kind` (8: Arrow IPC, 9: Parquet, 10: statistics bytes) with `edits` laid
+/// over it: each pair of input bytes picks a position (scaled to the file) and an XOR mask; a
+/// third byte of 0xFF cuts the file there.
+fn damaged_file(kind: u8, edits: &[u8]) {
+    use std::sync::Arc;
+    let t: Vec<f64> = (0..64).map(|k| 0.05 * k as f64).collect();
+    let x: Vec<f64> = t.iter().map(|v| v.sin()).collect();
+    let schema = Arc::new(arrow_schema::Schema::new(vec![
+        arrow_schema::Field::new("t", arrow_schema::DataType::Float64, false),
+        arrow_schema::Field::new("x", arrow_schema::DataType::Float64, false),
+    ]));
+    let batch = arrow_array::RecordBatch::try_new(
+        schema.clone(),
+        vec![Arc::new(arrow_array::Float64Array::from(t)), Arc::new(arrow_array::Float64Array::from(x))],
+    )
+    .expect("a batch");
+    let mut bytes = Vec::new();
+    let ext = match kind {
+        8 => {
+            let mut w = arrow_ipc::writer::FileWriter::try_new(&mut bytes, &schema).expect("writer");
+            w.write(&batch).expect("write");
+            w.finish().expect("finish");
+            drop(w);
+            "arrow"
+        }
+        9 => {
+            let mut w = parquet::arrow::ArrowWriter::try_new(&mut bytes, schema, None).expect("writer");
+            w.write(&batch).expect("write");
+            w.close().expect("close");
+            "parquet"
+        }
+        _ => {
+            let model = Model::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../models/lorenz.toml")))
+                .expect("models/lorenz.toml");
+            let frames = [lorenz_run(&model)];
+            let m = termid::identify::EquationMoments::of_runs(&model, "x_dot", &frames, &termid::data::CentralDifference, None)
+                .expect("statistics");
+            let mut b = m.to_bytes();
+            for pair in edits.chunks(2) {
+                if let [at, mask] = pair {
+                    let k = (*at as usize * b.len()) / 256;
+                    b[k] ^= mask;
+                }
+            }
+            if let Ok(read) = termid::identify::EquationMoments::from_bytes(&b, "fuzz.bin") {
+                let _ = read.fit(&model, true);
+            }
+            return;
+        }
+    };
+    for e in edits.chunks(3) {
+        let k = (e[0] as usize * bytes.len()) / 256;
+        match e {
+            [_, _, 0xFF] => bytes.truncate(k),
+            [_, mask, ..] if k < bytes.len() => bytes[k] ^= mask,
+            _ => {}
+        }
+    }
+    let path = std::env::temp_dir().join(format!("termid-fuzz-{}.{ext}", std::process::id()));
+    if std::fs::write(&path, &bytes).is_ok() {
+        let _ = Frame::read(&path, "t");
+        if let Ok(chunks) = termid::data::Chunks::open(&path, "t", 8, 2) {
+            for c in chunks {
+                if c.is_err() {
+                    break;
+                }
+            }
+        }
+    }
 }

@@ -38,17 +38,33 @@ impl Batches {
             path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
             Some("parquet" | "pq")
         );
+        // the readers panic on some corrupt files (a buffer offset beyond its length): every
+        // call into them is contained, and a panic is the file's error like any other
+        let corrupt = |m: String| format!("the file is damaged ({m})");
         let mut batches: Box<dyn Iterator<Item = Result<RecordBatch, String>>> = if parquet {
-            let reader = parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder::try_new(handle)
-                .and_then(|b| b.with_batch_size(65_536).build())
-                .map_err(|e| io(&e))?;
-            Box::new(reader.map(|b| b.map_err(|e| e.to_string())))
+            let reader = crate::contain::call(|| {
+                parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder::try_new(handle)
+                    .and_then(|b| b.with_batch_size(65_536).build())
+            })
+            .map_err(|m| io(&corrupt(m)))?
+            .map_err(|e| io(&e))?;
+            Box::new(Contained(reader.map(|b| b.map_err(|e| e.to_string()))))
         } else {
-            let reader = arrow_ipc::reader::FileReader::try_new(handle, None).map_err(|e| io(&e))?;
-            Box::new(reader.map(|b| b.map_err(|e| e.to_string())))
+            // the reader allocates what the footer declares before reading it: a damaged
+            // footer is refused here, against the file's own size
+            check_ipc_footer(path).map_err(|m| io(&corrupt(m)))?;
+            let reader = crate::contain::call(|| arrow_ipc::reader::FileReader::try_new(handle, None))
+                .map_err(|m| io(&corrupt(m)))?
+                .map_err(|e| io(&e))?;
+            Box::new(Contained(reader.map(|b| b.map_err(|e| e.to_string()))))
         };
-        let first =
-            batches.next().ok_or_else(|| DataError::NoHeader { file: file.clone() })?.map_err(|m| io(&m))?;
+        let first = batches
+            .next()
+            .ok_or_else(|| DataError::Io {
+                file: file.clone(),
+                message: "the file holds no rows (no record batch)".into(),
+            })?
+            .map_err(|m| io(&m))?;
         let names: Vec<String> = first.schema().fields().iter().map(|f| f.name().clone()).collect();
         for (i, h) in names.iter().enumerate() {
             if names[..i].contains(h) {
@@ -57,6 +73,83 @@ impl Batches {
         }
         Ok(Batches { batches, names, file, rows: 0, first: Some(first) })
     }
+}
+
+/// Checks an Arrow IPC file's footer: its length, and every block (dictionaries, record
+/// batches) within the file.
+fn check_ipc_footer(path: &Path) -> Result<(), String> {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut f = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let len = f.metadata().map_err(|e| e.to_string())?.len();
+    if len < 18 {
+        return Err(format!("{len} bytes are too few for an Arrow IPC file"));
+    }
+    let mut trailer = [0u8; 10];
+    f.seek(SeekFrom::End(-10)).and_then(|_| f.read_exact(&mut trailer)).map_err(|e| e.to_string())?;
+    if &trailer[4..] != b"ARROW1" {
+        return Err("no Arrow IPC end marker (ARROW1)".into());
+    }
+    let footer_len = i32::from_le_bytes([trailer[0], trailer[1], trailer[2], trailer[3]]);
+    let footer_len = u64::try_from(footer_len)
+        .ok()
+        .filter(|n| n + 10 + 8 <= len)
+        .ok_or_else(|| format!("its footer declares {footer_len} bytes in a file of {len}"))?;
+    let mut footer = vec![0u8; footer_len as usize];
+    f.seek(SeekFrom::End(-10 - footer_len as i64))
+        .and_then(|_| f.read_exact(&mut footer))
+        .map_err(|e| e.to_string())?;
+    let footer = crate::contain::call(|| {
+        arrow_ipc::root_as_footer(&footer).map(|ft| {
+            ft.dictionaries()
+                .into_iter()
+                .flatten()
+                .chain(ft.recordBatches().into_iter().flatten())
+                .map(|b| (b.offset(), i64::from(b.metaDataLength()), b.bodyLength()))
+                .collect::<Vec<_>>()
+        })
+    })?
+    .map_err(|e| format!("its footer is not readable: {e}"))?;
+    for (offset, meta, body) in footer {
+        let end = offset.checked_add(meta).and_then(|v| v.checked_add(body));
+        if offset < 0 || meta < 0 || body < 0 || end.is_none_or(|e| e as u64 > len) {
+            return Err(format!(
+                "a block at byte {offset} declares {meta} + {body} bytes, beyond the file's {len}"
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// A reader's batches, each read under [`crate::contain::call`]; a panic ends the iteration
+/// as an error.
+struct Contained<I>(I);
+
+impl<I: Iterator<Item = Result<RecordBatch, String>>> Iterator for Contained<I> {
+    type Item = Result<RecordBatch, String>;
+    fn next(&mut self) -> Option<Self::Item> {
+        crate::contain::call(|| self.0.next())
+            .unwrap_or_else(|m| Some(Err(format!("the file is damaged ({m})"))))
+            .map(|b| {
+                // a batch that does not hold together (lengths, offsets) is refused before use
+                b.and_then(|b| {
+                    crate::contain::call(|| validate(&b))
+                        .map_err(|m| format!("the file is damaged ({m})"))?
+                        .map(|()| b)
+                })
+            })
+    }
+}
+
+/// Checks a batch's arrays against their own lengths and offsets (the IPC reader trusts the
+/// file's; a damaged one would make a later read index out of bounds).
+fn validate(batch: &RecordBatch) -> Result<(), String> {
+    for c in batch.columns() {
+        c.to_data().validate_full().map_err(|e| format!("the file is damaged: {e}"))?;
+        if c.len() != batch.num_rows() {
+            return Err("the file is damaged: a column's length differs from its batch's".into());
+        }
+    }
+    Ok(())
 }
 
 impl super::stream::RowSource for Batches {
@@ -228,5 +321,66 @@ mod tests {
         let e = Frame::read(&dir.join("fake.parquet"), "t").unwrap_err().to_string();
         assert!(e.contains("fake.parquet"), "{e}");
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// A valid run as Arrow IPC and as Parquet bytes.
+    fn valid_files() -> [(&'static str, Vec<u8>); 2] {
+        let t: Vec<f64> = (0..200).map(|k| 0.1 * k as f64).collect();
+        let b = batch(vec![
+            ("t", Arc::new(Float64Array::from(t.clone())) as ArrayRef),
+            ("x", Arc::new(Float32Array::from(t.iter().map(|v| v.sin() as f32).collect::<Vec<_>>()))),
+            ("n", Arc::new(Int64Array::from((0..200).collect::<Vec<i64>>()))),
+        ]);
+        let mut arrow = Vec::new();
+        {
+            let mut w = arrow_ipc::writer::FileWriter::try_new(&mut arrow, &b.schema()).unwrap();
+            w.write(&b).unwrap();
+            w.write(&b.slice(0, 50)).unwrap();
+            w.finish().unwrap();
+        }
+        let mut parquet = Vec::new();
+        {
+            let mut w = parquet::arrow::ArrowWriter::try_new(&mut parquet, b.schema(), None).unwrap();
+            w.write(&b).unwrap();
+            w.close().unwrap();
+        }
+        [("arrow", arrow), ("parquet", parquet)]
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig { cases: 300, failure_persistence: None, ..Default::default() })]
+        /// A damaged Arrow or Parquet file (bytes flipped, cut short) is an error that names
+        /// the file, whole or in pieces; never a panic.
+        #[test]
+        fn damaged_columnar_files_are_errors_not_panics(
+            flips in proptest::collection::vec((0.0f64..1.0, 1u8..=255), 1..4),
+            cut in proptest::option::of(0.0f64..1.0),
+            which in 0usize..2,
+        ) {
+            let dir = std::env::temp_dir().join(format!("termid-damaged-{}", std::process::id()));
+            std::fs::create_dir_all(&dir).unwrap();
+            let (ext, mut bytes) = valid_files().into_iter().nth(which).unwrap();
+            for (at, x) in &flips {
+                let k = ((*at * bytes.len() as f64) as usize).min(bytes.len() - 1);
+                bytes[k] ^= x;
+            }
+            if let Some(c) = cut {
+                bytes.truncate((c * bytes.len() as f64) as usize);
+            }
+            let path = dir.join(format!("run{}.{ext}", std::thread::current().name().map_or(0, str::len)));
+            std::fs::write(&path, &bytes).unwrap();
+            let whole = std::panic::catch_unwind(|| Frame::read(&path, "t").map(|_| ()));
+            proptest::prop_assert!(whole.is_ok(), "reading {ext} whole panicked");
+            if let Ok(Err(e)) = whole {
+                proptest::prop_assert!(e.to_string().contains(&*path.to_string_lossy()), "{e}");
+            }
+            let pieces = std::panic::catch_unwind(|| -> Result<(), DataError> {
+                for c in crate::data::Chunks::open(&path, "t", 16, 2)? {
+                    c?;
+                }
+                Ok(())
+            });
+            proptest::prop_assert!(pieces.is_ok(), "reading {ext} in pieces panicked");
+        }
     }
 }

@@ -85,6 +85,17 @@ pub struct Refined {
 /// Marquardt on the re-simulation's scaled residuals, its Jacobian from forward sensitivities,
 /// with the regression's estimates as a prior and, where given, validation runs that stop it.
 pub fn refine(model: &Model, runs: &Runs, settings: &RefineSettings<'_>) -> Result<Refined, DiagnoseError> {
+    // a prior weight that is no number would make every step's cost NaN: no step is taken and
+    // the "refined" model is the regression's, silently
+    if !(settings.prior_weight.is_finite() && (0.0..=1e12).contains(&settings.prior_weight)) {
+        return Err(DiagnoseError::Setup(format!(
+            "the refinement's prior weight {} must be a number from 0 (no prior) to 1e12 (1 holds each coefficient within its standard error; the default is 1e-4)",
+            settings.prior_weight
+        )));
+    }
+    if settings.iterations == 0 {
+        return Err(DiagnoseError::Setup("the refinement needs at least one iteration".into()));
+    }
     // (equation, term, regression value, prior sd)
     let mut entries: Vec<(String, Term, f64, f64)> = Vec::new();
     for e in model.equations().iter().filter(|e| e.identify) {

@@ -207,6 +207,7 @@ impl EquationMoments {
             )));
         }
         self.runs.extend(other.runs);
+        self.check("merged statistics")?;
         Ok(self)
     }
 
@@ -224,7 +225,61 @@ impl EquationMoments {
                 m.candidates.len()
             )));
         }
+        m.check(origin)?;
         Ok(m)
+    }
+
+    /// Refuses statistics that no rows could have given (read from a file, they may have
+    /// been edited or damaged): per run, as many rows as weight (termid's statistics are
+    /// unweighted), sums of squares not negative, cross-products within Cauchy-Schwarz,
+    /// numbers whose squares stay finite; and no run twice.
+    fn check(&self, origin: &str) -> Result<(), IdentifyError> {
+        let refuse = |run: &str, why: String| {
+            Err(IdentifyError::Setup(format!(
+                "{origin}: the statistics of run `{run}` cannot come from data: {why}"
+            )))
+        };
+        let m = self.candidates.len() + 1;
+        for (k, r) in self.runs.iter().enumerate() {
+            let s = &r.moments;
+            if s.count() == 0 || s.weight() != s.count() as f64 {
+                return refuse(&r.run, format!("{} rows but a weight of {}", s.count(), s.weight()));
+            }
+            let name = |i: usize| self.candidates.get(i).map_or(self.target.as_str(), String::as_str);
+            if let Some(i) = (0..m).find(|&i| s.means()[i].abs() > 1e150) {
+                return refuse(
+                    &r.run,
+                    format!("the mean of `{}` is {:e}, beyond any measurement", name(i), s.means()[i]),
+                );
+            }
+            for i in 0..m {
+                let cii = s.corrected(i, i);
+                let scale = 1.0 + s.weight() * s.means()[i].powi(2);
+                if cii.is_nan() || cii < -1e-9 * scale || cii > 1e300 {
+                    return refuse(&r.run, format!("the sum of squares of `{}` is {cii:e}", name(i)));
+                }
+                for j in 0..i {
+                    let (cij, cjj) = (s.corrected(i, j), s.corrected(j, j));
+                    if cij.abs() > (cii.max(0.0) * cjj.max(0.0)).sqrt() * (1.0 + 1e-6) + 1e-9 * scale {
+                        return refuse(
+                            &r.run,
+                            format!(
+                                "the cross-product of `{}` and `{}` ({cij:e}) exceeds what their sums of squares allow",
+                                name(i),
+                                name(j)
+                            ),
+                        );
+                    }
+                }
+            }
+            if let Some(first) = self.runs[..k].iter().find(|o| o.run == r.run && o.moments == r.moments) {
+                return Err(IdentifyError::Setup(format!(
+                    "{origin}: run `{}` appears twice with the same statistics: it would be counted twice",
+                    first.run
+                )));
+            }
+        }
+        Ok(())
     }
 
     /// The statistics as JSON (every number round-trips exactly).
@@ -290,12 +345,14 @@ impl EquationMoments {
                 .ok_or_else(|| broken(&format!("the statistics of run `{run}` are not whole")))?;
             runs.push(RunMoments { run, moments });
         }
-        Ok(EquationMoments {
+        let m = EquationMoments {
             equation: header.equation,
             target: header.target,
             candidates: header.candidates,
             runs,
-        })
+        };
+        m.check(origin)?;
+        Ok(m)
     }
 
     /// Identifies the equation from the statistics with the model's forced and excluded terms
@@ -311,6 +368,13 @@ impl EquationMoments {
         }
         if self.runs.is_empty() {
             return Err(IdentifyError::Setup("no data: the statistics hold no run".into()));
+        }
+        let targets = [format!("{}_dot", eq.state), format!("d{}/dt", eq.state)];
+        if !targets.contains(&self.target) {
+            return Err(IdentifyError::Setup(format!(
+                "the statistics of `{}` explain `{}`, but equation `{}` of {} is the rate of `{}` ({} or {}): they belong to another equation",
+                self.equation, self.target, self.equation, model.path, eq.state, targets[0], targets[1]
+            )));
         }
         let index = |t: &crate::term::Term| design.candidates().iter().position(|c| c == t);
         let forced: Vec<usize> = eq.forced.iter().filter_map(index).collect();

@@ -27,6 +27,9 @@ pub struct Vocabulary {
     derived: Vec<Derived>,
     aliases: BTreeMap<String, String>,
     open: bool,
+    /// Every declared name → its place in `derived` (None: a variable or parameter), so that
+    /// a look-up does not scan (a file of 10⁵ derived variables loads in linear time).
+    index: rustc_hash::FxHashMap<String, Option<usize>>,
 }
 
 /// `∆` (U+2206, the increment sign keyboards produce) is read as `Δ` (U+0394).
@@ -68,14 +71,13 @@ impl Vocabulary {
     }
 
     fn is_declared(&self, name: &str) -> bool {
-        self.variables.iter().any(|v| v == name)
-            || self.parameters.iter().any(|v| v == name)
-            || self.derived.iter().any(|d| d.name == name)
+        self.index.contains_key(name)
     }
 
     /// Declares a variable (a data column, state or input).
     pub fn variable(&mut self, name: &str) -> Result<&mut Self, TermError> {
         let name = self.check_new(name)?;
+        self.index.insert(name.clone(), None);
         self.variables.push(name);
         Ok(self)
     }
@@ -83,6 +85,7 @@ impl Vocabulary {
     /// Declares a parameter (a constant per data set, e.g. `u0`).
     pub fn parameter(&mut self, name: &str) -> Result<&mut Self, TermError> {
         let name = self.check_new(name)?;
+        self.index.insert(name.clone(), None);
         self.parameters.push(name);
         Ok(self)
     }
@@ -91,6 +94,7 @@ impl Vocabulary {
     pub fn derive(&mut self, name: &str, definition: &str) -> Result<&mut Self, TermError> {
         let name = self.check_new(name)?;
         let definition = self.parse(definition)?;
+        self.index.insert(name.clone(), Some(self.derived.len()));
         self.derived.push(Derived { name, definition });
         Ok(self)
     }
@@ -130,7 +134,7 @@ impl Vocabulary {
 
     /// A derived variable's definition.
     pub fn derived_definition(&self, name: &str) -> Option<&Term> {
-        self.derived.iter().find(|d| d.name == name).map(|d| &d.definition)
+        self.index.get(name).copied().flatten().map(|k| &self.derived[k].definition)
     }
 
     /// The canonical spelling of a name, if the vocabulary knows it.

@@ -10,7 +10,7 @@ use crate::common::Scratch;
 
 /// Runs `termid args` and kills it if it has not ended within `limit`: (exit code, stdout,
 /// stderr). A process that had to be killed fails the test.
-fn run_within(args: &[&str], limit: Duration, env: &[(&str, &str)]) -> (i32, String, String) {
+pub(crate) fn run_within(args: &[&str], limit: Duration, env: &[(&str, &str)]) -> (i32, String, String) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_termid"))
         .args(args)
         .envs(env.iter().copied())
@@ -38,7 +38,7 @@ fn run_within(args: &[&str], limit: Duration, env: &[(&str, &str)]) -> (i32, Str
 }
 
 /// An error: exit code 2 within 30 s, the message on standard error containing every `needle`.
-fn refused(args: &[&str], needles: &[&str]) -> String {
+pub(crate) fn refused(args: &[&str], needles: &[&str]) -> String {
     let (code, _, err) = run_within(args, Duration::from_secs(30), &[]);
     assert_eq!(code, 2, "termid {}: expected an error, got exit {code}\n{err}", args.join(" "));
     for n in needles {
@@ -49,18 +49,18 @@ fn refused(args: &[&str], needles: &[&str]) -> String {
 }
 
 /// Success within 60 s; stdout.
-fn succeeds(args: &[&str]) -> String {
+pub(crate) fn succeeds(args: &[&str]) -> String {
     let (code, out, err) = run_within(args, Duration::from_secs(60), &[]);
     assert_eq!(code, 0, "termid {}:\n{err}", args.join(" "));
     out
 }
 
-fn s(p: &Path) -> &str {
+pub(crate) fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
 /// The default model with `backend` as the v̇ equation's back-end.
-fn model_with_backend(dir: &Path, backend: &str) -> std::path::PathBuf {
+pub(crate) fn model_with_backend(dir: &Path, backend: &str) -> std::path::PathBuf {
     let text = std::fs::read_to_string("models/oltmann1973.toml").unwrap();
     let marker = "[equations.v_dot]\n";
     assert!(text.contains(marker));
@@ -73,14 +73,14 @@ fn model_with_backend(dir: &Path, backend: &str) -> std::path::PathBuf {
     path
 }
 
-fn zigzag(dir: &Path) -> std::path::PathBuf {
+pub(crate) fn zigzag(dir: &Path) -> std::path::PathBuf {
     let path = dir.join("z30_10.csv");
     succeeds(&["simulate", "-m", "zigzag:30/10", "--out", s(&path)]);
     path
 }
 
 /// Files in a folder (hidden temporary ones included), sorted.
-fn listing(dir: &Path) -> Vec<String> {
+pub(crate) fn listing(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -153,7 +153,7 @@ fn failed_commands_leave_old_files_and_nothing_new() {
     // a folder that is someone else's is never replaced by reproduce
     std::fs::create_dir(dir.join("thesis")).unwrap();
     std::fs::write(dir.join("thesis/chapter1.tex"), "").unwrap();
-    refused(&["reproduce", "--out", s(&dir.join("thesis"))], &["holds other files"]);
+    refused(&["reproduce", "--out", s(&dir.join("thesis"))], &["did not write"]);
     assert!(dir.join("thesis/chapter1.tex").exists());
     // success replaces, through a link too
     succeeds(&["simulate", "-m", "zigzag:20/20", "--out", s(&out)]);

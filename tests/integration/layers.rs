@@ -7,6 +7,7 @@ use std::path::Path;
 /// Bottom to top. The simulator sits below the model files (it integrates any
 /// `sim::RightHandSide`), the regression back-ends below both; the ship plug-in and the registry of plug-ins are on top.
 const LAYERS: &[&str] = &[
+    "contain",
     "budget",
     "output",
     "term",

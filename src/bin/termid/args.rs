@@ -66,7 +66,7 @@ pub struct MomentsCommand {
     /// Rows per piece when `--data` files are read in pieces (one pass, memory bounded by
     /// a few pieces, whatever the file's size): with a derivative of fixed reach (central,
     /// five-point, savitzky-golay) or measured `<state>_dot` columns. 0 reads each file whole.
-    #[arg(long, default_value_t = 262_144)]
+    #[arg(allow_negative_numbers = true, long, default_value_t = 262_144)]
     pub chunk_rows: usize,
 }
 
@@ -80,7 +80,7 @@ pub struct ScaleCommand {
     #[arg(long)]
     pub model: PathBuf,
     /// Length factor λ (new length / old length; < 1 from ship to model).
-    #[arg(long)]
+    #[arg(allow_negative_numbers = true, long)]
     pub factor: f64,
     /// Write the rescaled model here.
     #[arg(long)]
@@ -177,7 +177,7 @@ pub struct IdentifyCommand {
     pub derivative: String,
     /// Resample every run to this interval [s] before differentiating (low-pass filtered
     /// first when coarser than the data, so noise does not alias).
-    #[arg(long)]
+    #[arg(allow_negative_numbers = true, long)]
     pub resample: Option<f64>,
     /// Replace each differentiated signal by the derivative method's smoothed estimate
     /// (spline, kalman), so the regressors are smoothed as well as the targets.
@@ -194,10 +194,16 @@ pub struct IdentifyCommand {
     pub refine: Option<String>,
     /// With --refine: weight of the regression's estimates as a prior (each coefficient held
     /// to its regression value within its standard error); 0 lets the refinement wander.
-    #[arg(long, value_name = "WEIGHT", default_value_t = 1e-4, requires = "refine")]
+    #[arg(
+        allow_negative_numbers = true,
+        long,
+        value_name = "WEIGHT",
+        default_value_t = 1e-4,
+        requires = "refine"
+    )]
     pub refine_prior: f64,
     /// With --refine: most Levenberg-Marquardt iterations (it stops earlier once converged).
-    #[arg(long, value_name = "N", default_value_t = 30, requires = "refine")]
+    #[arg(allow_negative_numbers = true, long, value_name = "N", default_value_t = 30, requires = "refine")]
     pub refine_iterations: usize,
     /// With --refine: a dataset file of runs the refinement does not fit but is stopped by
     /// (of its iterates, the one that predicts these runs best is kept).
@@ -224,7 +230,7 @@ pub struct IdentifyCommand {
     /// savitzky-golay) and none of --dataset, --resample, --smooth, --prepared-svg, --refine,
     /// --choose, --target. Default: in pieces of 262144 rows when the files together exceed
     /// 256 MiB and these hold; 0 reads them whole.
-    #[arg(long, value_name = "ROWS", requires = "model")]
+    #[arg(allow_negative_numbers = true, long, value_name = "ROWS", requires = "model")]
     pub chunk_rows: Option<usize>,
     /// Fit without an intercept b0.
     #[arg(long)]
@@ -233,13 +239,13 @@ pub struct IdentifyCommand {
     #[arg(long, conflicts_with = "model")]
     pub weight: Option<String>,
     /// Stepwise: stop when the next term's share of the total sum of squares is below this.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(allow_negative_numbers = true, long, default_value_t = 0.0)]
     pub min_proportion: f64,
     /// Stepwise: how the reported step is chosen.
     #[arg(long, value_enum, default_value = "f-max")]
     pub step_rule: RuleName,
     /// Stepwise: tolerance of the step rule (relative).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(allow_negative_numbers = true, long, default_value_t = 0.0)]
     pub step_tolerance: f64,
     /// Output format.
     #[arg(long, value_enum, default_value = "text")]
@@ -264,13 +270,13 @@ pub struct SimulateCommand {
     #[arg(long, value_enum, default_value = "b8")]
     pub integrator: Integrator,
     /// Step, s.
-    #[arg(long, default_value_t = 0.04)]
+    #[arg(allow_negative_numbers = true, long, default_value_t = 0.04)]
     pub dt: f64,
     /// Output interval, s (a multiple of the step).
-    #[arg(long, default_value_t = 0.2)]
+    #[arg(allow_negative_numbers = true, long, default_value_t = 0.2)]
     pub sample: f64,
     /// Duration, s (default: the manoeuvre's own).
-    #[arg(long)]
+    #[arg(allow_negative_numbers = true, long)]
     pub duration: Option<f64>,
     /// Write the run as CSV (SI units, angles in rad).
     #[arg(long, short = 'o')]
@@ -334,14 +340,14 @@ pub struct CompareCommand {
     #[arg(long)]
     pub replay: Option<PathBuf>,
     /// Integration step for the re-simulation, s.
-    #[arg(long, default_value_t = 0.04)]
+    #[arg(allow_negative_numbers = true, long, default_value_t = 0.04)]
     pub dt: f64,
     /// Time each fit as the median of this many repetitions after the warm-up.
-    #[arg(long, default_value_t = 5)]
+    #[arg(allow_negative_numbers = true, long, default_value_t = 5)]
     pub repeat: usize,
     /// Warm up by fitting for at least this long (s; at least one fit) before timing: a core
     /// that was idle runs slowly for the first ~0.1 s of work.
-    #[arg(long, default_value_t = 0.3)]
+    #[arg(allow_negative_numbers = true, long, default_value_t = 0.3)]
     pub warm_up: f64,
     /// Derivative method where a state's derivative is the target.
     #[arg(long, default_value = "central")]
@@ -404,10 +410,10 @@ pub struct ValidateCommand {
 pub struct MonteCarloArgs {
     /// Also simulate this many models drawn from the identified coefficients' covariance
     /// (stored by `identify --out`): a 90 % band in the figure and the spread of each metric.
-    #[arg(long, default_value_t = 0)]
+    #[arg(allow_negative_numbers = true, long, default_value_t = 0)]
     pub monte_carlo: usize,
     /// Seed of the draws.
-    #[arg(long, default_value_t = 1)]
+    #[arg(allow_negative_numbers = true, long, default_value_t = 1)]
     pub seed: u64,
 }
 
@@ -429,7 +435,7 @@ pub struct ResimArgs {
     #[arg(long, value_enum, default_value = "b8")]
     pub integrator: Integrator,
     /// Integration step, s.
-    #[arg(long, default_value_t = 0.04)]
+    #[arg(allow_negative_numbers = true, long, default_value_t = 0.04)]
     pub dt: f64,
     /// One figure per run (measured, simulated, residual) into this folder.
     #[arg(long)]

@@ -23,7 +23,27 @@ struct Entry {
     replay: Option<Result<StateErrors, String>>,
 }
 
+/// The most timed repetitions and the longest warm-up `compare` takes: beyond them a
+/// comparison would run for hours and tell no more.
+const MAX_REPEAT: usize = 100_000;
+const MAX_WARM_UP: f64 = 60.0;
+
 pub fn run(cmd: CompareCommand) -> Result<()> {
+    if !(0.0..=MAX_WARM_UP).contains(&cmd.warm_up) {
+        anyhow::bail!(
+            "--warm-up {}: give seconds from 0 to {MAX_WARM_UP} (the default 0.3 s wakes an idle core)",
+            cmd.warm_up
+        );
+    }
+    if !(1..=MAX_REPEAT).contains(&cmd.repeat) {
+        anyhow::bail!(
+            "--repeat {}: give 1 to {MAX_REPEAT} timed repetitions (the median of 5 is the default)",
+            cmd.repeat
+        );
+    }
+    if !(cmd.dt.is_finite() && cmd.dt > 0.0) {
+        anyhow::bail!("--dt {}: the integration step must be a number of seconds > 0", cmd.dt);
+    }
     let model = crate::simulate::load_model(&cmd.model)?;
     let time = model.spec().model.time.clone();
     let frames = crate::runs::load_for(&model, &cmd.data, cmd.dataset.as_deref())?;

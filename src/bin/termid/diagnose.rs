@@ -12,6 +12,9 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
     // outputs that cannot be written are refused before any work
     if let Some(out) = &cmd.out {
         termid::output::check_file(out)?;
+        let mut inputs = crate::runs::input_files(&cmd.runs.data, cmd.runs.dataset.as_deref());
+        inputs.extend(cmd.model.iter().map(|m| ("--model".to_string(), m.clone())));
+        crate::runs::check_outputs(&[("--out", out)], &inputs)?;
     }
     if let Some(dir) = &cmd.resim.svg {
         termid::output::check_folder(dir)?;

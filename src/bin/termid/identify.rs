@@ -22,6 +22,25 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     if let Some(dir) = &cmd.prepared_svg {
         termid::output::check_folder(dir)?;
     }
+    let mut inputs = crate::runs::input_files(&cmd.data, cmd.dataset.as_deref());
+    crate::runs::check_once(&inputs)?;
+    for (k, m) in cmd.moments.iter().enumerate() {
+        if let Some(first) = cmd.moments[..k].iter().find(|o| termid::output::same_file(o, m)) {
+            bail!(
+                "--moments {} is the same file as {}: its runs would be counted twice; give each file once",
+                m.display(),
+                first.display()
+            );
+        }
+    }
+    if let Some(out) = &cmd.out {
+        let named = |flag: &str, p: &std::path::PathBuf| (format!("{flag} {}", p.display()), p.clone());
+        inputs.extend(cmd.model.iter().map(|p| named("--model", p)));
+        inputs.extend(cmd.moments.iter().map(|p| named("--moments", p)));
+        inputs.extend(cmd.terms_file.iter().map(|p| named("--terms-file", p)));
+        inputs.extend(cmd.refine_validation.iter().map(|p| named("--refine-validation", p)));
+        crate::runs::check_outputs(&[("--out", out)], &inputs)?;
+    }
     if !cmd.moments.is_empty() {
         return run_moments(cmd);
     }
@@ -216,7 +235,7 @@ fn run_moments(cmd: IdentifyCommand) -> Result<()> {
     if cmd.backend.is_some() {
         model = model.with_backend(&configure_backend(&cmd)?)?;
     }
-    let (mut model, fits) = crate::moments::identify(&model, &cmd.moments, !cmd.no_intercept)?;
+    let (mut model, fits) = crate::moments::identify(&model, &cmd.moments, &cmd.equation, !cmd.no_intercept)?;
     if let Some(out) = &cmd.out {
         let sources = cmd.moments.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
         model.set_provenance(format!(

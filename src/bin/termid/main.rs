@@ -67,6 +67,10 @@ const PANIC_EXIT: u8 = 3;
 /// unwinding not get back to `main`).
 fn install_panic_report() {
     std::panic::set_hook(Box::new(|info| {
+        // a dependency's panic that termid turns into a located error
+        if termid::contain::active() {
+            return;
+        }
         let message = info
             .payload()
             .downcast_ref::<&str>()

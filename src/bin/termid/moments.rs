@@ -9,6 +9,10 @@ use crate::args::MomentsCommand;
 
 pub fn run(cmd: MomentsCommand) -> Result<()> {
     termid::output::check_file(&cmd.out)?;
+    let mut inputs = crate::runs::input_files(&cmd.data, cmd.dataset.as_deref());
+    crate::runs::check_once(&inputs)?;
+    inputs.push(("--model".into(), cmd.model.clone()));
+    crate::runs::check_outputs(&[("--out", &cmd.out)], &inputs)?;
     let model = termid::plugins::load(&cmd.model)?;
     let diff = differentiator(&cmd.derivative)?;
     let moments = match diff.reach() {
@@ -48,17 +52,33 @@ pub fn run(cmd: MomentsCommand) -> Result<()> {
 pub fn identify(
     model: &termid::model::Model,
     files: &[std::path::PathBuf],
+    equations: &[String],
     intercept: bool,
 ) -> Result<(termid::model::Model, Vec<(String, termid::identify::Fit)>)> {
     let parts = files
         .iter()
         .map(|path| {
             let text =
-                termid::budget::read_text(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+                termid::budget::read_json(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
             let origin = path.display().to_string();
             Ok((origin.clone(), EquationMoments::from_json(&text, &origin)?))
         })
         .collect::<Result<Vec<_>>>()?;
+    // --equation picks among the statistics; each one named must have some
+    for eq in equations {
+        if model.equation(eq).is_none() {
+            anyhow::bail!(
+                "--equation {eq}: {} has no equation `{eq}` (equations: {})",
+                model.path,
+                model.identifiable().join(", ")
+            );
+        }
+        if !parts.iter().any(|(_, m)| &m.equation == eq) {
+            anyhow::bail!("--equation {eq}: none of the --moments files holds statistics of `{eq}`");
+        }
+    }
+    let parts: Vec<_> =
+        parts.into_iter().filter(|(_, m)| equations.is_empty() || equations.contains(&m.equation)).collect();
     let identified = termid::identify::identify_from_moments(model, parts, intercept)?;
     Ok((identified.model, identified.fits))
 }

@@ -9,6 +9,9 @@ use anyhow::{bail, Result};
 use termid::model::Model;
 use termid::uncertainty::{spread, uncertain_equations, Normal, Sampler, Spread};
 
+/// The largest share of failed draws with which the others still describe the model.
+pub const MAX_FAILED: f64 = 0.05;
+
 /// The results of simulating drawn models.
 pub struct Draws<T> {
     /// Draws asked for.
@@ -71,12 +74,45 @@ impl<T> Draws<T> {
         Ok(out)
     }
 
-    /// The spread of the metrics each result gives (one JSON record per result).
-    pub fn spread(&self, metrics: impl Fn(&T) -> Vec<serde_json::Value>) -> BTreeMap<String, Spread> {
-        spread(&self.results.iter().flat_map(metrics).collect::<Vec<_>>())
+    /// Whether the draws that ran describe the model: no more than [`MAX_FAILED`] of them
+    /// failed. Survivors of a set that mostly failed are the draws that happened to stay
+    /// stable, not a sample of the model's uncertainty.
+    pub fn usable(&self) -> bool {
+        !self.results.is_empty() && self.failed as f64 <= MAX_FAILED * self.draws as f64
     }
 
-    /// JSON summary: draws, failures and the spread of every metric.
+    /// The results to draw as a band: all of them where [`Draws::usable`], none otherwise.
+    pub fn shown(&self) -> &[T] {
+        if self.usable() {
+            &self.results
+        } else {
+            &[]
+        }
+    }
+
+    /// The spread of the metrics each result gives (one JSON record per result); empty where
+    /// the draws are not [`Draws::usable`].
+    pub fn spread(&self, metrics: impl Fn(&T) -> Vec<serde_json::Value>) -> BTreeMap<String, Spread> {
+        spread(&self.shown().iter().flat_map(metrics).collect::<Vec<_>>())
+    }
+
+    /// Why the spread is not shown, and what helps (None where it is).
+    pub fn refusal(&self) -> Option<String> {
+        if self.usable() {
+            return None;
+        }
+        Some(format!(
+            "{} of {} draws failed ({:.0} %, more than the {:.0} % a spread can stand): no mean, sd or band is shown, since the draws that ran are only those that stayed stable. The drawn coefficients leave the region where the model can be simulated{}: the covariance is too wide for this manoeuvre. What helps: more or longer runs, or runs that excite the terms more (a wider rudder range), fewer candidate terms, or refining with --refine",
+            self.failed,
+            self.draws,
+            100.0 * self.failed as f64 / self.draws.max(1) as f64,
+            100.0 * MAX_FAILED,
+            self.first_failure.as_ref().map_or(String::new(), |f| format!(" (first failure: {f})"))
+        ))
+    }
+
+    /// JSON summary: draws, failures and the spread of every metric (null where not usable,
+    /// with the reason).
     pub fn summary(&self, spread: &BTreeMap<String, Spread>) -> serde_json::Value {
         serde_json::json!({
             "draws": self.draws,
@@ -84,7 +120,9 @@ impl<T> Draws<T> {
             "equations": self.equations,
             "failed": self.failed,
             "first_failure": self.first_failure,
-            "spread": spread,
+            "usable": self.usable(),
+            "refused": self.refusal(),
+            "spread": if self.usable() { serde_json::to_value(spread).unwrap_or_default() } else { serde_json::Value::Null },
         })
     }
 
@@ -103,6 +141,9 @@ impl<T> Draws<T> {
     /// A table of each metric: nominal value, mean, sd and the 5-95 % range over the draws.
     pub fn text(&self, spread: &BTreeMap<String, Spread>, nominal: &serde_json::Value) -> String {
         let mut out = format!("\n{}\n", self.headline());
+        if let Some(why) = self.refusal() {
+            return out + &format!("  warning: {why}\n");
+        }
         if let Some(why) = &self.first_failure {
             out += &format!("  first failure: {why}\n");
         }

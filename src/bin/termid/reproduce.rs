@@ -31,14 +31,14 @@ pub fn run(cmd: ReproduceCommand) -> Result<()> {
         bar.inc(1);
         bar.set_message(msg.to_string());
     };
-    // a folder that will not take the output is refused before the work
-    termid::output::check_folder(&cmd.out)?;
+    // a folder that will not take the output, or holds anything termid did not write there,
+    // is refused before the work
+    termid::output::check_replaceable(&cmd.out)?;
     let study = oltmann::run(&model, &options, &mut stage).context("reproducing Oltmann (1973)")?;
     let ship = Ship::new(&model, false)?;
     // built beside the target and swapped in whole: a failure, or another run at the same
     // time, never leaves a folder of mixed or partial files
-    let ours = |dir: &std::path::Path| dir.join("summary.json").is_file() && dir.join("report.md").is_file();
-    termid::output::replace_folder(&cmd.out, ours, |dir| -> Result<()> {
+    termid::output::replace_folder(&cmd.out, |dir| -> Result<()> {
         report::write(&study, &ship, dir, &mut stage)
             .with_context(|| format!("writing {}", cmd.out.display()))?;
         Ok(())

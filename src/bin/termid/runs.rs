@@ -38,7 +38,47 @@ pub fn load_for(model: &Model, data: &[PathBuf], dataset: Option<&Path>) -> Resu
     Ok(frames)
 }
 
+/// Every file a command reads runs from, named as the user named it: the `--data` files, the
+/// dataset file and the runs it lists (where it can be read; its errors come later, in their
+/// place). For [`termid::output::check_distinct`].
+pub fn input_files(data: &[PathBuf], dataset: Option<&Path>) -> Vec<(String, PathBuf)> {
+    let mut out: Vec<(String, PathBuf)> =
+        data.iter().map(|p| (format!("--data {}", p.display()), p.clone())).collect();
+    if let Some(path) = dataset {
+        out.push((format!("--dataset {}", path.display()), path.to_path_buf()));
+        if let Ok(ds) = Dataset::load(path) {
+            if let Ok(folder) = ds.folder(path) {
+                for r in &ds.runs {
+                    out.push((
+                        format!("run file {} of {}", r.file.display(), path.display()),
+                        folder.join(&r.file),
+                    ));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Refuses outputs that are inputs (or one another) before any work; `outputs` as (flag, path).
+pub fn check_outputs(outputs: &[(&str, &Path)], inputs: &[(String, PathBuf)]) -> Result<()> {
+    let inputs: Vec<(&str, &Path)> = inputs.iter().map(|(w, p)| (w.as_str(), p.as_path())).collect();
+    termid::output::check_distinct(outputs, &inputs)?;
+    Ok(())
+}
+
+/// Refuses a file given twice (by identity): its runs would count twice without a word.
+pub fn check_once(inputs: &[(String, PathBuf)]) -> Result<()> {
+    for (k, (what, path)) in inputs.iter().enumerate() {
+        if let Some((first, _)) = inputs[..k].iter().find(|(_, p)| termid::output::same_file(p, path)) {
+            bail!("{what} is the same file as {first}: its runs would be counted twice; give each file once");
+        }
+    }
+    Ok(())
+}
+
 pub fn load(data: &[PathBuf], dataset: Option<&Path>, time: &str) -> Result<Vec<Frame>> {
+    check_once(&input_files(data, dataset))?;
     let mut frames = data.iter().map(|p| Frame::read(p, time)).collect::<Result<Vec<_>, _>>()?;
     for f in &frames {
         // a logging dropout would be differentiated across as if it were one step (dataset

@@ -5,10 +5,16 @@ use anyhow::{bail, Result};
 use crate::args::ScaleCommand;
 
 pub fn run(cmd: ScaleCommand) -> Result<()> {
-    if !(cmd.factor.is_finite() && cmd.factor > 0.0) {
-        bail!("--factor {}: a length factor is a positive number", cmd.factor);
+    // beyond these, masses (× λ³) and the coefficients' powers of λ leave the numbers a
+    // model file can hold; no ship and no model differ by more than 10⁴ in length
+    if !(cmd.factor.is_finite() && (1e-4..=1e4).contains(&cmd.factor)) {
+        bail!(
+            "--factor {}: a length factor is a positive number from 1e-4 to 1e4 (new length / old length)",
+            cmd.factor
+        );
     }
     termid::output::check_file(&cmd.out)?;
+    crate::runs::check_outputs(&[("--out", &cmd.out)], &[("--model".into(), cmd.model.clone())])?;
     let model = termid::plugins::load(&cmd.model)?;
     let (length, time, mass) = (cmd.factor, cmd.factor.sqrt(), cmd.factor.powi(3));
     let mut scaled = termid::model::dimension::rescaled(&model, length, time, mass)?;

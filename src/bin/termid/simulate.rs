@@ -25,6 +25,18 @@ pub fn run(cmd: SimulateCommand) -> Result<()> {
     for path in cmd.out.iter().chain(&cmd.svg) {
         termid::output::check_file(path)?;
     }
+    let mut inputs: Vec<(String, std::path::PathBuf)> =
+        cmd.model.iter().map(|m| ("--model".into(), m.clone())).collect();
+    if let Some(file) = cmd.manoeuvre.as_deref().and_then(|m| m.strip_prefix("replay:")) {
+        inputs.push((format!("the replayed file {file}"), file.into()));
+    }
+    let outputs: Vec<(&str, &std::path::Path)> = cmd
+        .out
+        .iter()
+        .map(|p| ("--out", p.as_path()))
+        .chain(cmd.svg.iter().map(|p| ("--svg", p.as_path())))
+        .collect();
+    crate::runs::check_outputs(&outputs, &inputs)?;
     let mut model = load_model(&cmd.model)?;
     set_parameters(&mut model, &cmd.params)?;
     let integrator = cmd.integrator;
@@ -117,7 +129,7 @@ fn scenario_run(
     }
     if let Some(svg) = &cmd.svg {
         let title = format!("{}: {}", model.spec().model.name, scenario.label());
-        let draws: Vec<&_> = mc.iter().flat_map(|mc| mc.results.iter().map(|(_, t)| t)).collect();
+        let draws: Vec<&_> = mc.iter().flat_map(|mc| mc.shown().iter().map(|(_, t)| t)).collect();
         let fig = scenario.figure(&title, &run, &draws);
         outputs.file(svg, fig.to_svg().map_err(anyhow::Error::msg)?.as_bytes())?;
     }
@@ -179,23 +191,44 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, integrator: Integrator) -> 
         let i = system.input_index(&name).with_context(|| format!("--input: `{k}` is not an input"))?;
         inputs[i] = finite(v, || format!("--input `{p}`"))?;
     }
-    let mut replayed = None;
-    let mut controller: Box<dyn Controller> =
-        match cmd.manoeuvre.as_deref().and_then(|m| m.strip_prefix("replay:")) {
-            Some(file) => {
-                let frame = Frame::read(std::path::Path::new(file), &model.spec().model.time)?;
-                let t = frame.time();
-                replayed = Some(t[t.len() - 1] - t[0]);
-                Box::new(Replay::new(&frame, &system.inputs)?)
+    let replayed = match cmd.manoeuvre.as_deref().and_then(|m| m.strip_prefix("replay:")) {
+        Some(file) => {
+            let frame = Frame::read(std::path::Path::new(file), &model.spec().model.time)?;
+            if frame.len() < 2 {
+                bail!(
+                    "{file}: a replay needs at least two rows (its inputs over time); it has {}",
+                    frame.len()
+                );
             }
-            None => Box::new(Constant(inputs)),
-        };
+            Some(frame)
+        }
+        None => None,
+    };
+    let controller = |system: &termid::sim::System| -> Result<Box<dyn Controller>> {
+        Ok(match &replayed {
+            Some(frame) => Box::new(Replay::new(frame, &system.inputs)?),
+            None => Box::new(Constant(inputs.clone())),
+        })
+    };
     // a replay lasts as long as its recording; constant inputs have no natural end
-    let duration = cmd.duration.or(replayed).context(
+    let recorded = replayed.as_ref().map(|f| f.time()[f.len() - 1] - f.time()[0]);
+    let duration = cmd.duration.or(recorded).context(
         "give --duration SECONDS: with constant inputs the model has no natural end (a ship model's manoeuvre, or a replay, has)",
     )?;
     let settings = Settings { integrator, dt: cmd.dt, duration, sample: cmd.sample };
-    let traj = simulate(&system, &x0, controller.as_mut(), &settings)?;
+    let traj = simulate(&system, &x0, controller(&system)?.as_mut(), &settings)?;
+    // drawn models, simulated as the nominal one: a band per state and the final states' spread
+    let mc = match cmd.monte_carlo.monte_carlo {
+        0 => None,
+        n => Some(Draws::run(model, n, cmd.monte_carlo.seed, trajectory_values(&traj), |m| {
+            let system = termid::sim::System::new(m, &BTreeMap::new(), cmd.with_intercept)?;
+            let t = simulate(&system, &x0, controller(&system)?.as_mut(), &settings)?;
+            let last = t.last_state();
+            let finals: serde_json::Map<String, serde_json::Value> =
+                system.states.iter().zip(&last).map(|(s, v)| (format!("final {s}"), (*v).into())).collect();
+            Ok((serde_json::Value::Object(finals), t))
+        })?),
+    };
     let frame = traj.to_frame("simulation", &model.spec().model.time)?;
     let mut outputs = termid::output::Outputs::new();
     if let Some(out) = &cmd.out {
@@ -215,7 +248,17 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, integrator: Integrator) -> 
                     .iter()
                     .find(|t| &t.name == s)
                     .map_or(String::new(), |t| t.unit.clone()),
-                series: vec![Series::line(s, traj.time.clone(), traj.states[i].clone())],
+                series: {
+                    let mut series = vec![Series::line(s, traj.time.clone(), traj.states[i].clone())];
+                    if let Some(mc) = mc.as_ref().filter(|mc| mc.usable()) {
+                        let signals: Vec<Vec<f64>> =
+                            mc.shown().iter().map(|(_, t)| t.states[i].clone()).collect();
+                        let (lo, hi) = termid::uncertainty::band(&signals);
+                        let label = format!("90 % band ({} draws)", signals.len());
+                        series.insert(0, Series::band(&label, traj.time.clone(), lo, hi));
+                    }
+                    series
+                },
                 ..Panel::default()
             })
             .collect();
@@ -224,6 +267,9 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, integrator: Integrator) -> 
     }
     outputs.commit()?;
     let last = traj.last_state();
+    let nominal: serde_json::Map<String, serde_json::Value> =
+        system.states.iter().zip(&last).map(|(s, v)| (format!("final {s}"), (*v).into())).collect();
+    let spread = mc.as_ref().map(|mc| mc.spread(|r| vec![r.0.clone()]));
     match cmd.format {
         Format::Json => println!(
             "{}",
@@ -231,6 +277,7 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, integrator: Integrator) -> 
                 "model": model.path,
                 "samples": traj.time.len(),
                 "final_state": system.states.iter().zip(&last).map(|(s, v)| (s.clone(), *v)).collect::<BTreeMap<_, _>>(),
+                "monte_carlo": mc.as_ref().zip(spread.as_ref()).map(|(mc, s)| mc.summary(s)),
             }))?
         ),
         Format::Text => {
@@ -242,6 +289,9 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, integrator: Integrator) -> 
             );
             for (s, v) in system.states.iter().zip(&last) {
                 println!("  {s} = {v:.6}");
+            }
+            if let Some((mc, spread)) = mc.as_ref().zip(spread.as_ref()) {
+                print!("{}", mc.text(spread, &serde_json::Value::Object(nominal)));
             }
             if let Some(out) = &cmd.out {
                 println!("wrote {}", out.display());

@@ -52,7 +52,7 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
         let mut outputs = termid::output::Outputs::new();
         outputs.folder(dir)?;
         let draws: Vec<&[Trajectory]> =
-            mc.iter().flat_map(|mc| mc.results.iter().map(|(sims, _)| sims.as_slice())).collect();
+            mc.iter().flat_map(|mc| mc.shown().iter().map(|(sims, _)| sims.as_slice())).collect();
         for (k, (name, fig)) in
             comparison_figures(&model, &runs, &sims, &[], &draws, "validate").into_iter().enumerate()
         {
@@ -112,6 +112,9 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
             }
             if let Some(mc) = &mc {
                 println!("\n{}", mc.headline());
+                if let Some(why) = mc.refusal() {
+                    println!("  warning: {why}");
+                }
             }
         }
     }

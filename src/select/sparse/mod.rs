@@ -21,6 +21,9 @@ pub use constraints::{Candidate, Equality};
 use super::subset::Scaled;
 use super::{Moments, Problem, SelectError, Selection, Selector, Step, Stop};
 
+/// The longest λ path: each λ is a QP, and a path beyond this tells no more.
+pub const MAX_PATH: usize = 10_000;
+
 /// How λ is chosen on the path.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
@@ -95,11 +98,28 @@ impl Default for SparseFit {
 impl SparseFit {
     /// Checks the settings.
     pub fn validate(&self) -> Result<(), SelectError> {
-        if self.path == 0 || !(self.lambda_ratio > 0.0 && self.lambda_ratio < 1.0) {
-            return Err(SelectError::Config("sparse path must be ≥ 1 and 0 < lambda_ratio < 1".into()));
+        if self.path == 0 || self.path > MAX_PATH {
+            return Err(SelectError::Config(format!(
+                "sparse path = {} : the λ path takes 1 to {MAX_PATH} values (40 is the default; beyond a few hundred, neighbouring λ give the same terms)",
+                self.path
+            )));
         }
-        if self.lambda.is_some_and(|l| l.is_nan() || l < 0.0) || self.signs.iter().any(|s| s.1.abs() != 1.0) {
-            return Err(SelectError::Config("sparse lambda must be ≥ 0 and signs ±1".into()));
+        if !(self.lambda_ratio > 0.0 && self.lambda_ratio < 1.0) {
+            return Err(SelectError::Config(format!(
+                "sparse lambda_ratio = {}: it must lie strictly between 0 and 1",
+                self.lambda_ratio
+            )));
+        }
+        if let Some(l) = self.lambda.filter(|l| !(l.is_finite() && *l >= 0.0)) {
+            return Err(SelectError::Config(format!(
+                "sparse lambda = {l}: it must be a finite number ≥ 0 (in standardised units, where λ ≥ 1 keeps no term)"
+            )));
+        }
+        if !(self.support_tolerance.is_finite() && self.support_tolerance >= 0.0) {
+            return Err(SelectError::Config("sparse support_tolerance must be a finite number ≥ 0".into()));
+        }
+        if self.signs.iter().any(|s| s.1.abs() != 1.0) {
+            return Err(SelectError::Config("sparse signs must be +1 or −1".into()));
         }
         let values = self.fixed.iter().map(|f| f.1).chain(
             self.equalities.iter().flat_map(|e| e.terms.iter().map(|t| t.1).chain(std::iter::once(e.value))),
@@ -237,6 +257,15 @@ impl SparseFit {
             });
             shrunk.push(beta);
             steps.push(st);
+        }
+        if steps.is_empty()
+            && !notes.iter().any(|n| n.contains("collinear") || n.contains("more terms than rows"))
+        {
+            return Err(SelectError::Config(format!(
+                "no λ of the path keeps a term: the largest λ tried, {:.3e}, is at or above λ_max = {lambda_max:.3e} (standardised units), where every coefficient is zero{}",
+                lambdas[0],
+                if self.lambda.is_some() { "; give a smaller lambda, or none for the path" } else { "; give path ≥ 2 for a path from λ_max down" }
+            )));
         }
         if steps.is_empty() {
             return Err(SelectError::Config(format!(

@@ -311,17 +311,29 @@ impl SparseFit {
             input_sparse_dropzeros: false,
             ..DefaultSettings::default()
         };
+        if k == 0 {
+            // every column screened out (λ at or beyond λ_max): the solution is zero
+            return Ok(vec![0.0; p]);
+        }
+        // a panic inside the solver (it has had them on degenerate data) is an error here
+        let in_solver =
+            |e: String| SelectError::Config(format!("the QP solver failed at λ = {lambda:e}: {e}"));
         let reuse = cache
             .as_mut()
             .filter(|(cols, _)| cols == active)
-            .is_some_and(|(_, solver)| solver.update_q(&q).is_ok());
+            .is_some_and(|(_, solver)| crate::contain::call(|| solver.update_q(&q).is_ok()).unwrap_or(false));
         if !reuse {
-            let solver = DefaultSolver::new(&P, &q, &A, &b, &cones, settings)
+            let solver = crate::contain::call(|| DefaultSolver::new(&P, &q, &A, &b, &cones, settings))
+                .map_err(in_solver)?
                 .map_err(|e| SelectError::Config(format!("clarabel refused the problem: {e}")))?;
             *cache = Some((active.to_vec(), solver));
         }
         let Some((_, solver)) = cache.as_mut() else { unreachable!("just stored") };
-        solver.solve();
+        if let Err(e) = crate::contain::call(|| solver.solve()) {
+            // a solver that panicked is not reused
+            *cache = None;
+            return Err(in_solver(e));
+        }
         match solver.solution.status {
             SolverStatus::Solved => {
                 let mut beta = vec![0.0; p];

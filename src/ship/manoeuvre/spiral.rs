@@ -52,7 +52,9 @@ pub struct SpiralMetrics {
 impl Spiral {
     /// The rudder angles, in order.
     pub fn angles(&self) -> Vec<f64> {
-        let n = (self.max_deg / self.step_deg).round() as i64;
+        // whole steps up to the largest angle, never beyond it (30/20 holds 20° and 0°, not a
+        // rounded-up 40° the rudder limit would clamp while the table printed it)
+        let n = (self.max_deg / self.step_deg + 1e-9).floor() as i64;
         let down: Vec<f64> = (-n..=n).rev().map(|k| k as f64 * self.step_deg).collect();
         let up: Vec<f64> = down.iter().rev().skip(1).copied().collect();
         down.into_iter().chain(up).collect()
@@ -151,6 +153,11 @@ impl super::Test for Spiral {
             if s.max_deg <= 0.0 || s.step_deg <= 0.0 || s.hold_s <= 0.0 || s.max_deg / s.step_deg > 200.0 {
                 return Err(bad("largest angle, step and hold must be positive, with at most 200 steps"));
             }
+            if s.step_deg > s.max_deg {
+                return Err(bad(
+                    "the rudder step is larger than the largest angle: the spiral would hold 0° only",
+                ));
+            }
         }
         Ok(s)
     }
@@ -164,7 +171,7 @@ impl super::Test for Spiral {
     }
 
     fn largest_rudder_deg(&self) -> Option<f64> {
-        Some(self.max_deg)
+        self.angles().into_iter().map(f64::abs).reduce(f64::max)
     }
 
     fn controller(&self, ship: &Ship, start: &StraightRun) -> Result<Box<dyn Controller>, ShipError> {
