@@ -105,13 +105,54 @@ pub(super) fn read_table(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), Da
         });
     }
     // read as it is parsed: the numbers in memory, not the text as well
-    crate::budget::file_size(path).map_err(|e| DataError::Io { file, message: e.to_string() })?;
-    super::stream::read_all(super::stream::csv_rows(path)?)
+    crate::budget::file_size(path)
+        .map_err(|e| DataError::Io { file: file.clone(), message: e.to_string() })?;
+    super::stream::read_all(super::stream::csv_rows(path)?).map_err(|e| {
+        let head = || {
+            use std::io::Read;
+            let mut head = Vec::new();
+            let _ = std::fs::File::open(path).map(|f| f.take(HEAD).read_to_end(&mut head));
+            head
+        };
+        not_data(e, &file, head)
+    })
+}
+
+/// How much of a file is looked at to tell whether it is data at all.
+const HEAD: u64 = 16 << 10;
+
+/// An error found early in a file that holds no number in its first rows (a password file,
+/// a script, a document) is said as "not a table of numbers", without echoing its lines: of
+/// a file that is not data, no more than its name and the reason.
+pub(super) fn not_data(e: DataError, file: &str, head: impl FnOnce() -> Vec<u8>) -> DataError {
+    let early = match &e {
+        DataError::NotNumeric { row, .. } | DataError::Ragged { row, .. } => *row <= 5,
+        DataError::DuplicateColumn { .. } => true,
+        _ => false,
+    };
+    if !early {
+        return e;
+    }
+    let head = head();
+    let text = String::from_utf8_lossy(&head);
+    let any_number = text.lines().skip(1).take(5).any(|l| {
+        l.split([',', ';', '\t', ' '])
+            .any(|c| c.trim().replace(',', ".").parse::<f64>().is_ok_and(f64::is_finite))
+    });
+    if any_number {
+        return e;
+    }
+    DataError::Io {
+        file: file.into(),
+        message: "not a table of numbers: no number in its first rows (is it a data file? a CSV has a header row and numbers below it)".into(),
+    }
 }
 
 /// The header and the numeric columns of CSV text, every cell checked.
 pub(super) fn parse_table(text: &str, origin: &str) -> Result<(Vec<String>, Vec<Vec<f64>>), DataError> {
-    super::stream::read_all(super::stream::CsvRows::new(text.as_bytes(), origin)?)
+    super::stream::CsvRows::new(text.as_bytes(), origin)
+        .and_then(super::stream::read_all)
+        .map_err(|e| not_data(e, origin, || text.as_bytes()[..text.len().min(HEAD as usize)].to_vec()))
 }
 
 #[cfg(test)]

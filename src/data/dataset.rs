@@ -119,7 +119,16 @@ pub fn velocities_from_track(
 }
 
 /// `$NAME` and `${NAME}` replaced by `lookup(NAME)`; the first name it does not know is the error.
-fn expand_environment(text: &str, lookup: impl Fn(&str) -> Option<String>) -> Result<String, String> {
+/// Why a folder's `$NAME` could not be expanded.
+#[derive(Debug, PartialEq)]
+enum Unexpanded {
+    /// The variable is not set.
+    Unset(String),
+    /// The text is not `$NAME` or `${NAME}`.
+    Syntax(String),
+}
+
+fn expand_environment(text: &str, lookup: impl Fn(&str) -> Option<String>) -> Result<String, Unexpanded> {
     let mut out = String::new();
     let mut rest = text;
     while let Some(at) = rest.find('$') {
@@ -128,7 +137,11 @@ fn expand_environment(text: &str, lookup: impl Fn(&str) -> Option<String>) -> Re
         let (name, tail) = match after.strip_prefix('{') {
             Some(inner) => match inner.find('}') {
                 Some(end) => (&inner[..end], &inner[end + 1..]),
-                None => return Err(format!("{{{inner} (no closing brace)")),
+                None => {
+                    return Err(Unexpanded::Syntax(format!(
+                        "`${{{inner}` has no closing brace: write ${{NAME}}"
+                    )))
+                }
             },
             None => {
                 let end = after.find(|c: char| !(c.is_alphanumeric() || c == '_')).unwrap_or(after.len());
@@ -137,8 +150,12 @@ fn expand_environment(text: &str, lookup: impl Fn(&str) -> Option<String>) -> Re
         };
         if name.is_empty() {
             out.push('$');
+        } else if !name.chars().all(|c| c.is_alphanumeric() || c == '_') {
+            return Err(Unexpanded::Syntax(format!(
+                "`${{{name}}}`: termid reads $NAME and ${{NAME}} only, no shell forms such as ${{NAME:-default}}"
+            )));
         } else {
-            out.push_str(&lookup(name).ok_or_else(|| name.to_string())?);
+            out.push_str(&lookup(name).ok_or_else(|| Unexpanded::Unset(name.to_string()))?);
         }
         rest = tail;
     }
@@ -292,7 +309,32 @@ impl Dataset {
         let file = path.display().to_string();
         let text = crate::budget::read_text(path)
             .map_err(|e| DataError::Io { file: file.clone(), message: e.to_string() })?;
-        toml::from_str(&text).map_err(|e| DataError::Io { file, message: e.to_string() })
+        let ds: Dataset = toml::from_str(&text)
+            .map_err(|e| DataError::Io { file: file.clone(), message: e.to_string() })?;
+        ds.check().map_err(|message| DataError::Io { file, message })?;
+        Ok(ds)
+    }
+
+    /// What the schema cannot say: one file column per model variable, a sensible window.
+    fn check(&self) -> Result<(), String> {
+        let mut seen: BTreeMap<String, &str> = BTreeMap::new();
+        for (var, spec) in &self.columns {
+            let (column, _, _) = split_spec(spec);
+            if let Some(first) = seen.insert(column.clone(), var) {
+                return Err(format!(
+                    "`columns.{first}` and `columns.{var}` both read the file column `{column}`: one column is one variable"
+                ));
+            }
+        }
+        if let Some(t) = &self.track {
+            if !(1..=1000).contains(&t.half_window) {
+                return Err(format!(
+                    "`track.half_window = {}`: the central difference takes 1 to 1000 samples each side (default 2)",
+                    t.half_window
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// The folder the run files are read from, for a dataset file at `path`.
@@ -301,12 +343,15 @@ impl Dataset {
         let Some(folder) = &self.folder else { return Ok(own.to_path_buf()) };
         let text = folder.to_string_lossy();
         let expanded =
-            expand_environment(&text, |name| std::env::var(name).ok()).map_err(|name| DataError::Io {
+            expand_environment(&text, |name| std::env::var(name).ok()).map_err(|why| DataError::Io {
                 file: path.display().to_string(),
-                message: format!(
-                    "`folder = \"{text}\"` names the environment variable {name}, which is not set: \
-                     set it to the folder of the records ({name}=/path/to/records termid …)"
-                ),
+                message: match why {
+                    Unexpanded::Unset(name) => format!(
+                        "`folder = \"{text}\"` names the environment variable {name}, which is not set: \
+                         set it to the folder of the records ({name}=/path/to/records termid …)"
+                    ),
+                    Unexpanded::Syntax(m) => format!("`folder = \"{text}\"`: {m}"),
+                },
             })?;
         Ok(own.join(expanded))
     }
@@ -674,7 +719,13 @@ skip = 3
         assert_eq!(expand_environment("$A/x", env).unwrap(), "/data/x");
         assert_eq!(expand_environment("${A}x/y", env).unwrap(), "/datax/y");
         assert_eq!(expand_environment("a$/b", env).unwrap(), "a$/b");
-        assert_eq!(expand_environment("$B/x", env).unwrap_err(), "B");
+        assert_eq!(expand_environment("$B/x", env).unwrap_err(), Unexpanded::Unset("B".into()));
+        assert!(
+            matches!(expand_environment("${X", env), Err(Unexpanded::Syntax(m)) if m.contains("closing brace"))
+        );
+        assert!(
+            matches!(expand_environment("${X:-/tmp}", env), Err(Unexpanded::Syntax(m)) if m.contains(":-"))
+        );
     }
 
     #[test]

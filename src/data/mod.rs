@@ -160,11 +160,11 @@ pub enum DataError {
         what: String,
     },
     /// A unit that is unknown or contradicted by the values.
-    #[error("{file}: row {row}, column `{column}`: {message}")]
+    #[error("{file}: {}column `{column}`: {message}", if *.row == 0 { "the whole run, ".to_string() } else { format!("row {row}, ") })]
     Unit {
         /// The file.
         file: String,
-        /// 1-based data row (0: the declaration).
+        /// 1-based data row (0: the whole run, or the declaration).
         row: usize,
         /// The column.
         column: String,

@@ -269,6 +269,13 @@ impl<'a> CsvRows<'a> {
         if names.iter().all(String::is_empty) {
             return Err(DataError::NoHeader { file: origin.into() });
         }
+        let refuse = |message: &str| Err(DataError::Io { file: origin.into(), message: message.into() });
+        if names.len() == 1 && names[0].contains('\t') {
+            return refuse("the header is separated by tabs: termid reads commas or semicolons; convert the file, or read it through a dataset file with `delimiter = \"whitespace\"`");
+        }
+        if names.iter().all(|n| number(n.as_bytes(), semicolons).is_some()) {
+            return refuse("the first row holds numbers, not column names: a CSV needs a header row naming its columns (or a dataset file's `header = [...]`)");
+        }
         for (i, h) in names.iter().enumerate() {
             if names[..i].contains(h) {
                 return Err(DataError::DuplicateColumn { file: origin.into(), column: h.clone() });

@@ -60,6 +60,24 @@ impl Runs {
         if frames.is_empty() {
             return Err(DiagnoseError::Setup("no measured runs".into()));
         }
+        // a step that does not fit a run many times over re-simulates nothing of it
+        let shortest = frames
+            .iter()
+            .map(|f| f.time().last().copied().unwrap_or(0.0) - f.time().first().copied().unwrap_or(0.0))
+            .fold(f64::INFINITY, f64::min);
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(DiagnoseError::Setup(format!(
+                "the integration step {dt} must be a number of seconds > 0"
+            )));
+        }
+        if dt > shortest / 20.0 {
+            return Err(DiagnoseError::Setup(format!(
+                "the integration step {} s is too long for the shortest run ({} s): a re-simulation takes at least 20 steps; give --dt {} or less",
+                crate::identify::num(dt),
+                crate::identify::num(shortest),
+                crate::identify::num(shortest / 20.0)
+            )));
+        }
         let system = System::new(model, &Default::default(), false)?;
         let states: Vec<(usize, String)> = system
             .states

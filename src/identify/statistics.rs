@@ -536,4 +536,38 @@ mod tests {
         let e = EquationMoments::from_json("{\"equation\": 3}", "s.moments").unwrap_err().to_string();
         assert!(e.contains("s.moments"), "{e}");
     }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig { cases: 200, failure_persistence: None, ..Default::default() })]
+        /// Damaged statistics (bytes flipped in the binary form, numbers changed in the JSON)
+        /// are read and fitted, or refused with the file's name; never a panic.
+        #[test]
+        fn damaged_statistics_are_errors_not_panics(
+            flips in proptest::collection::vec((0.0f64..1.0, 1u8..=255), 1..4),
+            numbers in proptest::collection::vec((0.0f64..1.0, proptest::num::f64::ANY), 1..3),
+        ) {
+            let lorenz = Model::load(Path::new("models/lorenz.toml")).unwrap();
+            let frames = runs(&lorenz);
+            let m = EquationMoments::of_runs(&lorenz, "x_dot", &frames[..1], &CentralDifference, None).unwrap();
+            let mut bytes = m.to_bytes();
+            for (at, x) in &flips {
+                let k = ((at * bytes.len() as f64) as usize).min(bytes.len() - 1);
+                bytes[k] ^= x;
+            }
+            let read = std::panic::catch_unwind(|| EquationMoments::from_bytes(&bytes, "s.bin").map(|r| r.fit(&lorenz, true).map(|_| ())));
+            proptest::prop_assert!(read.is_ok(), "from_bytes panicked");
+            if let Ok(Err(e)) = read {
+                proptest::prop_assert!(e.to_string().contains("s.bin"), "{e}");
+            }
+            let mut v: serde_json::Value = serde_json::from_str(&m.to_json()).unwrap();
+            let list = v["runs"][0]["moments"]["numbers"].as_array_mut().unwrap();
+            for (at, x) in &numbers {
+                let k = ((at * list.len() as f64) as usize).min(list.len() - 1);
+                list[k] = serde_json::Value::from(*x);
+            }
+            let text = v.to_string();
+            let read = std::panic::catch_unwind(|| EquationMoments::from_json(&text, "s.json").map(|r| r.fit(&lorenz, true).map(|_| ())));
+            proptest::prop_assert!(read.is_ok(), "from_json panicked");
+        }
+    }
 }

@@ -201,6 +201,14 @@ impl Model {
 
     /// Parses and checks model text; `file` names it in errors.
     pub fn parse(text: &str, file: &str) -> Result<Model, ModelError> {
+        // old Mac line ends: TOML reads the whole file as one line and every error as line 1
+        if let Some(at) = text.find('\r').filter(|&i| text.as_bytes().get(i + 1) != Some(&b'\n')) {
+            let line = text[..at].matches('\r').count() + text[..at].matches('\n').count() + 1;
+            return Err(ModelError::Syntax {
+                file: file.into(),
+                message: format!("line {line} ends in a bare carriage return (CR, old Mac line ends): save the file with LF or CRLF line ends"),
+            });
+        }
         let spec: ModelFile = toml::from_str(text)
             .map_err(|e| ModelError::Syntax { file: file.into(), message: e.to_string() })?;
         Model::from_spec(spec, text, file)
@@ -221,6 +229,17 @@ impl Model {
                 return Err(key_err(
                     name,
                     "not a key of a model file (a plug-in's settings are a table)".into(),
+                ));
+            }
+        }
+        let time = &spec.model.time;
+        let states = spec.states.iter().map(|s| &s.name);
+        let inputs = spec.inputs.iter().map(|s| &s.name);
+        for (what, names) in [("states", states.collect::<Vec<_>>()), ("inputs", inputs.collect())] {
+            if let Some(i) = names.iter().position(|s| *s == time) {
+                return Err(key_err(
+                    &format!("{what}[{i}].name"),
+                    format!("`{time}` is also the time variable (`model.time`): name one of them otherwise"),
                 ));
             }
         }
@@ -262,9 +281,16 @@ impl Model {
         for (name, eq) in &spec.equations {
             let state = vocab.canonical(&eq.state).filter(|s| vocab.variables().contains(s));
             let Some(state) = state.filter(|s| spec.states.iter().any(|st| &st.name == s)) else {
+                let like = vocab.look_alike(&eq.state).map_or(String::new(), |l| {
+                    format!(
+                        ": it looks like `{l}` but is spelt with other characters ({} against {})",
+                        crate::term::code_points(&eq.state),
+                        crate::term::code_points(&l)
+                    )
+                });
                 return Err(key_err(
                     &format!("equations.{name}.state"),
-                    format!("`{}` is not a declared state", eq.state),
+                    format!("`{}` is not a declared state{like}", eq.state),
                 ));
             };
             let parse_list = |list: &[String], what: &str| -> Result<Vec<Term>, ModelError> {
@@ -565,7 +591,19 @@ impl Model {
             let k = num / den;
             let degree = 180.0 / std::f64::consts::PI;
             let near = |target: f64| (k / target - 1.0).abs() < 0.3;
-            let message = if near(1.0 / degree) {
+            let time = &self.spec.model.time;
+            // a time column in other units scales every rate alike: minutes (×60) sit close to
+            // the degree's 57.3, so a ratio that matches 60 better, and closely, is minutes
+            let close = |target: f64| (k / target - 1.0).abs();
+            let message = if close(60.0) < 0.02 && close(60.0) < close(degree) {
+                format!("`{}` rises {k:.2} × as fast as `{y}` says ({} = {c}·{y}): the time column `{time}` looks like minutes; give it in seconds", eq.state, eq.name)
+            } else if close(3600.0) < 0.05 {
+                format!("`{}` rises {k:.0} × as fast as `{y}` says ({} = {c}·{y}): the time column `{time}` looks like hours; give it in seconds", eq.state, eq.name)
+            } else if close(1e-3) < 0.05 {
+                format!("`{}` rises {k:.5} × as fast as `{y}` says ({} = {c}·{y}): the time column `{time}` looks like milliseconds; give it in seconds", eq.state, eq.name)
+            } else if close(1e-3 / degree) < 0.05 || close(1e-3 * degree) < 0.05 {
+                format!("`{}` rises {k:.3e} × as fast as `{y}` says ({} = {c}·{y}): the time column `{time}` looks like milliseconds and one of the angles like degrees; give seconds and radians", eq.state, eq.name)
+            } else if near(1.0 / degree) {
                 format!("`{}` rises {k:.4} × as fast as `{y}` says ({} = {c}·{y}): `{y}` looks like degrees (per s) where `{}` is in radians; give both in radians (a dataset file converts: [deg/s])", eq.state, eq.name, eq.state)
             } else if near(degree) {
                 format!("`{}` rises {k:.1} × as fast as `{y}` says ({} = {c}·{y}): `{}` looks like degrees where `{y}` is in radians; give both in radians (a dataset file converts: [deg])", eq.state, eq.name, eq.state)

@@ -113,6 +113,14 @@ pub struct Step {
 pub enum Stop {
     /// Every allowed candidate is in (or refused).
     AllEntered,
+    /// No candidate could enter at all: every one excluded, or refused as constant or
+    /// collinear.
+    NoCandidate,
+    /// The most steps the settings allow (`max_steps`) were taken.
+    StepLimit {
+        /// The limit.
+        steps: usize,
+    },
     /// The next term's share of the total fell below the user's constant.
     BelowThreshold {
         /// The term that would have entered next.
@@ -143,6 +151,8 @@ impl std::fmt::Display for Stop {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Stop::AllEntered => write!(f, "every candidate had entered"),
+            Stop::NoCandidate => write!(f, "no candidate could enter: every one was excluded, or refused as constant or collinear"),
+            Stop::StepLimit { steps } => write!(f, "the step limit (max_steps = {steps}) was reached"),
             Stop::BelowThreshold { term, proportion, threshold } => write!(
                 f,
                 "the next term, {term}, would explain {:.3} % of the variance, below the threshold of {:.3} %",

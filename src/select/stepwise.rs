@@ -185,8 +185,8 @@ impl Selector for Stepwise {
         let mut open: Vec<bool> = (0..p).map(|j| !pb.excluded.contains(&j)).collect();
         let mut pool: Vec<usize> = Vec::with_capacity(p);
         let stop = loop {
-            if self.max_steps.is_some_and(|k| entered.len() >= k) {
-                break Stop::Converged;
+            if let Some(k) = self.max_steps.filter(|k| entered.len() >= *k) {
+                break Stop::StepLimit { steps: k };
             }
             pool.clear();
             pool.extend(pb.forced.iter().copied().filter(|&j| open[j]));
@@ -195,7 +195,7 @@ impl Selector for Stepwise {
                 pool.extend((0..p).filter(|&j| open[j]));
             }
             if pool.is_empty() {
-                break Stop::AllEntered;
+                break if entered.is_empty() { Stop::NoCandidate } else { Stop::AllEntered };
             }
             let mut best: Option<(usize, f64)> = None;
             for &j in &pool {
@@ -228,7 +228,9 @@ impl Selector for Stepwise {
                     best = Some((j, c));
                 }
             }
-            let Some((j, share)) = best else { break Stop::AllEntered };
+            let Some((j, share)) = best else {
+                break if entered.is_empty() { Stop::NoCandidate } else { Stop::AllEntered };
+            };
             if !forcing && share < self.min_proportion {
                 break Stop::BelowThreshold {
                     term: pb.names[j].clone(),

@@ -143,6 +143,25 @@ impl ShipSpec {
                 ));
             }
         }
+        // beyond these no rudder works, and the servo's arithmetic loses its meaning
+        for (key, value, range, what) in [
+            (
+                "rudder_limit",
+                spec.rudder_limit,
+                0.1..=90.0,
+                "a rudder turns at most 90° each way (35° is usual)",
+            ),
+            (
+                "rudder_rate",
+                spec.rudder_rate,
+                0.01..=1000.0,
+                "a rudder's rate lies between 0.01 and 1000 °/s (2.3 °/s at full scale is usual)",
+            ),
+        ] {
+            if !range.contains(&value) {
+                return Err(key_err(&format!("{TABLE}.{key}"), format!("{value} is out of range: {what}")));
+            }
+        }
         if let Some(full) = spec.full_scale_lpp.filter(|v| !(v.is_finite() && *v > 0.0)) {
             return Err(key_err(
                 &format!("{TABLE}.full_scale_lpp"),

@@ -83,22 +83,22 @@ impl Settings {
     fn validate(&self) -> Result<(usize, usize), SimError> {
         let bad = |m: String| Err(SimError::Settings(m));
         if self.dt.is_nan() || self.dt <= 0.0 || self.dt.is_infinite() {
-            return bad(format!("step {} must be positive", self.dt));
+            return bad(format!("step {:?} s must be positive", self.dt));
         }
         if self.duration.is_nan() || self.duration < 0.0 || self.duration.is_infinite() {
-            return bad(format!("duration {} must be ≥ 0", self.duration));
+            return bad(format!("duration {:?} s must be ≥ 0", self.duration));
         }
         let every = (self.sample / self.dt).round();
         if every < 1.0 || (every * self.dt - self.sample).abs() > 1e-9 * self.sample.max(self.dt) {
             return bad(format!(
-                "output interval {} is not a whole multiple of the step {}",
+                "output interval {:?} s is not a whole multiple of the step {:?} s",
                 self.sample, self.dt
             ));
         }
         let steps = (self.duration / self.dt).round();
         if steps > 1e9 {
             return bad(format!(
-                "{:.3e} steps of {} s are too many (at most 1e9): shorten the duration or take longer steps",
+                "{:.3e} steps of {:?} s are too many (at most 1e9): shorten the duration or take longer steps",
                 steps, self.dt
             ));
         }

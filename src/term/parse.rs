@@ -134,6 +134,14 @@ pub const MAX_OPERATORS: usize = 256;
 /// pathological text would otherwise exhaust the stack (an abort, not an error). No candidate
 /// regressor comes near either limit.
 fn check_size(input: &str) -> Result<(), TermError> {
+    // the length first: a caret error would echo the whole text
+    let length = input.chars().count();
+    if length > MAX_LENGTH {
+        let start: String = input.chars().take(40).collect();
+        return Err(TermError::Declaration(format!(
+            "a term of {length} characters (`{start}…`) is longer than the {MAX_LENGTH} a term may have"
+        )));
+    }
     let (mut depth, mut operators) = (0usize, 0usize);
     for (i, c) in input.char_indices() {
         match c {
@@ -164,13 +172,6 @@ fn check_size(input: &str) -> Result<(), TermError> {
             }
             _ => {}
         }
-    }
-    let length = input.chars().count();
-    if length > MAX_LENGTH {
-        let start: String = input.chars().take(40).collect();
-        return Err(TermError::Declaration(format!(
-            "a term of {length} characters (`{start}…`) is longer than the {MAX_LENGTH} a term may have"
-        )));
     }
     Ok(())
 }
@@ -269,13 +270,14 @@ mod tests {
         std::thread::Builder::new()
             .stack_size(2 << 20)
             .spawn(|| {
-                let deep = format!("{}u{}", "(".repeat(5000), ")".repeat(5000));
+                // below the length limit, so that these limits are the ones met
+                let deep = format!("{}u{}", "(".repeat(400), ")".repeat(400));
                 let err = parse_expr(&deep).unwrap_err();
                 assert_eq!(err.line_col(), Some((1, MAX_DEPTH + 1)), "{err}");
                 assert!(err.to_string().contains("nested more than"), "{err}");
-                let calls = format!("{}u{}", "sin(".repeat(5000), ")".repeat(5000));
+                let calls = format!("{}u{}", "sin(".repeat(150), ")".repeat(150));
                 assert!(parse_expr(&calls).is_err());
-                for long in [format!("u{}", "*u".repeat(5000)), format!("{}u", "-".repeat(5000))] {
+                for long in [format!("u{}", "*u".repeat(400)), format!("{}u", "-".repeat(400))] {
                     let err = parse_expr(&long).unwrap_err();
                     assert!(err.to_string().contains("operators in one term"), "{err}");
                 }
@@ -286,6 +288,9 @@ mod tests {
                 // a long term is refused without echoing it whole
                 let err = parse_expr(&"u".repeat(100_000)).unwrap_err().to_string();
                 assert!(err.contains("100000 characters") && err.len() < 200, "{err}");
+                // beyond the length, nesting and operators are not what is said (nor echoed)
+                let err = parse_expr(&format!("u{}", "*u".repeat(50_000))).unwrap_err().to_string();
+                assert!(err.contains("100001 characters") && err.len() < 200, "{err}");
             })
             .unwrap()
             .join()

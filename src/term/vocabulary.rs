@@ -37,6 +37,40 @@ fn normalise_name(name: &str) -> String {
     name.replace('\u{2206}', "\u{394}")
 }
 
+/// A name as it looks: combining marks dropped, accented Latin letters and the Cyrillic and
+/// Greek letters drawn like Latin ones mapped to those.
+fn skeleton(name: &str) -> String {
+    name.chars()
+        .filter(|c| !('\u{300}'..='\u{36f}').contains(c))
+        .map(|c| match c {
+            'à' | 'á' | 'â' | 'ã' | 'ä' | 'å' | 'а' | 'α' => 'a',
+            'è' | 'é' | 'ê' | 'ë' | 'е' | 'ε' => 'e',
+            'ì' | 'í' | 'î' | 'ï' | 'і' | 'ι' => 'i',
+            'ò' | 'ó' | 'ô' | 'õ' | 'ö' | 'о' | 'ο' => 'o',
+            'ù' | 'ú' | 'û' | 'ü' | 'υ' => 'u',
+            'ý' | 'ÿ' | 'у' => 'y',
+            'ñ' => 'n',
+            'ç' | 'с' => 'c',
+            'р' | 'ρ' => 'p',
+            'х' | 'χ' => 'x',
+            'ѕ' => 's',
+            'ј' => 'j',
+            'к' | 'κ' => 'k',
+            'м' => 'm',
+            'т' | 'τ' => 't',
+            'в' => 'b',
+            'н' | 'η' => 'h',
+            'ν' => 'v',
+            other => other,
+        })
+        .collect()
+}
+
+/// A name's characters as code points (`U+0445`), to show what differs.
+pub fn code_points(name: &str) -> String {
+    name.chars().map(|c| format!("U+{:04X}", c as u32)).collect::<Vec<_>>().join(" ")
+}
+
 fn is_identifier(name: &str) -> bool {
     // plain ASCII names (`c12`, `x_dot`) are identifiers of the grammar without asking it
     let mut chars = name.chars();
@@ -137,6 +171,17 @@ impl Vocabulary {
         self.index.get(name).copied().flatten().map(|k| &self.derived[k].definition)
     }
 
+    /// A declared name that `name` looks like but is not (a Cyrillic `х` for `x`, a
+    /// decomposed `é` for a composed one): for an error that names the look-alike.
+    pub fn look_alike(&self, name: &str) -> Option<String> {
+        let want = skeleton(name);
+        self.index
+            .keys()
+            .chain(self.aliases.keys())
+            .find(|k| k.as_str() != name && skeleton(k) == want)
+            .cloned()
+    }
+
     /// The canonical spelling of a name, if the vocabulary knows it.
     pub fn canonical(&self, name: &str) -> Option<String> {
         let name = normalise_name(name);
@@ -170,7 +215,14 @@ impl Vocabulary {
                 None if function(name).is_some() => {
                     Err(at(format!("`{name}` is a function: write `{name}(…)`")))
                 }
-                None => Err(at(format!("unknown variable `{name}`; {}", self.known_names()))),
+                None => Err(at(match self.look_alike(name) {
+                    Some(like) => format!(
+                        "unknown variable `{name}`: it looks like `{like}` but is spelt with other characters ({} against {})",
+                        code_points(name),
+                        code_points(&like)
+                    ),
+                    None => format!("unknown variable `{name}`; {}", self.known_names()),
+                })),
             },
             ExprKind::Neg(e) => self.resolve(e, input)?.scale(-1.0).map_err(at),
             ExprKind::Pow(e, k) => self.resolve(e, input)?.powi(*k).map_err(at),

@@ -305,3 +305,163 @@ fn requests_are_honoured_or_refused_not_ignored() {
     // negative numbers reach the option's own check
     refused(&["simulate", "--model", "models/lorenz.toml", "--duration", "1", "--dt", "-0.04"], &["-0.04"]);
 }
+
+/// Items 15-17: repeated names, settings that do nothing sensible, and a time column in other
+/// units are refused, not accepted with a surprise.
+#[test]
+fn nonsense_settings_are_refused() {
+    let dir = Scratch::new("hostile2-nonsense");
+    let m = "models/lorenz.toml";
+    refused(&["simulate", "--model", m, "--duration", "1", "--initial", "x=1", "x=2"], &["`x` twice"]);
+    refused(&["simulate", "-m", "zigzag:20/20", "--param", "u0=1", "u0=2"], &["`u0` twice"]);
+    refused(&["simulate", "--model", m, "--duration", "0"], &["--duration 0"]);
+    refused(&["simulate", "--model", m, "--duration", "1", "--dt", "2"], &["longer than --duration"]);
+    refused(&["simulate", "--model", m, "--duration", "1", "--dt", "1e-300"], &["1e-300"]);
+    let csv = crate::common::lorenz_csv(&dir, "1");
+    let one = dir.join("one.csv");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    std::fs::write(&one, text.lines().take(2).collect::<Vec<_>>().join("\n") + "\n").unwrap();
+    refused(&["simulate", "--model", m, "-m", &format!("replay:{}", s(&one))], &["at least two rows"]);
+    refused(
+        &["validate", "--model", m, "--data", s(&csv), "--dt", "1000"],
+        &["too long for the shortest run"],
+    );
+    refused(
+        &["scale", "--model", "models/mmg_kvlcc2.toml", "--factor", "1e300", "--out", s(&dir.join("x.toml"))],
+        &["1e4"],
+    );
+    refused(&["identify", "--data", s(&csv), "--target", "dt/dt", "--terms", "x"], &["time column"]);
+    refused(
+        &["identify", "--data", s(&csv), "--target", "x_dot", "--terms", "x", "x_dot"],
+        &["among the candidate"],
+    );
+    // one file column onto two variables
+    std::fs::write(
+        dir.join("two.toml"),
+        "[columns]\nx = \"x\"\ny = \"x\"\n[[runs]]\nfile = \"lorenz.csv\"\n",
+    )
+    .unwrap();
+    refused(
+        &["identify", "--model", m, "--dataset", s(&dir.join("two.toml"))],
+        &["one column is one variable"],
+    );
+    std::fs::write(
+        dir.join("win.toml"),
+        "[columns]\nx = \"x\"\n[track]\nheading = \"x\"\nu = \"y\"\nv = \"z\"\nhalf_window = 0\n[[runs]]\nfile = \"lorenz.csv\"\n",
+    )
+    .unwrap();
+    refused(&["identify", "--model", m, "--dataset", s(&dir.join("win.toml"))], &["half_window = 0"]);
+    // a ship whose rudder limit or rate no rudder has
+    let ship = std::fs::read_to_string("models/oltmann1973.toml").unwrap();
+    for (from, to, needle) in [
+        ("rudder_limit = 35.0", "rudder_limit = 1e9", "rudder_limit"),
+        ("rudder_rate = 12.65", "rudder_rate = 1e-300", "rudder_rate"),
+    ] {
+        let p = dir.join("ship.toml");
+        std::fs::write(&p, ship.replace(from, to)).unwrap();
+        refused(&["simulate", "--model", s(&p), "-m", "turning:20"], &[needle, "out of range"]);
+    }
+    // a model with nothing to identify
+    let plain = dir.join("plain.toml");
+    std::fs::write(&plain, std::fs::read_to_string(m).unwrap().replace("candidates = ", "old_candidates = "))
+        .unwrap();
+    if crate::common::termid(&["simulate", "--model", s(&plain), "--duration", "0.1"]).0 {
+        refused(&["identify", "--model", s(&plain), "--data", s(&csv)], &["nothing to identify"]);
+    }
+    // the time column in milliseconds or minutes (item 17)
+    let z = zigzag(&dir);
+    let zz = std::fs::read_to_string(&z).unwrap();
+    for (unit, factor) in [("milliseconds", 1000.0), ("minutes", 1.0 / 60.0)] {
+        let mut lines = zz.lines();
+        let header = lines.next().unwrap();
+        let t = header.split(',').position(|h| h == "t").unwrap();
+        let mut out = vec![header.to_string()];
+        for l in lines {
+            let mut cells: Vec<String> = l.split(',').map(str::to_string).collect();
+            cells[t] = format!("{:?}", cells[t].parse::<f64>().unwrap() * factor);
+            out.push(cells.join(","));
+        }
+        let p = dir.join(format!("{unit}.csv"));
+        std::fs::write(&p, out.join("\n") + "\n").unwrap();
+        refused(&["validate", "--data", s(&p)], &[unit, "the whole run"]);
+    }
+}
+
+/// Items 18-20: messages that say what is wrong, and no echo of a file that is not data.
+#[test]
+fn messages_name_the_real_problem() {
+    let dir = Scratch::new("hostile2-messages");
+    let m = "models/lorenz.toml";
+    let w = |name: &str, text: &str| {
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    let tabs = w("tabs.csv", "t\tx\n0\t1\n1\t2\n");
+    refused(&["identify", "--data", s(&tabs), "--target", "dx/dt", "--terms", "x"], &["separated by tabs"]);
+    let headless = w("headless.csv", "0.0,1.0\n0.1,2.0\n");
+    refused(
+        &["identify", "--data", s(&headless), "--target", "dx/dt", "--terms", "x"],
+        &["holds numbers, not column names"],
+    );
+    let secret =
+        w("secret.txt", "root:*:20228:0:99999:7:::\ndaemon:*:20228:0:99999:7:::\nbin:*:20228:0:99999:7:::\n");
+    let err = refused(&["identify", "--model", m, "--data", s(&secret)], &["not a table of numbers"]);
+    assert!(!err.contains("daemon") && !err.contains("root"), "{err}");
+    let ds = w("ds.toml", &format!("[columns]\nx = \"x\"\n[[runs]]\nfile = \"{}\"\n", s(&secret)));
+    let err = refused(&["identify", "--model", m, "--dataset", s(&ds)], &["not a table of numbers"]);
+    assert!(!err.contains("daemon"), "{err}");
+    for (folder, needle) in [("${X", "closing brace"), ("${X:-/tmp}", "no shell forms")] {
+        let ds = w(
+            "env.toml",
+            &format!("folder = \"{folder}\"\n[columns]\nx = \"x\"\n[[runs]]\nfile = \"a.csv\"\n"),
+        );
+        refused(&["identify", "--model", m, "--dataset", s(&ds)], &[needle]);
+    }
+    let lorenz = std::fs::read_to_string(m).unwrap();
+    // a Cyrillic х for the state x
+    let cyr = w("cyr.toml", &lorenz.replacen("state = \"x\"", "state = \"\u{445}\"", 1));
+    refused(&["simulate", "--model", s(&cyr), "--duration", "1"], &["looks like `x`", "U+0445"]);
+    // the time named as a state
+    let timed = w("timed.toml", &lorenz.replacen("time = \"t\"", "time = \"x\"", 1));
+    refused(
+        &["simulate", "--model", s(&timed), "--duration", "1"],
+        &["timed.toml", "also the time variable"],
+    );
+    // CR-only line ends
+    let cr = w("cr.toml", &lorenz.replace('\n', "\r"));
+    refused(&["simulate", "--model", s(&cr), "--duration", "1"], &["carriage return"]);
+    // a huge term is not echoed whole
+    let huge = "x*".repeat(50_000) + "x";
+    let err = refused(
+        &[
+            "identify",
+            "--data",
+            s(&crate::common::lorenz_csv(&dir, "1")),
+            "--target",
+            "dx/dt",
+            "--terms",
+            &huge,
+        ],
+        &["longer than"],
+    );
+    assert!(err.len() < 2_000, "{} bytes of stderr", err.len());
+    // a stepwise with every candidate excluded says so
+    let out = succeeds(&[
+        "identify",
+        "--data",
+        s(&dir.join("lorenz.csv")),
+        "--target",
+        "dx/dt",
+        "--terms",
+        "x",
+        "y",
+        "--exclude",
+        "x",
+        "y",
+    ]);
+    assert!(
+        out.contains("no candidate could enter") && !out.contains("every candidate had entered"),
+        "{out}"
+    );
+}

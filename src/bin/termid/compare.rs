@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use termid::data::{differentiator, Frame};
 use termid::diagnose::{simulate_runs, Runs};
 use termid::identify::{coefficients_of, equation_design, fit_equation_design, Fit};
@@ -51,6 +51,16 @@ pub fn run(cmd: CompareCommand) -> Result<()> {
         if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };
     let diff = differentiator(&cmd.derivative)?;
     let replay = cmd.replay.as_ref().map(|p| Frame::read(p, &time)).transpose()?;
+    if let (Some(f), Some(p)) = (&replay, &cmd.replay) {
+        // checked before the fits: each back-end's replay would fail alike after all the work
+        if f.len() < 2 {
+            bail!(
+                "--replay {}: a replay needs at least two rows (its inputs over time); it has {}",
+                p.display(),
+                f.len()
+            );
+        }
+    }
     // the candidates are compiled once per equation, outside the timings, as the peers' design
     // matrix is built outside theirs
     let designs = equations

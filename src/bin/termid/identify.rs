@@ -22,6 +22,9 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     if let Some(dir) = &cmd.prepared_svg {
         termid::output::check_folder(dir)?;
     }
+    for (flag, list) in [("--param", &cmd.params), ("--derive", &cmd.derived), ("--alias", &cmd.aliases)] {
+        crate::runs::check_names_once(flag, list)?;
+    }
     let mut inputs = crate::runs::input_files(&cmd.data, cmd.dataset.as_deref());
     crate::runs::check_once(&inputs)?;
     for (k, m) in cmd.moments.iter().enumerate() {
@@ -62,6 +65,15 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
         crate::runs::load(&cmd.data, cmd.dataset.as_deref(), &cmd.time)?
     };
     let target = Target::parse(cmd.target.as_deref().unwrap_or_default());
+    match &target {
+        Target::Derivative(s) if *s == cmd.time => {
+            bail!("--target d{s}/dt: `{s}` is the time column, whose rate is 1; name a measured quantity")
+        }
+        Target::Column(c) if cmd.terms.iter().any(|t| t.trim() == c) => {
+            bail!("--target {c} is among the candidate terms: it would explain itself exactly; leave it out of --terms")
+        }
+        _ => {}
+    }
     if let Some(plugin) = termid::plugins::with_derivative(&cmd.derivative) {
         bail!(
             "--derivative {} is the {} plug-in's: it needs a --model with a [{}] section",
@@ -633,6 +645,9 @@ fn identify_start(
 ) -> Result<Start> {
     let names: Vec<String> =
         if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };
+    if names.is_empty() {
+        bail!("{}: no equation has candidate terms, so there is nothing to identify (an equation's `candidates` list them)", model.path);
+    }
     let states: Vec<String> =
         names.iter().filter_map(|n| model.equation(n).map(|e| e.state.clone())).collect();
     let diff = derivative_method(cmd)?;

@@ -67,6 +67,27 @@ pub fn check_outputs(outputs: &[(&str, &Path)], inputs: &[(String, PathBuf)]) ->
     Ok(())
 }
 
+/// Refuses a NAME=VALUE option that names one NAME twice (`--param u0=1 u0=2`): one of the
+/// values would be dropped without a word.
+pub fn check_names_once(flag: &str, pairs: &[String]) -> Result<()> {
+    let names: Vec<&str> =
+        pairs.iter().map(|p| p.split_once('=').map_or(p.as_str(), |(n, _)| n).trim()).collect();
+    for (k, n) in names.iter().enumerate() {
+        if names[..k].contains(n) {
+            bail!(
+                "{flag} gives `{n}` twice ({}): say each name once",
+                pairs
+                    .iter()
+                    .filter(|p| p.split_once('=').map_or(p.as_str(), |(a, _)| a).trim() == *n)
+                    .cloned()
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+        }
+    }
+    Ok(())
+}
+
 /// Refuses a file given twice (by identity): its runs would count twice without a word.
 pub fn check_once(inputs: &[(String, PathBuf)]) -> Result<()> {
     for (k, (what, path)) in inputs.iter().enumerate() {

@@ -37,6 +37,17 @@ pub fn run(cmd: SimulateCommand) -> Result<()> {
         .chain(cmd.svg.iter().map(|p| ("--svg", p.as_path())))
         .collect();
     crate::runs::check_outputs(&outputs, &inputs)?;
+    for (flag, list) in [("--param", &cmd.params), ("--initial", &cmd.initial), ("--input", &cmd.inputs)] {
+        crate::runs::check_names_once(flag, list)?;
+    }
+    if let Some(d) = cmd.duration {
+        if !(d.is_finite() && d > 0.0) {
+            bail!("--duration {d}: a simulation lasts a positive number of seconds");
+        }
+        if cmd.dt.is_finite() && cmd.dt > d {
+            bail!("--dt {} is longer than --duration {d}: not one step would be taken", cmd.dt);
+        }
+    }
     let mut model = load_model(&cmd.model)?;
     set_parameters(&mut model, &cmd.params)?;
     let integrator = cmd.integrator;
