@@ -10,9 +10,11 @@ fn bench(c: &mut Criterion) {
     let start = ship.straight_run().unwrap();
     let zigzag = Manoeuvre::parse("zigzag:20/20").unwrap();
     let mut g = c.benchmark_group("simulate");
-    for (name, integrator) in
-        [("zigzag_100s_b8", Integrator::ModifiedEuler), ("zigzag_100s_rk4", Integrator::Rk4)]
-    {
+    for (name, integrator) in [
+        ("zigzag_100s_b8", Integrator::ModifiedEuler),
+        ("zigzag_100s_rk4", Integrator::Rk4),
+        ("zigzag_100s_dopri5", Integrator::Dopri5),
+    ] {
         let s = Settings { integrator, dt: 0.04, duration: 100.0, sample: 0.2 };
         g.bench_function(name, |b| {
             b.iter(|| {

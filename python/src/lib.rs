@@ -86,12 +86,19 @@ fn backend_of(json: &str) -> PyResult<Backend> {
     Ok(backend)
 }
 
-fn integrator_of(name: &str) -> PyResult<Integrator> {
-    match name {
-        "b8" | "euler" | "modified-euler" => Ok(Integrator::ModifiedEuler),
-        "rk4" => Ok(Integrator::Rk4),
-        other => Err(refuse(format!("unknown integrator `{other}` (known: b8, rk4)"))),
-    }
+/// The method and control step asked for, else the model file's `[simulation]`, else the
+/// adaptive Dormand-Prince method at 0.04 s.
+fn method_of(
+    model: &termid::model::Model,
+    integrator: Option<&str>,
+    dt: Option<f64>,
+) -> PyResult<(Integrator, f64)> {
+    let (method, step) = model.simulation();
+    let method = match integrator {
+        Some(name) => Integrator::by_name(name).map_err(fail)?,
+        None => method,
+    };
+    Ok((method, dt.unwrap_or(step)))
 }
 
 fn to_json(value: &impl serde::Serialize) -> PyResult<String> {
@@ -163,12 +170,13 @@ impl PyModel {
         &self,
         py: Python<'_>,
         runs: Vec<Run<'_>>,
-        dt: f64,
-        integrator: &str,
+        dt: Option<f64>,
+        integrator: Option<&str>,
         with_intercept: bool,
     ) -> PyResult<(Vec<Frame>, termid::diagnose::Runs, Vec<Trajectory>)> {
         let frames = self.frames(runs)?;
-        let data = termid::diagnose::Runs::new(&self.inner, &frames, dt, integrator_of(integrator)?)
+        let (integrator, dt) = method_of(&self.inner, integrator, dt)?;
+        let data = termid::diagnose::Runs::new(&self.inner, &frames, dt, integrator)
             .map_err(fail)?
             .with_intercepts(with_intercept);
         let sims = py.detach(|| data.simulate(&self.inner, &[], &[])).map_err(fail)?;
@@ -412,16 +420,16 @@ impl PyModel {
 
     /// A plug-in's scenario (`zigzag:20/20`, `turning:35`, `spiral`): the simulated run's
     /// columns, its metrics (JSON), its label and its report lines.
-    #[pyo3(signature = (scenario, dt = 0.1, duration = None, sample = None, integrator = "b8", with_intercept = false))]
+    #[pyo3(signature = (scenario, dt = None, duration = None, sample = None, integrator = None, with_intercept = false))]
     #[allow(clippy::too_many_arguments, clippy::type_complexity)]
     fn simulate<'py>(
         &self,
         py: Python<'py>,
         scenario: &str,
-        dt: f64,
+        dt: Option<f64>,
         duration: Option<f64>,
         sample: Option<f64>,
-        integrator: &str,
+        integrator: Option<&str>,
         with_intercept: bool,
     ) -> PyResult<(Vec<(String, Bound<'py, PyArray1<f64>>)>, String, String, Vec<String>)> {
         let plugin = termid::plugins::of(&self.inner).ok_or_else(|| {
@@ -437,8 +445,9 @@ impl PyModel {
             inputs_given: false,
         };
         let scenario = plugin.scenario(&self.inner, &request).map_err(fail)?;
+        let (integrator, dt) = method_of(&self.inner, integrator, dt)?;
         let settings = Settings {
-            integrator: integrator_of(integrator)?,
+            integrator,
             dt,
             duration: duration.unwrap_or_else(|| scenario.default_duration()),
             sample: sample.unwrap_or(dt),
@@ -477,14 +486,14 @@ impl PyModel {
     }
 
     /// Each run re-simulated from its recorded initial state with its recorded inputs.
-    #[pyo3(signature = (runs, dt = 0.1, integrator = "b8", with_intercept = false))]
+    #[pyo3(signature = (runs, dt = None, integrator = None, with_intercept = false))]
     #[allow(clippy::type_complexity)]
     fn replay<'py>(
         &self,
         py: Python<'py>,
         runs: Vec<Run<'py>>,
-        dt: f64,
-        integrator: &str,
+        dt: Option<f64>,
+        integrator: Option<&str>,
         with_intercept: bool,
     ) -> PyResult<Vec<Vec<(String, Bound<'py, PyArray1<f64>>)>>> {
         let (_, _, sims) = self.resimulate(py, runs, dt, integrator, with_intercept)?;
@@ -494,13 +503,13 @@ impl PyModel {
 
     /// The model against held-out runs: the error of every compared state, and for a
     /// plug-in's models its metrics measured and simulated (JSON).
-    #[pyo3(signature = (runs, dt = 0.1, integrator = "b8", with_intercept = false))]
+    #[pyo3(signature = (runs, dt = None, integrator = None, with_intercept = false))]
     fn validate(
         &self,
         py: Python<'_>,
         runs: Vec<Run<'_>>,
-        dt: f64,
-        integrator: &str,
+        dt: Option<f64>,
+        integrator: Option<&str>,
         with_intercept: bool,
     ) -> PyResult<String> {
         let (frames, data, sims) = self.resimulate(py, runs, dt, integrator, with_intercept)?;
@@ -518,22 +527,23 @@ impl PyModel {
 
     /// Where model and runs disagree and which effect explains it (JSON), with the model that
     /// has the effect added (None when no effect explains enough).
-    #[pyo3(signature = (runs, dt = 0.1, integrator = "b8", with_intercept = false))]
+    #[pyo3(signature = (runs, dt = None, integrator = None, with_intercept = false))]
     fn diagnose(
         &self,
         py: Python<'_>,
         runs: Vec<Run<'_>>,
-        dt: f64,
-        integrator: &str,
+        dt: Option<f64>,
+        integrator: Option<&str>,
         with_intercept: bool,
     ) -> PyResult<(String, Option<PyModel>)> {
         let frames = self.frames(runs)?;
         let hypotheses = termid::plugins::of(&self.inner)
             .and_then(|p| p.hypotheses(&self.inner))
             .unwrap_or_else(|| termid::diagnose::generic_hypotheses(&self.inner));
+        let (integrator, dt) = method_of(&self.inner, integrator, dt)?;
         let settings = termid::diagnose::Settings {
             dt,
-            integrator: integrator_of(integrator)?,
+            integrator,
             with_intercepts: with_intercept,
             ..Default::default()
         };

@@ -390,10 +390,10 @@ class Model:
         self,
         scenario: str,
         *,
-        dt: float = 0.1,
+        dt: Optional[float] = None,
         duration: Optional[float] = None,
         sample: Optional[float] = None,
-        integrator: str = "b8",
+        integrator: Optional[str] = None,
         with_intercept: bool = False,
     ) -> pd.DataFrame:
         """A plug-in's scenario (``zigzag:20/20``, ``turning:35``, ``spiral``): the run as a
@@ -422,16 +422,16 @@ class Model:
         frame.attrs["name"] = f"{manoeuvre}#{seed}"
         return frame
 
-    def replay(self, runs: Union[Data, Sequence[Data]], *, dt: float = 0.1, integrator: str = "b8", with_intercept: bool = False) -> List[pd.DataFrame]:
+    def replay(self, runs: Union[Data, Sequence[Data]], *, dt: Optional[float] = None, integrator: Optional[str] = None, with_intercept: bool = False) -> List[pd.DataFrame]:
         """Each run re-simulated from its recorded initial state with its recorded inputs."""
         return [_frame(c) for c in self._native.replay(_runs(runs), dt, integrator, with_intercept)]
 
-    def validate(self, runs: Union[Data, Sequence[Data]], *, dt: float = 0.1, integrator: str = "b8", with_intercept: bool = False) -> Dict[str, Any]:
+    def validate(self, runs: Union[Data, Sequence[Data]], *, dt: Optional[float] = None, integrator: Optional[str] = None, with_intercept: bool = False) -> Dict[str, Any]:
         """Held-out runs against the model: per state RMS and largest error, and for a ship
         the metrics (overshoots, tactical diameter, ...) measured and simulated."""
         return json.loads(self._native.validate(_runs(runs), dt, integrator, with_intercept))
 
-    def diagnose(self, runs: Union[Data, Sequence[Data]], *, dt: float = 0.1, integrator: str = "b8", with_intercept: bool = False) -> Tuple[Dict[str, Any], Optional["Model"]]:
+    def diagnose(self, runs: Union[Data, Sequence[Data]], *, dt: Optional[float] = None, integrator: Optional[str] = None, with_intercept: bool = False) -> Tuple[Dict[str, Any], Optional["Model"]]:
         """Where model and runs disagree, which effect explains it, and the model with it."""
         text, native = self._native.diagnose(_runs(runs), dt, integrator, with_intercept)
         return json.loads(text), (Model(native) if native is not None else None)

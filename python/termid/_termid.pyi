@@ -61,23 +61,23 @@ class Model:
     def simulate(
         self,
         scenario: str,
-        dt: float = 0.1,
+        dt: Optional[float] = None,
         duration: Optional[float] = None,
         sample: Optional[float] = None,
-        integrator: str = "b8",
+        integrator: Optional[str] = None,
         with_intercept: bool = False,
     ) -> Tuple[NamedArrays, str, str, List[str]]: ...
     def record(
         self, manoeuvre: str, speed: float = 1.0, duration: float = 100.0, seed: int = 0, tracked: bool = False
     ) -> Tuple[NamedArrays, NamedArrays]: ...
     def replay(
-        self, runs: Sequence[Run], dt: float = 0.1, integrator: str = "b8", with_intercept: bool = False
+        self, runs: Sequence[Run], dt: Optional[float] = None, integrator: Optional[str] = None, with_intercept: bool = False
     ) -> List[NamedArrays]: ...
     def validate(
-        self, runs: Sequence[Run], dt: float = 0.1, integrator: str = "b8", with_intercept: bool = False
+        self, runs: Sequence[Run], dt: Optional[float] = None, integrator: Optional[str] = None, with_intercept: bool = False
     ) -> str: ...
     def diagnose(
-        self, runs: Sequence[Run], dt: float = 0.1, integrator: str = "b8", with_intercept: bool = False
+        self, runs: Sequence[Run], dt: Optional[float] = None, integrator: Optional[str] = None, with_intercept: bool = False
     ) -> Tuple[str, Optional[Model]]: ...
     def checks(self, runs: Sequence[Run] = ...) -> str: ...
     def __reduce__(self) -> Tuple[Any, Tuple[str, str]]: ...

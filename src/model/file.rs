@@ -30,9 +30,32 @@ pub struct ModelFile {
     /// Equations by name.
     #[serde(default)]
     pub equations: BTreeMap<String, EquationSpec>,
+    /// How the model is simulated when a command does not say (`[simulation]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub simulation: Option<SimulationSpec>,
     /// Plug-ins' tables by name (`ship`), as written; the core hands them on unread.
     #[serde(flatten)]
     pub plugins: BTreeMap<String, toml::Value>,
+}
+
+/// `[simulation]`: the method, control step and tolerances a model is simulated with by
+/// default (a command's `--integrator` and `--dt` override them). Without the table: the
+/// adaptive Dormand-Prince method at Δt = 0.04 with rtol 1e-7, atol 1e-9.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SimulationSpec {
+    /// `dopri5` (adaptive, the default), `rk4` or `b8` (Oltmann's eq. B8).
+    #[serde(default)]
+    pub method: crate::sim::Integrator,
+    /// The control step Δt: inputs are taken at its grid; the fixed step of `rk4` and `b8`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dt: Option<f64>,
+    /// Relative tolerance of `dopri5`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rtol: Option<f64>,
+    /// Absolute tolerance of `dopri5`, in each state's unit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub atol: Option<f64>,
 }
 
 /// `[model]`.

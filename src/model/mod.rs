@@ -134,7 +134,19 @@ pub struct Model {
     equations: Vec<Equation>,
 }
 
+/// The control step when neither the command nor the model file gives one, s.
+pub const DEFAULT_DT: f64 = 0.04;
+
 impl Model {
+    /// The method and control step the model is simulated with when a command does not say:
+    /// its `[simulation]` table, else the adaptive Dormand-Prince method at Δt = 0.04.
+    pub fn simulation(&self) -> (crate::sim::Integrator, f64) {
+        match &self.spec.simulation {
+            Some(s) => (s.method, s.dt.unwrap_or(DEFAULT_DT)),
+            None => (crate::sim::Integrator::default(), DEFAULT_DT),
+        }
+    }
+
     /// The model file as read (and as changed through the setters).
     pub fn spec(&self) -> &ModelFile {
         &self.spec
@@ -229,6 +241,21 @@ impl Model {
                 return Err(key_err(
                     name,
                     "not a key of a model file (a plug-in's settings are a table)".into(),
+                ));
+            }
+        }
+        if let Some(sim) = &spec.simulation {
+            if let Some(dt) = sim.dt.filter(|d| !(d.is_finite() && *d > 0.0)) {
+                return Err(key_err("simulation.dt", format!("{dt:?} is no step: give seconds > 0")));
+            }
+            let t = crate::sim::Tolerances {
+                rtol: sim.rtol.unwrap_or(crate::sim::Tolerances::default().rtol),
+                atol: sim.atol.unwrap_or(crate::sim::Tolerances::default().atol),
+            };
+            if let Err(e) = t.check() {
+                return Err(key_err(
+                    if sim.rtol.is_some() { "simulation.rtol" } else { "simulation.atol" },
+                    e.to_string(),
                 ));
             }
         }

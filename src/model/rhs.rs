@@ -13,6 +13,16 @@ impl crate::sim::RightHandSide for Model {
         &self.path
     }
 
+    fn tolerances(&self) -> crate::sim::Tolerances {
+        let d = crate::sim::Tolerances::default();
+        match &self.spec.simulation {
+            Some(s) => {
+                crate::sim::Tolerances { rtol: s.rtol.unwrap_or(d.rtol), atol: s.atol.unwrap_or(d.atol) }
+            }
+            None => d,
+        }
+    }
+
     fn states(&self) -> Result<Vec<(String, f64, f64)>, crate::sim::SimError> {
         let missing: Vec<&str> = self
             .spec

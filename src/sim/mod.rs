@@ -9,7 +9,7 @@ mod steady;
 mod system;
 
 pub use controller::{Constant, Controller, Replay};
-pub use integrator::{simulate, Integrator, Settings, Trajectory};
+pub use integrator::{simulate, Integrator, Settings, Tolerances, Trajectory};
 pub use steady::{solve_steady, SteadyProblem, Unknown};
 pub use system::{RightHandSide, System, Workspace};
 

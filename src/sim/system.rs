@@ -14,6 +14,8 @@ pub struct System {
     pub inputs: Vec<String>,
     /// Lower and upper bounds per state (±∞ when not declared).
     pub bounds: Vec<(f64, f64)>,
+    /// The adaptive integrator's tolerances (the model's own, else the defaults).
+    pub tolerances: super::Tolerances,
     rhs: Library,
     /// (scratch slot, state index) and (scratch slot, input index) of the library inputs
     /// that change from row to row; parameters (scratch slot, parameter index) sit in the
@@ -48,6 +50,10 @@ pub trait RightHandSide {
     /// ẋ of each state as one compiled library, one output per state in `states` order;
     /// with `with_intercept` each equation's stored constant b0 included.
     fn compile(&self, with_intercept: bool) -> Result<Library, SimError>;
+    /// The adaptive integrator's tolerances this model asks for.
+    fn tolerances(&self) -> super::Tolerances {
+        super::Tolerances::default()
+    }
 }
 
 impl System {
@@ -106,6 +112,7 @@ impl System {
             states,
             inputs,
             bounds,
+            tolerances: model.tolerances(),
             rhs,
             state_slots,
             input_slots,

@@ -266,12 +266,14 @@ pub struct SimulateCommand {
     /// they apply). Any model: replay:FILE.csv.
     #[arg(long, short = 'm')]
     pub manoeuvre: Option<String>,
-    /// Integrator: b8 (Oltmann's modified Euler, eq. B8) or rk4.
-    #[arg(long, value_enum, default_value = "b8")]
-    pub integrator: Integrator,
-    /// Step, s.
-    #[arg(allow_negative_numbers = true, long, default_value_t = 0.04)]
-    pub dt: f64,
+    /// Integrator: dopri5 (adaptive Dormand-Prince 5(4) with error control), rk4 or b8
+    /// (Oltmann's modified Euler, eq. B8). Default: the model file's `[simulation]`, else dopri5.
+    #[arg(long, value_enum)]
+    pub integrator: Option<Integrator>,
+    /// Control step, s: inputs are taken on its grid; the fixed step of rk4 and b8. Default:
+    /// the model file's `[simulation] dt`, else 0.04.
+    #[arg(allow_negative_numbers = true, long)]
+    pub dt: Option<f64>,
     /// Output interval, s (a multiple of the step).
     #[arg(allow_negative_numbers = true, long, default_value_t = 0.2)]
     pub sample: f64,
@@ -339,9 +341,9 @@ pub struct CompareCommand {
     /// A recorded run to re-simulate with each back-end's model (its inputs replayed).
     #[arg(long)]
     pub replay: Option<PathBuf>,
-    /// Integration step for the re-simulation, s.
-    #[arg(allow_negative_numbers = true, long, default_value_t = 0.04)]
-    pub dt: f64,
+    /// Control step of the re-simulation, s (default: the model file's, else 0.04).
+    #[arg(allow_negative_numbers = true, long)]
+    pub dt: Option<f64>,
     /// Time each fit as the median of this many repetitions after the warm-up.
     #[arg(allow_negative_numbers = true, long, default_value_t = 5)]
     pub repeat: usize,
@@ -431,12 +433,13 @@ pub struct RunsArgs {
 /// How measured runs are re-simulated, and where the figures go.
 #[derive(Debug, Args)]
 pub struct ResimArgs {
-    /// Integrator: b8 (the paper's modified Euler, default) or rk4.
-    #[arg(long, value_enum, default_value = "b8")]
-    pub integrator: Integrator,
-    /// Integration step, s.
-    #[arg(allow_negative_numbers = true, long, default_value_t = 0.04)]
-    pub dt: f64,
+    /// Integrator: dopri5 (adaptive), rk4 or b8 (the paper's modified Euler). Default: the
+    /// model file's `[simulation]`, else dopri5.
+    #[arg(long, value_enum)]
+    pub integrator: Option<Integrator>,
+    /// Control step, s (default: the model file's, else 0.04).
+    #[arg(allow_negative_numbers = true, long)]
+    pub dt: Option<f64>,
     /// One figure per run (measured, simulated, residual) into this folder.
     #[arg(long)]
     pub svg: Option<PathBuf>,

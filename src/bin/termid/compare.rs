@@ -9,7 +9,6 @@ use termid::data::{differentiator, Frame};
 use termid::diagnose::{simulate_runs, Runs};
 use termid::identify::{coefficients_of, equation_design, fit_equation_design, Fit};
 use termid::select::Backend;
-use termid::sim::Integrator;
 
 use crate::args::{CompareCommand, Format};
 use termid::identify::num;
@@ -41,8 +40,8 @@ pub fn run(cmd: CompareCommand) -> Result<()> {
             cmd.repeat
         );
     }
-    if !(cmd.dt.is_finite() && cmd.dt > 0.0) {
-        anyhow::bail!("--dt {}: the integration step must be a number of seconds > 0", cmd.dt);
+    if let Some(dt) = cmd.dt.filter(|dt| !(dt.is_finite() && *dt > 0.0)) {
+        anyhow::bail!("--dt {dt}: the integration step must be a number of seconds > 0");
     }
     let model = crate::simulate::load_model(&cmd.model)?;
     let time = model.spec().model.time.clone();
@@ -117,12 +116,13 @@ pub fn run(cmd: CompareCommand) -> Result<()> {
 }
 
 /// Replays the recorded inputs from the recorded initial state; RMS and max error per state.
-fn resimulate(model: &termid::model::Model, run: &Frame, dt: f64) -> Result<StateErrors> {
+fn resimulate(model: &termid::model::Model, run: &Frame, dt: Option<f64>) -> Result<StateErrors> {
     // the replay starts from the recorded state, so every state must have been measured
     for s in &model.spec().states {
         run.require(&s.name)?;
     }
-    let runs = Runs::new(model, std::slice::from_ref(run), dt, Integrator::ModifiedEuler)?;
+    let (method, step) = model.simulation();
+    let runs = Runs::new(model, std::slice::from_ref(run), dt.unwrap_or(step), method)?;
     let gap = runs.gap(&simulate_runs(&runs, model)?);
     Ok(gap.runs.into_iter().flat_map(|(_, states)| states).collect())
 }

@@ -25,8 +25,8 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
         .and_then(|p| p.hypotheses(&model))
         .unwrap_or_else(|| generic_hypotheses(&model));
     let settings = Settings {
-        dt: cmd.resim.dt,
-        integrator: cmd.resim.integrator,
+        dt: cmd.resim.dt.unwrap_or(model.simulation().1),
+        integrator: cmd.resim.integrator.unwrap_or(model.simulation().0),
         with_intercepts: cmd.resim.with_intercept,
         ..Settings::default()
     };

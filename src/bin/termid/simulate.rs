@@ -44,20 +44,23 @@ pub fn run(cmd: SimulateCommand) -> Result<()> {
         if !(d.is_finite() && d > 0.0) {
             bail!("--duration {d}: a simulation lasts a positive number of seconds");
         }
-        if cmd.dt.is_finite() && cmd.dt > d {
-            bail!("--dt {} is longer than --duration {d}: not one step would be taken", cmd.dt);
+        if let Some(dt) = cmd.dt.filter(|dt| dt.is_finite() && *dt > d) {
+            bail!("--dt {dt} is longer than --duration {d}: not one step would be taken");
         }
     }
     let mut model = load_model(&cmd.model)?;
     set_parameters(&mut model, &cmd.params)?;
-    let integrator = cmd.integrator;
+    // the command's method and step, else the model file's, else dopri5 at 0.04 s
+    let (method, step) = model.simulation();
+    let integrator = cmd.integrator.unwrap_or(method);
+    let dt = cmd.dt.unwrap_or(step);
     match (&cmd.manoeuvre, termid::plugins::of(&model)) {
         (Some(m), Some(plugin)) => {
             // a model that fails what its field knows is simulated, but not silently
             for c in plugin.checks(&model, &[]).iter().filter(|c| !c.passed && c.refuses) {
                 eprintln!("warning: {} fails a physical check: {}", model.path, c.line());
             }
-            scenario_run(&cmd, &model, plugin, m, integrator)
+            scenario_run(&cmd, &model, plugin, m, (integrator, dt))
         }
         (Some(m), None) if !m.starts_with("replay:") => {
             let tables: Vec<String> =
@@ -68,7 +71,7 @@ pub fn run(cmd: SimulateCommand) -> Result<()> {
                 tables.join(", ")
             )
         }
-        _ => generic_run(&cmd, &model, integrator),
+        _ => generic_run(&cmd, &model, (integrator, dt)),
     }
 }
 
@@ -111,7 +114,7 @@ fn scenario_run(
     model: &Model,
     plugin: &dyn Plugin,
     text: &str,
-    integrator: Integrator,
+    (integrator, dt): (Integrator, f64),
 ) -> Result<()> {
     let request = ScenarioRequest {
         text,
@@ -122,7 +125,7 @@ fn scenario_run(
     let scenario = plugin.scenario(model, &request)?;
     let settings = Settings {
         integrator,
-        dt: cmd.dt,
+        dt,
         duration: cmd.duration.unwrap_or_else(|| scenario.default_duration()),
         sample: cmd.sample,
     };
@@ -150,8 +153,8 @@ fn scenario_run(
             let mut report = serde_json::Map::new();
             report.insert("model".into(), model.path.clone().into());
             report.insert("manoeuvre".into(), scenario.label().into());
-            report.insert("integrator".into(), cmd.integrator.name().into());
-            report.insert("dt".into(), cmd.dt.into());
+            report.insert("integrator".into(), integrator.name().into());
+            report.insert("dt".into(), dt.into());
             report.extend(run.extra.clone());
             report.insert("metrics".into(), run.metrics.clone());
             report.insert(
@@ -182,7 +185,7 @@ pub fn trajectory_values(t: &termid::sim::Trajectory) -> usize {
     t.time.len() * (1 + t.states.len() + t.inputs.len() + t.derivatives.len())
 }
 
-fn generic_run(cmd: &SimulateCommand, model: &Model, integrator: Integrator) -> Result<()> {
+fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrator, f64)) -> Result<()> {
     let system = termid::sim::System::new(model, &BTreeMap::new(), cmd.with_intercept)?;
     let mut x0: Vec<f64> = system
         .states
@@ -226,7 +229,7 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, integrator: Integrator) -> 
     let duration = cmd.duration.or(recorded).context(
         "give --duration SECONDS: with constant inputs the model has no natural end (a ship model's manoeuvre, or a replay, has)",
     )?;
-    let settings = Settings { integrator, dt: cmd.dt, duration, sample: cmd.sample };
+    let settings = Settings { integrator, dt, duration, sample: cmd.sample };
     let traj = simulate(&system, &x0, controller(&system)?.as_mut(), &settings)?;
     // drawn models, simulated as the nominal one: a band per state and the final states' spread
     let mc = match cmd.monte_carlo.monte_carlo {
