@@ -515,7 +515,9 @@ coefficients = { "sin(theta)" = -9.81, "omega" = -0.5 }
 #[test]
 fn adaptive_integration_matches_dop853() {
     let tight = "\n[simulation]\nmethod = \"dopri5\"\nrtol = 1e-11\natol = 1e-12\n";
-    let cases: [(&str, String, BTreeMap<&str, f64>, f64, &[f64]); 3] = [
+    // (name, model text, constant inputs, duration, DOP853's final state)
+    type Case<'a> = (&'a str, String, BTreeMap<&'a str, f64>, f64, &'a [f64]);
+    let cases: [Case; 3] = [
         (
             "pendulum",
             PENDULUM.to_string(),
