@@ -329,15 +329,23 @@ impl PyModel {
 
     /// Every identifiable equation (or the named ones) from runs; returns the identified model
     /// and each fit as JSON.
-    #[pyo3(signature = (runs, derivative = "central", equations = vec![], intercept = true, backend = None))]
+    #[pyo3(signature = (runs, derivative = None, equations = vec![], intercept = None, backend = None))]
     fn identify(
         &self,
         runs: Vec<Run<'_>>,
-        derivative: &str,
+        derivative: Option<&str>,
         equations: Vec<String>,
-        intercept: bool,
+        intercept: Option<bool>,
         backend: Option<&str>,
     ) -> PyResult<(PyModel, Vec<(String, String)>)> {
+        // the defaults of `termid identify`: central differences for a plug-in's model (a
+        // ship, as the paper), the Kalman smoother for any other; the model file's intercept
+        let derivative = derivative.unwrap_or(if termid::plugins::of(&self.inner).is_some() {
+            "central"
+        } else {
+            "kalman"
+        });
+        let intercept = intercept.unwrap_or(self.inner.spec().model.intercept);
         let model = match backend {
             Some(json) => self.inner.with_backend(&backend_of(json)?).map_err(fail)?,
             None => self.inner.clone(),
@@ -377,12 +385,13 @@ impl PyModel {
     }
 
     /// The model identified from statistics (merged per equation in the order given).
-    #[pyo3(signature = (moments, intercept = true))]
+    #[pyo3(signature = (moments, intercept = None))]
     fn identify_from_moments(
         &self,
         moments: Vec<PyRef<'_, PyMoments>>,
-        intercept: bool,
+        intercept: Option<bool>,
     ) -> PyResult<(PyModel, Vec<(String, String)>)> {
+        let intercept = intercept.unwrap_or(self.inner.spec().model.intercept);
         let parts = moments
             .iter()
             .enumerate()

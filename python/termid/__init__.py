@@ -344,16 +344,18 @@ class Model:
     def identify(
         self,
         runs: Union[Data, Sequence[Data]],
-        derivative: str = "central",
+        derivative: Optional[str] = None,
         *,
         equations: Sequence[str] = (),
-        intercept: bool = True,
+        intercept: Optional[bool] = None,
         backend: Optional[str] = None,
         names: Optional[Sequence[str]] = None,
         **settings: Any,
     ) -> Identified:
         """Every identifiable equation (or ``equations``) from the runs, with the model's
-        candidates, forced terms and back-end (or ``backend`` with its settings as keywords)."""
+        candidates, forced terms and back-end (or ``backend`` with its settings as keywords).
+        ``derivative`` defaults to the Kalman smoother (central differences for a ship, as the
+        paper); ``intercept`` to the model file's (``[model] intercept``)."""
         native, fits = self._native.identify(
             _runs(runs, names), derivative, list(equations), intercept, _backend(backend, settings)
         )
@@ -373,7 +375,7 @@ class Model:
         found = self._native.moments(list(equation), _runs(runs, names), derivative)
         return dict(zip(equation, found))
 
-    def identify_from_moments(self, moments: Union["Moments", Sequence["Moments"]], intercept: bool = True) -> Identified:
+    def identify_from_moments(self, moments: Union["Moments", Sequence["Moments"]], intercept: Optional[bool] = None) -> Identified:
         """The model identified from statistics, merged per equation in the order given:
         the same model as from the rows together."""
         if isinstance(moments, _termid.Moments):

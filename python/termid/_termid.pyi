@@ -48,14 +48,14 @@ class Model:
     def identify(
         self,
         runs: Sequence[Run],
-        derivative: str = "central",
+        derivative: Optional[str] = None,
         equations: Sequence[str] = ...,
-        intercept: bool = True,
+        intercept: Optional[bool] = None,
         backend: Optional[str] = None,
     ) -> Tuple[Model, List[Tuple[str, str]]]: ...
     def moments(self, equations: Sequence[str], runs: Sequence[Run], derivative: str = "central") -> List[Moments]: ...
     def identify_from_moments(
-        self, moments: Sequence[Moments], intercept: bool = True
+        self, moments: Sequence[Moments], intercept: Optional[bool] = None
     ) -> Tuple[Model, List[Tuple[str, str]]]: ...
     def predict(self, run: Run, with_intercept: bool = False) -> NamedArrays: ...
     def simulate(

@@ -144,9 +144,13 @@ pub struct Diagnosis {
     pub candidates: Vec<Candidate>,
     /// Index of the significant winner in `candidates`, if any.
     pub winner: Option<usize>,
-    /// The model with the winner added.
+    /// The model with the winner added: only where it shrinks the gap it was meant to close
+    /// (the leading state's error) on every run; else None and `rejected` says why.
     #[serde(skip)]
     pub model: Option<Model>,
+    /// Why the winner's model was not kept: the runs on which it made the leading state's
+    /// error grow (run, before, after).
+    pub rejected: Option<Vec<(String, f64, f64)>>,
     /// The re-simulations before (and after) the winner, for figures.
     #[serde(skip)]
     pub before: Vec<crate::sim::Trajectory>,
@@ -239,6 +243,22 @@ pub fn diagnose(
         }
         None => (gap_before.clone(), None),
     };
+    // a repair is kept only where it closes the gap it was found for: the leading state's
+    // error may not grow on any run (by more than round-off)
+    let rms = |g: &Gap, run: usize| {
+        g.runs
+            .get(run)
+            .and_then(|(_, states)| states.iter().find(|(s, _, _)| *s == location.leading_state))
+            .map(|x| x.1)
+    };
+    let worse: Vec<(String, f64, f64)> = (0..gap_before.runs.len())
+        .filter_map(|k| match (rms(&gap_before, k), rms(&gap_after, k)) {
+            (Some(b), Some(a)) if a > b * (1.0 + 1e-6) + 1e-12 => Some((gap_before.runs[k].0.clone(), b, a)),
+            _ => None,
+        })
+        .collect();
+    let (new_model, rejected) =
+        if new_model.is_some() && !worse.is_empty() { (None, Some(worse)) } else { (new_model, None) };
     Ok(Diagnosis {
         location,
         gap_before,
@@ -246,6 +266,7 @@ pub fn diagnose(
         candidates,
         winner,
         model: new_model,
+        rejected,
         before: base,
         after: after_sims,
     })

@@ -532,7 +532,7 @@ mod tests {
         assert!(e.contains("cannot be merged"), "{e}");
         let text = x.to_json().replacen("\"numbers\":[", "\"numbers\":[1.0,", 1);
         let e = EquationMoments::from_json(&text, "s.moments").unwrap_err().to_string();
-        assert!(e.contains("s.moments") && e.contains("do not make the statistics of 9 regressors"), "{e}");
+        assert!(e.contains("s.moments") && e.contains("do not make the statistics of 10 regressors"), "{e}");
         let e = EquationMoments::from_json("{\"equation\": 3}", "s.moments").unwrap_err().to_string();
         assert!(e.contains("s.moments"), "{e}");
     }

@@ -73,6 +73,15 @@ pub struct Meta {
     /// Name of the time column in data and output.
     #[serde(default = "default_time")]
     pub time: String,
+    /// Whether every equation fits a forced intercept b0 (the paper's ship does). false: the
+    /// constant is a candidate term like any other (`"1"` in `candidates`), chosen only where
+    /// it helps.
+    #[serde(default = "yes", skip_serializing_if = "is_true")]
+    pub intercept: bool,
+}
+
+fn is_true(b: &bool) -> bool {
+    *b
 }
 
 fn default_time() -> String {

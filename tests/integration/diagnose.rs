@@ -287,3 +287,31 @@ fn output_error_refinement_recovers_the_true_coefficients() {
     let err = Runs::new(&off, &runs, 0.05, Integrator::Rk4).unwrap().comparing(&["y".into()]).err().unwrap();
     assert!(err.to_string().contains("cannot compare `y`"), "{err}");
 }
+
+/// A repair that closes the gap on some runs and widens it on others is not kept (issue 25
+/// §3): two runs with a hidden rudder offset and the same two without it. An offset fitted
+/// to all four halves the first pair's heading error and makes the second pair's grow; the
+/// diagnosis names the effect but keeps no model, and says on which runs it worsens.
+#[test]
+fn a_repair_that_worsens_some_runs_is_not_kept() {
+    let offset = hidden_rudder_error(1.5f64.to_radians(), 1.0, false);
+    let clean: Vec<Frame> = hidden_rudder_error(0.0, 1.0, false)
+        .iter()
+        .map(|f| {
+            let mut g = Frame::new(&format!("{}-clean", f.origin()), "t", f.time().to_vec()).unwrap();
+            for name in f.names().iter().filter(|n| *n != "t") {
+                g.push(name, f.require(name).unwrap().to_vec()).unwrap();
+            }
+            g
+        })
+        .collect();
+    let runs: Vec<Frame> = offset.into_iter().chain(clean).collect();
+    let d = run(&termid::ship::default_model(), &runs);
+    assert!(d.winner.is_some(), "the offset explains most of the gap");
+    assert!(d.model.is_none(), "a repair that worsens runs was kept");
+    let worse = d.rejected.as_ref().expect("the runs it worsens");
+    assert!(!worse.is_empty() && worse.iter().all(|(r, b, a)| r.ends_with("-clean") && a > b), "{worse:?}");
+    // on the offset runs alone the same effect is kept
+    let d = run(&termid::ship::default_model(), &hidden_rudder_error(1.5f64.to_radians(), 1.0, false));
+    assert!(d.model.is_some() && d.rejected.is_none());
+}

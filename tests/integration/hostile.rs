@@ -401,7 +401,7 @@ fn model_file_errors_name_the_right_line() {
     let err = refused(&["simulate", "--model", s(&p), "--duration", "1"], &["aliases.q"]);
     assert!(err.contains(&format!("alias.toml:{}:", line_of(&alias, "q = \"nothing\""))), "{err}");
     // a bad term: one caret block
-    let bad = text.replacen("candidates = [\"x\"", "candidates = [\"x**y\"", 1);
+    let bad = text.replacen("candidates = [\"1\", \"x\"", "candidates = [\"1\", \"x**y\"", 1);
     assert_ne!(bad, text, "lorenz.toml's layout changed");
     let p = write("bad.toml", &bad);
     let err = refused(&["simulate", "--model", s(&p), "--duration", "1"], &["^"]);

@@ -80,7 +80,7 @@ fn sparse_settings_beyond_the_solver_are_errors() {
         ("{ method = \"sparse\", path = 1 }", &["path ≥ 2"][..]),
     ] {
         let m = dir.join("l.toml");
-        std::fs::write(&m, lorenz.replace("{ method = \"stepwise\", prune_beta = 1e-3 }", backend)).unwrap();
+        std::fs::write(&m, lorenz.replace("{ method = \"stlsq\" }", backend)).unwrap();
         refused(&["identify", "--model", s(&m), "--data", s(&csv), "--equation", "x_dot"], needles);
     }
 }
@@ -459,6 +459,9 @@ fn messages_name_the_real_problem() {
         "--exclude",
         "x",
         "y",
+        "--backend",
+        "stepwise",
+        "--no-intercept",
     ]);
     assert!(
         out.contains("no candidate could enter") && !out.contains("every candidate had entered"),

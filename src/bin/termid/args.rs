@@ -173,7 +173,9 @@ pub struct IdentifyCommand {
     /// Several, comma-separated, with --model and --refine: one start each (prepared,
     /// identified, refined, checked), a table of them, and the one whose refined model
     /// re-simulates the runs best (the --refine-validation runs where given) is kept.
-    #[arg(long, default_value = "central")]
+    /// Default `auto`: kalman for any system, central for a model with a plug-in's table (a
+    /// ship, as the paper differentiated).
+    #[arg(long, default_value = "auto")]
     pub derivative: String,
     /// Resample every run to this interval [s] before differentiating (low-pass filtered
     /// first when coarser than the data, so noise does not alias).
@@ -233,8 +235,13 @@ pub struct IdentifyCommand {
     #[arg(allow_negative_numbers = true, long, value_name = "ROWS", requires = "model")]
     pub chunk_rows: Option<usize>,
     /// Fit without an intercept b0.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "intercept")]
     pub no_intercept: bool,
+    /// Fit a forced intercept b0 where the default would not: for a `dX/dt` target without
+    /// --model, and for a model file with `intercept = false` (there the constant `1` is a
+    /// candidate like any other).
+    #[arg(long)]
+    pub intercept: bool,
     /// Weighted least squares with the row weights in this column.
     #[arg(long, conflicts_with = "model")]
     pub weight: Option<String>,

@@ -61,6 +61,8 @@ fn json(d: &Diagnosis) -> serde_json::Value {
             serde_json::json!({"name": c.name, "terms": c.effect, "coefficients": c.estimate, "std_errors": c.std_error,
                                "explained": c.explained, "delta_bic": c.delta_bic})
         }),
+        "kept": d.model.is_some(),
+        "rejected": d.rejected,
         "gap_before": d.gap_before,
         "gap_after": d.gap_after,
         "candidates": d.candidates,
@@ -132,6 +134,20 @@ fn text(d: &Diagnosis, out: Option<&std::path::Path>, tested: usize) -> String {
     }
     if let (Some(p), Some(_)) = (out, &d.model) {
         s += &format!("\nwrote {} (the original is unchanged)\n", p.display());
+    }
+    if let Some(worse) = &d.rejected {
+        let (f, unit) = unit_of(&d.location.leading_state);
+        let runs: Vec<String> =
+            worse.iter().map(|(r, b, a)| format!("{r}: {} → {} {unit}", num(b * f), num(a * f))).collect();
+        s += &format!(
+            "
+warning: the repair was not kept{}: it makes the error of {}, the gap it was found for, grow on {} of {} runs ({}). The effect may be real but not alone, or the runs disagree; look at the runs it worsens.\n",
+            if out.is_some() { " and nothing was written" } else { "" },
+            d.location.leading_state,
+            worse.len(),
+            d.gap_before.runs.len(),
+            runs.join("; ")
+        );
     }
     s
 }

@@ -18,7 +18,50 @@ fn split_pair<'a>(text: &'a str, what: &str) -> Result<(&'a str, &'a str)> {
         .with_context(|| format!("{what} `{text}` must have the form NAME=VALUE"))
 }
 
-pub fn run(cmd: IdentifyCommand) -> Result<()> {
+/// The derivative method `auto` stands for: central differences for a model with a plug-in's
+/// table (a ship: the paper's own), five-point differences for files read in pieces, else the
+/// Kalman smoother, which recovers polynomial
+/// systems from noise-free and noisy samples alike where central differences leave an error
+/// that is smooth in the states and that spurious terms then fit.
+fn resolve_derivative(cmd: &mut IdentifyCommand) -> Result<()> {
+    if cmd.derivative != "auto" {
+        return Ok(());
+    }
+    let plugin = match &cmd.model {
+        Some(path) => termid::plugins::load(path).map(|m| termid::plugins::of(&m).is_some()).unwrap_or(false),
+        None => false,
+    };
+    // read in pieces, a method of fixed reach: five-point, the most accurate of them
+    let pieces = cmd.chunk_rows.is_some_and(|r| r > 0);
+    cmd.derivative = if plugin {
+        "central"
+    } else if pieces {
+        "five-point"
+    } else {
+        "kalman"
+    }
+    .into();
+    Ok(())
+}
+
+/// Whether the equations fit a forced intercept: the flags, else the model file's `intercept`,
+/// else (no model) only where the target is a column (classical regression); for a `dX/dt`
+/// target the constant is a candidate term instead.
+fn intercept_of(cmd: &IdentifyCommand, model: Option<&termid::model::Model>) -> bool {
+    if cmd.no_intercept {
+        return false;
+    }
+    if cmd.intercept {
+        return true;
+    }
+    match model {
+        Some(m) => m.spec().model.intercept,
+        None => !matches!(Target::parse(cmd.target.as_deref().unwrap_or_default()), Target::Derivative(_)),
+    }
+}
+
+pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
+    resolve_derivative(&mut cmd)?;
     if let Some(dir) = &cmd.prepared_svg {
         termid::output::check_folder(dir)?;
     }
@@ -136,13 +179,26 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     let candidates = parse_terms(&texts, &vocab)?;
     let forced = parse_terms(&cmd.forced, &vocab)?;
     let excluded = parse_terms(&cmd.exclude, &vocab)?;
-    let backend = configure_backend(&cmd)?;
+    // an ODE's defaults (a dX/dt target): sequential thresholding, scale-free, and the
+    // constant as a candidate like any other rather than a forced intercept
+    let ode = matches!(target, Target::Derivative(_));
+    let backend = if ode && cmd.backend.is_none() {
+        Backend::from(BackendName::Stlsq)
+    } else {
+        configure_backend(&cmd)?
+    };
+    let intercept = intercept_of(&cmd, None);
+    let mut candidates = candidates;
+    let one = vocab.parse("1")?;
+    if ode && !intercept && !cmd.no_intercept && !candidates.contains(&one) {
+        candidates.push(one);
+    }
     let selector = backend.build();
     let identification = Identification {
         vocabulary: &vocab,
         parameters: &params,
         differentiator: diff.as_ref(),
-        intercept: !cmd.no_intercept,
+        intercept,
         weights: cmd.weight.clone(),
     };
     let mut fit = crate::progress::with_spinner(&format!("{} on {}", selector.name(), target), || {
@@ -247,7 +303,8 @@ fn run_moments(cmd: IdentifyCommand) -> Result<()> {
     if cmd.backend.is_some() {
         model = model.with_backend(&configure_backend(&cmd)?)?;
     }
-    let (mut model, fits) = crate::moments::identify(&model, &cmd.moments, &cmd.equation, !cmd.no_intercept)?;
+    let intercept = intercept_of(&cmd, Some(&model));
+    let (mut model, fits) = crate::moments::identify(&model, &cmd.moments, &cmd.equation, intercept)?;
     if let Some(out) = &cmd.out {
         let sources = cmd.moments.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
         model.set_provenance(format!(
@@ -343,7 +400,7 @@ fn identify_in_pieces(cmd: &IdentifyCommand, model: &termid::model::Model, rows:
     }
     let origin = cmd.data.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
     let parts = all.into_iter().map(|m| (origin.clone(), m)).collect();
-    let identified = termid::identify::identify_from_moments(model, parts, !cmd.no_intercept)?;
+    let identified = termid::identify::identify_from_moments(model, parts, intercept_of(cmd, Some(model)))?;
     let checks =
         termid::plugins::of(&identified.model).map(|p| p.checks(&identified.model, &[])).unwrap_or_default();
     Ok(Start {
@@ -666,7 +723,7 @@ fn identify_start(
     let how = termid::identify::ModelIdentification {
         equations: names,
         differentiator: diff.as_ref(),
-        intercept: !cmd.no_intercept,
+        intercept: intercept_of(cmd, Some(model)),
         target: cmd.target.as_deref().map(Target::parse),
     };
     let (identified, chosen_text) = match &cmd.choose {
@@ -705,7 +762,7 @@ fn identify_start(
     let mut model = identified.model;
     let how_refined = RefineHow {
         states: refine.cloned().flatten(),
-        intercept: !cmd.no_intercept,
+        intercept: intercept_of(cmd, Some(&model)),
         prior: cmd.refine_prior,
         validation: validation.as_deref(),
         iterations: cmd.refine_iterations,
