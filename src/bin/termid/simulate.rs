@@ -53,7 +53,13 @@ pub fn run(cmd: SimulateCommand) -> Result<()> {
     // the command's method and step, else the model file's, else dopri5 at 0.04 s
     let (method, step) = model.simulation();
     let integrator = cmd.integrator.unwrap_or(method);
-    let dt = cmd.dt.unwrap_or(step);
+    // the adaptive method's accuracy does not hang on the control step: samples finer than
+    // it make it finer, rather than an error
+    let dt = match cmd.dt {
+        Some(dt) => dt,
+        None if integrator == Integrator::Dopri5 && cmd.sample > 0.0 && cmd.sample < step => cmd.sample,
+        None => step,
+    };
     match (&cmd.manoeuvre, termid::plugins::of(&model)) {
         (Some(m), Some(plugin)) => {
             // a model that fails what its field knows is simulated, but not silently
