@@ -85,13 +85,10 @@ fn sparse_settings_beyond_the_solver_are_errors() {
     }
 }
 
-/// Item 4: whatever `termid moments` writes, `identify --moments` reads back, however many
-/// runs (10 000 runs: a line of tens of MB).
-#[test]
-fn statistics_of_many_runs_read_back() {
-    let dir = Scratch::new("hostile2-moments-size");
-    let csv = crate::common::lorenz_csv(&dir, "1");
-    let one = dir.join("one.moments");
+/// `termid moments` of Lorenz's z_dot over one simulated second: the file and its JSON.
+fn z_statistics(dir: &Path) -> (std::path::PathBuf, serde_json::Value) {
+    let csv = crate::common::lorenz_csv(dir, "1");
+    let file = dir.join("z.moments");
     succeeds(&[
         "moments",
         "--model",
@@ -101,10 +98,18 @@ fn statistics_of_many_runs_read_back() {
         "--data",
         s(&csv),
         "--out",
-        s(&one),
+        s(&file),
     ]);
-    let text = std::fs::read_to_string(&one).unwrap();
-    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let v = serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    (file, v)
+}
+
+/// Item 4: whatever `termid moments` writes, `identify --moments` reads back, however many
+/// runs (10 000 runs: a line of tens of MB).
+#[test]
+fn statistics_of_many_runs_read_back() {
+    let dir = Scratch::new("hostile2-moments-size");
+    let (_, mut v) = z_statistics(&dir);
     let run = v["runs"][0].clone();
     let runs: Vec<serde_json::Value> = (0..10_000)
         .map(|k| {
@@ -126,21 +131,7 @@ fn statistics_of_many_runs_read_back() {
 #[test]
 fn statistics_files_are_checked_for_consistency() {
     let dir = Scratch::new("hostile2-moments-check");
-    let csv = crate::common::lorenz_csv(&dir, "1");
-    let one = dir.join("z.moments");
-    succeeds(&[
-        "moments",
-        "--model",
-        "models/lorenz.toml",
-        "--equation",
-        "z_dot",
-        "--data",
-        s(&csv),
-        "--out",
-        s(&one),
-    ]);
-    let text = std::fs::read_to_string(&one).unwrap();
-    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let (one, v) = z_statistics(&dir);
     let write = |name: &str, v: &serde_json::Value| {
         let p = dir.join(name);
         std::fs::write(&p, v.to_string()).unwrap();
