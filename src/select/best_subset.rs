@@ -285,8 +285,14 @@ impl BestSubset {
         for j in free.drain(..) {
             let pivot = a[j * m + j];
             if pivot.is_nan() || pivot <= self.pivot_tolerance {
-                let before: Vec<String> =
-                    forced.iter().chain(&kept).map(|&i| format!("`{}`", pb.names[i])).collect();
+                // the terms in the combination: after the sweeps, the swept rows of column j
+                // hold its regression on them (correlation scale); those not involved are ~0
+                let before: Vec<String> = forced
+                    .iter()
+                    .chain(&kept)
+                    .filter(|&&i| a[i * m + j].abs() > 1e-6)
+                    .map(|&i| format!("`{}`", pb.names[i]))
+                    .collect();
                 let with = match before.len() {
                     0 => "it does not vary".to_string(),
                     1..=4 => format!("collinear with {}", before.join(", ")),

@@ -437,6 +437,26 @@ fn messages_name_the_real_problem() {
         &["longer than"],
     );
     assert!(err.len() < 2_000, "{} bytes of stderr", err.len());
+    // the collinearity note names the terms in the combination only (c = 2a + 1, not b)
+    let col = w(
+        "col.csv",
+        "a,b,c,y\n1,2,3,1.1\n2,1,5,2.3\n3,5,7,2.9\n4,3,9,4.2\n5,4,11,5.1\n6,8,13,5.8\n7,6,15,7.2\n",
+    );
+    let out = succeeds(&[
+        "identify",
+        "--data",
+        s(&col),
+        "--no-time",
+        "--target",
+        "y",
+        "--terms",
+        "a",
+        "b",
+        "c",
+        "--backend",
+        "best-subset",
+    ]);
+    assert!(out.contains("`c` left out of the search: collinear with `a` (pivot"), "{out}");
     // a stepwise with every candidate excluded says so
     let out = succeeds(&[
         "identify",
