@@ -339,7 +339,7 @@ impl PyModel {
         backend: Option<&str>,
     ) -> PyResult<(PyModel, Vec<(String, String)>)> {
         // the defaults of `termid identify`: central differences for a plug-in's model (a
-        // ship, as the paper), the Kalman smoother for any other; the model file's intercept
+        // ship, as the paper), the integral form for any other; the model file's intercept
         let derivative = derivative.unwrap_or(if termid::plugins::of(&self.inner).is_some() {
             "central"
         } else {

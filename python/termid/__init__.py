@@ -354,8 +354,9 @@ class Model:
     ) -> Identified:
         """Every identifiable equation (or ``equations``) from the runs, with the model's
         candidates, forced terms and back-end (or ``backend`` with its settings as keywords).
-        ``derivative`` defaults to the Kalman smoother (central differences for a ship, as the
-        paper); ``intercept`` to the model file's (``[model] intercept``)."""
+        ``derivative`` defaults to ``integral`` (the integral form: no derivative estimated;
+        central differences for a ship, as the paper); ``intercept`` to the model file's
+        (``[model] intercept``)."""
         native, fits = self._native.identify(
             _runs(runs, names), derivative, list(equations), intercept, _backend(backend, settings)
         )

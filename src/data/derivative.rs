@@ -26,6 +26,12 @@ pub trait Differentiator: Send + Sync {
     fn reach(&self) -> Option<usize> {
         None
     }
+    /// `Some(W)` for the integral form ([`super::IntegralForm`]): no rate is estimated; the
+    /// identification regresses changes over windows of W intervals on the candidates'
+    /// integrals. `None` for every derivative method.
+    fn integral_window(&self) -> Option<usize> {
+        None
+    }
     /// The signal as the method estimates it, with its rate. Methods that smooth (spline,
     /// Kalman) return their smoothed curve, so the regressors can be the smoothed states too.
     fn smooth(&self, t: &[f64], x: &[f64]) -> Result<Smoothed, DataError> {
@@ -100,6 +106,13 @@ pub static DIFFERENTIATORS: &[(&str, &str, MakeDifferentiator)] = &[
     ("spline", "[:ALPHA] (default: chosen by GCV)", |o| match o {
         [] => Some(Box::new(super::SmoothingSpline { alpha: None })),
         [a] => Some(Box::new(super::SmoothingSpline { alpha: Some(*a) })),
+        _ => None,
+    }),
+    ("integral", "[:WINDOW] (default 8 sample intervals; no derivative, the integral form)", |o| match o {
+        [] => Some(Box::new(super::IntegralForm::default())),
+        [w] if w.fract() == 0.0 && *w >= 1.0 && *w <= 10_000.0 => {
+            Some(Box::new(super::IntegralForm { window: *w as usize }))
+        }
         _ => None,
     }),
     ("kalman", "[:RATIO] (default: maximum likelihood)", |o| match o {

@@ -344,9 +344,54 @@ impl Identification<'_> {
         target: &Target,
         frames: &[Frame],
     ) -> Result<Vec<Moments>, IdentifyError> {
+        if let (Some(w), Target::Derivative(_)) = (self.differentiator.integral_window(), target) {
+            return frames.iter().map(|f| self.integral_moments(library, target, f, w)).collect();
+        }
         let runs = frames.iter().map(|f| self.bind(library, target, f)).collect::<Result<Vec<_>, _>>()?;
         let rows: Vec<usize> = frames.iter().map(Frame::len).collect();
         gather(library.len(), &rows, |k, part, acc| runs[k].push(library, terms, part, acc))
+    }
+
+    /// One run's statistics in the integral form: the candidates evaluated on every row, then
+    /// integrated over windows of `w` intervals against the target's change over each.
+    fn integral_moments(
+        &self,
+        library: &Library,
+        target: &Target,
+        frame: &Frame,
+        w: usize,
+    ) -> Result<Moments, IdentifyError> {
+        if self.weights.is_some() {
+            return Err(IdentifyError::Setup(
+                "row weights do not apply to the integral form's windows".into(),
+            ));
+        }
+        let run = self.bind(library, target, frame)?;
+        let n = frame.len();
+        if n <= w + 1 {
+            return Err(IdentifyError::Setup(format!(
+                "{}: {n} rows are too few for the integral form's windows of {w} intervals",
+                frame.origin()
+            )));
+        }
+        let mut columns = vec![Vec::with_capacity(n); library.len()];
+        library.for_each_block(&run.sources, 0..n, |_, block| {
+            for (c, b) in columns.iter_mut().zip(block) {
+                c.extend_from_slice(b);
+            }
+        });
+        let (y, integrals) = crate::data::integral_rows(frame.time(), &run.y, &columns, w);
+        let refs: Vec<&[f64]> = integrals.iter().map(Vec::as_slice).collect();
+        let mut acc = Accumulator::new(library.len());
+        acc.push_columns(&refs, &y, None);
+        if let Some(j) = acc.not_finite() {
+            return Err(IdentifyError::Setup(format!(
+                "{}: the integral of candidate {} over some window is not finite",
+                frame.origin(),
+                j + 1
+            )));
+        }
+        Ok(acc.finish())
     }
 
     /// A run made ready for accumulation: its target, its inputs with its own parameters, and

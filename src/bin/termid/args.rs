@@ -173,8 +173,9 @@ pub struct IdentifyCommand {
     /// Several, comma-separated, with --model and --refine: one start each (prepared,
     /// identified, refined, checked), a table of them, and the one whose refined model
     /// re-simulates the runs best (the --refine-validation runs where given) is kept.
-    /// Default `auto`: kalman for any system, central for a model with a plug-in's table (a
-    /// ship, as the paper differentiated).
+    /// `integral[:W]` estimates no derivative: changes over windows of W samples against the
+    /// candidates' integrals (Simpson). Default `auto`: integral for any system, central for a
+    /// model with a plug-in's table (a ship, as the paper differentiated).
     #[arg(long, default_value = "auto")]
     pub derivative: String,
     /// Resample every run to this interval [s] before differentiating (low-pass filtered

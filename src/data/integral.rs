@@ -1,0 +1,123 @@
+//! The integral form of an equation of motion (as in weak SINDy; Schaeffer & McCalla 2017):
+//! instead of ẋ against θ(x) row by row, the change of x over a window against the integral
+//! of every candidate over the same window, x(t+W) − x(t) = Σ c_j ∫ θ_j dt. No derivative is
+//! estimated: the quadrature averages noise where differencing amplifies it, and Simpson's
+//! rule leaves an error of O(h⁴) where central differences leave O(h²) that is smooth in the
+//! states (and so fitted by spurious terms). Chosen as `--derivative integral[:W]`.
+
+use super::{DataError, Differentiator};
+
+/// The integral form over windows of `window` sample intervals.
+#[derive(Clone, Copy, Debug)]
+pub struct IntegralForm {
+    /// Sample intervals per window (even, for Simpson's rule on an even grid).
+    pub window: usize,
+}
+
+impl Default for IntegralForm {
+    fn default() -> Self {
+        IntegralForm { window: 8 }
+    }
+}
+
+impl Differentiator for IntegralForm {
+    fn name(&self) -> &'static str {
+        "integral"
+    }
+
+    /// No rate: the integral form's target is the signal itself, whose changes over windows
+    /// the identification takes ([`Differentiator::integral_window`]).
+    fn differentiate(&self, _t: &[f64], x: &[f64]) -> Result<Vec<f64>, DataError> {
+        Ok(x.to_vec())
+    }
+
+    fn smooth(&self, _t: &[f64], _x: &[f64]) -> Result<super::Smoothed, DataError> {
+        Err(DataError::Setting(
+            "the integral form estimates no rate, so there is nothing to smooth or draw: leave out --smooth and --prepared-svg, or choose a derivative method".into(),
+        ))
+    }
+
+    fn integral_window(&self) -> Option<usize> {
+        Some(self.window)
+    }
+}
+
+/// The rows of the integral form: for every window of `w` intervals starting at a sample,
+/// x at its end less x at its start, and each column integrated over it (composite Simpson
+/// on an even grid with `w` even, else the trapezoidal rule on the samples' own spacing).
+pub fn integral_rows(t: &[f64], x: &[f64], columns: &[Vec<f64>], w: usize) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let n = t.len();
+    if w == 0 || n <= w {
+        return (Vec::new(), vec![Vec::new(); columns.len()]);
+    }
+    let h = (t[n - 1] - t[0]) / (n - 1) as f64;
+    let even = t.windows(2).all(|p| ((p[1] - p[0]) - h).abs() <= 1e-6 * h);
+    let rows = n - w;
+    let simpson = even && w.is_multiple_of(2);
+    let weights = |k: usize| -> Vec<f64> {
+        if simpson {
+            (0..=w)
+                .map(|i| {
+                    h / 3.0
+                        * match i {
+                            0 => 1.0,
+                            i if i == w => 1.0,
+                            i if i % 2 == 1 => 4.0,
+                            _ => 2.0,
+                        }
+                })
+                .collect()
+        } else {
+            (0..=w)
+                .map(|i| {
+                    let left = if i > 0 { t[k + i] - t[k + i - 1] } else { 0.0 };
+                    let right = if i < w { t[k + i + 1] - t[k + i] } else { 0.0 };
+                    0.5 * (left + right)
+                })
+                .collect()
+        }
+    };
+    let fixed = simpson.then(|| weights(0));
+    let y: Vec<f64> = (0..rows).map(|k| x[k + w] - x[k]).collect();
+    let mut out = vec![vec![0.0; rows]; columns.len()];
+    for k in 0..rows {
+        let own;
+        let wk = match &fixed {
+            Some(f) => f,
+            None => {
+                own = weights(k);
+                &own
+            }
+        };
+        for (o, c) in out.iter_mut().zip(columns) {
+            o[k] = wk.iter().zip(&c[k..=k + w]).map(|(a, b)| a * b).sum();
+        }
+    }
+    (y, out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Simpson's rule integrates cubics exactly: x = t⁴/4 with θ = t³ gives the window's
+    /// change exactly; the trapezoid on uneven samples is exact for a linear θ.
+    #[test]
+    fn windows_integrate_exactly_where_the_rule_is_exact() {
+        let t: Vec<f64> = (0..41).map(|k| 0.05 * k as f64).collect();
+        let x: Vec<f64> = t.iter().map(|t| t.powi(4) / 4.0).collect();
+        let theta = vec![t.iter().map(|t| t.powi(3)).collect::<Vec<f64>>()];
+        let (y, cols) = integral_rows(&t, &x, &theta, 4);
+        assert_eq!(y.len(), 37);
+        for (a, b) in y.iter().zip(&cols[0]) {
+            assert!((a - b).abs() < 1e-13, "{a} vs {b}");
+        }
+        let t: Vec<f64> = (0..30).map(|k| (k as f64).powf(1.3) * 0.01).collect();
+        let x: Vec<f64> = t.iter().map(|t| 1.5 * t * t + 2.0 * t).collect();
+        let theta = vec![t.iter().map(|t| 3.0 * t + 2.0).collect::<Vec<f64>>()];
+        let (y, cols) = integral_rows(&t, &x, &theta, 3);
+        for (a, b) in y.iter().zip(&cols[0]) {
+            assert!((a - b).abs() < 1e-12, "{a} vs {b}");
+        }
+    }
+}
