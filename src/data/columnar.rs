@@ -316,6 +316,12 @@ mod tests {
         write_parquet(&dir.join("text.parquet"), &[text]);
         let e = Frame::read(&dir.join("text.parquet"), "t").unwrap_err().to_string();
         assert!(e.contains("`name`") && e.contains("Utf8"), "{e}");
+        // an Arrow file with its columns but no rows: said so, not "a CSV needs a header row"
+        let file = std::fs::File::create(dir.join("empty.arrow")).unwrap();
+        let mut w = arrow_ipc::writer::FileWriter::try_new(file, &part(0, 1).schema()).unwrap();
+        w.finish().unwrap();
+        let e = Frame::read(&dir.join("empty.arrow"), "t").unwrap_err().to_string();
+        assert!(e.contains("empty.arrow") && e.contains("no rows") && !e.contains("CSV"), "{e}");
         // not a Parquet file at all
         std::fs::write(dir.join("fake.parquet"), "t,r\n0,1\n").unwrap();
         let e = Frame::read(&dir.join("fake.parquet"), "t").unwrap_err().to_string();

@@ -413,6 +413,16 @@ fn messages_name_the_real_problem() {
     // a Cyrillic х for the state x
     let cyr = w("cyr.toml", &lorenz.replacen("state = \"x\"", "state = \"\u{445}\"", 1));
     refused(&["simulate", "--model", s(&cyr), "--duration", "1"], &["looks like `x`", "U+0445"]);
+    // a decomposed é (e + combining acute) for a composed one
+    let nfd = w(
+        "nfd.toml",
+        &lorenz.replacen("name = \"x\"", "name = \"\u{e9}\"", 1).replacen(
+            "state = \"x\"",
+            "state = \"e\u{301}\"",
+            1,
+        ),
+    );
+    refused(&["simulate", "--model", s(&nfd), "--duration", "1"], &["looks like `\u{e9}`", "U+0301"]);
     // the time named as a state
     let timed = w("timed.toml", &lorenz.replacen("time = \"t\"", "time = \"x\"", 1));
     refused(
