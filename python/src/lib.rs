@@ -93,12 +93,8 @@ fn method_of(
     integrator: Option<&str>,
     dt: Option<f64>,
 ) -> PyResult<(Integrator, f64)> {
-    let (method, step) = model.simulation();
-    let method = match integrator {
-        Some(name) => Integrator::by_name(name).map_err(fail)?,
-        None => method,
-    };
-    Ok((method, dt.unwrap_or(step)))
+    let method = integrator.map(Integrator::by_name).transpose().map_err(fail)?;
+    Ok(model.simulation(method, dt))
 }
 
 fn to_json(value: &impl serde::Serialize) -> PyResult<String> {

@@ -138,13 +138,19 @@ pub struct Model {
 pub const DEFAULT_DT: f64 = 0.04;
 
 impl Model {
-    /// The method and control step the model is simulated with when a command does not say:
-    /// its `[simulation]` table, else the adaptive Dormand-Prince method at Δt = 0.04.
-    pub fn simulation(&self) -> (crate::sim::Integrator, f64) {
-        match &self.spec.simulation {
-            Some(s) => (s.method, s.dt.unwrap_or(DEFAULT_DT)),
-            None => (crate::sim::Integrator::default(), DEFAULT_DT),
-        }
+    /// The method and control step the model is simulated with: what a command asks for,
+    /// else the model's `[simulation]` table, else the adaptive Dormand-Prince method at
+    /// Δt = 0.04.
+    pub fn simulation(
+        &self,
+        method: Option<crate::sim::Integrator>,
+        dt: Option<f64>,
+    ) -> (crate::sim::Integrator, f64) {
+        let own = self.spec.simulation.as_ref();
+        (
+            method.or(own.map(|s| s.method)).unwrap_or_default(),
+            dt.or(own.and_then(|s| s.dt)).unwrap_or(DEFAULT_DT),
+        )
     }
 
     /// The model file as read (and as changed through the setters).

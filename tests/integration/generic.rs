@@ -549,7 +549,7 @@ fn adaptive_integration_matches_dop853() {
         let x0: Vec<f64> = model.spec().states.iter().map(|s| s.initial).collect();
         let u: Vec<f64> =
             system.inputs.iter().map(|i| inputs.get(i.as_str()).copied().unwrap_or(0.0)).collect();
-        let (method, dt) = model.simulation();
+        let (method, dt) = model.simulation(None, None);
         assert_eq!(method, Integrator::Dopri5);
         let settings = Settings { integrator: method, dt, duration, sample: dt };
         let run = simulate(&system, &x0, &mut Constant(u), &settings).unwrap();

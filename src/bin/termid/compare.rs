@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use termid::data::{differentiator, Frame};
 use termid::diagnose::{simulate_runs, Runs};
 use termid::identify::{coefficients_of, equation_design, fit_equation_design, Fit};
@@ -49,17 +49,8 @@ pub fn run(cmd: CompareCommand) -> Result<()> {
     let equations: Vec<String> =
         if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };
     let diff = differentiator(&cmd.derivative)?;
-    let replay = cmd.replay.as_ref().map(|p| Frame::read(p, &time)).transpose()?;
-    if let (Some(f), Some(p)) = (&replay, &cmd.replay) {
-        // checked before the fits: each back-end's replay would fail alike after all the work
-        if f.len() < 2 {
-            bail!(
-                "--replay {}: a replay needs at least two rows (its inputs over time); it has {}",
-                p.display(),
-                f.len()
-            );
-        }
-    }
+    // read and checked before the fits: each back-end's replay would fail alike after the work
+    let replay = cmd.replay.as_ref().map(|p| crate::runs::replay_frame(p, &time)).transpose()?;
     // the candidates are compiled once per equation, outside the timings, as the peers' design
     // matrix is built outside theirs
     let designs = equations
@@ -121,8 +112,8 @@ fn resimulate(model: &termid::model::Model, run: &Frame, dt: Option<f64>) -> Res
     for s in &model.spec().states {
         run.require(&s.name)?;
     }
-    let (method, step) = model.simulation();
-    let runs = Runs::new(model, std::slice::from_ref(run), dt.unwrap_or(step), method)?;
+    let (method, dt) = model.simulation(None, dt);
+    let runs = Runs::new(model, std::slice::from_ref(run), dt, method)?;
     let gap = runs.gap(&simulate_runs(&runs, model)?);
     Ok(gap.runs.into_iter().flat_map(|(_, states)| states).collect())
 }

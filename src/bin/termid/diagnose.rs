@@ -24,12 +24,9 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
     let hypotheses = termid::plugins::of(&model)
         .and_then(|p| p.hypotheses(&model))
         .unwrap_or_else(|| generic_hypotheses(&model));
-    let settings = Settings {
-        dt: cmd.resim.dt.unwrap_or(model.simulation().1),
-        integrator: cmd.resim.integrator.unwrap_or(model.simulation().0),
-        with_intercepts: cmd.resim.with_intercept,
-        ..Settings::default()
-    };
+    let (integrator, dt) = model.simulation(cmd.resim.integrator, cmd.resim.dt);
+    let settings =
+        Settings { dt, integrator, with_intercepts: cmd.resim.with_intercept, ..Settings::default() };
     let d = diagnose(&model, &runs, &hypotheses, &settings).context("diagnosing")?;
     let mut outputs = termid::output::Outputs::new();
     if let Some(dir) = &cmd.resim.svg {

@@ -98,6 +98,20 @@ pub fn check_once(inputs: &[(String, PathBuf)]) -> Result<()> {
     Ok(())
 }
 
+/// A recorded run whose inputs are replayed (`simulate -m replay:FILE`, `compare --replay`):
+/// refused below two rows, where a replay would take no step and report nothing.
+pub fn replay_frame(path: &Path, time: &str) -> Result<Frame> {
+    let frame = Frame::read(path, time)?;
+    if frame.len() < 2 {
+        bail!(
+            "{}: a replay needs at least two rows (its inputs over time); it has {}",
+            path.display(),
+            frame.len()
+        );
+    }
+    Ok(frame)
+}
+
 pub fn load(data: &[PathBuf], dataset: Option<&Path>, time: &str) -> Result<Vec<Frame>> {
     check_once(&input_files(data, dataset))?;
     let mut frames = data.iter().map(|p| Frame::read(p, time)).collect::<Result<Vec<_>, _>>()?;

@@ -4,7 +4,6 @@
 use std::collections::BTreeMap;
 
 use anyhow::{bail, Context, Result};
-use termid::data::Frame;
 use termid::model::Model;
 use termid::plot::{Figure, Panel, Series};
 use termid::plugin::{Plugin, ScenarioRequest};
@@ -51,8 +50,7 @@ pub fn run(cmd: SimulateCommand) -> Result<()> {
     let mut model = load_model(&cmd.model)?;
     set_parameters(&mut model, &cmd.params)?;
     // the command's method and step, else the model file's, else dopri5 at 0.04 s
-    let (method, step) = model.simulation();
-    let integrator = cmd.integrator.unwrap_or(method);
+    let (integrator, step) = model.simulation(cmd.integrator, None);
     // the adaptive method's accuracy does not hang on the control step: samples finer than
     // it make it finer, rather than an error
     let dt = match cmd.dt {
@@ -185,6 +183,14 @@ fn scenario_run(
     Ok(())
 }
 
+/// A run's final states as the Monte-Carlo table's metrics (`final x`, …).
+fn final_states(system: &termid::sim::System, run: &termid::sim::Trajectory) -> serde_json::Value {
+    let last = run.last_state();
+    serde_json::Value::Object(
+        system.states.iter().zip(&last).map(|(s, v)| (format!("final {s}"), (*v).into())).collect(),
+    )
+}
+
 /// The values a trajectory holds (time, states, inputs, derivatives), for the memory check of
 /// Monte-Carlo draws that keep one each.
 pub fn trajectory_values(t: &termid::sim::Trajectory) -> usize {
@@ -211,19 +217,12 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
         let i = system.input_index(&name).with_context(|| format!("--input: `{k}` is not an input"))?;
         inputs[i] = finite(v, || format!("--input `{p}`"))?;
     }
-    let replayed = match cmd.manoeuvre.as_deref().and_then(|m| m.strip_prefix("replay:")) {
-        Some(file) => {
-            let frame = Frame::read(std::path::Path::new(file), &model.spec().model.time)?;
-            if frame.len() < 2 {
-                bail!(
-                    "{file}: a replay needs at least two rows (its inputs over time); it has {}",
-                    frame.len()
-                );
-            }
-            Some(frame)
-        }
-        None => None,
-    };
+    let replayed = cmd
+        .manoeuvre
+        .as_deref()
+        .and_then(|m| m.strip_prefix("replay:"))
+        .map(|file| crate::runs::replay_frame(std::path::Path::new(file), &model.spec().model.time))
+        .transpose()?;
     let controller = |system: &termid::sim::System| -> Result<Box<dyn Controller>> {
         Ok(match &replayed {
             Some(frame) => Box::new(Replay::new(frame, &system.inputs)?),
@@ -243,10 +242,7 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
         n => Some(Draws::run(model, n, cmd.monte_carlo.seed, trajectory_values(&traj), |m| {
             let system = termid::sim::System::new(m, &BTreeMap::new(), cmd.with_intercept)?;
             let t = simulate(&system, &x0, controller(&system)?.as_mut(), &settings)?;
-            let last = t.last_state();
-            let finals: serde_json::Map<String, serde_json::Value> =
-                system.states.iter().zip(&last).map(|(s, v)| (format!("final {s}"), (*v).into())).collect();
-            Ok((serde_json::Value::Object(finals), t))
+            Ok((final_states(&system, &t), t))
         })?),
     };
     let frame = traj.to_frame("simulation", &model.spec().model.time)?;
@@ -287,8 +283,7 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
     }
     outputs.commit()?;
     let last = traj.last_state();
-    let nominal: serde_json::Map<String, serde_json::Value> =
-        system.states.iter().zip(&last).map(|(s, v)| (format!("final {s}"), (*v).into())).collect();
+    let nominal = final_states(&system, &traj);
     let spread = mc.as_ref().map(|mc| mc.spread(|r| vec![r.0.clone()]));
     match cmd.format {
         Format::Json => println!(
@@ -311,7 +306,7 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
                 println!("  {s} = {v:.6}");
             }
             if let Some((mc, spread)) = mc.as_ref().zip(spread.as_ref()) {
-                print!("{}", mc.text(spread, &serde_json::Value::Object(nominal)));
+                print!("{}", mc.text(spread, &nominal));
             }
             if let Some(out) = &cmd.out {
                 println!("wrote {}", out.display());

@@ -20,10 +20,8 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
     }
     let model = crate::simulate::load_model(&cmd.model)?;
     let runs = crate::runs::load_for(&model, &cmd.runs.data, cmd.runs.dataset.as_deref())?;
-    let (method, step) = model.simulation();
-    let data =
-        Runs::new(&model, &runs, cmd.resim.dt.unwrap_or(step), cmd.resim.integrator.unwrap_or(method))?
-            .with_intercepts(cmd.resim.with_intercept);
+    let (integrator, dt) = model.simulation(cmd.resim.integrator, cmd.resim.dt);
+    let data = Runs::new(&model, &runs, dt, integrator)?.with_intercepts(cmd.resim.with_intercept);
     let sims = data.simulate(&model, &[], &[])?;
     let gap = data.gap(&sims);
     // a plug-in's models: its metrics read off measurement and simulation alike
