@@ -129,8 +129,10 @@ pub struct IdentifyCommand {
     /// The rows are not a time series (no time column; derivative targets are refused).
     #[arg(long, conflicts_with = "time")]
     pub no_time: bool,
-    /// What to explain: a column (`r_dot`) or the derivative of one (`dr/dt`). With --model
-    /// the default is each equation's `<state>_dot` column, else the state's derivative.
+    /// What to explain: a column (`y`) or the derivative of one (`dr/dt`). A rate (`dX/dt`, or
+    /// a column `X_dot` beside `X`) is an equation of motion: stlsq, the constant a candidate
+    /// term. With --model the default is each equation's `<state>_dot` column, else the
+    /// state's derivative.
     #[arg(long, required_unless_present = "model")]
     pub target: Option<String>,
     /// Candidate terms, e.g. --terms "u*v" "u*r" "u^2*δ".
@@ -164,7 +166,8 @@ pub struct IdentifyCommand {
     #[arg(long = "alias", num_args = 1..)]
     pub aliases: Vec<String>,
     /// Regression back-end (settings beyond the defaults: a model file's `backend` table).
-    /// Default: stepwise; with --model each equation's own, which this replaces when given.
+    /// Default: stlsq for a rate (`dX/dt`, `X_dot`), else stepwise; with --model each
+    /// equation's own, which this replaces when given.
     #[arg(long, value_enum)]
     pub backend: Option<BackendName>,
     /// Derivative method for `dX/dt` targets: central, five-point, savitzky-golay[:WINDOW:ORDER],
@@ -238,9 +241,9 @@ pub struct IdentifyCommand {
     /// Fit without an intercept b0.
     #[arg(long, conflicts_with = "intercept")]
     pub no_intercept: bool,
-    /// Fit a forced intercept b0 where the default would not: for a `dX/dt` target without
-    /// --model, and for a model file with `intercept = false` (there the constant `1` is a
-    /// candidate like any other).
+    /// Fit a forced intercept b0 where the default would not: for a rate target (`dX/dt`,
+    /// `X_dot`) without --model, and for a model file with `intercept = false` (there the
+    /// constant `1` is a candidate like any other).
     #[arg(long)]
     pub intercept: bool,
     /// Weighted least squares with the row weights in this column.

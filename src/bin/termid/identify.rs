@@ -45,19 +45,24 @@ fn resolve_derivative(cmd: &mut IdentifyCommand) -> Result<()> {
     Ok(())
 }
 
-/// Whether the equations fit a forced intercept: the flags, else the model file's `intercept`,
-/// else (no model) only where the target is a column (classical regression); for a `dX/dt`
-/// target the constant is a candidate term instead.
-fn intercept_of(cmd: &IdentifyCommand, model: Option<&termid::model::Model>) -> bool {
-    if cmd.no_intercept {
-        return false;
-    }
-    if cmd.intercept {
-        return true;
-    }
-    match model {
-        Some(m) => m.spec().model.intercept,
-        None => !matches!(Target::parse(cmd.target.as_deref().unwrap_or_default()), Target::Derivative(_)),
+/// Whether the equations fit a forced intercept: the flags, else `default` (a model file's
+/// `intercept`; without one, only where the target is not a rate, as in classical regression:
+/// for a rate the constant is a candidate term instead).
+fn intercept_of(cmd: &IdentifyCommand, default: bool) -> bool {
+    !cmd.no_intercept && (cmd.intercept || default)
+}
+
+/// Whether a target without a model file is a state's rate, so that an equation of motion is
+/// fitted: `dX/dt`, or a column `X_dot` beside a column `X` of timed runs (termid's own name
+/// for a measured rate, as model files and `simulate` write it).
+fn is_rate(target: &Target, frames: &[Frame], no_time: bool) -> bool {
+    match target {
+        Target::Derivative(_) => true,
+        Target::Column(c) => {
+            !no_time
+                && c.strip_suffix("_dot")
+                    .is_some_and(|s| frames.iter().all(|f| f.names().iter().any(|n| n == s)))
+        }
     }
 }
 
@@ -180,15 +185,15 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
     let candidates = parse_terms(&texts, &vocab)?;
     let forced = parse_terms(&cmd.forced, &vocab)?;
     let excluded = parse_terms(&cmd.exclude, &vocab)?;
-    // an ODE's defaults (a dX/dt target): sequential thresholding, scale-free, and the
+    // an ODE's defaults (a rate as target): sequential thresholding, scale-free, and the
     // constant as a candidate like any other rather than a forced intercept
-    let ode = matches!(target, Target::Derivative(_));
+    let ode = is_rate(&target, &frames, cmd.no_time);
     let backend = if ode && cmd.backend.is_none() {
         Backend::from(BackendName::Stlsq)
     } else {
         configure_backend(&cmd)?
     };
-    let intercept = intercept_of(&cmd, None);
+    let intercept = intercept_of(&cmd, !ode);
     let mut candidates = candidates;
     let one = vocab.parse("1")?;
     if ode && !intercept && !cmd.no_intercept && !candidates.contains(&one) {
@@ -304,7 +309,7 @@ fn run_moments(cmd: IdentifyCommand) -> Result<()> {
     if cmd.backend.is_some() {
         model = model.with_backend(&configure_backend(&cmd)?)?;
     }
-    let intercept = intercept_of(&cmd, Some(&model));
+    let intercept = intercept_of(&cmd, model.spec().model.intercept);
     let (mut model, fits) = crate::moments::identify(&model, &cmd.moments, &cmd.equation, intercept)?;
     if let Some(out) = &cmd.out {
         let sources = cmd.moments.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
@@ -401,7 +406,11 @@ fn identify_in_pieces(cmd: &IdentifyCommand, model: &termid::model::Model, rows:
     }
     let origin = cmd.data.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
     let parts = all.into_iter().map(|m| (origin.clone(), m)).collect();
-    let identified = termid::identify::identify_from_moments(model, parts, intercept_of(cmd, Some(model)))?;
+    let identified = termid::identify::identify_from_moments(
+        model,
+        parts,
+        intercept_of(cmd, model.spec().model.intercept),
+    )?;
     let checks =
         termid::plugins::of(&identified.model).map(|p| p.checks(&identified.model, &[])).unwrap_or_default();
     Ok(Start {
@@ -724,7 +733,7 @@ fn identify_start(
     let how = termid::identify::ModelIdentification {
         equations: names,
         differentiator: diff.as_ref(),
-        intercept: intercept_of(cmd, Some(model)),
+        intercept: intercept_of(cmd, model.spec().model.intercept),
         target: cmd.target.as_deref().map(Target::parse),
     };
     let (identified, chosen_text) = match &cmd.choose {
@@ -763,7 +772,7 @@ fn identify_start(
     let mut model = identified.model;
     let how_refined = RefineHow {
         states: refine.cloned().flatten(),
-        intercept: intercept_of(cmd, Some(&model)),
+        intercept: intercept_of(cmd, model.spec().model.intercept),
         prior: cmd.refine_prior,
         validation: validation.as_deref(),
         iterations: cmd.refine_iterations,
