@@ -4,6 +4,7 @@
 //! about ships; the manoeuvres of the ship plug-in are controllers.
 
 mod controller;
+mod dopri5;
 mod integrator;
 mod steady;
 mod system;

@@ -1,0 +1,355 @@
+//! Dormand & Prince's embedded Runge-Kutta 5(4) pair with error control and its dense output
+//! (Dormand & Prince 1980; Hairer, Nørsett & Wanner, *Solving ODEs I*, II.5-II.6). While the
+//! controller's inputs go on along one straight line (held, or a rudder turning at its rate),
+//! steps span as many control intervals as the tolerances allow and the states at the control
+//! times inside a step come from the dense output; an interval where the line breaks is
+//! integrated on its own in substeps, the input ramped across it.
+
+// The stage updates index several parallel arrays at once; index loops read best there.
+#![allow(clippy::needless_range_loop)]
+
+use super::system::{System, Workspace};
+use super::{SimError, Tolerances};
+
+// Dormand & Prince (1980), Table 5.2 of Hairer, Nørsett & Wanner
+const C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
+const A: [[f64; 6]; 7] = [
+    [0.0; 6],
+    [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
+    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
+    [19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0, 0.0, 0.0],
+    [9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0, 0.0],
+    [35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0],
+];
+/// The fifth-order weights less the embedded fourth-order ones: the error estimate.
+const E: [f64; 7] =
+    [71.0 / 57600.0, 0.0, -71.0 / 16695.0, 71.0 / 1920.0, -17253.0 / 339200.0, 22.0 / 525.0, -1.0 / 40.0];
+/// The dense output's fourth-order weights (Hairer's DOPRI5, `CONTD5`; Shampine 1986).
+const D: [f64; 7] = [
+    -12715105075.0 / 11282082432.0,
+    0.0,
+    87487479700.0 / 32700410799.0,
+    -10690763975.0 / 1880347072.0,
+    701980252875.0 / 199316789632.0,
+    -1453857185.0 / 822651844.0,
+    69997945.0 / 29380423.0,
+];
+
+/// The adaptive integrator's state between control intervals.
+pub(super) struct Dopri5 {
+    k: [Vec<f64>; 7],
+    stage: Vec<f64>,
+    trial: Vec<f64>,
+    u: Vec<f64>,
+    /// ẋ at a sample that no step end provides.
+    derivative: Vec<f64>,
+    /// The step size to try next.
+    h: f64,
+    /// Whether `k[0]` holds f at (`t`, `y`) (first same as last).
+    fresh: bool,
+    /// Where the integration stands: the end of the last step, which may lie beyond the
+    /// control time last asked for.
+    t: f64,
+    y: Vec<f64>,
+    /// The last free step, [t − span, t], as its dense-output polynomial.
+    span: f64,
+    dense: [Vec<f64>; 5],
+    /// The line the inputs follow: `held` at `held_t`, changing by `slope` per second.
+    held: Vec<f64>,
+    held_t: f64,
+    slope: Vec<f64>,
+    tol: Tolerances,
+    /// Whether (`t`, `y`) hold the run's start or a later point.
+    started: bool,
+    /// The control interval (for the smallest step allowed and the time tolerance).
+    dt: f64,
+}
+
+impl Dopri5 {
+    pub(super) fn new(n: usize, m: usize, dt: f64, tol: Tolerances) -> Dopri5 {
+        Dopri5 {
+            k: std::array::from_fn(|_| vec![0.0; n]),
+            stage: vec![0.0; n],
+            trial: vec![0.0; n],
+            u: vec![0.0; m],
+            derivative: vec![0.0; n],
+            h: dt,
+            fresh: false,
+            t: 0.0,
+            y: vec![0.0; n],
+            span: 0.0,
+            dense: std::array::from_fn(|_| vec![0.0; n]),
+            held: vec![f64::NAN; m],
+            held_t: 0.0,
+            slope: vec![0.0; m],
+            tol,
+            started: false,
+            dt,
+        }
+    }
+
+    /// ẋ = f(x, u) at the control time `t` (a sample), from the last step where it ended there.
+    pub(super) fn derivative_at(
+        &mut self,
+        system: &System,
+        ws: &mut Workspace,
+        t: f64,
+        x: &[f64],
+        u: &[f64],
+    ) -> &[f64] {
+        if self.fresh && self.at(t) && self.on_line(t, u) {
+            return &self.k[0];
+        }
+        system.derivatives(x, u, ws, &mut self.derivative);
+        &self.derivative
+    }
+
+    fn at(&self, t: f64) -> bool {
+        (self.t - t).abs() <= 1e-9 * self.dt
+    }
+
+    /// The inputs on the line at `t`.
+    fn line(&self, t: f64, out: &mut [f64]) {
+        for j in 0..out.len() {
+            out[j] = self.held[j] + self.slope[j] * (t - self.held_t);
+        }
+    }
+
+    /// Whether `u` lies on the line at `t` (to rounding: a rate added up step by step).
+    fn on_line(&self, t: f64, u: &[f64]) -> bool {
+        u.iter().enumerate().all(|(j, v)| {
+            let w = self.held[j] + self.slope[j] * (t - self.held_t);
+            (v - w).abs() <= 1e-10 * v.abs().max(w.abs()).max(1e-3)
+        })
+    }
+
+    /// From `x0` at `t0` (the state this integrator gave for `t0`) over the control interval
+    /// `dt` into `x`, the inputs going linearly from `u.0` to `u.1`; `end` is the last control
+    /// time of the run, beyond which no step reaches.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn advance(
+        &mut self,
+        system: &System,
+        ws: &mut Workspace,
+        x0: &[f64],
+        x: &mut [f64],
+        u: (&[f64], &[f64]),
+        (t0, dt): (f64, f64),
+        end: f64,
+    ) -> Result<(), SimError> {
+        let t1 = t0 + dt;
+        if !self.started {
+            self.started = true;
+            self.t = t0;
+            self.y.copy_from_slice(x0);
+            self.fresh = false;
+        }
+        if !self.on_line(t0, u.0) || !self.on_line(t1, u.1) {
+            // the inputs leave their line: the step that ran past t0 is cut there, this
+            // interval integrated on its own, and its ramp is the line from here on
+            if !self.at(t0) {
+                self.fresh = false;
+            }
+            self.interval(system, ws, x0, x, u, (t0, dt))?;
+            self.t = t1;
+            self.y.copy_from_slice(x);
+            self.held.copy_from_slice(u.1);
+            self.held_t = t1;
+            for j in 0..self.slope.len() {
+                self.slope[j] = (u.1[j] - u.0[j]) / dt;
+            }
+            self.span = 0.0;
+            return Ok(());
+        }
+        while self.t < t1 - 1e-9 * dt {
+            self.free_step(system, ws, end)?;
+        }
+        if self.at(t1) || self.span == 0.0 {
+            x.copy_from_slice(&self.y);
+        } else {
+            // dense output: θ = (t1 − t_start)/h within the last step
+            let theta = 1.0 - (self.t - t1) / self.span;
+            let eta = 1.0 - theta;
+            let [r1, r2, r3, r4, r5] = &self.dense;
+            for i in 0..x.len() {
+                x[i] = r1[i] + theta * (r2[i] + eta * (r3[i] + theta * (r4[i] + eta * r5[i])));
+            }
+        }
+        Ok(())
+    }
+
+    /// One step from (`t`, `y`) with the inputs held, of the size the error control allows,
+    /// retried smaller until accepted; keeps its dense output.
+    fn free_step(&mut self, system: &System, ws: &mut Workspace, end: f64) -> Result<(), SimError> {
+        let n = self.y.len();
+        if !self.fresh {
+            let mut u = std::mem::take(&mut self.u);
+            self.line(self.t, &mut u);
+            system.derivatives(&self.y, &u, ws, &mut self.k[0]);
+            self.u = u;
+            self.fresh = true;
+        }
+        let (held, slope, held_t) =
+            (std::mem::take(&mut self.held), std::mem::take(&mut self.slope), self.held_t);
+        let mut tries = 0usize;
+        loop {
+            let h = self.h.min(end - self.t).max(1e-12 * self.dt);
+            let (y, t) = (std::mem::take(&mut self.y), self.t);
+            let input = |st: usize, u: &mut [f64]| {
+                for j in 0..u.len() {
+                    u[j] = held[j] + slope[j] * (t + C[st] * h - held_t);
+                }
+            };
+            let err = self.attempt(system, ws, &y, h, &input);
+            self.y = y;
+            if err <= 1.0 {
+                // dense output before the last stage becomes the next step's first (Hairer's CONTD5)
+                for i in 0..n {
+                    let diff = self.trial[i] - self.y[i];
+                    let bspl = h * self.k[0][i] - diff;
+                    self.dense[0][i] = self.y[i];
+                    self.dense[1][i] = diff;
+                    self.dense[2][i] = bspl;
+                    self.dense[3][i] = diff - h * self.k[6][i] - bspl;
+                    let mut d = 0.0;
+                    for (j, w) in D.iter().enumerate() {
+                        d += w * self.k[j][i];
+                    }
+                    self.dense[4][i] = h * d;
+                }
+                self.y.copy_from_slice(&self.trial);
+                self.t += h;
+                self.span = h;
+                self.k.swap(0, 6);
+                self.h = h * grow(err);
+                (self.held, self.slope) = (held, slope);
+                return Ok(());
+            }
+            self.h = shrink(h, err);
+            tries += 1;
+            if self.h < self.dt * 1e-10 || tries > 100_000 {
+                self.fresh = false;
+                (self.held, self.slope) = (held, slope);
+                return Err(self.stuck(system, self.t));
+            }
+        }
+    }
+
+    /// Integrates from `x0` at `t0` over `dt` into `x` in substeps, the inputs going linearly
+    /// from `u.0` to `u.1`.
+    fn interval(
+        &mut self,
+        system: &System,
+        ws: &mut Workspace,
+        x0: &[f64],
+        x: &mut [f64],
+        u: (&[f64], &[f64]),
+        (t0, dt): (f64, f64),
+    ) -> Result<(), SimError> {
+        let input_at = |s: f64, out: &mut [f64]| {
+            let w = (s / dt).clamp(0.0, 1.0);
+            for j in 0..out.len() {
+                out[j] = u.0[j] + w * (u.1[j] - u.0[j]);
+            }
+        };
+        x.copy_from_slice(x0);
+        if !self.fresh {
+            input_at(0.0, &mut self.u);
+            system.derivatives(x, &self.u, ws, &mut self.k[0]);
+        }
+        let mut s = 0.0;
+        let mut tries = 0usize;
+        while s < dt {
+            let h = self.h.min(dt - s);
+            // the last substep of an interval ends on its grid point exactly
+            let ends = s + h >= dt * (1.0 - 1e-12);
+            let stage_input = |st: usize, out: &mut [f64]| {
+                input_at(if ends && C[st] == 1.0 { dt } else { s + C[st] * h }, out)
+            };
+            let err = self.attempt(system, ws, x, h, &stage_input);
+            if err <= 1.0 {
+                s = if ends { dt } else { s + h };
+                x.copy_from_slice(&self.trial);
+                self.k.swap(0, 6);
+                // a last substep cut short to end on the grid says nothing against the size
+                // the one before it had
+                self.h = if ends && grow(err) >= 1.0 { self.h.max(h) } else { h } * grow(err);
+            } else {
+                self.h = shrink(h, err);
+            }
+            tries += 1;
+            if self.h < dt * 1e-10 || tries > 100_000 {
+                self.fresh = false;
+                self.y.copy_from_slice(x);
+                return Err(self.stuck(system, t0 + s));
+            }
+        }
+        self.fresh = true;
+        Ok(())
+    }
+
+    /// Stages 2-7 of a step of `h` from `x` (`k[0]` holds f there), the fifth-order solution
+    /// into `trial`; returns the error estimate in units of the tolerances.
+    fn attempt(
+        &mut self,
+        system: &System,
+        ws: &mut Workspace,
+        x: &[f64],
+        h: f64,
+        input: &dyn Fn(usize, &mut [f64]),
+    ) -> f64 {
+        let n = x.len();
+        for st in 1..7 {
+            for i in 0..n {
+                let mut acc = 0.0;
+                for (j, a) in A[st][..st].iter().enumerate() {
+                    acc += a * self.k[j][i];
+                }
+                self.stage[i] = x[i] + h * acc;
+            }
+            input(st, &mut self.u);
+            let (_, rest) = self.k.split_at_mut(st);
+            system.derivatives(&self.stage, &self.u, ws, &mut rest[0]);
+        }
+        // stage 7's point is the fifth-order solution (A[6] = b)
+        self.trial.copy_from_slice(&self.stage);
+        let mut err = 0.0;
+        for i in 0..n {
+            let mut e = 0.0;
+            for (j, w) in E.iter().enumerate() {
+                e += w * self.k[j][i];
+            }
+            let scale = self.tol.atol + self.tol.rtol * x[i].abs().max(self.trial[i].abs());
+            err += (h * e / scale).powi(2);
+        }
+        (err / n.max(1) as f64).sqrt()
+    }
+
+    fn stuck(&self, system: &System, t: f64) -> SimError {
+        SimError::Settings(format!(
+            "the adaptive integrator could not meet its tolerances at t = {t:?} s (step {:?} s): the model is stiff or diverging there; state {}",
+            self.h,
+            system.states.iter().zip(self.y.iter()).map(|(n, v)| format!("{n} = {v:.6}")).collect::<Vec<_>>().join(", ")
+        ))
+    }
+}
+
+/// The next step after an accepted one: by the error's fifth root with a safety factor,
+/// by at most 5× (Hairer, Nørsett & Wanner II.4).
+fn grow(err: f64) -> f64 {
+    if err == 0.0 {
+        5.0
+    } else {
+        (0.9 * err.powf(-0.2)).clamp(0.2, 5.0)
+    }
+}
+
+/// The retry after a rejected step.
+fn shrink(h: f64, err: f64) -> f64 {
+    if err.is_finite() {
+        h * (0.9 * err.powf(-0.2)).clamp(0.1, 0.9)
+    } else {
+        h * 0.1
+    }
+}
