@@ -135,9 +135,12 @@ impl Settings {
         }
         let every = (self.sample / self.dt).round();
         if every < 1.0 || (every * self.dt - self.sample).abs() > 1e-9 * self.sample.max(self.dt) {
+            let every = (self.sample / self.dt).ceil().max(1.0);
             return bad(format!(
-                "output interval {:?} s is not a whole multiple of the step {:?} s",
-                self.sample, self.dt
+                "output interval {:?} s is not a whole multiple of the step {:?} s: give a step that divides it (e.g. --dt {:?}) or an interval that is a multiple",
+                self.sample,
+                self.dt,
+                self.sample / every
             ));
         }
         let steps = (self.duration / self.dt).round();

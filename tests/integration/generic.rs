@@ -897,3 +897,41 @@ fn the_benchmark_systems_are_model_files_termid_simulates() {
     }
     assert!(count >= 25, "{count} systems");
 }
+
+/// The adaptive method's output interval is free: 0.05 s beside the default control step of
+/// 0.04 s is sampled at 0.05 s (a step of 0.025 s for the inputs), not refused; a fixed-step
+/// method is still refused, with a step that would do.
+#[test]
+fn any_output_interval_for_the_adaptive_method() {
+    let dir = crate::common::Scratch::new("sample-interval");
+    let out = dir.join("l.csv");
+    let (ok, _, err) = termid(&[
+        "simulate",
+        "--model",
+        "models/lorenz.toml",
+        "--duration",
+        "1",
+        "--sample",
+        "0.05",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let text = std::fs::read_to_string(&out).unwrap();
+    let times: Vec<f64> =
+        text.lines().skip(1).map(|l| l.split(',').next().unwrap().parse().unwrap()).collect();
+    assert_eq!(times.len(), 21);
+    assert!(times.iter().enumerate().all(|(k, t)| (t - 0.05 * k as f64).abs() < 1e-12), "{times:?}");
+    let (ok, _, err) = termid(&[
+        "simulate",
+        "--model",
+        "models/lorenz.toml",
+        "--integrator",
+        "rk4",
+        "--duration",
+        "1",
+        "--sample",
+        "0.05",
+    ]);
+    assert!(!ok && err.contains("--dt 0.025"), "{err}");
+}

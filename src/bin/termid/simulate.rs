@@ -51,11 +51,15 @@ pub fn run(cmd: SimulateCommand) -> Result<()> {
     set_parameters(&mut model, &cmd.params)?;
     // the command's method and step, else the model file's, else dopri5 at 0.04 s
     let (integrator, step) = model.simulation(cmd.integrator, None);
-    // the adaptive method's accuracy does not hang on the control step: samples finer than
-    // it make it finer, rather than an error
+    // the adaptive method's accuracy does not hang on the control step: an output interval
+    // that is no whole multiple of it (finer, or 0.05 s beside 0.04 s) makes it the largest
+    // step at most as long that divides the interval, rather than an error
     let dt = match cmd.dt {
         Some(dt) => dt,
-        None if integrator == Integrator::Dopri5 && cmd.sample > 0.0 && cmd.sample < step => cmd.sample,
+        None if integrator == Integrator::Dopri5 && cmd.sample.is_finite() && cmd.sample > 0.0 => {
+            let every = (cmd.sample / step * (1.0 - 1e-9)).ceil().max(1.0);
+            cmd.sample / every
+        }
         None => step,
     };
     match (&cmd.manoeuvre, termid::plugins::of(&model)) {
