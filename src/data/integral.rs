@@ -37,6 +37,12 @@ impl Differentiator for IntegralForm {
         ))
     }
 
+    /// A window reaches `window` samples ahead: a run read in pieces with that much context
+    /// has every window of its own rows whole.
+    fn reach(&self) -> Option<usize> {
+        Some(self.window)
+    }
+
     fn integral_window(&self) -> Option<usize> {
         Some(self.window)
     }

@@ -328,6 +328,9 @@ impl Identification<'_> {
         frame: &Frame,
         rows: std::ops::Range<usize>,
     ) -> Result<Moments, IdentifyError> {
+        if let (Some(w), Target::Derivative(_)) = (self.differentiator.integral_window(), target) {
+            return self.integral_moments(library, target, frame, w, rows);
+        }
         let run = self.bind(library, target, frame)?;
         let offset = rows.start;
         let mut parts = gather(library.len(), &[rows.len()], |_, part, acc| {
@@ -345,7 +348,7 @@ impl Identification<'_> {
         frames: &[Frame],
     ) -> Result<Vec<Moments>, IdentifyError> {
         if let (Some(w), Target::Derivative(_)) = (self.differentiator.integral_window(), target) {
-            return frames.iter().map(|f| self.integral_moments(library, target, f, w)).collect();
+            return frames.iter().map(|f| self.integral_moments(library, target, f, w, 0..f.len())).collect();
         }
         let runs = frames.iter().map(|f| self.bind(library, target, f)).collect::<Result<Vec<_>, _>>()?;
         let rows: Vec<usize> = frames.iter().map(Frame::len).collect();
@@ -353,13 +356,16 @@ impl Identification<'_> {
     }
 
     /// One run's statistics in the integral form: the candidates evaluated on every row, then
-    /// integrated over windows of `w` intervals against the target's change over each.
+    /// integrated over windows of `w` intervals against the target's change over each; the
+    /// windows that start on `own` rows (all of a whole run; a piece's own, its context
+    /// after it holding their ends).
     fn integral_moments(
         &self,
         library: &Library,
         target: &Target,
         frame: &Frame,
         w: usize,
+        own: std::ops::Range<usize>,
     ) -> Result<Moments, IdentifyError> {
         if self.weights.is_some() {
             return Err(IdentifyError::Setup(
@@ -381,9 +387,10 @@ impl Identification<'_> {
             }
         });
         let (y, integrals) = crate::data::integral_rows(frame.time(), &run.y, &columns, w);
-        let refs: Vec<&[f64]> = integrals.iter().map(Vec::as_slice).collect();
+        let starts = own.start.min(y.len())..own.end.min(y.len());
+        let refs: Vec<&[f64]> = integrals.iter().map(|c| &c[starts.clone()]).collect();
         let mut acc = Accumulator::new(library.len());
-        acc.push_columns(&refs, &y, None);
+        acc.push_columns(&refs, &y[starts], None);
         if let Some(j) = acc.not_finite() {
             return Err(IdentifyError::Setup(format!(
                 "{}: the integral of candidate {} over some window is not finite",

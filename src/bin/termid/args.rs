@@ -57,7 +57,8 @@ pub struct MomentsCommand {
     #[arg(long)]
     pub dataset: Option<PathBuf>,
     /// Derivative method where the target is a state's derivative (the runs have no
-    /// `<state>_dot` column): central, five-point, savitzky-golay[:W:Q], spline[:ALPHA], kalman.
+    /// `<state>_dot` column): central, five-point, savitzky-golay[:W:Q], spline[:ALPHA], kalman,
+    /// or integral[:W] (no rate: changes over windows of W samples against integrals).
     #[arg(long, default_value = "central")]
     pub derivative: String,
     /// Write the statistics here (JSON; numbers round-trip exactly).
@@ -65,7 +66,8 @@ pub struct MomentsCommand {
     pub out: PathBuf,
     /// Rows per piece when `--data` files are read in pieces (one pass, memory bounded by
     /// a few pieces, whatever the file's size): with a derivative of fixed reach (central,
-    /// five-point, savitzky-golay) or measured `<state>_dot` columns. 0 reads each file whole.
+    /// five-point, savitzky-golay, integral) or measured `<state>_dot` columns. 0 reads each
+    /// file whole.
     #[arg(allow_negative_numbers = true, long, default_value_t = 262_144)]
     pub chunk_rows: usize,
 }
@@ -110,7 +112,7 @@ pub enum RuleName {
 /// `termid identify`.
 #[derive(Clone, Debug, Args)]
 #[command(
-    after_help = "Examples:\n  termid identify --data tests/data/hald.csv --no-time --target y --terms x1 x2 x3 x4\n  termid identify --model models/lorenz.toml --data lorenz.csv --out lorenz_id.toml\n  termid identify --model ship.toml --dataset runs.toml --derivative kinematic,kalman --smooth \\\n      --no-intercept --choose sparse,best-subset --compare u,v,r,ψ --refine u,v,r,ψ --out ship_id.toml\nBack-ends: stepwise (the paper's STPRG), efroymson, best-subset, sparse, stlsq.\nDerivatives: central, five-point, savitzky-golay[:W:Q], spline[:ALPHA], kalman[:RATIO]; kinematic (ship models).\nRuns: CSV (model names, SI; aliases and semicolons read), Parquet, Arrow IPC, or a dataset file (README)."
+    after_help = "Examples:\n  termid identify --data tests/data/hald.csv --no-time --target y --terms x1 x2 x3 x4\n  termid identify --model models/lorenz.toml --data lorenz.csv --out lorenz_id.toml\n  termid identify --model ship.toml --dataset runs.toml --derivative kinematic,kalman --smooth \\\n      --no-intercept --choose sparse,best-subset --compare u,v,r,ψ --refine u,v,r,ψ --out ship_id.toml\nBack-ends: stepwise (the paper's STPRG), efroymson, best-subset, sparse, stlsq.\nDerivatives: integral[:W] (no rate), central, five-point, savitzky-golay[:W:Q], spline[:ALPHA], kalman[:RATIO]; kinematic (ship models).\nRuns: CSV (model names, SI; aliases and semicolons read), Parquet, Arrow IPC, or a dataset file (README)."
 )]
 pub struct IdentifyCommand {
     /// CSV files with a header row; several are combined (the paper's "Komb. Daten").
@@ -233,7 +235,7 @@ pub struct IdentifyCommand {
     /// With --model and plain --data files: read them in pieces of this many rows, one pass
     /// and bounded memory whatever their size (statistics merged as `termid moments` and
     /// `identify --moments` would). Needs a derivative of fixed reach (central, five-point,
-    /// savitzky-golay) and none of --dataset, --resample, --smooth, --prepared-svg, --refine,
+    /// savitzky-golay, integral) and none of --dataset, --resample, --smooth, --prepared-svg, --refine,
     /// --choose, --target. Default: in pieces of 262144 rows when the files together exceed
     /// 256 MiB and these hold; 0 reads them whole.
     #[arg(allow_negative_numbers = true, long, value_name = "ROWS", requires = "model")]

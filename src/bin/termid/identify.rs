@@ -32,16 +32,9 @@ fn resolve_derivative(cmd: &mut IdentifyCommand) -> Result<()> {
         Some(path) => termid::plugins::load(path).map(|m| termid::plugins::of(&m).is_some()).unwrap_or(false),
         None => false,
     };
-    // read in pieces, a method of fixed reach: five-point, the most accurate of them
-    let pieces = cmd.chunk_rows.is_some_and(|r| r > 0);
-    cmd.derivative = if plugin {
-        "central"
-    } else if pieces {
-        "five-point"
-    } else {
-        "integral"
-    }
-    .into();
+    // the integral form reads in pieces as well as whole (its windows reach a fixed number
+    // of samples ahead)
+    cmd.derivative = if plugin { "central" } else { "integral" }.into();
     Ok(())
 }
 
