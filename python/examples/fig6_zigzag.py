@@ -24,7 +24,7 @@ runs = {m: ship.simulate(m) for m in
 # coefficients averaged where it was found in every run (NOTES.md §7, "Mittelwert").
 
 # %%
-singles = [ship.identify(run, "central", names=[name]).model for name, run in runs.items()]
+singles = [ship.identify(run, target="column", names=[name]).model for name, run in runs.items()]
 mean = termid.Model.from_toml(ship.to_toml(), "Mittelwert")
 for eq in ship.identifiable:
     tables = [m.coefficients(eq).set_index("term")["value"] for m in singles]

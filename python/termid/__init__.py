@@ -21,6 +21,7 @@ from __future__ import annotations
 import functools
 import json
 import os
+import warnings
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -77,9 +78,50 @@ def _frame_in_place(data: pd.DataFrame) -> Optional[Dict[str, np.ndarray]]:
     return dict(zip(map(str, data.columns.tolist()), arrays))
 
 
+def _seconds(name: str, values: Any) -> Any:
+    """A column of durations (timedelta64) in seconds, or of instants (datetime64) in seconds
+    since its first; termid reads times in seconds, and the raw numbers would be nanoseconds.
+    Other columns pass unchanged."""
+    array = np.asarray(values)
+    if array.dtype.kind not in "mM":
+        return values
+    kind = "durations" if array.dtype.kind == "m" else "date-times"
+    if array.dtype.kind == "M":
+        array = array - array[0] if len(array) else array.astype("timedelta64[ns]")
+    if np.isnat(array).any():
+        raise TermidError(f"column `{name}`: a missing time (NaT) at row {int(np.argmax(np.isnat(array))) + 1}")
+    warnings.warn(
+        f"termid: column `{name}` holds {kind}; read as seconds"
+        + (" since its first value" if kind == "date-times" else ""),
+        stacklevel=4,
+    )
+    return array.astype("timedelta64[ns]").astype(np.int64) / 1e9
+
+
+def _once(names: Sequence[Any]) -> None:
+    """Refuses column names given twice (a dict would keep the last without a word)."""
+    seen = set()
+    twice = []
+    for n in map(str, names):
+        if n in seen and n not in twice:
+            twice.append(n)
+        seen.add(n)
+    if twice:
+        raise TermidError(
+            f"column {', '.join(f'`{n}`' for n in twice)} appears twice: which one is meant is not clear; rename or drop one"
+        )
+
+
 def _columns(data: Data) -> Dict[str, np.ndarray]:
-    """Columns as contiguous float64 arrays, without copying where the layout allows."""
+    """Columns as contiguous float64 arrays, without copying where the layout allows; time
+    columns (timedelta64, datetime64) in seconds."""
     if isinstance(data, pd.DataFrame):
+        _once(data.columns)
+        if any(getattr(dt, "kind", "O") in "mM" for dt in data.dtypes):
+            data = pd.DataFrame(
+                {str(c): _seconds(str(c), data.iloc[:, j].to_numpy()) for j, c in enumerate(data.columns)},
+                index=data.index,
+            )
         in_place = _frame_in_place(data)
         if in_place is not None:
             return in_place
@@ -95,14 +137,15 @@ def _columns(data: Data) -> Dict[str, np.ndarray]:
     elif isinstance(data, Mapping):
         items = ((str(k), v) for k, v in data.items())
     elif hasattr(data, "column_names") and hasattr(data, "column"):  # pyarrow Table
-        items = ((n, data.column(n).to_numpy()) for n in data.column_names)
+        _once(data.column_names)
+        items = ((n, data.column(j).to_numpy()) for j, n in enumerate(data.column_names))
     elif hasattr(data, "to_pandas"):
         return _columns(data.to_pandas())
     else:
         raise TypeError(
             f"a run must be a pandas DataFrame, a dict of arrays or a pyarrow Table, not {type(data).__name__}"
         )
-    return {name: np.ascontiguousarray(values, dtype=np.float64) for name, values in items}
+    return {name: np.ascontiguousarray(_seconds(name, values), dtype=np.float64) for name, values in items}
 
 
 def _runs(runs: Union[Data, Sequence[Data]], names: Optional[Sequence[str]] = None) -> List[Tuple[str, Dict[str, np.ndarray]]]:
@@ -215,7 +258,7 @@ def _settings_text(backend: str, settings: Mapping[str, Any]) -> str:
 def fit(
     data: Data,
     target: str,
-    terms: Optional[Sequence[str]] = None,
+    terms: Union[str, Sequence[str], None] = None,
     backend: str = "stepwise",
     *,
     intercept: bool = True,
@@ -231,6 +274,9 @@ def fit(
     columns = _columns(data)
     if target not in columns:
         raise TermidError(f"no column `{target}` to fit (columns: {', '.join(columns)})")
+    if isinstance(terms, str):
+        # one term, not its characters
+        terms = [terms]
     if terms is None:
         terms = [c for c in columns if c not in (target, weights)]
     native = _termid.fit(
@@ -264,8 +310,15 @@ class Identified:
     def chosen_step(self, equation: str) -> Optional[int]:
         return self.reports[equation].get("chosen_step")
 
+    @property
+    def targets(self) -> Dict[str, str]:
+        """What each equation explained: a column of the runs (``r_dot``) or a derivative
+        estimated from them (``dr/dt``)."""
+        return {name: str(r.get("target", "")) for name, r in self.reports.items()}
+
     def __repr__(self) -> str:
-        return f"termid.Identified({self.model.name!r}: {', '.join(self.reports)})"
+        told = ", ".join(f"{name} ← {t}" for name, t in self.targets.items())
+        return f"termid.Identified({self.model.name!r}: {told})"
 
 
 class Model:
@@ -346,6 +399,7 @@ class Model:
         runs: Union[Data, Sequence[Data]],
         derivative: Optional[str] = None,
         *,
+        target: Optional[str] = None,
         equations: Sequence[str] = (),
         intercept: Optional[bool] = None,
         backend: Optional[str] = None,
@@ -354,12 +408,27 @@ class Model:
     ) -> Identified:
         """Every identifiable equation (or ``equations``) from the runs, with the model's
         candidates, forced terms and back-end (or ``backend`` with its settings as keywords).
-        ``derivative`` defaults to ``integral`` (the integral form: no derivative estimated;
-        central differences for a ship, as the paper); ``intercept`` to the model file's
-        (``[model] intercept``)."""
-        native, fits = self._native.identify(
-            _runs(runs, names), derivative, list(equations), intercept, _backend(backend, settings)
-        )
+
+        ``target``: ``"column"`` explains the runs' rate columns (``r_dot``), ``"derivative"``
+        the states' derivatives estimated by ``derivative``; by default the rate columns where
+        the runs have them and no ``derivative`` is named, else the derivatives
+        (:attr:`Identified.targets` says which). ``derivative`` defaults to ``integral`` (the
+        integral form: no derivative estimated; central differences for a ship, as the
+        paper); ``intercept`` to the model file's (``[model] intercept``)."""
+        if target not in (None, "column", "derivative"):
+            raise ValueError(f"target must be 'column', 'derivative' or None, not {target!r}")
+        data = _runs(runs, names)
+        rates = [f"{s}_dot" for s in self._native.states]
+        if target == "derivative" or (target is None and derivative is not None):
+            # the rate columns would be taken as the targets: without them the derivative is
+            data = [(n, {k: v for k, v in cols.items() if k not in rates}) for n, cols in data]
+        elif target == "column":
+            wanted = list(equations) or list(self._native.identifiable)
+            for n, cols in data:
+                missing = [r for r in rates if r in wanted and r not in cols]
+                if missing:
+                    raise TermidError(f"{n}: target='column' but the run has no column {', '.join(missing)}")
+        native, fits = self._native.identify(data, derivative, list(equations), intercept, _backend(backend, settings))
         return Identified(Model(native), fits)
 
     def moments(

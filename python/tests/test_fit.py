@@ -76,3 +76,14 @@ def test_frame_columns_are_read_in_place_and_mixed_types_converted(hald):
     a = termid.fit(frame, "y", ["x1", "x2", "x3", "x4"])
     b = termid.fit(mixed, "y", ["x1", "x2", "x3", "x4"])
     pd.testing.assert_series_equal(a.coefficients, b.coefficients)
+
+
+def test_one_term_as_a_string_is_one_term(hald):
+    # a string is one term, not its characters ("unknown variable `x`" before)
+    assert list(termid.fit(hald, "y", "x1").coefficients.index) == ["x1"]
+
+
+def test_a_column_named_twice_is_refused(hald):
+    twice = pd.concat([hald[["y", "x1"]], hald[["x2"]].rename(columns={"x2": "x1"})], axis=1)
+    with pytest.raises(termid.TermidError, match="`x1` appears twice"):
+        termid.fit(twice, "y", ["x1"])

@@ -28,7 +28,7 @@ def test_a_model_file_error_names_file_and_key(ship, tmp_path):
 
 
 def test_identify_from_exact_zigzags_gives_table_2(ship, zigzags):
-    identified = ship.identify(zigzags, "central")
+    identified = ship.identify(zigzags, target="column")
     # the paper's Table 2 (the default model's own coefficients) comes back from exact runs
     truth = ship.coefficients("r_dot").set_index("term")["value"]
     found = identified.model.coefficients("r_dot").set_index("term")["value"]
@@ -106,3 +106,33 @@ def test_per_run_rule_is_set_and_checked(zigzags):
         ship.set_parameter("u0", "middle:u")
     with pytest.raises(termid.TermidError, match="not a parameter"):
         ship.set_parameter("w0", 1.0)
+
+
+def test_a_time_column_of_durations_or_dates_is_read_in_seconds(ship, zigzags):
+    run = zigzags[0]
+    base = ship.identify([run], target="column").model.coefficients("r_dot").set_index("term")["value"]
+    for t in [pd.to_timedelta(run.t, unit="s"), pd.Timestamp("2026-11-25 12:00") + pd.to_timedelta(run.t, unit="s")]:
+        with pytest.warns(UserWarning, match="read as seconds"):
+            again = ship.identify([run.assign(t=t)], target="column")
+        found = again.model.coefficients("r_dot").set_index("term")["value"]
+        pd.testing.assert_series_equal(found, base)
+
+
+def test_the_target_is_the_callers_choice_and_said(ship, zigzags):
+    run = zigzags[0]
+    doubled = run.assign(r_dot=2 * run.r_dot)
+    truth = ship.coefficients("r_dot").set_index("term")["value"]
+    # a named derivative method is used, whatever rate columns the run carries
+    by_derivative = ship.identify([doubled], "central", equations=["r_dot"])
+    assert by_derivative.targets == {"r_dot": "dr/dt"}
+    found = by_derivative.model.coefficients("r_dot").set_index("term")["value"]
+    assert found["r*u"] == pytest.approx(truth["r*u"], rel=0.05)
+    # the columns when asked for (or when no method is named): twice the rate, twice the coefficients
+    by_column = ship.identify([doubled], target="column", equations=["r_dot"])
+    assert by_column.targets == {"r_dot": "r_dot"} and "r_dot ← r_dot" in repr(by_column)
+    found = by_column.model.coefficients("r_dot").set_index("term")["value"]
+    assert found["r*u"] == pytest.approx(2 * truth["r*u"], rel=1e-3)
+    with pytest.raises(termid.TermidError, match="no column r_dot"):
+        ship.identify([run.drop(columns=["r_dot"])], target="column", equations=["r_dot"])
+    with pytest.raises(ValueError):
+        ship.identify([run], target="rates")

@@ -7,7 +7,7 @@ import termid
 
 
 def test_merged_moments_fit_as_the_rows_do(ship, zigzags):
-    whole = ship.identify(zigzags, "central", equations=["r_dot"])
+    whole = ship.identify(zigzags, target="column", equations=["r_dot"])
     parts = [termid.Moments.from_frame(run, ship, "r_dot") for run in zigzags]
     merged = parts[0]
     for p in parts[1:]:
