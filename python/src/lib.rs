@@ -17,8 +17,10 @@ use termid::select::Backend;
 use termid::sim::{Integrator, Settings, System, Trajectory};
 use termid::term::{parse_terms, Library, Source, Term, Vocabulary};
 
+// named as the package exports it, so that it pickles (a process pool, Dask) and
+// `isinstance(e, termid.TermidError)` holds wherever it is unpickled
 pyo3::create_exception!(
-    _termid,
+    termid,
     TermidError,
     PyException,
     "termid refused the input; the message locates it (file, row, column, or a caret under a term)."

@@ -18,6 +18,7 @@ carrying termid's located message (file, row, column, or a caret under a term).
 
 from __future__ import annotations
 
+import errno
 import functools
 import json
 import os
@@ -27,7 +28,13 @@ from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 import numpy as np
 import pandas as pd
 
-from . import _termid
+try:
+    from . import _termid
+except ImportError as e:  # the source folder, found before the installed package
+    raise ImportError(
+        f"termid's native module is not beside {os.path.dirname(__file__)}: that is the source "
+        "folder, not the installed package (pip install ./python); run from another folder"
+    ) from e
 from ._termid import TermidError
 
 __all__ = [
@@ -112,9 +119,34 @@ def _once(names: Sequence[Any]) -> None:
         )
 
 
-def _columns(data: Data) -> Dict[str, np.ndarray]:
+class _Columns(Dict[str, np.ndarray]):
+    """Columns by name; ``left_out`` names the columns that hold no numbers (a run id, a
+    label) with their type: no term can use them, and an error that needs one says so."""
+
+    left_out: Dict[str, str] = {}
+
+
+def _explained(error: TermidError, left_out: Mapping[str, str]) -> TermidError:
+    """The error, with the type of a non-numeric column it names."""
+    named = [f"`{n}` holds {kind}, not numbers" for n, kind in left_out.items() if f"`{n}`" in str(error)]
+    return TermidError(f"{error} (column {'; '.join(named)})") if named else error
+
+
+def _numeric(items: Any) -> "_Columns":
+    out = _Columns()
+    out.left_out = {}
+    for name, values in items:
+        values = _seconds(name, values)
+        try:
+            out[name] = np.ascontiguousarray(values, dtype=np.float64)
+        except (TypeError, ValueError):
+            out.left_out[name] = str(getattr(values, "dtype", type(values).__name__))
+    return out
+
+
+def _columns(data: Data) -> "_Columns":
     """Columns as contiguous float64 arrays, without copying where the layout allows; time
-    columns (timedelta64, datetime64) in seconds."""
+    columns (timedelta64, datetime64) in seconds; columns that hold no numbers left out."""
     if isinstance(data, pd.DataFrame):
         _once(data.columns)
         if any(getattr(dt, "kind", "O") in "mM" for dt in data.dtypes):
@@ -124,7 +156,9 @@ def _columns(data: Data) -> Dict[str, np.ndarray]:
             )
         in_place = _frame_in_place(data)
         if in_place is not None:
-            return in_place
+            found = _Columns(in_place)
+            found.left_out = {}
+            return found
         # one column-major copy of the whole frame is faster than a conversion per column
         # (pandas' column access costs ~15 µs each); its columns are then contiguous views
         try:
@@ -132,7 +166,9 @@ def _columns(data: Data) -> Dict[str, np.ndarray]:
         except (TypeError, ValueError):
             block = None
         if block is not None:
-            return {str(c): block[:, j] for j, c in enumerate(data.columns)}
+            found = _Columns((str(c), block[:, j]) for j, c in enumerate(data.columns))
+            found.left_out = {}
+            return found
         items = ((str(c), data[c].to_numpy()) for c in data.columns)
     elif isinstance(data, Mapping):
         items = ((str(k), v) for k, v in data.items())
@@ -145,7 +181,7 @@ def _columns(data: Data) -> Dict[str, np.ndarray]:
         raise TypeError(
             f"a run must be a pandas DataFrame, a dict of arrays or a pyarrow Table, not {type(data).__name__}"
         )
-    return {name: np.ascontiguousarray(_seconds(name, values), dtype=np.float64) for name, values in items}
+    return _numeric(items)
 
 
 def _runs(runs: Union[Data, Sequence[Data]], names: Optional[Sequence[str]] = None) -> List[Tuple[str, Dict[str, np.ndarray]]]:
@@ -272,6 +308,8 @@ def fit(
     columns; default: every other column) with a back-end and its settings as keywords, e.g.
     ``fit(df, "y", ["x1", "x2", "x1*x2"], "stepwise", f_in=4.0, f_out=3.9)``."""
     columns = _columns(data)
+    if target in columns.left_out:
+        raise TermidError(f"column `{target}` holds {columns.left_out[target]}, not numbers: it cannot be fitted")
     if target not in columns:
         raise TermidError(f"no column `{target}` to fit (columns: {', '.join(columns)})")
     if isinstance(terms, str):
@@ -279,17 +317,20 @@ def fit(
         terms = [terms]
     if terms is None:
         terms = [c for c in columns if c not in (target, weights)]
-    native = _termid.fit(
-        target,
-        columns,
-        list(terms),
-        _settings_text(backend, settings),
-        intercept,
-        list(forced),
-        list(excluded),
-        dict(parameters or {}),
-        weights,
-    )
+    try:
+        native = _termid.fit(
+            target,
+            dict(columns),
+            list(terms),
+            _settings_text(backend, settings),
+            intercept,
+            list(forced),
+            list(excluded),
+            dict(parameters or {}),
+            weights,
+        )
+    except TermidError as e:
+        raise _explained(e, columns.left_out) from None
     return Fit(native, target)
 
 
@@ -334,8 +375,12 @@ class Model:
     # ---- files
     @staticmethod
     def load(path: Union[str, os.PathLike]) -> "Model":
-        """Reads a model file; errors name the file, line and key."""
-        return Model(_termid.Model.load(os.fspath(path)))
+        """Reads a model file; errors name the file, line and key (a missing file is
+        FileNotFoundError, as for ``open``)."""
+        path = os.fspath(path)
+        if not os.path.exists(path):
+            raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), path)
+        return Model(_termid.Model.load(path))
 
     @staticmethod
     def from_toml(text: str, name: str = "<text>") -> "Model":
@@ -348,6 +393,10 @@ class Model:
 
     def to_toml(self) -> str:
         return self._native.to_toml()
+
+    def __reduce__(self) -> Tuple[Any, Tuple[str, str]]:
+        # pickled as its file's text (a process pool, Dask), read back as it was written
+        return (Model.from_toml, (self.to_toml(), self._native.path))
 
     def save(self, path: Union[str, os.PathLike]) -> None:
         self._native.save(os.fspath(path))
@@ -421,14 +470,25 @@ class Model:
         rates = [f"{s}_dot" for s in self._native.states]
         if target == "derivative" or (target is None and derivative is not None):
             # the rate columns would be taken as the targets: without them the derivative is
-            data = [(n, {k: v for k, v in cols.items() if k not in rates}) for n, cols in data]
+            kept = []
+            for n, cols in data:
+                less = _Columns((k, v) for k, v in cols.items() if k not in rates)
+                less.left_out = getattr(cols, "left_out", {})
+                kept.append((n, less))
+            data = kept
         elif target == "column":
             wanted = list(equations) or list(self._native.identifiable)
             for n, cols in data:
                 missing = [r for r in rates if r in wanted and r not in cols]
                 if missing:
                     raise TermidError(f"{n}: target='column' but the run has no column {', '.join(missing)}")
-        native, fits = self._native.identify(data, derivative, list(equations), intercept, _backend(backend, settings))
+        try:
+            native, fits = self._native.identify(
+                data, derivative, list(equations), intercept, _backend(backend, settings)
+            )
+        except TermidError as e:
+            left_out = {n: k for _, cols in data for n, k in getattr(cols, "left_out", {}).items()}
+            raise _explained(e, left_out) from None
         return Identified(Model(native), fits)
 
     def moments(

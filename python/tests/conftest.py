@@ -1,10 +1,16 @@
 """Shared data: the Hald cement set (Draper & Smith) and the default ship's zigzags."""
 import os
+import sys
 
 import pandas as pd
 import pytest
 
-import termid
+# `python -m pytest` from python/ puts the source folder first on the path, where the native
+# module is not: the tests are of the installed package
+_SOURCE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path[:] = [p for p in sys.path if os.path.abspath(p or os.curdir) != _SOURCE]
+
+import termid  # noqa: E402
 
 ROOT = os.path.join(os.path.dirname(__file__), "..", "..")
 

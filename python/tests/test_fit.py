@@ -87,3 +87,13 @@ def test_a_column_named_twice_is_refused(hald):
     twice = pd.concat([hald[["y", "x1"]], hald[["x2"]].rename(columns={"x2": "x1"})], axis=1)
     with pytest.raises(termid.TermidError, match="`x1` appears twice"):
         termid.fit(twice, "y", ["x1"])
+
+
+def test_a_label_column_is_left_out_unless_a_term_needs_it(hald):
+    labelled = hald.assign(batch=[f"b{k}" for k in range(len(hald))])
+    plain = termid.fit(hald, "y", ["x1", "x2"]).coefficients
+    pd.testing.assert_series_equal(termid.fit(labelled, "y", ["x1", "x2"]).coefficients, plain)
+    with pytest.raises(termid.TermidError, match="`batch` holds object, not numbers"):
+        termid.fit(labelled, "y", ["x1", "batch"])
+    with pytest.raises(termid.TermidError, match="not numbers: it cannot be fitted"):
+        termid.fit(labelled, "batch", ["x1"])

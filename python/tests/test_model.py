@@ -136,3 +136,21 @@ def test_the_target_is_the_callers_choice_and_said(ship, zigzags):
         ship.identify([run.drop(columns=["r_dot"])], target="column", equations=["r_dot"])
     with pytest.raises(ValueError):
         ship.identify([run], target="rates")
+
+
+def test_errors_and_models_pickle_and_a_missing_file_is_file_not_found(ship, tmp_path):
+    import pickle
+
+    e = pickle.loads(pickle.dumps(termid.TermidError("row 3, column `u`: NaN")))
+    assert isinstance(e, termid.TermidError) and "row 3" in str(e)
+    again = pickle.loads(pickle.dumps(ship))
+    assert again.to_toml() == ship.to_toml()
+    with pytest.raises(FileNotFoundError):
+        termid.Model.load(tmp_path / "nope.toml")
+
+
+def test_a_run_id_column_does_not_break_identification(ship, zigzags):
+    run = zigzags[0]
+    base = ship.identify([run], target="column").model.coefficients("r_dot")
+    tagged = ship.identify([run.assign(run_id="Z15/10")], target="column").model.coefficients("r_dot")
+    pd.testing.assert_frame_equal(tagged, base)
