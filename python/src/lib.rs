@@ -425,6 +425,63 @@ impl PyModel {
         Ok(arrays(py, names.zip(dx).collect()))
     }
 
+    /// Any model from its initial states (the file's, or `initial`) with constant `inputs`
+    /// for `duration` seconds: the run's columns (time, states, inputs), as `termid simulate
+    /// --input` gives them.
+    #[pyo3(signature = (duration, inputs, initial, dt = None, sample = None, integrator = None, with_intercept = false))]
+    #[allow(clippy::too_many_arguments)]
+    fn simulate_free<'py>(
+        &self,
+        py: Python<'py>,
+        duration: f64,
+        inputs: BTreeMap<String, f64>,
+        initial: BTreeMap<String, f64>,
+        dt: Option<f64>,
+        sample: Option<f64>,
+        integrator: Option<&str>,
+        with_intercept: bool,
+    ) -> PyResult<Vec<(String, Bound<'py, PyArray1<f64>>)>> {
+        if !(duration.is_finite() && duration > 0.0) {
+            return Err(refuse(format!(
+                "duration {duration}: a simulation lasts a positive number of seconds"
+            )));
+        }
+        let system = System::new(&self.inner, &BTreeMap::new(), with_intercept).map_err(fail)?;
+        let spec = self.inner.spec();
+        for name in initial.keys() {
+            if !spec.states.iter().any(|s| &s.name == name) {
+                return Err(refuse(format!(
+                    "initial `{name}`: not a state of the model ({})",
+                    system.states.join(", ")
+                )));
+            }
+        }
+        for name in inputs.keys() {
+            if !system.inputs.contains(name) {
+                return Err(refuse(format!(
+                    "input `{name}`: not an input of the model ({})",
+                    system.inputs.join(", ")
+                )));
+            }
+        }
+        let x0: Vec<f64> =
+            spec.states.iter().map(|s| initial.get(&s.name).copied().unwrap_or(s.initial)).collect();
+        let u: Vec<f64> = system.inputs.iter().map(|n| inputs.get(n).copied().unwrap_or(0.0)).collect();
+        let (integrator, step) = method_of(&self.inner, integrator, dt)?;
+        // as the command line: the adaptive method's output interval is free
+        let sample = sample.unwrap_or(step);
+        let step = if dt.is_none() && integrator == Integrator::Dopri5 && sample.is_finite() && sample > 0.0 {
+            sample / (sample / step * (1.0 - 1e-9)).ceil().max(1.0)
+        } else {
+            step
+        };
+        let settings = Settings { integrator, dt: step, duration, sample };
+        let run = py
+            .detach(|| termid::sim::simulate(&system, &x0, &mut termid::sim::Constant(u), &settings))
+            .map_err(fail)?;
+        Ok(arrays(py, trajectory_columns(&self.time(), run)))
+    }
+
     /// A plug-in's scenario (`zigzag:20/20`, `turning:35`, `spiral`): the simulated run's
     /// columns, its metrics (JSON), its label and its report lines.
     #[pyo3(signature = (scenario, dt = None, duration = None, sample = None, integrator = None, with_intercept = false))]
@@ -441,7 +498,7 @@ impl PyModel {
     ) -> PyResult<(Vec<(String, Bound<'py, PyArray1<f64>>)>, String, String, Vec<String>)> {
         let plugin = termid::plugins::of(&self.inner).ok_or_else(|| {
             refuse(format!(
-                "{} has no plug-in table, so `{scenario}` does not apply: use replay",
+                "{} has no plug-in table, so `{scenario}` does not apply: give no scenario (a duration, constant inputs) or use replay",
                 self.inner.path
             ))
         })?;

@@ -520,16 +520,29 @@ class Model:
 
     def simulate(
         self,
-        scenario: str,
+        scenario: Optional[str] = None,
         *,
         dt: Optional[float] = None,
         duration: Optional[float] = None,
         sample: Optional[float] = None,
         integrator: Optional[str] = None,
         with_intercept: bool = False,
+        inputs: Optional[Mapping[str, float]] = None,
+        initial: Optional[Mapping[str, float]] = None,
     ) -> pd.DataFrame:
         """A plug-in's scenario (``zigzag:20/20``, ``turning:35``, ``spiral``): the run as a
-        DataFrame (SI, radians), its metrics in ``df.attrs["metrics"]``."""
+        DataFrame (SI, radians), its metrics in ``df.attrs["metrics"]``. Without a scenario,
+        any model (Lorenz, a pendulum): from its initial states (or ``initial``) with constant
+        ``inputs`` for ``duration`` seconds."""
+        if scenario is None:
+            if duration is None:
+                raise TypeError("simulate without a scenario needs a duration (seconds)")
+            columns = self._native.simulate_free(
+                duration, dict(inputs or {}), dict(initial or {}), dt, sample, integrator, with_intercept
+            )
+            return _frame(columns)
+        if inputs or initial:
+            raise TypeError("inputs and initial apply without a scenario; a scenario sets its own")
         columns, metrics, label, text = self._native.simulate(scenario, dt, duration, sample, integrator, with_intercept)
         frame = _frame(columns)
         frame.attrs.update(name=label, metrics=json.loads(metrics), report=list(text))

@@ -58,6 +58,16 @@ class Model:
         self, moments: Sequence[Moments], intercept: Optional[bool] = None
     ) -> Tuple[Model, List[Tuple[str, str]]]: ...
     def predict(self, run: Run, with_intercept: bool = False) -> NamedArrays: ...
+    def simulate_free(
+        self,
+        duration: float,
+        inputs: Dict[str, float],
+        initial: Dict[str, float],
+        dt: Optional[float] = None,
+        sample: Optional[float] = None,
+        integrator: Optional[str] = None,
+        with_intercept: bool = False,
+    ) -> NamedArrays: ...
     def simulate(
         self,
         scenario: str,

@@ -154,3 +154,22 @@ def test_a_run_id_column_does_not_break_identification(ship, zigzags):
     base = ship.identify([run], target="column").model.coefficients("r_dot")
     tagged = ship.identify([run.assign(run_id="Z15/10")], target="column").model.coefficients("r_dot")
     pd.testing.assert_frame_equal(tagged, base)
+
+
+def test_lorenz_simulated_and_identified_with_the_defaults():
+    # a model without a plug-in simulates from Python (it said "use replay"), and the
+    # generic defaults hold here too (central differences and a forced intercept gave
+    # z_dot = −57.72 + 0.698·y²)
+    path = os.path.join(os.path.dirname(__file__), "..", "..", "models", "lorenz.toml")
+    lorenz = termid.Model.load(path)
+    run = lorenz.simulate(duration=20.0, sample=0.01)
+    assert list(run.columns) == ["t", "x", "y", "z"] and len(run) == 2001
+    found = lorenz.identify(run)
+    assert found.targets["z_dot"] == "dz/dt"
+    z = found.model.coefficients("z_dot").set_index("term")["value"]
+    assert sorted(z.index) == ["x*y", "z"]
+    assert z["x*y"] == pytest.approx(1.0, rel=1e-3) and z["z"] == pytest.approx(-8 / 3, rel=1e-3)
+    moved = lorenz.simulate(duration=1.0, initial={"x": 1.0, "y": 1.0, "z": 1.0})
+    assert moved.x.iloc[0] == 1.0
+    with pytest.raises(termid.TermidError, match="not a state"):
+        lorenz.simulate(duration=1.0, initial={"w": 1.0})
