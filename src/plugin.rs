@@ -137,7 +137,7 @@ pub struct ScenarioRequest<'a> {
 }
 
 /// A scenario ready to run on a model and its drawn variants.
-pub trait Scenario {
+pub trait Scenario: Send {
     /// How a title names it (`zigzag 20°/20°`).
     fn label(&self) -> String;
     /// How long it runs unless told otherwise, s.

@@ -330,6 +330,7 @@ impl PyModel {
     #[pyo3(signature = (runs, derivative = None, equations = vec![], intercept = None, backend = None))]
     fn identify(
         &self,
+        py: Python<'_>,
         runs: Vec<Run<'_>>,
         derivative: Option<&str>,
         equations: Vec<String>,
@@ -341,7 +342,7 @@ impl PyModel {
         let derivative = derivative.unwrap_or(if termid::plugins::of(&self.inner).is_some() {
             "central"
         } else {
-            "kalman"
+            "integral"
         });
         let intercept = intercept.unwrap_or(self.inner.spec().model.intercept);
         let model = match backend {
@@ -351,8 +352,10 @@ impl PyModel {
         let frames = self.frames(runs)?;
         let diff = differentiator(derivative).map_err(fail)?;
         let how = ModelIdentification { equations, differentiator: diff.as_ref(), intercept, target: None };
-        let identified =
-            termid::identify::identify_model(&model, &frames, &how, &mut |_| {}).map_err(fail)?;
+        // the work without the GIL: other Python threads run meanwhile
+        let identified = py
+            .detach(|| termid::identify::identify_model(&model, &frames, &how, &mut |_| {}))
+            .map_err(fail)?;
         let fits = identified
             .fits
             .iter()
@@ -366,26 +369,28 @@ impl PyModel {
     #[pyo3(signature = (equations, runs, derivative = "central"))]
     fn moments(
         &self,
+        py: Python<'_>,
         equations: Vec<String>,
         runs: Vec<Run<'_>>,
         derivative: &str,
     ) -> PyResult<Vec<PyMoments>> {
         let frames = self.frames(runs)?;
         let diff = differentiator(derivative).map_err(fail)?;
-        equations
-            .iter()
-            .map(|eq| {
-                let inner =
-                    EquationMoments::of_runs(&self.inner, eq, &frames, diff.as_ref(), None).map_err(fail)?;
-                Ok(PyMoments { inner })
-            })
-            .collect()
+        let model = &self.inner;
+        let all = py.detach(|| {
+            equations
+                .iter()
+                .map(|eq| EquationMoments::of_runs(model, eq, &frames, diff.as_ref(), None))
+                .collect::<Result<Vec<_>, _>>()
+        });
+        Ok(all.map_err(fail)?.into_iter().map(|inner| PyMoments { inner }).collect())
     }
 
     /// The model identified from statistics (merged per equation in the order given).
     #[pyo3(signature = (moments, intercept = None))]
     fn identify_from_moments(
         &self,
+        py: Python<'_>,
         moments: Vec<PyRef<'_, PyMoments>>,
         intercept: Option<bool>,
     ) -> PyResult<(PyModel, Vec<(String, String)>)> {
@@ -395,8 +400,9 @@ impl PyModel {
             .enumerate()
             .map(|(k, m)| (format!("statistics {}", k + 1), m.inner.clone()))
             .collect();
+        let model = &self.inner;
         let identified =
-            termid::identify::identify_from_moments(&self.inner, parts, intercept).map_err(fail)?;
+            py.detach(|| termid::identify::identify_from_moments(model, parts, intercept)).map_err(fail)?;
         let fits = identified
             .fits
             .iter()
@@ -420,7 +426,7 @@ impl PyModel {
             own.insert(name.clone(), rule.resolve(&name, frame).map_err(fail)?);
         }
         let system = System::new(&self.inner, &own, with_intercept).map_err(fail)?;
-        let dx = system.derivatives_on(frame).map_err(fail)?;
+        let dx = py.detach(|| system.derivatives_on(frame)).map_err(fail)?;
         let names = system.state_names().iter().map(|s| format!("{s}_dot"));
         Ok(arrays(py, names.zip(dx).collect()))
     }
@@ -516,9 +522,10 @@ impl PyModel {
             duration: duration.unwrap_or_else(|| scenario.default_duration()),
             sample: sample.unwrap_or(dt),
         };
-        let outcome = scenario.run(&self.inner, &settings).map_err(fail)?;
+        let (model, label) = (&self.inner, scenario.label());
+        let outcome = py.detach(move || scenario.run(model, &settings)).map_err(fail)?;
         let frame = &outcome.frame;
-        Ok((arrays(py, frame_columns(frame)), to_json(&outcome.metrics)?, scenario.label(), outcome.text))
+        Ok((arrays(py, frame_columns(frame)), to_json(&outcome.metrics)?, label, outcome.text))
     }
 
     /// A ship's manoeuvre recorded as a model basin would (termid's synthetic basin): the
@@ -682,7 +689,7 @@ impl PyMoments {
         let runs: Vec<Run<'_>> = py.import("termid")?.getattr("_runs")?.call1((data,))?.extract()?;
         let native = if model.hasattr("_native")? { model.getattr("_native")? } else { model.clone() };
         let model: PyRef<'_, PyModel> = native.extract()?;
-        Ok(model.moments(vec![equation.to_string()], runs, derivative)?.remove(0))
+        Ok(model.moments(py, vec![equation.to_string()], runs, derivative)?.remove(0))
     }
 
     fn to_json(&self) -> String {

@@ -173,3 +173,30 @@ def test_lorenz_simulated_and_identified_with_the_defaults():
     assert moved.x.iloc[0] == 1.0
     with pytest.raises(termid.TermidError, match="not a state"):
         lorenz.simulate(duration=1.0, initial={"w": 1.0})
+
+
+def test_identification_releases_the_gil(ship, zigzags):
+    # while the Rust side works, a Python thread keeps running (it ran at 4 % before)
+    import threading
+    import time
+
+    runs = list(zigzags) * 4
+    done = threading.Event()
+    spent = []
+
+    def work():
+        start = time.perf_counter()
+        ship.identify(runs, target="column")
+        ship.moments("r_dot", runs)
+        spent.append(time.perf_counter() - start)
+        done.set()
+
+    worker = threading.Thread(target=work)
+    worker.start()
+    wakeups = 0
+    while not done.is_set():
+        time.sleep(0.001)
+        wakeups += 1
+    worker.join()
+    # a wake-up a millisecond or so while the work runs, not one at its end
+    assert wakeups > 0.2 * spent[0] / 0.001, (wakeups, spent)
