@@ -325,6 +325,16 @@ impl PyModel {
         Ok(())
     }
 
+    /// The defaults of `termid identify`: central differences for a plug-in's model (a ship,
+    /// as the paper), the integral form for any other.
+    fn default_derivative(&self) -> &'static str {
+        if termid::plugins::of(&self.inner).is_some() {
+            "central"
+        } else {
+            "integral"
+        }
+    }
+
     /// Every identifiable equation (or the named ones) from runs; returns the identified model
     /// and each fit as JSON.
     #[pyo3(signature = (runs, derivative = None, equations = vec![], intercept = None, backend = None))]
@@ -339,11 +349,7 @@ impl PyModel {
     ) -> PyResult<(PyModel, Vec<(String, String)>)> {
         // the defaults of `termid identify`: central differences for a plug-in's model (a
         // ship, as the paper), the integral form for any other; the model file's intercept
-        let derivative = derivative.unwrap_or(if termid::plugins::of(&self.inner).is_some() {
-            "central"
-        } else {
-            "integral"
-        });
+        let derivative = derivative.unwrap_or_else(|| self.default_derivative());
         let intercept = intercept.unwrap_or(self.inner.spec().model.intercept);
         let model = match backend {
             Some(json) => self.inner.with_backend(&backend_of(json)?).map_err(fail)?,
@@ -366,14 +372,15 @@ impl PyModel {
 
     /// The sufficient statistics of each of `equations` over runs (mergeable, picklable); the
     /// runs are read once for all of them.
-    #[pyo3(signature = (equations, runs, derivative = "central"))]
+    #[pyo3(signature = (equations, runs, derivative = None))]
     fn moments(
         &self,
         py: Python<'_>,
         equations: Vec<String>,
         runs: Vec<Run<'_>>,
-        derivative: &str,
+        derivative: Option<&str>,
     ) -> PyResult<Vec<PyMoments>> {
+        let derivative = derivative.unwrap_or_else(|| self.default_derivative());
         let frames = self.frames(runs)?;
         let diff = differentiator(derivative).map_err(fail)?;
         let model = &self.inner;
@@ -677,17 +684,24 @@ impl PyMoments {
     /// The statistics of `equation` of `model` over runs (a DataFrame, dict of arrays, pyarrow
     /// Table, or a list of them): one pass over the rows, where the rows are.
     #[staticmethod]
-    #[pyo3(signature = (data, model, equation, derivative = "central"))]
+    #[pyo3(signature = (data, model, equation, derivative = None, target = None))]
     fn from_frame(
         py: Python<'_>,
         data: &Bound<'_, PyAny>,
         model: &Bound<'_, PyAny>,
         equation: &str,
-        derivative: &str,
+        derivative: Option<&str>,
+        target: Option<&str>,
     ) -> PyResult<PyMoments> {
-        // the Python side's conversions (pandas, pyarrow → float64 arrays), and its Model
-        let runs: Vec<Run<'_>> = py.import("termid")?.getattr("_runs")?.call1((data,))?.extract()?;
+        // the Python side's conversions (pandas, pyarrow → float64 arrays; the target's
+        // columns as asked), and its Model
+        let termid = py.import("termid")?;
         let native = if model.hasattr("_native")? { model.getattr("_native")? } else { model.clone() };
+        let runs = termid.getattr("_runs")?.call1((data,))?;
+        let runs: Vec<Run<'_>> = termid
+            .getattr("_targeted")?
+            .call1((&native, runs, derivative, target, vec![equation]))?
+            .extract()?;
         let model: PyRef<'_, PyModel> = native.extract()?;
         Ok(model.moments(py, vec![equation.to_string()], runs, derivative)?.remove(0))
     }

@@ -334,6 +334,31 @@ def fit(
     return Fit(native, target)
 
 
+def _targeted(
+    native: Any, data: List[Tuple[str, Any]], derivative: Optional[str], target: Optional[str], equations: List[str]
+) -> List[Tuple[str, Any]]:
+    """The runs as the target asks: ``"derivative"`` (or a named ``derivative`` without a
+    target) leaves out the states' rate columns, which would otherwise be the targets;
+    ``"column"`` requires them."""
+    if target not in (None, "column", "derivative"):
+        raise ValueError(f"target must be 'column', 'derivative' or None, not {target!r}")
+    rates = [f"{s}_dot" for s in native.states]
+    if target == "derivative" or (target is None and derivative is not None):
+        kept = []
+        for n, cols in data:
+            less = _Columns((k, v) for k, v in cols.items() if k not in rates)
+            less.left_out = getattr(cols, "left_out", {})
+            kept.append((n, less))
+        return kept
+    if target == "column":
+        wanted = equations or list(native.identifiable)
+        for n, cols in data:
+            missing = [r for r in rates if r in wanted and r not in cols]
+            if missing:
+                raise TermidError(f"{n}: target='column' but the run has no column {', '.join(missing)}")
+    return data
+
+
 class Identified:
     """What ``Model.identify`` returns: the identified model and each equation's fit report
     (``steps`` and ``terms`` as DataFrames)."""
@@ -464,24 +489,7 @@ class Model:
         (:attr:`Identified.targets` says which). ``derivative`` defaults to ``integral`` (the
         integral form: no derivative estimated; central differences for a ship, as the
         paper); ``intercept`` to the model file's (``[model] intercept``)."""
-        if target not in (None, "column", "derivative"):
-            raise ValueError(f"target must be 'column', 'derivative' or None, not {target!r}")
-        data = _runs(runs, names)
-        rates = [f"{s}_dot" for s in self._native.states]
-        if target == "derivative" or (target is None and derivative is not None):
-            # the rate columns would be taken as the targets: without them the derivative is
-            kept = []
-            for n, cols in data:
-                less = _Columns((k, v) for k, v in cols.items() if k not in rates)
-                less.left_out = getattr(cols, "left_out", {})
-                kept.append((n, less))
-            data = kept
-        elif target == "column":
-            wanted = list(equations) or list(self._native.identifiable)
-            for n, cols in data:
-                missing = [r for r in rates if r in wanted and r not in cols]
-                if missing:
-                    raise TermidError(f"{n}: target='column' but the run has no column {', '.join(missing)}")
+        data = _targeted(self._native, _runs(runs, names), derivative, target, list(equations))
         try:
             native, fits = self._native.identify(
                 data, derivative, list(equations), intercept, _backend(backend, settings)
@@ -495,15 +503,18 @@ class Model:
         self,
         equation: Union[str, Sequence[str]],
         runs: Union[Data, Sequence[Data]],
-        derivative: str = "central",
+        derivative: Optional[str] = None,
         names: Optional[Sequence[str]] = None,
+        *,
+        target: Optional[str] = None,
     ) -> Any:
         """The sufficient statistics of ``equation`` over runs (see :class:`Moments`); given a
-        list of equations, a dict of each one's, the runs read once for all."""
-        if isinstance(equation, str):
-            return self._native.moments([equation], _runs(runs, names), derivative)[0]
-        found = self._native.moments(list(equation), _runs(runs, names), derivative)
-        return dict(zip(equation, found))
+        list of equations, a dict of each one's, the runs read once for all. ``derivative``
+        and ``target`` as for :meth:`identify`."""
+        wanted = [equation] if isinstance(equation, str) else list(equation)
+        data = _targeted(self._native, _runs(runs, names), derivative, target, wanted)
+        found = self._native.moments(wanted, data, derivative)
+        return found[0] if isinstance(equation, str) else dict(zip(wanted, found))
 
     def identify_from_moments(self, moments: Union["Moments", Sequence["Moments"]], intercept: Optional[bool] = None) -> Identified:
         """The model identified from statistics, merged per equation in the order given:

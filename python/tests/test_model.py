@@ -134,6 +134,11 @@ def test_the_target_is_the_callers_choice_and_said(ship, zigzags):
     assert found["r*u"] == pytest.approx(2 * truth["r*u"], rel=1e-3)
     with pytest.raises(termid.TermidError, match="no column r_dot"):
         ship.identify([run.drop(columns=["r_dot"])], target="column", equations=["r_dot"])
+    # statistics likewise: a named method is used, else the columns
+    for derivative, factor in [("central", 1.0), (None, 2.0)]:
+        m = termid.Moments.from_frame(doubled, ship, "r_dot", derivative)
+        b = ship.identify_from_moments(m).model.coefficients("r_dot").set_index("term")["value"]
+        assert b["r*u"] == pytest.approx(factor * truth["r*u"], rel=0.05), derivative
     with pytest.raises(ValueError):
         ship.identify([run], target="rates")
 
