@@ -269,9 +269,12 @@ class Fit:
     def chosen_step(self) -> Optional[int]:
         return self.report.get("chosen_step")
 
-    def predict(self, data: Data) -> np.ndarray:
-        """Σ cⱼ·termⱼ + b0 on data (the compiled evaluator; numpy arrays read in place)."""
-        return self._native.predict(_columns(data))
+    def predict(self, data: Data) -> pd.Series:
+        """Σ cⱼ·termⱼ + b0 on data (the compiled evaluator; numpy arrays read in place), a
+        Series on the data's index (a DataFrame's) named as the target."""
+        values = self._native.predict(_columns(data))
+        index = data.index if isinstance(data, pd.DataFrame) else None
+        return pd.Series(values, index=index, name=self.target)
 
     def __repr__(self) -> str:
         return f"termid.Fit({self.target}: {len(self.coefficients)} terms)"
@@ -450,7 +453,8 @@ class Model:
     def coefficients(self, equation: str) -> pd.DataFrame:
         """An equation's stored terms with value and standard error."""
         rows = self._native.coefficients(equation)
-        return pd.DataFrame(rows, columns=["term", "value", "std_error"])
+        # a missing standard error is NaN, so the column stays float64 (not object)
+        return pd.DataFrame(rows, columns=["term", "value", "std_error"]).astype({"value": float, "std_error": float})
 
     def intercept(self, equation: str) -> Optional[float]:
         return self._native.intercept(equation)
@@ -526,8 +530,12 @@ class Model:
 
     # ---- prediction and simulation
     def predict(self, run: Data, with_intercept: bool = False) -> pd.DataFrame:
-        """ẋ of every state on every row of a run (columns ``<state>_dot``)."""
-        return _frame(self._native.predict(_runs(run)[0], with_intercept))
+        """ẋ of every state on every row of a run (columns ``<state>_dot``), on the run's
+        index (a DataFrame's)."""
+        frame = _frame(self._native.predict(_runs(run)[0], with_intercept))
+        if isinstance(run, pd.DataFrame):
+            frame.index = run.index
+        return frame
 
     def simulate(
         self,

@@ -97,3 +97,14 @@ def test_a_label_column_is_left_out_unless_a_term_needs_it(hald):
         termid.fit(labelled, "y", ["x1", "batch"])
     with pytest.raises(termid.TermidError, match="not numbers: it cannot be fitted"):
         termid.fit(labelled, "batch", ["x1"])
+
+
+def test_predictions_keep_the_index_and_errors_are_floats(hald, ship, zigzags):
+    indexed = hald.set_index(pd.Index([f"row{k}" for k in range(len(hald))]))
+    fit = termid.fit(indexed, "y", ["x1", "x2"])
+    predicted = fit.predict(indexed)
+    assert isinstance(predicted, pd.Series) and predicted.name == "y"
+    assert list(predicted.index) == list(indexed.index)
+    run = zigzags[0].set_index(zigzags[0].t * 1000.0)
+    assert list(ship.predict(run).index) == list(run.index)
+    assert ship.coefficients("r_dot")["std_error"].dtype == np.float64
