@@ -625,19 +625,8 @@ fn lorenz_from_samples_with_the_defaults_and_unit_free_selection() {
             .join("\n")
             + "\n"
     };
-    let names = ["x", "y", "z"];
-    let mut monomials = Vec::new();
-    for a in 0..3 {
-        monomials.push(names[a].to_string());
-        for b in a..3 {
-            monomials.push(format!("{}*{}", names[a], names[b]));
-            for c in b..3 {
-                monomials.push(format!("{}*{}*{}", names[a], names[b], names[c]));
-            }
-        }
-    }
     let terms = dir.join("terms.txt");
-    std::fs::write(&terms, monomials.join("\n")).unwrap();
+    std::fs::write(&terms, cubic_library(&["x", "y", "z"])).unwrap();
     let truth: [(&str, &[(&str, f64)]); 3] = [
         ("x", &[("x", -10.0), ("y", 10.0)]),
         ("y", &[("x", 28.0), ("y", -1.0), ("x*z", -1.0)]),
@@ -676,37 +665,14 @@ fn lorenz_from_samples_with_the_defaults_and_unit_free_selection() {
             .unwrap();
         for (state, expected) in truth {
             let target = format!("d{state}/dt");
-            let (ok, out, err) = termid(&[
-                "identify",
-                "--data",
-                csv.to_str().unwrap(),
-                "--target",
-                &target,
-                "--terms-file",
-                terms.to_str().unwrap(),
-                "--format",
-                "json",
-            ]);
-            assert!(ok, "{err}");
-            let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-            let chosen = &v["terms"];
-            let found: Vec<(String, f64)> = chosen
-                .as_array()
-                .unwrap_or_else(|| panic!("{out}"))
-                .iter()
-                .map(|t| (t["term"].as_str().unwrap().to_string(), t["coefficient"].as_f64().unwrap()))
-                .collect();
+            let found = identify_with_defaults(&csv, &target, &terms);
             assert_eq!(found.len(), expected.len(), "{file} {state}: {found:?}");
             for (term, c) in expected {
                 // x in mm: a term's coefficient scales by 1000^(power of x in the target) / 1000^(power in the term)
                 let px = term.matches('x').count() as i32;
                 let pt = if state == "x" { 1 } else { 0 };
                 let want = c * scale.powi(pt - px);
-                let got = found
-                    .iter()
-                    .find(|(t, _)| t == term)
-                    .unwrap_or_else(|| panic!("{state}: {term} missing: {found:?}"))
-                    .1;
+                let got = *found.get(*term).unwrap_or_else(|| panic!("{state}: {term} missing: {found:?}"));
                 assert!(
                     (got - want).abs() < tolerance * want.abs(),
                     "{file} {state} {term}: {got} vs {want}"
@@ -803,9 +769,26 @@ fn cubic_library(states: &[&str]) -> String {
     out.join("\n") + "\n"
 }
 
-/// The terms and coefficients `identify --format json` reports, the intercept as `1`.
-fn identified_terms(json: &str) -> BTreeMap<String, f64> {
-    let v: serde_json::Value = serde_json::from_str(json).unwrap();
+/// `termid identify` of `target` in the run `data` with the candidates of `terms` and
+/// nothing else: the terms and coefficients it reports, the intercept as `1`.
+fn identify_with_defaults(
+    data: &std::path::Path,
+    target: &str,
+    terms: &std::path::Path,
+) -> BTreeMap<String, f64> {
+    let (ok, json, err) = termid(&[
+        "identify",
+        "--data",
+        data.to_str().unwrap(),
+        "--target",
+        target,
+        "--terms-file",
+        terms.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
     let mut out: BTreeMap<String, f64> = v["terms"]
         .as_array()
         .unwrap_or_else(|| panic!("{json}"))
@@ -850,19 +833,7 @@ fn a_small_true_term_is_kept_from_exact_rates_and_from_samples() {
     ];
     for (state, expected) in truth {
         for (target, tolerance) in [(format!("{state}_dot"), 1e-3), (format!("d{state}/dt"), 1e-2)] {
-            let (ok, out, err) = termid(&[
-                "identify",
-                "--data",
-                run.to_str().unwrap(),
-                "--target",
-                &target,
-                "--terms-file",
-                terms.to_str().unwrap(),
-                "--format",
-                "json",
-            ]);
-            assert!(ok, "{err}");
-            let found = identified_terms(&out);
+            let found = identify_with_defaults(&run, &target, &terms);
             let names: Vec<&str> = found.keys().map(String::as_str).collect();
             let mut want: Vec<&str> = expected.iter().map(|(t, _)| *t).collect();
             want.sort();
