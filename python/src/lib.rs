@@ -955,6 +955,13 @@ fn methods() -> (Vec<&'static str>, Vec<String>) {
     (Backend::NAMES.to_vec(), derivatives)
 }
 
+/// A back-end's settings with their defaults (JSON, `method` included).
+#[pyfunction]
+fn default_settings(name: &str) -> PyResult<String> {
+    let backend = Backend::by_name(name).map_err(fail)?;
+    to_json(&backend)
+}
+
 /// The version of termid inside.
 #[pyfunction]
 fn version() -> &'static str {
@@ -969,6 +976,7 @@ fn _termid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyFit>()?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add_function(wrap_pyfunction!(methods, m)?)?;
+    m.add_function(wrap_pyfunction!(default_settings, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
     Ok(())
 }

@@ -8,8 +8,12 @@ can simulate. This package calls termid's Rust library in the same process.
     >>> import termid
     >>> ship = termid.Model.default()            # Oltmann (1973), HSVA 1512
     >>> run = ship.simulate("zigzag:20/20")      # a pandas DataFrame, SI units
-    >>> fitted = ship.identify([run])            # every equation, from the run
-    >>> fitted.coefficients("r_dot")             # a DataFrame: term, value, std_error
+    >>> fitted = ship.identify([run])            # every equation, from the run's rates
+    >>> fitted.targets["r_dot"]                  # what it explained: the column r_dot
+    'r_dot'
+    >>> table = fitted.model.coefficients("r_dot")
+    >>> list(table.columns)                      # a DataFrame: term, value, std_error
+    ['term', 'value', 'std_error']
 
 Data is given as pandas DataFrames, dicts of numpy arrays or pyarrow Tables (columns named
 as the model's variables, SI units, angles in radians). Errors are :class:`TermidError`
@@ -45,6 +49,7 @@ __all__ = [
     "TermidError",
     "fit",
     "backends",
+    "settings",
     "derivatives",
     "__version__",
 ]
@@ -177,6 +182,14 @@ def _columns(data: Data) -> "_Columns":
         items = ((n, data.column(j).to_numpy()) for j, n in enumerate(data.column_names))
     elif hasattr(data, "to_pandas"):
         return _columns(data.to_pandas())
+    elif hasattr(data, "__arrow_c_stream__"):  # any Arrow PyCapsule producer (polars, ...)
+        import pyarrow
+
+        return _columns(pyarrow.table(data))
+    elif hasattr(data, "collect") and callable(data.collect):  # a lazy frame (polars)
+        return _columns(data.collect())
+    elif isinstance(data, np.ndarray) and data.dtype.names:  # a numpy record array
+        items = ((str(n), data[n]) for n in data.dtype.names)
     else:
         raise TypeError(
             f"a run must be a pandas DataFrame, a dict of arrays or a pyarrow Table, not {type(data).__name__}"
@@ -205,12 +218,24 @@ def _backend(backend: Optional[str], settings: Mapping[str, Any]) -> Optional[st
         if settings:
             raise TypeError(f"back-end settings {sorted(settings)} given without a back-end")
         return None
-    return json.dumps({"method": backend, **settings})
+    return _settings_text(backend, settings)
 
 
 def backends() -> List[str]:
     """The regression back-ends by name (``stepwise``, ``best-subset``, ``sparse``, ...)."""
     return list(_termid.methods()[0])
+
+
+def settings(backend: str) -> Dict[str, Any]:
+    """A back-end's settings and their defaults, as keywords of :func:`fit` and
+    :meth:`Model.identify` take them.
+
+    >>> settings("stlsq")["floor"]
+    0.01
+    """
+    found = json.loads(_termid.default_settings(backend))
+    found.pop("method", None)
+    return found
 
 
 def derivatives() -> List[str]:
@@ -287,7 +312,10 @@ def _settings_cached(backend: str, items: Tuple[Tuple[str, Any], ...]) -> str:
 
 def _settings_text(backend: str, settings: Mapping[str, Any]) -> str:
     """A back-end and its settings as the JSON the native side reads (the same settings,
-    once: repeated fits pass the same text)."""
+    once: repeated fits pass the same text). ``step_rule="last"`` is short for
+    ``step_rule={"rule": "last"}``."""
+    if isinstance(settings.get("step_rule"), str):
+        settings = {**settings, "step_rule": {"rule": settings["step_rule"]}}
     try:
         return _settings_cached(backend, tuple(settings.items()))
     except TypeError:  # a setting that cannot be hashed (a list)
@@ -309,7 +337,15 @@ def fit(
 ) -> Fit:
     """Fits ``target`` (a column of ``data``) by the candidate ``terms`` (text over the other
     columns; default: every other column) with a back-end and its settings as keywords, e.g.
-    ``fit(df, "y", ["x1", "x2", "x1*x2"], "stepwise", f_in=4.0, f_out=3.9)``."""
+    ``fit(df, "y", ["x1", "x2", "x1*x2"], "stepwise", step_rule="last")`` (a back-end's
+    settings: ``termid.settings(backend)``). A single string is one term.
+
+    >>> import pandas as pd
+    >>> df = pd.DataFrame({"x1": [1.0, 2, 3, 4, 5], "x2": [2.0, 1, 4, 3, 6]}).eval("y = x1 + 2*x2")
+    >>> fitted = fit(df, "y", ["x1", "x2"], "stepwise", step_rule="last")
+    >>> fitted.coefficients.round(6).to_dict()
+    {'x2': 2.0, 'x1': 1.0}
+    """
     columns = _columns(data)
     if target in columns.left_out:
         raise TermidError(f"column `{target}` holds {columns.left_out[target]}, not numbers: it cannot be fitted")
