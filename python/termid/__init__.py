@@ -25,6 +25,7 @@ from __future__ import annotations
 import errno
 import functools
 import json
+import math
 import os
 import warnings
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
@@ -243,6 +244,68 @@ def derivatives() -> List[str]:
     return list(_termid.methods()[1])
 
 
+def _t_two_sided(t: float, df: float) -> float:
+    """P(|T| ≥ |t|) for Student's t with ``df`` degrees of freedom: the regularized
+    incomplete beta I_x(df/2, 1/2) at x = df/(df + t²) (continued fraction, Lentz)."""
+    if not np.isfinite(t):
+        return 0.0 if not np.isnan(t) else float("nan")
+    x = df / (df + t * t)
+    a, b = df / 2.0, 0.5
+    if x <= 0.0:
+        return 0.0
+    if x >= 1.0:
+        return 1.0
+    front = math.exp(math.lgamma(a + b) - math.lgamma(a) - math.lgamma(b) + a * math.log(x) + b * math.log1p(-x))
+    if x > (a + 1.0) / (a + b + 2.0):  # the symmetric side converges faster
+        return 1.0 - front * _beta_fraction(b, a, 1.0 - x) / b
+    return front * _beta_fraction(a, b, x) / a
+
+
+def _beta_fraction(a: float, b: float, x: float) -> float:
+    tiny = 1e-300
+    c, d = 1.0, 1.0 - (a + b) * x / (a + 1.0)
+    d = 1.0 / (d if abs(d) > tiny else tiny)
+    h = d
+    for m in range(1, 300):
+        for num in (m * (b - m) * x / ((a + 2 * m - 1) * (a + 2 * m)), -(a + m) * (a + b + m) * x / ((a + 2 * m) * (a + 2 * m + 1))):
+            d = 1.0 + num * d
+            d = 1.0 / (d if abs(d) > tiny else tiny)
+            c = 1.0 + num / c
+            c = c if abs(c) > tiny else tiny
+            h *= d * c
+        if abs(d * c - 1.0) < 1e-15:
+            break
+    return h
+
+
+def _t_quantile(p_two_sided: float, df: float) -> float:
+    """The t for which P(|T| ≥ t) = ``p_two_sided`` (bisection on the tail)."""
+    lo, hi = 0.0, 1.0
+    while _t_two_sided(hi, df) > p_two_sided:
+        hi *= 2.0
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if _t_two_sided(mid, df) > p_two_sided else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+class Summary:
+    """A fit as statsmodels' ``summary()`` shows one: ``stats`` (rows, terms, R², adjusted R²,
+    F, AIC, BIC, the residuals' correlation time τ) and ``terms``, a DataFrame of each
+    coefficient with its standard error, the √τ-corrected one, t, p and confidence interval."""
+
+    def __init__(self, stats: Dict[str, Any], terms: pd.DataFrame, equation: str):
+        self.stats = stats
+        self.terms = terms
+        self.equation = equation
+
+    def __str__(self) -> str:
+        head = "  ".join(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}" for k, v in self.stats.items())
+        return f"{self.equation}\n{head}\n{self.terms.to_string(float_format=lambda v: f'{v:.6g}')}"
+
+    __repr__ = __str__
+
+
 class Fit:
     """One equation fitted by a back-end: its steps, chosen terms and coefficients.
 
@@ -301,8 +364,64 @@ class Fit:
         index = data.index if isinstance(data, pd.DataFrame) else None
         return pd.Series(values, index=index, name=self.target)
 
+    def equation(self, precision: int = 6) -> str:
+        """The fitted equation as text, ``y = 62.4 + 1.55 x1 + ...``."""
+        parts = [] if self.intercept is None else [f"{self.intercept:.{precision}g}"]
+        for term, value in self.coefficients.items():
+            parts.append(f"{value:.{precision}g} {term}")
+        return f"{self.target} = " + (" + ".join(parts) if parts else "0").replace("+ -", "- ")
+
+    def summary(self, alpha: float = 0.05) -> Summary:
+        """R², adjusted R², F, AIC and BIC of the chosen step, and every coefficient with its
+        standard error (and the one corrected for the residuals' correlation, ×√τ, where
+        the rows are a time series), t, two-sided p and the (1 − ``alpha``) interval."""
+        r = self.report
+        n = int(r.get("rows", 0))
+        steps = r.get("steps", [])
+        chosen = next((st for st in steps if st.get("step") == r.get("chosen_step")), steps[-1] if steps else {})
+        has_b0 = r.get("intercept") is not None
+        rows = [(t["term"], t["coefficient"], t["std_error"], t["t"]) for t in r.get("terms", [])]
+        if has_b0:
+            b0, se0 = r["intercept"], r.get("intercept_std_error") or float("nan")
+            rows.insert(0, ("(intercept)", b0, se0, b0 / se0 if se0 else float("nan")))
+        p = len(rows)
+        dof = max(n - p, 1)
+        r2 = float(chosen.get("r2", float("nan")))
+        s = float(chosen.get("standard_error", float("nan")))
+        rss = s * s * dof
+        llf = -0.5 * n * (math.log(2 * math.pi) + math.log(rss / n) + 1.0) if n and rss > 0 else float("nan")
+        tau = r.get("correlation_time")
+        stretch = math.sqrt(tau) if tau and tau > 1.0 else 1.0
+        q = _t_quantile(alpha, dof)
+        table = pd.DataFrame(
+            [
+                {
+                    "term": term,
+                    "coefficient": b,
+                    "std_error": se,
+                    "std_error_tau": se * stretch,
+                    "t": t,
+                    "p": _t_two_sided(t, dof),
+                    f"ci_{alpha / 2:g}": b - q * se,
+                    f"ci_{1 - alpha / 2:g}": b + q * se,
+                }
+                for term, b, se, t in rows
+            ]
+        ).set_index("term")
+        stats = {
+            "rows": n,
+            "terms": p,
+            "r2": r2,
+            "adj_r2": 1.0 - (1.0 - r2) * ((n - 1) if has_b0 else n) / dof,
+            "f": float(chosen.get("f", float("nan"))),
+            "aic": -2.0 * llf + 2.0 * p,
+            "bic": -2.0 * llf + p * math.log(n) if n else float("nan"),
+            "tau": float(tau) if tau else float("nan"),
+        }
+        return Summary(stats, table, self.equation())
+
     def __repr__(self) -> str:
-        return f"termid.Fit({self.target}: {len(self.coefficients)} terms)"
+        return f"termid.Fit({self.equation(4)})"
 
 
 @functools.lru_cache(maxsize=64)

@@ -108,3 +108,33 @@ def test_predictions_keep_the_index_and_errors_are_floats(hald, ship, zigzags):
     run = zigzags[0].set_index(zigzags[0].t * 1000.0)
     assert list(ship.predict(run).index) == list(run.index)
     assert ship.coefficients("r_dot")["std_error"].dtype == np.float64
+
+
+def test_summary_as_statsmodels_reports_it(hald):
+    from termid import _t_two_sided, _t_quantile
+
+    # Student's t in closed form: df = 1 (Cauchy) and df = 2
+    for t in [0.1, 1.0, 3.0, 25.0]:
+        assert _t_two_sided(t, 1) == pytest.approx(1 - 2 / np.pi * np.arctan(t), rel=1e-10)
+        assert _t_two_sided(t, 2) == pytest.approx(1 - t / np.sqrt(2 + t * t), rel=1e-10)
+    assert _t_quantile(0.05, 2) == pytest.approx(4.302652729911275, rel=1e-9)
+    fitted = termid.fit(hald, "y", ["x1", "x2"], "stepwise", step_rule="last")
+    s = fitted.summary()
+    # ordinary least squares by numpy, as statsmodels' OLS computes it
+    X = np.column_stack([np.ones(len(hald)), hald.x1, hald.x2])
+    beta, rss, *_ = np.linalg.lstsq(X, hald.y, rcond=None)
+    n, p = X.shape
+    sigma2 = rss[0] / (n - p)
+    se = np.sqrt(np.diag(sigma2 * np.linalg.inv(X.T @ X)))
+    llf = -0.5 * n * (np.log(2 * np.pi) + np.log(rss[0] / n) + 1)
+    r2 = 1 - rss[0] / ((hald.y - hald.y.mean()) ** 2).sum()
+    assert s.stats["r2"] == pytest.approx(r2, rel=1e-10)
+    assert s.stats["adj_r2"] == pytest.approx(1 - (1 - r2) * (n - 1) / (n - p), rel=1e-10)
+    assert s.stats["aic"] == pytest.approx(-2 * llf + 2 * p, rel=1e-10)
+    assert s.stats["bic"] == pytest.approx(-2 * llf + p * np.log(n), rel=1e-10)
+    terms = s.terms.loc[["(intercept)", "x1", "x2"]]
+    np.testing.assert_allclose(terms.coefficient, beta, rtol=1e-10)
+    np.testing.assert_allclose(terms.std_error, se, rtol=1e-8)
+    assert terms.loc["x1", "ci_0.025"] == pytest.approx(beta[1] - 2.2281388519649385 * se[1], rel=1e-8)
+    assert 0 < terms.loc["x1", "p"] < 1e-6
+    assert "y = " in str(s) and "x1" in repr(fitted)
