@@ -715,6 +715,16 @@ impl PyMoments {
         Ok(PyMoments { inner: self.inner.clone().merge(other.inner.clone()).map_err(fail)? })
     }
 
+    /// `a + b` is `a.merge(b)` (so `sum(parts[1:], parts[0])` merges a list).
+    fn __add__(&self, other: &PyMoments) -> PyResult<PyMoments> {
+        self.merge(other)
+    }
+
+    /// Equal when of the same equation, target and candidates with the same runs' numbers.
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other.extract::<PyRef<'_, PyMoments>>().is_ok_and(|o| o.inner == self.inner)
+    }
+
     #[getter]
     fn equation(&self) -> String {
         self.inner.equation.clone()

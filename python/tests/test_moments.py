@@ -36,3 +36,12 @@ def test_statistics_of_other_equations_do_not_merge(ship, zigzags):
     b = termid.Moments.from_frame(zigzags[0], ship, "r_dot")
     with pytest.raises(termid.TermidError, match="cannot be merged"):
         a.merge(b)
+
+
+def test_moments_add_and_compare(ship, zigzags):
+    parts = [termid.Moments.from_frame(run, ship, "r_dot") for run in zigzags[:3]]
+    merged = parts[0].merge(parts[1]).merge(parts[2])
+    assert parts[0] + parts[1] + parts[2] == merged
+    assert sum(parts[1:], parts[0]) == merged
+    assert merged != parts[0] and parts[0] == termid.Moments.from_frame(zigzags[0], ship, "r_dot")
+    assert (parts[0] == "statistics") is False
