@@ -492,6 +492,20 @@ def fit(
     return Fit(native, target)
 
 
+def _gap_frame(gap: Mapping[str, Any]) -> pd.DataFrame:
+    """A gap (per run and state: RMS and largest error) as a DataFrame indexed by run and
+    state, each state's unit beside; ``attrs["cost"]`` the scaled sum of squares."""
+    units = {name: unit for name, unit, *_ in gap.get("states", [])}
+    rows = [
+        {"run": run, "state": state, "unit": units.get(state, ""), "rms": float(rms), "max": float(largest)}
+        for run, states in gap.get("runs", [])
+        for state, rms, largest in states
+    ]
+    frame = pd.DataFrame(rows, columns=["run", "state", "unit", "rms", "max"]).set_index(["run", "state"])
+    frame.attrs["cost"] = gap.get("cost")
+    return frame
+
+
 def _targeted(
     native: Any, data: List[Tuple[str, Any]], derivative: Optional[str], target: Optional[str], equations: List[str]
 ) -> List[Tuple[str, Any]]:
@@ -745,15 +759,65 @@ class Model:
         """Each run re-simulated from its recorded initial state with its recorded inputs."""
         return [_frame(c) for c in self._native.replay(_runs(runs), dt, integrator, with_intercept)]
 
-    def validate(self, runs: Union[Data, Sequence[Data]], *, dt: Optional[float] = None, integrator: Optional[str] = None, with_intercept: bool = False) -> Dict[str, Any]:
-        """Held-out runs against the model: per state RMS and largest error, and for a ship
-        the metrics (overshoots, tactical diameter, ...) measured and simulated."""
-        return json.loads(self._native.validate(_runs(runs), dt, integrator, with_intercept))
+    def validate(
+        self,
+        runs: Union[Data, Sequence[Data]],
+        *,
+        dt: Optional[float] = None,
+        integrator: Optional[str] = None,
+        with_intercept: bool = False,
+        raw: bool = False,
+    ) -> Any:
+        """Held-out runs against the model: a DataFrame of every run's and state's RMS and
+        largest error (index run, state; the unit beside), ``attrs["cost"]`` the scaled sum of
+        squares, and for a ship ``attrs["metrics"]`` (overshoots, tactical diameter, ...)
+        measured and simulated, a DataFrame indexed by run and source. ``raw=True``: the
+        report as plain values."""
+        report = json.loads(self._native.validate(_runs(runs), dt, integrator, with_intercept))
+        if raw:
+            return report
+        frame = _gap_frame(report["gap"])
+        rows = [
+            {"run": m["run"], "source": source, **(m.get(source) or {})}
+            for m in report.get("metrics", [])
+            for source in ("measured", "simulated")
+            if m.get(source) is not None
+        ]
+        frame.attrs["metrics"] = pd.DataFrame(rows).set_index(["run", "source"]) if rows else pd.DataFrame()
+        return frame
 
-    def diagnose(self, runs: Union[Data, Sequence[Data]], *, dt: Optional[float] = None, integrator: Optional[str] = None, with_intercept: bool = False) -> Tuple[Dict[str, Any], Optional["Model"]]:
-        """Where model and runs disagree, which effect explains it, and the model with it."""
+    def diagnose(
+        self,
+        runs: Union[Data, Sequence[Data]],
+        *,
+        dt: Optional[float] = None,
+        integrator: Optional[str] = None,
+        with_intercept: bool = False,
+        raw: bool = False,
+    ) -> Tuple[Any, Optional["Model"]]:
+        """Where model and runs disagree, which effect explains it, and the model with it:
+        a DataFrame of every run's and state's error before and after the effect (columns
+        ``rms_before``, ``max_before``, ``rms_after``, ``max_after``), with ``attrs`` holding
+        ``location`` (its words, leading state, onset), ``effect`` and ``candidates`` (a
+        DataFrame of the effects tried); and the model with the effect, or None. ``raw=True``:
+        the report as plain values."""
         text, native = self._native.diagnose(_runs(runs), dt, integrator, with_intercept)
-        return json.loads(text), (Model(native) if native is not None else None)
+        report = json.loads(text)
+        model = Model(native) if native is not None else None
+        if raw:
+            return report, model
+        before = _gap_frame(report["gap_before"]).rename(columns={"rms": "rms_before", "max": "max_before"})
+        if report.get("gap_after"):
+            after = _gap_frame(report["gap_after"])[["rms", "max"]]
+            before = before.join(after.rename(columns={"rms": "rms_after", "max": "max_after"}))
+        before.attrs = {
+            "location": report.get("location"),
+            "effect": report.get("effect"),
+            "candidates": pd.DataFrame(
+                [{k: v for k, v in c.items() if k in ("name", "explained", "delta_bic", "cost", "declared")} for c in report.get("candidates", [])]
+            ),
+        }
+        return before, model
 
     def checks(self, runs: Union[Data, Sequence[Data], None] = None) -> pd.DataFrame:
         """The plug-in's physical checks (stability, damping signs, turning circles)."""

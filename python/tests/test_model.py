@@ -63,8 +63,14 @@ def test_replay_and_validate_of_the_models_own_run(ship, zigzags):
     replayed = ship.replay(zigzags[0])[0]
     np.testing.assert_allclose(replayed["r"].to_numpy(), zigzags[0]["r"].to_numpy(), atol=1e-9)
     report = ship.validate(zigzags[:1])
-    # per state: name, unit, RMS error, largest error
-    for name, unit, rms, largest in report["gap"]["states"]:
+    # per run and state: unit, RMS error, largest error, as a DataFrame
+    assert list(report.columns) == ["unit", "rms", "max"] and report.index.names == ["run", "state"]
+    assert (report["rms"] < 1e-9).all() and (report["max"] < 1e-9).all()
+    assert report.loc[(zigzags[0].attrs["name"], "u"), "unit"] == "m/s"
+    metrics = report.attrs["metrics"]
+    assert metrics.loc[(zigzags[0].attrs["name"], "simulated"), "first_overshoot_deg"] > 0
+    raw = ship.validate(zigzags[:1], raw=True)
+    for name, unit, rms, largest in raw["gap"]["states"]:
         assert rms < 1e-9 and largest < 1e-9, name
 
 
@@ -87,7 +93,10 @@ def test_checks_and_diagnose(ship, zigzags):
     assert {"name", "passed", "refuses", "detail"} <= set(checks.columns)
     assert checks["passed"].all()
     report, improved = ship.diagnose(zigzags[:2])
-    assert "gap_before" in report
+    assert {"unit", "rms_before", "max_before"} <= set(report.columns)
+    assert "leading_state" in report.attrs["location"]
+    raw, _ = ship.diagnose(zigzags[:2], raw=True)
+    assert "gap_before" in raw
 
 
 def test_basin_records_are_noisy_and_seeded(ship):
