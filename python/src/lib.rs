@@ -434,7 +434,11 @@ impl PyModel {
         }
         let system = System::new(&self.inner, &own, with_intercept).map_err(fail)?;
         let dx = py.detach(|| system.derivatives_on(frame)).map_err(fail)?;
-        let names = system.state_names().iter().map(|s| format!("{s}_dot"));
+        // each column named as the equation that gives it (`psi_dot` for ψ), else `<state>_dot`
+        let equations = self.inner.equations();
+        let names = system.state_names().iter().map(|s| {
+            equations.iter().find(|e| &e.state == s).map_or_else(|| format!("{s}_dot"), |e| e.name.clone())
+        });
         Ok(arrays(py, names.zip(dx).collect()))
     }
 

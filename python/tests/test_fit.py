@@ -106,7 +106,10 @@ def test_predictions_keep_the_index_and_errors_are_floats(hald, ship, zigzags):
     assert isinstance(predicted, pd.Series) and predicted.name == "y"
     assert list(predicted.index) == list(indexed.index)
     run = zigzags[0].set_index(zigzags[0].t * 1000.0)
-    assert list(ship.predict(run).index) == list(run.index)
+    predicted = ship.predict(run)
+    assert list(predicted.index) == list(run.index)
+    # named as the equations are (`psi_dot`, not `ψ_dot`)
+    assert list(predicted.columns) == ship.equations
     assert ship.coefficients("r_dot")["std_error"].dtype == np.float64
 
 
