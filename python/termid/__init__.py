@@ -700,8 +700,7 @@ class Model:
     # ---- prediction and simulation
     def predict(self, run: Data, with_intercept: bool = False) -> pd.DataFrame:
         """ẋ of every state on every row of a run (columns named as the equations, else
-        ``<state>_dot``), on the run's
-        index (a DataFrame's)."""
+        ``<state>_dot``), on the run's index (a DataFrame's)."""
         frame = _frame(self._native.predict(_runs(run)[0], with_intercept))
         if isinstance(run, pd.DataFrame):
             frame.index = run.index
