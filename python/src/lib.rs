@@ -44,6 +44,15 @@ fn refuse(text: impl Into<String>) -> PyErr {
     TermidError::new_err(text.into())
 }
 
+/// The repository's model files, inside the extension (no data files to install or find).
+const BUILTIN: [(&str, &str); 5] = [
+    ("oltmann1973", include_str!("../../models/oltmann1973.toml")),
+    ("lorenz", include_str!("../../models/lorenz.toml")),
+    ("duffing", include_str!("../../models/duffing.toml")),
+    ("mmg_kvlcc2", include_str!("../../models/mmg_kvlcc2.toml")),
+    ("new_ship", include_str!("../../models/new_ship.toml")),
+];
+
 /// A run handed over from Python: its name, and its columns as float64 arrays.
 type Run<'py> = (String, Bound<'py, PyDict>);
 
@@ -201,6 +210,22 @@ impl PyModel {
     #[staticmethod]
     fn default_model() -> Self {
         PyModel { inner: termid::plugins::default_model() }
+    }
+
+    /// A model file shipped inside the package, by name (`termid.Model.builtin_names()`).
+    #[staticmethod]
+    fn builtin(name: &str) -> PyResult<Self> {
+        let Some((_, text)) = BUILTIN.iter().find(|(n, _)| *n == name) else {
+            let names: Vec<&str> = BUILTIN.iter().map(|(n, _)| *n).collect();
+            return Err(refuse(format!("no built-in model `{name}` (there are: {})", names.join(", "))));
+        };
+        Ok(PyModel { inner: termid::plugins::parse(text, &format!("{name}.toml")).map_err(fail)? })
+    }
+
+    /// The names of the model files shipped inside the package.
+    #[staticmethod]
+    fn builtin_names() -> Vec<&'static str> {
+        BUILTIN.iter().map(|(n, _)| *n).collect()
     }
 
     fn to_toml(&self) -> String {

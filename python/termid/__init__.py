@@ -584,6 +584,20 @@ class Model:
         return Model(_termid.Model.parse(text, name))
 
     @staticmethod
+    def builtin(name: str) -> "Model":
+        """A model file shipped inside the package: ``oltmann1973``, ``lorenz``, ``duffing``,
+        ``mmg_kvlcc2`` (KVLCC2 in the MMG standard model) or ``new_ship`` (the template).
+
+        >>> Model.builtin("lorenz").states
+        ['x', 'y', 'z']
+        """
+        return Model(_termid.Model.builtin(name))
+
+    @staticmethod
+    def builtin_names() -> List[str]:
+        return list(_termid.Model.builtin_names())
+
+    @staticmethod
     def default() -> "Model":
         """Oltmann's (1973) HSVA 1512 with the coefficients of his Table 2."""
         return Model(_termid.Model.default_model())

@@ -214,3 +214,13 @@ def test_identification_releases_the_gil(ship, zigzags):
     worker.join()
     # a wake-up a millisecond or so while the work runs, not one at its end
     assert wakeups > 0.2 * spent[0] / 0.001, (wakeups, spent)
+
+
+def test_the_model_files_ship_inside_the_package(ship):
+    assert termid.Model.builtin_names() == ["oltmann1973", "lorenz", "duffing", "mmg_kvlcc2", "new_ship"]
+    assert termid.Model.builtin("oltmann1973").to_toml() == ship.to_toml()
+    path = os.path.join(os.path.dirname(__file__), "..", "..", "models", "lorenz.toml")
+    assert termid.Model.builtin("lorenz").to_toml() == termid.Model.load(path).to_toml()
+    assert termid.Model.builtin("mmg_kvlcc2").simulate("turning:35").attrs["metrics"]["tactical_diameter_m"] > 0
+    with pytest.raises(termid.TermidError, match="no built-in model `kvlcc3`"):
+        termid.Model.builtin("kvlcc3")
