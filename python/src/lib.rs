@@ -816,10 +816,53 @@ struct PyFit {
     coefficients: Vec<f64>,
     intercept: f64,
     parameters: BTreeMap<String, f64>,
+    /// The variables the terms were written over (for pickling: the terms are compiled again).
+    variables: Vec<String>,
+}
+
+/// What a pickled fit holds: its JSON, the variables and the parameters of its terms.
+type FitState = (String, Vec<String>, BTreeMap<String, f64>);
+
+impl PyFit {
+    /// A fit with its chosen terms compiled over `variables` and `parameters`.
+    fn compiled(fit: Fit, variables: Vec<String>, parameters: BTreeMap<String, f64>) -> PyResult<PyFit> {
+        let mut vocabulary = Vocabulary::new();
+        for name in &variables {
+            vocabulary.variable(name).map_err(fail)?;
+        }
+        for name in parameters.keys() {
+            vocabulary.parameter(name).map_err(fail)?;
+        }
+        let texts: Vec<String> = fit.selection.terms.iter().map(|t| t.term.clone()).collect();
+        let chosen = parse_terms(&texts, &vocabulary).map_err(fail)?;
+        Ok(PyFit {
+            chosen: Library::compile(&chosen, &vocabulary).map_err(fail)?,
+            coefficients: fit.selection.terms.iter().map(|t| t.coefficient).collect(),
+            intercept: fit.selection.intercept.as_ref().map_or(0.0, |b| b.value),
+            parameters,
+            variables,
+            fit,
+        })
+    }
 }
 
 #[pymethods]
 impl PyFit {
+    /// Pickled as its JSON and the names its terms are written over (a process pool, Dask).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, FitState)> {
+        let this = slf.borrow();
+        let restore = slf.get_type().getattr("_restore")?;
+        Ok((restore, (to_json(&this.fit)?, this.variables.clone(), this.parameters.clone())))
+    }
+
+    /// The fit `__reduce__` wrote.
+    #[staticmethod]
+    fn _restore(json: &str, variables: Vec<String>, parameters: BTreeMap<String, f64>) -> PyResult<PyFit> {
+        let fit: Fit =
+            serde_json::from_str(json).map_err(|e| refuse(format!("not a pickled termid fit: {e}")))?;
+        PyFit::compiled(fit, variables, parameters)
+    }
+
     /// The fit as JSON: target, candidates, the back-end's steps and chosen terms, covariance.
     fn to_json(&self) -> PyResult<String> {
         to_json(&self.fit)
@@ -948,6 +991,8 @@ fn fit(
 ) -> PyResult<PyFit> {
     let backend = backend_of(backend)?;
     let names: Vec<String> = columns.keys().iter().map(|k| k.extract()).collect::<PyResult<_>>()?;
+    let variables: Vec<String> =
+        names.iter().filter(|n| *n != target && Some(*n) != weights.as_ref()).cloned().collect();
     // the arrays used where they lie: read-only views, no copy (the rows are checked as
     // they are accumulated: a value that is not finite is refused with its row and term)
     let arrays = names
@@ -983,6 +1028,7 @@ fn fit(
         coefficients: fit.selection.terms.iter().map(|t| t.coefficient).collect(),
         intercept: fit.selection.intercept.as_ref().map_or(0.0, |b| b.value),
         parameters,
+        variables,
         fit,
     })
 }

@@ -141,3 +141,26 @@ def test_summary_as_statsmodels_reports_it(hald):
     assert terms.loc["x1", "ci_0.025"] == pytest.approx(beta[1] - 2.2281388519649385 * se[1], rel=1e-8)
     assert 0 < terms.loc["x1", "p"] < 1e-6
     assert "y = " in str(s) and "x1" in repr(fitted)
+
+
+def _fit_in_a_worker(frame):
+    return termid.fit(frame, "y", ["x1", "x2", "x1*x2"])
+
+
+def _refuse_in_a_worker(frame):
+    return termid.fit(frame, "y", ["x1*"])
+
+
+def test_fits_and_errors_cross_a_process_pool(hald):
+    import pickle
+    from concurrent.futures import ProcessPoolExecutor
+
+    here = _fit_in_a_worker(hald)
+    again = pickle.loads(pickle.dumps(here))
+    pd.testing.assert_series_equal(again.coefficients, here.coefficients)
+    pd.testing.assert_series_equal(again.predict(hald), here.predict(hald))
+    with ProcessPoolExecutor(max_workers=1) as pool:
+        there = pool.submit(_fit_in_a_worker, hald).result()
+        pd.testing.assert_series_equal(there.predict(hald), here.predict(hald))
+        with pytest.raises(termid.TermidError, match=r"\^"):
+            pool.submit(_refuse_in_a_worker, hald).result()
