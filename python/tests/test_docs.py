@@ -9,8 +9,11 @@ import termid
 
 
 def test_docstring_examples_run():
-    failures, tried = doctest.testmod(termid, optionflags=doctest.NORMALIZE_WHITESPACE)
-    assert tried >= 8 and failures == 0
+    import termid.sklearn
+
+    for module, least in [(termid, 8), (termid.sklearn, 4)]:
+        failures, tried = doctest.testmod(module, optionflags=doctest.NORMALIZE_WHITESPACE)
+        assert tried >= least and failures == 0, module.__name__
 
 
 def test_settings_are_discoverable_and_step_rule_may_be_a_name(hald):
