@@ -109,21 +109,30 @@ fn the_new_ship_recipe_predicts_turning_circles_it_was_not_trained_on() {
     ]);
     assert!(ok, "{err}");
     assert!(text.contains("← chosen"), "{text}");
-    let mut model = termid::plugins::load(&out).unwrap();
-    let mut spec = termid::ship::ShipSpec::of(&model).unwrap().unwrap();
-    spec.rudder_limit = 36.0;
-    spec.store(&mut model);
     let truth_ship = ship();
-    let identified = Ship::new(&model, false).unwrap();
-    for rudder in [35.0, -35.0] {
-        let Metrics::Turning(t) = run(&truth_ship, &format!("turning:{rudder}")) else { unreachable!() };
-        // the model's rudder is the indicator's, 0.3° more than the true angle
-        let Metrics::Turning(m) = run(&identified, &format!("turning:{}", rudder + 0.3)) else {
-            unreachable!()
-        };
-        let (a, b) = (m.tactical_diameter_m.unwrap(), t.tactical_diameter_m.unwrap());
-        assert!((a / b - 1.0).abs() < 0.03, "δ = {rudder}°: tactical diameter {a} m, truth {b} m");
-    }
+    // the identified model in `path` turns at ±35° within `tolerance` of the truth's tactical
+    // diameter; returns the model
+    let turns_within = |path: &std::path::Path, tolerance: f64, what: &str| {
+        let mut model = termid::plugins::load(path).unwrap();
+        let mut spec = termid::ship::ShipSpec::of(&model).unwrap().unwrap();
+        spec.rudder_limit = 36.0;
+        spec.store(&mut model);
+        let identified = Ship::new(&model, false).unwrap();
+        for rudder in [35.0, -35.0] {
+            let Metrics::Turning(t) = run(&truth_ship, &format!("turning:{rudder}")) else { unreachable!() };
+            // the model's rudder is the indicator's, 0.3° more than the true angle
+            let Metrics::Turning(m) = run(&identified, &format!("turning:{}", rudder + 0.3)) else {
+                unreachable!()
+            };
+            let (a, b) = (m.tactical_diameter_m.unwrap(), t.tactical_diameter_m.unwrap());
+            assert!(
+                (a / b - 1.0).abs() < tolerance,
+                "{what} δ = {rudder}°: tactical diameter {a} m, truth {b} m"
+            );
+        }
+        model
+    };
+    let model = turns_within(&out, 0.03, "chosen");
     let held = |m: &termid::model::Model| {
         let s = Ship::new(&at_approach_speed(m, 1.17248), false).unwrap();
         let Metrics::ZigZag(z) = run(&s, "zigzag:25/10") else { unreachable!() };
@@ -137,19 +146,7 @@ fn the_new_ship_recipe_predicts_turning_circles_it_was_not_trained_on() {
     let sparse = dir.join("stlsq.toml");
     let (ok, text, err) = identify(&["--backend", "stlsq", "--out", sparse.to_str().unwrap()]);
     assert!(ok && text.contains("== physical checks ==") && !text.contains("FAIL"), "{text}\n{err}");
-    let mut model = termid::plugins::load(&sparse).unwrap();
-    let mut spec = termid::ship::ShipSpec::of(&model).unwrap().unwrap();
-    spec.rudder_limit = 36.0;
-    spec.store(&mut model);
-    let identified = Ship::new(&model, false).unwrap();
-    for rudder in [35.0, -35.0] {
-        let Metrics::Turning(t) = run(&truth_ship, &format!("turning:{rudder}")) else { unreachable!() };
-        let Metrics::Turning(m) = run(&identified, &format!("turning:{}", rudder + 0.3)) else {
-            unreachable!()
-        };
-        let (a, b) = (m.tactical_diameter_m.unwrap(), t.tactical_diameter_m.unwrap());
-        assert!((a / b - 1.0).abs() < 0.10, "stlsq δ = {rudder}°: tactical diameter {a} m, truth {b} m");
-    }
+    turns_within(&sparse, 0.10, "stlsq");
 }
 
 /// `termid scale` takes the 7 m model to the 320 m ship by Froude's law: the turning circle
