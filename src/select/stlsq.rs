@@ -216,32 +216,44 @@ impl Selector for Stlsq {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::select::Accumulator;
+    use crate::select::{Accumulator, Moments};
+
+    /// The statistics of `n` rows at t = i/n, each row's candidates and target from `row`
+    /// (given t and a uniform noise source in [−0.5, 0.5) seeded by `seed`), with names x1, x2, ….
+    fn rows_of(
+        n: usize,
+        seed: u64,
+        row: impl Fn(f64, &mut dyn FnMut() -> f64) -> (Vec<f64>, f64),
+    ) -> (Moments, Vec<String>) {
+        let mut seed = seed;
+        let mut noise = move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let (mut cols, mut ys): (Vec<Vec<f64>>, Vec<f64>) = (Vec::new(), Vec::new());
+        for i in 0..n {
+            let (x, y) = row(i as f64 / n as f64, &mut noise);
+            cols.resize(x.len(), Vec::new());
+            for (c, v) in cols.iter_mut().zip(x) {
+                c.push(v);
+            }
+            ys.push(y);
+        }
+        let mut acc = Accumulator::new(cols.len());
+        let columns: Vec<&[f64]> = cols.iter().map(Vec::as_slice).collect();
+        acc.push_columns(&columns, &ys, None);
+        (acc.finish(), (1..=cols.len()).map(|i| format!("x{i}")).collect())
+    }
 
     /// y = 2·x1 − 3·x3 + 0.5 plus a little noise, six candidates: STLSQ keeps x1 and x3 and
     /// their coefficients are the least-squares ones on that support.
     #[test]
     fn keeps_the_true_terms_and_fits_them_by_least_squares() {
-        let n = 300;
-        let (mut cols, mut ys) = (vec![Vec::new(); 6], Vec::new());
-        let mut seed = 7u64;
-        let mut noise = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
-        for i in 0..n {
-            let t = i as f64 / n as f64;
-            let x = [t, (7.0 * t).sin(), (3.0 * t).cos(), t * t, (11.0 * t).sin() * 0.1, noise()];
-            ys.push(2.0 * x[0] - 3.0 * x[2] + 0.5 + 0.01 * noise());
-            for (c, v) in cols.iter_mut().zip(x) {
-                c.push(v);
-            }
-        }
-        let mut acc = Accumulator::new(6);
-        let columns: Vec<&[f64]> = cols.iter().map(Vec::as_slice).collect();
-        acc.push_columns(&columns, &ys, None);
-        let moments = acc.finish();
-        let names: Vec<String> = (1..=6).map(|i| format!("x{i}")).collect();
+        let (moments, names) = rows_of(300, 7, |t, noise| {
+            let x = vec![t, (7.0 * t).sin(), (3.0 * t).cos(), t * t, (11.0 * t).sin() * 0.1, noise()];
+            let y = 2.0 * x[0] - 3.0 * x[2] + 0.5 + 0.01 * noise();
+            (x, y)
+        });
         let pb = Problem { moments: &moments, names: &names, forced: &[], excluded: &[], intercept: true };
         let s = Stlsq::default().select(&pb).unwrap();
         let mut chosen: Vec<&str> = s.terms.iter().map(|t| t.term.as_str()).collect();
@@ -261,26 +273,11 @@ mod tests {
     /// threshold of 0.05 drops it; the path, by BIC, keeps it and nothing else.
     #[test]
     fn the_path_keeps_a_small_term_the_data_hold() {
-        let n = 400;
-        let (mut cols, mut ys) = (vec![Vec::new(); 5], Vec::new());
-        let mut seed = 11u64;
-        let mut noise = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
-        for i in 0..n {
-            let t = i as f64 / n as f64;
-            let x = [t, (7.0 * t).sin(), (3.0 * t).cos(), t * t, noise()];
-            ys.push(2.0 * x[0] - 3.0 * x[2] + 0.1 * x[1] + 1e-4 * noise());
-            for (c, v) in cols.iter_mut().zip(x) {
-                c.push(v);
-            }
-        }
-        let mut acc = Accumulator::new(5);
-        let columns: Vec<&[f64]> = cols.iter().map(Vec::as_slice).collect();
-        acc.push_columns(&columns, &ys, None);
-        let moments = acc.finish();
-        let names: Vec<String> = (1..=5).map(|i| format!("x{i}")).collect();
+        let (moments, names) = rows_of(400, 11, |t, noise| {
+            let x = vec![t, (7.0 * t).sin(), (3.0 * t).cos(), t * t, noise()];
+            let y = 2.0 * x[0] - 3.0 * x[2] + 0.1 * x[1] + 1e-4 * noise();
+            (x, y)
+        });
         let pb = Problem { moments: &moments, names: &names, forced: &[], excluded: &[], intercept: true };
         let chosen = |s: &Selection| {
             let mut c: Vec<String> = s.terms.iter().map(|t| t.term.clone()).collect();
