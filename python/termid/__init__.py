@@ -223,15 +223,19 @@ def _backend(backend: Optional[str], settings: Mapping[str, Any]) -> Optional[st
 
 
 def backends() -> List[str]:
-    """The regression back-ends by name (``stepwise``, ``best-subset``, ``sparse``, ...)."""
+    """The regression back-ends by name (``stepwise``, ``best-subset``, ``sparse``, ...).
+
+    >>> "stepwise" in termid.backends() and "stlsq" in termid.backends()
+    True
+    """
     return list(_termid.methods()[0])
 
 
 def settings(backend: str) -> Dict[str, Any]:
-    """A back-end's settings and their defaults, as keywords of :func:`fit` and
-    :meth:`Model.identify` take them.
+    """The settings of the back-end ``backend`` and their defaults, as keywords of
+    :func:`fit` and :meth:`Model.identify` take them.
 
-    >>> settings("stlsq")["floor"]
+    >>> termid.settings("stlsq")["floor"]
     0.01
     """
     found = json.loads(_termid.default_settings(backend))
@@ -240,7 +244,11 @@ def settings(backend: str) -> Dict[str, Any]:
 
 
 def derivatives() -> List[str]:
-    """The derivative methods with their options (``central``, ``savitzky-golay:W:O``, ...)."""
+    """The derivative methods with their options (``central``, ``savitzky-golay:W:O``, ...).
+
+    >>> [d.split("[")[0] for d in termid.derivatives()][:2]
+    ['central', 'five-point']
+    """
     return list(_termid.methods()[1])
 
 
@@ -292,7 +300,13 @@ def _t_quantile(p_two_sided: float, df: float) -> float:
 class Summary:
     """A fit as statsmodels' ``summary()`` shows one: ``stats`` (rows, terms, R², adjusted R²,
     F, AIC, BIC, the residuals' correlation time τ) and ``terms``, a DataFrame of each
-    coefficient with its standard error, the √τ-corrected one, t, p and confidence interval."""
+    coefficient with its standard error, the √τ-corrected one, t, p and confidence interval.
+
+    >>> df = pd.DataFrame({"x": [0.0, 1, 2, 3, 4], "y": [1.0, 3.1, 4.9, 7.0, 9.0]})
+    >>> s = termid.fit(df, "y", "x").summary()
+    >>> round(s.stats["r2"], 4), list(s.terms.index)
+    (0.9995, ['(intercept)', 'x'])
+    """
 
     def __init__(self, stats: Dict[str, Any], terms: pd.DataFrame, equation: str):
         self.stats = stats
@@ -312,6 +326,11 @@ class Fit:
     ``steps`` is the back-end's table (one row per step: term entered or removed, SSE, F),
     ``coefficients`` the chosen terms' values with standard errors, ``chosen_step`` the step
     the back-end stopped at; ``predict`` evaluates the chosen terms, compiled, on new data.
+    Made by :func:`fit`.
+
+    >>> df = pd.DataFrame({"x": [0.0, 1, 2, 3], "y": [1.0, 3, 5, 7]})
+    >>> termid.fit(df, "y", "x")
+    termid.Fit(y = 1 + 2 x)
     """
 
     def __init__(self, native: Any, target: str):
@@ -322,50 +341,101 @@ class Fit:
 
     @property
     def report(self) -> Dict[str, Any]:
-        """The fit's report (steps, terms, chosen step, stop) as plain values; read on first use."""
+        """The fit's report (steps, terms, chosen step, stop) as plain values; read on first use.
+
+        >>> fitted = termid.fit(pd.DataFrame({"x": [0.0, 1, 2, 3], "y": [1.0, 3, 5, 7]}), "y", "x")
+        >>> fitted.report["chosen_step"]
+        1
+        """
         if self._report is None:
             self._report = json.loads(self._native.report_json())
         return self._report
 
     @property
     def raw(self) -> Dict[str, Any]:
-        """The whole fit (selection, candidates, covariance) as plain values."""
+        """The whole fit (selection, candidates, covariance) as plain values.
+
+        >>> fitted = termid.fit(pd.DataFrame({"x": [0.0, 1, 2, 3], "y": [1.0, 3, 5, 7]}), "y", "x")
+        >>> sorted(fitted.raw)[:2]
+        ['candidates', 'correlation_time']
+        """
         if self._raw is None:
             self._raw = json.loads(self._native.to_json())
         return self._raw
 
     @property
     def steps(self) -> pd.DataFrame:
+        """The back-end's table, one row per step (the term entered or removed, SSE, R², F).
+
+        >>> fitted = termid.fit(pd.DataFrame({"x": [0.0, 1, 2, 3], "y": [1.0, 3, 5, 7]}), "y", "x")
+        >>> fitted.steps[["step", "term"]].to_dict("records")
+        [{'step': 1, 'term': 'x'}]
+        """
         return pd.DataFrame(self.report.get("steps", []))
 
     @property
     def coefficients(self) -> pd.Series:
+        """The chosen terms' coefficients, a Series indexed by term (the intercept apart).
+
+        >>> fitted = termid.fit(pd.DataFrame({"x": [0.0, 1, 2, 3], "y": [1.0, 3, 5, 7]}), "y", "x")
+        >>> fitted.coefficients.round(9).to_dict()
+        {'x': 2.0}
+        """
         terms = self.report.get("terms", [])
         return pd.Series({t["term"]: t["coefficient"] for t in terms}, name=self.target, dtype=float)
 
     @property
     def standard_errors(self) -> pd.Series:
+        """The chosen terms' standard errors, a float64 Series indexed by term.
+
+        >>> fitted = termid.fit(pd.DataFrame({"x": [0.0, 1, 2, 3], "y": [1.0, 3, 5, 7]}), "y", "x")
+        >>> fitted.standard_errors.dtype
+        dtype('float64')
+        """
         terms = self.report.get("terms", [])
         return pd.Series({t["term"]: t.get("std_error") for t in terms}, name=self.target, dtype=float)
 
     @property
     def intercept(self) -> Optional[float]:
+        """The constant b0, or None when fitted without one.
+
+        >>> fitted = termid.fit(pd.DataFrame({"x": [0.0, 1, 2, 3], "y": [1.0, 3, 5, 7]}), "y", "x")
+        >>> round(fitted.intercept, 9)
+        1.0
+        """
         b0 = self.raw["selection"].get("intercept")
         return None if b0 is None else b0["value"]
 
     @property
     def chosen_step(self) -> Optional[int]:
+        """The step the back-end's rule chose (1-based), None for back-ends without steps.
+
+        >>> fitted = termid.fit(pd.DataFrame({"x": [0.0, 1, 2, 3], "y": [1.0, 3, 5, 7]}), "y", "x")
+        >>> fitted.chosen_step
+        1
+        """
         return self.report.get("chosen_step")
 
     def predict(self, data: Data) -> pd.Series:
-        """Σ cⱼ·termⱼ + b0 on data (the compiled evaluator; numpy arrays read in place), a
-        Series on the data's index (a DataFrame's) named as the target."""
+        """Σ cⱼ·termⱼ + b0 on ``data`` (the compiled evaluator; numpy arrays read in place), a
+        Series on the data's index (a DataFrame's) named as the target.
+
+        >>> fitted = termid.fit(pd.DataFrame({"x": [0.0, 1, 2, 3], "y": [1.0, 3, 5, 7]}), "y", "x")
+        >>> fitted.predict({"x": np.array([10.0])}).round(9).tolist()
+        [21.0]
+        """
         values = self._native.predict(_columns(data))
         index = data.index if isinstance(data, pd.DataFrame) else None
         return pd.Series(values, index=index, name=self.target)
 
     def equation(self, precision: int = 6) -> str:
-        """The fitted equation as text, ``y = 62.4 + 1.55 x1 + ...``."""
+        """The fitted equation as text, ``y = 62.4 + 1.55 x1 + ...``, each number to
+        ``precision`` significant digits.
+
+        >>> fitted = termid.fit(pd.DataFrame({"x": [0.0, 1, 2, 3], "y": [1.0, 3, 5, 7]}), "y", "x")
+        >>> fitted.equation(3)
+        'y = 1 + 2 x'
+        """
         parts = [] if self.intercept is None else [f"{self.intercept:.{precision}g}"]
         for term, value in self.coefficients.items():
             parts.append(f"{value:.{precision}g} {term}")
@@ -374,7 +444,12 @@ class Fit:
     def summary(self, alpha: float = 0.05) -> Summary:
         """R², adjusted R², F, AIC and BIC of the chosen step, and every coefficient with its
         standard error (and the one corrected for the residuals' correlation, ×√τ, where
-        the rows are a time series), t, two-sided p and the (1 − ``alpha``) interval."""
+        the rows are a time series), t, two-sided p and the (1 − ``alpha``) interval.
+
+        >>> df = pd.DataFrame({"x": [0.0, 1, 2, 3, 4], "y": [1.0, 3.1, 4.9, 7.0, 9.0]})
+        >>> termid.fit(df, "y", "x").summary(alpha=0.1).terms.columns[-2:].tolist()
+        ['ci_0.05', 'ci_0.95']
+        """
         r = self.report
         n = int(r.get("rows", 0))
         steps = r.get("steps", [])
@@ -386,8 +461,9 @@ class Fit:
             rows.insert(0, ("(intercept)", b0, se0, b0 / se0 if se0 else float("nan")))
         p = len(rows)
         dof = max(n - p, 1)
-        r2 = float(chosen.get("r2", float("nan")))
-        s = float(chosen.get("standard_error", float("nan")))
+        # a step table may hold null (F of an exact fit): NaN, as statsmodels shows it
+        r2 = float(chosen.get("r2") if chosen.get("r2") is not None else float("nan"))
+        s = float(chosen.get("standard_error") if chosen.get("standard_error") is not None else float("nan"))
         rss = s * s * dof
         llf = -0.5 * n * (math.log(2 * math.pi) + math.log(rss / n) + 1.0) if n and rss > 0 else float("nan")
         tau = r.get("correlation_time")
@@ -413,7 +489,7 @@ class Fit:
             "terms": p,
             "r2": r2,
             "adj_r2": 1.0 - (1.0 - r2) * ((n - 1) if has_b0 else n) / dof,
-            "f": float(chosen.get("f", float("nan"))),
+            "f": float(chosen.get("f") if chosen.get("f") is not None else float("nan")),
             "aic": -2.0 * llf + 2.0 * p,
             "bic": -2.0 * llf + p * math.log(n) if n else float("nan"),
             "tau": float(tau) if tau else float("nan"),
@@ -459,9 +535,15 @@ def fit(
     ``fit(df, "y", ["x1", "x2", "x1*x2"], "stepwise", step_rule="last")`` (a back-end's
     settings: ``termid.settings(backend)``). A single string is one term.
 
+    Parameters: ``data`` a DataFrame, dict of arrays, Arrow table or record array;
+    ``target`` the column explained; ``terms`` the candidates; ``backend`` the selection
+    (:func:`backends`); ``intercept`` whether a constant b0 is fitted; ``forced`` terms kept
+    whatever their significance; ``excluded`` candidates left out; ``parameters`` values of
+    names the terms use that are not columns; ``weights`` a column of row weights.
+
     >>> import pandas as pd
     >>> df = pd.DataFrame({"x1": [1.0, 2, 3, 4, 5], "x2": [2.0, 1, 4, 3, 6]}).eval("y = x1 + 2*x2")
-    >>> fitted = fit(df, "y", ["x1", "x2"], "stepwise", step_rule="last")
+    >>> fitted = termid.fit(df, "y", ["x1", "x2"], "stepwise", step_rule="last")
     >>> fitted.coefficients.round(6).to_dict()
     {'x2': 2.0, 'x1': 1.0}
     """
@@ -533,25 +615,57 @@ def _targeted(
 
 class Identified:
     """What ``Model.identify`` returns: the identified model and each equation's fit report
-    (``steps`` and ``terms`` as DataFrames)."""
+    (``steps`` and ``terms`` as DataFrames).
+
+    >>> lorenz = termid.Model.builtin("lorenz")
+    >>> lorenz.identify(lorenz.simulate(duration=5.0))
+    termid.Identified('Lorenz system (σ = 10, ρ = 28, β = 8/3)': x_dot ← dx/dt, y_dot ← dy/dt, z_dot ← dz/dt)
+    """
 
     def __init__(self, model: "Model", fits: Sequence[Tuple[str, str]]):
         self.model = model
         self.reports: Dict[str, Dict[str, Any]] = {name: json.loads(text) for name, text in fits}
 
     def steps(self, equation: str) -> pd.DataFrame:
+        """The step table of ``equation``'s fit, one row per step.
+
+        >>> lorenz = termid.Model.builtin("lorenz")
+        >>> found = lorenz.identify(lorenz.simulate(duration=5.0))
+        >>> len(found.steps("z_dot")) >= 2
+        True
+        """
         return pd.DataFrame(self.reports[equation].get("steps", []))
 
     def terms(self, equation: str) -> pd.DataFrame:
+        """The terms chosen for ``equation`` with coefficient, standard error and t.
+
+        >>> lorenz = termid.Model.builtin("lorenz")
+        >>> found = lorenz.identify(lorenz.simulate(duration=5.0))
+        >>> sorted(found.terms("z_dot")["term"])
+        ['x*y', 'z']
+        """
         return pd.DataFrame(self.reports[equation].get("terms", []))
 
     def chosen_step(self, equation: str) -> Optional[int]:
+        """The step the back-end chose for ``equation`` (None for back-ends without steps).
+
+        >>> lorenz = termid.Model.builtin("lorenz")
+        >>> found = lorenz.identify(lorenz.simulate(duration=5.0))
+        >>> found.chosen_step("z_dot") is None or found.chosen_step("z_dot") >= 1
+        True
+        """
         return self.reports[equation].get("chosen_step")
 
     @property
     def targets(self) -> Dict[str, str]:
         """What each equation explained: a column of the runs (``r_dot``) or a derivative
-        estimated from them (``dr/dt``)."""
+        estimated from them (``dr/dt``).
+
+        >>> lorenz = termid.Model.builtin("lorenz")
+        >>> found = lorenz.identify(lorenz.simulate(duration=5.0))
+        >>> found.targets["z_dot"]
+        'dz/dt'
+        """
         return {name: str(r.get("target", "")) for name, r in self.reports.items()}
 
     def __repr__(self) -> str:
@@ -564,6 +678,9 @@ class Model:
 
     Load one (``Model.load``), take the default ship (``Model.default()``), identify its
     equations from runs, simulate it and write it back (``save``, ``to_toml``).
+
+    >>> termid.Model.builtin("lorenz")
+    termid.Model("Lorenz system (σ = 10, ρ = 28, β = 8/3)": 3 equations, 3 states)
     """
 
     def __init__(self, native: Any):
@@ -573,7 +690,16 @@ class Model:
     @staticmethod
     def load(path: Union[str, os.PathLike]) -> "Model":
         """Reads a model file; errors name the file, line and key (a missing file is
-        FileNotFoundError, as for ``open``)."""
+        FileNotFoundError, as for ``open``).
+
+        Parameters: ``path`` the TOML model file.
+
+        >>> import os, tempfile
+        >>> path = os.path.join(tempfile.mkdtemp(), "lorenz.toml")
+        >>> termid.Model.builtin("lorenz").save(path)
+        >>> termid.Model.load(path).states
+        ['x', 'y', 'z']
+        """
         path = os.fspath(path)
         if not os.path.exists(path):
             raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), path)
@@ -581,28 +707,49 @@ class Model:
 
     @staticmethod
     def from_toml(text: str, name: str = "<text>") -> "Model":
+        """A model from the TOML ``text`` of a model file; errors name ``name`` as the file.
+
+        >>> text = termid.Model.builtin("lorenz").to_toml()
+        >>> termid.Model.from_toml(text, "lorenz.toml").equations
+        ['x_dot', 'y_dot', 'z_dot']
+        """
         return Model(_termid.Model.parse(text, name))
 
     @staticmethod
     def builtin(name: str) -> "Model":
         """A model file shipped inside the package: ``oltmann1973``, ``lorenz``, ``duffing``,
-        ``mmg_kvlcc2`` (KVLCC2 in the MMG standard model) or ``new_ship`` (the template).
+        ``mmg_kvlcc2`` (KVLCC2 in the MMG standard model) or ``new_ship`` (the template),
+        by ``name`` (:meth:`builtin_names`).
 
-        >>> Model.builtin("lorenz").states
+        >>> termid.Model.builtin("lorenz").states
         ['x', 'y', 'z']
         """
         return Model(_termid.Model.builtin(name))
 
     @staticmethod
     def builtin_names() -> List[str]:
+        """The names of the model files shipped inside the package.
+
+        >>> "oltmann1973" in termid.Model.builtin_names()
+        True
+        """
         return list(_termid.Model.builtin_names())
 
     @staticmethod
     def default() -> "Model":
-        """Oltmann's (1973) HSVA 1512 with the coefficients of his Table 2."""
+        """Oltmann's (1973) HSVA 1512 with the coefficients of his Table 2.
+
+        >>> termid.Model.default().states
+        ['u', 'v', 'r', 'ψ', 'x0', 'y0']
+        """
         return Model(_termid.Model.default_model())
 
     def to_toml(self) -> str:
+        """The model file's text (what :meth:`save` writes).
+
+        >>> "[model]" in termid.Model.builtin("lorenz").to_toml()
+        True
+        """
         return self._native.to_toml()
 
     def __reduce__(self) -> Tuple[Any, Tuple[str, str]]:
@@ -610,43 +757,139 @@ class Model:
         return (Model.from_toml, (self.to_toml(), self._native.path))
 
     def save(self, path: Union[str, os.PathLike]) -> None:
+        """Writes the model file to ``path`` (identified coefficients with their standard
+        errors and covariance).
+
+        >>> import os, tempfile
+        >>> path = os.path.join(tempfile.mkdtemp(), "ship.toml")
+        >>> termid.Model.default().save(path)
+        >>> os.path.getsize(path) > 1000
+        True
+        """
         self._native.save(os.fspath(path))
 
     # ---- what it is
-    name = property(lambda self: self._native.name)
-    path = property(lambda self: self._native.path)
-    time = property(lambda self: self._native.time)
-    states = property(lambda self: list(self._native.states))
-    inputs = property(lambda self: list(self._native.inputs))
-    equations = property(lambda self: list(self._native.equations))
-    identifiable = property(lambda self: list(self._native.identifiable))
+    @property
+    def name(self) -> str:
+        """The model's name (``[model] name``).
+
+        >>> termid.Model.builtin("duffing").name
+        'Forced Duffing oscillator (ζ = 0.05, ω = 1, α = 0.2)'
+        """
+        return self._native.name
+
+    @property
+    def path(self) -> str:
+        """The file the model was read from (``<builtin>``-like names for the shipped ones).
+
+        >>> isinstance(termid.Model.builtin("lorenz").path, str)
+        True
+        """
+        return self._native.path
+
+    @property
+    def time(self) -> str:
+        """The name of the time column runs carry (``[model] time``).
+
+        >>> termid.Model.builtin("lorenz").time
+        't'
+        """
+        return self._native.time
+
+    @property
+    def states(self) -> List[str]:
+        """The states, in the model file's order.
+
+        >>> termid.Model.builtin("lorenz").states
+        ['x', 'y', 'z']
+        """
+        return list(self._native.states)
+
+    @property
+    def inputs(self) -> List[str]:
+        """The inputs (recorded, not simulated: a rudder angle, a forcing).
+
+        >>> termid.Model.default().inputs
+        ['δ']
+        """
+        return list(self._native.inputs)
+
+    @property
+    def equations(self) -> List[str]:
+        """The equations by name, one per state.
+
+        >>> termid.Model.builtin("lorenz").equations
+        ['x_dot', 'y_dot', 'z_dot']
+        """
+        return list(self._native.equations)
+
+    @property
+    def identifiable(self) -> List[str]:
+        """The equations that have candidate terms (those :meth:`identify` fits).
+
+        >>> termid.Model.default().identifiable
+        ['u_dot', 'v_dot', 'r_dot']
+        """
+        return list(self._native.identifiable)
 
     @property
     def parameters(self) -> Dict[str, float]:
+        """The named parameters and their values.
+
+        >>> termid.Model.builtin("lorenz").parameters
+        {}
+        """
         return dict(self._native.parameters)
 
     def set_parameter(self, name: str, value: Union[float, str]) -> None:
         """A parameter's value, or as text how each run sets it for identification
-        (``ship.set_parameter("u0", "mean:u:4")``: the mean of u over a record's first 4 s)."""
+        (``ship.set_parameter("u0", "mean:u:4")``: the mean of u over a record's first 4 s).
+
+        Parameters: ``name`` the parameter; ``value`` a number, or the per-run rule as text.
+
+        >>> ship = termid.Model.default()
+        >>> ship.set_parameter("u0", 1.2)
+        >>> ship.parameters["u0"]
+        1.2
+        """
         if isinstance(value, str):
             self._native.set_per_run(name, value)
         else:
             self._native.set_parameter(name, float(value))
 
     def coefficients(self, equation: str) -> pd.DataFrame:
-        """An equation's stored terms with value and standard error."""
+        """The stored terms of ``equation`` with value and standard error (float64, NaN where
+        none is stored).
+
+        >>> termid.Model.builtin("lorenz").coefficients("z_dot")["term"].tolist()
+        ['x*y', 'z']
+        """
         rows = self._native.coefficients(equation)
         # a missing standard error is NaN, so the column stays float64 (not object)
         return pd.DataFrame(rows, columns=["term", "value", "std_error"]).astype({"value": float, "std_error": float})
 
     def intercept(self, equation: str) -> Optional[float]:
+        """The stored constant of ``equation``, or None.
+
+        >>> termid.Model.builtin("lorenz").intercept("x_dot") is None
+        True
+        """
         return self._native.intercept(equation)
 
     def set_coefficients(
         self, equation: str, coefficients: Union[Mapping[str, float], pd.Series, pd.DataFrame], intercept: Optional[float] = None
     ) -> None:
         """Replaces an equation's terms and coefficients: ``{"u*v": -0.23, ...}``, a Series
-        indexed by term, or a DataFrame like ``coefficients()`` returns."""
+        indexed by term, or a DataFrame like ``coefficients()`` returns.
+
+        Parameters: ``equation`` its name; ``coefficients`` the new terms and values;
+        ``intercept`` the new constant (None: none).
+
+        >>> lorenz = termid.Model.builtin("lorenz")
+        >>> lorenz.set_coefficients("z_dot", {"x*y": 1.0, "z": -2.5})
+        >>> lorenz.coefficients("z_dot")["value"].tolist()
+        [1.0, -2.5]
+        """
         if isinstance(coefficients, pd.DataFrame):
             rows = [(str(t), float(v), None if pd.isna(s) else float(s))
                     for t, v, s in zip(coefficients["term"], coefficients["value"], coefficients.get("std_error", [None] * len(coefficients)))]
@@ -667,7 +910,8 @@ class Model:
         names: Optional[Sequence[str]] = None,
         **settings: Any,
     ) -> Identified:
-        """Every identifiable equation (or ``equations``) from the runs, with the model's
+        """Every identifiable equation (or ``equations``) from ``runs`` (one run or a list:
+        DataFrames, dicts of arrays, Arrow tables), with the model's
         candidates, forced terms and back-end (or ``backend`` with its settings as keywords).
 
         ``target``: ``"column"`` explains the runs' rate columns (``r_dot``), ``"derivative"``
@@ -675,7 +919,14 @@ class Model:
         the runs have them and no ``derivative`` is named, else the derivatives
         (:attr:`Identified.targets` says which). ``derivative`` defaults to ``integral`` (the
         integral form: no derivative estimated; central differences for a ship, as the
-        paper); ``intercept`` to the model file's (``[model] intercept``)."""
+        paper); ``intercept`` to the model file's (``[model] intercept``); ``names`` name the
+        runs (default: each DataFrame's ``attrs["name"]``, else ``run1``, ...).
+
+        >>> lorenz = termid.Model.builtin("lorenz")
+        >>> found = lorenz.identify(lorenz.simulate(duration=5.0))
+        >>> found.targets["z_dot"], found.model.coefficients("z_dot")["value"].round(2).tolist()
+        ('dz/dt', [1.0, -2.67])
+        """
         data = _targeted(self._native, _runs(runs, names), derivative, target, list(equations))
         try:
             native, fits = self._native.identify(
@@ -695,9 +946,15 @@ class Model:
         *,
         target: Optional[str] = None,
     ) -> Any:
-        """The sufficient statistics of ``equation`` over runs (see :class:`Moments`); given a
+        """The sufficient statistics of ``equation`` over ``runs`` (see :class:`Moments`); given a
         list of equations, a dict of each one's, the runs read once for all. ``derivative``
-        and ``target`` as for :meth:`identify`."""
+        and ``target`` as for :meth:`identify`, ``names`` the runs' names.
+
+        >>> ship = termid.Model.default()
+        >>> m = ship.moments("r_dot", ship.simulate("zigzag:20/20"))
+        >>> m.equation, m.rows > 1000
+        ('r_dot', True)
+        """
         wanted = [equation] if isinstance(equation, str) else list(equation)
         data = _targeted(self._native, _runs(runs, names), derivative, target, wanted)
         found = self._native.moments(wanted, data, derivative)
@@ -705,7 +962,15 @@ class Model:
 
     def identify_from_moments(self, moments: Union["Moments", Sequence["Moments"]], intercept: Optional[bool] = None) -> Identified:
         """The model identified from statistics, merged per equation in the order given:
-        the same model as from the rows together."""
+        the same model as from the rows together. ``moments``: one or a list (of several
+        equations, or of parts to merge); ``intercept`` as for :meth:`identify`.
+
+        >>> ship = termid.Model.default()
+        >>> parts = [ship.moments("r_dot", ship.simulate(z)) for z in ("zigzag:20/20", "zigzag:10/10")]
+        >>> found = ship.identify_from_moments(parts[0] + parts[1])
+        >>> found.targets["r_dot"]
+        'r_dot'
+        """
         if isinstance(moments, _termid.Moments):
             moments = [moments]
         native, fits = self._native.identify_from_moments(list(moments), intercept)
@@ -714,7 +979,14 @@ class Model:
     # ---- prediction and simulation
     def predict(self, run: Data, with_intercept: bool = False) -> pd.DataFrame:
         """ẋ of every state on every row of a run (columns named as the equations, else
-        ``<state>_dot``), on the run's index (a DataFrame's)."""
+        ``<state>_dot``), on the run's index (a DataFrame's). ``run`` holds the states and
+        inputs; ``with_intercept`` adds the identified constants.
+
+        >>> lorenz = termid.Model.builtin("lorenz")
+        >>> lorenz.predict(pd.DataFrame({"t": [0.0], "x": [1.0], "y": [2.0], "z": [3.0]}))
+           x_dot  y_dot  z_dot
+        0   10.0   23.0   -6.0
+        """
         frame = _frame(self._native.predict(_runs(run)[0], with_intercept))
         if isinstance(run, pd.DataFrame):
             frame.index = run.index
@@ -732,10 +1004,21 @@ class Model:
         inputs: Optional[Mapping[str, float]] = None,
         initial: Optional[Mapping[str, float]] = None,
     ) -> pd.DataFrame:
-        """A plug-in's scenario (``zigzag:20/20``, ``turning:35``, ``spiral``): the run as a
+        """A plug-in's ``scenario`` (``zigzag:20/20``, ``turning:35``, ``spiral``): the run as a
         DataFrame (SI, radians), its metrics in ``df.attrs["metrics"]``. Without a scenario,
         any model (Lorenz, a pendulum): from its initial states (or ``initial``) with constant
-        ``inputs`` for ``duration`` seconds."""
+        ``inputs`` for ``duration`` seconds.
+
+        Parameters: ``dt`` the integration step (default: the model file's method, else
+        adaptive Dormand-Prince 5(4) with output every ``sample`` seconds); ``integrator``
+        ``dopri5``, ``rk4`` or ``b8``; ``with_intercept`` adds the identified constants.
+
+        >>> run = termid.Model.default().simulate("zigzag:20/20")
+        >>> round(run.attrs["metrics"]["first_overshoot_deg"], 1)
+        11.2
+        >>> termid.Model.builtin("lorenz").simulate(duration=1.0, sample=0.5)["t"].tolist()
+        [0.0, 0.5, 1.0]
+        """
         if scenario is None:
             if duration is None:
                 raise TypeError("simulate without a scenario needs a duration (seconds)")
@@ -760,17 +1043,29 @@ class Model:
         tracked: bool = False,
         truth: bool = False,
     ) -> pd.DataFrame:
-        """A ship's manoeuvre recorded as in termid's synthetic basin: 20 Hz, a straight
+        """A ship's ``manoeuvre`` recorded as in termid's synthetic basin: 20 Hz, a straight
         approach, sensor noise fixed by ``seed``, approach speed ``speed`` × u0 (``tracked``:
         u and v from an optical track, a rudder offset, the rudder back at midship). The
-        measured run, or with ``truth=True`` the noise-free one."""
+        measured run, or with ``truth`` the noise-free one; ``duration`` in seconds.
+
+        >>> run = termid.Model.default().record("zigzag:20/20", seed=3)
+        >>> float(run["t"].diff().iloc[1])
+        0.05
+        """
         measured, exact = self._native.record(manoeuvre, speed, duration, seed, tracked)
         frame = _frame(exact if truth else measured)
         frame.attrs["name"] = f"{manoeuvre}#{seed}"
         return frame
 
     def replay(self, runs: Union[Data, Sequence[Data]], *, dt: Optional[float] = None, integrator: Optional[str] = None, with_intercept: bool = False) -> List[pd.DataFrame]:
-        """Each run re-simulated from its recorded initial state with its recorded inputs."""
+        """Each of ``runs`` re-simulated from its recorded initial state with its recorded
+        inputs (``dt``, ``integrator``, ``with_intercept`` as for :meth:`simulate`).
+
+        >>> ship = termid.Model.default()
+        >>> again = ship.replay(ship.simulate("zigzag:20/20"))[0]
+        >>> len(again) == len(ship.simulate("zigzag:20/20"))
+        True
+        """
         return [_frame(c) for c in self._native.replay(_runs(runs), dt, integrator, with_intercept)]
 
     def validate(
@@ -782,11 +1077,18 @@ class Model:
         with_intercept: bool = False,
         raw: bool = False,
     ) -> Any:
-        """Held-out runs against the model: a DataFrame of every run's and state's RMS and
+        """Held-out ``runs`` against the model: a DataFrame of every run's and state's RMS and
         largest error (index run, state; the unit beside), ``attrs["cost"]`` the scaled sum of
         squares, and for a ship ``attrs["metrics"]`` (overshoots, tactical diameter, ...)
-        measured and simulated, a DataFrame indexed by run and source. ``raw=True``: the
-        report as plain values."""
+        measured and simulated, a DataFrame indexed by run and source. ``raw``: the
+        report as plain values; ``dt``, ``integrator``, ``with_intercept`` as for
+        :meth:`simulate`.
+
+        >>> ship = termid.Model.default()
+        >>> gap = ship.validate(ship.record("zigzag:20/20", truth=True))
+        >>> gap.loc[("zigzag:20/20#0", "ψ"), "unit"], bool(gap.loc[("zigzag:20/20#0", "ψ"), "rms"] < 0.01)
+        ('rad', True)
+        """
         report = json.loads(self._native.validate(_runs(runs), dt, integrator, with_intercept))
         if raw:
             return report
@@ -809,12 +1111,19 @@ class Model:
         with_intercept: bool = False,
         raw: bool = False,
     ) -> Tuple[Any, Optional["Model"]]:
-        """Where model and runs disagree, which effect explains it, and the model with it:
+        """Where model and ``runs`` disagree, which effect explains it, and the model with it:
         a DataFrame of every run's and state's error before and after the effect (columns
         ``rms_before``, ``max_before``, ``rms_after``, ``max_after``), with ``attrs`` holding
         ``location`` (its words, leading state, onset), ``effect`` and ``candidates`` (a
-        DataFrame of the effects tried); and the model with the effect, or None. ``raw=True``:
-        the report as plain values."""
+        DataFrame of the effects tried); and the model with the effect, or None. ``raw``:
+        the report as plain values; ``dt``, ``integrator``, ``with_intercept`` as for
+        :meth:`simulate`.
+
+        >>> ship = termid.Model.default()
+        >>> gaps, repaired = ship.diagnose(ship.record("zigzag:20/20", truth=True))
+        >>> list(gaps.columns[:3])
+        ['unit', 'rms_before', 'max_before']
+        """
         text, native = self._native.diagnose(_runs(runs), dt, integrator, with_intercept)
         report = json.loads(text)
         model = Model(native) if native is not None else None
@@ -834,7 +1143,13 @@ class Model:
         return before, model
 
     def checks(self, runs: Union[Data, Sequence[Data], None] = None) -> pd.DataFrame:
-        """The plug-in's physical checks (stability, damping signs, turning circles)."""
+        """The plug-in's physical checks (stability, damping signs, turning circles), with
+        ``runs`` to compare against where a check needs them.
+
+        >>> checks = termid.Model.default().checks()
+        >>> {"name", "passed"} <= set(checks.columns)
+        True
+        """
         return pd.DataFrame(json.loads(self._native.checks(_runs(runs) if runs is not None else [])))
 
     def __repr__(self) -> str:

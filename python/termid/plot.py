@@ -27,7 +27,15 @@ def run(
     time: str = "t",
 ) -> Any:
     """Stacked panels on one time axis: each column of ``measured`` (every column but the
-    time by default) and, where given, the same column of ``simulated``."""
+    time by default) and, where given, the same column of ``simulated``; ``columns`` the
+    columns drawn, ``time`` the time column (seconds).
+
+    >>> from termid import plot
+    >>> ship = termid.Model.default()
+    >>> fig = plot.run(ship.record("zigzag:20/20"), ship.simulate("zigzag:20/20"), ["ψ", "δ", "r"])
+    >>> len(fig.axes)
+    3
+    """
     plt = _pyplot()
     names = list(columns) if columns is not None else [c for c in measured.columns if c != time]
     if not names:
@@ -52,7 +60,14 @@ def track(
     y: str = "y0",
 ) -> Any:
     """A ship's track, north up and at equal scale (x0 forward at the start, y0 to
-    starboard, as termid's ship model writes them), measured and simulated."""
+    starboard, as termid's ship model writes them), ``measured`` and ``simulated``; ``x`` and
+    ``y`` the position columns (metres).
+
+    >>> from termid import plot
+    >>> fig = plot.track(termid.Model.default().simulate("turning:35"))
+    >>> fig.axes[0].get_xlabel()
+    'y0 [m]'
+    """
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6, 6))
     ax.plot(measured[y], measured[x], color=COLOURS["measured"], label="measured")
@@ -69,7 +84,13 @@ def track(
 
 def steps(fit: Any) -> Any:
     """A fit's step table: R² and F against the step, the term entered at each, the chosen
-    step marked."""
+    step marked; ``fit`` a :class:`termid.Fit`.
+
+    >>> from termid import plot
+    >>> df = pd.DataFrame({"x": [0.0, 1, 2, 3, 4], "y": [1.0, 3.1, 4.9, 7.0, 9.0]})
+    >>> plot.steps(termid.fit(df, "y", "x")).axes[0].get_title()
+    'y: 1 steps'
+    """
     plt = _pyplot()
     table = fit.steps
     if table.empty:

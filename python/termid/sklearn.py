@@ -31,7 +31,17 @@ class TermRegressor(RegressorMixin, BaseEstimator):
     DataFrame's columns, else ``x0``, ``x1``, ...; default: every feature, linear) with a
     back-end (``stepwise``, ``best-subset``, ``sparse``, ``efroymson``, ``stlsq``) and its
     ``settings``. After ``fit``: ``coef_`` (a Series by term), ``intercept_``, ``fit_`` (the
-    :class:`termid.Fit`, with its steps and ``summary()``)."""
+    :class:`termid.Fit`, with its steps and ``summary()``).
+
+    Parameters: ``terms`` the candidates; ``backend`` the selection; ``intercept`` whether a
+    constant is fitted; ``settings`` the back-end's settings (``termid.settings(backend)``).
+
+    >>> from termid.sklearn import TermRegressor
+    >>> X = pd.DataFrame({"a": [0.0, 1, 2, 3, 4, 5], "b": [1.0, 0, 2, 1, 3, 2]})
+    >>> model = TermRegressor(terms=["a", "b", "a*b"]).fit(X, 2 * X.a * X.b + 1)
+    >>> model.coef_.round(6).to_dict()
+    {'a*b': 2.0}
+    """
 
     def __init__(
         self,
@@ -50,6 +60,14 @@ class TermRegressor(RegressorMixin, BaseEstimator):
         return [str(c) for c in names] if names is not None else [f"x{j}" for j in range(n)]
 
     def fit(self, X: Any, y: Any) -> "TermRegressor":
+        """Selects and fits the terms on features ``X`` (an array or a DataFrame) and target
+        ``y``; returns the estimator.
+
+        >>> from termid.sklearn import TermRegressor
+        >>> X = np.arange(12.0).reshape(6, 2)
+        >>> TermRegressor().fit(X, 3 * X[:, 0]).coef_.round(6).to_dict()
+        {'x0': 3.0}
+        """
         X, y = validate_data(self, X, y, y_numeric=True, dtype=np.float64)
         names = self._names(X.shape[1])
         target = "y"
@@ -74,6 +92,13 @@ class TermRegressor(RegressorMixin, BaseEstimator):
         return self
 
     def predict(self, X: Any) -> np.ndarray:
+        """The fitted equation on features ``X``, as an array.
+
+        >>> from termid.sklearn import TermRegressor
+        >>> X = np.arange(12.0).reshape(6, 2)
+        >>> TermRegressor().fit(X, 3 * X[:, 0] + 1).predict([[10.0, 0.0]]).round(6).tolist()
+        [31.0]
+        """
         check_is_fitted(self, "fit_")
         X = validate_data(self, X, reset=False, dtype=np.float64)
         names = self._names(X.shape[1])

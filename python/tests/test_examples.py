@@ -18,3 +18,68 @@ def test_fig6_zigzag_example(tmp_path, monkeypatch):
     # exact runs: the averaged single-run coefficients replay the manoeuvre (NOTES.md §7)
     original, replayed = scope["original"], scope["replayed"]
     assert np.degrees(np.abs(replayed["ψ"] - original["ψ"])).max() < 0.1
+
+
+NOTEBOOKS = os.path.join(EXAMPLES, "notebooks")
+
+
+@pytest.mark.parametrize("name", ["ship", "generic"])
+def test_notebook_examples_run(name, monkeypatch):
+    """The notebook-style examples (Jupytext percent format) run top to bottom as scripts."""
+    pytest.importorskip("matplotlib")
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    scope = runpy.run_path(os.path.join(NOTEBOOKS, f"{name}.py"), run_name="__main__")
+    if name == "ship":
+        # the turning circle no run covered, against the true ship's (a polynomial fitted to
+        # zigzags extrapolates roughly: the notebook says so)
+        assert abs(scope["d_found"] / scope["d_true"] - 1) < 0.15
+    if name == "generic":
+        z = scope["found"].model.coefficients("z_dot").set_index("term")["value"]
+        assert sorted(z.index) == ["x*y", "z"] and z["z"] == pytest.approx(-8 / 3, rel=0.02)
+        assert sorted(scope["fitted"].coefficients.index) == ["x*y", "z"]
+
+
+def test_fleet_notebook_runs():
+    """The Dask notebook, as its own process (its workers are processes too)."""
+    pytest.importorskip("dask.distributed")
+    import subprocess
+
+    done = subprocess.run(
+        [sys.executable, os.path.join(NOTEBOOKS, "fleet.py")], capture_output=True, text=True, timeout=600
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    for eq in ("u_dot", "v_dot", "r_dot"):
+        assert f"{eq} same terms: True" in done.stdout, done.stdout
+
+
+def test_package_readme_examples_run():
+    """The Python blocks of the package's README run as written, in order."""
+    text = open(os.path.join(EXAMPLES, "..", "README.md"), encoding="utf-8").read()
+    blocks = [b.split("```", 1)[0] for b in text.split("```python\n")[1:]]
+    assert len(blocks) >= 2
+    scope: dict = {}
+    for block in blocks:
+        exec(compile(block, "python/README.md", "exec"), scope)
+
+
+def test_project_readme_python_blocks_run(tmp_path, monkeypatch):
+    """The Python blocks of the project's README run as written, in order, in one scope (a
+    block after `<!-- readme-test: skip: why -->` is a fragment and is left out)."""
+    pytest.importorskip("matplotlib")
+    pytest.importorskip("sklearn")
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    monkeypatch.chdir(tmp_path)  # what the blocks write lands here
+    lines = open(os.path.join(EXAMPLES, "..", "..", "README.md"), encoding="utf-8").read().splitlines()
+    blocks, k = [], 0
+    while k < len(lines):
+        if lines[k].strip() == "```python":
+            end = lines.index("```", k + 1)
+            if "readme-test: skip" not in lines[k - 1]:
+                blocks.append((k + 1, "\n".join(lines[k + 1:end])))
+            k = end
+        k += 1
+    assert len(blocks) >= 2
+    scope: dict = {}
+    for line, block in blocks:
+        exec(compile("\n" * line + block, "README.md", "exec"), scope)
+    assert (tmp_path / "identified.toml").exists()
