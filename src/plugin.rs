@@ -109,6 +109,69 @@ pub struct Check {
     pub refuses: bool,
     /// The numbers behind the verdict.
     pub detail: String,
+    /// The one number a check is about where it has one (a turning circle's tactical
+    /// diameter): what models of one identification are compared by.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub measure: Option<Measure>,
+}
+
+/// A named number of a check, with its unit.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Measure {
+    /// What it is, e.g. `tactical diameter, δ = -30°`.
+    pub name: String,
+    /// Its value.
+    pub value: f64,
+    /// Its unit.
+    pub unit: String,
+}
+
+/// Where several models of one identification (the starts of a recipe, each plausible by
+/// its own checks) disagree by more than `tolerance` (relative) on a measure of a manoeuvre
+/// the runs did not cover: one flag per such measure, with the range of the models and the
+/// kept one's value. The runs cannot tell these models apart, so the spread is the
+/// uncertainty of that prediction.
+pub fn disagreement(models: &[(&str, &[Check])], kept: usize, tolerance: f64) -> Vec<Check> {
+    let Some((_, kept_checks)) = models.get(kept) else { return vec![] };
+    let mut out = Vec::new();
+    for m in kept_checks.iter().filter_map(|c| c.measure.as_ref()) {
+        let values: Vec<(&str, f64)> = models
+            .iter()
+            .filter_map(|(label, checks)| {
+                let v = checks.iter().filter_map(|c| c.measure.as_ref()).find(|n| n.name == m.name)?;
+                Some((*label, v.value))
+            })
+            .collect();
+        if values.len() < 2 {
+            continue;
+        }
+        let (lo, hi) =
+            values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (_, v)| (a.min(*v), b.max(*v)));
+        let spread = (hi - lo) / m.value.abs().max(1e-300);
+        let agree = spread <= tolerance;
+        let each: Vec<String> = values.iter().map(|(l, v)| format!("{l} {v:.2}")).collect();
+        out.push(Check {
+            name: format!("the starts agree on the {} (within {:.0} %)", m.name, 100.0 * tolerance),
+            passed: agree,
+            refuses: false,
+            detail: format!(
+                "{lo:.2}-{hi:.2} {unit} (kept {:.2}; {}): {}",
+                m.value,
+                each.join(", "),
+                if agree {
+                    format!("spread {:.1} %", 100.0 * spread)
+                } else {
+                    format!(
+                        "the runs cannot tell these models apart, so this prediction is uncertain by {:.0} %",
+                        100.0 * spread
+                    )
+                },
+                unit = m.unit
+            ),
+            measure: None,
+        });
+    }
+    out
 }
 
 impl Check {

@@ -35,9 +35,24 @@ impl Normal {
     }
 }
 
-/// Which equations a draw can perturb: those with a stored covariance.
+/// What a draw can perturb: the equations with a stored covariance, and `parameters` when the
+/// file holds the free parameters' covariance (`[parameter_covariance]`).
 pub fn uncertain_equations(model: &Model) -> Vec<String> {
-    model.equations().iter().filter(|e| e.covariance.is_some()).map(|e| e.name.clone()).collect()
+    let mut out: Vec<String> =
+        model.equations().iter().filter(|e| e.covariance.is_some()).map(|e| e.name.clone()).collect();
+    if model.spec().parameter_covariance.is_some() {
+        out.push("parameters".into());
+    }
+    out
+}
+
+/// A symmetric square root of a covariance (semi-definite matrices, as an exact fit or a term
+/// with zero error gives, have no Cholesky factor; the eigen-decomposition serves for both).
+fn square_root(sigma: nalgebra::DMatrix<f64>) -> nalgebra::DMatrix<f64> {
+    let eig = sigma.symmetric_eigen();
+    &eig.eigenvectors
+        * nalgebra::DMatrix::from_diagonal(&eig.eigenvalues.map(|l| l.max(0.0).sqrt()))
+        * eig.eigenvectors.transpose()
 }
 
 /// Draws models whose coefficients come from N(b, τΣ) equation by equation (b the stored
@@ -47,6 +62,9 @@ pub struct Sampler<'m> {
     model: &'m Model,
     /// (equation, its covariance's terms, a square root of τΣ).
     roots: Vec<(String, Vec<crate::term::Term>, nalgebra::DMatrix<f64>)>,
+    /// The free parameters' names and a square root of their covariance (output error:
+    /// already widened by the residuals' correlation time).
+    parameters: Option<(Vec<String>, nalgebra::DMatrix<f64>)>,
 }
 
 impl<'m> Sampler<'m> {
@@ -61,17 +79,14 @@ impl<'m> Sampler<'m> {
                 // rows of a time series are not independent: the effective covariance is τ
                 // times s²(X'X)⁻¹
                 let sigma = nalgebra::DMatrix::from_fn(k, k, |i, j| c.matrix[i][j] * c.correlation_time);
-                // semi-definite matrices (an exact fit, a term with zero error) have no
-                // Cholesky factor: a symmetric square root from the eigen-decomposition
-                // serves for both
-                let eig = sigma.symmetric_eigen();
-                let root = &eig.eigenvectors
-                    * nalgebra::DMatrix::from_diagonal(&eig.eigenvalues.map(|l| l.max(0.0).sqrt()))
-                    * eig.eigenvectors.transpose();
-                Some((eq.name.clone(), c.terms.clone(), root))
+                Some((eq.name.clone(), c.terms.clone(), square_root(sigma)))
             })
             .collect();
-        Sampler { model, roots }
+        let parameters = model.spec().parameter_covariance.as_ref().map(|c| {
+            let k = c.names.len();
+            (c.names.clone(), square_root(nalgebra::DMatrix::from_fn(k, k, |i, j| c.matrix[i][j])))
+        });
+        Sampler { model, roots, parameters }
     }
 
     /// One drawn model.
@@ -90,6 +105,15 @@ impl<'m> Sampler<'m> {
                 })
                 .collect();
             out.set_coefficients(name, coefficients, eq.intercept);
+        }
+        if let Some((names, root)) = &self.parameters {
+            let values = self.model.parameter_values();
+            let shift = root * nalgebra::DVector::from_fn(names.len(), |_, _| normal.sample());
+            for (name, d) in names.iter().zip(shift.iter()) {
+                if let Some(v) = values.get(name) {
+                    out.set_parameter(name, v + d);
+                }
+            }
         }
         out
     }
@@ -270,6 +294,48 @@ coefficients = { "r" = -1.0, "u*r" = 0.3 }
             assert!((c(a, b) - cov[a][b]).abs() < 0.05 * 9e-6, "[{a}][{b}]: {} vs {}", c(a, b), cov[a][b]);
         }
         assert_eq!(uncertain_equations(&model), vec!["u_dot".to_string()]);
+    }
+
+    /// Draws of free parameters reproduce `[parameter_covariance]`.
+    #[test]
+    fn parameter_draws_have_the_stored_covariance() {
+        let text = r#"
+[model]
+name = "nomoto"
+[[states]]
+name = "r"
+[[inputs]]
+name = "d"
+[parameters.K]
+value = 0.2
+free = true
+[parameters.T]
+value = 8.0
+free = true
+[equations.r_dot]
+state = "r"
+identify = false
+coefficients = { "K*d/T" = 1.0, "r/T" = -1.0 }
+[parameter_covariance]
+names = ["K", "T"]
+matrix = [[1e-4, 2e-3], [2e-3, 0.25]]
+"#;
+        let model = Model::parse(text, "nomoto.toml").unwrap();
+        assert_eq!(uncertain_equations(&model), vec!["parameters".to_string()]);
+        let sampler = Sampler::new(&model);
+        let mut g = Normal::new(2);
+        let n = 20000;
+        let d: Vec<[f64; 2]> = (0..n)
+            .map(|_| {
+                let p = sampler.draw(&mut g).parameter_values();
+                [p["K"] - 0.2, p["T"] - 8.0]
+            })
+            .collect();
+        let c = |a: usize, b: usize| d.iter().map(|r| r[a] * r[b]).sum::<f64>() / n as f64;
+        let cov = [[1e-4, 2e-3], [2e-3, 0.25]];
+        for (a, b) in [(0, 0), (0, 1), (1, 1)] {
+            assert!((c(a, b) / cov[a][b] - 1.0).abs() < 0.05, "[{a}][{b}]: {} vs {}", c(a, b), cov[a][b]);
+        }
     }
 
     #[test]

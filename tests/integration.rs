@@ -58,3 +58,6 @@ mod readme;
 // Every figure kind, read off its SVG as a person would look at it.
 #[path = "integration/figures.rs"]
 mod figures;
+// Grey-box: named parameters of a model file estimated by output error (Lorenz, Nomoto).
+#[path = "integration/greybox.rs"]
+mod greybox;

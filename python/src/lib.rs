@@ -45,12 +45,13 @@ fn refuse(text: impl Into<String>) -> PyErr {
 }
 
 /// The repository's model files, inside the extension (no data files to install or find).
-const BUILTIN: [(&str, &str); 5] = [
+const BUILTIN: [(&str, &str); 6] = [
     ("oltmann1973", include_str!("../../models/oltmann1973.toml")),
     ("lorenz", include_str!("../../models/lorenz.toml")),
     ("duffing", include_str!("../../models/duffing.toml")),
     ("mmg_kvlcc2", include_str!("../../models/mmg_kvlcc2.toml")),
     ("new_ship", include_str!("../../models/new_ship.toml")),
+    ("nomoto", include_str!("../../models/nomoto.toml")),
 ];
 
 /// A run handed over from Python: its name, and its columns as float64 arrays.
@@ -667,6 +668,44 @@ impl PyModel {
             "gap_after": d.gap_after, "candidates": d.candidates,
         });
         Ok((to_json(&json)?, d.model.map(|inner| PyModel { inner })))
+    }
+
+    /// The model file's free parameters estimated from runs by output error (JSON report),
+    /// with the model holding the estimates.
+    #[pyo3(signature = (runs, coefficients = false, states = None, initial_states = true, dt = None, iterations = 50))]
+    #[allow(clippy::too_many_arguments)]
+    fn estimate(
+        &self,
+        py: Python<'_>,
+        runs: Vec<Run<'_>>,
+        coefficients: bool,
+        states: Option<Vec<String>>,
+        initial_states: bool,
+        dt: Option<f64>,
+        iterations: usize,
+    ) -> PyResult<(String, PyModel)> {
+        let frames = self.frames(runs)?;
+        // one RK4 step per sample by default: the recorded inputs are known at the samples
+        let dt = dt.unwrap_or_else(|| {
+            frames.iter().map(|f| termid::data::median_step(f.time())).fold(f64::INFINITY, f64::min)
+        });
+        let settings = termid::diagnose::EstimateSettings {
+            coefficients,
+            iterations,
+            initial_states,
+            ..Default::default()
+        };
+        let fit = py
+            .detach(|| -> Result<_, termid::diagnose::DiagnoseError> {
+                let mut runs =
+                    termid::diagnose::Runs::new(&self.inner, &frames, dt, termid::sim::Integrator::Rk4)?;
+                if let Some(names) = &states {
+                    runs = runs.comparing(names)?;
+                }
+                termid::diagnose::estimate(&self.inner, &runs, &settings)
+            })
+            .map_err(fail)?;
+        Ok((to_json(&fit)?, PyModel { inner: fit.model }))
     }
 
     /// The plug-in's physical checks (JSON list: name, passed, refuses, detail).

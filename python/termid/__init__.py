@@ -718,7 +718,8 @@ class Model:
     @staticmethod
     def builtin(name: str) -> "Model":
         """A model file shipped inside the package: ``oltmann1973``, ``lorenz``, ``duffing``,
-        ``mmg_kvlcc2`` (KVLCC2 in the MMG standard model) or ``new_ship`` (the template),
+        ``mmg_kvlcc2`` (KVLCC2 in the MMG standard model), ``nomoto`` (Nomoto's steering model
+        with K and T free, for :meth:`estimate`) or ``new_ship`` (the template),
         by ``name`` (:meth:`builtin_names`).
 
         >>> termid.Model.builtin("lorenz").states
@@ -1141,6 +1142,63 @@ class Model:
             ),
         }
         return before, model
+
+    def estimate(
+        self,
+        runs: Union[Data, Sequence[Data]],
+        *,
+        coefficients: bool = False,
+        states: Optional[Sequence[str]] = None,
+        initial_states: bool = True,
+        dt: Optional[float] = None,
+        iterations: int = 50,
+    ) -> Tuple[pd.DataFrame, "Model"]:
+        """The model file's free parameters (``free = true`` under ``[parameters.NAME]``, with an
+        optional ``prior`` and ``bounds``) estimated from ``runs`` by output error: grey-box
+        identification. Returns a DataFrame of each parameter's start, estimate, standard
+        error and prior (``attrs``: the cost before and after, why it stopped, the
+        parameters' covariance) and the model holding the estimates.
+
+        Parameters: ``coefficients`` also estimates the identified equations' term
+        coefficients; ``states`` the states compared (default: every state the runs have);
+        ``initial_states`` estimates each run's initial state too (a noisy first sample would
+        bias the rest); ``dt`` the RK4 step (default: the runs' sample interval);
+        ``iterations`` the most Levenberg-Marquardt iterations per round.
+
+        >>> nomoto = termid.Model.builtin("nomoto")
+        >>> truth = termid.Model.builtin("nomoto")
+        >>> truth.set_parameter("K", 0.15); truth.set_parameter("T", 8.0)
+        >>> run = truth.simulate(duration=60.0, inputs={"δ": 0.1}, sample=0.1)
+        >>> table, found = nomoto.estimate(run)
+        >>> table["estimate"].round(4).to_dict()
+        {'K': 0.15, 'T': 8.0}
+        """
+        text, native = self._native.estimate(
+            _runs(runs), coefficients, None if states is None else list(states), initial_states, dt, iterations
+        )
+        report = json.loads(text)
+        table = pd.DataFrame(
+            [
+                {
+                    "parameter": p["name"],
+                    "start": p["start"],
+                    "estimate": p["value"],
+                    "std_error": float("nan") if p["std_error"] is None else float(p["std_error"]),
+                    "prior_mean": float("nan") if p["prior"] is None else p["prior"][0],
+                    "prior_sd": float("nan") if p["prior"] is None else p["prior"][1],
+                    "at_bound": p["at_bound"],
+                }
+                for p in report["parameters"]
+            ]
+        ).set_index("parameter")
+        names = list(table.index)
+        table.attrs = {
+            "cost_before": report["cost_before"],
+            "cost_after": report["cost_after"],
+            "stopped": report["stopped"],
+            "covariance": None if report["covariance"] is None else pd.DataFrame(report["covariance"], index=names, columns=names),
+        }
+        return table, Model(native)
 
     def checks(self, runs: Union[Data, Sequence[Data], None] = None) -> pd.DataFrame:
         """The plug-in's physical checks (stability, damping signs, turning circles), with

@@ -93,6 +93,15 @@ class Model:
     def diagnose(
         self, runs: Sequence[Run], dt: Optional[float] = None, integrator: Optional[str] = None, with_intercept: bool = False
     ) -> Tuple[str, Optional[Model]]: ...
+    def estimate(
+        self,
+        runs: Sequence[Run],
+        coefficients: bool = False,
+        states: Optional[Sequence[str]] = None,
+        initial_states: bool = True,
+        dt: Optional[float] = None,
+        iterations: int = 50,
+    ) -> Tuple[str, Model]: ...
     def checks(self, runs: Sequence[Run] = ...) -> str: ...
     def __reduce__(self) -> Tuple[Any, Tuple[str, str]]: ...
 

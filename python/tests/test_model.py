@@ -217,10 +217,31 @@ def test_identification_releases_the_gil(ship, zigzags):
 
 
 def test_the_model_files_ship_inside_the_package(ship):
-    assert termid.Model.builtin_names() == ["oltmann1973", "lorenz", "duffing", "mmg_kvlcc2", "new_ship"]
+    assert termid.Model.builtin_names() == ["oltmann1973", "lorenz", "duffing", "mmg_kvlcc2", "new_ship", "nomoto"]
     assert termid.Model.builtin("oltmann1973").to_toml() == ship.to_toml()
     path = os.path.join(os.path.dirname(__file__), "..", "..", "models", "lorenz.toml")
     assert termid.Model.builtin("lorenz").to_toml() == termid.Model.load(path).to_toml()
     assert termid.Model.builtin("mmg_kvlcc2").simulate("turning:35").attrs["metrics"]["tactical_diameter_m"] > 0
     with pytest.raises(termid.TermidError, match="no built-in model `kvlcc3`"):
         termid.Model.builtin("kvlcc3")
+
+
+def test_estimate_recovers_nomoto_k_and_t_from_a_noisy_run():
+    """Grey-box: K and T of the shipped Nomoto file (free, started at 0.1 and 10) from a
+    step response with gyro noise; the truth within three standard errors."""
+    truth = termid.Model.builtin("nomoto")
+    truth.set_parameter("K", 0.15)
+    truth.set_parameter("T", 8.0)
+    run = truth.simulate(duration=80.0, inputs={"δ": 0.1}, sample=0.1)[["t", "ψ", "r", "δ"]]
+    rng = np.random.default_rng(4)
+    run["ψ"] += np.radians(0.1) * rng.standard_normal(len(run))
+    run["r"] += np.radians(0.05) * rng.standard_normal(len(run))
+    table, found = termid.Model.builtin("nomoto").estimate(run)
+    assert list(table.index) == ["K", "T"] and table["std_error"].dtype == np.float64
+    for name, value in [("K", 0.15), ("T", 8.0)]:
+        row = table.loc[name]
+        assert abs(row["estimate"] - value) < max(3 * row["std_error"], 1e-3 * value), table
+    assert found.parameters["K"] == table.loc["K", "estimate"]
+    assert table.attrs["covariance"].shape == (2, 2) and table.attrs["cost_after"] < table.attrs["cost_before"]
+    with pytest.raises(termid.TermidError, match="free"):
+        termid.Model.builtin("lorenz").estimate(run.rename(columns={"ψ": "x", "r": "y", "δ": "z"}))

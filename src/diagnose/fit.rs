@@ -15,6 +15,7 @@ use crate::model::Model;
 use crate::sim::{simulate, Controller, Integrator, Replay, Settings, SimError, System, Trajectory};
 
 /// The measured runs prepared for re-simulation.
+#[derive(Clone)]
 pub struct Runs {
     pub(super) frames: Vec<Frame>,
     /// (state index in the system, measured column) for the compared states.
@@ -186,6 +187,35 @@ impl Runs {
     pub fn with_intercepts(mut self, yes: bool) -> Runs {
         self.intercepts = yes;
         self
+    }
+
+    /// The compared states (their indices in the model's system and names).
+    pub fn compared(&self) -> &[(usize, String)] {
+        &self.states
+    }
+
+    /// Number of runs.
+    pub fn len(&self) -> usize {
+        self.frames.len()
+    }
+
+    /// Whether there are no runs (never, once made).
+    pub fn is_empty(&self) -> bool {
+        self.frames.is_empty()
+    }
+
+    /// Run `run`'s initial value of the state with system index `state`.
+    pub fn initial(&self, run: usize, state: usize) -> f64 {
+        self.x0[run][state]
+    }
+
+    /// The runs re-simulated from other initial values: (run, state index, value).
+    pub fn with_initial(&self, values: &[(usize, usize, f64)]) -> Runs {
+        let mut out = self.clone();
+        for &(r, i, v) in values {
+            out.x0[r][i] = v;
+        }
+        out
     }
 
     /// Number of compared values.

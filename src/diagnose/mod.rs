@@ -7,6 +7,7 @@
 //! plug-in (the ship's) adds named hypotheses.
 
 mod choose;
+mod estimate;
 mod fit;
 mod hypotheses;
 mod refine;
@@ -15,6 +16,7 @@ mod sensitivity;
 use serde::Serialize;
 
 pub use choose::{choose_by_prediction, Chosen, Configuration, Prediction};
+pub use estimate::{estimate, Estimate, EstimateSettings, EstimatedParameter};
 pub use fit::{simulate_runs, EstimateError, Runs};
 pub use refine::{refine, RefineSettings, Refined, RefinedCoefficient};
 

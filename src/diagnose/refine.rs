@@ -10,7 +10,7 @@ use nalgebra::DMatrix;
 use serde::Serialize;
 
 use super::fit::{apply, cost as sum_of_squares, residuals};
-use super::sensitivity::{linearise, Linearised};
+use super::sensitivity::{linearise, Free, Linearised};
 use super::{DiagnoseError, Effect, EstimateError, Hypothesis, Runs};
 use crate::model::{Covariance, Model};
 use crate::term::Term;
@@ -109,7 +109,7 @@ pub fn refine(model: &Model, runs: &Runs, settings: &RefineSettings<'_>) -> Resu
     if entries.is_empty() {
         return Err(DiagnoseError::Setup("no identified coefficients to refine".into()));
     }
-    let terms: Vec<(String, Term)> = entries.iter().map(|(e, t, _, _)| (e.clone(), t.clone())).collect();
+    let terms: Vec<Free> = entries.iter().map(|(e, t, _, _)| Free::Term(e.clone(), t.clone())).collect();
     let hypothesis = Hypothesis {
         name: "output-error refinement".into(),
         effect: Effect::Terms {

@@ -4,7 +4,10 @@
 //! differences of the compiled right-hand side) and B_ij = φ_j(x, u) where term j belongs to
 //! the equation of state i. Integrated beside the state by the same RK4 step, S gives the
 //! whole Jacobian of the output error in one pass per run, instead of one re-simulation per
-//! coefficient (and two for central differences).
+//! coefficient (and two for central differences). A named parameter p of the model file
+//! (inside derived variables or equations, nonlinear in p) adds a column whose B is ∂f/∂p,
+//! by forward differences of the right-hand side at p + h: the grey-box case. A run's
+//! initial state x_i(0) adds a column with B = 0 and S(0) = e_i in that run alone.
 
 use std::collections::BTreeMap;
 
@@ -18,6 +21,29 @@ use crate::term::{Library, Term};
 
 /// Per sample of a run: its state and its sensitivities S (row-major, n × K).
 type Rows = (Vec<Vec<f64>>, Vec<Vec<f64>>);
+
+/// What an output-error fit may change: a term's coefficient (additively) or a named
+/// parameter of the model file.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Free {
+    /// The coefficient of `term` in `equation`.
+    Term(String, Term),
+    /// A parameter by name (one value for every run).
+    Parameter(String),
+    /// The initial value of a state (by index in the system) in one run (by index): a
+    /// nuisance of output error, since a noisy first sample would otherwise bias the rest.
+    Initial {
+        /// The run.
+        run: usize,
+        /// The state's index.
+        state: usize,
+    },
+}
+
+/// The forward-difference step of parameter p: small against p, never zero.
+pub(super) fn parameter_step(value: f64) -> f64 {
+    1e-6 * (1.0 + value.abs())
+}
 
 /// The identified terms as outputs over the model's names: φ_j(x, u) for the matrix B.
 struct Regressors<'a> {
@@ -56,13 +82,8 @@ pub(super) struct Linearised {
     pub jtr: DVector<f64>,
 }
 
-/// Linearises the output error of `model` on `runs` in its coefficients `entries` (equation,
-/// term).
-pub(super) fn linearise(
-    runs: &Runs,
-    model: &Model,
-    entries: &[(String, Term)],
-) -> Result<Linearised, DiagnoseError> {
+/// Linearises the output error of `model` on `runs` in `entries`.
+pub(super) fn linearise(runs: &Runs, model: &Model, entries: &[Free]) -> Result<Linearised, DiagnoseError> {
     let k = entries.len();
     let mut residuals = Vec::with_capacity(runs.residual_count());
     let mut jtj = DMatrix::zeros(k, k);
@@ -86,7 +107,7 @@ pub(super) fn linearise(
 fn residuals_and_jacobian(
     runs: &Runs,
     model: &Model,
-    entries: &[(String, Term)],
+    entries: &[Free],
 ) -> Result<(Vec<f64>, DMatrix<f64>), DiagnoseError> {
     let parts = per_run_jacobians(runs, model, entries, |res, jac| (res, jac))?;
     let rows: usize = parts.iter().map(|p| p.0.len()).sum();
@@ -106,26 +127,69 @@ fn residuals_and_jacobian(
 fn per_run_jacobians<T: Send>(
     runs: &Runs,
     model: &Model,
-    entries: &[(String, Term)],
+    entries: &[Free],
     reduce: impl Fn(Vec<f64>, DMatrix<f64>) -> T + Sync,
 ) -> Result<Vec<T>, DiagnoseError> {
     let system = System::new(model, &BTreeMap::new(), runs.intercepts)?;
-    let regressors = Regressors { model, terms: entries.iter().map(|(_, t)| t.clone()).collect() };
+    // the term columns: (column, owning state) and their regressors
+    let mut term_columns = Vec::new();
+    let mut terms = Vec::new();
+    let mut parameters = Vec::new();
+    for (j, entry) in entries.iter().enumerate() {
+        match entry {
+            Free::Term(eq, term) => {
+                let state = model.equation(eq).map(|e| e.state.clone()).unwrap_or_default();
+                let i = system
+                    .state_index(&state)
+                    .ok_or_else(|| DiagnoseError::Setup(format!("no state for `{eq}`")))?;
+                term_columns.push((j, i));
+                terms.push(term.clone());
+            }
+            Free::Parameter(name) => {
+                let value = *model.parameter_values().get(name).ok_or_else(|| {
+                    DiagnoseError::Setup(format!("`{name}` is not a parameter of {}", model.path))
+                })?;
+                if runs.params.iter().any(|p| p.contains_key(name)) {
+                    return Err(DiagnoseError::Setup(format!(
+                        "`{name}` is set per run (`per_run`): it cannot be one free parameter"
+                    )));
+                }
+                parameters.push((j, name.clone(), value));
+            }
+            Free::Initial { state, .. } if *state >= system.dim() => {
+                return Err(DiagnoseError::Setup(format!("no state {state} in {}", model.path)));
+            }
+            Free::Initial { .. } => {}
+        }
+    }
+    let regressors = Regressors { model, terms };
     let phi = System::new(&regressors, &BTreeMap::new(), false)?;
-    let owner: Vec<usize> = entries
-        .iter()
-        .map(|(eq, _)| {
-            let state = model.equation(eq).map(|e| e.state.clone()).unwrap_or_default();
-            system.state_index(&state).ok_or_else(|| DiagnoseError::Setup(format!("no state for `{eq}`")))
-        })
-        .collect::<Result<_, _>>()?;
-    let k = owner.len();
+    let k = entries.len();
     (0..runs.frames.len())
         .into_par_iter()
         .map(|r| {
             let system = system.with_parameters(&runs.params[r])?;
             let phi = phi.with_parameters(&runs.params[r])?;
-            let (x, s) = integrate(&system, &phi, &owner, runs, r)?;
+            // the right-hand side at p + h for each free parameter p
+            let perturbed = parameters
+                .iter()
+                .map(|(j, name, value)| {
+                    let h = parameter_step(*value);
+                    let mut at = runs.params[r].clone();
+                    at.insert(name.clone(), value + h);
+                    Ok((*j, system.with_parameters(&at)?, h))
+                })
+                .collect::<Result<Vec<_>, SimError>>()?;
+            let initial: Vec<(usize, usize)> = entries
+                .iter()
+                .enumerate()
+                .filter_map(|(j, e)| match e {
+                    Free::Initial { run, state } if *run == r => Some((j, *state)),
+                    _ => None,
+                })
+                .collect();
+            let columns = Columns { terms: &term_columns, perturbed: &perturbed, initial: &initial, k };
+            let (x, s) = integrate(&system, &phi, &columns, runs, r)?;
             let frame = &runs.frames[r];
             let rows: usize = runs.states.iter().map(|(_, n)| frame.column(n).map_or(0, <[f64]>::len)).sum();
             let mut res = Vec::with_capacity(rows);
@@ -150,30 +214,44 @@ fn per_run_jacobians<T: Send>(
         .collect()
 }
 
+/// The columns of S of one run by kind.
+struct Columns<'a> {
+    /// (column, the state whose equation holds the term), the terms in `phi`'s order.
+    terms: &'a [(usize, usize)],
+    /// (column, the right-hand side at p + h, h).
+    perturbed: &'a [(usize, System, f64)],
+    /// (column, state) of this run's free initial values.
+    initial: &'a [(usize, usize)],
+    /// All columns.
+    k: usize,
+}
+
 /// Run `r` of `runs` with its sensitivities: the state and S (row-major, n × K) at every
 /// sample of the run.
 fn integrate(
     system: &System,
     phi: &System,
-    owner: &[usize],
+    columns: &Columns<'_>,
     runs: &Runs,
     r: usize,
 ) -> Result<Rows, DiagnoseError> {
+    let Columns { terms: term_columns, perturbed, initial, k } = *columns;
     let settings = &runs.settings[r];
     if settings.integrator != Integrator::Rk4 {
         return Err(DiagnoseError::Setup("forward sensitivities integrate with RK4".into()));
     }
-    let (n, m, k) = (system.dim(), system.inputs.len(), owner.len());
+    let (n, m) = (system.dim(), system.inputs.len());
     let (steps, every) = settings.check(n)?;
     let dt = settings.dt;
     let mut replay = Replay::new(&runs.frames[r], &system.inputs)?;
     let mut ws = system.workspace();
     let mut wp = phi.workspace();
+    let mut wq: Vec<_> = perturbed.iter().map(|(_, sys, _)| sys.workspace()).collect();
     let mut fx = vec![0.0; n];
     let mut fp = vec![0.0; n];
     // ∂f/∂x_c is zero for a state the right-hand side does not read
     let read: Vec<usize> = (0..n).filter(|&c| system.reads_state(c)).collect();
-    let mut terms = vec![0.0; k];
+    let mut terms = vec![0.0; term_columns.len()];
     let mut xs = vec![0.0; n];
     // (ẋ, Ṡ) at (x, S, u)
     let mut rate = |x: &[f64], s: &[f64], u: &[f64], dx: &mut [f64], ds: &mut [f64]| {
@@ -181,8 +259,15 @@ fn integrate(
         dx.copy_from_slice(&fx);
         phi.derivatives(x, u, &mut wp, &mut terms);
         ds.fill(0.0);
-        for (j, &i) in owner.iter().enumerate() {
-            ds[i * k + j] = terms[j];
+        for (&(j, i), phi_j) in term_columns.iter().zip(&terms) {
+            ds[i * k + j] = *phi_j;
+        }
+        // ∂f/∂p: the right-hand side at p + h against f
+        for ((j, sys, h), w) in perturbed.iter().zip(wq.iter_mut()) {
+            sys.derivatives(x, u, w, &mut fp);
+            for i in 0..n {
+                ds[i * k + j] = (fp[i] - fx[i]) / h;
+            }
         }
         // A S by columns of A: ∂f/∂x_c by forward differences (the sensitivities need a few
         // digits, the step's truncation error is 1e-7 relative)
@@ -204,6 +289,9 @@ fn integrate(
     };
     let mut x = runs.x0[r].clone();
     let mut s = vec![0.0; n * k];
+    for &(j, i) in initial {
+        s[i * k + j] = 1.0;
+    }
     let (mut u_now, mut u_next, mut u_mid) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
     replay.input(0.0, &x, &mut u_now);
     let mut out_x = vec![x.clone()];
@@ -290,16 +378,22 @@ coefficients = { "x" = -1.0, "w" = -0.1, "x^3" = -0.2, "F" = 1.0 }
         f.push("w", t.iter().map(|t| -0.4 * (0.8 * t).sin()).collect()).unwrap();
         f.push("F", t.iter().map(|t| 0.7 * (0.9 * t).sin()).collect()).unwrap();
         let runs = Runs::new(&model, &[f], 0.05, Integrator::Rk4).unwrap();
-        let entries: Vec<(String, Term)> = ["x", "w", "x^3", "F"]
+        let entries: Vec<Free> = ["x", "w", "x^3", "F"]
             .iter()
-            .map(|t| ("w_dot".to_string(), model.vocabulary.parse(t).unwrap()))
+            .map(|t| Free::Term("w_dot".to_string(), model.vocabulary.parse(t).unwrap()))
             .collect();
         let (r0, jac) = residuals_and_jacobian(&runs, &model, &entries).unwrap();
         assert_eq!(r0, runs.residuals(&runs.simulate(&model, &[], &[]).unwrap()));
         let h = Hypothesis {
             name: "fd".into(),
             effect: crate::diagnose::Effect::Terms {
-                terms: entries.iter().map(|(e, t)| (e.clone(), t.to_string())).collect(),
+                terms: entries
+                    .iter()
+                    .map(|f| match f {
+                        Free::Term(e, t) => (e.clone(), t.to_string()),
+                        _ => unreachable!("only terms here"),
+                    })
+                    .collect(),
             },
         };
         for j in 0..entries.len() {

@@ -30,6 +30,9 @@ pub struct ModelFile {
     /// Equations by name.
     #[serde(default)]
     pub equations: BTreeMap<String, EquationSpec>,
+    /// The free parameters' covariance, written by an output-error estimate.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub parameter_covariance: Option<ParameterCovarianceSpec>,
     /// How the model is simulated when a command does not say (`[simulation]`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub simulation: Option<SimulationSpec>,
@@ -134,6 +137,46 @@ pub struct ParameterSpec {
     /// For identification, the value in each run: `first:u` (the run's first u) or `mean:u`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub per_run: Option<String>,
+    /// Estimated by output error (`termid estimate`; grey-box identification): `value` is
+    /// where the estimate starts.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub free: bool,
+    /// What is known before the runs: the estimate is pulled towards `prior.value` with
+    /// standard deviation `prior.sd` (a Gaussian prior; none: the runs alone decide).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub prior: Option<PriorSpec>,
+    /// `[lower, upper]`: the estimate stays within them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bounds: Option<[f64; 2]>,
+    /// The estimate's standard error (written by `termid estimate`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub std_error: Option<f64>,
+}
+
+/// `[parameters.NAME.prior]`: a Gaussian prior.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PriorSpec {
+    /// Its mean.
+    pub value: f64,
+    /// Its standard deviation (> 0).
+    pub sd: f64,
+}
+
+/// `[parameter_covariance]`: the free parameters' covariance from an output-error estimate,
+/// rows and columns in the order of `names`; Monte-Carlo draws use it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParameterCovarianceSpec {
+    /// The parameters, in matrix order.
+    pub names: Vec<String>,
+    /// Symmetric positive semi-definite matrix, one row per parameter, already widened by
+    /// the residuals' correlation time.
+    pub matrix: Vec<Vec<f64>>,
+}
+
+fn is_false(b: &bool) -> bool {
+    !*b
 }
 
 /// `[[derived]]`.

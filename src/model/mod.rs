@@ -16,7 +16,8 @@ pub use covariance::{Covariance, CovarianceError};
 pub use param::{ParamError, ParamValue};
 
 pub use file::{
-    CoefficientSpec, CovarianceSpec, EquationSpec, InputSpec, Meta, ModelFile, ParameterSpec, StateSpec,
+    CoefficientSpec, CovarianceSpec, EquationSpec, InputSpec, Meta, ModelFile, ParameterCovarianceSpec,
+    ParameterSpec, PriorSpec, StateSpec,
 };
 pub use locate::line_of_key;
 
@@ -137,7 +138,83 @@ pub struct Model {
 /// The control step when neither the command nor the model file gives one, s.
 pub const DEFAULT_DT: f64 = 0.04;
 
+/// A free parameter's keys make sense: a start within its bounds, a prior with sd > 0, and
+/// not also set per run. Err: (the key under `parameters.NAME`, why).
+fn check_free(name: &str, p: &ParameterSpec) -> Result<(), (String, String)> {
+    let finite = |v: f64| v.is_finite();
+    if let Some([lo, hi]) = p.bounds {
+        if lo >= hi || lo.is_nan() || hi.is_nan() {
+            return Err((
+                ".bounds".into(),
+                format!("[{lo}, {hi}] is no interval: write [lower, upper] with lower < upper"),
+            ));
+        }
+        if !(lo..=hi).contains(&p.value) {
+            return Err((".value".into(), format!("{} lies outside the bounds [{lo}, {hi}]", p.value)));
+        }
+    }
+    if let Some(prior) = &p.prior {
+        if !(finite(prior.value) && finite(prior.sd) && prior.sd > 0.0) {
+            return Err((
+                ".prior".into(),
+                format!("value {} and sd {} must be numbers, sd > 0", prior.value, prior.sd),
+            ));
+        }
+    }
+    if p.free && p.per_run.is_some() {
+        return Err((
+            ".free".into(),
+            format!("`{name}` is set per run (`per_run`): one estimate cannot stand for every run's value"),
+        ));
+    }
+    Ok(())
+}
+
+/// A parameter an output-error estimate may change, as the model file declares it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FreeParameter {
+    /// Its name.
+    pub name: String,
+    /// Its value now (where an estimate starts).
+    pub value: f64,
+    /// Its prior (mean, sd), if any.
+    pub prior: Option<(f64, f64)>,
+    /// Its bounds (±∞ where none).
+    pub bounds: (f64, f64),
+}
+
 impl Model {
+    /// The parameters declared `free`, in the file's (alphabetical) order.
+    pub fn free_parameters(&self) -> Vec<FreeParameter> {
+        self.spec
+            .parameters
+            .iter()
+            .filter(|(_, p)| p.free)
+            .map(|(n, p)| FreeParameter {
+                name: n.clone(),
+                value: p.value,
+                prior: p.prior.as_ref().map(|q| (q.value, q.sd)),
+                bounds: p.bounds.map_or((f64::NEG_INFINITY, f64::INFINITY), |[lo, hi]| (lo, hi)),
+            })
+            .collect()
+    }
+
+    /// Writes an output-error estimate: each parameter's value and standard error, and their
+    /// covariance (`None`: none could be formed, any stored one is dropped).
+    pub fn set_parameter_estimates(
+        &mut self,
+        estimates: &[(String, f64, Option<f64>)],
+        covariance: Option<ParameterCovarianceSpec>,
+    ) {
+        for (name, value, se) in estimates {
+            if let Some(p) = self.spec.parameters.get_mut(name) {
+                p.value = *value;
+                p.std_error = *se;
+            }
+        }
+        self.spec.parameter_covariance = covariance;
+    }
+
     /// The method and control step the model is simulated with: what a command asks for,
     /// else the model's `[simulation]` table, else the adaptive Dormand-Prince method at
     /// Δt = 0.04.
@@ -297,6 +374,24 @@ impl Model {
                 ParamValue::Rule(rule.clone())
                     .check_rule(name)
                     .map_err(|m| key_err(&format!("parameters.{name}.per_run"), m.to_string()))?;
+            }
+            check_free(name, p).map_err(|(key, m)| key_err(&format!("parameters.{name}{key}"), m))?;
+        }
+        if let Some(c) = &spec.parameter_covariance {
+            let k = c.names.len();
+            if let Some(n) = c.names.iter().find(|n| !spec.parameters.contains_key(*n)) {
+                return Err(key_err(
+                    "parameter_covariance.names",
+                    format!("`{n}` is not a parameter of the file"),
+                ));
+            }
+            if c.matrix.len() != k
+                || c.matrix.iter().any(|row| row.len() != k || row.iter().any(|v| !v.is_finite()))
+            {
+                return Err(key_err(
+                    "parameter_covariance.matrix",
+                    format!("must be {k} rows of {k} finite numbers, one per name"),
+                ));
             }
         }
         for (i, d) in spec.derived.iter().enumerate() {

@@ -8,7 +8,7 @@
 
 use super::{Manoeuvre, Metrics, Ship, ShipError};
 use crate::model::Model;
-use crate::plugin::Check;
+use crate::plugin::{Check, Measure};
 use crate::sim::{Integrator, Settings};
 
 /// The checks of `model` with turning circles at ± `rudder_deg` from the straight run's rudder.
@@ -41,12 +41,14 @@ pub fn physical_checks(model: &Model, rudder_deg: f64) -> Result<Vec<Check>, Shi
         name: "sway damping ∂v̇/∂v < 0".into(),
         passed: yv < 0.0,
         refuses: true,
+        measure: None,
         detail: format!("{yv:.4} 1/s at u0 = {} m/s", ship.spec.u0),
     });
     checks.push(Check {
         name: "yaw damping ∂ṙ/∂r < 0".into(),
         passed: nr < 0.0,
         refuses: true,
+        measure: None,
         detail: format!("{nr:.4} 1/s at u0"),
     });
     // the linear sway-yaw system is stable when its trace is negative and its determinant
@@ -58,6 +60,7 @@ pub fn physical_checks(model: &Model, rudder_deg: f64) -> Result<Vec<Check>, Shi
         name: "straight-line stability".into(),
         passed: trace < 0.0 && det > 0.0,
         refuses: false,
+        measure: None,
         detail: if trace < 0.0 && det > 0.0 {
             format!("stable, slowest eigenvalue {largest:.4} 1/s")
         } else {
@@ -87,6 +90,7 @@ pub fn physical_checks(model: &Model, rudder_deg: f64) -> Result<Vec<Check>, Shi
                     name: format!("{label} completes"),
                     passed: false,
                     refuses: true,
+                    measure: None,
                     detail: format!("the simulation fails: {e}"),
                 });
                 continue;
@@ -99,6 +103,11 @@ pub fn physical_checks(model: &Model, rudder_deg: f64) -> Result<Vec<Check>, Shi
             name: format!("{label} completes"),
             passed: t.tactical_diameter_m.is_some(),
             refuses: true,
+            measure: t.tactical_diameter_m.map(|d| Measure {
+                name: format!("tactical diameter, δ = {:+.0}°", side * rudder_deg),
+                value: d,
+                unit: "m".into(),
+            }),
             detail: match t.tactical_diameter_m {
                 Some(d) => format!("tactical diameter {d:.2} m = {:.2} L", d / ship.spec.lpp),
                 None if end + 1.0 < turned => {
@@ -114,6 +123,7 @@ pub fn physical_checks(model: &Model, rudder_deg: f64) -> Result<Vec<Check>, Shi
             name: format!("{label}: speed falls, to more than 15 %"),
             passed: t.speed_ratio > 0.15 && t.speed_ratio <= 1.0 + 1e-9,
             refuses: true,
+            measure: None,
             detail: format!("steady speed {:.1} % of the approach", 100.0 * t.speed_ratio),
         });
         let inward = t.drift_angle_deg * t.yaw_rate_deg_s > 0.0;
@@ -121,6 +131,7 @@ pub fn physical_checks(model: &Model, rudder_deg: f64) -> Result<Vec<Check>, Shi
             name: format!("{label}: drift with the bow inside the circle, under 35°"),
             passed: inward && t.drift_angle_deg.abs() < 35.0,
             refuses: !inward,
+            measure: None,
             detail: format!("drift angle {:.1}° at yaw rate {:.2} °/s", t.drift_angle_deg, t.yaw_rate_deg_s),
         });
     }

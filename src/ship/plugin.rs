@@ -137,6 +137,7 @@ impl Plugin for Manoeuvring {
                 passed: false,
                 refuses: true,
                 detail: e.to_string(),
+                measure: None,
             }],
         }
     }

@@ -230,3 +230,65 @@ fn observed_metrics_match_the_manoeuvres_own() {
         assert!((a.unwrap() - b.unwrap()).abs() < 0.05, "{a:?} vs {b:?}");
     }
 }
+
+/// The new-ship recipe on the shipped sample data (README's "Starting a new ship" command on
+/// `examples/data`): for each side, the kept model predicts its own truth's turning circle
+/// within 5 %, or the recipe flags that its starts disagree on it (they did not, and the kept
+/// start was 39 % off at δ = −30° with every check "ok").
+#[test]
+fn the_recipe_predicts_the_turning_circles_or_says_its_starts_disagree() {
+    let dir = crate::common::Scratch::new("recipe-honest");
+    let out = dir.join("ship_id.toml");
+    let (ok, text, err) = crate::common::termid(&[
+        "identify",
+        "--model",
+        "examples/data/ship.toml",
+        "--dataset",
+        "examples/data/runs.toml",
+        "--derivative",
+        "kinematic,kalman,savitzky-golay,central",
+        "--smooth",
+        "--no-intercept",
+        "--choose",
+        "sparse,best-subset,efroymson,stepwise",
+        "--compare",
+        "u,v,r,ψ",
+        "--refine",
+        "u,v,r,ψ",
+        "--refine-iterations",
+        "100",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let checks = &text[text.find("== physical checks ==").expect("checks printed")..];
+    let truth = Ship::new(&termid::ship::default_model(), false).unwrap();
+    let settings = Settings { integrator: Integrator::Rk4, dt: 0.05, duration: 300.0, sample: 0.05 };
+    let mut sides = 0;
+    for line in checks.lines().filter(|l| l.contains("completes: tactical diameter")) {
+        // "ok   turning circle δ = -30.2° completes: tactical diameter 42.77 m = 9.36 L"
+        let angle: f64 = line.split("δ = ").nth(1).unwrap().split('°').next().unwrap().parse().unwrap();
+        let predicted: f64 =
+            line.split("tactical diameter ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+        let Metrics::Turning(t) =
+            truth.run(&Manoeuvre::parse(&format!("turning:{angle}")).unwrap(), &settings).unwrap().metrics
+        else {
+            unreachable!()
+        };
+        let true_d = t.tactical_diameter_m.unwrap();
+        let flag = format!(
+            "FLAG the starts agree on the tactical diameter, δ = {:+.0}°",
+            angle.signum() * angle.abs().round()
+        );
+        let within = (predicted / true_d - 1.0).abs() < 0.05;
+        assert!(
+            within || checks.contains(&flag),
+            "δ = {angle}°: {predicted} m vs true {true_d} m, no flag\n{checks}"
+        );
+        if !within {
+            assert!(err.contains("warning: FLAG the starts agree"), "{err}");
+        }
+        sides += 1;
+    }
+    assert_eq!(sides, 2, "{checks}");
+}

@@ -36,6 +36,43 @@ pub enum Command {
     /// Write an equation's sufficient statistics over a shard of runs (merged and identified
     /// by `identify --moments`).
     Moments(MomentsCommand),
+    /// Estimate a model file's free parameters (`free = true`) by output error: grey-box
+    /// identification, alone or with the term coefficients.
+    Estimate(EstimateCommand),
+}
+
+/// `termid estimate`.
+#[derive(Debug, Args)]
+#[command(
+    after_help = "A parameter is free when its table says so, with an optional prior and bounds:\n  [parameters.K]\n  value = 0.2          # where the estimate starts\n  free = true\n  prior = { value = 0.2, sd = 0.05 }\n  bounds = [0.0, 5.0]\n\nExample:\n  termid estimate --model nomoto.toml --data zigzag.csv --out nomoto_estimated.toml"
+)]
+pub struct EstimateCommand {
+    /// The model file with free parameters.
+    #[arg(long)]
+    pub model: PathBuf,
+    /// Measured runs.
+    #[command(flatten)]
+    pub runs: RunsArgs,
+    /// Write the model with the estimates, their standard errors and covariance.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Also estimate every term coefficient of the identified equations (each held to its
+    /// stored value by its standard error).
+    #[arg(long)]
+    pub coefficients: bool,
+    /// Most Levenberg-Marquardt iterations per round (two rounds).
+    #[arg(long, default_value_t = 50)]
+    pub iterations: usize,
+    /// Compare only these states (default: every state the runs have).
+    #[arg(long, num_args = 1.., value_delimiter = ',')]
+    pub states: Option<Vec<String>>,
+    /// The RK4 step, s (default: the runs' sample interval; the recorded inputs are known only at
+    /// the samples).
+    #[arg(allow_negative_numbers = true, long)]
+    pub dt: Option<f64>,
+    /// Output format.
+    #[arg(long, value_enum, default_value = "text")]
+    pub format: Format,
 }
 
 /// `termid moments`.

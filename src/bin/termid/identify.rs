@@ -516,8 +516,22 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
     if starts.len() > 1 && matches!(cmd.format, Format::Text) {
         print!("{}", starts_table(&starts, kept, held.is_some()));
     }
-    let Start { model: kept_model, fits, chosen_text, refined, rejected, refine_error, checks, .. } =
+    // the starts that pass their checks are models the runs cannot tell apart: where they
+    // disagree on a manoeuvre the runs did not cover, that prediction is that uncertain
+    let plausible: Vec<(&str, &[termid::plugin::Check])> = starts
+        .iter()
+        .enumerate()
+        .filter(|(k, s)| *k == kept || s.refused() == 0)
+        .map(|(_, s)| (s.derivative.as_str(), s.checks.as_slice()))
+        .collect();
+    let at = plausible.iter().position(|(d, _)| *d == starts[kept].derivative).unwrap_or(0);
+    let agreement = termid::plugin::disagreement(&plausible, at, STARTS_AGREE);
+    for c in agreement.iter().filter(|c| !c.passed) {
+        eprintln!("warning: {}", c.line());
+    }
+    let Start { model: kept_model, fits, chosen_text, refined, rejected, refine_error, mut checks, .. } =
         starts.swap_remove(kept);
+    checks.extend(agreement);
     let mut model = kept_model;
     let names_fitted: Vec<String> = fits.iter().map(|(n, _)| n.clone()).collect();
     if matches!(cmd.format, Format::Text) {
@@ -654,6 +668,10 @@ fn run_model(cmd: IdentifyCommand) -> Result<()> {
     }
     Ok(())
 }
+
+/// How far (relative) the plausible starts may disagree on a measure of a manoeuvre the runs
+/// did not cover before the prediction is flagged as uncertain.
+const STARTS_AGREE: f64 = 0.10;
 
 /// The table of starts: each derivative method's costs and checks, the kept one marked.
 fn starts_table(starts: &[Start], kept: usize, validation: bool) -> String {

@@ -3,6 +3,7 @@
 mod args;
 mod compare;
 mod diagnose;
+mod estimate;
 mod identify;
 mod moments;
 mod monte_carlo;
@@ -36,6 +37,7 @@ fn main() -> ExitCode {
         args::Command::Validate(cmd) => validate::run(cmd),
         args::Command::Scale(cmd) => scale::run(cmd),
         args::Command::Moments(cmd) => moments::run(cmd),
+        args::Command::Estimate(cmd) => estimate::run(cmd),
     };
     // The command runs on a worker of the thread pool: the library's parallel passes over
     // the rows then start at once, where from outside the pool every pass would wait for a

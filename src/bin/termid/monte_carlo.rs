@@ -128,10 +128,23 @@ impl<T> Draws<T> {
 
     /// One line: how many models were drawn from what, how many ran.
     pub fn headline(&self) -> String {
+        // `parameters` stands for the free parameters' covariance, the rest are equations
+        let (params, equations): (Vec<&String>, Vec<&String>) =
+            self.equations.iter().partition(|e| e.as_str() == "parameters");
+        let mut what = Vec::new();
+        if !equations.is_empty() {
+            what.push(format!(
+                "{} coefficients",
+                equations.iter().map(|e| e.as_str()).collect::<Vec<_>>().join(", ")
+            ));
+        }
+        if !params.is_empty() {
+            what.push("the free parameters".to_string());
+        }
         format!(
-            "Monte Carlo: {} models with {} coefficients drawn from their covariance × correlation time (seed {}); {} ran, {} failed",
+            "Monte Carlo: {} models with {} drawn from their covariance × correlation time (seed {}); {} ran, {} failed",
             self.draws,
-            self.equations.join(", "),
+            what.join(" and "),
             self.seed,
             self.results.len(),
             self.failed

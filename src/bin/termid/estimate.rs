@@ -1,0 +1,53 @@
+//! `termid estimate`: a model file's free parameters estimated by output error (grey-box
+//! identification); the estimates, their standard errors and covariance written back.
+
+use anyhow::{Context, Result};
+use termid::diagnose::{estimate, EstimateSettings, Runs};
+use termid::sim::Integrator;
+
+use crate::args::{EstimateCommand, Format};
+
+pub fn run(cmd: EstimateCommand) -> Result<()> {
+    // an output that cannot be written is refused before any work
+    if let Some(out) = &cmd.out {
+        termid::output::check_file(out)?;
+        let mut inputs = crate::runs::input_files(&cmd.runs.data, cmd.runs.dataset.as_deref());
+        inputs.push(("--model".to_string(), cmd.model.clone()));
+        crate::runs::check_outputs(&[("--out", out)], &inputs)?;
+    }
+    let model = crate::simulate::load_model(&Some(cmd.model.clone()))?;
+    // said before any run is read
+    if model.free_parameters().is_empty() && !cmd.coefficients {
+        anyhow::bail!(
+            "{} declares no free parameter: mark those to estimate with `free = true` under [parameters.NAME] (or give --coefficients)",
+            model.path
+        );
+    }
+    let frames = crate::runs::load_for(&model, &cmd.runs.data, cmd.runs.dataset.as_deref())?;
+    // one RK4 step per sample by default: the recorded input is known only at the samples
+    let dt = cmd.dt.unwrap_or_else(|| {
+        frames.iter().map(|f| termid::data::median_step(f.time())).fold(f64::INFINITY, f64::min)
+    });
+    let mut runs = Runs::new(&model, &frames, dt, Integrator::Rk4)?;
+    if let Some(states) = &cmd.states {
+        runs = runs.comparing(states)?;
+    }
+    let settings =
+        EstimateSettings { coefficients: cmd.coefficients, iterations: cmd.iterations, ..Default::default() };
+    let fit = estimate(&model, &runs, &settings).context("estimating the free parameters")?;
+    if let Some(out) = &cmd.out {
+        let mut outputs = termid::output::Outputs::new();
+        outputs.file(out, fit.model.to_toml().as_bytes())?;
+        outputs.commit()?;
+    }
+    match cmd.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&fit)?),
+        Format::Text => {
+            print!("{}", fit.text());
+            if let Some(out) = &cmd.out {
+                println!("written: {}", out.display());
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,399 @@
+//! Grey-box identification: the model file's free parameters (named parameters anywhere in
+//! derived variables and equations, nonlinear in them: a rudder's ε, a Nomoto K and T,
+//! Lorenz's σ) estimated by output error, alone or together with the identified equations'
+//! term coefficients. Levenberg-Marquardt on the runs' re-simulation residuals, the Jacobian
+//! from forward sensitivities, each parameter's prior and bounds from the model file, and the
+//! covariance widened by the residuals' correlation time.
+
+use nalgebra::DMatrix;
+use serde::Serialize;
+
+use super::fit::{apply, cost as sum_of_squares};
+use super::refine::RefinedCoefficient;
+use super::sensitivity::{linearise, Free, Linearised};
+use super::{DiagnoseError, Effect, EstimateError, Hypothesis, Runs};
+use crate::model::{FreeParameter, Model, ParameterCovarianceSpec};
+use crate::term::Term;
+
+/// What an estimate changes and how long it may try.
+#[derive(Clone, Copy, Debug)]
+pub struct EstimateSettings {
+    /// Also every term coefficient of the identified equations (each pulled towards its
+    /// stored value with its standard error as the prior's, scaled by `prior_weight`).
+    pub coefficients: bool,
+    /// The weight of the coefficients' priors (1: as stored; as the refinement's).
+    pub prior_weight: f64,
+    /// Most Levenberg-Marquardt iterations in each of the two rounds.
+    pub iterations: usize,
+    /// Also each run's initial values of the compared states (nuisance parameters: a run is
+    /// re-simulated from its first sample, and the noise in that sample would otherwise
+    /// bias every estimate; a speed error persists for the whole run).
+    pub initial_states: bool,
+}
+
+impl Default for EstimateSettings {
+    fn default() -> Self {
+        EstimateSettings { coefficients: false, prior_weight: 1e-4, iterations: 50, initial_states: true }
+    }
+}
+
+/// One estimated parameter.
+#[derive(Clone, Debug, Serialize)]
+pub struct EstimatedParameter {
+    /// Its name.
+    pub name: String,
+    /// Where the estimate started (the model file's value).
+    pub start: f64,
+    /// The estimate.
+    pub value: f64,
+    /// Its standard error (from the covariance; NaN without one).
+    pub std_error: f64,
+    /// The prior (mean, sd), if the file gave one.
+    pub prior: Option<(f64, f64)>,
+    /// Whether the estimate sits on one of its bounds (its standard error then understates).
+    pub at_bound: bool,
+}
+
+/// An output-error estimate's result.
+#[derive(Clone, Debug, Serialize)]
+pub struct Estimate {
+    /// The model with the estimates, their standard errors and covariance.
+    #[serde(skip)]
+    pub model: Model,
+    /// Scaled sum of squares of the re-simulation over all runs, before.
+    pub cost_before: f64,
+    /// The same after.
+    pub cost_after: f64,
+    /// Why it stopped.
+    pub stopped: String,
+    /// Levenberg-Marquardt iterations taken, both rounds.
+    pub iterations: usize,
+    /// Integrated autocorrelation time of the re-simulation residuals, in samples.
+    pub correlation_time: Option<f64>,
+    /// Every free parameter.
+    pub parameters: Vec<EstimatedParameter>,
+    /// Every term coefficient estimated with them (empty unless asked).
+    pub coefficients: Vec<RefinedCoefficient>,
+    /// The parameters' covariance (rows as `parameters`), if the information matrix has an
+    /// inverse.
+    pub covariance: Option<Vec<Vec<f64>>>,
+    /// How many runs' initial values were estimated with them.
+    pub initial_values: usize,
+}
+
+/// The unknowns: the free parameters (absolute values), then the coefficients (changes).
+struct Unknowns {
+    entries: Vec<Free>,
+    parameters: Vec<FreeParameter>,
+    /// (equation, term, stored value, prior sd) of each coefficient.
+    coefficients: Vec<(String, Term, f64, f64)>,
+    /// (run, state index) of each free initial value.
+    initial: Vec<(usize, usize)>,
+    hypothesis: Hypothesis,
+    /// Prior precision and mean per unknown (0 precision: no prior).
+    precision: Vec<f64>,
+    mean: Vec<f64>,
+    bounds: Vec<(f64, f64)>,
+}
+
+impl Unknowns {
+    fn of(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Unknowns {
+        let parameters = model.free_parameters();
+        let mut coefficients = Vec::new();
+        if settings.coefficients {
+            for e in model.equations().iter().filter(|e| e.identify) {
+                let tau = e.covariance.as_ref().map_or(1.0, |c| c.correlation_time.max(1.0));
+                for (t, v, se) in &e.coefficients {
+                    // as the refinement: no standard error, a tenth of the value
+                    let sd = se.map_or(0.1 * v.abs(), |s| s * tau.sqrt()).max(1e-6 * v.abs()).max(1e-300);
+                    coefficients.push((e.name.clone(), t.clone(), *v, sd));
+                }
+            }
+        }
+        let initial: Vec<(usize, usize)> = if settings.initial_states {
+            (0..runs.len()).flat_map(|r| runs.compared().iter().map(move |(i, _)| (r, *i))).collect()
+        } else {
+            Vec::new()
+        };
+        let entries = parameters
+            .iter()
+            .map(|p| Free::Parameter(p.name.clone()))
+            .chain(coefficients.iter().map(|(e, t, _, _)| Free::Term(e.clone(), t.clone())))
+            .chain(initial.iter().map(|&(run, state)| Free::Initial { run, state }))
+            .collect();
+        let hypothesis = Hypothesis {
+            name: "grey-box estimate".into(),
+            effect: Effect::Terms {
+                terms: coefficients.iter().map(|(e, t, _, _)| (e.clone(), t.to_string())).collect(),
+            },
+        };
+        let mut precision = Vec::new();
+        let mut mean = Vec::new();
+        let mut bounds = Vec::new();
+        for p in &parameters {
+            let (m, prec) = p.prior.map_or((p.value, 0.0), |(m, sd)| (m, 1.0 / (sd * sd)));
+            precision.push(prec);
+            mean.push(m);
+            bounds.push(p.bounds);
+        }
+        for (_, _, _, sd) in &coefficients {
+            precision.push(settings.prior_weight / (sd * sd));
+            mean.push(0.0);
+            bounds.push((f64::NEG_INFINITY, f64::INFINITY));
+        }
+        for _ in &initial {
+            precision.push(0.0);
+            mean.push(0.0);
+            bounds.push((f64::NEG_INFINITY, f64::INFINITY));
+        }
+        Unknowns { entries, parameters, coefficients, initial, hypothesis, precision, mean, bounds }
+    }
+
+    fn start(&self, runs: &Runs) -> Vec<f64> {
+        self.parameters
+            .iter()
+            .map(|p| p.value)
+            .chain(self.coefficients.iter().map(|_| 0.0))
+            .chain(self.initial.iter().map(|&(r, i)| runs.initial(r, i)))
+            .collect()
+    }
+
+    /// The runs at θ: from the initial values θ holds.
+    fn runs_at(&self, runs: &Runs, theta: &[f64]) -> Runs {
+        let first = self.parameters.len() + self.coefficients.len();
+        let values: Vec<(usize, usize, f64)> =
+            self.initial.iter().zip(&theta[first..]).map(|(&(r, i), v)| (r, i, *v)).collect();
+        runs.with_initial(&values)
+    }
+
+    /// The model at θ.
+    fn at(&self, model: &Model, theta: &[f64]) -> Result<Model, DiagnoseError> {
+        let k = self.parameters.len();
+        let mut m = apply(model, &self.hypothesis, &theta[k..k + self.coefficients.len()])?;
+        for (p, v) in self.parameters.iter().zip(theta) {
+            m.set_parameter(&p.name, *v);
+        }
+        Ok(m)
+    }
+
+    fn prior_cost(&self, theta: &[f64]) -> f64 {
+        theta.iter().zip(&self.mean).zip(&self.precision).map(|((t, m), p)| p * (t - m) * (t - m)).sum()
+    }
+
+    fn clamp(&self, theta: &mut [f64]) {
+        for (t, (lo, hi)) in theta.iter_mut().zip(&self.bounds) {
+            *t = t.clamp(*lo, *hi);
+        }
+    }
+}
+
+/// Estimates the model file's free parameters (and, if asked, the term coefficients) from
+/// `runs` by output error.
+///
+/// The data's sum of squares is weighted by 1/(s²τ), s² the residuals' variance and τ their
+/// correlation time, so that a prior counts against the runs as it should: a first round
+/// starts with s² and τ from the start's residuals, a second from the first's end.
+pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Result<Estimate, DiagnoseError> {
+    if settings.iterations == 0 {
+        return Err(DiagnoseError::Setup("the estimate needs at least one iteration".into()));
+    }
+    if !(settings.prior_weight.is_finite() && settings.prior_weight >= 0.0) {
+        return Err(DiagnoseError::Setup(format!(
+            "the coefficients' prior weight {} must be a number ≥ 0",
+            settings.prior_weight
+        )));
+    }
+    let u = Unknowns::of(model, runs, settings);
+    if u.parameters.is_empty() && u.coefficients.is_empty() {
+        return Err(DiagnoseError::Setup(format!(
+            "{} declares no free parameter (`free = true` under [parameters.NAME])",
+            model.path
+        )));
+    }
+    let k = u.entries.len();
+    let data_cost = |theta: &[f64]| -> Option<f64> {
+        let m = u.at(model, theta).ok()?;
+        let runs = u.runs_at(runs, theta);
+        let r = runs.residuals(&runs.simulate(&m, &[], &[]).ok()?);
+        r.iter().all(|v| v.is_finite()).then(|| sum_of_squares(&r))
+    };
+    let linearised = |theta: &[f64]| -> Result<Linearised, DiagnoseError> {
+        linearise(&u.runs_at(runs, theta), &u.at(model, theta)?, &u.entries)
+            .map_err(|_| DiagnoseError::Refinement(EstimateError::Diverges("at an iterate")))
+    };
+    let mut theta = u.start(runs);
+    let cost_before = data_cost(&theta).ok_or(DiagnoseError::Refinement(EstimateError::Diverges(
+        "at the start (the free parameters' values in the file)",
+    )))?;
+    let mut lin = linearised(&theta)?;
+    let (mut stopped, mut taken) = (String::new(), 0);
+    for _round in 0..2 {
+        let (weight, _) = data_weight(runs, &lin.residuals, k);
+        let objective = |data: f64, theta: &[f64]| weight * data + u.prior_cost(theta);
+        let mut cost = objective(sum_of_squares(&lin.residuals), &theta);
+        let mut lambda = 1e-3;
+        stopped = format!("{} iterations", settings.iterations);
+        for _ in 0..settings.iterations {
+            taken += 1;
+            let mut a = &lin.jtj * weight;
+            let mut g = &lin.jtr * weight;
+            for i in 0..k {
+                a[(i, i)] += u.precision[i];
+                g[i] += u.precision[i] * (theta[i] - u.mean[i]);
+            }
+            let mut damped = a.clone();
+            for i in 0..k {
+                damped[(i, i)] += lambda * a[(i, i)].max(1e-300);
+            }
+            let Some(step) = damped.lu().solve(&g) else {
+                stopped = "singular normal equations (a free parameter the runs do not excite?)".into();
+                break;
+            };
+            let mut trial: Vec<f64> = theta.iter().zip(step.iter()).map(|(t, d)| t - d).collect();
+            u.clamp(&mut trial);
+            match data_cost(&trial).map(|c| objective(c, &trial)) {
+                Some(c) if c < cost => {
+                    let improvement = (cost - c) / cost.max(1e-300);
+                    let Ok(next) = linearised(&trial) else {
+                        lambda *= 10.0;
+                        continue;
+                    };
+                    let moved = trial
+                        .iter()
+                        .zip(&theta)
+                        .map(|(a, b)| (a - b).abs() / (1e-12 + b.abs()))
+                        .fold(0.0, f64::max);
+                    (theta, lin, cost) = (trial, next, c);
+                    lambda = (lambda / 10.0).max(1e-12);
+                    if improvement < 1e-10 || moved < 1e-9 {
+                        stopped = "converged".into();
+                        break;
+                    }
+                }
+                _ => {
+                    lambda *= 10.0;
+                    if lambda > 1e10 {
+                        // no step lowers the cost any more: a minimum to the precision the
+                        // simulation gives
+                        stopped = "converged (no step lowers the cost)".into();
+                        break;
+                    }
+                }
+            }
+        }
+    }
+    let (weight, tau) = data_weight(runs, &lin.residuals, k);
+    let mut info = &lin.jtj * weight;
+    for i in 0..k {
+        info[(i, i)] += u.precision[i];
+    }
+    let covariance: Option<DMatrix<f64>> = info.try_inverse();
+    let std_errors: Vec<f64> =
+        (0..k).map(|i| covariance.as_ref().map_or(f64::NAN, |c| c[(i, i)].max(0.0).sqrt())).collect();
+    let np = u.parameters.len();
+    let parameters: Vec<EstimatedParameter> = u
+        .parameters
+        .iter()
+        .enumerate()
+        .map(|(i, p)| EstimatedParameter {
+            name: p.name.clone(),
+            start: p.value,
+            value: theta[i],
+            std_error: std_errors[i],
+            prior: p.prior,
+            at_bound: theta[i] <= p.bounds.0 || theta[i] >= p.bounds.1,
+        })
+        .collect();
+    let mut estimated = u.at(model, &theta)?;
+    let matrix = covariance.as_ref().map(|c| {
+        (0..np)
+            .map(|i| (0..np).map(|j| 0.5 * (c[(i, j)] + c[(j, i)])).collect::<Vec<f64>>())
+            .collect::<Vec<_>>()
+    });
+    estimated.set_parameter_estimates(
+        &parameters
+            .iter()
+            .map(|p| (p.name.clone(), p.value, p.std_error.is_finite().then_some(p.std_error)))
+            .collect::<Vec<_>>(),
+        matrix.clone().map(|matrix| ParameterCovarianceSpec {
+            names: parameters.iter().map(|p| p.name.clone()).collect(),
+            matrix,
+        }),
+    );
+    let coefficients = u
+        .coefficients
+        .iter()
+        .enumerate()
+        .map(|(j, (e, t, v, sd))| RefinedCoefficient {
+            equation: e.clone(),
+            term: t.to_string(),
+            regression: *v,
+            refined: v + theta[np + j],
+            std_error: std_errors[np + j],
+            prior_sd: *sd,
+        })
+        .collect();
+    Ok(Estimate {
+        model: estimated,
+        cost_before,
+        cost_after: sum_of_squares(&lin.residuals),
+        stopped,
+        iterations: taken,
+        correlation_time: tau,
+        parameters,
+        coefficients,
+        covariance: matrix,
+        initial_values: u.initial.len(),
+    })
+}
+
+/// 1/(s²τ): the weight of the data's sum of squares against the priors, s² the residuals'
+/// variance (k unknowns spent) and τ their correlation time (correlated samples carry less
+/// information than their number says); and τ.
+fn data_weight(runs: &Runs, residuals: &[f64], k: usize) -> (f64, Option<f64>) {
+    let tau = crate::uncertainty::correlation_time(&runs.series(residuals));
+    let s2 = sum_of_squares(residuals) / (residuals.len() as f64 - k as f64).max(1.0);
+    (1.0 / (s2.max(1e-300) * tau.unwrap_or(1.0).max(1.0)), tau)
+}
+
+impl Estimate {
+    /// The estimate as a person reads it: the cost before and after and, per parameter, the
+    /// start, the estimate, its standard error and, where given, the prior.
+    pub fn text(&self) -> String {
+        use crate::identify::num;
+        let mut out = format!(
+            "== output-error estimate of the free parameters ==\nre-simulation cost (scaled sum of squares) {} → {}; {} iterations; residual correlation time {} samples; stopped: {}\n",
+            num(self.cost_before),
+            num(self.cost_after),
+            self.iterations,
+            self.correlation_time.map_or("—".into(), num),
+            self.stopped
+        );
+        out.push_str(&format!(
+            "{:<12} {:>14} {:>14} {:>12} {:>22}\n",
+            "parameter", "start", "estimate", "std. error", "prior (mean ± sd)"
+        ));
+        for p in &self.parameters {
+            let prior = p.prior.map_or("—".into(), |(m, sd)| format!("{} ± {}", num(m), num(sd)));
+            out.push_str(&format!(
+                "{:<12} {:>14} {:>14} {:>12} {:>22}{}\n",
+                p.name,
+                num(p.start),
+                num(p.value),
+                num(p.std_error),
+                prior,
+                if p.at_bound { "  at its bound: the standard error understates" } else { "" }
+            ));
+        }
+        if !self.coefficients.is_empty() {
+            out.push_str(&format!("and {} term coefficients with them\n", self.coefficients.len()));
+        }
+        if self.initial_values > 0 {
+            out.push_str(&format!(
+                "and {} initial values (each run's compared states at its start, nuisance parameters)\n",
+                self.initial_values
+            ));
+        }
+        out
+    }
+}
