@@ -11,6 +11,7 @@ pub mod hypotheses;
 pub mod imo;
 pub mod manoeuvre;
 pub mod observed;
+pub mod particulars;
 pub mod plugin;
 pub mod spec;
 pub mod tracking;

@@ -39,6 +39,23 @@ pub enum Command {
     /// Estimate a model file's free parameters (`free = true`) by output error: grey-box
     /// identification, alone or with the term coefficients.
     Estimate(EstimateCommand),
+    /// Write a grey-box MMG model file for a ship from its main particulars: every parameter
+    /// estimated by a cited formula and free with that estimate as its prior (then `estimate`).
+    NewShip(NewShipCommand),
+}
+
+/// `termid new-ship`.
+#[derive(Debug, Args)]
+#[command(
+    after_help = "A particulars file (TOML; SI, degrees):\n  name = \"KVLCC2\"\n  lpp = 7.0\n  beam = 1.27\n  draught = 0.46\n  block_coefficient = 0.81\n  x_g = 0.25                # from midship, forward positive (default 0)\n  rudder_area = 0.0539\n  rudder_span = 0.345\n  propeller_diameter = 0.216\n  u0 = 1.17248\n  rudder_rate = 15.8\n  # optional: rudder_limit = 35, density = 1025, kt = [k0, k1, k2] (the propeller's K_T(J))\n\nExample:\n  termid new-ship --particulars examples/kvlcc2_particulars.toml --out ship_greybox.toml\n  termid estimate --model ship_greybox.toml --dataset train.toml --out ship_estimated.toml"
+)]
+pub struct NewShipCommand {
+    /// The particulars file.
+    #[arg(long)]
+    pub particulars: PathBuf,
+    /// Where the grey-box model file goes.
+    #[arg(long)]
+    pub out: PathBuf,
 }
 
 /// `termid estimate`.

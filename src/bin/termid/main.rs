@@ -7,6 +7,7 @@ mod estimate;
 mod identify;
 mod moments;
 mod monte_carlo;
+mod new_ship;
 mod progress;
 mod reproduce;
 mod runs;
@@ -38,6 +39,7 @@ fn main() -> ExitCode {
         args::Command::Scale(cmd) => scale::run(cmd),
         args::Command::Moments(cmd) => moments::run(cmd),
         args::Command::Estimate(cmd) => estimate::run(cmd),
+        args::Command::NewShip(cmd) => new_ship::run(cmd),
     };
     // The command runs on a worker of the thread pool: the library's parallel passes over
     // the rows then start at once, where from outside the pool every pass would wait for a
