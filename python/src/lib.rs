@@ -672,7 +672,7 @@ impl PyModel {
 
     /// The model file's free parameters estimated from runs by output error (JSON report),
     /// with the model holding the estimates.
-    #[pyo3(signature = (runs, coefficients = false, states = None, initial_states = true, dt = None, iterations = 50))]
+    #[pyo3(signature = (runs, coefficients = false, states = None, initial_states = true, dt = None, iterations = 50, sources = vec![], per_source = vec![]))]
     #[allow(clippy::too_many_arguments)]
     fn estimate(
         &self,
@@ -683,6 +683,8 @@ impl PyModel {
         initial_states: bool,
         dt: Option<f64>,
         iterations: usize,
+        sources: Vec<usize>,
+        per_source: Vec<String>,
     ) -> PyResult<(String, PyModel)> {
         let frames = self.frames(runs)?;
         // one RK4 step per sample by default: the recorded inputs are known at the samples
@@ -693,6 +695,8 @@ impl PyModel {
             coefficients,
             iterations,
             initial_states,
+            sources,
+            per_source,
             ..Default::default()
         };
         let fit = py

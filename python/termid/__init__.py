@@ -1152,6 +1152,8 @@ class Model:
         initial_states: bool = True,
         dt: Optional[float] = None,
         iterations: int = 50,
+        sources: Optional[Sequence[int]] = None,
+        per_source: Sequence[str] = (),
     ) -> Tuple[pd.DataFrame, "Model"]:
         """The model file's free parameters (``free = true`` under ``[parameters.NAME]``, with an
         optional ``prior`` and ``bounds``) estimated from ``runs`` by output error: grey-box
@@ -1163,7 +1165,10 @@ class Model:
         coefficients; ``states`` the states compared (default: every state the runs have);
         ``initial_states`` estimates each run's initial state too (a noisy first sample would
         bias the rest); ``dt`` the RK4 step (default: the runs' sample interval);
-        ``iterations`` the most Levenberg-Marquardt iterations per round.
+        ``iterations`` the most Levenberg-Marquardt iterations per round; ``sources`` the
+        source (basin, campaign) of each run by number, and ``per_source`` the free parameters
+        estimated once per source (nuisances such as a basin's rudder zero; in
+        ``attrs["per_source"]``, a DataFrame, and not written to the model).
 
         >>> nomoto = termid.Model.builtin("nomoto")
         >>> truth = termid.Model.builtin("nomoto")
@@ -1174,7 +1179,14 @@ class Model:
         {'K': 0.15, 'T': 8.0}
         """
         text, native = self._native.estimate(
-            _runs(runs), coefficients, None if states is None else list(states), initial_states, dt, iterations
+            _runs(runs),
+            coefficients,
+            None if states is None else list(states),
+            initial_states,
+            dt,
+            iterations,
+            [int(s) for s in sources or []],
+            list(per_source),
         )
         report = json.loads(text)
         table = pd.DataFrame(
@@ -1197,6 +1209,7 @@ class Model:
             "cost_after": report["cost_after"],
             "stopped": report["stopped"],
             "covariance": None if report["covariance"] is None else pd.DataFrame(report["covariance"], index=names, columns=names),
+            "per_source": pd.DataFrame(report.get("per_source", []), columns=["name", "source", "value", "std_error"]),
         }
         return table, Model(native)
 

@@ -16,7 +16,7 @@ use crate::model::{FreeParameter, Model, ParameterCovarianceSpec};
 use crate::term::Term;
 
 /// What an estimate changes and how long it may try.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct EstimateSettings {
     /// Also every term coefficient of the identified equations (each pulled towards its
     /// stored value with its standard error as the prior's, scaled by `prior_weight`).
@@ -29,12 +29,37 @@ pub struct EstimateSettings {
     /// re-simulated from its first sample, and the noise in that sample would otherwise
     /// bias every estimate; a speed error persists for the whole run).
     pub initial_states: bool,
+    /// The source (basin, campaign) of each run, by index (empty: one source).
+    pub sources: Vec<usize>,
+    /// Free parameters estimated once per source (nuisances: a basin's rudder indicator
+    /// zero, its propeller rate's calibration), the rest once for all.
+    pub per_source: Vec<String>,
 }
 
 impl Default for EstimateSettings {
     fn default() -> Self {
-        EstimateSettings { coefficients: false, prior_weight: 1e-4, iterations: 50, initial_states: true }
+        EstimateSettings {
+            coefficients: false,
+            prior_weight: 1e-4,
+            iterations: 50,
+            initial_states: true,
+            sources: Vec::new(),
+            per_source: Vec::new(),
+        }
     }
+}
+
+/// A parameter estimated for one source.
+#[derive(Clone, Debug, Serialize)]
+pub struct SourceParameter {
+    /// The parameter.
+    pub name: String,
+    /// The source (index, as [`EstimateSettings::sources`] numbers them).
+    pub source: usize,
+    /// The estimate.
+    pub value: f64,
+    /// Its standard error.
+    pub std_error: f64,
 }
 
 /// One estimated parameter.
@@ -79,6 +104,8 @@ pub struct Estimate {
     pub covariance: Option<Vec<Vec<f64>>>,
     /// How many runs' initial values were estimated with them.
     pub initial_values: usize,
+    /// The per-source parameters (not written to the model: each source has its own).
+    pub per_source: Vec<SourceParameter>,
 }
 
 /// The unknowns: the free parameters (absolute values), then the coefficients (changes).
@@ -87,6 +114,8 @@ struct Unknowns {
     parameters: Vec<FreeParameter>,
     /// (equation, term, stored value, prior sd) of each coefficient.
     coefficients: Vec<(String, Term, f64, f64)>,
+    /// (parameter, source, its runs, start) of each per-source unknown.
+    groups: Vec<(FreeParameter, usize, Vec<usize>)>,
     /// (run, state index) of each free initial value.
     initial: Vec<(usize, usize)>,
     hypothesis: Hypothesis,
@@ -97,8 +126,27 @@ struct Unknowns {
 }
 
 impl Unknowns {
-    fn of(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Unknowns {
-        let parameters = model.free_parameters();
+    fn of(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Result<Unknowns, DiagnoseError> {
+        let all = model.free_parameters();
+        if let Some(n) = settings.per_source.iter().find(|n| !all.iter().any(|p| &p.name == *n)) {
+            return Err(DiagnoseError::Setup(format!(
+                "`{n}` is to be estimated per source, but it is no free parameter of {}",
+                model.path
+            )));
+        }
+        let (grouped, parameters): (Vec<FreeParameter>, Vec<FreeParameter>) =
+            all.into_iter().partition(|p| settings.per_source.contains(&p.name));
+        let source = |r: usize| settings.sources.get(r).copied().unwrap_or(0);
+        let count = (0..runs.len()).map(|r| source(r) + 1).max().unwrap_or(1);
+        let groups: Vec<(FreeParameter, usize, Vec<usize>)> = grouped
+            .iter()
+            .flat_map(|p| {
+                (0..count).filter_map(move |s| {
+                    let members: Vec<usize> = (0..runs.len()).filter(|&r| source(r) == s).collect();
+                    (!members.is_empty()).then(|| (p.clone(), s, members))
+                })
+            })
+            .collect();
         let mut coefficients = Vec::new();
         if settings.coefficients {
             for e in model.equations().iter().filter(|e| e.identify) {
@@ -119,6 +167,11 @@ impl Unknowns {
             .iter()
             .map(|p| Free::Parameter(p.name.clone()))
             .chain(coefficients.iter().map(|(e, t, _, _)| Free::Term(e.clone(), t.clone())))
+            .chain(
+                groups
+                    .iter()
+                    .map(|(p, _, members)| Free::Group { name: p.name.clone(), runs: members.clone() }),
+            )
             .chain(initial.iter().map(|&(run, state)| Free::Initial { run, state }))
             .collect();
         let hypothesis = Hypothesis {
@@ -141,12 +194,28 @@ impl Unknowns {
             mean.push(0.0);
             bounds.push((f64::NEG_INFINITY, f64::INFINITY));
         }
+        for (p, _, _) in &groups {
+            let (m, prec) = p.prior.map_or((p.value, 0.0), |(m, sd)| (m, 1.0 / (sd * sd)));
+            precision.push(prec);
+            mean.push(m);
+            bounds.push(p.bounds);
+        }
         for _ in &initial {
             precision.push(0.0);
             mean.push(0.0);
             bounds.push((f64::NEG_INFINITY, f64::INFINITY));
         }
-        Unknowns { entries, parameters, coefficients, initial, hypothesis, precision, mean, bounds }
+        Ok(Unknowns {
+            entries,
+            parameters,
+            coefficients,
+            groups,
+            initial,
+            hypothesis,
+            precision,
+            mean,
+            bounds,
+        })
     }
 
     fn start(&self, runs: &Runs) -> Vec<f64> {
@@ -154,16 +223,29 @@ impl Unknowns {
             .iter()
             .map(|p| p.value)
             .chain(self.coefficients.iter().map(|_| 0.0))
+            .chain(self.groups.iter().map(|(p, _, _)| p.value))
             .chain(self.initial.iter().map(|&(r, i)| runs.initial(r, i)))
             .collect()
     }
 
-    /// The runs at θ: from the initial values θ holds.
+    /// Where the per-source unknowns start in θ.
+    fn first_group(&self) -> usize {
+        self.parameters.len() + self.coefficients.len()
+    }
+
+    /// The runs at θ: from the initial values θ holds, with their sources' values.
     fn runs_at(&self, runs: &Runs, theta: &[f64]) -> Runs {
-        let first = self.parameters.len() + self.coefficients.len();
+        let g = self.first_group();
+        let first = g + self.groups.len();
         let values: Vec<(usize, usize, f64)> =
             self.initial.iter().zip(&theta[first..]).map(|(&(r, i), v)| (r, i, *v)).collect();
-        runs.with_initial(&values)
+        let own: Vec<(usize, &str, f64)> = self
+            .groups
+            .iter()
+            .zip(&theta[g..first])
+            .flat_map(|((p, _, members), v)| members.iter().map(move |&r| (r, p.name.as_str(), *v)))
+            .collect();
+        runs.with_initial(&values, &own)
     }
 
     /// The model at θ.
@@ -203,8 +285,8 @@ pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Resu
             settings.prior_weight
         )));
     }
-    let u = Unknowns::of(model, runs, settings);
-    if u.parameters.is_empty() && u.coefficients.is_empty() {
+    let u = Unknowns::of(model, runs, settings)?;
+    if u.parameters.is_empty() && u.coefficients.is_empty() && u.groups.is_empty() {
         return Err(DiagnoseError::Setup(format!(
             "{} declares no free parameter (`free = true` under [parameters.NAME])",
             model.path
@@ -344,6 +426,17 @@ pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Resu
         coefficients,
         covariance: matrix,
         initial_values: u.initial.len(),
+        per_source: u
+            .groups
+            .iter()
+            .enumerate()
+            .map(|(k, (p, source, _))| SourceParameter {
+                name: p.name.clone(),
+                source: *source,
+                value: theta[u.first_group() + k],
+                std_error: std_errors[u.first_group() + k],
+            })
+            .collect(),
     })
 }
 
@@ -387,6 +480,16 @@ impl Estimate {
         }
         if !self.coefficients.is_empty() {
             out.push_str(&format!("and {} term coefficients with them\n", self.coefficients.len()));
+        }
+        for p in &self.per_source {
+            out.push_str(&format!(
+                "{:<12} {:>14} {:>14} {:>12}   (source {})\n",
+                p.name,
+                "",
+                num(p.value),
+                num(p.std_error),
+                p.source + 1
+            ));
         }
         if self.initial_values > 0 {
             out.push_str(&format!(

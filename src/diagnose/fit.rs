@@ -209,11 +209,15 @@ impl Runs {
         self.x0[run][state]
     }
 
-    /// The runs re-simulated from other initial values: (run, state index, value).
-    pub fn with_initial(&self, values: &[(usize, usize, f64)]) -> Runs {
+    /// The runs re-simulated from other initial values, (run, state index, value), and with
+    /// their own values of parameters, (run, parameter, value).
+    pub fn with_initial(&self, values: &[(usize, usize, f64)], parameters: &[(usize, &str, f64)]) -> Runs {
         let mut out = self.clone();
         for &(r, i, v) in values {
             out.x0[r][i] = v;
+        }
+        for &(r, name, v) in parameters {
+            out.params[r].insert(name.to_string(), v);
         }
         out
     }

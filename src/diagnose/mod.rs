@@ -16,7 +16,7 @@ mod sensitivity;
 use serde::Serialize;
 
 pub use choose::{choose_by_prediction, Chosen, Configuration, Prediction};
-pub use estimate::{estimate, Estimate, EstimateSettings, EstimatedParameter};
+pub use estimate::{estimate, Estimate, EstimateSettings, EstimatedParameter, SourceParameter};
 pub use fit::{simulate_runs, EstimateError, Runs};
 pub use refine::{refine, RefineSettings, Refined, RefinedCoefficient};
 

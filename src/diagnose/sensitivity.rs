@@ -30,6 +30,14 @@ pub enum Free {
     Term(String, Term),
     /// A parameter by name (one value for every run).
     Parameter(String),
+    /// A parameter's value in a group of runs alone (a source's nuisance: one basin's rudder
+    /// indicator zero); the runs carry it among their own parameters.
+    Group {
+        /// The parameter.
+        name: String,
+        /// The runs (indices) it holds for.
+        runs: Vec<usize>,
+    },
     /// The initial value of a state (by index in the system) in one run (by index): a
     /// nuisance of output error, since a noisy first sample would otherwise bias the rest.
     Initial {
@@ -156,6 +164,19 @@ fn per_run_jacobians<T: Send>(
                 }
                 parameters.push((j, name.clone(), value));
             }
+            Free::Group { name, runs: group } => {
+                if !model.parameter_values().contains_key(name) {
+                    return Err(DiagnoseError::Setup(format!(
+                        "`{name}` is not a parameter of {}",
+                        model.path
+                    )));
+                }
+                if let Some(r) =
+                    group.iter().find(|r| !runs.params.get(**r).is_some_and(|p| p.contains_key(name)))
+                {
+                    return Err(DiagnoseError::Setup(format!("run {r} carries no value of `{name}`")));
+                }
+            }
             Free::Initial { state, .. } if *state >= system.dim() => {
                 return Err(DiagnoseError::Setup(format!("no state {state} in {}", model.path)));
             }
@@ -171,13 +192,22 @@ fn per_run_jacobians<T: Send>(
             let system = system.with_parameters(&runs.params[r])?;
             let phi = phi.with_parameters(&runs.params[r])?;
             // the right-hand side at p + h for each free parameter p
+            // this run's own values of the parameters its groups hold
+            let grouped = entries.iter().enumerate().filter_map(|(j, e)| match e {
+                Free::Group { name, runs: group } if group.contains(&r) => {
+                    Some((j, name.clone(), runs.params[r][name]))
+                }
+                _ => None,
+            });
             let perturbed = parameters
                 .iter()
+                .cloned()
+                .chain(grouped)
                 .map(|(j, name, value)| {
-                    let h = parameter_step(*value);
+                    let h = parameter_step(value);
                     let mut at = runs.params[r].clone();
-                    at.insert(name.clone(), value + h);
-                    Ok((*j, system.with_parameters(&at)?, h))
+                    at.insert(name, value + h);
+                    Ok((j, system.with_parameters(&at)?, h))
                 })
                 .collect::<Result<Vec<_>, SimError>>()?;
             let initial: Vec<(usize, usize)> = entries

@@ -494,3 +494,67 @@ fn the_new_ship_command_writes_a_model_estimate_reads() {
     ]);
     assert!(!ok && std::fs::read_to_string(&bad).unwrap().contains("= 81"), "{err}");
 }
+
+/// Two basins, one hull: each basin's rudder indicator reads off by its own zero (+0.3° and
+/// −0.5°), a nuisance estimated per source beside the hull's derivatives (started 30 % off);
+/// both come back, and the hull's derivatives as from one basin without offsets.
+#[test]
+fn two_basins_with_their_own_rudder_zero() {
+    use std::path::Path;
+    use termid::ship::basin::Basin;
+
+    let truth = termid::plugins::load(Path::new("models/mmg_kvlcc2.toml")).unwrap();
+    // the rudder the hull feels is the indicator's reading less the basin's zero δ_0
+    let text = std::fs::read_to_string("models/mmg_kvlcc2.toml").unwrap();
+    let text = text
+        .replacen("[[derived]]", "[[derived]]\nname = \"δ_t\"\ndefinition = \"δ - δ_0\"\n\n[[derived]]", 1)
+        .replace("definition = \"δ - atan2(v_R, u_R)\"", "definition = \"δ_t - atan2(v_R, u_R)\"")
+        .replace("sin(δ)", "sin(δ_t)")
+        .replace("cos(δ)", "cos(δ_t)")
+        .replace("# ---- hull (eq. 10), nondimensional ----", "[parameters.\"δ_0\"]\nvalue = 0.0\nunit = \"rad\"\nfree = true\nprior = { value = 0.0, sd = 0.02 }\n\n# ---- hull (eq. 10), nondimensional ----");
+    assert_eq!(text.matches("δ_t").count(), 5, "the rudder angle appears in α_R, X, Y and N");
+    let zeroed = termid::plugins::parse(&text, "kvlcc2_zero.toml").unwrap();
+    let free = ["Y_v", "Y_r", "N_v", "N_r"];
+    let start = zeroed
+        .edit(|file| {
+            for (k, name) in free.iter().enumerate() {
+                let p = file.parameters.get_mut(*name).unwrap();
+                p.value *= if k % 2 == 0 { 1.3 } else { 0.7 };
+                p.free = true;
+            }
+        })
+        .unwrap();
+    let offsets = [0.3f64.to_radians(), -0.5f64.to_radians()];
+    let mut frames = Vec::new();
+    let mut sources = Vec::new();
+    for (s, (offset, seed)) in offsets.iter().zip([41, 51]).enumerate() {
+        let zigzags = [("zigzag:20/20", 1.0), ("zigzag:20/20:port", 0.98)];
+        for (_, rec) in Basin::default().record_all(&truth, &zigzags, 1.17248, 60.0, seed, None).unwrap() {
+            let mut f = rec.measured;
+            let read: Vec<f64> = f.column("δ").unwrap().iter().map(|d| d + offset).collect();
+            f.set("δ", read).unwrap();
+            frames.push(f);
+            sources.push(s);
+        }
+    }
+    let sample = frames[0].time()[1] - frames[0].time()[0];
+    let runs = Runs::new(&start, &frames, sample, Integrator::Rk4).unwrap();
+    let settings = EstimateSettings { sources, per_source: vec!["δ_0".into()], ..Default::default() };
+    let fit = estimate(&start, &runs, &settings).unwrap();
+    for (s, offset) in offsets.iter().enumerate() {
+        let p = fit.per_source.iter().find(|p| p.source == s).unwrap();
+        assert!(
+            (p.value - offset).abs() < 0.1f64.to_radians(),
+            "source {s}: {} vs {offset}\n{}",
+            p.value,
+            fit.text()
+        );
+    }
+    let values = truth.parameter_values();
+    for name in free {
+        let p = fit.parameters.iter().find(|p| p.name == name).unwrap();
+        assert!((p.value / values[name] - 1.0).abs() < 0.05, "{name}: {}\n{}", p.value, fit.text());
+    }
+    // the model keeps the file's δ_0: each source's own is reported, not written
+    assert_eq!(fit.model.parameter_values()["δ_0"], 0.0);
+}

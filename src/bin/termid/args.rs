@@ -61,15 +61,24 @@ pub struct NewShipCommand {
 /// `termid estimate`.
 #[derive(Debug, Args)]
 #[command(
-    after_help = "A parameter is free when its table says so, with an optional prior and bounds:\n  [parameters.K]\n  value = 0.2          # where the estimate starts\n  free = true\n  prior = { value = 0.2, sd = 0.05 }\n  bounds = [0.0, 5.0]\n\nExample:\n  termid estimate --model nomoto.toml --data zigzag.csv --out nomoto_estimated.toml"
+    after_help = "A parameter is free when its table says so, with an optional prior and bounds:\n  [parameters.K]\n  value = 0.2          # where the estimate starts\n  free = true\n  prior = { value = 0.2, sd = 0.05 }\n  bounds = [0.0, 5.0]\n\nExample:\n  termid estimate --model nomoto.toml --data zigzag.csv --out nomoto_estimated.toml\n\nSeveral basins, each with its own rudder indicator zero `δ_0` (a free parameter of the model):\n  termid estimate --model ship.toml --dataset hsva.toml --dataset marin.toml --per-source δ_0 --out ship_est.toml"
 )]
 pub struct EstimateCommand {
     /// The model file with free parameters.
     #[arg(long)]
     pub model: PathBuf,
-    /// Measured runs.
-    #[command(flatten)]
-    pub runs: RunsArgs,
+    /// Runs (CSV with the time, the inputs and measured states in the model's names, SI):
+    /// one source.
+    #[arg(long = "data", short = 'd', num_args = 1.., required_unless_present = "dataset")]
+    pub data: Vec<PathBuf>,
+    /// A dataset file (TOML): runs with their own column names and units. Repeatable: each
+    /// is a source (a basin, a campaign) with its own columns, units and scale.
+    #[arg(long, action = clap::ArgAction::Append)]
+    pub dataset: Vec<PathBuf>,
+    /// Free parameters estimated once per source (nuisances, e.g. each basin's rudder
+    /// indicator zero); the others once for all.
+    #[arg(long, num_args = 1.., value_delimiter = ',')]
+    pub per_source: Vec<String>,
     /// Write the model with the estimates, their standard errors and covariance.
     #[arg(long)]
     pub out: Option<PathBuf>,

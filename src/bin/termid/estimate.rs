@@ -11,7 +11,10 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
     // an output that cannot be written is refused before any work
     if let Some(out) = &cmd.out {
         termid::output::check_file(out)?;
-        let mut inputs = crate::runs::input_files(&cmd.runs.data, cmd.runs.dataset.as_deref());
+        let mut inputs = crate::runs::input_files(&cmd.data, None);
+        for d in &cmd.dataset {
+            inputs.extend(crate::runs::input_files(&[], Some(d)));
+        }
         inputs.push(("--model".to_string(), cmd.model.clone()));
         crate::runs::check_outputs(&[("--out", out)], &inputs)?;
     }
@@ -23,7 +26,22 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
             model.path
         );
     }
-    let frames = crate::runs::load_for(&model, &cmd.runs.data, cmd.runs.dataset.as_deref())?;
+    // each dataset file a source, the --data files another
+    let mut frames = Vec::new();
+    let mut sources = Vec::new();
+    let mut labels = Vec::new();
+    if !cmd.data.is_empty() {
+        let more = crate::runs::load_for(&model, &cmd.data, None)?;
+        sources.extend(std::iter::repeat_n(labels.len(), more.len()));
+        labels.push("--data".to_string());
+        frames.extend(more);
+    }
+    for d in &cmd.dataset {
+        let more = crate::runs::load_for(&model, &[], Some(d))?;
+        sources.extend(std::iter::repeat_n(labels.len(), more.len()));
+        labels.push(d.display().to_string());
+        frames.extend(more);
+    }
     // one RK4 step per sample by default: the recorded input is known only at the samples
     let dt = cmd.dt.unwrap_or_else(|| {
         frames.iter().map(|f| termid::data::median_step(f.time())).fold(f64::INFINITY, f64::min)
@@ -32,8 +50,13 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
     if let Some(states) = &cmd.states {
         runs = runs.comparing(states)?;
     }
-    let settings =
-        EstimateSettings { coefficients: cmd.coefficients, iterations: cmd.iterations, ..Default::default() };
+    let settings = EstimateSettings {
+        coefficients: cmd.coefficients,
+        iterations: cmd.iterations,
+        sources,
+        per_source: cmd.per_source.clone(),
+        ..Default::default()
+    };
     let fit = estimate(&model, &runs, &settings).context("estimating the free parameters")?;
     if let Some(out) = &cmd.out {
         let mut outputs = termid::output::Outputs::new();
@@ -44,6 +67,11 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
         Format::Json => println!("{}", serde_json::to_string_pretty(&fit)?),
         Format::Text => {
             print!("{}", fit.text());
+            if !fit.per_source.is_empty() {
+                for (k, label) in labels.iter().enumerate() {
+                    println!("source {}: {label}", k + 1);
+                }
+            }
             if let Some(out) = &cmd.out {
                 println!("written: {}", out.display());
             }
