@@ -18,6 +18,7 @@ pub mod output;
 pub mod plot;
 pub mod plugin;
 pub mod plugins;
+pub mod recipe;
 pub mod select;
 pub mod ship;
 pub mod sim;

@@ -670,6 +670,74 @@ impl PyModel {
         Ok((to_json(&json)?, d.model.map(|inner| PyModel { inner })))
     }
 
+    /// The library's recipe (several derivative starts, choice among back-ends by
+    /// prediction, output-error refinement, checks, the starts' agreement): (JSON of every
+    /// start and the kept one's report, the report as text, the kept model).
+    #[pyo3(signature = (runs, derivatives, smooth = false, intercept = None, choose = vec![], compare = vec![], refine = None, refine_iterations = 100, refine_prior = 1e-4, held_out = vec![]))]
+    #[allow(clippy::too_many_arguments)]
+    fn recipe(
+        &self,
+        py: Python<'_>,
+        runs: Vec<Run<'_>>,
+        derivatives: Vec<String>,
+        smooth: bool,
+        intercept: Option<bool>,
+        choose: Vec<String>,
+        compare: Vec<String>,
+        refine: Option<Vec<String>>,
+        refine_iterations: usize,
+        refine_prior: f64,
+        held_out: Vec<Run<'_>>,
+    ) -> PyResult<(String, String, PyModel)> {
+        let frames = self.frames(runs)?;
+        let held = if held_out.is_empty() { None } else { Some(self.frames(held_out)?) };
+        let choose = choose
+            .iter()
+            .map(|name| {
+                let backend = Backend::by_name(name).map_err(fail)?;
+                Ok((name.clone(), self.inner.with_backend(&backend).map_err(fail)?))
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        let settings = termid::recipe::RecipeSettings {
+            derivatives,
+            smooth,
+            intercept: intercept.unwrap_or(self.inner.spec().model.intercept),
+            choose,
+            compare,
+            refine: refine.map(|states| termid::recipe::RefineOptions {
+                states: (!states.is_empty()).then_some(states),
+                prior: refine_prior,
+                iterations: refine_iterations,
+            }),
+            ..Default::default()
+        };
+        let recipe = py
+            .detach(|| termid::recipe::identify(&self.inner, &frames, held.as_deref(), &settings))
+            .map_err(fail)?;
+        let starts: Vec<serde_json::Value> = recipe
+            .starts
+            .iter()
+            .enumerate()
+            .map(|(k, s)| {
+                serde_json::json!({"derivative": s.derivative, "refused": s.refused(), "cost": s.cost(),
+                                   "kept": k == recipe.kept, "refine_error": s.refine_error})
+            })
+            .collect();
+        let json = serde_json::json!({
+            "starts": starts,
+            "failed": recipe.failed,
+            "checks": recipe.checks(),
+            "refusals": recipe.refusals(),
+            "report": recipe.json().map_err(fail)?,
+        });
+        let text = format!(
+            "{}{}",
+            if recipe.starts.len() > 1 { recipe.starts_text() } else { String::new() },
+            recipe.text()
+        );
+        Ok((to_json(&json)?, text, PyModel { inner: recipe.kept().model.clone() }))
+    }
+
     /// The model file's free parameters estimated from runs by output error (JSON report),
     /// with the model holding the estimates.
     #[pyo3(signature = (runs, coefficients = false, states = None, initial_states = true, dt = None, iterations = 50, sources = vec![], per_source = vec![]))]

@@ -47,6 +47,7 @@ __all__ = [
     "Moments",
     "Fit",
     "Identified",
+    "Recipe",
     "TermidError",
     "fit",
     "backends",
@@ -673,6 +674,35 @@ class Identified:
         return f"termid.Identified({self.model.name!r}: {told})"
 
 
+class Recipe:
+    """What :meth:`Model.recipe` returns: the kept ``model``, a DataFrame of the ``starts``
+    (derivative, refused checks, re-simulation cost, which is kept), the kept model's
+    ``checks`` (with the starts' agreement: a failing one flags a prediction the runs
+    cannot pin down), ``refusals`` (why it must not be written, if any), the ``report`` as
+    plain values and as ``text``.
+
+    >>> ship = termid.Model.default()
+    >>> runs = [ship.simulate(m) for m in ("zigzag:20/20", "zigzag:10/10")]
+    >>> found = ship.recipe(runs, ["central"], smooth=False, intercept=True, refine=None)
+    >>> found.refusals, bool(found.checks["passed"].all())
+    ([], True)
+    """
+
+    def __init__(self, model: "Model", report: Mapping[str, Any], text: str):
+        self.model = model
+        self.starts = pd.DataFrame(report["starts"])
+        self.checks = pd.DataFrame(report["checks"])
+        self.refusals: List[str] = list(report["refusals"])
+        self.failed = list(report["failed"])
+        self.report = report["report"]
+        self.text = text
+
+    def __repr__(self) -> str:
+        kept = self.starts.loc[self.starts["kept"], "derivative"].tolist()
+        flags = int((~self.checks["passed"]).sum()) if len(self.checks) else 0
+        return f"termid.Recipe(kept {kept[0] if kept else None!r} of {len(self.starts)} starts, {flags} checks not passed)"
+
+
 class Model:
     """A termid model file: states, inputs, parameters, derived variables and equations.
 
@@ -1142,6 +1172,53 @@ class Model:
             ),
         }
         return before, model
+
+    def recipe(
+        self,
+        runs: Union[Data, Sequence[Data]],
+        derivatives: Sequence[str] = ("kinematic", "kalman", "savitzky-golay", "central"),
+        *,
+        smooth: bool = True,
+        intercept: Optional[bool] = False,
+        choose: Sequence[str] = (),
+        compare: Sequence[str] = (),
+        refine: Optional[Sequence[str]] = ("u", "v", "r", "ψ"),
+        refine_iterations: int = 100,
+        refine_prior: float = 1e-4,
+        held_out: Union[Data, Sequence[Data], None] = None,
+    ) -> "Recipe":
+        """The command line's recipe for a model from runs (``termid identify --model`` with
+        several ``--derivative`` starts) from ``runs``: each start prepares them by one derivative method
+        in ``derivatives`` (``smooth``: states smoothed by it), identified (or chosen among the
+        back-ends ``choose`` by leave-one-run-out prediction of the states ``compare``),
+        refined by output error on the states ``refine`` (None: no refinement; an empty list:
+        every state) with ``refine_iterations`` and the regression as a prior of weight
+        ``refine_prior``, stopped by ``held_out`` runs where given, checked by the model's
+        plug-in; the start kept that passes the checks and re-simulates best, and a flag where
+        the plausible starts disagree on a turning circle. ``intercept`` as for
+        :meth:`identify` (None: the model file's). Defaults are the new-ship recipe's.
+
+        >>> ship = termid.Model.default()
+        >>> ship.set_parameter("u0", "mean:u:4")
+        >>> runs = [ship.record(m, seed=k) for k, m in enumerate(["zigzag:20/20", "zigzag:10/10:port", "zigzag:30/10"])]
+        >>> found = ship.recipe(runs, ["kinematic", "central"], refine=("u", "v", "r", "ψ"), refine_iterations=10)
+        >>> list(found.starts["derivative"]), int(found.starts["kept"].sum())
+        (['kinematic', 'central'], 1)
+        """
+        held = _runs(held_out) if held_out is not None else []
+        text_json, text, native = self._native.recipe(
+            _runs(runs),
+            list(derivatives),
+            smooth,
+            intercept,
+            list(choose),
+            list(compare),
+            None if refine is None else list(refine),
+            refine_iterations,
+            refine_prior,
+            held,
+        )
+        return Recipe(Model(native), json.loads(text_json), text)
 
     def estimate(
         self,

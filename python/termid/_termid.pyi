@@ -93,6 +93,19 @@ class Model:
     def diagnose(
         self, runs: Sequence[Run], dt: Optional[float] = None, integrator: Optional[str] = None, with_intercept: bool = False
     ) -> Tuple[str, Optional[Model]]: ...
+    def recipe(
+        self,
+        runs: Sequence[Run],
+        derivatives: Sequence[str],
+        smooth: bool = False,
+        intercept: Optional[bool] = None,
+        choose: Sequence[str] = ...,
+        compare: Sequence[str] = ...,
+        refine: Optional[Sequence[str]] = None,
+        refine_iterations: int = 100,
+        refine_prior: float = 1e-4,
+        held_out: Sequence[Run] = ...,
+    ) -> Tuple[str, str, Model]: ...
     def estimate(
         self,
         runs: Sequence[Run],

@@ -5,7 +5,8 @@
 use std::path::Path;
 
 /// Bottom to top. The simulator sits below the model files (it integrates any
-/// `sim::RightHandSide`), the regression back-ends below both; the ship plug-in and the registry of plug-ins are on top.
+/// `sim::RightHandSide`), the regression back-ends below both; the ship plug-in and the registry of plug-ins are
+/// near the top, and the recipe (which checks its starts by whatever plug-in a model has) on top.
 const LAYERS: &[&str] = &[
     "contain",
     "budget",
@@ -22,6 +23,7 @@ const LAYERS: &[&str] = &[
     "plugin",
     "ship",
     "plugins",
+    "recipe",
 ];
 
 /// Every `.rs` file under `dir`.

@@ -5,6 +5,7 @@ mod compare;
 mod diagnose;
 mod estimate;
 mod identify;
+mod identify_model;
 mod moments;
 mod monte_carlo;
 mod new_ship;

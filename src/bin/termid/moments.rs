@@ -1,11 +1,12 @@
 //! `termid moments`: an equation's sufficient statistics over a shard of runs, written for
 //! `identify --moments` to merge (the one pass over the rows done where the rows are).
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use termid::data::{differentiator, Chunks};
 use termid::identify::EquationMoments;
 
 use crate::args::MomentsCommand;
+use crate::args::{Format, IdentifyCommand};
 
 pub fn run(cmd: MomentsCommand) -> Result<()> {
     termid::output::check_file(&cmd.out)?;
@@ -81,4 +82,47 @@ pub fn identify(
         parts.into_iter().filter(|(_, m)| equations.is_empty() || equations.contains(&m.equation)).collect();
     let identified = termid::identify::identify_from_moments(model, parts, intercept)?;
     Ok((identified.model, identified.fits))
+}
+
+/// `identify --model M --moments FILES`: equations identified from merged statistics, as
+/// from the runs they were computed on (no residual pass: no correlation time, no checks).
+pub fn identify_from_files(cmd: IdentifyCommand) -> Result<()> {
+    let path = cmd.model.clone().context("--model")?;
+    if let Some(out) = &cmd.out {
+        termid::output::check_file(out)?;
+    }
+    let mut model = termid::plugins::load(&path)?;
+    if cmd.backend.is_some() {
+        model = model.with_backend(&crate::identify::configure_backend(&cmd)?)?;
+    }
+    let intercept = crate::identify::intercept_of(&cmd, model.spec().model.intercept);
+    let (mut model, fits) = crate::moments::identify(&model, &cmd.moments, &cmd.equation, intercept)?;
+    if let Some(out) = &cmd.out {
+        let sources = cmd.moments.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
+        model.set_provenance(format!(
+            "identified by termid from the statistics {sources} ({})",
+            model.spec().model.provenance
+        ));
+        termid::output::write_file(out, model.to_toml().as_bytes())?;
+    }
+    match cmd.format {
+        Format::Json => {
+            let all: serde_json::Map<String, serde_json::Value> = fits
+                .iter()
+                .map(|(n, f)| Ok((n.clone(), serde_json::to_value(f.report())?)))
+                .collect::<Result<_>>()?;
+            println!("{}", serde_json::to_string_pretty(&all)?);
+        }
+        Format::Text => {
+            for (name, fit) in &fits {
+                println!("== {name} ==");
+                print!("{}", fit.text());
+                println!();
+            }
+            if let Some(out) = &cmd.out {
+                println!("wrote {}", out.display());
+            }
+        }
+    }
+    Ok(())
 }

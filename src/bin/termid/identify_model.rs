@@ -1,0 +1,298 @@
+//! `termid identify --model`: every identifiable equation of a model file from its runs by
+//! the library's recipe (`termid::recipe`: starts, choice by prediction, refinement, checks,
+//! the starts' agreement); this file reads the command line, prints and writes.
+
+use anyhow::{bail, Context, Result};
+use termid::data::differentiator;
+use termid::identify::Target;
+use termid::recipe::{RecipeSettings, RefineOptions, Start};
+use termid::select::Backend;
+
+use crate::args::{Format, IdentifyCommand};
+use crate::identify::{configure_backend, intercept_of};
+
+/// `identify --model`: every identifiable equation (or the chosen ones) from the runs, each
+/// with the model's candidates, forced terms and back-end; optionally written back. Several
+/// `--derivative` methods (with `--refine`) are several starts: each prepares the runs its
+/// way, is identified and refined, and the one whose refined model re-simulates the runs best
+/// (the validation runs where given) is kept — output error finds different local minima from
+/// different starts.
+pub fn run(cmd: IdentifyCommand) -> Result<()> {
+    let path = cmd.model.clone().context("--model")?;
+    // outputs that cannot be written are refused before any work
+    if let Some(out) = &cmd.out {
+        termid::output::check_file(out)?;
+    }
+    let mut model = termid::plugins::load(&path)?;
+    if cmd.backend.is_some() {
+        // the command line's back-end (with its stepwise options) replaces the file's
+        model = model.with_backend(&configure_backend(&cmd)?)?;
+    }
+    let refine = cmd.refine.as_deref().map(|list| refine_states(list, &model)).transpose()?;
+    let methods: Vec<String> =
+        cmd.derivative.split(',').map(str::trim).filter(|m| !m.is_empty()).map(String::from).collect();
+    if methods.len() > 1 && refine.is_none() {
+        bail!(
+            "--derivative {}: several derivative methods are several starts of the output-error refinement, judged by its cost: give --refine too",
+            cmd.derivative
+        );
+    }
+    let recipe = match in_pieces(&cmd, refine.is_some())? {
+        Some(rows) => termid::recipe::Recipe::of(
+            vec![identify_in_pieces(&cmd, &model, rows)?],
+            vec![],
+            false,
+            STARTS_AGREE,
+        )?,
+        None => {
+            let frames = crate::runs::load_for(&model, &cmd.data, cmd.dataset.as_deref())?;
+            let held = cmd
+                .refine_validation
+                .as_ref()
+                .map(|p| crate::runs::load_for(&model, &[], Some(p)))
+                .transpose()?;
+            let settings = RecipeSettings {
+                equations: cmd.equation.clone(),
+                derivatives: methods,
+                resample: cmd.resample,
+                smooth: cmd.smooth,
+                figures: cmd.prepared_svg.is_some(),
+                intercept: intercept_of(&cmd, model.spec().model.intercept),
+                target: cmd.target.as_deref().map(Target::parse),
+                choose: match &cmd.choose {
+                    Some(list) => backend_variants(&model, list)?,
+                    None => vec![],
+                },
+                compare: match cmd.compare.as_deref().map(|l| refine_states(l, &model)).transpose()? {
+                    Some(Some(states)) => states,
+                    _ => vec![],
+                },
+                refine: refine.map(|states| RefineOptions {
+                    states,
+                    prior: cmd.refine_prior,
+                    iterations: cmd.refine_iterations,
+                }),
+                agree: STARTS_AGREE,
+            };
+            let label = format!(
+                "identifying ({} start{})",
+                settings.derivatives.len(),
+                if settings.derivatives.len() == 1 { "" } else { "s" }
+            );
+            let recipe = crate::progress::with_spinner(&label, || {
+                termid::recipe::identify(&model, &frames, held.as_deref(), &settings)
+            })?;
+            if let Some(dir) = &cmd.prepared_svg {
+                // the states of the identified equations, as each start prepared them
+                let names = if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };
+                let signals: Vec<String> =
+                    names.iter().filter_map(|n| model.equation(n).map(|e| e.state.clone())).collect();
+                crate::identify::prepared_figures(
+                    dir,
+                    &frames,
+                    &recipe.kept().prepared,
+                    &signals,
+                    Some(&model),
+                )?;
+            }
+            recipe
+        }
+    };
+    for (method, e) in &recipe.failed {
+        eprintln!("warning: the start from --derivative {method} fails: {e}");
+    }
+    if recipe.starts.len() > 1 && matches!(cmd.format, Format::Text) {
+        print!("{}", recipe.starts_text());
+    }
+    for c in recipe.agreement.iter().filter(|c| !c.passed) {
+        eprintln!("warning: {}", c.line());
+    }
+    let kept = recipe.kept();
+    if let Some((_, lost)) = &kept.rejected {
+        eprintln!(
+            "warning: the refinement is rejected: the refined model fails physical checks the regression's passes ({}); the regression's model is kept",
+            lost.join("; ")
+        );
+    }
+    // checked before anything is written
+    let refused = recipe.refusals();
+    let write = refused.is_empty() || cmd.keep_unphysical;
+    if let Some(out) = cmd.out.as_ref().filter(|_| write) {
+        let mut model = kept.model.clone();
+        let provenance = format!(
+            "identified by termid from {} ({})",
+            cmd.data.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "),
+            model.spec().model.provenance
+        );
+        model.set_provenance(provenance);
+        termid::output::write_file(out, model.to_toml().as_bytes())?;
+    }
+    // a refinement that failed loses nothing: the regression's model is written first
+    if let Some(e) = &kept.refine_error {
+        let kept = cmd
+            .out
+            .as_ref()
+            .map_or(String::new(), |o| format!("; {} holds the regression's model", o.display()));
+        return Err(anyhow::anyhow!("{e}").context(format!("output-error refinement failed{kept}")));
+    }
+    match cmd.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&recipe.json()?)?),
+        Format::Text => {
+            print!("{}", recipe.text());
+            if let Some(out) = cmd.out.as_ref().filter(|_| write) {
+                println!("wrote {}", out.display());
+            }
+        }
+    }
+    if !refused.is_empty() {
+        let what = if cmd.keep_unphysical {
+            "written anyway (--keep-unphysical)".to_string()
+        } else {
+            match &cmd.out {
+                Some(out) => format!("not written to {} (--keep-unphysical writes it)", out.display()),
+                None => "refused".to_string(),
+            }
+        };
+        if !cmd.keep_unphysical {
+            bail!("the identified model fails its checks, {what}:\n  {}", refused.join("\n  "));
+        }
+        eprintln!("warning: the identified model fails its checks, {what}:\n  {}", refused.join("\n  "));
+    }
+    Ok(())
+}
+
+/// How far (relative) the plausible starts may disagree on a measure of a manoeuvre the runs
+/// did not cover before the prediction is flagged as uncertain.
+const STARTS_AGREE: f64 = 0.10;
+
+/// Files together larger than this are read in pieces by `identify --model` where they can be.
+const WHOLE_LIMIT: u64 = 256 << 20;
+
+/// Rows a piece when `--chunk-rows` is not given.
+const PIECE_ROWS: usize = 262_144;
+
+/// Whether `identify --model` reads its runs in pieces, and in how many rows: asked for with
+/// `--chunk-rows`, or files beyond [`WHOLE_LIMIT`] where nothing needs whole runs.
+fn in_pieces(cmd: &IdentifyCommand, refine: bool) -> Result<Option<usize>> {
+    let local = differentiator(&cmd.derivative).ok().and_then(|d| d.reach()).is_some();
+    let whole_runs_needed = [
+        (cmd.dataset.is_some(), "--dataset"),
+        (cmd.resample.is_some(), "--resample"),
+        (cmd.smooth, "--smooth"),
+        (cmd.prepared_svg.is_some(), "--prepared-svg"),
+        (refine, "--refine"),
+        (cmd.choose.is_some(), "--choose"),
+        (cmd.target.is_some(), "--target"),
+        (!local, "a --derivative that needs whole runs"),
+    ];
+    let needs: Vec<&str> = whole_runs_needed.iter().filter(|(yes, _)| *yes).map(|(_, what)| *what).collect();
+    match cmd.chunk_rows {
+        Some(0) => Ok(None),
+        Some(_) if !needs.is_empty() => bail!(
+            "--chunk-rows reads runs in pieces, which {} cannot work on: leave it out",
+            needs.join(", ")
+        ),
+        Some(rows) => Ok(Some(rows)),
+        None => {
+            let size: u64 = cmd.data.iter().filter_map(|p| std::fs::metadata(p).ok()).map(|m| m.len()).sum();
+            if size > WHOLE_LIMIT && needs.is_empty() {
+                eprintln!(
+                    "note: the runs are {} MiB together: read in pieces of {PIECE_ROWS} rows (bounded memory; --chunk-rows 0 reads them whole)",
+                    size >> 20
+                );
+                Ok(Some(PIECE_ROWS))
+            } else {
+                Ok(None)
+            }
+        }
+    }
+}
+
+/// `identify --model` on runs read in pieces: each equation's statistics in one pass over
+/// the files (as `termid moments` writes them), identified as `identify --moments` would, and
+/// checked (the physical checks at the model's rudder limit: the runs are not kept).
+fn identify_in_pieces(cmd: &IdentifyCommand, model: &termid::model::Model, rows: usize) -> Result<Start> {
+    let diff = differentiator(&cmd.derivative)?;
+    let reach = diff.reach().context("a derivative of fixed reach")?;
+    let names: Vec<String> =
+        if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };
+    let runs = cmd
+        .data
+        .iter()
+        .map(|p| termid::data::Chunks::open(p, &model.spec().model.time, rows.max(1), 2 * reach + 2))
+        .collect::<Result<Vec<_>, _>>()?;
+    let label = format!("statistics of {} in pieces of {rows} rows ({})", names.join(", "), cmd.derivative);
+    let (all, notes) = crate::progress::with_spinner(&label, || {
+        termid::identify::EquationMoments::of_chunks_each(model, &names, runs, diff.as_ref())
+    })?;
+    for n in notes {
+        eprintln!("unit: {n}");
+    }
+    let origin = cmd.data.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
+    let parts = all.into_iter().map(|m| (origin.clone(), m)).collect();
+    let identified = termid::identify::identify_from_moments(
+        model,
+        parts,
+        crate::identify::intercept_of(cmd, model.spec().model.intercept),
+    )?;
+    let checks =
+        termid::plugins::of(&identified.model).map(|p| p.checks(&identified.model, &[])).unwrap_or_default();
+    Ok(Start {
+        derivative: cmd.derivative.clone(),
+        model: identified.model,
+        fits: identified.fits,
+        chosen_text: None,
+        refined: None,
+        rejected: None,
+        refine_error: None,
+        checks,
+        prepared: vec![],
+    })
+}
+
+/// `--choose`: the configurations to choose from — a back-end's name (the model with that
+/// back-end in every identified equation) or a model file (another candidate library, step
+/// rule or set of forced terms for the same equations).
+fn backend_variants(model: &termid::model::Model, list: &str) -> Result<Vec<(String, termid::model::Model)>> {
+    let names: Vec<&str> = if list.trim() == "all" {
+        Backend::NAMES.to_vec()
+    } else {
+        list.split(',').map(str::trim).filter(|n| !n.is_empty()).collect()
+    };
+    if names.is_empty() {
+        bail!("--choose `{list}` names no back-end or model file (back-ends: {})", Backend::NAMES.join(", "));
+    }
+    names
+        .into_iter()
+        .map(|name| {
+            if name.ends_with(".toml") {
+                let variant = termid::plugins::load(std::path::Path::new(name))?;
+                for e in model.identifiable() {
+                    if variant.equation(&e).is_none() {
+                        bail!("--choose: {name} has no equation `{e}` of {}", model.path);
+                    }
+                }
+                return Ok((name.to_string(), variant));
+            }
+            let backend = Backend::by_name(name).map_err(|e| anyhow::anyhow!("--choose: {e}"))?;
+            Ok((name.to_string(), model.with_backend(&backend)?))
+        })
+        .collect()
+}
+
+/// The states `--refine` names (`None`: all), each checked to be one of the model's.
+fn refine_states(list: &str, model: &termid::model::Model) -> Result<Option<Vec<String>>> {
+    if list.trim() == "all" {
+        return Ok(None);
+    }
+    let known: Vec<&str> = model.spec().states.iter().map(|s| s.name.as_str()).collect();
+    let names: Vec<String> =
+        list.split(',').map(str::trim).filter(|n| !n.is_empty()).map(String::from).collect();
+    if names.is_empty() {
+        bail!("--refine `{list}` names no state: list the states to compare, e.g. --refine u,v,r, or `all`");
+    }
+    if let Some(name) = names.iter().find(|n| !known.contains(&n.as_str())) {
+        bail!("--refine {list}: `{name}` is not a state of the model ({})", known.join(", "));
+    }
+    Ok(Some(names))
+}

@@ -1,0 +1,210 @@
+//! The recipe for a model identified from runs, as one call: several starts (one per
+//! derivative preparation), each identified or chosen among configurations by what it
+//! predicts, refined by output error and checked by its plug-in; the start kept that passes
+//! the checks and re-simulates best; and, where the plausible starts disagree on a manoeuvre
+//! the runs did not cover, a flag saying that prediction is uncertain.
+
+mod report;
+mod start;
+
+pub use report::Primes;
+pub use start::{derivative_method, prepare_runs, Start};
+
+use crate::data::Frame;
+use crate::identify::{num, Target};
+use crate::model::Model;
+use crate::plugin::Check;
+
+/// How the recipe identifies: plain data, as a command line or a Python call fills it in.
+#[derive(Clone, Debug)]
+pub struct RecipeSettings {
+    /// The equations (empty: every identifiable one).
+    pub equations: Vec<String>,
+    /// One start per derivative method (`kinematic`, `kalman`, `central`, ...).
+    pub derivatives: Vec<String>,
+    /// Resample the runs to this step, s, before anything else.
+    pub resample: Option<f64>,
+    /// Smooth the states with the derivative method.
+    pub smooth: bool,
+    /// The prepared runs are wanted (for figures): prepared even where nothing else asks.
+    pub figures: bool,
+    /// Fit an intercept b0.
+    pub intercept: bool,
+    /// What to explain instead of the state's derivative (one equation only).
+    pub target: Option<Target>,
+    /// Configurations to choose among by leave-one-run-out prediction (empty: the model's
+    /// own back-ends), each (label, model).
+    pub choose: Vec<(String, Model)>,
+    /// The states the choice compares (empty: every state of an identified equation).
+    pub compare: Vec<String>,
+    /// The output-error refinement of every start (none: no refinement).
+    pub refine: Option<RefineOptions>,
+    /// How far (relative) plausible starts may disagree on a measure of a manoeuvre the runs
+    /// did not cover before the prediction is flagged.
+    pub agree: f64,
+}
+
+impl Default for RecipeSettings {
+    fn default() -> Self {
+        RecipeSettings {
+            equations: vec![],
+            derivatives: vec!["central".into()],
+            resample: None,
+            smooth: false,
+            figures: false,
+            intercept: true,
+            target: None,
+            choose: vec![],
+            compare: vec![],
+            refine: None,
+            agree: 0.10,
+        }
+    }
+}
+
+/// The output-error refinement of a start.
+#[derive(Clone, Debug)]
+pub struct RefineOptions {
+    /// The compared states (`None`: all).
+    pub states: Option<Vec<String>>,
+    /// Weight of the regression's estimates as a prior.
+    pub prior: f64,
+    /// Most iterations.
+    pub iterations: usize,
+}
+
+/// Why the recipe could not run.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RecipeError {
+    /// Settings that cannot work together, or data that cannot be prepared.
+    #[error("{0}")]
+    Setup(String),
+    /// Every start failed; the first failure.
+    #[error("no start could be identified: {0}")]
+    NoStart(String),
+}
+
+/// The recipe's outcome: every start and which is kept.
+#[derive(Debug)]
+pub struct Recipe {
+    /// Every start that could be identified, in the order of the derivative methods.
+    pub starts: Vec<Start>,
+    /// The kept start's index: the fewest refusing checks, then the lowest re-simulation cost
+    /// (the validation runs' where there are any).
+    pub kept: usize,
+    /// Whether the plausible starts agree on each measure of the kept start's checks (a
+    /// failing one flags a prediction the runs cannot pin down).
+    pub agreement: Vec<Check>,
+    /// Starts that failed, with why.
+    pub failed: Vec<(String, String)>,
+    /// Whether costs are the validation runs'.
+    pub validated: bool,
+}
+
+/// Identifies `model` from `frames` by the recipe; `held` are runs that stop each refinement
+/// (prepared as the training runs are).
+pub fn identify(
+    model: &Model,
+    frames: &[Frame],
+    held: Option<&[Frame]>,
+    settings: &RecipeSettings,
+) -> Result<Recipe, RecipeError> {
+    if settings.derivatives.len() > 1 && settings.refine.is_none() {
+        return Err(RecipeError::Setup(format!(
+            "derivative methods {}: several are several starts of the output-error refinement, judged by its cost: refine too",
+            settings.derivatives.join(",")
+        )));
+    }
+    let mut starts = Vec::new();
+    let mut failed = Vec::new();
+    for method in &settings.derivatives {
+        match start::identify_start(model, frames, held, settings, method) {
+            Ok(s) => starts.push(s),
+            Err(e) if settings.derivatives.len() > 1 => failed.push((method.clone(), e.to_string())),
+            Err(e) => return Err(e),
+        }
+    }
+    Recipe::of(starts, failed, held.is_some(), settings.agree)
+}
+
+impl Recipe {
+    /// The recipe's verdict on identified starts: the kept one and the agreement of the
+    /// plausible ones.
+    pub fn of(
+        starts: Vec<Start>,
+        failed: Vec<(String, String)>,
+        validated: bool,
+        agree: f64,
+    ) -> Result<Recipe, RecipeError> {
+        let kept = (0..starts.len())
+            .min_by(|&a, &b| {
+                let (x, y) = (&starts[a], &starts[b]);
+                x.refused().cmp(&y.refused()).then(x.cost().total_cmp(&y.cost()))
+            })
+            .ok_or_else(|| {
+                RecipeError::NoStart(
+                    failed.first().map_or("no derivative method given".into(), |(m, e)| format!("{m}: {e}")),
+                )
+            })?;
+        // the starts that pass their checks are models the runs cannot tell apart: where
+        // they disagree on a manoeuvre the runs did not cover, that prediction is that uncertain
+        let plausible: Vec<(&str, &[Check])> = starts
+            .iter()
+            .enumerate()
+            .filter(|(k, s)| *k == kept || s.refused() == 0)
+            .map(|(_, s)| (s.derivative.as_str(), s.checks.as_slice()))
+            .collect();
+        let at = plausible.iter().position(|(d, _)| *d == starts[kept].derivative).unwrap_or(0);
+        let agreement = crate::plugin::disagreement(&plausible, at, agree);
+        Ok(Recipe { starts, kept, agreement, failed, validated })
+    }
+
+    /// The kept start.
+    pub fn kept(&self) -> &Start {
+        &self.starts[self.kept]
+    }
+
+    /// The kept start's checks with the starts' agreement.
+    pub fn checks(&self) -> Vec<Check> {
+        self.kept().checks.iter().chain(&self.agreement).cloned().collect()
+    }
+
+    /// The table of starts: each derivative method's costs and checks, the kept one marked.
+    pub fn starts_text(&self) -> String {
+        let mut out = format!(
+            "== starts: one identification per derivative method, each refined; kept: the lowest {} re-simulation cost among those that pass the checks ==\n{:<22} {:>6} {:>16} {:>16} {:>8}\n",
+            if self.validated { "validation runs'" } else { "training runs'" },
+            "derivative",
+            "terms",
+            "regression cost",
+            "refined cost",
+            "refused"
+        );
+        for (k, s) in self.starts.iter().enumerate() {
+            let terms: usize =
+                s.model.equations().iter().filter(|e| e.identify).map(|e| e.coefficients.len()).sum();
+            let (before, after) = match (&s.refined, &s.rejected) {
+                (Some(r), _) | (None, Some((r, _))) => match r.validation {
+                    Some((b, a)) => (b, a),
+                    None => (r.cost_before, r.cost_after),
+                },
+                _ => (f64::INFINITY, f64::INFINITY),
+            };
+            let after = if s.refined.is_some() { num(after) } else { "rejected".into() };
+            let mark = if k == self.kept { "  ← kept" } else { "" };
+            out += &format!(
+                "{:<22} {terms:>6} {:>16} {after:>16} {:>8}{mark}\n",
+                s.derivative,
+                num(before),
+                s.refused()
+            );
+        }
+        for s in &self.starts {
+            let lines: Vec<String> = s.checks.iter().map(|c| c.line()).collect();
+            out += &format!("{}:\n  {}\n", s.derivative, lines.join("\n  "));
+        }
+        out.push('\n');
+        out
+    }
+}

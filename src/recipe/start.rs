@@ -1,0 +1,234 @@
+//! One start of the recipe: the runs prepared by one derivative method, identified (or
+//! chosen among configurations by prediction), refined by output error and checked.
+
+use crate::data::{differentiator, prepare, resample, CentralDifference, Differentiator, Frame, Preparation};
+use crate::diagnose::{Prediction, RefineSettings, Refined, Runs};
+use crate::identify::{Fit, ModelIdentification};
+use crate::model::Model;
+use crate::plugin::Check;
+
+use super::{RecipeError, RecipeSettings, RefineOptions};
+
+/// One start: what one derivative method's preparation identified.
+#[derive(Debug)]
+pub struct Start {
+    /// The derivative method.
+    pub derivative: String,
+    /// The model as it will be written.
+    pub model: Model,
+    /// The regression's fits, per equation.
+    pub fits: Vec<(String, Fit)>,
+    /// The table the choice among configurations chose from.
+    pub chosen_text: Option<String>,
+    /// The refinement kept.
+    pub refined: Option<Refined>,
+    /// A refinement rejected by the checks, with the checks it lost.
+    pub rejected: Option<(Refined, Vec<String>)>,
+    /// A refinement that failed, why (the regression's model is kept).
+    pub refine_error: Option<String>,
+    /// The physical checks of `model`.
+    pub checks: Vec<Check>,
+    /// The runs as this start prepared them (for figures).
+    pub prepared: Vec<Frame>,
+}
+
+impl Start {
+    /// What the start is judged by: the re-simulation cost of the model it keeps, on the
+    /// validation runs where there are any, else on the training runs.
+    pub fn cost(&self) -> f64 {
+        match (&self.refined, &self.rejected) {
+            (Some(r), _) => r.validation.map_or(r.cost_after, |v| v.1),
+            (None, Some((r, _))) => r.validation.map_or(r.cost_before, |v| v.0),
+            _ => f64::INFINITY,
+        }
+    }
+
+    /// How many of its checks refuse the model.
+    pub fn refused(&self) -> usize {
+        self.checks.iter().filter(|c| !c.passed && c.refuses).count()
+    }
+}
+
+fn setup(e: impl std::fmt::Display) -> RecipeError {
+    RecipeError::Setup(e.to_string())
+}
+
+/// The derivative method by name. A plug-in's method (the ship's `kinematic` tracking filter)
+/// writes every rate as a column in [`prepare_runs`], so central differences stand in for it:
+/// nothing is left to differentiate then.
+pub fn derivative_method(name: &str) -> Result<Box<dyn Differentiator>, RecipeError> {
+    Ok(if crate::plugins::with_derivative(name).is_some() {
+        Box::new(CentralDifference)
+    } else {
+        differentiator(name).map_err(setup)?
+    })
+}
+
+/// The runs resampled and smoothed where asked for (or `always`, for figures of them): each
+/// differentiated signal gets its rate as `<signal>_dot` (which identification then takes as
+/// the target); a plug-in's method prepares all states of a run at once.
+pub fn prepare_runs(
+    frames: &[Frame],
+    signals: &[String],
+    model: Option<&Model>,
+    derivative: &str,
+    resample_to: Option<f64>,
+    smooth: bool,
+    always: bool,
+) -> Result<Vec<Frame>, RecipeError> {
+    let plugin = crate::plugins::with_derivative(derivative);
+    if resample_to.is_none() && !smooth && plugin.is_none() && !always {
+        return Ok(frames.to_vec());
+    }
+    if let Some(plugin) = plugin {
+        let model = model.ok_or_else(|| setup(format!("--derivative {derivative} needs a --model")))?;
+        return frames
+            .iter()
+            .map(|f| {
+                let f = match resample_to {
+                    Some(dt) => resample(f, dt).map_err(setup)?,
+                    None => f.clone(),
+                };
+                plugin.prepare(derivative, model, &f, smooth).map_err(setup)
+            })
+            .collect();
+    }
+    let method = derivative_method(derivative)?;
+    let how =
+        Preparation { resample: resample_to, method: method.as_ref(), signals: signals.to_vec(), smooth };
+    frames.iter().map(|f| prepare(f, &how).map_err(setup)).collect()
+}
+
+/// One start with `derivative`.
+pub(super) fn identify_start(
+    model: &Model,
+    frames: &[Frame],
+    held: Option<&[Frame]>,
+    settings: &RecipeSettings,
+    derivative: &str,
+) -> Result<Start, RecipeError> {
+    let names: Vec<String> =
+        if settings.equations.is_empty() { model.identifiable() } else { settings.equations.clone() };
+    if names.is_empty() {
+        return Err(setup(format!("{}: no equation has candidate terms, so there is nothing to identify (an equation's `candidates` list them)", model.path)));
+    }
+    if settings.target.is_some() && names.len() != 1 {
+        return Err(setup("a target applies to one equation: name it"));
+    }
+    let states: Vec<String> =
+        names.iter().filter_map(|n| model.equation(n).map(|e| e.state.clone())).collect();
+    let diff = derivative_method(derivative)?;
+    let prep = |f: &[Frame]| {
+        prepare_runs(
+            f,
+            &states,
+            Some(model),
+            derivative,
+            settings.resample,
+            settings.smooth,
+            settings.figures,
+        )
+    };
+    let prepared = prep(frames)?;
+    // runs that stop the refinement, prepared as the training runs are
+    let validation = held.map(prep).transpose()?;
+    let how = ModelIdentification {
+        equations: names,
+        differentiator: diff.as_ref(),
+        intercept: settings.intercept,
+        target: settings.target.clone(),
+    };
+    let (identified, chosen_text) = if settings.choose.is_empty() {
+        (crate::identify::identify_model(model, &prepared, &how, &mut |_| {}).map_err(setup)?, None)
+    } else {
+        let prediction = Prediction { states: settings.compare.clone(), ..Default::default() };
+        let chosen = crate::diagnose::choose_by_prediction(
+            &settings.choose,
+            &prepared,
+            &how,
+            &prediction,
+            &mut |_| {},
+        )
+        .map_err(setup)?;
+        let text = chosen.text();
+        (chosen.identified, Some(text))
+    };
+    let mut model = identified.model;
+    // what the field knows must hold: the plug-in's physical checks of a model
+    let checks_of = |m: &Model| crate::plugins::of(m).map(|p| p.checks(m, &prepared)).unwrap_or_default();
+    let failing = |checks: &[Check]| -> Vec<String> {
+        checks.iter().filter(|c| !c.passed && c.refuses).map(|c| c.name.clone()).collect()
+    };
+    let mut start = Start {
+        derivative: derivative.to_string(),
+        model: model.clone(),
+        fits: identified.fits,
+        chosen_text,
+        refined: None,
+        rejected: None,
+        refine_error: None,
+        checks: vec![],
+        prepared: vec![],
+    };
+    match &settings.refine {
+        // a refinement that fails loses nothing: the regression's model is kept
+        Some(options) => {
+            match refine(&model, &prepared, validation.as_deref(), options, settings.intercept) {
+                Ok(r) => {
+                    // a refinement must not make a model fail what its field knows it passed
+                    let (before, after) = (checks_of(&model), checks_of(&r.model));
+                    let was = failing(&before);
+                    let lost: Vec<String> =
+                        failing(&after).into_iter().filter(|c| !was.contains(c)).collect();
+                    if lost.is_empty() {
+                        model = r.model.clone();
+                        start.checks = after;
+                        start.refined = Some(r);
+                    } else {
+                        start.checks = before;
+                        start.rejected = Some((r, lost));
+                    }
+                }
+                Err(e) => {
+                    start.refine_error = Some(e);
+                    start.checks = checks_of(&model);
+                }
+            }
+        }
+        None => start.checks = checks_of(&model),
+    }
+    start.model = model;
+    start.prepared = prepared;
+    Ok(start)
+}
+
+/// Every identified coefficient refined by output error on the runs as they were prepared
+/// for the regression (smoothed initial states: a noisy first sample of a rate would
+/// otherwise drift through its integral).
+fn refine(
+    model: &Model,
+    frames: &[Frame],
+    held: Option<&[Frame]>,
+    options: &RefineOptions,
+    intercept: bool,
+) -> Result<Refined, String> {
+    let runs_of = |frames: &[Frame]| -> Result<Runs, String> {
+        let sample = frames.iter().map(|f| crate::data::median_step(f.time())).fold(f64::INFINITY, f64::min);
+        // one RK4 step per sample: the recorded input is known only at the samples
+        let runs = Runs::new(model, frames, sample, crate::sim::Integrator::Rk4)
+            .map_err(|e| e.to_string())?
+            .with_intercepts(intercept);
+        match &options.states {
+            Some(names) => runs.comparing(names).map_err(|e| e.to_string()),
+            None => Ok(runs),
+        }
+    };
+    let runs = runs_of(frames)?;
+    let validation = held.map(runs_of).transpose()?;
+    let settings = RefineSettings {
+        prior_weight: options.prior,
+        validation: validation.as_ref(),
+        iterations: options.iterations,
+    };
+    crate::diagnose::refine(model, &runs, &settings).map_err(|e| format!("{e:#}"))
+}
