@@ -230,6 +230,15 @@ impl Particulars {
             Estimate { name: "l_R", value: -0.8, sd: 0.3, unit: "", source: GENERIC },
             Estimate { name: "γ_Rm", value: 0.5, sd: 0.25, unit: "", source: GENERIC },
             Estimate { name: "γ_Rp", value: 0.5, sd: 0.25, unit: "", source: GENERIC },
+            // the indicator's zero and the rudder angle at which a single-screw ship goes
+            // straight (its propeller's side force) in one: a record's offset, 0 ± 2°
+            Estimate {
+                name: "δ_0",
+                value: 0.0,
+                sd: 2f64.to_radians(),
+                unit: "rad",
+                source: "the rudder indicator's zero; a nuisance, per basin with --per-source δ_0",
+            },
             // resistance: the straight run solves the propeller's rate for it, so it trades
             // against the propeller's parameters; a modest prior
             Estimate { name: "R_0", value: 0.02, sd: 0.01, unit: "", source: GENERIC },
