@@ -126,12 +126,12 @@ pub struct Measure {
     pub unit: String,
 }
 
-/// Where several models of one identification (the starts of a recipe, each plausible by
-/// its own checks) disagree by more than `tolerance` (relative) on a measure of a manoeuvre
+/// Where several models of one identification (`what`: the starts of a recipe, each
+/// plausible by its own checks; a grey-box and a polynomial model) disagree by more than `tolerance` (relative) on a measure of a manoeuvre
 /// the runs did not cover: one flag per such measure, with the range of the models and the
 /// kept one's value. The runs cannot tell these models apart, so the spread is the
 /// uncertainty of that prediction.
-pub fn disagreement(models: &[(&str, &[Check])], kept: usize, tolerance: f64) -> Vec<Check> {
+pub fn disagreement(models: &[(&str, &[Check])], kept: usize, tolerance: f64, what: &str) -> Vec<Check> {
     let Some((_, kept_checks)) = models.get(kept) else { return vec![] };
     let mut out = Vec::new();
     for m in kept_checks.iter().filter_map(|c| c.measure.as_ref()) {
@@ -151,7 +151,7 @@ pub fn disagreement(models: &[(&str, &[Check])], kept: usize, tolerance: f64) ->
         let agree = spread <= tolerance;
         let each: Vec<String> = values.iter().map(|(l, v)| format!("{l} {v:.2}")).collect();
         out.push(Check {
-            name: format!("the starts agree on the {} (within {:.0} %)", m.name, 100.0 * tolerance),
+            name: format!("{what} agree on the {} (within {:.0} %)", m.name, 100.0 * tolerance),
             passed: agree,
             refuses: false,
             detail: format!(

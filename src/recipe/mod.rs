@@ -156,7 +156,7 @@ impl Recipe {
             .map(|(_, s)| (s.derivative.as_str(), s.checks.as_slice()))
             .collect();
         let at = plausible.iter().position(|(d, _)| *d == starts[kept].derivative).unwrap_or(0);
-        let agreement = crate::plugin::disagreement(&plausible, at, agree);
+        let agreement = crate::plugin::disagreement(&plausible, at, agree, "the starts");
         Ok(Recipe { starts, kept, agreement, failed, validated })
     }
 

@@ -558,3 +558,47 @@ fn two_basins_with_their_own_rudder_zero() {
     // the model keeps the file's δ_0: each source's own is reported, not written
     assert_eq!(fit.model.parameter_values()["δ_0"], 0.0);
 }
+
+/// `estimate --against`: the estimated grey-box model and another of the same ship compared
+/// on what the runs did not cover; the particulars' unestimated model (19-31 % off on the
+/// turning circles) is flagged, the truth is not.
+#[test]
+fn estimate_against_another_model_flags_where_they_disagree() {
+    use termid::ship::basin::{columns, dataset_file, Basin};
+    let dir = crate::common::Scratch::new("estimate-against");
+    let truth = termid::plugins::load(std::path::Path::new("models/mmg_kvlcc2.toml")).unwrap();
+    let zigzags = [
+        ("zigzag:10/10", 0.98),
+        ("zigzag:10/10:port", 1.02),
+        ("zigzag:20/20", 1.01),
+        ("zigzag:20/20:port", 0.97),
+    ];
+    let recorded = Basin::default().record_all(&truth, &zigzags, 1.17248, 60.0, 31, Some(&dir)).unwrap();
+    let files: Vec<String> = recorded.into_iter().map(|(name, _)| name).collect();
+    let names: Vec<&str> = files.iter().map(String::as_str).collect();
+    std::fs::write(dir.join("train.toml"), dataset_file(&columns(&truth), &names)).unwrap();
+    let greybox = dir.join("greybox.toml");
+    let (ok, _, err) = crate::common::termid(&[
+        "new-ship",
+        "--particulars",
+        "examples/kvlcc2_particulars.toml",
+        "--out",
+        greybox.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let train = dir.join("train.toml");
+    for (against, flagged) in [("models/mmg_kvlcc2.toml", false), (greybox.to_str().unwrap(), true)] {
+        let (ok, text, err) = crate::common::termid(&[
+            "estimate",
+            "--model",
+            greybox.to_str().unwrap(),
+            "--dataset",
+            train.to_str().unwrap(),
+            "--against",
+            against,
+        ]);
+        assert!(ok, "{err}");
+        assert!(text.contains("the models agree on the tactical diameter"), "{text}");
+        assert_eq!(text.contains("FLAG the models agree"), flagged, "against {against}:\n{text}");
+    }
+}

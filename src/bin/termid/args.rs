@@ -79,6 +79,11 @@ pub struct EstimateCommand {
     /// indicator zero); the others once for all.
     #[arg(long, num_args = 1.., value_delimiter = ',')]
     pub per_source: Vec<String>,
+    /// Another model of the same ship (a polynomial one `identify` wrote): both models'
+    /// checks side by side, flagged where they disagree by more than 10 % on a manoeuvre the
+    /// runs did not cover (a turning circle): the runs cannot tell them apart there.
+    #[arg(long)]
+    pub against: Option<PathBuf>,
     /// Write the model with the estimates, their standard errors and covariance.
     #[arg(long)]
     pub out: Option<PathBuf>,

@@ -63,10 +63,40 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
         outputs.file(out, fit.model.to_toml().as_bytes())?;
         outputs.commit()?;
     }
+    // where another model of the same ship predicts differently what the runs did not cover
+    let agreement = match &cmd.against {
+        Some(path) => {
+            let other = crate::simulate::load_model(&Some(path.clone()))?;
+            let checks = |m: &termid::model::Model| {
+                termid::plugins::of(m).map(|p| p.checks(m, &frames)).unwrap_or_default()
+            };
+            let (mine, theirs) = (checks(&fit.model), checks(&other));
+            let label = path.display().to_string();
+            termid::plugin::disagreement(
+                &[("estimated", &mine), (label.as_str(), &theirs)],
+                0,
+                0.10,
+                "the models",
+            )
+        }
+        None => vec![],
+    };
+    for c in agreement.iter().filter(|c| !c.passed) {
+        eprintln!("warning: {}", c.line());
+    }
     match cmd.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&fit)?),
         Format::Text => {
             print!("{}", fit.text());
+            if !agreement.is_empty() {
+                println!(
+                    "== against {} ==",
+                    cmd.against.as_ref().map_or(String::new(), |p| p.display().to_string())
+                );
+                for c in &agreement {
+                    println!("{}", c.line());
+                }
+            }
             if !fit.per_source.is_empty() {
                 for (k, label) in labels.iter().enumerate() {
                     println!("source {}: {label}", k + 1);
