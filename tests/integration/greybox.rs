@@ -48,6 +48,68 @@ fn noisy_frame(name: &str, h: f64, names: &[&str], rows: &[Vec<f64>], sd: &[f64]
     f
 }
 
+/// Nomoto's T·ṙ + r = K·δ in a zigzag (the rudder put over to ∓`rudder` when the heading
+/// passes ±`rudder`; the test's own logic), from rest: the rows (ψ, r) every `h` seconds
+/// and the rudder as recorded at each (the value in force over the next interval).
+fn nomoto_zigzag(k: f64, t_const: f64, rudder: f64, h: f64, samples: usize) -> (Vec<Vec<f64>>, Vec<f64>) {
+    let mut delta = rudder;
+    let mut deltas = Vec::new();
+    let rows = trajectory(&[0.0, 0.0], h, samples, 4, |_, x| {
+        if delta > 0.0 && x[0] > rudder {
+            delta = -rudder;
+        } else if delta < 0.0 && x[0] < -rudder {
+            delta = rudder;
+        }
+        deltas.push(delta);
+        vec![x[1], (k * delta - x[1]) / t_const]
+    });
+    // four RK4 stages of four sub-steps a sample: the first stage's rudder is the sample's
+    let recorded = (0..rows.len()).map(|i| deltas[(i * 16).min(deltas.len() - 1)]).collect();
+    (rows, recorded)
+}
+
+/// The MMG truth (`models/mmg_kvlcc2.toml`).
+fn mmg_truth() -> Model {
+    termid::plugins::load(std::path::Path::new("models/mmg_kvlcc2.toml")).unwrap()
+}
+
+/// Four zigzags of the MMG basin (10/10 and 20/20 to both sides, 60 s after the approach,
+/// sensor noise on every channel), recorded from `truth`; written into `dir` when given.
+/// Returns (file name, measured run).
+fn basin_zigzags(truth: &Model, dir: Option<&std::path::Path>) -> Vec<(String, Frame)> {
+    let zigzags = [
+        ("zigzag:10/10", 0.98),
+        ("zigzag:10/10:port", 1.02),
+        ("zigzag:20/20", 1.01),
+        ("zigzag:20/20:port", 0.97),
+    ];
+    termid::ship::basin::Basin::default()
+        .record_all(truth, &zigzags, 1.17248, 60.0, 31, dir)
+        .unwrap()
+        .into_iter()
+        .map(|(name, r)| (name, r.measured))
+        .collect()
+}
+
+/// A ship model's tactical diameter turning with `rudder` degrees, m (RK4 at 0.01 s).
+fn tactical_diameter(model: &Model, rudder: f64) -> f64 {
+    use termid::ship::{Manoeuvre, Metrics, Ship};
+    let ship = Ship::new(model, false).unwrap();
+    let s = termid::sim::Settings { integrator: Integrator::Rk4, dt: 0.01, duration: 200.0, sample: 0.05 };
+    let Metrics::Turning(t) =
+        ship.run(&Manoeuvre::parse(&format!("turning:{rudder}")).unwrap(), &s).unwrap().metrics
+    else {
+        unreachable!()
+    };
+    t.tactical_diameter_m.unwrap()
+}
+
+/// Runs re-simulated one RK4 step a sample.
+fn runs_of(model: &Model, frames: &[Frame]) -> Runs {
+    let sample = frames[0].time()[1] - frames[0].time()[0];
+    Runs::new(model, frames, sample, Integrator::Rk4).unwrap()
+}
+
 const LORENZ: &str = r#"
 [model]
 name = "Lorenz system, σ, ρ and β free"
@@ -172,23 +234,8 @@ coefficients = { "K*δ/T" = 1.0, "r/T" = -1.0 }
 /// Nomoto's K and T from a 20°/20° zigzag with gyro noise, started 30 % off both.
 #[test]
 fn nomoto_k_and_t_from_a_zigzag() {
-    let (k, t_const) = (0.15, 8.0);
-    let h = 0.1;
-    let rudder = 20f64.to_radians();
-    // the zigzag: the rudder put over when the heading passes ±20° (the test's own logic)
-    let mut delta = rudder;
-    let mut deltas = Vec::new();
-    let rows = trajectory(&[0.0, 0.0], h, 1201, 4, |_, x| {
-        if delta > 0.0 && x[0] > rudder {
-            delta = -rudder;
-        } else if delta < 0.0 && x[0] < -rudder {
-            delta = rudder;
-        }
-        deltas.push(delta);
-        vec![x[1], (k * delta - x[1]) / t_const]
-    });
-    // the rudder as recorded at each sample (the value in force over the next interval)
-    let recorded: Vec<f64> = (0..rows.len()).map(|i| deltas[(i * 16).min(deltas.len() - 1)]).collect();
+    let (k, t_const, h) = (0.15, 8.0, 0.1);
+    let (rows, recorded) = nomoto_zigzag(k, t_const, 20f64.to_radians(), h, 1201);
     let mut rng = Lcg(11);
     let mut frame =
         noisy_frame("zigzag", h, &["ψ", "r"], &rows, &[0.1f64.to_radians(), 0.05f64.to_radians()], &mut rng);
@@ -266,20 +313,8 @@ fn free_parameter_keys_are_checked() {
 /// the noisy first samples the same fit lands 30-150 % off.
 #[test]
 fn mmg_kvlcc2_parameters_from_basin_zigzags() {
-    use std::path::Path;
-    use termid::ship::basin::Basin;
-    use termid::ship::{Manoeuvre, Metrics, Ship};
-    use termid::sim::Settings;
-
-    let truth = termid::plugins::load(Path::new("models/mmg_kvlcc2.toml")).unwrap();
-    let zigzags = [
-        ("zigzag:10/10", 0.98),
-        ("zigzag:10/10:port", 1.02),
-        ("zigzag:20/20", 1.01),
-        ("zigzag:20/20:port", 0.97),
-    ];
-    let recorded = Basin::default().record_all(&truth, &zigzags, 1.17248, 60.0, 31, None).unwrap();
-    let frames: Vec<Frame> = recorded.into_iter().map(|(_, r)| r.measured).collect();
+    let truth = mmg_truth();
+    let frames: Vec<Frame> = basin_zigzags(&truth, None).into_iter().map(|(_, f)| f).collect();
     let free = ["Y_v", "Y_r", "N_v", "N_r", "ε", "γ_Rp", "γ_Rm"];
     let values = truth.parameter_values();
     let start = truth
@@ -292,26 +327,14 @@ fn mmg_kvlcc2_parameters_from_basin_zigzags() {
             }
         })
         .unwrap();
-    let sample = frames[0].time()[1] - frames[0].time()[0];
-    let runs = Runs::new(&start, &frames, sample, Integrator::Rk4).unwrap();
-    let fit = estimate(&start, &runs, &EstimateSettings::default()).unwrap();
+    let fit = estimate(&start, &runs_of(&start, &frames), &EstimateSettings::default()).unwrap();
     for name in free {
         let p = fit.parameters.iter().find(|p| p.name == name).unwrap();
         let truth = values[name];
         assert!((p.value / truth - 1.0).abs() < 0.05, "{name}: {} vs {truth}\n{}", p.value, fit.text());
     }
-    let turn = |model: &Model, rudder: f64| {
-        let ship = Ship::new(model, false).unwrap();
-        let s = Settings { integrator: Integrator::Rk4, dt: 0.01, duration: 200.0, sample: 0.05 };
-        let Metrics::Turning(t) =
-            ship.run(&Manoeuvre::parse(&format!("turning:{rudder}")).unwrap(), &s).unwrap().metrics
-        else {
-            unreachable!()
-        };
-        t.tactical_diameter_m.unwrap()
-    };
     for rudder in [35.0, -35.0] {
-        let (a, b) = (turn(&fit.model, rudder), turn(&truth, rudder));
+        let (a, b) = (tactical_diameter(&fit.model, rudder), tactical_diameter(&truth, rudder));
         assert!(
             (a / b - 1.0).abs() < 0.01,
             "δ = {rudder}°: tactical diameter {a} m, truth {b} m\n{}",
@@ -326,23 +349,12 @@ fn mmg_kvlcc2_parameters_from_basin_zigzags() {
 #[test]
 fn the_estimate_command_writes_estimates_that_monte_carlo_draws_from() {
     let (k, t_const, h) = (0.15, 8.0, 0.1);
-    let rudder = 20f64.to_radians();
-    let mut delta = rudder;
-    let mut deltas = Vec::new();
-    let rows = trajectory(&[0.0, 0.0], h, 601, 4, |_, x| {
-        if delta > 0.0 && x[0] > rudder {
-            delta = -rudder;
-        } else if delta < 0.0 && x[0] < -rudder {
-            delta = rudder;
-        }
-        deltas.push(delta);
-        vec![x[1], (k * delta - x[1]) / t_const]
-    });
+    let (rows, deltas) = nomoto_zigzag(k, t_const, 20f64.to_radians(), h, 601);
     let mut rng = Lcg(5);
     let dir = crate::common::Scratch::new("estimate-cli");
     let mut csv = String::from("t,ψ,r,δ\n");
     for (i, row) in rows.iter().enumerate() {
-        let d = deltas[(i * 16).min(deltas.len() - 1)];
+        let d = deltas[i];
         let (psi, r) = (row[0] + 0.002 * rng.normal(), row[1] + 0.001 * rng.normal());
         csv.push_str(&format!("{},{psi},{r},{d}\n", i as f64 * h));
     }
@@ -398,38 +410,19 @@ fn the_estimate_command_writes_estimates_that_monte_carlo_draws_from() {
 /// 5 % of the truth's; the particulars alone are 19-31 % off.
 #[test]
 fn a_new_ship_from_its_particulars_and_four_zigzags() {
-    use std::path::Path;
-    use termid::ship::basin::Basin;
     use termid::ship::particulars::Particulars;
-    use termid::ship::{Manoeuvre, Metrics, Ship};
-    use termid::sim::Settings;
 
-    let truth = termid::plugins::load(Path::new("models/mmg_kvlcc2.toml")).unwrap();
+    let truth = mmg_truth();
     let particulars: Particulars = toml::from_str(KVLCC2_PARTICULARS).unwrap();
     let start = particulars.model().unwrap();
-    let zigzags = [
-        ("zigzag:10/10", 0.98),
-        ("zigzag:10/10:port", 1.02),
-        ("zigzag:20/20", 1.01),
-        ("zigzag:20/20:port", 0.97),
-    ];
-    let recorded = Basin::default().record_all(&truth, &zigzags, 1.17248, 60.0, 31, None).unwrap();
-    let frames: Vec<Frame> = recorded.into_iter().map(|(_, r)| r.measured).collect();
-    let turn = |model: &Model, rudder: f64| {
-        let ship = Ship::new(model, false).unwrap();
-        let s = Settings { integrator: Integrator::Rk4, dt: 0.01, duration: 200.0, sample: 0.05 };
-        let Metrics::Turning(t) =
-            ship.run(&Manoeuvre::parse(&format!("turning:{rudder}")).unwrap(), &s).unwrap().metrics
-        else {
-            unreachable!()
-        };
-        t.tactical_diameter_m.unwrap()
-    };
-    let sample = frames[0].time()[1] - frames[0].time()[0];
-    let runs = Runs::new(&start, &frames, sample, Integrator::Rk4).unwrap();
-    let fit = estimate(&start, &runs, &EstimateSettings::default()).unwrap();
+    let frames: Vec<Frame> = basin_zigzags(&truth, None).into_iter().map(|(_, f)| f).collect();
+    let fit = estimate(&start, &runs_of(&start, &frames), &EstimateSettings::default()).unwrap();
     for rudder in [35.0, -35.0] {
-        let (before, after, true_d) = (turn(&start, rudder), turn(&fit.model, rudder), turn(&truth, rudder));
+        let (before, after, true_d) = (
+            tactical_diameter(&start, rudder),
+            tactical_diameter(&fit.model, rudder),
+            tactical_diameter(&truth, rudder),
+        );
         assert!(
             (before / true_d - 1.0).abs() > 0.1,
             "δ = {rudder}°: the particulars alone {before} m, truth {true_d} m"
@@ -500,10 +493,9 @@ fn the_new_ship_command_writes_a_model_estimate_reads() {
 /// both come back, and the hull's derivatives as from one basin without offsets.
 #[test]
 fn two_basins_with_their_own_rudder_zero() {
-    use std::path::Path;
     use termid::ship::basin::Basin;
 
-    let truth = termid::plugins::load(Path::new("models/mmg_kvlcc2.toml")).unwrap();
+    let truth = mmg_truth();
     // the rudder the hull feels is the indicator's reading less the basin's zero δ_0
     let text = std::fs::read_to_string("models/mmg_kvlcc2.toml").unwrap();
     let text = text
@@ -537,10 +529,8 @@ fn two_basins_with_their_own_rudder_zero() {
             sources.push(s);
         }
     }
-    let sample = frames[0].time()[1] - frames[0].time()[0];
-    let runs = Runs::new(&start, &frames, sample, Integrator::Rk4).unwrap();
     let settings = EstimateSettings { sources, per_source: vec!["δ_0".into()], ..Default::default() };
-    let fit = estimate(&start, &runs, &settings).unwrap();
+    let fit = estimate(&start, &runs_of(&start, &frames), &settings).unwrap();
     for (s, offset) in offsets.iter().enumerate() {
         let p = fit.per_source.iter().find(|p| p.source == s).unwrap();
         assert!(
@@ -564,17 +554,10 @@ fn two_basins_with_their_own_rudder_zero() {
 /// turning circles) is flagged, the truth is not.
 #[test]
 fn estimate_against_another_model_flags_where_they_disagree() {
-    use termid::ship::basin::{columns, dataset_file, Basin};
+    use termid::ship::basin::{columns, dataset_file};
     let dir = crate::common::Scratch::new("estimate-against");
-    let truth = termid::plugins::load(std::path::Path::new("models/mmg_kvlcc2.toml")).unwrap();
-    let zigzags = [
-        ("zigzag:10/10", 0.98),
-        ("zigzag:10/10:port", 1.02),
-        ("zigzag:20/20", 1.01),
-        ("zigzag:20/20:port", 0.97),
-    ];
-    let recorded = Basin::default().record_all(&truth, &zigzags, 1.17248, 60.0, 31, Some(&dir)).unwrap();
-    let files: Vec<String> = recorded.into_iter().map(|(name, _)| name).collect();
+    let truth = mmg_truth();
+    let files: Vec<String> = basin_zigzags(&truth, Some(&dir)).into_iter().map(|(name, _)| name).collect();
     let names: Vec<&str> = files.iter().map(String::as_str).collect();
     std::fs::write(dir.join("train.toml"), dataset_file(&columns(&truth), &names)).unwrap();
     let greybox = dir.join("greybox.toml");
