@@ -3,7 +3,10 @@
 //! predicts MARIN's four zigzags, which it never saw (full scale, read at the model's scale),
 //! and its turning circles. Prints README's tables and writes two figures.
 //!
-//! `SIMMAN=/path/to/clone cargo run --release --example simman -- IDENTIFIED.toml [OUT_FOLDER]`
+//! `SIMMAN=/path/to/clone cargo run --release --example simman -- IDENTIFIED.toml [OUT_FOLDER]`;
+//! `… --example simman -- --table LABEL=MODEL.toml …` prints one row per model instead: the
+//! first overshoot of each MARIN zigzag (steered by the model) less MARIN's, and the ±35°
+//! tactical diameters (README's table of training sets and model families)
 //! (the clone: the public repository martinlarsalbert/System-identification-of-Vessel-
 //! Manoeuvring-Models; its records are read where they are, never copied).
 
@@ -22,7 +25,11 @@ type Error = Box<dyn std::error::Error>;
 const TURNS: [f64; 4] = [35.0, -35.0, 20.0, -20.0];
 
 fn main() -> Result<(), Error> {
-    let mut args = std::env::args().skip(1);
+    let all: Vec<String> = std::env::args().skip(1).collect();
+    if all.first().is_some_and(|a| a == "--table") {
+        return table(&all[1..]);
+    }
+    let mut args = all.into_iter();
     let model_path = PathBuf::from(args.next().ok_or("usage: simman IDENTIFIED.toml [OUT_FOLDER]")?);
     let out = args.next().map_or_else(|| std::env::temp_dir().join("termid-simman"), PathBuf::from);
     std::fs::create_dir_all(&out)?;
@@ -116,6 +123,47 @@ fn main() -> Result<(), Error> {
     turning.width = 560;
     turning.write_svg(&out.join("simman_turning.svg"))?;
     println!("\nfigures in {}", out.display());
+    Ok(())
+}
+
+/// `--table LABEL=MODEL.toml …`: per model, each MARIN zigzag's first overshoot as the model
+/// steers it less the measured one, and the ±35° tactical diameters at MARIN's approach.
+fn table(models: &[String]) -> Result<(), Error> {
+    let marin = Path::new("examples/simman/marin.toml");
+    let set = Dataset::load(marin)?;
+    let (runs, _) = set.read(&set.folder(marin)?, "t")?;
+    let settings = Settings { integrator: Integrator::Rk4, dt: 0.02, duration: 240.0, sample: 0.2 };
+    let mut head = "| model |".to_string();
+    for frame in &runs {
+        head += &format!(" {} |", zigzag_of(frame)?);
+    }
+    println!("{head} +35° | −35° |\n|---|{}---|---|", "---|".repeat(runs.len()));
+    for item in models {
+        let (label, path) = item.split_once('=').ok_or("--table takes LABEL=MODEL.toml")?;
+        let model = termid::plugins::load(Path::new(path))?;
+        let plugin = termid::plugins::of(&model).ok_or("not a ship model")?;
+        let mut row = format!("| {label} |");
+        for frame in &runs {
+            let measured = plugin.observe(&model, frame, None).ok_or("no metrics of the record")?.json;
+            let own =
+                Ship::new(&termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]), false)?
+                    .run(&Manoeuvre::parse(&zigzag_of(frame)?)?, &Settings { duration: 100.0, ..settings })?;
+            let Metrics::ZigZag(z) = &own.metrics else { return Err("not a zigzag".into()) };
+            row += &match (measured["first_overshoot_deg"].as_f64(), z.first_overshoot_deg) {
+                (Some(m), Some(p)) => format!(" {:+.2}° |", p - m),
+                _ => " -- |".into(),
+            };
+        }
+        let u0 =
+            runs.iter().map(|f| f.require("u").map(|u| u[0])).sum::<Result<f64, _>>()? / runs.len() as f64;
+        let ship = Ship::new(&termid::ship::basin::at_approach_speed(&model, u0), false)?;
+        for d in [35.0, -35.0] {
+            let run = ship.run(&Manoeuvre::parse(&format!("turning:{d}"))?, &settings)?;
+            let Metrics::Turning(t) = &run.metrics else { return Err("not a turning circle".into()) };
+            row += &t.tactical_diameter_m.map_or(" -- |".into(), |v| format!(" {v:.1} m |"));
+        }
+        println!("{row}");
+    }
     Ok(())
 }
 
