@@ -83,3 +83,97 @@ fn every_readme_block_runs_as_written() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Every subcommand's `--help` examples (the `termid …` lines under a line that starts with
+/// "Example"), each command's in order, with `\` continuations joined.
+fn help_examples(help: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut inside = false;
+    let mut pending = String::new();
+    for line in help.lines() {
+        if line.starts_with("Example") {
+            inside = true;
+            continue;
+        }
+        if !inside {
+            continue;
+        }
+        let text = line.trim();
+        if !pending.is_empty() {
+            pending.push(' ');
+            pending.push_str(text.trim_end_matches('\\').trim());
+            if !text.ends_with('\\') {
+                out.push(std::mem::take(&mut pending));
+            }
+            continue;
+        }
+        if !line.starts_with("  termid ") {
+            inside = line.starts_with("  ") || line.is_empty() && inside;
+            continue;
+        }
+        if text.ends_with('\\') {
+            pending = text.trim_end_matches('\\').trim().to_string();
+        } else {
+            out.push(text.to_string());
+        }
+    }
+    out
+}
+
+#[test]
+fn help_examples_are_read_with_their_continuations() {
+    let help = "Usage: x\n\nExamples:\n  termid a --x 1\n  termid b \\\n      --y 2\nBack-ends: stepwise\n";
+    assert_eq!(help_examples(help), ["termid a --x 1", "termid b --y 2"]);
+}
+
+/// Every `--help` example runs as written (each command's in a fresh folder holding the
+/// repository's models, examples and test data), and every subcommand has one.
+#[test]
+fn every_help_example_runs_as_written() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let bin = Path::new(env!("CARGO_BIN_EXE_termid")).parent().unwrap().to_path_buf();
+    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
+    // every subcommand `termid --help` lists
+    let top = Command::new(env!("CARGO_BIN_EXE_termid")).arg("--help").output().unwrap();
+    let top = String::from_utf8_lossy(&top.stdout).into_owned();
+    let commands: Vec<&str> = top
+        .lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        .filter_map(|l| l.split_whitespace().next())
+        .filter(|c| *c != "help")
+        .collect();
+    assert!(commands.len() >= 10, "{top}");
+    for command in commands {
+        let help = Command::new(env!("CARGO_BIN_EXE_termid")).args([command, "--help"]).output().unwrap();
+        let examples = help_examples(&String::from_utf8_lossy(&help.stdout));
+        assert!(!examples.is_empty(), "`termid {command} --help` has no example");
+        let dir = std::env::temp_dir().join(format!("termid-help-{command}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        for shared in ["models", "examples", "tests"] {
+            std::os::unix::fs::symlink(root.join(shared), dir.join(shared)).unwrap();
+        }
+        for example in &examples {
+            let out = Command::new("bash")
+                .args(["-euo", "pipefail", "-c", example])
+                .current_dir(&dir)
+                .env("PATH", &path)
+                .output()
+                .unwrap();
+            assert!(
+                out.status.success(),
+                "`termid {command} --help`: the example failed\n{example}\n--- stderr:\n{}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            for file in written(example) {
+                assert!(
+                    dir.join(&file).exists(),
+                    "`termid {command} --help`: `{file}` was not written by\n{example}"
+                );
+            }
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

@@ -47,7 +47,7 @@ pub enum Command {
 /// `termid new-ship`.
 #[derive(Debug, Args)]
 #[command(
-    after_help = "A particulars file (TOML; SI, degrees):\n  name = \"KVLCC2\"\n  lpp = 7.0\n  beam = 1.27\n  draught = 0.46\n  block_coefficient = 0.81\n  x_g = 0.25                # from midship, forward positive (default 0)\n  rudder_area = 0.0539\n  rudder_span = 0.345\n  propeller_diameter = 0.216\n  u0 = 1.17248\n  rudder_rate = 15.8\n  # optional: rudder_limit = 35, density = 1025, kt = [k0, k1, k2] (the propeller's K_T(J))\n\nExample:\n  termid new-ship --particulars examples/kvlcc2_particulars.toml --out ship_greybox.toml\n  termid estimate --model ship_greybox.toml --dataset train.toml --out ship_estimated.toml"
+    after_help = "A particulars file (TOML; SI, degrees):\n  name = \"KVLCC2\"\n  lpp = 7.0\n  beam = 1.27\n  draught = 0.46\n  block_coefficient = 0.81\n  x_g = 0.25                # from midship, forward positive (default 0)\n  rudder_area = 0.0539\n  rudder_span = 0.345\n  propeller_diameter = 0.216\n  u0 = 1.17248\n  rudder_rate = 15.8\n  # optional: rudder_limit = 35, density = 1025, kt = [k0, k1, k2] (the propeller's K_T(J))\n\nExample (then `termid estimate --model ship_greybox.toml --dataset YOUR_RUNS.toml`):\n  termid new-ship --particulars examples/kvlcc2_particulars.toml --out ship_greybox.toml\n  termid simulate --model ship_greybox.toml -m turning:35"
 )]
 pub struct NewShipCommand {
     /// The particulars file.
@@ -61,7 +61,7 @@ pub struct NewShipCommand {
 /// `termid estimate`.
 #[derive(Debug, Args)]
 #[command(
-    after_help = "A parameter is free when its table says so, with an optional prior and bounds:\n  [parameters.K]\n  value = 0.2          # where the estimate starts\n  free = true\n  prior = { value = 0.2, sd = 0.05 }\n  bounds = [0.0, 5.0]\n\nExample:\n  termid estimate --model nomoto.toml --data zigzag.csv --out nomoto_estimated.toml\n\nSeveral basins, each with its own rudder indicator zero `δ_0` (a free parameter of the model):\n  termid estimate --model ship.toml --dataset hsva.toml --dataset marin.toml --per-source δ_0 --out ship_est.toml"
+    after_help = "A parameter is free when its table says so, with an optional prior and bounds:\n  [parameters.K]\n  value = 0.2          # where the estimate starts\n  free = true\n  prior = { value = 0.2, sd = 0.05 }\n  bounds = [0.0, 5.0]\n\nExample (a step response of a ship with K = 0.15, T = 8; the file starts at 0.1 and 10):\n  termid simulate --model models/nomoto.toml --param K=0.15 T=8 --input δ=0.1 --duration 60 --sample 0.1 --out step.csv\n  termid estimate --model models/nomoto.toml --data step.csv --states ψ,r --out nomoto_estimated.toml\n\nSeveral basins, each with its own rudder indicator zero `δ_0` (a free parameter of the model): give\n`--dataset` once per basin and `--per-source δ_0`."
 )]
 pub struct EstimateCommand {
     /// The model file with free parameters.
@@ -109,7 +109,7 @@ pub struct EstimateCommand {
 /// `termid moments`.
 #[derive(Debug, Args)]
 #[command(
-    after_help = "Example, two shards identified together as their rows would be:\n  termid moments --model models/lorenz.toml --equation z_dot --data a.csv --out a.moments\n  termid moments --model models/lorenz.toml --equation z_dot --data b.csv --out b.moments\n  termid identify --model models/lorenz.toml --moments a.moments b.moments --out lorenz_id.toml"
+    after_help = "Example, two shards identified together as their rows would be:\n  termid simulate --model models/lorenz.toml --duration 10 --sample 0.01 --out a.csv\n  termid simulate --model models/lorenz.toml --duration 10 --sample 0.01 --initial x=1 y=1 z=20 --out b.csv\n  termid moments --model models/lorenz.toml --equation z_dot --data a.csv --out a.moments\n  termid moments --model models/lorenz.toml --equation z_dot --data b.csv --out b.moments\n  termid identify --model models/lorenz.toml --moments a.moments b.moments --out lorenz_id.toml"
 )]
 pub struct MomentsCommand {
     /// The model file whose equation's candidates are accumulated.
@@ -143,7 +143,7 @@ pub struct MomentsCommand {
 /// `termid scale`.
 #[derive(Debug, Args)]
 #[command(
-    after_help = "Example: termid scale --model models/mmg_kvlcc2.toml --factor 45.714 --out kvlcc2_full.toml\n(KVLCC2 from L = 7 m to 320 m: lengths × λ, speeds × √λ, times × √λ, masses × λ³; every coefficient by its dimension)"
+    after_help = "Example:\n  termid scale --model models/mmg_kvlcc2.toml --factor 45.714 --out kvlcc2_full.toml\n(KVLCC2 from L = 7 m to 320 m: lengths × λ, speeds × √λ, times × √λ, masses × λ³; every coefficient by its dimension)"
 )]
 pub struct ScaleCommand {
     /// The model file.
@@ -180,7 +180,7 @@ pub enum RuleName {
 /// `termid identify`.
 #[derive(Clone, Debug, Args)]
 #[command(
-    after_help = "Examples:\n  termid identify --data tests/data/hald.csv --no-time --target y --terms x1 x2 x3 x4\n  termid identify --model models/lorenz.toml --data lorenz.csv --out lorenz_id.toml\n  termid identify --model ship.toml --dataset runs.toml --derivative kinematic,kalman --smooth \\\n      --no-intercept --choose sparse,best-subset --compare u,v,r,ψ --refine u,v,r,ψ --out ship_id.toml\nBack-ends: stepwise (the paper's STPRG), efroymson, best-subset, sparse, stlsq.\nDerivatives: integral[:W] (no rate), central, five-point, savitzky-golay[:W:Q], spline[:ALPHA], kalman[:RATIO]; kinematic (ship models).\nRuns: CSV (model names, SI; aliases and semicolons read), Parquet, Arrow IPC, or a dataset file (README)."
+    after_help = "Examples:\n  termid identify --data tests/data/hald.csv --no-time --target y --terms x1 x2 x3 x4\n  termid simulate --model models/lorenz.toml --duration 20 --sample 0.01 --out lorenz.csv\n  termid identify --model models/lorenz.toml --data lorenz.csv --out lorenz_id.toml\n  termid identify --model examples/data/ship.toml --dataset examples/data/runs.toml --derivative kinematic,kalman \\\n      --smooth --no-intercept --choose sparse,best-subset --compare u,v,r,ψ --refine u,v,r,ψ --out ship_id.toml\nBack-ends: stepwise (the paper's STPRG), efroymson, best-subset, sparse, stlsq.\nDerivatives: integral[:W] (no rate), central, five-point, savitzky-golay[:W:Q], spline[:ALPHA], kalman[:RATIO]; kinematic (ship models).\nRuns: CSV (model names, SI; aliases and semicolons read), Parquet, Arrow IPC, or a dataset file (README)."
 )]
 pub struct IdentifyCommand {
     /// CSV files with a header row; several are combined (the paper's "Komb. Daten").
@@ -336,7 +336,7 @@ pub struct IdentifyCommand {
 /// `termid simulate`.
 #[derive(Debug, Args)]
 #[command(
-    after_help = "Examples:\n  termid simulate -m zigzag:20/20 --svg z.svg --out z.csv\n  termid simulate --model kvlcc2.toml -m turning:-35 --param u0=1.18\n  termid simulate --model models/lorenz.toml --integrator rk4 --dt 0.001 --duration 20\nManoeuvres: zigzag:RUDDER/HEADING[:port], turning:RUDDER, spiral[:MAX/STEP/HOLD], pullout:RUDDER, replay:FILE.\nRudder sign: the model's own (Oltmann's: positive δ turns to port; the MMG and new-ship models: to starboard);\n`port`/`starboard` are read off the heading."
+    after_help = "Examples:\n  termid simulate -m zigzag:20/20 --svg z.svg --out z.csv\n  termid simulate --model models/mmg_kvlcc2.toml -m turning:-35 --param u0=1.18\n  termid simulate --model models/lorenz.toml --integrator rk4 --dt 0.001 --duration 20\nManoeuvres: zigzag:RUDDER/HEADING[:port], turning:RUDDER, spiral[:MAX/STEP/HOLD], pullout:RUDDER, replay:FILE.\nRudder sign: the model's own (Oltmann's: positive δ turns to port; the MMG and new-ship models: to starboard);\n`port`/`starboard` are read off the heading."
 )]
 pub struct SimulateCommand {
     /// Model file (default: the embedded Oltmann 1973 ship model).
@@ -388,6 +388,9 @@ pub struct SimulateCommand {
 
 /// `termid reproduce`.
 #[derive(Debug, Args)]
+#[command(
+    after_help = "Example (the paper's Tables 1-5 and Figures 2-11 beside termid's, into oltmann1973/):\n  termid reproduce --out oltmann1973"
+)]
 pub struct ReproduceCommand {
     /// Output folder (report.md, figures/, tables/, data/, summary.json).
     #[arg(long, short = 'o', default_value = "termid-out")]
@@ -405,7 +408,9 @@ pub struct ReproduceCommand {
 
 /// `termid compare`.
 #[derive(Debug, Args)]
-#[command(after_help = "Example:\n  termid compare --model models/oltmann1973.toml --data run1.csv run2.csv")]
+#[command(
+    after_help = "Example (two runs of the default ship, every back-end on them):\n  termid simulate -m zigzag:20/20 --out run1.csv\n  termid simulate -m zigzag:10/10:port --out run2.csv\n  termid compare --model models/oltmann1973.toml --data run1.csv run2.csv"
+)]
 pub struct CompareCommand {
     /// Model file with the candidates (default: the embedded Oltmann model).
     #[arg(long)]
@@ -446,7 +451,7 @@ pub struct CompareCommand {
 /// `termid diagnose`.
 #[derive(Debug, Args)]
 #[command(
-    after_help = "Example:\n  termid diagnose --model identified.toml --dataset runs.toml --svg figs/ --out repaired.toml"
+    after_help = "Example (a model identified from the sample records, checked against them):\n  termid identify --model examples/data/ship.toml --dataset examples/data/runs.toml --derivative kalman \\\n      --smooth --no-intercept --out identified.toml\n  termid diagnose --model identified.toml --dataset examples/data/runs.toml --svg figs/\n(`--out repaired.toml` writes the model with the effect that explains the gap, where one does)"
 )]
 pub struct DiagnoseCommand {
     /// The model to check (default: the embedded Oltmann model).
@@ -469,7 +474,7 @@ pub struct DiagnoseCommand {
 /// `termid validate`.
 #[derive(Debug, Args)]
 #[command(
-    after_help = "Example:\n  termid validate --model identified.toml --dataset held_out.toml --monte-carlo 100 --svg figs/"
+    after_help = "Example (identified from four sample records, checked on the fifth):\n  termid identify --model examples/data/ship.toml --dataset examples/data/runs.toml --derivative kalman \\\n      --smooth --no-intercept --out identified.toml\n  termid validate --model identified.toml --dataset examples/data/held_out.toml --monte-carlo 100 --svg figs/"
 )]
 pub struct ValidateCommand {
     /// The model (default: the embedded Oltmann model).
