@@ -48,40 +48,63 @@ fn blocks_are_found_and_skips_give_a_reason() {
     assert_eq!(written("termid simulate -m x --out z.csv --svg f/"), ["z.csv", "f/"]);
 }
 
+/// A fresh folder holding the repository's models, examples and test data, where shell
+/// blocks run with the built `termid` first on the PATH; removed when dropped.
+struct Bench {
+    dir: PathBuf,
+    path: String,
+}
+
+impl Bench {
+    fn new(name: &str) -> Bench {
+        let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+        let dir = std::env::temp_dir().join(format!("termid-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        for shared in ["models", "examples", "tests"] {
+            std::os::unix::fs::symlink(root.join(shared), dir.join(shared)).unwrap();
+        }
+        let bin = Path::new(env!("CARGO_BIN_EXE_termid")).parent().unwrap().to_path_buf();
+        let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
+        Bench { dir, path }
+    }
+
+    /// Runs `block`, and asserts it succeeds and writes what it says it writes; `whence` names
+    /// the block in a failure.
+    fn run(&self, block: &str, whence: &str) {
+        let out = Command::new("bash")
+            .args(["-euo", "pipefail", "-c", block])
+            .current_dir(&self.dir)
+            .env("PATH", &self.path)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{whence}: the block failed\n{block}\n--- stderr:\n{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        for file in written(block) {
+            assert!(self.dir.join(&file).exists(), "{whence}: `{file}` was not written by\n{block}");
+        }
+    }
+}
+
+impl Drop for Bench {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.dir);
+    }
+}
+
 #[test]
 fn every_readme_block_runs_as_written() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
     let blocks = shell_blocks(&readme);
     assert!(blocks.iter().filter(|b| b.2.is_none()).count() >= 8, "README lost its shell blocks");
-    let dir = std::env::temp_dir().join(format!("termid-readme-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    for shared in ["models", "examples", "tests"] {
-        std::os::unix::fs::symlink(root.join(shared), dir.join(shared)).unwrap();
+    let bench = Bench::new("readme");
+    for (line, block, _) in blocks.iter().filter(|b| b.2.is_none()) {
+        bench.run(block, &format!("README.md:{line}"));
     }
-    let bin = Path::new(env!("CARGO_BIN_EXE_termid")).parent().unwrap().to_path_buf();
-    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
-    for (line, block, skip) in &blocks {
-        if skip.is_some() {
-            continue;
-        }
-        let out = Command::new("bash")
-            .args(["-euo", "pipefail", "-c", block])
-            .current_dir(&dir)
-            .env("PATH", &path)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "README.md:{line}: the block failed\n{block}\n--- stderr:\n{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        for file in written(block) {
-            assert!(dir.join(&file).exists(), "README.md:{line}: `{file}` was not written");
-        }
-    }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// Every subcommand's `--help` examples (the `termid …` lines under a line that starts with
@@ -130,9 +153,6 @@ fn help_examples_are_read_with_their_continuations() {
 /// repository's models, examples and test data), and every subcommand has one.
 #[test]
 fn every_help_example_runs_as_written() {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let bin = Path::new(env!("CARGO_BIN_EXE_termid")).parent().unwrap().to_path_buf();
-    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
     // every subcommand `termid --help` lists
     let top = Command::new(env!("CARGO_BIN_EXE_termid")).arg("--help").output().unwrap();
     let top = String::from_utf8_lossy(&top.stdout).into_owned();
@@ -149,31 +169,9 @@ fn every_help_example_runs_as_written() {
         let help = Command::new(env!("CARGO_BIN_EXE_termid")).args([command, "--help"]).output().unwrap();
         let examples = help_examples(&String::from_utf8_lossy(&help.stdout));
         assert!(!examples.is_empty(), "`termid {command} --help` has no example");
-        let dir = std::env::temp_dir().join(format!("termid-help-{command}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        for shared in ["models", "examples", "tests"] {
-            std::os::unix::fs::symlink(root.join(shared), dir.join(shared)).unwrap();
-        }
+        let bench = Bench::new(&format!("help-{command}"));
         for example in &examples {
-            let out = Command::new("bash")
-                .args(["-euo", "pipefail", "-c", example])
-                .current_dir(&dir)
-                .env("PATH", &path)
-                .output()
-                .unwrap();
-            assert!(
-                out.status.success(),
-                "`termid {command} --help`: the example failed\n{example}\n--- stderr:\n{}",
-                String::from_utf8_lossy(&out.stderr)
-            );
-            for file in written(example) {
-                assert!(
-                    dir.join(&file).exists(),
-                    "`termid {command} --help`: `{file}` was not written by\n{example}"
-                );
-            }
+            bench.run(example, &format!("`termid {command} --help`"));
         }
-        let _ = std::fs::remove_dir_all(&dir);
     }
 }
