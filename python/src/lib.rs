@@ -756,9 +756,7 @@ impl PyModel {
     ) -> PyResult<(String, PyModel)> {
         let frames = self.frames(runs)?;
         // one RK4 step per sample by default: the recorded inputs are known at the samples
-        let dt = dt.unwrap_or_else(|| {
-            frames.iter().map(|f| termid::data::median_step(f.time())).fold(f64::INFINITY, f64::min)
-        });
+        let dt = dt.unwrap_or_else(|| termid::data::sample_step(&frames));
         let settings = termid::diagnose::EstimateSettings {
             coefficients,
             iterations,

@@ -80,6 +80,12 @@ pub fn median_step(t: &[f64]) -> f64 {
     steps[steps.len() / 2]
 }
 
+/// The shortest of the runs' median sample intervals: the step that re-simulates every run
+/// once per sample (the recorded inputs are known only at the samples).
+pub fn sample_step(frames: &[Frame]) -> f64 {
+    frames.iter().map(|f| median_step(f.time())).fold(f64::INFINITY, f64::min)
+}
+
 /// Refuses a step in time more than `factor` times the median step (a logging gap or a jump).
 pub fn check_gaps(frame: &Frame, factor: f64) -> Result<(), DataError> {
     let t = frame.time();

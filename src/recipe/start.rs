@@ -213,7 +213,7 @@ fn refine(
     intercept: bool,
 ) -> Result<Refined, String> {
     let runs_of = |frames: &[Frame]| -> Result<Runs, String> {
-        let sample = frames.iter().map(|f| crate::data::median_step(f.time())).fold(f64::INFINITY, f64::min);
+        let sample = crate::data::sample_step(frames);
         // one RK4 step per sample: the recorded input is known only at the samples
         let runs = Runs::new(model, frames, sample, crate::sim::Integrator::Rk4)
             .map_err(|e| e.to_string())?

@@ -43,9 +43,7 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
         frames.extend(more);
     }
     // one RK4 step per sample by default: the recorded input is known only at the samples
-    let dt = cmd.dt.unwrap_or_else(|| {
-        frames.iter().map(|f| termid::data::median_step(f.time())).fold(f64::INFINITY, f64::min)
-    });
+    let dt = cmd.dt.unwrap_or_else(|| termid::data::sample_step(&frames));
     let mut runs = Runs::new(&model, &frames, dt, Integrator::Rk4)?;
     if let Some(states) = &cmd.states {
         runs = runs.comparing(states)?;
