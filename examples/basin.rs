@@ -1,7 +1,7 @@
 //! The synthetic-basin study of issue 7: the default model's five zigzags recorded at 20 Hz
 //! with sensor noise and per-run approach speeds, identified from four of them with each
 //! derivative method, validated on the fifth and on turning circles against the noise-free
-//! truth. Prints the README's table.
+//! truth. Prints the table of docs/guide/ship-records.md.
 //!
 //! `cargo run --release --example basin [-- OUTPUT_FOLDER]`
 

@@ -6,7 +6,7 @@
 //! back at midship at the end of each record. From the training zigzags only, termid's recipe
 //! for a new ship (`models/new_ship.toml`, the tracking filter, the back-end chosen by
 //! prediction on held-out runs) identifies a model that then predicts the truth's turning
-//! circles and the held-out zigzags. Prints README's table, one row per noise seed.
+//! circles and the held-out zigzags. Prints the table of docs/guide/mmg-basin.md, one row per noise seed.
 //!
 //! `cargo run --release --example mmg_basin [-- OUTPUT_FOLDER]` (seeds: MMG_SEEDS=0,1,2;
 //! MMG_RUNS=simman trains on the SIMMAN HSVA set instead — 13 zigzags from 5°/1° to 35°/5°,

@@ -1,4 +1,4 @@
-//! Writes `examples/data/`: what README's measured-data commands read, so that every README
+//! Writes `examples/data/`: what the measured-data commands of README and docs/guide/ship-records.md read, so that every README
 //! block runs on a fresh clone. Four training zigzags and one held-out zigzag of the default
 //! ship recorded in the synthetic basin (20 Hz, the basin's sensor noise, per-run approach
 //! speeds; the paper's five Z-manoeuvres, `PAPER_RUNS`), the dataset files `runs.toml` and

@@ -1,12 +1,11 @@
-//! The SIMMAN 2008 KVLCC2 case study (issue 15, README "A real ship: KVLCC2 of SIMMAN
-//! 2008"): a model identified from HSVA's thirteen zigzags (README's `identify` command)
+//! The SIMMAN 2008 KVLCC2 case study (docs/guide/simman.md): a model identified from HSVA's thirteen zigzags (the guide's `identify` command)
 //! predicts MARIN's four zigzags, which it never saw (full scale, read at the model's scale),
-//! and its turning circles. Prints README's tables and writes two figures.
+//! and its turning circles. Prints the guide's tables and writes two figures.
 //!
 //! `SIMMAN=/path/to/clone cargo run --release --example simman -- IDENTIFIED.toml [OUT_FOLDER]`;
 //! `… --example simman -- --table LABEL=MODEL.toml …` prints one row per model instead: the
 //! first overshoot of each MARIN zigzag (steered by the model) less MARIN's, and the ±35°
-//! tactical diameters (README's table of training sets and model families)
+//! tactical diameters (the guide's table of training sets and model families)
 //! (the clone: the public repository martinlarsalbert/System-identification-of-Vessel-
 //! Manoeuvring-Models; its records are read where they are, never copied).
 

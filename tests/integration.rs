@@ -52,7 +52,7 @@ mod mmg;
 // The SIMMAN case study's dataset files, on records laid out as the basins write them.
 #[path = "integration/simman.rs"]
 mod simman;
-// README as a script: every shell block runs, in order, on the repository's own files.
+// README and the guide as scripts: every shell block runs, in order, on the repository's own files.
 #[path = "integration/readme.rs"]
 mod readme;
 // Every figure kind, read off its SVG as a person would look at it.
@@ -61,3 +61,6 @@ mod figures;
 // Grey-box: named parameters of a model file estimated by output error (Lorenz, Nomoto).
 #[path = "integration/greybox.rs"]
 mod greybox;
+// The reference (docs/reference/) against the code: every key documented, nothing stale.
+#[path = "integration/reference.rs"]
+mod reference;

@@ -1,5 +1,6 @@
 """The examples run as written: the paper's Fig. 6 from Python."""
 import os
+import re
 import runpy
 import sys
 
@@ -62,14 +63,31 @@ def test_package_readme_examples_run():
         exec(compile(block, "python/README.md", "exec"), scope)
 
 
-def test_project_readme_python_blocks_run(tmp_path, monkeypatch):
-    """The Python blocks of the project's README run as written, in order, in one scope (a
-    block after `<!-- readme-test: skip: why -->` is a fragment and is left out)."""
+ROOT = os.path.join(EXAMPLES, "..", "..")
+
+
+def _pages_with_python():
+    """README.md and every page of the guide under docs/ that holds a Python block."""
+    pages = ["README.md"]
+    for folder, _, files in sorted(os.walk(os.path.join(ROOT, "docs"))):
+        pages += [os.path.relpath(os.path.join(folder, f), ROOT) for f in sorted(files) if f.endswith(".md")]
+    return [p for p in pages if "```python" in open(os.path.join(ROOT, p), encoding="utf-8").read()]
+
+
+def test_the_guide_has_python_blocks():
+    assert "README.md" in _pages_with_python() and len(_pages_with_python()) >= 2
+
+
+@pytest.mark.parametrize("page", _pages_with_python())
+def test_python_blocks_of_readme_and_the_guide_run(page, tmp_path, monkeypatch):
+    """The Python blocks of README.md and of each page of the guide run as written, in order,
+    in one scope per page (a block after `<!-- readme-test: skip: why -->` is a fragment and
+    is left out); every file a block saves is there afterwards."""
     pytest.importorskip("matplotlib")
     pytest.importorskip("sklearn")
     monkeypatch.setenv("MPLBACKEND", "Agg")
     monkeypatch.chdir(tmp_path)  # what the blocks write lands here
-    lines = open(os.path.join(EXAMPLES, "..", "..", "README.md"), encoding="utf-8").read().splitlines()
+    lines = open(os.path.join(ROOT, page), encoding="utf-8").read().splitlines()
     blocks, k = [], 0
     while k < len(lines):
         if lines[k].strip() == "```python":
@@ -78,8 +96,10 @@ def test_project_readme_python_blocks_run(tmp_path, monkeypatch):
                 blocks.append((k + 1, "\n".join(lines[k + 1:end])))
             k = end
         k += 1
-    assert len(blocks) >= 2
+    assert blocks, page
     scope: dict = {}
     for line, block in blocks:
-        exec(compile("\n" * line + block, "README.md", "exec"), scope)
-    assert (tmp_path / "identified.toml").exists()
+        exec(compile("\n" * line + block, page, "exec"), scope)
+    for _, block in blocks:
+        for saved in re.findall(r'\.save\("([^"]+)"\)', block):
+            assert (tmp_path / saved).exists(), saved

@@ -384,7 +384,9 @@ impl Dataset {
                     .cloned()
                     .chain(body.iter().map(|l| match run.delimiter {
                         Delimiter::Comma => l.to_string(),
-                        Delimiter::Semicolon => l.replace(';', ","),
+                        // a semicolon-separated file is a European spreadsheet's: its commas
+                        // are decimal commas
+                        Delimiter::Semicolon => l.replace(',', ".").replace(';', ","),
                         Delimiter::Whitespace => l.split_whitespace().collect::<Vec<_>>().join(","),
                     }))
                     .collect::<Vec<_>>()
@@ -575,6 +577,19 @@ mod tests {
 
     fn write(dir: &Path, name: &str, text: &str) {
         std::fs::write(dir.join(name), text).unwrap();
+    }
+
+    /// A semicolon-separated file with decimal commas, as a European spreadsheet writes it.
+    #[test]
+    fn semicolons_with_decimal_commas() {
+        let dir = std::env::temp_dir().join(format!("termid-semicolon-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        write(&dir, "e.csv", "Zeit;Ruder\n0;1,5\n0,5;-2,25\n");
+        let text = "[columns]\nt = \"Zeit [s]\"\n\"δ\" = \"Ruder [rad]\"\n[[runs]]\nfile = \"e.csv\"\ndelimiter = \"semicolon\"\n";
+        let set: Dataset = toml::from_str(text).unwrap();
+        let (frames, _) = set.read(&dir, "t").unwrap();
+        assert_eq!(frames[0].time(), [0.0, 0.5]);
+        assert_eq!(frames[0].column("δ").unwrap(), [1.5, -2.25]);
     }
 
     /// A basin file as HSVA writes them: Latin-1 header lines (a degree sign), no row of

@@ -1,4 +1,4 @@
-//! The serde shape of a model file. `models/README.md` documents each key.
+//! The serde shape of a model file. `docs/reference/model-file.md` documents each key (a test checks it).
 
 use std::collections::BTreeMap;
 

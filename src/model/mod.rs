@@ -1,6 +1,6 @@
 //! Model files (TOML): the states, inputs, parameters, derived variables and aliases of a
 //! system, and per equation its candidate terms, forced terms, back-end and identified
-//! coefficients. One format serves identification and simulation; `models/README.md`
+//! coefficients. One format serves identification and simulation; `docs/reference/model-file.md`
 //! documents every key. Errors name the file, the line and the key, and for a bad term the
 //! caret inside it.
 

@@ -238,13 +238,19 @@ impl Scenario for ShipScenario {
         }
         if let Some(map) = metrics.as_object() {
             for (k, v) in map {
-                if k == "manoeuvre" || k == "points" || k == "reversals_s" {
+                // a length in ship lengths goes beside the same length in metres
+                if k == "manoeuvre" || k == "points" || k == "reversals_s" || k.ends_with("_lpp") {
                     continue;
                 }
                 let (label, unit, decimals) = metric_label(k);
+                let in_lengths = k
+                    .strip_suffix("_m")
+                    .and_then(|stem| map.get(&format!("{stem}_lpp")))
+                    .and_then(serde_json::Value::as_f64)
+                    .map_or(String::new(), |l| format!(" ({l:.2} L)"));
                 let value = match (v.is_null(), v.as_f64()) {
-                    (true, _) => "not reached (run longer?)".to_string(),
-                    (false, Some(x)) => format!("{x:.decimals$} {unit}"),
+                    (true, _) => format!("not reached in {} s (a longer --duration)", settings.duration),
+                    (false, Some(x)) => format!("{x:.decimals$} {unit}{in_lengths}"),
                     (false, None) => v.as_str().map_or_else(|| v.to_string(), str::to_string),
                 };
                 text.push(format!("  {label:<28} {}", value.trim_end()));

@@ -1,8 +1,10 @@
-//! README runs as written: every ```sh block, in the order of the file and read from the file
-//! itself (so README and test cannot drift apart), runs with `termid` on PATH in one scratch
-//! folder that sees the repository's `models/`, `examples/` and `tests/`; each must exit 0 and
-//! leave every file or folder it names after `--out`, `--svg` or `--prepared-svg`. A block that
-//! cannot run here says why in an HTML comment on the line before it
+//! README and the guide run as written: every ```sh block of README.md and of every page under
+//! `docs/`, in the order of each file and read from the file itself (so page and test cannot
+//! drift apart), runs with `termid` on PATH in a scratch folder of its page's own that sees the
+//! repository's `models/`, `examples/` and `tests/`; each must exit 0 and leave every file or
+//! folder it names after `--out`, `--svg` or `--prepared-svg`, and no two commands of a page
+//! write the same path (an example does not overwrite another's output). A block that cannot
+//! run here says why in an HTML comment on the line before it
 //! (`<!-- readme-test: skip: why -->`), visible to whoever reads the source.
 
 use std::path::{Path, PathBuf};
@@ -95,16 +97,56 @@ impl Drop for Bench {
     }
 }
 
-#[test]
-fn every_readme_block_runs_as_written() {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
-    let blocks = shell_blocks(&readme);
-    assert!(blocks.iter().filter(|b| b.2.is_none()).count() >= 8, "README lost its shell blocks");
-    let bench = Bench::new("readme");
-    for (line, block, _) in blocks.iter().filter(|b| b.2.is_none()) {
-        bench.run(block, &format!("README.md:{line}"));
+/// README.md and every Markdown page under `docs/`, relative to the repository.
+fn pages() -> Vec<PathBuf> {
+    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+        let mut entries: Vec<PathBuf> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().path()).collect();
+        entries.sort();
+        for path in entries {
+            if path.is_dir() {
+                walk(&path, out);
+            } else if path.extension().is_some_and(|e| e == "md") {
+                out.push(path);
+            }
+        }
     }
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let mut out = vec![root.join("README.md")];
+    walk(&root.join("docs"), &mut out);
+    out.iter().map(|p| p.strip_prefix(&root).unwrap().to_path_buf()).collect()
+}
+
+#[test]
+fn every_block_of_readme_and_the_guide_runs_as_written() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let pages = pages();
+    assert!(pages.len() >= 20, "the guide lost its pages: {pages:?}");
+    let mut ran = 0;
+    for page in &pages {
+        let text = std::fs::read_to_string(root.join(page)).unwrap();
+        let blocks: Vec<_> = shell_blocks(&text).into_iter().filter(|b| b.2.is_none()).collect();
+        if blocks.is_empty() {
+            continue;
+        }
+        // each output path written by one command of the page only
+        let mut writers: Vec<(String, String)> = Vec::new();
+        for (line, block, _) in &blocks {
+            for file in written(block) {
+                let here = format!("{}:{line}", page.display());
+                if let Some((_, first)) = writers.iter().find(|(f, _)| *f == file) {
+                    panic!("`{file}` is written by {first} and again by {here}");
+                }
+                writers.push((file, here));
+            }
+        }
+        let name = page.to_string_lossy().replace(['/', '.'], "-");
+        let bench = Bench::new(&name);
+        for (line, block, _) in &blocks {
+            bench.run(block, &format!("{}:{line}", page.display()));
+            ran += 1;
+        }
+    }
+    assert!(ran >= 16, "only {ran} blocks ran");
 }
 
 /// Every subcommand's `--help` examples (the `termid …` lines under a line that starts with

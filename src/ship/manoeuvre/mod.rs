@@ -60,6 +60,9 @@ macro_rules! manoeuvres {
         }
 
         impl Manoeuvre {
+            /// One example of every manoeuvre, in the registry's order (its name before `:`).
+            pub const EXAMPLES: &'static [&'static str] = &[$($example),+];
+
             /// Parses a manoeuvre by its registry name: `zigzag:20/20`, `zigzag:20/10:port`,
             /// `turning:35`, `spiral`, `spiral:20/2/120` (max rudder °/step °/hold s),
             /// `pullout:20`, `replay:FILE.csv`, ….
@@ -69,7 +72,7 @@ macro_rules! manoeuvres {
                     $( $name $(| $alias)* => Ok(Manoeuvre::$variant(<$test as Test>::parse(text, rest)?)), )+
                     _ => Err(ShipError::Manoeuvre {
                         text: text.into(),
-                        message: format!("known manoeuvres: {}", [$($example),+].join(", ")),
+                        message: format!("known manoeuvres: {}", Manoeuvre::EXAMPLES.join(", ")),
                     }),
                 }
             }
