@@ -81,6 +81,11 @@ pub trait Plugin: Sync {
     fn reference(&self, _model: &Model) -> Option<(f64, f64, f64)> {
         None
     }
+    /// The plane a run of `model` moves in (a ship's track), for figures that set measured and
+    /// simulated runs side by side; `None`: every state is drawn over time.
+    fn plane(&self, _model: &Model) -> Option<crate::sim::Plane> {
+        None
+    }
     /// The field's name for a coefficient (`Y'_vvr` for the v̇ coefficient of v²r/u).
     fn coefficient_name(&self, _model: &Model, _equation: &str, _term: &crate::term::Term) -> Option<String> {
         None

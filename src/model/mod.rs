@@ -285,6 +285,16 @@ impl Model {
         self.spec.model.provenance = provenance;
     }
 
+    /// Marks the model as identified from `sources` (its data files, dataset or statistics
+    /// files): named so, with its former name and provenance kept in the provenance, so that
+    /// whatever simulates it is not titled as the model its candidates came from.
+    pub fn mark_identified(&mut self, sources: &str) {
+        let (name, provenance) = (&self.spec.model.name, &self.spec.model.provenance);
+        self.spec.model.provenance =
+            format!("identified by termid from {sources}, with the candidates of {name} ({provenance})");
+        self.spec.model.name = format!("identified from {sources}");
+    }
+
     /// Reads and checks a model file. Plug-in tables (`[ship]`) are kept unread:
     /// `crate::plugins::load` also checks them.
     pub fn load(path: &Path) -> Result<Model, ModelError> {

@@ -1,24 +1,31 @@
 //! Measured runs beside their simulations: one figure per run, a row per measured state with
 //! the model's simulation (and a second one, e.g. with a diagnosed effect) on the left and the
-//! residual on the right, each in the model's unit (angles in degrees).
+//! residual on the right, each in the model's unit (angles in degrees); positions in a plane
+//! (a ship's track) as one track at equal scale, with the distance between them over time.
 
 use super::{labelled, Figure, Panel, Series};
 use crate::data::Frame;
 use crate::diagnose::Diagnosis;
 use crate::model::dimension::shown;
 use crate::model::Model;
-use crate::sim::Trajectory;
+use crate::sim::{Plane, Trajectory};
 use crate::uncertainty::band;
 
 /// Figures of a diagnosis, one per run: each measured state against the simulation before
 /// (and after) the winning effect, and the residual.
-pub fn diagnosis_figures(model: &Model, d: &Diagnosis, runs: &[Frame]) -> Vec<(String, Figure)> {
-    comparison_figures(model, runs, &d.before, &d.after, &[], "diagnose")
+pub fn diagnosis_figures(
+    model: &Model,
+    d: &Diagnosis,
+    runs: &[Frame],
+    plane: Option<&Plane>,
+) -> Vec<(String, Figure)> {
+    comparison_figures(model, runs, &d.before, &d.after, &[], "diagnose", plane)
 }
 
 /// One figure per run: every measured state with the model's simulation (and a second
 /// simulation, if given; and the pointwise 5-95 % band of Monte-Carlo `draws`, the
-/// simulations of every run with each drawn model), and their residuals, side by side.
+/// simulations of every run with each drawn model), and their residuals, side by side. The
+/// states of a `plane` are drawn as one track instead, beside the distance between the tracks.
 pub fn comparison_figures(
     model: &Model,
     runs: &[Frame],
@@ -26,6 +33,7 @@ pub fn comparison_figures(
     other: &[Trajectory],
     draws: &[&[Trajectory]],
     title: &str,
+    plane: Option<&Plane>,
 ) -> Vec<(String, Figure)> {
     runs.iter()
         .enumerate()
@@ -33,8 +41,12 @@ pub fn comparison_figures(
             let before = sims.get(k)?;
             let t = f.time();
             let mut panels = Vec::new();
+            let in_plane = |name: &str| plane.is_some_and(|p| p.across.0 == name || p.up.0 == name);
             for (i, name) in before.state_names.iter().enumerate() {
                 let Some(meas) = f.column(name) else { continue };
+                if in_plane(name) {
+                    continue;
+                }
                 let (factor, shown) = shown(model.unit(name));
                 let n = meas.len().min(before.states[i].len()).min(t.len());
                 let time = t[..n].to_vec();
@@ -49,8 +61,9 @@ pub fn comparison_figures(
                     vec![Series::line("model − measured", time.clone(), gap(&before.states[i])).colored(1)];
                 if let Some(after) = other.get(k) {
                     series.push(Series::dashed("with the effect", time.clone(), scaled(&after.states[i])));
+                    // dashed over the first residual, which stays in sight under it
                     residual.push(
-                        Series::line("with the effect − measured", time.clone(), gap(&after.states[i]))
+                        Series::dashed("with the effect − measured", time.clone(), gap(&after.states[i]))
                             .colored(2),
                     );
                 }
@@ -81,6 +94,9 @@ pub fn comparison_figures(
                     ..Panel::default()
                 });
             }
+            if let Some(track) = plane.and_then(|p| track_panels(p, f, before, other.get(k))) {
+                panels.extend(track);
+            }
             let mut fig = Figure::new(&format!("{title}: {}", f.origin()), panels);
             fig.columns = 2;
             fig.shared_legend = true;
@@ -89,4 +105,59 @@ pub fn comparison_figures(
             Some((f.origin().to_string(), fig))
         })
         .collect()
+}
+
+/// The measured track and the simulated ones at equal scale, and the distance between them
+/// over time; `None` where the run does not hold both positions.
+fn track_panels(
+    plane: &Plane,
+    f: &Frame,
+    sim: &Trajectory,
+    other: Option<&Trajectory>,
+) -> Option<[Panel; 2]> {
+    let (across, up) = (f.column(&plane.across.0)?, f.column(&plane.up.0)?);
+    let l = plane.length;
+    let n = across.len().min(up.len()).min(f.time().len());
+    let scaled = |v: &[f64], m: usize| v[..m].iter().map(|x| x / l).collect::<Vec<f64>>();
+    let mut track = vec![Series::line("measured", scaled(across, n), scaled(up, n))];
+    let time = f.time()[..n].to_vec();
+    let mut distance = Vec::new();
+    for (k, (label, t)) in [("model", Some(sim)), ("with the effect", other)].into_iter().enumerate() {
+        let Some(t) = t else { continue };
+        let (x, y) = (state(t, &plane.across.0)?, state(t, &plane.up.0)?);
+        let m = n.min(x.len()).min(y.len());
+        track.push(Series::dashed(label, scaled(x, m), scaled(y, m)).colored(k + 1));
+        let gap = (0..m).map(|j| (x[j] - across[j]).hypot(y[j] - up[j]) / l).collect();
+        let name = format!("{label} − measured");
+        let s = if k == 0 {
+            Series::line(&name, time[..m].to_vec(), gap)
+        } else {
+            Series::dashed(&name, time[..m].to_vec(), gap)
+        };
+        distance.push(s.colored(k + 1));
+    }
+    Some([
+        Panel {
+            title: plane.title.clone(),
+            x_label: plane.across.1.clone(),
+            y_label: plane.up.1.clone(),
+            series: track,
+            equal_axes: true,
+            unit_ticks: true,
+            height: Some(420),
+            ..Panel::default()
+        },
+        Panel {
+            title: "distance between the tracks".into(),
+            x_label: "t [s]".into(),
+            y_label: "distance/L [-]".into(),
+            series: distance,
+            ..Panel::default()
+        },
+    ])
+}
+
+/// A simulated state by name.
+fn state<'a>(t: &'a Trajectory, name: &str) -> Option<&'a [f64]> {
+    t.state_names.iter().position(|n| n == name).map(|i| t.states[i].as_slice())
 }

@@ -162,12 +162,18 @@ pub enum PlotError {
 }
 
 /// An axis label: `name [unit]`, or the bare name where there is no unit.
-pub(crate) fn labelled(name: &str, unit: &str) -> String {
+pub fn labelled(name: &str, unit: &str) -> String {
     if unit.is_empty() {
         name.to_string()
     } else {
         format!("{name} [{unit}]")
     }
+}
+
+/// `c` mixed half with white: a wide line that lines drawn over it leave visible.
+fn lighter(c: RGBColor) -> RGBColor {
+    let mix = |v: u8| (f64::from(v) * 0.5 + 255.0 * 0.5).round() as u8;
+    RGBColor(mix(c.0), mix(c.1), mix(c.2))
 }
 
 fn style_is(a: Style, b: Style) -> bool {
@@ -235,7 +241,11 @@ fn legend_corner(
         .flat_map(|(k, (mx, label))| {
             let line = (0..=20).map(move |i| (*mx, y.0 + (y.1 - y.0) * f64::from(i) / 20.0));
             let at = y.1 - 0.08 * k as f64 * (y.1 - y.0);
-            let text = (0..label.chars().count()).map(move |c| (*mx + 5.5 * c as f64 * per_px, at));
+            let n = label.chars().count();
+            let width = (5.5 * n as f64 + 4.0) * per_px;
+            let left = panel.markers.iter().any(|(other, _)| *other > *mx && *other <= *mx + width);
+            let sign = if left { -1.0 } else { 1.0 };
+            let text = (0..n).map(move |c| (*mx + sign * 5.5 * c as f64 * per_px, at));
             line.chain(text)
         })
         .collect();
@@ -304,11 +314,6 @@ impl Figure {
         }
     }
 
-    /// Rows of panels the figure takes.
-    fn rows(&self) -> usize {
-        self.panels.len().max(1).div_ceil(self.columns.max(1))
-    }
-
     /// Writes the figure as SVG (atomically: the old file stays until the new one is whole).
     pub fn write_svg(&self, path: &Path) -> Result<(), PlotError> {
         let file = path.display().to_string();
@@ -323,12 +328,15 @@ impl Figure {
         let err = |e: &dyn std::fmt::Display| PlotError::Draw(e.to_string());
         let title_h = if self.title.is_empty() { 0 } else { 30 };
         let legend_h = if self.shared_legend { 24 } else { 0 };
-        // a one-column figure's panels may each have their own height; a grid's rows are even
-        let heights: Vec<u32> = if self.columns <= 1 {
-            self.panels.iter().map(|p| p.height.unwrap_or(self.panel_height)).collect()
-        } else {
-            vec![self.panel_height; self.rows()]
-        };
+        // a panel may have its own height (a track); a grid's row takes its tallest panel's
+        let columns = self.columns.max(1);
+        let heights: Vec<u32> = self
+            .panels
+            .chunks(columns)
+            .map(|row| {
+                row.iter().map(|p| p.height.unwrap_or(self.panel_height)).max().unwrap_or(self.panel_height)
+            })
+            .collect();
         let height = title_h + legend_h + heights.iter().sum::<u32>().max(self.panel_height);
         let mut svg = String::new();
         {
@@ -348,32 +356,48 @@ impl Figure {
             } else {
                 body
             };
-            let areas = if self.columns <= 1 {
-                let mut rest = body;
-                let mut areas = Vec::new();
-                for h in &heights {
-                    let (area, below) = rest.split_vertically(*h);
-                    areas.push(area);
-                    rest = below;
-                }
-                areas
-            } else {
-                body.split_evenly((self.rows(), self.columns))
-            };
-            for (panel, area) in self.panels.iter().zip(areas) {
-                self.draw_panel(panel, &area).map_err(|e| err(&e))?;
+            let mut rest = body;
+            let mut areas = Vec::new();
+            for h in &heights {
+                let (row, below) = rest.split_vertically(*h);
+                areas.extend(if columns > 1 { row.split_evenly((1, columns)) } else { vec![row] });
+                rest = below;
+            }
+            let shared = self.shared_x();
+            for ((panel, area), x) in self.panels.iter().zip(areas).zip(shared) {
+                self.draw_panel(panel, &area, x).map_err(|e| err(&e))?;
             }
             root.present().map_err(|e| err(&e))?;
         }
         Ok(svg)
     }
 
+    /// Each panel's x range where it shares one with other panels: panels over the same x
+    /// axis (the same label: time, in a figure of stacked panels) are drawn over the range of
+    /// all of them, so that one instant stands at one place in every panel. Tracks (equal
+    /// axes) keep their own.
+    fn shared_x(&self) -> Vec<Option<(f64, f64)>> {
+        let over = |p: &Panel| !p.equal_axes && !p.x_label.is_empty();
+        self.panels
+            .iter()
+            .map(|p| {
+                let same: Vec<&Panel> =
+                    self.panels.iter().filter(|q| over(q) && q.x_label == p.x_label).collect();
+                (over(p) && same.len() > 1).then(|| {
+                    range(same.iter().flat_map(|q| q.series.iter().flat_map(|s| s.x.iter().copied())), false)
+                })
+            })
+            .collect()
+    }
+
     fn draw_panel<DB: DrawingBackend>(
         &self,
         panel: &Panel,
         area: &DrawingArea<DB, plotters::coord::Shift>,
+        shared_x: Option<(f64, f64)>,
     ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
-        let (mut x0, mut x1) = range(panel.series.iter().flat_map(|s| s.x.iter().copied()), false);
+        let (mut x0, mut x1) =
+            shared_x.unwrap_or_else(|| range(panel.series.iter().flat_map(|s| s.x.iter().copied()), false));
         let (mut y0, mut y1) =
             range(panel.series.iter().flat_map(|s| s.y.iter().chain(&s.upper).copied()), panel.log_y);
         let px = plot_px(area.dim_in_pixel());
@@ -394,10 +418,10 @@ impl Figure {
         if own_legend && corner.1 > 0 && !panel.equal_axes {
             // every corner has data under the legend: room beside the data (a tall legend of
             // many entries) or above them (a wide one), whichever takes less of the panel,
-            // so that it covers none
+            // so that it covers none; above them where the x axis is shared with other panels
             let (lw, lh) = legend_px(panel);
             let (wide, high) = ((lw + 4.0) / px.0, (lh + 4.0) / px.1);
-            if wide < high && wide < 0.5 && !panel.log_y {
+            if wide < high && wide < 0.5 && !panel.log_y && shared_x.is_none() {
                 x1 = x0 + (x1 - x0) / (1.0 - wide);
             } else {
                 let room = 1.0 / (1.0 - high).max(1.0 / 3.0);
@@ -426,7 +450,7 @@ impl Figure {
                 .x_label_formatter(&|v| if counted { whole(*v) } else { short(*v) })
                 .y_label_formatter(&|v| format!("{v:.0e}"))
                 .draw()?;
-            draw_series(&mut chart, panel, legend, y0, y1)?;
+            draw_series(&mut chart, panel, legend, y0, y1, (x1 - x0) / px.0)?;
         } else {
             let mut chart = builder.build_cartesian_2d(x0..x1, y0..y1)?;
             // steps and alternatives are counted: their axis is labelled at whole numbers only
@@ -450,7 +474,7 @@ impl Figure {
                 .x_label_formatter(&|v| if counted { whole(*v) } else { short(*v) })
                 .y_label_formatter(&|v| short(*v))
                 .draw()?;
-            draw_series(&mut chart, panel, legend, y0, y1)?;
+            draw_series(&mut chart, panel, legend, y0, y1, (x1 - x0) / px.0)?;
         }
         Ok(())
     }
@@ -489,9 +513,12 @@ fn legend_row<DB: DrawingBackend>(
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     let mut seen: Vec<(String, Style, RGBColor)> = Vec::new();
     for panel in panels {
+        let under = panel.series.iter().any(|s| style_is(s.style, Style::Dashed));
         for (k, s) in panel.series.iter().enumerate() {
             if !s.name.is_empty() && !seen.iter().any(|(n, _, _)| *n == s.name) {
-                seen.push((s.name.clone(), s.style, PALETTE[s.color.unwrap_or(k) % PALETTE.len()]));
+                let color = PALETTE[s.color.unwrap_or(k) % PALETTE.len()];
+                let color = if under && style_is(s.style, Style::Line) { lighter(color) } else { color };
+                seen.push((s.name.clone(), s.style, color));
             }
         }
     }
@@ -518,6 +545,7 @@ fn draw_series<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate<
     legend: Option<SeriesLabelPosition>,
     y0: f64,
     y1: f64,
+    per_px: f64,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     for (k, (x, label)) in panel.markers.iter().enumerate() {
         chart.draw_series(std::iter::once(PathElement::new(
@@ -525,17 +553,25 @@ fn draw_series<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate<
             PALETTE[4].stroke_width(1),
         )))?;
         // each label a line lower than the one before, so that two close markers' labels
-        // do not print over each other
+        // do not print over each other; to the left of its line where another marker's line
+        // would cross it on the right
         let share = 0.08 * k as f64;
         let at = if panel.log_y { y1 * (y0 / y1).powf(share) } else { y1 - share * (y1 - y0) };
+        let width = (5.5 * label.chars().count() as f64 + 4.0) * per_px;
+        let crossed = panel.markers.iter().any(|(other, _)| *other > *x && *other <= *x + width);
+        let side = if crossed { HPos::Right } else { HPos::Left };
         chart.draw_series(std::iter::once(Text::new(
             label.clone(),
             (*x, at),
-            ("sans-serif", 11).into_font(),
+            TextStyle::from(("sans-serif", 11).into_font()).pos(Pos::new(side, VPos::Top)),
         )))?;
     }
+    // a solid line (the reference: measured, true) under dashed ones drawn over it is drawn
+    // wider and lighter, so that it shows beside the dashes that run along it
+    let under = panel.series.iter().any(|s| style_is(s.style, Style::Dashed));
     for (k, s) in panel.series.iter().enumerate() {
         let color = PALETTE[s.color.unwrap_or(k) % PALETTE.len()];
+        let color = if under && style_is(s.style, Style::Line) { lighter(color) } else { color };
         let pts: Vec<(f64, f64)> =
             s.x.iter()
                 .zip(&s.y)
@@ -543,6 +579,7 @@ fn draw_series<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate<
                 .map(|(x, y)| (*x, *y))
                 .collect();
         let anno = match s.style {
+            Style::Line if under => chart.draw_series(LineSeries::new(pts, color.stroke_width(5)))?,
             Style::Line => chart.draw_series(LineSeries::new(pts, color.stroke_width(2)))?,
             // dashes measured in pixels, whatever the sampling
             Style::Dashed => chart.draw_series(DashedLineSeries::new(pts, 7, 4, color.stroke_width(2)))?,

@@ -34,13 +34,34 @@ pub fn prepared_figure(
             every_rate = false;
             continue;
         };
+        // the axis is the prepared rate's (three times its range): differences of a noisy
+        // record reach far beyond it and would flatten the rate to a line
+        let rate = line(d);
+        let (lo, hi) = rate
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
+        let span = if hi > lo { hi - lo } else { lo.abs().max(1e-12) };
+        let (bottom, top) = (lo - span, hi + span);
         let mut series = Vec::new();
+        let mut beyond = 0;
         if let Ok(cd) = CentralDifference.differentiate(raw.time(), r) {
-            series.push(Series::points("central differences of raw", times(raw), line(&cd)));
+            let (t, v): (Vec<f64>, Vec<f64>) = times(raw)
+                .into_iter()
+                .zip(line(&cd))
+                .filter(|(_, v)| {
+                    let inside = *v >= bottom && *v <= top;
+                    beyond += usize::from(!inside);
+                    inside
+                })
+                .unzip();
+            series.push(Series::points("central differences of raw", t, v));
         }
-        series.push(Series::line("prepared rate", times(prepared), line(d)));
+        series.push(Series::line("prepared rate", times(prepared), rate));
+        let clipped =
+            if beyond > 0 { format!(" ({beyond} raw differences beyond the axis)") } else { String::new() };
         panels.push(Panel {
-            title: format!("d{name}/dt"),
+            title: format!("d{name}/dt{clipped}"),
             x_label: format!("{} [s]", raw.time_name()),
             y_label: labelled(&format!("d{name}/dt"), &per_second(&unit)),
             series,

@@ -11,12 +11,16 @@ const RUDDER: &str = "rudder δ";
 const HEADING: &str = "heading ψ";
 const SPEED: &str = "speed U/U0";
 const DRIFT: &str = "drift angle β and yaw rate r";
+const DRIFT_ONLY: &str = "drift angle β";
+const YAW: &str = "yaw rate r";
 const TRACK: &str = "track";
 
 /// One curve set per run: (legend, trajectory). As in the paper, δ and ψ share a panel over
 /// time, β and r another, U/U0 a third, and the track (in ship lengths, equal scale) the last;
 /// where the heading runs far beyond the rudder angle (a turning circle's ψ reaches 1000°
-/// and more, which would flatten δ to a line) δ and ψ get a panel each.
+/// and more, which would flatten δ to a line) δ and ψ get a panel each. Several runs (a true
+/// model and identified ones) get a panel per quantity instead, each run in one colour and
+/// style in every panel, named once in a legend under the title.
 pub fn manoeuvre_figure(ship: &Ship, title: &str, runs: &[(&str, &Trajectory)], track: bool) -> Figure {
     let r = &ship.roles;
     let deg = |v: &[f64]| v.iter().map(|x| x.to_degrees()).collect::<Vec<f64>>();
@@ -31,7 +35,8 @@ pub fn manoeuvre_figure(ship: &Ship, title: &str, runs: &[(&str, &Trajectory)], 
     let (rudder_span, heading_span) = runs.iter().fold((0f64, 0f64), |(a, b), (_, t)| {
         (a.max(span(&t.inputs[r.rudder])), b.max(span(&t.states[r.psi])))
     });
-    let apart = heading_span > 4.0 * rudder_span.max(1f64.to_radians());
+    let several = runs.len() > 1;
+    let apart = several || heading_span > 4.0 * rudder_span.max(1f64.to_radians());
     let panel = |title: &str, y_label: &str| Panel {
         title: title.into(),
         x_label: "t [s]".into(),
@@ -42,7 +47,9 @@ pub fn manoeuvre_figure(ship: &Ship, title: &str, runs: &[(&str, &Trajectory)], 
         panel(if apart { RUDDER } else { RUDDER_HEADING }, if apart { "δ [°]" } else { "δ, ψ [°]" });
     let mut heading = panel(HEADING, "ψ [°]");
     let mut speed = panel(SPEED, "U/U0 [-]");
-    let mut drift = panel(DRIFT, "β [°], r [°/s]");
+    let mut drift =
+        panel(if several { DRIFT_ONLY } else { DRIFT }, if several { "β [°]" } else { "β [°], r [°/s]" });
+    let mut yaw = panel(YAW, "r [°/s]");
     let lpp = ship.spec.lpp;
     let mut path = Panel {
         title: format!("{TRACK} (L = {lpp} m)"),
@@ -54,12 +61,18 @@ pub fn manoeuvre_figure(ship: &Ship, title: &str, runs: &[(&str, &Trajectory)], 
         ..Panel::default()
     };
     for (k, (name, t)) in runs.iter().enumerate() {
+        // one run: the quantities are the series; several: the runs are, by colour
         let mk = |label: &str, y: Vec<f64>| {
-            let n = if runs.len() > 1 { format!("{label} {name}") } else { label.to_string() };
-            if k == 0 {
+            let n = if several { name.to_string() } else { label.to_string() };
+            let s = if k == 0 {
                 Series::line(&n, t.time.clone(), y)
             } else {
                 Series::dashed(&n, t.time.clone(), y)
+            };
+            if several {
+                s.colored(k)
+            } else {
+                s
             }
         };
         let (speed_v, drift_v) = ship.speed_and_drift(t);
@@ -72,19 +85,30 @@ pub fn manoeuvre_figure(ship: &Ship, title: &str, runs: &[(&str, &Trajectory)], 
         }
         speed.series.push(mk("U/U0", speed_v.iter().map(|u| u / ship.spec.u0).collect()));
         drift.series.push(mk("β", deg(&drift_v)));
-        drift.series.push(mk("r", deg(&t.states[r.r])));
+        let yaw_rate = mk("r", deg(&t.states[r.r]));
+        if several {
+            yaw.series.push(yaw_rate);
+        } else {
+            drift.series.push(yaw_rate);
+        }
         let (y, x) = track_in_lengths(ship, t);
-        path.series.push(Series::line(name, y, x).colored(k));
+        let line = if k == 0 { Series::line(name, y, x) } else { Series::dashed(name, y, x) };
+        path.series.push(line.colored(k));
     }
     let mut panels = vec![rudder];
     if apart {
         panels.push(heading);
     }
     panels.extend([speed, drift]);
+    if several {
+        panels.push(yaw);
+    }
     if track {
         panels.push(path);
     }
-    Figure::new(title, panels)
+    let mut figure = Figure::new(title, panels);
+    figure.shared_legend = several;
+    figure
 }
 
 /// A run's track in ship lengths: (y0/L, x0/L), across and up as the figures draw it.

@@ -75,6 +75,17 @@ impl Plugin for Manoeuvring {
         Some((spec.lpp, spec.u0, spec.density.unwrap_or(1000.0)))
     }
 
+    fn plane(&self, model: &Model) -> Option<crate::sim::Plane> {
+        let spec = canonical_spec(model)?;
+        let n = &spec.names;
+        Some(crate::sim::Plane {
+            across: (n.y0.clone(), format!("{}/L [-] (starboard)", n.y0)),
+            up: (n.x0.clone(), format!("{}/L [-] (initial course)", n.x0)),
+            length: spec.lpp,
+            title: format!("track (L = {} m)", spec.lpp),
+        })
+    }
+
     fn coefficient_name(&self, model: &Model, equation: &str, term: &crate::term::Term) -> Option<String> {
         let spec = canonical_spec(model)?;
         let n = &spec.names;

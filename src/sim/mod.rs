@@ -48,3 +48,19 @@ pub enum SimError {
     #[error("no steady state found: {0}")]
     NoSteadyState(String),
 }
+
+/// The plane a vehicle's run moves in, where its model has one: the states of its position
+/// drawn across and up (a ship's y0 and x0), each with its axis label, and the length the
+/// positions are drawn in units of (a ship's length), so that a figure draws the track at
+/// equal scale instead of each position over time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Plane {
+    /// The state drawn across, and its axis label.
+    pub across: (String, String),
+    /// The state drawn up, and its axis label.
+    pub up: (String, String),
+    /// Positions are drawn divided by this (1: in the states' own unit).
+    pub length: f64,
+    /// The panel's title.
+    pub title: String,
+}

@@ -236,17 +236,50 @@ fn objections(file: &Path) -> Vec<String> {
         }
     }
 
+    // one time axis: every panel over time shows the same span, read off its tick labels
+    let spans: Vec<(f64, f64)> = texts
+        .iter()
+        .filter(|(_, e, _)| e.get("dy") == Some("-0.5ex") && e.text == "t [s]")
+        .filter_map(|(_, desc, _)| x_span(&texts, &areas, desc))
+        .collect();
+    if let Some(first) = spans.first() {
+        let width = (first.1 - first.0).abs().max(1e-9);
+        for span in &spans[1..] {
+            if (span.0 - first.0).abs() > 0.01 * width || (span.1 - first.1).abs() > 0.01 * width {
+                found.push(format!(
+                    "{name}: panels over time span {:.1}-{:.1} s and {:.1}-{:.1} s",
+                    first.0, first.1, span.0, span.1
+                ));
+            }
+        }
+    }
+
+    // a series keeps its colour and style: each legend entry's picture (colour, line, dashes,
+    // marker, ring, band) is the same wherever its name appears in the figure
+    let top = areas.iter().map(|a| a.y0).fold(f64::INFINITY, f64::min);
+    let mut pictures: Vec<(String, String)> = Vec::new();
+    for (_, e, b) in &texts {
+        let in_box = legends.iter().any(|(_, l)| b.within(l, 1.0));
+        let in_row = b.y1 < top && e.num("font-size") < 10.0;
+        if !(in_box || in_row) {
+            continue;
+        }
+        let picture = glyph(&els, b);
+        match pictures.iter().find(|(n, _)| *n == e.text) {
+            Some((_, seen)) if *seen != picture => {
+                found.push(format!("{name}: `{}` is drawn as {seen} and as {picture}", e.text))
+            }
+            Some(_) => {}
+            None => pictures.push((e.text.clone(), picture)),
+        }
+    }
+
     // tracks: the same pixels per unit on both axes, read off the tick labels, and a tick at
     // every whole ship length
     for (_, desc, _) in
         texts.iter().filter(|(_, e, _)| e.get("dy") == Some("-0.5ex") && e.text.contains("/L"))
     {
-        let y_desc = desc.num("y");
-        let area = areas
-            .iter()
-            .filter(|a| a.y1 < y_desc && desc.num("x") > a.x0 && desc.num("x") < a.x1)
-            .min_by(|a, b| (y_desc - a.y1).total_cmp(&(y_desc - b.y1)))
-            .expect("the track's plotting area");
+        let area = area_of(&areas, desc).expect("the track's plotting area");
         let ticks = |horizontal: bool| -> Vec<(f64, f64)> {
             texts
                 .iter()
@@ -298,6 +331,75 @@ fn objections(file: &Path) -> Vec<String> {
     found
 }
 
+/// The plotting area above an x-axis description: the nearest one whose width holds it.
+fn area_of<'a>(areas: &'a [Box2], desc: &Element) -> Option<&'a Box2> {
+    let y = desc.num("y");
+    areas
+        .iter()
+        .filter(|a| a.y1 < y && desc.num("x") > a.x0 && desc.num("x") < a.x1)
+        .min_by(|a, b| (y - a.y1).total_cmp(&(y - b.y1)))
+}
+
+/// The x values at the left and right edge of the plotting area above `desc`, from the tick
+/// labels under it (a straight line through them).
+fn x_span(texts: &[(usize, &Element, Box2)], areas: &[Box2], desc: &Element) -> Option<(f64, f64)> {
+    let area = area_of(areas, desc)?;
+    let ticks: Vec<(f64, f64)> = texts
+        .iter()
+        .filter(|(_, e, _)| {
+            e.get("dy") == Some("0.76em") && e.num("y") > area.y1 && e.num("y") < area.y1 + 20.0
+        })
+        .filter(|(_, e, _)| e.num("x") >= area.x0 - 1.0 && e.num("x") <= area.x1 + 1.0)
+        .filter_map(|(_, e, _)| Some((e.num("x"), e.text.replace('−', "-").parse::<f64>().ok()?)))
+        .collect();
+    let (a, b) = (ticks.first()?, ticks.last()?);
+    if ticks.len() < 2 || b.0 == a.0 {
+        return None;
+    }
+    let per_px = (b.1 - a.1) / (b.0 - a.0);
+    Some((a.1 + (area.x0 - a.0) * per_px, a.1 + (area.x1 - a.0) * per_px))
+}
+
+/// A legend entry's picture: the colours and shapes drawn left of its text, on its line
+/// (`line #000000`, `dashes #D62728`, `marker`, `ring`, `band`).
+fn glyph(els: &[Element], text: &Box2) -> String {
+    let (mid, left) = ((text.y0 + text.y1) / 2.0, text.x0);
+    let near = |x: f64, y: f64| x > left - 34.0 && x < left && (y - mid).abs() < 6.0;
+    let mut parts: Vec<String> = Vec::new();
+    let mut segments = 0;
+    let mut colour = String::new();
+    for e in els {
+        match e.name.as_str() {
+            "polyline" => {
+                let p = e.points();
+                if p.len() == 2 && p.iter().all(|(x, y)| near(*x, *y)) {
+                    segments += 1;
+                    colour = e.get("stroke").unwrap_or("").to_string();
+                }
+            }
+            "circle" if near(e.num("cx"), e.num("cy")) => {
+                let kind = if e.get("fill") == Some("none") { "ring" } else { "marker" };
+                parts.push(format!(
+                    "{kind} {}",
+                    e.get("stroke").filter(|c| *c != "none").or(e.get("fill")).unwrap_or("")
+                ));
+            }
+            "rect" if e.get("width") == Some("18") && near(e.num("x") + 9.0, e.num("y") + 5.0) => {
+                parts.push(format!("band {}", e.get("fill").unwrap_or("")));
+            }
+            _ => {}
+        }
+    }
+    // a line is three segments end to end, dashes two with a gap
+    match segments {
+        0 => {}
+        3 => parts.push(format!("line {colour}")),
+        _ => parts.push(format!("dashes {colour}")),
+    }
+    parts.sort();
+    parts.join(" + ")
+}
+
 fn svgs(dir: &Path) -> Vec<PathBuf> {
     let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
         .unwrap()
@@ -347,6 +449,20 @@ fn every_figure_kind_reads_as_a_person_would_have_it() {
         run(&["simulate", "--model", &s(&model), "-m", m, "--monte-carlo", draws, "--svg", &s(&out)]);
         files.push(out);
     }
+    // a model that is not a ship: its states over time, named with their units
+    let generic = dir.join("simulate_duffing.svg");
+    run(&[
+        "simulate",
+        "--model",
+        "models/duffing.toml",
+        "--input",
+        "F=0.5",
+        "--duration",
+        "60",
+        "--svg",
+        &s(&generic),
+    ]);
+    files.push(generic);
     let held = "examples/data/held_out.toml";
     run(&[
         "validate",
@@ -364,6 +480,14 @@ fn every_figure_kind_reads_as_a_person_would_have_it() {
         files.extend(svgs(d));
     }
     assert!(files.len() >= 30, "{} figures", files.len());
+    // a run that moves in a plane is drawn as a track at equal scale in every figure kind
+    for f in files.iter().filter(|f| {
+        let n = f.file_name().unwrap().to_string_lossy();
+        n.starts_with("validate_") || n.starts_with("diagnose_") || n.starts_with("predict_turning")
+    }) {
+        let svg = std::fs::read_to_string(f).unwrap();
+        assert!(svg.contains("y0/L [-]"), "{}: no track", f.display());
+    }
     let found: Vec<String> = files.iter().flat_map(|f| objections(f)).collect();
     assert!(found.is_empty(), "{} objections:\n{}", found.len(), found.join("\n"));
 }
@@ -380,6 +504,13 @@ fn the_reader_objects_to_a_bad_figure() {
 <text x="8" y="150" dy="0.76em" text-anchor="middle" font-size="10" transform="rotate(270, 8, 150)">speed</text>
 <text x="200" y="100" dy="0.76em" text-anchor="middle" font-size="10">overlapping label</text>
 <text x="205" y="102" dy="0.76em" text-anchor="middle" font-size="10">another label</text>
+<polyline fill="none" opacity="1" stroke="#FF0000" stroke-width="2" points="10,20 17,20 "/>
+<polyline fill="none" opacity="1" stroke="#FF0000" stroke-width="2" points="17,20 21,20 "/>
+<polyline fill="none" opacity="1" stroke="#FF0000" stroke-width="2" points="21,20 28,20 "/>
+<text x="34" y="20" dy="0.5ex" text-anchor="start" font-size="8.87">model</text>
+<polyline fill="none" opacity="1" stroke="#0000FF" stroke-width="2" points="150,20 157,20 "/>
+<polyline fill="none" opacity="1" stroke="#0000FF" stroke-width="2" points="161,20 168,20 "/>
+<text x="174" y="20" dy="0.5ex" text-anchor="start" font-size="8.87">model</text>
 </svg>"##;
     let file = dir.join("bad.svg");
     std::fs::write(&file, bad).unwrap();
@@ -387,4 +518,5 @@ fn the_reader_objects_to_a_bad_figure() {
     assert!(found.contains("covers data"), "{found}");
     assert!(found.contains("`overlapping label` and `another label` overlap"), "{found}");
     assert!(found.contains("the axis `speed` has no unit"), "{found}");
+    assert!(found.contains("`model` is drawn as line #FF0000 and as dashes #0000FF"), "{found}");
 }

@@ -31,7 +31,10 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
     let mut outputs = termid::output::Outputs::new();
     if let Some(dir) = &cmd.resim.svg {
         outputs.folder(dir)?;
-        for (k, (name, fig)) in termid::plot::diagnosis_figures(&model, &d, &runs).into_iter().enumerate() {
+        let plane = termid::plugins::of(&model).and_then(|p| p.plane(&model));
+        for (k, (name, fig)) in
+            termid::plot::diagnosis_figures(&model, &d, &runs, plane.as_ref()).into_iter().enumerate()
+        {
             let stem = std::path::Path::new(&name)
                 .file_stem()
                 .map_or(format!("run{k}"), |s| s.to_string_lossy().into_owned());

@@ -119,12 +119,9 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     let write = refused.is_empty() || cmd.keep_unphysical;
     if let Some(out) = cmd.out.as_ref().filter(|_| write) {
         let mut model = kept.model.clone();
-        let provenance = format!(
-            "identified by termid from {} ({})",
-            cmd.data.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "),
-            model.spec().model.provenance
-        );
-        model.set_provenance(provenance);
+        let sources: Vec<String> =
+            cmd.data.iter().chain(&cmd.dataset).map(|p| p.display().to_string()).collect();
+        model.mark_identified(&sources.join(", "));
         termid::output::write_file(out, model.to_toml().as_bytes())?;
     }
     // a refinement that failed loses nothing: the regression's model is written first

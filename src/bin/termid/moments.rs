@@ -99,10 +99,7 @@ pub fn identify_from_files(cmd: IdentifyCommand) -> Result<()> {
     let (mut model, fits) = crate::moments::identify(&model, &cmd.moments, &cmd.equation, intercept)?;
     if let Some(out) = &cmd.out {
         let sources = cmd.moments.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
-        model.set_provenance(format!(
-            "identified by termid from the statistics {sources} ({})",
-            model.spec().model.provenance
-        ));
+        model.mark_identified(&format!("the statistics {sources}"));
         termid::output::write_file(out, model.to_toml().as_bytes())?;
     }
     match cmd.format {

@@ -261,13 +261,19 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
             .enumerate()
             .map(|(i, s)| Panel {
                 title: s.clone(),
-                x_label: model.spec().model.time.clone(),
-                y_label: model
-                    .spec()
-                    .states
-                    .iter()
-                    .find(|t| &t.name == s)
-                    .map_or(String::new(), |t| t.unit.clone()),
+                // time in seconds, as every model file's; each state by its name and unit
+                x_label: termid::plot::labelled(&model.spec().model.time, "s"),
+                y_label: termid::plot::labelled(
+                    s,
+                    model
+                        .spec()
+                        .states
+                        .iter()
+                        .find(|t| &t.name == s)
+                        .map(|t| t.unit.as_str())
+                        .filter(|u| !u.is_empty())
+                        .unwrap_or("-"),
+                ),
                 series: {
                     let mut series = vec![Series::line(s, traj.time.clone(), traj.states[i].clone())];
                     if let Some(mc) = mc.as_ref().filter(|mc| mc.usable()) {

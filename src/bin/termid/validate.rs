@@ -51,10 +51,13 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
     if let Some(dir) = &cmd.resim.svg {
         let mut outputs = termid::output::Outputs::new();
         outputs.folder(dir)?;
+        let plane = termid::plugins::of(&model).and_then(|p| p.plane(&model));
         let draws: Vec<&[Trajectory]> =
             mc.iter().flat_map(|mc| mc.shown().iter().map(|(sims, _)| sims.as_slice())).collect();
         for (k, (name, fig)) in
-            comparison_figures(&model, &runs, &sims, &[], &draws, "validate").into_iter().enumerate()
+            comparison_figures(&model, &runs, &sims, &[], &draws, "validate", plane.as_ref())
+                .into_iter()
+                .enumerate()
         {
             let stem = std::path::Path::new(&name)
                 .file_stem()

@@ -360,45 +360,37 @@ pub fn write(
         );
         fig(&format!("predict_{}.svg", text.replace([':', '/'], "_")), f)?;
     }
-    // a panel per branch (the rudder stepped down from +δ, then back up from −δ), the true
-    // model as rings that the identified models' markers leave visible
-    let branch = |name: &str, title: &str| {
-        let series: Vec<Series> = study
-            .predictions
-            .iter()
-            .filter(|p| p.manoeuvre.starts_with("spiral"))
-            .filter_map(|p| match &p.metrics {
-                Ok(Metrics::Spiral(s)) => {
-                    let (x, y) = s
-                        .points
-                        .iter()
-                        .filter(|q| q.branch == name)
-                        .map(|q| (q.rudder_deg, q.yaw_rate_deg_s))
-                        .unzip();
-                    Some(if p.coefficients == "true" {
-                        Series::rings(&p.coefficients, x, y)
-                    } else {
-                        Series::points(&p.coefficients, x, y)
-                    })
-                }
-                _ => None,
-            })
-            .collect();
-        Panel {
-            title: title.into(),
+    // both branches in one panel, so that a loop between them shows: each model in one
+    // colour, the rudder stepped down from +δ as a line, back up from −δ as markers (the true
+    // model's rings, which the identified models' dots leave visible)
+    let mut series = Vec::new();
+    for (k, p) in study.predictions.iter().filter(|p| p.manoeuvre.starts_with("spiral")).enumerate() {
+        let Ok(Metrics::Spiral(s)) = &p.metrics else { continue };
+        let branch = |name: &str| -> (Vec<f64>, Vec<f64>) {
+            s.points.iter().filter(|q| q.branch == name).map(|q| (q.rudder_deg, q.yaw_rate_deg_s)).unzip()
+        };
+        let ((dx, dy), (ux, uy)) = (branch("down"), branch("up"));
+        let down = format!("{}: from +δ down", p.coefficients);
+        let up = format!("{}: back from −δ", p.coefficients);
+        let (line, marks) = if p.coefficients == "true" {
+            (Series::line(&down, dx, dy), Series::rings(&up, ux, uy))
+        } else {
+            (Series::dashed(&down, dx, dy), Series::points(&up, ux, uy))
+        };
+        series.extend([line.colored(k), marks.colored(k)]);
+    }
+    let mut spiral = Figure::new(
+        "Spiral test: steady yaw rate against rudder angle",
+        vec![Panel {
+            title: "both branches: a loop between them would be a course-unstable ship".into(),
             x_label: "δ [°]".into(),
             y_label: "r [°/s]".into(),
             series,
             ..Panel::default()
-        }
-    };
-    let mut spiral = Figure::new(
-        "Spiral test: steady yaw rate against rudder angle",
-        vec![branch("down", "from +δ down to −δ"), branch("up", "back from −δ up to +δ")],
+        }],
     );
-    spiral.columns = 2;
-    spiral.width = 1100;
-    spiral.panel_height = 360;
+    spiral.width = 900;
+    spiral.panel_height = 520;
     fig("predict_spiral.svg", spiral)?;
     for d in &study.drift {
         let mut series = Vec::new();
