@@ -75,6 +75,7 @@ fn main() -> Result<(), Error> {
         panels,
     );
     zigzags.panel_height = 220;
+    zigzags.shared_legend = true;
     zigzags.write_svg(&out.join("simman_zigzags.svg"))?;
 
     // turning circles at MARIN's approach speed, the propeller at the model's self-propulsion
@@ -175,7 +176,7 @@ fn zigzag_panel(name: &str, frame: &Frame, sim: &Trajectory) -> Result<Panel, Er
     Ok(Panel {
         title: name.into(),
         x_label: "t [s]".into(),
-        y_label: "[°]".into(),
+        y_label: "ψ, δ [°]".into(),
         series: vec![
             Series::line("ψ measured", every(frame.time(), 1.0), every(frame.require("ψ")?, deg)),
             Series::line(

@@ -244,3 +244,37 @@ pub struct Observation {
     /// them (said once under the table).
     pub note: Option<String>,
 }
+
+/// A metric's key as a person reads it: its name in words, its unit (from the key's suffix:
+/// `_deg_s`, `_deg`, `_s`, `_m`, `_lpp`, `_percent`) and the decimals that mean something at
+/// the sampling of a simulation (0.01°, 0.01 s, 0.01 m, 0.1 %).
+pub fn metric_label(key: &str) -> (String, &'static str, usize) {
+    let units: [(&str, &str, usize); 6] = [
+        ("_deg_s", "°/s", 3),
+        ("_deg", "°", 2),
+        ("_percent", "%", 1),
+        ("_lpp", "L", 2),
+        ("_m", "m", 2),
+        ("_s", "s", 2),
+    ];
+    let (name, unit, decimals) = units
+        .iter()
+        .find_map(|(suffix, unit, d)| key.strip_suffix(suffix).map(|n| (n, *unit, *d)))
+        .unwrap_or((key, "", 3));
+    (name.replace('_', " "), unit, decimals)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::metric_label;
+
+    #[test]
+    fn metric_keys_read_as_words_with_units() {
+        assert_eq!(metric_label("first_overshoot_deg"), ("first overshoot".to_string(), "°", 2));
+        assert_eq!(metric_label("yaw_rate_deg_s"), ("yaw rate".to_string(), "°/s", 3));
+        assert_eq!(metric_label("period_s"), ("period".to_string(), "s", 2));
+        assert_eq!(metric_label("tactical_diameter_lpp"), ("tactical diameter".to_string(), "L", 2));
+        assert_eq!(metric_label("speed_loss_percent"), ("speed loss".to_string(), "%", 1));
+        assert_eq!(metric_label("speed_ratio"), ("speed ratio".to_string(), "", 3));
+    }
+}

@@ -453,13 +453,13 @@ impl Estimate {
     /// The estimate as a person reads it: the cost before and after and, per parameter, the
     /// start, the estimate, its standard error and, where given, the prior.
     pub fn text(&self) -> String {
-        use crate::identify::num;
+        use crate::identify::{num, sig};
         let mut out = format!(
             "== output-error estimate of the free parameters ==\nre-simulation cost (scaled sum of squares) {} → {}; {} iterations; residual correlation time {} samples; stopped: {}\n",
-            num(self.cost_before),
-            num(self.cost_after),
+            sig(self.cost_before, 4),
+            sig(self.cost_after, 4),
             self.iterations,
-            self.correlation_time.map_or("—".into(), num),
+            self.correlation_time.map_or("—".into(), |t| format!("{t:.0}")),
             self.stopped
         );
         out.push_str(&format!(
@@ -473,7 +473,7 @@ impl Estimate {
                 p.name,
                 num(p.start),
                 num(p.value),
-                num(p.std_error),
+                sig(p.std_error, 3),
                 prior,
                 if p.at_bound { "  at its bound: the standard error understates" } else { "" }
             ));
@@ -487,7 +487,7 @@ impl Estimate {
                 p.name,
                 "",
                 num(p.value),
-                num(p.std_error),
+                sig(p.std_error, 3),
                 p.source + 1
             ));
         }

@@ -354,6 +354,7 @@ impl Runs {
         let (mut first, mut second) = (0.0, 0.0);
         // growth rate of the gap against the magnitude of every measured column
         let mut rates: Vec<f64> = Vec::new();
+        let mut times: Vec<f64> = Vec::new();
         let mut columns: Vec<(String, Vec<f64>)> =
             self.frames[0].names().iter().skip(1).map(|n| (n.clone(), Vec::new())).collect();
         for (f, sim) in self.frames.iter().zip(sims) {
@@ -372,6 +373,7 @@ impl Runs {
             second += e[half..].iter().map(|v| v * v).sum::<f64>();
             for k in 1..e.len() {
                 rates.push(((e[k] - e[k - 1]) / (t[k] - t[k - 1])).abs());
+                times.push(t[k] - t[0]);
                 for (name, col) in columns.iter_mut() {
                     col.push(f.column(name).map_or(f64::NAN, |c| c[k].abs()));
                 }
@@ -381,21 +383,30 @@ impl Runs {
         let regime = columns
             .iter()
             .filter(|(n, _)| n != lname && !n.ends_with("_dot"))
+            // a column that grows with the time run (a distance run, a position) says only
+            // "late in the run": not a regime of the motion
+            .filter(|(_, c)| correlation(&times, c).abs() < 0.9)
             .map(|(n, c)| (n.clone(), correlation(&rates, c)))
             .filter(|(_, r)| r.is_finite())
             .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
             .unwrap_or_default();
         let earliest = onset.iter().map(|o| o.1).fold(f64::INFINITY, f64::min);
+        let size = if regime.1 >= 0.0 { "large" } else { "small" };
+        let with = if regime.1.abs() >= 0.3 {
+            format!("it grows fastest where |{}| is {size} (correlation {:.2})", regime.0, regime.1)
+        } else {
+            format!(
+                "its growth goes with no one measured signal (the closest: |{}| {size}, correlation {:.2})",
+                regime.0, regime.1
+            )
+        };
         let words = format!(
-            "The gap is led by {lname}; it is visible from t = {earliest:.1} s on; {}; it grows fastest where |{}| is {} (correlation {:.2}).",
+            "The gap is led by {lname}; it is visible from t = {earliest:.1} s on; {}; {with}.",
             if growth > 1.5 {
                 format!("it keeps growing (second half {growth:.1}× the first): an effect that accumulates")
             } else {
                 format!("it does not grow much (second half {growth:.1}× the first)")
             },
-            regime.0,
-            if regime.1 >= 0.0 { "large" } else { "small" },
-            regime.1
         );
         Location { leading_state: lname.clone(), onset, growth, regime, words }
     }

@@ -262,17 +262,17 @@ impl Refined {
     /// the regression's value, the refined one, its standard error, the change, and the change
     /// in units of the prior's standard deviation (where it is large, why).
     pub fn text(&self) -> String {
-        use crate::identify::num;
+        use crate::identify::{num, sig};
         let r = self;
         let mut out = format!(
             "== output-error refinement ==\nre-simulation cost (scaled sum of squares) {} → {}; residual correlation time {} samples; stopped: {}\n",
-            num(r.cost_before),
-            num(r.cost_after),
+            sig(r.cost_before, 4),
+            sig(r.cost_after, 4),
             r.correlation_time.map_or("--".into(), |t| format!("{t:.0}")),
             r.stopped
         );
         if let Some((b, a)) = r.validation {
-            out += &format!("validation runs (not fitted): {} → {}\n", num(b), num(a));
+            out += &format!("validation runs (not fitted): {} → {}\n", sig(b, 4), sig(a, 4));
         }
         out += &format!(
             "{:<8} {:<18} {:>13} {:>13} {:>12} {:>8} {:>8}\n",
@@ -290,7 +290,7 @@ impl Refined {
                 c.term,
                 num(c.regression),
                 num(c.refined),
-                num(c.std_error),
+                sig(c.std_error, 3),
                 100.0 * (c.refined / c.regression - 1.0),
                 c.shift()
             );

@@ -50,7 +50,7 @@ pub use model::{
     coefficients_of, correlation_time_of, equation_design, fit_equation, fit_equation_design, identify_model,
     IdentifiedModel, ModelIdentification,
 };
-pub use report::{num, FitReport, StepReport, TermReport};
+pub use report::{num, sig, FitReport, StepReport, TermReport};
 pub use statistics::{identify_from_moments, EquationMoments, RunMoments};
 
 /// Why identification failed.

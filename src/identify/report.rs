@@ -17,6 +17,21 @@ pub fn num(x: f64) -> String {
     }
 }
 
+/// A measured quantity at `n` significant figures (an error, a spread: what its data
+/// support), fixed-point between 0.001 and 100 000 (`0.0206`, `1.55`, `2990`), else in
+/// scientific notation (`9.52e-5`).
+pub fn sig(x: f64, n: usize) -> String {
+    let n = n.max(1);
+    if x == 0.0 {
+        return "0".into();
+    }
+    if !x.is_finite() || !(1e-3..1e5).contains(&x.abs()) {
+        return format!("{x:.prec$e}", prec = n - 1);
+    }
+    let digits = (n as i32 - 1 - x.abs().log10().floor() as i32).max(0) as usize;
+    format!("{x:.digits$}")
+}
+
 /// One step of the table, as reported.
 #[derive(Clone, Debug, Serialize)]
 pub struct StepReport {
@@ -203,5 +218,19 @@ impl Fit {
             out += &format!("note: {n}\n");
         }
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::sig;
+
+    #[test]
+    fn significant_figures_read_as_the_data_support() {
+        assert_eq!(sig(0.0206417, 3), "0.0206");
+        assert_eq!(sig(1.55125, 3), "1.55");
+        assert_eq!(sig(2992.74, 3), "2993");
+        assert_eq!(sig(-9.5213e-5, 3), "-9.52e-5");
+        assert_eq!(sig(0.0, 3), "0");
     }
 }

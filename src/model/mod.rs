@@ -671,9 +671,8 @@ impl Model {
             if frame.column(alias).is_some() && frame.column(name).is_none() {
                 frame.rename(alias, name)?;
                 notes.push(format!(
-                    "{}: column `{alias}` read as `{name}` (an alias in {})",
-                    frame.origin(),
-                    self.path
+                    "{}: column `{alias}` read as `{name}` (an alias of the model)",
+                    frame.origin()
                 ));
             }
         }

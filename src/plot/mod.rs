@@ -401,13 +401,19 @@ impl Figure {
         let (mut y0, mut y1) =
             range(panel.series.iter().flat_map(|s| s.y.iter().chain(&s.upper).copied()), panel.log_y);
         let px = plot_px(area.dim_in_pixel());
-        if panel.equal_axes {
-            // the same metres per pixel on both axes: the ranges follow the plotting area's
-            // shape, so a circle is drawn round
+        // the same metres per pixel on both axes: the ranges follow the plotting area's shape,
+        // so a circle is drawn round
+        let equal = |(x0, x1): (f64, f64), (y0, y1): (f64, f64)| {
             let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
             let per_pixel = ((x1 - x0) / px.0).max((y1 - y0) / px.1);
-            (x0, x1) = (cx - per_pixel * px.0 / 2.0, cx + per_pixel * px.0 / 2.0);
-            (y0, y1) = (cy - per_pixel * px.1 / 2.0, cy + per_pixel * px.1 / 2.0);
+            (
+                (cx - per_pixel * px.0 / 2.0, cx + per_pixel * px.0 / 2.0),
+                (cy - per_pixel * px.1 / 2.0, cy + per_pixel * px.1 / 2.0),
+            )
+        };
+        let data_y = (y0, y1);
+        if panel.equal_axes {
+            ((x0, x1), (y0, y1)) = equal((x0, x1), (y0, y1));
         }
         let own_legend = has_legend(panel) && !self.shared_legend;
         let mut corner = if own_legend {
@@ -415,6 +421,23 @@ impl Figure {
         } else {
             (SeriesLabelPosition::UpperRight, 0)
         };
+        if own_legend && corner.1 > 0 && panel.equal_axes {
+            // a track under the legend in every corner: room above the data, both axes at
+            // the same scale still
+            let (_, lh) = legend_px(panel);
+            let high = ((lh + 4.0) / px.1).min(0.5);
+            let (lo, hi) = data_y;
+            let x = range(panel.series.iter().flat_map(|s| s.x.iter().copied()), false);
+            // the fit centres the data: where the width sets the scale, only part of the
+            // room added lands above them, so add more until the legend is clear
+            for more in [1.0, 2.0, 4.0] {
+                ((x0, x1), (y0, y1)) = equal(x, (lo, hi + more * (hi - lo) * high / (1.0 - high)));
+                corner = legend_corner(panel, (x0, x1), (y0, y1), px);
+                if corner.1 == 0 {
+                    break;
+                }
+            }
+        }
         if own_legend && corner.1 > 0 && !panel.equal_axes {
             // every corner has data under the legend: room beside the data (a tall legend of
             // many entries) or above them (a wide one), whichever takes less of the panel,

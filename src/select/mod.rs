@@ -160,7 +160,7 @@ impl std::fmt::Display for Stop {
                 100.0 * threshold
             ),
             Stop::ExactFit { residual_share } => {
-                write!(f, "the fit is exact to round-off (1 − R² = {:.1e})", residual_share.max(0.0))
+                write!(f, "the fit is exact to round-off (1 − R² = {})", round_off_share(*residual_share))
             }
             Stop::NoDegreesOfFreedom => write!(f, "no degrees of freedom were left for another term"),
             Stop::Converged => write!(f, "the back-end's own rule ended it"),
@@ -433,6 +433,16 @@ back_ends! {
 impl Default for Backend {
     fn default() -> Self {
         Backend::Stepwise(Stepwise::default())
+    }
+}
+
+/// The unexplained share 1 − R² of an exact fit as one text wherever it is reported: below
+/// 1e-15 it is round-off, of either sign, and reads so.
+pub(crate) fn round_off_share(share: f64) -> String {
+    if share.abs() < 1e-15 {
+        "0 to round-off".into()
+    } else {
+        format!("{share:.1e}")
     }
 }
 

@@ -256,7 +256,7 @@ impl Selector for Stepwise {
             let residual_share = sc.residual_share(&a);
             if residual_share <= self.exact_fit {
                 notes.push(format!(
-                    "exact fit after step {k} (1 − R² = {residual_share:.1e}): further steps would be chosen by round-off, so stepping stopped"
+                    "exact fit after step {k} (1 − R² = {}): further steps would be chosen by round-off, so stepping stopped", super::round_off_share(residual_share)
                 ));
                 break Stop::ExactFit { residual_share };
             }

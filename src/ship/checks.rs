@@ -75,7 +75,13 @@ pub fn physical_checks(model: &Model, rudder_deg: f64) -> Result<Vec<Check>, Shi
     for side in [1.0, -1.0] {
         let angle =
             (start.delta0_deg + side * rudder_deg).clamp(-ship.spec.rudder_limit, ship.spec.rudder_limit);
-        let label = format!("turning circle δ = {angle:.1}°");
+        // the angles are the runs' largest about the model's neutral rudder δ0 (29.2° and
+        // −30.8° for 30° about δ0 = −0.8°): both sides turn equally hard for the hull
+        let label = format!(
+            "turning circle δ = {angle:.1}° ({:+.0}° about δ0 = {:.1}°)",
+            side * rudder_deg,
+            start.delta0_deg
+        );
         let run = Manoeuvre::parse(&format!("turning:{angle}")).and_then(|m| ship.run(&m, &settings));
         let (run, t) = match run {
             Ok(run) => match &run.metrics {
@@ -120,7 +126,7 @@ pub fn physical_checks(model: &Model, rudder_deg: f64) -> Result<Vec<Check>, Shi
             continue;
         }
         checks.push(Check {
-            name: format!("{label}: speed falls, to more than 15 %"),
+            name: format!("{label}: the speed falls in the turn, not below 15 % of the approach"),
             passed: t.speed_ratio > 0.15 && t.speed_ratio <= 1.0 + 1e-9,
             refuses: true,
             measure: None,

@@ -253,19 +253,38 @@ impl Scenario for ShipScenario {
                 if k == "manoeuvre" || k == "points" || k == "reversals_s" || k.ends_with("_lpp") {
                     continue;
                 }
-                let (label, unit, decimals) = metric_label(k);
+                let (label, unit, decimals) = crate::plugin::metric_label(k);
                 let in_lengths = k
                     .strip_suffix("_m")
                     .and_then(|stem| map.get(&format!("{stem}_lpp")))
                     .and_then(serde_json::Value::as_f64)
                     .map_or(String::new(), |l| format!(" ({l:.2} L)"));
                 let value = match (v.is_null(), v.as_f64()) {
+                    // a spiral's branches that cross r = 0 within the sampling: no loop
+                    (false, Some(w)) if k == "loop_width_deg" && w < 0.005 => {
+                        "none: both branches cross r = 0 at one angle (course-stable)".to_string()
+                    }
                     (true, _) => format!("not reached in {} s (a longer --duration)", settings.duration),
                     (false, Some(x)) => format!("{x:.decimals$} {unit}{in_lengths}"),
                     (false, None) => v.as_str().map_or_else(|| v.to_string(), str::to_string),
                 };
                 text.push(format!("  {label:<28} {}", value.trim_end()));
             }
+        }
+        if let Metrics::Replay(_) = &run.metrics {
+            // a replay has no metrics of its own: say where it ended, and how to compare
+            let (t, last) = (run.trajectory.time.last().copied().unwrap_or(0.0), run.trajectory.last_state());
+            let r = &ship.roles;
+            text.push(format!(
+                "  ended at t = {t:.2} s: heading {:.2}°, yaw rate {:.3} °/s, speed {:.3} m/s",
+                last[r.psi].to_degrees(),
+                last[r.r].to_degrees(),
+                last[r.u]
+            ));
+            text.push(
+                "  a replay has no metrics of its own: `termid validate --data FILE.csv` sets the model beside the record, `--out` writes the run"
+                    .into(),
+            );
         }
         if let Metrics::Spiral(s) = &run.metrics {
             text.push(format!("  {:>8} {:>10} {:>6}", "δ [°]", "r [°/s]", "branch"));
@@ -309,39 +328,5 @@ impl Scenario for ShipScenario {
             add_bands(&mut fig, &self.ship, draws);
         }
         fig
-    }
-}
-
-/// A metric's key as a person reads it: its name in words, its unit (from the key's suffix:
-/// `_deg_s`, `_deg`, `_s`, `_m`, `_lpp`, `_percent`) and the decimals that mean something at
-/// the sampling of a simulation (0.01°, 0.01 s, 0.01 m, 0.1 %).
-fn metric_label(key: &str) -> (String, &'static str, usize) {
-    let units: [(&str, &str, usize); 6] = [
-        ("_deg_s", "°/s", 3),
-        ("_deg", "°", 2),
-        ("_percent", "%", 1),
-        ("_lpp", "L", 2),
-        ("_m", "m", 2),
-        ("_s", "s", 2),
-    ];
-    let (name, unit, decimals) = units
-        .iter()
-        .find_map(|(suffix, unit, d)| key.strip_suffix(suffix).map(|n| (n, *unit, *d)))
-        .unwrap_or((key, "", 3));
-    (name.replace('_', " "), unit, decimals)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::metric_label;
-
-    #[test]
-    fn metric_keys_read_as_words_with_units() {
-        assert_eq!(metric_label("first_overshoot_deg"), ("first overshoot".to_string(), "°", 2));
-        assert_eq!(metric_label("yaw_rate_deg_s"), ("yaw rate".to_string(), "°/s", 3));
-        assert_eq!(metric_label("period_s"), ("period".to_string(), "s", 2));
-        assert_eq!(metric_label("tactical_diameter_lpp"), ("tactical diameter".to_string(), "L", 2));
-        assert_eq!(metric_label("speed_loss_percent"), ("speed loss".to_string(), "%", 1));
-        assert_eq!(metric_label("speed_ratio"), ("speed ratio".to_string(), "", 3));
     }
 }

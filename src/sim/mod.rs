@@ -19,7 +19,7 @@ pub use system::{RightHandSide, System, Workspace};
 #[non_exhaustive]
 pub enum SimError {
     /// A state became NaN/∞ or left its declared bounds.
-    #[error("simulation diverged at t = {t} s: {state} = {value} ({why}); state was {snapshot}")]
+    #[error("simulation diverged at t = {t:.3} s: {state} = {value:.6} ({why}); state was {snapshot}")]
     Diverged {
         /// Time of the offending step.
         t: f64,

@@ -384,3 +384,66 @@ fn a_model_without_degrees_of_freedom_is_not_written() {
     assert!(!ok && err.contains("7 rows for") && err.contains("no degrees of freedom are left"), "{err}");
     assert!(!out.exists());
 }
+
+/// What termid prints says what happened, in words, with units and the decimals the data
+/// support (issue 28, item 10): no "noisy sample" warning on noise-free runs, an alias is a
+/// note and not a unit, a replay says where it ended, a spiral without a loop says so, a
+/// simulation without a manoeuvre or duration names `-m`, the Monte-Carlo table names its
+/// metrics in words, validation's errors carry three significant figures.
+#[test]
+fn words_say_what_happened() {
+    let dir = crate::common::Scratch::new("words");
+    let p = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    for (m, f) in [("zigzag:30/10", "z30.csv"), ("zigzag:20/20:port", "z20.csv")] {
+        let (ok, _, err) = termid(&["simulate", "-m", m, "--out", &p(f)]);
+        assert!(ok, "{err}");
+    }
+    // noise-free runs with the paper's u0 = first:u: nothing to warn about
+    let (ok, _, err) =
+        termid(&["identify", "--model", "models/oltmann1973.toml", "--data", &p("z30.csv"), &p("z20.csv")]);
+    assert!(ok && !err.contains("noisy sample"), "{err}");
+    // an alias read is a note, not a unit conversion
+    let text = std::fs::read_to_string(dir.join("z20.csv")).unwrap().replacen('δ', "delta", 1);
+    std::fs::write(dir.join("alias.csv"), text).unwrap();
+    let (ok, out, err) = termid(&["validate", "--data", &p("alias.csv")]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("note: ")
+            && err.contains("read as `δ` (an alias of the model)")
+            && !err.contains("unit: "),
+        "{err}"
+    );
+    // three significant figures: `ψ 0.0123 / 0.0456 °`, not six
+    let errors = out.lines().find(|l| l.contains("alias.csv:")).unwrap();
+    for cell in errors.split(", ") {
+        let number = cell.split_whitespace().nth(1).unwrap().trim_start_matches("alias.csv:");
+        let digits = number.trim_start_matches(['-', '0', '.']).chars().filter(char::is_ascii_digit).count();
+        assert!(digits <= 3 || number.contains('e'), "{cell} in {errors}");
+    }
+    let (ok, out, err) = termid(&["simulate", "-m", &format!("replay:{}", p("z20.csv"))]);
+    assert!(ok && out.contains("ended at t = ") && out.contains("termid validate"), "{out}{err}");
+    let (ok, out, _) = termid(&["simulate", "-m", "spiral"]);
+    assert!(ok && out.contains("loop width") && out.contains("none: both branches"), "{out}");
+    let (ok, _, err) = termid(&["simulate", "--model", "models/lorenz.toml"]);
+    assert!(!ok && err.contains("-m zigzag:20/20") && err.contains("--duration"), "{err}");
+    let model = p("identified.toml");
+    let (ok, _, err) = termid(&[
+        "identify",
+        "--model",
+        "examples/data/ship.toml",
+        "--dataset",
+        "examples/data/runs.toml",
+        "--derivative",
+        "kalman",
+        "--smooth",
+        "--no-intercept",
+        "--out",
+        &model,
+    ]);
+    assert!(ok, "{err}");
+    let (ok, out, err) = termid(&["simulate", "--model", &model, "-m", "turning:35", "--monte-carlo", "10"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("tactical diameter [m]") && !out.contains("tactical_diameter_m"), "{out}");
+    // the identified model is named as identified, not as the model its candidates came from
+    assert!(out.starts_with("identified from examples/data/runs.toml"), "{out}");
+}

@@ -5,7 +5,7 @@ use anyhow::{Context, Result};
 use termid::diagnose::{diagnose, generic_hypotheses, Diagnosis, Settings};
 
 use crate::args::{DiagnoseCommand, Format};
-use termid::identify::num;
+use termid::identify::{num, sig};
 use termid::model::dimension::shown;
 
 pub fn run(cmd: DiagnoseCommand) -> Result<()> {
@@ -114,10 +114,10 @@ fn text(d: &Diagnosis, out: Option<&std::path::Path>, tested: usize) -> String {
         s += &format!(
             "{:<8} {:>16} {:>16} {:>16} {:>16}  [{unit}]\n",
             b.0,
-            num(b.2 * f),
-            num(a.2 * f),
-            num(b.3 * f),
-            num(a.3 * f),
+            sig(b.2 * f, 3),
+            sig(a.2 * f, 3),
+            sig(b.3 * f, 3),
+            sig(a.3 * f, 3),
         );
     }
     s += "\nper run (RMS before → after):\n";
@@ -127,7 +127,7 @@ fn text(d: &Diagnosis, out: Option<&std::path::Path>, tested: usize) -> String {
             .zip(a)
             .map(|(x, y)| {
                 let (f, unit) = unit_of(&x.0);
-                format!("{} {} → {} {unit}", x.0, num(x.1 * f), num(y.1 * f))
+                format!("{} {} → {} {unit}", x.0, sig(x.1 * f, 3), sig(y.1 * f, 3))
             })
             .collect();
         s += &format!("  {run}: {}\n", cells.join(", "));
@@ -137,8 +137,10 @@ fn text(d: &Diagnosis, out: Option<&std::path::Path>, tested: usize) -> String {
     }
     if let Some(worse) = &d.rejected {
         let (f, unit) = unit_of(&d.location.leading_state);
-        let runs: Vec<String> =
-            worse.iter().map(|(r, b, a)| format!("{r}: {} → {} {unit}", num(b * f), num(a * f))).collect();
+        let runs: Vec<String> = worse
+            .iter()
+            .map(|(r, b, a)| format!("{r}: {} → {} {unit}", sig(b * f, 3), sig(a * f, 3)))
+            .collect();
         s += &format!(
             "
 warning: the repair was not kept{}: it makes the error of {}, the gap it was found for, grow on {} of {} runs ({}). The effect may be real but not alone, or the runs disagree; look at the runs it worsens.\n",

@@ -223,7 +223,7 @@ fn identify_in_pieces(cmd: &IdentifyCommand, model: &termid::model::Model, rows:
         termid::identify::EquationMoments::of_chunks_each(model, &names, runs, diff.as_ref())
     })?;
     for n in notes {
-        eprintln!("unit: {n}");
+        crate::runs::say(&n);
     }
     let origin = cmd.data.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
     let parts = all.into_iter().map(|m| (origin.clone(), m)).collect();

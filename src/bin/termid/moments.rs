@@ -26,7 +26,7 @@ pub fn run(cmd: MomentsCommand) -> Result<()> {
                 .collect::<Result<Vec<_>, _>>()?;
             let (moments, notes) = EquationMoments::of_chunks(&model, &cmd.equation, runs, diff.as_ref())?;
             for n in notes {
-                eprintln!("unit: {n}");
+                crate::runs::say(&n);
             }
             moments
         }

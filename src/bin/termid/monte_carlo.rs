@@ -166,9 +166,14 @@ impl<T> Draws<T> {
         );
         for (k, s) in spread {
             let nom = k.split('.').try_fold(nominal, |v, key| v.get(key)).and_then(serde_json::Value::as_f64);
+            // the metric in words with its unit, each number at the decimals its unit supports
+            // (the sd one more)
+            let (name, unit, d) = termid::plugin::metric_label(k.rsplit('.').next().unwrap_or(k));
+            let label = termid::plot::labelled(&name, unit);
+            let e = d + 1;
             out += &format!(
-                "  {k:<28} {:>10} {:>10.4} {:>10.4} {:>10.4} … {:<10.4}\n",
-                nom.map_or("--".into(), |v| format!("{v:.4}")),
+                "  {label:<28} {:>10} {:>10.d$} {:>10.e$} {:>10.d$} … {:<10.d$}\n",
+                nom.map_or("--".into(), |v| format!("{v:.d$}")),
                 s.mean,
                 s.sd,
                 s.p05,

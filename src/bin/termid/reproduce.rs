@@ -46,15 +46,21 @@ pub fn run(cmd: ReproduceCommand) -> Result<()> {
     let path = cmd.out.join("report.md");
     bar.finish_and_clear();
 
-    println!("Oltmann (1973) reproduced from {} in {:.1} s", model.path, started.elapsed().as_secs_f64());
+    // the embedded model unless --model named a file: a path that need not exist here
+    let from = if std::path::Path::new(&model.path).exists() {
+        model.path.clone()
+    } else {
+        format!("the embedded {}", model.path)
+    };
+    println!("Oltmann (1973) reproduced from {from} in {:.1} s", started.elapsed().as_secs_f64());
     println!("straight run: δ0 = {:.3}°\n", study.delta0_deg);
     println!(
-        "{:<8} {:>22} {:>22} {:>22}",
-        "", "exact: steps 30/10, Komb", "alt. 5: steps 30/10, Komb", "Komb terms (alt. 5)"
+        "chosen step of the 30°/10° run and of the five runs combined (Komb), exact and alternative 5 data:"
     );
+    println!("{:<8} {:>16} {:>16}   Komb terms (alternative 5)", "", "exact", "alternative 5");
     for (e, a) in study.exact.iter().zip(&study.alt5) {
         println!(
-            "{:<8} {:>22} {:>22}   {}",
+            "{:<8} {:>16} {:>16}   {}",
             e.equation,
             format!("{}, {}", e.runs[3].selection.chosen_step, e.komb.selection.chosen_step),
             format!("{}, {}", a.runs[3].selection.chosen_step, a.komb.selection.chosen_step),

@@ -25,7 +25,7 @@ pub fn load_for(model: &Model, data: &[PathBuf], dataset: Option<&Path>) -> Resu
     let mut frames = load(data, dataset, &model.spec().model.time)?;
     for f in &mut frames {
         for note in model.admit(f)? {
-            eprintln!("unit: {note}");
+            say(&note);
         }
     }
     // a per-run rule that reads one sample of a noisy record: said once, for the first such run
@@ -126,7 +126,7 @@ pub fn load(data: &[PathBuf], dataset: Option<&Path>, time: &str) -> Result<Vec<
             .read(&ds.folder(path)?, time)
             .with_context(|| format!("reading the runs of {}", path.display()))?;
         for n in notes {
-            eprintln!("unit: {n}");
+            say(&n);
         }
         frames.extend(more);
     }
@@ -134,4 +134,11 @@ pub fn load(data: &[PathBuf], dataset: Option<&Path>, time: &str) -> Result<Vec<
         bail!("no runs: give --data FILE… or --dataset FILE");
     }
     Ok(frames)
+}
+
+/// Says on standard error what reading a run did to it: a unit conversion as `unit:`, any
+/// other change (an alias, a negated column, velocities from the track) as `note:`.
+pub fn say(note: &str) {
+    let kind = if note.contains(" in SI (×") { "unit" } else { "note" };
+    eprintln!("{kind}: {note}");
 }

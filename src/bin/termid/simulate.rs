@@ -236,7 +236,7 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
     // a replay lasts as long as its recording; constant inputs have no natural end
     let recorded = replayed.as_ref().map(|f| f.time()[f.len() - 1] - f.time()[0]);
     let duration = cmd.duration.or(recorded).context(
-        "give --duration SECONDS: with constant inputs the model has no natural end (a ship model's manoeuvre, or a replay, has)",
+        "give a manoeuvre (-m zigzag:20/20, -m turning:35, -m spiral, -m replay:FILE.csv; each has its own length) or --duration SECONDS for the model under constant inputs (--input NAME=VALUE), which has no natural end",
     )?;
     let settings = Settings { integrator, dt, duration, sample: cmd.sample };
     let traj = simulate(&system, &x0, controller(&system)?.as_mut(), &settings)?;
@@ -307,13 +307,13 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
         ),
         Format::Text => {
             println!(
-                "{}: {} samples to t = {}",
+                "{}: {} samples to t = {} s",
                 model.spec().model.name,
                 traj.time.len(),
                 traj.time.last().copied().unwrap_or(0.0)
             );
             for (s, v) in system.states.iter().zip(&last) {
-                println!("  {s} = {v:.6}");
+                println!("  {s} = {}", termid::identify::sig(*v, 6));
             }
             if let Some((mc, spread)) = mc.as_ref().zip(spread.as_ref()) {
                 print!("{}", mc.text(spread, &nominal));

@@ -12,7 +12,7 @@ use termid::model::dimension::shown;
 
 use crate::args::{Format, ValidateCommand};
 use crate::monte_carlo::Draws;
-use termid::identify::num;
+use termid::identify::sig;
 
 pub fn run(cmd: ValidateCommand) -> Result<()> {
     if let Some(dir) = &cmd.resim.svg {
@@ -98,11 +98,13 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
                 println!("\n{}: metric, measured, model{band}", f.origin());
                 let row = |name: &str, key: &str, x: Option<f64>, y: Option<f64>| {
                     if x.is_some() || y.is_some() {
-                        let f = |v: Option<f64>| v.map_or("--".to_string(), num);
+                        // at the decimals the metric's unit supports (0.01°, 0.01 s)
+                        let (_, _, d) = termid::plugin::metric_label(key.rsplit('.').next().unwrap_or(key));
+                        let f = |v: Option<f64>| v.map_or("--".to_string(), |v| format!("{v:.d$}"));
                         let spread = s
                             .as_ref()
                             .and_then(|s| s.get(key))
-                            .map_or(String::new(), |sp| format!("   {} … {}", num(sp.p05), num(sp.p95)));
+                            .map_or(String::new(), |sp| format!("   {:.d$} … {:.d$}", sp.p05, sp.p95));
                         println!("  {name:<24} {:>12} {:>12}{spread}", f(x), f(y));
                     }
                 };
@@ -127,5 +129,5 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
 /// One state's error, RMS / max, in its unit with angles in degrees: `ψ 1.55 / 2.74 °`.
 pub fn error_cell(state: &str, rms: f64, max: f64, unit: &str) -> String {
     let (factor, unit) = shown(unit);
-    format!("{state} {} / {} {unit}", num(rms * factor), num(max * factor))
+    format!("{state} {} / {} {unit}", sig(rms * factor, 3), sig(max * factor, 3))
 }
