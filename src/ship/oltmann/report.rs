@@ -34,6 +34,11 @@ fn opt(x: Option<f64>) -> String {
     x.map_or("--".into(), fmt)
 }
 
+/// A metric at two decimals, `--` where the run did not reach it.
+fn two(x: Option<f64>) -> String {
+    x.map_or("--".into(), |v| format!("{v:.2}"))
+}
+
 fn cell(e: Option<(usize, f64)>) -> String {
     e.map_or("--".into(), |(s, c)| format!("{} ({s})", fmt(c)))
 }
@@ -261,24 +266,25 @@ fn resim_rows(list: &[Resimulation]) -> String {
 
 fn metric_line(m: &Metrics) -> String {
     match m {
+        // at the decimals a simulation sampled at 0.04 s supports: 0.01°, 0.01 s, 0.01 m
         Metrics::ZigZag(z) => format!(
             "1st overshoot {} °, 2nd {} °, period {} s",
-            opt(z.first_overshoot_deg),
-            opt(z.second_overshoot_deg),
-            opt(z.period_s)
+            two(z.first_overshoot_deg),
+            two(z.second_overshoot_deg),
+            two(z.period_s)
         ),
         Metrics::Turning(t) => format!(
             "advance {} m, transfer {} m, tactical diameter {} m, steady diameter {} m, speed loss {:.1} %, drift {:.2}°",
-            opt(t.advance_m),
-            opt(t.transfer_m),
-            opt(t.tactical_diameter_m),
-            fmt(t.steady_diameter_m),
+            two(t.advance_m),
+            two(t.transfer_m),
+            two(t.tactical_diameter_m),
+            two(Some(t.steady_diameter_m)),
             t.speed_loss_percent,
             t.drift_angle_deg
         ),
         Metrics::Spiral(s) => format!(
-            "loop width {} °, r at δ = ±10°: {}",
-            opt(s.loop_width_deg),
+            "loop width {}, r at δ = ±10°: {}",
+            s.loop_width_deg.map_or("--".into(), |w| if w < 0.005 { "none (course-stable)".into() } else { format!("{w:.2} °") }),
             s.points
                 .iter()
                 .filter(|p| p.branch == "down" && (p.rudder_deg.abs() - 10.0).abs() < 1e-9)
@@ -505,13 +511,14 @@ fn markdown(study: &Study) -> String {
     for p in &study.alternatives {
         let _ = writeln!(
             s,
-            "| {} | {} | {:?} | {} | {} | {} |",
+            // three significant figures, one notation down each column (F spans 15 decades)
+            "| {} | {} | {} | {} | {:.2e} | {:.2e} |",
             p.equation,
             Alternative::ALL[p.alternative - 1].label(),
-            p.rate_unit,
+            if p.rate_unit == RateUnit::Degrees { "°/s" } else { "rad/s" },
             p.chosen_step,
-            fmt(p.f),
-            fmt(p.standard_error)
+            p.f,
+            p.standard_error
         );
     }
     s += "\n![Fig. 5](figures/fig5_alternatives.svg)\n\nAs in the paper, F falls and the standard error rises as the data get coarser, most sharply once the accelerations are numerical derivatives (4, 5). The unit of rounding matters for ṙ: 2 decimals of °/s is 1.7e-4 rad/s, 2 decimals of rad/s is 0.57 °/s, 57 times coarser.\n\n";
