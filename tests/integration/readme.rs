@@ -217,3 +217,23 @@ fn every_help_example_runs_as_written() {
         }
     }
 }
+
+/// Every relative link of README and the guide names a file or folder of the repository.
+#[test]
+fn every_link_of_readme_and_the_guide_resolves() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let mut broken = Vec::new();
+    for page in pages() {
+        let text = std::fs::read_to_string(root.join(&page)).unwrap();
+        for part in text.split("](").skip(1) {
+            let link = part.split(')').next().unwrap_or("").split('#').next().unwrap_or("");
+            if link.is_empty() || link.contains("://") || link.contains(' ') {
+                continue;
+            }
+            if !root.join(&page).parent().unwrap().join(link).exists() {
+                broken.push(format!("{}: {link}", page.display()));
+            }
+        }
+    }
+    assert!(broken.is_empty(), "broken links:\n{}", broken.join("\n"));
+}
