@@ -447,3 +447,39 @@ fn words_say_what_happened() {
     // the identified model is named as identified, not as the model its candidates came from
     assert!(out.starts_with("identified from examples/data/runs.toml"), "{out}");
 }
+
+/// `--dataset` is repeatable wherever runs are read: the runs of two dataset files (two
+/// basins, two campaigns) identified together are the runs of one file that lists them all.
+#[test]
+fn datasets_add_up() {
+    let dir = crate::common::Scratch::new("two-datasets");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data");
+    let all = std::fs::read_to_string(root.join("runs.toml")).unwrap();
+    let (head, runs) = all.split_at(all.find("[[runs]]").unwrap());
+    let parts: Vec<&str> = runs.split("[[runs]]").filter(|r| !r.trim().is_empty()).collect();
+    let folder = format!("folder = \"{}\"\n", root.display());
+    let write = |name: &str, list: &[&str]| {
+        let body: String = list.iter().map(|r| format!("[[runs]]{r}")).collect();
+        std::fs::write(dir.join(name), format!("{folder}{head}{body}")).unwrap();
+        dir.join(name).to_str().unwrap().to_string()
+    };
+    let (one, a, b) = (write("all.toml", &parts), write("a.toml", &parts[..2]), write("b.toml", &parts[2..]));
+    let fit = |datasets: &[&str]| {
+        let mut args = vec![
+            "identify",
+            "--model",
+            "examples/data/ship.toml",
+            "--derivative",
+            "kalman",
+            "--format",
+            "json",
+        ];
+        for d in datasets {
+            args.extend(["--dataset", d]);
+        }
+        let (ok, out, err) = termid(&args);
+        assert!(ok, "{err}");
+        out
+    };
+    assert_eq!(fit(&[&one]), fit(&[&a, &b]));
+}

@@ -121,9 +121,10 @@ pub struct MomentsCommand {
     /// CSV files of runs (model names, SI).
     #[arg(long = "data", short = 'd', num_args = 1.., required_unless_present = "dataset")]
     pub data: Vec<PathBuf>,
-    /// A dataset file (TOML): runs with their own column names and units.
-    #[arg(long)]
-    pub dataset: Option<PathBuf>,
+    /// A dataset file (TOML): runs with their own column names and units. Repeatable: the
+    /// runs of every one together (each with its own columns, units and scale).
+    #[arg(long, action = clap::ArgAction::Append)]
+    pub dataset: Vec<PathBuf>,
     /// Derivative method where the target is a state's derivative (the runs have no
     /// `<state>_dot` column): central, five-point, savitzky-golay[:W:Q], spline[:ALPHA], kalman,
     /// or integral[:W] (no rate: changes over windows of W samples against integrals).
@@ -186,9 +187,10 @@ pub struct IdentifyCommand {
     /// CSV files with a header row; several are combined (the paper's "Komb. Daten").
     #[arg(long = "data", short = 'd', num_args = 1.., required_unless_present_any = ["dataset", "moments"])]
     pub data: Vec<PathBuf>,
-    /// A dataset file (TOML): runs with their own column names and units.
-    #[arg(long)]
-    pub dataset: Option<PathBuf>,
+    /// A dataset file (TOML): runs with their own column names and units. Repeatable: the
+    /// runs of every one together (each with its own columns, units and scale).
+    #[arg(long, action = clap::ArgAction::Append)]
+    pub dataset: Vec<PathBuf>,
     /// With --model: identify from statistics written by `termid moments` instead of runs
     /// (several files are merged; each names its equation).
     #[arg(long, num_args = 1.., requires = "model", conflicts_with_all = ["data", "dataset", "refine", "choose"])]
@@ -418,9 +420,10 @@ pub struct CompareCommand {
     /// Runs (CSV), combined.
     #[arg(long = "data", short = 'd', num_args = 1.., required_unless_present = "dataset")]
     pub data: Vec<PathBuf>,
-    /// A dataset file (TOML): runs with their own column names and units.
-    #[arg(long)]
-    pub dataset: Option<PathBuf>,
+    /// A dataset file (TOML): runs with their own column names and units. Repeatable: the
+    /// runs of every one together (each with its own columns, units and scale).
+    #[arg(long, action = clap::ArgAction::Append)]
+    pub dataset: Vec<PathBuf>,
     /// Equations to compare (default: all identifiable ones).
     #[arg(long, num_args = 1..)]
     pub equation: Vec<String>,
@@ -511,9 +514,10 @@ pub struct RunsArgs {
     /// Runs (CSV with the time, the inputs and measured states).
     #[arg(long = "data", short = 'd', num_args = 1.., required_unless_present = "dataset")]
     pub data: Vec<PathBuf>,
-    /// A dataset file (TOML): runs with their own column names and units.
-    #[arg(long)]
-    pub dataset: Option<PathBuf>,
+    /// A dataset file (TOML): runs with their own column names and units. Repeatable: the
+    /// runs of every one together (each with its own columns, units and scale).
+    #[arg(long, action = clap::ArgAction::Append)]
+    pub dataset: Vec<PathBuf>,
 }
 
 /// How measured runs are re-simulated, and where the figures go.

@@ -12,7 +12,7 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
     // outputs that cannot be written are refused before any work
     if let Some(out) = &cmd.out {
         termid::output::check_file(out)?;
-        let mut inputs = crate::runs::input_files(&cmd.runs.data, cmd.runs.dataset.as_deref());
+        let mut inputs = crate::runs::input_files(&cmd.runs.data, &cmd.runs.dataset);
         inputs.extend(cmd.model.iter().map(|m| ("--model".to_string(), m.clone())));
         crate::runs::check_outputs(&[("--out", out)], &inputs)?;
     }
@@ -20,7 +20,7 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
         termid::output::check_folder(dir)?;
     }
     let model = crate::simulate::load_model(&cmd.model)?;
-    let runs = crate::runs::load_for(&model, &cmd.runs.data, cmd.runs.dataset.as_deref())?;
+    let runs = crate::runs::load_for(&model, &cmd.runs.data, &cmd.runs.dataset)?;
     let hypotheses = termid::plugins::of(&model)
         .and_then(|p| p.hypotheses(&model))
         .unwrap_or_else(|| generic_hypotheses(&model));

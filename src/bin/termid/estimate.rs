@@ -11,9 +11,9 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
     // an output that cannot be written is refused before any work
     if let Some(out) = &cmd.out {
         termid::output::check_file(out)?;
-        let mut inputs = crate::runs::input_files(&cmd.data, None);
+        let mut inputs = crate::runs::input_files(&cmd.data, &[]);
         for d in &cmd.dataset {
-            inputs.extend(crate::runs::input_files(&[], Some(d)));
+            inputs.extend(crate::runs::input_files(&[], std::slice::from_ref(d)));
         }
         inputs.push(("--model".to_string(), cmd.model.clone()));
         crate::runs::check_outputs(&[("--out", out)], &inputs)?;
@@ -31,13 +31,13 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
     let mut sources = Vec::new();
     let mut labels = Vec::new();
     if !cmd.data.is_empty() {
-        let more = crate::runs::load_for(&model, &cmd.data, None)?;
+        let more = crate::runs::load_for(&model, &cmd.data, &[])?;
         sources.extend(std::iter::repeat_n(labels.len(), more.len()));
         labels.push("--data".to_string());
         frames.extend(more);
     }
     for d in &cmd.dataset {
-        let more = crate::runs::load_for(&model, &[], Some(d))?;
+        let more = crate::runs::load_for(&model, &[], std::slice::from_ref(d))?;
         sources.extend(std::iter::repeat_n(labels.len(), more.len()));
         labels.push(d.display().to_string());
         frames.extend(more);

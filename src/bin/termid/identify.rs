@@ -65,7 +65,7 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
     for (flag, list) in [("--param", &cmd.params), ("--derive", &cmd.derived), ("--alias", &cmd.aliases)] {
         crate::runs::check_names_once(flag, list)?;
     }
-    let mut inputs = crate::runs::input_files(&cmd.data, cmd.dataset.as_deref());
+    let mut inputs = crate::runs::input_files(&cmd.data, &cmd.dataset);
     crate::runs::check_once(&inputs)?;
     for (k, m) in cmd.moments.iter().enumerate() {
         if let Some(first) = cmd.moments[..k].iter().find(|o| termid::output::same_file(o, m)) {
@@ -96,13 +96,13 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
     let mut frames = if cmd.no_time {
         let mut frames =
             cmd.data.iter().map(|p| Frame::read_csv_untimed(p)).collect::<Result<Vec<_>, _>>()?;
-        if let Some(ds) = &cmd.dataset {
-            frames.extend(crate::runs::load(&[], Some(ds), &cmd.time)?);
+        if !cmd.dataset.is_empty() {
+            frames.extend(crate::runs::load(&[], &cmd.dataset, &cmd.time)?);
         }
         frames
     } else {
         // the same reading (and check for gaps in time) as every other command
-        crate::runs::load(&cmd.data, cmd.dataset.as_deref(), &cmd.time)?
+        crate::runs::load(&cmd.data, &cmd.dataset, &cmd.time)?
     };
     let target = Target::parse(cmd.target.as_deref().unwrap_or_default());
     match &target {

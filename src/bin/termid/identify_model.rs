@@ -45,11 +45,11 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
             STARTS_AGREE,
         )?,
         None => {
-            let frames = crate::runs::load_for(&model, &cmd.data, cmd.dataset.as_deref())?;
+            let frames = crate::runs::load_for(&model, &cmd.data, &cmd.dataset)?;
             let held = cmd
                 .refine_validation
                 .as_ref()
-                .map(|p| crate::runs::load_for(&model, &[], Some(p)))
+                .map(|p| crate::runs::load_for(&model, &[], std::slice::from_ref(p)))
                 .transpose()?;
             let settings = RecipeSettings {
                 equations: cmd.equation.clone(),
@@ -173,7 +173,7 @@ const PIECE_ROWS: usize = 262_144;
 fn in_pieces(cmd: &IdentifyCommand, refine: bool) -> Result<Option<usize>> {
     let local = differentiator(&cmd.derivative).ok().and_then(|d| d.reach()).is_some();
     let whole_runs_needed = [
-        (cmd.dataset.is_some(), "--dataset"),
+        (!cmd.dataset.is_empty(), "--dataset"),
         (cmd.resample.is_some(), "--resample"),
         (cmd.smooth, "--smooth"),
         (cmd.prepared_svg.is_some(), "--prepared-svg"),

@@ -10,7 +10,7 @@ use crate::args::{Format, IdentifyCommand};
 
 pub fn run(cmd: MomentsCommand) -> Result<()> {
     termid::output::check_file(&cmd.out)?;
-    let mut inputs = crate::runs::input_files(&cmd.data, cmd.dataset.as_deref());
+    let mut inputs = crate::runs::input_files(&cmd.data, &cmd.dataset);
     crate::runs::check_once(&inputs)?;
     inputs.push(("--model".into(), cmd.model.clone()));
     crate::runs::check_outputs(&[("--out", &cmd.out)], &inputs)?;
@@ -18,7 +18,7 @@ pub fn run(cmd: MomentsCommand) -> Result<()> {
     let diff = differentiator(&cmd.derivative)?;
     let moments = match diff.reach() {
         // plain files with a local derivative: read in pieces, one pass, bounded memory
-        Some(reach) if cmd.chunk_rows > 0 && cmd.dataset.is_none() => {
+        Some(reach) if cmd.chunk_rows > 0 && cmd.dataset.is_empty() => {
             let runs = cmd
                 .data
                 .iter()
@@ -31,7 +31,7 @@ pub fn run(cmd: MomentsCommand) -> Result<()> {
             moments
         }
         _ => {
-            let frames = crate::runs::load_for(&model, &cmd.data, cmd.dataset.as_deref())?;
+            let frames = crate::runs::load_for(&model, &cmd.data, &cmd.dataset)?;
             EquationMoments::of_runs(&model, &cmd.equation, &frames, diff.as_ref(), None)?
         }
     };

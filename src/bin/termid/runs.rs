@@ -9,8 +9,8 @@ use termid::model::Model;
 
 /// The runs of a command with a model: as [`load`], then each dataset mapping checked to name
 /// one of the model's variables and each run checked against the model's known kinematics.
-pub fn load_for(model: &Model, data: &[PathBuf], dataset: Option<&Path>) -> Result<Vec<Frame>> {
-    if let Some(path) = dataset {
+pub fn load_for(model: &Model, data: &[PathBuf], datasets: &[PathBuf]) -> Result<Vec<Frame>> {
+    for path in datasets {
         let ds = Dataset::load(path)?;
         let known = model.data_names();
         if let Some(var) = ds.columns.keys().find(|v| !known.contains(v)) {
@@ -22,7 +22,7 @@ pub fn load_for(model: &Model, data: &[PathBuf], dataset: Option<&Path>) -> Resu
             );
         }
     }
-    let mut frames = load(data, dataset, &model.spec().model.time)?;
+    let mut frames = load(data, datasets, &model.spec().model.time)?;
     for f in &mut frames {
         for note in model.admit(f)? {
             say(&note);
@@ -41,10 +41,10 @@ pub fn load_for(model: &Model, data: &[PathBuf], dataset: Option<&Path>) -> Resu
 /// Every file a command reads runs from, named as the user named it: the `--data` files, the
 /// dataset file and the runs it lists (where it can be read; its errors come later, in their
 /// place). For [`termid::output::check_distinct`].
-pub fn input_files(data: &[PathBuf], dataset: Option<&Path>) -> Vec<(String, PathBuf)> {
+pub fn input_files(data: &[PathBuf], datasets: &[PathBuf]) -> Vec<(String, PathBuf)> {
     let mut out: Vec<(String, PathBuf)> =
         data.iter().map(|p| (format!("--data {}", p.display()), p.clone())).collect();
-    if let Some(path) = dataset {
+    for path in datasets {
         out.push((format!("--dataset {}", path.display()), path.to_path_buf()));
         if let Ok(ds) = Dataset::load(path) {
             if let Ok(folder) = ds.folder(path) {
@@ -112,15 +112,15 @@ pub fn replay_frame(path: &Path, time: &str) -> Result<Frame> {
     Ok(frame)
 }
 
-pub fn load(data: &[PathBuf], dataset: Option<&Path>, time: &str) -> Result<Vec<Frame>> {
-    check_once(&input_files(data, dataset))?;
+pub fn load(data: &[PathBuf], datasets: &[PathBuf], time: &str) -> Result<Vec<Frame>> {
+    check_once(&input_files(data, datasets))?;
     let mut frames = data.iter().map(|p| Frame::read(p, time)).collect::<Result<Vec<_>, _>>()?;
     for f in &frames {
         // a logging dropout would be differentiated across as if it were one step (dataset
         // files are checked as they are read, in their own column names)
         check_gaps(f, 3.0)?;
     }
-    if let Some(path) = dataset {
+    for path in datasets {
         let ds = Dataset::load(path)?;
         let (more, notes) = ds
             .read(&ds.folder(path)?, time)

@@ -19,7 +19,7 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
         termid::output::check_folder(dir)?;
     }
     let model = crate::simulate::load_model(&cmd.model)?;
-    let runs = crate::runs::load_for(&model, &cmd.runs.data, cmd.runs.dataset.as_deref())?;
+    let runs = crate::runs::load_for(&model, &cmd.runs.data, &cmd.runs.dataset)?;
     let (integrator, dt) = model.simulation(cmd.resim.integrator, cmd.resim.dt);
     let data = Runs::new(&model, &runs, dt, integrator)?.with_intercepts(cmd.resim.with_intercept);
     let sims = data.simulate(&model, &[], &[])?;
