@@ -108,3 +108,24 @@ pub fn lorenz_csv(dir: &std::path::Path, duration: &str) -> std::path::PathBuf {
     assert!(ok, "{err}");
     csv
 }
+
+/// `termid identify` on the shipped sample records (`examples/data`: four noisy zigzags) with
+/// the Kalman smoother and no intercept, writing the model to `out`; `extra` adds arguments.
+pub fn identify_sample_records(out: &std::path::Path, extra: &[&str]) -> (bool, String, String) {
+    let out = out.to_str().unwrap();
+    let mut args = vec![
+        "identify",
+        "--model",
+        "examples/data/ship.toml",
+        "--dataset",
+        "examples/data/runs.toml",
+        "--derivative",
+        "kalman",
+        "--smooth",
+        "--no-intercept",
+        "--out",
+        out,
+    ];
+    args.extend(extra);
+    termid(&args)
+}
