@@ -170,10 +170,26 @@ pub fn labelled(name: &str, unit: &str) -> String {
     }
 }
 
-/// `c` mixed half with white: a wide line that lines drawn over it leave visible.
-fn lighter(c: RGBColor) -> RGBColor {
-    let mix = |v: u8| (f64::from(v) * 0.5 + 255.0 * 0.5).round() as u8;
-    RGBColor(mix(c.0), mix(c.1), mix(c.2))
+/// Whether the label of the marker at `x` goes left of its line: where another marker's line
+/// would cross it on the right (11 px text, 5.5 px a character; `per_px`: x units a pixel).
+fn label_left(panel: &Panel, x: f64, label: &str, per_px: f64) -> bool {
+    let width = (5.5 * label.chars().count() as f64 + 4.0) * per_px;
+    panel.markers.iter().any(|(other, _)| *other > x && *other <= x + width)
+}
+
+/// The colour the `k`-th series of `panel` is drawn in: its own or the palette's; a solid line
+/// (the reference: measured, true) under dashed ones is drawn wide (see [`draw_series`]) and
+/// mixed half with white, so that it shows beside the dashes that run along it.
+fn paint(panel: &Panel, k: usize) -> RGBColor {
+    let s = &panel.series[k];
+    let c = PALETTE[s.color.unwrap_or(k) % PALETTE.len()];
+    let under = panel.series.iter().any(|s| style_is(s.style, Style::Dashed));
+    if under && style_is(s.style, Style::Line) {
+        let mix = |v: u8| (f64::from(v) * 0.5 + 255.0 * 0.5).round() as u8;
+        RGBColor(mix(c.0), mix(c.1), mix(c.2))
+    } else {
+        c
+    }
 }
 
 fn style_is(a: Style, b: Style) -> bool {
@@ -241,11 +257,8 @@ fn legend_corner(
         .flat_map(|(k, (mx, label))| {
             let line = (0..=20).map(move |i| (*mx, y.0 + (y.1 - y.0) * f64::from(i) / 20.0));
             let at = y.1 - 0.08 * k as f64 * (y.1 - y.0);
-            let n = label.chars().count();
-            let width = (5.5 * n as f64 + 4.0) * per_px;
-            let left = panel.markers.iter().any(|(other, _)| *other > *mx && *other <= *mx + width);
-            let sign = if left { -1.0 } else { 1.0 };
-            let text = (0..n).map(move |c| (*mx + sign * 5.5 * c as f64 * per_px, at));
+            let sign = if label_left(panel, *mx, label, per_px) { -1.0 } else { 1.0 };
+            let text = (0..label.chars().count()).map(move |c| (*mx + sign * 5.5 * c as f64 * per_px, at));
             line.chain(text)
         })
         .collect();
@@ -536,12 +549,9 @@ fn legend_row<DB: DrawingBackend>(
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     let mut seen: Vec<(String, Style, RGBColor)> = Vec::new();
     for panel in panels {
-        let under = panel.series.iter().any(|s| style_is(s.style, Style::Dashed));
         for (k, s) in panel.series.iter().enumerate() {
             if !s.name.is_empty() && !seen.iter().any(|(n, _, _)| *n == s.name) {
-                let color = PALETTE[s.color.unwrap_or(k) % PALETTE.len()];
-                let color = if under && style_is(s.style, Style::Line) { lighter(color) } else { color };
-                seen.push((s.name.clone(), s.style, color));
+                seen.push((s.name.clone(), s.style, paint(panel, k)));
             }
         }
     }
@@ -580,21 +590,16 @@ fn draw_series<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate<
         // would cross it on the right
         let share = 0.08 * k as f64;
         let at = if panel.log_y { y1 * (y0 / y1).powf(share) } else { y1 - share * (y1 - y0) };
-        let width = (5.5 * label.chars().count() as f64 + 4.0) * per_px;
-        let crossed = panel.markers.iter().any(|(other, _)| *other > *x && *other <= *x + width);
-        let side = if crossed { HPos::Right } else { HPos::Left };
+        let side = if label_left(panel, *x, label, per_px) { HPos::Right } else { HPos::Left };
         chart.draw_series(std::iter::once(Text::new(
             label.clone(),
             (*x, at),
             TextStyle::from(("sans-serif", 11).into_font()).pos(Pos::new(side, VPos::Top)),
         )))?;
     }
-    // a solid line (the reference: measured, true) under dashed ones drawn over it is drawn
-    // wider and lighter, so that it shows beside the dashes that run along it
     let under = panel.series.iter().any(|s| style_is(s.style, Style::Dashed));
     for (k, s) in panel.series.iter().enumerate() {
-        let color = PALETTE[s.color.unwrap_or(k) % PALETTE.len()];
-        let color = if under && style_is(s.style, Style::Line) { lighter(color) } else { color };
+        let color = paint(panel, k);
         let pts: Vec<(f64, f64)> =
             s.x.iter()
                 .zip(&s.y)
