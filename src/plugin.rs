@@ -245,10 +245,12 @@ pub struct Observation {
     pub note: Option<String>,
 }
 
-/// A metric's key as a person reads it: its name in words, its unit (from the key's suffix:
-/// `_deg_s`, `_deg`, `_s`, `_m`, `_lpp`, `_percent`) and the decimals that mean something at
-/// the sampling of a simulation (0.01°, 0.01 s, 0.01 m, 0.1 %).
+/// A metric's key (its last `.`-part, where nested) as a person reads it: its name in words,
+/// its unit (from the key's suffix: `_deg_s`, `_deg`, `_s`, `_m`, `_lpp`, `_percent`) and the
+/// decimals that mean something at the sampling of a simulation (0.01°, 0.01 s, 0.01 m, 0.1 %).
 pub fn metric_label(key: &str) -> (String, &'static str, usize) {
+    // a nested metric (`turning.tactical_diameter_m`) by its own name
+    let key = key.rsplit('.').next().unwrap_or(key);
     let units: [(&str, &str, usize); 6] = [
         ("_deg_s", "°/s", 3),
         ("_deg", "°", 2),
@@ -273,6 +275,7 @@ mod tests {
         assert_eq!(metric_label("first_overshoot_deg"), ("first overshoot".to_string(), "°", 2));
         assert_eq!(metric_label("yaw_rate_deg_s"), ("yaw rate".to_string(), "°/s", 3));
         assert_eq!(metric_label("period_s"), ("period".to_string(), "s", 2));
+        assert_eq!(metric_label("turning.advance_m"), ("advance".to_string(), "m", 2));
         assert_eq!(metric_label("tactical_diameter_lpp"), ("tactical diameter".to_string(), "L", 2));
         assert_eq!(metric_label("speed_loss_percent"), ("speed loss".to_string(), "%", 1));
         assert_eq!(metric_label("speed_ratio"), ("speed ratio".to_string(), "", 3));

@@ -168,7 +168,7 @@ impl<T> Draws<T> {
             let nom = k.split('.').try_fold(nominal, |v, key| v.get(key)).and_then(serde_json::Value::as_f64);
             // the metric in words with its unit, each number at the decimals its unit supports
             // (the sd one more)
-            let (name, unit, d) = termid::plugin::metric_label(k.rsplit('.').next().unwrap_or(k));
+            let (name, unit, d) = termid::plugin::metric_label(k);
             let label = termid::plot::labelled(&name, unit);
             let e = d + 1;
             out += &format!(

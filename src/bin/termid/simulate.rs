@@ -265,14 +265,7 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
                 x_label: termid::plot::labelled(&model.spec().model.time, "s"),
                 y_label: termid::plot::labelled(
                     s,
-                    model
-                        .spec()
-                        .states
-                        .iter()
-                        .find(|t| &t.name == s)
-                        .map(|t| t.unit.as_str())
-                        .filter(|u| !u.is_empty())
-                        .unwrap_or("-"),
+                    Some(model.unit(s)).filter(|u| !u.is_empty()).unwrap_or("-"),
                 ),
                 series: {
                     let mut series = vec![Series::line(s, traj.time.clone(), traj.states[i].clone())];

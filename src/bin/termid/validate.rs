@@ -99,7 +99,7 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
                 let row = |name: &str, key: &str, x: Option<f64>, y: Option<f64>| {
                     if x.is_some() || y.is_some() {
                         // at the decimals the metric's unit supports (0.01°, 0.01 s)
-                        let (_, _, d) = termid::plugin::metric_label(key.rsplit('.').next().unwrap_or(key));
+                        let (_, _, d) = termid::plugin::metric_label(key);
                         let f = |v: Option<f64>| v.map_or("--".to_string(), |v| format!("{v:.d$}"));
                         let spread = s
                             .as_ref()
