@@ -11,7 +11,8 @@
 //! `cargo run --release --example mmg_basin [-- OUTPUT_FOLDER]` (seeds: MMG_SEEDS=0,1,2;
 //! MMG_RUNS=simman trains on the SIMMAN HSVA set instead — 13 zigzags from 5°/1° to 35°/5°,
 //! all at one speed and propeller rate, 180 s each; MMG_REFINE=1 adds a row for the chosen
-//! model refined by output error)
+//! model refined by output error; MMG_GREYBOX=1 adds a row for the grey-box MMG model that
+//! `termid new-ship` writes from KVLCC2's particulars, estimated on the same runs)
 
 use std::path::{Path, PathBuf};
 
@@ -129,6 +130,24 @@ fn main() -> Result<(), Error> {
             let refined = termid::diagnose::refine(&model, &runs, &Default::default())?;
             let (cells, _) = predict(&refined.model, &true_turns, &true_held, u0, &settings)?;
             println!("| {seed} | {} refined |{cells}", chosen.candidates[chosen.best].label);
+        }
+        if std::env::var("MMG_GREYBOX").is_ok_and(|v| v == "1") {
+            // a ship nobody has tested: its particulars only, then its zigzags (what `termid
+            // new-ship` and `termid estimate --states u,v,r,ψ` do)
+            let particulars: termid::ship::particulars::Particulars =
+                toml::from_str(&std::fs::read_to_string("examples/kvlcc2_particulars.toml")?)?;
+            let start = particulars.model()?;
+            let runs = termid::diagnose::Runs::new(
+                &start,
+                &frames,
+                termid::data::sample_step(&frames),
+                Integrator::Rk4,
+            )?
+            .comparing(&["u", "v", "r", "ψ"].map(String::from))?;
+            let fit = termid::diagnose::estimate(&start, &runs, &Default::default())?;
+            std::fs::write(dir.join(format!("greybox_{seed}.toml")), fit.model.to_toml())?;
+            let (cells, _) = predict(&fit.model, &true_turns, &true_held, u0, &settings)?;
+            println!("| {seed} | grey-box from particulars |{cells}");
         }
         // every back-end's own model, for the summary: how much the choice matters
         for (k, (label, variant)) in configurations.iter().enumerate() {

@@ -10,6 +10,8 @@ mod start;
 pub use report::Primes;
 pub use start::{derivative_method, prepare_runs, Start};
 
+use rayon::prelude::*;
+
 use crate::data::Frame;
 use crate::identify::{num, Target};
 use crate::model::Model;
@@ -118,8 +120,14 @@ pub fn identify(
     }
     let mut starts = Vec::new();
     let mut failed = Vec::new();
-    for method in &settings.derivatives {
-        match start::identify_start(model, frames, held, settings, method) {
+    // the starts are independent: side by side, they fill the cores the per-run work leaves idle
+    let results: Vec<_> = settings
+        .derivatives
+        .par_iter()
+        .map(|method| start::identify_start(model, frames, held, settings, method))
+        .collect();
+    for (method, result) in settings.derivatives.iter().zip(results) {
+        match result {
             Ok(s) => starts.push(s),
             Err(e) if settings.derivatives.len() > 1 => failed.push((method.clone(), e.to_string())),
             Err(e) => return Err(e),
