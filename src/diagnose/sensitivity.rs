@@ -267,10 +267,16 @@ fn integrate(
 ) -> Result<Rows, DiagnoseError> {
     let Columns { terms: term_columns, perturbed, initial, k } = *columns;
     let settings = &runs.settings[r];
+    let n = system.dim();
+    // S's rows that matter: the compared states' and those the right-hand side reads (through
+    // them the others'); a state nothing reads and nobody compares (a ship's x0, y0) feeds
+    // nothing back, so its row is not integrated (it stays 0 in the output)
+    let rows: Vec<usize> =
+        (0..n).filter(|&i| system.reads_state(i) || runs.states.iter().any(|(c, _)| *c == i)).collect();
     if settings.integrator != Integrator::Rk4 {
         return Err(DiagnoseError::Setup("forward sensitivities integrate with RK4".into()));
     }
-    let (n, m) = (system.dim(), system.inputs.len());
+    let m = system.inputs.len();
     let (steps, every) = settings.check(n)?;
     let dt = settings.dt;
     let mut replay = Replay::new(&runs.frames[r], &system.inputs)?;
@@ -295,7 +301,7 @@ fn integrate(
         // ∂f/∂p: the right-hand side at p + h against f
         for ((j, sys, h), w) in perturbed.iter().zip(wq.iter_mut()) {
             sys.derivatives(x, u, w, &mut fp);
-            for i in 0..n {
+            for &i in &rows {
                 ds[i * k + j] = (fp[i] - fx[i]) / h;
             }
         }
@@ -307,7 +313,7 @@ fn integrate(
             xs[c] = x[c] + h;
             system.derivatives(&xs, u, &mut ws, &mut fp);
             xs[c] = x[c];
-            for i in 0..n {
+            for &i in &rows {
                 let a = (fp[i] - fx[i]) / h;
                 if a != 0.0 {
                     for j in 0..k {
@@ -339,8 +345,10 @@ fn integrate(
             for i in 0..n {
                 tx[i] = x[i] + w * dt * kx[stage][i];
             }
-            for i in 0..n * k {
-                ts[i] = s[i] + w * dt * ks[stage][i];
+            for &i in &rows {
+                for q in i * k..(i + 1) * k {
+                    ts[q] = s[q] + w * dt * ks[stage][q];
+                }
             }
             let (kx_next, ks_next) = (&mut kx[stage + 1], &mut ks[stage + 1]);
             rate(&tx, &ts, u, kx_next, ks_next);
@@ -348,8 +356,10 @@ fn integrate(
         for i in 0..n {
             x[i] += dt / 6.0 * (kx[0][i] + 2.0 * kx[1][i] + 2.0 * kx[2][i] + kx[3][i]);
         }
-        for i in 0..n * k {
-            s[i] += dt / 6.0 * (ks[0][i] + 2.0 * ks[1][i] + 2.0 * ks[2][i] + ks[3][i]);
+        for &i in &rows {
+            for q in i * k..(i + 1) * k {
+                s[q] += dt / 6.0 * (ks[0][q] + 2.0 * ks[1][q] + 2.0 * ks[2][q] + ks[3][q]);
+            }
         }
         if let Some((i, v)) = x.iter().enumerate().find(|(i, v)| {
             let (lo, hi) = system.bounds[*i];
