@@ -270,7 +270,7 @@ fn integrate(
     let n = system.dim();
     // S's rows that matter: the compared states' and those the right-hand side reads (through
     // them the others'); a state nothing reads and nobody compares (a ship's x0, y0) feeds
-    // nothing back, so its row is not integrated (it stays 0 in the output)
+    // nothing back, so its row is not integrated (it keeps its start in the output)
     let rows: Vec<usize> =
         (0..n).filter(|&i| system.reads_state(i) || runs.states.iter().any(|(c, _)| *c == i)).collect();
     if settings.integrator != Integrator::Rk4 {
