@@ -427,7 +427,7 @@ fn words_say_what_happened() {
     let (ok, _, err) = termid(&["simulate", "--model", "models/lorenz.toml"]);
     assert!(!ok && err.contains("-m zigzag:20/20") && err.contains("--duration"), "{err}");
     let model = p("identified.toml");
-    let (ok, _, err) = crate::common::identify_sample_records(std::path::Path::new(&model), &[]);
+    let (ok, _, err) = crate::common::identify_sample_records(std::path::Path::new(&model), "kalman", &[]);
     assert!(ok, "{err}");
     let (ok, out, err) = termid(&["simulate", "--model", &model, "-m", "turning:35", "--monte-carlo", "10"]);
     assert!(ok, "{err}");

@@ -110,8 +110,13 @@ pub fn lorenz_csv(dir: &std::path::Path, duration: &str) -> std::path::PathBuf {
 }
 
 /// `termid identify` on the shipped sample records (`examples/data`: four noisy zigzags) with
-/// the Kalman smoother and no intercept, writing the model to `out`; `extra` adds arguments.
-pub fn identify_sample_records(out: &std::path::Path, extra: &[&str]) -> (bool, String, String) {
+/// the `derivative` method(s), smoothed states and no intercept, writing the model to `out`;
+/// `extra` adds arguments.
+pub fn identify_sample_records(
+    out: &std::path::Path,
+    derivative: &str,
+    extra: &[&str],
+) -> (bool, String, String) {
     let out = out.to_str().unwrap();
     let mut args = vec![
         "identify",
@@ -120,7 +125,7 @@ pub fn identify_sample_records(out: &std::path::Path, extra: &[&str]) -> (bool, 
         "--dataset",
         "examples/data/runs.toml",
         "--derivative",
-        "kalman",
+        derivative,
         "--smooth",
         "--no-intercept",
         "--out",

@@ -429,7 +429,8 @@ fn every_figure_kind_reads_as_a_person_would_have_it() {
     let (prepared, validated, diagnosed) =
         (dir.join("prepared"), dir.join("validated"), dir.join("diagnosed"));
     let model = dir.join("identified.toml");
-    let (ok, _, err) = crate::common::identify_sample_records(&model, &["--prepared-svg", &s(&prepared)]);
+    let (ok, _, err) =
+        crate::common::identify_sample_records(&model, "kalman", &["--prepared-svg", &s(&prepared)]);
     assert!(ok, "{err}");
     for (m, draws) in [("turning:35", "20"), ("zigzag:20/20", "20"), ("spiral", "0"), ("pullout:20", "0")] {
         let out = dir.join(format!("simulate_{}.svg", m.replace([':', '/'], "_")));

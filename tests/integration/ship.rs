@@ -239,27 +239,20 @@ fn observed_metrics_match_the_manoeuvres_own() {
 fn the_recipe_predicts_the_turning_circles_or_says_its_starts_disagree() {
     let dir = crate::common::Scratch::new("recipe-honest");
     let out = dir.join("ship_id.toml");
-    let (ok, text, err) = crate::common::termid(&[
-        "identify",
-        "--model",
-        "examples/data/ship.toml",
-        "--dataset",
-        "examples/data/runs.toml",
-        "--derivative",
+    let (ok, text, err) = crate::common::identify_sample_records(
+        &out,
         "kinematic,kalman,savitzky-golay,central",
-        "--smooth",
-        "--no-intercept",
-        "--choose",
-        "sparse,best-subset,efroymson,stepwise",
-        "--compare",
-        "u,v,r,ψ",
-        "--refine",
-        "u,v,r,ψ",
-        "--refine-iterations",
-        "100",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+        &[
+            "--choose",
+            "sparse,best-subset,efroymson,stepwise",
+            "--compare",
+            "u,v,r,ψ",
+            "--refine",
+            "u,v,r,ψ",
+            "--refine-iterations",
+            "100",
+        ],
+    );
     assert!(ok, "{err}");
     let checks = &text[text.find("== physical checks ==").expect("checks printed")..];
     let truth = Ship::new(&termid::ship::default_model(), false).unwrap();
