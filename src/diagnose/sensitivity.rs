@@ -1,13 +1,13 @@
 //! Forward sensitivities of a re-simulation with respect to the model's coefficients. The
 //! right-hand side is linear in its coefficients, ẋ_i = Σ_j θ_j φ_j(x, u) over the terms of
-//! equation i, so S = ∂x/∂θ obeys Ṡ = A(x, u) S + B(x, u), with A = ∂f/∂x (forward
-//! differences of the compiled right-hand side) and B_ij = φ_j(x, u) where term j belongs to
-//! the equation of state i. Integrated beside the state by the same RK4 step, S gives the
-//! whole Jacobian of the output error in one pass per run, instead of one re-simulation per
-//! coefficient (and two for central differences). A named parameter p of the model file
-//! (inside derived variables or equations, nonlinear in p) adds a column whose B is ∂f/∂p,
-//! by forward differences of the right-hand side at p + h: the grey-box case. A run's
-//! initial state x_i(0) adds a column with B = 0 and S(0) = e_i in that run alone.
+//! equation i, so S = ∂x/∂θ obeys Ṡ = A(x, u) S + B(x, u), with A = ∂f/∂x and B_ij =
+//! φ_j(x, u) where term j belongs to the equation of state i. Integrated beside the state by
+//! the same RK4 step, S gives the whole Jacobian of the output error in one pass per run,
+//! instead of one re-simulation per coefficient (and two for central differences). A named
+//! parameter p of the model file (inside derived variables or equations, nonlinear in p) adds
+//! a column whose B is ∂f/∂p: the grey-box case. A and ∂f/∂p come exactly, by forward-mode
+//! derivatives through the compiled right-hand side, in one pass. A run's initial state
+//! x_i(0) adds a column with B = 0 and S(0) = e_i in that run alone.
 
 use std::collections::BTreeMap;
 
@@ -46,11 +46,6 @@ pub enum Free {
         /// The state's index.
         state: usize,
     },
-}
-
-/// The forward-difference step of parameter p: small against p, never zero.
-pub(super) fn parameter_step(value: f64) -> f64 {
-    1e-6 * (1.0 + value.abs())
 }
 
 /// The identified terms as outputs over the model's names: φ_j(x, u) for the matrix B.
@@ -191,25 +186,13 @@ fn per_run_jacobians<T: Send>(
         .map(|r| {
             let system = system.with_parameters(&runs.params[r])?;
             let phi = phi.with_parameters(&runs.params[r])?;
-            // the right-hand side at p + h for each free parameter p
-            // this run's own values of the parameters its groups hold
+            // the free parameters of this run: every run's and those of its groups
             let grouped = entries.iter().enumerate().filter_map(|(j, e)| match e {
-                Free::Group { name, runs: group } if group.contains(&r) => {
-                    Some((j, name.clone(), runs.params[r][name]))
-                }
+                Free::Group { name, runs: group } if group.contains(&r) => Some((j, name.clone())),
                 _ => None,
             });
-            let perturbed = parameters
-                .iter()
-                .cloned()
-                .chain(grouped)
-                .map(|(j, name, value)| {
-                    let h = parameter_step(value);
-                    let mut at = runs.params[r].clone();
-                    at.insert(name, value + h);
-                    Ok((j, system.with_parameters(&at)?, h))
-                })
-                .collect::<Result<Vec<_>, SimError>>()?;
+            let free: Vec<(usize, String)> =
+                parameters.iter().map(|(j, name, _)| (*j, name.clone())).chain(grouped).collect();
             let initial: Vec<(usize, usize)> = entries
                 .iter()
                 .enumerate()
@@ -218,7 +201,7 @@ fn per_run_jacobians<T: Send>(
                     _ => None,
                 })
                 .collect();
-            let columns = Columns { terms: &term_columns, perturbed: &perturbed, initial: &initial, k };
+            let columns = Columns { terms: &term_columns, parameters: &free, initial: &initial, k };
             let (x, s) = integrate(&system, &phi, &columns, runs, r)?;
             let frame = &runs.frames[r];
             let rows: usize = runs.states.iter().map(|(_, n)| frame.column(n).map_or(0, <[f64]>::len)).sum();
@@ -248,8 +231,8 @@ fn per_run_jacobians<T: Send>(
 struct Columns<'a> {
     /// (column, the state whose equation holds the term), the terms in `phi`'s order.
     terms: &'a [(usize, usize)],
-    /// (column, the right-hand side at p + h, h).
-    perturbed: &'a [(usize, System, f64)],
+    /// (column, name) of the free parameters.
+    parameters: &'a [(usize, String)],
     /// (column, state) of this run's free initial values.
     initial: &'a [(usize, usize)],
     /// All columns.
@@ -265,7 +248,7 @@ fn integrate(
     runs: &Runs,
     r: usize,
 ) -> Result<Rows, DiagnoseError> {
-    let Columns { terms: term_columns, perturbed, initial, k } = *columns;
+    let Columns { terms: term_columns, parameters, initial, k } = *columns;
     let settings = &runs.settings[r];
     let n = system.dim();
     // S's rows that matter: the compared states' and those the right-hand side reads (through
@@ -282,39 +265,32 @@ fn integrate(
     let mut replay = Replay::new(&runs.frames[r], &system.inputs)?;
     let mut ws = system.workspace();
     let mut wp = phi.workspace();
-    let mut wq: Vec<_> = perturbed.iter().map(|(_, sys, _)| sys.workspace()).collect();
-    let mut fx = vec![0.0; n];
-    let mut fp = vec![0.0; n];
     // ∂f/∂x_c is zero for a state the right-hand side does not read
     let read: Vec<usize> = (0..n).filter(|&c| system.reads_state(c)).collect();
+    let names: Vec<String> = parameters.iter().map(|(_, name)| name.clone()).collect();
+    let mut tangents = system.partials(&read, &names)?;
+    let d = tangents.directions();
+    let mut fx = vec![0.0; n];
+    let mut partials = vec![0.0; n * d];
     let mut terms = vec![0.0; term_columns.len()];
-    let mut xs = vec![0.0; n];
     // (ẋ, Ṡ) at (x, S, u)
     let mut rate = |x: &[f64], s: &[f64], u: &[f64], dx: &mut [f64], ds: &mut [f64]| {
-        system.derivatives(x, u, &mut ws, &mut fx);
+        system.derivatives_and_partials(x, u, &mut ws, &mut tangents, &mut fx, &mut partials);
         dx.copy_from_slice(&fx);
         phi.derivatives(x, u, &mut wp, &mut terms);
         ds.fill(0.0);
         for (&(j, i), phi_j) in term_columns.iter().zip(&terms) {
             ds[i * k + j] = *phi_j;
         }
-        // ∂f/∂p: the right-hand side at p + h against f
-        for ((j, sys, h), w) in perturbed.iter().zip(wq.iter_mut()) {
-            sys.derivatives(x, u, w, &mut fp);
-            for &i in &rows {
-                ds[i * k + j] = (fp[i] - fx[i]) / h;
+        for &i in &rows {
+            let p = &partials[i * d..(i + 1) * d];
+            // ∂f/∂p
+            for (q, (j, _)) in parameters.iter().enumerate() {
+                ds[i * k + j] = p[read.len() + q];
             }
-        }
-        // A S by columns of A: ∂f/∂x_c by forward differences (the sensitivities need a few
-        // digits, the step's truncation error is 1e-7 relative)
-        xs.copy_from_slice(x);
-        for &c in &read {
-            let h = 1e-7 * (1.0 + x[c].abs());
-            xs[c] = x[c] + h;
-            system.derivatives(&xs, u, &mut ws, &mut fp);
-            xs[c] = x[c];
-            for &i in &rows {
-                let a = (fp[i] - fx[i]) / h;
+            // A S, by the columns of A
+            for (q, &c) in read.iter().enumerate() {
+                let a = p[q];
                 if a != 0.0 {
                     for j in 0..k {
                         ds[i * k + j] += a * s[c * k + j];

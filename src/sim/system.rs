@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 
 use super::SimError;
-use crate::term::{Library, RowScratch};
+use crate::term::{Library, RowScratch, Tangents};
 
 /// The compiled right-hand side of a model with its states, inputs and parameters.
 #[derive(Clone, Debug)]
@@ -158,6 +158,43 @@ impl System {
             self.rhs.set_input(&mut ws.scratch, slot, input[i]);
         }
         self.rhs.eval_row_prepared(&mut ws.scratch, dx);
+    }
+
+    /// The directions of [`System::derivatives_and_partials`]: the states `states` (by index)
+    /// and then the parameters `parameters` (by name), in that order. A state the right-hand
+    /// side does not read has derivatives zero.
+    pub fn partials(&self, states: &[usize], parameters: &[String]) -> Result<Tangents, SimError> {
+        let mut slots: Vec<Option<usize>> = states
+            .iter()
+            .map(|&c| self.state_slots.iter().find(|(_, i)| *i == c).map(|(slot, _)| *slot))
+            .collect();
+        for name in parameters {
+            let i = self.param_names.iter().position(|n| n == name).ok_or_else(|| {
+                SimError::Settings(format!("`{name}` is not a parameter ({})", self.param_names.join(", ")))
+            })?;
+            slots.push(self.param_slots.iter().find(|(_, p)| *p == i).map(|(slot, _)| *slot));
+        }
+        Ok(self.rhs.tangents(&slots))
+    }
+
+    /// ẋ = f(x, input) and its partial derivatives with respect to the directions of
+    /// `tangents` (made by [`System::partials`]): `partials` row-major, a row per state.
+    pub fn derivatives_and_partials(
+        &self,
+        x: &[f64],
+        input: &[f64],
+        ws: &mut Workspace,
+        tangents: &mut Tangents,
+        dx: &mut [f64],
+        partials: &mut [f64],
+    ) {
+        for &(slot, i) in &self.state_slots {
+            self.rhs.set_input(&mut ws.scratch, slot, x[i]);
+        }
+        for &(slot, i) in &self.input_slots {
+            self.rhs.set_input(&mut ws.scratch, slot, input[i]);
+        }
+        self.rhs.eval_row_tangents(&mut ws.scratch, tangents, dx, partials);
     }
 
     /// ẋ on every row of a measured run, one column per state: the states and inputs read

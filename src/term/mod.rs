@@ -10,7 +10,7 @@ mod parse;
 mod vocabulary;
 
 pub use canon::{Atom, Monomial, Term};
-pub use compile::{Library, RowScratch, Source};
+pub use compile::{Library, RowScratch, Source, Tangents};
 pub use error::TermError;
 pub use functions::{Function, FUNCTIONS};
 pub use parse::{parse_expr, BinOp, Expr, ExprKind};

@@ -7,6 +7,9 @@
 use rustc_hash::FxHashMap as HashMap;
 
 mod levels;
+mod tangent;
+
+pub use tangent::Tangents;
 
 use levels::{Group, RowProgram};
 
