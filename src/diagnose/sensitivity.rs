@@ -149,15 +149,18 @@ fn per_run_jacobians<T: Send>(
                 terms.push(term.clone());
             }
             Free::Parameter(name) => {
-                let value = *model.parameter_values().get(name).ok_or_else(|| {
-                    DiagnoseError::Setup(format!("`{name}` is not a parameter of {}", model.path))
-                })?;
+                if !model.parameter_values().contains_key(name) {
+                    return Err(DiagnoseError::Setup(format!(
+                        "`{name}` is not a parameter of {}",
+                        model.path
+                    )));
+                }
                 if runs.params.iter().any(|p| p.contains_key(name)) {
                     return Err(DiagnoseError::Setup(format!(
                         "`{name}` is set per run (`per_run`): it cannot be one free parameter"
                     )));
                 }
-                parameters.push((j, name.clone(), value));
+                parameters.push((j, name.clone()));
             }
             Free::Group { name, runs: group } => {
                 if !model.parameter_values().contains_key(name) {
@@ -191,8 +194,7 @@ fn per_run_jacobians<T: Send>(
                 Free::Group { name, runs: group } if group.contains(&r) => Some((j, name.clone())),
                 _ => None,
             });
-            let free: Vec<(usize, String)> =
-                parameters.iter().map(|(j, name, _)| (*j, name.clone())).chain(grouped).collect();
+            let free: Vec<(usize, String)> = parameters.iter().cloned().chain(grouped).collect();
             let initial: Vec<(usize, usize)> = entries
                 .iter()
                 .enumerate()
@@ -270,13 +272,11 @@ fn integrate(
     let names: Vec<String> = parameters.iter().map(|(_, name)| name.clone()).collect();
     let mut tangents = system.partials(&read, &names)?;
     let d = tangents.directions();
-    let mut fx = vec![0.0; n];
     let mut partials = vec![0.0; n * d];
     let mut terms = vec![0.0; term_columns.len()];
     // (ẋ, Ṡ) at (x, S, u)
     let mut rate = |x: &[f64], s: &[f64], u: &[f64], dx: &mut [f64], ds: &mut [f64]| {
-        system.derivatives_and_partials(x, u, &mut ws, &mut tangents, &mut fx, &mut partials);
-        dx.copy_from_slice(&fx);
+        system.derivatives_and_partials(x, u, &mut ws, &mut tangents, dx, &mut partials);
         phi.derivatives(x, u, &mut wp, &mut terms);
         ds.fill(0.0);
         for (&(j, i), phi_j) in term_columns.iter().zip(&terms) {
