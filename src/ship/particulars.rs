@@ -230,8 +230,19 @@ impl Particulars {
             Estimate { name: "l_R", value: -0.8, sd: 0.3, unit: "", source: GENERIC },
             Estimate { name: "γ_Rm", value: 0.5, sd: 0.25, unit: "", source: GENERIC },
             Estimate { name: "γ_Rp", value: 0.5, sd: 0.25, unit: "", source: GENERIC },
-            // the indicator's zero and the rudder angle at which a single-screw ship goes
-            // straight (its propeller's side force) in one: a record's offset, 0 ± 2°
+            // a single-screw propeller's side force at the stern turns the ship one way at
+            // every speed (the asymmetry a polynomial library holds in its u², n² terms): a
+            // yaw moment N_P·ρn²D_p⁵, scaled with the propeller's load and not with the
+            // rudder's inflow, so the runs tell it from the rudder's zero; of the order of a
+            // tenth of the thrust at L/2, 0 ± 0.1·k_0·(L/2)/D_p
+            Estimate {
+                name: "N_P",
+                value: 0.0,
+                sd: 0.1 * self.kt[0] * 0.5 * l / self.propeller_diameter,
+                unit: "",
+                source: "no formula from particulars: a propeller's side force of up to a tenth of its thrust, at the stern",
+            },
+            // the rudder indicator's zero: a record's offset, 0 ± 2°
             Estimate {
                 name: "δ_0",
                 value: 0.0,

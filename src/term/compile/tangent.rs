@@ -39,6 +39,7 @@ impl Library {
         // an input's derivative with respect to itself is 1 and never changes
         for (k, slot) in slots.iter().enumerate() {
             if let Some(i) = slot {
+                assert!(*i < self.ops.len(), "slot {i} is not in this library (input_slot gives them)");
                 t[i * d + k] = 1.0;
                 pattern[*i].push(k as u32);
             }
