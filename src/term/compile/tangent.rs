@@ -133,9 +133,14 @@ impl Library {
                             for &k in pattern(i) {
                                 *at(i, k) = 0.0;
                             }
+                            // an argument that does not move moves nothing, even where the
+                            // function's slope is infinite (sqrt(v²) at v = 0: ∞·0 would be NaN)
                             for (&a, &w) in args.iter().zip(grad.iter()) {
                                 for &k in pattern(a) {
-                                    *at(i, k) += w * *at(a, k);
+                                    let ta = *at(a, k);
+                                    if ta != 0.0 {
+                                        *at(i, k) += w * ta;
+                                    }
                                 }
                             }
                         }
@@ -184,6 +189,26 @@ impl Library {
 #[cfg(test)]
 mod tests {
     use crate::term::{Library, Term, Vocabulary};
+
+    /// Where a function's slope is infinite but its argument does not move, the derivative is
+    /// zero, not NaN: sqrt(v² + w²) at v = w = 0 (and atan2's 0/0 slope at the origin).
+    #[test]
+    fn a_still_argument_of_an_infinitely_steep_function_gives_zero() {
+        let v = Vocabulary::open();
+        let terms: Vec<Term> =
+            ["sqrt(v^2 + w^2)", "atan2(v^2, w^2)"].iter().map(|t| v.parse(t).unwrap()).collect();
+        let lib = Library::compile(&terms, &v).unwrap();
+        let slots: Vec<Option<usize>> = (0..lib.inputs().len()).map(|j| lib.input_slot(j)).collect();
+        let mut tangents = lib.tangents(&slots);
+        let mut scratch = lib.scratch();
+        for &slot in slots.iter().flatten() {
+            lib.set_input(&mut scratch, slot, 0.0);
+        }
+        let (mut out, mut partials) = (vec![0.0; 2], vec![f64::NAN; 2 * slots.len()]);
+        lib.eval_row_tangents(&mut scratch, &mut tangents, &mut out, &mut partials);
+        assert_eq!(out, [0.0, 0.0]);
+        assert!(partials.iter().all(|p| *p == 0.0), "{partials:?}");
+    }
 
     /// The forward-mode partials equal central differences of the values, on terms that use
     /// every kind of operation: products and powers, a reciprocal, functions of one and two
