@@ -151,13 +151,19 @@ impl System {
     /// ẋ = f(x, input).
     #[inline]
     pub fn derivatives(&self, x: &[f64], input: &[f64], ws: &mut Workspace, dx: &mut [f64]) {
+        self.load(x, input, ws);
+        self.rhs.eval_row_prepared(&mut ws.scratch, dx);
+    }
+
+    /// The states and inputs into the workspace's slots (the parameters are there already).
+    #[inline(always)]
+    fn load(&self, x: &[f64], input: &[f64], ws: &mut Workspace) {
         for &(slot, i) in &self.state_slots {
             self.rhs.set_input(&mut ws.scratch, slot, x[i]);
         }
         for &(slot, i) in &self.input_slots {
             self.rhs.set_input(&mut ws.scratch, slot, input[i]);
         }
-        self.rhs.eval_row_prepared(&mut ws.scratch, dx);
     }
 
     /// The directions of [`System::derivatives_and_partials`]: the states `states` (by index)
@@ -188,12 +194,7 @@ impl System {
         dx: &mut [f64],
         partials: &mut [f64],
     ) {
-        for &(slot, i) in &self.state_slots {
-            self.rhs.set_input(&mut ws.scratch, slot, x[i]);
-        }
-        for &(slot, i) in &self.input_slots {
-            self.rhs.set_input(&mut ws.scratch, slot, input[i]);
-        }
+        self.load(x, input, ws);
         self.rhs.eval_row_tangents(&mut ws.scratch, tangents, dx, partials);
     }
 
