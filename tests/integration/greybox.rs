@@ -442,7 +442,7 @@ fn a_new_ship_from_its_particulars_and_four_zigzags() {
 /// 0.2 %; here its seed 0, −1.22 % and −1.48 %).
 #[test]
 fn a_new_ship_from_its_particulars_and_the_basins_zigzags_turns_within_one_and_a_half_percent() {
-    use termid::ship::basin::{Basin, ZIGZAGS_BOTH_SIDES};
+    use termid::ship::basin::Basin;
     use termid::ship::particulars::Particulars;
     use termid::ship::ShipSpec;
 
@@ -450,12 +450,7 @@ fn a_new_ship_from_its_particulars_and_the_basins_zigzags_turns_within_one_and_a
     let truth = mmg_truth();
     let basin = Basin::tracked();
     assert_eq!(basin.artefacts.rudder_offset_deg, OFFSET_DEG);
-    let frames: Vec<Frame> = basin
-        .record_all(&truth, &ZIGZAGS_BOTH_SIDES, 1.17248, 80.0, 1, None)
-        .unwrap()
-        .into_iter()
-        .map(|(_, r)| r.measured)
-        .collect();
+    let frames = tracked_zigzags(&basin, &truth, 1);
     let particulars: Particulars = toml::from_str(KVLCC2_PARTICULARS).unwrap();
     let start = particulars.model().unwrap();
     let runs = runs_of(&start, &frames).comparing(&["u", "v", "r", "ψ"].map(String::from)).unwrap();
@@ -483,7 +478,7 @@ fn a_new_ship_from_its_particulars_and_the_basins_zigzags_turns_within_one_and_a
 /// from the particulars (both started at 0, every parameter free) tells them apart.
 #[test]
 fn the_propellers_yaw_moment_is_told_from_the_rudders_zero() {
-    use termid::ship::basin::{Basin, ZIGZAGS_BOTH_SIDES};
+    use termid::ship::basin::Basin;
     use termid::ship::particulars::Particulars;
 
     let particulars: Particulars = toml::from_str(KVLCC2_PARTICULARS).unwrap();
@@ -493,12 +488,7 @@ fn the_propellers_yaw_moment_is_told_from_the_rudders_zero() {
     let basin = Basin::tracked();
     let offset = basin.artefacts.rudder_offset_deg.to_radians();
     assert!(offset > 0.0);
-    let frames: Vec<Frame> = basin
-        .record_all(&truth, &ZIGZAGS_BOTH_SIDES, 1.17248, 80.0, 3, None)
-        .unwrap()
-        .into_iter()
-        .map(|(_, r)| r.measured)
-        .collect();
+    let frames = tracked_zigzags(&basin, &truth, 3);
     let fit = estimate(&start, &runs_of(&start, &frames), &EstimateSettings::default()).unwrap();
     let value = |name: &str| fit.parameters.iter().find(|p| p.name == name).unwrap().value;
     assert!((value("N_P") / -0.3 - 1.0).abs() < 0.1, "N_P {}\n{}", value("N_P"), fit.text());
@@ -509,6 +499,17 @@ fn the_propellers_yaw_moment_is_told_from_the_rudders_zero() {
         offset.to_degrees(),
         fit.text()
     );
+}
+
+/// The MMG basin's eight zigzags (10/10, 20/20, 15/5, 35/5 to both sides, 80 s) of `truth`
+/// as `basin` records them with noise `seed`.
+fn tracked_zigzags(basin: &termid::ship::basin::Basin, truth: &Model, seed: u64) -> Vec<Frame> {
+    basin
+        .record_all(truth, &termid::ship::basin::ZIGZAGS_BOTH_SIDES, 1.17248, 80.0, seed, None)
+        .unwrap()
+        .into_iter()
+        .map(|(_, r)| r.measured)
+        .collect()
 }
 
 /// KVLCC2 at model scale (SIMMAN 2008; Yasukawa & Yoshimura 2015, Table 1) as a particulars file.
