@@ -2,13 +2,15 @@
 //! MMG KVLCC2 basin of `examples/mmg_basin.rs`: zigzags of several amplitudes to both sides,
 //! ~90 s each, the tracking filter's prepared runs), as `identify --refine u,v,r,ψ` runs it:
 //! the Jacobian from forward sensitivities, all 60-odd coefficients together. Issue 15's
-//! target: under 1 s on this 2-core machine.
+//! target: under 1 s on this 2-core machine. Beside it the grey-box estimate of the same ship
+//! from its particulars on the basin's eight zigzags, as `termid estimate --states u,v,r,ψ`
+//! runs it (30 parameters and each run's initial state).
 
 use std::path::Path;
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use termid::data::{CentralDifference, Frame};
-use termid::diagnose::{refine, RefineSettings, Runs};
+use termid::diagnose::{estimate, refine, EstimateSettings, RefineSettings, Runs};
 use termid::identify::{identify_model, ModelIdentification};
 use termid::select::Backend;
 use termid::ship::basin::{Basin, ZIGZAGS_BOTH_SIDES};
@@ -50,6 +52,26 @@ fn bench(c: &mut Criterion) {
     g.sample_size(10);
     g.bench_function("mmg_basin_13_runs_20hz", |b| {
         b.iter(|| black_box(refine(&model, &runs, &RefineSettings::default()).unwrap()))
+    });
+    g.finish();
+
+    let particulars: termid::ship::particulars::Particulars =
+        toml::from_str(&std::fs::read_to_string("examples/kvlcc2_particulars.toml").unwrap()).unwrap();
+    let start = particulars.model().unwrap();
+    let measured: Vec<Frame> = Basin::tracked()
+        .record_all(&truth, &ZIGZAGS_BOTH_SIDES, 1.17248, 80.0, 7, None)
+        .unwrap()
+        .into_iter()
+        .map(|(_, rec)| rec.measured)
+        .collect();
+    let runs = Runs::new(&start, &measured, termid::data::sample_step(&measured), Integrator::Rk4)
+        .unwrap()
+        .comparing(&states)
+        .unwrap();
+    let mut g = c.benchmark_group("estimate");
+    g.sample_size(10);
+    g.bench_function("mmg_basin_8_zigzags_greybox", |b| {
+        b.iter(|| black_box(estimate(&start, &runs, &EstimateSettings::default()).unwrap()))
     });
     g.finish();
 }
