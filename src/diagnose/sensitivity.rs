@@ -138,6 +138,8 @@ fn per_run_jacobians<T: Send>(
     let mut term_columns = Vec::new();
     let mut terms = Vec::new();
     let mut parameters = Vec::new();
+    let values = model.parameter_values();
+    let unknown = |name: &str| DiagnoseError::Setup(format!("`{name}` is not a parameter of {}", model.path));
     for (j, entry) in entries.iter().enumerate() {
         match entry {
             Free::Term(eq, term) => {
@@ -149,11 +151,8 @@ fn per_run_jacobians<T: Send>(
                 terms.push(term.clone());
             }
             Free::Parameter(name) => {
-                if !model.parameter_values().contains_key(name) {
-                    return Err(DiagnoseError::Setup(format!(
-                        "`{name}` is not a parameter of {}",
-                        model.path
-                    )));
+                if !values.contains_key(name) {
+                    return Err(unknown(name));
                 }
                 if runs.params.iter().any(|p| p.contains_key(name)) {
                     return Err(DiagnoseError::Setup(format!(
@@ -163,11 +162,8 @@ fn per_run_jacobians<T: Send>(
                 parameters.push((j, name.clone()));
             }
             Free::Group { name, runs: group } => {
-                if !model.parameter_values().contains_key(name) {
-                    return Err(DiagnoseError::Setup(format!(
-                        "`{name}` is not a parameter of {}",
-                        model.path
-                    )));
+                if !values.contains_key(name) {
+                    return Err(unknown(name));
                 }
                 if let Some(r) =
                     group.iter().find(|r| !runs.params.get(**r).is_some_and(|p| p.contains_key(name)))

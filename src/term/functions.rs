@@ -107,13 +107,13 @@ pub fn function(name: &str) -> Option<(usize, &'static Function)> {
 mod tests {
     use super::*;
 
-    /// Every function's partial derivatives equal central differences of its values, at
-    /// points away from its kinks (abs and sign at 0).
     #[test]
     fn no_function_takes_more_than_max_arity_arguments() {
         assert!(FUNCTIONS.iter().all(|f| f.arity <= MAX_ARITY));
     }
 
+    /// Every function's partial derivatives equal central differences of its values, at
+    /// points away from its kinks (abs and sign at 0).
     #[test]
     fn gradients_equal_central_differences() {
         let points: [[f64; MAX_ARITY]; 4] = [[0.7, 1.3], [-0.4, 2.1], [2.5, -0.6], [-1.2, -0.9]];
