@@ -75,6 +75,9 @@ pub struct Refined {
     pub validation: Option<(f64, f64)>,
     /// Why it stopped.
     pub stopped: String,
+    /// Levenberg-Marquardt iterations taken (each one re-simulation; an accepted step also
+    /// one linearisation).
+    pub iterations: usize,
     /// Integrated autocorrelation time of the re-simulation residuals, in samples.
     pub correlation_time: Option<f64>,
     /// Every refined coefficient.
@@ -130,8 +133,10 @@ pub fn refine(model: &Model, runs: &Runs, settings: &RefineSettings<'_>) -> Resu
     let mut best = (theta.clone(), validation_before.unwrap_or(f64::NAN));
     let mut rises = 0;
     let mut lambda = 1e-3;
-    let mut stopped = format!("{} iterations", settings.iterations);
+    let mut stopped = "at the most iterations".to_string();
+    let mut iterations = 0;
     for _ in 0..settings.iterations {
+        iterations += 1;
         let (mut a, mut g) = (lin.jtj.clone(), lin.jtr.clone());
         for i in 0..k {
             a[(i, i)] += prior[i];
@@ -252,6 +257,7 @@ pub fn refine(model: &Model, runs: &Runs, settings: &RefineSettings<'_>) -> Resu
         cost_after: data_cost,
         validation,
         stopped,
+        iterations,
         correlation_time: tau,
         coefficients,
     })
@@ -265,11 +271,12 @@ impl Refined {
         use crate::identify::{num, sig};
         let r = self;
         let mut out = format!(
-            "== output-error refinement ==\nre-simulation cost (scaled sum of squares) {} → {}; residual correlation time {} samples; stopped: {}\n",
+            "== output-error refinement ==\nre-simulation cost (scaled sum of squares) {} → {}; residual correlation time {} samples; stopped: {} ({} iterations)\n",
             sig(r.cost_before, 4),
             sig(r.cost_after, 4),
             r.correlation_time.map_or("--".into(), |t| format!("{t:.0}")),
-            r.stopped
+            r.stopped,
+            r.iterations
         );
         if let Some((b, a)) = r.validation {
             out += &format!("validation runs (not fitted): {} → {}\n", sig(b, 4), sig(a, 4));

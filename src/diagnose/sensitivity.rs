@@ -19,9 +19,6 @@ use crate::model::Model;
 use crate::sim::{Controller, Integrator, Replay, RightHandSide, SimError, System};
 use crate::term::{Library, Term};
 
-/// Per sample of a run: its state and its sensitivities S (row-major, n × K).
-type Rows = (Vec<Vec<f64>>, Vec<Vec<f64>>);
-
 /// What an output-error fit may change: a term's coefficient (additively) or a named
 /// parameter of the model file.
 #[derive(Clone, Debug, PartialEq)]
@@ -91,10 +88,35 @@ pub(super) fn linearise(runs: &Runs, model: &Model, entries: &[Free]) -> Result<
     let mut residuals = Vec::with_capacity(runs.residual_count());
     let mut jtj = DMatrix::zeros(k, k);
     let mut jtr = DVector::zeros(k);
-    for part in per_run_jacobians(runs, model, entries, |res, jac| {
-        let jt = jac.transpose();
-        let r = DVector::from_column_slice(&res);
-        let (a, g) = (&jt * &jac, &jt * r);
+    for part in per_run_jacobians(runs, model, entries, |res, jt| {
+        let rows = res.len();
+        let mut a = DMatrix::zeros(k, k);
+        if rows > 0 && k > 0 {
+            // JᵀJ = Jᵀ (Jᵀ)ᵀ straight from Jᵀ's storage (column-major k × rows): one blocked
+            // product, no transposed copy
+            // SAFETY: Jᵀ holds k·rows values with row stride 1 and column stride k, its
+            // transpose is the same storage read with the strides swapped, and `a` is a
+            // distinct k × k column-major matrix
+            unsafe {
+                matrixmultiply::dgemm(
+                    k,
+                    rows,
+                    k,
+                    1.0,
+                    jt.as_ptr(),
+                    1,
+                    k as isize,
+                    jt.as_ptr(),
+                    k as isize,
+                    1,
+                    0.0,
+                    a.as_mut_ptr(),
+                    1,
+                    k as isize,
+                );
+            }
+        }
+        let g = &jt * DVector::from_column_slice(&res);
         (res, a, g)
     })? {
         let (r, a, g) = part;
@@ -112,7 +134,7 @@ fn residuals_and_jacobian(
     model: &Model,
     entries: &[Free],
 ) -> Result<(Vec<f64>, DMatrix<f64>), DiagnoseError> {
-    let parts = per_run_jacobians(runs, model, entries, |res, jac| (res, jac))?;
+    let parts = per_run_jacobians(runs, model, entries, |res, jt| (res, jt.transpose()))?;
     let rows: usize = parts.iter().map(|p| p.0.len()).sum();
     let mut residuals = Vec::with_capacity(rows);
     let mut jacobian = DMatrix::zeros(rows, entries.len());
@@ -125,8 +147,9 @@ fn residuals_and_jacobian(
     Ok((residuals, jacobian))
 }
 
-/// Each run's scaled residuals and their Jacobian (a row per residual), handed to `reduce` in
-/// the thread that made them; the runs in parallel.
+/// Each run's scaled residuals and their Jacobian, transposed (k × residuals, column-major: a
+/// residual's derivatives lie side by side, as S holds them), handed to `reduce` in the thread
+/// that made them; the runs in parallel.
 fn per_run_jacobians<T: Send>(
     runs: &Runs,
     model: &Model,
@@ -200,27 +223,30 @@ fn per_run_jacobians<T: Send>(
                 })
                 .collect();
             let columns = Columns { terms: &term_columns, parameters: &free, initial: &initial, k };
-            let (x, s) = integrate(&system, &phi, &columns, runs, r)?;
             let frame = &runs.frames[r];
-            let rows: usize = runs.states.iter().map(|(_, n)| frame.column(n).map_or(0, <[f64]>::len)).sum();
-            let mut res = Vec::with_capacity(rows);
-            let mut jac = DMatrix::zeros(rows, k);
+            // the residuals state by state, as `Runs::residuals` orders them: (first row,
+            // state, scale, measured)
+            let mut blocks = Vec::with_capacity(runs.states.len());
+            let mut rows = 0;
             for ((i, name), sc) in runs.states.iter().zip(&runs.scale) {
                 let meas = frame.column(name).unwrap_or(&[]);
-                for (t, m) in meas.iter().enumerate() {
-                    let row = res.len();
-                    res.push(x.get(t).map_or(f64::NAN, |x| x[*i] - m) / sc);
-                    match s.get(t) {
-                        Some(s) => {
-                            for (j, v) in s[*i * k..(*i + 1) * k].iter().enumerate() {
-                                jac[(row, j)] = v / sc;
-                            }
+                blocks.push((rows, *i, *sc, meas));
+                rows += meas.len();
+            }
+            // a sample the simulation does not reach stays NaN
+            let mut res = vec![f64::NAN; rows];
+            let mut jt = DMatrix::from_element(k, rows, f64::NAN);
+            integrate(&system, &phi, &columns, runs, r, &mut |t, x, s| {
+                for &(first, i, sc, meas) in &blocks {
+                    if let Some(m) = meas.get(t) {
+                        res[first + t] = (x[i] - m) / sc;
+                        for (out, v) in jt.column_mut(first + t).iter_mut().zip(&s[i * k..(i + 1) * k]) {
+                            *out = v / sc;
                         }
-                        None => jac.row_mut(row).fill(f64::NAN),
                     }
                 }
-            }
-            Ok(reduce(res, jac))
+            })?;
+            Ok(reduce(res, jt))
         })
         .collect()
 }
@@ -238,14 +264,15 @@ struct Columns<'a> {
 }
 
 /// Run `r` of `runs` with its sensitivities: the state and S (row-major, n × K) at every
-/// sample of the run.
+/// sample of the run, handed to `sample` with the sample's index.
 fn integrate(
     system: &System,
     phi: &System,
     columns: &Columns<'_>,
     runs: &Runs,
     r: usize,
-) -> Result<Rows, DiagnoseError> {
+    sample: &mut impl FnMut(usize, &[f64], &[f64]),
+) -> Result<(), DiagnoseError> {
     let Columns { terms: term_columns, parameters, initial, k } = *columns;
     let settings = &runs.settings[r];
     let n = system.dim();
@@ -284,12 +311,13 @@ fn integrate(
             for (q, (j, _)) in parameters.iter().enumerate() {
                 ds[i * k + j] = p[read.len() + q];
             }
-            // A S, by the columns of A
+            // A S, by the columns of A (whole rows of S: slices the compiler vectorises)
+            let row = &mut ds[i * k..(i + 1) * k];
             for (q, &c) in read.iter().enumerate() {
                 let a = p[q];
                 if a != 0.0 {
-                    for j in 0..k {
-                        ds[i * k + j] += a * s[c * k + j];
+                    for (d, s) in row.iter_mut().zip(&s[c * k..(c + 1) * k]) {
+                        *d += a * s;
                     }
                 }
             }
@@ -302,8 +330,7 @@ fn integrate(
     }
     let (mut u_now, mut u_next, mut u_mid) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
     replay.input(0.0, &x, &mut u_now);
-    let mut out_x = vec![x.clone()];
-    let mut out_s = vec![s.clone()];
+    sample(0, &x, &s);
     let (mut kx, mut ks) = (vec![vec![0.0; n]; 4], vec![vec![0.0; n * k]; 4]);
     let (mut tx, mut ts) = (vec![0.0; n], vec![0.0; n * k]);
     for step in 1..=steps {
@@ -318,8 +345,9 @@ fn integrate(
                 tx[i] = x[i] + w * dt * kx[stage][i];
             }
             for &i in &rows {
-                for q in i * k..(i + 1) * k {
-                    ts[q] = s[q] + w * dt * ks[stage][q];
+                let span = i * k..(i + 1) * k;
+                for ((t, s), d) in ts[span.clone()].iter_mut().zip(&s[span.clone()]).zip(&ks[stage][span]) {
+                    *t = s + w * dt * d;
                 }
             }
             let (kx_next, ks_next) = (&mut kx[stage + 1], &mut ks[stage + 1]);
@@ -329,8 +357,11 @@ fn integrate(
             x[i] += dt / 6.0 * (kx[0][i] + 2.0 * kx[1][i] + 2.0 * kx[2][i] + kx[3][i]);
         }
         for &i in &rows {
-            for q in i * k..(i + 1) * k {
-                s[q] += dt / 6.0 * (ks[0][q] + 2.0 * ks[1][q] + 2.0 * ks[2][q] + ks[3][q]);
+            let span = i * k..(i + 1) * k;
+            let (k0, k1, k2, k3) =
+                (&ks[0][span.clone()], &ks[1][span.clone()], &ks[2][span.clone()], &ks[3][span.clone()]);
+            for (q, s) in s[span].iter_mut().enumerate() {
+                *s += dt / 6.0 * (k0[q] + 2.0 * k1[q] + 2.0 * k2[q] + k3[q]);
             }
         }
         if let Some((i, v)) = x.iter().enumerate().find(|(i, v)| {
@@ -348,11 +379,10 @@ fn integrate(
         }
         std::mem::swap(&mut u_now, &mut u_next);
         if step % every == 0 {
-            out_x.push(x.clone());
-            out_s.push(s.clone());
+            sample(step / every, &x, &s);
         }
     }
-    Ok((out_x, out_s))
+    Ok(())
 }
 
 #[cfg(test)]
