@@ -15,8 +15,9 @@ use serde::Serialize;
 
 use super::{DiagnoseError, Runs};
 use crate::data::Frame;
-use crate::identify::{identify_model, IdentifiedModel, ModelIdentification};
+use crate::identify::{identify_coefficients, identify_model, IdentifiedModel, ModelIdentification};
 use crate::model::Model;
+use crate::select::Backend;
 use crate::sim::Integrator;
 
 /// How held-out runs are re-simulated and compared.
@@ -90,13 +91,22 @@ pub fn choose_by_prediction(
     let mut candidates = Vec::with_capacity(configurations.len());
     for (label, model) in configurations {
         progress(label);
+        // the folds' models are only simulated: their back-ends need not prove what only a
+        // report reads
+        let fold_model = model
+            .edit(|file| {
+                for e in file.equations.values_mut() {
+                    e.backend = e.backend.as_ref().map(Backend::for_prediction);
+                }
+            })
+            .map_err(|e| DiagnoseError::Setup(e.to_string()))?;
         let mut folds = Vec::with_capacity(frames.len());
         let mut mean_squares = Vec::with_capacity(frames.len());
         for k in 0..frames.len() {
             let training: Vec<Frame> =
                 frames.iter().enumerate().filter(|(i, _)| *i != k).map(|(_, f)| f.clone()).collect();
             let held = &frames[k];
-            let cost = identify_model(model, &training, how, &mut |_| {})
+            let cost = identify_coefficients(&fold_model, &training, how)
                 .ok()
                 .and_then(|id| held_out_cost(&id.model, held, prediction, how).ok());
             let rows = (held.len() * compared(model, prediction).len()).max(1) as f64;

@@ -39,6 +39,27 @@ pub fn identify_model(
     how: &ModelIdentification<'_>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<IdentifiedModel, IdentifyError> {
+    fit_model(model, frames, how, progress, true)
+}
+
+/// [`identify_model`] for a model that is only simulated (a fold of a choice by prediction):
+/// the coefficients without the residuals' correlation time, which takes a second pass over
+/// every run and widens only the covariance (left unwidened here).
+pub(crate) fn identify_coefficients(
+    model: &Model,
+    frames: &[Frame],
+    how: &ModelIdentification<'_>,
+) -> Result<IdentifiedModel, IdentifyError> {
+    fit_model(model, frames, how, &mut |_| {}, false)
+}
+
+fn fit_model(
+    model: &Model,
+    frames: &[Frame],
+    how: &ModelIdentification<'_>,
+    progress: &mut dyn FnMut(&str),
+    correlation: bool,
+) -> Result<IdentifiedModel, IdentifyError> {
     let names = if how.equations.is_empty() { model.identifiable() } else { how.equations.clone() };
     if how.target.is_some() && names.len() != 1 {
         return Err(IdentifyError::Setup(
@@ -56,8 +77,10 @@ pub fn identify_model(
         let coefficients = coefficients_of(&fit, &model.vocabulary).map_err(in_equation)?;
         let terms: Vec<Term> = coefficients.iter().map(|(t, _, _)| t.clone()).collect();
         identified.set_coefficients(name, coefficients, fit.selection.intercept.as_ref().map(|b| b.value));
-        fit.correlation_time =
-            correlation_time_of(&identified, frames, how.differentiator, &fit).map_err(in_equation)?;
+        if correlation {
+            fit.correlation_time =
+                correlation_time_of(&identified, frames, how.differentiator, &fit).map_err(in_equation)?;
+        }
         if let Some(matrix) = &fit.covariance {
             let covariance = Covariance {
                 terms,

@@ -36,11 +36,26 @@ pub enum Criterion {
     LeaveOneRunOut,
 }
 
+/// Which model sizes the search proves best.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Sizes {
+    /// Every size's subset is the best of its size (the table of sizes is exact).
+    #[default]
+    All,
+    /// Only the subset the criterion chooses is proven best: a subtree none of whose sizes
+    /// can beat the best criterion value found is pruned too, which is much faster where the
+    /// table is not read (a fold of a choice by prediction). Other sizes' subsets are then the
+    /// best found. The leave-one-run-out criterion has no such bound and searches all sizes.
+    Chosen,
+}
+
 /// Settings.
 ///
 /// | setting | default | meaning |
 /// |---|---|---|
 /// | `criterion` | `bic` | chooses the size |
+/// | `sizes` | `all` | `chosen`: only the chosen size proven best (faster) |
 /// | `max_size` | all | largest model size searched (terms, forced included) |
 /// | `node_limit` | 20 000 000 | stop the search after this many nodes, with a caveat |
 /// | `time_limit` | 60 s | likewise for time |
@@ -54,6 +69,8 @@ pub enum Criterion {
 pub struct BestSubset {
     /// Size criterion.
     pub criterion: Criterion,
+    /// Which sizes are proven best.
+    pub sizes: Sizes,
     /// Largest size searched.
     pub max_size: Option<usize>,
     /// Node limit.
@@ -68,6 +85,7 @@ impl Default for BestSubset {
     fn default() -> Self {
         BestSubset {
             criterion: Criterion::Bic,
+            sizes: Sizes::All,
             max_size: None,
             node_limit: 20_000_000,
             time_limit: 60.0,
@@ -77,6 +95,34 @@ impl Default for BestSubset {
 }
 
 const RSS_FLOOR: f64 = 1e-13;
+
+/// A size criterion as a function of the size k and the relative RSS: for each criterion
+/// but leave-one-run-out it rises with the RSS at a given size and with the size at a given
+/// RSS, so no subset of a subtree scores below its fewest terms at its bound's RSS.
+struct Score {
+    criterion: Criterion,
+    n: f64,
+    n_eff: f64,
+    total: f64,
+    sigma2: f64,
+    intercept: bool,
+    /// The smallest size scored (smaller ones are never chosen).
+    smallest: usize,
+}
+
+impl Score {
+    fn of(&self, k: usize, rss: f64) -> f64 {
+        let n = self.n;
+        let kk = k as f64 + if self.intercept { 1.0 } else { 0.0 };
+        match self.criterion {
+            Criterion::Bic => n * (rss * self.total / n).ln() + kk * n.ln(),
+            Criterion::Aic => n * (rss * self.total / n).ln() + 2.0 * kk,
+            Criterion::Cp => rss / self.sigma2 - self.n_eff + 2.0 * kk,
+            Criterion::AdjustedR2 => -(1.0 - rss * self.n_eff / (self.n_eff - k as f64).max(1e-300)),
+            Criterion::LeaveOneRunOut => f64::NEG_INFINITY,
+        }
+    }
+}
 
 /// Per model size, the smallest relative RSS found and its set (sorted).
 type Best = Vec<(f64, Vec<usize>)>;
@@ -106,6 +152,8 @@ struct Search<'a> {
     stopped: bool,
     /// One matrix per depth of the tree, reused: a node's exclude branch sweeps into it.
     stack: Vec<Vec<f64>>,
+    /// With [`Sizes::Chosen`], the criterion and the lowest value this region has found.
+    bound: Option<(&'a Score, f64)>,
 }
 
 /// What the regions searched in parallel share: the limits, and per size the smallest RSS
@@ -149,6 +197,11 @@ impl Search<'_> {
     fn record(&mut self, rss: f64, parts: &[&[usize]]) {
         if let Some(k) = keep_if_better(&mut self.best, self.kmax, rss, parts) {
             self.limits.found[k].fetch_min(rss.to_bits(), Ordering::Relaxed);
+            if let Some((score, lowest)) = &mut self.bound {
+                if k >= score.smallest {
+                    *lowest = lowest.min(score.of(k, rss));
+                }
+            }
         }
     }
 
@@ -167,9 +220,12 @@ impl Search<'_> {
     /// on this region's best, or with RSS > another region's: a tie with another region is
     /// still searched, so that the merge can keep the one a single search would have met
     /// first whatever the timing.
+    /// With [`Sizes::Chosen`], also none of those sizes can score below the lowest criterion
+    /// value found (a tie is still searched).
     fn hopeless(&self, lo: usize, hi: usize, rss: f64) -> bool {
         let hi = hi.min(self.kmax);
         lo > hi
+            || self.bound.is_some_and(|(score, lowest)| score.of(lo.max(score.smallest), rss) > lowest)
             || (lo..=hi).all(|k| {
                 rss >= self.best[k].0 || rss > f64::from_bits(self.limits.found[k].load(Ordering::Relaxed))
             })
@@ -321,6 +377,29 @@ impl BestSubset {
                 keep_if_better(&mut best, kmax, (1.0 - st.r2).max(RSS_FLOOR), &[&st.set]);
             }
         }
+        let n = sc.n as f64;
+        let all = forced.len() + kept.len();
+        // the pruning criterion: Cp's σ̂² is the full model's, known before the search only
+        // when the full model is among the sizes searched
+        let bound = (self.sizes == Sizes::Chosen
+            && self.criterion != Criterion::LeaveOneRunOut
+            && (self.criterion != Criterion::Cp || kmax == all))
+            .then(|| Score {
+                criterion: self.criterion,
+                n,
+                n_eff: sc.n_eff,
+                total: sc.total,
+                sigma2: sc.residual_share(&a).max(RSS_FLOOR) / (sc.n_eff - kmax as f64).max(1.0),
+                intercept: sc.intercept,
+                smallest: forced.len().max(1),
+            });
+        let lowest = bound.as_ref().map(|score| {
+            best.iter()
+                .enumerate()
+                .filter(|(k, b)| *k >= score.smallest && b.0.is_finite())
+                .map(|(k, b)| score.of(k, b.0))
+                .fold(f64::INFINITY, f64::min)
+        });
         let limits = Limits {
             found: best.iter().map(|b| AtomicU64::new(b.0.to_bits())).collect(),
             nodes: AtomicU64::new(0),
@@ -345,6 +424,7 @@ impl BestSubset {
                     limits: &limits,
                     stopped: false,
                     stack: vec![vec![0.0; m * m]; undecided.len() + 1],
+                    bound: bound.as_ref().zip(lowest),
                 };
                 let mut inn = inn.clone();
                 search.visit(a, &mut inn, undecided);
@@ -366,13 +446,25 @@ impl BestSubset {
             notes.push(format!(
                 "search stopped at its limit after {nodes} nodes: the subsets reported are the best found, not proven best"
             ));
+        } else if bound.is_some() {
+            notes.push(format!(
+                "exact for the size chosen: {nodes} nodes searched; the other sizes' subsets are the best found before the criterion ruled them out (sizes = \"all\" proves each)"
+            ));
         } else {
             notes.push(format!("exact: {nodes} nodes searched"));
         }
         // one step per size, chosen by the criterion
-        let n = sc.n as f64;
         let full_rss = best.iter().rev().find(|b| b.0.is_finite()).map_or(1.0, |b| b.0);
         let sigma2 = full_rss / (sc.n_eff - kmax as f64).max(1.0);
+        let scoring = Score {
+            criterion: self.criterion,
+            n,
+            n_eff: sc.n_eff,
+            total: sc.total,
+            sigma2,
+            intercept: sc.intercept,
+            smallest: forced.len().max(1),
+        };
         let mut steps = Vec::new();
         let mut scores = Vec::new();
         let validation = match self.criterion {
@@ -391,13 +483,9 @@ impl BestSubset {
                 .unwrap_or(0);
             let mut st = sc.step(&sw, set, pb.names, newest, false, forced.contains(&newest));
             st.step = k;
-            let kk = k as f64 + if sc.intercept { 1.0 } else { 0.0 };
             let score = match self.criterion {
-                Criterion::Bic => n * (rss * sc.total / n).ln() + kk * n.ln(),
-                Criterion::Aic => n * (rss * sc.total / n).ln() + 2.0 * kk,
-                Criterion::Cp => rss / sigma2 - sc.n_eff + 2.0 * kk,
-                Criterion::AdjustedR2 => -(1.0 - rss * sc.n_eff / (sc.n_eff - k as f64).max(1e-300)),
                 Criterion::LeaveOneRunOut => validation.as_ref().map_or(f64::INFINITY, |cv| cv.error(set)),
+                _ => scoring.of(k, *rss),
             };
             scores.push(score);
             steps.push(st);

@@ -17,7 +17,7 @@ mod subset;
 
 use serde::{Deserialize, Serialize};
 
-pub use best_subset::{BestSubset, Criterion};
+pub use best_subset::{BestSubset, Criterion, Sizes};
 pub use efroymson::Efroymson;
 pub use moments::{gather, in_parallel, Accumulator, Moments};
 pub use sparse::{Candidate, Equality, LambdaChoice, SparseFit};
@@ -433,6 +433,18 @@ back_ends! {
 impl Default for Backend {
     fn default() -> Self {
         Backend::Stepwise(Stepwise::default())
+    }
+}
+
+impl Backend {
+    /// The back-end as a fit that is only simulated needs it (a fold of a choice by
+    /// prediction): the same chosen terms, without proving what only a report reads (best
+    /// subset's other sizes).
+    pub fn for_prediction(&self) -> Backend {
+        match self {
+            Backend::BestSubset(b) => Backend::BestSubset(BestSubset { sizes: Sizes::Chosen, ..b.clone() }),
+            other => other.clone(),
+        }
     }
 }
 

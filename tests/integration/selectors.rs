@@ -3,7 +3,7 @@
 //! particular to each: best subset against brute force, Efroymson against MATLAB's example.
 
 use proptest::prelude::*;
-use termid::select::{Backend, BestSubset, Efroymson, Problem, SelectError, Selector};
+use termid::select::{Backend, BestSubset, Criterion, Efroymson, Problem, SelectError, Selector, Sizes};
 
 use crate::common::{moments_of, qr_fit, Lcg};
 
@@ -183,6 +183,35 @@ proptest! {
             let k = st.set.len();
             let rss = (1.0 - st.r2) * tss;
             prop_assert!((rss - best[k]).abs() <= 1e-8 * tss, "size {}: {} vs brute force {}", k, rss, best[k]);
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    /// Proving only the chosen size chooses what proving every size chooses, for every
+    /// criterion with a bound, and that subset is brute force's best of its size.
+    #[test]
+    fn best_subset_of_the_chosen_size_alone_chooses_the_same(p in 2usize..=14, seed in any::<u64>(), forced_first in any::<bool>(), noise in 0.05f64..3.0) {
+        let n = 40;
+        let mut g = Lcg(seed);
+        let cols: Vec<Vec<f64>> = (0..p).map(|_| (0..n).map(|_| g.normal()).collect()).collect();
+        let y: Vec<f64> = (0..n).map(|i| cols.iter().enumerate().map(|(j, c)| c[i] * ((j % 3) as f64 - 1.0)).sum::<f64>() + noise * g.normal()).collect();
+        let m = moments_of(&cols, &y);
+        let names = names(p);
+        let forced: Vec<usize> = if forced_first { vec![0] } else { vec![] };
+        let pb = Problem { moments: &m, names: &names, forced: &forced, excluded: &[], intercept: true };
+        let ybar = y.iter().sum::<f64>() / n as f64;
+        let tss: f64 = y.iter().map(|v| (v - ybar).powi(2)).sum();
+        for criterion in [Criterion::Bic, Criterion::Aic, Criterion::Cp, Criterion::AdjustedR2] {
+            let all = BestSubset { criterion, ..BestSubset::default() }.select(&pb).unwrap();
+            let chosen = BestSubset { criterion, sizes: Sizes::Chosen, ..BestSubset::default() }.select(&pb).unwrap();
+            let set = |s: &termid::select::Selection| s.steps[s.chosen_step - 1].set.clone();
+            prop_assert_eq!(set(&all), set(&chosen), "{:?}", criterion);
+            let (a, c) = (&all.steps[all.chosen_step - 1], &chosen.steps[chosen.chosen_step - 1]);
+            prop_assert!(((a.r2 - c.r2) * tss).abs() <= 1e-8 * tss, "{:?}: {} vs {}", criterion, a.r2, c.r2);
+            prop_assert!(chosen.notes.iter().any(|n| n.starts_with("exact for the size chosen")), "{:?}", chosen.notes);
         }
     }
 }
