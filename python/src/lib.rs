@@ -673,7 +673,7 @@ impl PyModel {
     /// The library's recipe (several derivative starts, choice among back-ends by
     /// prediction, output-error refinement, checks, the starts' agreement): (JSON of every
     /// start and the kept one's report, the report as text, the kept model).
-    #[pyo3(signature = (runs, derivatives, smooth = false, intercept = None, choose = vec![], compare = vec![], refine = None, refine_iterations = 100, refine_prior = 1e-4, held_out = vec![]))]
+    #[pyo3(signature = (runs, derivatives, smooth = false, intercept = None, choose = vec![], compare = vec![], refine = None, refine_iterations = 100, refine_prior = 1e-4, held_out = vec![], refine_step = None))]
     #[allow(clippy::too_many_arguments)]
     fn recipe(
         &self,
@@ -688,6 +688,7 @@ impl PyModel {
         refine_iterations: usize,
         refine_prior: f64,
         held_out: Vec<Run<'_>>,
+        refine_step: Option<f64>,
     ) -> PyResult<(String, String, PyModel)> {
         let frames = self.frames(runs)?;
         let held = if held_out.is_empty() { None } else { Some(self.frames(held_out)?) };
@@ -708,6 +709,7 @@ impl PyModel {
                 states: (!states.is_empty()).then_some(states),
                 prior: refine_prior,
                 iterations: refine_iterations,
+                step: refine_step,
             }),
             ..Default::default()
         };

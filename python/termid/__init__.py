@@ -1186,6 +1186,7 @@ class Model:
         refine_iterations: int = 100,
         refine_prior: float = 1e-4,
         held_out: Union[Data, Sequence[Data], None] = None,
+        refine_step: Optional[float] = None,
     ) -> "Recipe":
         """The command line's recipe for a model from runs (``termid identify --model`` with
         several ``--derivative`` starts) from ``runs``: each start prepares them by one derivative method
@@ -1193,7 +1194,9 @@ class Model:
         back-ends ``choose`` by leave-one-run-out prediction of the states ``compare``),
         refined by output error on the states ``refine`` (None: no refinement; an empty list:
         every state) with ``refine_iterations`` and the regression as a prior of weight
-        ``refine_prior``, stopped by ``held_out`` runs where given, checked by the model's
+        ``refine_prior``, re-simulated at ``refine_step`` seconds (None: the coarsest step, up
+        to 8 samples, at which the runs still hold their compared states and inputs; the costs
+        are reported at every sample), stopped by ``held_out`` runs where given, checked by the model's
         plug-in; the start kept that passes the checks and re-simulates best, and a flag where
         the plausible starts disagree on a turning circle. ``intercept`` as for
         :meth:`identify` (None: the model file's). Defaults are the new-ship recipe's.
@@ -1217,6 +1220,7 @@ class Model:
             refine_iterations,
             refine_prior,
             held,
+            refine_step,
         )
         return Recipe(Model(native), json.loads(text_json), text)
 

@@ -53,12 +53,13 @@ fn low_pass(fc: f64, width: f64) -> Vec<f64> {
     taps
 }
 
-/// Symmetric filtering; the ends are extended by odd reflection (2x₀ − x₋ₖ), which keeps a
-/// linear trend undistorted up to the last sample.
-fn filter(x: &[f64], taps: &[f64]) -> Vec<f64> {
+/// Symmetric filtering at the samples `at` of `x` alone (a decimation reads one in so many);
+/// the ends are extended by odd reflection (2x₀ − x₋ₖ), which keeps a linear trend undistorted
+/// up to the last sample.
+fn filter_at(x: &[f64], taps: &[f64], at: impl Iterator<Item = usize>) -> Vec<f64> {
     let n = x.len() as i64;
     let half = (taps.len() / 2) as i64;
-    let at = |i: i64| -> f64 {
+    let value = |i: i64| -> f64 {
         if i < 0 {
             2.0 * x[0] - x[(-i).min(n - 1) as usize]
         } else if i >= n {
@@ -67,7 +68,10 @@ fn filter(x: &[f64], taps: &[f64]) -> Vec<f64> {
             x[i as usize]
         }
     };
-    (0..n).map(|i| taps.iter().enumerate().map(|(k, w)| w * at(i + k as i64 - half)).sum()).collect()
+    // the signal with its reflected ends laid out once: each output is then one dot product
+    // over a contiguous window
+    let padded: Vec<f64> = (-half..n + half).map(value).collect();
+    at.map(|i| taps.iter().zip(&padded[i..i + taps.len()]).map(|(w, v)| w * v).sum()).collect()
 }
 
 /// The median spacing of a time column.
@@ -151,8 +155,9 @@ pub fn resample(frame: &Frame, dt: f64) -> Result<Frame, DataError> {
         let values = match &fine {
             None => interpolate(t, x, &coarse),
             Some((fine_t, taps)) => {
-                let smooth = filter(&interpolate(t, x, fine_t), taps);
-                (0..coarse.len()).map(|i| smooth[(i * factor).min(smooth.len() - 1)]).collect()
+                let fine = interpolate(t, x, fine_t);
+                let last = fine.len() - 1;
+                filter_at(&fine, taps, (0..coarse.len()).map(|i| (i * factor).min(last)))
             }
         };
         out.push(name, values)?;

@@ -26,8 +26,10 @@ pub struct Prediction {
     /// The states compared (each scaled by its spread in the held-out run); empty: every
     /// state of an identified equation.
     pub states: Vec<String>,
-    /// Integration step, s (the runs' own sampling is kept for the comparison).
-    pub dt: f64,
+    /// Integration step, s (the runs' own sampling is kept for the comparison); `None`: the
+    /// held-out run's sample step, one step per sample (its recorded inputs are known only
+    /// at the samples, and the step scales with the system's own time).
+    pub dt: Option<f64>,
     /// Integrator.
     pub integrator: Integrator,
     /// Simulate with the identified intercepts.
@@ -36,7 +38,7 @@ pub struct Prediction {
 
 impl Default for Prediction {
     fn default() -> Self {
-        Prediction { states: vec![], dt: 0.01, integrator: Integrator::Rk4, intercepts: false }
+        Prediction { states: vec![], dt: None, integrator: Integrator::Rk4, intercepts: false }
     }
 }
 
@@ -158,7 +160,8 @@ fn held_out_cost(
     how: &ModelIdentification<'_>,
 ) -> Result<f64, DiagnoseError> {
     let intercepts = prediction.intercepts && how.intercept;
-    let runs = Runs::new(model, std::slice::from_ref(run), prediction.dt, prediction.integrator)?
+    let dt = prediction.dt.unwrap_or_else(|| crate::data::sample_step(std::slice::from_ref(run)));
+    let runs = Runs::new(model, std::slice::from_ref(run), dt, prediction.integrator)?
         .with_intercepts(intercepts)
         .comparing(&compared(model, prediction))?;
     let sims = runs.simulate(model, &[], &[])?;

@@ -27,6 +27,8 @@ pub struct Runs {
     pub(super) params: Vec<BTreeMap<String, f64>>,
     pub(super) settings: Vec<Settings>,
     pub(super) intercepts: bool,
+    /// The model's inputs, which the re-simulation replays from the runs.
+    inputs: Vec<String>,
 }
 
 /// Recorded inputs with an offset and a factor applied.
@@ -156,7 +158,17 @@ impl Runs {
                     .collect::<Result<BTreeMap<_, _>, DiagnoseError>>()
             })
             .collect::<Result<Vec<_>, _>>()?;
-        Ok(Runs { frames: frames.to_vec(), states, scale, units, x0, params, settings, intercepts: false })
+        Ok(Runs {
+            frames: frames.to_vec(),
+            states,
+            scale,
+            units,
+            x0,
+            params,
+            settings,
+            intercepts: false,
+            inputs: system.inputs.clone(),
+        })
     }
 
     /// Compares only the named states (all must be compared ones); the others are still
@@ -220,6 +232,71 @@ impl Runs {
             out.params[r].insert(name.to_string(), v);
         }
         out
+    }
+
+    /// The runs resampled (anti-aliased) to `factor` times their sample step and re-simulated
+    /// one RK4 step per new sample, compared and weighted as these are, from the same
+    /// recorded initial states and with the same per-run parameters. Only what a
+    /// re-simulation reads and is compared with is kept of each run.
+    pub fn coarser(&self, factor: usize) -> Result<Runs, DiagnoseError> {
+        let mut out = self.clone();
+        if factor <= 1 {
+            return Ok(out);
+        }
+        let setup = |e: crate::data::DataError| DiagnoseError::Setup(e.to_string());
+        let read: Vec<&String> = self.inputs.iter().chain(self.states.iter().map(|(_, name)| name)).collect();
+        for (f, s) in out.frames.iter_mut().zip(&mut out.settings) {
+            let mut slim = Frame::new(f.origin(), f.time_name(), f.time().to_vec()).map_err(setup)?;
+            for name in &read {
+                if let Some(column) = f.column(name) {
+                    if slim.column(name).is_none() {
+                        slim.push(name, column.to_vec()).map_err(setup)?;
+                    }
+                }
+            }
+            let step = s.sample * factor as f64;
+            *f = crate::data::resample(&slim, step).map_err(setup)?;
+            *s = Settings { dt: step, sample: step, ..*s };
+        }
+        Ok(out)
+    }
+
+    /// These runs coarsened as far as `model` allows, with the factor ([`Runs::coarser`], up to
+    /// `most`): the model re-simulates them there as at their samples, every compared state
+    /// within `tolerance` of its scale (RMS over all runs, at the coarse samples). Both the
+    /// integration's error and the inputs' resampling show in that difference. Factor 1 (the
+    /// runs themselves) where no coarser step holds or the model does not re-simulate them.
+    pub fn coarsest(&self, model: &Model, tolerance: f64, most: usize) -> (usize, Runs) {
+        let Ok(fine) = self.simulate(model, &[], &[]) else { return (1, self.clone()) };
+        let holds = |factor: usize| -> Option<Runs> {
+            let coarse = self.coarser(factor).ok()?;
+            let sims = coarse.simulate(model, &[], &[]).ok()?;
+            self.states
+                .iter()
+                .zip(&self.scale)
+                .all(|((i, _), scale)| {
+                    let (mut sq, mut n) = (0.0, 0usize);
+                    for (a, b) in fine.iter().zip(&sims) {
+                        for (k, v) in b.states[*i].iter().enumerate() {
+                            if let Some(w) = a.states[*i].get(k * factor) {
+                                sq += (v - w).powi(2);
+                                n += 1;
+                            }
+                        }
+                    }
+                    n > 0 && (sq / n as f64).sqrt() <= tolerance * scale
+                })
+                .then_some(coarse)
+        };
+        // the first factor that does not hold ends the search
+        let mut kept = (1, self.clone());
+        for factor in 2..=most {
+            match holds(factor) {
+                Some(runs) => kept = (factor, runs),
+                None => break,
+            }
+        }
+        kept
     }
 
     /// Number of compared values.

@@ -75,6 +75,10 @@ pub struct Refined {
     pub validation: Option<(f64, f64)>,
     /// Why it stopped.
     pub stopped: String,
+    /// The step the runs were re-simulated at where a caller coarsened them
+    /// ([`Runs::coarser`]); the costs are then the runs' at every sample, the correlation time
+    /// in coarse steps.
+    pub step: Option<f64>,
     /// Levenberg-Marquardt iterations taken (each one re-simulation; an accepted step also
     /// one linearisation).
     pub iterations: usize,
@@ -257,6 +261,7 @@ pub fn refine(model: &Model, runs: &Runs, settings: &RefineSettings<'_>) -> Resu
         cost_after: data_cost,
         validation,
         stopped,
+        step: None,
         iterations,
         correlation_time: tau,
         coefficients,
@@ -271,13 +276,20 @@ impl Refined {
         use crate::identify::{num, sig};
         let r = self;
         let mut out = format!(
-            "== output-error refinement ==\nre-simulation cost (scaled sum of squares) {} → {}; residual correlation time {} samples; stopped: {} ({} iterations)\n",
+            "== output-error refinement ==\nre-simulation cost (scaled sum of squares) {} → {}; residual correlation time {} {}; stopped: {} ({} iterations)\n",
             sig(r.cost_before, 4),
             sig(r.cost_after, 4),
             r.correlation_time.map_or("--".into(), |t| format!("{t:.0}")),
+            if r.step.is_some() { "steps" } else { "samples" },
             r.stopped,
             r.iterations
         );
+        if let Some(step) = r.step {
+            out += &format!(
+                "re-simulated at a step of {} s (the runs resampled, anti-aliased; there the regression's model re-simulates them as at their samples); the costs at every sample\n",
+                sig(step, 3)
+            );
+        }
         if let Some((b, a)) = r.validation {
             out += &format!("validation runs (not fitted): {} → {}\n", sig(b, 4), sig(a, 4));
         }
@@ -351,6 +363,47 @@ coefficients = {{ "u" = 1.0, "x" = {b} }}
         assert!((b + 0.5).abs() < 1e-4 && (a - 1.0).abs() < 1e-4, "a = {a}, b = {b}");
         assert!(r.cost_after < 1e-6 * r.cost_before, "{} → {}", r.cost_before, r.cost_after);
         assert!(r.text().contains("output-error refinement"));
+    }
+
+    /// A run sampled far faster than the model moves may be coarsened, up to the most asked
+    /// for; one whose model moves within a few samples, or whose input does, may not.
+    #[test]
+    fn runs_are_coarsened_as_far_as_the_model_and_the_inputs_allow() {
+        let sampled = |dt: f64, input: &dyn Fn(f64) -> f64| {
+            let t: Vec<f64> = (0..=1000).map(|i| dt * i as f64).collect();
+            let mut f = Frame::new("run", "t", t.clone()).unwrap();
+            // from x = 1, away from where the input holds it: the model's own mode is excited
+            f.push("x", t.iter().map(|&t| (-0.5 * t).exp()).collect()).unwrap();
+            f.push("u", t.iter().map(|&t| input(t)).collect()).unwrap();
+            f
+        };
+        let coarsest = |b: f64, frame: Frame| {
+            let model = lag(b);
+            let runs = Runs::new(&model, &[frame], 0.01, Integrator::Rk4).unwrap();
+            runs.coarsest(&model, 1e-3, 8).0
+        };
+        let slow = |t: f64| (0.5 * t).sin();
+        // time constant 2 s, sampled every 0.01 s: RK4 at 0.08 s re-simulates it as at 0.01 s
+        assert_eq!(coarsest(-0.5, sampled(0.01, &slow)), 8);
+        // time constant 0.01 s: one sample per time constant already
+        assert_eq!(coarsest(-100.0, sampled(0.01, &slow)), 1);
+        // a slow model driven at 10 Hz: a coarser sampling filters the input the model follows
+        let fast = |t: f64| (2.0 * std::f64::consts::PI * 10.0 * t).sin();
+        let factor = coarsest(-0.5, sampled(0.01, &fast));
+        assert!(factor < 4, "{factor}");
+        // the coarsened runs keep what a re-simulation reads, at the coarse step
+        let runs = Runs::new(&lag(-0.5), &[sampled(0.01, &slow)], 0.01, Integrator::Rk4).unwrap();
+        let coarse = runs.coarser(4).unwrap();
+        assert_eq!(coarse.frames[0].len(), 251);
+        assert!(
+            (coarse.settings[0].dt - 0.04).abs() < 1e-12 && (coarse.settings[0].sample - 0.04).abs() < 1e-12
+        );
+        // coarsened runs are refined to the same coefficients
+        let model = lag(-0.3);
+        let runs = Runs::new(&model, &[step_response()], 0.01, Integrator::Rk4).unwrap().coarser(2).unwrap();
+        let r = refine(&model, &runs, &RefineSettings { prior_weight: 0.0, ..Default::default() }).unwrap();
+        let b = r.coefficients.iter().find(|c| c.term == "x").unwrap().refined;
+        assert!((b + 0.5).abs() < 1e-3, "b = {b}");
     }
 
     #[test]

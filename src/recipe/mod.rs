@@ -73,7 +73,21 @@ pub struct RefineOptions {
     pub prior: f64,
     /// Most iterations.
     pub iterations: usize,
+    /// The step the runs are re-simulated and compared at, s (resampled, anti-aliased, to
+    /// the nearest whole number of samples); `None`: the coarsest, up to
+    /// [`MOST_SAMPLES_PER_STEP`] samples, at which the regression's model re-simulates the runs
+    /// as at their samples ([`Runs::coarsest`](crate::diagnose::Runs::coarsest) within
+    /// [`RESOLVED`]). The costs reported are the runs' own, at every sample.
+    pub step: Option<f64>,
 }
+
+/// How closely the model must re-simulate the runs at the refinement's step as at their
+/// samples where the step is not given: a thousandth of each compared state's spread (RMS),
+/// far below any re-simulation error a refinement is about.
+pub const RESOLVED: f64 = 1e-3;
+
+/// The coarsest step the refinement takes by itself, in samples.
+pub const MOST_SAMPLES_PER_STEP: usize = 8;
 
 /// Why the recipe could not run.
 #[derive(Debug, thiserror::Error)]

@@ -204,7 +204,8 @@ pub(super) fn identify_start(
 
 /// Every identified coefficient refined by output error on the runs as they were prepared
 /// for the regression (smoothed initial states: a noisy first sample of a rate would
-/// otherwise drift through its integral).
+/// otherwise drift through its integral), re-simulated at the refinement's step; the costs
+/// reported are the runs' at every sample.
 fn refine(
     model: &Model,
     frames: &[Frame],
@@ -225,10 +226,76 @@ fn refine(
     };
     let runs = runs_of(frames)?;
     let validation = held.map(runs_of).transpose()?;
+    let sample = crate::data::sample_step(frames);
+    let (factor, coarse) = match options.step {
+        Some(step) => {
+            let factor = (step / sample).round().max(1.0) as usize;
+            (factor, runs.coarser(factor).map_err(|e| e.to_string())?)
+        }
+        None => runs.coarsest(model, super::RESOLVED, super::MOST_SAMPLES_PER_STEP),
+    };
+    let coarse_validation =
+        validation.as_ref().map(|v| v.coarser(factor).map_err(|e| e.to_string())).transpose()?;
     let settings = RefineSettings {
         prior_weight: options.prior,
-        validation: validation.as_ref(),
+        validation: coarse_validation.as_ref(),
         iterations: options.iterations,
     };
-    crate::diagnose::refine(model, &runs, &settings).map_err(|e| format!("{e:#}"))
+    let mut refined = crate::diagnose::refine(model, &coarse, &settings).map_err(|e| format!("{e:#}"))?;
+    if factor > 1 {
+        // the costs the starts are judged by are the runs' own, at every sample
+        let cost = |runs: &Runs, m: &Model| -> Result<f64, String> {
+            let sims = runs.simulate(m, &[], &[]).map_err(|e| e.to_string())?;
+            Ok(runs.gap(&sims).cost)
+        };
+        refined.cost_before = cost(&runs, model)?;
+        refined.cost_after = cost(&runs, &refined.model)?;
+        if let Some(v) = &validation {
+            refined.validation = Some((cost(v, model)?, cost(v, &refined.model)?));
+        }
+        refined.step = Some(sample * factor as f64);
+    }
+    Ok(refined)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The refinement goes at the coarsest step the model allows, and its costs are the runs'
+    /// at every sample: ẋ = u + b·x from b = −0.3 to the runs' −0.5.
+    #[test]
+    fn a_coarse_refinement_reports_the_costs_at_every_sample() {
+        let text = r#"
+[model]
+name = "lag"
+[[states]]
+name = "x"
+[[inputs]]
+name = "u"
+[equations.x_dot]
+state = "x"
+candidates = ["u", "x"]
+coefficients = { "u" = 1.0, "x" = -0.3 }
+"#;
+        let model = Model::parse(text, "lag.toml").unwrap();
+        let t: Vec<f64> = (0..=1000).map(|i| 0.01 * i as f64).collect();
+        let mut f = Frame::new("step", "t", t.clone()).unwrap();
+        f.push("x", t.iter().map(|t| (1.0 - (-0.5 * t).exp()) / 0.5).collect()).unwrap();
+        f.push("u", vec![1.0; t.len()]).unwrap();
+        let options = RefineOptions { states: None, prior: 0.0, iterations: 30, step: None };
+        let r = refine(&model, std::slice::from_ref(&f), None, &options, false).unwrap();
+        assert!(r.step.is_some_and(|s| (s - 0.08).abs() < 1e-9), "{:?}", r.step);
+        let b = r.coefficients.iter().find(|c| c.term == "x").unwrap().refined;
+        assert!((b + 0.5).abs() < 1e-3, "b = {b}");
+        let runs = Runs::new(&model, std::slice::from_ref(&f), 0.01, crate::sim::Integrator::Rk4).unwrap();
+        let at_samples = |m: &Model| runs.gap(&runs.simulate(m, &[], &[]).unwrap()).cost;
+        assert_eq!(r.cost_before, at_samples(&model));
+        assert_eq!(r.cost_after, at_samples(&r.model));
+        assert!(r.text().contains("re-simulated at a step of 0.08"), "{}", r.text());
+        // a step given is taken, to the nearest whole number of samples
+        let given = RefineOptions { step: Some(0.031), ..options };
+        let r = refine(&model, &[f], None, &given, false).unwrap();
+        assert!(r.step.is_some_and(|s| (s - 0.03).abs() < 1e-9), "{:?}", r.step);
+    }
 }

@@ -213,7 +213,10 @@ fn choosing_by_prediction_prefers_the_library_that_predicts_held_out_runs() {
     assert!(chosen.text().contains("← chosen"));
     // the first fold of the linear library, computed directly
     let id = identify_model(&linear, &frames[1..], &how, &mut |_| {}).unwrap();
-    let runs = Runs::new(&id.model, &frames[..1], prediction.dt, prediction.integrator)
+    // by default one step per sample of the held-out run
+    assert_eq!(prediction.dt, None);
+    let step = frames[0].time()[1] - frames[0].time()[0];
+    let runs = Runs::new(&id.model, &frames[..1], step, prediction.integrator)
         .unwrap()
         .comparing(&["v".to_string()])
         .unwrap();

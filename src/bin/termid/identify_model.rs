@@ -71,6 +71,7 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
                     states,
                     prior: cmd.refine_prior,
                     iterations: cmd.refine_iterations,
+                    step: cmd.refine_step,
                 }),
                 agree: STARTS_AGREE,
             };
