@@ -37,7 +37,8 @@ fn process_noise(dt: f64, q: f64) -> Matrix3<f64> {
     q * Matrix3::new(d5 / 20.0, d4 / 8.0, d3 / 6.0, d4 / 8.0, d3 / 3.0, d2 / 2.0, d3 / 6.0, d2 / 2.0, dt)
 }
 
-/// Runs filter and (if `smooth`) smoother on `y` over the scaled steps `h`.
+/// Runs filter and (if `smooth`) smoother on `y` over the scaled steps `h`. Without `smooth`
+/// only the likelihood is wanted (the noise ratio's search): no state is kept.
 fn pass(h: &[f64], y: &[f64], q: f64, smooth: bool) -> Option<Pass> {
     let n = y.len();
     // exact start instead of a numerically fragile diffuse prior: the parabola through the
@@ -48,15 +49,29 @@ fn pass(h: &[f64], y: &[f64], q: f64, smooth: bool) -> Option<Pass> {
     let j = v.try_inverse()?;
     let mut x = j * Vector3::new(y[0], y[1], y[2]);
     let mut p = j * j.transpose();
-    let (mut filtered, mut predicted) = (Vec::with_capacity(n), Vec::with_capacity(n));
-    filtered.push((x, p));
-    predicted.push((x, p));
-    let (mut sum_log_s, mut sum_v2) = (0.0, 0.0);
-    for k in 3..n {
-        let f = transition(h[k - 1]);
-        x = f * x;
-        p = f * p * f.transpose() + process_noise(h[k - 1], q);
+    let room = if smooth { n } else { 0 };
+    let (mut filtered, mut predicted) = (Vec::with_capacity(room), Vec::with_capacity(room));
+    if smooth {
+        filtered.push((x, p));
         predicted.push((x, p));
+    }
+    let (mut sum_log_s, mut sum_v2) = (0.0, 0.0);
+    let mut finite = x.iter().all(|v| v.is_finite());
+    // the model of a step, computed again only where the step changes (mostly it does not)
+    let mut step = f64::NAN;
+    let (mut f, mut ft, mut noise) = (Matrix3::identity(), Matrix3::identity(), Matrix3::zeros());
+    for k in 3..n {
+        if h[k - 1].to_bits() != step.to_bits() {
+            step = h[k - 1];
+            f = transition(step);
+            ft = f.transpose();
+            noise = process_noise(step, q);
+        }
+        x = f * x;
+        p = f * p * ft + noise;
+        if smooth {
+            predicted.push((x, p));
+        }
         let s = p[(0, 0)] + 1.0;
         let v = y[k] - x[0];
         let gain: Vector3<f64> = p.column(0) / s;
@@ -67,23 +82,27 @@ fn pass(h: &[f64], y: &[f64], q: f64, smooth: bool) -> Option<Pass> {
         p = ikh * p * ikh.transpose() + gain * gain.transpose();
         sum_log_s += s.ln();
         sum_v2 += v * v / s;
-        filtered.push((x, p));
+        finite &= x.iter().all(|v| v.is_finite());
+        if smooth {
+            filtered.push((x, p));
+        }
     }
     let m = (n - 3) as f64;
     // −∞ for data the model fits exactly (no noise at all): the best possible score
     let deviance = sum_log_s + m * (sum_v2 / m).ln();
-    if deviance.is_nan() || states_blew_up(&filtered) {
+    if deviance.is_nan() || !finite {
         return None;
+    }
+    if !smooth {
+        return Some(Pass { states: vec![], deviance, variance: sum_v2 / m });
     }
     // filtered[i] is sample i + 2
     let mut states: Vec<Vector3<f64>> = filtered.iter().map(|(x, _)| *x).collect();
-    if smooth {
-        for i in (0..states.len() - 1).rev() {
-            let (xf, pf) = filtered[i];
-            let (xp, pp) = predicted[i + 1];
-            let c = pf * transition(h[i + 2]).transpose() * pp.try_inverse()?;
-            states[i] = xf + c * (states[i + 1] - xp);
-        }
+    for i in (0..states.len() - 1).rev() {
+        let (xf, pf) = filtered[i];
+        let (xp, pp) = predicted[i + 1];
+        let c = pf * transition(h[i + 2]).transpose() * pp.try_inverse()?;
+        states[i] = xf + c * (states[i + 1] - xp);
     }
     // samples 0 and 1: the state at sample 2 carried back along the kinematic model
     let first = states[0];
@@ -91,10 +110,6 @@ fn pass(h: &[f64], y: &[f64], q: f64, smooth: bool) -> Option<Pass> {
     let mut all = vec![back(h[0] + h[1]), back(h[1])];
     all.extend(states);
     Some(Pass { states: all, deviance, variance: sum_v2 / m })
-}
-
-fn states_blew_up(filtered: &[(Vector3<f64>, Matrix3<f64>)]) -> bool {
-    filtered.iter().any(|(x, _)| !x.iter().all(|v| v.is_finite()))
 }
 
 /// What the likelihood says about a signal's noise: its measurement variance and the

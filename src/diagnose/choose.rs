@@ -15,7 +15,7 @@ use serde::Serialize;
 
 use super::{DiagnoseError, Runs};
 use crate::data::Frame;
-use crate::identify::{identify_coefficients, identify_model, IdentifiedModel, ModelIdentification};
+use crate::identify::{identify_model, IdentifiedModel, ModelIdentification, RunStatistics};
 use crate::model::Model;
 use crate::select::Backend;
 use crate::sim::Integrator;
@@ -104,13 +104,20 @@ pub fn choose_by_prediction(
             .map_err(|e| DiagnoseError::Setup(e.to_string()))?;
         let mut folds = Vec::with_capacity(frames.len());
         let mut mean_squares = Vec::with_capacity(frames.len());
+        // each run's statistics once; a fold merges all but its own
+        let statistics = RunStatistics::of(&fold_model, frames, how);
         for k in 0..frames.len() {
-            let training: Vec<Frame> =
-                frames.iter().enumerate().filter(|(i, _)| *i != k).map(|(_, f)| f.clone()).collect();
             let held = &frames[k];
-            let cost = identify_coefficients(&fold_model, &training, how)
-                .ok()
-                .and_then(|id| held_out_cost(&id.model, held, prediction, how).ok());
+            let identified = match &statistics {
+                Ok(s) => s.identify_without(&fold_model, k),
+                // a run the statistics refused fails only the folds that train on it
+                Err(_) => {
+                    let training: Vec<Frame> =
+                        frames.iter().enumerate().filter(|(i, _)| *i != k).map(|(_, f)| f.clone()).collect();
+                    identify_model(&fold_model, &training, how, &mut |_| {})
+                }
+            };
+            let cost = identified.ok().and_then(|id| held_out_cost(&id.model, held, prediction, how).ok());
             let rows = (held.len() * compared(model, prediction).len()).max(1) as f64;
             folds.push((held.origin().to_string(), cost.unwrap_or(f64::INFINITY)));
             mean_squares.push(cost.map_or(f64::INFINITY, |c| c / rows));

@@ -187,7 +187,7 @@ pub fn refine(model: &Model, runs: &Runs, settings: &RefineSettings<'_>) -> Resu
                 }
             }
             _ => {
-                lambda *= 10.0;
+                lambda = (lambda * 10.0).max(1e-6);
                 if lambda > 1e10 {
                     stopped = "no step lowers the error".into();
                     break;

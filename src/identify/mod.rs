@@ -46,7 +46,7 @@ mod model;
 mod report;
 mod statistics;
 
-pub(crate) use model::identify_coefficients;
+pub(crate) use model::RunStatistics;
 pub use model::{
     coefficients_of, correlation_time_of, equation_design, fit_equation, fit_equation_design, identify_model,
     IdentifiedModel, ModelIdentification,

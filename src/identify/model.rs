@@ -6,6 +6,7 @@
 use super::{Design, Fit, Identification, IdentifyError, Target};
 use crate::data::{Differentiator, Frame};
 use crate::model::{Covariance, Equation, Model};
+use crate::select::Moments;
 use crate::term::{Term, Vocabulary};
 
 /// How a model's equations are identified.
@@ -39,27 +40,6 @@ pub fn identify_model(
     how: &ModelIdentification<'_>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<IdentifiedModel, IdentifyError> {
-    fit_model(model, frames, how, progress, true)
-}
-
-/// [`identify_model`] for a model that is only simulated (a fold of a choice by prediction):
-/// the coefficients without the residuals' correlation time, which takes a second pass over
-/// every run and widens only the covariance (left unwidened here).
-pub(crate) fn identify_coefficients(
-    model: &Model,
-    frames: &[Frame],
-    how: &ModelIdentification<'_>,
-) -> Result<IdentifiedModel, IdentifyError> {
-    fit_model(model, frames, how, &mut |_| {}, false)
-}
-
-fn fit_model(
-    model: &Model,
-    frames: &[Frame],
-    how: &ModelIdentification<'_>,
-    progress: &mut dyn FnMut(&str),
-    correlation: bool,
-) -> Result<IdentifiedModel, IdentifyError> {
     let names = if how.equations.is_empty() { model.identifiable() } else { how.equations.clone() };
     if how.target.is_some() && names.len() != 1 {
         return Err(IdentifyError::Setup(
@@ -77,10 +57,8 @@ fn fit_model(
         let coefficients = coefficients_of(&fit, &model.vocabulary).map_err(in_equation)?;
         let terms: Vec<Term> = coefficients.iter().map(|(t, _, _)| t.clone()).collect();
         identified.set_coefficients(name, coefficients, fit.selection.intercept.as_ref().map(|b| b.value));
-        if correlation {
-            fit.correlation_time =
-                correlation_time_of(&identified, frames, how.differentiator, &fit).map_err(in_equation)?;
-        }
+        fit.correlation_time =
+            correlation_time_of(&identified, frames, how.differentiator, &fit).map_err(in_equation)?;
         if let Some(matrix) = &fit.covariance {
             let covariance = Covariance {
                 terms,
@@ -94,6 +72,102 @@ fn fit_model(
         fits.push((name.clone(), fit));
     }
     Ok(IdentifiedModel { model: identified, fits })
+}
+
+/// A model's equations as each run's statistics: identified on all runs but one (a fold of a
+/// choice by prediction) without another pass over their rows. A fold gives what
+/// [`identify_model`] on those runs gives, to the bit (the same statistics of each run,
+/// merged in the same order), without the residuals' correlation time and the covariance,
+/// which a model that is only simulated does not need.
+pub(crate) struct RunStatistics {
+    equations: Vec<EquationRuns>,
+    intercept: bool,
+}
+
+/// One equation's part of [`RunStatistics`].
+struct EquationRuns {
+    name: String,
+    target: String,
+    /// The candidates' names, in column order.
+    names: Vec<String>,
+    forced: Vec<usize>,
+    excluded: Vec<usize>,
+    /// Each run's statistics, in the runs' order.
+    runs: Vec<Moments>,
+}
+
+impl RunStatistics {
+    /// The statistics of the equations `how` identifies, over every run of `frames`.
+    pub(crate) fn of(
+        model: &Model,
+        frames: &[Frame],
+        how: &ModelIdentification<'_>,
+    ) -> Result<RunStatistics, IdentifyError> {
+        let names = if how.equations.is_empty() { model.identifiable() } else { how.equations.clone() };
+        if how.target.is_some() && names.len() != 1 {
+            return Err(IdentifyError::Setup(
+                "a target other than the state's derivative applies to one equation: name it".into(),
+            ));
+        }
+        let rules = model.parameter_rules();
+        let identification = Identification {
+            vocabulary: &model.vocabulary,
+            parameters: &rules,
+            differentiator: how.differentiator,
+            intercept: how.intercept,
+            weights: None,
+        };
+        let mut equations = Vec::new();
+        for name in &names {
+            let in_equation = |e: IdentifyError| e.in_equation(name);
+            let eq = model_equation(model, name).map_err(in_equation)?;
+            let target = how.target.clone().unwrap_or_else(|| default_target(eq, frames));
+            let design = Design::new(&eq.candidates, &model.vocabulary).map_err(in_equation)?;
+            let forced = design.columns_of(&eq.forced, "forced").map_err(in_equation)?;
+            let excluded = design.columns_of(&eq.excluded, "excluded").map_err(in_equation)?;
+            let runs = identification
+                .moments_of_runs(&design.library, design.candidates(), &target, frames)
+                .map_err(in_equation)?;
+            equations.push(EquationRuns {
+                name: name.clone(),
+                target: target.to_string(),
+                names: design.names().to_vec(),
+                forced,
+                excluded,
+                runs,
+            });
+        }
+        Ok(RunStatistics { equations, intercept: how.intercept })
+    }
+
+    /// `model` (the one the statistics are of, its back-ends as the fold should select)
+    /// identified on every run but `left_out`.
+    pub(crate) fn identify_without(
+        &self,
+        model: &Model,
+        left_out: usize,
+    ) -> Result<IdentifiedModel, IdentifyError> {
+        let mut identified = model.clone();
+        let mut fits = Vec::new();
+        for EquationRuns { name, target, names, forced, excluded, runs } in &self.equations {
+            let in_equation = |e: IdentifyError| e.in_equation(name);
+            let eq = model_equation(model, name).map_err(in_equation)?;
+            let folds: Vec<Moments> =
+                runs.iter().enumerate().filter(|(k, _)| *k != left_out).map(|(_, m)| m.clone()).collect();
+            let backend = eq.backend.build();
+            let fit =
+                super::fit_folds(target, names, forced, excluded, self.intercept, &folds, backend.as_ref())
+                    .map_err(in_equation)?;
+            let coefficients = coefficients_of(&fit, &model.vocabulary).map_err(in_equation)?;
+            identified.set_coefficients(
+                name,
+                coefficients,
+                fit.selection.intercept.as_ref().map(|b| b.value),
+            );
+            fits.push((name.clone(), fit));
+        }
+        Ok(IdentifiedModel { model: identified, fits })
+    }
 }
 
 /// Identifies one equation of a model from runs: candidates, forced and excluded terms and

@@ -505,6 +505,44 @@ mod tests {
         }
     }
 
+    /// A fold identified from each run's statistics is the model identified on the fold's
+    /// runs, to the bit, for every back-end.
+    #[test]
+    fn a_fold_of_run_statistics_is_the_model_identified_on_its_runs() {
+        let lorenz = Model::load(Path::new("models/lorenz.toml")).unwrap();
+        let frames = runs(&lorenz);
+        let how = crate::identify::ModelIdentification {
+            equations: vec![],
+            differentiator: &CentralDifference,
+            intercept: true,
+            target: None,
+        };
+        for backend in Backend::NAMES {
+            let model = lorenz.with_backend(&Backend::by_name(backend).unwrap()).unwrap();
+            let statistics = crate::identify::RunStatistics::of(&model, &frames, &how).unwrap();
+            for left_out in 0..frames.len() {
+                let fold = statistics.identify_without(&model, left_out).unwrap();
+                let rest: Vec<Frame> = frames
+                    .iter()
+                    .enumerate()
+                    .filter(|(k, _)| *k != left_out)
+                    .map(|(_, f)| f.clone())
+                    .collect();
+                let direct = crate::identify::identify_model(&model, &rest, &how, &mut |_| {}).unwrap();
+                for (a, b) in fold.model.equations().iter().zip(direct.model.equations()) {
+                    let values = |e: &crate::model::Equation| {
+                        e.coefficients
+                            .iter()
+                            .map(|(t, v, _)| (t.to_string(), v.to_bits()))
+                            .collect::<Vec<_>>()
+                    };
+                    assert_eq!(values(a), values(b), "{backend}, run {left_out} left out: {}", a.name);
+                    assert_eq!(a.intercept.map(f64::to_bits), b.intercept.map(f64::to_bits));
+                }
+            }
+        }
+    }
+
     #[test]
     fn broken_bytes_are_refused() {
         let lorenz = Model::load(Path::new("models/lorenz.toml")).unwrap();

@@ -211,6 +211,24 @@ struct Limits {
     node_limit: u64,
     deadline: Instant,
     stopped: AtomicBool,
+    /// With [`Sizes::Chosen`], the lowest criterion value any region has found ([`ordered`]).
+    lowest: AtomicU64,
+}
+
+/// A float's bits as an integer that orders as the float does (negative ones included), for
+/// an atomic minimum.
+fn ordered(x: f64) -> u64 {
+    let b = x.to_bits();
+    if b >> 63 == 1 {
+        !b
+    } else {
+        b | 1 << 63
+    }
+}
+
+/// The inverse of [`ordered`].
+fn from_ordered(o: u64) -> f64 {
+    f64::from_bits(if o >> 63 == 1 { o & !(1 << 63) } else { !o })
 }
 
 /// Nodes a region visits between looks at the shared limits.
@@ -246,7 +264,9 @@ impl Search<'_> {
             self.limits.found[k].fetch_min(rss.to_bits(), Ordering::Relaxed);
             if let Some(bound) = &mut self.bound {
                 if k >= bound.score.smallest {
-                    bound.lower(bound.score.of(k, rss));
+                    let value = bound.score.of(k, rss);
+                    bound.lower(value);
+                    self.limits.lowest.fetch_min(ordered(value), Ordering::Relaxed);
                 }
             }
         }
@@ -259,6 +279,11 @@ impl Search<'_> {
         self.nodes = 0;
         if total >= self.limits.node_limit || Instant::now() > self.limits.deadline {
             self.limits.stopped.store(true, Ordering::Relaxed);
+        }
+        // the lowest criterion value any region has found bounds this one too: only the
+        // chosen size is proven, so which region prunes what first changes nothing reported
+        if let Some(bound) = &mut self.bound {
+            bound.lower(from_ordered(self.limits.lowest.load(Ordering::Relaxed)));
         }
         self.stopped = self.limits.stopped.load(Ordering::Relaxed);
     }
@@ -453,6 +478,7 @@ impl BestSubset {
             node_limit: self.node_limit,
             deadline: Instant::now() + std::time::Duration::from_secs_f64(self.time_limit.max(0.0)),
             stopped: AtomicBool::new(false),
+            lowest: AtomicU64::new(ordered(lowest.unwrap_or(f64::INFINITY))),
         };
         // the subtrees below each choice of the first three terms are searched in parallel,
         // each pruning on its own best sets and, strictly, on the others' (`hopeless`); merged
@@ -547,5 +573,22 @@ impl BestSubset {
         }
         let stop = if stopped { Stop::Limit { nodes } } else { Stop::AllEntered };
         Ok(Selection::from_steps(self.name(), sc.n, pb.names, steps, chosen, stop, notes))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The shared minimum of criterion values (of either sign) orders as the floats do.
+    #[test]
+    fn ordered_floats_order_as_floats() {
+        let xs = [f64::NEG_INFINITY, -1e300, -2.5, -1e-300, -0.0, 0.0, 1e-300, 3.0, 1e300, f64::INFINITY];
+        for w in xs.windows(2) {
+            assert!(ordered(w[0]) <= ordered(w[1]), "{} {}", w[0], w[1]);
+        }
+        for x in xs {
+            assert_eq!(from_ordered(ordered(x)).to_bits(), x.to_bits());
+        }
     }
 }
