@@ -501,22 +501,36 @@ fn correlation(a: &[f64], b: &[f64]) -> f64 {
     sab / (saa * sbb).sqrt()
 }
 
+/// An equation's coefficients as a model stores them: (term, value, standard error).
+type Coefficients = Vec<(crate::term::Term, f64, Option<f64>)>;
+
 /// The model with a hypothesis's term coefficients added (inputs are changed in simulation).
 pub fn apply(model: &Model, h: &Hypothesis, theta: &[f64]) -> Result<Model, super::DiagnoseError> {
     let mut m = model.clone();
     if let Effect::Terms { terms } = &h.effect {
+        // each equation's coefficients changed together and stored once (a refinement
+        // applies every identified term at every iteration)
+        let mut changed: Vec<(&str, Coefficients, Option<f64>)> = Vec::new();
         for ((eq, text), value) in terms.iter().zip(theta) {
             let term = m.vocabulary.parse(text)?;
-            let e = m
-                .equation(eq)
-                .ok_or_else(|| super::DiagnoseError::Setup(format!("no equation {eq}")))?
-                .clone();
-            let mut coefs = e.coefficients.clone();
+            let at = match changed.iter().position(|(name, _, _)| name == eq) {
+                Some(at) => at,
+                None => {
+                    let e = m
+                        .equation(eq)
+                        .ok_or_else(|| super::DiagnoseError::Setup(format!("no equation {eq}")))?;
+                    changed.push((eq.as_str(), e.coefficients.clone(), e.intercept));
+                    changed.len() - 1
+                }
+            };
+            let coefs = &mut changed[at].1;
             match coefs.iter_mut().find(|(t, _, _)| *t == term) {
                 Some(c) => c.1 += value,
                 None => coefs.push((term, *value, None)),
             }
-            m.set_coefficients(eq, coefs, e.intercept);
+        }
+        for (eq, coefs, intercept) in changed {
+            m.set_coefficients(eq, coefs, intercept);
         }
     }
     Ok(m)
