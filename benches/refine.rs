@@ -4,7 +4,8 @@
 //! the Jacobian from forward sensitivities, all 60-odd coefficients together. Issue 15's
 //! target: under 1 s on this 2-core machine. Beside it the grey-box estimate of the same ship
 //! from its particulars on the basin's eight zigzags, as `termid estimate --states u,v,r,ψ`
-//! runs it (30 parameters and each run's initial state).
+//! runs it (30 parameters and each run's initial state), and the whole new-ship recipe on the
+//! 13 records.
 
 use std::path::Path;
 
@@ -12,6 +13,7 @@ use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use termid::data::{CentralDifference, Frame};
 use termid::diagnose::{estimate, refine, EstimateSettings, RefineSettings, Runs};
 use termid::identify::{identify_model, ModelIdentification};
+use termid::recipe::{RecipeSettings, RefineOptions};
 use termid::select::Backend;
 use termid::ship::basin::{Basin, ZIGZAGS_BOTH_SIDES};
 use termid::sim::Integrator;
@@ -32,9 +34,9 @@ fn bench(c: &mut Criterion) {
         .with_backend(&Backend::by_name("sparse").unwrap())
         .unwrap();
     let plugin = termid::plugins::with_derivative("kinematic").unwrap();
-    let runs: Vec<(&str, f64)> = ZIGZAGS_BOTH_SIDES.iter().chain(&MORE).copied().collect();
+    let runs_of_13: Vec<(&str, f64)> = ZIGZAGS_BOTH_SIDES.iter().chain(&MORE).copied().collect();
     let frames: Vec<Frame> = Basin::tracked()
-        .record_all(&truth, &runs, 1.17248, 80.0, 7, None)
+        .record_all(&truth, &runs_of_13, 1.17248, 80.0, 7, None)
         .unwrap()
         .iter()
         .map(|(_, rec)| plugin.prepare("kinematic", &template, &rec.measured, true).unwrap())
@@ -52,6 +54,40 @@ fn bench(c: &mut Criterion) {
     g.sample_size(10);
     g.bench_function("mmg_basin_13_runs_20hz", |b| {
         b.iter(|| black_box(refine(&model, &runs, &RefineSettings::default()).unwrap()))
+    });
+    g.finish();
+
+    // the whole recipe on the same 13 records, as README's new-ship command runs it: four
+    // derivative starts side by side, each choosing among four back-ends by leave-one-run-out
+    // prediction, refined and checked (issue 26's target: under 5 s for 13 runs)
+    let records: Vec<Frame> = Basin::tracked()
+        .record_all(&truth, &runs_of_13, 1.17248, 80.0, 7, None)
+        .unwrap()
+        .into_iter()
+        .map(|(_, rec)| rec.measured)
+        .collect();
+    let ship = termid::plugins::load(Path::new("models/new_ship.toml")).unwrap();
+    let settings = RecipeSettings {
+        derivatives: ["kinematic", "kalman", "savitzky-golay", "central"].map(String::from).to_vec(),
+        smooth: true,
+        intercept: false,
+        choose: ["sparse", "best-subset", "efroymson", "stepwise"]
+            .iter()
+            .map(|name| (name.to_string(), ship.with_backend(&Backend::by_name(name).unwrap()).unwrap()))
+            .collect(),
+        compare: states.clone(),
+        refine: Some(RefineOptions {
+            states: Some(states.clone()),
+            prior: 1e-4,
+            iterations: 100,
+            step: None,
+        }),
+        ..Default::default()
+    };
+    let mut g = c.benchmark_group("recipe");
+    g.sample_size(10);
+    g.bench_function("mmg_basin_13_runs_four_starts", |b| {
+        b.iter(|| black_box(termid::recipe::identify(&ship, &records, None, &settings).unwrap()))
     });
     g.finish();
 

@@ -145,9 +145,19 @@ fn table(models: &[String]) -> Result<(), Error> {
         let mut row = format!("| {label} |");
         for frame in &runs {
             let measured = plugin.observe(&model, frame, None).ok_or("no metrics of the record")?.json;
-            let own =
-                Ship::new(&termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]), false)?
-                    .run(&Manoeuvre::parse(&zigzag_of(frame)?)?, &Settings { duration: 100.0, ..settings })?;
+            // a model that leaves its bounds is a row of the table too, saying where
+            let own = match Ship::new(
+                &termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]),
+                false,
+            )?
+            .run(&Manoeuvre::parse(&zigzag_of(frame)?)?, &Settings { duration: 100.0, ..settings })
+            {
+                Ok(own) => own,
+                Err(e) => {
+                    row += &format!(" {} |", diverged(&e));
+                    continue;
+                }
+            };
             let Metrics::ZigZag(z) = &own.metrics else { return Err("not a zigzag".into()) };
             row += &match (measured["first_overshoot_deg"].as_f64(), z.first_overshoot_deg) {
                 (Some(m), Some(p)) => format!(" {:+.2}° |", p - m),
@@ -158,13 +168,29 @@ fn table(models: &[String]) -> Result<(), Error> {
             runs.iter().map(|f| f.require("u").map(|u| u[0])).sum::<Result<f64, _>>()? / runs.len() as f64;
         let ship = Ship::new(&termid::ship::basin::at_approach_speed(&model, u0), false)?;
         for d in [35.0, -35.0] {
-            let run = ship.run(&Manoeuvre::parse(&format!("turning:{d}"))?, &settings)?;
+            let run = match ship.run(&Manoeuvre::parse(&format!("turning:{d}"))?, &settings) {
+                Ok(run) => run,
+                Err(e) => {
+                    row += &format!(" {} |", diverged(&e));
+                    continue;
+                }
+            };
             let Metrics::Turning(t) = &run.metrics else { return Err("not a turning circle".into()) };
             row += &t.tactical_diameter_m.map_or(" -- |".into(), |v| format!(" {v:.1} m |"));
         }
         println!("{row}");
     }
     Ok(())
+}
+
+/// A prediction that failed, as a cell: where a simulation left its bounds, when.
+fn diverged(e: &dyn std::fmt::Display) -> String {
+    let text = e.to_string();
+    let at = text.split("diverged at t = ").nth(1).and_then(|rest| rest.split_whitespace().next());
+    match at.and_then(|t| t.parse::<f64>().ok()) {
+        Some(t) => format!("diverges at {t:.0} s"),
+        None => "fails".into(),
+    }
 }
 
 /// Heading measured and predicted, and the rudder, in degrees over the run (every fifth

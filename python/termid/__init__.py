@@ -1207,6 +1207,9 @@ class Model:
         >>> found = ship.recipe(runs, ["kinematic", "central"], refine=("u", "v", "r", "ψ"), refine_iterations=10)
         >>> list(found.starts["derivative"]), int(found.starts["kept"].sum())
         (['kinematic', 'central'], 1)
+        >>> stepped = ship.recipe(runs, ["central"], refine=("u", "v", "r", "ψ"), refine_iterations=5, refine_step=0.2)
+        >>> "re-simulated at a step of 0.2" in stepped.text
+        True
         """
         held = _runs(held_out) if held_out is not None else []
         text_json, text, native = self._native.recipe(
