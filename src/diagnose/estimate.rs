@@ -300,8 +300,10 @@ pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Resu
         r.iter().all(|v| v.is_finite()).then(|| sum_of_squares(&r))
     };
     let linearised = |theta: &[f64]| -> Result<Linearised, DiagnoseError> {
-        linearise(&u.runs_at(runs, theta), &u.at(model, theta)?, &u.entries)
-            .map_err(|_| DiagnoseError::Refinement(EstimateError::Diverges("at an iterate")))
+        linearise(&u.runs_at(runs, theta), &u.at(model, theta)?, &u.entries).map_err(|e| match e {
+            slope @ DiagnoseError::Refinement(EstimateError::SlopeNotFinite(_)) => slope,
+            _ => DiagnoseError::Refinement(EstimateError::Diverges("at an iterate")),
+        })
     };
     let mut theta = u.start(runs);
     let cost_before = data_cost(&theta).ok_or(DiagnoseError::Refinement(EstimateError::Diverges(

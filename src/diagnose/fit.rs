@@ -580,6 +580,12 @@ pub enum EstimateError {
     /// JᵀJ has no inverse (a parameter the runs do not excite).
     #[error("has singular normal equations")]
     Singular,
+    /// The re-simulation's derivative with respect to these is not finite (a term whose slope
+    /// is infinite where the motion passes through).
+    #[error(
+        "has no finite slope with respect to {0}: a term whose slope is infinite where the motion passes (sqrt(v), |v|^0.5 at v = 0) cannot be fitted by output error there; hold that free value fixed, or write the term so that it is smooth there"
+    )]
+    SlopeNotFinite(String),
 }
 
 /// `iterations` Gauss-Newton steps from θ = 0; (θ, cost).

@@ -130,8 +130,10 @@ pub fn refine(model: &Model, runs: &Runs, settings: &RefineSettings<'_>) -> Resu
         |runs: &Runs, theta: &[f64]| residuals(runs, model, &hypothesis, theta).map(|r| sum_of_squares(&r));
     let before = runs.gap(&runs.simulate(model, &[], &[])?).cost;
     let mut theta = vec![0.0; k];
-    let mut lin = linearise(runs, model, &terms)
-        .map_err(|_| DiagnoseError::Refinement(EstimateError::Diverges("at the start")))?;
+    let mut lin = linearise(runs, model, &terms).map_err(|e| match e {
+        slope @ DiagnoseError::Refinement(EstimateError::SlopeNotFinite(_)) => slope,
+        _ => DiagnoseError::Refinement(EstimateError::Diverges("at the start")),
+    })?;
     let mut cost = sum_of_squares(&lin.residuals) + prior_cost(&theta);
     let validation_before = settings.validation.and_then(|v| simulate_cost(v, &theta));
     let mut best = (theta.clone(), validation_before.unwrap_or(f64::NAN));

@@ -45,6 +45,18 @@ pub enum Free {
     },
 }
 
+impl Free {
+    /// How an error names it.
+    pub fn label(&self) -> String {
+        match self {
+            Free::Term(equation, term) => format!("`{term}` of {equation}"),
+            Free::Parameter(name) => format!("`{name}`"),
+            Free::Group { name, runs } => format!("`{name}` of runs {runs:?}"),
+            Free::Initial { run, state } => format!("the initial value of state {state} in run {run}"),
+        }
+    }
+}
+
 /// The identified terms as outputs over the model's names: φ_j(x, u) for the matrix B.
 struct Regressors<'a> {
     model: &'a Model,
@@ -88,15 +100,28 @@ pub(super) fn linearise(runs: &Runs, model: &Model, entries: &[Free]) -> Result<
     let mut residuals = Vec::with_capacity(runs.residual_count());
     let mut jtj = DMatrix::zeros(k, k);
     let mut jtr = DVector::zeros(k);
-    for part in per_run_jacobians(runs, model, entries, |res, jt| {
+    let parts = per_run_jacobians(runs, model, entries, |res, jt| {
         let a = gram_of_rows(&jt);
         let g = &jt * DVector::from_column_slice(&res);
         (res, a, g)
-    })? {
-        let (r, a, g) = part;
+    })?;
+    for (r, a, g) in parts {
         residuals.extend(r);
         jtj += a;
         jtr += g;
+    }
+    // a slope that is not finite would make every step NaN and the fit stop saying only that
+    // no step lowers the error: name what it is the slope with respect to
+    let infinite: Vec<String> = entries
+        .iter()
+        .enumerate()
+        .filter(|(j, _)| !(jtj[(*j, *j)].is_finite() && jtr[*j].is_finite()))
+        .map(|(_, e)| e.label())
+        .collect();
+    if !infinite.is_empty() && residuals.iter().all(|r| r.is_finite()) {
+        return Err(DiagnoseError::Refinement(super::fit::EstimateError::SlopeNotFinite(
+            infinite.join(", "),
+        )));
     }
     Ok(Linearised { residuals, jtj, jtr })
 }
@@ -412,6 +437,37 @@ mod tests {
             let full = &a * a.transpose();
             assert!((&c - &full).amax() <= 1e-12 * full.amax(), "{k} × {n}");
         }
+    }
+
+    /// A slope that is infinite where the motion passes (√x from x = 0) is refused naming the
+    /// free value, not left to stop the fit as a step that lowers nothing.
+    #[test]
+    fn an_infinite_slope_is_named() {
+        let text = r#"
+[model]
+name = "root"
+[[states]]
+name = "x"
+[[inputs]]
+name = "u"
+[equations.x_dot]
+state = "x"
+candidates = ["sqrt(x)", "u"]
+coefficients = { "sqrt(x)" = -0.1, "u" = 1.0 }
+"#;
+        let model = Model::parse(text, "root.toml").unwrap();
+        let t: Vec<f64> = (0..=100).map(|i| i as f64 * 0.05).collect();
+        let mut f = Frame::new("run", "t", t.clone()).unwrap();
+        f.push("x", t.clone()).unwrap();
+        f.push("u", vec![1.0; t.len()]).unwrap();
+        let runs = Runs::new(&model, &[f], 0.05, Integrator::Rk4).unwrap();
+        let entries = vec![Free::Term("x_dot".into(), model.vocabulary.parse("u").unwrap())];
+        let Err(e) = linearise(&runs, &model, &entries) else { panic!("a finite slope from √x at 0") };
+        let message = e.to_string();
+        assert!(message.contains("no finite slope with respect to `u` of x_dot"), "{message}");
+        // the same with a smooth term is linearised as before
+        let smooth = Model::parse(&text.replace("sqrt(x)", "x"), "smooth.toml").unwrap();
+        assert!(linearise(&runs, &smooth, &entries).is_ok());
     }
 
     /// The forward sensitivities equal central differences of re-simulations, on a nonlinear
