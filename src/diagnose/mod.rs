@@ -13,6 +13,31 @@ mod hypotheses;
 mod refine;
 mod sensitivity;
 
+/// Models the tests of this module and of the recipe share.
+#[cfg(test)]
+pub(crate) mod fixtures {
+    use crate::model::Model;
+
+    /// ẋ = u + b·`term` (candidates u and `term`): a first-order lag where `term` is x.
+    pub(crate) fn lag(term: &str, b: f64) -> Model {
+        let text = format!(
+            r#"
+[model]
+name = "lag"
+[[states]]
+name = "x"
+[[inputs]]
+name = "u"
+[equations.x_dot]
+state = "x"
+candidates = ["u", "{term}"]
+coefficients = {{ "u" = 1.0, "{term}" = {b} }}
+"#
+        );
+        Model::parse(&text, "lag.toml").unwrap()
+    }
+}
+
 use serde::Serialize;
 
 pub use choose::{choose_by_prediction, Chosen, Configuration, Prediction};

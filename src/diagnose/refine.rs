@@ -328,21 +328,7 @@ mod tests {
 
     /// ẋ = a·u + b·x: identified as a = 1, b = −0.3; the runs come from a = 1, b = −0.5.
     fn lag(b: f64) -> Model {
-        let text = format!(
-            r#"
-[model]
-name = "lag"
-[[states]]
-name = "x"
-[[inputs]]
-name = "u"
-[equations.x_dot]
-state = "x"
-candidates = ["u", "x"]
-coefficients = {{ "u" = 1.0, "x" = {b} }}
-"#
-        );
-        Model::parse(&text, "lag.toml").unwrap()
+        crate::diagnose::fixtures::lag("x", b)
     }
 
     /// A step of u = 1 from x = 0: x(t) = (1 − e^(−kt))/k, k = 0.5, in closed form.

@@ -443,19 +443,7 @@ mod tests {
     /// free value, not left to stop the fit as a step that lowers nothing.
     #[test]
     fn an_infinite_slope_is_named() {
-        let text = r#"
-[model]
-name = "root"
-[[states]]
-name = "x"
-[[inputs]]
-name = "u"
-[equations.x_dot]
-state = "x"
-candidates = ["sqrt(x)", "u"]
-coefficients = { "sqrt(x)" = -0.1, "u" = 1.0 }
-"#;
-        let model = Model::parse(text, "root.toml").unwrap();
+        let model = crate::diagnose::fixtures::lag("sqrt(x)", -0.1);
         let t: Vec<f64> = (0..=100).map(|i| i as f64 * 0.05).collect();
         let mut f = Frame::new("run", "t", t.clone()).unwrap();
         f.push("x", t.clone()).unwrap();
@@ -466,8 +454,7 @@ coefficients = { "sqrt(x)" = -0.1, "u" = 1.0 }
         let message = e.to_string();
         assert!(message.contains("no finite slope with respect to `u` of x_dot"), "{message}");
         // the same with a smooth term is linearised as before
-        let smooth = Model::parse(&text.replace("sqrt(x)", "x"), "smooth.toml").unwrap();
-        assert!(linearise(&runs, &smooth, &entries).is_ok());
+        assert!(linearise(&runs, &crate::diagnose::fixtures::lag("x", -0.1), &entries).is_ok());
     }
 
     /// The forward sensitivities equal central differences of re-simulations, on a nonlinear

@@ -266,19 +266,7 @@ mod tests {
     /// at every sample: ẋ = u + b·x from b = −0.3 to the runs' −0.5.
     #[test]
     fn a_coarse_refinement_reports_the_costs_at_every_sample() {
-        let text = r#"
-[model]
-name = "lag"
-[[states]]
-name = "x"
-[[inputs]]
-name = "u"
-[equations.x_dot]
-state = "x"
-candidates = ["u", "x"]
-coefficients = { "u" = 1.0, "x" = -0.3 }
-"#;
-        let model = Model::parse(text, "lag.toml").unwrap();
+        let model = crate::diagnose::fixtures::lag("x", -0.3);
         let t: Vec<f64> = (0..=1000).map(|i| 0.01 * i as f64).collect();
         let mut f = Frame::new("step", "t", t.clone()).unwrap();
         f.push("x", t.iter().map(|t| (1.0 - (-0.5 * t).exp()) / 0.5).collect()).unwrap();
