@@ -40,12 +40,7 @@ pub fn identify_model(
     how: &ModelIdentification<'_>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<IdentifiedModel, IdentifyError> {
-    let names = if how.equations.is_empty() { model.identifiable() } else { how.equations.clone() };
-    if how.target.is_some() && names.len() != 1 {
-        return Err(IdentifyError::Setup(
-            "a target other than the state's derivative applies to one equation: name it".into(),
-        ));
-    }
+    let names = equations_of(model, how)?;
     let mut identified = model.clone();
     let mut fits = Vec::new();
     for name in &names {
@@ -54,9 +49,7 @@ pub fn identify_model(
         let mut fit =
             fit_equation(model, name, frames, how.differentiator, how.intercept, how.target.clone())
                 .map_err(in_equation)?;
-        let coefficients = coefficients_of(&fit, &model.vocabulary).map_err(in_equation)?;
-        let terms: Vec<Term> = coefficients.iter().map(|(t, _, _)| t.clone()).collect();
-        identified.set_coefficients(name, coefficients, fit.selection.intercept.as_ref().map(|b| b.value));
+        let terms = store_fit(&mut identified, name, &fit).map_err(in_equation)?;
         fit.correlation_time =
             correlation_time_of(&identified, frames, how.differentiator, &fit).map_err(in_equation)?;
         if let Some(matrix) = &fit.covariance {
@@ -72,6 +65,26 @@ pub fn identify_model(
         fits.push((name.clone(), fit));
     }
     Ok(IdentifiedModel { model: identified, fits })
+}
+
+/// The equations `how` identifies: those it names, else every identifiable one; a target
+/// other than the state's derivative names one.
+fn equations_of(model: &Model, how: &ModelIdentification<'_>) -> Result<Vec<String>, IdentifyError> {
+    let names = if how.equations.is_empty() { model.identifiable() } else { how.equations.clone() };
+    if how.target.is_some() && names.len() != 1 {
+        return Err(IdentifyError::Setup(
+            "a target other than the state's derivative applies to one equation: name it".into(),
+        ));
+    }
+    Ok(names)
+}
+
+/// Stores a fit's coefficients and intercept as equation `name` of `model`; the terms stored.
+pub(super) fn store_fit(model: &mut Model, name: &str, fit: &Fit) -> Result<Vec<Term>, IdentifyError> {
+    let coefficients = coefficients_of(fit, &model.vocabulary)?;
+    let terms = coefficients.iter().map(|(t, _, _)| t.clone()).collect();
+    model.set_coefficients(name, coefficients, fit.selection.intercept.as_ref().map(|b| b.value));
+    Ok(terms)
 }
 
 /// A model's equations as each run's statistics: identified on all runs but one (a fold of a
@@ -103,12 +116,7 @@ impl RunStatistics {
         frames: &[Frame],
         how: &ModelIdentification<'_>,
     ) -> Result<RunStatistics, IdentifyError> {
-        let names = if how.equations.is_empty() { model.identifiable() } else { how.equations.clone() };
-        if how.target.is_some() && names.len() != 1 {
-            return Err(IdentifyError::Setup(
-                "a target other than the state's derivative applies to one equation: name it".into(),
-            ));
-        }
+        let names = equations_of(model, how)?;
         let rules = model.parameter_rules();
         let identification = Identification {
             vocabulary: &model.vocabulary,
@@ -158,12 +166,7 @@ impl RunStatistics {
             let fit =
                 super::fit_folds(target, names, forced, excluded, self.intercept, &folds, backend.as_ref())
                     .map_err(in_equation)?;
-            let coefficients = coefficients_of(&fit, &model.vocabulary).map_err(in_equation)?;
-            identified.set_coefficients(
-                name,
-                coefficients,
-                fit.selection.intercept.as_ref().map(|b| b.value),
-            );
+            store_fit(&mut identified, name, &fit).map_err(in_equation)?;
             fits.push((name.clone(), fit));
         }
         Ok(IdentifiedModel { model: identified, fits })

@@ -418,12 +418,7 @@ pub fn identify_from_moments(
     for m in &merged {
         let in_equation = |e: IdentifyError| e.in_equation(&m.equation);
         let fit = m.fit(model, intercept).map_err(in_equation)?;
-        let coefficients = super::coefficients_of(&fit, &model.vocabulary).map_err(in_equation)?;
-        identified.set_coefficients(
-            &m.equation,
-            coefficients,
-            fit.selection.intercept.as_ref().map(|b| b.value),
-        );
+        super::model::store_fit(&mut identified, &m.equation, &fit).map_err(in_equation)?;
         fits.push((m.equation.clone(), fit));
     }
     Ok(super::IdentifiedModel { model: identified, fits })

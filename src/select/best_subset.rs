@@ -111,6 +111,19 @@ struct Score {
 }
 
 impl Score {
+    /// `criterion` on the scaled problem `sc`, Cp's σ̂² given, sizes below `smallest` unscored.
+    fn new(criterion: Criterion, sc: &Scaled, sigma2: f64, smallest: usize) -> Score {
+        Score {
+            criterion,
+            n: sc.n as f64,
+            n_eff: sc.n_eff,
+            total: sc.total,
+            sigma2,
+            intercept: sc.intercept,
+            smallest,
+        }
+    }
+
     fn of(&self, k: usize, rss: f64) -> f64 {
         let n = self.n;
         let kk = k as f64 + if self.intercept { 1.0 } else { 0.0 };
@@ -449,21 +462,16 @@ impl BestSubset {
                 keep_if_better(&mut best, kmax, (1.0 - st.r2).max(RSS_FLOOR), &[&st.set]);
             }
         }
-        let n = sc.n as f64;
         let all = forced.len() + kept.len();
+        let smallest = forced.len().max(1);
         // the pruning criterion: Cp's σ̂² is the full model's, known before the search only
         // when the full model is among the sizes searched
         let bound = (self.sizes == Sizes::Chosen
             && self.criterion != Criterion::LeaveOneRunOut
             && (self.criterion != Criterion::Cp || kmax == all))
-            .then(|| Score {
-                criterion: self.criterion,
-                n,
-                n_eff: sc.n_eff,
-                total: sc.total,
-                sigma2: sc.residual_share(&a).max(RSS_FLOOR) / (sc.n_eff - kmax as f64).max(1.0),
-                intercept: sc.intercept,
-                smallest: forced.len().max(1),
+            .then(|| {
+                let sigma2 = sc.residual_share(&a).max(RSS_FLOOR) / (sc.n_eff - kmax as f64).max(1.0);
+                Score::new(self.criterion, &sc, sigma2, smallest)
             });
         let lowest = bound.as_ref().map(|score| {
             best.iter()
@@ -529,15 +537,7 @@ impl BestSubset {
         // one step per size, chosen by the criterion
         let full_rss = best.iter().rev().find(|b| b.0.is_finite()).map_or(1.0, |b| b.0);
         let sigma2 = full_rss / (sc.n_eff - kmax as f64).max(1.0);
-        let scoring = Score {
-            criterion: self.criterion,
-            n,
-            n_eff: sc.n_eff,
-            total: sc.total,
-            sigma2,
-            intercept: sc.intercept,
-            smallest: forced.len().max(1),
-        };
+        let scoring = Score::new(self.criterion, &sc, sigma2, smallest);
         let mut steps = Vec::new();
         let mut scores = Vec::new();
         let validation = match self.criterion {
