@@ -10,7 +10,7 @@ use serde::Serialize;
 
 use super::fit::{apply, cost as sum_of_squares};
 use super::refine::RefinedCoefficient;
-use super::sensitivity::{linearise, Free, Linearised};
+use super::sensitivity::{fit_failure, linearise, Free, Linearised};
 use super::{DiagnoseError, Effect, EstimateError, Hypothesis, Runs};
 use crate::model::{FreeParameter, Model, ParameterCovarianceSpec};
 use crate::term::Term;
@@ -300,10 +300,8 @@ pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Resu
         r.iter().all(|v| v.is_finite()).then(|| sum_of_squares(&r))
     };
     let linearised = |theta: &[f64]| -> Result<Linearised, DiagnoseError> {
-        linearise(&u.runs_at(runs, theta), &u.at(model, theta)?, &u.entries).map_err(|e| match e {
-            slope @ DiagnoseError::Refinement(EstimateError::SlopeNotFinite(_)) => slope,
-            _ => DiagnoseError::Refinement(EstimateError::Diverges("at an iterate")),
-        })
+        linearise(&u.runs_at(runs, theta), &u.at(model, theta)?, &u.entries)
+            .map_err(|e| fit_failure(e, "at an iterate"))
     };
     let mut theta = u.start(runs);
     let cost_before = data_cost(&theta).ok_or(DiagnoseError::Refinement(EstimateError::Diverges(

@@ -262,12 +262,12 @@ impl Runs {
     }
 
     /// These runs coarsened as far as `model` allows, with the factor ([`Runs::coarser`], up to
-    /// `most`): the model re-simulates them there as at their samples, every compared state
-    /// within `tolerance` of its scale (RMS over all runs, at the coarse samples). Both the
-    /// integration's error and the inputs' resampling show in that difference. Factor 1 (the
-    /// runs themselves) where no coarser step holds or the model does not re-simulate them.
-    pub fn coarsest(&self, model: &Model, tolerance: f64, most: usize) -> (usize, Runs) {
-        let Ok(fine) = self.simulate(model, &[], &[]) else { return (1, self.clone()) };
+    /// `most`): the model re-simulates them there as it did at their samples (`fine`, its
+    /// simulation of these runs), every compared state within `tolerance` of its scale (RMS over
+    /// all runs, at the coarse samples). Both the integration's error and the inputs'
+    /// resampling show in that difference. Factor 1 (the runs themselves) where no coarser step
+    /// holds.
+    pub fn coarsest(&self, model: &Model, fine: &[Trajectory], tolerance: f64, most: usize) -> (usize, Runs) {
         let holds = |factor: usize| -> Option<Runs> {
             let coarse = self.coarser(factor).ok()?;
             let sims = coarse.simulate(model, &[], &[]).ok()?;

@@ -10,7 +10,7 @@ use nalgebra::DMatrix;
 use serde::Serialize;
 
 use super::fit::{apply, cost as sum_of_squares, residuals};
-use super::sensitivity::{linearise, Free, Linearised};
+use super::sensitivity::{fit_failure, linearise, Free, Linearised};
 use super::{DiagnoseError, Effect, EstimateError, Hypothesis, Runs};
 use crate::model::{Covariance, Model};
 use crate::term::Term;
@@ -130,10 +130,7 @@ pub fn refine(model: &Model, runs: &Runs, settings: &RefineSettings<'_>) -> Resu
         |runs: &Runs, theta: &[f64]| residuals(runs, model, &hypothesis, theta).map(|r| sum_of_squares(&r));
     let before = runs.gap(&runs.simulate(model, &[], &[])?).cost;
     let mut theta = vec![0.0; k];
-    let mut lin = linearise(runs, model, &terms).map_err(|e| match e {
-        slope @ DiagnoseError::Refinement(EstimateError::SlopeNotFinite(_)) => slope,
-        _ => DiagnoseError::Refinement(EstimateError::Diverges("at the start")),
-    })?;
+    let mut lin = linearise(runs, model, &terms).map_err(|e| fit_failure(e, "at the start"))?;
     let mut cost = sum_of_squares(&lin.residuals) + prior_cost(&theta);
     let validation_before = settings.validation.and_then(|v| simulate_cost(v, &theta));
     let mut best = (theta.clone(), validation_before.unwrap_or(f64::NAN));
@@ -368,7 +365,8 @@ mod tests {
         let coarsest = |b: f64, frame: Frame| {
             let model = lag(b);
             let runs = Runs::new(&model, &[frame], 0.01, Integrator::Rk4).unwrap();
-            runs.coarsest(&model, 1e-3, 8).0
+            let fine = runs.simulate(&model, &[], &[]).unwrap();
+            runs.coarsest(&model, &fine, 1e-3, 8).0
         };
         let slow = |t: f64| (0.5 * t).sin();
         // time constant 2 s, sampled every 0.01 s: RK4 at 0.08 s re-simulates it as at 0.01 s

@@ -126,6 +126,16 @@ pub(super) fn linearise(runs: &Runs, model: &Model, entries: &[Free]) -> Result<
     Ok(Linearised { residuals, jtj, jtr })
 }
 
+/// A linearisation's failure as an output-error fit reports it: a slope that is not finite as
+/// it is (it names the free values), any other (the re-simulation left its bounds) as the fit
+/// diverging `at`.
+pub(super) fn fit_failure(e: DiagnoseError, at: &'static str) -> DiagnoseError {
+    match e {
+        slope @ DiagnoseError::Refinement(super::fit::EstimateError::SlopeNotFinite(_)) => slope,
+        _ => DiagnoseError::Refinement(super::fit::EstimateError::Diverges(at)),
+    }
+}
+
 /// A Aᵀ of a k × n column-major matrix (JᵀJ from Jᵀ): one blocked product straight from its
 /// storage, no transposed copy. (Computing only the blocks on and below the diagonal saved
 /// nothing measurable at k = 64: the smaller products pack less efficiently.)

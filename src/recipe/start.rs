@@ -227,12 +227,15 @@ fn refine(
     let runs = runs_of(frames)?;
     let validation = held.map(runs_of).transpose()?;
     let sample = crate::data::sample_step(frames);
+    // the regression's model at every sample: what the step is checked against, and the cost
+    // reported before the refinement
+    let fine = runs.simulate(model, &[], &[]).map_err(|e| e.to_string())?;
     let (factor, coarse) = match options.step {
         Some(step) => {
             let factor = (step / sample).round().max(1.0) as usize;
             (factor, runs.coarser(factor).map_err(|e| e.to_string())?)
         }
-        None => runs.coarsest(model, super::RESOLVED, super::MOST_SAMPLES_PER_STEP),
+        None => runs.coarsest(model, &fine, super::RESOLVED, super::MOST_SAMPLES_PER_STEP),
     };
     let coarse_validation =
         validation.as_ref().map(|v| v.coarser(factor).map_err(|e| e.to_string())).transpose()?;
@@ -248,7 +251,7 @@ fn refine(
             let sims = runs.simulate(m, &[], &[]).map_err(|e| e.to_string())?;
             Ok(runs.gap(&sims).cost)
         };
-        refined.cost_before = cost(&runs, model)?;
+        refined.cost_before = runs.gap(&fine).cost;
         refined.cost_after = cost(&runs, &refined.model)?;
         if let Some(v) = &validation {
             refined.validation = Some((cost(v, model)?, cost(v, &refined.model)?));
