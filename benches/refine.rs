@@ -35,12 +35,14 @@ fn bench(c: &mut Criterion) {
         .unwrap();
     let plugin = termid::plugins::with_derivative("kinematic").unwrap();
     let runs_of_13: Vec<(&str, f64)> = ZIGZAGS_BOTH_SIDES.iter().chain(&MORE).copied().collect();
-    let frames: Vec<Frame> = Basin::tracked()
+    let records: Vec<Frame> = Basin::tracked()
         .record_all(&truth, &runs_of_13, 1.17248, 80.0, 7, None)
         .unwrap()
-        .iter()
-        .map(|(_, rec)| plugin.prepare("kinematic", &template, &rec.measured, true).unwrap())
+        .into_iter()
+        .map(|(_, rec)| rec.measured)
         .collect();
+    let frames: Vec<Frame> =
+        records.iter().map(|f| plugin.prepare("kinematic", &template, f, true).unwrap()).collect();
     let how = ModelIdentification {
         equations: vec![],
         differentiator: &CentralDifference,
@@ -60,12 +62,6 @@ fn bench(c: &mut Criterion) {
     // the whole recipe on the same 13 records, as README's new-ship command runs it: four
     // derivative starts side by side, each choosing among four back-ends by leave-one-run-out
     // prediction, refined and checked (issue 26's target: under 5 s for 13 runs)
-    let records: Vec<Frame> = Basin::tracked()
-        .record_all(&truth, &runs_of_13, 1.17248, 80.0, 7, None)
-        .unwrap()
-        .into_iter()
-        .map(|(_, rec)| rec.measured)
-        .collect();
     let ship = termid::plugins::load(Path::new("models/new_ship.toml")).unwrap();
     let settings = RecipeSettings {
         derivatives: ["kinematic", "kalman", "savitzky-golay", "central"].map(String::from).to_vec(),
