@@ -3,9 +3,10 @@
 //! and its turning circles. Prints the guide's tables and writes two figures.
 //!
 //! `SIMMAN=/path/to/clone cargo run --release --example simman -- IDENTIFIED.toml [OUT_FOLDER]`;
-//! `… --example simman -- --table LABEL=MODEL.toml …` prints one row per model instead: the
-//! first overshoot of each MARIN zigzag (steered by the model) less MARIN's, and the ±35°
-//! tactical diameters (the guide's table of training sets and model families)
+//! `… --example simman -- --table [--about-neutral] LABEL=MODEL.toml …` prints one row per
+//! model instead: the first overshoot of each MARIN zigzag (steered by the model, the rudder
+//! laid about 0 as MARIN laid it, or about the model's straight-run angle) less MARIN's, and
+//! the ±35° tactical diameters (the guide's table of training sets and model families)
 //! (the clone: the public repository martinlarsalbert/System-identification-of-Vessel-
 //! Manoeuvring-Models; its records are read where they are, never copied).
 
@@ -44,9 +45,11 @@ fn main() -> Result<(), Error> {
     let sims = data.simulate(&model, &[], &[])?;
     let plugin = termid::plugins::of(&model).ok_or("not a ship model")?;
     // and each zigzag as the model steers it itself: same amplitude and side, from the run's
-    // approach speed (the propeller at the model's self-propulsion point for it)
-    println!("| MARIN run | zigzag (termid) | 1st overshoot measured | predicted | error | 2nd overshoot measured | predicted | error | 1st overshoot, recorded rudder replayed |");
-    println!("|---|---|---|---|---|---|---|---|---|");
+    // approach speed (the propeller at the model's self-propulsion point for it), the rudder
+    // laid to ±A on its own scale as MARIN's records show it laid (plateaus at ±10° and ±20°
+    // of the indicator), and for comparison about the straight run's δ0 (Oltmann's §5)
+    println!("| MARIN run | zigzag (termid) | 1st overshoot measured | predicted | error | 2nd overshoot measured | predicted | error | 1st overshoot, rudder about δ0 | 1st overshoot, recorded rudder replayed |");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
     let mut panels = Vec::new();
     for (frame, sim) in runs.iter().zip(&sims) {
         let name =
@@ -54,10 +57,16 @@ fn main() -> Result<(), Error> {
         let measured = plugin.observe(&model, frame, None).ok_or("no metrics of the record")?.json;
         let replayed = plugin.observe(&model, frame, Some(sim)).ok_or("no metrics of the simulation")?.json;
         let manoeuvre = zigzag_of(frame)?;
-        let own = Ship::new(&termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]), false)?
-            .run(&Manoeuvre::parse(&manoeuvre)?, &Settings { duration: 100.0, ..settings })?;
-        let Metrics::ZigZag(z) = &own.metrics else { return Err("not a zigzag".into()) };
-        let mut row = format!("| {name} | {manoeuvre} |");
+        let ship = Ship::new(&termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]), false)?;
+        let steered = |spec: &str| -> Result<termid::ship::manoeuvre::ZigZagMetrics, Error> {
+            match ship.run(&Manoeuvre::parse(spec)?, &Settings { duration: 100.0, ..settings })?.metrics {
+                Metrics::ZigZag(z) => Ok(z),
+                _ => Err("not a zigzag".into()),
+            }
+        };
+        let z = steered(&manoeuvre)?;
+        let about_neutral = steered(manoeuvre.trim_end_matches(":absolute"))?;
+        let mut row = format!("| {name} | {} |", manoeuvre.trim_start_matches("zigzag:"));
         for (key, p) in
             [("first_overshoot_deg", z.first_overshoot_deg), ("second_overshoot_deg", z.second_overshoot_deg)]
         {
@@ -66,10 +75,12 @@ fn main() -> Result<(), Error> {
                 _ => " -- | -- | -- |".into(),
             };
         }
+        row += &about_neutral.first_overshoot_deg.map_or(" -- |".into(), |p| format!(" {p:.2}° |"));
         row += &replayed["first_overshoot_deg"].as_f64().map_or(" -- |".into(), |p| format!(" {p:.2}° |"));
         println!("{row}");
         panels.push(zigzag_panel(&name, frame, sim)?);
     }
+    own_zigzags(&model, &settings)?;
     let mut zigzags = Figure::new(
         "MARIN's KVLCC2 zigzags (model scale), predicted by the model identified from HSVA's",
         panels,
@@ -126,16 +137,57 @@ fn main() -> Result<(), Error> {
     Ok(())
 }
 
-/// `--table LABEL=MODEL.toml …`: per model, each MARIN zigzag's first overshoot as the model
-/// steers it less the measured one, and the ±35° tactical diameters at MARIN's approach.
+/// HSVA's thirteen zigzags, which the model was identified from, as it steers them itself from
+/// each run's approach: the rudder about 0, as HSVA laid it (the records start at the execute
+/// with the rudder at 0 and lay it to ±A), and about the model's straight-run angle δ0. Which
+/// convention reproduces the basin's own runs is the one to predict its other runs with.
+fn own_zigzags(model: &termid::model::Model, settings: &Settings) -> Result<(), Error> {
+    let hsva = Path::new("examples/simman/hsva.toml");
+    let set = Dataset::load(hsva)?;
+    let (runs, _) = set.read(&set.folder(hsva)?, "t")?;
+    let plugin = termid::plugins::of(model).ok_or("not a ship model")?;
+    println!("\nHSVA's zigzags (the training runs) as the model steers them, first overshoot:\n");
+    println!("| HSVA run | zigzag (termid) | measured | rudder about 0 | error | rudder about δ0 | error |");
+    println!("|---|---|---|---|---|---|---|");
+    for frame in &runs {
+        let name =
+            Path::new(frame.origin()).file_stem().map_or(String::new(), |s| s.to_string_lossy().into());
+        let measured = plugin.observe(model, frame, None).ok_or("no metrics of the record")?.json;
+        let manoeuvre = zigzag_of(frame)?;
+        let ship = Ship::new(&termid::ship::basin::at_approach_speed(model, frame.require("u")?[0]), false)?;
+        let mut row = format!("| {name} | {} |", manoeuvre.trim_start_matches("zigzag:"));
+        let m = measured["first_overshoot_deg"].as_f64();
+        row += &m.map_or(" -- |".into(), |m| format!(" {m:.2}° |"));
+        for spec in [manoeuvre.as_str(), manoeuvre.trim_end_matches(":absolute")] {
+            let run = ship.run(&Manoeuvre::parse(spec)?, &Settings { duration: 100.0, ..*settings })?;
+            let Metrics::ZigZag(z) = &run.metrics else { return Err("not a zigzag".into()) };
+            row += &match (m, z.first_overshoot_deg) {
+                (Some(m), Some(p)) => format!(" {p:.2}° | {:+.2}° |", p - m),
+                _ => " -- | -- |".into(),
+            };
+        }
+        println!("{row}");
+    }
+    Ok(())
+}
+
+/// `--table [--about-neutral] LABEL=MODEL.toml …`: per model, each MARIN zigzag's first overshoot as the model
+/// steers it less the measured one, and the ±35° tactical diameters at MARIN's approach; the
+/// rudder laid about 0 as MARIN laid it, or with `--about-neutral` about the model's δ0.
 fn table(models: &[String]) -> Result<(), Error> {
+    let about_neutral = models.first().is_some_and(|a| a == "--about-neutral");
+    let models = &models[usize::from(about_neutral)..];
+    let zigzag = |frame: &Frame| -> Result<String, Error> {
+        let spec = zigzag_of(frame)?;
+        Ok(if about_neutral { spec.trim_end_matches(":absolute").to_string() } else { spec })
+    };
     let marin = Path::new("examples/simman/marin.toml");
     let set = Dataset::load(marin)?;
     let (runs, _) = set.read(&set.folder(marin)?, "t")?;
     let settings = Settings { integrator: Integrator::Rk4, dt: 0.02, duration: 240.0, sample: 0.2 };
     let mut head = "| model |".to_string();
     for frame in &runs {
-        head += &format!(" {} |", zigzag_of(frame)?);
+        head += &format!(" {} |", zigzag(frame)?.trim_start_matches("zigzag:").trim_end_matches(":absolute"));
     }
     println!("{head} +35° | −35° |\n|---|{}---|---|", "---|".repeat(runs.len()));
     for item in models {
@@ -150,7 +202,7 @@ fn table(models: &[String]) -> Result<(), Error> {
                 &termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]),
                 false,
             )?
-            .run(&Manoeuvre::parse(&zigzag_of(frame)?)?, &Settings { duration: 100.0, ..settings })
+            .run(&Manoeuvre::parse(&zigzag(frame)?)?, &Settings { duration: 100.0, ..settings })
             {
                 Ok(own) => own,
                 Err(e) => {
@@ -216,17 +268,31 @@ fn zigzag_panel(name: &str, frame: &Frame, sim: &Trajectory) -> Result<Panel, Er
     })
 }
 
-/// The zigzag a record is: `zigzag:A/A` with its rudder angle (the largest, to whole 5°: the
-/// indicator overshoots its command a little) and the side its heading first turns to
-/// (MARIN's zigzags switch at the rudder angle).
+/// The zigzag a record is: `zigzag:A/H:absolute` with its rudder angle A (the largest, to whole
+/// 5°: the indicator overshoots its command a little), the heading change H at which the rudder
+/// is first reversed (read where the rudder leaves its first plateau, snapped to the usual
+/// 1°, 5°, 10°, 15° or 20°) and the side its heading first turns to; the rudder about 0, as
+/// the records lay it.
 fn zigzag_of(frame: &Frame) -> Result<String, Error> {
     let deg = 180.0 / std::f64::consts::PI;
-    let largest = frame.require("δ")?.iter().fold(0.0f64, |m, d| m.max((d * deg).abs()));
+    let rudder: Vec<f64> = frame.require("δ")?.iter().map(|d| d * deg).collect();
+    let largest = rudder.iter().fold(0.0f64, |m, d| m.max(d.abs()));
     let amplitude = 5.0 * (largest / 5.0).round();
     let psi = frame.require("ψ")?;
-    let first =
-        psi.iter().map(|p| (p - psi[0]) * deg).find(|p| p.abs() > 1.0).ok_or("the heading never turns")?;
-    Ok(format!("zigzag:{amplitude}/{amplitude}{}", if first < 0.0 { ":port" } else { "" }))
+    let heading: Vec<f64> = psi.iter().map(|p| (p - psi[0]) * deg).collect();
+    let first = *heading.iter().find(|p| p.abs() > 0.5).ok_or("the heading never turns")?;
+    let laid = rudder.iter().position(|d| d.abs() > amplitude - 1.5).ok_or("the rudder is never laid")?;
+    let side = rudder[laid].signum();
+    let back = rudder[laid..]
+        .iter()
+        .position(|d| d * side < amplitude - 1.5)
+        .ok_or("the rudder is never reversed")?;
+    let at = heading[laid + back].abs();
+    let check = [1.0, 5.0, 10.0, 15.0, 20.0]
+        .into_iter()
+        .min_by(|a: &f64, b: &f64| (a - at).abs().total_cmp(&(b - at).abs()))
+        .unwrap_or(at);
+    Ok(format!("zigzag:{amplitude}/{check}{}:absolute", if first < 0.0 { ":port" } else { "" }))
 }
 
 /// A run's track, x0 up and y0 across.

@@ -350,7 +350,8 @@ pub struct SimulateCommand {
     /// Model file (default: the embedded Oltmann 1973 ship model).
     #[arg(long)]
     pub model: Option<PathBuf>,
-    /// Ship models: zigzag:20/20[:port], turning:35, spiral[:MAX/STEP/HOLD], pullout:20,
+    /// Ship models: zigzag:20/20[:port][:absolute] (the rudder about the straight run's δ0,
+    /// or about 0 as basins lay it), turning:35, spiral[:MAX/STEP/HOLD], pullout:20,
     /// initial-turning[:10/10], replay:FILE.csv (IMO MSC.137(76) criteria are judged where
     /// they apply). Any model: replay:FILE.csv.
     #[arg(long, short = 'm')]

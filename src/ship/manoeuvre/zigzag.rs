@@ -1,5 +1,6 @@
 //! Zigzag (Z-manoeuvre) δ/ψ: the rudder is laid to δ0 ∓ δ_z (relative to the straight-run
-//! angle δ0, Oltmann 1973 §5) and reversed each time the heading change from the initial
+//! angle δ0, Oltmann 1973 §5), or to ∓δ_z on the rudder's own scale as a basin lays it by its
+//! indicator (`:absolute`), and reversed each time the heading change from the initial
 //! heading reaches ±ψ_z. Overshoot is the heading beyond the switching heading (not beyond
 //! the rudder angle; for a 20°/10° zigzag those differ), IMO MSC.137(76).
 
@@ -11,12 +12,16 @@ use crate::sim::{Controller, Trajectory};
 /// A zigzag manoeuvre.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ZigZag {
-    /// Rudder angle δ_z, degrees (relative to δ0).
+    /// Rudder angle δ_z, degrees (relative to δ0, or to 0 when `absolute`).
     pub rudder_deg: f64,
     /// Heading change ψ_z at which the rudder is reversed, degrees.
     pub heading_deg: f64,
     /// First turn to starboard (ψ increasing), else to port.
     pub starboard_first: bool,
+    /// The rudder laid to ±δ_z about 0 (as the basins' records show it laid by the indicator)
+    /// instead of about the straight-run angle δ0. A model whose straight run needs δ0 ≠ 0
+    /// turns 2·δ0 more to one side than to the other this way, as the model ship did.
+    pub absolute: bool,
 }
 
 /// Zigzag metrics (IMO MSC.137(76), ITTC 7.5-04-02-01).
@@ -91,7 +96,7 @@ impl ZigZag {
             ZigZagControl {
                 servo: Servo::new(ship, start),
                 switch: Switch { dir: self.dir0(), limit: self.heading_deg.to_radians() },
-                delta0: start.input[ship.roles.rudder],
+                delta0: if self.absolute { 0.0 } else { start.input[ship.roles.rudder] },
                 amplitude: self.rudder_deg.to_radians(),
                 turn_sign: ship.turn_sign,
                 psi: ship.roles.psi,
@@ -159,23 +164,32 @@ impl<C: Controller> Controller for RudderOnly<C> {
 impl super::Test for ZigZag {
     type Metrics = ZigZagMetrics;
 
-    /// `zigzag:RUDDER/HEADING[:port]`, e.g. `zigzag:20/20`, `zigzag:20/10:port`.
+    /// `zigzag:RUDDER/HEADING[:port][:absolute]`, e.g. `zigzag:20/20`, `zigzag:20/10:port`,
+    /// `zigzag:10/10:port:absolute`.
     fn parse(text: &str, rest: &str) -> Result<Self, ShipError> {
         let bad = |m: &str| ShipError::Manoeuvre { text: text.into(), message: m.into() };
         let mut parts = rest.split(':');
         let angles = parts.next().unwrap_or("");
         let (d, p) =
             angles.split_once('/').ok_or_else(|| bad("write zigzag:RUDDER/HEADING, e.g. zigzag:20/20"))?;
-        let side = parts.next().unwrap_or("starboard");
-        let starboard_first = match side {
-            "starboard" | "stb" | "s" => true,
-            "port" | "p" => false,
-            _ => return Err(bad("the side is `starboard` or `port`")),
-        };
+        let (mut side, mut absolute) = (None, false);
+        for part in parts {
+            match part {
+                "starboard" | "stb" | "s" if side.is_none() => side = Some(true),
+                "port" | "p" if side.is_none() => side = Some(false),
+                "absolute" if !absolute => absolute = true,
+                _ => {
+                    return Err(bad(
+                        "after the angles: the side (`starboard` or `port`) and `absolute` (the rudder about 0, not about the straight run's δ0), each once",
+                    ))
+                }
+            }
+        }
         let z = ZigZag {
             rudder_deg: super::parse_num(text, d, "rudder angle")?,
             heading_deg: super::parse_num(text, p, "heading change")?,
-            starboard_first,
+            starboard_first: side.unwrap_or(true),
+            absolute,
         };
         if z.rudder_deg <= 0.0 || z.heading_deg <= 0.0 {
             return Err(bad("rudder angle and heading change are positive; choose the side with `:port`"));
@@ -185,10 +199,11 @@ impl super::Test for ZigZag {
 
     fn label(&self) -> String {
         format!(
-            "zigzag {}°/{}° {}",
+            "zigzag {}°/{}° {}{}",
             self.rudder_deg,
             self.heading_deg,
-            if self.starboard_first { "starboard" } else { "port" }
+            if self.starboard_first { "starboard" } else { "port" },
+            if self.absolute { ", rudder about 0" } else { "" }
         )
     }
 
@@ -206,5 +221,44 @@ impl super::Test for ZigZag {
 
     fn metrics(&self, ship: &Ship, run: &Trajectory) -> ZigZagMetrics {
         ZigZag::metrics(self, ship, run)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{Manoeuvre, Metrics};
+    use crate::sim::{Integrator, Settings};
+
+    /// The default ship holds a straight course at δ0 = −0.8° (Oltmann's model is not
+    /// symmetric), and a negative rudder turns it to starboard. About δ0 the rudder goes to
+    /// δ0 ± 20°; laid absolute, to ±20° exactly, which is 19.2° from its neutral to starboard
+    /// and 20.8° to port: the first overshoot of a zigzag to starboard shrinks and one to
+    /// port grows.
+    #[test]
+    fn an_absolute_zigzag_lays_the_rudder_about_zero() {
+        let ship = crate::ship::Ship::new(&crate::ship::default_model(), false).unwrap();
+        let settings = Settings { integrator: Integrator::Rk4, dt: 0.04, duration: 60.0, sample: 0.04 };
+        let run = |spec: &str| {
+            let run = ship.run(&Manoeuvre::parse(spec).unwrap(), &settings).unwrap();
+            let rudder =
+                run.trajectory.input("δ").unwrap().iter().map(|d| d.to_degrees()).collect::<Vec<_>>();
+            let (lo, hi) = rudder.iter().fold((f64::MAX, f64::MIN), |(lo, hi), d| (lo.min(*d), hi.max(*d)));
+            let Metrics::ZigZag(z) = run.metrics else { panic!("zigzag metrics") };
+            (lo, hi, z.first_overshoot_deg.unwrap())
+        };
+        let delta0 = ship.straight_run().unwrap().input[ship.roles.rudder].to_degrees();
+        assert!((delta0 + 0.8).abs() < 0.05 && ship.turn_sign < 0.0, "δ0 = {delta0}");
+        let (lo, hi, about_neutral) = run("zigzag:20/20");
+        assert!((lo - (delta0 - 20.0)).abs() < 1e-9 && (hi - (delta0 + 20.0)).abs() < 1e-9, "{lo} {hi}");
+        let (lo, hi, absolute) = run("zigzag:20/20:absolute");
+        assert!((lo + 20.0).abs() < 1e-9 && (hi - 20.0).abs() < 1e-9, "{lo} {hi}");
+        assert!(absolute < about_neutral, "to starboard: {absolute} ≥ {about_neutral}");
+        let (_, _, about_neutral) = run("zigzag:20/20:port");
+        let (_, _, absolute) = run("zigzag:20/20:absolute:port");
+        assert!(absolute > about_neutral, "to port: {absolute} ≤ {about_neutral}");
+        for bad in ["zigzag:20/20:port:port", "zigzag:20/20:absolute:absolute", "zigzag:20/20:sideways"] {
+            assert!(Manoeuvre::parse(bad).is_err(), "{bad}");
+        }
+        assert!(Manoeuvre::parse("zigzag:20/20:port:absolute").unwrap().label().ends_with("rudder about 0"));
     }
 }
