@@ -15,6 +15,7 @@ use std::path::{Path, PathBuf};
 use termid::data::{Dataset, Frame};
 use termid::diagnose::Runs;
 use termid::plot::{Figure, Panel, Series};
+use termid::ship::manoeuvre::ZigZagMetrics;
 use termid::ship::{Manoeuvre, Metrics, Ship};
 use termid::sim::{Integrator, Settings, Trajectory};
 
@@ -58,14 +59,8 @@ fn main() -> Result<(), Error> {
         let replayed = plugin.observe(&model, frame, Some(sim)).ok_or("no metrics of the simulation")?.json;
         let manoeuvre = zigzag_of(frame)?;
         let ship = Ship::new(&termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]), false)?;
-        let steered = |spec: &str| -> Result<termid::ship::manoeuvre::ZigZagMetrics, Error> {
-            match ship.run(&Manoeuvre::parse(spec)?, &Settings { duration: 100.0, ..settings })?.metrics {
-                Metrics::ZigZag(z) => Ok(z),
-                _ => Err("not a zigzag".into()),
-            }
-        };
-        let z = steered(&manoeuvre)?;
-        let about_neutral = steered(manoeuvre.trim_end_matches(":absolute"))?;
+        let z = steer(&ship, &manoeuvre, &settings)?;
+        let about_neutral = steer(&ship, manoeuvre.trim_end_matches(":absolute"), &settings)?;
         let mut row = format!("| {name} | {} |", manoeuvre.trim_start_matches("zigzag:"));
         for (key, p) in
             [("first_overshoot_deg", z.first_overshoot_deg), ("second_overshoot_deg", z.second_overshoot_deg)]
@@ -159,8 +154,7 @@ fn own_zigzags(model: &termid::model::Model, settings: &Settings) -> Result<(), 
         let m = measured["first_overshoot_deg"].as_f64();
         row += &m.map_or(" -- |".into(), |m| format!(" {m:.2}° |"));
         for spec in [manoeuvre.as_str(), manoeuvre.trim_end_matches(":absolute")] {
-            let run = ship.run(&Manoeuvre::parse(spec)?, &Settings { duration: 100.0, ..*settings })?;
-            let Metrics::ZigZag(z) = &run.metrics else { return Err("not a zigzag".into()) };
+            let z = steer(&ship, spec, settings)?;
             row += &match (m, z.first_overshoot_deg) {
                 (Some(m), Some(p)) => format!(" {p:.2}° | {:+.2}° |", p - m),
                 _ => " -- | -- |".into(),
@@ -171,9 +165,10 @@ fn own_zigzags(model: &termid::model::Model, settings: &Settings) -> Result<(), 
     Ok(())
 }
 
-/// `--table [--about-neutral] LABEL=MODEL.toml …`: per model, each MARIN zigzag's first overshoot as the model
-/// steers it less the measured one, and the ±35° tactical diameters at MARIN's approach; the
-/// rudder laid about 0 as MARIN laid it, or with `--about-neutral` about the model's δ0.
+/// `--table [--about-neutral] LABEL=MODEL.toml …`: per model, each MARIN zigzag's first
+/// overshoot as the model steers it less the measured one, and the ±35° tactical diameters at
+/// MARIN's approach; the rudder laid about 0 as MARIN laid it, or with `--about-neutral` about
+/// the model's δ0.
 fn table(models: &[String]) -> Result<(), Error> {
     let about_neutral = models.first().is_some_and(|a| a == "--about-neutral");
     let models = &models[usize::from(about_neutral)..];
@@ -198,19 +193,15 @@ fn table(models: &[String]) -> Result<(), Error> {
         for frame in &runs {
             let measured = plugin.observe(&model, frame, None).ok_or("no metrics of the record")?.json;
             // a model that leaves its bounds is a row of the table too, saying where
-            let own = match Ship::new(
-                &termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]),
-                false,
-            )?
-            .run(&Manoeuvre::parse(&zigzag(frame)?)?, &Settings { duration: 100.0, ..settings })
-            {
-                Ok(own) => own,
+            let ship =
+                Ship::new(&termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]), false)?;
+            let z = match steer(&ship, &zigzag(frame)?, &settings) {
+                Ok(z) => z,
                 Err(e) => {
                     row += &format!(" {} |", diverged(&e));
                     continue;
                 }
             };
-            let Metrics::ZigZag(z) = &own.metrics else { return Err("not a zigzag".into()) };
             row += &match (measured["first_overshoot_deg"].as_f64(), z.first_overshoot_deg) {
                 (Some(m), Some(p)) => format!(" {:+.2}° |", p - m),
                 _ => " -- |".into(),
@@ -233,6 +224,14 @@ fn table(models: &[String]) -> Result<(), Error> {
         println!("{row}");
     }
     Ok(())
+}
+
+/// A zigzag as the ship steers it itself over 100 s, its metrics.
+fn steer(ship: &Ship, spec: &str, settings: &Settings) -> Result<ZigZagMetrics, Error> {
+    match ship.run(&Manoeuvre::parse(spec)?, &Settings { duration: 100.0, ..*settings })?.metrics {
+        Metrics::ZigZag(z) => Ok(z),
+        _ => Err("not a zigzag".into()),
+    }
 }
 
 /// A prediction that failed, as a cell: where a simulation left its bounds, when.

@@ -19,8 +19,9 @@ pub struct ZigZag {
     /// First turn to starboard (ψ increasing), else to port.
     pub starboard_first: bool,
     /// The rudder laid to ±δ_z about 0 (as the basins' records show it laid by the indicator)
-    /// instead of about the straight-run angle δ0. A model whose straight run needs δ0 ≠ 0
-    /// turns 2·δ0 more to one side than to the other this way, as the model ship did.
+    /// instead of about the straight-run angle δ0. A model whose straight run needs δ0 ≠ 0 is
+    /// then turned by δ_z + |δ0| to one side and δ_z − |δ0| to the other, as a basin's ship
+    /// is whose neutral rudder angle is not its indicator's zero.
     pub absolute: bool,
 }
 
