@@ -1,11 +1,14 @@
-//! The SIMMAN 2008 KVLCC2 case study (docs/guide/simman.md): a model identified from HSVA's thirteen zigzags (the guide's `identify` command)
-//! predicts MARIN's four zigzags, which it never saw (full scale, read at the model's scale),
-//! and its turning circles. Prints the guide's tables and writes two figures.
+//! The SIMMAN 2008 KVLCC2 case study (docs/guide/simman.md): a model identified from HSVA's
+//! thirteen zigzags (the guide's `identify` command) predicts MARIN's four zigzags, which it
+//! never saw (full scale, read at the model's scale), and its turning circles; and steers
+//! HSVA's own zigzags, each basin's steering gear read off its records. Prints the guide's
+//! tables and writes two figures.
 //!
 //! `SIMMAN=/path/to/clone cargo run --release --example simman -- IDENTIFIED.toml [OUT_FOLDER]`;
-//! `… --example simman -- --table [--about-neutral] LABEL=MODEL.toml …` prints one row per
-//! model instead: the first overshoot of each MARIN zigzag (steered by the model, the rudder
-//! laid about 0 as MARIN laid it, or about the model's straight-run angle) less MARIN's, and
+//! `… --example simman -- --table [--gear-at-once] [--about-neutral] LABEL=MODEL.toml …` prints
+//! one row per model instead: the first overshoot of each MARIN zigzag (steered by the model,
+//! the rudder laid about 0 by MARIN's steering gear as MARIN's records show both; or by a gear
+//! at full rate at once; or that and about the model's straight-run angle) less MARIN's, and
 //! the ±35° tactical diameters (the guide's table of training sets and model families)
 //! (the clone: the public repository martinlarsalbert/System-identification-of-Vessel-
 //! Manoeuvring-Models; its records are read where they are, never copied).
@@ -14,9 +17,10 @@ use std::path::{Path, PathBuf};
 
 use termid::data::{Dataset, Frame};
 use termid::diagnose::Runs;
+use termid::model::Model;
 use termid::plot::{Figure, Panel, Series};
 use termid::ship::manoeuvre::ZigZagMetrics;
-use termid::ship::{Manoeuvre, Metrics, Ship};
+use termid::ship::{Manoeuvre, Metrics, Ship, ShipSpec};
 use termid::sim::{Integrator, Settings, Trajectory};
 
 type Error = Box<dyn std::error::Error>;
@@ -48,9 +52,13 @@ fn main() -> Result<(), Error> {
     // and each zigzag as the model steers it itself: same amplitude and side, from the run's
     // approach speed (the propeller at the model's self-propulsion point for it), the rudder
     // laid to ±A on its own scale as MARIN's records show it laid (plateaus at ±10° and ±20°
-    // of the indicator), and for comparison about the straight run's δ0 (Oltmann's §5)
-    println!("| MARIN run | zigzag (termid) | 1st overshoot measured | predicted | error | 2nd overshoot measured | predicted | error | 1st overshoot, rudder about δ0 | 1st overshoot, recorded rudder replayed |");
-    println!("|---|---|---|---|---|---|---|---|---|---|");
+    // of the indicator) by MARIN's steering gear as its records show it; for comparison by a
+    // gear at its full rate at once (the model file's), and about the straight run's δ0 as
+    // well (Oltmann's §5)
+    let gear = Gear::of(&runs)?;
+    println!("MARIN's steering gear (model scale): {gear}\n");
+    println!("| MARIN run | zigzag (termid) | 1st overshoot measured | predicted | error | 2nd overshoot measured | predicted | error | 1st overshoot, gear at full rate at once | the same, rudder about δ0 | 1st overshoot, recorded rudder replayed |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     let mut panels = Vec::new();
     for (frame, sim) in runs.iter().zip(&sims) {
         let name =
@@ -59,8 +67,13 @@ fn main() -> Result<(), Error> {
         let replayed = plugin.observe(&model, frame, Some(sim)).ok_or("no metrics of the simulation")?.json;
         let manoeuvre = zigzag_of(frame)?;
         let ship = Ship::new(&termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]), false)?;
-        let z = steer(&ship, &manoeuvre, &settings)?;
+        let at_once = steer(&ship, &manoeuvre, &settings)?;
         let about_neutral = steer(&ship, manoeuvre.trim_end_matches(":absolute"), &settings)?;
+        let geared = Ship::new(
+            &gear.on(&termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]))?,
+            false,
+        )?;
+        let z = steer(&geared, &manoeuvre, &settings)?;
         let mut row = format!("| {name} | {} |", manoeuvre.trim_start_matches("zigzag:"));
         for (key, p) in
             [("first_overshoot_deg", z.first_overshoot_deg), ("second_overshoot_deg", z.second_overshoot_deg)]
@@ -70,7 +83,9 @@ fn main() -> Result<(), Error> {
                 _ => " -- | -- | -- |".into(),
             };
         }
-        row += &about_neutral.first_overshoot_deg.map_or(" -- |".into(), |p| format!(" {p:.2}° |"));
+        for p in [at_once.first_overshoot_deg, about_neutral.first_overshoot_deg] {
+            row += &p.map_or(" -- |".into(), |p| format!(" {p:.2}° |"));
+        }
         row += &replayed["first_overshoot_deg"].as_f64().map_or(" -- |".into(), |p| format!(" {p:.2}° |"));
         println!("{row}");
         panels.push(zigzag_panel(&name, frame, sim)?);
@@ -136,25 +151,31 @@ fn main() -> Result<(), Error> {
 /// each run's approach: the rudder about 0, as HSVA laid it (the records start at the execute
 /// with the rudder at 0 and lay it to ±A), and about the model's straight-run angle δ0. Which
 /// convention reproduces the basin's own runs is the one to predict its other runs with.
-fn own_zigzags(model: &termid::model::Model, settings: &Settings) -> Result<(), Error> {
+fn own_zigzags(model: &Model, settings: &Settings) -> Result<(), Error> {
     let hsva = Path::new("examples/simman/hsva.toml");
     let set = Dataset::load(hsva)?;
     let (runs, _) = set.read(&set.folder(hsva)?, "t")?;
     let plugin = termid::plugins::of(model).ok_or("not a ship model")?;
-    println!("\nHSVA's zigzags (the training runs) as the model steers them, first overshoot:\n");
-    println!("| HSVA run | zigzag (termid) | measured | rudder about 0 | error | rudder about δ0 | error |");
-    println!("|---|---|---|---|---|---|---|");
+    let gear = Gear::of(&runs)?;
+    println!("\nHSVA's zigzags (the training runs) as the model steers them, first overshoot (HSVA's steering gear: {gear}):\n");
+    println!("| HSVA run | zigzag (termid) | measured | rudder about 0 | error | rudder about δ0 | error | rudder about 0, HSVA's gear | error |");
+    println!("|---|---|---|---|---|---|---|---|---|");
     for frame in &runs {
         let name =
             Path::new(frame.origin()).file_stem().map_or(String::new(), |s| s.to_string_lossy().into());
         let measured = plugin.observe(model, frame, None).ok_or("no metrics of the record")?.json;
         let manoeuvre = zigzag_of(frame)?;
-        let ship = Ship::new(&termid::ship::basin::at_approach_speed(model, frame.require("u")?[0]), false)?;
+        let approach = termid::ship::basin::at_approach_speed(model, frame.require("u")?[0]);
+        let (ship, geared) = (Ship::new(&approach, false)?, Ship::new(&gear.on(&approach)?, false)?);
         let mut row = format!("| {name} | {} |", manoeuvre.trim_start_matches("zigzag:"));
         let m = measured["first_overshoot_deg"].as_f64();
         row += &m.map_or(" -- |".into(), |m| format!(" {m:.2}° |"));
-        for spec in [manoeuvre.as_str(), manoeuvre.trim_end_matches(":absolute")] {
-            let z = steer(&ship, spec, settings)?;
+        for (ship, spec) in [
+            (&ship, manoeuvre.as_str()),
+            (&ship, manoeuvre.trim_end_matches(":absolute")),
+            (&geared, manoeuvre.as_str()),
+        ] {
+            let z = steer(ship, spec, settings)?;
             row += &match (m, z.first_overshoot_deg) {
                 (Some(m), Some(p)) => format!(" {p:.2}° | {:+.2}° |", p - m),
                 _ => " -- | -- |".into(),
@@ -165,13 +186,24 @@ fn own_zigzags(model: &termid::model::Model, settings: &Settings) -> Result<(), 
     Ok(())
 }
 
-/// `--table [--about-neutral] LABEL=MODEL.toml …`: per model, each MARIN zigzag's first
-/// overshoot as the model steers it less the measured one, and the ±35° tactical diameters at
-/// MARIN's approach; the rudder laid about 0 as MARIN laid it, or with `--about-neutral` about
-/// the model's δ0.
-fn table(models: &[String]) -> Result<(), Error> {
-    let about_neutral = models.first().is_some_and(|a| a == "--about-neutral");
-    let models = &models[usize::from(about_neutral)..];
+/// `--table [--gear-at-once] [--about-neutral] LABEL=MODEL.toml …`: per model, each MARIN
+/// zigzag's first overshoot as the model steers it less the measured one, and the ±35° tactical
+/// diameters at MARIN's approach; the rudder laid about 0 by MARIN's steering gear, or with
+/// `--gear-at-once` by the model file's gear (full rate at once), with `--about-neutral` that
+/// and about the model's δ0.
+fn table(args: &[String]) -> Result<(), Error> {
+    let flags = args.iter().take_while(|a| a.starts_with("--")).count();
+    let about_neutral = args[..flags].iter().any(|a| a == "--about-neutral");
+    let with_gear = !about_neutral && !args[..flags].iter().any(|a| a == "--gear-at-once");
+    if let Some(other) =
+        args[..flags].iter().find(|a| !["--about-neutral", "--gear-at-once"].contains(&a.as_str()))
+    {
+        return Err(format!(
+            "unknown option {other}: --table [--gear-at-once] [--about-neutral] LABEL=MODEL.toml …"
+        )
+        .into());
+    }
+    let models = &args[flags..];
     let zigzag = |frame: &Frame| -> Result<String, Error> {
         let spec = zigzag_of(frame)?;
         Ok(if about_neutral { spec.trim_end_matches(":absolute").to_string() } else { spec })
@@ -179,6 +211,10 @@ fn table(models: &[String]) -> Result<(), Error> {
     let marin = Path::new("examples/simman/marin.toml");
     let set = Dataset::load(marin)?;
     let (runs, _) = set.read(&set.folder(marin)?, "t")?;
+    let gear = with_gear.then(|| Gear::of(&runs)).transpose()?;
+    if let Some(gear) = &gear {
+        println!("MARIN's steering gear (model scale): {gear}\n");
+    }
     let settings = Settings { integrator: Integrator::Rk4, dt: 0.02, duration: 240.0, sample: 0.2 };
     let mut head = "| model |".to_string();
     for frame in &runs {
@@ -193,8 +229,8 @@ fn table(models: &[String]) -> Result<(), Error> {
         for frame in &runs {
             let measured = plugin.observe(&model, frame, None).ok_or("no metrics of the record")?.json;
             // a model that leaves its bounds is a row of the table too, saying where
-            let ship =
-                Ship::new(&termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]), false)?;
+            let approach = termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]);
+            let ship = Ship::new(&gear.map_or(Ok(approach.clone()), |g| g.on(&approach))?, false)?;
             let z = match steer(&ship, &zigzag(frame)?, &settings) {
                 Ok(z) => z,
                 Err(e) => {
@@ -267,31 +303,145 @@ fn zigzag_panel(name: &str, frame: &Frame, sim: &Trajectory) -> Result<Panel, Er
     })
 }
 
-/// The zigzag a record is: `zigzag:A/H:absolute` with its rudder angle A (the largest, to whole
-/// 5°: the indicator overshoots its command a little), the heading change H at which the rudder
-/// is first reversed (read where the rudder leaves its first plateau, snapped to the usual
-/// 1°, 5°, 10°, 15° or 20°) and the side its heading first turns to; the rudder about 0, as
-/// the records lay it.
+/// The zigzag a record is: `zigzag:A/H:absolute` (see [`Shape`]), the rudder about 0, as the
+/// records lay it.
 fn zigzag_of(frame: &Frame) -> Result<String, Error> {
-    let deg = 180.0 / std::f64::consts::PI;
-    let rudder: Vec<f64> = frame.require("δ")?.iter().map(|d| d * deg).collect();
-    let largest = rudder.iter().fold(0.0f64, |m, d| m.max(d.abs()));
-    let amplitude = 5.0 * (largest / 5.0).round();
-    let psi = frame.require("ψ")?;
-    let heading: Vec<f64> = psi.iter().map(|p| (p - psi[0]) * deg).collect();
-    let first = *heading.iter().find(|p| p.abs() > 0.5).ok_or("the heading never turns")?;
-    let laid = rudder.iter().position(|d| d.abs() > amplitude - 1.5).ok_or("the rudder is never laid")?;
-    let side = rudder[laid].signum();
-    let back = rudder[laid..]
-        .iter()
-        .position(|d| d * side < amplitude - 1.5)
-        .ok_or("the rudder is never reversed")?;
-    let at = heading[laid + back].abs();
-    let check = [1.0, 5.0, 10.0, 15.0, 20.0]
-        .into_iter()
-        .min_by(|a: &f64, b: &f64| (a - at).abs().total_cmp(&(b - at).abs()))
-        .unwrap_or(at);
-    Ok(format!("zigzag:{amplitude}/{check}{}:absolute", if first < 0.0 { ":port" } else { "" }))
+    let z = Shape::of(frame)?;
+    Ok(format!("zigzag:{}/{}{}:absolute", z.amplitude, z.check, if z.first < 0.0 { ":port" } else { "" }))
+}
+
+/// A zigzag record's shape, in degrees: its rudder angle A (the largest, to whole 5°: the
+/// indicator overshoots its command a little), the heading change H at which the rudder is first
+/// reversed (read where the rudder leaves its first plateau, snapped to the usual 1°, 5°, 10°,
+/// 15° or 20°), the side its heading first turns to, and the record itself in degrees.
+struct Shape {
+    amplitude: f64,
+    check: f64,
+    first: f64,
+    rudder: Vec<f64>,
+    heading: Vec<f64>,
+    /// Where the rudder is first laid.
+    laid: usize,
+}
+
+impl Shape {
+    fn of(frame: &Frame) -> Result<Shape, Error> {
+        let deg = 180.0 / std::f64::consts::PI;
+        let rudder: Vec<f64> = frame.require("δ")?.iter().map(|d| d * deg).collect();
+        let largest = rudder.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+        let amplitude = 5.0 * (largest / 5.0).round();
+        let psi = frame.require("ψ")?;
+        let heading: Vec<f64> = psi.iter().map(|p| (p - psi[0]) * deg).collect();
+        let first = *heading.iter().find(|p| p.abs() > 0.5).ok_or("the heading never turns")?;
+        let laid = rudder.iter().position(|d| d.abs() > amplitude - 1.5).ok_or("the rudder is never laid")?;
+        let side = rudder[laid].signum();
+        let back = rudder[laid..]
+            .iter()
+            .position(|d| d * side < amplitude - 1.5)
+            .ok_or("the rudder is never reversed")?;
+        let at = heading[laid + back].abs();
+        let check = [1.0, 5.0, 10.0, 15.0, 20.0]
+            .into_iter()
+            .min_by(|a: &f64, b: &f64| (a - at).abs().total_cmp(&(b - at).abs()))
+            .unwrap_or(at);
+        Ok(Shape { amplitude, check, first, rudder, heading, laid })
+    }
+}
+
+/// A basin's steering gear as its zigzag records show it, at the model's scale: the dead time
+/// from the heading passing the check angle to the rudder starting to move, the acceleration
+/// with which its rate builds up, and its full rate; medians over every reversal.
+#[derive(Clone, Copy, Debug)]
+struct Gear {
+    delay: f64,
+    acceleration: f64,
+    rate: f64,
+    reversals: usize,
+}
+
+impl Gear {
+    fn of(runs: &[Frame]) -> Result<Gear, Error> {
+        let (mut delays, mut accelerations, mut rates) = (Vec::new(), Vec::new(), Vec::new());
+        for frame in runs {
+            let z = Shape::of(frame)?;
+            let (t, n) = (frame.time(), z.rudder.len());
+            // the time at which `v` passes `level` between samples j − 1 and j
+            let when = |v: &dyn Fn(usize) -> f64, j: usize, level: f64| {
+                let (a, b) = (v(j - 1), v(j));
+                t[j - 1] + (t[j] - t[j - 1]) * ((level - a) / (b - a)).clamp(0.0, 1.0)
+            };
+            let mut i = z.laid;
+            let mut side = z.rudder[i].signum();
+            loop {
+                let laid = |j: usize| z.rudder[j] * side;
+                // the plateau's top, and where the rudder leaves it by 0.2° and by 2°
+                let mut top = f64::MIN;
+                let Some(a) = (i..n).find(|&j| {
+                    top = top.max(laid(j));
+                    laid(j) < top - 0.2
+                }) else {
+                    break;
+                };
+                let Some(b) = (a..n).find(|&j| laid(j) < top - 2.0) else { break };
+                let (ta, tb) = (when(&laid, a, top - 0.2), when(&laid, b, top - 2.0));
+                // from rest at t0 at the acceleration α: 0.2° = α (ta − t0)²/2, 2° = α (tb − t0)²/2
+                let root = 10f64.sqrt();
+                let t0 = (tb - root * ta) / (1.0 - root);
+                let alpha = 4.0 / (tb - t0).powi(2);
+                // the full rate: between a quarter and three quarters of the swing to the other side
+                let half = z.amplitude / 2.0;
+                let Some(q1) = (b..n).find(|&j| laid(j) < half) else { break };
+                let Some(q3) = (q1..n).find(|&j| laid(j) < -half) else { break };
+                let rate = z.amplitude / (when(&laid, q3, -half) - when(&laid, q1, half));
+                // the heading passed the check angle last before the rudder left its plateau
+                let sign = z.heading[a].signum();
+                let beyond = |j: usize| sign * z.heading[j];
+                if let Some(c) = (z.laid..a).rev().find(|&j| beyond(j) < z.check) {
+                    delays.push(t0 - when(&beyond, c + 1, z.check));
+                    accelerations.push(alpha);
+                    rates.push(rate);
+                }
+                side = -side;
+                let Some(next) = (q3..n).find(|&j| z.rudder[j] * side > z.amplitude - 1.5) else { break };
+                i = next;
+            }
+        }
+        let median = |mut v: Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 2]
+        };
+        if delays.is_empty() {
+            return Err("no rudder reversal in the records".into());
+        }
+        let reversals = delays.len();
+        Ok(Gear {
+            delay: median(delays).max(0.0),
+            acceleration: median(accelerations),
+            rate: median(rates),
+            reversals,
+        })
+    }
+
+    /// The model with this steering gear in its `[ship]` table.
+    fn on(&self, model: &Model) -> Result<Model, Error> {
+        let mut model = model.clone();
+        let mut spec = ShipSpec::of(&model)?.ok_or("not a ship model")?;
+        spec.rudder_delay = self.delay;
+        spec.rudder_acceleration = Some(self.acceleration);
+        spec.rudder_rate = self.rate;
+        spec.store(&mut model);
+        Ok(model)
+    }
+}
+
+impl std::fmt::Display for Gear {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        write!(
+            f,
+            "dead time {:.2} s, rate {:.1}°/s reached at {:.0}°/s² (medians of {} reversals)",
+            self.delay, self.rate, self.acceleration, self.reversals
+        )
+    }
 }
 
 /// A run's track, x0 up and y0 across.

@@ -127,6 +127,8 @@ impl Plugin for Manoeuvring {
         spec.displacement *= mass;
         spec.u0 *= length / time;
         spec.rudder_rate /= time;
+        spec.rudder_delay *= time;
+        spec.rudder_acceleration = spec.rudder_acceleration.map(|a| a / (time * time));
         spec.store(model);
         Ok(())
     }

@@ -39,6 +39,14 @@ pub struct ShipSpec {
     pub rudder_rate: f64,
     /// Largest rudder angle, °.
     pub rudder_limit: f64,
+    /// The steering gear's dead time, s: a rudder command takes effect this long after it is
+    /// given (0: at once).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub rudder_delay: f64,
+    /// The steering gear's angular acceleration, °/s²: the rudder's rate builds up to
+    /// `rudder_rate` and falls to rest at its command at this (none: the full rate at once).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rudder_acceleration: Option<f64>,
     /// Approach speed, m/s.
     pub u0: f64,
     /// Water density, kg/m³ (nondimensional coefficients; 1000 when not given, a basin's fresh
@@ -162,6 +170,23 @@ impl ShipSpec {
                 return Err(key_err(&format!("{TABLE}.{key}"), format!("{value} is out of range: {what}")));
             }
         }
+        if !(spec.rudder_delay.is_finite() && (0.0..=60.0).contains(&spec.rudder_delay)) {
+            return Err(key_err(
+                &format!("{TABLE}.rudder_delay"),
+                format!(
+                    "{} is out of range: the steering gear's dead time lies between 0 and 60 s",
+                    spec.rudder_delay
+                ),
+            ));
+        }
+        if let Some(a) = spec.rudder_acceleration.filter(|a| !(a.is_finite() && (0.01..=1e5).contains(a))) {
+            return Err(key_err(
+                &format!("{TABLE}.rudder_acceleration"),
+                format!(
+                    "{a} is out of range: the steering gear's acceleration lies between 0.01 and 1e5 °/s²"
+                ),
+            ));
+        }
         if let Some(full) = spec.full_scale_lpp.filter(|v| !(v.is_finite() && *v > 0.0)) {
             return Err(key_err(
                 &format!("{TABLE}.full_scale_lpp"),
@@ -201,4 +226,8 @@ impl ShipSpec {
         }
         Ok(())
     }
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }

@@ -285,3 +285,35 @@ fn the_recipe_predicts_the_turning_circles_or_says_its_starts_disagree() {
     }
     assert_eq!(sides, 2, "{checks}");
 }
+
+/// A steering gear that answers late (a dead time) or builds up its rate (an acceleration)
+/// reverses the rudder later: a zigzag's first overshoot grows. Out-of-range gears are refused
+/// by key.
+#[test]
+fn a_slower_steering_gear_overshoots_more() {
+    let text = termid::ship::DEFAULT_MODEL;
+    let with = |extra: &str| text.replace("rudder_limit = 35.0", &format!("rudder_limit = 35.0\n{extra}"));
+    let overshoot = |text: &str| {
+        let model = termid::plugins::parse(text, "ship.toml").unwrap();
+        let ship = Ship::new(&model, false).unwrap();
+        let run = ship
+            .run(&Manoeuvre::parse("zigzag:20/20").unwrap(), &settings(Integrator::Rk4, 0.04, 60.0))
+            .unwrap();
+        let Metrics::ZigZag(z) = run.metrics else { panic!("zigzag metrics") };
+        z.first_overshoot_deg.unwrap()
+    };
+    let base = overshoot(text);
+    let late = overshoot(&with("rudder_delay = 0.5"));
+    let built = overshoot(&with("rudder_acceleration = 5.0"));
+    assert!(late > base + 0.1 && built > base + 0.1, "{base} {late} {built}");
+    // Froude's law: the dead time as a time (× √λ), the acceleration as an angle per time²
+    let mut model =
+        termid::plugins::parse(&with("rudder_delay = 0.5\nrudder_acceleration = 5.0"), "ship.toml").unwrap();
+    termid::plugins::of(&model).unwrap().rescale(&mut model, 4.0, 2.0, 64.0).unwrap();
+    let spec = termid::ship::ShipSpec::of(&model).unwrap().unwrap();
+    assert!((spec.rudder_delay - 1.0).abs() < 1e-12 && spec.rudder_acceleration == Some(1.25), "{spec:?}");
+    for (key, value) in [("rudder_delay", "-1.0"), ("rudder_delay", "1e9"), ("rudder_acceleration", "0.0")] {
+        let e = termid::plugins::parse(&with(&format!("{key} = {value}")), "ship.toml").unwrap_err();
+        assert!(e.to_string().contains(key) && e.to_string().contains("out of range"), "{e}");
+    }
+}

@@ -129,32 +129,81 @@ manoeuvres! {
     InitialTurning(InitialTurning) = "initial-turning", e.g. "initial-turning";
 }
 
-/// A rudder moving at a limited rate towards its command, within its limit.
+/// The steering gear: a rudder moving towards its command at a limited rate, within its limit;
+/// a command takes effect `rudder_delay` after it is given, and with `rudder_acceleration` the
+/// rate builds up from rest and falls to rest again at the command (a basin's gear does not
+/// reach its full rate at once: the SIMMAN case study's HSVA records lag such a gear by 0.3 s).
 #[derive(Clone, Debug)]
 pub(crate) struct Servo {
     pub angle: f64,
     pub rate: f64,
     pub limit: f64,
     pub last_t: f64,
+    /// Dead time, s.
+    delay: f64,
+    /// Angular acceleration, rad/s² (none: the full rate at once).
+    acceleration: Option<f64>,
+    /// The rudder's angular velocity now, rad/s (with an acceleration).
+    speed: f64,
+    /// Commands given and not yet in effect: (time given, command).
+    given: std::collections::VecDeque<(f64, f64)>,
+    /// The command in effect.
+    command: f64,
 }
 
 impl Servo {
     pub fn new(ship: &Ship, start: &StraightRun) -> Servo {
+        let angle = start.input[ship.roles.rudder];
         Servo {
-            angle: start.input[ship.roles.rudder],
+            angle,
             rate: ship.spec.rudder_rate.to_radians(),
             limit: ship.spec.rudder_limit.to_radians(),
             last_t: 0.0,
+            delay: ship.spec.rudder_delay,
+            acceleration: ship.spec.rudder_acceleration.map(f64::to_radians),
+            speed: 0.0,
+            given: std::collections::VecDeque::new(),
+            command: angle,
         }
     }
 
-    /// Moves towards `command` over the time since the last call.
+    /// Gives `command` at `t` and moves the rudder over the time since the last call.
     #[inline]
     pub fn step(&mut self, t: f64, command: f64) -> f64 {
-        let target = command.clamp(-self.limit, self.limit);
-        let max = self.rate * (t - self.last_t).max(0.0);
-        self.angle += (target - self.angle).clamp(-max, max);
+        if self.delay > 0.0 {
+            if self.given.back().map_or(self.command, |g| g.1) != command {
+                self.given.push_back((t, command));
+            }
+            // in effect from `delay` after it was given, resolved to the control step
+            while let Some(&(_, c)) = self.given.front().filter(|g| g.0 + self.delay <= t + 1e-9) {
+                self.command = c;
+                self.given.pop_front();
+            }
+        } else {
+            self.command = command;
+        }
+        let target = self.command.clamp(-self.limit, self.limit);
+        let dt = (t - self.last_t).max(0.0);
         self.last_t = t;
+        match self.acceleration {
+            None => {
+                let max = self.rate * dt;
+                self.angle += (target - self.angle).clamp(-max, max);
+            }
+            Some(a) => {
+                let gap = target - self.angle;
+                // the fastest speed from which the gear still stops at the command: v² = 2·a·|gap|
+                let wanted = gap.signum() * self.rate.min((2.0 * a * gap.abs()).sqrt());
+                self.speed += (wanted - self.speed).clamp(-a * dt, a * dt);
+                let step = self.speed * dt;
+                if gap == 0.0 || (gap - step) * gap <= 0.0 {
+                    self.angle = target;
+                    self.speed = 0.0;
+                } else {
+                    self.angle += step;
+                }
+            }
+        }
         self.angle
     }
 }
@@ -189,5 +238,55 @@ impl Manoeuvre {
         start: &StraightRun,
     ) -> Result<Box<dyn Controller>, ShipError> {
         self.controller(ship, start)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Servo;
+
+    /// A gear of 15°/s within ±35°, from 0°.
+    fn gear(delay: f64, acceleration: Option<f64>) -> Servo {
+        Servo {
+            angle: 0.0,
+            rate: 15f64.to_radians(),
+            limit: 35f64.to_radians(),
+            last_t: 0.0,
+            delay,
+            acceleration: acceleration.map(f64::to_radians),
+            speed: 0.0,
+            given: Default::default(),
+            command: 0.0,
+        }
+    }
+
+    /// The rudder angle, °, at each millisecond of `until` seconds under a 20° command given
+    /// at t = 0.
+    fn follow(mut servo: Servo, until: f64) -> Vec<f64> {
+        (0..=(until * 1000.0).round() as usize)
+            .map(|i| servo.step(i as f64 * 1e-3, 20f64.to_radians()).to_degrees())
+            .collect()
+    }
+
+    #[test]
+    fn the_gear_follows_its_command_late_and_at_its_rate() {
+        // at once and at full rate: 15°/s from t = 0, there at 4/3 s
+        let at_once = follow(gear(0.0, None), 2.0);
+        assert!((at_once[500] - 7.5).abs() < 1e-9 && at_once[1400] == 20.0, "{}", at_once[500]);
+        // a dead time of 0.3 s: nothing before it, then the same ramp 0.3 s later
+        let late = follow(gear(0.3, None), 2.0);
+        assert!(late[..300].iter().all(|a| *a == 0.0), "{}", late[299]);
+        assert!((late[800] - 7.5).abs() < 0.02 && late[1700] == 20.0, "{} {}", late[800], late[1700]);
+        // 30°/s²: the rate builds up over 0.5 s (3.75°), holds 15°/s and falls to rest at the
+        // command over the last 3.75°; there after 20/15 + 15/30 = 11/6 s, never beyond it
+        let built = follow(gear(0.0, Some(30.0)), 2.5);
+        assert!((built[250] - 0.5 * 30.0 * 0.25 * 0.25).abs() < 0.02, "{}", built[250]);
+        assert!((built[1000] - (3.75 + 15.0 * 0.5)).abs() < 0.05, "{}", built[1000]);
+        assert!(
+            (built[1700] - (20.0 - 0.5 * 30.0 * (11.0 / 6.0 - 1.7f64).powi(2))).abs() < 0.05,
+            "{}",
+            built[1700]
+        );
+        assert!(built.iter().all(|a| *a <= 20.0) && built[1860] == 20.0, "{}", built[1860]);
     }
 }
