@@ -19,7 +19,7 @@ use termid::data::{Dataset, Frame};
 use termid::diagnose::Runs;
 use termid::model::Model;
 use termid::plot::{Figure, Panel, Series};
-use termid::ship::manoeuvre::ZigZagMetrics;
+use termid::ship::observed::{observe, Observed};
 use termid::ship::{Manoeuvre, Metrics, Ship, ShipSpec};
 use termid::sim::{Integrator, Settings, Trajectory};
 
@@ -262,12 +262,14 @@ fn table(args: &[String]) -> Result<(), Error> {
     Ok(())
 }
 
-/// A zigzag as the ship steers it itself over 100 s, its metrics.
-fn steer(ship: &Ship, spec: &str, settings: &Settings) -> Result<ZigZagMetrics, Error> {
-    match ship.run(&Manoeuvre::parse(spec)?, &Settings { duration: 100.0, ..*settings })?.metrics {
-        Metrics::ZigZag(z) => Ok(z),
-        _ => Err("not a zigzag".into()),
-    }
+/// A zigzag as the ship steers it itself over 100 s, read off as its record would be.
+fn steer(ship: &Ship, spec: &str, settings: &Settings) -> Result<Observed, Error> {
+    // sampled at every step, read off as a record is: overshoots beyond the heading at each
+    // rudder reversal, which a steering gear that answers late moves past the check angle
+    let every = Settings { duration: 100.0, sample: settings.dt, ..*settings };
+    let run = ship.run(&Manoeuvre::parse(spec)?, &every)?.trajectory;
+    let column = |name: &str| run.state(name).or_else(|| run.input(name)).ok_or(format!("no {name}"));
+    Ok(observe(&run.time, column("ψ")?, column("δ")?, column("x0")?, column("y0")?))
 }
 
 /// A prediction that failed, as a cell: where a simulation left its bounds, when.
