@@ -20,7 +20,7 @@ use termid::diagnose::Runs;
 use termid::model::Model;
 use termid::plot::{Figure, Panel, Series};
 use termid::ship::observed::{observe, Observed};
-use termid::ship::{Manoeuvre, Metrics, Ship, ShipSpec};
+use termid::ship::{Manoeuvre, Metrics, Ship, ShipSpec, StraightRun};
 use termid::sim::{Integrator, Settings, Trajectory};
 
 type Error = Box<dyn std::error::Error>;
@@ -158,8 +158,8 @@ fn own_zigzags(model: &Model, settings: &Settings) -> Result<(), Error> {
     let plugin = termid::plugins::of(model).ok_or("not a ship model")?;
     let gear = Gear::of(&runs)?;
     println!("\nHSVA's zigzags (the training runs) as the model steers them, first overshoot (HSVA's steering gear: {gear}):\n");
-    println!("| HSVA run | zigzag (termid) | measured | rudder about 0 | error | rudder about δ0 | error | rudder about 0, HSVA's gear | error |");
-    println!("|---|---|---|---|---|---|---|---|---|");
+    println!("| HSVA run | zigzag (termid) | measured | rudder about 0 | error | rudder about δ0 | error | rudder about 0, HSVA's gear | error | the same from the record's first sample | error |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     for frame in &runs {
         let name =
             Path::new(frame.origin()).file_stem().map_or(String::new(), |s| s.to_string_lossy().into());
@@ -176,11 +176,10 @@ fn own_zigzags(model: &Model, settings: &Settings) -> Result<(), Error> {
             (&geared, manoeuvre.as_str()),
         ] {
             let z = steer(ship, spec, settings)?;
-            row += &match (m, z.first_overshoot_deg) {
-                (Some(m), Some(p)) => format!(" {p:.2}° | {:+.2}° |", p - m),
-                _ => " -- | -- |".into(),
-            };
+            row += &cell(m, z.first_overshoot_deg);
         }
+        let z = steer_from(&geared, &manoeuvre, settings, recorded_start(&geared, frame)?)?;
+        row += &cell(m, z.first_overshoot_deg);
         println!("{row}");
     }
     Ok(())
@@ -262,14 +261,36 @@ fn table(args: &[String]) -> Result<(), Error> {
     Ok(())
 }
 
+/// A predicted value and its error, as two cells.
+fn cell(measured: Option<f64>, predicted: Option<f64>) -> String {
+    match (measured, predicted) {
+        (Some(m), Some(p)) => format!(" {p:.2}° | {:+.2}° |", p - m),
+        _ => " -- | -- |".into(),
+    }
+}
+
 /// A zigzag as the ship steers it itself over 100 s, read off as its record would be.
 fn steer(ship: &Ship, spec: &str, settings: &Settings) -> Result<Observed, Error> {
+    steer_from(ship, spec, settings, ship.straight_run()?)
+}
+
+/// The same from a given start (a record's first sample: its state, rudder and propeller).
+fn steer_from(ship: &Ship, spec: &str, settings: &Settings, start: StraightRun) -> Result<Observed, Error> {
     // sampled at every step, read off as a record is: overshoots beyond the heading at each
     // rudder reversal, which a steering gear that answers late moves past the check angle
     let every = Settings { duration: 100.0, sample: settings.dt, ..*settings };
-    let run = ship.run(&Manoeuvre::parse(spec)?, &every)?.trajectory;
+    let run = ship.run_from(&Manoeuvre::parse(spec)?, &every, start)?.trajectory;
     let column = |name: &str| run.state(name).or_else(|| run.input(name)).ok_or(format!("no {name}"));
     Ok(observe(&run.time, column("ψ")?, column("δ")?, column("x0")?, column("y0")?))
+}
+
+/// A record's first sample as the start of a manoeuvre: its states, its rudder and propeller.
+fn recorded_start(ship: &Ship, frame: &Frame) -> Result<StraightRun, Error> {
+    let first = |name: &String| frame.require(name).map(|c| c[0]);
+    let x = ship.system.states.iter().map(first).collect::<Result<Vec<_>, _>>()?;
+    let input = ship.system.inputs.iter().map(first).collect::<Result<Vec<_>, _>>()?;
+    let delta0_deg = frame.require("δ")?[0].to_degrees();
+    Ok(StraightRun { x, input, delta0_deg, v0: frame.require("v")?[0], surge_residual: 0.0 })
 }
 
 /// A prediction that failed, as a cell: where a simulation left its bounds, when.
