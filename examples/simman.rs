@@ -19,7 +19,7 @@ use termid::data::{Dataset, Frame};
 use termid::diagnose::Runs;
 use termid::model::Model;
 use termid::plot::{Figure, Panel, Series};
-use termid::ship::observed::{observe, Observed};
+use termid::ship::observed::{observe, steering_gear, Observed, SteeringGear, ZigZagShape};
 use termid::ship::{Manoeuvre, Metrics, Ship, ShipSpec, StraightRun};
 use termid::sim::{Integrator, Settings, Trajectory};
 
@@ -55,8 +55,8 @@ fn main() -> Result<(), Error> {
     // of the indicator) by MARIN's steering gear as its records show it; for comparison by a
     // gear at its full rate at once (the model file's), and about the straight run's δ0 as
     // well (Oltmann's §5)
-    let gear = Gear::of(&runs)?;
-    println!("MARIN's steering gear (model scale): {gear}\n");
+    let gear = gear_of(&runs)?;
+    println!("MARIN's steering gear (model scale): {}\n", describe(&gear));
     println!("| MARIN run | zigzag (termid) | 1st overshoot measured | predicted | error | 2nd overshoot measured | predicted | error | 1st overshoot, gear at full rate at once | the same, rudder about δ0 | 1st overshoot, recorded rudder replayed |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|");
     let mut panels = Vec::new();
@@ -70,7 +70,10 @@ fn main() -> Result<(), Error> {
         let at_once = steer(&ship, &manoeuvre, &settings)?;
         let about_neutral = steer(&ship, manoeuvre.trim_end_matches(":absolute"), &settings)?;
         let geared = Ship::new(
-            &gear.on(&termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]))?,
+            &with_steering_gear(
+                &termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]),
+                &gear,
+            )?,
             false,
         )?;
         let z = steer(&geared, &manoeuvre, &settings)?;
@@ -156,8 +159,8 @@ fn own_zigzags(model: &Model, settings: &Settings) -> Result<(), Error> {
     let set = Dataset::load(hsva)?;
     let (runs, _) = set.read(&set.folder(hsva)?, "t")?;
     let plugin = termid::plugins::of(model).ok_or("not a ship model")?;
-    let gear = Gear::of(&runs)?;
-    println!("\nHSVA's zigzags (the training runs) as the model steers them, first overshoot (HSVA's steering gear: {gear}):\n");
+    let gear = gear_of(&runs)?;
+    println!("\nHSVA's zigzags (the training runs) as the model steers them, first overshoot (HSVA's steering gear: {}):\n", describe(&gear));
     println!("| HSVA run | zigzag (termid) | measured | rudder about 0 | error | rudder about δ0 | error | rudder about 0, HSVA's gear | error | the same from the record's first sample | error |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|");
     for frame in &runs {
@@ -166,7 +169,8 @@ fn own_zigzags(model: &Model, settings: &Settings) -> Result<(), Error> {
         let measured = plugin.observe(model, frame, None).ok_or("no metrics of the record")?.json;
         let manoeuvre = zigzag_of(frame)?;
         let approach = termid::ship::basin::at_approach_speed(model, frame.require("u")?[0]);
-        let (ship, geared) = (Ship::new(&approach, false)?, Ship::new(&gear.on(&approach)?, false)?);
+        let (ship, geared) =
+            (Ship::new(&approach, false)?, Ship::new(&with_steering_gear(&approach, &gear)?, false)?);
         let mut row = format!("| {name} | {} |", manoeuvre.trim_start_matches("zigzag:"));
         let m = measured["first_overshoot_deg"].as_f64();
         row += &m.map_or(" -- |".into(), |m| format!(" {m:.2}° |"));
@@ -210,9 +214,9 @@ fn table(args: &[String]) -> Result<(), Error> {
     let marin = Path::new("examples/simman/marin.toml");
     let set = Dataset::load(marin)?;
     let (runs, _) = set.read(&set.folder(marin)?, "t")?;
-    let gear = with_gear.then(|| Gear::of(&runs)).transpose()?;
+    let gear = with_gear.then(|| gear_of(&runs)).transpose()?;
     if let Some(gear) = &gear {
-        println!("MARIN's steering gear (model scale): {gear}\n");
+        println!("MARIN's steering gear (model scale): {}\n", describe(gear));
     }
     let settings = Settings { integrator: Integrator::Rk4, dt: 0.02, duration: 240.0, sample: 0.2 };
     let mut head = "| model |".to_string();
@@ -229,7 +233,10 @@ fn table(args: &[String]) -> Result<(), Error> {
             let measured = plugin.observe(&model, frame, None).ok_or("no metrics of the record")?.json;
             // a model that leaves its bounds is a row of the table too, saying where
             let approach = termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]);
-            let ship = Ship::new(&gear.map_or(Ok(approach.clone()), |g| g.on(&approach))?, false)?;
+            let ship = Ship::new(
+                &gear.as_ref().map_or(Ok(approach.clone()), |g| with_steering_gear(&approach, g))?,
+                false,
+            )?;
             let z = match steer(&ship, &zigzag(frame)?, &settings) {
                 Ok(z) => z,
                 Err(e) => {
@@ -326,145 +333,40 @@ fn zigzag_panel(name: &str, frame: &Frame, sim: &Trajectory) -> Result<Panel, Er
     })
 }
 
-/// The zigzag a record is: `zigzag:A/H:absolute` (see [`Shape`]), the rudder about 0, as the
-/// records lay it.
+/// The zigzag a record is: `zigzag:A/H:absolute` (its shape as the ship plug-in reads it),
+/// the rudder about 0, as the records lay it.
 fn zigzag_of(frame: &Frame) -> Result<String, Error> {
-    let z = Shape::of(frame)?;
-    Ok(format!("zigzag:{}/{}{}:absolute", z.amplitude, z.check, if z.first < 0.0 { ":port" } else { "" }))
+    let z = ZigZagShape::of(frame.require("ψ")?, frame.require("δ")?).ok_or("not a zigzag")?;
+    let side = if z.starboard_first { "" } else { ":port" };
+    Ok(format!("zigzag:{}/{}{side}:absolute", z.amplitude, z.check))
 }
 
-/// A zigzag record's shape, in degrees: its rudder angle A (the largest, to whole 5°: the
-/// indicator overshoots its command a little), the heading change H at which the rudder is first
-/// reversed (read where the rudder leaves its first plateau, snapped to the usual 1°, 5°, 10°,
-/// 15° or 20°), the side its heading first turns to, and the record itself in degrees.
-struct Shape {
-    amplitude: f64,
-    check: f64,
-    first: f64,
-    rudder: Vec<f64>,
-    heading: Vec<f64>,
-    /// Where the rudder is first laid.
-    laid: usize,
+/// A basin's steering gear as its zigzag records show it (model scale).
+fn gear_of(runs: &[Frame]) -> Result<SteeringGear, Error> {
+    let columns = runs
+        .iter()
+        .map(|f| Ok((f.time(), f.require("ψ")?, f.require("δ")?)))
+        .collect::<Result<Vec<_>, Error>>()?;
+    steering_gear(&columns).ok_or_else(|| "no rudder reversal in the records".into())
 }
 
-impl Shape {
-    fn of(frame: &Frame) -> Result<Shape, Error> {
-        let deg = 180.0 / std::f64::consts::PI;
-        let rudder: Vec<f64> = frame.require("δ")?.iter().map(|d| d * deg).collect();
-        let largest = rudder.iter().fold(0.0f64, |m, d| m.max(d.abs()));
-        let amplitude = 5.0 * (largest / 5.0).round();
-        let psi = frame.require("ψ")?;
-        let heading: Vec<f64> = psi.iter().map(|p| (p - psi[0]) * deg).collect();
-        let first = *heading.iter().find(|p| p.abs() > 0.5).ok_or("the heading never turns")?;
-        let laid = rudder.iter().position(|d| d.abs() > amplitude - 1.5).ok_or("the rudder is never laid")?;
-        let side = rudder[laid].signum();
-        let back = rudder[laid..]
-            .iter()
-            .position(|d| d * side < amplitude - 1.5)
-            .ok_or("the rudder is never reversed")?;
-        let at = heading[laid + back].abs();
-        let check = [1.0, 5.0, 10.0, 15.0, 20.0]
-            .into_iter()
-            .min_by(|a: &f64, b: &f64| (a - at).abs().total_cmp(&(b - at).abs()))
-            .unwrap_or(at);
-        Ok(Shape { amplitude, check, first, rudder, heading, laid })
-    }
+/// The model with `gear` in its `[ship]` table.
+fn with_steering_gear(model: &Model, gear: &SteeringGear) -> Result<Model, Error> {
+    let mut model = model.clone();
+    let mut spec = ShipSpec::of(&model)?.ok_or("not a ship model")?;
+    spec.rudder_delay = gear.delay_s;
+    spec.rudder_acceleration = Some(gear.acceleration_deg_s2);
+    spec.rudder_rate = gear.rate_deg_s;
+    spec.store(&mut model);
+    Ok(model)
 }
 
-/// A basin's steering gear as its zigzag records show it, at the model's scale: the dead time
-/// from the heading passing the check angle to the rudder starting to move, the acceleration
-/// with which its rate builds up, and its full rate; medians over every reversal.
-#[derive(Clone, Copy, Debug)]
-struct Gear {
-    delay: f64,
-    acceleration: f64,
-    rate: f64,
-    reversals: usize,
-}
-
-impl Gear {
-    fn of(runs: &[Frame]) -> Result<Gear, Error> {
-        let (mut delays, mut accelerations, mut rates) = (Vec::new(), Vec::new(), Vec::new());
-        for frame in runs {
-            let z = Shape::of(frame)?;
-            let (t, n) = (frame.time(), z.rudder.len());
-            // the time at which `v` passes `level` between samples j − 1 and j
-            let when = |v: &dyn Fn(usize) -> f64, j: usize, level: f64| {
-                let (a, b) = (v(j - 1), v(j));
-                t[j - 1] + (t[j] - t[j - 1]) * ((level - a) / (b - a)).clamp(0.0, 1.0)
-            };
-            let mut i = z.laid;
-            let mut side = z.rudder[i].signum();
-            loop {
-                let laid = |j: usize| z.rudder[j] * side;
-                // the plateau's top, and where the rudder leaves it by 0.2° and by 2°
-                let mut top = f64::MIN;
-                let Some(a) = (i..n).find(|&j| {
-                    top = top.max(laid(j));
-                    laid(j) < top - 0.2
-                }) else {
-                    break;
-                };
-                let Some(b) = (a..n).find(|&j| laid(j) < top - 2.0) else { break };
-                let (ta, tb) = (when(&laid, a, top - 0.2), when(&laid, b, top - 2.0));
-                // from rest at t0 at the acceleration α: 0.2° = α (ta − t0)²/2, 2° = α (tb − t0)²/2
-                let root = 10f64.sqrt();
-                let t0 = (tb - root * ta) / (1.0 - root);
-                let alpha = 4.0 / (tb - t0).powi(2);
-                // the full rate: between a quarter and three quarters of the swing to the other side
-                let half = z.amplitude / 2.0;
-                let Some(q1) = (b..n).find(|&j| laid(j) < half) else { break };
-                let Some(q3) = (q1..n).find(|&j| laid(j) < -half) else { break };
-                let rate = z.amplitude / (when(&laid, q3, -half) - when(&laid, q1, half));
-                // the heading passed the check angle last before the rudder left its plateau
-                let sign = z.heading[a].signum();
-                let beyond = |j: usize| sign * z.heading[j];
-                if let Some(c) = (z.laid..a).rev().find(|&j| beyond(j) < z.check) {
-                    delays.push(t0 - when(&beyond, c + 1, z.check));
-                    accelerations.push(alpha);
-                    rates.push(rate);
-                }
-                side = -side;
-                let Some(next) = (q3..n).find(|&j| z.rudder[j] * side > z.amplitude - 1.5) else { break };
-                i = next;
-            }
-        }
-        let median = |mut v: Vec<f64>| {
-            v.sort_by(f64::total_cmp);
-            v[v.len() / 2]
-        };
-        if delays.is_empty() {
-            return Err("no rudder reversal in the records".into());
-        }
-        let reversals = delays.len();
-        Ok(Gear {
-            delay: median(delays).max(0.0),
-            acceleration: median(accelerations),
-            rate: median(rates),
-            reversals,
-        })
-    }
-
-    /// The model with this steering gear in its `[ship]` table.
-    fn on(&self, model: &Model) -> Result<Model, Error> {
-        let mut model = model.clone();
-        let mut spec = ShipSpec::of(&model)?.ok_or("not a ship model")?;
-        spec.rudder_delay = self.delay;
-        spec.rudder_acceleration = Some(self.acceleration);
-        spec.rudder_rate = self.rate;
-        spec.store(&mut model);
-        Ok(model)
-    }
-}
-
-impl std::fmt::Display for Gear {
-    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-        write!(
-            f,
-            "dead time {:.2} s, rate {:.1}°/s reached at {:.0}°/s² (medians of {} reversals)",
-            self.delay, self.rate, self.acceleration, self.reversals
-        )
-    }
+/// A gear as the tables' headings say it.
+fn describe(gear: &SteeringGear) -> String {
+    format!(
+        "dead time {:.2} s, rate {:.1}°/s reached at {:.0}°/s² (medians of {} reversals)",
+        gear.delay_s, gear.rate_deg_s, gear.acceleration_deg_s2, gear.reversals
+    )
 }
 
 /// A run's track, x0 up and y0 across.

@@ -111,6 +111,125 @@ pub fn observe(t: &[f64], psi: &[f64], delta: &[f64], x0: &[f64], y0: &[f64]) ->
     out
 }
 
+/// A steering gear as zigzag records show it: the dead time from the heading passing the
+/// check angle to the rudder starting back, the angular acceleration with which its rate builds
+/// up, and its full rate (medians over every reversal). What `[ship] rudder_delay`,
+/// `rudder_acceleration` and `rudder_rate` say of a model's gear.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct SteeringGear {
+    /// Dead time, s (≥ 0).
+    pub delay_s: f64,
+    /// Angular acceleration, °/s².
+    pub acceleration_deg_s2: f64,
+    /// Full rate, °/s.
+    pub rate_deg_s: f64,
+    /// Reversals read.
+    pub reversals: usize,
+}
+
+/// A zigzag record's shape, in degrees: its rudder angle A (the largest, to whole 5°: an
+/// indicator overshoots its command a little), the heading change H at which the rudder is
+/// first reversed (where the rudder leaves its first plateau, snapped to the usual 1°, 5°, 10°,
+/// 15° or 20°: a record does not state it), the side the heading first turns to, the rudder and
+/// the heading change in degrees, and where the rudder is first laid.
+#[derive(Clone, Debug)]
+pub struct ZigZagShape {
+    /// Rudder angle A, °.
+    pub amplitude: f64,
+    /// Heading change H at the reversals, °.
+    pub check: f64,
+    /// The first turn to starboard (the heading increasing).
+    pub starboard_first: bool,
+    rudder: Vec<f64>,
+    heading: Vec<f64>,
+    laid: usize,
+}
+
+impl ZigZagShape {
+    /// From samples of heading ψ and rudder δ (rad); `None` for a record that is no zigzag.
+    pub fn of(psi: &[f64], delta: &[f64]) -> Option<ZigZagShape> {
+        let n = psi.len().min(delta.len());
+        let rudder: Vec<f64> = delta[..n].iter().map(|d| d.to_degrees()).collect();
+        let heading: Vec<f64> = psi[..n].iter().map(|p| (p - psi[0]).to_degrees()).collect();
+        let largest = rudder.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+        let amplitude = 5.0 * (largest / 5.0).round();
+        if amplitude < 5.0 {
+            return None;
+        }
+        let first = *heading.iter().find(|p| p.abs() > 0.5)?;
+        let laid = rudder.iter().position(|d| d.abs() > amplitude - 1.5)?;
+        let side = rudder[laid].signum();
+        let back = rudder[laid..].iter().position(|d| d * side < amplitude - 1.5)?;
+        let at = heading[laid + back].abs();
+        let check = [1.0, 5.0, 10.0, 15.0, 20.0]
+            .into_iter()
+            .min_by(|a: &f64, b: &f64| (a - at).abs().total_cmp(&(b - at).abs()))
+            .unwrap_or(at);
+        Some(ZigZagShape { amplitude, check, starboard_first: first > 0.0, rudder, heading, laid })
+    }
+}
+
+/// The steering gear that zigzag records of time, heading ψ and rudder δ (rad) show; `None`
+/// when they hold no reversal it can be read at.
+pub fn steering_gear(records: &[(&[f64], &[f64], &[f64])]) -> Option<SteeringGear> {
+    let (mut delays, mut accelerations, mut rates) = (Vec::new(), Vec::new(), Vec::new());
+    for &(t, psi, delta) in records {
+        let Some(z) = ZigZagShape::of(psi, delta) else { continue };
+        let n = z.rudder.len().min(t.len());
+        // the time at which `v` passes `level` between samples j − 1 and j
+        let when = |v: &dyn Fn(usize) -> f64, j: usize, level: f64| {
+            let (a, b) = (v(j - 1), v(j));
+            t[j - 1] + (t[j] - t[j - 1]) * ((level - a) / (b - a)).clamp(0.0, 1.0)
+        };
+        let mut i = z.laid;
+        let mut side = z.rudder[i].signum();
+        loop {
+            let laid = |j: usize| z.rudder[j] * side;
+            // the plateau's top, and where the rudder leaves it by 0.2° and by 2°
+            let mut top = f64::MIN;
+            let Some(a) = (i..n).find(|&j| {
+                top = top.max(laid(j));
+                laid(j) < top - 0.2
+            }) else {
+                break;
+            };
+            let Some(b) = (a..n).find(|&j| laid(j) < top - 2.0) else { break };
+            let (ta, tb) = (when(&laid, a, top - 0.2), when(&laid, b, top - 2.0));
+            // from rest at t0 at the acceleration α: 0.2° = α (ta − t0)²/2, 2° = α (tb − t0)²/2
+            let root = 10f64.sqrt();
+            let t0 = (tb - root * ta) / (1.0 - root);
+            let alpha = 4.0 / (tb - t0).powi(2);
+            // the full rate: between a quarter and three quarters of the swing to the other side
+            let half = z.amplitude / 2.0;
+            let Some(q1) = (b..n).find(|&j| laid(j) < half) else { break };
+            let Some(q3) = (q1..n).find(|&j| laid(j) < -half) else { break };
+            let rate = z.amplitude / (when(&laid, q3, -half) - when(&laid, q1, half));
+            // the heading passed the check angle last before the rudder left its plateau
+            let sign = z.heading[a].signum();
+            let beyond = |j: usize| sign * z.heading[j];
+            if let Some(c) = (z.laid..a).rev().find(|&j| beyond(j) < z.check) {
+                delays.push(t0 - when(&beyond, c + 1, z.check));
+                accelerations.push(alpha);
+                rates.push(rate);
+            }
+            side = -side;
+            let Some(next) = (q3..n).find(|&j| z.rudder[j] * side > z.amplitude - 1.5) else { break };
+            i = next;
+        }
+    }
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let reversals = delays.len();
+    (reversals > 0).then(|| SteeringGear {
+        delay_s: median(delays).max(0.0),
+        acceleration_deg_s2: median(accelerations),
+        rate_deg_s: median(rates),
+        reversals,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -147,5 +266,39 @@ mod tests {
             assert!((g - w).abs() < 0.1, "{g} m vs the manoeuvre's {w} m");
         }
         assert!(seen.first_overshoot_deg.is_none());
+    }
+
+    /// Zigzags recorded from the default ship with a gear of 0.25 s dead time, 20°/s² and
+    /// 12.65°/s (the paper's rate) read back as that gear: the dead time within a control step
+    /// (the controller sees the check at its next step), the rate and acceleration within 5 %.
+    #[test]
+    fn a_zigzag_record_shows_its_steering_gear() {
+        let text = crate::ship::DEFAULT_MODEL.replace(
+            "rudder_limit = 35.0",
+            "rudder_limit = 35.0\nrudder_delay = 0.25\nrudder_acceleration = 20.0",
+        );
+        let model = crate::plugins::parse(&text, "geared.toml").unwrap();
+        let basin = Basin {
+            noise: crate::ship::basin::Noise { rudder_deg: 0.0, ..Default::default() },
+            ..Basin::default()
+        };
+        let records: Vec<_> = ["zigzag:20/20", "zigzag:10/10:port"]
+            .iter()
+            .enumerate()
+            .map(|(k, m)| {
+                basin.record(&model, &Manoeuvre::parse(m).unwrap(), 2.01, 80.0, k as u64, "z.dat").unwrap()
+            })
+            .collect();
+        let columns: Vec<_> = records
+            .iter()
+            .map(|r| (r.measured.time(), r.measured.column("ψ").unwrap(), r.measured.column("δ").unwrap()))
+            .collect();
+        let gear = steering_gear(&columns).expect("reversals to read");
+        assert!(gear.reversals >= 4, "{gear:?}");
+        assert!(gear.delay_s >= 0.25 - 0.02 && gear.delay_s <= 0.25 + 0.05, "{gear:?}");
+        assert!((gear.acceleration_deg_s2 / 20.0 - 1.0).abs() < 0.05, "{gear:?}");
+        assert!((gear.rate_deg_s / 12.65 - 1.0).abs() < 0.05, "{gear:?}");
+        let shape = ZigZagShape::of(columns[1].1, columns[1].2).unwrap();
+        assert_eq!((shape.amplitude, shape.check, shape.starboard_first), (10.0, 10.0, false));
     }
 }
