@@ -130,12 +130,16 @@ pub struct SteeringGear {
 /// A zigzag record's shape, in degrees: its rudder angle A (the largest, to whole 5°: an
 /// indicator overshoots its command a little), the heading change H at which the rudder is
 /// first reversed (where the rudder leaves its first plateau, snapped to the usual 1°, 5°, 10°,
-/// 15° or 20°: a record does not state it), the side the heading first turns to, the rudder and
-/// the heading change in degrees, and where the rudder is first laid.
+/// 15° or 20°: a record does not state it), the side the heading first turns to, the angles
+/// the rudder was laid to, the rudder and the heading change in degrees, and where the rudder
+/// is first laid.
 #[derive(Clone, Debug)]
 pub struct ZigZagShape {
     /// Rudder angle A, °.
     pub amplitude: f64,
+    /// The angles the rudder held to each side, °: (positive, negative), (+A, −A) for a
+    /// rudder laid exactly about 0.
+    pub laid_deg: (f64, f64),
     /// Heading change H at the reversals, °.
     pub check: f64,
     /// The first turn to starboard (the heading increasing).
@@ -165,12 +169,24 @@ impl ZigZagShape {
             .into_iter()
             .min_by(|a: &f64, b: &f64| (a - at).abs().total_cmp(&(b - at).abs()))
             .unwrap_or(at);
-        Some(ZigZagShape { amplitude, check, starboard_first: first > 0.0, rudder, heading, laid })
+        // the median of what it held beyond A − 1.5° to a side: the hold, not the ramps to it
+        let held = |sign: f64| {
+            let mut side: Vec<f64> = rudder.iter().copied().filter(|d| d * sign > amplitude - 1.5).collect();
+            side.sort_by(f64::total_cmp);
+            side.get(side.len() / 2).copied()
+        };
+        let laid_deg = (held(1.0)?, held(-1.0)?);
+        Some(ZigZagShape { amplitude, laid_deg, check, starboard_first: first > 0.0, rudder, heading, laid })
     }
 }
 
 /// The steering gear that zigzag records of time, heading ψ and rudder δ (rad) show; `None`
-/// when they hold no reversal it can be read at.
+/// when they hold no reversal it can be read at. At each reversal: when the rudder leaves its
+/// hold by 0.5° (ten times a good indicator's noise), its full rate between a quarter and three
+/// quarters of its swing, and where that swing, drawn back at the full rate, leaves the hold.
+/// A gear that builds its rate up at α reaches that line r/(2α) after it starts and has moved
+/// 0.5° after 1/√α, which gives α; the dead time runs from the heading passing the check angle
+/// to the start.
 pub fn steering_gear(records: &[(&[f64], &[f64], &[f64])]) -> Option<SteeringGear> {
     let (mut delays, mut accelerations, mut rates) = (Vec::new(), Vec::new(), Vec::new());
     for &(t, psi, delta) in records {
@@ -185,31 +201,28 @@ pub fn steering_gear(records: &[(&[f64], &[f64], &[f64])]) -> Option<SteeringGea
         let mut side = z.rudder[i].signum();
         loop {
             let laid = |j: usize| z.rudder[j] * side;
-            // the plateau's top, and where the rudder leaves it by 0.2° and by 2°
-            let mut top = f64::MIN;
-            let Some(a) = (i..n).find(|&j| {
-                top = top.max(laid(j));
-                laid(j) < top - 0.2
-            }) else {
-                break;
-            };
-            let Some(b) = (a..n).find(|&j| laid(j) < top - 2.0) else { break };
-            let (ta, tb) = (when(&laid, a, top - 0.2), when(&laid, b, top - 2.0));
-            // from rest at t0 at the acceleration α: 0.2° = α (ta − t0)²/2, 2° = α (tb − t0)²/2
-            let root = 10f64.sqrt();
-            let t0 = (tb - root * ta) / (1.0 - root);
-            let alpha = 4.0 / (tb - t0).powi(2);
-            // the full rate: between a quarter and three quarters of the swing to the other side
-            let half = z.amplitude / 2.0;
-            let Some(q1) = (b..n).find(|&j| laid(j) < half) else { break };
-            let Some(q3) = (q1..n).find(|&j| laid(j) < -half) else { break };
-            let rate = z.amplitude / (when(&laid, q3, -half) - when(&laid, q1, half));
-            // the heading passed the check angle last before the rudder left its plateau
+            // the hold on this side and on the other, as angles towards this side
+            let (hold, other) = if side > 0.0 { z.laid_deg } else { (-z.laid_deg.1, -z.laid_deg.0) };
+            let swing = hold - other;
+            let Some(held) = (i..n).find(|&j| laid(j) >= hold - 0.5) else { break };
+            let Some(a) = (held..n).find(|&j| laid(j) < hold - 0.5) else { break };
+            let (l1, l3) = (hold - 0.25 * swing, hold - 0.75 * swing);
+            let Some(q1) = (a..n).find(|&j| laid(j) < l1) else { break };
+            let Some(q3) = (q1..n).find(|&j| laid(j) < l3) else { break };
+            let (t1, t3) = (when(&laid, q1, l1), when(&laid, q3, l3));
+            let rate = 0.5 * swing / (t3 - t1);
+            let moved = when(&laid, a, hold - 0.5);
+            let line = t1 - (hold - l1) / rate;
+            // r·s²/2 − s − (line − moved) = 0 for s = 1/√α
+            let root = (1.0 + 2.0 * rate * (line - moved)).max(0.0).sqrt();
+            let s = (1.0 + root) / rate;
+            let start = moved - s;
+            // the heading passed the check angle last before the rudder left its hold
             let sign = z.heading[a].signum();
             let beyond = |j: usize| sign * z.heading[j];
             if let Some(c) = (z.laid..a).rev().find(|&j| beyond(j) < z.check) {
-                delays.push(t0 - when(&beyond, c + 1, z.check));
-                accelerations.push(alpha);
+                delays.push(start - when(&beyond, c + 1, z.check));
+                accelerations.push(1.0 / (s * s));
                 rates.push(rate);
             }
             side = -side;
@@ -278,10 +291,7 @@ mod tests {
             "rudder_limit = 35.0\nrudder_delay = 0.25\nrudder_acceleration = 20.0",
         );
         let model = crate::plugins::parse(&text, "geared.toml").unwrap();
-        let basin = Basin {
-            noise: crate::ship::basin::Noise { rudder_deg: 0.0, ..Default::default() },
-            ..Basin::default()
-        };
+        let basin = Basin::default();
         let records: Vec<_> = ["zigzag:20/20", "zigzag:10/10:port"]
             .iter()
             .enumerate()
@@ -300,5 +310,8 @@ mod tests {
         assert!((gear.rate_deg_s / 12.65 - 1.0).abs() < 0.05, "{gear:?}");
         let shape = ZigZagShape::of(columns[1].1, columns[1].2).unwrap();
         assert_eq!((shape.amplitude, shape.check, shape.starboard_first), (10.0, 10.0, false));
+        // the basin's zigzags lay the rudder about the default ship's δ0 = −0.8°
+        let (plus, minus) = shape.laid_deg;
+        assert!((plus - 9.2).abs() < 0.05 && (minus + 10.8).abs() < 0.05, "{plus} {minus}");
     }
 }

@@ -144,7 +144,10 @@ impl Plugin for Manoeuvring {
             .fold(0.0, f64::max);
         let rudder = if used > 0.0 { used.min(spec.rudder_limit) } else { spec.rudder_limit };
         match super::checks::physical_checks(model, rudder) {
-            Ok(checks) => checks,
+            Ok(mut checks) => {
+                checks.extend(super::checks::steering_check(model, runs));
+                checks
+            }
             Err(e) => vec![Check {
                 name: "the model simulates as a ship".into(),
                 passed: false,

@@ -12,17 +12,18 @@ use crate::sim::{Controller, Trajectory};
 /// A zigzag manoeuvre.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ZigZag {
-    /// Rudder angle δ_z, degrees (relative to δ0, or to 0 when `absolute`).
+    /// Rudder angle δ_z, degrees (relative to δ0, or to `about_deg`).
     pub rudder_deg: f64,
     /// Heading change ψ_z at which the rudder is reversed, degrees.
     pub heading_deg: f64,
     /// First turn to starboard (ψ increasing), else to port.
     pub starboard_first: bool,
-    /// The rudder laid to ±δ_z about 0 (as the basins' records show it laid by the indicator)
-    /// instead of about the straight-run angle δ0. A model whose straight run needs δ0 ≠ 0 is
-    /// then turned by δ_z + |δ0| to one side and δ_z − |δ0| to the other, as a basin's ship
-    /// is whose neutral rudder angle is not its indicator's zero.
-    pub absolute: bool,
+    /// The angle, degrees, the rudder is laid ±δ_z about, where not about the straight-run
+    /// angle δ0: 0 (`:absolute`) as the basins' records show it laid by the indicator, or a
+    /// record's own. A model whose straight run needs δ0 ≠ 0 is then turned by δ_z + |δ0| to
+    /// one side and δ_z − |δ0| to the other, as a basin's ship is whose neutral rudder angle is
+    /// not its indicator's zero.
+    pub about_deg: Option<f64>,
 }
 
 /// Zigzag metrics (IMO MSC.137(76), ITTC 7.5-04-02-01).
@@ -97,7 +98,7 @@ impl ZigZag {
             ZigZagControl {
                 servo: Servo::new(ship, start),
                 switch: Switch { dir: self.dir0(), limit: self.heading_deg.to_radians() },
-                delta0: if self.absolute { 0.0 } else { start.input[ship.roles.rudder] },
+                delta0: self.about_deg.map_or(start.input[ship.roles.rudder], f64::to_radians),
                 amplitude: self.rudder_deg.to_radians(),
                 turn_sign: ship.turn_sign,
                 psi: ship.roles.psi,
@@ -173,12 +174,12 @@ impl super::Test for ZigZag {
         let angles = parts.next().unwrap_or("");
         let (d, p) =
             angles.split_once('/').ok_or_else(|| bad("write zigzag:RUDDER/HEADING, e.g. zigzag:20/20"))?;
-        let (mut side, mut absolute) = (None, false);
+        let (mut side, mut about_deg) = (None, None);
         for part in parts {
             match part {
                 "starboard" | "stb" | "s" if side.is_none() => side = Some(true),
                 "port" | "p" if side.is_none() => side = Some(false),
-                "absolute" if !absolute => absolute = true,
+                "absolute" if about_deg.is_none() => about_deg = Some(0.0),
                 _ => {
                     return Err(bad(
                         "after the angles: the side (`starboard` or `port`) and `absolute` (the rudder about 0, not about the straight run's δ0), each once",
@@ -190,7 +191,7 @@ impl super::Test for ZigZag {
             rudder_deg: super::parse_num(text, d, "rudder angle")?,
             heading_deg: super::parse_num(text, p, "heading change")?,
             starboard_first: side.unwrap_or(true),
-            absolute,
+            about_deg,
         };
         if z.rudder_deg <= 0.0 || z.heading_deg <= 0.0 {
             return Err(bad("rudder angle and heading change are positive; choose the side with `:port`"));
@@ -204,7 +205,11 @@ impl super::Test for ZigZag {
             self.rudder_deg,
             self.heading_deg,
             if self.starboard_first { "starboard" } else { "port" },
-            if self.absolute { ", rudder about 0" } else { "" }
+            match self.about_deg {
+                Some(0.0) => ", rudder about 0".to_string(),
+                Some(a) => format!(", rudder about {a}°"),
+                None => String::new(),
+            }
         )
     }
 

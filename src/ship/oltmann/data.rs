@@ -115,7 +115,7 @@ pub fn simulate_manoeuvres(ship: &Ship, timing: AccelerationTiming) -> Result<Ve
     MANOEUVRES
         .iter()
         .map(|(name, d, p)| {
-            let zigzag = ZigZag { rudder_deg: *d, heading_deg: *p, starboard_first: true, absolute: false };
+            let zigzag = ZigZag { rudder_deg: *d, heading_deg: *p, starboard_first: true, about_deg: None };
             let run = ship.run(&Manoeuvre::ZigZag(zigzag.clone()), &settings)?;
             let frame = sample(ship, &run.trajectory, every, timing, name)?;
             Ok(Recorded { name: name.to_string(), zigzag, fine: run.trajectory, frame, metrics: run.metrics })
