@@ -20,7 +20,7 @@ use termid::diagnose::Runs;
 use termid::model::Model;
 use termid::plot::{Figure, Panel, Series};
 use termid::ship::observed::{observe, steering_gear, Observed, SteeringGear, ZigZagShape};
-use termid::ship::{Manoeuvre, Metrics, Ship, ShipSpec, StraightRun};
+use termid::ship::{Manoeuvre, Metrics, Ship, StraightRun};
 use termid::sim::{Integrator, Settings, Trajectory};
 
 type Error = Box<dyn std::error::Error>;
@@ -66,16 +66,11 @@ fn main() -> Result<(), Error> {
         let measured = plugin.observe(&model, frame, None).ok_or("no metrics of the record")?.json;
         let replayed = plugin.observe(&model, frame, Some(sim)).ok_or("no metrics of the simulation")?.json;
         let manoeuvre = zigzag_of(frame)?;
-        let ship = Ship::new(&termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]), false)?;
+        let approach = termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]);
+        let ship = Ship::new(&approach, false)?;
         let at_once = steer(&ship, &manoeuvre, &settings)?;
         let about_neutral = steer(&ship, manoeuvre.trim_end_matches(":absolute"), &settings)?;
-        let geared = Ship::new(
-            &with_steering_gear(
-                &termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]),
-                &gear,
-            )?,
-            false,
-        )?;
+        let geared = Ship::new(&gear.on(&approach), false)?;
         let z = steer(&geared, &manoeuvre, &settings)?;
         let mut row = format!("| {name} | {} |", manoeuvre.trim_start_matches("zigzag:"));
         for (key, p) in
@@ -169,8 +164,7 @@ fn own_zigzags(model: &Model, settings: &Settings) -> Result<(), Error> {
         let measured = plugin.observe(model, frame, None).ok_or("no metrics of the record")?.json;
         let manoeuvre = zigzag_of(frame)?;
         let approach = termid::ship::basin::at_approach_speed(model, frame.require("u")?[0]);
-        let (ship, geared) =
-            (Ship::new(&approach, false)?, Ship::new(&with_steering_gear(&approach, &gear)?, false)?);
+        let (ship, geared) = (Ship::new(&approach, false)?, Ship::new(&gear.on(&approach), false)?);
         let mut row = format!("| {name} | {} |", manoeuvre.trim_start_matches("zigzag:"));
         let m = measured["first_overshoot_deg"].as_f64();
         row += &m.map_or(" -- |".into(), |m| format!(" {m:.2}° |"));
@@ -233,10 +227,7 @@ fn table(args: &[String]) -> Result<(), Error> {
             let measured = plugin.observe(&model, frame, None).ok_or("no metrics of the record")?.json;
             // a model that leaves its bounds is a row of the table too, saying where
             let approach = termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]);
-            let ship = Ship::new(
-                &gear.as_ref().map_or(Ok(approach.clone()), |g| with_steering_gear(&approach, g))?,
-                false,
-            )?;
+            let ship = Ship::new(&gear.as_ref().map_or(approach.clone(), |g| g.on(&approach)), false)?;
             let z = match steer(&ship, &zigzag(frame)?, &settings) {
                 Ok(z) => z,
                 Err(e) => {
@@ -348,17 +339,6 @@ fn gear_of(runs: &[Frame]) -> Result<SteeringGear, Error> {
         .map(|f| Ok((f.time(), f.require("ψ")?, f.require("δ")?)))
         .collect::<Result<Vec<_>, Error>>()?;
     steering_gear(&columns).ok_or_else(|| "no rudder reversal in the records".into())
-}
-
-/// The model with `gear` in its `[ship]` table.
-fn with_steering_gear(model: &Model, gear: &SteeringGear) -> Result<Model, Error> {
-    let mut model = model.clone();
-    let mut spec = ShipSpec::of(&model)?.ok_or("not a ship model")?;
-    spec.rudder_delay = gear.delay_s;
-    spec.rudder_acceleration = Some(gear.acceleration_deg_s2);
-    spec.rudder_rate = gear.rate_deg_s;
-    spec.store(&mut model);
-    Ok(model)
 }
 
 /// A gear as the tables' headings say it.

@@ -180,13 +180,7 @@ pub fn steering_check(model: &Model, runs: &[Frame]) -> Option<Check> {
         // a record without a track is still read for its overshoots (the track is for turns)
         let (x0, y0) = (frame.column(&n.x0).unwrap_or(psi), frame.column(&n.y0).unwrap_or(psi));
         let Some(measured) = observe(frame.time(), psi, delta, x0, y0).first_overshoot_deg else { continue };
-        let mut approach = super::basin::at_approach_speed(model, u[0]);
-        if let Ok(Some(mut geared)) = super::ShipSpec::of(&approach) {
-            geared.rudder_delay = gear.delay_s;
-            geared.rudder_acceleration = Some(gear.acceleration_deg_s2);
-            geared.rudder_rate = gear.rate_deg_s;
-            geared.store(&mut approach);
-        }
+        let approach = gear.on(&super::basin::at_approach_speed(model, u[0]));
         let (plus, minus) = shape.laid_deg;
         let zigzag = ZigZag {
             rudder_deg: (plus - minus) / 2.0,

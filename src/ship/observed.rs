@@ -127,6 +127,20 @@ pub struct SteeringGear {
     pub reversals: usize,
 }
 
+impl SteeringGear {
+    /// `model` with this gear in its `[ship]` table (unchanged if it is not a ship model).
+    pub fn on(&self, model: &crate::model::Model) -> crate::model::Model {
+        let mut model = model.clone();
+        if let Ok(Some(mut spec)) = super::ShipSpec::of(&model) {
+            spec.rudder_delay = self.delay_s;
+            spec.rudder_acceleration = Some(self.acceleration_deg_s2);
+            spec.rudder_rate = self.rate_deg_s;
+            spec.store(&mut model);
+        }
+        model
+    }
+}
+
 /// A zigzag record's shape, in degrees: its rudder angle A (the largest, to whole 5°: an
 /// indicator overshoots its command a little), the heading change H at which the rudder is
 /// first reversed (where the rudder leaves its first plateau, snapped to the usual 1°, 5°, 10°,
