@@ -789,6 +789,13 @@ impl PyModel {
         to_json(&checks)
     }
 
+    /// The steering gear a ship model's zigzag runs show (JSON: delay_s, acceleration_deg_s2,
+    /// rate_deg_s, reversals), `None` for another model or runs without a reversal.
+    fn steering_gear(&self, runs: Vec<Run<'_>>) -> PyResult<Option<String>> {
+        let frames = self.frames(runs)?;
+        termid::ship::observed::SteeringGear::of_runs(&self.inner, &frames).map(|g| to_json(&g)).transpose()
+    }
+
     /// Pickling (to a worker process): the model file's text and its name.
     fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (String, String))> {
         let make = py.get_type::<PyModel>().getattr("parse")?;

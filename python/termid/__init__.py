@@ -1307,6 +1307,22 @@ class Model:
         """
         return pd.DataFrame(json.loads(self._native.checks(_runs(runs) if runs is not None else [])))
 
+    def steering_gear(self, runs: Union[Data, Sequence[Data]]) -> Optional[Dict[str, float]]:
+        """The steering gear a ship model's zigzag ``runs`` show: ``delay_s`` (the dead time from
+        the heading passing the check angle to the rudder starting back), ``acceleration_deg_s2``
+        (how fast its rate builds up), ``rate_deg_s`` and the ``reversals`` read (medians over
+        them); ``None`` for another model or runs without a rudder reversal. Set them as
+        ``rudder_delay``, ``rudder_acceleration`` and ``rudder_rate`` in the model file's
+        ``[ship]`` table to steer its zigzags as the basin did.
+
+        >>> ship = termid.Model.default()
+        >>> gear = ship.steering_gear(ship.simulate("zigzag:20/20", dt=0.04, sample=0.04))
+        >>> abs(gear["rate_deg_s"] - 12.65) < 0.1, gear["delay_s"] < 0.05
+        (True, True)
+        """
+        text = self._native.steering_gear(_runs(runs))
+        return None if text is None else json.loads(text)
+
     def __repr__(self) -> str:
         return repr(self._native)
 

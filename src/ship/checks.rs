@@ -7,7 +7,7 @@
 //! are course-unstable.
 
 use super::manoeuvre::ZigZag;
-use super::observed::{observe, steering_gear, ZigZagShape};
+use super::observed::{observe, SteeringGear, ZigZagShape};
 use super::{Manoeuvre, Metrics, Ship, ShipError};
 use crate::data::Frame;
 use crate::model::Model;
@@ -161,11 +161,7 @@ pub fn steering_check(model: &Model, runs: &[Frame]) -> Option<Check> {
         .iter()
         .filter_map(|f| Some((f, ZigZagShape::of(f.column(&n.psi)?, f.column(&n.rudder)?)?)))
         .collect();
-    let columns: Vec<_> = zigzags
-        .iter()
-        .filter_map(|(f, _)| Some((f.time(), f.column(&n.psi)?, f.column(&n.rudder)?)))
-        .collect();
-    let gear = steering_gear(&columns)?;
+    let gear = SteeringGear::of_runs(model, runs)?;
     let name = "steers its training zigzags as recorded".to_string();
     let mut errors: Vec<(f64, String)> = Vec::new();
     for (frame, shape) in &zigzags {

@@ -128,6 +128,17 @@ pub struct SteeringGear {
 }
 
 impl SteeringGear {
+    /// The gear that a ship model's zigzag runs show, their heading and rudder read by the
+    /// model's names; `None` for another model or runs without a reversal to read.
+    pub fn of_runs(model: &crate::model::Model, runs: &[crate::data::Frame]) -> Option<SteeringGear> {
+        let spec = super::canonical_spec(model)?;
+        let columns: Vec<_> = runs
+            .iter()
+            .filter_map(|f| Some((f.time(), f.column(&spec.names.psi)?, f.column(&spec.names.rudder)?)))
+            .collect();
+        steering_gear(&columns)
+    }
+
     /// `model` with this gear in its `[ship]` table (unchanged if it is not a ship model).
     pub fn on(&self, model: &crate::model::Model) -> crate::model::Model {
         let mut model = model.clone();
