@@ -19,7 +19,7 @@ use termid::data::{Dataset, Frame};
 use termid::diagnose::Runs;
 use termid::model::Model;
 use termid::plot::{Figure, Panel, Series};
-use termid::ship::observed::{observe, steering_gear, Observed, SteeringGear, ZigZagShape};
+use termid::ship::observed::{observe, Observed, SteeringGear, ZigZagShape};
 use termid::ship::{Manoeuvre, Metrics, Ship, StraightRun};
 use termid::sim::{Integrator, Settings, Trajectory};
 
@@ -55,7 +55,7 @@ fn main() -> Result<(), Error> {
     // of the indicator) by MARIN's steering gear as its records show it; for comparison by a
     // gear at its full rate at once (the model file's), and about the straight run's δ0 as
     // well (Oltmann's §5)
-    let gear = gear_of(&runs)?;
+    let gear = gear_of(&model, &runs)?;
     println!("MARIN's steering gear (model scale): {}\n", describe(&gear));
     println!("| MARIN run | zigzag (termid) | 1st overshoot measured | predicted | error | 2nd overshoot measured | predicted | error | 1st overshoot, gear at full rate at once | the same, rudder about δ0 | 1st overshoot, recorded rudder replayed |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|");
@@ -154,7 +154,7 @@ fn own_zigzags(model: &Model, settings: &Settings) -> Result<(), Error> {
     let set = Dataset::load(hsva)?;
     let (runs, _) = set.read(&set.folder(hsva)?, "t")?;
     let plugin = termid::plugins::of(model).ok_or("not a ship model")?;
-    let gear = gear_of(&runs)?;
+    let gear = gear_of(model, &runs)?;
     println!("\nHSVA's zigzags (the training runs) as the model steers them, first overshoot (HSVA's steering gear: {}):\n", describe(&gear));
     println!("| HSVA run | zigzag (termid) | measured | rudder about 0 | error | rudder about δ0 | error | rudder about 0, HSVA's gear | error | the same from the record's first sample | error |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|");
@@ -200,7 +200,13 @@ fn table(args: &[String]) -> Result<(), Error> {
         )
         .into());
     }
-    let models = &args[flags..];
+    let models = args[flags..]
+        .iter()
+        .map(|item| {
+            let (label, path) = item.split_once('=').ok_or("--table takes LABEL=MODEL.toml")?;
+            Ok((label, termid::plugins::load(Path::new(path))?))
+        })
+        .collect::<Result<Vec<_>, Error>>()?;
     let zigzag = |frame: &Frame| -> Result<String, Error> {
         let spec = zigzag_of(frame)?;
         Ok(if about_neutral { spec.trim_end_matches(":absolute").to_string() } else { spec })
@@ -208,7 +214,11 @@ fn table(args: &[String]) -> Result<(), Error> {
     let marin = Path::new("examples/simman/marin.toml");
     let set = Dataset::load(marin)?;
     let (runs, _) = set.read(&set.folder(marin)?, "t")?;
-    let gear = with_gear.then(|| gear_of(&runs)).transpose()?;
+    // the records' gear, read by the first model's names (the models are of one ship)
+    let gear = match models.first() {
+        Some((_, model)) if with_gear => Some(gear_of(model, &runs)?),
+        _ => None,
+    };
     if let Some(gear) = &gear {
         println!("MARIN's steering gear (model scale): {}\n", describe(gear));
     }
@@ -218,15 +228,13 @@ fn table(args: &[String]) -> Result<(), Error> {
         head += &format!(" {} |", zigzag(frame)?.trim_start_matches("zigzag:").trim_end_matches(":absolute"));
     }
     println!("{head} +35° | −35° |\n|---|{}---|---|", "---|".repeat(runs.len()));
-    for item in models {
-        let (label, path) = item.split_once('=').ok_or("--table takes LABEL=MODEL.toml")?;
-        let model = termid::plugins::load(Path::new(path))?;
-        let plugin = termid::plugins::of(&model).ok_or("not a ship model")?;
+    for (label, model) in &models {
+        let plugin = termid::plugins::of(model).ok_or("not a ship model")?;
         let mut row = format!("| {label} |");
         for frame in &runs {
-            let measured = plugin.observe(&model, frame, None).ok_or("no metrics of the record")?.json;
+            let measured = plugin.observe(model, frame, None).ok_or("no metrics of the record")?.json;
             // a model that leaves its bounds is a row of the table too, saying where
-            let approach = termid::ship::basin::at_approach_speed(&model, frame.require("u")?[0]);
+            let approach = termid::ship::basin::at_approach_speed(model, frame.require("u")?[0]);
             let ship = Ship::new(&gear.as_ref().map_or(approach.clone(), |g| g.on(&approach)), false)?;
             let z = match steer(&ship, &zigzag(frame)?, &settings) {
                 Ok(z) => z,
@@ -242,7 +250,7 @@ fn table(args: &[String]) -> Result<(), Error> {
         }
         let u0 =
             runs.iter().map(|f| f.require("u").map(|u| u[0])).sum::<Result<f64, _>>()? / runs.len() as f64;
-        let ship = Ship::new(&termid::ship::basin::at_approach_speed(&model, u0), false)?;
+        let ship = Ship::new(&termid::ship::basin::at_approach_speed(model, u0), false)?;
         for d in [35.0, -35.0] {
             let run = match ship.run(&Manoeuvre::parse(&format!("turning:{d}"))?, &settings) {
                 Ok(run) => run,
@@ -333,12 +341,8 @@ fn zigzag_of(frame: &Frame) -> Result<String, Error> {
 }
 
 /// A basin's steering gear as its zigzag records show it (model scale).
-fn gear_of(runs: &[Frame]) -> Result<SteeringGear, Error> {
-    let columns = runs
-        .iter()
-        .map(|f| Ok((f.time(), f.require("ψ")?, f.require("δ")?)))
-        .collect::<Result<Vec<_>, Error>>()?;
-    steering_gear(&columns).ok_or_else(|| "no rudder reversal in the records".into())
+fn gear_of(model: &Model, runs: &[Frame]) -> Result<SteeringGear, Error> {
+    SteeringGear::of_runs(model, runs).ok_or_else(|| "no rudder reversal in the records".into())
 }
 
 /// A gear as the tables' headings say it.
