@@ -361,13 +361,22 @@ pub fn check_replaceable(target: &Path) -> Result<(), OutputError> {
 
 /// Builds a whole output folder with `build` in a fresh folder beside `target`, then swaps it
 /// in under a lock on the parent folder, so two runs at once each leave a complete folder and
-/// the last one wins. A `target` that exists must pass [`check_replaceable`] (checked first and
-/// again under the lock, just before the swap): termid never deletes a file it did not write.
+/// the last one wins. A `target` that exists must pass [`check_replaceable`] (checked first —
+/// under the lock when that first look fails, since another run may be swapping its folder in —
+/// and again under the lock, just before the swap): termid never deletes a file it did not
+/// write.
 pub fn replace_folder<E: From<OutputError>>(
     target: &Path,
     build: impl FnOnce(&Path) -> Result<(), E>,
 ) -> Result<(), E> {
-    check_replaceable(target)?;
+    let parent = folder_of(target);
+    if check_replaceable(target).is_err() {
+        // another run may be swapping its folder in right now (its old one half deleted):
+        // judged again under the lock, where no swap is under way
+        let lock = File::open(parent).map_err(io_error(parent))?;
+        lock.lock().map_err(io_error(parent))?;
+        check_replaceable(target)?;
+    }
     let fresh = sibling(target, "new");
     std::fs::create_dir(&fresh).map_err(io_error(&fresh))?;
     // removes the fresh folder on any failure below
@@ -381,7 +390,6 @@ pub fn replace_folder<E: From<OutputError>>(
     build(&fresh)?;
     let manifest = manifest_of(&fresh).map_err(io_error(&fresh))?;
     std::fs::write(fresh.join(MANIFEST), manifest).map_err(io_error(&fresh))?;
-    let parent = folder_of(target);
     let lock = File::open(parent).map_err(io_error(parent))?;
     lock.lock().map_err(io_error(parent))?;
     // what the user may have put there while the folder was built
