@@ -19,7 +19,7 @@ use termid::data::{Dataset, Frame};
 use termid::diagnose::Runs;
 use termid::model::Model;
 use termid::plot::{Figure, Panel, Series};
-use termid::ship::observed::{observe, Observed, SteeringGear, ZigZagShape};
+use termid::ship::observed::{observe_run, Observed, SteeringGear, ZigZagShape};
 use termid::ship::{Manoeuvre, Metrics, Ship, StraightRun};
 use termid::sim::{Integrator, Settings, Trajectory};
 
@@ -286,8 +286,8 @@ fn steer_from(ship: &Ship, spec: &str, settings: &Settings, start: StraightRun) 
     // rudder reversal, which a steering gear that answers late moves past the check angle
     let every = Settings { duration: 100.0, sample: settings.dt, ..*settings };
     let run = ship.run_from(&Manoeuvre::parse(spec)?, &every, start)?.trajectory;
-    let column = |name: &str| run.state(name).or_else(|| run.input(name)).ok_or(format!("no {name}"));
-    Ok(observe(&run.time, column("ψ")?, column("δ")?, column("x0")?, column("y0")?))
+    observe_run(&run, &ship.spec.names)
+        .ok_or_else(|| "the run lacks the ship's heading, rudder or track".into())
 }
 
 /// A record's first sample as the start of a manoeuvre: its states, its rudder and propeller.

@@ -7,7 +7,7 @@
 //! are course-unstable.
 
 use super::manoeuvre::ZigZag;
-use super::observed::{observe, SteeringGear, ZigZagShape};
+use super::observed::{observe, observe_run, SteeringGear, ZigZagShape};
 use super::{Manoeuvre, Metrics, Ship, ShipError};
 use crate::data::Frame;
 use crate::model::Model;
@@ -206,13 +206,7 @@ pub fn steering_check(model: &Model, runs: &[Frame]) -> Option<Check> {
                 })
             }
         };
-        let column = |name: &str| run.state(name).or_else(|| run.input(name));
-        let (Some(p), Some(d), Some(x), Some(y)) =
-            (column(&n.psi), column(&n.rudder), column(&n.x0), column(&n.y0))
-        else {
-            continue;
-        };
-        if let Some(predicted) = observe(&run.time, p, d, x, y).first_overshoot_deg {
+        if let Some(predicted) = observe_run(&run, n).and_then(|o| o.first_overshoot_deg) {
             errors.push((predicted - measured, label));
         }
     }

@@ -111,6 +111,20 @@ pub fn observe(t: &[f64], psi: &[f64], delta: &[f64], x0: &[f64], y0: &[f64]) ->
     out
 }
 
+/// Metrics read off a simulated run of a ship as off a record (its heading, rudder and track by
+/// `names`), so that a prediction is measured as its measurement is; `None` when the run lacks
+/// one of them.
+pub fn observe_run(run: &crate::sim::Trajectory, names: &super::ShipNames) -> Option<Observed> {
+    let column = |name: &str| run.state(name).or_else(|| run.input(name));
+    Some(observe(
+        &run.time,
+        column(&names.psi)?,
+        column(&names.rudder)?,
+        column(&names.x0)?,
+        column(&names.y0)?,
+    ))
+}
+
 /// A steering gear as zigzag records show it: the dead time from the heading passing the
 /// check angle to the rudder starting back, the angular acceleration with which its rate builds
 /// up, and its full rate (medians over every reversal). What `[ship] rudder_delay`,
