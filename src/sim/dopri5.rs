@@ -2,8 +2,9 @@
 //! (Dormand & Prince 1980; Hairer, Nørsett & Wanner, *Solving ODEs I*, II.5-II.6). While the
 //! controller's inputs go on along one straight line (held, or a rudder turning at its rate),
 //! steps span as many control intervals as the tolerances allow and the states at the control
-//! times inside a step come from the dense output; an interval where the line breaks is
-//! integrated on its own in substeps, the input ramped across it.
+//! times inside a step come from the dense output. Where the line breaks, the step that ran
+//! past the last control time is cut there and a new line starts, through the inputs at that
+//! control time and the next.
 
 // The stage updates index several parallel arrays at once; index loops read best there.
 #![allow(clippy::needless_range_loop)]
@@ -52,9 +53,10 @@ pub(super) struct Dopri5 {
     /// control time last asked for.
     t: f64,
     y: Vec<f64>,
-    /// The last free step, [t − span, t], as its dense-output polynomial.
+    /// The last free step, [t − span, t], as its dense-output polynomial: per state its five
+    /// coefficients side by side (the control times read all five of each state).
     span: f64,
-    dense: [Vec<f64>; 5],
+    dense: Vec<[f64; 5]>,
     /// The line the inputs follow: `held` at `held_t`, changing by `slope` per second.
     held: Vec<f64>,
     held_t: f64,
@@ -64,6 +66,7 @@ pub(super) struct Dopri5 {
     started: bool,
     /// The control interval (for the smallest step allowed and the time tolerance).
     dt: f64,
+    control: StepControl,
 }
 
 impl Dopri5 {
@@ -79,13 +82,14 @@ impl Dopri5 {
             t: 0.0,
             y: vec![0.0; n],
             span: 0.0,
-            dense: std::array::from_fn(|_| vec![0.0; n]),
+            dense: vec![[0.0; 5]; n],
             held: vec![f64::NAN; m],
             held_t: 0.0,
             slope: vec![0.0; m],
             tol,
             started: false,
             dt,
+            control: StepControl::default(),
         }
     }
 
@@ -145,22 +149,23 @@ impl Dopri5 {
             self.y.copy_from_slice(x0);
             self.fresh = false;
         }
-        if !self.on_line(t0, u.0) || !self.on_line(t1, u.1) {
-            // the inputs leave their line: the step that ran past t0 is cut there, this
-            // interval integrated on its own, and its ramp is the line from here on
-            if !self.at(t0) {
-                self.fresh = false;
-            }
-            self.interval(system, ws, x0, x, u, (t0, dt))?;
-            self.t = t1;
-            self.y.copy_from_slice(x);
-            self.held.copy_from_slice(u.1);
-            self.held_t = t1;
+        let from_line = self.on_line(t0, u.0);
+        if !from_line || !self.on_line(t1, u.1) {
+            // the inputs leave their line: the step that ran past t0 is cut there and a new
+            // line starts, through this interval's two ends; f at t0 is kept only where it was
+            // taken there with this input
+            self.fresh &= from_line && self.at(t0);
+            self.t = t0;
+            self.y.copy_from_slice(x0);
+            self.held.copy_from_slice(u.0);
+            self.held_t = t0;
             for j in 0..self.slope.len() {
                 self.slope[j] = (u.1[j] - u.0[j]) / dt;
             }
             self.span = 0.0;
-            return Ok(());
+            // a kink in the inputs excites what the step before it had settled: the steps
+            // start again short (five control steps at most) and grow as the error allows
+            self.h = self.h.min(5.0 * dt);
         }
         while self.t < t1 - 1e-9 * dt {
             self.free_step(system, ws, end)?;
@@ -171,9 +176,8 @@ impl Dopri5 {
             // dense output: θ = (t1 − t_start)/h within the last step
             let theta = 1.0 - (self.t - t1) / self.span;
             let eta = 1.0 - theta;
-            let [r1, r2, r3, r4, r5] = &self.dense;
-            for i in 0..x.len() {
-                x[i] = r1[i] + theta * (r2[i] + eta * (r3[i] + theta * (r4[i] + eta * r5[i])));
+            for (x, [r1, r2, r3, r4, r5]) in x.iter_mut().zip(&self.dense) {
+                *x = r1 + theta * (r2 + eta * (r3 + theta * (r4 + eta * r5)));
             }
         }
         Ok(())
@@ -182,7 +186,6 @@ impl Dopri5 {
     /// One step from (`t`, `y`) with the inputs held, of the size the error control allows,
     /// retried smaller until accepted; keeps its dense output.
     fn free_step(&mut self, system: &System, ws: &mut Workspace, end: f64) -> Result<(), SimError> {
-        let n = self.y.len();
         if !self.fresh {
             let mut u = std::mem::take(&mut self.u);
             self.line(self.t, &mut u);
@@ -201,32 +204,31 @@ impl Dopri5 {
                     u[j] = held[j] + slope[j] * (t + C[st] * h - held_t);
                 }
             };
-            let err = self.attempt(system, ws, &y, h, &input);
+            let err = self.attempt(system, ws, &y, h, input);
             self.y = y;
             if err <= 1.0 {
                 // dense output before the last stage becomes the next step's first (Hairer's CONTD5)
-                for i in 0..n {
+                let k = &self.k;
+                for (i, r) in self.dense.iter_mut().enumerate() {
                     let diff = self.trial[i] - self.y[i];
-                    let bspl = h * self.k[0][i] - diff;
-                    self.dense[0][i] = self.y[i];
-                    self.dense[1][i] = diff;
-                    self.dense[2][i] = bspl;
-                    self.dense[3][i] = diff - h * self.k[6][i] - bspl;
-                    let mut d = 0.0;
-                    for (j, w) in D.iter().enumerate() {
-                        d += w * self.k[j][i];
-                    }
-                    self.dense[4][i] = h * d;
+                    let bspl = h * k[0][i] - diff;
+                    let d = D[0] * k[0][i]
+                        + D[2] * k[2][i]
+                        + D[3] * k[3][i]
+                        + D[4] * k[4][i]
+                        + D[5] * k[5][i]
+                        + D[6] * k[6][i];
+                    *r = [self.y[i], diff, bspl, diff - h * k[6][i] - bspl, h * d];
                 }
                 self.y.copy_from_slice(&self.trial);
                 self.t += h;
                 self.span = h;
                 self.k.swap(0, 6);
-                self.h = h * grow(err);
+                self.h = h * self.control.accept(err);
                 (self.held, self.slope) = (held, slope);
                 return Ok(());
             }
-            self.h = shrink(h, err);
+            self.h = self.control.reject(h, err);
             tries += 1;
             if self.h < self.dt * 1e-10 || tries > 100_000 {
                 self.fresh = false;
@@ -234,59 +236,6 @@ impl Dopri5 {
                 return Err(self.stuck(system, self.t));
             }
         }
-    }
-
-    /// Integrates from `x0` at `t0` over `dt` into `x` in substeps, the inputs going linearly
-    /// from `u.0` to `u.1`.
-    fn interval(
-        &mut self,
-        system: &System,
-        ws: &mut Workspace,
-        x0: &[f64],
-        x: &mut [f64],
-        u: (&[f64], &[f64]),
-        (t0, dt): (f64, f64),
-    ) -> Result<(), SimError> {
-        let input_at = |s: f64, out: &mut [f64]| {
-            let w = (s / dt).clamp(0.0, 1.0);
-            for j in 0..out.len() {
-                out[j] = u.0[j] + w * (u.1[j] - u.0[j]);
-            }
-        };
-        x.copy_from_slice(x0);
-        if !self.fresh {
-            input_at(0.0, &mut self.u);
-            system.derivatives(x, &self.u, ws, &mut self.k[0]);
-        }
-        let mut s = 0.0;
-        let mut tries = 0usize;
-        while s < dt {
-            let h = self.h.min(dt - s);
-            // the last substep of an interval ends on its grid point exactly
-            let ends = s + h >= dt * (1.0 - 1e-12);
-            let stage_input = |st: usize, out: &mut [f64]| {
-                input_at(if ends && C[st] == 1.0 { dt } else { s + C[st] * h }, out)
-            };
-            let err = self.attempt(system, ws, x, h, &stage_input);
-            if err <= 1.0 {
-                s = if ends { dt } else { s + h };
-                x.copy_from_slice(&self.trial);
-                self.k.swap(0, 6);
-                // a last substep cut short to end on the grid says nothing against the size
-                // the one before it had
-                self.h = if ends && grow(err) >= 1.0 { self.h.max(h) } else { h } * grow(err);
-            } else {
-                self.h = shrink(h, err);
-            }
-            tries += 1;
-            if self.h < dt * 1e-10 || tries > 100_000 {
-                self.fresh = false;
-                self.y.copy_from_slice(x);
-                return Err(self.stuck(system, t0 + s));
-            }
-        }
-        self.fresh = true;
-        Ok(())
     }
 
     /// Stages 2-7 of a step of `h` from `x` (`k[0]` holds f there), the fifth-order solution
@@ -297,16 +246,16 @@ impl Dopri5 {
         ws: &mut Workspace,
         x: &[f64],
         h: f64,
-        input: &dyn Fn(usize, &mut [f64]),
+        input: impl Fn(usize, &mut [f64]),
     ) -> f64 {
-        let n = x.len();
         for st in 1..7 {
-            for i in 0..n {
-                let mut acc = 0.0;
-                for (j, a) in A[st][..st].iter().enumerate() {
-                    acc += a * self.k[j][i];
+            // stage = x + h·Σ a_j k_j, one state vector at a time (the loops vectorise)
+            self.stage.copy_from_slice(x);
+            for (j, a) in A[st][..st].iter().enumerate() {
+                if *a != 0.0 {
+                    let c = h * a;
+                    self.stage.iter_mut().zip(&self.k[j]).for_each(|(s, k)| *s += c * k);
                 }
-                self.stage[i] = x[i] + h * acc;
             }
             input(st, &mut self.u);
             let (_, rest) = self.k.split_at_mut(st);
@@ -314,16 +263,24 @@ impl Dopri5 {
         }
         // stage 7's point is the fifth-order solution (A[6] = b)
         self.trial.copy_from_slice(&self.stage);
-        let mut err = 0.0;
-        for i in 0..n {
-            let mut e = 0.0;
-            for (j, w) in E.iter().enumerate() {
-                e += w * self.k[j][i];
-            }
-            let scale = self.tol.atol + self.tol.rtol * x[i].abs().max(self.trial[i].abs());
-            err += (h * e / scale).powi(2);
+        // the error estimate h·Σ e_j k_j, gathered in `stage` (free until the next attempt)
+        let err = &mut self.stage;
+        err.iter_mut().zip(&self.k[0]).for_each(|(e, k)| *e = h * E[0] * k);
+        for (j, w) in E.iter().enumerate().skip(2) {
+            let c = h * w;
+            err.iter_mut().zip(&self.k[j]).for_each(|(e, k)| *e += c * k);
         }
-        (err / n.max(1) as f64).sqrt()
+        let (atol, rtol) = (self.tol.atol, self.tol.rtol);
+        let sum: f64 = err
+            .iter()
+            .zip(x)
+            .zip(&self.trial)
+            .map(|((e, x), y)| {
+                let q = e / (atol + rtol * x.abs().max(y.abs()));
+                q * q
+            })
+            .sum();
+        (sum / x.len().max(1) as f64).sqrt()
     }
 
     fn stuck(&self, system: &System, t: f64) -> SimError {
@@ -335,21 +292,31 @@ impl Dopri5 {
     }
 }
 
-/// The next step after an accepted one: by the error's fifth root with a safety factor,
-/// by at most 5× (Hairer, Nørsett & Wanner II.4).
-fn grow(err: f64) -> f64 {
-    if err == 0.0 {
-        5.0
-    } else {
-        (0.9 * err.powf(-0.2)).clamp(0.2, 5.0)
-    }
+/// Step-size control (Hairer, Nørsett & Wanner II.4): the next step by the error's fifth root
+/// with a safety factor, at most 10× longer and 10× shorter; after a rejection the step does
+/// not grow again at once.
+#[derive(Clone, Copy, Debug, Default)]
+struct StepControl {
+    /// Whether the step before was rejected.
+    rejected: bool,
 }
 
-/// The retry after a rejected step.
-fn shrink(h: f64, err: f64) -> f64 {
-    if err.is_finite() {
-        h * (0.9 * err.powf(-0.2)).clamp(0.1, 0.9)
-    } else {
-        h * 0.1
+impl StepControl {
+    /// The factor on `h` for the step after one accepted with error `err` (≤ 1).
+    fn accept(&mut self, err: f64) -> f64 {
+        let factor = if err == 0.0 { 10.0 } else { (0.9 * err.powf(-0.2)).clamp(0.1, 10.0) };
+        let factor = if self.rejected { factor.min(1.0) } else { factor };
+        self.rejected = false;
+        factor
+    }
+
+    /// The retry after a step rejected with error `err` (> 1).
+    fn reject(&mut self, h: f64, err: f64) -> f64 {
+        self.rejected = true;
+        if err.is_finite() {
+            h * (0.9 * err.powf(-0.2)).clamp(0.1, 0.9)
+        } else {
+            h * 0.1
+        }
     }
 }

@@ -288,7 +288,8 @@ pub fn simulate(
             }
         }
     };
-    check(system, 0.0, &x, x0)?;
+    let limits = finite_limits(system);
+    check(system, &limits, 0.0, &x, x0)?;
     record(0.0, &x, &u_now, &mut out);
     let mut pending = true;
     let mut k = [vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]];
@@ -301,10 +302,13 @@ pub fn simulate(
     if settings.integrator == Integrator::Dopri5 {
         system.tolerances.check()?;
     }
+    // samples counted down, not found by a remainder (a division per control step)
+    let mut to_sample = every;
     for step in 1..=steps {
         let t1 = step as f64 * dt;
         controller.input(t1, &x, &mut u_next);
-        prev.copy_from_slice(&x);
+        // every method below writes all of x
+        std::mem::swap(&mut prev, &mut x);
         let x_old: &[f64] = &prev;
         match settings.integrator {
             Integrator::ModifiedEuler => {
@@ -357,10 +361,12 @@ pub fn simulate(
                 }
             }
         }
-        check(system, t1, &x, &prev)?;
+        check(system, &limits, t1, &x, &prev)?;
         std::mem::swap(&mut u_now, &mut u_next);
         let done = controller.done(t1, &x);
-        if step % every == 0 || done {
+        to_sample -= 1;
+        if to_sample == 0 || done {
+            to_sample = every;
             record(t1, &x, &u_now, &mut out);
             pending = true;
         }
@@ -376,17 +382,19 @@ pub fn simulate(
 }
 
 #[inline(always)]
-fn check(system: &System, t: f64, x: &[f64], prev: &[f64]) -> Result<(), SimError> {
-    // one branch for all states, not three per state (`&` where `&&` would branch);
-    // v·0 is NaN exactly when v is ±∞ or NaN, and costs less than is_finite here
-    let ok = x
-        .iter()
-        .zip(&system.bounds)
-        .fold(true, |ok, (v, (lo, hi))| ok & (*v >= *lo) & (*v <= *hi) & (*v * 0.0 == 0.0));
+fn check(system: &System, limits: &[(f64, f64)], t: f64, x: &[f64], prev: &[f64]) -> Result<(), SimError> {
+    // one branch for all states (`&` where `&&` would branch); the limits are finite, so a
+    // NaN or ±∞ fails them as a value out of bounds does
+    let ok = x.iter().zip(limits).fold(true, |ok, (v, (lo, hi))| ok & (*v >= *lo) & (*v <= *hi));
     if ok {
         return Ok(());
     }
     report(system, t, x, prev)
+}
+
+/// Each state's bounds for [`check`], ±∞ replaced by the largest finite numbers.
+fn finite_limits(system: &System) -> Vec<(f64, f64)> {
+    system.bounds.iter().map(|(lo, hi)| (lo.max(f64::MIN), hi.min(f64::MAX))).collect()
 }
 
 #[cold]
