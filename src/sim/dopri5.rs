@@ -6,9 +6,6 @@
 //! past the last control time is cut there and a new line starts, through the inputs at that
 //! control time and the next.
 
-// The stage updates index several parallel arrays at once; index loops read best there.
-#![allow(clippy::needless_range_loop)]
-
 use super::system::{System, Workspace};
 use super::{SimError, Tolerances};
 
@@ -115,8 +112,8 @@ impl Dopri5 {
 
     /// The inputs on the line at `t`.
     fn line(&self, t: f64, out: &mut [f64]) {
-        for j in 0..out.len() {
-            out[j] = self.held[j] + self.slope[j] * (t - self.held_t);
+        for ((o, held), slope) in out.iter_mut().zip(&self.held).zip(&self.slope) {
+            *o = held + slope * (t - self.held_t);
         }
     }
 
@@ -212,6 +209,7 @@ impl Dopri5 {
                 for (i, r) in self.dense.iter_mut().enumerate() {
                     let diff = self.trial[i] - self.y[i];
                     let bspl = h * k[0][i] - diff;
+                    // D[1] = 0
                     let d = D[0] * k[0][i]
                         + D[2] * k[2][i]
                         + D[3] * k[3][i]
@@ -263,7 +261,7 @@ impl Dopri5 {
         }
         // stage 7's point is the fifth-order solution (A[6] = b)
         self.trial.copy_from_slice(&self.stage);
-        // the error estimate h·Σ e_j k_j, gathered in `stage` (free until the next attempt)
+        // the error estimate h·Σ e_j k_j (e_2 = 0), gathered in `stage` (free until the next attempt)
         let err = &mut self.stage;
         err.iter_mut().zip(&self.k[0]).for_each(|(e, k)| *e = h * E[0] * k);
         for (j, w) in E.iter().enumerate().skip(2) {
