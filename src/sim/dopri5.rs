@@ -4,7 +4,8 @@
 //! steps span as many control intervals as the tolerances allow and the states at the control
 //! times inside a step come from the dense output. Where the line breaks, the step that ran
 //! past the last control time is cut there and a new line starts, through the inputs at that
-//! control time and the next.
+//! control time and the next; where it broke at the control time before as well (a replayed
+//! record), the steps end on the next control time.
 
 use super::system::{System, Workspace};
 use super::{SimError, Tolerances};
@@ -64,6 +65,8 @@ pub(super) struct Dopri5 {
     /// The control interval (for the smallest step allowed and the time tolerance).
     dt: f64,
     control: StepControl,
+    /// Whether the inputs left their line at the last control time.
+    broke: bool,
 }
 
 impl Dopri5 {
@@ -87,6 +90,7 @@ impl Dopri5 {
             started: false,
             dt,
             control: StepControl::default(),
+            broke: false,
         }
     }
 
@@ -147,7 +151,14 @@ impl Dopri5 {
             self.fresh = false;
         }
         let from_line = self.on_line(t0, u.0);
-        if !from_line || !self.on_line(t1, u.1) {
+        let breaks = !from_line || !self.on_line(t1, u.1);
+        // how far a step may reach: past t1 while the line may hold on; to t1 where the line
+        // broke at the control time before as well (a replayed record breaks it at every
+        // control time: a step past t1 would be cut there, its work lost and the state at t1
+        // read off the dense output instead of a step's end)
+        let reach = if breaks && self.broke { t1 } else { end };
+        self.broke = breaks;
+        if breaks {
             // the inputs leave their line: the step that ran past t0 is cut there and a new
             // line starts, through this interval's two ends; f at t0 is kept only where it was
             // taken there with this input
@@ -165,7 +176,7 @@ impl Dopri5 {
             self.h = self.h.min(5.0 * dt);
         }
         while self.t < t1 - 1e-9 * dt {
-            self.free_step(system, ws, end)?;
+            self.free_step(system, ws, reach)?;
         }
         if self.at(t1) || self.span == 0.0 {
             x.copy_from_slice(&self.y);
@@ -180,9 +191,10 @@ impl Dopri5 {
         Ok(())
     }
 
-    /// One step from (`t`, `y`) with the inputs held, of the size the error control allows,
-    /// retried smaller until accepted; keeps its dense output.
-    fn free_step(&mut self, system: &System, ws: &mut Workspace, end: f64) -> Result<(), SimError> {
+    /// One step from (`t`, `y`) along the inputs' line, of the size the error control allows
+    /// and ending at `reach` at the latest, retried smaller until accepted; keeps its dense
+    /// output.
+    fn free_step(&mut self, system: &System, ws: &mut Workspace, reach: f64) -> Result<(), SimError> {
         if !self.fresh {
             let mut u = std::mem::take(&mut self.u);
             self.line(self.t, &mut u);
@@ -194,7 +206,7 @@ impl Dopri5 {
             (std::mem::take(&mut self.held), std::mem::take(&mut self.slope), self.held_t);
         let mut tries = 0usize;
         loop {
-            let h = self.h.min(end - self.t).max(1e-12 * self.dt);
+            let h = self.h.min(reach - self.t).max(1e-12 * self.dt);
             let (y, t) = (std::mem::take(&mut self.y), self.t);
             let input = |st: usize, u: &mut [f64]| {
                 for j in 0..u.len() {

@@ -532,8 +532,9 @@ mod tests {
 
     /// The adaptive method across many kinks of its input, against the closed form: a lag
     /// ẋ = u − x driven by a rudder-like input (held, turned at a rate that stops between
-    /// control times, reversed at a state-dependent moment), interpolated linearly between the
-    /// control times as the simulator does. On an interval where u = u_k + s·τ, the exact step
+    /// control times, reversed at a state-dependent moment), then by a replayed record's (a
+    /// new value at every control time), interpolated linearly between the control times as
+    /// the simulator does. On an interval where u = u_k + s·τ, the exact step
     /// is x_{k+1} = u_k − s + s·Δt + (x_k − u_k + s)·e^(−Δt). Every step cut at a kink starts
     /// from the right state and derivative, or this drifts.
     #[test]
@@ -572,6 +573,25 @@ mod tests {
         }
         // ~1.3e-8 here (1.0e-8 before the cut at kinks); a stale f at a kink costs ~1e-3
         assert!(worst < 1e-7, "{worst}");
+        // a replayed record: the input breaks its line at every control time, each control
+        // step then ends on its control time (not read off a longer step's dense output)
+        struct Noisy(u64);
+        impl Controller for Noisy {
+            fn input(&mut self, _: f64, _: &[f64], u: &mut [f64]) {
+                self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                u[0] = (self.0 >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+            }
+        }
+        let run = simulate(&lag, &[0.0], &mut Noisy(7), &settings).unwrap();
+        let (x, u) = (&run.states[0], &run.inputs[0]);
+        let (mut exact, mut worst) = (0.0f64, 0.0f64);
+        for k in 0..x.len() - 1 {
+            let slope = (u[k + 1] - u[k]) / 0.1;
+            exact = u[k] - slope + slope * 0.1 + (exact - u[k] + slope) * e;
+            worst = worst.max((x[k + 1] - exact).abs());
+        }
+        // 4.9e-10; 1.2e-8 when each step ran past its control time and was read off there
+        assert!(worst < 3e-9, "{worst}");
     }
 
     /// The adaptive method on closed forms: ẋ = −x (e^(−t)), a damped oscillator, and an
