@@ -9,7 +9,8 @@
 //! one row per model instead: the first overshoot of each MARIN zigzag (steered by the model,
 //! the rudder laid about 0 by MARIN's steering gear as MARIN's records show both; or by a gear
 //! at full rate at once; or that and about the model's straight-run angle) less MARIN's, and
-//! the ±35° tactical diameters (the guide's table of training sets and model families)
+//! the ±35° tactical diameters (the guide's table of training sets and model families); then
+//! each model's linear sway and yaw at MARIN's approach (time constants, rudder, damping)
 //! (the clone: the public repository martinlarsalbert/System-identification-of-Vessel-
 //! Manoeuvring-Models; its records are read where they are, never copied).
 
@@ -20,6 +21,7 @@ use termid::diagnose::Runs;
 use termid::model::Model;
 use termid::plot::{Figure, Panel, Series};
 use termid::ship::observed::{observe_run, Observed, SteeringGear, ZigZagShape};
+use termid::ship::stability::SwayYaw;
 use termid::ship::{Manoeuvre, Metrics, Ship, StraightRun};
 use termid::sim::{Integrator, Settings, Trajectory};
 
@@ -228,6 +230,7 @@ fn table(args: &[String]) -> Result<(), Error> {
         head += &format!(" {} |", zigzag(frame)?.trim_start_matches("zigzag:").trim_end_matches(":absolute"));
     }
     println!("{head} +35° | −35° |\n|---|{}---|---|", "---|".repeat(runs.len()));
+    let mut linear = Vec::new();
     for (label, model) in &models {
         let plugin = termid::plugins::of(model).ok_or("not a ship model")?;
         let mut row = format!("| {label} |");
@@ -251,6 +254,8 @@ fn table(args: &[String]) -> Result<(), Error> {
         let u0 =
             runs.iter().map(|f| f.require("u").map(|u| u[0])).sum::<Result<f64, _>>()? / runs.len() as f64;
         let ship = Ship::new(&termid::ship::basin::at_approach_speed(model, u0), false)?;
+        let start = ship.straight_run()?;
+        linear.push((label, start.delta0_deg, SwayYaw::of(&ship, &start)));
         for d in [35.0, -35.0] {
             let run = match ship.run(&Manoeuvre::parse(&format!("turning:{d}"))?, &settings) {
                 Ok(run) => run,
@@ -263,6 +268,22 @@ fn table(args: &[String]) -> Result<(), Error> {
             row += &t.tactical_diameter_m.map_or(" -- |".into(), |v| format!(" {v:.1} m |"));
         }
         println!("{row}");
+    }
+    // what each model carries into the turns: its linear sway and yaw at MARIN's approach
+    println!(
+        "\nlinear sway-yaw at MARIN's approach, u0 = {:.3} m/s:\n",
+        linear.first().map_or(0.0, |l| l.2.u0)
+    );
+    println!("| model | time constants | ∂ṙ/∂δ | ∂ṙ/∂r | ∂v̇/∂v | δ0 |\n|---|---|---|---|---|---|");
+    for (label, delta0, s) in linear {
+        let t = s.time_constants().map_or("oscillating".to_string(), |(fast, slow)| {
+            let unstable = if slow < 0.0 { " (course-unstable)" } else { "" };
+            format!("{fast:.2} s, {slow:.1} s{unstable}")
+        });
+        println!(
+            "| {label} | {t} | {:.4} 1/s² | {:.3} 1/s | {:.3} 1/s | {delta0:+.2}° |",
+            s.n_delta, s.nr, s.yv
+        );
     }
     Ok(())
 }

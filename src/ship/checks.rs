@@ -8,6 +8,7 @@
 
 use super::manoeuvre::ZigZag;
 use super::observed::{observe, observe_run, SteeringGear, ZigZagShape};
+use super::stability::SwayYaw;
 use super::{Manoeuvre, Metrics, Ship, ShipError};
 use crate::data::Frame;
 use crate::model::Model;
@@ -20,26 +21,8 @@ pub fn physical_checks(model: &Model, rudder_deg: f64) -> Result<Vec<Check>, Shi
     let start = ship.straight_run()?;
     let r = ship.roles;
     let mut checks = Vec::new();
-    // the sway-yaw derivatives at the straight run, by central differences
-    let jacobian = {
-        let mut ws = ship.system.workspace();
-        let mut d = vec![0.0; start.x.len()];
-        let mut rate = |state: usize, h: f64| {
-            let mut x = start.x.clone();
-            x[state] += h;
-            ship.system.derivatives(&x, &start.input, &mut ws, &mut d);
-            (d[r.v], d[r.r])
-        };
-        let hv = 1e-4 * ship.spec.u0;
-        let hr = hv / ship.spec.lpp;
-        let (vp, vm) = (rate(r.v, hv), rate(r.v, -hv));
-        let (rp, rm) = (rate(r.r, hr), rate(r.r, -hr));
-        [
-            [(vp.0 - vm.0) / (2.0 * hv), (rp.0 - rm.0) / (2.0 * hr)],
-            [(vp.1 - vm.1) / (2.0 * hv), (rp.1 - rm.1) / (2.0 * hr)],
-        ]
-    };
-    let [[yv, yr], [nv, nr]] = jacobian;
+    let sway_yaw = SwayYaw::of(&ship, &start);
+    let (yv, nr) = (sway_yaw.yv, sway_yaw.nr);
     checks.push(Check {
         name: "sway damping ∂v̇/∂v < 0".into(),
         passed: yv < 0.0,
@@ -54,17 +37,13 @@ pub fn physical_checks(model: &Model, rudder_deg: f64) -> Result<Vec<Check>, Shi
         measure: None,
         detail: format!("{nr:.4} 1/s at u0"),
     });
-    // the linear sway-yaw system is stable when its trace is negative and its determinant
-    // positive; the determinant's sign is the classical stability criterion
-    let (trace, det) = (yv + nr, yv * nr - yr * nv);
-    let disc = trace * trace / 4.0 - det;
-    let largest = if disc >= 0.0 { trace / 2.0 + disc.sqrt() } else { trace / 2.0 };
+    let largest = sway_yaw.largest_eigenvalue();
     checks.push(Check {
         name: "straight-line stability".into(),
-        passed: trace < 0.0 && det > 0.0,
+        passed: sway_yaw.course_stable(),
         refuses: false,
         measure: None,
-        detail: if trace < 0.0 && det > 0.0 {
+        detail: if sway_yaw.course_stable() {
             format!("stable, slowest eigenvalue {largest:.4} 1/s")
         } else {
             format!(

@@ -14,6 +14,7 @@ pub mod observed;
 pub mod particulars;
 pub mod plugin;
 pub mod spec;
+pub mod stability;
 pub mod tracking;
 
 use std::collections::BTreeMap;
