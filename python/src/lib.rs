@@ -796,6 +796,28 @@ impl PyModel {
         termid::ship::observed::SteeringGear::of_runs(&self.inner, &frames).map(|g| to_json(&g)).transpose()
     }
 
+    /// A ship model's linear sway and yaw at its straight run, at `speed` (m/s) or its own u0
+    /// (JSON), `None` for another model.
+    #[pyo3(signature = (speed = None))]
+    fn sway_yaw(&self, speed: Option<f64>) -> PyResult<Option<String>> {
+        if termid::ship::ShipSpec::of(&self.inner).map_err(fail)?.is_none() {
+            return Ok(None);
+        }
+        let model = speed.map_or(Cow::Borrowed(&self.inner), |u| {
+            Cow::Owned(termid::ship::basin::at_approach_speed(&self.inner, u))
+        });
+        let ship = termid::ship::Ship::new(&model, false).map_err(fail)?;
+        let start = ship.straight_run().map_err(fail)?;
+        let s = termid::ship::stability::SwayYaw::of(&ship, &start);
+        to_json(&serde_json::json!({
+            "u0": s.u0, "delta0_deg": start.delta0_deg,
+            "yv": s.yv, "yr": s.yr, "nv": s.nv, "nr": s.nr, "n_delta": s.n_delta,
+            "time_constants_s": s.time_constants().map(|(fast, slow)| [fast, slow]),
+            "largest_eigenvalue": s.largest_eigenvalue(), "course_stable": s.course_stable(),
+        }))
+        .map(Some)
+    }
+
     /// Pickling (to a worker process): the model file's text and its name.
     fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (String, String))> {
         let make = py.get_type::<PyModel>().getattr("parse")?;

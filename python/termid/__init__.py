@@ -1323,6 +1323,22 @@ class Model:
         text = self._native.steering_gear(_runs(runs))
         return None if text is None else json.loads(text)
 
+    def sway_yaw(self, speed: Optional[float] = None) -> Optional[Dict[str, Any]]:
+        """A ship model's linear sway and yaw at its straight run, at ``speed`` (m/s; ``None``:
+        the model's own u0): ``yv`` = ∂v̇/∂v and ``nr`` = ∂ṙ/∂r (1/s, the damping; negative on
+        every hull), ``yr`` = ∂v̇/∂r, ``nv`` = ∂ṙ/∂v, ``n_delta`` = ∂ṙ/∂δ (1/s², the rudder's
+        yaw moment per radian), ``time_constants_s`` (the fast and the slow mode, s; a negative
+        one is course-unstable; ``None`` for an oscillating pair), ``largest_eigenvalue`` (1/s),
+        ``course_stable``, ``u0`` and ``delta0_deg`` of the straight run; ``None`` for another
+        model. What a model carries into the turns beyond what its zigzags bound.
+
+        >>> s = termid.Model.default().sway_yaw()
+        >>> s["course_stable"], s["yv"] < 0, s["nr"] < 0, s["time_constants_s"][0] > 0
+        (True, True, True, True)
+        """
+        text = self._native.sway_yaw(speed)
+        return None if text is None else json.loads(text)
+
     def __repr__(self) -> str:
         return repr(self._native)
 

@@ -91,9 +91,9 @@ impl SwayYaw {
 mod tests {
     use super::*;
 
-    /// The paper's ship: damped in sway and yaw, course-stable, its rudder turning it to
-    /// starboard for δ > 0; the eigenvalues from the time constants agree with the trace and
-    /// determinant, and a closed-form 2×2 case (diagonal) gives its own time constants.
+    /// The paper's ship: damped in sway and yaw, course-stable, with a rudder moment; the
+    /// eigenvalues from the time constants agree with the trace and the determinant; closed-form
+    /// 2×2 cases (triangular: their own time constants; coupled into instability).
     #[test]
     fn the_papers_ship_and_a_diagonal_case() {
         let ship = Ship::new(&crate::ship::default_model(), false).unwrap();
