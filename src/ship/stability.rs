@@ -60,18 +60,13 @@ impl SwayYaw {
 
     /// The larger real part of the two eigenvalues, 1/s (positive: a disturbance grows).
     pub fn largest_eigenvalue(&self) -> f64 {
-        let disc = self.trace() * self.trace() / 4.0 - self.determinant();
-        if disc >= 0.0 {
-            self.trace() / 2.0 + disc.sqrt()
-        } else {
-            self.trace() / 2.0
-        }
+        self.trace() / 2.0 + self.discriminant().max(0.0).sqrt()
     }
 
     /// The two time constants −1/λ, s, fast first, where both eigenvalues are real (a negative
     /// one is the doubling time of an unstable mode over ln 2); `None` for an oscillating pair.
     pub fn time_constants(&self) -> Option<(f64, f64)> {
-        let disc = self.trace() * self.trace() / 4.0 - self.determinant();
+        let disc = self.discriminant();
         (disc >= 0.0).then(|| {
             let (a, b) = (self.trace() / 2.0 - disc.sqrt(), self.trace() / 2.0 + disc.sqrt());
             (-1.0 / a, -1.0 / b)
@@ -85,6 +80,11 @@ impl SwayYaw {
     fn determinant(&self) -> f64 {
         self.yv * self.nr - self.yr * self.nv
     }
+
+    /// (trace/2)² − determinant: the eigenvalues are trace/2 ± its root, real where ≥ 0.
+    fn discriminant(&self) -> f64 {
+        self.trace() * self.trace() / 4.0 - self.determinant()
+    }
 }
 
 #[cfg(test)]
@@ -95,7 +95,7 @@ mod tests {
     /// eigenvalues from the time constants agree with the trace and the determinant; closed-form
     /// 2×2 cases (triangular: their own time constants; coupled into instability).
     #[test]
-    fn the_papers_ship_and_a_diagonal_case() {
+    fn the_papers_ship_and_closed_form_cases() {
         let ship = Ship::new(&crate::ship::default_model(), false).unwrap();
         let start = ship.straight_run().unwrap();
         let s = SwayYaw::of(&ship, &start);
