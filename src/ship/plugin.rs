@@ -106,7 +106,7 @@ impl Plugin for Manoeuvring {
         for (atom, k) in &m.factors {
             let name = match atom {
                 crate::term::Atom::Var(v) if *v == n.u || v == "U" => continue,
-                crate::term::Atom::Var(v) if *v == n.rudder => "δ".to_string(),
+                crate::term::Atom::Var(v) if rudder_angle(model, v, &n.rudder) => "δ".to_string(),
                 crate::term::Atom::Var(v) => v.clone(),
                 crate::term::Atom::Call(f, args) if f == "abs" => format!("|{}|", args.first()?),
                 _ => return None,
@@ -333,5 +333,52 @@ impl Scenario for ShipScenario {
             add_bands(&mut fig, &self.ship, draws);
         }
         fig
+    }
+}
+
+/// Whether `name` is the rudder's angle: the rudder input itself, or a derived variable that
+/// is the input less a parameter (the angle from its indicator's zero, `δ_t = δ - δ_0`).
+fn rudder_angle(model: &Model, name: &str, rudder: &str) -> bool {
+    use crate::term::Atom;
+    if name == rudder {
+        return true;
+    }
+    let Some(definition) = model.vocabulary.derived_definition(name) else { return false };
+    let parameters = model.vocabulary.parameters();
+    let single = |m: &crate::term::Monomial, want: &dyn Fn(&str) -> bool| matches!(m.factors.as_slice(), [(Atom::Var(v), 1)] if want(v));
+    match definition.monomials() {
+        [a, b] => {
+            let (input, zero) = if single(a, &|v| v == rudder) { (a, b) } else { (b, a) };
+            input.coef == 1.0
+                && single(input, &|v| v == rudder)
+                && zero.coef == -1.0
+                && single(zero, &|v| parameters.iter().any(|p| p == v))
+        }
+        _ => false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plugin::Plugin;
+
+    /// The field's names of the template's coefficients: the rudder is δ whether a term reads
+    /// the input or its angle from the indicator's zero (`δ_t = δ - δ_0`); u and U make the
+    /// term a force and are no subscript.
+    #[test]
+    fn coefficients_are_named_as_the_field_names_them() {
+        let model = Model::parse(include_str!("../../models/new_ship.toml"), "new_ship.toml").unwrap();
+        let name = |equation: &str, term: &str| {
+            let t = model.vocabulary.parse(term).unwrap();
+            Manoeuvring.coefficient_name(&model, equation, &t)
+        };
+        assert_eq!(name("r_dot", "u^2*δ_t").as_deref(), Some("N'_δ"));
+        assert_eq!(name("v_dot", "u^2*δ_t^3").as_deref(), Some("Y'_δδδ"));
+        assert_eq!(name("r_dot", "u^2*δ").as_deref(), Some("N'_δ"));
+        assert_eq!(name("v_dot", "U*v").as_deref(), Some("Y'_v"));
+        assert_eq!(name("u_dot", "u^2").as_deref(), Some("X'_0"));
+        // a derived variable that is not the rudder less a parameter keeps its own name
+        assert!(!rudder_angle(&model, "U", "δ"));
     }
 }

@@ -626,6 +626,58 @@ fn two_basins_with_their_own_rudder_zero() {
     assert_eq!(fit.model.parameter_values()["δ_0"], 0.0);
 }
 
+/// The polynomial template from two basins, each with its own rudder zero (+0.3° and −0.5°):
+/// the recipe's regression cannot move `δ_0` (its rudder terms read `δ_t = δ − δ_0`), so each
+/// basin's zero is estimated with the term coefficients afterwards. The absolute zero trades
+/// against the template's asymmetry terms (u², n²); the two basins' difference cannot, and
+/// comes back.
+#[test]
+fn the_polynomial_template_from_two_basins_with_their_own_rudder_zero() {
+    use termid::recipe::{identify, RecipeSettings};
+    use termid::ship::basin::Basin;
+
+    let truth = mmg_truth();
+    let template = termid::plugins::load(std::path::Path::new("models/new_ship.toml")).unwrap();
+    let offsets = [0.3f64.to_radians(), -0.5f64.to_radians()];
+    let mut frames = Vec::new();
+    let mut sources = Vec::new();
+    for (s, (offset, seed)) in offsets.iter().zip([41, 51]).enumerate() {
+        let zigzags = [("zigzag:20/20", 1.0), ("zigzag:20/20:port", 0.98), ("zigzag:10/10", 1.0)];
+        for (_, rec) in Basin::default().record_all(&truth, &zigzags, 1.17248, 60.0, seed, None).unwrap() {
+            let mut f = rec.measured;
+            let read: Vec<f64> = f.column("δ").unwrap().iter().map(|d| d + offset).collect();
+            f.set("δ", read).unwrap();
+            frames.push(f);
+            sources.push(s);
+        }
+    }
+    let settings = RecipeSettings {
+        derivatives: vec!["kalman".into()],
+        smooth: true,
+        intercept: false,
+        ..Default::default()
+    };
+    let identified = identify(&template, &frames, None, &settings).unwrap().kept().model.clone();
+    assert_eq!(identified.parameter_values()["δ_0"], 0.0);
+    let settings = EstimateSettings {
+        coefficients: true,
+        sources,
+        per_source: vec!["δ_0".into()],
+        ..Default::default()
+    };
+    let fit = estimate(&identified, &runs_of(&identified, &frames), &settings).unwrap();
+    let zero = |s: usize| fit.per_source.iter().find(|p| p.source == s).unwrap().value;
+    let (got, want) = (zero(0) - zero(1), offsets[0] - offsets[1]);
+    assert!(
+        (got - want).abs() < 0.1f64.to_radians(),
+        "the basins' zeros differ by {:.3}°, truly {:.3}°\n{}",
+        got.to_degrees(),
+        want.to_degrees(),
+        fit.text()
+    );
+    assert!(fit.cost_after < fit.cost_before, "{}", fit.text());
+}
+
 /// `estimate --against`: the estimated grey-box model and another of the same ship compared
 /// on what the runs did not cover; the particulars' unestimated model (19-31 % off on the
 /// turning circles) is flagged, the truth is not.
