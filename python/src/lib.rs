@@ -673,7 +673,7 @@ impl PyModel {
     /// The library's recipe (several derivative starts, choice among back-ends by
     /// prediction, output-error refinement, checks, the starts' agreement): (JSON of every
     /// start and the kept one's report, the report as text, the kept model).
-    #[pyo3(signature = (runs, derivatives, smooth = false, intercept = None, choose = vec![], compare = vec![], refine = None, refine_iterations = 100, refine_prior = 1e-4, held_out = vec![], refine_step = None))]
+    #[pyo3(signature = (runs, derivatives, smooth = false, intercept = None, choose = vec![], compare = vec![], refine = None, refine_iterations = 100, refine_prior = 1e-4, held_out = vec![], refine_step = None, parameters = false, sources = vec![], per_source = vec![]))]
     #[allow(clippy::too_many_arguments)]
     fn recipe(
         &self,
@@ -689,6 +689,9 @@ impl PyModel {
         refine_prior: f64,
         held_out: Vec<Run<'_>>,
         refine_step: Option<f64>,
+        parameters: bool,
+        sources: Vec<usize>,
+        per_source: Vec<String>,
     ) -> PyResult<(String, String, PyModel)> {
         let frames = self.frames(runs)?;
         let held = if held_out.is_empty() { None } else { Some(self.frames(held_out)?) };
@@ -699,20 +702,23 @@ impl PyModel {
                 Ok((name.clone(), self.inner.with_backend(&backend).map_err(fail)?))
             })
             .collect::<PyResult<Vec<_>>>()?;
-        let settings = termid::recipe::RecipeSettings {
-            derivatives,
-            smooth,
-            intercept: intercept.unwrap_or(self.inner.spec().model.intercept),
-            choose,
-            compare,
-            refine: refine.map(|states| termid::recipe::RefineOptions {
-                states: (!states.is_empty()).then_some(states),
-                prior: refine_prior,
-                iterations: refine_iterations,
-                step: refine_step,
-            }),
-            ..Default::default()
-        };
+        let settings =
+            termid::recipe::RecipeSettings {
+                derivatives,
+                smooth,
+                intercept: intercept.unwrap_or(self.inner.spec().model.intercept),
+                choose,
+                compare,
+                refine: refine.map(|states| termid::recipe::RefineOptions {
+                    states: (!states.is_empty()).then_some(states),
+                    prior: refine_prior,
+                    iterations: refine_iterations,
+                    step: refine_step,
+                }),
+                parameters: (parameters || !per_source.is_empty())
+                    .then(|| termid::recipe::ParameterOptions { sources, per_source, ..Default::default() }),
+                ..Default::default()
+            };
         let recipe = py
             .detach(|| termid::recipe::identify(&self.inner, &frames, held.as_deref(), &settings))
             .map_err(fail)?;

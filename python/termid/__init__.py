@@ -679,7 +679,9 @@ class Recipe:
     (derivative, refused checks, re-simulation cost, which is kept), the kept model's
     ``checks`` (with the starts' agreement: a failing one flags a prediction the runs
     cannot pin down), ``refusals`` (why it must not be written, if any), the ``report`` as
-    plain values and as ``text``.
+    plain values and as ``text``, and the estimate of the model file's free ``parameters``
+    where asked for (the report's ``parameter_estimate``: each parameter, and under
+    ``per_source`` each source's; None where not asked for or not kept).
 
     >>> ship = termid.Model.default()
     >>> runs = [ship.simulate(m) for m in ("zigzag:20/20", "zigzag:10/10")]
@@ -695,6 +697,7 @@ class Recipe:
         self.refusals: List[str] = list(report["refusals"])
         self.failed = list(report["failed"])
         self.report = report["report"]
+        self.parameters: Optional[Mapping[str, Any]] = self.report.get("parameter_estimate")
         self.text = text
 
     def __repr__(self) -> str:
@@ -1187,6 +1190,9 @@ class Model:
         refine_prior: float = 1e-4,
         held_out: Union[Data, Sequence[Data], None] = None,
         refine_step: Optional[float] = None,
+        parameters: bool = False,
+        sources: Optional[Sequence[int]] = None,
+        per_source: Sequence[str] = (),
     ) -> "Recipe":
         """The command line's recipe for a model from runs (``termid identify --model`` with
         several ``--derivative`` starts) from ``runs``: each start prepares them by one derivative method
@@ -1199,7 +1205,13 @@ class Model:
         are reported at every sample), stopped by ``held_out`` runs where given, checked by the model's
         plug-in; the start kept that passes the checks and re-simulates best, and a flag where
         the plausible starts disagree on a turning circle. ``intercept`` as for
-        :meth:`identify` (None: the model file's). Defaults are the new-ship recipe's.
+        :meth:`identify` (None: the model file's). ``parameters`` (implied by ``per_source``)
+        lastly estimates the model file's free parameters with every coefficient of the kept
+        start and each run's initial state, kept where the checks it passed still pass (a
+        regression cannot estimate a parameter inside its terms, such as the new-ship
+        template's rudder zero ``δ_0``); ``per_source`` names those estimated once per source,
+        ``sources`` numbering each run's source (basin); the estimate in ``parameters`` of the
+        result. Defaults are the new-ship recipe's.
 
         >>> ship = termid.Model.default()
         >>> ship.set_parameter("u0", "mean:u:4")
@@ -1224,6 +1236,9 @@ class Model:
             refine_prior,
             held,
             refine_step,
+            parameters,
+            [int(s) for s in sources or []],
+            list(per_source),
         )
         return Recipe(Model(native), json.loads(text_json), text)
 

@@ -105,6 +105,10 @@ class Model:
         refine_iterations: int = 100,
         refine_prior: float = 1e-4,
         held_out: Sequence[Run] = ...,
+        refine_step: Optional[float] = None,
+        parameters: bool = False,
+        sources: Sequence[int] = ...,
+        per_source: Sequence[str] = ...,
     ) -> Tuple[str, str, Model]: ...
     def estimate(
         self,

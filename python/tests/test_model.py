@@ -245,3 +245,26 @@ def test_estimate_recovers_nomoto_k_and_t_from_a_noisy_run():
     assert table.attrs["covariance"].shape == (2, 2) and table.attrs["cost_after"] < table.attrs["cost_before"]
     with pytest.raises(termid.TermidError, match="free"):
         termid.Model.builtin("lorenz").estimate(run.rename(columns={"ψ": "x", "r": "y", "δ": "z"}))
+
+
+def test_recipe_estimates_each_basins_rudder_zero():
+    """The new-ship template from two basins whose rudder indicators read +0.3° and −0.5°
+    off: the recipe's parameter stage estimates each basin's zero with the coefficients; their
+    difference comes back (the common part trades against the template's asymmetry terms)."""
+    truth = termid.Model.builtin("mmg_kvlcc2")
+    runs, sources = [], []
+    for source, (offset, seed) in enumerate([(0.3, 41), (-0.5, 51)]):
+        for k, manoeuvre in enumerate(["zigzag:20/20", "zigzag:20/20:port", "zigzag:10/10"]):
+            run = truth.record(manoeuvre, duration=60.0, seed=seed + k)
+            run["δ"] += np.radians(offset)
+            runs.append(run)
+            sources.append(source)
+    found = termid.Model.builtin("new_ship").recipe(
+        runs, ["kalman"], refine=None, per_source=["δ_0"], sources=sources
+    )
+    zeros = {p["source"]: p["value"] for p in found.parameters["per_source"]}
+    assert abs(np.degrees(zeros[0] - zeros[1]) - 0.8) < 0.1, found.text
+    assert found.model.parameters["δ_0"] == 0.0
+    with pytest.raises(termid.TermidError, match="no parameter is free"):
+        ship = termid.Model.default()
+        ship.recipe([ship.simulate("zigzag:20/20")], ["central"], refine=None, parameters=True)

@@ -1,12 +1,15 @@
 //! The recipe for a model identified from runs, as one call: several starts (one per
 //! derivative preparation), each identified or chosen among configurations by what it
 //! predicts, refined by output error and checked by its plug-in; the start kept that passes
-//! the checks and re-simulates best; and, where the plausible starts disagree on a manoeuvre
-//! the runs did not cover, a flag saying that prediction is uncertain.
+//! the checks and re-simulates best, its model file's free parameters estimated with its
+//! coefficients where asked; and, where the plausible starts disagree on a manoeuvre the runs
+//! did not cover, a flag saying that prediction is uncertain.
 
+mod parameters;
 mod report;
 mod start;
 
+pub use parameters::{ParameterOptions, ParameterStage};
 pub use report::Primes;
 pub use start::{derivative_method, prepare_runs, Start};
 
@@ -44,6 +47,8 @@ pub struct RecipeSettings {
     /// How far (relative) plausible starts may disagree on a measure of a manoeuvre the runs
     /// did not cover before the prediction is flagged.
     pub agree: f64,
+    /// The kept start's free parameters estimated with its coefficients (none: not).
+    pub parameters: Option<ParameterOptions>,
 }
 
 impl Default for RecipeSettings {
@@ -60,6 +65,7 @@ impl Default for RecipeSettings {
             compare: vec![],
             refine: None,
             agree: 0.10,
+            parameters: None,
         }
     }
 }
@@ -116,6 +122,8 @@ pub struct Recipe {
     pub failed: Vec<(String, String)>,
     /// Whether costs are the validation runs'.
     pub validated: bool,
+    /// What the parameter stage did to the kept start, where it ran.
+    pub parameters: Option<ParameterStage>,
 }
 
 /// Identifies `model` from `frames` by the recipe; `held` are runs that stop each refinement
@@ -132,6 +140,30 @@ pub fn identify(
             settings.derivatives.join(",")
         )));
     }
+    if let Some(options) = &settings.parameters {
+        // said before any work
+        if model.free_parameters().is_empty() {
+            return Err(RecipeError::Setup(format!(
+                "{}: no parameter is free (`free = true` under [parameters.NAME]), so there is none to estimate",
+                model.path
+            )));
+        }
+        let free: Vec<String> = model.free_parameters().iter().map(|p| p.name.clone()).collect();
+        if let Some(n) = options.per_source.iter().find(|n| !free.contains(n)) {
+            return Err(RecipeError::Setup(format!(
+                "`{n}` is to be estimated per source, but it is no free parameter of {} (free: {})",
+                model.path,
+                free.join(", ")
+            )));
+        }
+        if !options.sources.is_empty() && options.sources.len() != frames.len() {
+            return Err(RecipeError::Setup(format!(
+                "{} sources for {} runs: give each run its source",
+                options.sources.len(),
+                frames.len()
+            )));
+        }
+    }
     let mut starts = Vec::new();
     let mut failed = Vec::new();
     // the starts are independent: side by side, they fill the cores the per-run work leaves idle
@@ -147,7 +179,32 @@ pub fn identify(
             Err(e) => return Err(e),
         }
     }
-    Recipe::of(starts, failed, held.is_some(), settings.agree)
+    let mut recipe = Recipe::of(starts, failed, held.is_some(), settings.agree)?;
+    if let Some(options) = &settings.parameters {
+        let states = settings.refine.as_ref().and_then(|r| r.states.as_deref());
+        let kept = &mut recipe.starts[recipe.kept];
+        let stage = parameters::estimate_parameters(kept, frames, states, settings.intercept, options);
+        if matches!(stage, ParameterStage::Kept(_)) {
+            // the kept model changed: its agreement with the other starts is its new one
+            recipe.agreement = agreement(&recipe.starts, recipe.kept, settings.agree);
+        }
+        recipe.parameters = Some(stage);
+    }
+    Ok(recipe)
+}
+
+/// Whether the plausible starts agree with the kept one (`kept`) on each measure of its checks.
+fn agreement(starts: &[Start], kept: usize, agree: f64) -> Vec<Check> {
+    // the starts that pass their checks are models the runs cannot tell apart: where
+    // they disagree on a manoeuvre the runs did not cover, that prediction is that uncertain
+    let plausible: Vec<(&str, &[Check])> = starts
+        .iter()
+        .enumerate()
+        .filter(|(k, s)| *k == kept || s.refused() == 0)
+        .map(|(_, s)| (s.derivative.as_str(), s.checks.as_slice()))
+        .collect();
+    let at = plausible.iter().position(|(d, _)| *d == starts[kept].derivative).unwrap_or(0);
+    crate::plugin::disagreement(&plausible, at, agree, "the starts")
 }
 
 impl Recipe {
@@ -169,17 +226,8 @@ impl Recipe {
                     failed.first().map_or("no derivative method given".into(), |(m, e)| format!("{m}: {e}")),
                 )
             })?;
-        // the starts that pass their checks are models the runs cannot tell apart: where
-        // they disagree on a manoeuvre the runs did not cover, that prediction is that uncertain
-        let plausible: Vec<(&str, &[Check])> = starts
-            .iter()
-            .enumerate()
-            .filter(|(k, s)| *k == kept || s.refused() == 0)
-            .map(|(_, s)| (s.derivative.as_str(), s.checks.as_slice()))
-            .collect();
-        let at = plausible.iter().position(|(d, _)| *d == starts[kept].derivative).unwrap_or(0);
-        let agreement = crate::plugin::disagreement(&plausible, at, agree, "the starts");
-        Ok(Recipe { starts, kept, agreement, failed, validated })
+        let agreement = agreement(&starts, kept, agree);
+        Ok(Recipe { starts, kept, agreement, failed, validated, parameters: None })
     }
 
     /// The kept start.

@@ -109,6 +109,9 @@ impl Recipe {
         if let Some(r) = &kept.refined {
             out += &r.text();
         }
+        if let Some(stage) = &self.parameters {
+            out += &stage.text();
+        }
         if let Some(p) = self.primes() {
             out += &p.text();
         }
@@ -133,6 +136,21 @@ impl Recipe {
         }
         if let Some(r) = &kept.refined {
             all.insert("output_error_refinement".into(), serde_json::to_value(r)?);
+        }
+        match &self.parameters {
+            Some(super::ParameterStage::Kept(e)) => {
+                all.insert("parameter_estimate".into(), serde_json::to_value(e)?);
+            }
+            Some(super::ParameterStage::Rejected(e, lost)) => {
+                all.insert(
+                    "parameter_estimate_rejected".into(),
+                    serde_json::json!({"estimate": e, "fails": lost}),
+                );
+            }
+            Some(super::ParameterStage::Failed(why)) => {
+                all.insert("parameter_estimate_failed".into(), why.clone().into());
+            }
+            None => {}
         }
         let checks = self.checks();
         if !checks.is_empty() {

@@ -156,9 +156,6 @@ pub(super) fn identify_start(
     let mut model = identified.model;
     // what the field knows must hold: the plug-in's physical checks of a model
     let checks_of = |m: &Model| crate::plugins::of(m).map(|p| p.checks(m, &prepared)).unwrap_or_default();
-    let failing = |checks: &[Check]| -> Vec<String> {
-        checks.iter().filter(|c| !c.passed && c.refuses).map(|c| c.name.clone()).collect()
-    };
     let mut start = Start {
         derivative: derivative.to_string(),
         model: model.clone(),
@@ -177,9 +174,7 @@ pub(super) fn identify_start(
                 Ok(r) => {
                     // a refinement must not make a model fail what its field knows it passed
                     let (before, after) = (checks_of(&model), checks_of(&r.model));
-                    let was = failing(&before);
-                    let lost: Vec<String> =
-                        failing(&after).into_iter().filter(|c| !was.contains(c)).collect();
+                    let lost = lost_checks(&before, &after);
                     if lost.is_empty() {
                         model = r.model.clone();
                         start.checks = after;
@@ -200,6 +195,16 @@ pub(super) fn identify_start(
     start.model = model;
     start.prepared = prepared;
     Ok(start)
+}
+
+/// The refusing checks that `after` fails and `before` passed: what a later stage (a
+/// refinement, a parameter estimate) must not lose.
+pub(super) fn lost_checks(before: &[Check], after: &[Check]) -> Vec<String> {
+    let failing = |checks: &[Check]| -> Vec<String> {
+        checks.iter().filter(|c| !c.passed && c.refuses).map(|c| c.name.clone()).collect()
+    };
+    let was = failing(before);
+    failing(after).into_iter().filter(|c| !was.contains(c)).collect()
 }
 
 /// Every identified coefficient refined by output error on the runs as they were prepared

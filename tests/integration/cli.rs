@@ -295,6 +295,9 @@ fn backend_and_choose_with_a_model() {
     assert!(std::fs::read_to_string(&written).unwrap().contains("x*z"));
     let (ok, _, err) = identify(&["--choose", "lasso"]);
     assert!(!ok && err.contains("unknown back-end `lasso`"), "{err}");
+    // a parameter stage needs a free parameter to estimate
+    let (ok, _, err) = identify(&["--no-intercept", "--parameters"]);
+    assert!(!ok && err.contains("no parameter is free"), "{err}");
     // a model file among the configurations: a library without x·z cannot predict y
     let text = std::fs::read_to_string("models/lorenz.toml").unwrap().replace("\"x*z\", ", "");
     let poor = dir.join("no_xz.toml");

@@ -626,14 +626,14 @@ fn two_basins_with_their_own_rudder_zero() {
     assert_eq!(fit.model.parameter_values()["δ_0"], 0.0);
 }
 
-/// The polynomial template from two basins, each with its own rudder zero (+0.3° and −0.5°):
-/// the recipe's regression cannot move `δ_0` (its rudder terms read `δ_t = δ − δ_0`), so each
-/// basin's zero is estimated with the term coefficients afterwards. The absolute zero trades
-/// against the template's asymmetry terms (u², n²); the two basins' difference cannot, and
-/// comes back.
+/// The polynomial template from two basins, each with its own rudder zero (+0.3° and −0.5°),
+/// by the recipe with its parameter stage: the regression cannot move `δ_0` (the template's
+/// rudder terms read `δ_t = δ − δ_0`), so each basin's zero is estimated with the term
+/// coefficients last. The absolute zero trades against the template's asymmetry terms (u²,
+/// n²); the two basins' difference cannot, and comes back.
 #[test]
 fn the_polynomial_template_from_two_basins_with_their_own_rudder_zero() {
-    use termid::recipe::{identify, RecipeSettings};
+    use termid::recipe::{identify, ParameterOptions, ParameterStage, RecipeSettings};
     use termid::ship::basin::Basin;
 
     let truth = mmg_truth();
@@ -655,17 +655,13 @@ fn the_polynomial_template_from_two_basins_with_their_own_rudder_zero() {
         derivatives: vec!["kalman".into()],
         smooth: true,
         intercept: false,
+        parameters: Some(ParameterOptions { sources, per_source: vec!["δ_0".into()], ..Default::default() }),
         ..Default::default()
     };
-    let identified = identify(&template, &frames, None, &settings).unwrap().kept().model.clone();
-    assert_eq!(identified.parameter_values()["δ_0"], 0.0);
-    let settings = EstimateSettings {
-        coefficients: true,
-        sources,
-        per_source: vec!["δ_0".into()],
-        ..Default::default()
+    let recipe = identify(&template, &frames, None, &settings).unwrap();
+    let Some(ParameterStage::Kept(fit)) = &recipe.parameters else {
+        panic!("the parameter stage: {}", recipe.text());
     };
-    let fit = estimate(&identified, &runs_of(&identified, &frames), &settings).unwrap();
     let zero = |s: usize| fit.per_source.iter().find(|p| p.source == s).unwrap().value;
     let (got, want) = (zero(0) - zero(1), offsets[0] - offsets[1]);
     assert!(
@@ -676,6 +672,15 @@ fn the_polynomial_template_from_two_basins_with_their_own_rudder_zero() {
         fit.text()
     );
     assert!(fit.cost_after < fit.cost_before, "{}", fit.text());
+    // the kept model holds the estimated coefficients and the file's zero; the report says so
+    assert_eq!(recipe.kept().model.parameter_values()["δ_0"], 0.0);
+    assert!(recipe.text().contains("output-error estimate of the free parameters"), "{}", recipe.text());
+    // the checks that steer the runs as recorded do so with each basin's own zero
+    assert!(
+        recipe.checks().iter().any(|c| c.detail.contains("source 1:") && c.detail.contains("source 2:")),
+        "{}",
+        recipe.text()
+    );
 }
 
 /// `estimate --against`: the estimated grey-box model and another of the same ship compared

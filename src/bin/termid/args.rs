@@ -293,6 +293,16 @@ pub struct IdentifyCommand {
     /// (of its iterates, the one that predicts these runs best is kept).
     #[arg(long, value_name = "DATASET", requires = "refine")]
     pub refine_validation: Option<PathBuf>,
+    /// With --model: last, estimate the model file's free parameters (`free = true`, e.g. the
+    /// new-ship template's rudder zero `δ_0`) by output error together with every coefficient
+    /// of the kept start and each run's initial state; kept where the checks it passed still
+    /// pass. A regression cannot estimate a parameter inside its terms.
+    #[arg(long, requires = "model")]
+    pub parameters: bool,
+    /// With --parameters (implied): these free parameters estimated once per source (each
+    /// --dataset a source, the --data files another), e.g. each basin's rudder indicator zero.
+    #[arg(long, num_args = 1.., value_delimiter = ',', requires = "model")]
+    pub per_source: Vec<String>,
     /// With --model: choose among these back-ends and model files (comma-separated, or `all`
     /// back-ends; a model file is another candidate library for the same equations) by what
     /// they predict: each run is re-simulated by the model identified on the other runs; of

@@ -26,22 +26,7 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
             model.path
         );
     }
-    // each dataset file a source, the --data files another
-    let mut frames = Vec::new();
-    let mut sources = Vec::new();
-    let mut labels = Vec::new();
-    if !cmd.data.is_empty() {
-        let more = crate::runs::load_for(&model, &cmd.data, &[])?;
-        sources.extend(std::iter::repeat_n(labels.len(), more.len()));
-        labels.push("--data".to_string());
-        frames.extend(more);
-    }
-    for d in &cmd.dataset {
-        let more = crate::runs::load_for(&model, &[], std::slice::from_ref(d))?;
-        sources.extend(std::iter::repeat_n(labels.len(), more.len()));
-        labels.push(d.display().to_string());
-        frames.extend(more);
-    }
+    let (frames, sources, labels) = crate::runs::load_sources(&model, &cmd.data, &cmd.dataset)?;
     // one RK4 step per sample by default: the recorded input is known only at the samples
     let dt = cmd.dt.unwrap_or_else(|| termid::data::sample_step(&frames));
     let mut runs = Runs::new(&model, &frames, dt, Integrator::Rk4)?;
@@ -96,9 +81,7 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
                 }
             }
             if !fit.per_source.is_empty() {
-                for (k, label) in labels.iter().enumerate() {
-                    println!("source {}: {label}", k + 1);
-                }
+                print!("{}", crate::runs::source_labels(&labels));
             }
             if let Some(out) = &cmd.out {
                 println!("written: {}", out.display());

@@ -1,11 +1,11 @@
 //! `termid identify --model`: every identifiable equation of a model file from its runs by
-//! the library's recipe (`termid::recipe`: starts, choice by prediction, refinement, checks,
-//! the starts' agreement); this file reads the command line, prints and writes.
+//! the library's recipe (`termid::recipe`: starts, choice by prediction, refinement, the
+//! model file's free parameters, checks, the starts' agreement); this file reads the command
+//! line, prints and writes.
 
 use anyhow::{bail, Context, Result};
-use termid::data::differentiator;
 use termid::identify::Target;
-use termid::recipe::{RecipeSettings, RefineOptions, Start};
+use termid::recipe::{ParameterOptions, ParameterStage, RecipeSettings, RefineOptions};
 use termid::select::Backend;
 
 use crate::args::{Format, IdentifyCommand};
@@ -37,15 +37,17 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
             cmd.derivative
         );
     }
-    let recipe = match in_pieces(&cmd, refine.is_some())? {
+    let mut source_labels = Vec::new();
+    let recipe = match crate::moments::in_pieces(&cmd, refine.is_some())? {
         Some(rows) => termid::recipe::Recipe::of(
-            vec![identify_in_pieces(&cmd, &model, rows)?],
+            vec![crate::moments::identify_in_pieces(&cmd, &model, rows)?],
             vec![],
             false,
             STARTS_AGREE,
         )?,
         None => {
-            let frames = crate::runs::load_for(&model, &cmd.data, &cmd.dataset)?;
+            let (frames, sources, labels) = crate::runs::load_sources(&model, &cmd.data, &cmd.dataset)?;
+            source_labels = labels;
             let held = cmd
                 .refine_validation
                 .as_ref()
@@ -74,6 +76,11 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
                     step: cmd.refine_step,
                 }),
                 agree: STARTS_AGREE,
+                parameters: (cmd.parameters || !cmd.per_source.is_empty()).then(|| ParameterOptions {
+                    sources,
+                    per_source: cmd.per_source.clone(),
+                    ..Default::default()
+                }),
             };
             let label = format!(
                 "identifying ({} start{})",
@@ -115,6 +122,16 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
             lost.join("; ")
         );
     }
+    match &recipe.parameters {
+        Some(ParameterStage::Rejected(_, lost)) => eprintln!(
+            "warning: the parameter estimate is rejected: the model would fail checks it passes ({}); the model is kept as refined",
+            lost.join("; ")
+        ),
+        Some(ParameterStage::Failed(why)) => {
+            eprintln!("warning: the parameter estimate failed: {why}; the model is kept as refined")
+        }
+        _ => {}
+    }
     // checked before anything is written
     let refused = recipe.refusals();
     let write = refused.is_empty() || cmd.keep_unphysical;
@@ -137,6 +154,9 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
         Format::Json => println!("{}", serde_json::to_string_pretty(&recipe.json()?)?),
         Format::Text => {
             print!("{}", recipe.text());
+            if !cmd.per_source.is_empty() {
+                print!("{}", crate::runs::source_labels(&source_labels));
+            }
             if let Some(out) = cmd.out.as_ref().filter(|_| write) {
                 println!("wrote {}", out.display());
             }
@@ -162,91 +182,6 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
 /// How far (relative) the plausible starts may disagree on a measure of a manoeuvre the runs
 /// did not cover before the prediction is flagged as uncertain.
 const STARTS_AGREE: f64 = 0.10;
-
-/// Files together larger than this are read in pieces by `identify --model` where they can be.
-const WHOLE_LIMIT: u64 = 256 << 20;
-
-/// Rows a piece when `--chunk-rows` is not given.
-const PIECE_ROWS: usize = 262_144;
-
-/// Whether `identify --model` reads its runs in pieces, and in how many rows: asked for with
-/// `--chunk-rows`, or files beyond [`WHOLE_LIMIT`] where nothing needs whole runs.
-fn in_pieces(cmd: &IdentifyCommand, refine: bool) -> Result<Option<usize>> {
-    let local = differentiator(&cmd.derivative).ok().and_then(|d| d.reach()).is_some();
-    let whole_runs_needed = [
-        (!cmd.dataset.is_empty(), "--dataset"),
-        (cmd.resample.is_some(), "--resample"),
-        (cmd.smooth, "--smooth"),
-        (cmd.prepared_svg.is_some(), "--prepared-svg"),
-        (refine, "--refine"),
-        (cmd.choose.is_some(), "--choose"),
-        (cmd.target.is_some(), "--target"),
-        (!local, "a --derivative that needs whole runs"),
-    ];
-    let needs: Vec<&str> = whole_runs_needed.iter().filter(|(yes, _)| *yes).map(|(_, what)| *what).collect();
-    match cmd.chunk_rows {
-        Some(0) => Ok(None),
-        Some(_) if !needs.is_empty() => bail!(
-            "--chunk-rows reads runs in pieces, which {} cannot work on: leave it out",
-            needs.join(", ")
-        ),
-        Some(rows) => Ok(Some(rows)),
-        None => {
-            let size: u64 = cmd.data.iter().filter_map(|p| std::fs::metadata(p).ok()).map(|m| m.len()).sum();
-            if size > WHOLE_LIMIT && needs.is_empty() {
-                eprintln!(
-                    "note: the runs are {} MiB together: read in pieces of {PIECE_ROWS} rows (bounded memory; --chunk-rows 0 reads them whole)",
-                    size >> 20
-                );
-                Ok(Some(PIECE_ROWS))
-            } else {
-                Ok(None)
-            }
-        }
-    }
-}
-
-/// `identify --model` on runs read in pieces: each equation's statistics in one pass over
-/// the files (as `termid moments` writes them), identified as `identify --moments` would, and
-/// checked (the physical checks at the model's rudder limit: the runs are not kept).
-fn identify_in_pieces(cmd: &IdentifyCommand, model: &termid::model::Model, rows: usize) -> Result<Start> {
-    let diff = differentiator(&cmd.derivative)?;
-    let reach = diff.reach().context("a derivative of fixed reach")?;
-    let names: Vec<String> =
-        if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };
-    let runs = cmd
-        .data
-        .iter()
-        .map(|p| termid::data::Chunks::open(p, &model.spec().model.time, rows.max(1), 2 * reach + 2))
-        .collect::<Result<Vec<_>, _>>()?;
-    let label = format!("statistics of {} in pieces of {rows} rows ({})", names.join(", "), cmd.derivative);
-    let (all, notes) = crate::progress::with_spinner(&label, || {
-        termid::identify::EquationMoments::of_chunks_each(model, &names, runs, diff.as_ref())
-    })?;
-    for n in notes {
-        crate::runs::say(&n);
-    }
-    let origin = cmd.data.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
-    let parts = all.into_iter().map(|m| (origin.clone(), m)).collect();
-    let identified = termid::identify::identify_from_moments(
-        model,
-        parts,
-        crate::identify::intercept_of(cmd, model.spec().model.intercept),
-    )?;
-    let checks =
-        termid::plugins::of(&identified.model).map(|p| p.checks(&identified.model, &[])).unwrap_or_default();
-    Ok(Start {
-        derivative: cmd.derivative.clone(),
-        model: identified.model,
-        fits: identified.fits,
-        chosen_text: None,
-        refined: None,
-        rejected: None,
-        refine_error: None,
-        checks,
-        prepared: vec![],
-    })
-}
 
 /// `--choose`: the configurations to choose from — a back-end's name (the model with that
 /// back-end in every identified equation) or a model file (another candidate library, step

@@ -1,9 +1,11 @@
 //! `termid moments`: an equation's sufficient statistics over a shard of runs, written for
-//! `identify --moments` to merge (the one pass over the rows done where the rows are).
+//! `identify --moments` to merge (the one pass over the rows done where the rows are); and
+//! `identify --model` on runs too large to read whole, by the same pass.
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use termid::data::{differentiator, Chunks};
 use termid::identify::EquationMoments;
+use termid::recipe::Start;
 
 use crate::args::MomentsCommand;
 use crate::args::{Format, IdentifyCommand};
@@ -122,4 +124,90 @@ pub fn identify_from_files(cmd: IdentifyCommand) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Files together larger than this are read in pieces by `identify --model` where they can be.
+const WHOLE_LIMIT: u64 = 256 << 20;
+
+/// Rows a piece when `--chunk-rows` is not given.
+const PIECE_ROWS: usize = 262_144;
+
+/// Whether `identify --model` reads its runs in pieces, and in how many rows: asked for with
+/// `--chunk-rows`, or files beyond [`WHOLE_LIMIT`] where nothing needs whole runs.
+pub fn in_pieces(cmd: &IdentifyCommand, refine: bool) -> Result<Option<usize>> {
+    let local = differentiator(&cmd.derivative).ok().and_then(|d| d.reach()).is_some();
+    let whole_runs_needed = [
+        (!cmd.dataset.is_empty(), "--dataset"),
+        (cmd.resample.is_some(), "--resample"),
+        (cmd.smooth, "--smooth"),
+        (cmd.prepared_svg.is_some(), "--prepared-svg"),
+        (refine, "--refine"),
+        (cmd.parameters || !cmd.per_source.is_empty(), "--parameters"),
+        (cmd.choose.is_some(), "--choose"),
+        (cmd.target.is_some(), "--target"),
+        (!local, "a --derivative that needs whole runs"),
+    ];
+    let needs: Vec<&str> = whole_runs_needed.iter().filter(|(yes, _)| *yes).map(|(_, what)| *what).collect();
+    match cmd.chunk_rows {
+        Some(0) => Ok(None),
+        Some(_) if !needs.is_empty() => bail!(
+            "--chunk-rows reads runs in pieces, which {} cannot work on: leave it out",
+            needs.join(", ")
+        ),
+        Some(rows) => Ok(Some(rows)),
+        None => {
+            let size: u64 = cmd.data.iter().filter_map(|p| std::fs::metadata(p).ok()).map(|m| m.len()).sum();
+            if size > WHOLE_LIMIT && needs.is_empty() {
+                eprintln!(
+                    "note: the runs are {} MiB together: read in pieces of {PIECE_ROWS} rows (bounded memory; --chunk-rows 0 reads them whole)",
+                    size >> 20
+                );
+                Ok(Some(PIECE_ROWS))
+            } else {
+                Ok(None)
+            }
+        }
+    }
+}
+
+/// `identify --model` on runs read in pieces: each equation's statistics in one pass over
+/// the files (as `termid moments` writes them), identified as `identify --moments` would, and
+/// checked (the physical checks at the model's rudder limit: the runs are not kept).
+pub fn identify_in_pieces(cmd: &IdentifyCommand, model: &termid::model::Model, rows: usize) -> Result<Start> {
+    let diff = differentiator(&cmd.derivative)?;
+    let reach = diff.reach().context("a derivative of fixed reach")?;
+    let names: Vec<String> =
+        if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };
+    let runs = cmd
+        .data
+        .iter()
+        .map(|p| termid::data::Chunks::open(p, &model.spec().model.time, rows.max(1), 2 * reach + 2))
+        .collect::<Result<Vec<_>, _>>()?;
+    let label = format!("statistics of {} in pieces of {rows} rows ({})", names.join(", "), cmd.derivative);
+    let (all, notes) = crate::progress::with_spinner(&label, || {
+        termid::identify::EquationMoments::of_chunks_each(model, &names, runs, diff.as_ref())
+    })?;
+    for n in notes {
+        crate::runs::say(&n);
+    }
+    let origin = cmd.data.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
+    let parts = all.into_iter().map(|m| (origin.clone(), m)).collect();
+    let identified = termid::identify::identify_from_moments(
+        model,
+        parts,
+        crate::identify::intercept_of(cmd, model.spec().model.intercept),
+    )?;
+    let checks =
+        termid::plugins::of(&identified.model).map(|p| p.checks(&identified.model, &[])).unwrap_or_default();
+    Ok(Start {
+        derivative: cmd.derivative.clone(),
+        model: identified.model,
+        fits: identified.fits,
+        chosen_text: None,
+        refined: None,
+        rejected: None,
+        refine_error: None,
+        checks,
+        prepared: vec![],
+    })
 }

@@ -38,6 +38,33 @@ pub fn load_for(model: &Model, data: &[PathBuf], datasets: &[PathBuf]) -> Result
     Ok(frames)
 }
 
+/// The runs of a command with a model, each with its source: every `--dataset` file a source
+/// of its own (a basin, a campaign), the `--data` files together another; with each source's
+/// label, in the sources' order.
+pub fn load_sources(
+    model: &Model,
+    data: &[PathBuf],
+    datasets: &[PathBuf],
+) -> Result<(Vec<Frame>, Vec<usize>, Vec<String>)> {
+    check_once(&input_files(data, datasets))?;
+    let (mut frames, mut sources, mut labels) = (Vec::new(), Vec::new(), Vec::new());
+    let data_source = (!data.is_empty()).then(|| ("--data".to_string(), data, &[][..]));
+    let dataset_sources =
+        datasets.iter().map(|d| (d.display().to_string(), &[][..], std::slice::from_ref(d)));
+    for (label, data, datasets) in data_source.into_iter().chain(dataset_sources) {
+        let more = load_for(model, data, datasets)?;
+        sources.extend(std::iter::repeat_n(labels.len(), more.len()));
+        labels.push(label);
+        frames.extend(more);
+    }
+    Ok((frames, sources, labels))
+}
+
+/// The sources' labels as the per-source estimates number them (`source 1: …`), a line each.
+pub fn source_labels(labels: &[String]) -> String {
+    labels.iter().enumerate().map(|(k, label)| format!("source {}: {label}\n", k + 1)).collect()
+}
+
 /// Every file a command reads runs from, named as the user named it: the `--data` files, the
 /// dataset file and the runs it lists (where it can be read; its errors come later, in their
 /// place). For [`termid::output::check_distinct`].

@@ -1,0 +1,144 @@
+//! The recipe's last stage: the model file's free parameters (a rudder indicator's zero per
+//! basin, a grey-box model's derivatives) estimated by output error together with every
+//! coefficient of the kept start. A regression cannot estimate them (they sit inside the
+//! terms); kept only where the checks the model passed still pass.
+
+use crate::data::Frame;
+use crate::diagnose::{estimate, Estimate, EstimateSettings, Runs};
+use crate::plugin::Check;
+
+use super::Start;
+
+/// How the parameter stage runs.
+#[derive(Clone, Debug)]
+pub struct ParameterOptions {
+    /// The source (basin, campaign) of each training run, by index (empty: one source).
+    pub sources: Vec<usize>,
+    /// Free parameters estimated once per source (each basin's rudder zero), the others once
+    /// for all.
+    pub per_source: Vec<String>,
+    /// Most Levenberg-Marquardt iterations in each of the estimate's two rounds.
+    pub iterations: usize,
+}
+
+impl Default for ParameterOptions {
+    fn default() -> Self {
+        ParameterOptions { sources: vec![], per_source: vec![], iterations: 50 }
+    }
+}
+
+/// What the parameter stage did to the kept start.
+#[derive(Debug)]
+pub enum ParameterStage {
+    /// Kept: the start's model holds the estimates (the per-source ones are reported, the
+    /// file's value stays).
+    Kept(Estimate),
+    /// Rejected: the estimate fails the named checks the model passed; the model is as before.
+    Rejected(Estimate, Vec<String>),
+    /// Failed, why; the model is as before.
+    Failed(String),
+}
+
+impl ParameterStage {
+    /// The stage as text.
+    pub fn text(&self) -> String {
+        match self {
+            ParameterStage::Kept(e) => e.text(),
+            ParameterStage::Rejected(e, lost) => format!(
+                "{}the parameter estimate is rejected: the model would fail checks it passes ({}); the model is kept as refined\n\n",
+                e.text(),
+                lost.join("; ")
+            ),
+            ParameterStage::Failed(why) => {
+                format!("== output-error estimate of the free parameters ==\nfailed: {why}; the model is kept as refined\n\n")
+            }
+        }
+    }
+}
+
+/// Runs the stage on `start` with the training runs `frames` (as read: each run's initial
+/// state is estimated with the parameters), comparing `states` (`None`: all).
+pub(super) fn estimate_parameters(
+    start: &mut Start,
+    frames: &[Frame],
+    states: Option<&[String]>,
+    intercept: bool,
+    options: &ParameterOptions,
+) -> ParameterStage {
+    let settings = EstimateSettings {
+        coefficients: true,
+        iterations: options.iterations,
+        sources: options.sources.clone(),
+        per_source: options.per_source.clone(),
+        ..Default::default()
+    };
+    let fit = (|| {
+        // one RK4 step per sample: the recorded inputs are known only at the samples
+        let sample = crate::data::sample_step(frames);
+        let runs =
+            Runs::new(&start.model, frames, sample, crate::sim::Integrator::Rk4)?.with_intercepts(intercept);
+        let runs = match states {
+            Some(names) => runs.comparing(names)?,
+            None => runs,
+        };
+        estimate(&start.model, &runs, &settings)
+    })();
+    let fit = match fit {
+        Ok(fit) => fit,
+        Err(e) => return ParameterStage::Failed(e.to_string()),
+    };
+    // as for the refinement: an estimate must not make the model fail what its field knows
+    // it passed
+    let checks = checks_per_source(&fit, &start.prepared, &options.sources);
+    let lost = super::start::lost_checks(&start.checks, &checks);
+    if !lost.is_empty() {
+        return ParameterStage::Rejected(fit, lost);
+    }
+    start.model = fit.model.clone();
+    start.checks = checks;
+    ParameterStage::Kept(fit)
+}
+
+/// The plug-in's checks of the estimated model. Where parameters were estimated per source
+/// (a basin's rudder zero), a check that reads the runs (steering them as recorded) holds
+/// only with each source's own values: each source's runs are checked with its values, and
+/// the checks merged (passed where every source passes; each source's numbers where they
+/// differ). The model is written with the file's values.
+fn checks_per_source(fit: &Estimate, prepared: &[Frame], sources: &[usize]) -> Vec<Check> {
+    let Some(plugin) = crate::plugins::of(&fit.model) else { return vec![] };
+    if fit.per_source.is_empty() || sources.len() != prepared.len() {
+        return plugin.checks(&fit.model, prepared);
+    }
+    let count = sources.iter().max().map_or(0, |m| m + 1);
+    let each: Vec<Vec<Check>> = (0..count)
+        .map(|s| {
+            let mut model = fit.model.clone();
+            for p in fit.per_source.iter().filter(|p| p.source == s) {
+                model.set_parameter(&p.name, p.value);
+            }
+            let runs: Vec<Frame> =
+                prepared.iter().zip(sources).filter(|(_, k)| **k == s).map(|(f, _)| f.clone()).collect();
+            plugin.checks(&model, &runs)
+        })
+        .collect();
+    let Some(first) = each.first() else { return vec![] };
+    first
+        .iter()
+        .map(|c| {
+            let same: Vec<(usize, &Check)> = each
+                .iter()
+                .enumerate()
+                .filter_map(|(k, cs)| cs.iter().find(|o| o.name == c.name).map(|o| (k, o)))
+                .collect();
+            let mut merged = c.clone();
+            merged.passed = same.iter().all(|(_, o)| o.passed);
+            merged.refuses = same.iter().any(|(_, o)| o.refuses);
+            if same.iter().any(|(_, o)| o.detail != c.detail) {
+                let parts: Vec<String> =
+                    same.iter().map(|(k, o)| format!("source {}: {}", k + 1, o.detail)).collect();
+                merged.detail = parts.join("; ");
+            }
+            merged
+        })
+        .collect()
+}
