@@ -99,15 +99,16 @@ pub(super) fn estimate_parameters(
     ParameterStage::Kept(fit)
 }
 
-/// The plug-in's checks of the estimated model. Where parameters were estimated per source
-/// (a basin's rudder zero), a check that reads the runs (steering them as recorded) holds
-/// only with each source's own values: each source's runs are checked with its values, and
-/// the checks merged (passed where every source passes; each source's numbers where they
-/// differ). The model is written with the file's values.
+/// The plug-in's checks of the estimated model as written (with the file's values). Where
+/// parameters were estimated per source (a basin's rudder zero), a check that reads the runs
+/// (steering them as recorded) holds only with each source's own values: where every source's
+/// runs, checked with its values, have that check, those verdicts are merged (passed where
+/// every source passes; each source's numbers where they differ).
 fn checks_per_source(fit: &Estimate, prepared: &[Frame], sources: &[usize]) -> Vec<Check> {
     let Some(plugin) = crate::plugins::of(&fit.model) else { return vec![] };
+    let written = plugin.checks(&fit.model, prepared);
     if fit.per_source.is_empty() || sources.len() != prepared.len() {
-        return plugin.checks(&fit.model, prepared);
+        return written;
     }
     let count = sources.iter().max().map_or(0, |m| m + 1);
     let each: Vec<Vec<Check>> = (0..count)
@@ -121,23 +122,26 @@ fn checks_per_source(fit: &Estimate, prepared: &[Frame], sources: &[usize]) -> V
             plugin.checks(&model, &runs)
         })
         .collect();
-    let Some(first) = each.first() else { return vec![] };
-    first
-        .iter()
+    written
+        .into_iter()
         .map(|c| {
-            let same: Vec<(usize, &Check)> = each
-                .iter()
-                .enumerate()
-                .filter_map(|(k, cs)| cs.iter().find(|o| o.name == c.name).map(|o| (k, o)))
-                .collect();
-            let mut merged = c.clone();
-            merged.passed = same.iter().all(|(_, o)| o.passed);
-            merged.refuses = same.iter().any(|(_, o)| o.refuses);
-            if same.iter().any(|(_, o)| o.detail != c.detail) {
-                let parts: Vec<String> =
-                    same.iter().map(|(k, o)| format!("source {}: {}", k + 1, o.detail)).collect();
-                merged.detail = parts.join("; ");
+            let same: Vec<&Check> =
+                each.iter().filter_map(|cs| cs.iter().find(|o| o.name == c.name)).collect();
+            if same.len() < each.len() {
+                // not every source has it (a turning circle labelled by that source's neutral
+                // angle): the written model's own
+                return c;
             }
+            let mut merged = c;
+            merged.passed = same.iter().all(|o| o.passed);
+            merged.refuses = same.iter().any(|o| o.refuses);
+            merged.detail = if same.iter().all(|o| o.detail == same[0].detail) {
+                same[0].detail.clone()
+            } else {
+                let parts: Vec<String> =
+                    same.iter().enumerate().map(|(k, o)| format!("source {}: {}", k + 1, o.detail)).collect();
+                parts.join("; ")
+            };
             merged
         })
         .collect()
