@@ -142,13 +142,13 @@ pub fn identify(
     }
     if let Some(options) = &settings.parameters {
         // said before any work
-        if model.free_parameters().is_empty() {
+        let free: Vec<String> = model.free_parameters().iter().map(|p| p.name.clone()).collect();
+        if free.is_empty() {
             return Err(RecipeError::Setup(format!(
                 "{}: no parameter is free (`free = true` under [parameters.NAME]), so there is none to estimate",
                 model.path
             )));
         }
-        let free: Vec<String> = model.free_parameters().iter().map(|p| p.name.clone()).collect();
         if let Some(n) = options.per_source.iter().find(|n| !free.contains(n)) {
             return Err(RecipeError::Setup(format!(
                 "`{n}` is to be estimated per source, but it is no free parameter of {} (free: {})",

@@ -45,12 +45,12 @@ impl ParameterStage {
         match self {
             ParameterStage::Kept(e) => e.text(),
             ParameterStage::Rejected(e, lost) => format!(
-                "{}the parameter estimate is rejected: the model would fail checks it passes ({}); the model is kept as refined\n\n",
+                "{}the parameter estimate is rejected: the model would fail checks it passes ({}); the model stays as it was\n\n",
                 e.text(),
                 lost.join("; ")
             ),
             ParameterStage::Failed(why) => {
-                format!("== output-error estimate of the free parameters ==\nfailed: {why}; the model is kept as refined\n\n")
+                format!("== output-error estimate of the free parameters ==\nfailed: {why}; the model stays as it was\n\n")
             }
         }
     }

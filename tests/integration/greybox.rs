@@ -565,13 +565,32 @@ fn the_new_ship_command_writes_a_model_estimate_reads() {
     assert!(!ok && std::fs::read_to_string(&bad).unwrap().contains("= 81"), "{err}");
 }
 
+/// The rudder indicator's zero of each of two basins, degrees.
+const BASIN_ZEROS: [f64; 2] = [0.3, -0.5];
+
+/// `zigzags` of `truth` as two basins record them (each its own noise), their rudder
+/// indicators reading [`BASIN_ZEROS`] off: the runs and each run's basin.
+fn two_basins(truth: &Model, zigzags: &[(&str, f64)]) -> (Vec<Frame>, Vec<usize>) {
+    let (mut frames, mut sources) = (Vec::new(), Vec::new());
+    for (s, (zero, seed)) in BASIN_ZEROS.iter().zip([41, 51]).enumerate() {
+        let records =
+            termid::ship::basin::Basin::default().record_all(truth, zigzags, 1.17248, 60.0, seed, None);
+        for (_, rec) in records.unwrap() {
+            let mut f = rec.measured;
+            let read: Vec<f64> = f.column("δ").unwrap().iter().map(|d| d + zero.to_radians()).collect();
+            f.set("δ", read).unwrap();
+            frames.push(f);
+            sources.push(s);
+        }
+    }
+    (frames, sources)
+}
+
 /// Two basins, one hull: each basin's rudder indicator reads off by its own zero (+0.3° and
 /// −0.5°), a nuisance estimated per source beside the hull's derivatives (started 30 % off);
 /// both come back, and the hull's derivatives as from one basin without offsets.
 #[test]
 fn two_basins_with_their_own_rudder_zero() {
-    use termid::ship::basin::Basin;
-
     let truth = mmg_truth();
     // the rudder the hull feels is the indicator's reading less the basin's zero δ_0
     let text = std::fs::read_to_string("models/mmg_kvlcc2.toml").unwrap();
@@ -593,22 +612,10 @@ fn two_basins_with_their_own_rudder_zero() {
             }
         })
         .unwrap();
-    let offsets = [0.3f64.to_radians(), -0.5f64.to_radians()];
-    let mut frames = Vec::new();
-    let mut sources = Vec::new();
-    for (s, (offset, seed)) in offsets.iter().zip([41, 51]).enumerate() {
-        let zigzags = [("zigzag:20/20", 1.0), ("zigzag:20/20:port", 0.98)];
-        for (_, rec) in Basin::default().record_all(&truth, &zigzags, 1.17248, 60.0, seed, None).unwrap() {
-            let mut f = rec.measured;
-            let read: Vec<f64> = f.column("δ").unwrap().iter().map(|d| d + offset).collect();
-            f.set("δ", read).unwrap();
-            frames.push(f);
-            sources.push(s);
-        }
-    }
+    let (frames, sources) = two_basins(&truth, &[("zigzag:20/20", 1.0), ("zigzag:20/20:port", 0.98)]);
     let settings = EstimateSettings { sources, per_source: vec!["δ_0".into()], ..Default::default() };
     let fit = estimate(&start, &runs_of(&start, &frames), &settings).unwrap();
-    for (s, offset) in offsets.iter().enumerate() {
+    for (s, offset) in BASIN_ZEROS.iter().map(|z| z.to_radians()).enumerate() {
         let p = fit.per_source.iter().find(|p| p.source == s).unwrap();
         assert!(
             (p.value - offset).abs() < 0.1f64.to_radians(),
@@ -634,23 +641,11 @@ fn two_basins_with_their_own_rudder_zero() {
 #[test]
 fn the_polynomial_template_from_two_basins_with_their_own_rudder_zero() {
     use termid::recipe::{identify, ParameterOptions, ParameterStage, RecipeSettings};
-    use termid::ship::basin::Basin;
 
     let truth = mmg_truth();
     let template = termid::plugins::load(std::path::Path::new("models/new_ship.toml")).unwrap();
-    let offsets = [0.3f64.to_radians(), -0.5f64.to_radians()];
-    let mut frames = Vec::new();
-    let mut sources = Vec::new();
-    for (s, (offset, seed)) in offsets.iter().zip([41, 51]).enumerate() {
-        let zigzags = [("zigzag:20/20", 1.0), ("zigzag:20/20:port", 0.98), ("zigzag:10/10", 1.0)];
-        for (_, rec) in Basin::default().record_all(&truth, &zigzags, 1.17248, 60.0, seed, None).unwrap() {
-            let mut f = rec.measured;
-            let read: Vec<f64> = f.column("δ").unwrap().iter().map(|d| d + offset).collect();
-            f.set("δ", read).unwrap();
-            frames.push(f);
-            sources.push(s);
-        }
-    }
+    let zigzags = [("zigzag:20/20", 1.0), ("zigzag:20/20:port", 0.98), ("zigzag:10/10", 1.0)];
+    let (frames, sources) = two_basins(&truth, &zigzags);
     let settings = RecipeSettings {
         derivatives: vec!["kalman".into()],
         smooth: true,
@@ -663,7 +658,7 @@ fn the_polynomial_template_from_two_basins_with_their_own_rudder_zero() {
         panic!("the parameter stage: {}", recipe.text());
     };
     let zero = |s: usize| fit.per_source.iter().find(|p| p.source == s).unwrap().value;
-    let (got, want) = (zero(0) - zero(1), offsets[0] - offsets[1]);
+    let (got, want) = (zero(0) - zero(1), (BASIN_ZEROS[0] - BASIN_ZEROS[1]).to_radians());
     assert!(
         (got - want).abs() < 0.1f64.to_radians(),
         "the basins' zeros differ by {:.3}°, truly {:.3}°\n{}",

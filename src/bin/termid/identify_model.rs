@@ -124,11 +124,11 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     }
     match &recipe.parameters {
         Some(ParameterStage::Rejected(_, lost)) => eprintln!(
-            "warning: the parameter estimate is rejected: the model would fail checks it passes ({}); the model is kept as refined",
+            "warning: the parameter estimate is rejected: the model would fail checks it passes ({}); the model stays as it was",
             lost.join("; ")
         ),
         Some(ParameterStage::Failed(why)) => {
-            eprintln!("warning: the parameter estimate failed: {why}; the model is kept as refined")
+            eprintln!("warning: the parameter estimate failed: {why}; the model stays as it was")
         }
         _ => {}
     }
