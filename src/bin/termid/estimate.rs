@@ -26,7 +26,7 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
             model.path
         );
     }
-    let (frames, sources, labels) = crate::runs::load_sources(&model, &cmd.data, &cmd.dataset)?;
+    let (frames, sources) = crate::runs::load_sources(&model, &cmd.data, &cmd.dataset)?;
     // one RK4 step per sample by default: the recorded input is known only at the samples
     let dt = cmd.dt.unwrap_or_else(|| termid::data::sample_step(&frames));
     let mut runs = Runs::new(&model, &frames, dt, Integrator::Rk4)?;
@@ -81,7 +81,7 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
                 }
             }
             if !fit.per_source.is_empty() {
-                print!("{}", crate::runs::source_labels(&labels));
+                print!("{}", crate::runs::source_labels(&cmd.data, &cmd.dataset));
             }
             if let Some(out) = &cmd.out {
                 println!("written: {}", out.display());

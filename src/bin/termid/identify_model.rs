@@ -37,7 +37,6 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
             cmd.derivative
         );
     }
-    let mut source_labels = Vec::new();
     let recipe = match crate::moments::in_pieces(&cmd, refine.is_some())? {
         Some(rows) => termid::recipe::Recipe::of(
             vec![crate::moments::identify_in_pieces(&cmd, &model, rows)?],
@@ -46,8 +45,7 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
             STARTS_AGREE,
         )?,
         None => {
-            let (frames, sources, labels) = crate::runs::load_sources(&model, &cmd.data, &cmd.dataset)?;
-            source_labels = labels;
+            let (frames, sources) = crate::runs::load_sources(&model, &cmd.data, &cmd.dataset)?;
             let held = cmd
                 .refine_validation
                 .as_ref()
@@ -155,7 +153,7 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
         Format::Text => {
             print!("{}", recipe.text());
             if !cmd.per_source.is_empty() {
-                print!("{}", crate::runs::source_labels(&source_labels));
+                print!("{}", crate::runs::source_labels(&cmd.data, &cmd.dataset));
             }
             if let Some(out) = cmd.out.as_ref().filter(|_| write) {
                 println!("wrote {}", out.display());

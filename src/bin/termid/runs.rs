@@ -39,30 +39,31 @@ pub fn load_for(model: &Model, data: &[PathBuf], datasets: &[PathBuf]) -> Result
 }
 
 /// The runs of a command with a model, each with its source: every `--dataset` file a source
-/// of its own (a basin, a campaign), the `--data` files together another; with each source's
-/// label, in the sources' order.
+/// of its own (a basin, a campaign), the `--data` files together another, in the order
+/// [`source_labels`] names them.
 pub fn load_sources(
     model: &Model,
     data: &[PathBuf],
     datasets: &[PathBuf],
-) -> Result<(Vec<Frame>, Vec<usize>, Vec<String>)> {
+) -> Result<(Vec<Frame>, Vec<usize>)> {
     check_once(&input_files(data, datasets))?;
-    let (mut frames, mut sources, mut labels) = (Vec::new(), Vec::new(), Vec::new());
-    let data_source = (!data.is_empty()).then(|| ("--data".to_string(), data, &[][..]));
-    let dataset_sources =
-        datasets.iter().map(|d| (d.display().to_string(), &[][..], std::slice::from_ref(d)));
-    for (label, data, datasets) in data_source.into_iter().chain(dataset_sources) {
+    let (mut frames, mut sources) = (Vec::new(), Vec::new());
+    let data_source = (!data.is_empty()).then_some((data, &[][..]));
+    let dataset_sources = datasets.iter().map(|d| (&[][..], std::slice::from_ref(d)));
+    for (k, (data, datasets)) in data_source.into_iter().chain(dataset_sources).enumerate() {
         let more = load_for(model, data, datasets)?;
-        sources.extend(std::iter::repeat_n(labels.len(), more.len()));
-        labels.push(label);
+        sources.extend(std::iter::repeat_n(k, more.len()));
         frames.extend(more);
     }
-    Ok((frames, sources, labels))
+    Ok((frames, sources))
 }
 
-/// The sources' labels as the per-source estimates number them (`source 1: …`), a line each.
-pub fn source_labels(labels: &[String]) -> String {
-    labels.iter().enumerate().map(|(k, label)| format!("source {}: {label}\n", k + 1)).collect()
+/// The sources of [`load_sources`] as the per-source estimates number them (`source 1: …`),
+/// a line each.
+pub fn source_labels(data: &[PathBuf], datasets: &[PathBuf]) -> String {
+    let data_label = (!data.is_empty()).then(|| "--data".to_string());
+    let labels = data_label.into_iter().chain(datasets.iter().map(|d| d.display().to_string()));
+    labels.enumerate().map(|(k, label)| format!("source {}: {label}\n", k + 1)).collect()
 }
 
 /// Every file a command reads runs from, named as the user named it: the `--data` files, the
