@@ -98,17 +98,21 @@ pub(super) struct Linearised {
 pub(super) fn linearise(runs: &Runs, model: &Model, entries: &[Free]) -> Result<Linearised, DiagnoseError> {
     let k = entries.len();
     let mut residuals = Vec::with_capacity(runs.residual_count());
-    let mut jtj = DMatrix::zeros(k, k);
-    let mut jtr = DVector::zeros(k);
-    let parts = per_run_jacobians(runs, model, entries, |res, jt| {
+    let mut jtj = DMatrix::<f64>::zeros(k, k);
+    let mut jtr = DVector::<f64>::zeros(k);
+    let parts = per_run_jacobians(runs, model, entries, |res, jt, active| {
         let a = gram_of_rows(&jt);
         let g = &jt * DVector::from_column_slice(&res);
-        (res, a, g)
+        (res, a, g, active.to_vec())
     })?;
-    for (r, a, g) in parts {
+    for (r, a, g, active) in parts {
         residuals.extend(r);
-        jtj += a;
-        jtr += g;
+        for (q, &j) in active.iter().enumerate() {
+            for (p, &i) in active.iter().enumerate() {
+                jtj[(i, j)] += a[(p, q)];
+            }
+            jtr[j] += g[q];
+        }
     }
     // a slope that is not finite would make every step NaN and the fit stop saying only that
     // no step lowers the error: name what it is the slope with respect to
@@ -176,27 +180,33 @@ fn residuals_and_jacobian(
     model: &Model,
     entries: &[Free],
 ) -> Result<(Vec<f64>, DMatrix<f64>), DiagnoseError> {
-    let parts = per_run_jacobians(runs, model, entries, |res, jt| (res, jt.transpose()))?;
+    let parts =
+        per_run_jacobians(runs, model, entries, |res, jt, active| (res, jt.transpose(), active.to_vec()))?;
     let rows: usize = parts.iter().map(|p| p.0.len()).sum();
     let mut residuals = Vec::with_capacity(rows);
     let mut jacobian = DMatrix::zeros(rows, entries.len());
     let mut at = 0;
-    for (r, j) in parts {
-        jacobian.rows_mut(at, r.len()).copy_from(&j);
+    for (r, j, active) in parts {
+        for (q, &column) in active.iter().enumerate() {
+            jacobian.view_mut((at, column), (r.len(), 1)).copy_from(&j.column(q));
+        }
         at += r.len();
         residuals.extend(r);
     }
     Ok((residuals, jacobian))
 }
 
-/// Each run's scaled residuals and their Jacobian, transposed (k × residuals, column-major: a
-/// residual's derivatives lie side by side, as S holds them), handed to `reduce` in the thread
-/// that made them; the runs in parallel.
+/// Each run's scaled residuals and their Jacobian, transposed (columns × residuals, column-
+/// major: a residual's derivatives lie side by side, as S holds them), handed to `reduce` in the
+/// thread that made them with the entries its rows stand for; the runs in parallel. A run's
+/// Jacobian has no rows for the entries that cannot move it (another run's initial state, a
+/// group it is not in): their sensitivities are zero throughout, and with every run's initial
+/// states free they would otherwise be most of S and of JᵀJ.
 fn per_run_jacobians<T: Send>(
     runs: &Runs,
     model: &Model,
     entries: &[Free],
-    reduce: impl Fn(Vec<f64>, DMatrix<f64>) -> T + Sync,
+    reduce: impl Fn(Vec<f64>, DMatrix<f64>, &[usize]) -> T + Sync,
 ) -> Result<Vec<T>, DiagnoseError> {
     let system = System::new(model, &BTreeMap::new(), runs.intercepts)?;
     // the term columns: (column, owning state) and their regressors
@@ -244,27 +254,43 @@ fn per_run_jacobians<T: Send>(
     }
     let regressors = Regressors { model, terms };
     let phi = System::new(&regressors, &BTreeMap::new(), false)?;
-    let k = entries.len();
     (0..runs.frames.len())
         .into_par_iter()
         .map(|r| {
             let system = system.with_parameters(&runs.params[r])?;
             let phi = phi.with_parameters(&runs.params[r])?;
-            // the free parameters of this run: every run's and those of its groups
-            let grouped = entries.iter().enumerate().filter_map(|(j, e)| match e {
-                Free::Group { name, runs: group } if group.contains(&r) => Some((j, name.clone())),
-                _ => None,
-            });
-            let free: Vec<(usize, String)> = parameters.iter().cloned().chain(grouped).collect();
-            let initial: Vec<(usize, usize)> = entries
+            // the entries that move this run, in the order of `entries`; S's columns are theirs
+            let active: Vec<usize> = entries
                 .iter()
                 .enumerate()
-                .filter_map(|(j, e)| match e {
-                    Free::Initial { run, state } if *run == r => Some((j, *state)),
+                .filter(|(_, e)| match e {
+                    Free::Group { runs: group, .. } => group.contains(&r),
+                    Free::Initial { run, .. } => *run == r,
+                    Free::Term(..) | Free::Parameter(_) => true,
+                })
+                .map(|(j, _)| j)
+                .collect();
+            let mut local = vec![usize::MAX; entries.len()];
+            for (q, &j) in active.iter().enumerate() {
+                local[j] = q;
+            }
+            let terms: Vec<(usize, usize)> = term_columns.iter().map(|&(j, i)| (local[j], i)).collect();
+            // the free parameters of this run: every run's and those of its groups
+            let grouped = active.iter().filter_map(|&j| match &entries[j] {
+                Free::Group { name, .. } => Some((local[j], name.clone())),
+                _ => None,
+            });
+            let free: Vec<(usize, String)> =
+                parameters.iter().map(|(j, name)| (local[*j], name.clone())).chain(grouped).collect();
+            let initial: Vec<(usize, usize)> = active
+                .iter()
+                .filter_map(|&j| match entries[j] {
+                    Free::Initial { state, .. } => Some((local[j], state)),
                     _ => None,
                 })
                 .collect();
-            let columns = Columns { terms: &term_columns, parameters: &free, initial: &initial, k };
+            let k = active.len();
+            let columns = Columns { terms: &terms, parameters: &free, initial: &initial, k };
             let frame = &runs.frames[r];
             // the residuals state by state, as `Runs::residuals` orders them: (first row,
             // state, scale, measured)
@@ -290,7 +316,7 @@ fn per_run_jacobians<T: Send>(
                     }
                 }
             })?;
-            Ok(reduce(res, jt))
+            Ok(reduce(res, jt, &active))
         })
         .collect()
 }
@@ -467,11 +493,57 @@ mod tests {
         assert!(linearise(&runs, &crate::diagnose::fixtures::lag("x", -0.1), &entries).is_ok());
     }
 
-    /// The forward sensitivities equal central differences of re-simulations, on a nonlinear
-    /// model with an input (a forced Duffing oscillator).
+    /// With several runs, a run's initial state moves that run alone: its column is zero on the
+    /// other runs' rows and equals central differences on its own, and the normal equations
+    /// gathered run by run (each over the entries that move it) are JᵀJ and Jᵀr of the whole J.
     #[test]
-    fn sensitivities_equal_finite_differences() {
-        let text = r#"
+    fn an_initial_state_moves_its_own_run_alone() {
+        let model = Model::parse(DUFFING, "duffing.toml").unwrap();
+        let frame = |phase: f64| {
+            let t: Vec<f64> = (0..=120).map(|i| i as f64 * 0.05).collect();
+            let mut f = Frame::new("run", "t", t.clone()).unwrap();
+            f.push("x", t.iter().map(|t| 0.5 * (0.8 * t + phase).cos()).collect()).unwrap();
+            f.push("w", t.iter().map(|t| -0.4 * (0.8 * t + phase).sin()).collect()).unwrap();
+            f.push("F", t.iter().map(|t| 0.7 * (0.9 * t + phase).sin()).collect()).unwrap();
+            f
+        };
+        let runs = Runs::new(&model, &[frame(0.0), frame(1.0), frame(2.0)], 0.05, Integrator::Rk4).unwrap();
+        let entries = vec![
+            Free::Initial { run: 1, state: 0 },
+            Free::Term("w_dot".to_string(), model.vocabulary.parse("x^3").unwrap()),
+            Free::Initial { run: 0, state: 1 },
+            Free::Initial { run: 2, state: 0 },
+        ];
+        let (r0, jac) = residuals_and_jacobian(&runs, &model, &entries).unwrap();
+        let rows: Vec<usize> = runs.frames.iter().map(|f| 2 * f.len()).collect();
+        let first = |run: usize| rows[..run].iter().sum::<usize>();
+        for (j, (run, state)) in [(0, (1, 0)), (2, (0, 1)), (3, (2, 0))] {
+            let shifted = |h: f64| {
+                let mut moved = runs.clone();
+                moved.x0[run][state] += h;
+                moved.residuals(&moved.simulate(&model, &[], &[]).unwrap())
+            };
+            let h = 1e-6;
+            let (up, down) = (shifted(h), shifted(-h));
+            for row in 0..r0.len() {
+                let fd = (up[row] - down[row]) / (2.0 * h);
+                let mine = (first(run)..first(run) + rows[run]).contains(&row);
+                assert!(mine || jac[(row, j)] == 0.0, "entry {j} moves row {row} of another run");
+                assert!(
+                    (jac[(row, j)] - fd).abs() < 1e-6 * (1.0 + fd.abs()),
+                    "row {row}, {j}: {} vs {fd}",
+                    jac[(row, j)]
+                );
+            }
+        }
+        let lin = linearise(&runs, &model, &entries).unwrap();
+        let r = DVector::from_column_slice(&r0);
+        let (jtj, jtr) = (jac.transpose() * &jac, jac.transpose() * r);
+        assert!((&lin.jtj - &jtj).amax() <= 1e-12 * jtj.amax(), "{} vs {}", lin.jtj, jtj);
+        assert!((&lin.jtr - &jtr).amax() <= 1e-12 * jtr.amax(), "{} vs {}", lin.jtr, jtr);
+    }
+
+    const DUFFING: &str = r#"
 [model]
 name = "duffing"
 [[states]]
@@ -489,7 +561,12 @@ state = "w"
 candidates = ["x", "w", "x^3", "F"]
 coefficients = { "x" = -1.0, "w" = -0.1, "x^3" = -0.2, "F" = 1.0 }
 "#;
-        let model = Model::parse(text, "duffing.toml").unwrap();
+
+    /// The forward sensitivities equal central differences of re-simulations, on a nonlinear
+    /// model with an input (a forced Duffing oscillator).
+    #[test]
+    fn sensitivities_equal_finite_differences() {
+        let model = Model::parse(DUFFING, "duffing.toml").unwrap();
         let t: Vec<f64> = (0..=200).map(|i| i as f64 * 0.05).collect();
         let mut f = Frame::new("run", "t", t.clone()).unwrap();
         f.push("x", t.iter().map(|t| 0.5 * (0.8 * t).cos()).collect()).unwrap();
