@@ -491,6 +491,16 @@ impl Estimate {
                 p.source + 1
             ));
         }
+        if let Some(p) = self.per_source.last() {
+            // the written model keeps the file's value of a per-source parameter (its sources'
+            // values are nuisances of their records): a prediction for one source must set it
+            out.push_str(&format!(
+                "  (each source's own value, not written: the model keeps its file's `{0}`; predict source {1}'s runs with `--param {0}={2}`)\n",
+                p.name,
+                p.source + 1,
+                num(p.value)
+            ));
+        }
         if self.initial_values > 0 {
             out.push_str(&format!(
                 "and {} initial values (each run's compared states at its start, nuisance parameters)\n",

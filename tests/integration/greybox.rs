@@ -629,8 +629,16 @@ fn two_basins_with_their_own_rudder_zero() {
         let p = fit.parameters.iter().find(|p| p.name == name).unwrap();
         assert!((p.value / values[name] - 1.0).abs() < 0.05, "{name}: {}\n{}", p.value, fit.text());
     }
-    // the model keeps the file's δ_0: each source's own is reported, not written
+    // the model keeps the file's δ_0: each source's own is reported, not written, and the
+    // report says how to predict a source with it
     assert_eq!(fit.model.parameter_values()["δ_0"], 0.0);
+    let text = fit.text();
+    assert!(
+        text.contains(
+            "not written: the model keeps its file's `δ_0`; predict source 2's runs with `--param δ_0="
+        ),
+        "{text}"
+    );
 }
 
 /// The polynomial template from two basins, each with its own rudder zero (+0.3° and −0.5°),
