@@ -134,7 +134,58 @@ impl Particulars {
                 why: "the rudder spans about the propeller's diameter and less than the draught",
             });
         }
+        // proportions no displacement ship has: a value in other units (cm, feet) or a key
+        // mistaken for another, which the formulas would turn into a model without complaint
+        let (l_b, b_d) = (self.lpp / self.beam, self.beam / self.draught);
+        if !(2.0..=15.0).contains(&l_b) {
+            return Err(ParticularsError::Value {
+                key: "beam",
+                value: self.beam,
+                why: "L/B outside 2-15, no displacement ship's: are lpp and beam in metres?",
+            });
+        }
+        if !(1.0..=10.0).contains(&b_d) {
+            return Err(ParticularsError::Value {
+                key: "draught",
+                value: self.draught,
+                why: "B/d outside 1-10, no displacement ship's: are beam and draught in metres?",
+            });
+        }
+        if self.x_g.abs() >= 0.5 * self.lpp || !self.x_g.is_finite() {
+            return Err(ParticularsError::Value {
+                key: "x_g",
+                value: self.x_g,
+                why: "the centre of gravity lies within the ship, |x_g| < L/2 (from midship, m)",
+            });
+        }
+        if self.rudder_limit >= 90.0 {
+            return Err(ParticularsError::Value {
+                key: "rudder_limit",
+                value: self.rudder_limit,
+                why: "a rudder's largest angle is below 90° (usually 35°)",
+            });
+        }
         Ok(())
+    }
+
+    /// Where the particulars lie outside a usual merchant hull's proportions (L/B 4-9, B/d
+    /// 1.8-5, C_B 0.5-0.9): the hull formulas are regressions over merchant hulls, so their
+    /// estimates there are extrapolations, less sure than the priors' standard deviations say.
+    /// Empty where every proportion is usual.
+    pub fn cautions(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for (what, value, (lo, hi)) in [
+            ("L/B", self.lpp / self.beam, (4.0, 9.0)),
+            ("B/d", self.beam / self.draught, (1.8, 5.0)),
+            ("C_B", self.block_coefficient, (0.5, 0.9)),
+        ] {
+            if !(lo..=hi).contains(&value) {
+                out.push(format!(
+                    "{what} = {value:.3} lies outside {lo}-{hi}, a usual merchant hull's: the hull formulas (Kijima, Clarke) are regressions over merchant hulls and extrapolate here; let the runs decide (`termid estimate`) and compare the result with the priors"
+                ));
+            }
+        }
+        out
     }
 
     /// Every parameter of the MMG model estimated from the particulars, the hull's
@@ -369,6 +420,31 @@ mod tests {
             rudder_limit: 35.0,
             density: 1025.0,
         }
+    }
+
+    /// Particulars no displacement ship has (a unit slip, a key mistaken for another) are
+    /// refused naming the key; unusual but possible proportions pass with a caution.
+    #[test]
+    fn impossible_particulars_are_refused_and_unusual_ones_cautioned() {
+        assert!(kvlcc2().check().is_ok());
+        assert!(kvlcc2().cautions().is_empty(), "{:?}", kvlcc2().cautions());
+        let refused = |edit: fn(&mut Particulars), key: &str| {
+            let mut p = kvlcc2();
+            edit(&mut p);
+            let message = p.model().err().map(|e| e.to_string()).unwrap_or_default();
+            assert!(message.contains(&format!("`{key}`")), "{key}: {message}");
+        };
+        refused(|p| p.draught = 46.0, "draught"); // centimetres
+        refused(|p| p.beam = 127.0, "beam");
+        refused(|p| p.x_g = 25.0, "x_g");
+        refused(|p| p.x_g = f64::NAN, "x_g");
+        refused(|p| p.rudder_limit = 95.0, "rudder_limit");
+        // a slender fast hull: a model, with a word on the formulas' range
+        let mut slender = kvlcc2();
+        (slender.beam, slender.block_coefficient) = (0.7, 0.45);
+        assert!(slender.model().is_ok());
+        let cautions = slender.cautions().join("\n");
+        assert!(cautions.contains("L/B = 10.000") && cautions.contains("C_B = 0.450"), "{cautions}");
     }
 
     /// The formulas against values worked by hand from the papers' expressions (KVLCC2,

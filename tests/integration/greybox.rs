@@ -563,6 +563,18 @@ fn the_new_ship_command_writes_a_model_estimate_reads() {
         bad.to_str().unwrap(),
     ]);
     assert!(!ok && std::fs::read_to_string(&bad).unwrap().contains("= 81"), "{err}");
+    // a slender hull is written, with a caution that the hull formulas extrapolate there
+    let slender = dir.join("slender.toml");
+    std::fs::write(&slender, KVLCC2_PARTICULARS.replace("beam = 1.27", "beam = 0.7")).unwrap();
+    let written = dir.join("slender_greybox.toml");
+    let (ok, _, err) = crate::common::termid(&[
+        "new-ship",
+        "--particulars",
+        slender.to_str().unwrap(),
+        "--out",
+        written.to_str().unwrap(),
+    ]);
+    assert!(ok && written.exists() && err.contains("caution: L/B = 10.000"), "{err}");
 }
 
 /// The rudder indicator's zero of each of two basins, degrees.

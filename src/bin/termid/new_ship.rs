@@ -30,6 +30,9 @@ pub fn run(cmd: NewShipCommand) -> Result<()> {
             e.source
         );
     }
+    for caution in particulars.cautions() {
+        eprintln!("caution: {caution}");
+    }
     termid::output::write_file(&cmd.out, model.to_toml().as_bytes())?;
     println!(
         "wrote {} ({} free parameters): `termid estimate --model {} --dataset …` fits them to the ship's runs",
