@@ -48,6 +48,7 @@ __all__ = [
     "Fit",
     "Identified",
     "Recipe",
+    "Summary",
     "TermidError",
     "fit",
     "backends",
@@ -57,6 +58,17 @@ __all__ = [
 ]
 
 __version__ = _termid.version()
+
+
+def __dir__() -> List[str]:
+    """What ``dir(termid)`` and tab completion offer: the public names and the submodules
+    imported so far, not the modules this one imports for itself (``np``, ``pd``, ``typing``).
+
+    >>> "fit" in dir(termid) and "np" not in dir(termid)
+    True
+    """
+    loaded = [m for m in ("plot", "sklearn") if m in globals()]
+    return sorted(set(__all__) | {"Data"} | set(loaded))
 
 #: What a run may be: a DataFrame, a dict of arrays, a pyarrow Table (or anything with
 #: ``to_pandas``).

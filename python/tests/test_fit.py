@@ -164,3 +164,11 @@ def test_fits_and_errors_cross_a_process_pool(hald):
         pd.testing.assert_series_equal(there.predict(hald), here.predict(hald))
         with pytest.raises(termid.TermidError, match=r"\^"):
             pool.submit(_refuse_in_a_worker, hald).result()
+
+
+def test_tab_completion_offers_the_public_names_alone():
+    names = dir(termid)
+    assert set(termid.__all__) <= set(names)
+    assert not {"np", "pd", "json", "os", "Dict", "Optional", "warnings"} & set(names), names
+    # every name offered is there to be read
+    assert all(hasattr(termid, n) for n in names)
