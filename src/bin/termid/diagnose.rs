@@ -27,7 +27,9 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
     let (integrator, dt) = model.simulation(cmd.resim.integrator, cmd.resim.dt);
     let settings =
         Settings { dt, integrator, with_intercepts: cmd.resim.with_intercept, ..Settings::default() };
-    let d = diagnose(&model, &runs, &hypotheses, &settings).context("diagnosing")?;
+    let label = format!("trying {} hypotheses on {} runs", hypotheses.len(), runs.len());
+    let d = crate::progress::with_spinner(&label, || diagnose(&model, &runs, &hypotheses, &settings))
+        .context("diagnosing")?;
     let mut outputs = termid::output::Outputs::new();
     if let Some(dir) = &cmd.resim.svg {
         outputs.folder(dir)?;

@@ -40,7 +40,14 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
         per_source: cmd.per_source.clone(),
         ..Default::default()
     };
-    let fit = estimate(&model, &runs, &settings).context("estimating the free parameters")?;
+    let label = format!(
+        "estimating {} free parameters{} by output error on {} runs",
+        model.free_parameters().len(),
+        if cmd.coefficients { " and the term coefficients" } else { "" },
+        frames.len()
+    );
+    let fit = crate::progress::with_spinner(&label, || estimate(&model, &runs, &settings))
+        .context("estimating the free parameters")?;
     if let Some(out) = &cmd.out {
         let mut outputs = termid::output::Outputs::new();
         outputs.file(out, fit.model.to_toml().as_bytes())?;
