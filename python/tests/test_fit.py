@@ -172,3 +172,9 @@ def test_tab_completion_offers_the_public_names_alone():
     assert not {"np", "pd", "json", "os", "Dict", "Optional", "warnings"} & set(names), names
     # every name offered is there to be read
     assert all(hasattr(termid, n) for n in names)
+
+
+def test_a_target_that_is_not_a_number_is_named_with_its_row():
+    df = pd.DataFrame({"x": [0.0, 1, 2, 3, 4, 5], "y": [1.0, 3.1, np.nan, 7.0, 9.0, 11.2]})
+    with pytest.raises(termid.TermidError, match=r"row 3: the target `y` evaluates to NaN \(check the data there\)"):
+        termid.fit(df, "y", "x")

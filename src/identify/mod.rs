@@ -67,17 +67,21 @@ pub enum IdentifyError {
     /// In the regression.
     #[error(transparent)]
     Select(#[from] SelectError),
-    /// A term evaluates to NaN or ±∞ on some row.
+    /// A term or the target evaluates to NaN or ±∞ on some row.
     #[error(
-        "{file}: row {row}: term `{term}` evaluates to {value} (check its denominators and the data there)"
+        "{file}: row {row}: {} `{term}` evaluates to {value} (check {})",
+        if *target { "the target" } else { "term" },
+        if *target { "the data there" } else { "its denominators and the data there" }
     )]
     NonFinite {
         /// The run.
         file: String,
         /// 1-based row.
         row: usize,
-        /// The term.
+        /// The term, or the target where `target`.
         term: String,
+        /// Whether it is the target (a column or its derivative), not a term.
+        target: bool,
         /// Its value.
         value: f64,
     },
@@ -100,8 +104,8 @@ impl IdentifyError {
     pub fn shifted(self, rows: usize) -> IdentifyError {
         match self {
             IdentifyError::Data(e) => IdentifyError::Data(e.shifted(rows)),
-            IdentifyError::NonFinite { file, row, term, value } => {
-                IdentifyError::NonFinite { file, row: row + rows, term, value }
+            IdentifyError::NonFinite { file, row, term, value, target } => {
+                IdentifyError::NonFinite { file, row: row + rows, term, value, target }
             }
             e => e,
         }
@@ -196,6 +200,8 @@ impl Design {
 /// One run bound to a compiled library (see `Identification::bind`).
 struct BoundRun<'a> {
     origin: &'a str,
+    /// What `y` is, for messages.
+    target: String,
     y: Vec<f64>,
     sources: Vec<Source<'a>>,
     weights: Option<&'a [f64]>,
@@ -223,8 +229,8 @@ impl BoundRun<'_> {
             // the accumulator notices a value that is not finite in passing; find it only then
             if let Some(j) = acc.not_finite() {
                 let (values, term) = match columns.get(j) {
-                    Some(c) => (*c, terms.get(j).map_or_else(|| format!("term {}", j + 1), Term::to_string)),
-                    None => (y, "the target".to_string()),
+                    Some(c) => (*c, terms.get(j).map_or_else(|| format!("{}", j + 1), Term::to_string)),
+                    None => (y, self.target.clone()),
                 };
                 // no such value: the sum overflowed; name the largest
                 let i = values.iter().position(|v| !v.is_finite()).unwrap_or_else(|| {
@@ -235,6 +241,7 @@ impl BoundRun<'_> {
                 bad = Some(IdentifyError::NonFinite {
                     file: self.origin.into(),
                     row: start + i + 1,
+                    target: columns.get(j).is_none(),
                     term,
                     value: values.get(i).copied().unwrap_or(f64::NAN),
                 });
@@ -417,7 +424,7 @@ impl Identification<'_> {
             Some(col) => Some(checked_weights(frame.origin(), col, frame.require(col)?)?),
             None => None,
         };
-        Ok(BoundRun { origin: frame.origin(), y, sources, weights })
+        Ok(BoundRun { origin: frame.origin(), target: target.to_string(), y, sources, weights })
     }
 
     /// Identifies one equation, `target` explained by the candidates of `design`, from rows
@@ -475,7 +482,7 @@ impl Identification<'_> {
             Some(col) => Some(checked_weights(origin, col, require(col)?)?),
             None => None,
         };
-        let run = BoundRun { origin, y: y.to_vec(), sources, weights };
+        let run = BoundRun { origin, target: target.to_string(), y: y.to_vec(), sources, weights };
         let (forced, excluded) =
             (design.columns_of(forced, "forced")?, design.columns_of(excluded, "excluded")?);
         let folds =
@@ -668,7 +675,7 @@ mod tests {
                 .fit(&Target::Column("y".into()), &terms, &[], &[], &[f], &crate::select::Stepwise::default())
                 .unwrap_err();
             match err {
-                IdentifyError::NonFinite { file, row, term, value } => {
+                IdentifyError::NonFinite { file, row, term, value, target: false } => {
                     assert_eq!((file.as_str(), row, term.as_str()), ("run7.csv", zero_at + 1, "y/x"));
                     assert!(value.is_infinite());
                 }
