@@ -1369,6 +1369,17 @@ class Model:
     def __repr__(self) -> str:
         return repr(self._native)
 
+    def __str__(self) -> str:
+        # what print() shows: the name and each equation with its stored coefficients (six
+        # significant digits), as Fit.equation writes one; repr() stays the one-line summary
+        lines = [self.name]
+        for equation in self.equations:
+            b0 = self.intercept(equation)
+            parts = [] if b0 is None else [f"{b0:.6g}"]
+            parts += [f"{v:.6g} {t}" for t, v in zip(*(self.coefficients(equation)[c] for c in ("term", "value")))]
+            lines.append(f"  {equation} = " + (" + ".join(parts) if parts else "0").replace("+ -", "- "))
+        return "\n".join(lines)
+
 
 #: Sufficient statistics of one equation: ``Moments.from_frame(df, model, "r_dot")``,
 #: ``a.merge(b)``, ``pickle.dumps(m)``, ``model.identify_from_moments([a, b])``.

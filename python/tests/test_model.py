@@ -268,3 +268,11 @@ def test_recipe_estimates_each_basins_rudder_zero():
     with pytest.raises(termid.TermidError, match="no parameter is free"):
         ship = termid.Model.default()
         ship.recipe([ship.simulate("zigzag:20/20")], ["central"], refine=None, parameters=True)
+
+
+def test_print_shows_each_equation_with_its_coefficients():
+    lorenz = termid.Model.builtin("lorenz")
+    text = str(lorenz)
+    assert text.splitlines()[0] == lorenz.name
+    assert "  z_dot = 1 x*y - 2.66667 z" in text, text
+    assert repr(lorenz).startswith("termid.Model(")
