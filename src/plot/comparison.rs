@@ -19,20 +19,23 @@ pub fn diagnosis_figures(
     runs: &[Frame],
     plane: Option<&Plane>,
 ) -> Vec<(String, Figure)> {
-    comparison_figures(model, runs, &d.before, &d.after, &[], "diagnose", plane)
+    comparison_figures(model, runs, (&d.before, &d.after), &[], ("diagnose", LABELS), plane)
 }
+
+/// The two simulations' names in a figure where the second one adds an effect to the model.
+pub const LABELS: [&str; 2] = ["model", "with the effect"];
 
 /// One figure per run: every measured state with the model's simulation (and a second
 /// simulation, if given; and the pointwise 5-95 % band of Monte-Carlo `draws`, the
-/// simulations of every run with each drawn model), and their residuals, side by side. The
-/// states of a `plane` are drawn as one track instead, beside the distance between the tracks.
+/// simulations of every run with each drawn model), and their residuals, side by side; the
+/// figures titled `title` and the two simulations named by `labels`. The states of a `plane`
+/// are drawn as one track instead, beside the distance between the tracks.
 pub fn comparison_figures(
     model: &Model,
     runs: &[Frame],
-    sims: &[Trajectory],
-    other: &[Trajectory],
+    (sims, other): (&[Trajectory], &[Trajectory]),
     draws: &[&[Trajectory]],
-    title: &str,
+    (title, labels): (&str, [&str; 2]),
     plane: Option<&Plane>,
 ) -> Vec<(String, Figure)> {
     runs.iter()
@@ -54,17 +57,25 @@ pub fn comparison_figures(
                 let gap = |sim: &[f64]| (0..n).map(|j| (sim[j] - meas[j]) * factor).collect::<Vec<f64>>();
                 let mut series = vec![
                     Series::line("measured", time.clone(), scaled(meas)),
-                    Series::dashed("model", time.clone(), scaled(&before.states[i])),
+                    Series::dashed(labels[0], time.clone(), scaled(&before.states[i])),
                 ];
                 // a residual in the colour of its simulation
-                let mut residual =
-                    vec![Series::line("model − measured", time.clone(), gap(&before.states[i])).colored(1)];
+                let mut residual = vec![Series::line(
+                    &format!("{} − measured", labels[0]),
+                    time.clone(),
+                    gap(&before.states[i]),
+                )
+                .colored(1)];
                 if let Some(after) = other.get(k) {
-                    series.push(Series::dashed("with the effect", time.clone(), scaled(&after.states[i])));
+                    series.push(Series::dashed(labels[1], time.clone(), scaled(&after.states[i])));
                     // dashed over the first residual, which stays in sight under it
                     residual.push(
-                        Series::dashed("with the effect − measured", time.clone(), gap(&after.states[i]))
-                            .colored(2),
+                        Series::dashed(
+                            &format!("{} − measured", labels[1]),
+                            time.clone(),
+                            gap(&after.states[i]),
+                        )
+                        .colored(2),
                     );
                 }
                 let signals: Vec<Vec<f64>> =
@@ -94,7 +105,7 @@ pub fn comparison_figures(
                     ..Panel::default()
                 });
             }
-            if let Some(track) = plane.and_then(|p| track_panels(p, f, before, other.get(k))) {
+            if let Some(track) = plane.and_then(|p| track_panels(p, f, before, other.get(k), labels)) {
                 panels.extend(track);
             }
             let mut fig = Figure::new(&format!("{title}: {}", f.origin()), panels);
@@ -114,6 +125,7 @@ fn track_panels(
     f: &Frame,
     sim: &Trajectory,
     other: Option<&Trajectory>,
+    labels: [&str; 2],
 ) -> Option<[Panel; 2]> {
     let (across, up) = (f.column(&plane.across.0)?, f.column(&plane.up.0)?);
     let l = plane.length;
@@ -122,7 +134,7 @@ fn track_panels(
     let mut track = vec![Series::line("measured", scaled(across, n), scaled(up, n))];
     let time = f.time()[..n].to_vec();
     let mut distance = Vec::new();
-    for (k, (label, t)) in [("model", Some(sim)), ("with the effect", other)].into_iter().enumerate() {
+    for (k, (label, t)) in [(labels[0], Some(sim)), (labels[1], other)].into_iter().enumerate() {
         let Some(t) = t else { continue };
         let (x, y) = (state(t, &plane.across.0)?, state(t, &plane.up.0)?);
         let m = n.min(x.len()).min(y.len());

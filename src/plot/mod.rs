@@ -6,7 +6,7 @@
 mod comparison;
 mod prepared;
 
-pub use comparison::{comparison_figures, diagnosis_figures};
+pub use comparison::{comparison_figures, diagnosis_figures, LABELS};
 pub use prepared::prepared_figure;
 
 use std::path::Path;

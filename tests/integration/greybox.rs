@@ -361,6 +361,7 @@ fn the_estimate_command_writes_estimates_that_monte_carlo_draws_from() {
     let data = dir.join("zigzag.csv");
     std::fs::write(&data, csv).unwrap();
     let out = dir.join("nomoto_estimated.toml");
+    let figures = dir.join("figures");
     let (ok, text, err) = crate::common::termid(&[
         "estimate",
         "--model",
@@ -369,9 +370,14 @@ fn the_estimate_command_writes_estimates_that_monte_carlo_draws_from() {
         data.to_str().unwrap(),
         "--out",
         out.to_str().unwrap(),
+        "--svg",
+        figures.to_str().unwrap(),
     ]);
     assert!(ok, "{err}");
     assert!(text.contains("estimate") && text.contains("initial values"), "{text}");
+    // the run measured beside the start values' simulation and the estimate's
+    let svg = std::fs::read_to_string(figures.join("estimate_zigzag.svg")).unwrap();
+    assert!(svg.contains("start values") && svg.contains("estimated") && svg.contains("measured"), "{text}");
     let model = Model::load(&out).unwrap();
     let p = model.parameter_values();
     assert!((p["K"] / k - 1.0).abs() < 0.03 && (p["T"] / t_const - 1.0).abs() < 0.03, "{p:?}\n{text}");

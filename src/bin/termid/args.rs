@@ -101,6 +101,11 @@ pub struct EstimateCommand {
     /// the samples).
     #[arg(allow_negative_numbers = true, long)]
     pub dt: Option<f64>,
+    /// One figure per run (SVG) into this folder: each compared state measured, simulated with
+    /// the model's values and with the estimates (each from the run's first sample, each
+    /// source with its own values), and the residuals
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
     /// Output format.
     #[arg(long, value_enum, default_value = "text")]
     pub format: Format,

@@ -18,6 +18,9 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
         inputs.push(("--model".to_string(), cmd.model.clone()));
         crate::runs::check_outputs(&[("--out", out)], &inputs)?;
     }
+    if let Some(dir) = &cmd.svg {
+        termid::output::check_folder(dir)?;
+    }
     let model = crate::simulate::load_model(&Some(cmd.model.clone()))?;
     // said before any run is read
     if model.free_parameters().is_empty() && !cmd.coefficients {
@@ -36,7 +39,7 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
     let settings = EstimateSettings {
         coefficients: cmd.coefficients,
         iterations: cmd.iterations,
-        sources,
+        sources: sources.clone(),
         per_source: cmd.per_source.clone(),
         ..Default::default()
     };
@@ -48,11 +51,25 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
     );
     let fit = crate::progress::with_spinner(&label, || estimate(&model, &runs, &settings))
         .context("estimating the free parameters")?;
+    let mut outputs = termid::output::Outputs::new();
     if let Some(out) = &cmd.out {
-        let mut outputs = termid::output::Outputs::new();
         outputs.file(out, fit.model.to_toml().as_bytes())?;
-        outputs.commit()?;
     }
+    let mut drawn = false;
+    if let Some(dir) = &cmd.svg {
+        // a run the start values cannot simulate costs the figures, not the estimate
+        match figures(&model, &fit, &runs, &frames, &sources) {
+            Ok(figures) => {
+                outputs.folder(dir)?;
+                for (name, svg) in figures {
+                    outputs.file(&dir.join(name), svg.as_bytes())?;
+                }
+                drawn = true;
+            }
+            Err(e) => eprintln!("warning: no figures: {e:#}"),
+        }
+    }
+    outputs.commit()?;
     // where another model of the same ship predicts differently what the runs did not cover
     let agreement = match &cmd.against {
         Some(path) => {
@@ -93,7 +110,50 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
             if let Some(out) = &cmd.out {
                 println!("written: {}", out.display());
             }
+            if let (Some(dir), true) = (&cmd.svg, drawn) {
+                println!("figures: {}/estimate_<run>.svg", dir.display());
+            }
         }
     }
     Ok(())
+}
+
+/// `estimate_<run>.svg` per run: the compared states measured, simulated with the model's
+/// values and with the estimates, each from the run's first sample (the estimated initial
+/// states are nuisances of the fit) and each source with its own per-source values.
+fn figures(
+    model: &termid::model::Model,
+    fit: &termid::diagnose::Estimate,
+    runs: &Runs,
+    frames: &[termid::data::Frame],
+    sources: &[usize],
+) -> Result<Vec<(String, String)>> {
+    let own: Vec<(usize, &str, f64)> = fit
+        .per_source
+        .iter()
+        .flat_map(|p| {
+            let runs = sources.iter().enumerate().filter(move |(_, s)| **s == p.source);
+            runs.map(move |(r, _)| (r, p.name.as_str(), p.value))
+        })
+        .collect();
+    let before = runs.simulate(model, &[], &[])?;
+    let after = runs.with_initial(&[], &own).simulate(&fit.model, &[], &[])?;
+    let plane = termid::plugins::of(model).and_then(|p| p.plane(model));
+    termid::plot::comparison_figures(
+        model,
+        frames,
+        (&before, &after),
+        &[],
+        ("estimate", ["start values", "estimated"]),
+        plane.as_ref(),
+    )
+    .into_iter()
+    .enumerate()
+    .map(|(k, (name, fig))| {
+        let stem = std::path::Path::new(&name)
+            .file_stem()
+            .map_or(format!("run{k}"), |s| s.to_string_lossy().into_owned());
+        Ok((format!("estimate_{stem}.svg"), fig.to_svg().map_err(anyhow::Error::msg)?))
+    })
+    .collect()
 }

@@ -4,7 +4,7 @@
 
 use anyhow::Result;
 use termid::diagnose::Runs;
-use termid::plot::comparison_figures;
+use termid::plot::{comparison_figures, LABELS};
 use termid::plugin::Observation;
 use termid::sim::Trajectory;
 
@@ -55,7 +55,7 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
         let draws: Vec<&[Trajectory]> =
             mc.iter().flat_map(|mc| mc.shown().iter().map(|(sims, _)| sims.as_slice())).collect();
         for (k, (name, fig)) in
-            comparison_figures(&model, &runs, &sims, &[], &draws, "validate", plane.as_ref())
+            comparison_figures(&model, &runs, (&sims, &[]), &draws, ("validate", LABELS), plane.as_ref())
                 .into_iter()
                 .enumerate()
         {
