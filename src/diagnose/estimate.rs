@@ -62,6 +62,28 @@ pub struct SourceParameter {
     pub std_error: f64,
 }
 
+/// The estimated model from each run's recorded first sample (its estimated initial values
+/// set aside), as `termid validate` and every prediction start it.
+#[derive(Clone, Debug, Serialize)]
+pub struct FromRecords {
+    /// The scaled sum of squares from there (`None`: the simulation left its bounds).
+    pub cost: Option<f64>,
+    /// How far the estimated initial values moved from the recorded first samples, in units
+    /// of each record's noise there ([`Runs::noise`]): the root mean square over them.
+    pub moved: Option<f64>,
+    /// The largest such move, and which run and state it was in (by name).
+    pub largest: Option<(f64, String, String)>,
+    /// Whether the fit leans on its initial values: they moved by more than [`LEANS`] times
+    /// the records' noise (root mean square). A noisy first sample moves its initial value by
+    /// about its noise; far beyond it the initial values absorb what the model does not
+    /// explain, and the fit's cost overstates how well the model predicts the runs.
+    pub leans: bool,
+}
+
+/// How far (root mean square, in units of the records' noise) the estimated initial values may
+/// move from the recorded first samples before the fit is said to lean on them.
+pub const LEANS: f64 = 3.0;
+
 /// One estimated parameter.
 #[derive(Clone, Debug, Serialize)]
 pub struct EstimatedParameter {
@@ -104,6 +126,9 @@ pub struct Estimate {
     pub covariance: Option<Vec<Vec<f64>>>,
     /// How many runs' initial values were estimated with them.
     pub initial_values: usize,
+    /// Where initial values were estimated: the estimated model re-simulated from each run's
+    /// recorded first sample instead, as a prediction starts.
+    pub from_records: Option<FromRecords>,
     /// The per-source parameters (not written to the model: each source has its own).
     pub per_source: Vec<SourceParameter>,
 }
@@ -364,6 +389,30 @@ pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Resu
             }
         }
     }
+    let from_records = (!u.initial.is_empty()).then(|| {
+        let mut recorded = theta.clone();
+        let first = u.first_group() + u.groups.len();
+        for (v, &(r, i)) in recorded[first..].iter_mut().zip(&u.initial) {
+            *v = runs.initial(r, i);
+        }
+        let cost = data_cost(&recorded);
+        let moves: Vec<(f64, usize, usize)> = u
+            .initial
+            .iter()
+            .zip(&theta[first..])
+            .filter_map(|(&(r, i), v)| runs.noise(r, i).map(|s| ((v - runs.initial(r, i)) / s, r, i)))
+            .collect();
+        let moved = (!moves.is_empty())
+            .then(|| (moves.iter().map(|(z, _, _)| z * z).sum::<f64>() / moves.len() as f64).sqrt());
+        let largest = moves.iter().max_by(|a, b| a.0.abs().total_cmp(&b.0.abs())).map(|&(z, r, i)| {
+            (
+                z,
+                runs.frames[r].origin().to_string(),
+                runs.compared().iter().find(|(j, _)| *j == i).map_or_else(String::new, |(_, n)| n.clone()),
+            )
+        });
+        FromRecords { cost, moved, largest, leans: moved.is_some_and(|m| m > LEANS) }
+    });
     let (weight, tau) = data_weight(runs, &lin.residuals, k);
     let mut info = &lin.jtj * weight;
     for i in 0..k {
@@ -426,6 +475,7 @@ pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Resu
         coefficients,
         covariance: matrix,
         initial_values: u.initial.len(),
+        from_records,
         per_source: u
             .groups
             .iter()
@@ -506,6 +556,25 @@ impl Estimate {
                 "and {} initial values (each run's compared states at its start, nuisance parameters)\n",
                 self.initial_values
             ));
+        }
+        if let Some(f) = &self.from_records {
+            let cost = f.cost.map_or("— (the simulation leaves its bounds)".to_string(), |c| sig(c, 4));
+            out.push_str(&format!(
+                "from each run's recorded first sample instead (as a prediction starts): cost {cost}\n"
+            ));
+            if let (Some(moved), Some((z, run, state))) = (f.moved, &f.largest) {
+                out.push_str(&format!(
+                    "the estimated initial values moved {} times the records' noise from their first samples (root mean square; at most {:+.1} times, {state} of {run})\n",
+                    sig(moved, 2),
+                    z
+                ));
+            }
+            if f.leans {
+                out.push_str(&format!(
+                    "FLAG the fit leans on its estimated initial values: they moved far beyond the first samples' noise, so they absorb what the model does not explain (a missing effect, a structure that does not hold) and the cost {} overstates how well it predicts these runs (from their first samples: {cost}); read the estimates with care, see the runs as predicted (`--svg`, `termid validate`)\n",
+                    sig(self.cost_after, 4)
+                ));
+            }
         }
         out
     }

@@ -247,6 +247,40 @@ fn nomoto_k_and_t_from_a_zigzag() {
         let p = fit.parameters.iter().find(|p| p.name == name).unwrap();
         assert!((p.value / truth - 1.0).abs() < 0.03, "{name}: {} vs {truth}\n{}", p.value, fit.text());
     }
+    // the initial values move by about the first samples' noise: the structure holds
+    let from = fit.from_records.as_ref().unwrap();
+    assert!(!from.leans && from.moved.unwrap() < 2.0, "{}", fit.text());
+}
+
+/// A fit whose model lacks an effect the ship has (a rudder that holds the course at 3°, not
+/// at 0) leans on its estimated initial values: they move far beyond the first samples' noise
+/// to absorb it, and the report says so rather than print the fit's cost as the model's.
+#[test]
+fn a_fit_that_leans_on_its_initial_values_is_flagged() {
+    let (k, t_const, h, rudder, bias) = (0.15, 8.0, 0.1, 20f64.to_radians(), 3f64.to_radians());
+    let mut delta = rudder;
+    let mut deltas = Vec::new();
+    let rows = trajectory(&[0.0, 0.0], h, 1201, 4, |_, x| {
+        if delta > 0.0 && x[0] > rudder {
+            delta = -rudder;
+        } else if delta < 0.0 && x[0] < -rudder {
+            delta = rudder;
+        }
+        deltas.push(delta);
+        vec![x[1], (k * (delta + bias) - x[1]) / t_const]
+    });
+    let recorded: Vec<f64> = (0..rows.len()).map(|i| deltas[(i * 16).min(deltas.len() - 1)]).collect();
+    let mut rng = Lcg(11);
+    let mut frame =
+        noisy_frame("biased", h, &["ψ", "r"], &rows, &[0.1f64.to_radians(), 0.05f64.to_radians()], &mut rng);
+    frame.push("δ", recorded).unwrap();
+    let model = Model::parse(NOMOTO, "nomoto.toml").unwrap();
+    let runs = Runs::new(&model, &[frame], h, Integrator::Rk4).unwrap();
+    let fit = estimate(&model, &runs, &EstimateSettings::default()).unwrap();
+    let from = fit.from_records.as_ref().unwrap();
+    assert!(from.leans && from.moved.unwrap() > 3.0, "{}", fit.text());
+    let text = fit.text();
+    assert!(text.contains("FLAG the fit leans on its estimated initial values"), "{text}");
 }
 
 /// A prior holds what the runs cannot see: a ship at rest (ψ and r noise about zero, no
@@ -341,6 +375,8 @@ fn mmg_kvlcc2_parameters_from_basin_zigzags() {
             fit.text()
         );
     }
+    // the model has the truth's structure: its initial values move by the sensors' noise
+    assert!(!fit.from_records.as_ref().unwrap().leans, "{}", fit.text());
 }
 
 /// `termid estimate` end to end on the shipped Nomoto file: a zigzag CSV in, the estimates
