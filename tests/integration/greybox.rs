@@ -3,7 +3,7 @@
 //! own (not termid's simulator), and the estimates start well away from them.
 
 use termid::data::Frame;
-use termid::diagnose::{estimate, EstimateSettings, Runs};
+use termid::diagnose::{estimate, Estimate, EstimateSettings, Runs};
 use termid::model::Model;
 use termid::sim::Integrator;
 
@@ -52,6 +52,19 @@ fn noisy_frame(name: &str, h: f64, names: &[&str], rows: &[Vec<f64>], sd: &[f64]
 /// passes ±`rudder`; the test's own logic), from rest: the rows (ψ, r) every `h` seconds
 /// and the rudder as recorded at each (the value in force over the next interval).
 fn nomoto_zigzag(k: f64, t_const: f64, rudder: f64, h: f64, samples: usize) -> (Vec<Vec<f64>>, Vec<f64>) {
+    nomoto_zigzag_holding(k, t_const, rudder, 0.0, h, samples)
+}
+
+/// The same for a ship that holds its course at the rudder angle `−bias` (rad): it answers to
+/// δ + bias, recorded as δ.
+fn nomoto_zigzag_holding(
+    k: f64,
+    t_const: f64,
+    rudder: f64,
+    bias: f64,
+    h: f64,
+    samples: usize,
+) -> (Vec<Vec<f64>>, Vec<f64>) {
     let mut delta = rudder;
     let mut deltas = Vec::new();
     let rows = trajectory(&[0.0, 0.0], h, samples, 4, |_, x| {
@@ -61,7 +74,7 @@ fn nomoto_zigzag(k: f64, t_const: f64, rudder: f64, h: f64, samples: usize) -> (
             delta = rudder;
         }
         deltas.push(delta);
-        vec![x[1], (k * delta - x[1]) / t_const]
+        vec![x[1], (k * (delta + bias) - x[1]) / t_const]
     });
     // four RK4 stages of four sub-steps a sample: the first stage's rudder is the sample's
     let recorded = (0..rows.len()).map(|i| deltas[(i * 16).min(deltas.len() - 1)]).collect();
@@ -231,18 +244,23 @@ identify = false
 coefficients = { "K*δ/T" = 1.0, "r/T" = -1.0 }
 "#;
 
+/// Nomoto's K and T estimated from a 20°/20° zigzag of `rows` with gyro noise, started 30 %
+/// off both.
+fn nomoto_estimate(name: &str, h: f64, (rows, recorded): (Vec<Vec<f64>>, Vec<f64>)) -> Estimate {
+    let mut rng = Lcg(11);
+    let mut frame =
+        noisy_frame(name, h, &["ψ", "r"], &rows, &[0.1f64.to_radians(), 0.05f64.to_radians()], &mut rng);
+    frame.push("δ", recorded).unwrap();
+    let model = Model::parse(NOMOTO, "nomoto.toml").unwrap();
+    let runs = Runs::new(&model, &[frame], h, Integrator::Rk4).unwrap();
+    estimate(&model, &runs, &EstimateSettings::default()).unwrap()
+}
+
 /// Nomoto's K and T from a 20°/20° zigzag with gyro noise, started 30 % off both.
 #[test]
 fn nomoto_k_and_t_from_a_zigzag() {
     let (k, t_const, h) = (0.15, 8.0, 0.1);
-    let (rows, recorded) = nomoto_zigzag(k, t_const, 20f64.to_radians(), h, 1201);
-    let mut rng = Lcg(11);
-    let mut frame =
-        noisy_frame("zigzag", h, &["ψ", "r"], &rows, &[0.1f64.to_radians(), 0.05f64.to_radians()], &mut rng);
-    frame.push("δ", recorded).unwrap();
-    let model = Model::parse(NOMOTO, "nomoto.toml").unwrap();
-    let runs = Runs::new(&model, &[frame], h, Integrator::Rk4).unwrap();
-    let fit = estimate(&model, &runs, &EstimateSettings::default()).unwrap();
+    let fit = nomoto_estimate("zigzag", h, nomoto_zigzag(k, t_const, 20f64.to_radians(), h, 1201));
     for (name, truth) in [("K", k), ("T", t_const)] {
         let p = fit.parameters.iter().find(|p| p.name == name).unwrap();
         assert!((p.value / truth - 1.0).abs() < 0.03, "{name}: {} vs {truth}\n{}", p.value, fit.text());
@@ -252,31 +270,14 @@ fn nomoto_k_and_t_from_a_zigzag() {
     assert!(!from.leans && from.moved.unwrap() < 2.0, "{}", fit.text());
 }
 
-/// A fit whose model lacks an effect the ship has (a rudder that holds the course at 3°, not
+/// A fit whose model lacks an effect the ship has (a rudder that holds the course at −3°, not
 /// at 0) leans on its estimated initial values: they move far beyond the first samples' noise
 /// to absorb it, and the report says so rather than print the fit's cost as the model's.
 #[test]
 fn a_fit_that_leans_on_its_initial_values_is_flagged() {
-    let (k, t_const, h, rudder, bias) = (0.15, 8.0, 0.1, 20f64.to_radians(), 3f64.to_radians());
-    let mut delta = rudder;
-    let mut deltas = Vec::new();
-    let rows = trajectory(&[0.0, 0.0], h, 1201, 4, |_, x| {
-        if delta > 0.0 && x[0] > rudder {
-            delta = -rudder;
-        } else if delta < 0.0 && x[0] < -rudder {
-            delta = rudder;
-        }
-        deltas.push(delta);
-        vec![x[1], (k * (delta + bias) - x[1]) / t_const]
-    });
-    let recorded: Vec<f64> = (0..rows.len()).map(|i| deltas[(i * 16).min(deltas.len() - 1)]).collect();
-    let mut rng = Lcg(11);
-    let mut frame =
-        noisy_frame("biased", h, &["ψ", "r"], &rows, &[0.1f64.to_radians(), 0.05f64.to_radians()], &mut rng);
-    frame.push("δ", recorded).unwrap();
-    let model = Model::parse(NOMOTO, "nomoto.toml").unwrap();
-    let runs = Runs::new(&model, &[frame], h, Integrator::Rk4).unwrap();
-    let fit = estimate(&model, &runs, &EstimateSettings::default()).unwrap();
+    let (k, t_const, h) = (0.15, 8.0, 0.1);
+    let zigzag = nomoto_zigzag_holding(k, t_const, 20f64.to_radians(), 3f64.to_radians(), h, 1201);
+    let fit = nomoto_estimate("biased", h, zigzag);
     let from = fit.from_records.as_ref().unwrap();
     assert!(from.leans && from.moved.unwrap() > 3.0, "{}", fit.text());
     let text = fit.text();
@@ -574,14 +575,17 @@ rudder_rate = 15.8
 #[test]
 fn the_new_ship_command_writes_a_model_estimate_reads() {
     let dir = crate::common::Scratch::new("new-ship");
+    let new_ship = |particulars: &std::path::Path, out: &std::path::Path| {
+        crate::common::termid(&[
+            "new-ship",
+            "--particulars",
+            particulars.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+    };
     let out = dir.join("kvlcc2_greybox.toml");
-    let (ok, text, err) = crate::common::termid(&[
-        "new-ship",
-        "--particulars",
-        "examples/kvlcc2_particulars.toml",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let (ok, text, err) = new_ship(std::path::Path::new("examples/kvlcc2_particulars.toml"), &out);
     assert!(ok, "{err}");
     assert!(text.contains("Kijima") && text.contains("Clarke") && text.contains("Fujii"), "{text}");
     let model = termid::plugins::load(&out).unwrap();
@@ -589,33 +593,15 @@ fn the_new_ship_command_writes_a_model_estimate_reads() {
     let bad = dir.join("bad.toml");
     std::fs::write(&bad, KVLCC2_PARTICULARS.replace("block_coefficient = 0.81", "block_coefficient = 81"))
         .unwrap();
-    let (ok, _, err) = crate::common::termid(&[
-        "new-ship",
-        "--particulars",
-        bad.to_str().unwrap(),
-        "--out",
-        dir.join("x.toml").to_str().unwrap(),
-    ]);
+    let (ok, _, err) = new_ship(&bad, &dir.join("x.toml"));
     assert!(!ok && err.contains("bad.toml") && err.contains("block_coefficient"), "{err}");
-    let (ok, _, err) = crate::common::termid(&[
-        "new-ship",
-        "--particulars",
-        bad.to_str().unwrap(),
-        "--out",
-        bad.to_str().unwrap(),
-    ]);
+    let (ok, _, err) = new_ship(&bad, &bad);
     assert!(!ok && std::fs::read_to_string(&bad).unwrap().contains("= 81"), "{err}");
     // a slender hull is written, with a caution that the hull formulas extrapolate there
     let slender = dir.join("slender.toml");
     std::fs::write(&slender, KVLCC2_PARTICULARS.replace("beam = 1.27", "beam = 0.7")).unwrap();
     let written = dir.join("slender_greybox.toml");
-    let (ok, _, err) = crate::common::termid(&[
-        "new-ship",
-        "--particulars",
-        slender.to_str().unwrap(),
-        "--out",
-        written.to_str().unwrap(),
-    ]);
+    let (ok, _, err) = new_ship(&slender, &written);
     assert!(ok && written.exists() && err.contains("caution: L/B = 10.000"), "{err}");
 }
 
