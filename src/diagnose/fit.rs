@@ -221,28 +221,17 @@ impl Runs {
         self.x0[run][state]
     }
 
-    /// The noise of a compared state's first sample in run `run` (a standard deviation, in
-    /// the state's unit): the scatter about a straight line over the record's first two
-    /// seconds (ten samples at least), where the run is still on its approach or just leaving
-    /// it; what a record's rounding, held samples or a filter's start leave there counts as
-    /// noise. `None` where the state is not compared, the stretch is too short or it does not
-    /// scatter at all.
+    /// The measurement noise of a compared state in run `run` (a standard deviation, in the
+    /// state's unit), from the record's second differences: a motion sampled finely leaves
+    /// little in them besides the noise (white noise of σ gives differences of variance 6σ²),
+    /// and a record's rounding or held samples count with it, as they should. `None` where the
+    /// state is not compared or its record is constant.
     pub fn noise(&self, run: usize, state: usize) -> Option<f64> {
         let (_, name) = self.states.iter().find(|(i, _)| *i == state)?;
-        let frame = self.frames.get(run)?;
-        let (t, x) = (frame.time(), frame.column(name)?);
-        let t0 = *t.first()?;
-        let n = t.iter().take_while(|&&ti| ti - t0 <= 2.0).count().max(10).min(x.len());
-        if n < 5 {
-            return None;
-        }
-        let (t, x) = (&t[..n], &x[..n]);
-        let (mt, mx) = (t.iter().sum::<f64>() / n as f64, x.iter().sum::<f64>() / n as f64);
-        let stt: f64 = t.iter().map(|v| (v - mt) * (v - mt)).sum();
-        let stx: f64 = t.iter().zip(x).map(|(a, b)| (a - mt) * (b - mx)).sum();
-        let slope = if stt > 0.0 { stx / stt } else { 0.0 };
-        let ss: f64 = t.iter().zip(x).map(|(a, b)| (b - mx - slope * (a - mt)).powi(2)).sum();
-        let sigma = (ss / (n - 2) as f64).sqrt();
+        let x = self.frames.get(run)?.column(name)?;
+        let n = x.len().checked_sub(2).filter(|n| *n > 0)?;
+        let ss: f64 = x.windows(3).map(|w| (w[2] - 2.0 * w[1] + w[0]).powi(2)).sum();
+        let sigma = (ss / (6.0 * n as f64)).sqrt();
         (sigma > 0.0 && sigma.is_finite()).then_some(sigma)
     }
 
