@@ -1279,7 +1279,10 @@ class Model:
         ``iterations`` the most Levenberg-Marquardt iterations per round; ``sources`` the
         source (basin, campaign) of each run by number, and ``per_source`` the free parameters
         estimated once per source (nuisances such as a basin's rudder zero; in
-        ``attrs["per_source"]``, a DataFrame, and not written to the model).
+        ``attrs["per_source"]``, a DataFrame, and not written to the model). ``attrs["from_records"]``
+        holds the estimated model's cost from the recorded first samples and how far the
+        estimated initial values moved in units of the records' noise; beyond 3 times a warning
+        says the fit leans on them (the model does not explain everything the runs show).
 
         >>> nomoto = termid.Model.builtin("nomoto")
         >>> truth = termid.Model.builtin("nomoto")
@@ -1321,7 +1324,20 @@ class Model:
             "stopped": report["stopped"],
             "covariance": None if report["covariance"] is None else pd.DataFrame(report["covariance"], index=names, columns=names),
             "per_source": pd.DataFrame(report.get("per_source", []), columns=["name", "source", "value", "std_error"]),
+            "from_records": report.get("from_records"),
         }
+        leaning = report.get("from_records") or {}
+        if leaning.get("leans"):
+            # a fit whose initial values absorb what the model does not explain: its cost says
+            # more than the model predicts (the CLI flags it in its report)
+            cost = leaning.get("cost")
+            warnings.warn(
+                f"termid: the fit leans on its estimated initial values: they moved {leaning['moved']:.3g} times "
+                f"the records' noise from the first samples; from those the cost is "
+                f"{'beyond bounds' if cost is None else f'{cost:.4g}'} against {report['cost_after']:.4g} "
+                "(attrs['from_records']); the model does not explain everything the runs show",
+                stacklevel=2,
+            )
         return table, Model(native)
 
     def checks(self, runs: Union[Data, Sequence[Data], None] = None) -> pd.DataFrame:

@@ -243,6 +243,18 @@ def test_estimate_recovers_nomoto_k_and_t_from_a_noisy_run():
         assert abs(row["estimate"] - value) < max(3 * row["std_error"], 1e-3 * value), table
     assert found.parameters["K"] == table.loc["K", "estimate"]
     assert table.attrs["covariance"].shape == (2, 2) and table.attrs["cost_after"] < table.attrs["cost_before"]
+    # the structure holds: the initial values move by about the gyro's noise, and no warning
+    assert table.attrs["from_records"]["moved"] < 3 and not table.attrs["from_records"]["leans"]
+    # a ship whose rudder holds its course at −3° fitted without that offset: the fit leans on
+    # its initial values, and says so
+    t = np.arange(0.0, 120.0, 0.1)
+    rudder = np.where((t // 20) % 2 == 0, 0.2, -0.2)  # reversed every 20 s
+    laid = pd.DataFrame({"t": t, "ψ": 0.0, "r": 0.0, "δ": rudder + np.radians(3)})
+    biased = truth.replay(laid)[0][["t", "ψ", "r"]].assign(δ=rudder)
+    biased["ψ"] += np.radians(0.1) * rng.standard_normal(len(biased))
+    biased["r"] += np.radians(0.05) * rng.standard_normal(len(biased))
+    with pytest.warns(UserWarning, match="leans on its estimated initial values"):
+        termid.Model.builtin("nomoto").estimate(biased)
     with pytest.raises(termid.TermidError, match="free"):
         termid.Model.builtin("lorenz").estimate(run.rename(columns={"ψ": "x", "r": "y", "δ": "z"}))
 
