@@ -71,13 +71,24 @@ pub struct FromRecords {
     /// How far the estimated initial values moved from the recorded first samples, in units
     /// of each record's noise there ([`Runs::noise`]): the root mean square over them.
     pub moved: Option<f64>,
-    /// The largest such move, and which run and state it was in (by name).
-    pub largest: Option<(f64, String, String)>,
+    /// The largest such move.
+    pub largest: Option<Move>,
     /// Whether the fit leans on its initial values: they moved by more than [`LEANS`] times
     /// the records' noise (root mean square). A noisy first sample moves its initial value by
     /// about its noise; far beyond it the initial values absorb what the model does not
     /// explain, and the fit's cost overstates how well the model predicts the runs.
     pub leans: bool,
+}
+
+/// One estimated initial value's move from its recorded first sample.
+#[derive(Clone, Debug, Serialize)]
+pub struct Move {
+    /// In units of the record's noise, signed.
+    pub z: f64,
+    /// The run (its origin).
+    pub run: String,
+    /// The state.
+    pub state: String,
 }
 
 /// How far (root mean square, in units of the records' noise) the estimated initial values may
@@ -404,12 +415,10 @@ pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Resu
             .collect();
         let moved = (!moves.is_empty())
             .then(|| (moves.iter().map(|(z, _, _)| z * z).sum::<f64>() / moves.len() as f64).sqrt());
-        let largest = moves.iter().max_by(|a, b| a.0.abs().total_cmp(&b.0.abs())).map(|&(z, r, i)| {
-            (
-                z,
-                runs.frames[r].origin().to_string(),
-                runs.compared().iter().find(|(j, _)| *j == i).map_or_else(String::new, |(_, n)| n.clone()),
-            )
+        let largest = moves.iter().max_by(|a, b| a.0.abs().total_cmp(&b.0.abs())).map(|&(z, r, i)| Move {
+            z,
+            run: runs.frames[r].origin().to_string(),
+            state: runs.compared().iter().find(|(j, _)| *j == i).map_or_else(String::new, |(_, n)| n.clone()),
         });
         FromRecords { cost, moved, largest, leans: moved.is_some_and(|m| m > LEANS) }
     });
@@ -562,11 +571,13 @@ impl Estimate {
             out.push_str(&format!(
                 "from each run's recorded first sample instead (as a prediction starts): cost {cost}\n"
             ));
-            if let (Some(moved), Some((z, run, state))) = (f.moved, &f.largest) {
+            if let (Some(moved), Some(m)) = (f.moved, &f.largest) {
                 out.push_str(&format!(
-                    "the estimated initial values moved {} times the records' noise from their first samples (root mean square; at most {:+.1} times, {state} of {run})\n",
+                    "the estimated initial values moved {} times the records' noise from their first samples (root mean square; at most {:+.1} times, {} of {})\n",
                     sig(moved, 2),
-                    z
+                    m.z,
+                    m.state,
+                    m.run
                 ));
             }
             if f.leans {

@@ -41,7 +41,9 @@ coefficients = {{ "u" = 1.0, "{term}" = {b} }}
 use serde::Serialize;
 
 pub use choose::{choose_by_prediction, Chosen, Configuration, Prediction};
-pub use estimate::{estimate, Estimate, EstimateSettings, EstimatedParameter, SourceParameter};
+pub use estimate::{
+    estimate, Estimate, EstimateSettings, EstimatedParameter, FromRecords, Move, SourceParameter, LEANS,
+};
 pub use fit::{simulate_runs, EstimateError, Runs};
 pub use refine::{refine, RefineSettings, Refined, RefinedCoefficient};
 
