@@ -32,17 +32,9 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
         .context("diagnosing")?;
     let mut outputs = termid::output::Outputs::new();
     if let Some(dir) = &cmd.resim.svg {
-        outputs.folder(dir)?;
         let plane = termid::plugins::of(&model).and_then(|p| p.plane(&model));
-        for (k, (name, fig)) in
-            termid::plot::diagnosis_figures(&model, &d, &runs, plane.as_ref()).into_iter().enumerate()
-        {
-            let stem = std::path::Path::new(&name)
-                .file_stem()
-                .map_or(format!("run{k}"), |s| s.to_string_lossy().into_owned());
-            let svg = fig.to_svg().map_err(anyhow::Error::msg)?;
-            outputs.file(&dir.join(format!("diagnose_{stem}.svg")), svg.as_bytes())?;
-        }
+        let figures = termid::plot::diagnosis_figures(&model, &d, &runs, plane.as_ref());
+        crate::figures::write(&mut outputs, dir, "diagnose", figures)?;
     }
     if let (Some(out), Some(m)) = (&cmd.out, &d.model) {
         outputs.file(out, m.to_toml().as_bytes())?;

@@ -60,10 +60,7 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
         // a run the start values cannot simulate costs the figures, not the estimate
         match figures(&model, &fit, &runs, &frames, &sources) {
             Ok(figures) => {
-                outputs.folder(dir)?;
-                for (name, svg) in figures {
-                    outputs.file(&dir.join(name), svg.as_bytes())?;
-                }
+                crate::figures::write(&mut outputs, dir, "estimate", figures)?;
                 drawn = true;
             }
             Err(e) => eprintln!("warning: no figures: {e:#}"),
@@ -118,16 +115,16 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
     Ok(())
 }
 
-/// `estimate_<run>.svg` per run: the compared states measured, simulated with the model's
-/// values and with the estimates, each from the run's first sample (the estimated initial
-/// states are nuisances of the fit) and each source with its own per-source values.
+/// A figure per run: the compared states measured, simulated with the model's values and
+/// with the estimates, each from the run's first sample (the estimated initial states are
+/// nuisances of the fit) and each source with its own per-source values.
 fn figures(
     model: &termid::model::Model,
     fit: &termid::diagnose::Estimate,
     runs: &Runs,
     frames: &[termid::data::Frame],
     sources: &[usize],
-) -> Result<Vec<(String, String)>> {
+) -> Result<Vec<(String, termid::plot::Figure)>> {
     let own: Vec<(usize, &str, f64)> = fit
         .per_source
         .iter()
@@ -139,21 +136,12 @@ fn figures(
     let before = runs.simulate(model, &[], &[])?;
     let after = runs.with_initial(&[], &own).simulate(&fit.model, &[], &[])?;
     let plane = termid::plugins::of(model).and_then(|p| p.plane(model));
-    termid::plot::comparison_figures(
+    Ok(termid::plot::comparison_figures(
         model,
         frames,
         (&before, &after),
         &[],
         ("estimate", ["start values", "estimated"]),
         plane.as_ref(),
-    )
-    .into_iter()
-    .enumerate()
-    .map(|(k, (name, fig))| {
-        let stem = std::path::Path::new(&name)
-            .file_stem()
-            .map_or(format!("run{k}"), |s| s.to_string_lossy().into_owned());
-        Ok((format!("estimate_{stem}.svg"), fig.to_svg().map_err(anyhow::Error::msg)?))
-    })
-    .collect()
+    ))
 }

@@ -4,6 +4,7 @@ mod args;
 mod compare;
 mod diagnose;
 mod estimate;
+mod figures;
 mod identify;
 mod identify_model;
 mod moments;

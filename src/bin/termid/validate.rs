@@ -50,21 +50,12 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
         .collect();
     if let Some(dir) = &cmd.resim.svg {
         let mut outputs = termid::output::Outputs::new();
-        outputs.folder(dir)?;
         let plane = termid::plugins::of(&model).and_then(|p| p.plane(&model));
         let draws: Vec<&[Trajectory]> =
             mc.iter().flat_map(|mc| mc.shown().iter().map(|(sims, _)| sims.as_slice())).collect();
-        for (k, (name, fig)) in
-            comparison_figures(&model, &runs, (&sims, &[]), &draws, ("validate", LABELS), plane.as_ref())
-                .into_iter()
-                .enumerate()
-        {
-            let stem = std::path::Path::new(&name)
-                .file_stem()
-                .map_or(format!("run{k}"), |s| s.to_string_lossy().into_owned());
-            let svg = fig.to_svg().map_err(anyhow::Error::msg)?;
-            outputs.file(&dir.join(format!("validate_{stem}.svg")), svg.as_bytes())?;
-        }
+        let figures =
+            comparison_figures(&model, &runs, (&sims, &[]), &draws, ("validate", LABELS), plane.as_ref());
+        crate::figures::write(&mut outputs, dir, "validate", figures)?;
         outputs.commit()?;
     }
     match cmd.format {
