@@ -702,23 +702,21 @@ impl PyModel {
                 Ok((name.clone(), self.inner.with_backend(&backend).map_err(fail)?))
             })
             .collect::<PyResult<Vec<_>>>()?;
-        let settings =
-            termid::recipe::RecipeSettings {
-                derivatives,
-                smooth,
-                intercept: intercept.unwrap_or(self.inner.spec().model.intercept),
-                choose,
-                compare,
-                refine: refine.map(|states| termid::recipe::RefineOptions {
-                    states: (!states.is_empty()).then_some(states),
-                    prior: refine_prior,
-                    iterations: refine_iterations,
-                    step: refine_step,
-                }),
-                parameters: (parameters || !per_source.is_empty())
-                    .then(|| termid::recipe::ParameterOptions { sources, per_source, ..Default::default() }),
-                ..Default::default()
-            };
+        let settings = termid::recipe::RecipeSettings {
+            derivatives,
+            smooth,
+            intercept: intercept.unwrap_or(self.inner.spec().model.intercept),
+            choose,
+            compare,
+            refine: refine.map(|states| termid::recipe::RefineOptions {
+                states: (!states.is_empty()).then_some(states),
+                prior: refine_prior,
+                iterations: refine_iterations,
+                step: refine_step,
+            }),
+            parameters: termid::recipe::ParameterOptions::asked(parameters, sources, per_source),
+            ..Default::default()
+        };
         let recipe = py
             .detach(|| termid::recipe::identify(&self.inner, &frames, held.as_deref(), &settings))
             .map_err(fail)?;

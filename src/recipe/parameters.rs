@@ -4,7 +4,7 @@
 //! terms); kept only where the checks the model passed still pass.
 
 use crate::data::Frame;
-use crate::diagnose::{estimate, Estimate, EstimateSettings, Runs};
+use crate::diagnose::{estimate, Estimate, EstimateSettings};
 use crate::plugin::Check;
 
 use super::Start;
@@ -27,6 +27,18 @@ impl Default for ParameterOptions {
     }
 }
 
+impl ParameterOptions {
+    /// The stage as a caller asks for it: run where `asked` or where any parameter is to be
+    /// estimated per source (which is asking for it); `None`: not asked.
+    pub fn asked(asked: bool, sources: Vec<usize>, per_source: Vec<String>) -> Option<ParameterOptions> {
+        (asked || !per_source.is_empty()).then(|| ParameterOptions {
+            sources,
+            per_source,
+            ..Default::default()
+        })
+    }
+}
+
 /// What the parameter stage did to the kept start.
 #[derive(Debug)]
 pub enum ParameterStage {
@@ -44,13 +56,26 @@ impl ParameterStage {
     pub fn text(&self) -> String {
         match self {
             ParameterStage::Kept(e) => e.text(),
-            ParameterStage::Rejected(e, lost) => format!(
-                "{}the parameter estimate is rejected: the model would fail checks it passes ({}); the model stays as it was\n\n",
-                e.text(),
-                lost.join("; ")
+            ParameterStage::Rejected(e, _) => {
+                format!("{}{}\n\n", e.text(), self.warning().unwrap_or_default())
+            }
+            ParameterStage::Failed(_) => format!(
+                "== output-error estimate of the free parameters ==\n{}\n\n",
+                self.warning().unwrap_or_default()
             ),
+        }
+    }
+
+    /// Where the estimate was not kept, why, in a sentence (a caller's warning).
+    pub fn warning(&self) -> Option<String> {
+        match self {
+            ParameterStage::Kept(_) => None,
+            ParameterStage::Rejected(_, lost) => Some(format!(
+                "the parameter estimate is rejected: the model would fail checks it passes ({}); the model stays as it was",
+                lost.join("; ")
+            )),
             ParameterStage::Failed(why) => {
-                format!("== output-error estimate of the free parameters ==\nfailed: {why}; the model stays as it was\n\n")
+                Some(format!("the parameter estimate failed: {why}; the model stays as it was"))
             }
         }
     }
@@ -72,17 +97,8 @@ pub(super) fn estimate_parameters(
         per_source: options.per_source.clone(),
         ..Default::default()
     };
-    let fit = (|| {
-        // one RK4 step per sample: the recorded inputs are known only at the samples
-        let sample = crate::data::sample_step(frames);
-        let runs =
-            Runs::new(&start.model, frames, sample, crate::sim::Integrator::Rk4)?.with_intercepts(intercept);
-        let runs = match states {
-            Some(names) => runs.comparing(names)?,
-            None => runs,
-        };
-        estimate(&start.model, &runs, &settings)
-    })();
+    let fit = super::start::output_error_runs(&start.model, frames, states, intercept)
+        .and_then(|runs| estimate(&start.model, &runs, &settings));
     let fit = match fit {
         Ok(fit) => fit,
         Err(e) => return ParameterStage::Failed(e.to_string()),

@@ -207,6 +207,22 @@ pub(super) fn lost_checks(before: &[Check], after: &[Check]) -> Vec<String> {
     failing(after).into_iter().filter(|c| !was.contains(c)).collect()
 }
 
+/// `frames` made ready for an output-error fit of `model`: one RK4 step per sample (the
+/// recorded inputs are known only at the samples), comparing `states` (`None`: all).
+pub(super) fn output_error_runs(
+    model: &Model,
+    frames: &[Frame],
+    states: Option<&[String]>,
+    intercept: bool,
+) -> Result<Runs, crate::diagnose::DiagnoseError> {
+    let sample = crate::data::sample_step(frames);
+    let runs = Runs::new(model, frames, sample, crate::sim::Integrator::Rk4)?.with_intercepts(intercept);
+    match states {
+        Some(names) => runs.comparing(names),
+        None => Ok(runs),
+    }
+}
+
 /// Every identified coefficient refined by output error on the runs as they were prepared
 /// for the regression (smoothed initial states: a noisy first sample of a rate would
 /// otherwise drift through its integral), re-simulated at the refinement's step; the costs
@@ -218,16 +234,8 @@ fn refine(
     options: &RefineOptions,
     intercept: bool,
 ) -> Result<Refined, String> {
-    let runs_of = |frames: &[Frame]| -> Result<Runs, String> {
-        let sample = crate::data::sample_step(frames);
-        // one RK4 step per sample: the recorded input is known only at the samples
-        let runs = Runs::new(model, frames, sample, crate::sim::Integrator::Rk4)
-            .map_err(|e| e.to_string())?
-            .with_intercepts(intercept);
-        match &options.states {
-            Some(names) => runs.comparing(names).map_err(|e| e.to_string()),
-            None => Ok(runs),
-        }
+    let runs_of = |frames: &[Frame]| {
+        output_error_runs(model, frames, options.states.as_deref(), intercept).map_err(|e| e.to_string())
     };
     let runs = runs_of(frames)?;
     let validation = held.map(runs_of).transpose()?;

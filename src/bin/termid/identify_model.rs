@@ -74,11 +74,7 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
                     step: cmd.refine_step,
                 }),
                 agree: STARTS_AGREE,
-                parameters: (cmd.parameters || !cmd.per_source.is_empty()).then(|| ParameterOptions {
-                    sources,
-                    per_source: cmd.per_source.clone(),
-                    ..Default::default()
-                }),
+                parameters: ParameterOptions::asked(cmd.parameters, sources, cmd.per_source.clone()),
             };
             let label = format!(
                 "identifying ({} start{})",
@@ -120,15 +116,8 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
             lost.join("; ")
         );
     }
-    match &recipe.parameters {
-        Some(ParameterStage::Rejected(_, lost)) => eprintln!(
-            "warning: the parameter estimate is rejected: the model would fail checks it passes ({}); the model stays as it was",
-            lost.join("; ")
-        ),
-        Some(ParameterStage::Failed(why)) => {
-            eprintln!("warning: the parameter estimate failed: {why}; the model stays as it was")
-        }
-        _ => {}
+    if let Some(why) = recipe.parameters.as_ref().and_then(ParameterStage::warning) {
+        eprintln!("warning: {why}");
     }
     // checked before anything is written
     let refused = recipe.refusals();
