@@ -673,7 +673,7 @@ impl PyModel {
     /// The library's recipe (several derivative starts, choice among back-ends by
     /// prediction, output-error refinement, checks, the starts' agreement): (JSON of every
     /// start and the kept one's report, the report as text, the kept model).
-    #[pyo3(signature = (runs, derivatives, smooth = false, intercept = None, choose = vec![], compare = vec![], refine = None, refine_iterations = 100, refine_prior = 1e-4, held_out = vec![], refine_step = None, parameters = false, sources = vec![], per_source = vec![]))]
+    #[pyo3(signature = (runs, derivatives, smooth = false, intercept = None, choose = vec![], compare = vec![], refine = None, refine_iterations = 100, refine_prior = 1e-4, held_out = vec![], refine_step = None, parameters = false, sources = vec![], per_source = vec![], per_run = vec![]))]
     #[allow(clippy::too_many_arguments)]
     fn recipe(
         &self,
@@ -692,6 +692,7 @@ impl PyModel {
         parameters: bool,
         sources: Vec<usize>,
         per_source: Vec<String>,
+        per_run: Vec<String>,
     ) -> PyResult<(String, String, PyModel)> {
         let frames = self.frames(runs)?;
         let held = if held_out.is_empty() { None } else { Some(self.frames(held_out)?) };
@@ -714,7 +715,7 @@ impl PyModel {
                 iterations: refine_iterations,
                 step: refine_step,
             }),
-            parameters: termid::recipe::ParameterOptions::asked(parameters, sources, per_source),
+            parameters: termid::recipe::ParameterOptions::asked(parameters, sources, per_source, per_run),
             ..Default::default()
         };
         let recipe = py
@@ -746,7 +747,7 @@ impl PyModel {
 
     /// The model file's free parameters estimated from runs by output error (JSON report),
     /// with the model holding the estimates.
-    #[pyo3(signature = (runs, coefficients = false, states = None, initial_states = true, dt = None, iterations = 50, sources = vec![], per_source = vec![]))]
+    #[pyo3(signature = (runs, coefficients = false, states = None, initial_values = "auto".to_string(), dt = None, iterations = 50, sources = vec![], per_source = vec![], per_run = vec![]))]
     #[allow(clippy::too_many_arguments)]
     fn estimate(
         &self,
@@ -754,21 +755,30 @@ impl PyModel {
         runs: Vec<Run<'_>>,
         coefficients: bool,
         states: Option<Vec<String>>,
-        initial_states: bool,
+        initial_values: String,
         dt: Option<f64>,
         iterations: usize,
         sources: Vec<usize>,
         per_source: Vec<String>,
+        per_run: Vec<String>,
     ) -> PyResult<(String, PyModel)> {
+        let initial_values = termid::diagnose::InitialValues::parse(&initial_values).ok_or_else(|| {
+            let names: Vec<&str> = termid::diagnose::InitialValues::NAMES.iter().map(|(n, _)| *n).collect();
+            pyo3::exceptions::PyValueError::new_err(format!(
+                "initial_values `{initial_values}` is none of {}",
+                names.join(", ")
+            ))
+        })?;
         let frames = self.frames(runs)?;
         // one RK4 step per sample by default: the recorded inputs are known at the samples
         let dt = dt.unwrap_or_else(|| termid::data::sample_step(&frames));
         let settings = termid::diagnose::EstimateSettings {
             coefficients,
             iterations,
-            initial_states,
+            initial_values,
             sources,
             per_source,
+            per_run,
             ..Default::default()
         };
         let fit = py

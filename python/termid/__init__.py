@@ -1205,6 +1205,7 @@ class Model:
         parameters: bool = False,
         sources: Optional[Sequence[int]] = None,
         per_source: Sequence[str] = (),
+        per_run: Sequence[str] = (),
     ) -> "Recipe":
         """The command line's recipe for a model from runs (``termid identify --model`` with
         several ``--derivative`` starts) from ``runs``: each start prepares them by one derivative method
@@ -1217,13 +1218,13 @@ class Model:
         are reported at every sample), stopped by ``held_out`` runs where given, checked by the model's
         plug-in; the start kept that passes the checks and re-simulates best, and a flag where
         the plausible starts disagree on a turning circle. ``intercept`` as for
-        :meth:`identify` (None: the model file's). ``parameters`` (implied by ``per_source``)
-        lastly estimates the model file's free parameters with every coefficient of the kept
-        start and each run's initial state, kept where the checks it passed still pass (a
-        regression cannot estimate a parameter inside its terms, such as the new-ship
+        :meth:`identify` (None: the model file's). ``parameters`` (implied by ``per_source`` and
+        ``per_run``) lastly estimates the model file's free parameters with every coefficient of
+        the kept start and each run's initial state, kept where the checks it passed still pass
+        (a regression cannot estimate a parameter inside its terms, such as the new-ship
         template's rudder zero ``δ_0``); ``per_source`` names those estimated once per source,
-        ``sources`` numbering each run's source (basin); the estimate in ``parameters`` of the
-        result. Defaults are the new-ship recipe's.
+        ``sources`` numbering each run's source (basin), ``per_run`` those estimated once per
+        run; the estimate in ``parameters`` of the result. Defaults are the new-ship recipe's.
 
         >>> ship = termid.Model.default()
         >>> ship.set_parameter("u0", "mean:u:4")
@@ -1251,6 +1252,7 @@ class Model:
             parameters,
             [int(s) for s in sources or []],
             list(per_source),
+            list(per_run),
         )
         return Recipe(Model(native), json.loads(text_json), text)
 
@@ -1260,11 +1262,12 @@ class Model:
         *,
         coefficients: bool = False,
         states: Optional[Sequence[str]] = None,
-        initial_states: bool = True,
+        initial_values: str = "auto",
         dt: Optional[float] = None,
         iterations: int = 50,
         sources: Optional[Sequence[int]] = None,
         per_source: Sequence[str] = (),
+        per_run: Sequence[str] = (),
     ) -> Tuple[pd.DataFrame, "Model"]:
         """The model file's free parameters (``free = true`` under ``[parameters.NAME]``, with an
         optional ``prior`` and ``bounds``) estimated from ``runs`` by output error: grey-box
@@ -1274,12 +1277,20 @@ class Model:
 
         Parameters: ``coefficients`` also estimates the identified equations' term
         coefficients; ``states`` the states compared (default: every state the runs have);
-        ``initial_states`` estimates each run's initial state too (a noisy first sample would
-        bias the rest); ``dt`` the RK4 step (default: the runs' sample interval);
-        ``iterations`` the most Levenberg-Marquardt iterations per round; ``sources`` the
-        source (basin, campaign) of each run by number, and ``per_source`` the free parameters
-        estimated once per source (nuisances such as a basin's rudder zero; in
-        ``attrs["per_source"]``, a DataFrame, and not written to the model). ``attrs["from_records"]``
+        ``initial_values`` how each run's initial state enters (a noisy first sample would
+        bias the rest): ``"auto"`` (estimated free; where the fit leans on them, estimated
+        again held to the recorded first samples by the records' noise, and that fit kept
+        where it predicts the runs from their records better; ``attrs["held_again"]``),
+        ``"measured"`` (held so from the start), ``"free"`` (without a prior: they may absorb
+        what the model does not explain) or ``"recorded"`` (the first sample as it is); ``dt`` the RK4 step
+        (default: the runs' sample interval); ``iterations`` the most Levenberg-Marquardt
+        iterations per round; ``sources`` the source (basin, campaign) of each run by number,
+        ``per_source`` the free parameters estimated once per source (nuisances such as a
+        basin's rudder zero) and ``per_run`` those estimated once per run (a rudder zero that
+        drifts from run to run); both in ``attrs["per_source"]``, a DataFrame (its ``run``
+        column names the run where estimated per run). A per-source value is not written to
+        the model; a per-run parameter's mean over the runs is (``attrs["per_run"]``: its mean
+        and sd, how uncertain a new run's value is). ``attrs["from_records"]``
         holds the estimated model's cost from the recorded first samples and how far the
         estimated initial values moved in units of the records' noise; beyond 3 times a warning
         says the fit leans on them (the model does not explain everything the runs show).
@@ -1296,11 +1307,12 @@ class Model:
             _runs(runs),
             coefficients,
             None if states is None else list(states),
-            initial_states,
+            initial_values,
             dt,
             iterations,
             [int(s) for s in sources or []],
             list(per_source),
+            list(per_run),
         )
         report = json.loads(text)
         table = pd.DataFrame(
@@ -1323,8 +1335,10 @@ class Model:
             "cost_after": report["cost_after"],
             "stopped": report["stopped"],
             "covariance": None if report["covariance"] is None else pd.DataFrame(report["covariance"], index=names, columns=names),
-            "per_source": pd.DataFrame(report.get("per_source", []), columns=["name", "source", "value", "std_error"]),
+            "per_source": pd.DataFrame(report.get("per_source", []), columns=["name", "source", "run", "value", "std_error"]),
             "from_records": report.get("from_records"),
+            "per_run": pd.DataFrame(report.get("per_run", []), columns=["name", "runs", "mean", "sd"]),
+            "held_again": report.get("held_again"),
         }
         leaning = report.get("from_records") or {}
         if leaning.get("leans"):

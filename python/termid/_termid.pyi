@@ -109,17 +109,19 @@ class Model:
         parameters: bool = False,
         sources: Sequence[int] = ...,
         per_source: Sequence[str] = ...,
+        per_run: Sequence[str] = ...,
     ) -> Tuple[str, str, Model]: ...
     def estimate(
         self,
         runs: Sequence[Run],
         coefficients: bool = False,
         states: Optional[Sequence[str]] = None,
-        initial_states: bool = True,
+        initial_values: str = "auto",
         dt: Optional[float] = None,
         iterations: int = 50,
         sources: Sequence[int] = ...,
         per_source: Sequence[str] = ...,
+        per_run: Sequence[str] = ...,
     ) -> Tuple[str, Model]: ...
     def checks(self, runs: Sequence[Run] = ...) -> str: ...
     def steering_gear(self, runs: Sequence[Run]) -> Optional[str]: ...

@@ -1,5 +1,6 @@
 """Model files from Python: load, write, identify, predict, simulate, validate."""
 import os
+import warnings
 
 import numpy as np
 import pandas as pd
@@ -254,9 +255,37 @@ def test_estimate_recovers_nomoto_k_and_t_from_a_noisy_run():
     biased["ψ"] += np.radians(0.1) * rng.standard_normal(len(biased))
     biased["r"] += np.radians(0.05) * rng.standard_normal(len(biased))
     with pytest.warns(UserWarning, match="leans on its estimated initial values"):
-        termid.Model.builtin("nomoto").estimate(biased)
+        termid.Model.builtin("nomoto").estimate(biased, initial_values="free")
+    # by default the lean is seen, the fit made again with the initial values held to the
+    # records' noise and kept: it predicts the run from its record better, and no warning
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        held, _ = termid.Model.builtin("nomoto").estimate(biased)
+    assert held.attrs["held_again"]["kept"] and held.attrs["held_again"]["other"]["leans"]
+    assert not held.attrs["from_records"]["leans"]
+    with pytest.raises(ValueError, match="none of auto, measured, free, recorded"):
+        termid.Model.builtin("nomoto").estimate(biased, initial_values="fixed")
     with pytest.raises(termid.TermidError, match="free"):
         termid.Model.builtin("lorenz").estimate(run.rename(columns={"ψ": "x", "r": "y", "δ": "z"}))
+
+
+def test_estimate_per_run():
+    """A parameter estimated once per run: each run's own value in ``attrs["per_source"]``
+    (named by its run), the model holding their mean, ``attrs["per_run"]`` their spread."""
+    runs = []
+    for k in (0.15, 0.17):
+        truth = termid.Model.builtin("nomoto")
+        truth.set_parameter("K", k)
+        truth.set_parameter("T", 8.0)
+        runs.append(truth.simulate(duration=60.0, inputs={"δ": 0.1}, sample=0.1)[["t", "ψ", "r", "δ"]])
+    table, found = termid.Model.builtin("nomoto").estimate(runs, per_run=["K"])
+    own = table.attrs["per_source"]
+    assert list(own["name"]) == ["K", "K"] and own["run"].notna().all()
+    assert np.allclose(own["value"], [0.15, 0.17], rtol=1e-3), own
+    spread = table.attrs["per_run"].set_index("name").loc["K"]
+    assert spread["runs"] == 2 and abs(spread["mean"] - 0.16) < 1e-4 and abs(spread["sd"] - 0.01414) < 1e-4
+    assert abs(found.parameters["K"] - spread["mean"]) < 1e-12
+    assert abs(table.loc["T", "estimate"] - 8.0) < 0.01
 
 
 def test_recipe_estimates_each_basins_rudder_zero():

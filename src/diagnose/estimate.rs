@@ -25,15 +25,18 @@ pub struct EstimateSettings {
     pub prior_weight: f64,
     /// Most Levenberg-Marquardt iterations in each of the two rounds.
     pub iterations: usize,
-    /// Also each run's initial values of the compared states (nuisance parameters: a run is
-    /// re-simulated from its first sample, and the noise in that sample would otherwise
-    /// bias every estimate; a speed error persists for the whole run).
-    pub initial_states: bool,
+    /// How each run's initial values of the compared states enter (nuisance parameters: a
+    /// run is re-simulated from its first sample, and the noise in that sample would
+    /// otherwise bias every estimate; a speed error persists for the whole run).
+    pub initial_values: InitialValues,
     /// The source (basin, campaign) of each run, by index (empty: one source).
     pub sources: Vec<usize>,
     /// Free parameters estimated once per source (nuisances: a basin's rudder indicator
     /// zero, its propeller rate's calibration), the rest once for all.
     pub per_source: Vec<String>,
+    /// Free parameters estimated once per run (nuisances that change between runs of one
+    /// basin: the rudder's zero as the indicator drifts, a current across the tank).
+    pub per_run: Vec<String>,
 }
 
 impl Default for EstimateSettings {
@@ -42,20 +45,60 @@ impl Default for EstimateSettings {
             coefficients: false,
             prior_weight: 1e-4,
             iterations: 50,
-            initial_states: true,
+            initial_values: InitialValues::Auto,
             sources: Vec::new(),
             per_source: Vec::new(),
+            per_run: Vec::new(),
         }
     }
 }
 
-/// A parameter estimated for one source.
+/// How an estimate treats each run's initial values of the compared states.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum InitialValues {
+    /// Free; where the fit leans on them ([`FromRecords::leans`]), estimated again held as
+    /// [`InitialValues::Measured`] holds them, and that fit kept where it predicts the runs
+    /// from their recorded first samples better. Free initial values are the efficient
+    /// estimate where the model's structure holds; where it does not, they absorb what the
+    /// model does not explain, and a prediction (which starts from the record) pays for it.
+    #[default]
+    Auto,
+    /// Estimated, each held to its recorded first sample by a prior of the record's noise
+    /// there ([`Runs::noise`]): the first sample is a measurement of the initial state.
+    Measured,
+    /// Estimated without a prior (the fit may lean on them: [`FromRecords::leans`]).
+    Free,
+    /// Not estimated: every run starts at its recorded first sample.
+    Recorded,
+}
+
+impl InitialValues {
+    /// Every way, as its name reads on a command line.
+    pub const NAMES: [(&'static str, InitialValues); 4] = [
+        ("auto", InitialValues::Auto),
+        ("measured", InitialValues::Measured),
+        ("free", InitialValues::Free),
+        ("recorded", InitialValues::Recorded),
+    ];
+
+    /// The way of a name ([`InitialValues::NAMES`]).
+    pub fn parse(name: &str) -> Option<InitialValues> {
+        Self::NAMES.iter().find(|(n, _)| *n == name).map(|(_, v)| *v)
+    }
+}
+
+/// A parameter estimated for one source, or for one run.
 #[derive(Clone, Debug, Serialize)]
 pub struct SourceParameter {
     /// The parameter.
     pub name: String,
     /// The source (index, as [`EstimateSettings::sources`] numbers them).
     pub source: usize,
+    /// The run (its origin), where the parameter is estimated per run.
+    pub run: Option<String>,
+    /// The runs (indices) that share this value.
+    pub runs: Vec<usize>,
     /// The estimate.
     pub value: f64,
     /// Its standard error.
@@ -89,6 +132,11 @@ pub struct Move {
     pub run: String,
     /// The state.
     pub state: String,
+}
+
+/// A run's file name without its folder, as the report names it.
+fn file_name(origin: &str) -> &str {
+    std::path::Path::new(origin).file_name().and_then(|n| n.to_str()).unwrap_or(origin)
 }
 
 /// How far (root mean square, in units of the records' noise) the estimated initial values may
@@ -142,6 +190,55 @@ pub struct Estimate {
     pub from_records: Option<FromRecords>,
     /// The per-source parameters (not written to the model: each source has its own).
     pub per_source: Vec<SourceParameter>,
+    /// Each parameter estimated per run, over its runs: the model holds their mean.
+    pub per_run: Vec<RunSpread>,
+    /// Where free initial values leaned ([`InitialValues::Auto`]): the other fit, with them
+    /// held by the records' noise, and which of the two this is.
+    pub held_again: Option<HeldAgain>,
+}
+
+/// A parameter estimated once per run, over the runs: a new run's value is as uncertain as
+/// they scatter.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunSpread {
+    /// The parameter.
+    pub name: String,
+    /// How many runs.
+    pub runs: usize,
+    /// The runs' mean (written to the model: a new run's best guess).
+    pub mean: f64,
+    /// The runs' standard deviation.
+    pub sd: f64,
+}
+
+impl RunSpread {
+    /// The spread of each parameter estimated per run among `values`.
+    fn of(values: &[SourceParameter]) -> Vec<RunSpread> {
+        let mut names: Vec<&str> =
+            values.iter().filter(|p| p.run.is_some()).map(|p| p.name.as_str()).collect();
+        names.dedup();
+        names
+            .into_iter()
+            .map(|name| {
+                let v: Vec<f64> =
+                    values.iter().filter(|p| p.run.is_some() && p.name == name).map(|p| p.value).collect();
+                let n = v.len() as f64;
+                let mean = v.iter().sum::<f64>() / n;
+                let sd = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0)).sqrt();
+                RunSpread { name: name.to_string(), runs: v.len(), mean, sd }
+            })
+            .collect()
+    }
+}
+
+/// The two fits of [`InitialValues::Auto`] where the free one leaned on its initial values.
+#[derive(Clone, Debug, Serialize)]
+pub struct HeldAgain {
+    /// Whether the fit with the initial values held was kept (it predicts the runs from
+    /// their recorded first samples better than the free one).
+    pub kept: bool,
+    /// The fit not kept, from the recorded first samples.
+    pub other: FromRecords,
 }
 
 /// The unknowns: the free parameters (absolute values), then the coefficients (changes).
@@ -162,25 +259,44 @@ struct Unknowns {
 }
 
 impl Unknowns {
-    fn of(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Result<Unknowns, DiagnoseError> {
+    fn of(
+        model: &Model,
+        runs: &Runs,
+        settings: &EstimateSettings,
+        held: bool,
+    ) -> Result<Unknowns, DiagnoseError> {
         let all = model.free_parameters();
-        if let Some(n) = settings.per_source.iter().find(|n| !all.iter().any(|p| &p.name == *n)) {
+        for (names, per) in [(&settings.per_source, "source"), (&settings.per_run, "run")] {
+            if let Some(n) = names.iter().find(|n| !all.iter().any(|p| &p.name == *n)) {
+                return Err(DiagnoseError::Setup(format!(
+                    "`{n}` is to be estimated per {per}, but it is no free parameter of {}",
+                    model.path
+                )));
+            }
+        }
+        if let Some(n) = settings.per_run.iter().find(|n| settings.per_source.contains(n)) {
             return Err(DiagnoseError::Setup(format!(
-                "`{n}` is to be estimated per source, but it is no free parameter of {}",
-                model.path
+                "`{n}` is to be estimated per source and per run: choose one"
             )));
         }
-        let (grouped, parameters): (Vec<FreeParameter>, Vec<FreeParameter>) =
-            all.into_iter().partition(|p| settings.per_source.contains(&p.name));
+        let (grouped, parameters): (Vec<FreeParameter>, Vec<FreeParameter>) = all
+            .into_iter()
+            .partition(|p| settings.per_source.contains(&p.name) || settings.per_run.contains(&p.name));
         let source = |r: usize| settings.sources.get(r).copied().unwrap_or(0);
         let count = (0..runs.len()).map(|r| source(r) + 1).max().unwrap_or(1);
         let groups: Vec<(FreeParameter, usize, Vec<usize>)> = grouped
             .iter()
-            .flat_map(|p| {
-                (0..count).filter_map(move |s| {
-                    let members: Vec<usize> = (0..runs.len()).filter(|&r| source(r) == s).collect();
-                    (!members.is_empty()).then(|| (p.clone(), s, members))
-                })
+            .flat_map(|p| -> Vec<(FreeParameter, usize, Vec<usize>)> {
+                if settings.per_run.contains(&p.name) {
+                    (0..runs.len()).map(|r| (p.clone(), source(r), vec![r])).collect()
+                } else {
+                    (0..count)
+                        .filter_map(|s| {
+                            let members: Vec<usize> = (0..runs.len()).filter(|&r| source(r) == s).collect();
+                            (!members.is_empty()).then(|| (p.clone(), s, members))
+                        })
+                        .collect()
+                }
             })
             .collect();
         let mut coefficients = Vec::new();
@@ -194,7 +310,7 @@ impl Unknowns {
                 }
             }
         }
-        let initial: Vec<(usize, usize)> = if settings.initial_states {
+        let initial: Vec<(usize, usize)> = if settings.initial_values != InitialValues::Recorded {
             (0..runs.len()).flat_map(|r| runs.compared().iter().map(move |(i, _)| (r, *i))).collect()
         } else {
             Vec::new()
@@ -236,9 +352,11 @@ impl Unknowns {
             mean.push(m);
             bounds.push(p.bounds);
         }
-        for _ in &initial {
-            precision.push(0.0);
-            mean.push(0.0);
+        for &(r, i) in &initial {
+            // a record without a noise estimate (constant, too short) leaves its value free
+            let noise = held.then(|| runs.noise(r, i)).flatten();
+            precision.push(noise.map_or(0.0, |s| 1.0 / (s * s)));
+            mean.push(runs.initial(r, i));
             bounds.push((f64::NEG_INFINITY, f64::INFINITY));
         }
         Ok(Unknowns {
@@ -306,12 +424,37 @@ impl Unknowns {
 }
 
 /// Estimates the model file's free parameters (and, if asked, the term coefficients) from
-/// `runs` by output error.
+/// `runs` by output error, each run's initial values as [`EstimateSettings::initial_values`]
+/// says.
 ///
 /// The data's sum of squares is weighted by 1/(s²τ), s² the residuals' variance and τ their
 /// correlation time, so that a prior counts against the runs as it should: a first round
 /// starts with s² and τ from the start's residuals, a second from the first's end.
 pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Result<Estimate, DiagnoseError> {
+    let free = fit(model, runs, settings, settings.initial_values == InitialValues::Measured)?;
+    let leaned = free.from_records.as_ref().filter(|f| f.leans);
+    let (Some(leaned), InitialValues::Auto) = (leaned, settings.initial_values) else {
+        return Ok(free);
+    };
+    let mut held = fit(model, runs, settings, true)?;
+    let cost = |e: &Estimate| e.from_records.as_ref().and_then(|f| f.cost).unwrap_or(f64::INFINITY);
+    if cost(&held) < cost(&free) {
+        held.held_again = Some(HeldAgain { kept: true, other: leaned.clone() });
+        Ok(held)
+    } else {
+        let mut free = free;
+        free.held_again = held.from_records.map(|other| HeldAgain { kept: false, other });
+        Ok(free)
+    }
+}
+
+/// One output-error fit, each run's initial values free or `held` by the records' noise.
+fn fit(
+    model: &Model,
+    runs: &Runs,
+    settings: &EstimateSettings,
+    held: bool,
+) -> Result<Estimate, DiagnoseError> {
     if settings.iterations == 0 {
         return Err(DiagnoseError::Setup("the estimate needs at least one iteration".into()));
     }
@@ -321,7 +464,7 @@ pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Resu
             settings.prior_weight
         )));
     }
-    let u = Unknowns::of(model, runs, settings)?;
+    let u = Unknowns::of(model, runs, settings, held)?;
     if u.parameters.is_empty() && u.coefficients.is_empty() && u.groups.is_empty() {
         return Err(DiagnoseError::Setup(format!(
             "{} declares no free parameter (`free = true` under [parameters.NAME])",
@@ -473,6 +616,25 @@ pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Resu
             prior_sd: *sd,
         })
         .collect();
+    let per_source: Vec<SourceParameter> = u
+        .groups
+        .iter()
+        .enumerate()
+        .map(|(k, (p, source, members))| SourceParameter {
+            name: p.name.clone(),
+            source: *source,
+            run: settings.per_run.contains(&p.name).then(|| runs.frames[members[0]].origin().to_string()),
+            runs: members.clone(),
+            value: theta[u.first_group() + k],
+            std_error: std_errors[u.first_group() + k],
+        })
+        .collect();
+    // a per-source value belongs to its source's records (a basin's indicator), so the file's
+    // value stays; runs are a sample of one basin's drift, and their mean is a new run's guess
+    let per_run = RunSpread::of(&per_source);
+    for r in &per_run {
+        estimated.set_parameter(&r.name, r.mean);
+    }
     Ok(Estimate {
         model: estimated,
         cost_before,
@@ -485,17 +647,9 @@ pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Resu
         covariance: matrix,
         initial_values: u.initial.len(),
         from_records,
-        per_source: u
-            .groups
-            .iter()
-            .enumerate()
-            .map(|(k, (p, source, _))| SourceParameter {
-                name: p.name.clone(),
-                source: *source,
-                value: theta[u.first_group() + k],
-                std_error: std_errors[u.first_group() + k],
-            })
-            .collect(),
+        per_source,
+        per_run,
+        held_again: None,
     })
 }
 
@@ -541,23 +695,34 @@ impl Estimate {
             out.push_str(&format!("and {} term coefficients with them\n", self.coefficients.len()));
         }
         for p in &self.per_source {
+            let whose = match &p.run {
+                Some(run) => format!("run {}", file_name(run)),
+                None => format!("source {}", p.source + 1),
+            };
             out.push_str(&format!(
-                "{:<12} {:>14} {:>14} {:>12}   (source {})\n",
+                "{:<12} {:>14} {:>14} {:>12}   ({whose})\n",
                 p.name,
                 "",
                 num(p.value),
-                sig(p.std_error, 3),
-                p.source + 1
+                sig(p.std_error, 3)
             ));
         }
-        if let Some(p) = self.per_source.last() {
-            // the written model keeps the file's value of a per-source parameter (its sources'
-            // values are nuisances of their records): a prediction for one source must set it
+        // the written model keeps the file's value of a per-source or per-run parameter (their
+        // values are nuisances of their records): a prediction for one of them must set it
+        if let Some(p) = self.per_source.iter().rfind(|p| p.run.is_none()) {
             out.push_str(&format!(
                 "  (each source's own value, not written: the model keeps its file's `{0}`; predict source {1}'s runs with `--param {0}={2}`)\n",
                 p.name,
                 p.source + 1,
                 num(p.value)
+            ));
+        }
+        for r in &self.per_run {
+            out.push_str(&format!(
+                "  (each run's own value; the model holds their mean {} over the {} runs, sd {}: a new run's value is that uncertain)\n",
+                num(r.mean),
+                r.runs,
+                sig(r.sd, 3)
             ));
         }
         if self.initial_values > 0 {
@@ -584,6 +749,20 @@ impl Estimate {
                 out.push_str(&format!(
                     "FLAG the fit leans on its estimated initial values: they moved far beyond the first samples' noise, so they absorb what the model does not explain (a missing effect, a structure that does not hold) and the cost {} overstates how well it predicts these runs (from their first samples: {cost}); read the estimates with care, see the runs as predicted (`--svg`, `termid validate`)\n",
                     sig(self.cost_after, 4)
+                ));
+            }
+        }
+        if let Some(h) = &self.held_again {
+            let cost =
+                h.other.cost.map_or("— (the simulation leaves its bounds)".to_string(), |c| sig(c, 4));
+            if h.kept {
+                out.push_str(&format!(
+                    "the initial values held to the first samples' noise: estimated free, they leaned on them (moved {} times the records' noise; from the records cost {cost}), and held they predict the runs from their records better (`--initial-values free` gives the free fit)\n",
+                    h.other.moved.map_or("—".into(), |m| sig(m, 2))
+                ));
+            } else {
+                out.push_str(&format!(
+                    "held to the first samples' noise, the initial values give a fit that predicts the runs from their records no better (cost {cost}): the free fit is kept\n"
                 ));
             }
         }

@@ -42,7 +42,8 @@ use serde::Serialize;
 
 pub use choose::{choose_by_prediction, Chosen, Configuration, Prediction};
 pub use estimate::{
-    estimate, Estimate, EstimateSettings, EstimatedParameter, FromRecords, Move, SourceParameter, LEANS,
+    estimate, Estimate, EstimateSettings, EstimatedParameter, FromRecords, InitialValues, Move,
+    SourceParameter, LEANS,
 };
 pub use fit::{simulate_runs, EstimateError, Runs};
 pub use refine::{refine, RefineSettings, Refined, RefinedCoefficient};

@@ -149,12 +149,14 @@ pub fn identify(
                 model.path
             )));
         }
-        if let Some(n) = options.per_source.iter().find(|n| !free.contains(n)) {
-            return Err(RecipeError::Setup(format!(
-                "`{n}` is to be estimated per source, but it is no free parameter of {} (free: {})",
-                model.path,
-                free.join(", ")
-            )));
+        for (names, per) in [(&options.per_source, "source"), (&options.per_run, "run")] {
+            if let Some(n) = names.iter().find(|n| !free.contains(n)) {
+                return Err(RecipeError::Setup(format!(
+                    "`{n}` is to be estimated per {per}, but it is no free parameter of {} (free: {})",
+                    model.path,
+                    free.join(", ")
+                )));
+            }
         }
         if !options.sources.is_empty() && options.sources.len() != frames.len() {
             return Err(RecipeError::Setup(format!(

@@ -17,23 +17,31 @@ pub struct ParameterOptions {
     /// Free parameters estimated once per source (each basin's rudder zero), the others once
     /// for all.
     pub per_source: Vec<String>,
+    /// Free parameters estimated once per run (a rudder zero that drifts from run to run).
+    pub per_run: Vec<String>,
     /// Most Levenberg-Marquardt iterations in each of the estimate's two rounds.
     pub iterations: usize,
 }
 
 impl Default for ParameterOptions {
     fn default() -> Self {
-        ParameterOptions { sources: vec![], per_source: vec![], iterations: 50 }
+        ParameterOptions { sources: vec![], per_source: vec![], per_run: vec![], iterations: 50 }
     }
 }
 
 impl ParameterOptions {
     /// The stage as a caller asks for it: run where `asked` or where any parameter is to be
-    /// estimated per source (which is asking for it); `None`: not asked.
-    pub fn asked(asked: bool, sources: Vec<usize>, per_source: Vec<String>) -> Option<ParameterOptions> {
-        (asked || !per_source.is_empty()).then(|| ParameterOptions {
+    /// estimated per source or per run (which is asking for it); `None`: not asked.
+    pub fn asked(
+        asked: bool,
+        sources: Vec<usize>,
+        per_source: Vec<String>,
+        per_run: Vec<String>,
+    ) -> Option<ParameterOptions> {
+        (asked || !per_source.is_empty() || !per_run.is_empty()).then(|| ParameterOptions {
             sources,
             per_source,
+            per_run,
             ..Default::default()
         })
     }
@@ -95,6 +103,7 @@ pub(super) fn estimate_parameters(
         iterations: options.iterations,
         sources: options.sources.clone(),
         per_source: options.per_source.clone(),
+        per_run: options.per_run.clone(),
         ..Default::default()
     };
     let fit = super::start::output_error_runs(&start.model, frames, states, intercept)
@@ -105,7 +114,7 @@ pub(super) fn estimate_parameters(
     };
     // as for the refinement: an estimate must not make the model fail what its field knows
     // it passed
-    let checks = checks_per_source(&fit, &start.prepared, &options.sources);
+    let checks = checks_with_own_values(&fit, &start.prepared);
     let lost = super::start::lost_checks(&start.checks, &checks);
     if !lost.is_empty() {
         return ParameterStage::Rejected(fit, lost);
@@ -116,46 +125,62 @@ pub(super) fn estimate_parameters(
 }
 
 /// The plug-in's checks of the estimated model as written (with the file's values). Where
-/// parameters were estimated per source (a basin's rudder zero), a check that reads the runs
-/// (steering them as recorded) holds only with each source's own values: where every source's
-/// runs, checked with its values, have that check, those verdicts are merged (passed where
-/// every source passes; each source's numbers where they differ).
-fn checks_per_source(fit: &Estimate, prepared: &[Frame], sources: &[usize]) -> Vec<Check> {
+/// parameters were estimated per source or per run (a basin's rudder zero), a check that reads
+/// the runs (steering them as recorded) holds only with their own values: the runs are checked
+/// in classes that share their values, and where every class has that check, those verdicts
+/// are merged (passed where every class passes; each class's numbers where they differ).
+fn checks_with_own_values(fit: &Estimate, prepared: &[Frame]) -> Vec<Check> {
     let Some(plugin) = crate::plugins::of(&fit.model) else { return vec![] };
     let written = plugin.checks(&fit.model, prepared);
-    if fit.per_source.is_empty() || sources.len() != prepared.len() {
+    if fit.per_source.is_empty() {
         return written;
     }
-    let count = sources.iter().max().map_or(0, |m| m + 1);
-    let each: Vec<Vec<Check>> = (0..count)
-        .map(|s| {
+    // each run's own values, as indices into per_source; runs alike form one class
+    let own = |r: usize| -> Vec<usize> {
+        (0..fit.per_source.len()).filter(|&k| fit.per_source[k].runs.contains(&r)).collect()
+    };
+    let mut classes: Vec<(Vec<usize>, Vec<usize>)> = Vec::new();
+    for r in 0..prepared.len() {
+        let key = own(r);
+        match classes.iter_mut().find(|(k, _)| *k == key) {
+            Some((_, runs)) => runs.push(r),
+            None => classes.push((key, vec![r])),
+        }
+    }
+    let each: Vec<(String, Vec<Check>)> = classes
+        .iter()
+        .map(|(values, members)| {
             let mut model = fit.model.clone();
-            for p in fit.per_source.iter().filter(|p| p.source == s) {
+            for p in values.iter().map(|&k| &fit.per_source[k]) {
                 model.set_parameter(&p.name, p.value);
             }
-            let runs: Vec<Frame> =
-                prepared.iter().zip(sources).filter(|(_, k)| **k == s).map(|(f, _)| f.clone()).collect();
-            plugin.checks(&model, &runs)
+            let label = values.iter().find_map(|&k| fit.per_source[k].run.clone()).unwrap_or_else(|| {
+                format!("source {}", fit.per_source[values.first().copied().unwrap_or(0)].source + 1)
+            });
+            let runs: Vec<Frame> = members.iter().map(|&r| prepared[r].clone()).collect();
+            (label, plugin.checks(&model, &runs))
         })
         .collect();
     written
         .into_iter()
         .map(|c| {
-            let same: Vec<&Check> =
-                each.iter().filter_map(|cs| cs.iter().find(|o| o.name == c.name)).collect();
+            let same: Vec<(&str, &Check)> = each
+                .iter()
+                .filter_map(|(label, cs)| cs.iter().find(|o| o.name == c.name).map(|o| (label.as_str(), o)))
+                .collect();
             if same.len() < each.len() {
-                // not every source has it (a turning circle labelled by that source's neutral
+                // not every class has it (a turning circle labelled by that source's neutral
                 // angle): the written model's own
                 return c;
             }
             let mut merged = c;
-            merged.passed = same.iter().all(|o| o.passed);
-            merged.refuses = same.iter().any(|o| o.refuses);
-            merged.detail = if same.iter().all(|o| o.detail == same[0].detail) {
-                same[0].detail.clone()
+            merged.passed = same.iter().all(|(_, o)| o.passed);
+            merged.refuses = same.iter().any(|(_, o)| o.refuses);
+            merged.detail = if same.iter().all(|(_, o)| o.detail == same[0].1.detail) {
+                same[0].1.detail.clone()
             } else {
                 let parts: Vec<String> =
-                    same.iter().enumerate().map(|(k, o)| format!("source {}: {}", k + 1, o.detail)).collect();
+                    same.iter().map(|(label, o)| format!("{label}: {}", o.detail)).collect();
                 parts.join("; ")
             };
             merged

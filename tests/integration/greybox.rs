@@ -3,7 +3,7 @@
 //! own (not termid's simulator), and the estimates start well away from them.
 
 use termid::data::Frame;
-use termid::diagnose::{estimate, Estimate, EstimateSettings, Runs};
+use termid::diagnose::{estimate, Estimate, EstimateSettings, InitialValues, Runs};
 use termid::model::Model;
 use termid::sim::Integrator;
 
@@ -245,43 +245,68 @@ coefficients = { "K*δ/T" = 1.0, "r/T" = -1.0 }
 "#;
 
 /// Nomoto's K and T estimated from a 20°/20° zigzag of `rows` with gyro noise, started 30 %
-/// off both.
-fn nomoto_estimate(name: &str, h: f64, (rows, recorded): (Vec<Vec<f64>>, Vec<f64>)) -> Estimate {
+/// off both, the initial values as `initial`.
+fn nomoto_estimate(
+    name: &str,
+    h: f64,
+    (rows, recorded): (Vec<Vec<f64>>, Vec<f64>),
+    initial: InitialValues,
+) -> Estimate {
     let mut rng = Lcg(11);
     let mut frame =
         noisy_frame(name, h, &["ψ", "r"], &rows, &[0.1f64.to_radians(), 0.05f64.to_radians()], &mut rng);
     frame.push("δ", recorded).unwrap();
     let model = Model::parse(NOMOTO, "nomoto.toml").unwrap();
     let runs = Runs::new(&model, &[frame], h, Integrator::Rk4).unwrap();
-    estimate(&model, &runs, &EstimateSettings::default()).unwrap()
+    estimate(&model, &runs, &EstimateSettings { initial_values: initial, ..Default::default() }).unwrap()
 }
 
 /// Nomoto's K and T from a 20°/20° zigzag with gyro noise, started 30 % off both.
 #[test]
 fn nomoto_k_and_t_from_a_zigzag() {
     let (k, t_const, h) = (0.15, 8.0, 0.1);
-    let fit = nomoto_estimate("zigzag", h, nomoto_zigzag(k, t_const, 20f64.to_radians(), h, 1201));
-    for (name, truth) in [("K", k), ("T", t_const)] {
-        let p = fit.parameters.iter().find(|p| p.name == name).unwrap();
-        assert!((p.value / truth - 1.0).abs() < 0.03, "{name}: {} vs {truth}\n{}", p.value, fit.text());
+    for initial in [InitialValues::Measured, InitialValues::Free] {
+        let fit =
+            nomoto_estimate("zigzag", h, nomoto_zigzag(k, t_const, 20f64.to_radians(), h, 1201), initial);
+        for (name, truth) in [("K", k), ("T", t_const)] {
+            let p = fit.parameters.iter().find(|p| p.name == name).unwrap();
+            assert!((p.value / truth - 1.0).abs() < 0.03, "{name}: {} vs {truth}\n{}", p.value, fit.text());
+        }
+        // the initial values move by about the first samples' noise: the structure holds
+        let from = fit.from_records.as_ref().unwrap();
+        assert!(!from.leans && from.moved.unwrap() < 2.0, "{initial:?}: {}", fit.text());
     }
-    // the initial values move by about the first samples' noise: the structure holds
-    let from = fit.from_records.as_ref().unwrap();
-    assert!(!from.leans && from.moved.unwrap() < 2.0, "{}", fit.text());
 }
 
 /// A fit whose model lacks an effect the ship has (a rudder that holds the course at −3°, not
 /// at 0) leans on its estimated initial values: they move far beyond the first samples' noise
-/// to absorb it, and the report says so rather than print the fit's cost as the model's.
+/// to absorb it when free, and the report says so rather than print the fit's cost as the
+/// model's; held by the records' noise they do not, and the default then keeps that fit.
 #[test]
 fn a_fit_that_leans_on_its_initial_values_is_flagged() {
     let (k, t_const, h) = (0.15, 8.0, 0.1);
     let zigzag = nomoto_zigzag_holding(k, t_const, 20f64.to_radians(), 3f64.to_radians(), h, 1201);
-    let fit = nomoto_estimate("biased", h, zigzag);
-    let from = fit.from_records.as_ref().unwrap();
-    assert!(from.leans && from.moved.unwrap() > 3.0, "{}", fit.text());
-    let text = fit.text();
+    let free = nomoto_estimate("biased", h, zigzag.clone(), InitialValues::Free);
+    let from = free.from_records.as_ref().unwrap();
+    assert!(from.leans && from.moved.unwrap() > 3.0, "{}", free.text());
+    let text = free.text();
     assert!(text.contains("FLAG the fit leans on its estimated initial values"), "{text}");
+    // held by the first samples' noise they cannot: the fit's cost is the cost
+    // from the records, the one a prediction has, and the missing effect shows in it
+    let held = nomoto_estimate("biased", h, zigzag.clone(), InitialValues::Measured);
+    let from = held.from_records.as_ref().unwrap();
+    assert!(!from.leans && from.moved.unwrap() < 2.0, "{}", held.text());
+    assert!((from.cost.unwrap() / held.cost_after - 1.0).abs() < 0.05, "{}", held.text());
+    assert!(held.cost_after > 2.0 * free.cost_after, "{}\n{}", held.text(), free.text());
+    assert!(!held.text().contains("FLAG"), "{}", held.text());
+    // the default fits free, sees the lean, fits again held and keeps that fit: it predicts
+    // the run from its record better
+    let auto = nomoto_estimate("biased", h, zigzag, InitialValues::Auto);
+    let again = auto.held_again.as_ref().unwrap();
+    assert!(again.kept && again.other.leans, "{}", auto.text());
+    assert_eq!(auto.cost_after, held.cost_after);
+    assert!(auto.text().contains("the initial values held to the first samples' noise"), "{}", auto.text());
+    assert!(!auto.text().contains("FLAG"), "{}", auto.text());
 }
 
 /// A prior holds what the runs cannot see: a ship at rest (ψ and r noise about zero, no
@@ -312,13 +337,50 @@ fn a_prior_holds_what_the_runs_do_not_see() {
     f.push("δ", vec![0.0; t.len()]).unwrap();
     let runs = Runs::new(&model, &[f], 0.1, Integrator::Rk4).unwrap();
     // the initial values held at the first sample (estimated, a noise-sized r(0) would tell T)
-    let settings = EstimateSettings { initial_states: false, ..Default::default() };
+    let settings = EstimateSettings { initial_values: InitialValues::Recorded, ..Default::default() };
     let fit = estimate(&model, &runs, &settings).unwrap();
     for (name, mean, sd) in [("K", 0.2, 0.01), ("T", 6.0, 0.5)] {
         let p = fit.parameters.iter().find(|p| p.name == name).unwrap();
         assert!((p.value - mean).abs() < 1e-3 * mean, "{}", fit.text());
         assert!((p.std_error / sd - 1.0).abs() < 1e-3, "{}", fit.text());
     }
+}
+
+/// `termid estimate --initial-values`: by default a fit that leans on its initial values (a
+/// ship holding its course at −3°, fitted without that offset) is made again with them held
+/// and says so; `free` keeps the leaning fit, flagged; a way that is none is refused by name.
+#[test]
+fn the_estimate_command_holds_initial_values_where_the_fit_leans() {
+    let (k, t_const, h) = (0.15, 8.0, 0.1);
+    let (rows, deltas) = nomoto_zigzag_holding(k, t_const, 20f64.to_radians(), 3f64.to_radians(), h, 1201);
+    let mut rng = Lcg(7);
+    let dir = crate::common::Scratch::new("estimate-initial");
+    let mut csv = String::from("t,ψ,r,δ\n");
+    for (i, row) in rows.iter().enumerate() {
+        let (psi, r) =
+            (row[0] + 0.1f64.to_radians() * rng.normal(), row[1] + 0.05f64.to_radians() * rng.normal());
+        csv.push_str(&format!("{},{psi},{r},{}\n", i as f64 * h, deltas[i]));
+    }
+    let data = dir.join("biased.csv");
+    std::fs::write(&data, csv).unwrap();
+    let run = |way: Option<&str>| {
+        let mut args = vec!["estimate", "--model", "models/nomoto.toml", "--data", data.to_str().unwrap()];
+        if let Some(way) = way {
+            args.extend(["--initial-values", way]);
+        }
+        crate::common::termid(&args)
+    };
+    let (ok, text, err) = run(None);
+    assert!(ok, "{err}");
+    assert!(
+        text.contains("the initial values held to the first samples' noise") && !text.contains("FLAG"),
+        "{text}"
+    );
+    let (ok, text, err) = run(Some("free"));
+    assert!(ok, "{err}");
+    assert!(text.contains("FLAG the fit leans on its estimated initial values"), "{text}");
+    let (ok, _, err) = run(Some("fixed"));
+    assert!(!ok && err.contains("none of auto, measured, free, recorded"), "{err}");
 }
 
 /// Keys that make no sense are refused with the file and key.
@@ -626,13 +688,9 @@ fn two_basins(truth: &Model, zigzags: &[(&str, f64)]) -> (Vec<Frame>, Vec<usize>
     (frames, sources)
 }
 
-/// Two basins, one hull: each basin's rudder indicator reads off by its own zero (+0.3° and
-/// −0.5°), a nuisance estimated per source beside the hull's derivatives (started 30 % off);
-/// both come back, and the hull's derivatives as from one basin without offsets.
-#[test]
-fn two_basins_with_their_own_rudder_zero() {
-    let truth = mmg_truth();
-    // the rudder the hull feels is the indicator's reading less the basin's zero δ_0
+/// The MMG KVLCC2 with a rudder indicator zero `δ_0` (free, prior 0 ± 0.02 rad: the rudder
+/// the hull feels is the reading less it) and the hull's linear derivatives freed 30 % off.
+fn zeroed_start() -> (Model, [&'static str; 4]) {
     let text = std::fs::read_to_string("models/mmg_kvlcc2.toml").unwrap();
     let text = text
         .replacen("[[derived]]", "[[derived]]\nname = \"δ_t\"\ndefinition = \"δ - δ_0\"\n\n[[derived]]", 1)
@@ -652,6 +710,16 @@ fn two_basins_with_their_own_rudder_zero() {
             }
         })
         .unwrap();
+    (start, free)
+}
+
+/// Two basins, one hull: each basin's rudder indicator reads off by its own zero (+0.3° and
+/// −0.5°), a nuisance estimated per source beside the hull's derivatives (started 30 % off);
+/// both come back, and the hull's derivatives as from one basin without offsets.
+#[test]
+fn two_basins_with_their_own_rudder_zero() {
+    let truth = mmg_truth();
+    let (start, free) = zeroed_start();
     let (frames, sources) = two_basins(&truth, &[("zigzag:20/20", 1.0), ("zigzag:20/20:port", 0.98)]);
     let settings = EstimateSettings { sources, per_source: vec!["δ_0".into()], ..Default::default() };
     let fit = estimate(&start, &runs_of(&start, &frames), &settings).unwrap();
@@ -679,6 +747,79 @@ fn two_basins_with_their_own_rudder_zero() {
         ),
         "{text}"
     );
+}
+
+/// One basin whose rudder indicator drifts: each of four zigzags reads off by its own zero
+/// (−0.6° to +0.5°), a nuisance estimated per run beside the hull's derivatives (started 30 %
+/// off). Each run's zero comes back, and the derivatives within 2 %; one zero for all runs
+/// cannot stand in for them.
+#[test]
+fn runs_with_their_own_rudder_zero() {
+    let truth = mmg_truth();
+    let (start, free) = zeroed_start();
+    let zigzags = [
+        ("zigzag:20/20", 1.0),
+        ("zigzag:20/20:port", 0.98),
+        ("zigzag:10/10", 1.01),
+        ("zigzag:10/10:port", 0.99),
+    ];
+    let zeros = [0.5f64, -0.6, 0.2, -0.3];
+    let records =
+        termid::ship::basin::Basin::default().record_all(&truth, &zigzags, 1.17248, 60.0, 61, None).unwrap();
+    let frames: Vec<Frame> = records
+        .into_iter()
+        .zip(zeros)
+        .map(|((_, rec), zero)| {
+            let mut f = rec.measured;
+            let read: Vec<f64> = f.column("δ").unwrap().iter().map(|d| d + zero.to_radians()).collect();
+            f.set("δ", read).unwrap();
+            f
+        })
+        .collect();
+    let runs = runs_of(&start, &frames);
+    let settings = EstimateSettings { per_run: vec!["δ_0".into()], ..Default::default() };
+    let per_run = estimate(&start, &runs, &settings).unwrap();
+    assert_eq!(per_run.per_source.len(), 4, "{}", per_run.text());
+    for (p, zero) in per_run.per_source.iter().zip(zeros) {
+        assert!(p.run.is_some(), "{}", per_run.text());
+        assert!(
+            (p.value.to_degrees() - zero).abs() < 0.1,
+            "{:?}: {}° vs {zero}°\n{}",
+            p.run,
+            p.value.to_degrees(),
+            per_run.text()
+        );
+    }
+    let values = truth.parameter_values();
+    // the hull's derivatives' largest relative error
+    let off = |fit: &Estimate| -> f64 {
+        let error =
+            |name: &str| fit.parameters.iter().find(|p| p.name == name).unwrap().value / values[name] - 1.0;
+        free.iter().map(|name| error(name).abs()).fold(0.0, f64::max)
+    };
+    assert!(off(&per_run) < 0.02, "{}", per_run.text());
+    let text = per_run.text();
+    assert!(
+        text.contains("(run zigzag_20_20_port.dat)") && text.contains("the model holds their mean"),
+        "{text}"
+    );
+    // the model holds the runs' mean, a new run's best guess (the zeros' mean: −0.05°)
+    let written = per_run.model.parameter_values()["δ_0"].to_degrees();
+    assert!(
+        (written - (-0.05)).abs() < 0.05 && (per_run.per_run[0].sd.to_degrees() - 0.49).abs() < 0.1,
+        "{text}"
+    );
+    // one zero for all four runs cannot stand in for theirs: the derivatives bend for it
+    let once = estimate(&start, &runs, &EstimateSettings::default()).unwrap();
+    assert!(off(&once) > 0.04 && off(&once) > 3.0 * off(&per_run), "{}\n{}", once.text(), per_run.text());
+    // a parameter per source and per run at once is refused
+    let both = EstimateSettings {
+        per_run: vec!["δ_0".into()],
+        per_source: vec!["δ_0".into()],
+        ..Default::default()
+    };
+    let e = estimate(&start, &runs, &both).unwrap_err().to_string();
+    assert!(e.contains("per source and per run"), "{e}");
 }
 
 /// The polynomial template from two basins, each with its own rudder zero (+0.3° and −0.5°),

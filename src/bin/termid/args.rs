@@ -79,6 +79,10 @@ pub struct EstimateCommand {
     /// indicator zero); the others once for all.
     #[arg(long, num_args = 1.., value_delimiter = ',')]
     pub per_source: Vec<String>,
+    /// Free parameters estimated once per run (nuisances that change from run to run, such
+    /// as the rudder's zero `δ_0` as a basin's indicator drifts; not written to the model).
+    #[arg(long, num_args = 1.., value_delimiter = ',')]
+    pub per_run: Vec<String>,
     /// Another model of the same ship (a polynomial one `identify` wrote): both models'
     /// checks side by side, flagged where they disagree by more than 10 % on a manoeuvre the
     /// runs did not cover (a turning circle): the runs cannot tell them apart there.
@@ -94,6 +98,14 @@ pub struct EstimateCommand {
     /// Most Levenberg-Marquardt iterations per round (two rounds).
     #[arg(long, default_value_t = 50)]
     pub iterations: usize,
+    /// Each run's initial values of the compared states: `auto` (free; where the fit leans on
+    /// them, fitted again held as `measured` holds them, and that fit kept where it predicts
+    /// the runs from their recorded first samples better), `measured` (estimated, held to the
+    /// recorded first sample by the record's noise), `free` (estimated without a prior: they
+    /// may absorb what the model does not explain) or `recorded` (the first sample, not
+    /// estimated).
+    #[arg(long = "initial-values", default_value = "auto", value_parser = initial_values)]
+    pub initial_values: termid::diagnose::InitialValues,
     /// Compare only these states (default: every state the runs have).
     #[arg(long, num_args = 1.., value_delimiter = ',')]
     pub states: Option<Vec<String>>,
@@ -308,6 +320,10 @@ pub struct IdentifyCommand {
     /// --dataset a source, the --data files another), e.g. each basin's rudder indicator zero.
     #[arg(long, num_args = 1.., value_delimiter = ',', requires = "model")]
     pub per_source: Vec<String>,
+    /// With --parameters (implied): these free parameters estimated once per run (a rudder
+    /// zero that drifts from run to run); not written to the model.
+    #[arg(long, num_args = 1.., value_delimiter = ',', requires = "model")]
+    pub per_run: Vec<String>,
     /// With --model: choose among these back-ends and model files (comma-separated, or `all`
     /// back-ends; a model file is another candidate library for the same equations) by what
     /// they predict: each run is re-simulated by the model identified on the other runs; of
@@ -558,4 +574,12 @@ pub struct ResimArgs {
     /// Include each equation's stored intercept b0 in the simulation.
     #[arg(long)]
     pub with_intercept: bool,
+}
+
+/// `--initial-values`: one of [`termid::diagnose::InitialValues::NAMES`].
+fn initial_values(name: &str) -> Result<termid::diagnose::InitialValues, String> {
+    termid::diagnose::InitialValues::parse(name).ok_or_else(|| {
+        let names: Vec<&str> = termid::diagnose::InitialValues::NAMES.iter().map(|(n, _)| *n).collect();
+        format!("`{name}` is none of {}", names.join(", "))
+    })
 }

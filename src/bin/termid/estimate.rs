@@ -39,8 +39,10 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
     let settings = EstimateSettings {
         coefficients: cmd.coefficients,
         iterations: cmd.iterations,
+        initial_values: cmd.initial_values,
         sources: sources.clone(),
         per_source: cmd.per_source.clone(),
+        per_run: cmd.per_run.clone(),
         ..Default::default()
     };
     let label = format!(
@@ -58,7 +60,7 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
     let mut drawn = false;
     if let Some(dir) = &cmd.svg {
         // a run the start values cannot simulate costs the figures, not the estimate
-        match figures(&model, &fit, &runs, &frames, &sources) {
+        match figures(&model, &fit, &runs, &frames) {
             Ok(figures) => {
                 crate::figures::write(&mut outputs, dir, "estimate", figures)?;
                 drawn = true;
@@ -101,7 +103,7 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
                     println!("{}", c.line());
                 }
             }
-            if !fit.per_source.is_empty() {
+            if !cmd.per_source.is_empty() {
                 print!("{}", crate::runs::source_labels(&cmd.data, &cmd.dataset));
             }
             if let Some(out) = &cmd.out {
@@ -117,21 +119,17 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
 
 /// A figure per run: the compared states measured, simulated with the model's values and
 /// with the estimates, each from the run's first sample (the estimated initial states are
-/// nuisances of the fit) and each source with its own per-source values.
+/// nuisances of the fit) and each source or run with its own values.
 fn figures(
     model: &termid::model::Model,
     fit: &termid::diagnose::Estimate,
     runs: &Runs,
     frames: &[termid::data::Frame],
-    sources: &[usize],
 ) -> Result<Vec<(String, termid::plot::Figure)>> {
     let own: Vec<(usize, &str, f64)> = fit
         .per_source
         .iter()
-        .flat_map(|p| {
-            let runs = sources.iter().enumerate().filter(move |(_, s)| **s == p.source);
-            runs.map(move |(r, _)| (r, p.name.as_str(), p.value))
-        })
+        .flat_map(|p| p.runs.iter().map(move |&r| (r, p.name.as_str(), p.value)))
         .collect();
     let before = runs.simulate(model, &[], &[])?;
     let after = runs.with_initial(&[], &own).simulate(&fit.model, &[], &[])?;

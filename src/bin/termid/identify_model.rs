@@ -74,7 +74,12 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
                     step: cmd.refine_step,
                 }),
                 agree: STARTS_AGREE,
-                parameters: ParameterOptions::asked(cmd.parameters, sources, cmd.per_source.clone()),
+                parameters: ParameterOptions::asked(
+                    cmd.parameters,
+                    sources,
+                    cmd.per_source.clone(),
+                    cmd.per_run.clone(),
+                ),
             };
             let label = format!(
                 "identifying ({} start{})",
@@ -141,7 +146,7 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
         Format::Json => println!("{}", serde_json::to_string_pretty(&recipe.json()?)?),
         Format::Text => {
             print!("{}", recipe.text());
-            if !cmd.per_source.is_empty() {
+            if !cmd.per_source.is_empty() || !cmd.per_run.is_empty() {
                 print!("{}", crate::runs::source_labels(&cmd.data, &cmd.dataset));
             }
             if let Some(out) = cmd.out.as_ref().filter(|_| write) {

@@ -142,7 +142,16 @@ pub fn in_pieces(cmd: &IdentifyCommand, refine: bool) -> Result<Option<usize>> {
         (cmd.smooth, "--smooth"),
         (cmd.prepared_svg.is_some(), "--prepared-svg"),
         (refine, "--refine"),
-        (cmd.parameters || !cmd.per_source.is_empty(), "--parameters"),
+        (
+            termid::recipe::ParameterOptions::asked(
+                cmd.parameters,
+                vec![],
+                cmd.per_source.clone(),
+                cmd.per_run.clone(),
+            )
+            .is_some(),
+            "--parameters",
+        ),
         (cmd.choose.is_some(), "--choose"),
         (cmd.target.is_some(), "--target"),
         (!local, "a --derivative that needs whole runs"),
