@@ -12,7 +12,7 @@ use super::fit::{apply, cost as sum_of_squares};
 use super::refine::RefinedCoefficient;
 use super::sensitivity::{fit_failure, linearise, Free, Linearised};
 use super::{DiagnoseError, Effect, EstimateError, Hypothesis, Runs};
-use crate::model::{FreeParameter, Model, ParameterCovarianceSpec};
+use crate::model::{FreeParameter, Model, Nuisance, ParameterCovarianceSpec};
 use crate::term::Term;
 
 /// What an estimate changes and how long it may try.
@@ -249,6 +249,8 @@ struct Unknowns {
     coefficients: Vec<(String, Term, f64, f64)>,
     /// (parameter, source, its runs, start) of each per-source unknown.
     groups: Vec<(FreeParameter, usize, Vec<usize>)>,
+    /// The parameters estimated once per run.
+    per_run: Vec<String>,
     /// (run, state index) of each free initial value.
     initial: Vec<(usize, usize)>,
     hypothesis: Hypothesis,
@@ -279,15 +281,28 @@ impl Unknowns {
                 "`{n}` is to be estimated per source and per run: choose one"
             )));
         }
-        let (grouped, parameters): (Vec<FreeParameter>, Vec<FreeParameter>) = all
-            .into_iter()
-            .partition(|p| settings.per_source.contains(&p.name) || settings.per_run.contains(&p.name));
+        // the command's word first, then the file's (`nuisance = "run"`)
+        let scope = |p: &FreeParameter, asked: &[String], declared: Nuisance, other: &[String]| {
+            asked.contains(&p.name) || (p.nuisance == Some(declared) && !other.contains(&p.name))
+        };
+        let per_run: Vec<String> = all
+            .iter()
+            .filter(|p| scope(p, &settings.per_run, Nuisance::Run, &settings.per_source))
+            .map(|p| p.name.clone())
+            .collect();
+        let per_source: Vec<String> = all
+            .iter()
+            .filter(|p| scope(p, &settings.per_source, Nuisance::Source, &settings.per_run))
+            .map(|p| p.name.clone())
+            .collect();
+        let (grouped, parameters): (Vec<FreeParameter>, Vec<FreeParameter>) =
+            all.into_iter().partition(|p| per_source.contains(&p.name) || per_run.contains(&p.name));
         let source = |r: usize| settings.sources.get(r).copied().unwrap_or(0);
         let count = (0..runs.len()).map(|r| source(r) + 1).max().unwrap_or(1);
         let groups: Vec<(FreeParameter, usize, Vec<usize>)> = grouped
             .iter()
             .flat_map(|p| -> Vec<(FreeParameter, usize, Vec<usize>)> {
-                if settings.per_run.contains(&p.name) {
+                if per_run.contains(&p.name) {
                     (0..runs.len()).map(|r| (p.clone(), source(r), vec![r])).collect()
                 } else {
                     (0..count)
@@ -364,6 +379,7 @@ impl Unknowns {
             parameters,
             coefficients,
             groups,
+            per_run,
             initial,
             hypothesis,
             precision,
@@ -623,7 +639,7 @@ fn fit(
         .map(|(k, (p, source, members))| SourceParameter {
             name: p.name.clone(),
             source: *source,
-            run: settings.per_run.contains(&p.name).then(|| runs.frames[members[0]].origin().to_string()),
+            run: u.per_run.contains(&p.name).then(|| runs.frames[members[0]].origin().to_string()),
             runs: members.clone(),
             value: theta[u.first_group() + k],
             std_error: std_errors[u.first_group() + k],

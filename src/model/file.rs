@@ -151,6 +151,20 @@ pub struct ParameterSpec {
     /// The estimate's standard error (written by `termid estimate`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub std_error: Option<f64>,
+    /// A free parameter that belongs to the records, not to the system: estimated once per
+    /// run or per source unless the command says otherwise (`--per-run`, `--per-source`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nuisance: Option<Nuisance>,
+}
+
+/// `nuisance = "run"` or `"source"` under `[parameters.NAME]`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Nuisance {
+    /// Its own value in every run (a rudder zero that drifts from run to run).
+    Run,
+    /// Its own value in every source (a basin's rudder indicator zero).
+    Source,
 }
 
 /// `[parameters.NAME.prior]`: a Gaussian prior.

@@ -16,8 +16,8 @@ pub use covariance::{Covariance, CovarianceError};
 pub use param::{ParamError, ParamValue};
 
 pub use file::{
-    CoefficientSpec, CovarianceSpec, EquationSpec, InputSpec, Meta, ModelFile, ParameterCovarianceSpec,
-    ParameterSpec, PriorSpec, StateSpec,
+    CoefficientSpec, CovarianceSpec, EquationSpec, InputSpec, Meta, ModelFile, Nuisance,
+    ParameterCovarianceSpec, ParameterSpec, PriorSpec, StateSpec,
 };
 pub use locate::line_of_key;
 
@@ -161,6 +161,12 @@ fn check_free(name: &str, p: &ParameterSpec) -> Result<(), (String, String)> {
             ));
         }
     }
+    if p.nuisance.is_some() && !p.free {
+        return Err((
+            ".nuisance".into(),
+            format!("`{name}` is no free parameter: only a free one (`free = true`) is estimated per run or source"),
+        ));
+    }
     if p.free && p.per_run.is_some() {
         return Err((
             ".free".into(),
@@ -181,6 +187,8 @@ pub struct FreeParameter {
     pub prior: Option<(f64, f64)>,
     /// Its bounds (±∞ where none).
     pub bounds: (f64, f64),
+    /// Estimated once per run or per source by default (`nuisance`), if the file says so.
+    pub nuisance: Option<Nuisance>,
 }
 
 impl Model {
@@ -195,6 +203,7 @@ impl Model {
                 value: p.value,
                 prior: p.prior.as_ref().map(|q| (q.value, q.sd)),
                 bounds: p.bounds.map_or((f64::NEG_INFINITY, f64::INFINITY), |[lo, hi]| (lo, hi)),
+                nuisance: p.nuisance,
             })
             .collect()
     }

@@ -299,7 +299,7 @@ impl Particulars {
                 value: 0.0,
                 sd: 2f64.to_radians(),
                 unit: "rad",
-                source: "the rudder indicator's zero; a nuisance, per basin with --per-source δ_0",
+                source: "the rudder indicator's zero; a nuisance, its own in every run (--per-source δ_0: one per basin)",
             },
             // resistance: the straight run solves the propeller's rate for it, so it trades
             // against the propeller's parameters; a modest prior
