@@ -53,6 +53,17 @@ impl Default for EstimateSettings {
     }
 }
 
+impl SourceParameter {
+    /// Whose value this is, as a report names it: the run's file name without its folder, or
+    /// the source's number.
+    pub fn whose(&self) -> String {
+        match &self.run {
+            Some(run) => format!("run {}", file_name(run)),
+            None => format!("source {}", self.source + 1),
+        }
+    }
+}
+
 /// How an estimate treats each run's initial values of the compared states.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -711,16 +722,13 @@ impl Estimate {
             out.push_str(&format!("and {} term coefficients with them\n", self.coefficients.len()));
         }
         for p in &self.per_source {
-            let whose = match &p.run {
-                Some(run) => format!("run {}", file_name(run)),
-                None => format!("source {}", p.source + 1),
-            };
             out.push_str(&format!(
-                "{:<12} {:>14} {:>14} {:>12}   ({whose})\n",
+                "{:<12} {:>14} {:>14} {:>12}   ({})\n",
                 p.name,
                 "",
                 num(p.value),
-                sig(p.std_error, 3)
+                sig(p.std_error, 3),
+                p.whose()
             ));
         }
         // the written model keeps the file's value of a per-source or per-run parameter (their

@@ -154,9 +154,12 @@ fn checks_with_own_values(fit: &Estimate, prepared: &[Frame]) -> Vec<Check> {
             for p in values.iter().map(|&k| &fit.per_source[k]) {
                 model.set_parameter(&p.name, p.value);
             }
-            let label = values.iter().find_map(|&k| fit.per_source[k].run.clone()).unwrap_or_else(|| {
-                format!("source {}", fit.per_source[values.first().copied().unwrap_or(0)].source + 1)
-            });
+            // a class is one source's runs, or one run where a value is per run
+            let label = values
+                .iter()
+                .map(|&k| &fit.per_source[k])
+                .max_by_key(|p| p.run.is_some())
+                .map_or_else(String::new, |p| p.whose());
             let runs: Vec<Frame> = members.iter().map(|&r| prepared[r].clone()).collect();
             (label, plugin.checks(&model, &runs))
         })
