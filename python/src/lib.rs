@@ -762,13 +762,8 @@ impl PyModel {
         per_source: Vec<String>,
         per_run: Vec<String>,
     ) -> PyResult<(String, PyModel)> {
-        let initial_values = termid::diagnose::InitialValues::parse(&initial_values).ok_or_else(|| {
-            let names: Vec<&str> = termid::diagnose::InitialValues::NAMES.iter().map(|(n, _)| *n).collect();
-            pyo3::exceptions::PyValueError::new_err(format!(
-                "initial_values `{initial_values}` is none of {}",
-                names.join(", ")
-            ))
-        })?;
+        let initial_values = termid::diagnose::InitialValues::parse(&initial_values)
+            .map_err(|e| pyo3::exceptions::PyValueError::new_err(format!("initial_values {e}")))?;
         let frames = self.frames(runs)?;
         // one RK4 step per sample by default: the recorded inputs are known at the samples
         let dt = dt.unwrap_or_else(|| termid::data::sample_step(&frames));

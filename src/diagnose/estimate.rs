@@ -93,9 +93,12 @@ impl InitialValues {
         ("recorded", InitialValues::Recorded),
     ];
 
-    /// The way of a name ([`InitialValues::NAMES`]).
-    pub fn parse(name: &str) -> Option<InitialValues> {
-        Self::NAMES.iter().find(|(n, _)| *n == name).map(|(_, v)| *v)
+    /// The way of a name ([`InitialValues::NAMES`]); Err: why not, naming every way.
+    pub fn parse(name: &str) -> Result<InitialValues, String> {
+        Self::NAMES.iter().find(|(n, _)| *n == name).map(|(_, v)| *v).ok_or_else(|| {
+            let names: Vec<&str> = Self::NAMES.iter().map(|(n, _)| *n).collect();
+            format!("`{name}` is none of {}", names.join(", "))
+        })
     }
 }
 
@@ -199,7 +202,8 @@ pub struct Estimate {
     /// Where initial values were estimated: the estimated model re-simulated from each run's
     /// recorded first sample instead, as a prediction starts.
     pub from_records: Option<FromRecords>,
-    /// The per-source parameters (not written to the model: each source has its own).
+    /// The parameters estimated per source or per run, each value (a per-source value is not
+    /// written to the model; a per-run parameter's mean is: [`Estimate::per_run`]).
     pub per_source: Vec<SourceParameter>,
     /// Each parameter estimated per run, over its runs: the model holds their mean.
     pub per_run: Vec<RunSpread>,
@@ -458,18 +462,19 @@ impl Unknowns {
 /// correlation time, so that a prior counts against the runs as it should: a first round
 /// starts with s² and τ from the start's residuals, a second from the first's end.
 pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Result<Estimate, DiagnoseError> {
-    let free = fit(model, runs, settings, settings.initial_values == InitialValues::Measured)?;
-    let leaned = free.from_records.as_ref().filter(|f| f.leans);
+    let first = fit(model, runs, settings, settings.initial_values == InitialValues::Measured)?;
+    let leaned = first.from_records.as_ref().filter(|f| f.leans);
     let (Some(leaned), InitialValues::Auto) = (leaned, settings.initial_values) else {
-        return Ok(free);
+        return Ok(first);
     };
+    let free = &first;
     let mut held = fit(model, runs, settings, true)?;
     let cost = |e: &Estimate| e.from_records.as_ref().and_then(|f| f.cost).unwrap_or(f64::INFINITY);
-    if cost(&held) < cost(&free) {
+    if cost(&held) < cost(free) {
         held.held_again = Some(HeldAgain { kept: true, other: leaned.clone() });
         Ok(held)
     } else {
-        let mut free = free;
+        let mut free = first;
         free.held_again = held.from_records.map(|other| HeldAgain { kept: false, other });
         Ok(free)
     }
@@ -731,8 +736,8 @@ impl Estimate {
                 p.whose()
             ));
         }
-        // the written model keeps the file's value of a per-source or per-run parameter (their
-        // values are nuisances of their records): a prediction for one of them must set it
+        // the written model keeps the file's value of a per-source parameter (a source's value
+        // is a nuisance of its records): a prediction for one source must set it
         if let Some(p) = self.per_source.iter().rfind(|p| p.run.is_none()) {
             out.push_str(&format!(
                 "  (each source's own value, not written: the model keeps its file's `{0}`; predict source {1}'s runs with `--param {0}={2}`)\n",

@@ -104,7 +104,7 @@ pub struct EstimateCommand {
     /// recorded first sample by the record's noise), `free` (estimated without a prior: they
     /// may absorb what the model does not explain) or `recorded` (the first sample, not
     /// estimated).
-    #[arg(long = "initial-values", default_value = "auto", value_parser = initial_values)]
+    #[arg(long = "initial-values", default_value = "auto", value_parser = termid::diagnose::InitialValues::parse)]
     pub initial_values: termid::diagnose::InitialValues,
     /// Compare only these states (default: every state the runs have).
     #[arg(long, num_args = 1.., value_delimiter = ',')]
@@ -574,12 +574,4 @@ pub struct ResimArgs {
     /// Include each equation's stored intercept b0 in the simulation.
     #[arg(long)]
     pub with_intercept: bool,
-}
-
-/// `--initial-values`: one of [`termid::diagnose::InitialValues::NAMES`].
-fn initial_values(name: &str) -> Result<termid::diagnose::InitialValues, String> {
-    termid::diagnose::InitialValues::parse(name).ok_or_else(|| {
-        let names: Vec<&str> = termid::diagnose::InitialValues::NAMES.iter().map(|(n, _)| *n).collect();
-        format!("`{name}` is none of {}", names.join(", "))
-    })
 }
