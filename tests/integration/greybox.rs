@@ -832,6 +832,10 @@ fn runs_with_their_own_rudder_zero() {
     };
     let e = estimate(&start, &runs, &both).unwrap_err().to_string();
     assert!(e.contains("per source and per run"), "{e}");
+    // and one that is no free parameter, by name
+    let unknown = EstimateSettings { per_run: vec!["δ_1".into()], ..Default::default() };
+    let e = estimate(&start, &runs, &unknown).unwrap_err().to_string();
+    assert!(e.contains("`δ_1` is to be estimated per run, but it is no free parameter"), "{e}");
 }
 
 /// The polynomial template from two basins, each with its own rudder zero (+0.3° and −0.5°),

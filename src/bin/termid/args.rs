@@ -76,11 +76,13 @@ pub struct EstimateCommand {
     #[arg(long, action = clap::ArgAction::Append)]
     pub dataset: Vec<PathBuf>,
     /// Free parameters estimated once per source (nuisances, e.g. each basin's rudder
-    /// indicator zero); the others once for all.
+    /// indicator zero; not written to the model); the others once for all unless the model
+    /// file declares them a nuisance (`nuisance = "run"`).
     #[arg(long, num_args = 1.., value_delimiter = ',')]
     pub per_source: Vec<String>,
     /// Free parameters estimated once per run (nuisances that change from run to run, such
-    /// as the rudder's zero `δ_0` as a basin's indicator drifts; not written to the model).
+    /// as the rudder's zero `δ_0` as a basin's indicator drifts; the model keeps the runs'
+    /// mean). A model file declares its own with `nuisance = "run"`.
     #[arg(long, num_args = 1.., value_delimiter = ',')]
     pub per_run: Vec<String>,
     /// Another model of the same ship (a polynomial one `identify` wrote): both models'
@@ -321,7 +323,8 @@ pub struct IdentifyCommand {
     #[arg(long, num_args = 1.., value_delimiter = ',', requires = "model")]
     pub per_source: Vec<String>,
     /// With --parameters (implied): these free parameters estimated once per run (a rudder
-    /// zero that drifts from run to run); not written to the model.
+    /// zero that drifts from run to run; the model keeps the runs' mean). A model file
+    /// declares its own with `nuisance = "run"`.
     #[arg(long, num_args = 1.., value_delimiter = ',', requires = "model")]
     pub per_run: Vec<String>,
     /// With --model: choose among these back-ends and model files (comma-separated, or `all`
