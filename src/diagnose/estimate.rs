@@ -695,6 +695,12 @@ fn data_weight(runs: &Runs, residuals: &[f64], k: usize) -> (f64, Option<f64>) {
 }
 
 impl Estimate {
+    /// Whether any value was estimated per source (the report numbers the sources, so a
+    /// caller names them).
+    pub fn per_source_values(&self) -> bool {
+        self.per_source.iter().any(|p| p.run.is_none())
+    }
+
     /// The estimate as a person reads it: the cost before and after and, per parameter, the
     /// start, the estimate, its standard error and, where given, the prior.
     pub fn text(&self) -> String {

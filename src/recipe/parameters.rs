@@ -74,6 +74,14 @@ impl ParameterStage {
         }
     }
 
+    /// The estimate, where the stage ran (kept or rejected).
+    pub fn estimate(&self) -> Option<&Estimate> {
+        match self {
+            ParameterStage::Kept(e) | ParameterStage::Rejected(e, _) => Some(e),
+            ParameterStage::Failed(_) => None,
+        }
+    }
+
     /// Where the estimate was not kept, why, in a sentence (a caller's warning).
     pub fn warning(&self) -> Option<String> {
         match self {

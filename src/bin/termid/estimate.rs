@@ -103,7 +103,7 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
                     println!("{}", c.line());
                 }
             }
-            if !cmd.per_source.is_empty() {
+            if fit.per_source_values() {
                 print!("{}", crate::runs::source_labels(&cmd.data, &cmd.dataset));
             }
             if let Some(out) = &cmd.out {

@@ -146,7 +146,7 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
         Format::Json => println!("{}", serde_json::to_string_pretty(&recipe.json()?)?),
         Format::Text => {
             print!("{}", recipe.text());
-            if !cmd.per_source.is_empty() || !cmd.per_run.is_empty() {
+            if recipe.parameters.as_ref().and_then(|s| s.estimate()).is_some_and(|e| e.per_source_values()) {
                 print!("{}", crate::runs::source_labels(&cmd.data, &cmd.dataset));
             }
             if let Some(out) = cmd.out.as_ref().filter(|_| write) {
