@@ -175,11 +175,6 @@ fn held_out_cost(
     Ok(runs.gap(&sims).cost)
 }
 
-/// A run's file name without its folder (the table's column stays narrow).
-fn file_name(origin: &str) -> String {
-    std::path::Path::new(origin).file_name().map_or(origin.to_string(), |n| n.to_string_lossy().into_owned())
-}
-
 impl Chosen {
     /// The table as a person reads it: per configuration its mean scaled error over the
     /// held-out runs and the worst run, the chosen one marked.
@@ -209,7 +204,7 @@ impl Chosen {
                 c.label,
                 score,
                 se,
-                worst.map_or("--".to_string(), |w| file_name(&w.0)),
+                worst.map_or("--".to_string(), |w| super::file_name(&w.0)),
             );
         }
         if self.best != self.lowest {

@@ -58,7 +58,7 @@ impl SourceParameter {
     /// the source's number.
     pub fn whose(&self) -> String {
         match &self.run {
-            Some(run) => format!("run {}", file_name(run)),
+            Some(run) => format!("run {}", super::file_name(run)),
             None => format!("source {}", self.source + 1),
         }
     }
@@ -148,11 +148,6 @@ pub struct Move {
     pub state: String,
 }
 
-/// A run's file name without its folder, as the report names it.
-fn file_name(origin: &str) -> &str {
-    std::path::Path::new(origin).file_name().and_then(|n| n.to_str()).unwrap_or(origin)
-}
-
 /// How far (root mean square, in units of the records' noise) the estimated initial values may
 /// move from the recorded first samples before the fit is said to lean on them.
 pub const LEANS: f64 = 3.0;
@@ -234,13 +229,11 @@ impl RunSpread {
         names.dedup();
         names
             .into_iter()
-            .map(|name| {
+            .filter_map(|name| {
                 let v: Vec<f64> =
                     values.iter().filter(|p| p.run.is_some() && p.name == name).map(|p| p.value).collect();
-                let n = v.len() as f64;
-                let mean = v.iter().sum::<f64>() / n;
-                let sd = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0)).sqrt();
-                RunSpread { name: name.to_string(), runs: v.len(), mean, sd }
+                let s = crate::uncertainty::spread_of(&v)?;
+                Some(RunSpread { name: name.to_string(), runs: s.count, mean: s.mean, sd: s.sd })
             })
             .collect()
     }
