@@ -682,6 +682,13 @@ fn the_new_ship_command_writes_a_model_estimate_reads() {
 /// The rudder indicator's zero of each of two basins, degrees.
 const BASIN_ZEROS: [f64; 2] = [0.3, -0.5];
 
+/// A record whose rudder indicator reads `zero_deg` degrees off.
+fn reading_off(mut f: Frame, zero_deg: f64) -> Frame {
+    let read: Vec<f64> = f.column("δ").unwrap().iter().map(|d| d + zero_deg.to_radians()).collect();
+    f.set("δ", read).unwrap();
+    f
+}
+
 /// `zigzags` of `truth` as two basins record them (each its own noise), their rudder
 /// indicators reading [`BASIN_ZEROS`] off: the runs and each run's basin.
 fn two_basins(truth: &Model, zigzags: &[(&str, f64)]) -> (Vec<Frame>, Vec<usize>) {
@@ -690,10 +697,7 @@ fn two_basins(truth: &Model, zigzags: &[(&str, f64)]) -> (Vec<Frame>, Vec<usize>
         let records =
             termid::ship::basin::Basin::default().record_all(truth, zigzags, 1.17248, 60.0, seed, None);
         for (_, rec) in records.unwrap() {
-            let mut f = rec.measured;
-            let read: Vec<f64> = f.column("δ").unwrap().iter().map(|d| d + zero.to_radians()).collect();
-            f.set("δ", read).unwrap();
-            frames.push(f);
+            frames.push(reading_off(rec.measured, *zero));
             sources.push(s);
         }
     }
@@ -778,16 +782,8 @@ fn runs_with_their_own_rudder_zero() {
     let zeros = [0.5f64, -0.6, 0.2, -0.3];
     let records =
         termid::ship::basin::Basin::default().record_all(&truth, &zigzags, 1.17248, 60.0, 61, None).unwrap();
-    let frames: Vec<Frame> = records
-        .into_iter()
-        .zip(zeros)
-        .map(|((_, rec), zero)| {
-            let mut f = rec.measured;
-            let read: Vec<f64> = f.column("δ").unwrap().iter().map(|d| d + zero.to_radians()).collect();
-            f.set("δ", read).unwrap();
-            f
-        })
-        .collect();
+    let frames: Vec<Frame> =
+        records.into_iter().zip(zeros).map(|((_, rec), zero)| reading_off(rec.measured, zero)).collect();
     let runs = runs_of(&start, &frames);
     let settings = EstimateSettings { per_run: vec!["δ_0".into()], ..Default::default() };
     let per_run = estimate(&start, &runs, &settings).unwrap();
