@@ -57,13 +57,15 @@ impl Free {
     }
 }
 
-/// The identified terms as outputs over the model's names: φ_j(x, u) for the matrix B.
-struct Regressors<'a> {
+/// The model's right-hand side followed by the identified terms as further outputs: ẋ and
+/// φ_j(x, u) for the matrix B from one evaluation, where the terms are the very sub-expressions
+/// ẋ is made of (compiled apart, every φ_j was computed twice per stage).
+struct WithRegressors<'a> {
     model: &'a Model,
     terms: Vec<Term>,
 }
 
-impl RightHandSide for Regressors<'_> {
+impl RightHandSide for WithRegressors<'_> {
     fn origin(&self) -> &str {
         &self.model.path
     }
@@ -76,8 +78,11 @@ impl RightHandSide for Regressors<'_> {
     fn parameters(&self) -> BTreeMap<String, f64> {
         self.model.parameters()
     }
-    fn compile(&self, _with_intercept: bool) -> Result<Library, SimError> {
-        Ok(Library::compile(&self.terms, &self.model.vocabulary)?)
+    fn compile(&self, with_intercept: bool) -> Result<Library, SimError> {
+        let mut outputs =
+            self.model.equations().iter().map(|e| e.rhs(with_intercept)).collect::<Result<Vec<_>, _>>()?;
+        outputs.extend(self.terms.iter().cloned());
+        Ok(Library::compile(&outputs, &self.model.vocabulary)?)
     }
 }
 
@@ -252,13 +257,12 @@ fn per_run_jacobians<T: Send>(
             Free::Initial { .. } => {}
         }
     }
-    let regressors = Regressors { model, terms };
-    let phi = System::new(&regressors, &BTreeMap::new(), false)?;
+    // the same states, inputs and parameters, with the terms as outputs after the states'
+    let system = System::new(&WithRegressors { model, terms }, &BTreeMap::new(), runs.intercepts)?;
     (0..runs.frames.len())
         .into_par_iter()
         .map(|r| {
             let system = system.with_parameters(&runs.params[r])?;
-            let phi = phi.with_parameters(&runs.params[r])?;
             // the entries that move this run, in the order of `entries`; S's columns are theirs
             let active: Vec<usize> = entries
                 .iter()
@@ -304,7 +308,7 @@ fn per_run_jacobians<T: Send>(
             // a sample the simulation does not reach stays NaN
             let mut res = vec![f64::NAN; rows];
             let mut jt = DMatrix::from_element(k, rows, f64::NAN);
-            integrate(&system, &phi, &columns, runs, r, &mut |t, x, s| {
+            integrate(&system, &columns, runs, r, &mut |t, x, s| {
                 for &(first, i, sc, meas) in &blocks {
                     if let Some(m) = meas.get(t) {
                         res[first + t] = (x[i] - m) / sc;
@@ -323,7 +327,8 @@ fn per_run_jacobians<T: Send>(
 
 /// The columns of S of one run by kind.
 struct Columns<'a> {
-    /// (column, the state whose equation holds the term), the terms in `phi`'s order.
+    /// (column, the state whose equation holds the term), the terms in the order of the
+    /// system's outputs after the states'.
     terms: &'a [(usize, usize)],
     /// (column, name) of the free parameters.
     parameters: &'a [(usize, String)],
@@ -334,10 +339,10 @@ struct Columns<'a> {
 }
 
 /// Run `r` of `runs` with its sensitivities: the state and S (row-major, n × K) at every
-/// sample of the run, handed to `sample` with the sample's index.
+/// sample of the run, handed to `sample` with the sample's index. `system` yields ẋ and then
+/// the terms' values ([`WithRegressors`]).
 fn integrate(
     system: &System,
-    phi: &System,
     columns: &Columns<'_>,
     runs: &Runs,
     r: usize,
@@ -359,23 +364,25 @@ fn integrate(
     let dt = settings.dt;
     let mut replay = Replay::new(&runs.frames[r], &system.inputs)?;
     let mut ws = system.workspace();
-    let mut wp = phi.workspace();
     // ∂f/∂x_c is zero for a state the right-hand side does not read
     let read: Vec<usize> = (0..n).filter(|&c| system.reads_state(c)).collect();
     let names: Vec<String> = parameters.iter().map(|(_, name)| name.clone()).collect();
     let mut tangents = system.partials(&read, &names)?;
     let d = tangents.directions();
     let mut partials = vec![0.0; n * d];
-    let mut terms = vec![0.0; term_columns.len()];
+    // ẋ and then the terms φ_j
+    let mut values = vec![0.0; n + term_columns.len()];
     // (ẋ, Ṡ) at (x, S, u)
     let mut rate = |x: &[f64], s: &[f64], u: &[f64], dx: &mut [f64], ds: &mut [f64]| {
-        system.derivatives_and_partials(x, u, &mut ws, &mut tangents, dx, &mut partials);
-        phi.derivatives(x, u, &mut wp, &mut terms);
+        // the partials of ẋ alone (`partials` holds n rows)
+        system.derivatives_and_partials(x, u, &mut ws, &mut tangents, &mut values, &mut partials);
+        let (rates, terms) = values.split_at(n);
+        dx.copy_from_slice(rates);
         // only the integrated rows are read (the others stay zero)
         for &i in &rows {
             ds[i * k..(i + 1) * k].fill(0.0);
         }
-        for (&(j, i), phi_j) in term_columns.iter().zip(&terms) {
+        for (&(j, i), phi_j) in term_columns.iter().zip(terms) {
             ds[i * k + j] = *phi_j;
         }
         for &i in &rows {
