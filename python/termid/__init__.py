@@ -1290,7 +1290,11 @@ class Model:
         drifts from run to run); both in ``attrs["per_source"]``, a DataFrame (its ``run``
         column names the run where estimated per run). A per-source value is not written to
         the model; a per-run parameter's mean over the runs is (``attrs["per_run"]``: its mean
-        and sd, how uncertain a new run's value is). ``attrs["from_records"]``
+        and sd, how uncertain a new run's value is, and Wald's ``chi_square`` and ``p_value``
+        that the runs' values are equal). A parameter the model file declares per run
+        (``nuisance = "run"``) whose runs' values agree (p ≥ 0.05) is estimated once for all
+        runs instead (``attrs["one_value"]``: the per-run fit's spread and test); asked for in
+        ``per_run``, it stays per run. ``attrs["from_records"]``
         holds the estimated model's cost from the recorded first samples and how far the
         estimated initial values moved in units of the records' noise; beyond 3 times a warning
         says the fit leans on them (the model does not explain everything the runs show).
@@ -1337,7 +1341,8 @@ class Model:
             "covariance": None if report["covariance"] is None else pd.DataFrame(report["covariance"], index=names, columns=names),
             "per_source": pd.DataFrame(report.get("per_source", []), columns=["name", "source", "run", "value", "std_error"]),
             "from_records": report.get("from_records"),
-            "per_run": pd.DataFrame(report.get("per_run", []), columns=["name", "runs", "mean", "sd"]),
+            "per_run": pd.DataFrame(report.get("per_run", []), columns=["name", "runs", "mean", "sd", "chi_square", "p_value"]),
+            "one_value": pd.DataFrame(report.get("one_value", []), columns=["name", "runs", "mean", "sd", "chi_square", "p_value"]),
             "held_again": report.get("held_again"),
         }
         leaning = report.get("from_records") or {}

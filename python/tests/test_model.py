@@ -288,6 +288,37 @@ def test_estimate_per_run():
     assert abs(table.loc["T", "estimate"] - 8.0) < 0.01
 
 
+def test_estimate_one_value_where_the_runs_agree():
+    """A parameter the model file declares per run (``nuisance = "run"``): where the runs'
+    values differ it stays per run with the test in ``attrs["per_run"]``; where they agree
+    (one K, noisy records) one value is estimated for all and ``attrs["one_value"]`` says so."""
+    text = termid.Model.builtin("nomoto").to_toml().replace(
+        "[parameters.K]\n", '[parameters.K]\nnuisance = "run"\n', 1
+    )
+    declared = termid.Model.from_toml(text)
+    rng = np.random.default_rng(7)
+
+    def records(ks):
+        runs = []
+        for k in ks:
+            truth = termid.Model.builtin("nomoto")
+            truth.set_parameter("K", k)
+            truth.set_parameter("T", 8.0)
+            run = truth.simulate(duration=60.0, inputs={"δ": 0.1}, sample=0.1)[["t", "ψ", "r", "δ"]]
+            run["ψ"] += rng.normal(0.0, 0.002, len(run))
+            run["r"] += rng.normal(0.0, 0.0005, len(run))
+            runs.append(run)
+        return runs
+
+    table, _ = declared.estimate(records([0.15, 0.17]))
+    spread = table.attrs["per_run"].set_index("name").loc["K"]
+    assert spread["p_value"] < 1e-3 and table.attrs["one_value"].empty
+    table, found = declared.estimate(records([0.16, 0.16, 0.16]))
+    agreed = table.attrs["one_value"].set_index("name").loc["K"]
+    assert agreed["runs"] == 3 and agreed["p_value"] >= 0.05 and table.attrs["per_run"].empty
+    assert abs(table.loc["K", "estimate"] - 0.16) < 0.002 and found.parameters["K"] == table.loc["K", "estimate"]
+
+
 def test_recipe_estimates_each_basins_rudder_zero():
     """The new-ship template from two basins whose rudder indicators read +0.3° and −0.5°
     off: the recipe's parameter stage estimates each basin's zero with the coefficients; their

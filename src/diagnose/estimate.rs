@@ -5,7 +5,7 @@
 //! from forward sensitivities, each parameter's prior and bounds from the model file, and the
 //! covariance widened by the residuals' correlation time.
 
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
 use super::fit::{apply, cost as sum_of_squares};
@@ -202,6 +202,10 @@ pub struct Estimate {
     pub per_source: Vec<SourceParameter>,
     /// Each parameter estimated per run, over its runs: the model holds their mean.
     pub per_run: Vec<RunSpread>,
+    /// The parameters the model file declares per run whose runs' values agreed within their
+    /// uncertainty ([`RunSpread::agree`]): estimated once for every run instead (this is
+    /// that fit); each with the per-run fit's spread and test.
+    pub one_value: Vec<RunSpread>,
     /// Where free initial values leaned ([`InitialValues::Auto`]): the other fit, with them
     /// held by the records' noise, and which of the two this is.
     pub held_again: Option<HeldAgain>,
@@ -219,6 +223,54 @@ pub struct RunSpread {
     pub mean: f64,
     /// The runs' standard deviation.
     pub sd: f64,
+    /// Wald's χ² of the values' differences from run to run with the fit's covariance, on
+    /// `runs` − 1 degrees of freedom (none where the covariance could not be formed): how far
+    /// the runs differ beyond what their values' uncertainty allows.
+    pub chi_square: Option<f64>,
+    /// P(a χ² as large) where the runs' values were equal.
+    pub p_value: Option<f64>,
+}
+
+/// Below this probability of a χ² as large, the runs' values differ: a parameter the file
+/// declares per run stays per run; above it the runs agree and it is estimated once.
+pub const RUNS_DIFFER: f64 = 0.05;
+
+impl RunSpread {
+    /// Whether the runs' values agree within their uncertainty (a p-value at least
+    /// [`RUNS_DIFFER`]).
+    pub fn agree(&self) -> bool {
+        self.p_value.is_some_and(|p| p >= RUNS_DIFFER)
+    }
+
+    /// The test in words: "χ² 97.6 on 3 degrees of freedom, p < 0.001".
+    fn test(&self) -> String {
+        match (self.chi_square, self.p_value) {
+            (Some(q), Some(p)) => {
+                let p = if p < 0.001 { "p < 0.001".to_string() } else { format!("p = {p:.3}") };
+                format!("χ² {q:.1} on {} degrees of freedom, {p}", self.runs - 1)
+            }
+            _ => "not tested: the fit's covariance could not be formed".into(),
+        }
+    }
+}
+
+/// Wald's χ² that the values θ[i], i in `values`, are equal: the differences d from the last,
+/// dᵀ (C Σ Cᵀ)⁻¹ d with the full covariance Σ. Not each value's own standard error: what the
+/// runs share (a mean zero that trades against a propeller's moment) makes each value
+/// uncertain, but not their differences.
+fn differences(theta: &[f64], covariance: &DMatrix<f64>, values: &[usize]) -> Option<f64> {
+    let (&last, rest) = values.split_last()?;
+    if rest.is_empty() {
+        return None;
+    }
+    let c = covariance;
+    let d = DVector::from_iterator(rest.len(), rest.iter().map(|&i| theta[i] - theta[last]));
+    let s = DMatrix::from_fn(rest.len(), rest.len(), |a, b| {
+        let (i, j) = (rest[a], rest[b]);
+        c[(i, j)] - c[(i, last)] - c[(last, j)] + c[(last, last)]
+    });
+    let q = d.dot(&(s.try_inverse()? * &d));
+    q.is_finite().then_some(q.max(0.0))
 }
 
 impl RunSpread {
@@ -233,7 +285,14 @@ impl RunSpread {
                 let v: Vec<f64> =
                     values.iter().filter(|p| p.run.is_some() && p.name == name).map(|p| p.value).collect();
                 let s = crate::uncertainty::spread_of(&v)?;
-                Some(RunSpread { name: name.to_string(), runs: s.count, mean: s.mean, sd: s.sd })
+                Some(RunSpread {
+                    name: name.to_string(),
+                    runs: s.count,
+                    mean: s.mean,
+                    sd: s.sd,
+                    chi_square: None,
+                    p_value: None,
+                })
             })
             .collect()
     }
@@ -274,6 +333,7 @@ impl Unknowns {
         runs: &Runs,
         settings: &EstimateSettings,
         held: bool,
+        one: &[String],
     ) -> Result<Unknowns, DiagnoseError> {
         let all = model.free_parameters();
         for (names, per) in [(&settings.per_source, "source"), (&settings.per_run, "run")] {
@@ -289,9 +349,10 @@ impl Unknowns {
                 "`{n}` is to be estimated per source and per run: choose one"
             )));
         }
-        // the command's word first, then the file's (`nuisance = "run"`)
+        // the command's word first, then the file's (`nuisance = "run"`) unless its runs agreed
         let scope = |p: &FreeParameter, asked: &[String], declared: Nuisance, other: &[String]| {
-            asked.contains(&p.name) || (p.nuisance == Some(declared) && !other.contains(&p.name))
+            asked.contains(&p.name)
+                || (p.nuisance == Some(declared) && !other.contains(&p.name) && !one.contains(&p.name))
         };
         let per_run: Vec<String> = all
             .iter()
@@ -454,14 +515,40 @@ impl Unknowns {
 /// The data's sum of squares is weighted by 1/(s²τ), s² the residuals' variance and τ their
 /// correlation time, so that a prior counts against the runs as it should: a first round
 /// starts with s² and τ from the start's residuals, a second from the first's end.
+///
+/// A parameter the file declares per run (`nuisance = "run"`) whose runs' values agree within
+/// their uncertainty ([`RunSpread::agree`]) is estimated again as one value for all runs: where
+/// the runs share it (a basin's indicator that holds its zero), the values the runs do not need
+/// only take up noise the other parameters would have used. Asked for per run (the command's
+/// `per_run`), it stays per run.
 pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Result<Estimate, DiagnoseError> {
-    let first = fit(model, runs, settings, settings.initial_values == InitialValues::Measured)?;
+    let each = with_initial_values(model, runs, settings, &[])?;
+    let agree: Vec<RunSpread> =
+        each.per_run.iter().filter(|r| r.agree() && !settings.per_run.contains(&r.name)).cloned().collect();
+    if agree.is_empty() {
+        return Ok(each);
+    }
+    let names: Vec<String> = agree.iter().map(|r| r.name.clone()).collect();
+    let mut one = with_initial_values(model, runs, settings, &names)?;
+    one.one_value = agree;
+    Ok(one)
+}
+
+/// [`estimate`] with the parameters `one` once for all runs, each run's initial values as
+/// [`EstimateSettings::initial_values`] says.
+fn with_initial_values(
+    model: &Model,
+    runs: &Runs,
+    settings: &EstimateSettings,
+    one: &[String],
+) -> Result<Estimate, DiagnoseError> {
+    let first = fit(model, runs, settings, settings.initial_values == InitialValues::Measured, one)?;
     let leaned = first.from_records.as_ref().filter(|f| f.leans);
     let (Some(leaned), InitialValues::Auto) = (leaned, settings.initial_values) else {
         return Ok(first);
     };
     let free = &first;
-    let mut held = fit(model, runs, settings, true)?;
+    let mut held = fit(model, runs, settings, true, one)?;
     let cost = |e: &Estimate| e.from_records.as_ref().and_then(|f| f.cost).unwrap_or(f64::INFINITY);
     if cost(&held) < cost(free) {
         held.held_again = Some(HeldAgain { kept: true, other: leaned.clone() });
@@ -479,6 +566,7 @@ fn fit(
     runs: &Runs,
     settings: &EstimateSettings,
     held: bool,
+    one: &[String],
 ) -> Result<Estimate, DiagnoseError> {
     if settings.iterations == 0 {
         return Err(DiagnoseError::Setup("the estimate needs at least one iteration".into()));
@@ -489,7 +577,7 @@ fn fit(
             settings.prior_weight
         )));
     }
-    let u = Unknowns::of(model, runs, settings, held)?;
+    let u = Unknowns::of(model, runs, settings, held, one)?;
     if u.parameters.is_empty() && u.coefficients.is_empty() && u.groups.is_empty() {
         return Err(DiagnoseError::Setup(format!(
             "{} declares no free parameter (`free = true` under [parameters.NAME])",
@@ -656,7 +744,15 @@ fn fit(
         .collect();
     // a per-source value belongs to its source's records (a basin's indicator), so the file's
     // value stays; runs are a sample of one basin's drift, and their mean is a new run's guess
-    let per_run = RunSpread::of(&per_source);
+    let mut per_run = RunSpread::of(&per_source);
+    for r in &mut per_run {
+        let values: Vec<usize> = (0..u.groups.len())
+            .filter(|&g| u.groups[g].0.name == r.name)
+            .map(|g| u.first_group() + g)
+            .collect();
+        r.chi_square = covariance.as_ref().and_then(|c| differences(&theta, c, &values));
+        r.p_value = r.chi_square.map(|q| crate::select::chi_square_pvalue(q, (r.runs - 1) as f64));
+    }
     for r in &per_run {
         estimated.set_parameter(&r.name, r.mean);
     }
@@ -674,6 +770,7 @@ fn fit(
         from_records,
         per_source,
         per_run,
+        one_value: Vec::new(),
         held_again: None,
     })
 }
@@ -747,9 +844,21 @@ impl Estimate {
         }
         for r in &self.per_run {
             out.push_str(&format!(
-                "  (each run's own value; the model holds their mean {} over the {} runs, sd {}: a new run's value is that uncertain)\n",
+                "  (each run's own value; the model holds their mean {} over the {} runs, sd {}: a new run's value is that uncertain; the runs' values {}: {})\n",
                 num(r.mean),
                 r.runs,
+                sig(r.sd, 3),
+                if r.agree() { "agree" } else { "differ" },
+                r.test()
+            ));
+        }
+        for r in &self.one_value {
+            out.push_str(&format!(
+                "  (`{}` one value for every run: declared per run, but the {} runs' values agreed within their uncertainty ({}; mean {}, sd {}))\n",
+                r.name,
+                r.runs,
+                r.test(),
+                num(r.mean),
                 sig(r.sd, 3)
             ));
         }

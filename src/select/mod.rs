@@ -23,7 +23,7 @@ pub use moments::{gather, in_parallel, Accumulator, Moments};
 pub use sparse::{Candidate, Equality, LambdaChoice, SparseFit};
 pub use stepwise::{StepRule, Stepwise};
 pub use stlsq::Stlsq;
-pub(crate) use subset::sweep;
+pub(crate) use subset::{chi_square_pvalue, sweep};
 
 /// What a back-end is asked to do.
 #[derive(Clone, Copy, Debug)]
