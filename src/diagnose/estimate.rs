@@ -700,22 +700,11 @@ fn fit(
             at_bound: theta[i] <= p.bounds.0 || theta[i] >= p.bounds.1,
         })
         .collect();
-    let mut estimated = u.at(model, &theta)?;
     let matrix = covariance.as_ref().map(|c| {
         (0..np)
             .map(|i| (0..np).map(|j| 0.5 * (c[(i, j)] + c[(j, i)])).collect::<Vec<f64>>())
             .collect::<Vec<_>>()
     });
-    estimated.set_parameter_estimates(
-        &parameters
-            .iter()
-            .map(|p| (p.name.clone(), p.value, p.std_error.is_finite().then_some(p.std_error)))
-            .collect::<Vec<_>>(),
-        matrix.clone().map(|matrix| ParameterCovarianceSpec {
-            names: parameters.iter().map(|p| p.name.clone()).collect(),
-            matrix,
-        }),
-    );
     let coefficients = u
         .coefficients
         .iter()
@@ -753,6 +742,44 @@ fn fit(
         r.chi_square = covariance.as_ref().and_then(|c| differences(&theta, c, &values));
         r.p_value = r.chi_square.map(|q| crate::select::chi_square_pvalue(q, (r.runs - 1) as f64));
     }
+    // a new run's value of a per-run parameter: the runs' mean, as uncertain as the runs
+    // scatter (sd², and the mean's own sd²/n), independent of the ship's parameters; written
+    // with them, so that Monte-Carlo draws of a new run vary it as a new run would
+    let new_run: Vec<(String, f64, f64)> = per_run
+        .iter()
+        .filter(|r| r.runs > 1)
+        .map(|r| (r.name.clone(), r.mean, r.sd * r.sd * (1.0 + 1.0 / r.runs as f64)))
+        .collect();
+    let mut estimated = u.at(model, &theta)?;
+    estimated.set_parameter_estimates(
+        &parameters
+            .iter()
+            .map(|p| (p.name.clone(), p.value, p.std_error.is_finite().then_some(p.std_error)))
+            .chain(new_run.iter().map(|(name, mean, var)| (name.clone(), *mean, Some(var.sqrt()))))
+            .collect::<Vec<_>>(),
+        matrix.clone().map(|matrix| {
+            let n = np + new_run.len();
+            let rows = (0..n)
+                .map(|i| {
+                    (0..n)
+                        .map(|j| match (i < np, j < np) {
+                            (true, true) => matrix[i][j],
+                            (false, false) if i == j => new_run[i - np].2,
+                            _ => 0.0,
+                        })
+                        .collect()
+                })
+                .collect();
+            ParameterCovarianceSpec {
+                names: parameters
+                    .iter()
+                    .map(|p| p.name.clone())
+                    .chain(new_run.iter().map(|r| r.0.clone()))
+                    .collect(),
+                matrix: rows,
+            }
+        }),
+    );
     for r in &per_run {
         estimated.set_parameter(&r.name, r.mean);
     }

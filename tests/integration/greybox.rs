@@ -825,6 +825,18 @@ fn runs_with_their_own_rudder_zero() {
         (written - (-0.05)).abs() < 0.05 && (per_run.per_run[0].sd.to_degrees() - 0.49).abs() < 0.1,
         "{text}"
     );
+    // a new run's zero is as uncertain as the runs' scatter (sd² and the mean's sd²/n), in the
+    // written covariance beside the hull's, uncorrelated with them: Monte-Carlo draws vary it
+    let c = per_run.model.spec().parameter_covariance.clone().expect("a covariance");
+    let i = c.names.iter().position(|n| n == "δ_0").expect("δ_0 in the covariance");
+    let sd = per_run.per_run[0].sd;
+    assert!((c.matrix[i][i] / (sd * sd * 1.25) - 1.0).abs() < 1e-12, "{:?}", c.matrix[i]);
+    assert!(c.matrix[i].iter().enumerate().all(|(j, v)| j == i || *v == 0.0));
+    let sampler = termid::uncertainty::Sampler::new(&per_run.model);
+    let mut normal = termid::uncertainty::Normal::new(3);
+    let drawn: Vec<f64> = (0..400).map(|_| sampler.draw(&mut normal).parameter_values()["δ_0"]).collect();
+    let spread = termid::uncertainty::spread_of(&drawn).unwrap();
+    assert!((spread.sd / (sd * 1.25f64.sqrt()) - 1.0).abs() < 0.15, "{spread:?} for sd {sd}");
     // the zeros differ beyond their uncertainty, and the report says so
     let spread = &per_run.per_run[0];
     assert!(!spread.agree() && spread.p_value.unwrap() < 1e-3, "{text}");
