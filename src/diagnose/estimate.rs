@@ -37,6 +37,11 @@ pub struct EstimateSettings {
     /// Free parameters estimated once per run (nuisances that change between runs of one
     /// basin: the rudder's zero as the indicator drifts, a current across the tank).
     pub per_run: Vec<String>,
+    /// Fit at the coarsest step, of up to `.1` samples, at which the start re-simulates the runs
+    /// as at their samples (each compared state within `.0` of its scale: [`Runs::coarsest`]),
+    /// as the identify recipe's refinement does; the costs and the initial values' moves are
+    /// still reported at every sample. `None`: fit at every sample.
+    pub coarsest: Option<(f64, usize)>,
 }
 
 impl Default for EstimateSettings {
@@ -49,6 +54,7 @@ impl Default for EstimateSettings {
             sources: Vec::new(),
             per_source: Vec::new(),
             per_run: Vec::new(),
+            coarsest: None,
         }
     }
 }
@@ -308,6 +314,14 @@ pub struct HeldAgain {
     pub other: FromRecords,
 }
 
+/// The runs an estimate fits (`fit`, perhaps at a coarser step) and the same runs at every
+/// sample (`every`), where its costs and the records' noise are read.
+#[derive(Clone, Copy)]
+struct Scales<'r> {
+    fit: &'r Runs,
+    every: &'r Runs,
+}
+
 /// The unknowns: the free parameters (absolute values), then the coefficients (changes).
 struct Unknowns {
     entries: Vec<Free>,
@@ -330,11 +344,12 @@ struct Unknowns {
 impl Unknowns {
     fn of(
         model: &Model,
-        runs: &Runs,
+        scales: &Scales<'_>,
         settings: &EstimateSettings,
         held: bool,
         one: &[String],
     ) -> Result<Unknowns, DiagnoseError> {
+        let runs = scales.fit;
         let all = model.free_parameters();
         for (names, per) in [(&settings.per_source, "source"), (&settings.per_run, "run")] {
             if let Some(n) = names.iter().find(|n| !all.iter().any(|p| &p.name == *n)) {
@@ -438,7 +453,8 @@ impl Unknowns {
         }
         for &(r, i) in &initial {
             // a record without a noise estimate (constant, too short) leaves its value free
-            let noise = held.then(|| runs.noise(r, i)).flatten();
+            // the record's noise at its own rate (a coarser resampling averages it down)
+            let noise = held.then(|| scales.every.noise(r, i)).flatten();
             precision.push(noise.map_or(0.0, |s| 1.0 / (s * s)));
             mean.push(runs.initial(r, i));
             bounds.push((f64::NEG_INFINITY, f64::INFINITY));
@@ -522,6 +538,14 @@ impl Unknowns {
 /// only take up noise the other parameters would have used. Asked for per run (the command's
 /// `per_run`), it stays per run.
 pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Result<Estimate, DiagnoseError> {
+    // a start that does not re-simulate the runs is fitted at every sample, where the fit says
+    // where it diverges
+    let coarse = settings.coarsest.and_then(|(tolerance, most)| {
+        let fine = runs.simulate(model, &[], &[]).ok()?;
+        let (factor, coarse) = runs.coarsest(model, &fine, tolerance, most);
+        (factor > 1).then_some(coarse)
+    });
+    let runs = &Scales { fit: coarse.as_ref().unwrap_or(runs), every: runs };
     let each = with_initial_values(model, runs, settings, &[])?;
     let agree: Vec<RunSpread> =
         each.per_run.iter().filter(|r| r.agree() && !settings.per_run.contains(&r.name)).cloned().collect();
@@ -538,7 +562,7 @@ pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Resu
 /// [`EstimateSettings::initial_values`] says.
 fn with_initial_values(
     model: &Model,
-    runs: &Runs,
+    runs: &Scales<'_>,
     settings: &EstimateSettings,
     one: &[String],
 ) -> Result<Estimate, DiagnoseError> {
@@ -563,7 +587,7 @@ fn with_initial_values(
 /// One output-error fit, each run's initial values free or `held` by the records' noise.
 fn fit(
     model: &Model,
-    runs: &Runs,
+    scales: &Scales<'_>,
     settings: &EstimateSettings,
     held: bool,
     one: &[String],
@@ -577,7 +601,8 @@ fn fit(
             settings.prior_weight
         )));
     }
-    let u = Unknowns::of(model, runs, settings, held, one)?;
+    let Scales { fit: runs, every } = *scales;
+    let u = Unknowns::of(model, scales, settings, held, one)?;
     if u.parameters.is_empty() && u.coefficients.is_empty() && u.groups.is_empty() {
         return Err(DiagnoseError::Setup(format!(
             "{} declares no free parameter (`free = true` under [parameters.NAME])",
@@ -585,12 +610,16 @@ fn fit(
         )));
     }
     let k = u.entries.len();
-    let data_cost = |theta: &[f64]| -> Option<f64> {
+    let residuals_on = |runs: &Runs, theta: &[f64]| -> Option<Vec<f64>> {
         let m = u.at(model, theta).ok()?;
         let runs = u.runs_at(runs, theta);
         let r = runs.residuals(&runs.simulate(&m, &[], &[]).ok()?);
-        r.iter().all(|v| v.is_finite()).then(|| sum_of_squares(&r))
+        r.iter().all(|v| v.is_finite()).then_some(r)
     };
+    let cost_on = |runs: &Runs, theta: &[f64]| residuals_on(runs, theta).map(|r| sum_of_squares(&r));
+    let data_cost = |theta: &[f64]| cost_on(runs, theta);
+    // costs as reported: at every sample, where the fit is at a coarser step
+    let coarse = !std::ptr::eq(runs, every);
     let linearised = |theta: &[f64]| -> Result<Linearised, DiagnoseError> {
         linearise(&u.runs_at(runs, theta), &u.at(model, theta)?, &u.entries)
             .map_err(|e| fit_failure(e, "at an iterate"))
@@ -599,6 +628,7 @@ fn fit(
     let cost_before = data_cost(&theta).ok_or(DiagnoseError::Refinement(EstimateError::Diverges(
         "at the start (the free parameters' values in the file)",
     )))?;
+    let cost_before = if coarse { cost_on(every, &theta).unwrap_or(f64::NAN) } else { cost_before };
     let mut lin = linearised(&theta)?;
     let (mut stopped, mut taken) = (String::new(), 0);
     for _round in 0..2 {
@@ -656,18 +686,19 @@ fn fit(
             }
         }
     }
+    // from the records as they were measured (every sample), where a prediction starts
     let from_records = (!u.initial.is_empty()).then(|| {
         let mut recorded = theta.clone();
         let first = u.first_group() + u.groups.len();
         for (v, &(r, i)) in recorded[first..].iter_mut().zip(&u.initial) {
-            *v = runs.initial(r, i);
+            *v = every.initial(r, i);
         }
-        let cost = data_cost(&recorded);
+        let cost = cost_on(every, &recorded);
         let moves: Vec<(f64, usize, usize)> = u
             .initial
             .iter()
             .zip(&theta[first..])
-            .filter_map(|(&(r, i), v)| runs.noise(r, i).map(|s| ((v - runs.initial(r, i)) / s, r, i)))
+            .filter_map(|(&(r, i), v)| every.noise(r, i).map(|s| ((v - every.initial(r, i)) / s, r, i)))
             .collect();
         let moved = (!moves.is_empty())
             .then(|| (moves.iter().map(|(z, _, _)| z * z).sum::<f64>() / moves.len() as f64).sqrt());
@@ -679,6 +710,13 @@ fn fit(
         FromRecords { cost, moved, largest, leans: moved.is_some_and(|m| m > LEANS) }
     });
     let (weight, tau) = data_weight(runs, &lin.residuals, k);
+    // the residuals' cost and correlation time at every sample (at the coarse step a white
+    // residual is still correlated over one step)
+    let (cost_after, tau) = match coarse.then(|| residuals_on(every, &theta)) {
+        None => (sum_of_squares(&lin.residuals), tau),
+        Some(Some(r)) => (sum_of_squares(&r), crate::uncertainty::correlation_time(&every.series(&r))),
+        Some(None) => (f64::NAN, None),
+    };
     let mut info = &lin.jtj * weight;
     for i in 0..k {
         info[(i, i)] += u.precision[i];
@@ -786,7 +824,7 @@ fn fit(
     Ok(Estimate {
         model: estimated,
         cost_before,
-        cost_after: sum_of_squares(&lin.residuals),
+        cost_after,
         stopped,
         iterations: taken,
         correlation_time: tau,

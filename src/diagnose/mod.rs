@@ -42,8 +42,8 @@ use serde::Serialize;
 
 pub use choose::{choose_by_prediction, Chosen, Configuration, Prediction};
 pub use estimate::{
-    estimate, Estimate, EstimateSettings, EstimatedParameter, FromRecords, InitialValues, Move,
-    SourceParameter, LEANS,
+    estimate, Estimate, EstimateSettings, EstimatedParameter, FromRecords, HeldAgain, InitialValues, Move,
+    RunSpread, SourceParameter, LEANS, RUNS_DIFFER,
 };
 pub use fit::{simulate_runs, EstimateError, Runs};
 pub use refine::{refine, RefineSettings, Refined, RefinedCoefficient};

@@ -112,6 +112,8 @@ pub(super) fn estimate_parameters(
         sources: options.sources.clone(),
         per_source: options.per_source.clone(),
         per_run: options.per_run.clone(),
+        // at the refinement's step: the coarsest that resolves the runs
+        coarsest: Some((super::RESOLVED, super::MOST_SAMPLES_PER_STEP)),
         ..Default::default()
     };
     let fit = super::start::output_error_runs(&start.model, frames, states, intercept)

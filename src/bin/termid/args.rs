@@ -314,8 +314,9 @@ pub struct IdentifyCommand {
     pub refine_validation: Option<PathBuf>,
     /// With --model: last, estimate the model file's free parameters (`free = true`, e.g. the
     /// new-ship template's rudder zero `δ_0`) by output error together with every coefficient
-    /// of the kept start and each run's initial state; kept where the checks it passed still
-    /// pass. A regression cannot estimate a parameter inside its terms.
+    /// of the kept start and each run's initial state, at the refinement's step (the coarsest
+    /// that resolves the runs; its costs at every sample); kept where the checks it passed
+    /// still pass. A regression cannot estimate a parameter inside its terms.
     #[arg(long, requires = "model")]
     pub parameters: bool,
     /// With --parameters (implied): these free parameters estimated once per source (each
