@@ -248,6 +248,29 @@ impl RunSpread {
         self.p_value.is_some_and(|p| p >= RUNS_DIFFER)
     }
 
+    /// The spread of each parameter estimated per run among `values`.
+    fn of(values: &[SourceParameter]) -> Vec<RunSpread> {
+        let mut names: Vec<&str> =
+            values.iter().filter(|p| p.run.is_some()).map(|p| p.name.as_str()).collect();
+        names.dedup();
+        names
+            .into_iter()
+            .filter_map(|name| {
+                let v: Vec<f64> =
+                    values.iter().filter(|p| p.run.is_some() && p.name == name).map(|p| p.value).collect();
+                let s = crate::uncertainty::spread_of(&v)?;
+                Some(RunSpread {
+                    name: name.to_string(),
+                    runs: s.count,
+                    mean: s.mean,
+                    sd: s.sd,
+                    chi_square: None,
+                    p_value: None,
+                })
+            })
+            .collect()
+    }
+
     /// The test in words: "χ² 97.6 on 3 degrees of freedom, p < 0.001".
     fn test(&self) -> String {
         match (self.chi_square, self.p_value) {
@@ -277,31 +300,6 @@ fn differences(theta: &[f64], covariance: &DMatrix<f64>, values: &[usize]) -> Op
     });
     let q = d.dot(&(s.try_inverse()? * &d));
     q.is_finite().then_some(q.max(0.0))
-}
-
-impl RunSpread {
-    /// The spread of each parameter estimated per run among `values`.
-    fn of(values: &[SourceParameter]) -> Vec<RunSpread> {
-        let mut names: Vec<&str> =
-            values.iter().filter(|p| p.run.is_some()).map(|p| p.name.as_str()).collect();
-        names.dedup();
-        names
-            .into_iter()
-            .filter_map(|name| {
-                let v: Vec<f64> =
-                    values.iter().filter(|p| p.run.is_some() && p.name == name).map(|p| p.value).collect();
-                let s = crate::uncertainty::spread_of(&v)?;
-                Some(RunSpread {
-                    name: name.to_string(),
-                    runs: s.count,
-                    mean: s.mean,
-                    sd: s.sd,
-                    chi_square: None,
-                    p_value: None,
-                })
-            })
-            .collect()
-    }
 }
 
 /// The two fits of [`InitialValues::Auto`] where the free one leaned on its initial values.

@@ -213,7 +213,8 @@ fn per_run_jacobians<T: Send>(
     entries: &[Free],
     reduce: impl Fn(Vec<f64>, DMatrix<f64>, &[usize]) -> T + Sync,
 ) -> Result<Vec<T>, DiagnoseError> {
-    let system = System::new(model, &BTreeMap::new(), runs.intercepts)?;
+    // the system's states in its order (the model's)
+    let states: Vec<String> = model.states()?.into_iter().map(|(name, _, _)| name).collect();
     // the term columns: (column, owning state) and their regressors
     let mut term_columns = Vec::new();
     let mut terms = Vec::new();
@@ -224,8 +225,9 @@ fn per_run_jacobians<T: Send>(
         match entry {
             Free::Term(eq, term) => {
                 let state = model.equation(eq).map(|e| e.state.clone()).unwrap_or_default();
-                let i = system
-                    .state_index(&state)
+                let i = states
+                    .iter()
+                    .position(|s| *s == state)
                     .ok_or_else(|| DiagnoseError::Setup(format!("no state for `{eq}`")))?;
                 term_columns.push((j, i));
                 terms.push(term.clone());
@@ -251,13 +253,13 @@ fn per_run_jacobians<T: Send>(
                     return Err(DiagnoseError::Setup(format!("run {r} carries no value of `{name}`")));
                 }
             }
-            Free::Initial { state, .. } if *state >= system.dim() => {
+            Free::Initial { state, .. } if *state >= states.len() => {
                 return Err(DiagnoseError::Setup(format!("no state {state} in {}", model.path)));
             }
             Free::Initial { .. } => {}
         }
     }
-    // the same states, inputs and parameters, with the terms as outputs after the states'
+    // the model's states, inputs and parameters, with the terms as outputs after the states'
     let system = System::new(&WithRegressors { model, terms }, &BTreeMap::new(), runs.intercepts)?;
     (0..runs.frames.len())
         .into_par_iter()

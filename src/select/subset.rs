@@ -238,7 +238,6 @@ pub(crate) fn chi_square_pvalue(q: f64, dof: f64) -> f64 {
         (1.0 - front * sum).max(0.0)
     } else {
         // Q(a, x) by Lentz's method
-        const TINY: f64 = 1e-300;
         let mut b = x + 1.0 - a;
         let mut c = 1.0 / TINY;
         let mut d = 1.0 / b;
@@ -246,12 +245,7 @@ pub(crate) fn chi_square_pvalue(q: f64, dof: f64) -> f64 {
         for i in 1..500 {
             let an = -(i as f64) * (i as f64 - a);
             b += 2.0;
-            d = an * d + b;
-            d = if d.abs() < TINY { TINY } else { d };
-            c = b + an / c;
-            c = if c.abs() < TINY { TINY } else { c };
-            d = 1.0 / d;
-            let del = d * c;
+            let del = lentz(an, b, &mut c, &mut d);
             h *= del;
             if (del - 1.0).abs() < 1e-16 {
                 break;
@@ -303,8 +297,20 @@ pub(crate) fn incomplete_beta(a: f64, b: f64, x: f64) -> f64 {
     }
 }
 
+/// Keeps Lentz's method off a zero denominator.
+const TINY: f64 = 1e-300;
+
+/// One term of a continued fraction … + a/(b + …) by Lentz's method: `c` and `d` carried from
+/// the term before, the factor the fraction's value is multiplied by returned (Numerical
+/// Recipes §5.2).
+fn lentz(a: f64, b: f64, c: &mut f64, d: &mut f64) -> f64 {
+    let nonzero = |v: f64| if v.abs() < TINY { TINY } else { v };
+    *d = 1.0 / nonzero(b + a * *d);
+    *c = nonzero(b + a / *c);
+    *d * *c
+}
+
 fn beta_cf(a: f64, b: f64, x: f64) -> f64 {
-    const TINY: f64 = 1e-300;
     let (qab, qap, qam) = (a + b, a + 1.0, a - 1.0);
     let mut c = 1.0;
     let mut d = 1.0 - qab * x / qap;
@@ -317,19 +323,9 @@ fn beta_cf(a: f64, b: f64, x: f64) -> f64 {
         let m = m as f64;
         let m2 = 2.0 * m;
         let aa = m * (b - m) * x / ((qam + m2) * (a + m2));
-        d = 1.0 + aa * d;
-        d = if d.abs() < TINY { TINY } else { d };
-        c = 1.0 + aa / c;
-        c = if c.abs() < TINY { TINY } else { c };
-        d = 1.0 / d;
-        h *= d * c;
+        h *= lentz(aa, 1.0, &mut c, &mut d);
         let aa = -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2));
-        d = 1.0 + aa * d;
-        d = if d.abs() < TINY { TINY } else { d };
-        c = 1.0 + aa / c;
-        c = if c.abs() < TINY { TINY } else { c };
-        d = 1.0 / d;
-        let del = d * c;
+        let del = lentz(aa, 1.0, &mut c, &mut d);
         h *= del;
         if (del - 1.0).abs() < 1e-15 {
             break;
