@@ -304,6 +304,6 @@ pub fn diagnose(
 
 /// A run's file name without its folder, as a report names it (a table's column stays
 /// narrow).
-fn file_name(origin: &str) -> String {
+pub fn file_name(origin: &str) -> String {
     std::path::Path::new(origin).file_name().map_or(origin.to_string(), |n| n.to_string_lossy().into_owned())
 }

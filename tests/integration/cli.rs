@@ -474,3 +474,94 @@ fn datasets_add_up() {
     };
     assert_eq!(fit(&[&one]), fit(&[&a, &b]));
 }
+
+/// With `--monte-carlo`, `validate` counts the measured metrics within the model's own 90 %
+/// band and names those outside: the shipped held-out run's two overshoots are counted; the
+/// same run with its heading and yaw rate doubled (overshoots twice as large) falls outside on
+/// both, named in the JSON and the text.
+#[test]
+fn validate_says_which_measurements_leave_the_models_band() {
+    let dir = crate::common::Scratch::new("validate_band");
+    let model = dir.join("ship.toml");
+    let (ok, _, err) = termid(&[
+        "identify",
+        "--model",
+        "examples/data/ship.toml",
+        "--dataset",
+        "examples/data/runs.toml",
+        "--derivative",
+        "kalman",
+        "--smooth",
+        "--no-intercept",
+        "--out",
+        model.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let validate = |set: &str| {
+        let (ok, out, err) = termid(&[
+            "validate",
+            "--model",
+            model.to_str().unwrap(),
+            "--dataset",
+            set,
+            "--monte-carlo",
+            "40",
+            "--format",
+            "json",
+        ]);
+        assert!(ok, "{err}");
+        serde_json::from_str::<serde_json::Value>(&out).unwrap()
+    };
+    let v = validate("examples/data/held_out.toml");
+    let band = &v["within_band"];
+    let outside = band["outside"].as_array().unwrap().len();
+    assert_eq!(band["within"].as_u64().unwrap() as usize + outside, 2, "{band}");
+    // the same run turning twice as far: its heading and rate doubled
+    let text = std::fs::read_to_string("examples/data/zigzag_25_10.dat").unwrap();
+    let doubled: Vec<String> = text
+        .lines()
+        .map(|line| {
+            let mut cells: Vec<String> = line.split_whitespace().map(String::from).collect();
+            if let (Some(r), Some(psi)) = (
+                cells.get(3).and_then(|c| c.parse::<f64>().ok()),
+                cells.get(4).and_then(|c| c.parse::<f64>().ok()),
+            ) {
+                cells[3] = (2.0 * r).to_string();
+                cells[4] = (2.0 * psi).to_string();
+                cells.join(" ")
+            } else {
+                line.to_string()
+            }
+        })
+        .collect();
+    std::fs::write(dir.join("doubled.dat"), doubled.join("\n")).unwrap();
+    let set = dir.join("doubled.toml");
+    std::fs::write(
+        &set,
+        std::fs::read_to_string("examples/data/held_out.toml")
+            .unwrap()
+            .replace("zigzag_25_10.dat", "doubled.dat"),
+    )
+    .unwrap();
+    let v = validate(set.to_str().unwrap());
+    let band = &v["within_band"];
+    assert_eq!(band["within"], 0, "{band}");
+    let outside: Vec<&str> =
+        band["outside"].as_array().unwrap().iter().map(|o| o.as_str().unwrap()).collect();
+    assert!(outside.len() == 2 && outside.iter().all(|o| o.ends_with("of doubled.dat")), "{outside:?}");
+    let (ok, out, err) = termid(&[
+        "validate",
+        "--model",
+        model.to_str().unwrap(),
+        "--dataset",
+        set.to_str().unwrap(),
+        "--monte-carlo",
+        "40",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("measured within the model's 90 % band: 0 of 2 metrics (outside: 1st overshoot"),
+        "{out}"
+    );
+    assert!(out.contains("measured outside"), "{out}");
+}

@@ -58,6 +58,29 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
         crate::figures::write(&mut outputs, dir, "validate", figures)?;
         outputs.commit()?;
     }
+    // whether each measured metric lies outside the model's own 90 % band (none: no band)
+    let outside_band = |k: usize, key: &str, x: Option<f64>| -> Option<bool> {
+        let sp = spreads[k].as_ref()?.get(key)?;
+        x.map(|x| x < sp.p05 || x > sp.p95)
+    };
+    // (run, metric) of every banded metric, and whether it fell outside
+    let verdicts: Vec<(String, String, bool)> = metrics
+        .iter()
+        .enumerate()
+        .filter_map(|(k, m)| m.as_ref().map(|(a, _)| (k, a)))
+        .flat_map(|(k, a)| {
+            let run = termid::diagnose::file_name(runs[k].origin());
+            a.rows
+                .iter()
+                .filter_map(|(name, key, x)| {
+                    outside_band(k, key, *x).map(|off| (run.clone(), name.clone(), off))
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let outside: Vec<String> =
+        verdicts.iter().filter(|v| v.2).map(|(run, name, _)| format!("{name} of {run}")).collect();
+    let within = verdicts.len() - outside.len();
     match cmd.format {
         Format::Json => println!(
             "{}",
@@ -69,6 +92,10 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
                     "simulated": m.as_ref().map(|m| &m.1.json),
                     "monte_carlo": mc.as_ref().zip(s.as_ref()).map(|(mc, s)| mc.summary(s)),
                 })).collect::<Vec<_>>(),
+                "within_band": (!verdicts.is_empty()).then(|| serde_json::json!({
+                    "within": within,
+                    "outside": outside,
+                })),
             }))?
         ),
         Format::Text => {
@@ -83,25 +110,36 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
                     per.iter().map(|(s, r, m)| error_cell(s, *r, *m, model.unit(s))).collect();
                 println!("  {run}: {}", cells.join(", "));
             }
-            for ((m, f), s) in metrics.iter().zip(&runs).zip(&spreads) {
+            for (k, ((m, f), s)) in metrics.iter().zip(&runs).zip(&spreads).enumerate() {
                 let Some((a, b)) = m else { continue };
                 let band = if s.is_some() { "   model 5 % … 95 %" } else { "" };
                 println!("\n{}: metric, measured, model{band}", f.origin());
-                let row = |name: &str, key: &str, x: Option<f64>, y: Option<f64>| {
-                    if x.is_some() || y.is_some() {
-                        // at the decimals the metric's unit supports (0.01°, 0.01 s)
-                        let (_, _, d) = termid::plugin::metric_label(key);
-                        let f = |v: Option<f64>| v.map_or("--".to_string(), |v| format!("{v:.d$}"));
-                        let spread = s
-                            .as_ref()
-                            .and_then(|s| s.get(key))
-                            .map_or(String::new(), |sp| format!("   {:.d$} … {:.d$}", sp.p05, sp.p95));
-                        println!("  {name:<24} {:>12} {:>12}{spread}", f(x), f(y));
+                for ((name, key, x), (_, _, y)) in a.rows.iter().zip(&b.rows) {
+                    if x.is_none() && y.is_none() {
+                        continue;
                     }
-                };
-                for ((label, key, x), (_, _, y)) in a.rows.iter().zip(&b.rows) {
-                    row(label, key, *x, *y);
+                    // at the decimals the metric's unit supports (0.01°, 0.01 s)
+                    let (_, _, d) = termid::plugin::metric_label(key);
+                    let shown = |v: Option<f64>| v.map_or("--".to_string(), |v| format!("{v:.d$}"));
+                    let spread = s.as_ref().and_then(|s| s.get(key)).map_or(String::new(), |sp| {
+                        let mark =
+                            if outside_band(k, key, *x) == Some(true) { "   measured outside" } else { "" };
+                        format!("   {:.d$} … {:.d$}{mark}", sp.p05, sp.p95)
+                    });
+                    println!("  {name:<24} {:>12} {:>12}{spread}", shown(*x), shown(*y));
                 }
+            }
+            if !verdicts.is_empty() {
+                // a 90 % band leaves one measurement in ten outside by chance
+                println!(
+                    "\nmeasured within the model's 90 % band: {within} of {} metrics{}",
+                    verdicts.len(),
+                    if outside.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" (outside: {})", outside.join("; "))
+                    }
+                );
             }
             if let Some(note) = metrics.iter().flatten().find_map(|(a, _)| a.note.as_ref()) {
                 println!("\nNote: {note}.");
