@@ -94,10 +94,11 @@ pub fn observe(t: &[f64], psi: &[f64], delta: &[f64], x0: &[f64], y0: &[f64]) ->
     let off: Vec<f64> = delta[..n].iter().map(|d| d - delta[0]).collect();
     let main = off.iter().copied().fold(0.0f64, |m, d| if d.abs() > m.abs() { d } else { m });
     let turn = off.iter().all(|d| d * main.signum() > -1f64.to_radians());
-    if n > 1 && turn && main.abs() > 1f64.to_radians() {
-        // the execute: the last sample before the rudder leaves its approach angle by 0.5°
-        let e = off.iter().position(|d| d.abs() > 0.5f64.to_radians()).map_or(0, |k| k.saturating_sub(1));
-        let m = n.min(x0.len()).min(y0.len());
+    // the execute: the last sample before the rudder leaves its approach angle by 0.5°
+    let e = off.iter().position(|d| d.abs() > 0.5f64.to_radians()).map_or(0, |k| k.saturating_sub(1));
+    // a record without a track (no x0, y0) has no turning metrics, but its overshoots
+    let m = n.min(x0.len()).min(y0.len());
+    if n > 1 && turn && main.abs() > 1f64.to_radians() && m > e + 1 {
         let (ce, se) = (psi[e].cos(), psi[e].sin());
         let sign = if psi[m - 1] >= psi[e] { 1.0 } else { -1.0 };
         let turned: Vec<f64> = psi[e..m].iter().map(|p| sign * (p - psi[e]).to_degrees()).collect();
@@ -318,6 +319,28 @@ mod tests {
             assert!((g - w).abs() < 0.1, "{g} m vs the manoeuvre's {w} m");
         }
         assert!(seen.first_overshoot_deg.is_none());
+        // without its track the same record has no turning metrics (and reads without a fault)
+        let seen = observe(f.time(), &psi, c("δ"), &[], &[]);
+        assert!(seen.advance_m.is_none() && seen.tactical_diameter_m.is_none() && seen.transfer_m.is_none());
+    }
+
+    /// A zigzag recorded without its track (heading and rudder only) still has its overshoots,
+    /// the same as with it.
+    #[test]
+    fn a_zigzag_without_its_track_has_its_overshoots() {
+        let model = crate::ship::default_model();
+        let rec = Basin::default()
+            .record(&model, &Manoeuvre::parse("zigzag:20/20").unwrap(), 2.01, 60.0, 3, "zz.dat")
+            .unwrap();
+        let f = &rec.measured;
+        let c = |n: &str| f.column(n).unwrap();
+        let with = observe(f.time(), c("ψ"), c("δ"), c("x0"), c("y0"));
+        let without = observe(f.time(), c("ψ"), c("δ"), &[], &[]);
+        assert!(with.first_overshoot_deg.is_some() && with.second_overshoot_deg.is_some());
+        assert_eq!(
+            (with.first_overshoot_deg, with.second_overshoot_deg),
+            (without.first_overshoot_deg, without.second_overshoot_deg)
+        );
     }
 
     /// Zigzags recorded from the default ship with a gear of 0.25 s dead time, 20°/s² and

@@ -169,7 +169,9 @@ impl Plugin for Manoeuvring {
         let seen = match simulated {
             None => {
                 let col = |c: &str| frame.column(c);
-                observe(frame.time(), col(&n.psi)?, col(&n.rudder)?, col(&n.x0)?, col(&n.y0)?)
+                // a record without a track still has its zigzag's overshoots
+                let track = |c: &str| col(c).unwrap_or(&[]);
+                observe(frame.time(), col(&n.psi)?, col(&n.rudder)?, track(&n.x0), track(&n.y0))
             }
             Some(s) => {
                 let state = |c: &str| s.state(c);
