@@ -35,6 +35,11 @@ impl Normal {
     }
 }
 
+/// The largest share of failed draws with which the others still describe the model: beyond
+/// it the draws that ran are those that happened to stay stable, not a sample of the model's
+/// uncertainty, and no mean, sd or band may be made of them.
+pub const MAX_FAILED: f64 = 0.05;
+
 /// What a draw can perturb: the equations with a stored covariance, and `parameters` when the
 /// file holds the free parameters' covariance (`[parameter_covariance]`).
 pub fn uncertain_equations(model: &Model) -> Vec<String> {

@@ -340,6 +340,20 @@ impl PyModel {
 
     /// Sets a parameter, or a value of the plug-in's table (a ship's `u0`); unknown names are
     /// refused.
+    /// `n` models drawn from the stored covariances (seeded): each equation's coefficients
+    /// and the free parameters, as `simulate --monte-carlo` draws them.
+    fn draws(&self, n: usize, seed: u64) -> PyResult<Vec<PyModel>> {
+        if termid::uncertainty::uncertain_equations(&self.inner).is_empty() {
+            return Err(refuse(format!(
+                "{}: nothing to draw from: the model stores no covariance (`identify` with --out, a refinement or `estimate` write one)",
+                self.inner.path
+            )));
+        }
+        let sampler = termid::uncertainty::Sampler::new(&self.inner);
+        let mut normal = termid::uncertainty::Normal::new(seed);
+        Ok((0..n).map(|_| PyModel { inner: sampler.draw(&mut normal) }).collect())
+    }
+
     fn set_parameter(&mut self, name: &str, value: f64) -> PyResult<()> {
         let mut known = self.inner.set_parameter(name, value);
         if let Some(plugin) = termid::plugins::of(&self.inner) {
@@ -1295,5 +1309,6 @@ fn _termid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(methods, m)?)?;
     m.add_function(wrap_pyfunction!(default_settings, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
+    m.add("MAX_FAILED", termid::uncertainty::MAX_FAILED)?;
     Ok(())
 }

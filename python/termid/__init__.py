@@ -1079,6 +1079,59 @@ class Model:
         frame.attrs.update(name=label, metrics=json.loads(metrics), report=list(text))
         return frame
 
+    def draws(self, n: int, *, seed: int = 1) -> List["Model"]:
+        """``n`` models drawn from the stored covariances (seeded by ``seed``), as ``simulate
+        --monte-carlo`` draws them: each identified equation's coefficients from its
+        covariance widened by the residuals' correlation time, and the free parameters from
+        theirs (a per-run parameter with a new run's spread). Raises where the model stores no
+        covariance. For the spread of a scenario's metrics see :meth:`monte_carlo`.
+
+        >>> truth = termid.Model.builtin("nomoto"); truth.set_parameter("K", 0.15)
+        >>> run = truth.simulate(duration=30.0, inputs={"δ": 0.1}, sample=0.1)[["t", "ψ", "r", "δ"]]
+        >>> run["ψ"] += np.random.default_rng(1).normal(0.0, 0.002, len(run))
+        >>> _, found = termid.Model.builtin("nomoto").estimate(run)
+        >>> ks = [m.parameters["K"] for m in found.draws(50)]
+        >>> bool(abs(np.mean(ks) - 0.15) < 0.01 and np.std(ks) > 0)
+        True
+        """
+        return [Model(native) for native in self._native.draws(n, seed)]
+
+    def monte_carlo(self, scenario: str, n: int = 100, *, seed: int = 1, **simulate: Any) -> pd.DataFrame:
+        """The spread of a plug-in ``scenario``'s metrics over ``n`` drawn models
+        (:meth:`draws` with ``seed``, each simulated as :meth:`simulate` with ``simulate``'s keywords): a
+        DataFrame of the metrics, a row per draw that ran (``describe()`` gives mean, sd and
+        percentiles); ``attrs``: ``nominal`` (the model's own metrics), ``draws``, ``failed``,
+        ``first_failure``. Where more than ``MAX_FAILED`` (5 %) of the draws fail, the rest are
+        those that happened to stay stable, not a sample of the model's uncertainty: it raises
+        :class:`TermidError` saying so instead of returning them (``draws`` gives them to
+        whoever wants them still).
+
+        >>> ship = termid.Model.default()
+        >>> found = ship.identify([ship.record("zigzag:20/20", seed=1), ship.record("zigzag:20/20:port", seed=2)], "kalman")
+        >>> spread = found.model.monte_carlo("zigzag:20/20", 20)
+        >>> len(spread), spread.attrs["failed"]
+        (20, 0)
+        """
+        nominal = self.simulate(scenario, **simulate).attrs.get("metrics", {})
+        rows, failed, first = [], 0, None
+        for model in self.draws(n, seed=seed):
+            try:
+                rows.append(model.simulate(scenario, **simulate).attrs.get("metrics", {}))
+            except TermidError as e:
+                failed += 1
+                first = first or str(e)
+        if failed > _termid.MAX_FAILED * n or not rows:
+            raise TermidError(
+                f"{failed} of {n} draws failed ({100.0 * failed / max(n, 1):.0f} %, more than the "
+                f"{100.0 * _termid.MAX_FAILED:.0f} % a spread can stand): the drawn coefficients leave the "
+                f"region where the model can be simulated (first failure: {first}); the covariance is too "
+                "wide for this scenario. What helps: more or longer runs, runs that excite the terms more, "
+                "fewer candidate terms, or a refinement"
+            )
+        table = pd.DataFrame(rows)
+        table.attrs = {"nominal": nominal, "draws": n, "failed": failed, "first_failure": first}
+        return table
+
     def record(
         self,
         manoeuvre: str,

@@ -1,5 +1,6 @@
 """Model files from Python: load, write, identify, predict, simulate, validate."""
 import os
+import re
 import warnings
 
 import numpy as np
@@ -348,3 +349,24 @@ def test_print_shows_each_equation_with_its_coefficients():
     assert text.splitlines()[0] == lorenz.name
     assert "  z_dot = 1 x*y - 2.66667 z" in text, text
     assert repr(lorenz).startswith("termid.Model(")
+
+
+def test_monte_carlo_spread_and_its_refusal():
+    """``Model.monte_carlo``: the metrics of drawn models, a row per draw, the model's own
+    among them; where more than 5 % of the draws fail (a covariance widened a billion times)
+    it raises saying so rather than return the draws that happened to stay stable."""
+    ship = termid.Model.default()
+    runs = [ship.record(m, seed=k) for k, m in enumerate(["zigzag:20/20", "zigzag:20/20:port", "zigzag:10/10"])]
+    found = ship.identify(runs, "kalman").model
+    spread = found.monte_carlo("zigzag:20/20", 30)
+    assert len(spread) == 30 and spread.attrs["failed"] == 0 and spread.attrs["draws"] == 30
+    overshoot = spread["first_overshoot_deg"]
+    assert overshoot.quantile(0.05) <= spread.attrs["nominal"]["first_overshoot_deg"] <= overshoot.quantile(0.95)
+    assert overshoot.std() > 0
+    # the same seed, the same draws
+    assert found.monte_carlo("zigzag:20/20", 5, seed=4).equals(found.monte_carlo("zigzag:20/20", 5, seed=4))
+    wide = termid.Model.from_toml(re.sub(r"correlation_time = [0-9.e+]+", "correlation_time = 1e9", found.to_toml()))
+    with pytest.raises(termid.TermidError, match="draws failed .* more than the 5 %"):
+        wide.monte_carlo("turning:35", 20)
+    with pytest.raises(termid.TermidError, match="no covariance"):
+        termid.Model.default().draws(3)

@@ -7,10 +7,7 @@ use std::collections::BTreeMap;
 
 use anyhow::{bail, Result};
 use termid::model::Model;
-use termid::uncertainty::{spread, uncertain_equations, Normal, Sampler, Spread};
-
-/// The largest share of failed draws with which the others still describe the model.
-pub const MAX_FAILED: f64 = 0.05;
+use termid::uncertainty::{spread, uncertain_equations, Normal, Sampler, Spread, MAX_FAILED};
 
 /// The results of simulating drawn models.
 pub struct Draws<T> {
