@@ -40,6 +40,27 @@ impl Normal {
 /// uncertainty, and no mean, sd or band may be made of them.
 pub const MAX_FAILED: f64 = 0.05;
 
+/// Whether `ran` of `draws` drawn models describe the model: some ran, and no more than
+/// [`MAX_FAILED`] of the draws failed.
+pub fn usable(draws: usize, ran: usize) -> bool {
+    ran > 0 && draws.saturating_sub(ran) as f64 <= MAX_FAILED * draws as f64
+}
+
+/// Why no spread may be made of `ran` of `draws` drawn models, and what helps (`None` where
+/// they are [`usable`]); `first_failure` says how the first failed draw failed.
+pub fn refusal(draws: usize, ran: usize, first_failure: Option<&str>) -> Option<String> {
+    if usable(draws, ran) {
+        return None;
+    }
+    let failed = draws.saturating_sub(ran);
+    Some(format!(
+        "{failed} of {draws} draws failed ({:.0} %, more than the {:.0} % a spread can stand): no mean, sd or band is shown, since the draws that ran are only those that stayed stable. The drawn coefficients leave the region where the model can be simulated{}: the covariance is too wide for this manoeuvre. What helps: more or longer runs, or runs that excite the terms more (a wider rudder range), fewer candidate terms, or refining with --refine",
+        100.0 * failed as f64 / draws.max(1) as f64,
+        100.0 * MAX_FAILED,
+        first_failure.map_or(String::new(), |f| format!(" (first failure: {f})"))
+    ))
+}
+
 /// What a draw can perturb: the equations with a stored covariance, and `parameters` when the
 /// file holds the free parameters' covariance (`[parameter_covariance]`).
 pub fn uncertain_equations(model: &Model) -> Vec<String> {
@@ -239,6 +260,17 @@ pub fn correlation_time(residuals: &[Vec<f64>]) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Up to 5 % of the draws may fail; beyond that, or with none that ran, the refusal says
+    /// how many failed and how the first failed.
+    #[test]
+    fn a_spread_stands_five_percent_of_failed_draws() {
+        assert!(usable(100, 95) && !usable(100, 94) && !usable(10, 0) && usable(1, 1));
+        assert_eq!(refusal(100, 95, None), None);
+        let why = refusal(100, 94, Some("diverged at t = 3 s")).unwrap();
+        assert!(why.starts_with("6 of 100 draws failed (6 %, more than the 5 %"), "{why}");
+        assert!(why.contains("(first failure: diverged at t = 3 s)"), "{why}");
+    }
 
     #[test]
     fn normal_numbers_have_unit_variance() {

@@ -1299,6 +1299,13 @@ fn version() -> &'static str {
     env!("CARGO_PKG_VERSION")
 }
 
+/// Why no spread may be made of `ran` of `draws` drawn models (`None` where it may): the
+/// command line's rule and words.
+#[pyfunction]
+fn monte_carlo_refusal(draws: usize, ran: usize, first_failure: Option<&str>) -> Option<String> {
+    termid::uncertainty::refusal(draws, ran, first_failure)
+}
+
 #[pymodule]
 fn _termid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("TermidError", m.py().get_type::<TermidError>())?;
@@ -1309,6 +1316,6 @@ fn _termid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(methods, m)?)?;
     m.add_function(wrap_pyfunction!(default_settings, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
-    m.add("MAX_FAILED", termid::uncertainty::MAX_FAILED)?;
+    m.add_function(wrap_pyfunction!(monte_carlo_refusal, m)?)?;
     Ok(())
 }

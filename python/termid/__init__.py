@@ -1101,7 +1101,7 @@ class Model:
         (:meth:`draws` with ``seed``, each simulated as :meth:`simulate` with ``simulate``'s keywords): a
         DataFrame of the metrics, a row per draw that ran (``describe()`` gives mean, sd and
         percentiles); ``attrs``: ``nominal`` (the model's own metrics), ``draws``, ``failed``,
-        ``first_failure``. Where more than ``MAX_FAILED`` (5 %) of the draws fail, the rest are
+        ``first_failure``. Where more than 5 % of the draws fail, the rest are
         those that happened to stay stable, not a sample of the model's uncertainty: it raises
         :class:`TermidError` saying so instead of returning them (``draws`` gives them to
         whoever wants them still).
@@ -1120,14 +1120,9 @@ class Model:
             except TermidError as e:
                 failed += 1
                 first = first or str(e)
-        if failed > _termid.MAX_FAILED * n or not rows:
-            raise TermidError(
-                f"{failed} of {n} draws failed ({100.0 * failed / max(n, 1):.0f} %, more than the "
-                f"{100.0 * _termid.MAX_FAILED:.0f} % a spread can stand): the drawn coefficients leave the "
-                f"region where the model can be simulated (first failure: {first}); the covariance is too "
-                "wide for this scenario. What helps: more or longer runs, runs that excite the terms more, "
-                "fewer candidate terms, or a refinement"
-            )
+        refusal = _termid.monte_carlo_refusal(n, len(rows), first)
+        if refusal is not None:
+            raise TermidError(refusal)
         table = pd.DataFrame(rows)
         table.attrs = {"nominal": nominal, "draws": n, "failed": failed, "first_failure": first}
         return table

@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 
 use anyhow::{bail, Result};
 use termid::model::Model;
-use termid::uncertainty::{spread, uncertain_equations, Normal, Sampler, Spread, MAX_FAILED};
+use termid::uncertainty::{spread, uncertain_equations, Normal, Sampler, Spread};
 
 /// The results of simulating drawn models.
 pub struct Draws<T> {
@@ -71,11 +71,12 @@ impl<T> Draws<T> {
         Ok(out)
     }
 
-    /// Whether the draws that ran describe the model: no more than [`MAX_FAILED`] of them
+    /// Whether the draws that ran describe the model: no more than
+    /// [`MAX_FAILED`](termid::uncertainty::MAX_FAILED) of them
     /// failed. Survivors of a set that mostly failed are the draws that happened to stay
     /// stable, not a sample of the model's uncertainty.
     pub fn usable(&self) -> bool {
-        !self.results.is_empty() && self.failed as f64 <= MAX_FAILED * self.draws as f64
+        termid::uncertainty::usable(self.draws, self.results.len())
     }
 
     /// The results to draw as a band: all of them where [`Draws::usable`], none otherwise.
@@ -95,17 +96,7 @@ impl<T> Draws<T> {
 
     /// Why the spread is not shown, and what helps (None where it is).
     pub fn refusal(&self) -> Option<String> {
-        if self.usable() {
-            return None;
-        }
-        Some(format!(
-            "{} of {} draws failed ({:.0} %, more than the {:.0} % a spread can stand): no mean, sd or band is shown, since the draws that ran are only those that stayed stable. The drawn coefficients leave the region where the model can be simulated{}: the covariance is too wide for this manoeuvre. What helps: more or longer runs, or runs that excite the terms more (a wider rudder range), fewer candidate terms, or refining with --refine",
-            self.failed,
-            self.draws,
-            100.0 * self.failed as f64 / self.draws.max(1) as f64,
-            100.0 * MAX_FAILED,
-            self.first_failure.as_ref().map_or(String::new(), |f| format!(" (first failure: {f})"))
-        ))
+        termid::uncertainty::refusal(self.draws, self.results.len(), self.first_failure.as_deref())
     }
 
     /// JSON summary: draws, failures and the spread of every metric (null where not usable,
