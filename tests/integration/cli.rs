@@ -483,19 +483,7 @@ fn datasets_add_up() {
 fn validate_says_which_measurements_leave_the_models_band() {
     let dir = crate::common::Scratch::new("validate_band");
     let model = dir.join("ship.toml");
-    let (ok, _, err) = termid(&[
-        "identify",
-        "--model",
-        "examples/data/ship.toml",
-        "--dataset",
-        "examples/data/runs.toml",
-        "--derivative",
-        "kalman",
-        "--smooth",
-        "--no-intercept",
-        "--out",
-        model.to_str().unwrap(),
-    ]);
+    let (ok, _, err) = crate::common::identify_sample_records(&model, "kalman", &[]);
     assert!(ok, "{err}");
     let validate = |set: &str| {
         let (ok, out, err) = termid(&[
