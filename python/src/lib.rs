@@ -338,8 +338,6 @@ impl PyModel {
         self.inner.equation(equation).and_then(|e| e.intercept)
     }
 
-    /// Sets a parameter, or a value of the plug-in's table (a ship's `u0`); unknown names are
-    /// refused.
     /// `n` models drawn from the stored covariances (seeded): each equation's coefficients
     /// and the free parameters, as `simulate --monte-carlo` draws them.
     fn draws(&self, n: usize, seed: u64) -> PyResult<Vec<PyModel>> {
@@ -354,6 +352,8 @@ impl PyModel {
         Ok((0..n).map(|_| PyModel { inner: sampler.draw(&mut normal) }).collect())
     }
 
+    /// Sets a parameter, or a value of the plug-in's table (a ship's `u0`); unknown names are
+    /// refused.
     fn set_parameter(&mut self, name: &str, value: f64) -> PyResult<()> {
         let mut known = self.inner.set_parameter(name, value);
         if let Some(plugin) = termid::plugins::of(&self.inner) {

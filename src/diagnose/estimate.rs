@@ -543,15 +543,15 @@ pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Resu
         let (factor, coarse) = runs.coarsest(model, &fine, tolerance, most);
         (factor > 1).then_some(coarse)
     });
-    let runs = &Scales { fit: coarse.as_ref().unwrap_or(runs), every: runs };
-    let each = with_initial_values(model, runs, settings, &[])?;
+    let scales = &Scales { fit: coarse.as_ref().unwrap_or(runs), every: runs };
+    let each = with_initial_values(model, scales, settings, &[])?;
     let agree: Vec<RunSpread> =
         each.per_run.iter().filter(|r| r.agree() && !settings.per_run.contains(&r.name)).cloned().collect();
     if agree.is_empty() {
         return Ok(each);
     }
     let names: Vec<String> = agree.iter().map(|r| r.name.clone()).collect();
-    let mut one = with_initial_values(model, runs, settings, &names)?;
+    let mut one = with_initial_values(model, scales, settings, &names)?;
     one.one_value = agree;
     Ok(one)
 }
@@ -560,17 +560,17 @@ pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Resu
 /// [`EstimateSettings::initial_values`] says.
 fn with_initial_values(
     model: &Model,
-    runs: &Scales<'_>,
+    scales: &Scales<'_>,
     settings: &EstimateSettings,
     one: &[String],
 ) -> Result<Estimate, DiagnoseError> {
-    let first = fit(model, runs, settings, settings.initial_values == InitialValues::Measured, one)?;
+    let first = fit(model, scales, settings, settings.initial_values == InitialValues::Measured, one)?;
     let leaned = first.from_records.as_ref().filter(|f| f.leans);
     let (Some(leaned), InitialValues::Auto) = (leaned, settings.initial_values) else {
         return Ok(first);
     };
     let free = &first;
-    let mut held = fit(model, runs, settings, true, one)?;
+    let mut held = fit(model, scales, settings, true, one)?;
     let cost = |e: &Estimate| e.from_records.as_ref().and_then(|f| f.cost).unwrap_or(f64::INFINITY);
     if cost(&held) < cost(free) {
         held.held_again = Some(HeldAgain { kept: true, other: leaned.clone() });
