@@ -5,10 +5,12 @@
 //! tables and writes two figures.
 //!
 //! `SIMMAN=/path/to/clone cargo run --release --example simman -- IDENTIFIED.toml [OUT_FOLDER]`;
-//! `… --example simman -- --table [--gear-at-once] [--about-neutral] LABEL=MODEL.toml …` prints
-//! one row per model instead: the first overshoot of each MARIN zigzag (steered by the model,
-//! the rudder laid about 0 by MARIN's steering gear as MARIN's records show both; or by a gear
-//! at full rate at once; or that and about the model's straight-run angle) less MARIN's, and
+//! `… --example simman -- --table [--gear-at-once] [--about-neutral] [--zero-from-approach]
+//! LABEL=MODEL.toml …` prints one row per model instead: the first overshoot of each MARIN
+//! zigzag (steered by the model, the rudder laid about 0 by MARIN's steering gear as MARIN's
+//! records show both; or by a gear at full rate at once; or that and about the model's
+//! straight-run angle; with `--zero-from-approach` the model's rudder zero moved for each run so
+//! that its straight run needs the rudder the record's approach held) less MARIN's, and
 //! the ±35° tactical diameters (the guide's table of training sets and model families); then
 //! each model's linear sway and yaw at MARIN's approach (time constants, rudder, damping)
 //! (the clone: the public repository martinlarsalbert/System-identification-of-Vessel-
@@ -185,20 +187,21 @@ fn own_zigzags(model: &Model, settings: &Settings) -> Result<(), Error> {
     Ok(())
 }
 
-/// `--table [--gear-at-once] [--about-neutral] LABEL=MODEL.toml …`: per model, each MARIN
-/// zigzag's first overshoot as the model steers it less the measured one, and the ±35° tactical
-/// diameters at MARIN's approach; the rudder laid about 0 by MARIN's steering gear, or with
-/// `--gear-at-once` by the model file's gear (full rate at once), with `--about-neutral` that
-/// and about the model's δ0.
+/// `--table [--gear-at-once] [--about-neutral] [--zero-from-approach] LABEL=MODEL.toml …`: per
+/// model, each MARIN zigzag's first overshoot as the model steers it less the measured one, and
+/// the ±35° tactical diameters at MARIN's approach; the rudder laid about 0 by MARIN's steering
+/// gear, or with `--gear-at-once` by the model file's gear (full rate at once), with
+/// `--about-neutral` that and about the model's δ0; `--zero-from-approach` moves the model's
+/// rudder zero for each run so that its straight run needs the rudder the approach held.
 fn table(args: &[String]) -> Result<(), Error> {
     let flags = args.iter().take_while(|a| a.starts_with("--")).count();
     let about_neutral = args[..flags].iter().any(|a| a == "--about-neutral");
     let with_gear = !about_neutral && !args[..flags].iter().any(|a| a == "--gear-at-once");
-    if let Some(other) =
-        args[..flags].iter().find(|a| !["--about-neutral", "--gear-at-once"].contains(&a.as_str()))
-    {
+    let zero_from_approach = args[..flags].iter().any(|a| a == "--zero-from-approach");
+    let known = ["--about-neutral", "--gear-at-once", "--zero-from-approach"];
+    if let Some(other) = args[..flags].iter().find(|a| !known.contains(&a.as_str())) {
         return Err(format!(
-            "unknown option {other}: --table [--gear-at-once] [--about-neutral] LABEL=MODEL.toml …"
+            "unknown option {other}: --table [--gear-at-once] [--about-neutral] [--zero-from-approach] LABEL=MODEL.toml …"
         )
         .into());
     }
@@ -238,6 +241,8 @@ fn table(args: &[String]) -> Result<(), Error> {
             let measured = plugin.observe(model, frame, None).ok_or("no metrics of the record")?.json;
             // a model that leaves its bounds is a row of the table too, saying where
             let approach = termid::ship::basin::at_approach_speed(model, frame.require("u")?[0]);
+            let approach =
+                if zero_from_approach { with_neutral(&approach, approach_rudder(frame)?)? } else { approach };
             let ship = Ship::new(&gear.as_ref().map_or(approach.clone(), |g| g.on(&approach)), false)?;
             let z = match steer(&ship, &zigzag(frame)?, &settings) {
                 Ok(z) => z,
@@ -286,6 +291,26 @@ fn table(args: &[String]) -> Result<(), Error> {
         );
     }
     Ok(())
+}
+
+/// The rudder angle that held the record's approach: the mean of its samples before the
+/// rudder first moves 0.5° from where it started (the execute).
+fn approach_rudder(frame: &Frame) -> Result<f64, Error> {
+    let d = frame.require("δ")?;
+    let execute =
+        d.iter().position(|x| (x - d[0]).abs() > 0.5f64.to_radians()).ok_or("the rudder never moves")?;
+    Ok(d[..execute].iter().sum::<f64>() / execute as f64)
+}
+
+/// The model with its rudder indicator's zero `δ_0` moved so that its straight run needs the
+/// rudder angle `delta` (every rudder term reads δ − δ_0, so the straight run's angle moves with
+/// the zero one for one).
+fn with_neutral(model: &Model, delta: f64) -> Result<Model, Error> {
+    let neutral = Ship::new(model, false)?.straight_run()?.delta0_deg.to_radians();
+    let zero = *model.parameter_values().get("δ_0").ok_or("the model has no rudder zero δ_0")?;
+    let mut moved = model.clone();
+    moved.set_parameter("δ_0", zero + delta - neutral);
+    Ok(moved)
 }
 
 /// A predicted value and its error, as two cells.

@@ -761,7 +761,7 @@ impl PyModel {
 
     /// The model file's free parameters estimated from runs by output error (JSON report),
     /// with the model holding the estimates.
-    #[pyo3(signature = (runs, coefficients = false, states = None, initial_values = "auto".to_string(), dt = None, iterations = 50, sources = vec![], per_source = vec![], per_run = vec![]))]
+    #[pyo3(signature = (runs, coefficients = false, states = None, initial_values = "auto".to_string(), dt = None, iterations = 50, sources = vec![], per_source = vec![], per_run = vec![], coarse = false))]
     #[allow(clippy::too_many_arguments)]
     fn estimate(
         &self,
@@ -775,6 +775,7 @@ impl PyModel {
         sources: Vec<usize>,
         per_source: Vec<String>,
         per_run: Vec<String>,
+        coarse: bool,
     ) -> PyResult<(String, PyModel)> {
         let initial_values = termid::diagnose::InitialValues::parse(&initial_values)
             .map_err(|e| pyo3::exceptions::PyValueError::new_err(format!("initial_values {e}")))?;
@@ -788,6 +789,7 @@ impl PyModel {
             sources,
             per_source,
             per_run,
+            coarsest: coarse.then_some((termid::recipe::RESOLVED, termid::recipe::MOST_SAMPLES_PER_STEP)),
             ..Default::default()
         };
         let fit = py

@@ -1316,6 +1316,7 @@ class Model:
         sources: Optional[Sequence[int]] = None,
         per_source: Sequence[str] = (),
         per_run: Sequence[str] = (),
+        coarse: bool = False,
     ) -> Tuple[pd.DataFrame, "Model"]:
         """The model file's free parameters (``free = true`` under ``[parameters.NAME]``, with an
         optional ``prior`` and ``bounds``) estimated from ``runs`` by output error: grey-box
@@ -1346,6 +1347,11 @@ class Model:
         holds the estimated model's cost from the recorded first samples and how far the
         estimated initial values moved in units of the records' noise; beyond 3 times a warning
         says the fit leans on them (the model does not explain everything the runs show).
+        ``coarse`` fits at the coarsest step (up to 8 samples) at which the model's start
+        re-simulates the runs as at every sample, as the recipe's parameter stage does: on
+        finely sampled records several times faster (SIMMAN's 13 HSVA runs at 20 Hz: 21 s →
+        4.5 s, every estimate within 0.32 standard errors); costs still at every sample, the
+        fit's step in ``attrs["step_samples"]``.
 
         >>> nomoto = termid.Model.builtin("nomoto")
         >>> truth = termid.Model.builtin("nomoto")
@@ -1365,6 +1371,7 @@ class Model:
             [int(s) for s in sources or []],
             list(per_source),
             list(per_run),
+            coarse,
         )
         report = json.loads(text)
         table = pd.DataFrame(
@@ -1392,6 +1399,7 @@ class Model:
             "per_run": pd.DataFrame(report.get("per_run", []), columns=["name", "runs", "mean", "sd", "chi_square", "p_value"]),
             "one_value": pd.DataFrame(report.get("one_value", []), columns=["name", "runs", "mean", "sd", "chi_square", "p_value"]),
             "held_again": report.get("held_again"),
+            "step_samples": report.get("step_samples", 1),
         }
         leaning = report.get("from_records") or {}
         if leaning.get("leans"):

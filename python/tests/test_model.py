@@ -245,6 +245,10 @@ def test_estimate_recovers_nomoto_k_and_t_from_a_noisy_run():
         assert abs(row["estimate"] - value) < max(3 * row["std_error"], 1e-3 * value), table
     assert found.parameters["K"] == table.loc["K", "estimate"]
     assert table.attrs["covariance"].shape == (2, 2) and table.attrs["cost_after"] < table.attrs["cost_before"]
+    # at the coarsest step that resolves the run: said, and the same within the standard errors
+    coarse, _ = termid.Model.builtin("nomoto").estimate(run, coarse=True)
+    assert table.attrs["step_samples"] == 1 and coarse.attrs["step_samples"] > 1
+    assert ((coarse["estimate"] - table["estimate"]).abs() < table["std_error"]).all(), coarse
     # the structure holds: the initial values move by about the gyro's noise, and no warning
     assert table.attrs["from_records"]["moved"] < 3 and not table.attrs["from_records"]["leans"]
     # a ship whose rudder holds its course at −3° fitted without that offset: the fit leans on

@@ -215,6 +215,9 @@ pub struct Estimate {
     /// Where free initial values leaned ([`InitialValues::Auto`]): the other fit, with them
     /// held by the records' noise, and which of the two this is.
     pub held_again: Option<HeldAgain>,
+    /// The step the fit re-simulated the runs at, in samples: 1, or the coarsest step that
+    /// resolves them ([`EstimateSettings::coarsest`]); the costs are at every sample either way.
+    pub step_samples: usize,
 }
 
 /// A parameter estimated once per run, over the runs: a new run's value is as uncertain as
@@ -318,6 +321,8 @@ pub struct HeldAgain {
 struct Scales<'r> {
     fit: &'r Runs,
     every: &'r Runs,
+    /// `fit`'s step in samples of `every`.
+    samples: usize,
 }
 
 /// The unknowns: the free parameters (absolute values), then the coefficients (changes).
@@ -541,9 +546,12 @@ pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Resu
     let coarse = settings.coarsest.and_then(|(tolerance, most)| {
         let fine = runs.simulate(model, &[], &[]).ok()?;
         let (factor, coarse) = runs.coarsest(model, &fine, tolerance, most);
-        (factor > 1).then_some(coarse)
+        (factor > 1).then_some((factor, coarse))
     });
-    let scales = &Scales { fit: coarse.as_ref().unwrap_or(runs), every: runs };
+    let scales = &match &coarse {
+        Some((samples, fit)) => Scales { fit, every: runs, samples: *samples },
+        None => Scales { fit: runs, every: runs, samples: 1 },
+    };
     let each = with_initial_values(model, scales, settings, &[])?;
     let agree: Vec<RunSpread> =
         each.per_run.iter().filter(|r| r.agree() && !settings.per_run.contains(&r.name)).cloned().collect();
@@ -599,7 +607,7 @@ fn fit(
             settings.prior_weight
         )));
     }
-    let Scales { fit: runs, every } = *scales;
+    let Scales { fit: runs, every, samples } = *scales;
     let u = Unknowns::of(model, scales, settings, held, one)?;
     if u.parameters.is_empty() && u.coefficients.is_empty() && u.groups.is_empty() {
         return Err(DiagnoseError::Setup(format!(
@@ -835,6 +843,7 @@ fn fit(
         per_run,
         one_value: Vec::new(),
         held_again: None,
+        step_samples: samples,
     })
 }
 
@@ -866,6 +875,12 @@ impl Estimate {
             self.correlation_time.map_or("—".into(), |t| format!("{t:.0}")),
             self.stopped
         );
+        if self.step_samples > 1 {
+            out.push_str(&format!(
+                "fitted at a step of {} samples (the coarsest at which the start re-simulates the runs as at every sample); costs at every sample\n",
+                self.step_samples
+            ));
+        }
         out.push_str(&format!(
             "{:<12} {:>14} {:>14} {:>12} {:>22}\n",
             "parameter", "start", "estimate", "std. error", "prior (mean ± sd)"

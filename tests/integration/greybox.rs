@@ -282,6 +282,8 @@ fn an_estimate_at_a_coarser_step_reports_at_every_sample() {
     let every = nomoto_estimate_with("zigzag", h, zigzag.clone(), &EstimateSettings::default());
     let coarse = EstimateSettings { coarsest: Some((1e-3, 8)), ..Default::default() };
     let coarse = nomoto_estimate_with("zigzag", h, zigzag, &coarse);
+    assert_eq!(every.step_samples, 1);
+    assert!(coarse.step_samples > 1 && coarse.text().contains("fitted at a step of"), "{}", coarse.text());
     assert_eq!(coarse.cost_before, every.cost_before);
     // another fit (a coarser step holds for this run), reported at every sample
     assert_ne!(coarse.cost_after, every.cost_after);
@@ -536,6 +538,26 @@ fn the_estimate_command_writes_estimates_that_monte_carlo_draws_from() {
     let spec = model.spec();
     assert!(spec.parameters["K"].std_error.is_some_and(|s| s > 0.0 && s < 0.01), "{text}");
     assert_eq!(spec.parameter_covariance.as_ref().unwrap().names, ["K", "T"]);
+    // at the coarsest step that resolves the run (as the recipe's parameter stage fits), said
+    // so, the same estimates within their standard errors
+    let (ok, coarse, err) = crate::common::termid(&[
+        "estimate",
+        "--model",
+        "models/nomoto.toml",
+        "--data",
+        data.to_str().unwrap(),
+        "--coarse",
+        "--format",
+        "json",
+    ]);
+    assert!(ok, "{err}");
+    let coarse: serde_json::Value = serde_json::from_str(&coarse).unwrap();
+    assert!(coarse["step_samples"].as_u64().unwrap() > 1, "{coarse}");
+    for q in coarse["parameters"].as_array().unwrap() {
+        let name = q["name"].as_str().unwrap();
+        let sd = spec.parameters[name].std_error.unwrap();
+        assert!((q["value"].as_f64().unwrap() - p[name]).abs() < sd, "{name}: {q}");
+    }
     // the draws come from the parameters' covariance: the model has no other
     let (ok, text, err) = crate::common::termid(&[
         "simulate",

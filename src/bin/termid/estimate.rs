@@ -43,6 +43,7 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
         sources: sources.clone(),
         per_source: cmd.per_source.clone(),
         per_run: cmd.per_run.clone(),
+        coarsest: cmd.coarse.then_some((termid::recipe::RESOLVED, termid::recipe::MOST_SAMPLES_PER_STEP)),
         ..Default::default()
     };
     let label = format!(
