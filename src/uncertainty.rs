@@ -160,6 +160,14 @@ pub struct Spread {
     pub p95: f64,
 }
 
+impl Spread {
+    /// Whether `x` (a measured value) lies outside the 5-95 % range: one measurement in ten
+    /// does by chance where the model's uncertainty is right.
+    pub fn outside(&self, x: f64) -> bool {
+        x < self.p05 || x > self.p95
+    }
+}
+
 /// Linear-interpolated percentile of sorted values.
 fn percentile(sorted: &[f64], p: f64) -> f64 {
     let x = p * (sorted.len() - 1) as f64;
@@ -260,6 +268,15 @@ pub fn correlation_time(residuals: &[Vec<f64>]) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The values 0, 1, …, 100: the 5-95 % range is [5, 95], its ends inside.
+    #[test]
+    fn outside_is_beyond_the_five_to_ninety_five_percent_range() {
+        let s = spread_of(&(0..=100).map(f64::from).collect::<Vec<_>>()).unwrap();
+        assert_eq!((s.p05, s.p95), (5.0, 95.0));
+        assert!(s.outside(4.9) && s.outside(95.1));
+        assert!(!s.outside(5.0) && !s.outside(50.0) && !s.outside(95.0));
+    }
 
     /// Up to 5 % of the draws may fail; beyond that, or with none that ran, the refusal says
     /// how many failed and how the first failed.

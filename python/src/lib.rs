@@ -647,6 +647,85 @@ impl PyModel {
         to_json(&serde_json::json!({"gap": data.gap(&sims), "metrics": metrics}))
     }
 
+    /// The model's uncertainty against held-out runs: every run simulated as `validate`
+    /// simulates it with each of `n` models drawn from the stored covariances (seeded), and per
+    /// run each metric's spread over the draws and whether the measured value lies outside its
+    /// 5-95 % range (JSON: draws, failed, first_failure, refused, runs). Where too many draws
+    /// fail, `refused` says why and no spread is given.
+    #[pyo3(signature = (runs, n, seed = 1, dt = None, integrator = None, with_intercept = false))]
+    #[allow(clippy::too_many_arguments)]
+    fn validate_monte_carlo(
+        &self,
+        py: Python<'_>,
+        runs: Vec<Run<'_>>,
+        n: usize,
+        seed: u64,
+        dt: Option<f64>,
+        integrator: Option<&str>,
+        with_intercept: bool,
+    ) -> PyResult<String> {
+        let drawn = self.draws(n, seed)?;
+        let frames = self.frames(runs)?;
+        let (integrator, dt) = method_of(&self.inner, integrator, dt)?;
+        let data = termid::diagnose::Runs::new(&self.inner, &frames, dt, integrator)
+            .map_err(fail)?
+            .with_intercepts(with_intercept);
+        let plugin = termid::plugins::of(&self.inner);
+        let observe = |m: &termid::model::Model, f: &Frame, s: Option<&Trajectory>| {
+            plugin.and_then(|p| p.observe(m, f, s)).map(|o| o.json)
+        };
+        // each draw that ran: every run's metrics as the drawn model steered it
+        let (seen, failed, first) = py.detach(|| {
+            let (mut seen, mut failed, mut first) = (Vec::new(), 0usize, None::<String>);
+            for m in &drawn {
+                match data.simulate(&m.inner, &[], &[]) {
+                    Ok(sims) => seen.push(
+                        frames
+                            .iter()
+                            .zip(&sims)
+                            .map(|(f, s)| observe(&m.inner, f, Some(s)))
+                            .collect::<Vec<_>>(),
+                    ),
+                    Err(e) => {
+                        failed += 1;
+                        first.get_or_insert(e.to_string());
+                    }
+                }
+            }
+            (seen, failed, first)
+        });
+        let refused = termid::uncertainty::refusal(n, seen.len(), first.as_deref());
+        // the metrics a table shows (as `termid validate` bands them), per run
+        let per_run: Vec<serde_json::Value> = frames
+            .iter()
+            .enumerate()
+            .map(|(k, f)| {
+                let records: Vec<serde_json::Value> =
+                    seen.iter().filter_map(|draw: &Vec<Option<serde_json::Value>>| draw[k].clone()).collect();
+                let spread = if refused.is_none() {
+                    termid::uncertainty::spread(&records)
+                } else {
+                    Default::default()
+                };
+                let rows =
+                    plugin.and_then(|p| p.observe(&self.inner, f, None)).map_or_else(Vec::new, |o| o.rows);
+                let metrics: Vec<serde_json::Value> = rows
+                    .into_iter()
+                    .map(|(name, key, x)| {
+                        let sp = spread.get(&key);
+                        serde_json::json!({"name": name, "key": key, "measured": x, "spread": sp,
+                                           "outside": sp.zip(x).map(|(sp, x)| sp.outside(x))})
+                    })
+                    .collect();
+                serde_json::json!({"run": f.origin(), "metrics": metrics})
+            })
+            .collect();
+        to_json(&serde_json::json!({
+            "draws": n, "seed": seed, "failed": failed, "first_failure": first,
+            "refused": refused, "runs": per_run,
+        }))
+    }
+
     /// Where model and runs disagree and which effect explains it (JSON), with the model that
     /// has the effect added (None when no effect explains enough).
     #[pyo3(signature = (runs, dt = None, integrator = None, with_intercept = false))]

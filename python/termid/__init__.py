@@ -587,6 +587,14 @@ def fit(
     return Fit(native, target)
 
 
+def _leaf(record: Optional[Mapping[str, Any]], key: str) -> Optional[float]:
+    """A number of a JSON record by its dotted path (``spread``'s keys), or None."""
+    value: Any = record
+    for part in key.split("."):
+        value = value.get(part) if isinstance(value, Mapping) else None
+    return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else None
+
+
 def _gap_frame(gap: Mapping[str, Any]) -> pd.DataFrame:
     """A gap (per run and state: RMS and largest error) as a DataFrame indexed by run and
     state, each state's unit beside; ``attrs["cost"]`` the scaled sum of squares."""
@@ -1170,6 +1178,8 @@ class Model:
         integrator: Optional[str] = None,
         with_intercept: bool = False,
         raw: bool = False,
+        monte_carlo: int = 0,
+        seed: int = 1,
     ) -> Any:
         """Held-out ``runs`` against the model: a DataFrame of every run's and state's RMS and
         largest error (index run, state; the unit beside), ``attrs["cost"]`` the scaled sum of
@@ -1178,12 +1188,30 @@ class Model:
         report as plain values; ``dt``, ``integrator``, ``with_intercept`` as for
         :meth:`simulate`.
 
+        ``monte_carlo``: every run simulated also with that many models drawn from the stored
+        covariances (:meth:`draws` with ``seed``), as ``termid validate --monte-carlo`` does:
+        ``attrs["band"]``, a DataFrame indexed by run and metric with each metric measured,
+        its mean, sd, 5 % and 95 % over the draws and whether the measured value lies
+        ``outside`` that range, and ``attrs["within_band"]`` (``within``, ``metrics``,
+        ``outside``: one measurement in ten falls outside by chance). Where more than 5 % of
+        the draws fail it raises :class:`TermidError` saying why, as :meth:`monte_carlo` does.
+
         >>> ship = termid.Model.default()
         >>> gap = ship.validate(ship.record("zigzag:20/20", truth=True))
         >>> gap.loc[("zigzag:20/20#0", "ψ"), "unit"], bool(gap.loc[("zigzag:20/20#0", "ψ"), "rms"] < 0.01)
         ('rad', True)
+        >>> found = ship.identify([ship.record("zigzag:20/20", seed=1), ship.record("zigzag:20/20:port", seed=2)], "kalman")
+        >>> checked = found.model.validate(ship.record("zigzag:20/20", seed=3), monte_carlo=20)
+        >>> list(checked.attrs["band"].columns)
+        ['measured', 'mean', 'sd', 'p05', 'p95', 'outside']
         """
         report = json.loads(self._native.validate(_runs(runs), dt, integrator, with_intercept))
+        band = None
+        if monte_carlo:
+            band = json.loads(self._native.validate_monte_carlo(_runs(runs), monte_carlo, seed, dt, integrator, with_intercept))
+            if band["refused"] is not None:
+                raise TermidError(band["refused"])
+            report["monte_carlo"] = band
         if raw:
             return report
         frame = _gap_frame(report["gap"])
@@ -1194,6 +1222,29 @@ class Model:
             if m.get(source) is not None
         ]
         frame.attrs["metrics"] = pd.DataFrame(rows).set_index(["run", "source"]) if rows else pd.DataFrame()
+        if band is not None:
+            rows = [
+                {
+                    "run": r["run"],
+                    "metric": m["key"],
+                    "name": m["name"],
+                    "measured": m["measured"],
+                    **{k: (m["spread"] or {}).get(k) for k in ("mean", "sd", "p05", "p95")},
+                    "outside": m["outside"],
+                }
+                for r in band["runs"]
+                for m in r["metrics"]
+                if m["spread"] is not None
+            ]
+            columns = ["run", "metric", "name", "measured", "mean", "sd", "p05", "p95", "outside"]
+            table = pd.DataFrame(rows, columns=columns).set_index(["run", "metric"])
+            judged = table.dropna(subset=["outside"])
+            frame.attrs["band"] = table.drop(columns="name")
+            frame.attrs["within_band"] = {
+                "within": int((~judged["outside"].astype(bool)).sum()),
+                "metrics": int(len(judged)),
+                "outside": [f"{name} of {run}" for (run, _), name, off in zip(judged.index, judged["name"], judged["outside"]) if off],
+            }
         return frame
 
     def diagnose(

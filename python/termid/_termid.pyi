@@ -90,6 +90,15 @@ class Model:
     def validate(
         self, runs: Sequence[Run], dt: Optional[float] = None, integrator: Optional[str] = None, with_intercept: bool = False
     ) -> str: ...
+    def validate_monte_carlo(
+        self,
+        runs: Sequence[Run],
+        n: int,
+        seed: int = 1,
+        dt: Optional[float] = None,
+        integrator: Optional[str] = None,
+        with_intercept: bool = False,
+    ) -> str: ...
     def diagnose(
         self, runs: Sequence[Run], dt: Optional[float] = None, integrator: Optional[str] = None, with_intercept: bool = False
     ) -> Tuple[str, Optional[Model]]: ...

@@ -374,3 +374,29 @@ def test_monte_carlo_spread_and_its_refusal():
         wide.monte_carlo("turning:35", 20)
     with pytest.raises(termid.TermidError, match="no covariance"):
         termid.Model.default().draws(3)
+
+
+def test_validate_with_monte_carlo_marks_what_falls_outside_the_band():
+    """``validate(monte_carlo=n)``: each held-out run's metrics over drawn models, the
+    measured value beside its 5-95 % range and whether it falls outside; a run whose heading
+    and yaw rate are doubled (a ship turning twice as far) falls outside on every metric; a
+    covariance widened a billion times is refused, as the command refuses it."""
+    ship = termid.Model.default()
+    runs = [ship.record(m, seed=k) for k, m in enumerate(["zigzag:20/20", "zigzag:20/20:port", "zigzag:10/10"])]
+    found = ship.identify(runs, "kalman").model
+    held = ship.record("zigzag:20/20", seed=7)
+    gap = found.validate(held, monte_carlo=40)
+    band = gap.attrs["band"]
+    row = band.loc[("zigzag:20/20#7", "first_overshoot_deg")]
+    assert row["p05"] <= row["mean"] <= row["p95"] and row["sd"] > 0, band
+    measured = gap.attrs["metrics"].loc[("zigzag:20/20#7", "measured"), "first_overshoot_deg"]
+    assert row["measured"] == measured and row["outside"] == (not row["p05"] <= measured <= row["p95"])
+    within = gap.attrs["within_band"]
+    assert within["within"] + len(within["outside"]) == within["metrics"] == band["outside"].notna().sum()
+    doubled = held.assign(ψ=2 * held["ψ"], r=2 * held["r"])
+    far = found.validate(doubled, monte_carlo=40).attrs["within_band"]
+    assert far["within"] == 0 and far["metrics"] >= 2, far
+    assert all(o.endswith("of zigzag:20/20#7") for o in far["outside"]), far
+    wide = termid.Model.from_toml(re.sub(r"correlation_time = [0-9.e+]+", "correlation_time = 1e9", found.to_toml()))
+    with pytest.raises(termid.TermidError, match="draws failed .* more than the 5 %"):
+        wide.validate(held, monte_carlo=20)

@@ -61,7 +61,7 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
     // whether each measured metric lies outside the model's own 90 % band (none: no band)
     let outside_band = |k: usize, key: &str, x: Option<f64>| -> Option<bool> {
         let sp = spreads[k].as_ref()?.get(key)?;
-        x.map(|x| x < sp.p05 || x > sp.p95)
+        x.map(|x| sp.outside(x))
     };
     // (run, metric) of every banded metric, and whether it fell outside
     let verdicts: Vec<(String, String, bool)> = metrics
