@@ -1394,7 +1394,9 @@ class Model:
         that the runs' values are equal). A parameter the model file declares per run
         (``nuisance = "run"``) whose runs' values agree (p ≥ 0.05) is estimated once for all
         runs instead (``attrs["one_value"]``: the per-run fit's spread and test); asked for in
-        ``per_run``, it stays per run. ``attrs["from_records"]``
+        ``per_run``, it stays per run. One declared per source (``nuisance = "source"``) is
+        tested alike over two or more sources (``attrs["per_source_spread"]``) and merged where
+        they agree (``per`` in ``attrs["one_value"]`` says which). ``attrs["from_records"]``
         holds the estimated model's cost from the recorded first samples and how far the
         estimated initial values moved in units of the records' noise; beyond 3 times a warning
         says the fit leans on them (the model does not explain everything the runs show).
@@ -1448,7 +1450,8 @@ class Model:
             "per_source": pd.DataFrame(report.get("per_source", []), columns=["name", "source", "run", "value", "std_error"]),
             "from_records": report.get("from_records"),
             "per_run": pd.DataFrame(report.get("per_run", []), columns=["name", "runs", "mean", "sd", "chi_square", "p_value"]),
-            "one_value": pd.DataFrame(report.get("one_value", []), columns=["name", "runs", "mean", "sd", "chi_square", "p_value"]),
+            "per_source_spread": pd.DataFrame(report.get("per_source_spread", []), columns=["name", "runs", "mean", "sd", "chi_square", "p_value"]),
+            "one_value": pd.DataFrame(report.get("one_value", []), columns=["name", "per", "runs", "mean", "sd", "chi_square", "p_value"]),
             "held_again": report.get("held_again"),
             "step_samples": report.get("step_samples", 1),
         }

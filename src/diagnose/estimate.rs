@@ -208,9 +208,12 @@ pub struct Estimate {
     pub per_source: Vec<SourceParameter>,
     /// Each parameter estimated per run, over its runs: the model holds their mean.
     pub per_run: Vec<RunSpread>,
-    /// The parameters the model file declares per run whose runs' values agreed within their
-    /// uncertainty ([`RunSpread::agree`]): estimated once for every run instead (this is
-    /// that fit); each with the per-run fit's spread and test.
+    /// Each parameter estimated per source, over its sources (where there are two or more):
+    /// the test that their values differ (the model keeps its file's value).
+    pub per_source_spread: Vec<RunSpread>,
+    /// The parameters the model file declares per run or per source whose runs' (sources')
+    /// values agreed within their uncertainty ([`RunSpread::agree`]): estimated once for every
+    /// run instead (this is that fit); each with the first fit's spread and test.
     pub one_value: Vec<RunSpread>,
     /// Where free initial values leaned ([`InitialValues::Auto`]): the other fit, with them
     /// held by the records' noise, and which of the two this is.
@@ -220,13 +223,15 @@ pub struct Estimate {
     pub step_samples: usize,
 }
 
-/// A parameter estimated once per run, over the runs: a new run's value is as uncertain as
-/// they scatter.
+/// A parameter estimated once per run (or per source), over the runs (sources): a new run's
+/// value is as uncertain as they scatter.
 #[derive(Clone, Debug, Serialize)]
 pub struct RunSpread {
     /// The parameter.
     pub name: String,
-    /// How many runs.
+    /// Whether its values are the runs' or the sources'.
+    pub per: Nuisance,
+    /// How many runs (or sources).
     pub runs: usize,
     /// The runs' mean (written to the model: a new run's best guess).
     pub mean: f64,
@@ -251,19 +256,21 @@ impl RunSpread {
         self.p_value.is_some_and(|p| p >= RUNS_DIFFER)
     }
 
-    /// The spread of each parameter estimated per run among `values`.
-    fn of(values: &[SourceParameter]) -> Vec<RunSpread> {
-        let mut names: Vec<&str> =
-            values.iter().filter(|p| p.run.is_some()).map(|p| p.name.as_str()).collect();
+    /// The spread of each parameter estimated `per` run or per source among `values` (per
+    /// source where there are two sources or more).
+    fn of(values: &[SourceParameter], per: Nuisance) -> Vec<RunSpread> {
+        let ours = |p: &SourceParameter| p.run.is_some() == (per == Nuisance::Run);
+        let mut names: Vec<&str> = values.iter().filter(|p| ours(p)).map(|p| p.name.as_str()).collect();
         names.dedup();
         names
             .into_iter()
             .filter_map(|name| {
                 let v: Vec<f64> =
-                    values.iter().filter(|p| p.run.is_some() && p.name == name).map(|p| p.value).collect();
-                let s = crate::uncertainty::spread_of(&v)?;
+                    values.iter().filter(|p| ours(p) && p.name == name).map(|p| p.value).collect();
+                let s = crate::uncertainty::spread_of(&v).filter(|s| per == Nuisance::Run || s.count > 1)?;
                 Some(RunSpread {
                     name: name.to_string(),
+                    per,
                     runs: s.count,
                     mean: s.mean,
                     sd: s.sd,
@@ -272,6 +279,14 @@ impl RunSpread {
                 })
             })
             .collect()
+    }
+
+    /// What its values are of: "runs" or "sources".
+    fn whose(&self) -> &'static str {
+        match self.per {
+            Nuisance::Run => "runs",
+            Nuisance::Source => "sources",
+        }
     }
 
     /// The test in words: "χ² 97.6 on 3 degrees of freedom, p < 0.001".
@@ -553,8 +568,15 @@ pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Resu
         None => Scales { fit: runs, every: runs, samples: 1 },
     };
     let each = with_initial_values(model, scales, settings, &[])?;
-    let agree: Vec<RunSpread> =
-        each.per_run.iter().filter(|r| r.agree() && !settings.per_run.contains(&r.name)).cloned().collect();
+    // the file's declarations are tested; what the command asks for stays
+    let asked = |name: &String| settings.per_run.contains(name) || settings.per_source.contains(name);
+    let agree: Vec<RunSpread> = each
+        .per_run
+        .iter()
+        .chain(&each.per_source_spread)
+        .filter(|r| r.agree() && !asked(&r.name))
+        .cloned()
+        .collect();
     if agree.is_empty() {
         return Ok(each);
     }
@@ -777,8 +799,9 @@ fn fit(
         .collect();
     // a per-source value belongs to its source's records (a basin's indicator), so the file's
     // value stays; runs are a sample of one basin's drift, and their mean is a new run's guess
-    let mut per_run = RunSpread::of(&per_source);
-    for r in &mut per_run {
+    let mut per_run = RunSpread::of(&per_source, Nuisance::Run);
+    let mut per_source_spread = RunSpread::of(&per_source, Nuisance::Source);
+    for r in per_run.iter_mut().chain(per_source_spread.iter_mut()) {
         let values: Vec<usize> = (0..u.groups.len())
             .filter(|&g| u.groups[g].0.name == r.name)
             .map(|g| u.first_group() + g)
@@ -841,6 +864,7 @@ fn fit(
         from_records,
         per_source,
         per_run,
+        per_source_spread,
         one_value: Vec::new(),
         held_again: None,
         step_samples: samples,
@@ -930,9 +954,20 @@ impl Estimate {
                 r.test()
             ));
         }
-        for r in &self.one_value {
+        for r in &self.per_source_spread {
             out.push_str(&format!(
-                "  (`{}` one value for every run: declared per run, but the {} runs' values agreed within their uncertainty ({}; mean {}, sd {}))\n",
+                "  (the {} sources' values of `{}` {}: {})\n",
+                r.runs,
+                r.name,
+                if r.agree() { "agree" } else { "differ" },
+                r.test()
+            ));
+        }
+        for r in &self.one_value {
+            let per = if r.per == Nuisance::Run { "run" } else { "source" };
+            let whose = r.whose();
+            out.push_str(&format!(
+                "  (`{}` one value for every run: declared per {per}, but the {} {whose}' values agreed within their uncertainty ({}; mean {}, sd {}))\n",
                 r.name,
                 r.runs,
                 r.test(),

@@ -769,8 +769,13 @@ fn reading_off(mut f: Frame, zero_deg: f64) -> Frame {
 /// `zigzags` of `truth` as two basins record them (each its own noise), their rudder
 /// indicators reading [`BASIN_ZEROS`] off: the runs and each run's basin.
 fn two_basins(truth: &Model, zigzags: &[(&str, f64)]) -> (Vec<Frame>, Vec<usize>) {
+    two_basins_reading(truth, zigzags, BASIN_ZEROS)
+}
+
+/// [`two_basins`] with the indicators reading `zeros` off, degrees.
+fn two_basins_reading(truth: &Model, zigzags: &[(&str, f64)], zeros: [f64; 2]) -> (Vec<Frame>, Vec<usize>) {
     let (mut frames, mut sources) = (Vec::new(), Vec::new());
-    for (s, (zero, seed)) in BASIN_ZEROS.iter().zip([41, 51]).enumerate() {
+    for (s, (zero, seed)) in zeros.iter().zip([41, 51]).enumerate() {
         let records =
             termid::ship::basin::Basin::default().record_all(truth, zigzags, 1.17248, 60.0, seed, None);
         for (_, rec) in records.unwrap() {
@@ -804,6 +809,36 @@ fn zeroed_start() -> (Model, [&'static str; 4]) {
         })
         .unwrap();
     (start, free)
+}
+
+/// A rudder zero the model file declares per source (`nuisance = "source"`) is tested as a
+/// per-run one is: two basins whose indicators read alike (+0.3° both) agree, and the zero is
+/// estimated once for both; two that read +0.3° and −0.5° differ, each keeps its own.
+#[test]
+fn a_zero_declared_per_source_is_one_where_the_basins_agree() {
+    let truth = mmg_truth();
+    let (start, _) = zeroed_start();
+    let declared = start
+        .edit(|file| file.parameters.get_mut("δ_0").unwrap().nuisance = Some(termid::model::Nuisance::Source))
+        .unwrap();
+    let zigzags = [("zigzag:20/20", 1.0), ("zigzag:20/20:port", 0.98)];
+    let fit = |zeros: [f64; 2]| {
+        let (frames, sources) = two_basins_reading(&truth, &zigzags, zeros);
+        let settings = EstimateSettings { sources, ..Default::default() };
+        estimate(&declared, &runs_of(&declared, &frames), &settings).unwrap()
+    };
+    let alike = fit([0.3, 0.3]);
+    let merged =
+        alike.one_value.iter().find(|r| r.name == "δ_0").unwrap_or_else(|| panic!("{}", alike.text()));
+    assert!(merged.per == termid::model::Nuisance::Source && merged.runs == 2, "{}", alike.text());
+    assert!(alike.per_source.is_empty() && alike.text().contains("declared per source"), "{}", alike.text());
+    let zero = alike.parameters.iter().find(|p| p.name == "δ_0").unwrap().value;
+    assert!((zero - 0.3f64.to_radians()).abs() < 0.1f64.to_radians(), "{}", alike.text());
+    let apart = fit(BASIN_ZEROS);
+    assert!(apart.one_value.is_empty(), "{}", apart.text());
+    let test = &apart.per_source_spread[0];
+    assert!(test.name == "δ_0" && test.runs == 2 && !test.agree(), "{}", apart.text());
+    assert_eq!(apart.per_source.len(), 2);
 }
 
 /// Two basins, one hull: each basin's rudder indicator reads off by its own zero (+0.3° and
