@@ -347,6 +347,15 @@ impl PyModel {
                 self.inner.path
             )));
         }
+        // a model in memory takes about seven times its file's length (measured: 55 kB for a
+        // 7.6 kB file): n of them are refused before the first is drawn where they would not fit
+        let each = 8.0 * self.inner.to_toml().len() as f64;
+        termid::budget::check_bytes(
+            n as f64 * each,
+            || format!("{n} drawn models"),
+            "draw fewer (a few hundred give a 90 % band), or draw them in batches",
+        )
+        .map_err(fail)?;
         let sampler = termid::uncertainty::Sampler::new(&self.inner);
         let mut normal = termid::uncertainty::Normal::new(seed);
         Ok((0..n).map(|_| PyModel { inner: sampler.draw(&mut normal) }).collect())
@@ -664,8 +673,18 @@ impl PyModel {
         integrator: Option<&str>,
         with_intercept: bool,
     ) -> PyResult<String> {
-        let drawn = self.draws(n, seed)?;
+        if termid::uncertainty::uncertain_equations(&self.inner).is_empty() {
+            // refused in the words `draws` refuses with
+            self.draws(0, seed)?;
+        }
         let frames = self.frames(runs)?;
+        // each draw keeps every run's metrics (a few dozen numbers)
+        termid::budget::check_values(
+            n as f64 * frames.len() as f64 * 64.0,
+            || format!("the metrics of {n} drawn models on {} runs", frames.len()),
+            "ask for fewer draws (a few hundred give a 90 % band)",
+        )
+        .map_err(fail)?;
         let (integrator, dt) = method_of(&self.inner, integrator, dt)?;
         let data = termid::diagnose::Runs::new(&self.inner, &frames, dt, integrator)
             .map_err(fail)?
@@ -674,17 +693,17 @@ impl PyModel {
         let observe = |m: &termid::model::Model, f: &Frame, s: Option<&Trajectory>| {
             plugin.and_then(|p| p.observe(m, f, s)).map(|o| o.json)
         };
-        // each draw that ran: every run's metrics as the drawn model steered it
+        // each draw that ran: every run's metrics as the drawn model steered it; the models
+        // drawn one at a time, in the order `draws` draws them
+        let sampler = termid::uncertainty::Sampler::new(&self.inner);
+        let mut normal = termid::uncertainty::Normal::new(seed);
         let (seen, failed, first) = py.detach(|| {
             let (mut seen, mut failed, mut first) = (Vec::new(), 0usize, None::<String>);
-            for m in &drawn {
-                match data.simulate(&m.inner, &[], &[]) {
+            for _ in 0..n {
+                let m = sampler.draw(&mut normal);
+                match data.simulate(&m, &[], &[]) {
                     Ok(sims) => seen.push(
-                        frames
-                            .iter()
-                            .zip(&sims)
-                            .map(|(f, s)| observe(&m.inner, f, Some(s)))
-                            .collect::<Vec<_>>(),
+                        frames.iter().zip(&sims).map(|(f, s)| observe(&m, f, Some(s))).collect::<Vec<_>>(),
                     ),
                     Err(e) => {
                         failed += 1;

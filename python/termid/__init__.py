@@ -1092,7 +1092,8 @@ class Model:
         --monte-carlo`` draws them: each identified equation's coefficients from its
         covariance widened by the residuals' correlation time, and the free parameters from
         theirs (a per-run parameter with a new run's spread). Raises where the model stores no
-        covariance. For the spread of a scenario's metrics see :meth:`monte_carlo`.
+        covariance, and where ``n`` models would not fit in memory (a model takes about seven
+        times its file's length). For the spread of a scenario's metrics see :meth:`monte_carlo`.
 
         >>> truth = termid.Model.builtin("nomoto"); truth.set_parameter("K", 0.15)
         >>> run = truth.simulate(duration=30.0, inputs={"δ": 0.1}, sample=0.1)[["t", "ψ", "r", "δ"]]

@@ -374,6 +374,9 @@ def test_monte_carlo_spread_and_its_refusal():
         wide.monte_carlo("turning:35", 20)
     with pytest.raises(termid.TermidError, match="no covariance"):
         termid.Model.default().draws(3)
+    # more models than memory holds are refused before the first is drawn
+    with pytest.raises(termid.TermidError, match="10000000 drawn models would take .* of memory"):
+        found.draws(10_000_000)
 
 
 def test_validate_with_monte_carlo_marks_what_falls_outside_the_band():
@@ -400,3 +403,5 @@ def test_validate_with_monte_carlo_marks_what_falls_outside_the_band():
     wide = termid.Model.from_toml(re.sub(r"correlation_time = [0-9.e+]+", "correlation_time = 1e9", found.to_toml()))
     with pytest.raises(termid.TermidError, match="draws failed .* more than the 5 %"):
         wide.validate(held, monte_carlo=20)
+    with pytest.raises(termid.TermidError, match="would take .* of memory"):
+        found.validate(held, monte_carlo=10**10)
