@@ -41,8 +41,6 @@ pub(super) struct Dopri5 {
     stage: Vec<f64>,
     trial: Vec<f64>,
     u: Vec<f64>,
-    /// ẋ at a sample that no step end provides.
-    derivative: Vec<f64>,
     /// The step size to try next.
     h: f64,
     /// Whether `k[0]` holds f at (`t`, `y`) (first same as last).
@@ -76,7 +74,6 @@ impl Dopri5 {
             stage: vec![0.0; n],
             trial: vec![0.0; n],
             u: vec![0.0; m],
-            derivative: vec![0.0; n],
             h: dt,
             fresh: false,
             t: 0.0,
@@ -92,22 +89,6 @@ impl Dopri5 {
             control: StepControl::default(),
             broke: false,
         }
-    }
-
-    /// ẋ = f(x, u) at the control time `t` (a sample), from the last step where it ended there.
-    pub(super) fn derivative_at(
-        &mut self,
-        system: &System,
-        ws: &mut Workspace,
-        t: f64,
-        x: &[f64],
-        u: &[f64],
-    ) -> &[f64] {
-        if self.fresh && self.at(t) && self.on_line(t, u) {
-            return &self.k[0];
-        }
-        system.derivatives(x, u, ws, &mut self.derivative);
-        &self.derivative
     }
 
     fn at(&self, t: f64) -> bool {
@@ -144,13 +125,17 @@ impl Dopri5 {
         end: f64,
     ) -> Result<(), SimError> {
         let t1 = t0 + dt;
-        if !self.started {
+        let first = !self.started;
+        if first {
             self.started = true;
             self.t = t0;
             self.y.copy_from_slice(x0);
             self.fresh = false;
         }
-        let from_line = self.on_line(t0, u.0);
+        // the inputs at t0 are the last call's at its t1, which lie on the line (it was drawn
+        // through them where they left the one before): only the first call has none
+        let from_line = !first;
+        debug_assert!(first || self.on_line(t0, u.0), "advance continues the interval before");
         let breaks = !from_line || !self.on_line(t1, u.1);
         // how far a step may reach: past t1 while the line may hold on; to t1 where the line
         // broke at the control time before as well (a replayed record breaks it at every

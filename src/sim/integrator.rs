@@ -328,11 +328,9 @@ pub fn simulate(
                 }
             }
             Integrator::Dopri5 => {
+                // the samples' ẋ all at once after the run (below): the steps end between them
+                pending = false;
                 let start = t1 - dt;
-                if pending {
-                    fill(dopri.derivative_at(system, &mut ws, start, x_old, &u_now), &mut out);
-                    pending = false;
-                }
                 dopri.advance(system, &mut ws, x_old, &mut x, (&u_now, &u_next), (start, dt), end)?;
             }
             Integrator::Rk4 => {
@@ -374,7 +372,9 @@ pub fn simulate(
             break;
         }
     }
-    if pending {
+    if settings.integrator == Integrator::Dopri5 {
+        out.derivatives = system.derivatives_on_columns(&out.states, &out.inputs);
+    } else if pending {
         system.derivatives(&x, &u_now, &mut ws, &mut tmp);
         fill(&tmp, &mut out);
     }
@@ -463,6 +463,25 @@ mod tests {
         let t = simulate(&system, &[1.0], &mut Constant(vec![u]), &settings).unwrap();
         assert!((t.time.last().unwrap() - 2.0).abs() < 1e-9);
         *t.states[0].last().unwrap()
+    }
+
+    /// ẋ on many rows at once (block by block, as the adaptive method's samples get it) is
+    /// ẋ row by row: the states, the inputs and the parameters each where they belong.
+    #[test]
+    fn derivatives_on_columns_are_those_of_each_row() {
+        let lag = Lag { k: 2.0, bounds: (f64::NEG_INFINITY, f64::INFINITY) };
+        let system = System::new(&lag, &BTreeMap::from([("k".to_string(), 0.5)]), false).unwrap();
+        let x: Vec<f64> = (0..600).map(|i| (i as f64 * 0.37).sin()).collect();
+        let u: Vec<f64> = (0..600).map(|i| (i as f64 * 0.11).cos()).collect();
+        let all = system.derivatives_on_columns(std::slice::from_ref(&x), std::slice::from_ref(&u));
+        let mut ws = system.workspace();
+        let mut dx = [0.0];
+        for i in 0..600 {
+            system.derivatives(&[x[i]], &[u[i]], &mut ws, &mut dx);
+            assert_eq!(all[0][i], dx[0], "row {i}");
+            assert_eq!(dx[0], u[i] - 0.5 * x[i]);
+        }
+        assert_eq!(system.derivatives_on_columns(&[vec![]], &[vec![]]), vec![Vec::<f64>::new()]);
     }
 
     /// The right-hand side on a run's rows is u − k·x row by row; a missing column is named.

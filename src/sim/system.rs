@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 
 use super::SimError;
-use crate::term::{Library, RowScratch, Tangents};
+use crate::term::{Library, RowScratch, Source, Tangents};
 
 /// The compiled right-hand side of a model with its states, inputs and parameters.
 #[derive(Clone, Debug)]
@@ -23,6 +23,8 @@ pub struct System {
     state_slots: Vec<(usize, usize)>,
     input_slots: Vec<(usize, usize)>,
     param_slots: Vec<(usize, usize)>,
+    /// What each of the library's inputs is, in its order (for evaluating many rows at once).
+    reads: Vec<Slot>,
     param_names: Vec<String>,
     params: Vec<f64>,
 }
@@ -117,6 +119,7 @@ impl System {
             state_slots,
             input_slots,
             param_slots,
+            reads: map,
             param_names,
             params: values.into_values().collect(),
         })
@@ -196,6 +199,32 @@ impl System {
     ) {
         self.load(x, input, ws);
         self.rhs.eval_row_tangents(&mut ws.scratch, tangents, dx, partials);
+    }
+
+    /// ẋ on many rows at once, one column per state, from columns of the states and the
+    /// inputs (in the system's orders, all of one length): the compiled terms evaluated block
+    /// by block, several times faster per row than one row at a time.
+    pub fn derivatives_on_columns(&self, states: &[Vec<f64>], inputs: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        let n = states.first().or(inputs.first()).map_or(0, Vec::len);
+        let mut out = vec![Vec::with_capacity(n); self.dim()];
+        if n == 0 {
+            return out;
+        }
+        let sources: Vec<Source<'_>> = self
+            .reads
+            .iter()
+            .map(|r| match *r {
+                Slot::State(i) => Source::Column(&states[i]),
+                Slot::Input(k) => Source::Column(&inputs[k]),
+                Slot::Param(p) => Source::Constant(self.params[p]),
+            })
+            .collect();
+        self.rhs.for_each_block(&sources, 0..n, |_, columns| {
+            for (o, c) in out.iter_mut().zip(columns) {
+                o.extend_from_slice(c);
+            }
+        });
+        out
     }
 
     /// ẋ on every row of a measured run, one column per state: the states and inputs read
