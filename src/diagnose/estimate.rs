@@ -233,7 +233,8 @@ pub struct RunSpread {
     pub per: Nuisance,
     /// How many runs (or sources).
     pub runs: usize,
-    /// The runs' mean (written to the model: a new run's best guess).
+    /// The runs' (sources') mean; a per-run parameter's is written to the model, a new run's
+    /// best guess.
     pub mean: f64,
     /// The runs' standard deviation.
     pub sd: f64,
@@ -553,8 +554,9 @@ impl Unknowns {
 /// A parameter the file declares per run (`nuisance = "run"`) whose runs' values agree within
 /// their uncertainty ([`RunSpread::agree`]) is estimated again as one value for all runs: where
 /// the runs share it (a basin's indicator that holds its zero), the values the runs do not need
-/// only take up noise the other parameters would have used. Asked for per run (the command's
-/// `per_run`), it stays per run.
+/// only take up noise the other parameters would have used; one declared per source likewise,
+/// over two or more sources. Asked for per run or per source (the settings' `per_run`,
+/// `per_source`), it stays so.
 pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Result<Estimate, DiagnoseError> {
     // a start that does not re-simulate the runs is fitted at every sample, where the fit says
     // where it diverges

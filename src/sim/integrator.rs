@@ -373,7 +373,10 @@ pub fn simulate(
         }
     }
     if settings.integrator == Integrator::Dopri5 {
-        out.derivatives = system.derivatives_on_columns(&out.states, &out.inputs);
+        let states: Vec<&[f64]> = out.states.iter().map(Vec::as_slice).collect();
+        let inputs: Vec<&[f64]> = out.inputs.iter().map(Vec::as_slice).collect();
+        let derivatives = system.derivatives_on_columns(&states, &inputs);
+        out.derivatives = derivatives;
     } else if pending {
         system.derivatives(&x, &u_now, &mut ws, &mut tmp);
         fill(&tmp, &mut out);
@@ -473,7 +476,7 @@ mod tests {
         let system = System::new(&lag, &BTreeMap::from([("k".to_string(), 0.5)]), false).unwrap();
         let x: Vec<f64> = (0..600).map(|i| (i as f64 * 0.37).sin()).collect();
         let u: Vec<f64> = (0..600).map(|i| (i as f64 * 0.11).cos()).collect();
-        let all = system.derivatives_on_columns(std::slice::from_ref(&x), std::slice::from_ref(&u));
+        let all = system.derivatives_on_columns(&[&x], &[&u]);
         let mut ws = system.workspace();
         let mut dx = [0.0];
         for i in 0..600 {
@@ -481,7 +484,7 @@ mod tests {
             assert_eq!(all[0][i], dx[0], "row {i}");
             assert_eq!(dx[0], u[i] - 0.5 * x[i]);
         }
-        assert_eq!(system.derivatives_on_columns(&[vec![]], &[vec![]]), vec![Vec::<f64>::new()]);
+        assert_eq!(system.derivatives_on_columns(&[&[]], &[&[]]), vec![Vec::<f64>::new()]);
     }
 
     /// The right-hand side on a run's rows is u − k·x row by row; a missing column is named.

@@ -203,9 +203,21 @@ impl System {
 
     /// ẋ on many rows at once, one column per state, from columns of the states and the
     /// inputs (in the system's orders, all of one length): the compiled terms evaluated block
-    /// by block, several times faster per row than one row at a time.
-    pub fn derivatives_on_columns(&self, states: &[Vec<f64>], inputs: &[Vec<f64>]) -> Vec<Vec<f64>> {
-        let n = states.first().or(inputs.first()).map_or(0, Vec::len);
+    /// by block, about twice as fast per row as one row at a time.
+    ///
+    /// # Panics
+    /// Where a state's or an input's column is missing or the columns' lengths differ.
+    pub fn derivatives_on_columns(&self, states: &[&[f64]], inputs: &[&[f64]]) -> Vec<Vec<f64>> {
+        assert!(
+            states.len() == self.dim() && inputs.len() == self.inputs.len(),
+            "{} state and {} input columns for {} states and {} inputs",
+            states.len(),
+            inputs.len(),
+            self.dim(),
+            self.inputs.len()
+        );
+        let n = states.first().or(inputs.first()).map_or(0, |c| c.len());
+        assert!(states.iter().chain(inputs).all(|c| c.len() == n), "columns of different lengths");
         let mut out = vec![Vec::with_capacity(n); self.dim()];
         if n == 0 {
             return out;
@@ -214,8 +226,8 @@ impl System {
             .reads
             .iter()
             .map(|r| match *r {
-                Slot::State(i) => Source::Column(&states[i]),
-                Slot::Input(k) => Source::Column(&inputs[k]),
+                Slot::State(i) => Source::Column(states[i]),
+                Slot::Input(k) => Source::Column(inputs[k]),
                 Slot::Param(p) => Source::Constant(self.params[p]),
             })
             .collect();
@@ -235,17 +247,7 @@ impl System {
             names.iter().map(|n| Ok(frame.require(n)?)).collect()
         };
         let (states, inputs) = (read(&self.states)?, read(&self.inputs)?);
-        let mut ws = self.workspace();
-        let (mut x, mut u, mut dx) =
-            (vec![0.0; states.len()], vec![0.0; inputs.len()], vec![0.0; self.dim()]);
-        let mut out = vec![Vec::with_capacity(frame.len()); self.dim()];
-        for row in 0..frame.len() {
-            x.iter_mut().zip(&states).for_each(|(x, c)| *x = c[row]);
-            u.iter_mut().zip(&inputs).for_each(|(u, c)| *u = c[row]);
-            self.derivatives(&x, &u, &mut ws, &mut dx);
-            out.iter_mut().zip(&dx).for_each(|(o, d)| o.push(*d));
-        }
-        Ok(out)
+        Ok(self.derivatives_on_columns(&states, &inputs))
     }
 
     /// State names in integration order.
