@@ -587,14 +587,6 @@ def fit(
     return Fit(native, target)
 
 
-def _leaf(record: Optional[Mapping[str, Any]], key: str) -> Optional[float]:
-    """A number of a JSON record by its dotted path (``spread``'s keys), or None."""
-    value: Any = record
-    for part in key.split("."):
-        value = value.get(part) if isinstance(value, Mapping) else None
-    return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else None
-
-
 def _gap_frame(gap: Mapping[str, Any]) -> pd.DataFrame:
     """A gap (per run and state: RMS and largest error) as a DataFrame indexed by run and
     state, each state's unit beside; ``attrs["cost"]`` the scaled sum of squares."""
@@ -1206,10 +1198,11 @@ class Model:
         >>> list(checked.attrs["band"].columns)
         ['measured', 'mean', 'sd', 'p05', 'p95', 'outside']
         """
-        report = json.loads(self._native.validate(_runs(runs), dt, integrator, with_intercept))
+        given = _runs(runs)
+        report = json.loads(self._native.validate(given, dt, integrator, with_intercept))
         band = None
         if monte_carlo:
-            band = json.loads(self._native.validate_monte_carlo(_runs(runs), monte_carlo, seed, dt, integrator, with_intercept))
+            band = json.loads(self._native.validate_monte_carlo(given, monte_carlo, seed, dt, integrator, with_intercept))
             if band["refused"] is not None:
                 raise TermidError(band["refused"])
             report["monte_carlo"] = band
