@@ -182,13 +182,25 @@ impl PyModel {
         integrator: Option<&str>,
         with_intercept: bool,
     ) -> PyResult<(Vec<Frame>, termid::diagnose::Runs, Vec<Trajectory>)> {
+        let (frames, data) = self.replayable(runs, dt, integrator, with_intercept)?;
+        let sims = py.detach(|| data.simulate(&self.inner, &[], &[])).map_err(fail)?;
+        Ok((frames, data, sims))
+    }
+
+    /// The runs read, and ready to be re-simulated by this model's method (or `integrator`).
+    fn replayable(
+        &self,
+        runs: Vec<Run<'_>>,
+        dt: Option<f64>,
+        integrator: Option<&str>,
+        with_intercept: bool,
+    ) -> PyResult<(Vec<Frame>, termid::diagnose::Runs)> {
         let frames = self.frames(runs)?;
         let (integrator, dt) = method_of(&self.inner, integrator, dt)?;
         let data = termid::diagnose::Runs::new(&self.inner, &frames, dt, integrator)
             .map_err(fail)?
             .with_intercepts(with_intercept);
-        let sims = py.detach(|| data.simulate(&self.inner, &[], &[])).map_err(fail)?;
-        Ok((frames, data, sims))
+        Ok((frames, data))
     }
 }
 
@@ -677,7 +689,7 @@ impl PyModel {
             // refused in the words `draws` refuses with
             self.draws(0, seed)?;
         }
-        let frames = self.frames(runs)?;
+        let (frames, data) = self.replayable(runs, dt, integrator, with_intercept)?;
         // each draw keeps every run's metrics (a few dozen numbers)
         termid::budget::check_values(
             n as f64 * frames.len() as f64 * 64.0,
@@ -685,10 +697,6 @@ impl PyModel {
             "ask for fewer draws (a few hundred give a 90 % band)",
         )
         .map_err(fail)?;
-        let (integrator, dt) = method_of(&self.inner, integrator, dt)?;
-        let data = termid::diagnose::Runs::new(&self.inner, &frames, dt, integrator)
-            .map_err(fail)?
-            .with_intercepts(with_intercept);
         let plugin = termid::plugins::of(&self.inner);
         let observe = |m: &termid::model::Model, f: &Frame, s: Option<&Trajectory>| {
             plugin.and_then(|p| p.observe(m, f, s)).map(|o| o.json)
