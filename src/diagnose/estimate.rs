@@ -295,7 +295,8 @@ impl RunSpread {
         match (self.chi_square, self.p_value) {
             (Some(q), Some(p)) => {
                 let p = if p < 0.001 { "p < 0.001".to_string() } else { format!("p = {p:.3}") };
-                format!("χ² {q:.1} on {} degrees of freedom, {p}", self.runs - 1)
+                let df = self.runs - 1;
+                format!("χ² {q:.1} on {df} degree{} of freedom, {p}", if df == 1 { "" } else { "s" })
             }
             _ => "not tested: the fit's covariance could not be formed".into(),
         }

@@ -838,6 +838,12 @@ fn a_zero_declared_per_source_is_one_where_the_basins_agree() {
     assert!(apart.one_value.is_empty(), "{}", apart.text());
     let test = &apart.per_source_spread[0];
     assert!(test.name == "δ_0" && test.runs == 2 && !test.agree(), "{}", apart.text());
+    assert!(
+        apart.text().contains("sources' values of `δ_0` differ: χ²")
+            && apart.text().contains("on 1 degree of freedom"),
+        "{}",
+        apart.text()
+    );
     assert_eq!(apart.per_source.len(), 2);
 }
 
