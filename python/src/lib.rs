@@ -187,6 +187,17 @@ impl PyModel {
         Ok((frames, data, sims))
     }
 
+    /// Refused where the model stores no covariance to draw models from.
+    fn drawable(&self) -> PyResult<()> {
+        if termid::uncertainty::uncertain_equations(&self.inner).is_empty() {
+            return Err(refuse(format!(
+                "{}: nothing to draw from: the model stores no covariance (`identify` with --out, a refinement or `estimate` write one)",
+                self.inner.path
+            )));
+        }
+        Ok(())
+    }
+
     /// The runs read, and ready to be re-simulated by this model's method (or `integrator`).
     fn replayable(
         &self,
@@ -353,12 +364,7 @@ impl PyModel {
     /// `n` models drawn from the stored covariances (seeded): each equation's coefficients
     /// and the free parameters, as `simulate --monte-carlo` draws them.
     fn draws(&self, n: usize, seed: u64) -> PyResult<Vec<PyModel>> {
-        if termid::uncertainty::uncertain_equations(&self.inner).is_empty() {
-            return Err(refuse(format!(
-                "{}: nothing to draw from: the model stores no covariance (`identify` with --out, a refinement or `estimate` write one)",
-                self.inner.path
-            )));
-        }
+        self.drawable()?;
         // a model in memory takes about seven times its file's length (measured: 55 kB for a
         // 7.6 kB file): n of them are refused before the first is drawn where they would not fit
         let each = 8.0 * self.inner.to_toml().len() as f64;
@@ -685,10 +691,7 @@ impl PyModel {
         integrator: Option<&str>,
         with_intercept: bool,
     ) -> PyResult<String> {
-        if termid::uncertainty::uncertain_equations(&self.inner).is_empty() {
-            // refused in the words `draws` refuses with
-            self.draws(0, seed)?;
-        }
+        self.drawable()?;
         let (frames, data) = self.replayable(runs, dt, integrator, with_intercept)?;
         // each draw keeps every run's metrics (a few dozen numbers)
         termid::budget::check_values(

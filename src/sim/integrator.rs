@@ -329,7 +329,6 @@ pub fn simulate(
             }
             Integrator::Dopri5 => {
                 // the samples' ẋ all at once after the run (below): the steps end between them
-                pending = false;
                 let start = t1 - dt;
                 dopri.advance(system, &mut ws, x_old, &mut x, (&u_now, &u_next), (start, dt), end)?;
             }
@@ -375,8 +374,7 @@ pub fn simulate(
     if settings.integrator == Integrator::Dopri5 {
         let states: Vec<&[f64]> = out.states.iter().map(Vec::as_slice).collect();
         let inputs: Vec<&[f64]> = out.inputs.iter().map(Vec::as_slice).collect();
-        let derivatives = system.derivatives_on_columns(&states, &inputs);
-        out.derivatives = derivatives;
+        out.derivatives = system.derivatives_on_columns(&states, &inputs);
     } else if pending {
         system.derivatives(&x, &u_now, &mut ws, &mut tmp);
         fill(&tmp, &mut out);
