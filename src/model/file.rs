@@ -43,7 +43,7 @@ pub struct ModelFile {
 
 /// `[simulation]`: the method, control step and tolerances a model is simulated with by
 /// default (a command's `--integrator` and `--dt` override them). Without the table: the
-/// adaptive Dormand-Prince method at Δt = 0.04 with rtol 1e-7, atol 1e-9.
+/// adaptive Dormand-Prince method at Δt = 0.04 with rtol 1e-6, atol 1e-7.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SimulationSpec {

@@ -1,6 +1,9 @@
 //! Controllers set a system's inputs. The integrator asks once per step for the inputs at
 //! the end of the step, given the state at its start: that is what Oltmann's modified Euler
-//! (eq. B8) uses, and RK4 interpolates between the two ends.
+//! (eq. B8) uses, and RK4 interpolates between the two ends. A controller that knows its
+//! inputs ahead (a rudder held, or turning at its rate, until the heading reaches a limit)
+//! says so ([`Controller::ahead`]), and the adaptive integrator steps past the control times
+//! without asking.
 
 use crate::data::{DataError, Frame};
 
@@ -12,6 +15,56 @@ pub trait Controller {
     fn done(&self, _t: f64, _x: &[f64]) -> bool {
         false
     }
+    /// Asked right after the inputs for control time `t` were given: whether those of the
+    /// control times ahead are known without asking, with their rate of change (per second,
+    /// one per input) written into `slope`. A promise: at a control time t′ before
+    /// [`Ahead::until`], while the watched state lay inside its bounds at every control time
+    /// from `t` up to the one before t′, [`Controller::input`] would give the inputs for `t`
+    /// plus `slope·(t′ − t)` and [`Controller::done`] would be false. The adaptive integrator
+    /// then steps past those control times (the dense output read only for the watched state
+    /// and at the samples) and, before it asks again, says with [`Controller::passed`] how far
+    /// it went. `None`, the default: asked at every control time.
+    fn ahead(&self, _t: f64, _slope: &mut [f64]) -> Option<Ahead> {
+        None
+    }
+    /// The control times up to `t` passed as [`Controller::ahead`] promised, unasked: the
+    /// controller catches up to `t` as if it had been asked at each (a gear turned on to
+    /// where the line says), so that the next ask moves it over one control step alone.
+    fn passed(&mut self, _t: f64) {}
+}
+
+/// What [`Controller::ahead`] promises of the control times after the one just asked.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ahead {
+    /// The inputs go on along their line at the control times before this (∞: for ever).
+    pub until: f64,
+    /// While this state stays inside its bounds (none: whatever the states do).
+    pub watch: Option<Watch>,
+}
+
+impl Ahead {
+    /// For ever, whatever the states do.
+    pub const ALWAYS: Ahead = Ahead { until: f64::INFINITY, watch: None };
+}
+
+/// A state the controller answers (a zigzag's heading): strictly inside (`low`, `high`) the
+/// inputs go on as promised; at a bound the controller is asked again.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Watch {
+    /// The state's index.
+    pub state: usize,
+    /// Lower bound (−∞: none).
+    pub low: f64,
+    /// Upper bound (∞: none).
+    pub high: f64,
+}
+
+impl Watch {
+    /// Whether `value` of the watched state keeps the promise.
+    #[inline]
+    pub fn holds(&self, value: f64) -> bool {
+        value > self.low && value < self.high
+    }
 }
 
 /// Fixed inputs.
@@ -21,6 +74,10 @@ pub struct Constant(pub Vec<f64>);
 impl Controller for Constant {
     fn input(&mut self, _t: f64, _x: &[f64], out: &mut [f64]) {
         out.copy_from_slice(&self.0);
+    }
+    fn ahead(&self, _t: f64, slope: &mut [f64]) -> Option<Ahead> {
+        slope.fill(0.0);
+        Some(Ahead::ALWAYS)
     }
 }
 

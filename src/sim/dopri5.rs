@@ -8,7 +8,7 @@
 //! record), the steps end on the next control time.
 
 use super::system::{System, Workspace};
-use super::{SimError, Tolerances};
+use super::{SimError, Tolerances, Watch};
 
 // Dormand & Prince (1980), Table 5.2 of Hairer, Nørsett & Wanner
 const C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
@@ -52,6 +52,8 @@ pub(super) struct Dopri5 {
     /// The last free step, [t − span, t], as its dense-output polynomial: per state its five
     /// coefficients side by side (the control times read all five of each state).
     span: f64,
+    /// 1/`span` (θ at a control time without a division).
+    per_span: f64,
     dense: Vec<[f64; 5]>,
     /// The line the inputs follow: `held` at `held_t`, changing by `slope` per second.
     held: Vec<f64>,
@@ -79,6 +81,7 @@ impl Dopri5 {
             t: 0.0,
             y: vec![0.0; n],
             span: 0.0,
+            per_span: 0.0,
             dense: vec![[0.0; 5]; n],
             held: vec![f64::NAN; m],
             held_t: 0.0,
@@ -160,20 +163,83 @@ impl Dopri5 {
             // start again short (five control steps at most) and grow as the error allows
             self.h = self.h.min(5.0 * dt);
         }
-        while self.t < t1 - 1e-9 * dt {
-            self.free_step(system, ws, reach)?;
+        self.reach(system, ws, t1, reach)?;
+        self.states_at(t1, x);
+        Ok(())
+    }
+
+    /// Free steps along the inputs' line until the integration has passed `t`, none ending
+    /// beyond `end`; whether any was taken.
+    #[inline]
+    pub(super) fn reach(
+        &mut self,
+        system: &System,
+        ws: &mut Workspace,
+        t: f64,
+        end: f64,
+    ) -> Result<bool, SimError> {
+        if self.t >= t - 1e-9 * self.dt {
+            return Ok(false);
         }
-        if self.at(t1) || self.span == 0.0 {
+        while self.t < t - 1e-9 * self.dt {
+            self.free_step(system, ws, end)?;
+        }
+        Ok(true)
+    }
+
+    /// The states at `t`, within the last step (its end, or its dense output).
+    pub(super) fn states_at(&self, t: f64, x: &mut [f64]) {
+        if self.at(t) || self.span == 0.0 {
             x.copy_from_slice(&self.y);
         } else {
-            // dense output: θ = (t1 − t_start)/h within the last step
-            let theta = 1.0 - (self.t - t1) / self.span;
-            let eta = 1.0 - theta;
-            for (x, [r1, r2, r3, r4, r5]) in x.iter_mut().zip(&self.dense) {
-                *x = r1 + theta * (r2 + eta * (r3 + theta * (r4 + eta * r5)));
+            let (theta, eta) = self.theta(t);
+            for (x, r) in x.iter_mut().zip(&self.dense) {
+                *x = Self::interpolate(r, theta, eta);
             }
         }
-        Ok(())
+    }
+
+    /// θ = (t − t_start)/h within the last step, and 1 − θ.
+    #[inline]
+    fn theta(&self, t: f64) -> (f64, f64) {
+        let theta = 1.0 - (self.t - t) * self.per_span;
+        (theta, 1.0 - theta)
+    }
+
+    #[inline]
+    fn interpolate([r1, r2, r3, r4, r5]: &[f64; 5], theta: f64, eta: f64) -> f64 {
+        r1 + theta * (r2 + eta * (r3 + theta * (r4 + eta * r5)))
+    }
+
+    /// The first control step in `from..=to` (at `j·dt`, all within the last step) at which
+    /// the watched state lies outside its bounds.
+    pub(super) fn first_outside(&self, watch: Watch, from: usize, to: usize, dt: f64) -> Option<usize> {
+        if self.span == 0.0 {
+            return (!watch.holds(self.y[watch.state])).then_some(from);
+        }
+        // θ at each control time, read off the one polynomial in a loop without branches but the test
+        let r = &self.dense[watch.state];
+        (from..=to).find(|&j| {
+            let (theta, eta) = self.theta(j as f64 * dt);
+            !watch.holds(Self::interpolate(r, theta, eta))
+        })
+    }
+
+    /// Whether the inputs `u` at control time `t` go on along the line the steps follow (a
+    /// controller's promise of the control times ahead is taken only where they do).
+    pub(super) fn continues(&self, t: f64, u: &[f64]) -> bool {
+        self.started && self.on_line(t, u)
+    }
+
+    /// The control times up to `t` passed without asking, the inputs on their line: the next
+    /// interval continues it.
+    pub(super) fn coasted(&mut self) {
+        self.broke = false;
+    }
+
+    /// Where the integration stands: the end of the last step and the states there.
+    pub(super) fn end_of_step(&self) -> (f64, &[f64]) {
+        (self.t, &self.y)
     }
 
     /// One step from (`t`, `y`) along the inputs' line, of the size the error control allows
@@ -218,6 +284,7 @@ impl Dopri5 {
                 self.y.copy_from_slice(&self.trial);
                 self.t += h;
                 self.span = h;
+                self.per_span = 1.0 / h;
                 self.k.swap(0, 6);
                 self.h = h * self.control.accept(err);
                 (self.held, self.slope) = (held, slope);
@@ -299,7 +366,7 @@ struct StepControl {
 impl StepControl {
     /// The factor on `h` for the step after one accepted with error `err` (≤ 1).
     fn accept(&mut self, err: f64) -> f64 {
-        let factor = if err == 0.0 { 10.0 } else { (0.9 * err.powf(-0.2)).clamp(0.1, 10.0) };
+        let factor = if err == 0.0 { 10.0 } else { (0.9 * inverse_fifth_root(err)).clamp(0.1, 10.0) };
         let factor = if self.rejected { factor.min(1.0) } else { factor };
         self.rejected = false;
         factor
@@ -309,9 +376,16 @@ impl StepControl {
     fn reject(&mut self, h: f64, err: f64) -> f64 {
         self.rejected = true;
         if err.is_finite() {
-            h * (0.9 * err.powf(-0.2)).clamp(0.1, 0.9)
+            h * (0.9 * inverse_fifth_root(err)).clamp(0.1, 0.9)
         } else {
             h * 0.1
         }
     }
+}
+
+/// err^(−1/5) as exp(−ln(err)/5): half a `powf`'s time, and a step control needs no more
+/// than its first digits.
+#[inline]
+fn inverse_fifth_root(err: f64) -> f64 {
+    (-0.2 * err.ln()).exp()
 }

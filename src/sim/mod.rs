@@ -9,7 +9,7 @@ mod integrator;
 mod steady;
 mod system;
 
-pub use controller::{Constant, Controller, Replay};
+pub use controller::{Ahead, Constant, Controller, Replay, Watch};
 pub use integrator::{simulate, Integrator, Settings, Tolerances, Trajectory};
 pub use steady::{solve_steady, SteadyProblem, Unknown};
 pub use system::{RightHandSide, System, Workspace};

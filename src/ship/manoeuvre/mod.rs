@@ -206,6 +206,25 @@ impl Servo {
         }
         self.angle
     }
+
+    /// The rudder's course after the last [`Servo::step`] while the command stays: its rate
+    /// (rad/s) and the time before which it holds — until the rudder reaches its command (the
+    /// step that would pass it stops there instead) or a command given takes effect. None where
+    /// the gear accelerates: its angle is not a line in time then.
+    pub fn ahead(&self) -> Option<(f64, f64)> {
+        // a margin on the times: where the promise and the step disagree by a rounding, the
+        // control time is asked instead
+        let margin = 1e-9 * self.last_t.abs().max(1.0);
+        let effect = self.given.front().map_or(f64::INFINITY, |g| g.0 + self.delay - 1e-9 - margin);
+        let gap = self.command.clamp(-self.limit, self.limit) - self.angle;
+        if gap == 0.0 {
+            return (self.speed == 0.0).then_some((0.0, effect));
+        }
+        match self.acceleration {
+            Some(_) => None,
+            None => Some((self.rate.copysign(gap), effect.min(self.last_t + gap.abs() / self.rate - margin))),
+        }
+    }
 }
 
 fn parse_num(text: &str, part: &str, what: &str) -> Result<f64, ShipError> {
@@ -288,5 +307,99 @@ mod tests {
             built[1700]
         );
         assert!(built.iter().all(|a| *a <= 20.0) && built[1860] == 20.0, "{}", built[1860]);
+    }
+
+    /// What the gear promises of the control times ahead holds: at each control time before
+    /// `until` a stepped gear is where the line says, and a gear left alone until then and
+    /// asked once ends where the one asked at every control time ends. Commands of ±20° and
+    /// 0° given now and then, with and without a dead time.
+    #[test]
+    fn the_gears_promise_holds() {
+        let dt = 0.04;
+        for delay in [0.0, 0.3] {
+            let command = |k: usize| [20f64, -20.0, 0.0, 35.0][(k / 150) % 4].to_radians();
+            let mut asked = gear(delay, None);
+            let mut promised = 0;
+            for k in 0..1200 {
+                let t = k as f64 * dt;
+                let angle = asked.step(t, command(k));
+                let Some((rate, until)) = asked.ahead() else { panic!("a gear without acceleration") };
+                // the command stays for the control steps the test looks ahead (to its next change)
+                let mut alone = asked.clone();
+                for j in k + 1..(k / 150 + 1) * 150 {
+                    let t_j = j as f64 * dt;
+                    if t_j >= until {
+                        break;
+                    }
+                    let mut stepped = asked.clone();
+                    for i in k + 1..=j {
+                        stepped.step(i as f64 * dt, command(k));
+                    }
+                    let line = angle + rate * (t_j - t);
+                    assert!((stepped.angle - line).abs() < 1e-12, "delay {delay}, k {k}, j {j}");
+                    // not asked until j: the same gear as asked at every control time
+                    let once = alone.clone().step(t_j, command(k));
+                    assert!((once - stepped.angle).abs() < 1e-12, "delay {delay}, k {k}, j {j}");
+                    promised += 1;
+                }
+                alone.step(t + dt, command(k));
+            }
+            // most control steps lie in a promise (the gear at rest or turning)
+            assert!(promised > 10_000, "{promised}");
+        }
+        // a gear that accelerates promises only at rest
+        let mut built = gear(0.0, Some(30.0));
+        built.step(0.04, 20f64.to_radians());
+        assert!(built.ahead().is_none());
+        for k in 2..200 {
+            built.step(k as f64 * 0.04, 20f64.to_radians());
+        }
+        assert_eq!(built.ahead().map(|a| a.0), Some(0.0));
+    }
+
+    /// A manoeuvre simulated by the adaptive method whose controller promises the control
+    /// times ahead (the steps pass them unasked) against the same controller asked at every
+    /// control time: the same reversals and metrics, the states within the tolerances.
+    #[test]
+    fn unasked_control_times_change_nothing() {
+        use crate::sim::{simulate, Controller, Integrator, Settings};
+        struct Asked(Box<dyn Controller>);
+        impl Controller for Asked {
+            fn input(&mut self, t: f64, x: &[f64], out: &mut [f64]) {
+                self.0.input(t, x, out)
+            }
+            fn done(&self, t: f64, x: &[f64]) -> bool {
+                self.0.done(t, x)
+            }
+        }
+        let model = super::super::default_model();
+        for (delay, acceleration) in [(0.0, None), (0.3, None), (0.2, Some(8.0))] {
+            let mut ship = super::Ship::new(&model, false).unwrap();
+            ship.spec.rudder_delay = delay;
+            ship.spec.rudder_acceleration = acceleration;
+            let start = ship.straight_run().unwrap();
+            for text in ["zigzag:20/20", "zigzag:10/10:port", "turning:35", "pullout:20", "spiral:10/5/40"] {
+                let manoeuvre = super::Manoeuvre::parse(text).unwrap();
+                let settings =
+                    Settings { integrator: Integrator::Dopri5, dt: 0.04, duration: 150.0, sample: 0.2 };
+                let free = manoeuvre.controller(&ship, &start).unwrap();
+                let a = simulate(&ship.system, &start.x, &mut Asked(free), &settings).unwrap();
+                let mut free = manoeuvre.controller(&ship, &start).unwrap();
+                let b = simulate(&ship.system, &start.x, free.as_mut(), &settings).unwrap();
+                assert_eq!(a.time, b.time, "{text}");
+                assert_eq!(a.inputs.len(), b.inputs.len());
+                for (ca, cb) in a.inputs.iter().zip(&b.inputs) {
+                    for (x, y) in ca.iter().zip(cb) {
+                        assert!((x - y).abs() < 1e-12, "{text} (delay {delay}): input {x} vs {y}");
+                    }
+                }
+                for ((ca, cb), name) in a.states.iter().zip(&b.states).zip(&a.state_names) {
+                    let scale = ca.iter().fold(1e-3f64, |m, v| m.max(v.abs()));
+                    for (x, y) in ca.iter().zip(cb) {
+                        assert!((x - y).abs() < 1e-5 * scale, "{text} (delay {delay}): {name} {x} vs {y}");
+                    }
+                }
+            }
+        }
     }
 }

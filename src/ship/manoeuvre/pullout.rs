@@ -6,7 +6,7 @@ use serde::Serialize;
 
 use super::zigzag::RudderOnly;
 use super::{Servo, Ship, ShipError, StraightRun};
-use crate::sim::{Controller, Trajectory};
+use crate::sim::{Ahead, Controller, Trajectory};
 
 /// A pull-out manoeuvre.
 #[derive(Clone, Debug, PartialEq)]
@@ -47,6 +47,17 @@ impl Controller for PullOutControl {
     fn input(&mut self, t: f64, _x: &[f64], out: &mut [f64]) {
         let command = if t < self.switch_at { self.turn } else { self.back };
         out[0] = self.servo.step(t, command);
+    }
+    fn passed(&mut self, t: f64) {
+        self.input(t, &[], &mut [0.0]);
+    }
+    /// The rudder's course, up to the return to its straight-run angle.
+    fn ahead(&self, t: f64, slope: &mut [f64]) -> Option<Ahead> {
+        let (rate, until) = self.servo.ahead()?;
+        slope[0] = rate;
+        let switch =
+            if t < self.switch_at { self.switch_at - 1e-9 * self.switch_at.max(1.0) } else { f64::INFINITY };
+        Some(Ahead { until: until.min(switch), watch: None })
     }
 }
 

@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use super::zigzag::RudderOnly;
 use super::{Servo, Ship, ShipError, StraightRun};
-use crate::sim::{Controller, Trajectory};
+use crate::sim::{Ahead, Controller, Trajectory};
 
 /// A spiral test.
 #[derive(Clone, Debug, PartialEq)]
@@ -132,6 +132,22 @@ impl Controller for SpiralControl {
     fn input(&mut self, t: f64, _x: &[f64], out: &mut [f64]) {
         let k = ((t / self.hold) as usize).min(self.angles.len() - 1);
         out[0] = self.servo.step(t, self.angles[k]);
+    }
+    fn passed(&mut self, t: f64) {
+        self.input(t, &[], &mut [0.0]);
+    }
+    /// The rudder's course, up to the next angle of the spiral.
+    fn ahead(&self, t: f64, slope: &mut [f64]) -> Option<Ahead> {
+        let (rate, until) = self.servo.ahead()?;
+        slope[0] = rate;
+        let k = (t / self.hold) as usize;
+        let next = if k + 1 < self.angles.len() {
+            let at = (k + 1) as f64 * self.hold;
+            at - 1e-9 * at.max(1.0)
+        } else {
+            f64::INFINITY
+        };
+        Some(Ahead { until: until.min(next), watch: None })
     }
 }
 

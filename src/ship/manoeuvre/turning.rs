@@ -6,7 +6,7 @@ use serde::Serialize;
 
 use super::zigzag::RudderOnly;
 use super::{Servo, Ship, ShipError, StraightRun};
-use crate::sim::{Controller, Trajectory};
+use crate::sim::{Ahead, Controller, Trajectory};
 
 /// A turning circle.
 #[derive(Clone, Debug, PartialEq)]
@@ -50,6 +50,14 @@ pub struct TurnControl {
 impl Controller for TurnControl {
     fn input(&mut self, t: f64, _x: &[f64], out: &mut [f64]) {
         out[0] = self.servo.step(t, self.command);
+    }
+    fn passed(&mut self, t: f64) {
+        self.servo.step(t, self.command);
+    }
+    fn ahead(&self, _t: f64, slope: &mut [f64]) -> Option<Ahead> {
+        let (rate, until) = self.servo.ahead()?;
+        slope[0] = rate;
+        Some(Ahead { until, watch: None })
     }
 }
 

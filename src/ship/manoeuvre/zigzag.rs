@@ -7,7 +7,7 @@
 use serde::Serialize;
 
 use super::{Servo, Ship, ShipError, StraightRun};
-use crate::sim::{Controller, Trajectory};
+use crate::sim::{Ahead, Controller, Trajectory, Watch};
 
 /// A zigzag manoeuvre.
 #[derive(Clone, Debug, PartialEq)]
@@ -72,13 +72,35 @@ pub struct ZigZagControl {
     psi0: f64,
 }
 
+impl ZigZagControl {
+    /// The rudder for a turn in the switch's direction (+ = starboard): sign from ∂ṙ/∂δ.
+    fn command(&self) -> f64 {
+        self.delta0 + self.turn_sign * self.switch.dir * self.amplitude
+    }
+}
+
 impl Controller for ZigZagControl {
     #[inline]
     fn input(&mut self, t: f64, x: &[f64], out: &mut [f64]) {
         self.switch.update(x[self.psi] - self.psi0);
-        // rudder for a turn in direction `dir` (+ = starboard): sign from ∂ṙ/∂δ
-        let command = self.delta0 + self.turn_sign * self.switch.dir * self.amplitude;
-        out[0] = self.servo.step(t, command);
+        out[0] = self.servo.step(t, self.command());
+    }
+
+    fn passed(&mut self, t: f64) {
+        self.servo.step(t, self.command());
+    }
+
+    /// The rudder's course until it reaches its command, while the heading change stays short
+    /// of the switching heading in the turn's direction.
+    fn ahead(&self, _t: f64, slope: &mut [f64]) -> Option<Ahead> {
+        let (rate, until) = self.servo.ahead()?;
+        slope[0] = rate;
+        let limit = self.psi0 + self.switch.dir * self.switch.limit;
+        // short of it by a rounding's margin: `update` compares ψ − ψ0 with the limit
+        let limit = limit - self.switch.dir * 1e-12 * (limit.abs() + 1.0);
+        let (low, high) =
+            if self.switch.dir > 0.0 { (f64::NEG_INFINITY, limit) } else { (limit, f64::INFINITY) };
+        Some(Ahead { until, watch: Some(Watch { state: self.psi, low, high }) })
     }
 }
 
@@ -160,6 +182,16 @@ impl<C: Controller> Controller for RudderOnly<C> {
     }
     fn done(&self, t: f64, x: &[f64]) -> bool {
         self.inner.done(t, x)
+    }
+    fn passed(&mut self, t: f64) {
+        self.inner.passed(t)
+    }
+    fn ahead(&self, t: f64, slope: &mut [f64]) -> Option<Ahead> {
+        let mut rudder = [0.0];
+        let ahead = self.inner.ahead(t, &mut rudder)?;
+        slope.fill(0.0);
+        slope[self.rudder] = rudder[0];
+        Some(ahead)
     }
 }
 
