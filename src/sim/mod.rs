@@ -1,7 +1,7 @@
 //! Simulation of identified equations: a [`System`] (any [`RightHandSide`], e.g. a model
 //! file's equations, compiled once),
-//! a [`Controller`] that sets the inputs, and a fixed-step [`Integrator`]. Nothing here knows
-//! about ships; the manoeuvres of the ship plug-in are controllers.
+//! a [`Controller`] that sets the inputs, and an [`Integrator`] (adaptive by default). Nothing
+//! here knows about ships; the manoeuvres of the ship plug-in are controllers.
 
 mod controller;
 mod dopri5;
