@@ -408,13 +408,21 @@ pub fn simulate(
         let from = step;
         while step < last {
             let next = step + 1;
-            if dopri.reach(system, &mut ws, next as f64 * dt, limit)? {
-                let (t_end, y) = dopri.end_of_step();
-                check(system, &limits, t_end, y, &x)?;
-            }
+            let stepped = dopri.reach(system, &mut ws, next as f64 * dt, limit)?;
             // the control steps within the step just taken; the first whose watched state
             // left its bounds is the stretch's last (the controller is asked at the one after)
             let covered = ((dopri.end_of_step().0 / dt + 1e-9).floor() as usize).clamp(next, last);
+            let (t_end, y) = dopri.end_of_step();
+            if stepped && check(system, &limits, t_end, y, &x).is_err() {
+                // reported at the first control time beyond the bounds, as where every control
+                // time is asked
+                for j in next..=covered {
+                    dopri.states_at(j as f64 * dt, &mut tmp);
+                    check(system, &limits, j as f64 * dt, &tmp, &x)?;
+                }
+                let (t_end, y) = dopri.end_of_step();
+                check(system, &limits, t_end, y, &x)?;
+            }
             let left = ahead.watch.and_then(|w| dopri.first_outside(w, next, covered, dt));
             let upto = left.unwrap_or(covered);
             while step + to_sample <= upto {
@@ -434,6 +442,7 @@ pub fn simulate(
         if step > from {
             let t = step as f64 * dt;
             dopri.states_at(t, &mut x);
+            check(system, &limits, t, &x, &prev)?;
             on_line(step, &mut u_now);
             dopri.coasted();
             controller.passed(t);
@@ -589,6 +598,18 @@ mod tests {
                 assert!((t - 10f64.ln()).abs() < 0.02 && value > 10.0, "t = {t}, x = {value}");
             }
             other => panic!("expected divergence, got {other:?}"),
+        }
+        // the adaptive method passing the control times of a constant input unasked stops
+        // there too, at the first control time beyond the bound, whether samples lie there or not
+        for sample in [0.01, 0.5] {
+            let settings = Settings { integrator: Integrator::Dopri5, dt: 0.01, duration: 5.0, sample };
+            match simulate(&system, &[1.0], &mut Constant(vec![0.0]), &settings) {
+                Err(SimError::Diverged { t, state, value, .. }) => {
+                    assert_eq!(state, "x");
+                    assert!(t > 10f64.ln() && t - 10f64.ln() < 0.011 && value > 10.0, "t = {t}, x = {value}");
+                }
+                other => panic!("expected divergence, got {other:?}"),
+            }
         }
     }
 
