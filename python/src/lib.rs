@@ -379,6 +379,13 @@ impl PyModel {
         Ok((0..n).map(|_| PyModel { inner: sampler.draw(&mut normal) }).collect())
     }
 
+    /// Sets the adaptive method's tolerances where given; refused where no step control works
+    /// with them.
+    #[pyo3(signature = (rtol = None, atol = None))]
+    fn set_tolerances(&mut self, rtol: Option<f64>, atol: Option<f64>) -> PyResult<()> {
+        self.inner.set_tolerances(rtol, atol).map_err(|e| refuse(e.to_string()))
+    }
+
     /// Sets a parameter, or a value of the plug-in's table (a ship's `u0`); unknown names are
     /// refused.
     fn set_parameter(&mut self, name: &str, value: f64) -> PyResult<()> {

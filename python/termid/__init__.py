@@ -903,6 +903,21 @@ class Model:
         else:
             self._native.set_parameter(name, float(value))
 
+    def set_tolerances(self, rtol: Optional[float] = None, atol: Optional[float] = None) -> None:
+        """The adaptive integrator's tolerances for this model's simulations, each where
+        given (defaults: the model file's ``[simulation]`` table, else ``rtol`` 1e-6 and
+        ``atol`` 1e-7, in each state's unit); raises ``TermidError`` where no step control
+        works with them (``rtol`` outside (0, 1), ``atol`` below 0).
+
+        Parameters: ``rtol`` the relative tolerance; ``atol`` the absolute tolerance.
+
+        >>> lorenz = termid.Model.builtin("lorenz")
+        >>> lorenz.set_tolerances(rtol=1e-10, atol=1e-12)
+        >>> round(float(lorenz.simulate(duration=1.0, sample=0.5)["x"].iloc[-1]), 6)
+        5.523677
+        """
+        self._native.set_tolerances(rtol, atol)
+
     def coefficients(self, equation: str) -> pd.DataFrame:
         """The stored terms of ``equation`` with value and standard error (float64, NaN where
         none is stored).

@@ -191,6 +191,22 @@ def test_lorenz_simulated_and_identified_with_the_defaults():
         lorenz.simulate(duration=1.0, initial={"w": 1.0})
 
 
+def test_tolerances_set_from_python_are_the_simulations():
+    # Lorenz after 1 s against scipy's DOP853 at 1e-13 (x, y, z = 5.52368, 9.51880, 13.58350):
+    # within 1e-9 at tight tolerances, within 1e-4 at the defaults; refused where no step
+    # control works
+    lorenz = termid.Model.builtin("lorenz")
+    want = np.array([5.523676640069421, 9.518798956834514, 13.583499714528173])
+    default = lorenz.simulate(duration=1.0, sample=0.5)[["x", "y", "z"]].iloc[-1].to_numpy()
+    lorenz.set_tolerances(rtol=1e-11, atol=1e-12)
+    tight = lorenz.simulate(duration=1.0, sample=0.5)[["x", "y", "z"]].iloc[-1].to_numpy()
+    assert np.max(np.abs(tight - want) / want) < 1e-9
+    assert 1e-9 < np.max(np.abs(default - want) / want) < 1e-4
+    for bad in [dict(rtol=2.0), dict(atol=-1.0), dict(rtol=float("nan"))]:
+        with pytest.raises(termid.TermidError, match="rtol lies in"):
+            lorenz.set_tolerances(**bad)
+
+
 def test_identification_releases_the_gil(ship, zigzags):
     # while the Rust side works, a Python thread keeps running (it ran at 4 % before)
     import threading

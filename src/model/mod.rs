@@ -239,6 +239,29 @@ impl Model {
         )
     }
 
+    /// The adaptive method's tolerances set where given (a command's `--rtol`, `--atol`), into
+    /// the model's `[simulation]` table; refused where no step control can work with them.
+    pub fn set_tolerances(
+        &mut self,
+        rtol: Option<f64>,
+        atol: Option<f64>,
+    ) -> Result<(), crate::sim::SimError> {
+        if rtol.is_none() && atol.is_none() {
+            return Ok(());
+        }
+        let own = crate::sim::RightHandSide::tolerances(self);
+        crate::sim::Tolerances { rtol: rtol.unwrap_or(own.rtol), atol: atol.unwrap_or(own.atol) }.check()?;
+        let sim = self.spec.simulation.get_or_insert_with(|| file::SimulationSpec {
+            method: Default::default(),
+            dt: None,
+            rtol: None,
+            atol: None,
+        });
+        sim.rtol = rtol.or(sim.rtol);
+        sim.atol = atol.or(sim.atol);
+        Ok(())
+    }
+
     /// The model file as read (and as changed through the setters).
     pub fn spec(&self) -> &ModelFile {
         &self.spec

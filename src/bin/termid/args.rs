@@ -406,6 +406,13 @@ pub struct SimulateCommand {
     /// the model file's `[simulation] dt`, else 0.04.
     #[arg(allow_negative_numbers = true, long)]
     pub dt: Option<f64>,
+    /// Relative tolerance of dopri5. Default: the model file's `[simulation] rtol`, else 1e-6.
+    #[arg(allow_negative_numbers = true, long)]
+    pub rtol: Option<f64>,
+    /// Absolute tolerance of dopri5, in each state's unit. Default: the model file's
+    /// `[simulation] atol`, else 1e-7.
+    #[arg(allow_negative_numbers = true, long)]
+    pub atol: Option<f64>,
     /// Output interval, s (a multiple of the step).
     #[arg(allow_negative_numbers = true, long, default_value_t = 0.2)]
     pub sample: f64,
@@ -579,6 +586,12 @@ pub struct ResimArgs {
     /// Control step, s (default: the model file's, else 0.04).
     #[arg(allow_negative_numbers = true, long)]
     pub dt: Option<f64>,
+    /// Relative tolerance of dopri5 (default: the model file's, else 1e-6).
+    #[arg(allow_negative_numbers = true, long)]
+    pub rtol: Option<f64>,
+    /// Absolute tolerance of dopri5, in each state's unit (default: the model file's, else 1e-7).
+    #[arg(allow_negative_numbers = true, long)]
+    pub atol: Option<f64>,
     /// One figure per run (measured, simulated, residual) into this folder.
     #[arg(long)]
     pub svg: Option<PathBuf>,

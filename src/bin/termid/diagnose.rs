@@ -19,7 +19,8 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
     if let Some(dir) = &cmd.resim.svg {
         termid::output::check_folder(dir)?;
     }
-    let model = crate::simulate::load_model(&cmd.model)?;
+    let mut model = crate::simulate::load_model(&cmd.model)?;
+    model.set_tolerances(cmd.resim.rtol, cmd.resim.atol)?;
     let runs = crate::runs::load_for(&model, &cmd.runs.data, &cmd.runs.dataset)?;
     let hypotheses = termid::plugins::of(&model)
         .and_then(|p| p.hypotheses(&model))

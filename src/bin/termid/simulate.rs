@@ -49,6 +49,7 @@ pub fn run(cmd: SimulateCommand) -> Result<()> {
     }
     let mut model = load_model(&cmd.model)?;
     set_parameters(&mut model, &cmd.params)?;
+    model.set_tolerances(cmd.rtol, cmd.atol)?;
     // the command's method and step, else the model file's, else dopri5 at 0.04 s
     let (integrator, step) = model.simulation(cmd.integrator, None);
     // the adaptive method's accuracy does not hang on the control step: an output interval

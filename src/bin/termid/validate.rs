@@ -18,7 +18,8 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
     if let Some(dir) = &cmd.resim.svg {
         termid::output::check_folder(dir)?;
     }
-    let model = crate::simulate::load_model(&cmd.model)?;
+    let mut model = crate::simulate::load_model(&cmd.model)?;
+    model.set_tolerances(cmd.resim.rtol, cmd.resim.atol)?;
     let runs = crate::runs::load_for(&model, &cmd.runs.data, &cmd.runs.dataset)?;
     let (integrator, dt) = model.simulation(cmd.resim.integrator, cmd.resim.dt);
     let data = Runs::new(&model, &runs, dt, integrator)?.with_intercepts(cmd.resim.with_intercept);
