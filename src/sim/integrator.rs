@@ -5,7 +5,8 @@
 //! eq. (B8): explicit Euler with the inputs taken at the *end* of the step, δ(t+Δt), so that v and r respond in the first step;
 //! the paper's model file asks for it. `Rk4` is the classical fourth-order method. Inputs are
 //! asked of the controller at the grid t = k·Δt alone, whatever the method, and interpolated
-//! linearly within a step.
+//! linearly within a step; the adaptive method does not ask at the grid times whose inputs the
+//! controller promised ([`Controller::ahead`]).
 
 // The stage updates index several parallel arrays at once; index loops read best there.
 #![allow(clippy::needless_range_loop)]
