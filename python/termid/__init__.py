@@ -1064,6 +1064,8 @@ class Model:
         with_intercept: bool = False,
         inputs: Optional[Mapping[str, float]] = None,
         initial: Optional[Mapping[str, float]] = None,
+        rtol: Optional[float] = None,
+        atol: Optional[float] = None,
     ) -> pd.DataFrame:
         """A plug-in's ``scenario`` (``zigzag:20/20``, ``turning:35``, ``spiral``): the run as a
         DataFrame (SI, radians), its metrics in ``df.attrs["metrics"]``. Without a scenario,
@@ -1072,7 +1074,9 @@ class Model:
 
         Parameters: ``dt`` the integration step (default: the model file's method, else
         adaptive Dormand-Prince 5(4) with output every ``sample`` seconds); ``integrator``
-        ``dopri5``, ``rk4`` or ``b8``; ``with_intercept`` adds the identified constants.
+        ``dopri5``, ``rk4`` or ``b8``; ``with_intercept`` adds the identified constants;
+        ``rtol``, ``atol`` the adaptive method's tolerances for this run (else the model's:
+        :meth:`set_tolerances`).
 
         >>> run = termid.Model.default().simulate("zigzag:20/20")
         >>> round(run.attrs["metrics"]["first_overshoot_deg"], 1)
@@ -1080,6 +1084,20 @@ class Model:
         >>> termid.Model.builtin("lorenz").simulate(duration=1.0, sample=0.5)["t"].tolist()
         [0.0, 0.5, 1.0]
         """
+        if rtol is not None or atol is not None:
+            # this run's tolerances on a copy: the model keeps its own
+            model = Model.from_toml(self.to_toml(), self._native.path)
+            model.set_tolerances(rtol, atol)
+            return model.simulate(
+                scenario,
+                dt=dt,
+                duration=duration,
+                sample=sample,
+                integrator=integrator,
+                with_intercept=with_intercept,
+                inputs=inputs,
+                initial=initial,
+            )
         if scenario is None:
             if duration is None:
                 raise TypeError("simulate without a scenario needs a duration (seconds)")

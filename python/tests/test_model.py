@@ -202,6 +202,12 @@ def test_tolerances_set_from_python_are_the_simulations():
     tight = lorenz.simulate(duration=1.0, sample=0.5)[["x", "y", "z"]].iloc[-1].to_numpy()
     assert np.max(np.abs(tight - want) / want) < 1e-9
     assert 1e-9 < np.max(np.abs(default - want) / want) < 1e-4
+    # for one run: the model keeps its own
+    fresh = termid.Model.builtin("lorenz")
+    once = fresh.simulate(duration=1.0, sample=0.5, rtol=1e-11, atol=1e-12)[["x", "y", "z"]].iloc[-1].to_numpy()
+    assert np.max(np.abs(once - want) / want) < 1e-9
+    again = fresh.simulate(duration=1.0, sample=0.5)[["x", "y", "z"]].iloc[-1].to_numpy()
+    assert np.array_equal(again, default)
     for bad in [dict(rtol=2.0), dict(atol=-1.0), dict(rtol=float("nan"))]:
         with pytest.raises(termid.TermidError, match="rtol lies in"):
             lorenz.set_tolerances(**bad)
