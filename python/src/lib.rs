@@ -803,7 +803,7 @@ impl PyModel {
     /// The library's recipe (several derivative starts, choice among back-ends by
     /// prediction, output-error refinement, checks, the starts' agreement): (JSON of every
     /// start and the kept one's report, the report as text, the kept model).
-    #[pyo3(signature = (runs, derivatives, smooth = false, intercept = None, choose = vec![], compare = vec![], refine = None, refine_iterations = 100, refine_prior = 1e-4, held_out = vec![], refine_step = None, parameters = false, sources = vec![], per_source = vec![], per_run = vec![]))]
+    #[pyo3(signature = (runs, derivatives, smooth = false, intercept = None, choose = vec![], compare = vec![], refine = None, refine_iterations = 100, refine_prior = 1e-4, held_out = vec![], refine_step = None, parameters = None, sources = vec![], per_source = vec![], per_run = vec![]))]
     #[allow(clippy::too_many_arguments)]
     fn recipe(
         &self,
@@ -819,7 +819,7 @@ impl PyModel {
         refine_prior: f64,
         held_out: Vec<Run<'_>>,
         refine_step: Option<f64>,
-        parameters: bool,
+        parameters: Option<bool>,
         sources: Vec<usize>,
         per_source: Vec<String>,
         per_run: Vec<String>,
@@ -833,6 +833,7 @@ impl PyModel {
                 Ok((name.clone(), self.inner.with_backend(&backend).map_err(fail)?))
             })
             .collect::<PyResult<Vec<_>>>()?;
+        let refined = refine.is_some();
         let settings = termid::recipe::RecipeSettings {
             derivatives,
             smooth,
@@ -845,7 +846,14 @@ impl PyModel {
                 iterations: refine_iterations,
                 step: refine_step,
             }),
-            parameters: termid::recipe::ParameterOptions::asked(parameters, sources, per_source, per_run),
+            parameters: termid::recipe::ParameterOptions::asked(
+                &self.inner,
+                parameters,
+                refined,
+                sources,
+                per_source,
+                per_run,
+            ),
             ..Default::default()
         };
         let recipe = py

@@ -1328,7 +1328,7 @@ class Model:
         refine_prior: float = 1e-4,
         held_out: Union[Data, Sequence[Data], None] = None,
         refine_step: Optional[float] = None,
-        parameters: bool = False,
+        parameters: Optional[bool] = None,
         sources: Optional[Sequence[int]] = None,
         per_source: Sequence[str] = (),
         per_run: Sequence[str] = (),
@@ -1344,13 +1344,17 @@ class Model:
         are reported at every sample), stopped by ``held_out`` runs where given, checked by the model's
         plug-in; the start kept that passes the checks and re-simulates best, and a flag where
         the plausible starts disagree on a turning circle. ``intercept`` as for
-        :meth:`identify` (None: the model file's). ``parameters`` (implied by ``per_source`` and
-        ``per_run``) lastly estimates the model file's free parameters with every coefficient of
-        the kept start and each run's initial state, kept where the checks it passed still pass
-        (a regression cannot estimate a parameter inside its terms, such as the new-ship
-        template's rudder zero ``δ_0``); ``per_source`` names those estimated once per source,
-        ``sources`` numbering each run's source (basin), ``per_run`` those estimated once per
-        run; the estimate in ``parameters`` of the result. Defaults are the new-ship recipe's.
+        :meth:`identify` (None: the model file's). ``parameters`` estimates the model file's
+        free parameters with every coefficient of each start and each run's initial state, in
+        place of the refinement (after it where ``held_out`` runs stop it), kept where the
+        checks the start passed still pass, else the start is refined without them (a
+        regression cannot estimate a parameter inside its terms, such as the new-ship
+        template's rudder zero ``δ_0``, its own in every run): None (the default) where
+        ``refine`` is given and the model file declares free parameters, True also without
+        ``refine`` (implied by ``per_source`` and ``per_run``), False not; ``per_source`` names
+        those estimated once per source, ``sources`` numbering each run's source (basin),
+        ``per_run`` those estimated once per run; the kept start's estimate in ``parameters``
+        of the result. Defaults are the new-ship recipe's.
 
         >>> ship = termid.Model.default()
         >>> ship.set_parameter("u0", "mean:u:4")

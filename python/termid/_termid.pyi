@@ -115,7 +115,7 @@ class Model:
         refine_prior: float = 1e-4,
         held_out: Sequence[Run] = ...,
         refine_step: Optional[float] = None,
-        parameters: bool = False,
+        parameters: Optional[bool] = None,
         sources: Sequence[int] = ...,
         per_source: Sequence[str] = ...,
         per_run: Sequence[str] = ...,

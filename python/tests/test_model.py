@@ -369,6 +369,20 @@ def test_recipe_estimates_each_basins_rudder_zero():
         ship.recipe([ship.simulate("zigzag:20/20")], ["central"], refine=None, parameters=True)
 
 
+def test_recipe_refines_with_the_templates_free_parameters_by_default():
+    """With ``refine``, the new-ship template's rudder zero (free, each run's own) is refined
+    with the coefficients of every start by default; ``parameters=False`` refines the
+    coefficients alone and keeps the file's zero."""
+    truth = termid.Model.builtin("mmg_kvlcc2")
+    runs = [truth.record(m, duration=60.0, seed=k) for k, m in enumerate(["zigzag:20/20", "zigzag:20/20:port", "zigzag:10/10"])]
+    template = termid.Model.builtin("new_ship")
+    found = template.recipe(runs, ["kalman"], refine=("u", "v", "r", "ψ"), refine_iterations=20)
+    assert found.parameters is not None and "free parameters" in found.text, found.text
+    plain = template.recipe(runs, ["kalman"], refine=("u", "v", "r", "ψ"), refine_iterations=20, parameters=False)
+    assert plain.parameters is None and "output-error refinement" in plain.text
+    assert plain.model.parameters["δ_0"] == 0.0
+
+
 def test_print_shows_each_equation_with_its_coefficients():
     lorenz = termid.Model.builtin("lorenz")
     text = str(lorenz)

@@ -47,7 +47,9 @@ pub struct RecipeSettings {
     /// How far (relative) plausible starts may disagree on a measure of a manoeuvre the runs
     /// did not cover before the prediction is flagged.
     pub agree: f64,
-    /// The kept start's free parameters estimated with its coefficients (none: not).
+    /// Each start's free parameters estimated with its coefficients, in place of its
+    /// refinement (none: not; [`ParameterOptions::asked`] runs it where the model declares
+    /// free parameters).
     pub parameters: Option<ParameterOptions>,
 }
 
@@ -122,8 +124,6 @@ pub struct Recipe {
     pub failed: Vec<(String, String)>,
     /// Whether costs are the validation runs'.
     pub validated: bool,
-    /// What the parameter stage did to the kept start, where it ran.
-    pub parameters: Option<ParameterStage>,
 }
 
 /// Identifies `model` from `frames` by the recipe; `held` are runs that stop each refinement
@@ -181,18 +181,7 @@ pub fn identify(
             Err(e) => return Err(e),
         }
     }
-    let mut recipe = Recipe::of(starts, failed, held.is_some(), settings.agree)?;
-    if let Some(options) = &settings.parameters {
-        let states = settings.refine.as_ref().and_then(|r| r.states.as_deref());
-        let kept = &mut recipe.starts[recipe.kept];
-        let stage = parameters::estimate_parameters(kept, frames, states, settings.intercept, options);
-        if matches!(stage, ParameterStage::Kept(_)) {
-            // the kept model changed: its agreement with the other starts is its new one
-            recipe.agreement = agreement(&recipe.starts, recipe.kept, settings.agree);
-        }
-        recipe.parameters = Some(stage);
-    }
-    Ok(recipe)
+    Recipe::of(starts, failed, held.is_some(), settings.agree)
 }
 
 /// Whether the plausible starts agree with the kept one (`kept`) on each measure of its checks.
@@ -229,7 +218,7 @@ impl Recipe {
                 )
             })?;
         let agreement = agreement(&starts, kept, agree);
-        Ok(Recipe { starts, kept, agreement, failed, validated, parameters: None })
+        Ok(Recipe { starts, kept, agreement, failed, validated })
     }
 
     /// The kept start.
@@ -244,8 +233,27 @@ impl Recipe {
 
     /// The table of starts: each derivative method's costs and checks, the kept one marked.
     pub fn starts_text(&self) -> String {
+        // the free parameters the starts were refined with, where they were
+        let free: Vec<String> = self
+            .starts
+            .iter()
+            .filter_map(|s| s.parameters.as_ref().and_then(ParameterStage::estimate))
+            .flat_map(|e| {
+                e.parameters.iter().map(|p| p.name.clone()).chain(e.per_run.iter().map(|p| p.name.clone()))
+            })
+            .fold(Vec::new(), |mut all, name| {
+                if !all.contains(&name) {
+                    all.push(name);
+                }
+                all
+            });
+        let with = if free.is_empty() {
+            String::new()
+        } else {
+            format!(" with the model file's free parameters ({})", free.join(", "))
+        };
         let mut out = format!(
-            "== starts: one identification per derivative method, each refined; kept: the lowest {} re-simulation cost among those that pass the checks ==\n{:<22} {:>6} {:>16} {:>16} {:>8}\n",
+            "== starts: one identification per derivative method, each refined{with}; kept: the lowest {} re-simulation cost among those that pass the checks ==\n{:<22} {:>6} {:>16} {:>16} {:>8}\n",
             if self.validated { "validation runs'" } else { "training runs'" },
             "derivative",
             "terms",
@@ -256,14 +264,8 @@ impl Recipe {
         for (k, s) in self.starts.iter().enumerate() {
             let terms: usize =
                 s.model.equations().iter().filter(|e| e.identify).map(|e| e.coefficients.len()).sum();
-            let (before, after) = match (&s.refined, &s.rejected) {
-                (Some(r), _) | (None, Some((r, _))) => match r.validation {
-                    Some((b, a)) => (b, a),
-                    None => (r.cost_before, r.cost_after),
-                },
-                _ => (f64::INFINITY, f64::INFINITY),
-            };
-            let after = if s.refined.is_some() { num(after) } else { "rejected".into() };
+            let (before, after) = s.costs();
+            let after = after.map_or_else(|| "rejected".to_string(), num);
             let mark = if k == self.kept { "  ← kept" } else { "" };
             out += &format!(
                 "{:<22} {terms:>6} {:>16} {after:>16} {:>8}{mark}\n",

@@ -1,10 +1,12 @@
-//! The recipe's last stage: the model file's free parameters (a rudder indicator's zero per
-//! basin, a grey-box model's derivatives) estimated by output error together with every
-//! coefficient of the kept start. A regression cannot estimate them (they sit inside the
-//! terms); kept only where the checks the model passed still pass.
+//! The model file's free parameters (a rudder indicator's zero per run or per basin, a
+//! grey-box model's derivatives) estimated by output error together with every coefficient
+//! of a start: the start's refinement where the file declares any. A regression cannot
+//! estimate them (they sit inside the terms); kept only where the checks the model passed
+//! still pass.
 
 use crate::data::Frame;
 use crate::diagnose::{estimate, Estimate, EstimateSettings, InitialValues};
+use crate::model::Model;
 use crate::plugin::Check;
 
 use super::Start;
@@ -21,6 +23,9 @@ pub struct ParameterOptions {
     pub per_run: Vec<String>,
     /// Most Levenberg-Marquardt iterations in each of the estimate's two rounds.
     pub iterations: usize,
+    /// A round ends at a step that lowers the cost by less than this fraction (as the
+    /// refinement's: no prediction that matters moves by then).
+    pub converged: f64,
     /// How each run's initial values are estimated: by default held to the records' first
     /// samples by their noise, as the refinement before this stage started every run from its
     /// record. A library's structure is not the ship's, and free initial values then lean on
@@ -37,30 +42,35 @@ impl Default for ParameterOptions {
             per_source: vec![],
             per_run: vec![],
             iterations: 50,
+            converged: 1e-3,
             initial_values: InitialValues::Measured,
         }
     }
 }
 
 impl ParameterOptions {
-    /// The stage as a caller asks for it: run where `asked` or where any parameter is to be
-    /// estimated per source or per run (which is asking for it); `None`: not asked.
+    /// The stage as a caller asks for it: `Some(true)` or any parameter to be estimated per
+    /// source or per run (which is asking for it) runs it, `Some(false)` does not, `None` runs
+    /// it where the starts are `refined` and `model` declares a free parameter: a value the
+    /// file leaves to the runs is refined with the coefficients, not held at its first value.
     pub fn asked(
-        asked: bool,
+        model: &Model,
+        asked: Option<bool>,
+        refined: bool,
         sources: Vec<usize>,
         per_source: Vec<String>,
         per_run: Vec<String>,
     ) -> Option<ParameterOptions> {
-        (asked || !per_source.is_empty() || !per_run.is_empty()).then(|| ParameterOptions {
-            sources,
-            per_source,
-            per_run,
-            ..Default::default()
-        })
+        let named = !per_source.is_empty() || !per_run.is_empty();
+        let run = match asked {
+            Some(asked) => asked || named,
+            None => named || (refined && !model.free_parameters().is_empty()),
+        };
+        run.then(|| ParameterOptions { sources, per_source, per_run, ..Default::default() })
     }
 }
 
-/// What the parameter stage did to the kept start.
+/// What the parameter stage did to a start.
 #[derive(Debug)]
 pub enum ParameterStage {
     /// Kept: the start's model holds the estimates (the per-source ones are reported, the
@@ -111,23 +121,26 @@ impl ParameterStage {
 }
 
 /// Runs the stage on `start` with the training runs `frames` (as read: each run's initial
-/// state is estimated with the parameters), comparing `states` (`None`: all).
+/// state is estimated with the parameters), comparing `states` (`None`: all), re-simulated at
+/// `step` samples (`None`: the coarsest that resolves the runs, as the refinement's).
 pub(super) fn estimate_parameters(
     start: &mut Start,
     frames: &[Frame],
     states: Option<&[String]>,
     intercept: bool,
+    step: Option<usize>,
     options: &ParameterOptions,
 ) -> ParameterStage {
     let settings = EstimateSettings {
         coefficients: true,
         iterations: options.iterations,
+        converged: options.converged,
         initial_values: options.initial_values,
         sources: options.sources.clone(),
         per_source: options.per_source.clone(),
         per_run: options.per_run.clone(),
-        // at the refinement's step: the coarsest that resolves the runs
-        coarsest: Some((super::RESOLVED, super::MOST_SAMPLES_PER_STEP)),
+        // a step that is asked for holds whatever the runs' resolution (no tolerance fails it)
+        coarsest: Some(step.map_or((super::RESOLVED, super::MOST_SAMPLES_PER_STEP), |f| (f64::INFINITY, f))),
         ..Default::default()
     };
     let fit = super::start::output_error_runs(&start.model, frames, states, intercept)

@@ -109,7 +109,7 @@ impl Recipe {
         if let Some(r) = &kept.refined {
             out += &r.text();
         }
-        if let Some(stage) = &self.parameters {
+        if let Some(stage) = &kept.parameters {
             out += &stage.text();
         }
         if let Some(p) = self.primes() {
@@ -137,7 +137,7 @@ impl Recipe {
         if let Some(r) = &kept.refined {
             all.insert("output_error_refinement".into(), serde_json::to_value(r)?);
         }
-        match &self.parameters {
+        match &kept.parameters {
             Some(super::ParameterStage::Kept(e)) => {
                 all.insert("parameter_estimate".into(), serde_json::to_value(e)?);
             }

@@ -1,5 +1,6 @@
 //! One start of the recipe: the runs prepared by one derivative method, identified (or
-//! chosen among configurations by prediction), refined by output error and checked.
+//! chosen among configurations by prediction), refined by output error (with the model file's
+//! free parameters where it declares any) and checked.
 
 use crate::data::{differentiator, prepare, resample, CentralDifference, Differentiator, Frame, Preparation};
 use crate::diagnose::{Prediction, RefineSettings, Refined, Runs};
@@ -7,6 +8,7 @@ use crate::identify::{Fit, ModelIdentification};
 use crate::model::Model;
 use crate::plugin::Check;
 
+use super::parameters::{estimate_parameters, ParameterStage};
 use super::{RecipeError, RecipeSettings, RefineOptions};
 
 /// One start: what one derivative method's preparation identified.
@@ -26,6 +28,10 @@ pub struct Start {
     pub rejected: Option<(Refined, Vec<String>)>,
     /// A refinement that failed, why (the regression's model is kept).
     pub refine_error: Option<String>,
+    /// The model file's free parameters estimated with the coefficients, where asked: in place
+    /// of the refinement (which runs only where validation runs stop it, or where this stage
+    /// is not kept).
+    pub parameters: Option<ParameterStage>,
     /// The physical checks of `model`.
     pub checks: Vec<Check>,
     /// The runs as this start prepared them (for figures).
@@ -36,10 +42,27 @@ impl Start {
     /// What the start is judged by: the re-simulation cost of the model it keeps, on the
     /// validation runs where there are any, else on the training runs.
     pub fn cost(&self) -> f64 {
-        match (&self.refined, &self.rejected) {
-            (Some(r), _) => r.validation.map_or(r.cost_after, |v| v.1),
-            (None, Some((r, _))) => r.validation.map_or(r.cost_before, |v| v.0),
-            _ => f64::INFINITY,
+        let (before, after) = self.costs();
+        after.unwrap_or(before)
+    }
+
+    /// The regression's re-simulation cost and the refined one (`None`: no refinement kept),
+    /// the validation runs' where there are any.
+    pub fn costs(&self) -> (f64, Option<f64>) {
+        let refined = |r: &Refined| r.validation.unwrap_or((r.cost_before, r.cost_after));
+        match (&self.parameters, &self.refined, &self.rejected) {
+            (_, Some(r), _) if r.validation.is_some() => {
+                let (before, after) = refined(r);
+                (before, Some(after))
+            }
+            (Some(ParameterStage::Kept(e)), ..) => (e.cost_before, Some(e.cost_after)),
+            (_, Some(r), _) => {
+                let (before, after) = refined(r);
+                (before, Some(after))
+            }
+            (_, None, Some((r, _))) => (refined(r).0, None),
+            (Some(ParameterStage::Rejected(e, _)), None, None) => (e.cost_before, None),
+            _ => (f64::INFINITY, None),
         }
     }
 
@@ -154,8 +177,6 @@ pub(super) fn identify_start(
         (chosen.identified, Some(text))
     };
     let mut model = identified.model;
-    // what the field knows must hold: the plug-in's physical checks of a model
-    let checks_of = |m: &Model| crate::plugins::of(m).map(|p| p.checks(m, &prepared)).unwrap_or_default();
     let mut start = Start {
         derivative: derivative.to_string(),
         model: model.clone(),
@@ -164,37 +185,70 @@ pub(super) fn identify_start(
         refined: None,
         rejected: None,
         refine_error: None,
+        parameters: None,
         checks: vec![],
         prepared: vec![],
     };
-    match &settings.refine {
-        // a refinement that fails loses nothing: the regression's model is kept
-        Some(options) => {
-            match refine(&model, &prepared, validation.as_deref(), options, settings.intercept) {
-                Ok(r) => {
-                    // a refinement must not make a model fail what its field knows it passed
-                    let (before, after) = (checks_of(&model), checks_of(&r.model));
-                    let lost = lost_checks(&before, &after);
-                    if lost.is_empty() {
-                        model = r.model.clone();
-                        start.checks = after;
-                        start.refined = Some(r);
-                    } else {
-                        start.checks = before;
-                        start.rejected = Some((r, lost));
-                    }
-                }
-                Err(e) => {
-                    start.refine_error = Some(e);
-                    start.checks = checks_of(&model);
-                }
-            }
-        }
-        None => start.checks = checks_of(&model),
+    // the free parameters with the coefficients are the refinement, but for validation runs,
+    // which only the refinement is stopped by (the estimate follows it there)
+    let in_place = settings.parameters.is_some() && validation.is_none();
+    start.checks = checks_of(&model, &prepared);
+    if !in_place {
+        refine_start(&mut start, &mut model, &prepared, validation.as_deref(), settings);
     }
     start.model = model;
     start.prepared = prepared;
+    if let Some(options) = &settings.parameters {
+        let refine = settings.refine.as_ref();
+        let states = refine.and_then(|r| r.states.as_deref());
+        // at the refinement's step where it is given
+        let sample = crate::data::sample_step(frames);
+        let step = refine.and_then(|r| r.step).map(|s| (s / sample).round().max(1.0) as usize);
+        let stage = estimate_parameters(&mut start, frames, states, settings.intercept, step, options);
+        if in_place && !matches!(stage, ParameterStage::Kept(_)) {
+            // a stage that is not kept loses nothing: the start is refined as it would be
+            // without it
+            let (mut model, prepared) = (start.model.clone(), std::mem::take(&mut start.prepared));
+            refine_start(&mut start, &mut model, &prepared, None, settings);
+            (start.model, start.prepared) = (model, prepared);
+        }
+        start.parameters = Some(stage);
+    }
     Ok(start)
+}
+
+/// The output-error refinement of `start`'s `model` where asked: kept where it loses none of
+/// the checks the model passed.
+fn refine_start(
+    start: &mut Start,
+    model: &mut Model,
+    prepared: &[Frame],
+    validation: Option<&[Frame]>,
+    settings: &RecipeSettings,
+) {
+    let Some(options) = &settings.refine else { return };
+    // a refinement that fails loses nothing: the regression's model is kept
+    match refine(model, prepared, validation, options, settings.intercept) {
+        Ok(r) => {
+            // a refinement must not make a model fail what its field knows it passed
+            let after = checks_of(&r.model, prepared);
+            let lost = lost_checks(&start.checks, &after);
+            if lost.is_empty() {
+                *model = r.model.clone();
+                start.checks = after;
+                start.refined = Some(r);
+            } else {
+                start.rejected = Some((r, lost));
+            }
+        }
+        Err(e) => start.refine_error = Some(e),
+    }
+}
+
+/// What the field knows must hold: the plug-in's physical checks of a model on the runs as
+/// prepared.
+fn checks_of(model: &Model, prepared: &[Frame]) -> Vec<Check> {
+    crate::plugins::of(model).map(|p| p.checks(model, prepared)).unwrap_or_default()
 }
 
 /// The refusing checks that `after` fails and `before` passed: what a later stage (a

@@ -54,6 +54,18 @@ fn identify_text_and_errors() {
     let (ok, _, err) = identify_hald(&["--target", "y", "--terms", "x1", "x2*x1", "x1*x2"]);
     assert!(!ok);
     assert!(err.contains("duplicate"), "{err}");
+    // the free parameters not estimated and estimated per run: one or the other
+    let (ok, _, err) = crate::common::termid(&[
+        "identify",
+        "--model",
+        "models/new_ship.toml",
+        "--data",
+        "examples/data/zigzag_15_10.dat",
+        "--no-parameters",
+        "--per-run",
+        "δ_0",
+    ]);
+    assert!(!ok && err.contains("--no-parameters") && err.contains("--per-run"), "{err}");
 }
 
 #[test]

@@ -995,7 +995,7 @@ fn the_polynomial_template_from_two_basins_with_their_own_rudder_zero() {
         ..Default::default()
     };
     let recipe = identify(&template, &frames, None, &settings).unwrap();
-    let Some(ParameterStage::Kept(fit)) = &recipe.parameters else {
+    let Some(ParameterStage::Kept(fit)) = &recipe.kept().parameters else {
         panic!("the parameter stage: {}", recipe.text());
     };
     let zero = |s: usize| fit.per_source.iter().find(|p| p.source == s).unwrap().value;
@@ -1017,6 +1017,93 @@ fn the_polynomial_template_from_two_basins_with_their_own_rudder_zero() {
         "{}",
         recipe.text()
     );
+}
+
+/// The recipe with `--refine` on the polynomial template, which declares each run's rudder zero
+/// free: every start is refined with it (the estimate in place of the refinement, so no start
+/// is refined twice), the table of starts says so, and the starts are judged by that
+/// estimate's cost; asked not to, or without a refinement, the stage does not run; with runs
+/// that stop the refinement, it follows the refinement.
+#[test]
+fn the_recipe_refines_every_start_with_the_templates_free_parameters() {
+    use termid::recipe::{identify, ParameterOptions, ParameterStage, RecipeSettings, RefineOptions};
+
+    let truth = mmg_truth();
+    let template = termid::plugins::load(std::path::Path::new("models/new_ship.toml")).unwrap();
+    let (frames, _) = two_basins_reading(
+        &truth,
+        &[("zigzag:20/20", 1.0), ("zigzag:20/20:port", 0.98), ("zigzag:10/10", 1.0)],
+        [0.3, 0.3],
+    );
+    let asked = |asked, refined| ParameterOptions::asked(&template, asked, refined, vec![], vec![], vec![]);
+    assert!(asked(None, true).is_some(), "the template declares `δ_0` free: refined with it");
+    assert!(asked(None, false).is_none() && asked(Some(false), true).is_none());
+    assert!(asked(Some(true), false).is_some());
+    let paper = termid::plugins::load(std::path::Path::new("models/oltmann1973.toml")).unwrap();
+    assert!(ParameterOptions::asked(&paper, None, true, vec![], vec![], vec![]).is_none());
+    let refine = RefineOptions {
+        states: Some(["u", "v", "r", "ψ"].map(String::from).to_vec()),
+        prior: 1e-4,
+        iterations: 30,
+        step: None,
+    };
+    let settings = RecipeSettings {
+        derivatives: vec!["kalman".into(), "central".into()],
+        smooth: true,
+        intercept: false,
+        refine: Some(refine),
+        parameters: asked(None, true),
+        ..Default::default()
+    };
+    let recipe = identify(&template, &frames, None, &settings).unwrap();
+    for start in &recipe.starts {
+        let Some(ParameterStage::Kept(fit)) = &start.parameters else {
+            panic!(
+                "{}: the stage {:?}\n{}",
+                start.derivative,
+                start.parameters.as_ref().map(|p| p.text()),
+                recipe.starts_text()
+            );
+        };
+        assert!(start.refined.is_none() && start.rejected.is_none(), "{} refined twice", start.derivative);
+        assert_eq!(start.cost(), fit.cost_after);
+        assert!(fit.cost_after < fit.cost_before && !fit.coefficients.is_empty(), "{}", fit.text());
+    }
+    assert!(
+        recipe.starts_text().contains("each refined with the model file's free parameters (δ_0)"),
+        "{}",
+        recipe.starts_text()
+    );
+    assert!(recipe.text().contains("output-error estimate of the free parameters"), "{}", recipe.text());
+    // runs that stop the refinement: it runs first, the stage after it
+    let (train, held) = frames.split_at(frames.len() - 1);
+    let recipe = identify(
+        &template,
+        train,
+        Some(held),
+        &RecipeSettings { derivatives: vec!["kalman".into()], ..settings.clone() },
+    )
+    .unwrap();
+    let kept = recipe.kept();
+    assert!(kept.refined.is_some() && kept.parameters.is_some(), "{}", recipe.text());
+    // not asked: the refinement alone, the file's zero kept
+    let recipe = identify(
+        &template,
+        &frames,
+        None,
+        &RecipeSettings { derivatives: vec!["kalman".into()], parameters: None, ..settings },
+    )
+    .unwrap();
+    let kept = recipe.kept();
+    assert!(kept.refined.is_some() && kept.parameters.is_none());
+    assert_eq!(kept.model.parameter_values()["δ_0"], 0.0);
+    assert!(!recipe.starts_text().contains("free parameters"));
+    // a stopping fraction that would stop at once, or never, is refused
+    for converged in [1.0, f64::NAN, -1e-3] {
+        let settings = EstimateSettings { converged, ..Default::default() };
+        let e = estimate(&truth, &runs_of(&truth, &frames), &settings).unwrap_err().to_string();
+        assert!(e.contains("stopping fraction"), "{e}");
+    }
 }
 
 /// `estimate --against`: the estimated grey-box model and another of the same ship compared

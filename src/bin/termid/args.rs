@@ -319,13 +319,20 @@ pub struct IdentifyCommand {
     /// (of its iterates, the one that predicts these runs best is kept).
     #[arg(long, value_name = "DATASET", requires = "refine")]
     pub refine_validation: Option<PathBuf>,
-    /// With --model: last, estimate the model file's free parameters (`free = true`, e.g. the
-    /// new-ship template's rudder zero `δ_0`) by output error together with every coefficient
-    /// of the kept start and each run's initial state, at the refinement's step (the coarsest
-    /// that resolves the runs; its costs at every sample); kept where the checks it passed
-    /// still pass. A regression cannot estimate a parameter inside its terms.
-    #[arg(long, requires = "model")]
+    /// With --model: estimate the model file's free parameters (`free = true`, e.g. the
+    /// new-ship template's rudder zero `δ_0`, its own in every run) by output error together
+    /// with every coefficient of each start and each run's initial state, at the refinement's
+    /// step; kept where the checks the start passed still pass (else the start is refined
+    /// without them). A regression cannot estimate a parameter inside its terms. The default
+    /// with --refine where the model file declares free parameters (then in place of the
+    /// refinement, but for --refine-validation runs, which stop the refinement first); this
+    /// flag asks for it without --refine too.
+    #[arg(long, requires = "model", conflicts_with = "no_parameters")]
     pub parameters: bool,
+    /// With --refine: refine the coefficients alone, the model file's free parameters kept at
+    /// their values (a rudder zero of 0).
+    #[arg(long, requires = "model", conflicts_with_all = ["per_source", "per_run"])]
+    pub no_parameters: bool,
     /// With --parameters (implied): these free parameters estimated once per source (each
     /// --dataset a source, the --data files another), e.g. each basin's rudder indicator zero.
     #[arg(long, num_args = 1.., value_delimiter = ',', requires = "model")]

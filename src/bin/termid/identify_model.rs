@@ -11,6 +11,15 @@ use termid::select::Backend;
 use crate::args::{Format, IdentifyCommand};
 use crate::identify::{configure_backend, intercept_of};
 
+/// The parameter stage as the command asks for it: on, off, or as the model file says.
+pub fn asked_parameters(cmd: &IdentifyCommand) -> Option<bool> {
+    match (cmd.parameters, cmd.no_parameters) {
+        (true, _) => Some(true),
+        (_, true) => Some(false),
+        _ => None,
+    }
+}
+
 /// `identify --model`: every identifiable equation (or the chosen ones) from the runs, each
 /// with the model's candidates, forced terms and back-end; optionally written back. Several
 /// `--derivative` methods (with `--refine`) are several starts: each prepares the runs its
@@ -67,7 +76,7 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
                     Some(Some(states)) => states,
                     _ => vec![],
                 },
-                refine: refine.map(|states| RefineOptions {
+                refine: refine.clone().map(|states| RefineOptions {
                     states,
                     prior: cmd.refine_prior,
                     iterations: cmd.refine_iterations,
@@ -75,7 +84,9 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
                 }),
                 agree: STARTS_AGREE,
                 parameters: ParameterOptions::asked(
-                    cmd.parameters,
+                    &model,
+                    asked_parameters(&cmd),
+                    refine.is_some(),
                     sources,
                     cmd.per_source.clone(),
                     cmd.per_run.clone(),
@@ -121,7 +132,7 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
             lost.join("; ")
         );
     }
-    if let Some(why) = recipe.parameters.as_ref().and_then(ParameterStage::warning) {
+    if let Some(why) = kept.parameters.as_ref().and_then(ParameterStage::warning) {
         eprintln!("warning: {why}");
     }
     // checked before anything is written
@@ -146,7 +157,7 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
         Format::Json => println!("{}", serde_json::to_string_pretty(&recipe.json()?)?),
         Format::Text => {
             print!("{}", recipe.text());
-            if recipe.parameters.as_ref().and_then(|s| s.estimate()).is_some_and(|e| e.per_source_values()) {
+            if kept.parameters.as_ref().and_then(|s| s.estimate()).is_some_and(|e| e.per_source_values()) {
                 print!("{}", crate::runs::source_labels(&cmd.data, &cmd.dataset));
             }
             if let Some(out) = cmd.out.as_ref().filter(|_| write) {

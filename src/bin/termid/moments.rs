@@ -142,16 +142,8 @@ pub fn in_pieces(cmd: &IdentifyCommand, refine: bool) -> Result<Option<usize>> {
         (cmd.smooth, "--smooth"),
         (cmd.prepared_svg.is_some(), "--prepared-svg"),
         (refine, "--refine"),
-        (
-            termid::recipe::ParameterOptions::asked(
-                cmd.parameters,
-                vec![],
-                cmd.per_source.clone(),
-                cmd.per_run.clone(),
-            )
-            .is_some(),
-            "--parameters",
-        ),
+        // (the stage by default comes with --refine, above)
+        (cmd.parameters || !cmd.per_source.is_empty() || !cmd.per_run.is_empty(), "--parameters"),
         (cmd.choose.is_some(), "--choose"),
         (cmd.target.is_some(), "--target"),
         (!local, "a --derivative that needs whole runs"),
@@ -216,6 +208,7 @@ pub fn identify_in_pieces(cmd: &IdentifyCommand, model: &termid::model::Model, r
         refined: None,
         rejected: None,
         refine_error: None,
+        parameters: None,
         checks,
         prepared: vec![],
     })
