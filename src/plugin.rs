@@ -76,6 +76,12 @@ pub trait Plugin: Sync {
     fn checks(&self, _model: &Model, _runs: &[Frame]) -> Vec<Check> {
         vec![]
     }
+    /// Those of [`Plugin::checks`] that read the runs themselves (a ship steering its zigzags
+    /// as recorded), by the same names: what a caller checks again with each run's own values
+    /// of a parameter estimated per run. Empty: none.
+    fn run_checks(&self, _model: &Model, _runs: &[Frame]) -> Vec<Check> {
+        vec![]
+    }
     /// The reference length, speed and density of a model of this field, for nondimensional
     /// coefficients (a ship's length, approach speed and water density).
     fn reference(&self, _model: &Model) -> Option<(f64, f64, f64)> {

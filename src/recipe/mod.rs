@@ -181,6 +181,12 @@ pub fn identify(
             Err(e) => return Err(e),
         }
     }
+    let in_place = settings.parameters.is_some() && held.is_none();
+    let kept = |s: &Start| matches!(s.parameters, Some(ParameterStage::Kept(_)));
+    if in_place && !starts.iter().any(kept) {
+        // no start's free parameters could be kept: each is refined without them
+        starts.par_iter_mut().for_each(|s| start::refine_instead(s, settings));
+    }
     Recipe::of(starts, failed, held.is_some(), settings.agree)
 }
 

@@ -198,7 +198,8 @@ fn checks_with_own_values(fit: &Estimate, prepared: &[Frame]) -> Vec<Check> {
                 .max_by_key(|p| p.run.is_some())
                 .map_or_else(String::new, |p| p.whose());
             let runs: Vec<Frame> = members.iter().map(|&r| prepared[r].clone()).collect();
-            (label, plugin.checks(&model, &runs))
+            // the checks of the model alone (its turning circles) are the written model's
+            (label, plugin.run_checks(&model, &runs))
         })
         .collect();
     written
@@ -209,8 +210,7 @@ fn checks_with_own_values(fit: &Estimate, prepared: &[Frame]) -> Vec<Check> {
                 .filter_map(|(label, cs)| cs.iter().find(|o| o.name == c.name).map(|o| (label.as_str(), o)))
                 .collect();
             if same.len() < each.len() {
-                // not every class has it (a turning circle labelled by that source's neutral
-                // angle): the written model's own
+                // not every class has it (a check of the model alone): the written model's own
                 return c;
             }
             let mut merged = c;

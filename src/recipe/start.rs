@@ -29,8 +29,8 @@ pub struct Start {
     /// A refinement that failed, why (the regression's model is kept).
     pub refine_error: Option<String>,
     /// The model file's free parameters estimated with the coefficients, where asked: in place
-    /// of the refinement (which runs only where validation runs stop it, or where this stage
-    /// is not kept).
+    /// of the refinement (which runs only where validation runs stop it, or where no start's
+    /// stage is kept).
     pub parameters: Option<ParameterStage>,
     /// The physical checks of `model`.
     pub checks: Vec<Check>,
@@ -205,16 +205,22 @@ pub(super) fn identify_start(
         let sample = crate::data::sample_step(frames);
         let step = refine.and_then(|r| r.step).map(|s| (s / sample).round().max(1.0) as usize);
         let stage = estimate_parameters(&mut start, frames, states, settings.intercept, step, options);
-        if in_place && !matches!(stage, ParameterStage::Kept(_)) {
-            // a stage that is not kept loses nothing: the start is refined as it would be
-            // without it
-            let (mut model, prepared) = (start.model.clone(), std::mem::take(&mut start.prepared));
-            refine_start(&mut start, &mut model, &prepared, None, settings);
-            (start.model, start.prepared) = (model, prepared);
-        }
         start.parameters = Some(stage);
     }
     Ok(start)
+}
+
+/// A start whose parameter stage, run in place of its refinement, was not kept, refined
+/// without the free parameters (the recipe does so where no start's stage is kept: a start
+/// refined with more free values re-simulates the runs better than one refined without).
+pub(super) fn refine_instead(start: &mut Start, settings: &RecipeSettings) {
+    let kept = matches!(start.parameters, Some(ParameterStage::Kept(_)));
+    if kept || start.refined.is_some() || start.rejected.is_some() || start.refine_error.is_some() {
+        return;
+    }
+    let (mut model, prepared) = (start.model.clone(), std::mem::take(&mut start.prepared));
+    refine_start(start, &mut model, &prepared, None, settings);
+    (start.model, start.prepared) = (model, prepared);
 }
 
 /// The output-error refinement of `start`'s `model` where asked: kept where it loses none of

@@ -145,7 +145,7 @@ impl Plugin for Manoeuvring {
         let rudder = if used > 0.0 { used.min(spec.rudder_limit) } else { spec.rudder_limit };
         match super::checks::physical_checks(model, rudder) {
             Ok(mut checks) => {
-                checks.extend(super::checks::steering_check(model, runs));
+                checks.extend(self.run_checks(model, runs));
                 checks
             }
             Err(e) => vec![Check {
@@ -156,6 +156,10 @@ impl Plugin for Manoeuvring {
                 measure: None,
             }],
         }
+    }
+
+    fn run_checks(&self, model: &Model, runs: &[Frame]) -> Vec<Check> {
+        super::checks::steering_check(model, runs).into_iter().collect()
     }
 
     fn hypotheses(&self, model: &Model) -> Option<Vec<Hypothesis>> {

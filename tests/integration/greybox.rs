@@ -1086,6 +1086,19 @@ fn the_recipe_refines_every_start_with_the_templates_free_parameters() {
     .unwrap();
     let kept = recipe.kept();
     assert!(kept.refined.is_some() && kept.parameters.is_some(), "{}", recipe.text());
+    // where no start's stage is kept (here each fails: a stopping fraction it refuses), every
+    // start is refined without the free parameters, and the stage's failure is reported
+    let failing = ParameterOptions { converged: 2.0, ..asked(None, true).unwrap() };
+    let recipe = identify(
+        &template,
+        &frames,
+        None,
+        &RecipeSettings { derivatives: vec!["kalman".into()], parameters: Some(failing), ..settings.clone() },
+    )
+    .unwrap();
+    let kept = recipe.kept();
+    assert!(matches!(kept.parameters, Some(ParameterStage::Failed(_))) && kept.refined.is_some());
+    assert!(recipe.text().contains("stopping fraction") && recipe.text().contains("output-error refinement"));
     // not asked: the refinement alone, the file's zero kept
     let recipe = identify(
         &template,
