@@ -1432,7 +1432,7 @@ class Model:
         estimated initial values moved in units of the records' noise; beyond 3 times a warning
         says the fit leans on them (the model does not explain everything the runs show).
         ``coarse`` fits at the coarsest step (up to 8 samples) at which the model's start
-        re-simulates the runs as at every sample, as the recipe's parameter stage does: on
+        re-simulates the runs as at every sample, as the recipe's refinement does: on
         finely sampled records several times faster (SIMMAN's 13 HSVA runs at 20 Hz: 21 s →
         4.5 s, every estimate within 0.32 standard errors); costs still at every sample, the
         fit's step in ``attrs["step_samples"]``.

@@ -1,9 +1,9 @@
 //! The recipe for a model identified from runs, as one call: several starts (one per
 //! derivative preparation), each identified or chosen among configurations by what it
-//! predicts, refined by output error and checked by its plug-in; the start kept that passes
-//! the checks and re-simulates best, its model file's free parameters estimated with its
-//! coefficients where asked; and, where the plausible starts disagree on a manoeuvre the runs
-//! did not cover, a flag saying that prediction is uncertain.
+//! predicts, refined by output error (with the model file's free parameters, where it declares
+//! any) and checked by its plug-in; the start kept that passes the checks and re-simulates
+//! best; and, where the plausible starts disagree on a manoeuvre the runs did not cover, a flag
+//! saying that prediction is uncertain.
 
 mod parameters;
 mod report;
