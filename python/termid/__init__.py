@@ -1338,7 +1338,8 @@ class Model:
         in ``derivatives`` (``smooth``: states smoothed by it), identified (or chosen among the
         back-ends ``choose`` by leave-one-run-out prediction of the states ``compare``),
         refined by output error on the states ``refine`` (None: no refinement; an empty list:
-        every state) with ``refine_iterations`` and the regression as a prior of weight
+        every state) with ``refine_iterations`` (in each of two rounds where the free parameters
+        are refined too) and the regression as a prior of weight
         ``refine_prior``, re-simulated at ``refine_step`` seconds (None: the coarsest step, up
         to 8 samples, at which the runs still hold their compared states and inputs; the costs
         are reported at every sample), stopped by ``held_out`` runs where given, checked by the model's

@@ -8,7 +8,7 @@ use crate::identify::{Fit, ModelIdentification};
 use crate::model::Model;
 use crate::plugin::Check;
 
-use super::parameters::{estimate_parameters, ParameterStage};
+use super::parameters::{estimate_parameters, ParameterOptions, ParameterStage};
 use super::{RecipeError, RecipeSettings, RefineOptions};
 
 /// One start: what one derivative method's preparation identified.
@@ -204,7 +204,13 @@ pub(super) fn identify_start(
         // at the refinement's step where it is given
         let sample = crate::data::sample_step(frames);
         let step = refine.and_then(|r| r.step).map(|s| (s / sample).round().max(1.0) as usize);
-        let stage = estimate_parameters(&mut start, frames, states, settings.intercept, step, options);
+        // in place of the refinement, as many iterations a round as the refinement was given
+        let iterations = match refine {
+            Some(r) if in_place => r.iterations,
+            _ => options.iterations,
+        };
+        let options = ParameterOptions { iterations, ..options.clone() };
+        let stage = estimate_parameters(&mut start, frames, states, settings.intercept, step, &options);
         start.parameters = Some(stage);
     }
     Ok(start)

@@ -1075,6 +1075,14 @@ fn the_recipe_refines_every_start_with_the_templates_free_parameters() {
         recipe.starts_text()
     );
     assert!(recipe.text().contains("output-error estimate of the free parameters"), "{}", recipe.text());
+    // in place of the refinement, the estimate takes the refinement's iterations a round
+    let short = RefineOptions { iterations: 1, ..settings.refine.clone().unwrap() };
+    let one = RecipeSettings { derivatives: vec!["kalman".into()], refine: Some(short), ..settings.clone() };
+    let recipe = identify(&template, &frames, None, &one).unwrap();
+    let Some(ParameterStage::Kept(fit) | ParameterStage::Rejected(fit, _)) = &recipe.kept().parameters else {
+        panic!("{}", recipe.text());
+    };
+    assert!(fit.iterations <= 2, "{} iterations in two rounds of one", fit.iterations);
     // runs that stop the refinement: it runs first, the stage after it
     let (train, held) = frames.split_at(frames.len() - 1);
     let recipe = identify(

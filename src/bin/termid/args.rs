@@ -306,7 +306,8 @@ pub struct IdentifyCommand {
         requires = "refine"
     )]
     pub refine_prior: f64,
-    /// With --refine: most Levenberg-Marquardt iterations (it stops earlier once converged).
+    /// With --refine: most Levenberg-Marquardt iterations (it stops earlier once converged; with
+    /// the model file's free parameters, in each of the estimate's two rounds).
     #[arg(allow_negative_numbers = true, long, value_name = "N", default_value_t = 30, requires = "refine")]
     pub refine_iterations: usize,
     /// With --refine: re-simulate and compare the runs at this step, s (resampled,
