@@ -864,8 +864,15 @@ impl PyModel {
             .iter()
             .enumerate()
             .map(|(k, s)| {
+                // how the start's free parameters fared, where they were refined with it
+                let parameters = s.parameters.as_ref().map(|p| match p {
+                    termid::recipe::ParameterStage::Kept(_) => "kept",
+                    termid::recipe::ParameterStage::Rejected(..) => "rejected",
+                    termid::recipe::ParameterStage::Failed(_) => "failed",
+                });
                 serde_json::json!({"derivative": s.derivative, "refused": s.refused(), "cost": s.cost(),
-                                   "kept": k == recipe.kept, "refine_error": s.refine_error})
+                                   "kept": k == recipe.kept, "refine_error": s.refine_error,
+                                   "parameters": parameters})
             })
             .collect();
         let json = serde_json::json!({

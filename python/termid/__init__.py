@@ -688,12 +688,14 @@ class Identified:
 
 class Recipe:
     """What :meth:`Model.recipe` returns: the kept ``model``, a DataFrame of the ``starts``
-    (derivative, refused checks, re-simulation cost, which is kept), the kept model's
+    (derivative, refused checks, re-simulation cost, which is kept, and ``parameters``: whether
+    its estimate with the model file's free parameters was ``"kept"``, ``"rejected"`` by the
+    checks or ``"failed"``, None where not run), the kept model's
     ``checks`` (with the starts' agreement: a failing one flags a prediction the runs
     cannot pin down), ``refusals`` (why it must not be written, if any), the ``report`` as
-    plain values and as ``text``, and the estimate of the model file's free ``parameters``
-    where asked for (the report's ``parameter_estimate``: each parameter, and under
-    ``per_source`` each source's; None where not asked for or not kept).
+    plain values and as ``text``, and the kept start's estimate of the model file's free
+    ``parameters`` (the report's ``parameter_estimate``: each parameter, and under
+    ``per_source`` each source's or run's; None where not run or not kept).
 
     >>> ship = termid.Model.default()
     >>> runs = [ship.simulate(m) for m in ("zigzag:20/20", "zigzag:10/10")]

@@ -378,6 +378,7 @@ def test_recipe_refines_with_the_templates_free_parameters_by_default():
     template = termid.Model.builtin("new_ship")
     found = template.recipe(runs, ["kalman"], refine=("u", "v", "r", "ψ"), refine_iterations=20)
     assert found.parameters is not None and "free parameters" in found.text, found.text
+    assert list(found.starts["parameters"]) == ["kept"], found.starts
     plain = template.recipe(runs, ["kalman"], refine=("u", "v", "r", "ψ"), refine_iterations=20, parameters=False)
     assert plain.parameters is None and "output-error refinement" in plain.text
     assert plain.model.parameters["δ_0"] == 0.0
