@@ -13,7 +13,7 @@ use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use termid::data::{CentralDifference, Frame};
 use termid::diagnose::{estimate, refine, EstimateSettings, RefineSettings, Runs};
 use termid::identify::{identify_model, ModelIdentification};
-use termid::recipe::{RecipeSettings, RefineOptions};
+use termid::recipe::{ParameterOptions, RecipeSettings, RefineOptions};
 use termid::select::Backend;
 use termid::ship::basin::{Basin, ZIGZAGS_BOTH_SIDES};
 use termid::sim::Integrator;
@@ -61,7 +61,8 @@ fn bench(c: &mut Criterion) {
 
     // the whole recipe on the same 13 records, as README's new-ship command runs it: four
     // derivative starts side by side, each choosing among four back-ends by leave-one-run-out
-    // prediction, refined and checked (issue 26's target: under 5 s for 13 runs)
+    // prediction, refined with each run's rudder zero (the template declares it free) and
+    // checked (issue 26's target: under 5 s for 13 runs)
     let ship = termid::plugins::load(Path::new("models/new_ship.toml")).unwrap();
     let settings = RecipeSettings {
         derivatives: ["kinematic", "kalman", "savitzky-golay", "central"].map(String::from).to_vec(),
@@ -78,6 +79,7 @@ fn bench(c: &mut Criterion) {
             iterations: 100,
             step: None,
         }),
+        parameters: ParameterOptions::asked(&ship, None, true, vec![], vec![], vec![]),
         ..Default::default()
     };
     let mut g = c.benchmark_group("recipe");
