@@ -126,7 +126,36 @@ pub fn physical_checks(model: &Model, rudder_deg: f64) -> Result<Vec<Check>, Shi
             detail: format!("drift angle {:.1}° at yaw rate {:.2} °/s", t.drift_angle_deg, t.yaw_rate_deg_s),
         });
     }
+    if rudder_deg < ship.spec.rudder_limit - 0.5 {
+        for side in [1.0, -1.0] {
+            checks.push(at_the_limit(&ship, &settings, side, rudder_deg));
+        }
+    }
     Ok(checks)
+}
+
+/// The turning circle at the rudder limit to one `side`, beyond the runs' largest angle
+/// `rudder_deg`: an extrapolation, flagged where it does not complete (not refused: the runs
+/// did not cover it), since the standard turning circle is what a user predicts next (a
+/// polynomial model from MARIN's four 20° zigzags turns its 20° circles and diverges at 35°).
+fn at_the_limit(ship: &Ship, settings: &Settings, side: f64, rudder_deg: f64) -> Check {
+    let limit = ship.spec.rudder_limit;
+    let angle = side * limit;
+    let name = format!(
+        "turning circle δ = {angle:+.0}° (the rudder limit, beyond the runs' {rudder_deg:.0}°) completes"
+    );
+    let run = Manoeuvre::parse(&format!("turning:{angle}")).and_then(|m| ship.run(&m, settings));
+    let (passed, detail) = match run {
+        Err(e) => (false, format!("the simulation fails: {e}")),
+        Ok(run) => match &run.metrics {
+            Metrics::Turning(t) => match t.tactical_diameter_m {
+                Some(d) => (true, format!("tactical diameter {d:.2} m = {:.2} L", d / ship.spec.lpp)),
+                None => (false, format!("no tactical diameter in {:.0} s", settings.duration)),
+            },
+            _ => (false, "not a turning circle".into()),
+        },
+    };
+    Check { name, passed, refuses: false, measure: None, detail }
 }
 
 /// The milder turns checked beside the hardest, as fractions of its rudder angle: a polynomial
@@ -250,7 +279,11 @@ mod tests {
         let model = crate::ship::default_model();
         let checks = physical_checks(&model, 30.0).unwrap();
         assert!(checks.iter().all(|c| c.passed || !c.refuses), "{checks:#?}");
-        assert_eq!(checks.iter().filter(|c| c.name.contains("completes")).count(), 2);
+        // at 30° about δ0 and, beyond the runs, at the rudder limit (35°): flagged, not refused
+        assert_eq!(checks.iter().filter(|c| c.name.contains("completes")).count(), 4);
+        let limit: Vec<&Check> = checks.iter().filter(|c| c.name.contains("the rudder limit")).collect();
+        assert!(limit.len() == 2 && limit.iter().all(|c| c.passed && !c.refuses), "{limit:#?}");
+        assert!(physical_checks(&model, 35.0).unwrap().iter().all(|c| !c.name.contains("the rudder limit")));
         // and the milder turns, at a third and two thirds of 30° to each side
         let milder: Vec<&Check> = checks.iter().filter(|c| c.name.ends_with("holds")).collect();
         assert_eq!(milder.len(), 4, "{checks:#?}");

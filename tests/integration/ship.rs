@@ -258,7 +258,11 @@ fn the_recipe_predicts_the_turning_circles_or_says_its_starts_disagree() {
     let truth = Ship::new(&termid::ship::default_model(), false).unwrap();
     let settings = Settings { integrator: Integrator::Rk4, dt: 0.05, duration: 300.0, sample: 0.05 };
     let mut sides = 0;
-    for line in checks.lines().filter(|l| l.contains("completes: tactical diameter")) {
+    // the circles at the runs' largest angle (those at the rudder limit, beyond the runs, are
+    // flagged where they fail, not compared)
+    let at_the_runs =
+        |l: &&str| l.contains("completes: tactical diameter") && !l.contains("the rudder limit");
+    for line in checks.lines().filter(at_the_runs) {
         // "ok   turning circle δ = -30.2° completes: tactical diameter 42.77 m = 9.36 L"
         let angle: f64 = line.split("δ = ").nth(1).unwrap().split('°').next().unwrap().parse().unwrap();
         let predicted: f64 =
