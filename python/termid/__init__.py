@@ -1349,7 +1349,8 @@ class Model:
         the plausible starts disagree on a turning circle. ``intercept`` as for
         :meth:`identify` (None: the model file's). ``parameters`` estimates the model file's
         free parameters with every coefficient of each start and each run's initial state, in
-        place of the refinement (after it where ``held_out`` runs stop it), kept where the
+        place of the refinement (with ``held_out`` runs, which stop only the refinement, after it
+        and only where asked with True), kept where the
         checks the start passed still pass, else the start is refined without them (a
         regression cannot estimate a parameter inside its terms, such as the new-ship
         template's rudder zero ``δ_0``, its own in every run): None (the default) where

@@ -916,7 +916,7 @@ impl Estimate {
         );
         if self.step_samples > 1 {
             out.push_str(&format!(
-                "fitted at a step of {} samples (the coarsest at which the start re-simulates the runs as at every sample); costs at every sample\n",
+                "fitted at a step of {} samples (the coarsest at which the start re-simulates the runs as at every sample, or the step asked for); costs at every sample\n",
                 self.step_samples
             ));
         }

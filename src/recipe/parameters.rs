@@ -26,6 +26,10 @@ pub struct ParameterOptions {
     /// A round ends at a step that lowers the cost by less than this fraction (as the
     /// refinement's: no prediction that matters moves by then).
     pub converged: f64,
+    /// Run because the model file declares free parameters, not because the caller asked:
+    /// where validation runs stop the refinement, they are not overruled by an estimate
+    /// after it that they cannot stop.
+    pub by_default: bool,
     /// How each run's initial values are estimated: by default held to the records' first
     /// samples by their noise, as the refinement before this stage started every run from its
     /// record. A library's structure is not the ship's, and free initial values then lean on
@@ -43,6 +47,7 @@ impl Default for ParameterOptions {
             per_run: vec![],
             iterations: 50,
             converged: 1e-3,
+            by_default: false,
             initial_values: InitialValues::Measured,
         }
     }
@@ -62,11 +67,12 @@ impl ParameterOptions {
         per_run: Vec<String>,
     ) -> Option<ParameterOptions> {
         let named = !per_source.is_empty() || !per_run.is_empty();
-        let run = match asked {
-            Some(asked) => asked || named,
-            None => named || (refined && !model.free_parameters().is_empty()),
+        let (run, by_default) = match asked {
+            Some(asked) => (asked || named, false),
+            None if named => (true, false),
+            None => (refined && !model.free_parameters().is_empty(), true),
         };
-        run.then(|| ParameterOptions { sources, per_source, per_run, ..Default::default() })
+        run.then(|| ParameterOptions { sources, per_source, per_run, by_default, ..Default::default() })
     }
 }
 

@@ -29,8 +29,8 @@ pub struct Start {
     /// A refinement that failed, why (the regression's model is kept).
     pub refine_error: Option<String>,
     /// The model file's free parameters estimated with the coefficients, where asked: in place
-    /// of the refinement (which runs only where validation runs stop it, or where no start's
-    /// stage is kept).
+    /// of the refinement (which runs only where validation runs stop it, the estimate then
+    /// after it where asked for explicitly, or where no start's stage is kept).
     pub parameters: Option<ParameterStage>,
     /// The physical checks of `model`.
     pub checks: Vec<Check>,
@@ -190,7 +190,7 @@ pub(super) fn identify_start(
         prepared: vec![],
     };
     // the free parameters with the coefficients are the refinement, but for validation runs,
-    // which only the refinement is stopped by (the estimate follows it there)
+    // which only the refinement is stopped by (the estimate follows it there where asked)
     let in_place = settings.parameters.is_some() && validation.is_none();
     start.checks = checks_of(&model, &prepared);
     if !in_place {
@@ -198,7 +198,9 @@ pub(super) fn identify_start(
     }
     start.model = model;
     start.prepared = prepared;
-    if let Some(options) = &settings.parameters {
+    // validation runs that stop the refinement are not overruled unasked
+    let stage = settings.parameters.as_ref().filter(|o| in_place || !o.by_default);
+    if let Some(options) = stage {
         let refine = settings.refine.as_ref();
         let states = refine.and_then(|r| r.states.as_deref());
         // at the refinement's step where it is given

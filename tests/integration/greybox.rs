@@ -1083,15 +1083,16 @@ fn the_recipe_refines_every_start_with_the_templates_free_parameters() {
         panic!("{}", recipe.text());
     };
     assert!(fit.iterations <= 2, "{} iterations in two rounds of one", fit.iterations);
-    // runs that stop the refinement: it runs first, the stage after it
+    // runs that stop the refinement: by default they are not overruled (the refinement alone);
+    // asked for, the estimate runs after the refinement
     let (train, held) = frames.split_at(frames.len() - 1);
-    let recipe = identify(
-        &template,
-        train,
-        Some(held),
-        &RecipeSettings { derivatives: vec!["kalman".into()], ..settings.clone() },
-    )
-    .unwrap();
+    let with_held = |parameters| {
+        let settings = RecipeSettings { derivatives: vec!["kalman".into()], parameters, ..settings.clone() };
+        identify(&template, train, Some(held), &settings).unwrap()
+    };
+    let recipe = with_held(asked(None, true));
+    assert!(recipe.kept().refined.is_some() && recipe.kept().parameters.is_none(), "{}", recipe.text());
+    let recipe = with_held(asked(Some(true), true));
     let kept = recipe.kept();
     assert!(kept.refined.is_some() && kept.parameters.is_some(), "{}", recipe.text());
     // where no start's stage is kept (here each fails: a stopping fraction it refuses), every

@@ -325,9 +325,10 @@ pub struct IdentifyCommand {
     /// with every coefficient of each start and each run's initial state, at the refinement's
     /// step; kept where the checks the start passed still pass (else the start is refined
     /// without them). A regression cannot estimate a parameter inside its terms. The default
-    /// with --refine where the model file declares free parameters (then in place of the
-    /// refinement, but for --refine-validation runs, which stop the refinement first); this
-    /// flag asks for it without --refine too.
+    /// with --refine where the model file declares free parameters, in place of the
+    /// refinement (not with --refine-validation runs, which stop the refinement and which the
+    /// estimate cannot heed); this flag asks for it without --refine too, and after a
+    /// refinement that --refine-validation runs stop.
     #[arg(long, requires = "model", conflicts_with = "no_parameters")]
     pub parameters: bool,
     /// With --refine: refine the coefficients alone, the model file's free parameters kept at
