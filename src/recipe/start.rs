@@ -50,12 +50,10 @@ impl Start {
     /// the validation runs' where there are any.
     pub fn costs(&self) -> (f64, Option<f64>) {
         let refined = |r: &Refined| r.validation.unwrap_or((r.cost_before, r.cost_after));
+        // validation runs judge the refinement they stopped, which a stage after it cannot see
+        let validated = self.refined.as_ref().is_some_and(|r| r.validation.is_some());
         match (&self.parameters, &self.refined, &self.rejected) {
-            (_, Some(r), _) if r.validation.is_some() => {
-                let (before, after) = refined(r);
-                (before, Some(after))
-            }
-            (Some(ParameterStage::Kept(e)), ..) => (e.cost_before, Some(e.cost_after)),
+            (Some(ParameterStage::Kept(e)), ..) if !validated => (e.cost_before, Some(e.cost_after)),
             (_, Some(r), _) => {
                 let (before, after) = refined(r);
                 (before, Some(after))

@@ -1,10 +1,11 @@
 //! Physical checks of an identified ship model, made before it is written: the sway and yaw
 //! damping at the straight run have the signs every hull has, turning circles at the rudder
 //! angles the training runs used complete, and in them the ship slows down (but keeps some
-//! speed) and drifts with its bow inside the circle; milder turns hold too. A regression that fits zigzags well can
-//! still fail these (a model that turns 60° and then turns back), and such a model must not be
-//! written silently. Straight-line stability is reported, not required: some full-form hulls
-//! are course-unstable.
+//! speed) and drifts with its bow inside the circle; milder turns hold too. A regression that
+//! fits zigzags well can still fail these (a model that turns 60° and then turns back), and
+//! such a model must not be written silently. Straight-line stability is reported, not
+//! required: some full-form hulls are course-unstable; nor is the circle at the rudder limit
+//! where the runs stayed below it (flagged).
 
 use super::manoeuvre::ZigZag;
 use super::observed::{observe, observe_run, SteeringGear, ZigZagShape};
@@ -86,9 +87,7 @@ pub fn physical_checks(model: &Model, rudder_deg: f64) -> Result<Vec<Check>, Shi
                 continue;
             }
         };
-        let psi = &run.trajectory.states[r.psi];
-        let turned = psi.iter().map(|p| (p - psi[0]).abs()).fold(0.0, f64::max).to_degrees();
-        let end = (psi[psi.len() - 1] - psi[0]).abs().to_degrees();
+        let (turned, end) = turned_and_end(&run.trajectory.states[r.psi]);
         checks.push(Check {
             name: format!("{label} completes"),
             passed: t.tactical_diameter_m.is_some(),
@@ -174,9 +173,7 @@ fn milder_turn(ship: &Ship, settings: &Settings, delta0_deg: f64, rudder_deg: f6
     let (passed, detail) = match run {
         Err(e) => (false, format!("the simulation fails: {e}")),
         Ok(run) => {
-            let psi = &run.trajectory.states[ship.roles.psi];
-            let turned = psi.iter().map(|p| (p - psi[0]).abs()).fold(0.0, f64::max).to_degrees();
-            let end = (psi[psi.len() - 1] - psi[0]).abs().to_degrees();
+            let (turned, end) = turned_and_end(&run.trajectory.states[ship.roles.psi]);
             if end + 1.0 < turned {
                 (
                     false,
@@ -188,6 +185,14 @@ fn milder_turn(ship: &Ship, settings: &Settings, delta0_deg: f64, rudder_deg: f6
         }
     };
     Check { name, passed, refuses: true, measure: None, detail }
+}
+
+/// How far a heading turned at most and where it ended, degrees from its start: a turn that
+/// ends short of its most turned back.
+fn turned_and_end(psi: &[f64]) -> (f64, f64) {
+    let turned = psi.iter().map(|p| (p - psi[0]).abs()).fold(0.0, f64::max).to_degrees();
+    let end = (psi[psi.len() - 1] - psi[0]).abs().to_degrees();
+    (turned, end)
 }
 
 /// Each training zigzag steered by the model itself from the record's approach speed, the
