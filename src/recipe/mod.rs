@@ -89,6 +89,14 @@ pub struct RefineOptions {
     pub step: Option<f64>,
 }
 
+impl RefineOptions {
+    /// The step asked for, in whole samples of `frames` (at least one); `None`: not asked.
+    fn samples_per_step(&self, frames: &[Frame]) -> Option<usize> {
+        let sample = crate::data::sample_step(frames);
+        self.step.map(|step| (step / sample).round().max(1.0) as usize)
+    }
+}
+
 /// How closely the model must re-simulate the runs at the refinement's step as at their
 /// samples where the step is not given: a thousandth of each compared state's spread (RMS),
 /// far below any re-simulation error a refinement is about.

@@ -202,8 +202,7 @@ pub(super) fn identify_start(
         let refine = settings.refine.as_ref();
         let states = refine.and_then(|r| r.states.as_deref());
         // at the refinement's step where it is given
-        let sample = crate::data::sample_step(frames);
-        let step = refine.and_then(|r| r.step).map(|s| (s / sample).round().max(1.0) as usize);
+        let step = refine.and_then(|r| r.samples_per_step(frames));
         // in place of the refinement, as many iterations a round as the refinement was given
         let iterations = match refine {
             Some(r) if in_place => r.iterations,
@@ -309,11 +308,8 @@ fn refine(
     // the regression's model at every sample: what the step is checked against, and the cost
     // reported before the refinement
     let fine = runs.simulate(model, &[], &[]).map_err(|e| e.to_string())?;
-    let (factor, coarse) = match options.step {
-        Some(step) => {
-            let factor = (step / sample).round().max(1.0) as usize;
-            (factor, runs.coarser(factor).map_err(|e| e.to_string())?)
-        }
+    let (factor, coarse) = match options.samples_per_step(frames) {
+        Some(factor) => (factor, runs.coarser(factor).map_err(|e| e.to_string())?),
         None => runs.coarsest(model, &fine, super::RESOLVED, super::MOST_SAMPLES_PER_STEP),
     };
     let coarse_validation =

@@ -12,7 +12,7 @@ use crate::args::{Format, IdentifyCommand};
 use crate::identify::{configure_backend, intercept_of};
 
 /// The parameter stage as the command asks for it: on, off, or as the model file says.
-pub fn asked_parameters(cmd: &IdentifyCommand) -> Option<bool> {
+fn asked_parameters(cmd: &IdentifyCommand) -> Option<bool> {
     match (cmd.parameters, cmd.no_parameters) {
         (true, _) => Some(true),
         (_, true) => Some(false),
