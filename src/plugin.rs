@@ -251,6 +251,93 @@ pub struct Observation {
     pub note: Option<String>,
 }
 
+/// One metric of one run, read off its record and off a simulation of that run alike (a fit's
+/// re-simulation, a prediction): what a report sets side by side.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct MetricPair {
+    /// The run (its file, as the frame's origin says).
+    pub run: String,
+    /// The metric's key (`first_overshoot_deg`; its unit in the suffix, [`metric_label`]).
+    pub metric: String,
+    /// Read off the record.
+    pub measured: f64,
+    /// Read off the simulation.
+    pub simulated: f64,
+}
+
+/// Every metric `plugin` reads off both a run's record and `sims`' simulation of it (the runs
+/// in order, one simulation each).
+pub fn metric_pairs(
+    plugin: &dyn Plugin,
+    model: &Model,
+    frames: &[Frame],
+    sims: &[Trajectory],
+) -> Vec<MetricPair> {
+    let mut pairs = Vec::new();
+    for (frame, sim) in frames.iter().zip(sims) {
+        let (Some(measured), Some(simulated)) =
+            (plugin.observe(model, frame, None), plugin.observe(model, frame, Some(sim)))
+        else {
+            continue;
+        };
+        for ((_, key, m), (_, _, s)) in measured.rows.iter().zip(&simulated.rows) {
+            if let (Some(m), Some(s)) = (m, s) {
+                pairs.push(MetricPair {
+                    run: frame.origin().to_string(),
+                    metric: key.clone(),
+                    measured: *m,
+                    simulated: *s,
+                });
+            }
+        }
+    }
+    pairs
+}
+
+/// `pairs` as lines of text, a run a line (`name: first overshoot 11.35° → 10.47° (−0.88°), …`:
+/// measured → simulated, the difference), and the largest difference of each metric.
+pub fn metric_pairs_text(pairs: &[MetricPair]) -> String {
+    let mut text = String::new();
+    let mut runs: Vec<&str> = pairs.iter().map(|p| p.run.as_str()).collect();
+    runs.dedup();
+    for run in &runs {
+        let cells: Vec<String> = pairs
+            .iter()
+            .filter(|p| p.run == *run)
+            .map(|p| {
+                let (name, unit, d) = metric_label(&p.metric);
+                format!(
+                    "{name} {:.d$}{unit} → {:.d$}{unit} ({:+.d$}{unit})",
+                    p.measured,
+                    p.simulated,
+                    p.simulated - p.measured
+                )
+            })
+            .collect();
+        let name = std::path::Path::new(run).file_name().map_or(*run, |n| n.to_str().unwrap_or(run));
+        text += &format!("  {name}: {}\n", cells.join(", "));
+    }
+    let mut metrics: Vec<&str> = pairs.iter().map(|p| p.metric.as_str()).collect();
+    metrics.sort_unstable();
+    metrics.dedup();
+    for metric in metrics {
+        let worst = pairs
+            .iter()
+            .filter(|p| p.metric == metric)
+            .max_by(|a, b| (a.simulated - a.measured).abs().total_cmp(&(b.simulated - b.measured).abs()));
+        if let Some(p) = worst {
+            let (name, unit, d) = metric_label(metric);
+            let run =
+                std::path::Path::new(&p.run).file_name().map_or(p.run.as_str(), |n| n.to_str().unwrap_or(""));
+            text += &format!(
+                "  largest difference of the {name}: {:+.d$}{unit} ({run})\n",
+                p.simulated - p.measured
+            );
+        }
+    }
+    text
+}
+
 /// A metric's key (its last `.`-part, where nested) as a person reads it: its name in words,
 /// its unit (from the key's suffix: `_deg_s`, `_deg`, `_s`, `_m`, `_lpp`, `_percent`) and the
 /// decimals that mean something at the sampling of a simulation (0.01°, 0.01 s, 0.01 m, 0.1 %).
@@ -274,7 +361,30 @@ pub fn metric_label(key: &str) -> (String, &'static str, usize) {
 
 #[cfg(test)]
 mod tests {
-    use super::metric_label;
+    use super::{metric_label, metric_pairs_text, MetricPair};
+
+    #[test]
+    fn metric_pairs_read_a_run_a_line_and_the_largest_difference() {
+        let pair = |run: &str, metric: &str, measured: f64, simulated: f64| MetricPair {
+            run: run.into(),
+            metric: metric.into(),
+            measured,
+            simulated,
+        };
+        let text = metric_pairs_text(&[
+            pair("/basin/z1.dat", "first_overshoot_deg", 11.35, 10.49),
+            pair("/basin/z1.dat", "second_overshoot_deg", 13.04, 14.02),
+            pair("/basin/z2.dat", "first_overshoot_deg", 9.0, 11.5),
+        ]);
+        assert_eq!(
+            text,
+            "  z1.dat: first overshoot 11.35° → 10.49° (-0.86°), second overshoot 13.04° → 14.02° (+0.98°)\n\
+             \x20 z2.dat: first overshoot 9.00° → 11.50° (+2.50°)\n\
+             \x20 largest difference of the first overshoot: +2.50° (z2.dat)\n\
+             \x20 largest difference of the second overshoot: +0.98° (z1.dat)\n"
+        );
+        assert_eq!(metric_pairs_text(&[]), "");
+    }
 
     #[test]
     fn metric_keys_read_as_words_with_units() {

@@ -13,6 +13,20 @@ pub fn of(model: &Model) -> Option<&'static dyn Plugin> {
     PLUGINS.iter().copied().find(|p| model.spec().plugins.contains_key(p.table()))
 }
 
+/// How a grey-box fit reproduces what the model's plug-in reads off each of its runs (a ship's
+/// overshoots, its tactical diameter): each run's record beside the fit's re-simulation
+/// ([`crate::diagnose::Estimate::re_simulated`]); empty for a model no plug-in owns. A
+/// structure can fit the runs' time series in the mean and still miss the numbers a manoeuvre
+/// is judged by.
+pub fn fit_metrics(
+    fit: &crate::diagnose::Estimate,
+    runs: &crate::diagnose::Runs,
+) -> Result<Vec<crate::plugin::MetricPair>, crate::sim::SimError> {
+    let Some(plugin) = of(&fit.model) else { return Ok(vec![]) };
+    let sims = fit.re_simulated(runs)?;
+    Ok(crate::plugin::metric_pairs(plugin, &fit.model, runs.frames(), &sims))
+}
+
 /// The plug-in that adds derivative method `name`.
 pub fn with_derivative(name: &str) -> Option<&'static dyn Plugin> {
     PLUGINS.iter().copied().find(|p| p.derivative_methods().contains(&name))

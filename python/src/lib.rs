@@ -923,17 +923,23 @@ impl PyModel {
             coarsest: coarse.then_some((termid::recipe::RESOLVED, termid::recipe::MOST_SAMPLES_PER_STEP)),
             ..Default::default()
         };
-        let fit = py
+        let (fit, metrics) = py
             .detach(|| -> Result<_, termid::diagnose::DiagnoseError> {
                 let mut runs =
                     termid::diagnose::Runs::new(&self.inner, &frames, dt, termid::sim::Integrator::Rk4)?;
                 if let Some(names) = &states {
                     runs = runs.comparing(names)?;
                 }
-                termid::diagnose::estimate(&self.inner, &runs, &settings)
+                let fit = termid::diagnose::estimate(&self.inner, &runs, &settings)?;
+                // a fit whose estimates do not re-simulate every run has no metrics to show
+                let metrics = termid::plugins::fit_metrics(&fit, &runs).unwrap_or_default();
+                Ok((fit, metrics))
             })
             .map_err(fail)?;
-        Ok((to_json(&fit)?, PyModel { inner: fit.model }))
+        let serialise = |e: serde_json::Error| refuse(format!("could not serialise: {e}"));
+        let mut report = serde_json::to_value(&fit).map_err(serialise)?;
+        report["metrics"] = serde_json::to_value(&metrics).map_err(serialise)?;
+        Ok((report.to_string(), PyModel { inner: fit.model }))
     }
 
     /// The plug-in's physical checks (JSON list: name, passed, refuses, detail).

@@ -1439,7 +1439,12 @@ class Model:
         re-simulates the runs as at every sample, as the recipe's refinement does: on
         finely sampled records several times faster (SIMMAN's 13 HSVA runs at 20 Hz: 21 s →
         4.5 s, every estimate within 0.32 standard errors); costs still at every sample, the
-        fit's step in ``attrs["step_samples"]``.
+        fit's step in ``attrs["step_samples"]``. For a ship, ``attrs["metrics"]`` sets what
+        its plug-in reads off each run (first and second overshoot, tactical diameter) as
+        measured beside the fit's re-simulation (the estimates, each run's own values and
+        estimated initial state): a DataFrame of ``run``, ``metric``, ``measured`` and
+        ``simulated``, empty for other models. A structure that fits the time series in the
+        mean may still miss the numbers a manoeuvre is judged by.
 
         >>> nomoto = termid.Model.builtin("nomoto")
         >>> truth = termid.Model.builtin("nomoto")
@@ -1489,6 +1494,7 @@ class Model:
             "one_value": pd.DataFrame(report.get("one_value", []), columns=["name", "per", "runs", "mean", "sd", "chi_square", "p_value"]),
             "held_again": report.get("held_again"),
             "step_samples": report.get("step_samples", 1),
+            "metrics": pd.DataFrame(report.get("metrics", []), columns=["run", "metric", "measured", "simulated"]),
         }
         leaning = report.get("from_records") or {}
         if leaning.get("leans"):

@@ -296,6 +296,24 @@ def test_estimate_recovers_nomoto_k_and_t_from_a_noisy_run():
         termid.Model.builtin("lorenz").estimate(run.rename(columns={"ψ": "x", "r": "y", "δ": "z"}))
 
 
+def test_estimate_reads_a_ships_metrics_off_its_fit():
+    """For a ship, ``attrs["metrics"]``: each run's overshoots measured beside the fit's
+    re-simulation; the MMG model's rudder wake ratio ε started 25 % low and estimated from
+    its own noise-free zigzag: the fit's overshoots are the record's."""
+    truth = termid.Model.builtin("mmg_kvlcc2")
+    run = truth.record("zigzag:20/20", truth=True, duration=80.0)
+    text = truth.to_toml().replace('[parameters."ε"]\nvalue = 1.09\n', '[parameters."ε"]\nvalue = 0.82\nfree = true\n')
+    table, _ = termid.Model.from_toml(text).estimate(run)
+    assert abs(table.loc["ε", "estimate"] - 1.09) < 0.01, table
+    metrics = table.attrs["metrics"].set_index("metric")
+    assert {"first_overshoot_deg", "second_overshoot_deg"} <= set(metrics.index), metrics
+    assert ((metrics["simulated"] - metrics["measured"]).abs() < 0.05).all(), metrics
+    # no plug-in owns the Nomoto model: no metrics
+    nomoto = termid.Model.builtin("nomoto")
+    step = nomoto.simulate(duration=20.0, inputs={"δ": 0.1}, sample=0.1)[["t", "ψ", "r", "δ"]]
+    assert nomoto.estimate(step)[0].attrs["metrics"].empty
+
+
 def test_estimate_per_run():
     """A parameter estimated once per run: each run's own value in ``attrs["per_source"]``
     (named by its run), the model holding their mean, ``attrs["per_run"]`` their spread."""

@@ -206,6 +206,9 @@ pub struct Estimate {
     pub covariance: Option<Vec<Vec<f64>>>,
     /// How many runs' initial values were estimated with them.
     pub initial_values: usize,
+    /// Those estimated initial values: (run, state index in the model's system, value).
+    #[serde(skip)]
+    pub initial_states: Vec<(usize, usize, f64)>,
     /// Where initial values were estimated: the estimated model re-simulated from each run's
     /// recorded first sample instead, as a prediction starts.
     pub from_records: Option<FromRecords>,
@@ -876,6 +879,10 @@ fn fit(
         coefficients,
         covariance: matrix,
         initial_values: u.initial.len(),
+        initial_states: {
+            let first = u.first_group() + u.groups.len();
+            u.initial.iter().zip(&theta[first..]).map(|(&(r, i), &v)| (r, i, v)).collect()
+        },
         from_records,
         per_source,
         per_run,
@@ -896,6 +903,18 @@ fn data_weight(runs: &Runs, residuals: &[f64], k: usize) -> (f64, Option<f64>) {
 }
 
 impl Estimate {
+    /// `runs` (those fitted, at every sample) re-simulated as the fit has them: with the
+    /// estimates, each run with its own values of what was estimated per run or per source, from
+    /// its estimated initial state (its recorded first sample where that was not estimated).
+    pub fn re_simulated(&self, runs: &Runs) -> Result<Vec<crate::sim::Trajectory>, crate::sim::SimError> {
+        let own: Vec<(usize, &str, f64)> = self
+            .per_source
+            .iter()
+            .flat_map(|p| p.runs.iter().map(move |&r| (r, p.name.as_str(), p.value)))
+            .collect();
+        runs.with_initial(&self.initial_states, &own).simulate(&self.model, &[], &[])
+    }
+
     /// Whether any value was estimated per source (the report numbers the sources, so a
     /// caller names them).
     pub fn per_source_values(&self) -> bool {

@@ -206,6 +206,11 @@ impl Runs {
         &self.states
     }
 
+    /// The runs' records.
+    pub fn frames(&self) -> &[Frame] {
+        &self.frames
+    }
+
     /// Number of runs.
     pub fn len(&self) -> usize {
         self.frames.len()

@@ -54,6 +54,14 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
     );
     let fit = crate::progress::with_spinner(&label, || estimate(&model, &runs, &settings))
         .context("estimating the free parameters")?;
+    // what a plug-in reads off each run, measured and as the fit re-simulates it
+    let metrics = match termid::plugins::fit_metrics(&fit, &runs) {
+        Ok(m) => m,
+        Err(e) => {
+            eprintln!("warning: no metrics of the fit: the estimates do not re-simulate every run: {e}");
+            vec![]
+        }
+    };
     let mut outputs = termid::output::Outputs::new();
     if let Some(out) = &cmd.out {
         outputs.file(out, fit.model.to_toml().as_bytes())?;
@@ -92,9 +100,17 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
         eprintln!("warning: {}", c.line());
     }
     match cmd.format {
-        Format::Json => println!("{}", serde_json::to_string_pretty(&fit)?),
+        Format::Json => {
+            let mut report = serde_json::to_value(&fit)?;
+            report["metrics"] = serde_json::to_value(&metrics)?;
+            println!("{}", serde_json::to_string_pretty(&report)?)
+        }
         Format::Text => {
             print!("{}", fit.text());
+            if !metrics.is_empty() {
+                println!("== each run's metrics: measured → as the fit re-simulates it (the estimates, the run's own values and initial state) ==");
+                print!("{}", termid::plugin::metric_pairs_text(&metrics));
+            }
             if !agreement.is_empty() {
                 println!(
                     "== against {} ==",
@@ -118,22 +134,17 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
     Ok(())
 }
 
-/// A figure per run: the compared states measured, simulated with the model's values and
-/// with the estimates, each from the run's first sample (the estimated initial states are
-/// nuisances of the fit) and each source or run with its own values.
+/// A figure per run: the compared states measured, simulated with the model's values from the
+/// run's first sample, and as the fit re-simulates them (the estimates, each source's or run's
+/// own values, the estimated initial state).
 fn figures(
     model: &termid::model::Model,
     fit: &termid::diagnose::Estimate,
     runs: &Runs,
     frames: &[termid::data::Frame],
 ) -> Result<Vec<(String, termid::plot::Figure)>> {
-    let own: Vec<(usize, &str, f64)> = fit
-        .per_source
-        .iter()
-        .flat_map(|p| p.runs.iter().map(move |&r| (r, p.name.as_str(), p.value)))
-        .collect();
     let before = runs.simulate(model, &[], &[])?;
-    let after = runs.with_initial(&[], &own).simulate(&fit.model, &[], &[])?;
+    let after = fit.re_simulated(runs)?;
     let plane = termid::plugins::of(model).and_then(|p| p.plane(model));
     Ok(termid::plot::comparison_figures(
         model,
