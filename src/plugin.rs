@@ -306,6 +306,7 @@ pub fn metric_pairs_text(pairs: &[MetricPair]) -> String {
             .filter(|p| p.run == *run)
             .map(|p| {
                 let (name, unit, d) = metric_label(&p.metric);
+                let unit = spaced(unit);
                 format!(
                     "{name} {:.d$}{unit} → {:.d$}{unit} ({:+.d$}{unit})",
                     p.measured,
@@ -327,6 +328,7 @@ pub fn metric_pairs_text(pairs: &[MetricPair]) -> String {
             .max_by(|a, b| (a.simulated - a.measured).abs().total_cmp(&(b.simulated - b.measured).abs()));
         if let Some(p) = worst {
             let (name, unit, d) = metric_label(metric);
+            let unit = spaced(unit);
             let run =
                 std::path::Path::new(&p.run).file_name().map_or(p.run.as_str(), |n| n.to_str().unwrap_or(""));
             text += &format!(
@@ -336,6 +338,16 @@ pub fn metric_pairs_text(pairs: &[MetricPair]) -> String {
         }
     }
     text
+}
+
+/// A unit as it follows a number: degrees close up (`9.32°`), the rest after a space
+/// (`21.45 m`).
+fn spaced(unit: &str) -> String {
+    if unit.is_empty() || unit.starts_with('°') {
+        unit.to_string()
+    } else {
+        format!(" {unit}")
+    }
 }
 
 /// A metric's key (its last `.`-part, where nested) as a person reads it: its name in words,
@@ -375,13 +387,16 @@ mod tests {
             pair("/basin/z1.dat", "first_overshoot_deg", 11.35, 10.49),
             pair("/basin/z1.dat", "second_overshoot_deg", 13.04, 14.02),
             pair("/basin/z2.dat", "first_overshoot_deg", 9.0, 11.5),
+            pair("/basin/t.dat", "tactical_diameter_m", 21.12, 21.11),
         ]);
         assert_eq!(
             text,
             "  z1.dat: first overshoot 11.35° → 10.49° (-0.86°), second overshoot 13.04° → 14.02° (+0.98°)\n\
              \x20 z2.dat: first overshoot 9.00° → 11.50° (+2.50°)\n\
+             \x20 t.dat: tactical diameter 21.12 m → 21.11 m (-0.01 m)\n\
              \x20 largest difference of the first overshoot: +2.50° (z2.dat)\n\
-             \x20 largest difference of the second overshoot: +0.98° (z1.dat)\n"
+             \x20 largest difference of the second overshoot: +0.98° (z1.dat)\n\
+             \x20 largest difference of the tactical diameter: -0.01 m (t.dat)\n"
         );
         assert_eq!(metric_pairs_text(&[]), "");
     }
