@@ -315,8 +315,7 @@ pub fn metric_pairs_text(pairs: &[MetricPair]) -> String {
                 )
             })
             .collect();
-        let name = std::path::Path::new(run).file_name().map_or(*run, |n| n.to_str().unwrap_or(run));
-        text += &format!("  {name}: {}\n", cells.join(", "));
+        text += &format!("  {}: {}\n", file_name(run), cells.join(", "));
     }
     let mut metrics: Vec<&str> = pairs.iter().map(|p| p.metric.as_str()).collect();
     metrics.sort_unstable();
@@ -329,15 +328,19 @@ pub fn metric_pairs_text(pairs: &[MetricPair]) -> String {
         if let Some(p) = worst {
             let (name, unit, d) = metric_label(metric);
             let unit = spaced(unit);
-            let run =
-                std::path::Path::new(&p.run).file_name().map_or(p.run.as_str(), |n| n.to_str().unwrap_or(""));
             text += &format!(
-                "  largest difference of the {name}: {:+.d$}{unit} ({run})\n",
-                p.simulated - p.measured
+                "  largest difference of the {name}: {:+.d$}{unit} ({})\n",
+                p.simulated - p.measured,
+                file_name(&p.run)
             );
         }
     }
     text
+}
+
+/// A run's file without its folder, as a report names it.
+fn file_name(run: &str) -> &str {
+    std::path::Path::new(run).file_name().and_then(|n| n.to_str()).unwrap_or(run)
 }
 
 /// A unit as it follows a number: degrees close up (`9.32°`), the rest after a space

@@ -931,14 +931,17 @@ impl PyModel {
                     runs = runs.comparing(names)?;
                 }
                 let fit = termid::diagnose::estimate(&self.inner, &runs, &settings)?;
-                // a fit whose estimates do not re-simulate every run has no metrics to show
-                let metrics = termid::plugins::fit_metrics(&fit, &runs).unwrap_or_default();
+                // a fit whose estimates do not re-simulate every run has no metrics, and says why
+                let metrics = termid::plugins::fit_metrics(&fit, &runs).map_err(|e| e.to_string());
                 Ok((fit, metrics))
             })
             .map_err(fail)?;
         let serialise = |e: serde_json::Error| refuse(format!("could not serialise: {e}"));
         let mut report = serde_json::to_value(&fit).map_err(serialise)?;
-        report["metrics"] = serde_json::to_value(&metrics).map_err(serialise)?;
+        match metrics {
+            Ok(metrics) => report["metrics"] = serde_json::to_value(&metrics).map_err(serialise)?,
+            Err(why) => report["metrics_failed"] = why.into(),
+        }
         Ok((report.to_string(), PyModel { inner: fit.model }))
     }
 

@@ -1496,6 +1496,11 @@ class Model:
             "step_samples": report.get("step_samples", 1),
             "metrics": pd.DataFrame(report.get("metrics", []), columns=["run", "metric", "measured", "simulated"]),
         }
+        if report.get("metrics_failed"):
+            warnings.warn(
+                f"termid: no metrics of the fit: the estimates do not re-simulate every run: {report['metrics_failed']}",
+                stacklevel=2,
+            )
         leaning = report.get("from_records") or {}
         if leaning.get("leans"):
             # a fit whose initial values absorb what the model does not explain: its cost says
