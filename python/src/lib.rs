@@ -796,6 +796,7 @@ impl PyModel {
         let json = serde_json::json!({
             "location": d.location, "effect": effect, "gap_before": d.gap_before,
             "gap_after": d.gap_after, "candidates": d.candidates,
+            "own_values": d.own_values, "one_value": d.one_value,
         });
         Ok((to_json(&json)?, d.model.map(|inner| PyModel { inner })))
     }

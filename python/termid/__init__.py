@@ -1289,9 +1289,12 @@ class Model:
         a DataFrame of every run's and state's error before and after the effect (columns
         ``rms_before``, ``max_before``, ``rms_after``, ``max_after``), with ``attrs`` holding
         ``location`` (its words, leading state, onset), ``effect`` and ``candidates`` (a
-        DataFrame of the effects tried); and the model with the effect, or None. ``raw``:
-        the report as plain values; ``dt``, ``integrator``, ``with_intercept`` as for
-        :meth:`simulate`.
+        DataFrame of the effects tried); and the model with the effect, or None. Where the
+        model file declares nuisances of each run or source (a rudder indicator's zero,
+        ``nuisance = "run"``), each run is diagnosed with its own values, estimated first with
+        the rest of the model held: ``attrs["own_values"]`` (a DataFrame of ``name``, ``run``,
+        ``value``, ``std_error``; empty where none). ``raw``: the report as plain values;
+        ``dt``, ``integrator``, ``with_intercept`` as for :meth:`simulate`.
 
         >>> ship = termid.Model.default()
         >>> gaps, repaired = ship.diagnose(ship.record("zigzag:20/20", truth=True))
@@ -1313,6 +1316,7 @@ class Model:
             "candidates": pd.DataFrame(
                 [{k: v for k, v in c.items() if k in ("name", "explained", "delta_bic", "cost", "declared")} for c in report.get("candidates", [])]
             ),
+            "own_values": pd.DataFrame(report.get("own_values", []), columns=["name", "run", "value", "std_error"]),
         }
         return before, model
 

@@ -101,6 +101,68 @@ def test_checks_and_diagnose(ship, zigzags):
     assert "gap_before" in raw
 
 
+NOMOTO_ZERO = """
+[model]
+name = "Nomoto, the indicator's zero its own in each run"
+intercept = false
+[simulation]
+method = "rk4"
+dt = 0.05
+[[states]]
+name = "ψ"
+unit = "rad"
+[[states]]
+name = "r"
+unit = "rad/s"
+[[inputs]]
+name = "δ"
+unit = "rad"
+[parameters.K]
+value = 0.15
+unit = "1/s"
+[parameters.T]
+value = 8.0
+unit = "s"
+[parameters."δ_0"]
+value = 0.0
+unit = "rad"
+free = true
+nuisance = "run"
+[equations.psi_dot]
+state = "ψ"
+identify = false
+coefficients = { "r" = 1.0 }
+[equations.r_dot]
+state = "r"
+identify = false
+coefficients = { "K*(δ - δ_0)/T" = 1.0, "r/T" = -1.0 }
+"""
+
+
+def test_diagnose_each_run_with_its_own_nuisances():
+    """A Nomoto ship whose rudder indicator's zero, declared a nuisance of each run, is 1.5°
+    off one way in one run and the other way in the next: diagnosed with each run's own zero,
+    found first (``attrs["own_values"]``), and nothing claimed for what the zeros explain."""
+    declared = termid.Model.from_toml(NOMOTO_ZERO)
+    t = np.arange(0.0, 120.0, 0.1)
+    rudder = np.where((t // 20) % 2 == 0, 0.2, -0.2)
+    rng = np.random.default_rng(5)
+    runs = []
+    for offset in (1.5, -1.5):
+        truth = termid.Model.from_toml(NOMOTO_ZERO)
+        truth.set_parameter("δ_0", np.radians(offset))
+        run = truth.replay(pd.DataFrame({"t": t, "ψ": 0.0, "r": 0.0, "δ": rudder}))[0][["t", "ψ", "r"]].assign(δ=rudder)
+        run["ψ"] += np.radians(0.1) * rng.standard_normal(len(run))
+        runs.append(run)
+    gaps, repaired = declared.diagnose(runs)
+    own = np.degrees(gaps.attrs["own_values"]["value"].to_numpy())
+    assert len(own) == 2 and abs(own[0] - 1.5) < 0.1 and abs(own[1] + 1.5) < 0.1, gaps.attrs["own_values"]
+    assert gaps.attrs["effect"] is None and repaired is None
+    # the Nomoto file declares no nuisance: none estimated
+    plain, _ = termid.Model.builtin("nomoto").diagnose(runs[0])
+    assert plain.attrs["own_values"].empty
+
+
 def test_basin_records_are_noisy_and_seeded(ship):
     a = ship.record("zigzag:20/20", seed=3, duration=40.0)
     b = ship.record("zigzag:20/20", seed=3, duration=40.0)

@@ -181,12 +181,58 @@ pub struct Diagnosis {
     /// Why the winner's model was not kept: the runs on which it made the leading state's
     /// error grow (run, before, after).
     pub rejected: Option<Vec<(String, f64, f64)>>,
+    /// The nuisances the model file declares of each run or source (a rudder indicator's
+    /// zero, `nuisance = "run"`), estimated first with the rest of the model held: the runs
+    /// are diagnosed each with its own values (empty where the file declares none).
+    pub own_values: Vec<SourceParameter>,
+    /// Those nuisances whose runs agreed, estimated once for all runs instead (the model's
+    /// value, the runs' spread and the test).
+    pub one_value: Vec<RunSpread>,
     /// The re-simulations before (and after) the winner, for figures.
     #[serde(skip)]
     pub before: Vec<crate::sim::Trajectory>,
     /// After.
     #[serde(skip)]
     pub after: Vec<crate::sim::Trajectory>,
+}
+
+/// The nuisances `model`'s file declares of each run or source, estimated from the `frames`
+/// with every other parameter held and each run started from its record (as the diagnosis
+/// re-simulates it; one RK4 step a sample, as `termid estimate` fits): the estimate, `model`
+/// holding the nuisances' new values (their runs' mean, or the one value where the runs
+/// agreed; its other parameters as they were, free where they were), and `data`, the runs
+/// as diagnosed, each with its own values. `None` where it declares none.
+#[allow(clippy::type_complexity)]
+fn own_nuisances(
+    model: &Model,
+    frames: &[Frame],
+    data: Runs,
+) -> Result<(Option<(Estimate, Model)>, Runs), DiagnoseError> {
+    let free = model.free_parameters();
+    if !free.iter().any(|p| p.nuisance.is_some()) {
+        return Ok((None, data));
+    }
+    let mut held = model.clone();
+    for p in free.iter().filter(|p| p.nuisance.is_none()) {
+        held.hold(&p.name);
+    }
+    let settings = EstimateSettings { initial_values: InitialValues::Recorded, ..Default::default() };
+    let sampled = Runs::new(&held, frames, crate::data::sample_step(frames), crate::sim::Integrator::Rk4)?;
+    let fit = estimate::estimate(&held, &sampled, &settings)?;
+    let mut with_values = model.clone();
+    let values = fit.model.parameter_values();
+    for p in free.iter().filter(|p| p.nuisance.is_some()) {
+        if let Some(v) = values.get(&p.name) {
+            with_values.set_parameter(&p.name, *v);
+        }
+    }
+    let own: Vec<(usize, &str, f64)> = fit
+        .per_source
+        .iter()
+        .flat_map(|p| p.runs.iter().map(move |&r| (r, p.name.as_str(), p.value)))
+        .collect();
+    let data = data.with_initial(&[], &own);
+    Ok((Some((fit, with_values)), data))
 }
 
 /// Runs the workflow on measured runs (time column = the model's; states and inputs by name).
@@ -198,6 +244,12 @@ pub fn diagnose(
 ) -> Result<Diagnosis, DiagnoseError> {
     let data =
         Runs::new(model, runs, settings.dt, settings.integrator)?.with_intercepts(settings.with_intercepts);
+    // Each run with its own nuisances: re-simulated with their mean instead, the runs' own
+    // offsets are the gap, and an effect that mimics them "explains" it (on SIMMAN's HSVA runs
+    // a propeller asymmetry, 80 % of a gap the runs' own rudder zeros close).
+    let (nuisances, data) = own_nuisances(model, runs, data)?;
+    let with_values = nuisances.as_ref().map(|(_, m)| m);
+    let model = with_values.unwrap_or(model);
     let base = data.simulate(model, &[], &[])?;
     let gap_before = data.gap(&base);
     let location = data.locate(&base);
@@ -297,6 +349,8 @@ pub fn diagnose(
         winner,
         model: new_model,
         rejected,
+        own_values: nuisances.as_ref().map_or_else(Vec::new, |(fit, _)| fit.per_source.clone()),
+        one_value: nuisances.map_or_else(Vec::new, |(fit, _)| fit.one_value),
         before: base,
         after: after_sims,
     })

@@ -302,6 +302,18 @@ impl Model {
         }
     }
 
+    /// Holds a free parameter at its value (`free = false`): what an estimate leaves alone.
+    /// `false`: the model has no such parameter.
+    pub fn hold(&mut self, name: &str) -> bool {
+        match self.spec.parameters.get_mut(name) {
+            Some(p) => {
+                p.free = false;
+                true
+            }
+            None => false,
+        }
+    }
+
     /// Sets a plug-in's table (the plug-in checks what it reads).
     pub fn set_plugin_table(&mut self, name: &str, table: toml::Value) {
         self.spec.plugins.insert(name.into(), table);

@@ -43,7 +43,10 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
     outputs.commit()?;
     match cmd.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&json(&d))?),
-        Format::Text => print!("{}", text(&d, cmd.out.as_deref(), hypotheses.len())),
+        Format::Text => {
+            print!("{}", own_values(&d, &model));
+            print!("{}", text(&d, cmd.out.as_deref(), hypotheses.len()))
+        }
     }
     Ok(())
 }
@@ -61,7 +64,43 @@ fn json(d: &Diagnosis) -> serde_json::Value {
         "gap_before": d.gap_before,
         "gap_after": d.gap_after,
         "candidates": d.candidates,
+        "own_values": d.own_values,
+        "one_value": d.one_value,
     })
+}
+
+/// The nuisances of each run or source the model file declares, as estimated before the
+/// diagnosis (each in its unit, angles in degrees): one line each, or nothing.
+fn own_values(d: &Diagnosis, model: &termid::model::Model) -> String {
+    let mut s = String::new();
+    let mut names: Vec<&str> = d.own_values.iter().map(|p| p.name.as_str()).collect();
+    names.dedup();
+    for name in names {
+        let (f, unit) = shown(model.unit(name));
+        let unit = if unit.is_empty() || unit.starts_with('°') { unit } else { format!(" {unit}") };
+        let values: Vec<f64> = d.own_values.iter().filter(|p| p.name == name).map(|p| p.value * f).collect();
+        let (lo, hi) =
+            values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
+        s += &format!(
+            "{name}, which the model file declares of each run or source, estimated first with the rest of the model held: {} values from {}{unit} to {}{unit}; each run is diagnosed with its own\n",
+            values.len(),
+            sig(lo, 3),
+            sig(hi, 3)
+        );
+    }
+    for r in &d.one_value {
+        let (f, unit) = shown(model.unit(&r.name));
+        let unit = if unit.is_empty() || unit.starts_with('°') { unit } else { format!(" {unit}") };
+        s += &format!(
+            "{}, which the model file declares of each run or source, agrees over the runs (their mean {}{unit}): estimated once for all first, the rest of the model held\n",
+            r.name,
+            sig(r.mean * f, 3)
+        );
+    }
+    if !s.is_empty() {
+        s += "\n";
+    }
+    s
 }
 
 fn text(d: &Diagnosis, out: Option<&std::path::Path>, tested: usize) -> String {
