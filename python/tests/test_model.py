@@ -101,42 +101,9 @@ def test_checks_and_diagnose(ship, zigzags):
     assert "gap_before" in raw
 
 
-NOMOTO_ZERO = """
-[model]
-name = "Nomoto, the indicator's zero its own in each run"
-intercept = false
-[simulation]
-method = "rk4"
-dt = 0.05
-[[states]]
-name = "ψ"
-unit = "rad"
-[[states]]
-name = "r"
-unit = "rad/s"
-[[inputs]]
-name = "δ"
-unit = "rad"
-[parameters.K]
-value = 0.15
-unit = "1/s"
-[parameters.T]
-value = 8.0
-unit = "s"
-[parameters."δ_0"]
-value = 0.0
-unit = "rad"
-free = true
-nuisance = "run"
-[equations.psi_dot]
-state = "ψ"
-identify = false
-coefficients = { "r" = 1.0 }
-[equations.r_dot]
-state = "r"
-identify = false
-coefficients = { "K*(δ - δ_0)/T" = 1.0, "r/T" = -1.0 }
-"""
+# Nomoto's model with its rudder indicator's zero declared a nuisance of each run
+with open(os.path.join(os.path.dirname(__file__), "..", "..", "tests", "data", "nomoto_zero.toml"), encoding="utf-8") as _file:
+    NOMOTO_ZERO = _file.read()
 
 
 def test_diagnose_each_run_with_its_own_nuisances():

@@ -317,43 +317,7 @@ fn a_repair_that_worsens_some_runs_is_not_kept() {
 }
 
 /// Nomoto's model with its rudder indicator's zero declared a nuisance of each run.
-const NOMOTO_ZERO: &str = r#"
-[model]
-name = "Nomoto, the indicator's zero its own in each run"
-intercept = false
-[simulation]
-method = "rk4"
-dt = 0.05
-[[states]]
-name = "ψ"
-unit = "rad"
-[[states]]
-name = "r"
-unit = "rad/s"
-[[inputs]]
-name = "δ"
-unit = "rad"
-[parameters.K]
-value = 0.15
-unit = "1/s"
-[parameters.T]
-value = 8.0
-unit = "s"
-[parameters."δ_0"]
-value = 0.0
-unit = "rad"
-free = true
-nuisance = "run"
-prior = { value = 0.0, sd = 0.05 }
-[equations.psi_dot]
-state = "ψ"
-identify = false
-coefficients = { "r" = 1.0 }
-[equations.r_dot]
-state = "r"
-identify = false
-coefficients = { "K*(δ - δ_0)/T" = 1.0, "r/T" = -1.0 }
-"#;
+const NOMOTO_ZERO: &str = include_str!("../data/nomoto_zero.toml");
 
 /// A model whose file declares a nuisance of each run (the indicator's zero, 1.5° one way in
 /// one run and the other way in the next) is diagnosed with each run's own value, estimated
