@@ -82,6 +82,12 @@ pub trait Plugin: Sync {
     fn run_checks(&self, _model: &Model, _runs: &[Frame]) -> Vec<Check> {
         vec![]
     }
+    /// Checks of how closely a fit re-simulates what this field reads off its runs
+    /// ([`metric_pairs`]: a grey-box estimate's, each run with its own values), by the field's
+    /// own tolerance. Empty: none.
+    fn metric_checks(&self, _pairs: &[MetricPair]) -> Vec<Check> {
+        vec![]
+    }
     /// The reference length, speed and density of a model of this field, for nondimensional
     /// coefficients (a ship's length, approach speed and water density).
     fn reference(&self, _model: &Model) -> Option<(f64, f64, f64)> {

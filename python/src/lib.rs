@@ -940,7 +940,12 @@ impl PyModel {
         let serialise = |e: serde_json::Error| refuse(format!("could not serialise: {e}"));
         let mut report = serde_json::to_value(&fit).map_err(serialise)?;
         match metrics {
-            Ok(metrics) => report["metrics"] = serde_json::to_value(&metrics).map_err(serialise)?,
+            Ok(metrics) => {
+                let checks =
+                    termid::plugins::of(&fit.model).map(|p| p.metric_checks(&metrics)).unwrap_or_default();
+                report["metrics"] = serde_json::to_value(&metrics).map_err(serialise)?;
+                report["metric_checks"] = serde_json::to_value(&checks).map_err(serialise)?;
+            }
             Err(why) => report["metrics_failed"] = why.into(),
         }
         Ok((report.to_string(), PyModel { inner: fit.model }))

@@ -1448,7 +1448,9 @@ class Model:
         measured beside the fit's re-simulation (the estimates, each run's own values and
         estimated initial state): a DataFrame of ``run``, ``metric``, ``measured`` and
         ``simulated``, empty for other models. A structure that fits the time series in the
-        mean may still miss the numbers a manoeuvre is judged by.
+        mean may still miss the numbers a manoeuvre is judged by: ``attrs["metric_checks"]``
+        holds the field's check of them (a ship's first overshoots within 1°), and a warning
+        says where one fails.
 
         >>> nomoto = termid.Model.builtin("nomoto")
         >>> truth = termid.Model.builtin("nomoto")
@@ -1499,7 +1501,13 @@ class Model:
             "held_again": report.get("held_again"),
             "step_samples": report.get("step_samples", 1),
             "metrics": pd.DataFrame(report.get("metrics", []), columns=["run", "metric", "measured", "simulated"]),
+            "metric_checks": pd.DataFrame(report.get("metric_checks", []), columns=["name", "passed", "refuses", "detail"]),
         }
+        for check in report.get("metric_checks", []):
+            if not check["passed"]:
+                # the fit misses what the field judges its runs by (a ship's overshoots): said as
+                # the CLI says it
+                warnings.warn(f"termid: FLAG {check['name']}: {check['detail']}", stacklevel=2)
         if report.get("metrics_failed"):
             warnings.warn(
                 f"termid: no metrics of the fit: the estimates do not re-simulate every run: {report['metrics_failed']}",

@@ -337,6 +337,7 @@ def test_estimate_reads_a_ships_metrics_off_its_fit():
     metrics = table.attrs["metrics"].set_index("metric")
     assert {"first_overshoot_deg", "second_overshoot_deg"} <= set(metrics.index), metrics
     assert ((metrics["simulated"] - metrics["measured"]).abs() < 0.05).all(), metrics
+    assert table.attrs["metric_checks"]["passed"].all(), table.attrs["metric_checks"]
     # no plug-in owns the Nomoto model: no metrics
     nomoto = termid.Model.builtin("nomoto")
     step = nomoto.simulate(duration=20.0, inputs={"δ": 0.1}, sample=0.1)[["t", "ψ", "r", "δ"]]

@@ -162,6 +162,10 @@ impl Plugin for Manoeuvring {
         super::checks::steering_check(model, runs).into_iter().collect()
     }
 
+    fn metric_checks(&self, pairs: &[crate::plugin::MetricPair]) -> Vec<Check> {
+        super::checks::overshoot_check(pairs).into_iter().collect()
+    }
+
     fn hypotheses(&self, model: &Model) -> Option<Vec<Hypothesis>> {
         Some(super::hypotheses::hypotheses(model))
     }

@@ -1164,6 +1164,7 @@ fn estimate_against_another_model_flags_where_they_disagree() {
         assert!(ok, "{err}");
         assert!(text.contains("the models agree on the tactical diameter"), "{text}");
         assert_eq!(text.contains("FLAG the models agree"), flagged, "against {against}:\n{text}");
+        assert!(text.contains("ok   the fit re-simulates its runs' first overshoots within 1°"), "{text}");
         // the structure is the truth's: the fit re-simulates every run's overshoots as the
         // records show them, within what reading them off noisy samples allows (an extremum of
         // a heading noisy by 0.05°, less the heading at the reversal, itself noisy: 0.5°);

@@ -62,6 +62,9 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
             vec![]
         }
     };
+    // and whether it re-simulates them within the field's tolerance
+    let metric_checks =
+        termid::plugins::of(&fit.model).map(|p| p.metric_checks(&metrics)).unwrap_or_default();
     let mut outputs = termid::output::Outputs::new();
     if let Some(out) = &cmd.out {
         outputs.file(out, fit.model.to_toml().as_bytes())?;
@@ -96,13 +99,14 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
         }
         None => vec![],
     };
-    for c in agreement.iter().filter(|c| !c.passed) {
+    for c in agreement.iter().chain(&metric_checks).filter(|c| !c.passed) {
         eprintln!("warning: {}", c.line());
     }
     match cmd.format {
         Format::Json => {
             let mut report = serde_json::to_value(&fit)?;
             report["metrics"] = serde_json::to_value(&metrics)?;
+            report["metric_checks"] = serde_json::to_value(&metric_checks)?;
             println!("{}", serde_json::to_string_pretty(&report)?)
         }
         Format::Text => {
@@ -110,6 +114,9 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
             if !metrics.is_empty() {
                 println!("== each run's metrics: measured → as the fit re-simulates it (the estimates, the run's own values and initial state) ==");
                 print!("{}", termid::plugin::metric_pairs_text(&metrics));
+                for c in &metric_checks {
+                    println!("{}", c.line());
+                }
             }
             if !agreement.is_empty() {
                 println!(
