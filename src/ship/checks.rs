@@ -298,7 +298,7 @@ pub fn overshoot_check(pairs: &[MetricPair]) -> Option<Check> {
             worst.abs(),
             errors.len(),
             if worst.abs() > 1.0 {
-                ": the structure does not swing on as the ship did, and predicts zigzags so"
+                ": the structure does not reproduce how far the ship swings on, and its predicted zigzags inherit that"
             } else {
                 ""
             }
