@@ -218,7 +218,13 @@ fn own_nuisances(
     }
     let settings = EstimateSettings { initial_values: InitialValues::Recorded, ..Default::default() };
     let sampled = Runs::new(&held, frames, crate::data::sample_step(frames), crate::sim::Integrator::Rk4)?;
-    let fit = estimate::estimate(&held, &sampled, &settings)?;
+    let fit = estimate::estimate(&held, &sampled, &settings).map_err(|e| {
+        let names: Vec<&str> = free.iter().filter(|p| p.nuisance.is_some()).map(|p| p.name.as_str()).collect();
+        DiagnoseError::Setup(format!(
+            "estimating each run's own {} first (the model file declares them of each run or source), the rest of the model held: {e}",
+            names.join(", ")
+        ))
+    })?;
     let mut with_values = model.clone();
     let values = fit.model.parameter_values();
     for p in free.iter().filter(|p| p.nuisance.is_some()) {

@@ -368,4 +368,10 @@ fn each_run_is_diagnosed_with_its_own_nuisances() {
     assert!(d.own_values.is_empty());
     let heading = d.gap_before.states.iter().find(|s| s.0 == "ψ").unwrap().2.to_degrees();
     assert!(heading > 10.0, "ψ RMS {heading}°");
+    // where the zeros cannot be estimated (a yaw rate bound the runs exceed), it says so
+    let bounded = NOMOTO_ZERO.replace("unit = \"rad/s\"", "unit = \"rad/s\"\nmax = 0.001");
+    let bounded = Model::parse(&bounded, "bounded.toml").unwrap();
+    let e =
+        diagnose(&bounded, &runs, &termid::diagnose::generic_hypotheses(&bounded), &settings).unwrap_err();
+    assert!(e.to_string().contains("estimating each run's own δ_0 first"), "{e}");
 }
