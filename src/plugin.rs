@@ -312,7 +312,7 @@ pub fn metric_pairs_text(pairs: &[MetricPair]) -> String {
             .filter(|p| p.run == *run)
             .map(|p| {
                 let (name, unit, d) = metric_label(&p.metric);
-                let unit = spaced(unit);
+                let unit = crate::model::dimension::after_number(unit);
                 format!(
                     "{name} {:.d$}{unit} → {:.d$}{unit} ({:+.d$}{unit})",
                     p.measured,
@@ -321,7 +321,7 @@ pub fn metric_pairs_text(pairs: &[MetricPair]) -> String {
                 )
             })
             .collect();
-        text += &format!("  {}: {}\n", file_name(run), cells.join(", "));
+        text += &format!("  {}: {}\n", crate::diagnose::file_name(run), cells.join(", "));
     }
     let mut metrics: Vec<&str> = pairs.iter().map(|p| p.metric.as_str()).collect();
     metrics.sort_unstable();
@@ -333,30 +333,15 @@ pub fn metric_pairs_text(pairs: &[MetricPair]) -> String {
             .max_by(|a, b| (a.simulated - a.measured).abs().total_cmp(&(b.simulated - b.measured).abs()));
         if let Some(p) = worst {
             let (name, unit, d) = metric_label(metric);
-            let unit = spaced(unit);
+            let unit = crate::model::dimension::after_number(unit);
             text += &format!(
                 "  largest difference of the {name}: {:+.d$}{unit} ({})\n",
                 p.simulated - p.measured,
-                file_name(&p.run)
+                crate::diagnose::file_name(&p.run)
             );
         }
     }
     text
-}
-
-/// A run's file without its folder, as a report names it.
-fn file_name(run: &str) -> &str {
-    std::path::Path::new(run).file_name().and_then(|n| n.to_str()).unwrap_or(run)
-}
-
-/// A unit as it follows a number: degrees close up (`9.32°`), the rest after a space
-/// (`21.45 m`).
-fn spaced(unit: &str) -> String {
-    if unit.is_empty() || unit.starts_with('°') {
-        unit.to_string()
-    } else {
-        format!(" {unit}")
-    }
 }
 
 /// A metric's key (its last `.`-part, where nested) as a person reads it: its name in words,

@@ -13,18 +13,20 @@ pub fn of(model: &Model) -> Option<&'static dyn Plugin> {
     PLUGINS.iter().copied().find(|p| model.spec().plugins.contains_key(p.table()))
 }
 
-/// How a grey-box fit reproduces what the model's plug-in reads off each of its runs (a ship's
-/// overshoots, its tactical diameter): each run's record beside the fit's re-simulation
-/// ([`crate::diagnose::Estimate::re_simulated`]); empty for a model no plug-in owns. A
-/// structure can fit the runs' time series in the mean and still miss the numbers a manoeuvre
-/// is judged by.
+/// How a fit reproduces what `model`'s plug-in reads off each of its runs (a ship's
+/// overshoots, its tactical diameter): each run's record in `frames` beside its re-simulation
+/// in `sims` (a grey-box estimate's: [`crate::diagnose::Estimate::re_simulated`]), and the
+/// plug-in's checks of them; empty for a model no plug-in owns. A structure can fit the runs'
+/// time series in the mean and still miss the numbers a manoeuvre is judged by.
 pub fn fit_metrics(
-    fit: &crate::diagnose::Estimate,
-    runs: &crate::diagnose::Runs,
-) -> Result<Vec<crate::plugin::MetricPair>, crate::sim::SimError> {
-    let Some(plugin) = of(&fit.model) else { return Ok(vec![]) };
-    let sims = fit.re_simulated(runs)?;
-    Ok(crate::plugin::metric_pairs(plugin, &fit.model, runs.frames(), &sims))
+    model: &Model,
+    frames: &[crate::data::Frame],
+    sims: &[crate::sim::Trajectory],
+) -> (Vec<crate::plugin::MetricPair>, Vec<crate::plugin::Check>) {
+    let Some(plugin) = of(model) else { return (vec![], vec![]) };
+    let pairs = crate::plugin::metric_pairs(plugin, model, frames, sims);
+    let checks = plugin.metric_checks(&pairs);
+    (pairs, checks)
 }
 
 /// The plug-in that adds derivative method `name`.

@@ -933,16 +933,17 @@ impl PyModel {
                 }
                 let fit = termid::diagnose::estimate(&self.inner, &runs, &settings)?;
                 // a fit whose estimates do not re-simulate every run has no metrics, and says why
-                let metrics = termid::plugins::fit_metrics(&fit, &runs).map_err(|e| e.to_string());
+                let metrics = fit
+                    .re_simulated(&runs)
+                    .map(|sims| termid::plugins::fit_metrics(&fit.model, runs.frames(), &sims))
+                    .map_err(|e| e.to_string());
                 Ok((fit, metrics))
             })
             .map_err(fail)?;
         let serialise = |e: serde_json::Error| refuse(format!("could not serialise: {e}"));
         let mut report = serde_json::to_value(&fit).map_err(serialise)?;
         match metrics {
-            Ok(metrics) => {
-                let checks =
-                    termid::plugins::of(&fit.model).map(|p| p.metric_checks(&metrics)).unwrap_or_default();
+            Ok((metrics, checks)) => {
                 report["metrics"] = serde_json::to_value(&metrics).map_err(serialise)?;
                 report["metric_checks"] = serde_json::to_value(&checks).map_err(serialise)?;
             }

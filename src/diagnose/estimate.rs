@@ -907,12 +907,16 @@ impl Estimate {
     /// estimates, each run with its own values of what was estimated per run or per source, from
     /// its estimated initial state (its recorded first sample where that was not estimated).
     pub fn re_simulated(&self, runs: &Runs) -> Result<Vec<crate::sim::Trajectory>, crate::sim::SimError> {
-        let own: Vec<(usize, &str, f64)> = self
-            .per_source
+        runs.with_initial(&self.initial_states, &self.own_values()).simulate(&self.model, &[], &[])
+    }
+
+    /// Each run's own value of every parameter estimated per run or per source, (run,
+    /// parameter, value), as [`Runs::with_initial`] takes them.
+    pub fn own_values(&self) -> Vec<(usize, &str, f64)> {
+        self.per_source
             .iter()
             .flat_map(|p| p.runs.iter().map(move |&r| (r, p.name.as_str(), p.value)))
-            .collect();
-        runs.with_initial(&self.initial_states, &own).simulate(&self.model, &[], &[])
+            .collect()
     }
 
     /// Whether any value was estimated per source (the report numbers the sources, so a

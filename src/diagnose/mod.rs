@@ -232,12 +232,7 @@ fn own_nuisances(
             with_values.set_parameter(&p.name, *v);
         }
     }
-    let own: Vec<(usize, &str, f64)> = fit
-        .per_source
-        .iter()
-        .flat_map(|p| p.runs.iter().map(move |&r| (r, p.name.as_str(), p.value)))
-        .collect();
-    let data = data.with_initial(&[], &own);
+    let data = data.with_initial(&[], &fit.own_values());
     Ok((Some((fit, with_values)), data))
 }
 

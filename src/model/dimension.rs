@@ -18,6 +18,16 @@ pub fn shown(unit: &str) -> (f64, String) {
     }
 }
 
+/// A unit as it follows a number: degrees close up (`9.32°`), the rest after a space
+/// (`21.45 m`), none as none.
+pub fn after_number(unit: &str) -> String {
+    if unit.is_empty() || unit.starts_with('°') {
+        unit.to_string()
+    } else {
+        format!(" {unit}")
+    }
+}
+
 /// Exponents of length, time and mass.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Dimension {

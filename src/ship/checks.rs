@@ -213,9 +213,7 @@ pub fn steering_check(model: &Model, runs: &[Frame]) -> Option<Check> {
     let name = "steers its training zigzags as recorded".to_string();
     let mut errors: Vec<(f64, String)> = Vec::new();
     for (frame, shape) in &zigzags {
-        let label = std::path::Path::new(frame.origin())
-            .file_stem()
-            .map_or_else(|| frame.origin().to_string(), |s| s.to_string_lossy().into_owned());
+        let label = run_label(frame.origin());
         let (Some(psi), Some(delta), Some(u)) =
             (frame.column(&n.psi), frame.column(&n.rudder), frame.column(&n.u))
         else {
@@ -287,7 +285,7 @@ pub fn overshoot_check(pairs: &[MetricPair]) -> Option<Check> {
         .map(|p| (p.simulated - p.measured, p.run.as_str()))
         .collect();
     let (worst, run) = *errors.iter().max_by(|a, b| a.0.abs().total_cmp(&b.0.abs()))?;
-    let label = std::path::Path::new(run).file_stem().and_then(|s| s.to_str()).unwrap_or(run);
+    let label = run_label(run);
     Some(Check {
         name: "the fit re-simulates its runs' first overshoots within 1°".into(),
         passed: worst.abs() <= 1.0,
@@ -304,6 +302,13 @@ pub fn overshoot_check(pairs: &[MetricPair]) -> Option<Check> {
             }
         ),
     })
+}
+
+/// A run as a check names it: its file without folder and extension.
+fn run_label(origin: &str) -> String {
+    std::path::Path::new(origin)
+        .file_stem()
+        .map_or_else(|| origin.to_string(), |s| s.to_string_lossy().into_owned())
 }
 
 #[cfg(test)]

@@ -77,7 +77,7 @@ fn own_values(d: &Diagnosis, model: &termid::model::Model) -> String {
     names.dedup();
     for name in names {
         let (f, unit) = shown(model.unit(name));
-        let unit = if unit.is_empty() || unit.starts_with('°') { unit } else { format!(" {unit}") };
+        let unit = termid::model::dimension::after_number(&unit);
         let values: Vec<f64> = d.own_values.iter().filter(|p| p.name == name).map(|p| p.value * f).collect();
         let (lo, hi) =
             values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
@@ -90,7 +90,7 @@ fn own_values(d: &Diagnosis, model: &termid::model::Model) -> String {
     }
     for r in &d.one_value {
         let (f, unit) = shown(model.unit(&r.name));
-        let unit = if unit.is_empty() || unit.starts_with('°') { unit } else { format!(" {unit}") };
+        let unit = termid::model::dimension::after_number(&unit);
         s += &format!(
             "{}, which the model file declares of each run or source, agrees over the runs (their mean {}{unit}): estimated once for all first, the rest of the model held\n",
             r.name,

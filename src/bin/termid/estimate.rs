@@ -54,17 +54,16 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
     );
     let fit = crate::progress::with_spinner(&label, || estimate(&model, &runs, &settings))
         .context("estimating the free parameters")?;
-    // what a plug-in reads off each run, measured and as the fit re-simulates it
-    let metrics = match termid::plugins::fit_metrics(&fit, &runs) {
-        Ok(m) => m,
+    // the runs as the fit re-simulates them: what a plug-in reads off each beside its record
+    // (and whether within the field's tolerance), and the figures
+    let refit = fit.re_simulated(&runs);
+    let (metrics, metric_checks) = match &refit {
+        Ok(sims) => termid::plugins::fit_metrics(&fit.model, runs.frames(), sims),
         Err(e) => {
             eprintln!("warning: no metrics of the fit: the estimates do not re-simulate every run: {e}");
-            vec![]
+            (vec![], vec![])
         }
     };
-    // and whether it re-simulates them within the field's tolerance
-    let metric_checks =
-        termid::plugins::of(&fit.model).map(|p| p.metric_checks(&metrics)).unwrap_or_default();
     let mut outputs = termid::output::Outputs::new();
     if let Some(out) = &cmd.out {
         outputs.file(out, fit.model.to_toml().as_bytes())?;
@@ -72,7 +71,9 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
     let mut drawn = false;
     if let Some(dir) = &cmd.svg {
         // a run the start values cannot simulate costs the figures, not the estimate
-        match figures(&model, &fit, &runs, &frames) {
+        let figures =
+            refit.map_err(anyhow::Error::from).and_then(|after| figures(&model, &after, &runs, &frames));
+        match figures {
             Ok(figures) => {
                 crate::figures::write(&mut outputs, dir, "estimate", figures)?;
                 drawn = true;
@@ -146,17 +147,16 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
 /// own values, the estimated initial state).
 fn figures(
     model: &termid::model::Model,
-    fit: &termid::diagnose::Estimate,
+    after: &[termid::sim::Trajectory],
     runs: &Runs,
     frames: &[termid::data::Frame],
 ) -> Result<Vec<(String, termid::plot::Figure)>> {
     let before = runs.simulate(model, &[], &[])?;
-    let after = fit.re_simulated(runs)?;
     let plane = termid::plugins::of(model).and_then(|p| p.plane(model));
     Ok(termid::plot::comparison_figures(
         model,
         frames,
-        (&before, &after),
+        (&before, after),
         &[],
         ("estimate", ["start values", "estimated"]),
         plane.as_ref(),
