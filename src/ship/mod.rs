@@ -70,6 +70,13 @@ pub struct Roles {
     pub propeller: Option<usize>,
 }
 
+impl Roles {
+    /// Whether state `i` is one of the ship's own (velocities, heading, position).
+    fn kinematic(&self, i: usize) -> bool {
+        [self.u, self.v, self.r, self.psi, self.x0, self.y0].contains(&i)
+    }
+}
+
 /// The straight run before a manoeuvre: rudder δ0 and sway v0 that cancel the asymmetry
 /// terms at u = u0, r = 0.
 #[derive(Clone, Debug, PartialEq)]
@@ -208,6 +215,12 @@ impl Ship {
         if let Some(p) = r.propeller {
             unknowns.push(Unknown::Input(p));
             zero.push(r.u);
+        }
+        // states the ship has no role for (a lag, a filter of the model file's own) are
+        // steady in a straight run too
+        for i in (0..self.system.dim()).filter(|i| !r.kinematic(*i)) {
+            unknowns.push(Unknown::State(i));
+            zero.push(i);
         }
         let p = SteadyProblem { system: &self.system, x, input, unknowns, zero };
         let (x, input) = sim::solve_steady(&p)?;

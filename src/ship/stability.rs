@@ -3,10 +3,15 @@
 //! a model carries into the turns beyond what its zigzags bound; the physical checks read it,
 //! and so can a study that sets models side by side.
 
+use nalgebra::{DMatrix, DVector, Matrix2, Vector2};
+
 use super::{Ship, StraightRun};
 
 /// The linearised sway and yaw at a straight run, by central differences of the right-hand
-/// side (steps of 10⁻⁴ u0 in v, that over L in r, 0.01° in δ).
+/// side (steps of 10⁻⁴ u0 in v, that over L in r, 0.01° in δ). States of the model's own
+/// beyond the ship's (a lag of the hull's forces, a filter) enter at their steady values
+/// (static condensation), so the derivatives are the steady ones a captive test measures and
+/// the determinant's criterion of straight-line stability holds for such a model too.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SwayYaw {
     /// Speed of the straight run, m/s.
@@ -27,11 +32,13 @@ impl SwayYaw {
     /// The derivatives of `ship` at `start` (its straight run).
     pub fn of(ship: &Ship, start: &StraightRun) -> SwayYaw {
         let r = ship.roles;
+        let own: Vec<usize> = (0..start.x.len()).filter(|i| !r.kinematic(*i)).collect();
+        let rows: Vec<usize> = [r.v, r.r].into_iter().chain(own.iter().copied()).collect();
         let mut ws = ship.system.workspace();
         let mut d = vec![0.0; start.x.len()];
         let mut rate = |x: &[f64], input: &[f64]| {
             ship.system.derivatives(x, input, &mut ws, &mut d);
-            (d[r.v], d[r.r])
+            rows.iter().map(|&i| d[i]).collect::<Vec<f64>>()
         };
         let mut slope = |state: Option<usize>, h: f64| {
             let (mut x, mut input) = (start.x.clone(), start.input.clone());
@@ -43,13 +50,22 @@ impl SwayYaw {
             let plus = rate(&x, &input);
             shift(&mut x, &mut input, -2.0 * h);
             let minus = rate(&x, &input);
-            ((plus.0 - minus.0) / (2.0 * h), (plus.1 - minus.1) / (2.0 * h))
+            DVector::from_iterator(plus.len(), plus.iter().zip(&minus).map(|(p, m)| (p - m) / (2.0 * h)))
         };
         let hv = 1e-4 * ship.spec.u0;
-        let (yv, nv) = slope(Some(r.v), hv);
-        let (yr, nr) = slope(Some(r.r), hv / ship.spec.lpp);
-        let (_, n_delta) = slope(None, 0.01f64.to_radians());
-        SwayYaw { u0: start.x[r.u], yv, yr, nv, nr, n_delta }
+        let mut columns = vec![slope(Some(r.v), hv), slope(Some(r.r), hv / ship.spec.lpp)];
+        columns.extend(own.iter().map(|&i| slope(Some(i), 1e-6 * start.x[i].abs().max(1.0))));
+        let jacobian = DMatrix::from_columns(&columns);
+        let rudder = slope(None, 0.01f64.to_radians());
+        let (a, b) = condensed(&jacobian, &rudder);
+        SwayYaw {
+            u0: start.x[r.u],
+            yv: a[(0, 0)],
+            yr: a[(0, 1)],
+            nv: a[(1, 0)],
+            nr: a[(1, 1)],
+            n_delta: b[1],
+        }
     }
 
     /// Whether the linear sway-yaw system is stable: trace negative, determinant positive (the
@@ -87,6 +103,24 @@ impl SwayYaw {
     }
 }
 
+/// The sway-yaw block of `jacobian` (rows and columns v, r, then the model's own states) and
+/// the rudder's column with the own states at their steady values: A − B E⁻¹ C. Where the own
+/// states have no steady value of their own (E singular), the block as it stands.
+fn condensed(jacobian: &DMatrix<f64>, rudder: &DVector<f64>) -> (Matrix2<f64>, Vector2<f64>) {
+    let a = Matrix2::from_fn(|i, j| jacobian[(i, j)]);
+    let b = Vector2::new(rudder[0], rudder[1]);
+    let n = jacobian.nrows();
+    if n == 2 {
+        return (a, b);
+    }
+    let e = jacobian.view((2, 2), (n - 2, n - 2)).into_owned();
+    let Some(e_inv) = e.try_inverse() else { return (a, b) };
+    let coupling = jacobian.view((0, 2), (2, n - 2)) * e_inv;
+    let a = a - Matrix2::from_iterator((&coupling * jacobian.view((2, 0), (n - 2, 2))).iter().copied());
+    let b = b - Vector2::from_iterator((&coupling * rudder.rows(2, n - 2)).iter().copied());
+    (a, b)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -113,5 +147,59 @@ mod tests {
         let u = SwayYaw { yr: 2.0, nv: 1.0, ..d };
         assert!(!u.course_stable() && u.largest_eigenvalue() > 0.0);
         assert!(u.time_constants().unwrap().1 < 0.0);
+    }
+
+    /// A linear ship whose hull moment reaches ṙ through a first-order lag (a state of the
+    /// model's own) has the plain ship's straight run and steady derivatives, and the lag's
+    /// state sits at its steady value; before, the straight run held the lag at 0 and the yaw
+    /// damping read 0 (the hull's moment only through the lag).
+    #[test]
+    fn a_lag_of_the_models_own_is_steady_in_the_straight_run() {
+        let hull = "-0.3*v - 0.8*r + 0.004";
+        let ship = |lagged: bool| {
+            let (yaw, lag) = if lagged {
+                (
+                    "\"h\" = 1.0".to_string(),
+                    format!(
+                        "[[states]]\nname = \"h\"\nunit = \"rad/s²\"\n[equations.h_dot]\nstate = \"h\"\n\
+                         identify = false\ncoefficients = {{ \"({hull} - h)/1.5\" = 1.0 }}\n"
+                    ),
+                )
+            } else {
+                (format!("\"{hull}\" = 1.0"), String::new())
+            };
+            let text = format!(
+                "[model]\nname = \"linear\"\nintercept = false\n\
+                 [[states]]\nname = \"u\"\nunit = \"m/s\"\n[[states]]\nname = \"v\"\nunit = \"m/s\"\n\
+                 [[states]]\nname = \"r\"\nunit = \"rad/s\"\n[[states]]\nname = \"ψ\"\nunit = \"rad\"\n\
+                 [[states]]\nname = \"x0\"\nunit = \"m\"\n[[states]]\nname = \"y0\"\nunit = \"m\"\n\
+                 [[inputs]]\nname = \"δ\"\nunit = \"rad\"\n\
+                 [equations.u_dot]\nstate = \"u\"\nidentify = false\ncoefficients = {{ \"0*u\" = 1.0 }}\n\
+                 [equations.v_dot]\nstate = \"v\"\nidentify = false\n\
+                 coefficients = {{ \"-0.5*v - 0.2*r + 0.05*δ + 0.002\" = 1.0 }}\n\
+                 [equations.r_dot]\nstate = \"r\"\nidentify = false\ncoefficients = {{ {yaw}, \"0.1*δ\" = 1.0 }}\n\
+                 [equations.psi_dot]\nstate = \"ψ\"\nidentify = false\ncoefficients = {{ r = 1.0 }}\n\
+                 [equations.x0_dot]\nstate = \"x0\"\nidentify = false\ncoefficients = {{ \"u*cos(ψ)\" = 1.0 }}\n\
+                 [equations.y0_dot]\nstate = \"y0\"\nidentify = false\ncoefficients = {{ \"u*sin(ψ)\" = 1.0 }}\n\
+                 {lag}\
+                 [ship]\nlpp = 7.0\nrudder_rate = 15.0\nrudder_limit = 35.0\nu0 = 1.0\n"
+            );
+            Ship::new(&crate::model::Model::parse(&text, "linear.toml").unwrap(), false).unwrap()
+        };
+        let (plain, lagged) = (ship(false), ship(true));
+        let (p, l) = (plain.straight_run().unwrap(), lagged.straight_run().unwrap());
+        // closed form: −0.5 v + 0.05 δ = −0.002, −0.3 v + 0.1 δ = −0.004
+        let (v0, delta0) = (0.0, -0.04);
+        assert!((p.v0 - v0).abs() < 1e-9 && (p.delta0_deg.to_radians() - delta0).abs() < 1e-9, "{p:?}");
+        assert!((l.v0 - v0).abs() < 1e-9 && (l.delta0_deg - p.delta0_deg).abs() < 1e-9, "{l:?}");
+        let h = lagged.system.states.iter().position(|s| s == "h").unwrap();
+        assert!((l.x[h] - (-0.3 * v0 + 0.004)).abs() < 1e-9, "{l:?}");
+        let (sp, sl) = (SwayYaw::of(&plain, &p), SwayYaw::of(&lagged, &l));
+        for (a, b, exact) in
+            [(sp.yv, sl.yv, -0.5), (sp.yr, sl.yr, -0.2), (sp.nv, sl.nv, -0.3), (sp.nr, sl.nr, -0.8)]
+        {
+            assert!((a - exact).abs() < 1e-6 && (b - exact).abs() < 1e-6, "{sp:?} {sl:?}");
+        }
+        assert!((sl.n_delta - 0.1).abs() < 1e-6 && sl.course_stable(), "{sl:?}");
     }
 }
