@@ -53,6 +53,15 @@ pub struct RecipeSettings {
     pub parameters: Option<ParameterOptions>,
 }
 
+impl RecipeSettings {
+    /// Whether each start's free parameters are estimated with its coefficients in place of
+    /// its refinement: where asked, but not with validation runs, which only the refinement
+    /// is stopped by (the estimate follows it there where asked).
+    pub(crate) fn parameters_in_place(&self, validated: bool) -> bool {
+        self.parameters.is_some() && !validated
+    }
+}
+
 impl Default for RecipeSettings {
     fn default() -> Self {
         RecipeSettings {
@@ -189,7 +198,7 @@ pub fn identify(
             Err(e) => return Err(e),
         }
     }
-    let in_place = settings.parameters.is_some() && held.is_none();
+    let in_place = settings.parameters_in_place(held.is_some());
     let kept = |s: &Start| matches!(s.parameters, Some(ParameterStage::Kept(_)));
     if in_place && !starts.iter().any(kept) {
         // no start's free parameters could be kept: each is refined without them

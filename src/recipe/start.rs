@@ -187,9 +187,7 @@ pub(super) fn identify_start(
         checks: vec![],
         prepared: vec![],
     };
-    // the free parameters with the coefficients are the refinement, but for validation runs,
-    // which only the refinement is stopped by (the estimate follows it there where asked)
-    let in_place = settings.parameters.is_some() && validation.is_none();
+    let in_place = settings.parameters_in_place(validation.is_some());
     start.checks = checks_of(&model, &prepared);
     if !in_place {
         refine_start(&mut start, &mut model, &prepared, validation.as_deref(), settings);
