@@ -70,13 +70,6 @@ pub struct Roles {
     pub propeller: Option<usize>,
 }
 
-impl Roles {
-    /// Whether state `i` is one of the ship's own (velocities, heading, position).
-    fn kinematic(&self, i: usize) -> bool {
-        [self.u, self.v, self.r, self.psi, self.x0, self.y0].contains(&i)
-    }
-}
-
 /// The straight run before a manoeuvre: rudder δ0 and sway v0 that cancel the asymmetry
 /// terms at u = u0, r = 0.
 #[derive(Clone, Debug, PartialEq)]
@@ -203,6 +196,27 @@ impl Ship {
         Ok(effect)
     }
 
+    /// The model's own states beyond the ship's (a lag of the hull's forces, a roll angle)
+    /// that some derivative depends on at `x`, `input`: those a straight run holds steady. One
+    /// nothing depends on (a distance run, like the track's x0 and y0) only integrates.
+    pub(crate) fn own_states(&self, x: &[f64], input: &[f64]) -> Vec<usize> {
+        let r = &self.roles;
+        let roles = [r.u, r.v, r.r, r.psi, r.x0, r.y0];
+        let mut ws = self.system.workspace();
+        let mut base = vec![0.0; x.len()];
+        self.system.derivatives(x, input, &mut ws, &mut base);
+        let mut moved = vec![0.0; x.len()];
+        (0..x.len())
+            .filter(|i| !roles.contains(i))
+            .filter(|&i| {
+                let mut x = x.to_vec();
+                x[i] += 1e-6 * x[i].abs().max(1.0);
+                self.system.derivatives(&x, input, &mut ws, &mut moved);
+                moved.iter().zip(&base).any(|(a, b)| a != b)
+            })
+            .collect()
+    }
+
     /// Steady straight running at u0: δ0 and v0 with v̇ = ṙ = 0 (r = 0, heading 0), and
     /// the propeller's rate with u̇ = 0 where the ship names one.
     pub fn straight_run(&self) -> Result<StraightRun, ShipError> {
@@ -218,7 +232,7 @@ impl Ship {
         }
         // states the ship has no role for (a lag, a filter of the model file's own) are
         // steady in a straight run too
-        for i in (0..self.system.dim()).filter(|i| !r.kinematic(*i)) {
+        for i in self.own_states(&x, &input) {
             unknowns.push(Unknown::State(i));
             zero.push(i);
         }

@@ -32,7 +32,7 @@ impl SwayYaw {
     /// The derivatives of `ship` at `start` (its straight run).
     pub fn of(ship: &Ship, start: &StraightRun) -> SwayYaw {
         let r = ship.roles;
-        let own: Vec<usize> = (0..start.x.len()).filter(|i| !r.kinematic(*i)).collect();
+        let own = ship.own_states(&start.x, &start.input);
         let rows: Vec<usize> = [r.v, r.r].into_iter().chain(own.iter().copied()).collect();
         let mut ws = ship.system.workspace();
         let mut d = vec![0.0; start.x.len()];
@@ -152,7 +152,8 @@ mod tests {
     /// A linear ship whose hull moment reaches ṙ through a first-order lag (a state of the
     /// model's own) has the plain ship's straight run and steady derivatives, and the lag's
     /// state sits at its steady value; before, the straight run held the lag at 0 and the yaw
-    /// damping read 0 (the hull's moment only through the lag).
+    /// damping read 0 (the hull's moment only through the lag). A distance run (ṡ = u), which
+    /// nothing depends on, only integrates, as the track does.
     #[test]
     fn a_lag_of_the_models_own_is_steady_in_the_straight_run() {
         let hull = "-0.3*v - 0.8*r + 0.004";
@@ -162,7 +163,9 @@ mod tests {
                     "\"h\" = 1.0".to_string(),
                     format!(
                         "[[states]]\nname = \"h\"\nunit = \"rad/s²\"\n[equations.h_dot]\nstate = \"h\"\n\
-                         identify = false\ncoefficients = {{ \"({hull} - h)/1.5\" = 1.0 }}\n"
+                         identify = false\ncoefficients = {{ \"({hull} - h)/1.5\" = 1.0 }}\n\
+                         [[states]]\nname = \"s\"\nunit = \"m\"\n[equations.s_dot]\nstate = \"s\"\n\
+                         identify = false\ncoefficients = {{ u = 1.0 }}\n"
                     ),
                 )
             } else {
