@@ -11,7 +11,8 @@ use super::{Ship, StraightRun};
 /// side (steps of 10⁻⁴ u0 in v, that over L in r, 0.01° in δ). States of the model's own
 /// beyond the ship's (a lag of the hull's forces, a filter) enter at their steady values
 /// (static condensation), so the derivatives are the steady ones a captive test measures and
-/// the determinant's criterion of straight-line stability holds for such a model too.
+/// the determinant's criterion of straight-line stability holds for such a model too (its own
+/// states stable by themselves, as a lag is).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SwayYaw {
     /// Speed of the straight run, m/s.
