@@ -1,0 +1,238 @@
+//! `termid.fit` and `termid.Fit`: one equation fitted to columns by a back-end, its chosen
+//! terms compiled for `predict`, the compiled candidates kept for the next call.
+
+use std::collections::BTreeMap;
+
+use numpy::{IntoPyArray, PyArray1};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use termid::identify::{Fit, Identification};
+use termid::term::{parse_terms, Library, Source, Term, Vocabulary};
+
+use crate::convert::{backend_of, column, fail, in_place, refuse, to_json};
+
+/// One equation fitted to columns: the back-end's steps and chosen terms (JSON) and the
+/// compiled chosen terms for `predict`.
+#[pyclass(module = "termid._termid", name = "Fit")]
+pub(crate) struct PyFit {
+    fit: Fit,
+    chosen: Library,
+    coefficients: Vec<f64>,
+    intercept: f64,
+    parameters: BTreeMap<String, f64>,
+    /// The variables the terms were written over (for pickling: the terms are compiled again).
+    variables: Vec<String>,
+}
+
+/// What a pickled fit holds: its JSON, the variables and the parameters of its terms.
+type FitState = (String, Vec<String>, BTreeMap<String, f64>);
+
+impl PyFit {
+    /// A fit with its chosen terms compiled over `variables` and `parameters`.
+    fn compiled(fit: Fit, variables: Vec<String>, parameters: BTreeMap<String, f64>) -> PyResult<PyFit> {
+        let mut vocabulary = Vocabulary::new();
+        for name in &variables {
+            vocabulary.variable(name).map_err(fail)?;
+        }
+        for name in parameters.keys() {
+            vocabulary.parameter(name).map_err(fail)?;
+        }
+        let texts: Vec<String> = fit.selection.terms.iter().map(|t| t.term.clone()).collect();
+        let chosen = parse_terms(&texts, &vocabulary).map_err(fail)?;
+        Ok(PyFit {
+            chosen: Library::compile(&chosen, &vocabulary).map_err(fail)?,
+            coefficients: fit.selection.terms.iter().map(|t| t.coefficient).collect(),
+            intercept: fit.selection.intercept.as_ref().map_or(0.0, |b| b.value),
+            parameters,
+            variables,
+            fit,
+        })
+    }
+}
+
+#[pymethods]
+impl PyFit {
+    /// Pickled as its JSON and the names its terms are written over (a process pool, Dask).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, FitState)> {
+        let this = slf.borrow();
+        let restore = slf.get_type().getattr("_restore")?;
+        Ok((restore, (to_json(&this.fit)?, this.variables.clone(), this.parameters.clone())))
+    }
+
+    /// The fit `__reduce__` wrote.
+    #[staticmethod]
+    fn _restore(json: &str, variables: Vec<String>, parameters: BTreeMap<String, f64>) -> PyResult<PyFit> {
+        let fit: Fit =
+            serde_json::from_str(json).map_err(|e| refuse(format!("not a pickled termid fit: {e}")))?;
+        PyFit::compiled(fit, variables, parameters)
+    }
+
+    /// The fit as JSON: target, candidates, the back-end's steps and chosen terms, covariance.
+    fn to_json(&self) -> PyResult<String> {
+        to_json(&self.fit)
+    }
+
+    /// The report's numbers (steps with SSE and F, chosen terms with standard errors) as JSON.
+    fn report_json(&self) -> PyResult<String> {
+        to_json(&self.fit.report())
+    }
+
+    /// Σ cⱼ·termⱼ + b0 on columns (float64 arrays, read in place).
+    fn predict<'py>(
+        &self,
+        py: Python<'py>,
+        columns: &Bound<'py, PyDict>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        // each input a column, or a parameter's value where there is no column of its name
+        let mut arrays = Vec::with_capacity(self.chosen.inputs().len());
+        let mut given = Vec::with_capacity(self.chosen.inputs().len());
+        for name in self.chosen.inputs() {
+            match (columns.get_item(name)?, self.parameters.get(name)) {
+                (Some(v), _) => {
+                    arrays.push(column("predict", name, &v)?);
+                    given.push(true);
+                }
+                (None, Some(_)) => given.push(false),
+                (None, None) => return Err(refuse(format!("predict: no column `{name}`"))),
+            }
+        }
+        let values = in_place(&arrays);
+        let mut next = values.iter();
+        let slices: Vec<Option<&[f64]>> =
+            given.iter().map(|g| if *g { next.next().map(|v| &**v) } else { None }).collect();
+        let n = slices.iter().flatten().map(|s| s.len()).next().unwrap_or(0);
+        if let Some(bad) = slices.iter().flatten().find(|s| s.len() != n) {
+            return Err(refuse(format!("predict: columns of {} and {n} rows", bad.len())));
+        }
+        let sources: Vec<Source<'_>> = self
+            .chosen
+            .inputs()
+            .iter()
+            .zip(&slices)
+            .map(|(name, s)| s.map_or_else(|| Source::Constant(self.parameters[name]), Source::Column))
+            .collect();
+        let mut out = vec![self.intercept; n];
+        self.chosen.for_each_block(&sources, 0..n, |start, block| {
+            for (c, values) in self.coefficients.iter().zip(block) {
+                for (o, v) in out[start..start + values.len()].iter_mut().zip(*values) {
+                    *o += c * v;
+                }
+            }
+        });
+        Ok(out.into_pyarray(py))
+    }
+}
+
+/// The texts `fit` compiles: the target, the column names, the terms and the parameters'
+/// names. Equal texts compile to equal terms.
+#[derive(PartialEq)]
+struct CompileKey {
+    target: String,
+    names: Vec<String>,
+    terms: Vec<String>,
+    forced: Vec<String>,
+    excluded: Vec<String>,
+    parameters: Vec<String>,
+    weights: Option<String>,
+}
+
+/// What `fit` compiles from the texts alone: the columns' vocabulary, the parsed terms and
+/// their compiled design (~15 µs of a 0.15 ms fit of 29 terms). The last one is kept for a
+/// next call with the same texts: fits of the same candidates to new rows (resampling,
+/// rolling windows, shards) compile once, as the command line does.
+struct Compiled {
+    key: CompileKey,
+    vocabulary: Vocabulary,
+    candidates: Vec<Term>,
+    forced: Vec<Term>,
+    excluded: Vec<Term>,
+    design: termid::identify::Design,
+}
+
+static LAST_COMPILED: std::sync::Mutex<Option<std::sync::Arc<Compiled>>> = std::sync::Mutex::new(None);
+
+impl Compiled {
+    fn of(key: CompileKey) -> PyResult<std::sync::Arc<Compiled>> {
+        let mut last = LAST_COMPILED.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        if let Some(c) = last.as_ref().filter(|c| c.key == key) {
+            return Ok(c.clone());
+        }
+        let mut vocabulary = Vocabulary::new();
+        for name in &key.names {
+            if *name != key.target && Some(name) != key.weights.as_ref() {
+                vocabulary.variable(name).map_err(fail)?;
+            }
+        }
+        for name in &key.parameters {
+            vocabulary.parameter(name).map_err(fail)?;
+        }
+        let parse = |texts: &[String]| parse_terms(texts, &vocabulary).map_err(fail);
+        let (candidates, forced, excluded) = (parse(&key.terms)?, parse(&key.forced)?, parse(&key.excluded)?);
+        let design = termid::identify::Design::new(&candidates, &vocabulary).map_err(fail)?;
+        let compiled =
+            std::sync::Arc::new(Compiled { key, vocabulary, candidates, forced, excluded, design });
+        *last = Some(compiled.clone());
+        Ok(compiled)
+    }
+}
+
+/// One equation from columns: `target` explained by the candidate `terms` (text in termid's
+/// term language over the column names) with a back-end given as JSON settings.
+#[pyfunction]
+#[pyo3(signature = (target, columns, terms, backend = "{\"method\": \"stepwise\"}", intercept = true, forced = vec![], excluded = vec![], parameters = BTreeMap::new(), weights = None))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn fit(
+    py: Python<'_>,
+    target: &str,
+    columns: &Bound<'_, PyDict>,
+    terms: Vec<String>,
+    backend: &str,
+    intercept: bool,
+    forced: Vec<String>,
+    excluded: Vec<String>,
+    parameters: BTreeMap<String, f64>,
+    weights: Option<String>,
+) -> PyResult<PyFit> {
+    let backend = backend_of(backend)?;
+    let names: Vec<String> = columns.keys().iter().map(|k| k.extract()).collect::<PyResult<_>>()?;
+    let variables: Vec<String> =
+        names.iter().filter(|n| *n != target && Some(*n) != weights.as_ref()).cloned().collect();
+    // the arrays used where they lie: read-only views, no copy (the rows are checked as
+    // they are accumulated: a value that is not finite is refused with its row and term)
+    let arrays = names
+        .iter()
+        .zip(columns.values().iter())
+        .map(|(name, value)| column("data", name, &value))
+        .collect::<PyResult<Vec<_>>>()?;
+    let values = in_place(&arrays);
+    let slices: Vec<(&str, &[f64])> =
+        names.iter().map(String::as_str).zip(values.iter().map(|v| &**v)).collect();
+    let key = CompileKey {
+        target: target.into(),
+        names: names.clone(),
+        terms,
+        forced,
+        excluded,
+        parameters: parameters.keys().cloned().collect(),
+        weights: weights.clone(),
+    };
+    let compiled = Compiled::of(key)?;
+    let Compiled { vocabulary, candidates, forced, excluded, design, .. } = &*compiled;
+    let rules =
+        parameters.iter().map(|(n, v)| (n.clone(), termid::identify::ParamValue::Value(*v))).collect();
+    let central = termid::data::CentralDifference;
+    let how = Identification { vocabulary, parameters: &rules, differentiator: &central, intercept, weights };
+    let selector = backend.build();
+    let fit = py
+        .detach(|| how.fit_columns("data", &slices, target, design, forced, excluded, selector.as_ref()))
+        .map_err(fail)?;
+    let chosen: Vec<Term> = fit.selection.terms.iter().map(|t| candidates[t.index].clone()).collect();
+    Ok(PyFit {
+        chosen: Library::compile(&chosen, vocabulary).map_err(fail)?,
+        coefficients: fit.selection.terms.iter().map(|t| t.coefficient).collect(),
+        intercept: fit.selection.intercept.as_ref().map_or(0.0, |b| b.value),
+        parameters,
+        variables,
+        fit,
+    })
+}
