@@ -632,21 +632,7 @@ fn fit(
     held: bool,
     one: &[String],
 ) -> Result<Estimate, DiagnoseError> {
-    if settings.iterations == 0 {
-        return Err(DiagnoseError::Setup("the estimate needs at least one iteration".into()));
-    }
-    if !(settings.converged.is_finite() && (0.0..1.0).contains(&settings.converged)) {
-        return Err(DiagnoseError::Setup(format!(
-            "the estimate's stopping fraction {} must be a number from 0 to below 1",
-            settings.converged
-        )));
-    }
-    if !(settings.prior_weight.is_finite() && settings.prior_weight >= 0.0) {
-        return Err(DiagnoseError::Setup(format!(
-            "the coefficients' prior weight {} must be a number ≥ 0",
-            settings.prior_weight
-        )));
-    }
+    check(settings)?;
     let Scales { fit: runs, every, samples } = *scales;
     let u = Unknowns::of(model, scales, settings, held, one)?;
     if u.parameters.is_empty() && u.coefficients.is_empty() && u.groups.is_empty() {
@@ -663,20 +649,114 @@ fn fit(
         r.iter().all(|v| v.is_finite()).then_some(r)
     };
     let cost_on = |runs: &Runs, theta: &[f64]| residuals_on(runs, theta).map(|r| sum_of_squares(&r));
-    let data_cost = |theta: &[f64]| cost_on(runs, theta);
     // costs as reported: at every sample, where the fit is at a coarser step
     let coarse = !std::ptr::eq(runs, every);
     let linearised = |theta: &[f64]| -> Result<Linearised, DiagnoseError> {
         linearise(&u.runs_at(runs, theta), &u.at(model, theta)?, &u.entries)
             .map_err(|e| fit_failure(e, "at an iterate"))
     };
-    let mut theta = u.start(runs);
-    let cost_before = data_cost(&theta).ok_or(DiagnoseError::Refinement(EstimateError::Diverges(
+    let theta = u.start(runs);
+    let cost_before = cost_on(runs, &theta).ok_or(DiagnoseError::Refinement(EstimateError::Diverges(
         "at the start (the free parameters' values in the file)",
     )))?;
     let cost_before = if coarse { cost_on(every, &theta).unwrap_or(f64::NAN) } else { cost_before };
-    let mut lin = linearised(&theta)?;
-    let (mut stopped, mut taken) = (String::new(), 0);
+    let start = linearised(&theta)?;
+    let Minimum { theta, lin, stopped, iterations } =
+        minimise(&u, settings, runs, (theta, start), |t| cost_on(runs, t), linearised);
+    let from_records = from_records(&u, scales, &theta, |runs, t| cost_on(runs, t));
+    let (weight, tau) = data_weight(runs, &lin.residuals, k);
+    // the residuals' cost and correlation time at every sample (at the coarse step a white
+    // residual is still correlated over one step)
+    let (cost_after, tau) = match coarse.then(|| residuals_on(every, &theta)) {
+        None => (sum_of_squares(&lin.residuals), tau),
+        Some(Some(r)) => (sum_of_squares(&r), crate::uncertainty::correlation_time(&every.series(&r))),
+        Some(None) => (f64::NAN, None),
+    };
+    let mut info = &lin.jtj * weight;
+    for i in 0..k {
+        info[(i, i)] += u.precision[i];
+    }
+    let covariance: Option<DMatrix<f64>> = info.try_inverse();
+    let std_errors: Vec<f64> =
+        (0..k).map(|i| covariance.as_ref().map_or(f64::NAN, |c| c[(i, i)].max(0.0).sqrt())).collect();
+    let parameters = u.estimated_parameters(&theta, &std_errors);
+    let np = parameters.len();
+    let matrix = covariance.as_ref().map(|c| {
+        (0..np)
+            .map(|i| (0..np).map(|j| 0.5 * (c[(i, j)] + c[(j, i)])).collect::<Vec<f64>>())
+            .collect::<Vec<_>>()
+    });
+    let per_source = u.source_parameters(runs, &theta, &std_errors);
+    let (per_run, per_source_spread) = u.spreads(&per_source, &theta, covariance.as_ref());
+    Ok(Estimate {
+        model: u.written(model, &theta, &parameters, matrix.as_ref(), &per_run)?,
+        cost_before,
+        cost_after,
+        stopped,
+        iterations,
+        correlation_time: tau,
+        coefficients: u.estimated_coefficients(&theta, &std_errors),
+        parameters,
+        covariance: matrix,
+        initial_values: u.initial.len(),
+        initial_states: {
+            let first = u.first_group() + u.groups.len();
+            u.initial.iter().zip(&theta[first..]).map(|(&(r, i), &v)| (r, i, v)).collect()
+        },
+        from_records,
+        per_source,
+        per_run,
+        per_source_spread,
+        one_value: Vec::new(),
+        held_again: None,
+        step_samples: samples,
+    })
+}
+
+/// The settings no fit can run with, refused with why.
+fn check(settings: &EstimateSettings) -> Result<(), DiagnoseError> {
+    if settings.iterations == 0 {
+        return Err(DiagnoseError::Setup("the estimate needs at least one iteration".into()));
+    }
+    if !(settings.converged.is_finite() && (0.0..1.0).contains(&settings.converged)) {
+        return Err(DiagnoseError::Setup(format!(
+            "the estimate's stopping fraction {} must be a number from 0 to below 1",
+            settings.converged
+        )));
+    }
+    if !(settings.prior_weight.is_finite() && settings.prior_weight >= 0.0) {
+        return Err(DiagnoseError::Setup(format!(
+            "the coefficients' prior weight {} must be a number ≥ 0",
+            settings.prior_weight
+        )));
+    }
+    Ok(())
+}
+
+/// Where [`minimise`] ends: the unknowns, the output error linearised there, why it stopped
+/// and the iterations it took.
+struct Minimum {
+    theta: Vec<f64>,
+    lin: Linearised,
+    stopped: String,
+    iterations: usize,
+}
+
+/// Levenberg-Marquardt on the data's weighted sum of squares (`data_cost` of θ) and the
+/// unknowns' priors, from `start` (θ and the output error linearised there). Two rounds, each
+/// weighting the data as its start's residuals say ([`data_weight`]): a prior counts against
+/// the runs only once their residuals' variance and correlation time are those of a fit.
+fn minimise(
+    u: &Unknowns,
+    settings: &EstimateSettings,
+    runs: &Runs,
+    start: (Vec<f64>, Linearised),
+    data_cost: impl Fn(&[f64]) -> Option<f64>,
+    linearised: impl Fn(&[f64]) -> Result<Linearised, DiagnoseError>,
+) -> Minimum {
+    let k = u.entries.len();
+    let (mut theta, mut lin) = start;
+    let (mut stopped, mut iterations) = (String::new(), 0);
     for _round in 0..2 {
         let (weight, _) = data_weight(runs, &lin.residuals, k);
         let objective = |data: f64, theta: &[f64]| weight * data + u.prior_cost(theta);
@@ -684,7 +764,7 @@ fn fit(
         let mut lambda = 1e-3;
         stopped = format!("{} iterations", settings.iterations);
         for _ in 0..settings.iterations {
-            taken += 1;
+            iterations += 1;
             let mut a = &lin.jtj * weight;
             let mut g = &lin.jtr * weight;
             for i in 0..k {
@@ -732,165 +812,175 @@ fn fit(
             }
         }
     }
-    // from the records as they were measured (every sample), where a prediction starts
-    let from_records = (!u.initial.is_empty()).then(|| {
-        let mut recorded = theta.clone();
-        let first = u.first_group() + u.groups.len();
-        for (v, &(r, i)) in recorded[first..].iter_mut().zip(&u.initial) {
-            *v = every.initial(r, i);
-        }
-        let cost = cost_on(every, &recorded);
-        let moves: Vec<(f64, usize, usize)> = u
-            .initial
-            .iter()
-            .zip(&theta[first..])
-            .filter_map(|(&(r, i), v)| every.noise(r, i).map(|s| ((v - every.initial(r, i)) / s, r, i)))
-            .collect();
-        let moved = (!moves.is_empty())
-            .then(|| (moves.iter().map(|(z, _, _)| z * z).sum::<f64>() / moves.len() as f64).sqrt());
-        let largest = moves.iter().max_by(|a, b| a.0.abs().total_cmp(&b.0.abs())).map(|&(z, r, i)| Move {
-            z,
-            run: runs.frames[r].origin().to_string(),
-            state: runs.compared().iter().find(|(j, _)| *j == i).map_or_else(String::new, |(_, n)| n.clone()),
-        });
-        FromRecords { cost, moved, largest, leans: moved.is_some_and(|m| m > LEANS) }
-    });
-    let (weight, tau) = data_weight(runs, &lin.residuals, k);
-    // the residuals' cost and correlation time at every sample (at the coarse step a white
-    // residual is still correlated over one step)
-    let (cost_after, tau) = match coarse.then(|| residuals_on(every, &theta)) {
-        None => (sum_of_squares(&lin.residuals), tau),
-        Some(Some(r)) => (sum_of_squares(&r), crate::uncertainty::correlation_time(&every.series(&r))),
-        Some(None) => (f64::NAN, None),
-    };
-    let mut info = &lin.jtj * weight;
-    for i in 0..k {
-        info[(i, i)] += u.precision[i];
+    Minimum { theta, lin, stopped, iterations }
+}
+
+/// The fit at θ re-simulated from the records as they were measured (every sample), where a
+/// prediction starts, and how far its initial values moved from them in the records' noise;
+/// `None` where no initial value was estimated. `cost_on` is the data's cost of θ on runs.
+fn from_records(
+    u: &Unknowns,
+    scales: &Scales<'_>,
+    theta: &[f64],
+    cost_on: impl Fn(&Runs, &[f64]) -> Option<f64>,
+) -> Option<FromRecords> {
+    let Scales { fit: runs, every, .. } = *scales;
+    if u.initial.is_empty() {
+        return None;
     }
-    let covariance: Option<DMatrix<f64>> = info.try_inverse();
-    let std_errors: Vec<f64> =
-        (0..k).map(|i| covariance.as_ref().map_or(f64::NAN, |c| c[(i, i)].max(0.0).sqrt())).collect();
-    let np = u.parameters.len();
-    let parameters: Vec<EstimatedParameter> = u
-        .parameters
-        .iter()
-        .enumerate()
-        .map(|(i, p)| EstimatedParameter {
-            name: p.name.clone(),
-            start: p.value,
-            value: theta[i],
-            std_error: std_errors[i],
-            prior: p.prior,
-            at_bound: theta[i] <= p.bounds.0 || theta[i] >= p.bounds.1,
-        })
-        .collect();
-    let matrix = covariance.as_ref().map(|c| {
-        (0..np)
-            .map(|i| (0..np).map(|j| 0.5 * (c[(i, j)] + c[(j, i)])).collect::<Vec<f64>>())
-            .collect::<Vec<_>>()
-    });
-    let coefficients = u
-        .coefficients
-        .iter()
-        .enumerate()
-        .map(|(j, (e, t, v, sd))| RefinedCoefficient {
-            equation: e.clone(),
-            term: t.to_string(),
-            regression: *v,
-            refined: v + theta[np + j],
-            std_error: std_errors[np + j],
-            prior_sd: *sd,
-        })
-        .collect();
-    let per_source: Vec<SourceParameter> = u
-        .groups
-        .iter()
-        .enumerate()
-        .map(|(k, (p, source, members))| SourceParameter {
-            name: p.name.clone(),
-            source: *source,
-            run: u.per_run.contains(&p.name).then(|| runs.frames[members[0]].origin().to_string()),
-            runs: members.clone(),
-            value: theta[u.first_group() + k],
-            std_error: std_errors[u.first_group() + k],
-        })
-        .collect();
-    // a per-source value belongs to its source's records (a basin's indicator), so the file's
-    // value stays; runs are a sample of one basin's drift, and their mean is a new run's guess
-    let mut per_run = RunSpread::of(&per_source, Nuisance::Run);
-    let mut per_source_spread = RunSpread::of(&per_source, Nuisance::Source);
-    for r in per_run.iter_mut().chain(per_source_spread.iter_mut()) {
-        let values: Vec<usize> = (0..u.groups.len())
-            .filter(|&g| u.groups[g].0.name == r.name)
-            .map(|g| u.first_group() + g)
-            .collect();
-        r.chi_square = covariance.as_ref().and_then(|c| differences(&theta, c, &values));
-        r.p_value = r.chi_square.map(|q| crate::select::chi_square_pvalue(q, (r.runs - 1) as f64));
+    let mut recorded = theta.to_vec();
+    let first = u.first_group() + u.groups.len();
+    for (v, &(r, i)) in recorded[first..].iter_mut().zip(&u.initial) {
+        *v = every.initial(r, i);
     }
-    // a new run's value of a per-run parameter: the runs' mean, as uncertain as the runs
-    // scatter (sd², and the mean's own sd²/n), independent of the ship's parameters; written
-    // with them, so that Monte-Carlo draws of a new run vary it as a new run would
-    let new_run: Vec<(String, f64, f64)> = per_run
+    let cost = cost_on(every, &recorded);
+    let moves: Vec<(f64, usize, usize)> = u
+        .initial
         .iter()
-        .filter(|r| r.runs > 1)
-        .map(|r| (r.name.clone(), r.mean, r.sd * r.sd * (1.0 + 1.0 / r.runs as f64)))
+        .zip(&theta[first..])
+        .filter_map(|(&(r, i), v)| every.noise(r, i).map(|s| ((v - every.initial(r, i)) / s, r, i)))
         .collect();
-    let mut estimated = u.at(model, &theta)?;
-    estimated.set_parameter_estimates(
-        &parameters
+    let moved = (!moves.is_empty())
+        .then(|| (moves.iter().map(|(z, _, _)| z * z).sum::<f64>() / moves.len() as f64).sqrt());
+    let largest = moves.iter().max_by(|a, b| a.0.abs().total_cmp(&b.0.abs())).map(|&(z, r, i)| Move {
+        z,
+        run: runs.frames[r].origin().to_string(),
+        state: runs.compared().iter().find(|(j, _)| *j == i).map_or_else(String::new, |(_, n)| n.clone()),
+    });
+    Some(FromRecords { cost, moved, largest, leans: moved.is_some_and(|m| m > LEANS) })
+}
+
+impl Unknowns {
+    /// Each free parameter at θ with its standard error.
+    fn estimated_parameters(&self, theta: &[f64], std_errors: &[f64]) -> Vec<EstimatedParameter> {
+        self.parameters
             .iter()
-            .map(|p| (p.name.clone(), p.value, p.std_error.is_finite().then_some(p.std_error)))
-            .chain(new_run.iter().map(|(name, mean, var)| (name.clone(), *mean, Some(var.sqrt()))))
-            .collect::<Vec<_>>(),
-        matrix.clone().map(|matrix| {
-            let n = np + new_run.len();
-            let rows = (0..n)
-                .map(|i| {
-                    (0..n)
-                        .map(|j| match (i < np, j < np) {
-                            (true, true) => matrix[i][j],
-                            (false, false) if i == j => new_run[i - np].2,
-                            _ => 0.0,
-                        })
-                        .collect()
-                })
+            .enumerate()
+            .map(|(i, p)| EstimatedParameter {
+                name: p.name.clone(),
+                start: p.value,
+                value: theta[i],
+                std_error: std_errors[i],
+                prior: p.prior,
+                at_bound: theta[i] <= p.bounds.0 || theta[i] >= p.bounds.1,
+            })
+            .collect()
+    }
+
+    /// Each term coefficient at θ (the stored value and θ's change) with its standard error.
+    fn estimated_coefficients(&self, theta: &[f64], std_errors: &[f64]) -> Vec<RefinedCoefficient> {
+        let np = self.parameters.len();
+        self.coefficients
+            .iter()
+            .enumerate()
+            .map(|(j, (e, t, v, sd))| RefinedCoefficient {
+                equation: e.clone(),
+                term: t.to_string(),
+                regression: *v,
+                refined: v + theta[np + j],
+                std_error: std_errors[np + j],
+                prior_sd: *sd,
+            })
+            .collect()
+    }
+
+    /// Each per-source (per-run) unknown at θ with its standard error, named by its runs.
+    fn source_parameters(&self, runs: &Runs, theta: &[f64], std_errors: &[f64]) -> Vec<SourceParameter> {
+        let g = self.first_group();
+        self.groups
+            .iter()
+            .enumerate()
+            .map(|(k, (p, source, members))| SourceParameter {
+                name: p.name.clone(),
+                source: *source,
+                run: self.per_run.contains(&p.name).then(|| runs.frames[members[0]].origin().to_string()),
+                runs: members.clone(),
+                value: theta[g + k],
+                std_error: std_errors[g + k],
+            })
+            .collect()
+    }
+
+    /// The spread over the runs of each parameter estimated per run and over the sources of
+    /// each estimated per source, with Wald's test that their values differ (θ's `covariance`).
+    fn spreads(
+        &self,
+        per_source: &[SourceParameter],
+        theta: &[f64],
+        covariance: Option<&DMatrix<f64>>,
+    ) -> (Vec<RunSpread>, Vec<RunSpread>) {
+        let mut per_run = RunSpread::of(per_source, Nuisance::Run);
+        let mut per_source_spread = RunSpread::of(per_source, Nuisance::Source);
+        for r in per_run.iter_mut().chain(per_source_spread.iter_mut()) {
+            let values: Vec<usize> = (0..self.groups.len())
+                .filter(|&g| self.groups[g].0.name == r.name)
+                .map(|g| self.first_group() + g)
                 .collect();
-            ParameterCovarianceSpec {
-                names: parameters
-                    .iter()
-                    .map(|p| p.name.clone())
-                    .chain(new_run.iter().map(|r| r.0.clone()))
-                    .collect(),
-                matrix: rows,
-            }
-        }),
-    );
-    for r in &per_run {
-        estimated.set_parameter(&r.name, r.mean);
+            r.chi_square = covariance.and_then(|c| differences(theta, c, &values));
+            r.p_value = r.chi_square.map(|q| crate::select::chi_square_pvalue(q, (r.runs - 1) as f64));
+        }
+        (per_run, per_source_spread)
     }
-    Ok(Estimate {
-        model: estimated,
-        cost_before,
-        cost_after,
-        stopped,
-        iterations: taken,
-        correlation_time: tau,
-        parameters,
-        coefficients,
-        covariance: matrix,
-        initial_values: u.initial.len(),
-        initial_states: {
-            let first = u.first_group() + u.groups.len();
-            u.initial.iter().zip(&theta[first..]).map(|(&(r, i), &v)| (r, i, v)).collect()
-        },
-        from_records,
-        per_source,
-        per_run,
-        per_source_spread,
-        one_value: Vec::new(),
-        held_again: None,
-        step_samples: samples,
-    })
+
+    /// The model at θ as a file writes it: the parameters' estimates with their standard
+    /// errors and covariance (`matrix`, rows as `parameters`), and each per-run parameter's
+    /// mean.
+    ///
+    /// A per-source value belongs to its source's records (a basin's indicator), so the
+    /// file's value stays; runs are a sample of one basin's drift, and their mean is a new
+    /// run's guess.
+    fn written(
+        &self,
+        model: &Model,
+        theta: &[f64],
+        parameters: &[EstimatedParameter],
+        matrix: Option<&Vec<Vec<f64>>>,
+        per_run: &[RunSpread],
+    ) -> Result<Model, DiagnoseError> {
+        let np = parameters.len();
+        // a new run's value of a per-run parameter: the runs' mean, as uncertain as the runs
+        // scatter (sd², and the mean's own sd²/n), independent of the ship's parameters;
+        // written with them, so that Monte-Carlo draws of a new run vary it as a new run would
+        let new_run: Vec<(String, f64, f64)> = per_run
+            .iter()
+            .filter(|r| r.runs > 1)
+            .map(|r| (r.name.clone(), r.mean, r.sd * r.sd * (1.0 + 1.0 / r.runs as f64)))
+            .collect();
+        let mut estimated = self.at(model, theta)?;
+        estimated.set_parameter_estimates(
+            &parameters
+                .iter()
+                .map(|p| (p.name.clone(), p.value, p.std_error.is_finite().then_some(p.std_error)))
+                .chain(new_run.iter().map(|(name, mean, var)| (name.clone(), *mean, Some(var.sqrt()))))
+                .collect::<Vec<_>>(),
+            matrix.map(|matrix| {
+                let n = np + new_run.len();
+                let rows = (0..n)
+                    .map(|i| {
+                        (0..n)
+                            .map(|j| match (i < np, j < np) {
+                                (true, true) => matrix[i][j],
+                                (false, false) if i == j => new_run[i - np].2,
+                                _ => 0.0,
+                            })
+                            .collect()
+                    })
+                    .collect();
+                ParameterCovarianceSpec {
+                    names: parameters
+                        .iter()
+                        .map(|p| p.name.clone())
+                        .chain(new_run.iter().map(|r| r.0.clone()))
+                        .collect(),
+                    matrix: rows,
+                }
+            }),
+        );
+        for r in per_run {
+            estimated.set_parameter(&r.name, r.mean);
+        }
+        Ok(estimated)
+    }
 }
 
 /// 1/(s²τ): the weight of the data's sum of squares against the priors, s² the residuals'
