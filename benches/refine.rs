@@ -51,7 +51,7 @@ fn bench(c: &mut Criterion) {
     };
     let model = identify_model(&template, &frames, &how, &mut |_| {}).unwrap().model;
     let states: Vec<String> = ["u", "v", "r", "ψ"].map(String::from).to_vec();
-    let runs = Runs::new(&model, &frames, 0.05, Integrator::Rk4).unwrap().comparing(&states).unwrap();
+    let runs = Runs::new(&model, &frames, 0.05, Integrator::Rk4).unwrap().comparing(&model, &states).unwrap();
     let mut g = c.benchmark_group("refine");
     g.sample_size(10);
     g.bench_function("mmg_basin_13_runs_20hz", |b| {
@@ -100,7 +100,7 @@ fn bench(c: &mut Criterion) {
         .collect();
     let runs = Runs::new(&start, &measured, termid::data::sample_step(&measured), Integrator::Rk4)
         .unwrap()
-        .comparing(&states)
+        .comparing(&start, &states)
         .unwrap();
     let mut g = c.benchmark_group("estimate");
     g.sample_size(10);

@@ -185,7 +185,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let states: Vec<String> = ["u", "v", "r", "ψ"].map(String::from).to_vec();
             let training = Runs::new(&identified, &prepared, 0.05, Integrator::Rk4)?
                 .with_intercepts(intercept)
-                .comparing(&states)?;
+                .comparing(&identified, &states)?;
             identified = refine(&identified, &training, &RefineSettings::default())?.model;
         }
         let mut errors = Vec::new();

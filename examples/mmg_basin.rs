@@ -126,7 +126,7 @@ fn main() -> Result<(), Error> {
         println!("| {seed} | {} |{cells}", chosen.candidates[chosen.best].label);
         if std::env::var("MMG_REFINE").is_ok_and(|v| v == "1") {
             let runs = termid::diagnose::Runs::new(&model, &prepared, 0.05, Integrator::Rk4)?
-                .comparing(&["u", "v", "r", "ψ"].map(String::from))?;
+                .comparing(&model, &["u", "v", "r", "ψ"].map(String::from))?;
             let refined = termid::diagnose::refine(&model, &runs, &Default::default())?;
             let (cells, _) = predict(&refined.model, &true_turns, &true_held, u0, &settings)?;
             println!("| {seed} | {} refined |{cells}", chosen.candidates[chosen.best].label);
@@ -143,7 +143,7 @@ fn main() -> Result<(), Error> {
                 termid::data::sample_step(&frames),
                 Integrator::Rk4,
             )?
-            .comparing(&["u", "v", "r", "ψ"].map(String::from))?;
+            .comparing(&start, &["u", "v", "r", "ψ"].map(String::from))?;
             let fit = termid::diagnose::estimate(&start, &runs, &Default::default())?;
             std::fs::write(dir.join(format!("greybox_{seed}.toml")), fit.model.to_toml())?;
             let (cells, _) = predict(&fit.model, &true_turns, &true_held, u0, &settings)?;

@@ -824,7 +824,7 @@ impl PyModel {
                 let mut runs =
                     termid::diagnose::Runs::new(&self.inner, &frames, dt, termid::sim::Integrator::Rk4)?;
                 if let Some(names) = &states {
-                    runs = runs.comparing(names)?;
+                    runs = runs.comparing(&self.inner, names)?;
                 }
                 let fit = termid::diagnose::estimate(&self.inner, &runs, &settings)?;
                 // a fit whose estimates do not re-simulate every run has no metrics, and says why

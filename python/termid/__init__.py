@@ -1415,8 +1415,10 @@ class Model:
         parameters' covariance) and the model holding the estimates.
 
         Parameters: ``coefficients`` also estimates the identified equations' term
-        coefficients; ``states`` the states compared (default: every state the runs have);
-        ``initial_values`` how each run's initial state enters (a noisy first sample would
+        coefficients; ``states`` the states compared (default: every state the runs have),
+        and beside them any derived variable of the model (``[[derived]]``, a propeller's
+        thrust) to compare with the runs' column of its name, evaluated along the
+        re-simulation; ``initial_values`` how each run's initial state enters (a noisy first sample would
         bias the rest): ``"auto"`` (estimated free; where the fit leans on them, estimated
         again held to the recorded first samples by the records' noise, and that fit kept
         where it predicts the runs from their records better; ``attrs["held_again"]``),

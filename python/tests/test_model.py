@@ -325,6 +325,53 @@ def test_estimate_recovers_nomoto_k_and_t_from_a_noisy_run():
         termid.Model.builtin("lorenz").estimate(run.rename(columns={"ψ": "x", "r": "y", "δ": "z"}))
 
 
+LOAD_CELL = """
+[model]
+name = "a forced spring on a load cell"
+[[states]]
+name = "x"
+[[states]]
+name = "w"
+[[inputs]]
+name = "F"
+[parameters.k]
+value = K
+free = true
+[parameters.b]
+value = B
+free = true
+[parameters.g]
+value = G
+free = true
+[[derived]]
+name = "cell"
+definition = "g*(k*x + 0.3*x^3)"
+[equations.x_dot]
+state = "x"
+identify = false
+coefficients = { "w" = 1.0 }
+[equations.w_dot]
+state = "w"
+identify = false
+coefficients = { "-k*x - 0.3*x^3 - b*w + F" = 1.0 }
+"""
+
+
+def test_estimate_compares_a_derived_variable_with_its_record():
+    """A load cell's reading (a derived variable of the model, ``g`` its gain, which the motion
+    does not show) compared beside the motion: the gain and the spring from a start 30 % off."""
+    cell = lambda k, b, g: LOAD_CELL.replace("K", str(k)).replace("B", str(b)).replace("G", str(g))
+    truth = termid.Model.from_toml(cell(1.4, 0.2, 0.8))
+    run = truth.simulate(duration=30.0, inputs={"F": 0.5}, sample=0.05)[["t", "x", "w", "F"]]
+    run["cell"] = 0.8 * (1.4 * run["x"] + 0.3 * run["x"] ** 3)
+    start = termid.Model.from_toml(cell(1.0, 0.14, 1.1))
+    table, found = start.estimate(run, states=["x", "w", "cell"])
+    for name, value in [("k", 1.4), ("b", 0.2), ("g", 0.8)]:
+        assert abs(table.loc[name, "estimate"] / value - 1) < 0.01, table
+    with pytest.raises(termid.TermidError, match="its derived variables cell"):
+        start.estimate(run, states=["x", "torque"])
+
+
 def test_estimate_reads_a_ships_metrics_off_its_fit():
     """For a ship, ``attrs["metrics"]``: each run's overshoots measured beside the fit's
     re-simulation; the MMG model's rudder wake ratio ε started 25 % low and estimated from

@@ -170,7 +170,7 @@ fn held_out_cost(
     let dt = prediction.dt.unwrap_or_else(|| crate::data::sample_step(std::slice::from_ref(run)));
     let runs = Runs::new(model, std::slice::from_ref(run), dt, prediction.integrator)?
         .with_intercepts(intercepts)
-        .comparing(&compared(model, prediction))?;
+        .comparing(model, &compared(model, prediction))?;
     let sims = runs.simulate(model, &[], &[])?;
     Ok(runs.gap(&sims).cost)
 }

@@ -1,5 +1,6 @@
 //! Output error: simulate the measured runs with their recorded inputs from their recorded
-//! initial states, compare every measured state (each scaled by its spread in the data), and
+//! initial states, compare every measured state (each scaled by its spread in the data; and
+//! any derived variable asked for, evaluated along the re-simulation), and
 //! fit a hypothesis's parameters by Gauss-Newton / Levenberg-Marquardt on those residuals.
 
 use nalgebra::{DMatrix, DVector};
@@ -12,7 +13,10 @@ use std::collections::BTreeMap;
 use crate::data::Frame;
 use crate::identify::ParamValue;
 use crate::model::Model;
-use crate::sim::{simulate, Controller, Integrator, Replay, Settings, SimError, System, Trajectory};
+use crate::sim::{
+    simulate, Controller, Integrator, Replay, RightHandSide, Settings, SimError, System, Trajectory,
+};
+use crate::term::{Library, Term};
 
 /// The measured runs prepared for re-simulation.
 #[derive(Clone)]
@@ -29,6 +33,71 @@ pub struct Runs {
     pub(super) intercepts: bool,
     /// The model's inputs, which the re-simulation replays from the runs.
     inputs: Vec<String>,
+    /// The model's derived quantities compared with their records (after the states).
+    pub(super) outputs: Vec<Output>,
+}
+
+/// A derived variable of the model compared with its record (a propeller's thrust, a rudder's
+/// force): evaluated along each re-simulation from its states, inputs and parameters.
+#[derive(Clone, Debug)]
+pub(super) struct Output {
+    /// Its name, the model's and the record's column's.
+    pub name: String,
+    /// What it is, in the model's states, inputs and parameters.
+    pub term: Term,
+    /// Its spread in the records, as a state's scales its residuals.
+    pub scale: f64,
+}
+
+/// A model's right-hand side with further outputs after ẋ (or in its place, without
+/// `rates`): the derived quantities a fit compares with their records, the identified terms
+/// whose values the sensitivities need. Compiled as one library, what they share is computed
+/// once.
+pub(super) struct WithOutputs<'a> {
+    pub model: &'a Model,
+    /// Whether ẋ comes first.
+    pub rates: bool,
+    pub outputs: Vec<Term>,
+}
+
+impl RightHandSide for WithOutputs<'_> {
+    fn origin(&self) -> &str {
+        &self.model.path
+    }
+    fn states(&self) -> Result<Vec<(String, f64, f64)>, SimError> {
+        self.model.states()
+    }
+    fn inputs(&self) -> Vec<String> {
+        self.model.inputs()
+    }
+    fn parameters(&self) -> BTreeMap<String, f64> {
+        self.model.parameters()
+    }
+    fn compile(&self, with_intercept: bool) -> Result<Library, SimError> {
+        let mut outputs = Vec::new();
+        if self.rates {
+            for e in self.model.equations() {
+                outputs.push(e.rhs(with_intercept)?);
+            }
+        }
+        outputs.extend(self.outputs.iter().cloned());
+        Ok(Library::compile(&outputs, &self.model.vocabulary)?)
+    }
+}
+
+/// One compared quantity's errors in one run, model − measured: (name, unit, errors).
+type Compared = (String, String, Vec<f64>);
+
+/// The spread of a column over every run (1 where it does not vary): what scales its residuals.
+fn spread(frames: &[Frame], name: &str) -> f64 {
+    let all: Vec<f64> = frames.iter().flat_map(|f| f.column(name).unwrap_or(&[]).iter().copied()).collect();
+    let mean = all.iter().sum::<f64>() / all.len() as f64;
+    let sd = (all.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / all.len() as f64).sqrt();
+    if sd > 0.0 {
+        sd
+    } else {
+        1.0
+    }
 }
 
 /// Recorded inputs with an offset and a factor applied.
@@ -100,20 +169,7 @@ impl Runs {
                 f.require(i)?;
             }
         }
-        let scale = states
-            .iter()
-            .map(|(_, s)| {
-                let all: Vec<f64> =
-                    frames.iter().flat_map(|f| f.column(s).unwrap_or(&[]).iter().copied()).collect();
-                let mean = all.iter().sum::<f64>() / all.len() as f64;
-                let sd = (all.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / all.len() as f64).sqrt();
-                if sd > 0.0 {
-                    sd
-                } else {
-                    1.0
-                }
-            })
-            .collect();
+        let scale = states.iter().map(|(_, s)| spread(frames, s)).collect();
         let units = states
             .iter()
             .map(|(_, s)| {
@@ -168,21 +224,56 @@ impl Runs {
             settings,
             intercepts: false,
             inputs: system.inputs.clone(),
+            outputs: Vec::new(),
         })
     }
 
-    /// Compares only the named states (all must be compared ones); the others are still
-    /// simulated from their recorded initial values.
-    pub fn comparing(mut self, names: &[String]) -> Result<Runs, DiagnoseError> {
+    /// Compares only the named states (all must be compared ones; the others are still
+    /// simulated from their recorded initial values) and the named derived variables of
+    /// `model` (`[[derived]]`: a propeller's thrust), each with the runs' column of its name,
+    /// evaluated along the re-simulation.
+    pub fn comparing(mut self, model: &Model, names: &[String]) -> Result<Runs, DiagnoseError> {
+        let derived = &model.spec().derived;
+        let state = |n: &String| self.states.iter().any(|(_, s)| s == n);
+        if names.iter().any(|n| derived.iter().any(|d| &d.name == n)) && !names.iter().any(state) {
+            return Err(DiagnoseError::Setup(
+                "compare at least one state: the derived variables alone do not hold a re-simulation to its record"
+                    .into(),
+            ));
+        }
+        let mut outputs = Vec::new();
         for n in names {
-            if !self.states.iter().any(|(_, s)| s == n) {
+            if state(n) {
+                continue;
+            }
+            if !derived.iter().any(|d| &d.name == n) {
                 let have: Vec<&str> = self.states.iter().map(|(_, s)| s.as_str()).collect();
+                let derived: Vec<&str> = derived.iter().map(|d| d.name.as_str()).collect();
                 return Err(DiagnoseError::Setup(format!(
-                    "cannot compare `{n}`: the model's states the runs have are {}",
-                    have.join(", ")
+                    "cannot compare `{n}`: the model's states the runs have are {}{}",
+                    have.join(", "),
+                    if derived.is_empty() {
+                        String::new()
+                    } else {
+                        format!("; its derived variables {}", derived.join(", "))
+                    }
                 )));
             }
+            if let Some(f) = self.frames.iter().find(|f| f.column(n).is_none()) {
+                return Err(DiagnoseError::Setup(format!(
+                    "cannot compare the derived `{n}`: run {} has no column `{n}` (a dataset file names it under [columns])",
+                    f.origin()
+                )));
+            }
+            outputs.push(Output {
+                name: n.clone(),
+                term: model.vocabulary.parse(n)?,
+                scale: spread(&self.frames, n),
+            });
         }
+        self.outputs = outputs;
+        let names: Vec<String> =
+            names.iter().filter(|n| self.states.iter().any(|(_, s)| s == *n)).cloned().collect();
         // states, scales and units are parallel lists
         fn kept<T>(v: Vec<T>, keep: &[bool]) -> Vec<T> {
             v.into_iter().zip(keep).filter(|(_, k)| **k).map(|(x, _)| x).collect()
@@ -263,7 +354,12 @@ impl Runs {
             return Ok(out);
         }
         let setup = |e: crate::data::DataError| DiagnoseError::Setup(e.to_string());
-        let read: Vec<&String> = self.inputs.iter().chain(self.states.iter().map(|(_, name)| name)).collect();
+        let read: Vec<&String> = self
+            .inputs
+            .iter()
+            .chain(self.states.iter().map(|(_, name)| name))
+            .chain(self.outputs.iter().map(|o| &o.name))
+            .collect();
         for (f, s) in out.frames.iter_mut().zip(&mut out.settings) {
             let mut slim = Frame::new(f.origin(), f.time_name(), f.time().to_vec()).map_err(setup)?;
             for name in &read {
@@ -320,7 +416,12 @@ impl Runs {
 
     /// Number of compared values.
     pub fn residual_count(&self) -> usize {
-        self.frames.iter().map(|f| f.len()).sum::<usize>() * self.states.len()
+        self.frames.iter().map(|f| f.len()).sum::<usize>() * (self.states.len() + self.outputs.len())
+    }
+
+    /// The compared derived variables' names.
+    pub fn observed(&self) -> Vec<String> {
+        self.outputs.iter().map(|o| o.name.clone()).collect()
     }
 
     /// Simulates every run; `offsets` and `factors` by input index.
@@ -331,36 +432,70 @@ impl Runs {
         factors: &[(usize, f64)],
     ) -> Result<Vec<Trajectory>, SimError> {
         let system = System::new(model, &Default::default(), self.intercepts)?;
-        let m = system.inputs.len();
-        self.frames
-            .iter()
-            .zip(&self.x0)
-            .zip(&self.settings)
-            .zip(&self.params)
-            .map(|(((f, x0), s), p)| {
-                let system = system.with_parameters(p)?;
-                let mut c = Transformed {
-                    replay: Replay::new(f, &system.inputs)?,
-                    offset: vec![0.0; m],
-                    factor: vec![1.0; m],
-                };
-                for &(i, v) in offsets {
-                    c.offset[i] = v;
+        let observer = match self.outputs.is_empty() {
+            true => None,
+            false => {
+                let outputs = self.outputs.iter().map(|o| o.term.clone()).collect();
+                Some(System::new(&WithOutputs { model, rates: false, outputs }, &Default::default(), false)?)
+            }
+        };
+        (0..self.frames.len())
+            .map(|r| {
+                let run = self.simulate_one(&system, r, offsets, factors)?;
+                match &observer {
+                    Some(observer) => self.observe(observer, &self.params[r], run),
+                    None => Ok(run),
                 }
-                for &(i, v) in factors {
-                    c.factor[i] = v;
-                }
-                simulate(&system, x0, &mut c, s)
             })
             .collect()
     }
 
-    /// [`Runs::residuals`] cut into their series, one per run and compared state.
+    /// The compared derived variables along a re-simulated run, in its `observed`.
+    fn observe(
+        &self,
+        observer: &System,
+        parameters: &BTreeMap<String, f64>,
+        mut run: Trajectory,
+    ) -> Result<Trajectory, SimError> {
+        let observer = observer.with_parameters(parameters)?;
+        let states: Vec<&[f64]> = run.states.iter().map(|c| c.as_slice()).collect();
+        let inputs: Vec<&[f64]> = run.inputs.iter().map(|c| c.as_slice()).collect();
+        let values = observer.derivatives_on_columns(&states, &inputs);
+        run.observed = self.outputs.iter().map(|o| o.name.clone()).zip(values).collect();
+        Ok(run)
+    }
+
+    /// Run `r` re-simulated with its recorded inputs, `offsets` and `factors` by input index.
+    fn simulate_one(
+        &self,
+        system: &System,
+        r: usize,
+        offsets: &[(usize, f64)],
+        factors: &[(usize, f64)],
+    ) -> Result<Trajectory, SimError> {
+        let m = system.inputs.len();
+        let system = system.with_parameters(&self.params[r])?;
+        let mut c = Transformed {
+            replay: Replay::new(&self.frames[r], &system.inputs)?,
+            offset: vec![0.0; m],
+            factor: vec![1.0; m],
+        };
+        for &(i, v) in offsets {
+            c.offset[i] = v;
+        }
+        for &(i, v) in factors {
+            c.factor[i] = v;
+        }
+        simulate(&system, &self.x0[r], &mut c, &self.settings[r])
+    }
+
+    /// [`Runs::residuals`] cut into their series, one per run and compared state or derived
+    /// variable.
     pub fn series(&self, residuals: &[f64]) -> Vec<Vec<f64>> {
         let mut out = Vec::new();
         let mut at = 0;
         for f in &self.frames {
-            for _ in &self.states {
+            for _ in 0..self.states.len() + self.outputs.len() {
                 let end = (at + f.len()).min(residuals.len());
                 out.push(residuals[at..end].to_vec());
                 at = end;
@@ -369,14 +504,29 @@ impl Runs {
         out
     }
 
-    /// Scaled residuals (sim − measured) of every compared state, run by run.
+    /// What a run's re-simulation `sim` is compared in: each compared state and then each
+    /// derived variable, as (name, unit, scale, simulated at the samples).
+    fn compared_in<'a>(&'a self, sim: &'a Trajectory) -> Vec<(&'a str, &'a str, f64, &'a [f64])> {
+        let states = self.states.iter().zip(&self.units).zip(&self.scale).map(|(((i, name), unit), sc)| {
+            (name.as_str(), unit.as_str(), *sc, sim.states.get(*i).map_or(&[][..], |c| c.as_slice()))
+        });
+        let outputs = self.outputs.iter().map(|o| {
+            let simulated =
+                sim.observed.iter().find(|(n, _)| *n == o.name).map_or(&[][..], |(_, c)| c.as_slice());
+            (o.name.as_str(), "", o.scale, simulated)
+        });
+        states.chain(outputs).collect()
+    }
+
+    /// Scaled residuals (sim − measured) of every compared state and derived variable, run by
+    /// run (a sample the re-simulation did not reach is NaN).
     pub fn residuals(&self, sims: &[Trajectory]) -> Vec<f64> {
         let mut r = Vec::with_capacity(self.residual_count());
         for (f, sim) in self.frames.iter().zip(sims) {
-            for ((i, name), sc) in self.states.iter().zip(&self.scale) {
+            for (name, _, sc, simulated) in self.compared_in(sim) {
                 let meas = f.column(name).unwrap_or(&[]);
                 for (k, m) in meas.iter().enumerate() {
-                    let s = sim.states[*i].get(k).copied().unwrap_or(f64::NAN);
+                    let s = simulated.get(k).copied().unwrap_or(f64::NAN);
                     r.push((s - m) / sc);
                 }
             }
@@ -384,44 +534,58 @@ impl Runs {
         r
     }
 
-    /// RMS and max per state, in the state's unit.
+    /// RMS and max per compared state and derived variable, in its unit.
     pub fn gap(&self, sims: &[Trajectory]) -> Gap {
-        let mut states = Vec::new();
-        for (((i, name), unit), _) in self.states.iter().zip(&self.units).zip(&self.scale) {
-            let mut sq = 0.0;
-            let mut n = 0usize;
-            let mut max = 0.0f64;
-            for (f, sim) in self.frames.iter().zip(sims) {
-                for (k, m) in f.column(name).unwrap_or(&[]).iter().enumerate() {
-                    let d = sim.states[*i].get(k).copied().unwrap_or(f64::NAN) - m;
-                    sq += d * d;
-                    n += 1;
-                    max = max.max(d.abs());
-                }
-            }
-            states.push((name.clone(), unit.clone(), (sq / n.max(1) as f64).sqrt(), max));
-        }
-        let cost = self.residuals(sims).iter().map(|r| r * r).sum();
-        let runs = self
+        // each run's errors (model − measured) of each compared quantity
+        let errors: Vec<(String, Vec<Compared>)> = self
             .frames
             .iter()
             .zip(sims)
             .map(|(f, sim)| {
                 let per = self
-                    .states
-                    .iter()
-                    .map(|(i, name)| {
+                    .compared_in(sim)
+                    .into_iter()
+                    .map(|(name, unit, _, simulated)| {
                         let meas = f.column(name).unwrap_or(&[]);
                         let d: Vec<f64> = meas
                             .iter()
                             .enumerate()
-                            .map(|(k, m)| sim.states[*i].get(k).copied().unwrap_or(f64::NAN) - m)
+                            .map(|(k, m)| simulated.get(k).copied().unwrap_or(f64::NAN) - m)
                             .collect();
-                        let rms = (d.iter().map(|v| v * v).sum::<f64>() / d.len().max(1) as f64).sqrt();
-                        (name.clone(), rms, d.iter().fold(0.0f64, |a, b| a.max(b.abs())))
+                        (name.to_string(), unit.to_string(), d)
                     })
                     .collect();
                 (f.origin().to_string(), per)
+            })
+            .collect();
+        // over all runs, sample after sample
+        let quantities = errors.first().map_or(0, |(_, per)| per.len());
+        let states = (0..quantities)
+            .map(|q| {
+                let (mut sq, mut n, mut max) = (0.0, 0usize, 0.0f64);
+                for d in errors.iter().map(|(_, per)| &per[q].2) {
+                    for v in d {
+                        sq += v * v;
+                        n += 1;
+                        max = max.max(v.abs());
+                    }
+                }
+                let (name, unit, _) = &errors[0].1[q];
+                (name.clone(), unit.clone(), (sq / n.max(1) as f64).sqrt(), max)
+            })
+            .collect();
+        let cost = self.residuals(sims).iter().map(|r| r * r).sum();
+        let runs = errors
+            .into_iter()
+            .map(|(run, per)| {
+                let per = per
+                    .into_iter()
+                    .map(|(name, _, d)| {
+                        let rms = (d.iter().map(|v| v * v).sum::<f64>() / d.len().max(1) as f64).sqrt();
+                        (name, rms, d.iter().fold(0.0f64, |a, b| a.max(b.abs())))
+                    })
+                    .collect();
+                (run, per)
             })
             .collect();
         Gap { states, runs, cost }

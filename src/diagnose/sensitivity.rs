@@ -7,17 +7,20 @@
 //! parameter p of the model file (inside derived variables or equations, nonlinear in p) adds
 //! a column whose B is ∂f/∂p: the grey-box case. A and ∂f/∂p come exactly, by forward-mode
 //! derivatives through the compiled right-hand side, in one pass. A run's initial state
-//! x_i(0) adds a column with B = 0 and S(0) = e_i in that run alone.
+//! x_i(0) adds a column with B = 0 and S(0) = e_i in that run alone. A derived variable
+//! y = g(x, u; p) compared with its record (a propeller's thrust) adds residuals whose
+//! Jacobian rows are ∂g/∂x S + ∂g/∂p, from the same forward-mode pass at each sample.
 
 use std::collections::BTreeMap;
 
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
+use super::fit::WithOutputs;
 use super::{DiagnoseError, Runs};
 use crate::model::Model;
 use crate::sim::{Controller, Integrator, Replay, RightHandSide, SimError, System};
-use crate::term::{Library, Term};
+use crate::term::Term;
 
 /// What an output-error fit may change: a term's coefficient (additively) or a named
 /// parameter of the model file.
@@ -54,35 +57,6 @@ impl Free {
             Free::Group { name, runs } => format!("`{name}` of runs {runs:?}"),
             Free::Initial { run, state } => format!("the initial value of state {state} in run {run}"),
         }
-    }
-}
-
-/// The model's right-hand side followed by the identified terms as further outputs: ẋ and
-/// φ_j(x, u) for the matrix B from one evaluation, where the terms are the very sub-expressions
-/// ẋ is made of (compiled apart, every φ_j was computed twice per stage).
-struct WithRegressors<'a> {
-    model: &'a Model,
-    terms: Vec<Term>,
-}
-
-impl RightHandSide for WithRegressors<'_> {
-    fn origin(&self) -> &str {
-        &self.model.path
-    }
-    fn states(&self) -> Result<Vec<(String, f64, f64)>, SimError> {
-        self.model.states()
-    }
-    fn inputs(&self) -> Vec<String> {
-        self.model.inputs()
-    }
-    fn parameters(&self) -> BTreeMap<String, f64> {
-        self.model.parameters()
-    }
-    fn compile(&self, with_intercept: bool) -> Result<Library, SimError> {
-        let mut outputs =
-            self.model.equations().iter().map(|e| e.rhs(with_intercept)).collect::<Result<Vec<_>, _>>()?;
-        outputs.extend(self.terms.iter().cloned());
-        Ok(Library::compile(&outputs, &self.model.vocabulary)?)
     }
 }
 
@@ -259,8 +233,12 @@ fn per_run_jacobians<T: Send>(
             Free::Initial { .. } => {}
         }
     }
-    // the model's states, inputs and parameters, with the terms as outputs after the states'
-    let system = System::new(&WithRegressors { model, terms }, &BTreeMap::new(), runs.intercepts)?;
+    // the model's states, inputs and parameters; after ẋ the compared derived variables and
+    // the terms φ_j (for the matrix B), from one evaluation: compiled apart, every φ_j was
+    // computed twice per stage, as they are the very sub-expressions ẋ is made of
+    let outputs = runs.outputs.iter().map(|o| o.term.clone()).chain(terms).collect();
+    let system =
+        System::new(&WithOutputs { model, rates: true, outputs }, &BTreeMap::new(), runs.intercepts)?;
     (0..runs.frames.len())
         .into_par_iter()
         .map(|r| {
@@ -296,27 +274,36 @@ fn per_run_jacobians<T: Send>(
                 })
                 .collect();
             let k = active.len();
-            let columns = Columns { terms: &terms, parameters: &free, initial: &initial, k };
+            let outputs = runs.outputs.len();
+            let columns = Columns { terms: &terms, parameters: &free, initial: &initial, outputs, k };
             let frame = &runs.frames[r];
-            // the residuals state by state, as `Runs::residuals` orders them: (first row,
-            // state, scale, measured)
+            // the residuals state by state and then derived variable by derived variable, as
+            // `Runs::residuals` orders them: (first row, index in x or y, scale, measured)
             let mut blocks = Vec::with_capacity(runs.states.len());
+            let mut observed = Vec::with_capacity(outputs);
             let mut rows = 0;
             for ((i, name), sc) in runs.states.iter().zip(&runs.scale) {
                 let meas = frame.column(name).unwrap_or(&[]);
                 blocks.push((rows, *i, *sc, meas));
                 rows += meas.len();
             }
+            for (q, o) in runs.outputs.iter().enumerate() {
+                let meas = frame.column(&o.name).unwrap_or(&[]);
+                observed.push((rows, q, o.scale, meas));
+                rows += meas.len();
+            }
             // a sample the simulation does not reach stays NaN
             let mut res = vec![f64::NAN; rows];
             let mut jt = DMatrix::from_element(k, rows, f64::NAN);
-            integrate(&system, &columns, runs, r, &mut |t, x, s| {
-                for &(first, i, sc, meas) in &blocks {
+            integrate(&system, &columns, runs, r, &mut |t, x, s, y, sy| {
+                // a state's value and row of S, or a derived variable's and its sensitivities
+                let blocks = blocks.iter().map(|b| (b, x, s)).chain(observed.iter().map(|b| (b, y, sy)));
+                for (&(first, i, sc, meas), values, slopes) in blocks {
                     if let Some(m) = meas.get(t) {
-                        res[first + t] = (x[i] - m) / sc;
+                        res[first + t] = (values[i] - m) / sc;
                         let inverse = 1.0 / sc;
                         let column = &mut jt.as_mut_slice()[(first + t) * k..(first + t + 1) * k];
-                        for (out, v) in column.iter_mut().zip(&s[i * k..(i + 1) * k]) {
+                        for (out, v) in column.iter_mut().zip(&slopes[i * k..(i + 1) * k]) {
                             *out = v * inverse;
                         }
                     }
@@ -336,21 +323,25 @@ struct Columns<'a> {
     parameters: &'a [(usize, String)],
     /// (column, state) of this run's free initial values.
     initial: &'a [(usize, usize)],
+    /// How many derived variables are compared (the system's outputs after ẋ, before the
+    /// terms).
+    outputs: usize,
     /// All columns.
     k: usize,
 }
 
-/// Run `r` of `runs` with its sensitivities: the state and S (row-major, n × K) at every
-/// sample of the run, handed to `sample` with the sample's index. `system` yields ẋ and then
-/// the terms' values ([`WithRegressors`]).
+/// Run `r` of `runs` with its sensitivities: the state and S (row-major, n × K), the compared
+/// derived variables y and theirs (row-major, outputs × K) at every sample of the run, handed
+/// to `sample` with the sample's index. `system` yields ẋ, then y, then the terms' values
+/// ([`WithOutputs`]).
 fn integrate(
     system: &System,
     columns: &Columns<'_>,
     runs: &Runs,
     r: usize,
-    sample: &mut impl FnMut(usize, &[f64], &[f64]),
+    sample: &mut impl FnMut(usize, &[f64], &[f64], &[f64], &[f64]),
 ) -> Result<(), DiagnoseError> {
-    let Columns { terms: term_columns, parameters, initial, k } = *columns;
+    let Columns { terms: term_columns, parameters, initial, outputs, k } = *columns;
     let settings = &runs.settings[r];
     let n = system.dim();
     // S's rows that matter: the compared states' and those the right-hand side reads (through
@@ -372,13 +363,16 @@ fn integrate(
     let mut tangents = system.partials(&read, &names)?;
     let d = tangents.directions();
     let mut partials = vec![0.0; n * d];
-    // ẋ and then the terms φ_j
-    let mut values = vec![0.0; n + term_columns.len()];
+    // ẋ, the derived variables and then the terms φ_j
+    let mut values = vec![0.0; n + outputs + term_columns.len()];
+    // the same for y = g(x, u) at the samples, in buffers of its own
+    let (mut ws_y, mut tangents_y, mut values_y) = (system.workspace(), tangents.clone(), values.clone());
     // (ẋ, Ṡ) at (x, S, u)
     let mut rate = |x: &[f64], s: &[f64], u: &[f64], dx: &mut [f64], ds: &mut [f64]| {
         // the partials of ẋ alone (`partials` holds n rows)
         system.derivatives_and_partials(x, u, &mut ws, &mut tangents, &mut values, &mut partials);
-        let (rates, terms) = values.split_at(n);
+        let (rates, rest) = values.split_at(n);
+        let terms = &rest[outputs..];
         dx.copy_from_slice(rates);
         // only the integrated rows are read (the others stay zero)
         for &i in &rows {
@@ -405,6 +399,31 @@ fn integrate(
             }
         }
     };
+    // y = g(x, u) and its sensitivities ∂g/∂x S + ∂g/∂p at a sample, by their own workspace
+    let mut partials_y = vec![0.0; (n + outputs) * d];
+    let mut sy = vec![0.0; outputs * k];
+    let mut observe = |x: &[f64], s: &[f64], u: &[f64], sy: &mut [f64]| -> Vec<f64> {
+        if outputs == 0 {
+            return Vec::new();
+        }
+        system.derivatives_and_partials(x, u, &mut ws_y, &mut tangents_y, &mut values_y, &mut partials_y);
+        for q in 0..outputs {
+            let p = &partials_y[(n + q) * d..(n + q + 1) * d];
+            let row = &mut sy[q * k..(q + 1) * k];
+            row.fill(0.0);
+            for (c, &state) in read.iter().enumerate() {
+                if p[c] != 0.0 {
+                    for (out, v) in row.iter_mut().zip(&s[state * k..(state + 1) * k]) {
+                        *out += p[c] * v;
+                    }
+                }
+            }
+            for (q, (j, _)) in parameters.iter().enumerate() {
+                row[*j] += p[read.len() + q];
+            }
+        }
+        values_y[n..n + outputs].to_vec()
+    };
     let mut x = runs.x0[r].clone();
     let mut s = vec![0.0; n * k];
     for &(j, i) in initial {
@@ -412,7 +431,8 @@ fn integrate(
     }
     let (mut u_now, mut u_next, mut u_mid) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
     replay.input(0.0, &x, &mut u_now);
-    sample(0, &x, &s);
+    let y = observe(&x, &s, &u_now, &mut sy);
+    sample(0, &x, &s, &y, &sy);
     let (mut kx, mut ks) = (vec![vec![0.0; n]; 4], vec![vec![0.0; n * k]; 4]);
     let (mut tx, mut ts) = (vec![0.0; n], vec![0.0; n * k]);
     for step in 1..=steps {
@@ -461,7 +481,8 @@ fn integrate(
         }
         std::mem::swap(&mut u_now, &mut u_next);
         if step % every == 0 {
-            sample(step / every, &x, &s);
+            let y = observe(&x, &s, &u_now, &mut sy);
+            sample(step / every, &x, &s, &y, &sy);
         }
     }
     Ok(())
@@ -508,14 +529,7 @@ mod tests {
     #[test]
     fn an_initial_state_moves_its_own_run_alone() {
         let model = Model::parse(DUFFING, "duffing.toml").unwrap();
-        let frame = |phase: f64| {
-            let t: Vec<f64> = (0..=120).map(|i| i as f64 * 0.05).collect();
-            let mut f = Frame::new("run", "t", t.clone()).unwrap();
-            f.push("x", t.iter().map(|t| 0.5 * (0.8 * t + phase).cos()).collect()).unwrap();
-            f.push("w", t.iter().map(|t| -0.4 * (0.8 * t + phase).sin()).collect()).unwrap();
-            f.push("F", t.iter().map(|t| 0.7 * (0.9 * t + phase).sin()).collect()).unwrap();
-            f
-        };
+        let frame = |phase: f64| forced(121, phase);
         let runs = Runs::new(&model, &[frame(0.0), frame(1.0), frame(2.0)], 0.05, Integrator::Rk4).unwrap();
         let entries = vec![
             Free::Initial { run: 1, state: 0 },
@@ -552,6 +566,17 @@ mod tests {
         assert!((&lin.jtr - &jtr).amax() <= 1e-12 * jtr.amax(), "{} vs {}", lin.jtr, jtr);
     }
 
+    /// A run of a forced oscillator's states x, w and its force F, `samples` of 0.05 s from
+    /// the phase `phase`.
+    fn forced(samples: usize, phase: f64) -> Frame {
+        let t: Vec<f64> = (0..samples).map(|i| i as f64 * 0.05).collect();
+        let mut f = Frame::new("run", "t", t.clone()).unwrap();
+        f.push("x", t.iter().map(|t| 0.5 * (0.8 * t + phase).cos()).collect()).unwrap();
+        f.push("w", t.iter().map(|t| -0.4 * (0.8 * t + phase).sin()).collect()).unwrap();
+        f.push("F", t.iter().map(|t| 0.7 * (0.9 * t + phase).sin()).collect()).unwrap();
+        f
+    }
+
     const DUFFING: &str = r#"
 [model]
 name = "duffing"
@@ -576,12 +601,7 @@ coefficients = { "x" = -1.0, "w" = -0.1, "x^3" = -0.2, "F" = 1.0 }
     #[test]
     fn sensitivities_equal_finite_differences() {
         let model = Model::parse(DUFFING, "duffing.toml").unwrap();
-        let t: Vec<f64> = (0..=200).map(|i| i as f64 * 0.05).collect();
-        let mut f = Frame::new("run", "t", t.clone()).unwrap();
-        f.push("x", t.iter().map(|t| 0.5 * (0.8 * t).cos()).collect()).unwrap();
-        f.push("w", t.iter().map(|t| -0.4 * (0.8 * t).sin()).collect()).unwrap();
-        f.push("F", t.iter().map(|t| 0.7 * (0.9 * t).sin()).collect()).unwrap();
-        let runs = Runs::new(&model, &[f], 0.05, Integrator::Rk4).unwrap();
+        let runs = Runs::new(&model, &[forced(201, 0.0)], 0.05, Integrator::Rk4).unwrap();
         let entries: Vec<Free> = ["x", "w", "x^3", "F"]
             .iter()
             .map(|t| Free::Term("w_dot".to_string(), model.vocabulary.parse(t).unwrap()))
@@ -620,5 +640,131 @@ coefficients = { "x" = -1.0, "w" = -0.1, "x^3" = -0.2, "F" = 1.0 }
                 );
             }
         }
+    }
+
+    /// A spring whose stiffness `k` is a parameter, and a derived `load` that also reads `d`,
+    /// a parameter of nothing else.
+    const SPRING: &str = r#"
+[model]
+name = "forced spring"
+[[states]]
+name = "x"
+[[states]]
+name = "w"
+[[inputs]]
+name = "F"
+[parameters.k]
+value = 1.0
+free = true
+[parameters.d]
+value = 0.3
+free = true
+[[derived]]
+name = "spring"
+definition = "k*x + 0.2*x^3"
+[[derived]]
+name = "load"
+definition = "spring*F + d*w^2"
+[equations.x_dot]
+state = "x"
+identify = false
+coefficients = { "w" = 1.0 }
+[equations.w_dot]
+state = "w"
+candidates = ["spring", "w", "F"]
+coefficients = { "spring" = -1.0, "w" = -0.1, "F" = 1.0 }
+"#;
+
+    /// A compared derived variable's residuals are those of the re-simulation, and its
+    /// sensitivities (∂g/∂x S + ∂g/∂p) equal central differences, with respect to a parameter
+    /// of the motion and the output, one of the output alone, a term and an initial state.
+    #[test]
+    fn a_derived_variables_sensitivities_equal_finite_differences() {
+        let model = Model::parse(SPRING, "spring.toml").unwrap();
+        let mut f = forced(161, 0.0);
+        let t = f.time().to_vec();
+        f.push("load", t.iter().map(|t| 0.3 * (0.9 * t).cos()).collect()).unwrap();
+        let names: Vec<String> = ["x", "w", "load"].iter().map(|s| s.to_string()).collect();
+        let runs = Runs::new(&model, &[f], 0.05, Integrator::Rk4).unwrap().comparing(&model, &names).unwrap();
+        assert_eq!(runs.observed(), ["load"]);
+        let entries = vec![
+            Free::Parameter("k".into()),
+            Free::Parameter("d".into()),
+            Free::Term("w_dot".into(), model.vocabulary.parse("w").unwrap()),
+            Free::Initial { run: 0, state: 0 },
+        ];
+        let (r0, jac) = residuals_and_jacobian(&runs, &model, &entries).unwrap();
+        let residuals = |m: &Model, runs: &Runs| runs.residuals(&runs.simulate(m, &[], &[]).unwrap());
+        assert_eq!(r0.len(), 3 * t.len());
+        assert_eq!(r0, residuals(&model, &runs));
+        let h = 1e-6;
+        let moved = |j: usize, by: f64| -> Vec<f64> {
+            let mut m = model.clone();
+            let mut runs = runs.clone();
+            match j {
+                0 => {
+                    m.set_parameter("k", 1.0 + by);
+                }
+                1 => {
+                    m.set_parameter("d", 0.3 + by);
+                }
+                2 => m.set_coefficients(
+                    "w_dot",
+                    model
+                        .equation("w_dot")
+                        .unwrap()
+                        .coefficients
+                        .iter()
+                        .map(|(t, v, se)| (t.clone(), if t.to_string() == "w" { v + by } else { *v }, *se))
+                        .collect(),
+                    None,
+                ),
+                _ => runs.x0[0][0] += by,
+            }
+            residuals(&m, &runs)
+        };
+        for j in 0..entries.len() {
+            let (up, down) = (moved(j, h), moved(j, -h));
+            for row in 0..r0.len() {
+                let fd = (up[row] - down[row]) / (2.0 * h);
+                assert!(
+                    (jac[(row, j)] - fd).abs() < 1e-5 * (1.0 + fd.abs()),
+                    "row {row}, {j}: {} vs {fd}",
+                    jac[(row, j)]
+                );
+            }
+        }
+        // `d` moves the load alone, and does move it
+        let states = 2 * t.len();
+        assert!((0..states).all(|row| jac[(row, 1)] == 0.0));
+        assert!((states..r0.len()).any(|row| jac[(row, 1)].abs() > 1e-3));
+    }
+
+    /// A name that is neither a state nor a derived variable, or a derived variable without a
+    /// column, is refused, saying which.
+    #[test]
+    fn a_derived_variable_without_its_record_is_refused() {
+        let model = Model::parse(SPRING, "spring.toml").unwrap();
+        let t: Vec<f64> = (0..=40).map(|i| i as f64 * 0.05).collect();
+        let mut f = Frame::new("run", "t", t.clone()).unwrap();
+        for name in ["x", "w", "F"] {
+            f.push(name, vec![0.1; t.len()]).unwrap();
+        }
+        let runs = Runs::new(&model, &[f], 0.05, Integrator::Rk4).unwrap();
+        let compare = |names: &[&str]| {
+            let names: Vec<String> = names.iter().map(|s| s.to_string()).collect();
+            runs.clone().comparing(&model, &names).err().map(|e| e.to_string()).unwrap_or_default()
+        };
+        assert!(
+            compare(&["x", "load"]).contains("run run has no column `load`"),
+            "{}",
+            compare(&["x", "load"])
+        );
+        assert!(
+            compare(&["x", "torque"]).contains("its derived variables spring, load"),
+            "{}",
+            compare(&["x", "torque"])
+        );
+        assert!(compare(&["spring"]).contains("compare at least one state"), "{}", compare(&["spring"]));
     }
 }

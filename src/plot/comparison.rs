@@ -45,41 +45,37 @@ pub fn comparison_figures(
             let t = f.time();
             let mut panels = Vec::new();
             let in_plane = |name: &str| plane.is_some_and(|p| p.across.0 == name || p.up.0 == name);
-            for (i, name) in before.state_names.iter().enumerate() {
-                let Some(meas) = f.column(name) else { continue };
+            // the states, then what was observed along the run (derived variables compared
+            // with their records)
+            let names = before.state_names.iter().chain(before.observed.iter().map(|(n, _)| n));
+            for name in names {
+                let (Some(meas), Some(simulated)) = (f.column(name), before.column(name)) else { continue };
                 if in_plane(name) {
                     continue;
                 }
                 let (factor, shown) = shown(model.unit(name));
-                let n = meas.len().min(before.states[i].len()).min(t.len());
+                let n = meas.len().min(simulated.len()).min(t.len());
                 let time = t[..n].to_vec();
                 let scaled = |v: &[f64]| v[..n].iter().map(|x| x * factor).collect::<Vec<f64>>();
                 let gap = |sim: &[f64]| (0..n).map(|j| (sim[j] - meas[j]) * factor).collect::<Vec<f64>>();
                 let mut series = vec![
                     Series::line("measured", time.clone(), scaled(meas)),
-                    Series::dashed(labels[0], time.clone(), scaled(&before.states[i])),
+                    Series::dashed(labels[0], time.clone(), scaled(simulated)),
                 ];
                 // a residual in the colour of its simulation
-                let mut residual = vec![Series::line(
-                    &format!("{} − measured", labels[0]),
-                    time.clone(),
-                    gap(&before.states[i]),
-                )
-                .colored(1)];
-                if let Some(after) = other.get(k) {
-                    series.push(Series::dashed(labels[1], time.clone(), scaled(&after.states[i])));
+                let mut residual =
+                    vec![Series::line(&format!("{} − measured", labels[0]), time.clone(), gap(simulated))
+                        .colored(1)];
+                if let Some(after) = other.get(k).and_then(|o| o.column(name)).filter(|c| c.len() >= n) {
+                    series.push(Series::dashed(labels[1], time.clone(), scaled(after)));
                     // dashed over the first residual, which stays in sight under it
                     residual.push(
-                        Series::dashed(
-                            &format!("{} − measured", labels[1]),
-                            time.clone(),
-                            gap(&after.states[i]),
-                        )
-                        .colored(2),
+                        Series::dashed(&format!("{} − measured", labels[1]), time.clone(), gap(after))
+                            .colored(2),
                     );
                 }
                 let signals: Vec<Vec<f64>> =
-                    draws.iter().filter_map(|d| d.get(k)).map(|s| s.states[i].clone()).collect();
+                    draws.iter().filter_map(|d| d.get(k)?.column(name)).map(|c| c.to_vec()).collect();
                 if !signals.is_empty() {
                     let (lo, hi) = band(&signals);
                     let m = n.min(lo.len());

@@ -281,7 +281,7 @@ pub(super) fn output_error_runs(
     let sample = crate::data::sample_step(frames);
     let runs = Runs::new(model, frames, sample, crate::sim::Integrator::Rk4)?.with_intercepts(intercept);
     match states {
-        Some(names) => runs.comparing(names),
+        Some(names) => runs.comparing(model, names),
         None => Ok(runs),
     }
 }

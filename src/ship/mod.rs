@@ -318,6 +318,7 @@ fn downsample(t: &Trajectory, every: usize) -> Trajectory {
         states: t.states.iter().map(pick).collect(),
         inputs: t.inputs.iter().map(pick).collect(),
         derivatives: t.derivatives.iter().map(pick).collect(),
+        observed: t.observed.iter().map(|(n, c)| (n.clone(), pick(c))).collect(),
     }
 }
 pub mod oltmann;

@@ -170,12 +170,21 @@ pub struct Trajectory {
     pub inputs: Vec<Vec<f64>>,
     /// One column per state: ẋ = f(x(t), input(t)) at the sample time.
     pub derivatives: Vec<Vec<f64>>,
+    /// Further quantities along the run, by name, at the sample times (a model's derived
+    /// variables that a fit compares with their records); empty unless a caller evaluates
+    /// them.
+    pub observed: Vec<(String, Vec<f64>)>,
 }
 
 impl Trajectory {
     /// A state's column.
     pub fn state(&self, name: &str) -> Option<&[f64]> {
         self.state_names.iter().position(|n| n == name).map(|i| self.states[i].as_slice())
+    }
+
+    /// A state's column, or else a quantity observed along the run ([`Trajectory::observed`]).
+    pub fn column(&self, name: &str) -> Option<&[f64]> {
+        self.state(name).or_else(|| self.observed.iter().find(|(n, _)| n == name).map(|(_, c)| c.as_slice()))
     }
 
     /// An input's column.
@@ -269,6 +278,7 @@ pub fn simulate(
         states: vec![Vec::with_capacity(cap); n],
         inputs: vec![Vec::with_capacity(cap); m],
         derivatives: vec![Vec::with_capacity(if adaptive { 0 } else { cap }); n],
+        observed: Vec::new(),
     };
     // A sample's derivative f(x(t), input(t)) is filled in by the next step when that step
     // evaluates the same thing (always for RK4's first stage; for B8 when the input is at rest,

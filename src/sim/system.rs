@@ -201,9 +201,10 @@ impl System {
         self.rhs.eval_row_tangents(&mut ws.scratch, tangents, dx, partials);
     }
 
-    /// ẋ on many rows at once, one column per state, from columns of the states and the
-    /// inputs (in the system's orders, all of one length): the compiled terms evaluated block
-    /// by block, about twice as fast per row as one row at a time.
+    /// ẋ on many rows at once, one column per state (per output of the compiled right-hand
+    /// side, where it yields more than ẋ), from columns of the states and the inputs (in the
+    /// system's orders, all of one length): the compiled terms evaluated block by block, about
+    /// twice as fast per row as one row at a time.
     ///
     /// # Panics
     /// Where a state's or an input's column is missing or the columns' lengths differ.
@@ -218,7 +219,7 @@ impl System {
         );
         let n = states.first().or(inputs.first()).map_or(0, |c| c.len());
         assert!(states.iter().chain(inputs).all(|c| c.len() == n), "columns of different lengths");
-        let mut out = vec![Vec::with_capacity(n); self.dim()];
+        let mut out = vec![Vec::with_capacity(n); self.rhs.len()];
         if n == 0 {
             return out;
         }

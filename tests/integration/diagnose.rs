@@ -284,7 +284,8 @@ fn output_error_refinement_recovers_the_true_coefficients() {
     assert!(eq.coefficients.iter().all(|c| c.2.is_some_and(|s| s > 0.0 && s.is_finite())));
     assert!(eq.covariance.as_ref().is_some_and(|c| c.correlation_time >= 1.0));
     // comparing a state the runs do not have is refused by name
-    let err = Runs::new(&off, &runs, 0.05, Integrator::Rk4).unwrap().comparing(&["y".into()]).err().unwrap();
+    let err =
+        Runs::new(&off, &runs, 0.05, Integrator::Rk4).unwrap().comparing(&off, &["y".into()]).err().unwrap();
     assert!(err.to_string().contains("cannot compare `y`"), "{err}");
 }
 

@@ -218,7 +218,7 @@ fn choosing_by_prediction_prefers_the_library_that_predicts_held_out_runs() {
     let step = frames[0].time()[1] - frames[0].time()[0];
     let runs = Runs::new(&id.model, &frames[..1], step, prediction.integrator)
         .unwrap()
-        .comparing(&["v".to_string()])
+        .comparing(&id.model, &["v".to_string()])
         .unwrap();
     let direct = runs.gap(&runs.simulate(&id.model, &[], &[]).unwrap()).cost;
     assert!((lin.folds[0].1 - direct).abs() <= 1e-9 * direct, "{} vs {direct}", lin.folds[0].1);

@@ -108,7 +108,9 @@ pub struct EstimateCommand {
     /// estimated).
     #[arg(long = "initial-values", default_value = "auto", value_parser = termid::diagnose::InitialValues::parse)]
     pub initial_values: termid::diagnose::InitialValues,
-    /// Compare only these states (default: every state the runs have).
+    /// Compare only these states (default: every state the runs have), and these derived
+    /// variables of the model (`[[derived]]`: a propeller's thrust), each with the runs' column
+    /// of its name, evaluated along the re-simulation.
     #[arg(long, num_args = 1.., value_delimiter = ',')]
     pub states: Option<Vec<String>>,
     /// The RK4 step, s (default: the runs' sample interval; the recorded inputs are known only at

@@ -34,7 +34,7 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
     let dt = cmd.dt.unwrap_or_else(|| termid::data::sample_step(&frames));
     let mut runs = Runs::new(&model, &frames, dt, Integrator::Rk4)?;
     if let Some(states) = &cmd.states {
-        runs = runs.comparing(states)?;
+        runs = runs.comparing(&model, states)?;
     }
     let settings = EstimateSettings {
         coefficients: cmd.coefficients,
@@ -57,6 +57,8 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
     // the runs as the fit re-simulates them: what a plug-in reads off each beside its record
     // (and whether within the field's tolerance), and the figures
     let refit = fit.re_simulated(&runs);
+    // what was compared (the states, and the derived variables beside them), over all runs
+    let gap = refit.as_ref().ok().map(|sims| runs.gap(sims));
     let (metrics, metric_checks) = match &refit {
         Ok(sims) => termid::plugins::fit_metrics(&fit.model, runs.frames(), sims),
         Err(e) => {
@@ -107,11 +109,29 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
         Format::Json => {
             let mut report = serde_json::to_value(&fit)?;
             report["metrics"] = serde_json::to_value(&metrics)?;
+            report["gap"] = serde_json::json!(gap.as_ref().map(|g| g
+                .states
+                .iter()
+                .map(|(name, unit, rms, max)| serde_json::json!({ "name": name, "unit": unit, "rms": rms, "max": max }))
+                .collect::<Vec<_>>()));
             report["metric_checks"] = serde_json::to_value(&metric_checks)?;
             println!("{}", serde_json::to_string_pretty(&report)?)
         }
         Format::Text => {
             print!("{}", fit.text());
+            if let Some(gap) = &gap {
+                let cells: Vec<String> = gap
+                    .states
+                    .iter()
+                    .map(|(name, _, rms, max)| {
+                        crate::validate::error_cell(name, *rms, *max, model.unit(name))
+                    })
+                    .collect();
+                println!(
+                    "the fit's re-simulation against the records (model − measured), RMS / max: {}",
+                    cells.join(", ")
+                );
+            }
             if !metrics.is_empty() {
                 println!("== each run's metrics: measured → as the fit re-simulates it (the estimates, the run's own values and initial state) ==");
                 print!("{}", termid::plugin::metric_pairs_text(&metrics));

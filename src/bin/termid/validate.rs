@@ -159,5 +159,5 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
 /// One state's error, RMS / max, in its unit with angles in degrees: `ψ 1.55 / 2.74 °`.
 pub fn error_cell(state: &str, rms: f64, max: f64, unit: &str) -> String {
     let (factor, unit) = shown(unit);
-    format!("{state} {} / {} {unit}", sig(rms * factor, 3), sig(max * factor, 3))
+    format!("{state} {} / {} {unit}", sig(rms * factor, 3), sig(max * factor, 3)).trim_end().to_string()
 }

@@ -106,6 +106,7 @@ pub fn original_samples(rec: &Recorded) -> Trajectory {
         states: rec.fine.states.iter().map(pick).collect(),
         inputs: rec.fine.inputs.iter().map(pick).collect(),
         derivatives: rec.fine.derivatives.iter().map(pick).collect(),
+        observed: rec.fine.observed.iter().map(|(n, c)| (n.clone(), pick(c))).collect(),
     }
 }
 
