@@ -206,6 +206,10 @@ pub struct Estimate {
     pub covariance: Option<Vec<Vec<f64>>>,
     /// How many runs' initial values were estimated with them.
     pub initial_values: usize,
+    /// How many of them are of states the runs do not record that the motion depends on (a
+    /// lag, an engine), started where they are steady at each run's first sample (free
+    /// initial values only: held, they stay there).
+    pub hidden_initial_values: usize,
     /// Those estimated initial values: (run, state index in the model's system, value).
     #[serde(skip)]
     pub initial_states: Vec<(usize, usize, f64)>,
@@ -438,8 +442,18 @@ impl Unknowns {
                 }
             }
         }
+        // each run's compared states, and where they are free the states it does not record
+        // that the motion depends on (started where they are steady: `Runs::new`); held, those
+        // stay there, as the records' steady approach says (free, with nothing to hold them,
+        // they absorb what the model does not explain as the recorded ones do)
         let initial: Vec<(usize, usize)> = if settings.initial_values != InitialValues::Recorded {
-            (0..runs.len()).flat_map(|r| runs.compared().iter().map(move |(i, _)| (r, *i))).collect()
+            (0..runs.len())
+                .flat_map(|r| {
+                    let compared = runs.compared().iter().map(|(i, _)| *i);
+                    let hidden = runs.hidden[r].iter().copied().filter(|_| !held);
+                    compared.chain(hidden).map(move |i| (r, i))
+                })
+                .collect()
         } else {
             Vec::new()
         };
@@ -699,6 +713,7 @@ fn fit(
         parameters,
         covariance: matrix,
         initial_values: u.initial.len(),
+        hidden_initial_values: u.initial.iter().filter(|&&(r, i)| runs.hidden[r].contains(&i)).count(),
         initial_states: {
             let first = u.first_group() + u.groups.len();
             u.initial.iter().zip(&theta[first..]).map(|(&(r, i), &v)| (r, i, v)).collect()
@@ -1105,8 +1120,14 @@ impl Estimate {
         }
         if self.initial_values > 0 {
             out.push_str(&format!(
-                "and {} initial values (each run's compared states at its start, nuisance parameters)\n",
-                self.initial_values
+                "and {} initial values (each run's compared states at its start{}, nuisance parameters)\n",
+                self.initial_values,
+                match self.hidden_initial_values {
+                    0 => String::new(),
+                    n => format!(
+                        "; {n} of states the runs do not record that the motion depends on, started where they are steady"
+                    ),
+                }
             ));
         }
         if let Some(f) = &self.from_records {

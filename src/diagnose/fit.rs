@@ -14,7 +14,8 @@ use crate::data::Frame;
 use crate::identify::ParamValue;
 use crate::model::Model;
 use crate::sim::{
-    simulate, Controller, Integrator, Replay, RightHandSide, Settings, SimError, System, Trajectory,
+    simulate, solve_steady, Controller, Integrator, Replay, RightHandSide, Settings, SimError, SteadyProblem,
+    System, Trajectory, Unknown,
 };
 use crate::term::{Library, Term};
 
@@ -35,6 +36,40 @@ pub struct Runs {
     inputs: Vec<String>,
     /// The model's derived quantities compared with their records (after the states).
     pub(super) outputs: Vec<Output>,
+    /// Per run, the states (indices) it does not record that the motion depends on: their
+    /// initial values are unknowns of an estimate, started where they are steady.
+    pub(super) hidden: Vec<Vec<usize>>,
+}
+
+/// A run's initial state with its `hidden` states (unrecorded, read by the motion) where they
+/// are steady with the recorded ones and the inputs at the run's first sample (a lag of the
+/// hull's forces, an engine's rate: a run starts from a steady approach more often than not,
+/// and a file's initial value is no better a guess); all together where that has a solution,
+/// else each alone, else the `declared` value (a state whose own rate does not depend on it).
+fn steady_hidden(system: &System, frame: &Frame, declared: Vec<f64>, hidden: &[usize]) -> Vec<f64> {
+    if hidden.is_empty() {
+        return declared;
+    }
+    let input: Vec<f64> = system
+        .inputs
+        .iter()
+        .map(|i| frame.column(i).and_then(|c| c.first().copied()).unwrap_or(0.0))
+        .collect();
+    let solve = |x: &[f64], states: &[usize]| -> Option<Vec<f64>> {
+        let problem = SteadyProblem {
+            system,
+            x: x.to_vec(),
+            input: input.clone(),
+            unknowns: states.iter().map(|&i| Unknown::State(i)).collect(),
+            zero: states.to_vec(),
+        };
+        let (x, _) = solve_steady(&problem).ok()?;
+        x.iter().all(|v| v.is_finite()).then_some(x)
+    };
+    if let Some(x) = solve(&declared, hidden) {
+        return x;
+    }
+    hidden.iter().fold(declared, |x, &i| solve(&x, &[i]).unwrap_or(x))
 }
 
 /// A derived variable of the model compared with its record (a propeller's thrust, a rudder's
@@ -176,30 +211,6 @@ impl Runs {
                 model.spec().states.iter().find(|t| &t.name == s).map_or(String::new(), |t| t.unit.clone())
             })
             .collect();
-        let x0 = frames
-            .iter()
-            .map(|f| {
-                system
-                    .states
-                    .iter()
-                    .map(|s| {
-                        f.column(s).map_or_else(
-                            || model.spec().states.iter().find(|t| &t.name == s).map_or(0.0, |t| t.initial),
-                            |c| c[0],
-                        )
-                    })
-                    .collect()
-            })
-            .collect();
-        let settings = frames
-            .iter()
-            .map(|f| {
-                let t = f.time();
-                let sample = if t.len() > 1 { t[1] - t[0] } else { dt };
-                let sub = (sample / dt).round().max(1.0);
-                Settings { integrator, dt: sample / sub, duration: t[t.len() - 1] - t[0], sample }
-            })
-            .collect();
         // a run is simulated at its own parameters, as it was identified (Δu = u − u0 of that run)
         let rules = model.parameter_rules();
         let params = frames
@@ -214,6 +225,42 @@ impl Runs {
                     .collect::<Result<BTreeMap<_, _>, DiagnoseError>>()
             })
             .collect::<Result<Vec<_>, _>>()?;
+        // the states a run does not record that the motion depends on (a lag, an engine)
+        let hidden: Vec<Vec<usize>> = frames
+            .iter()
+            .map(|f| {
+                (0..system.dim())
+                    .filter(|&i| system.reads_state(i) && f.column(&system.states[i]).is_none())
+                    .collect()
+            })
+            .collect();
+        let x0 = frames
+            .iter()
+            .zip(&params)
+            .zip(&hidden)
+            .map(|((f, p), hidden)| {
+                let declared: Vec<f64> = system
+                    .states
+                    .iter()
+                    .map(|s| {
+                        f.column(s).map_or_else(
+                            || model.spec().states.iter().find(|t| &t.name == s).map_or(0.0, |t| t.initial),
+                            |c| c[0],
+                        )
+                    })
+                    .collect();
+                Ok(steady_hidden(&system.with_parameters(p)?, f, declared, hidden))
+            })
+            .collect::<Result<Vec<_>, DiagnoseError>>()?;
+        let settings = frames
+            .iter()
+            .map(|f| {
+                let t = f.time();
+                let sample = if t.len() > 1 { t[1] - t[0] } else { dt };
+                let sub = (sample / dt).round().max(1.0);
+                Settings { integrator, dt: sample / sub, duration: t[t.len() - 1] - t[0], sample }
+            })
+            .collect();
         Ok(Runs {
             frames: frames.to_vec(),
             states,
@@ -225,6 +272,7 @@ impl Runs {
             intercepts: false,
             inputs: system.inputs.clone(),
             outputs: Vec::new(),
+            hidden,
         })
     }
 
