@@ -291,7 +291,8 @@ impl Runs {
         }
         let mut outputs = Vec::new();
         for n in names {
-            if state(n) {
+            // a name given twice is compared once, as a state is
+            if state(n) || outputs.iter().any(|o: &Output| &o.name == n) {
                 continue;
             }
             if !derived.iter().any(|d| &d.name == n) {

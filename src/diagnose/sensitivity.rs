@@ -766,5 +766,11 @@ coefficients = { "spring" = -1.0, "w" = -0.1, "F" = 1.0 }
             compare(&["x", "torque"])
         );
         assert!(compare(&["spring"]).contains("compare at least one state"), "{}", compare(&["spring"]));
+        // a name given twice is compared once
+        let mut f = runs.frames[0].clone();
+        f.push("load", vec![0.2; f.len()]).unwrap();
+        let twice: Vec<String> = ["x", "load", "load", "x"].iter().map(|s| s.to_string()).collect();
+        let once = Runs::new(&model, &[f], 0.05, Integrator::Rk4).unwrap().comparing(&model, &twice).unwrap();
+        assert_eq!((once.observed(), once.compared().len()), (vec!["load".to_string()], 1));
     }
 }
