@@ -201,7 +201,7 @@ fn identified_from_noisy_basin_runs_the_model_predicts_within_the_targets() {
         "--out",
         &never,
     ]);
-    assert!(!ok && err.contains("`psi` is not a state of the model"), "{err}");
+    assert!(!ok && err.contains("`psi` is neither a state nor a derived variable of the model"), "{err}");
     assert!(!std::path::Path::new(&never).exists());
     std::fs::copy(dir.join("id_kalman.toml"), dir.join("id.toml")).unwrap();
     // the tracking filter is the ship plug-in's: refused without a ship

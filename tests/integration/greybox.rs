@@ -1370,3 +1370,73 @@ fn a_state_no_run_records_starts_steady_and_is_estimated() {
     let k_held = fit.parameters.iter().find(|p| p.name == "K").unwrap().value;
     assert!((k_held / k - 1.0).abs() < 0.02, "K {k_held}\n{}", fit.text());
 }
+
+/// `identify --refine` compares a derived variable as `estimate --states` does: the spring's
+/// identified coefficients refined with the load cell's reading beside the motion (the cell's
+/// gain known), each within 2 % of the truth's; a name that is neither a state nor a derived
+/// variable is refused, naming both kinds.
+#[test]
+fn the_refinement_compares_a_derived_variable_with_its_record() {
+    let (k, b, g, h) = (1.4, 0.2, 0.8, 0.05);
+    let force = |t: f64| 0.8 * (0.7 * t).sin() + 0.5 * (1.9 * t).sin();
+    let rows = trajectory(&[0.0, 0.0], h, 801, 4, |t, x| {
+        vec![x[1], -k * x[0] - 0.3 * x[0].powi(3) - b * x[1] + force(t)]
+    });
+    let rows: Vec<Vec<f64>> = rows
+        .iter()
+        .enumerate()
+        .map(|(i, x)| vec![x[0], x[1], force(i as f64 * h), g * (k * x[0] + 0.3 * x[0].powi(3))])
+        .collect();
+    let frame =
+        noisy_frame("cell", h, &["x", "w", "F", "cell"], &rows, &[0.002, 0.004, 0.0, 0.01], &mut Lcg(2));
+    let model = r#"
+[model]
+name = "a spring to identify, on a load cell"
+[[states]]
+name = "x"
+[[states]]
+name = "w"
+[[inputs]]
+name = "F"
+[parameters.g]
+value = 0.8
+[[derived]]
+name = "cell"
+definition = "g*(1.4*x + 0.3*x^3)"
+[equations.x_dot]
+state = "x"
+identify = false
+coefficients = { "w" = 1.0 }
+[equations.w_dot]
+state = "w"
+candidates = ["x", "x^3", "w", "F"]
+"#;
+    let dir = crate::common::Scratch::new("refine-derived");
+    let (model_path, data, out) = (dir.join("spring.toml"), dir.join("run.csv"), dir.join("identified.toml"));
+    std::fs::write(&model_path, model).unwrap();
+    frame.write_csv(&data).unwrap();
+    let identify = |refine: &str| {
+        crate::common::termid(&[
+            "identify",
+            "--model",
+            model_path.to_str().unwrap(),
+            "--data",
+            data.to_str().unwrap(),
+            "--refine",
+            refine,
+            "--out",
+            out.to_str().unwrap(),
+        ])
+    };
+    let (ok, report, err) = identify("x,w,cell");
+    assert!(ok, "{err}");
+    assert!(report.contains("output-error refinement"), "{report}");
+    let identified = Model::load(&out).unwrap();
+    let eq = identified.equation("w_dot").unwrap();
+    for (term, truth) in [("x", -k), ("x^3", -0.3), ("w", -b), ("F", 1.0)] {
+        let c = eq.coefficients.iter().find(|(t, _, _)| t.to_string() == term).unwrap().1;
+        assert!((c / truth - 1.0).abs() < 0.02, "{term}: {c} vs {truth}\n{report}");
+    }
+    let (ok, _, err) = identify("x,w,torque");
+    assert!(!ok && err.contains("neither a state nor a derived variable") && err.contains("cell"), "{err}");
+}

@@ -296,6 +296,8 @@ pub struct IdentifyCommand {
     /// re-simulate the (prepared) runs from their initial states with their recorded inputs
     /// and fit these states, comma-separated model names (e.g. `u,v,r,ψ`), or `all`. Compare
     /// velocities and heading; positions integrate every earlier error and dominate the fit.
+    /// A derived variable of the model among them is compared with the runs' column of its
+    /// name (a propeller's thrust).
     #[arg(long, value_name = "STATES")]
     pub refine: Option<String>,
     /// With --refine: weight of the regression's estimates as a prior (each coefficient held

@@ -216,19 +216,29 @@ fn backend_variants(model: &termid::model::Model, list: &str) -> Result<Vec<(Str
         .collect()
 }
 
-/// The states `--refine` names (`None`: all), each checked to be one of the model's.
+/// The states `--refine` names (`None`: all), each checked to be one of the model's states or
+/// derived variables (compared with the runs' column of its name).
 fn refine_states(list: &str, model: &termid::model::Model) -> Result<Option<Vec<String>>> {
     if list.trim() == "all" {
         return Ok(None);
     }
-    let known: Vec<&str> = model.spec().states.iter().map(|s| s.name.as_str()).collect();
+    let spec = model.spec();
+    let known: Vec<&str> = spec
+        .states
+        .iter()
+        .map(|s| s.name.as_str())
+        .chain(spec.derived.iter().map(|d| d.name.as_str()))
+        .collect();
     let names: Vec<String> =
         list.split(',').map(str::trim).filter(|n| !n.is_empty()).map(String::from).collect();
     if names.is_empty() {
         bail!("--refine `{list}` names no state: list the states to compare, e.g. --refine u,v,r, or `all`");
     }
     if let Some(name) = names.iter().find(|n| !known.contains(&n.as_str())) {
-        bail!("--refine {list}: `{name}` is not a state of the model ({})", known.join(", "));
+        bail!(
+            "--refine {list}: `{name}` is neither a state nor a derived variable of the model ({})",
+            known.join(", ")
+        );
     }
     Ok(Some(names))
 }
