@@ -36,8 +36,8 @@ pub struct Runs {
     inputs: Vec<String>,
     /// The model's derived quantities compared with their records (after the states).
     pub(super) outputs: Vec<Output>,
-    /// Per run, the states (indices) it does not record that the motion depends on: their
-    /// initial values are unknowns of an estimate, started where they are steady.
+    /// Per run, the states (indices) it does not record that the motion depends on, started
+    /// where they are steady; an estimate frees them where it frees the runs' initial values.
     pub(super) hidden: Vec<Vec<usize>>,
 }
 
