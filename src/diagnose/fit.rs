@@ -427,28 +427,29 @@ impl Runs {
 
     /// These runs coarsened as far as `model` allows, with the factor ([`Runs::coarser`], up to
     /// `most`): the model re-simulates them there as it did at their samples (`fine`, its
-    /// simulation of these runs), every compared state within `tolerance` of its scale (RMS over
-    /// all runs, at the coarse samples). Both the integration's error and the inputs'
-    /// resampling show in that difference. Factor 1 (the runs themselves) where no coarser step
-    /// holds.
+    /// simulation of these runs), every compared state and derived variable within `tolerance`
+    /// of its scale (RMS over all runs, at the coarse samples). Both the integration's error and
+    /// the inputs' resampling show in that difference. Factor 1 (the runs themselves) where no
+    /// coarser step holds.
     pub fn coarsest(&self, model: &Model, fine: &[Trajectory], tolerance: f64, most: usize) -> (usize, Runs) {
         let holds = |factor: usize| -> Option<Runs> {
             let coarse = self.coarser(factor).ok()?;
             let sims = coarse.simulate(model, &[], &[]).ok()?;
-            self.states
-                .iter()
-                .zip(&self.scale)
-                .all(|((i, _), scale)| {
+            // each compared state and derived variable, over all runs
+            let pairs: Vec<_> =
+                fine.iter().zip(&sims).map(|(a, b)| (self.compared_in(a), coarse.compared_in(b))).collect();
+            (0..self.states.len() + self.outputs.len())
+                .all(|q| {
                     let (mut sq, mut n) = (0.0, 0usize);
-                    for (a, b) in fine.iter().zip(&sims) {
-                        for (k, v) in b.states[*i].iter().enumerate() {
-                            if let Some(w) = a.states[*i].get(k * factor) {
+                    for (a, b) in &pairs {
+                        for (k, v) in b[q].3.iter().enumerate() {
+                            if let Some(w) = a[q].3.get(k * factor) {
                                 sq += (v - w).powi(2);
                                 n += 1;
                             }
                         }
                     }
-                    n > 0 && (sq / n as f64).sqrt() <= tolerance * scale
+                    n > 0 && (sq / n as f64).sqrt() <= tolerance * self.compared_scale(q)
                 })
                 .then_some(coarse)
         };
@@ -565,6 +566,11 @@ impl Runs {
             (o.name.as_str(), "", o.scale, simulated)
         });
         states.chain(outputs).collect()
+    }
+
+    /// The scale of compared quantity `q` ([`Runs::compared_in`]'s order).
+    fn compared_scale(&self, q: usize) -> f64 {
+        self.scale.get(q).copied().unwrap_or_else(|| self.outputs[q - self.scale.len()].scale)
     }
 
     /// Scaled residuals (sim − measured) of every compared state and derived variable, run by

@@ -740,6 +740,31 @@ coefficients = { "spring" = -1.0, "w" = -0.1, "F" = 1.0 }
         assert!((states..r0.len()).any(|row| jac[(row, 1)].abs() > 1e-3));
     }
 
+    /// The coarsest step that resolves the runs resolves the compared derived variables too: a
+    /// load that follows a fast force the motion smooths out holds the step finer than the
+    /// states alone would.
+    #[test]
+    fn the_coarsest_step_resolves_the_derived_variables_too() {
+        let model = Model::parse(SPRING, "spring.toml").unwrap();
+        let t: Vec<f64> = (0..400).map(|i| i as f64 * 0.05).collect();
+        let mut f = Frame::new("run", "t", t.clone()).unwrap();
+        f.push("x", t.iter().map(|t| 0.5 * (0.8 * t).cos()).collect()).unwrap();
+        f.push("w", t.iter().map(|t| -0.4 * (0.8 * t).sin()).collect()).unwrap();
+        f.push("F", t.iter().map(|t| 0.7 * (0.9 * t).sin() + 0.3 * (30.0 * t).sin()).collect()).unwrap();
+        f.push("load", vec![0.0; t.len()]).unwrap();
+        let names = |n: &[&str]| n.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        let factor = |compared: &[&str]| {
+            let runs = Runs::new(&model, std::slice::from_ref(&f), 0.05, Integrator::Rk4)
+                .unwrap()
+                .comparing(&model, &names(compared))
+                .unwrap();
+            let fine = runs.simulate(&model, &[], &[]).unwrap();
+            runs.coarsest(&model, &fine, 0.05, 8).0
+        };
+        let (states, with_load) = (factor(&["x", "w"]), factor(&["x", "w", "load"]));
+        assert!(with_load < states, "with the load {with_load}, the states alone {states}");
+    }
+
     /// A name that is neither a state nor a derived variable, or a derived variable without a
     /// column, is refused, saying which.
     #[test]
