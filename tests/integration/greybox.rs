@@ -1222,12 +1222,13 @@ identify = false
 coefficients = { "-spring - b*w + F" = 1.0 }
 "#;
 
-/// A derived variable compared with its record (a load cell's reading beside the motion)
-/// estimates what only it shows, the cell's gain, with the motion's parameters: each within
-/// 2 % from a start 30 % off, through the library and the `estimate` command alike.
-#[test]
-fn a_derived_variable_compared_with_its_record_estimates_what_only_it_shows() {
-    let (k, b, g, h) = (1.4, 0.2, 0.8, 0.05);
+/// The load cell's truth: stiffness k, damping b, the cell's gain g.
+const LOAD_CELL_TRUTH: (f64, f64, f64) = (1.4, 0.2, 0.8);
+
+/// The truth forced by two sines (the test's own RK4), 40 s at 0.05 s: x, w, F and the cell's
+/// reading, with noise (seed `seed`) on all but the force.
+fn load_cell_run(seed: u64) -> Frame {
+    let ((k, b, g), h) = (LOAD_CELL_TRUTH, 0.05);
     let force = |t: f64| 0.8 * (0.7 * t).sin() + 0.5 * (1.9 * t).sin();
     let rows = trajectory(&[0.0, 0.0], h, 801, 4, |t, x| {
         vec![x[1], -k * x[0] - 0.3 * x[0].powi(3) - b * x[1] + force(t)]
@@ -1237,14 +1238,22 @@ fn a_derived_variable_compared_with_its_record_estimates_what_only_it_shows() {
         .enumerate()
         .map(|(i, x)| vec![x[0], x[1], force(i as f64 * h), g * (k * x[0] + 0.3 * x[0].powi(3))])
         .collect();
-    let mut rng = Lcg(5);
-    let frame = noisy_frame("cell", h, &["x", "w", "F", "cell"], &rows, &[0.002, 0.004, 0.0, 0.01], &mut rng);
+    noisy_frame("cell", h, &["x", "w", "F", "cell"], &rows, &[0.002, 0.004, 0.0, 0.01], &mut Lcg(seed))
+}
+
+/// A derived variable compared with its record (a load cell's reading beside the motion)
+/// estimates what only it shows, the cell's gain, with the motion's parameters: each within
+/// 2 % from a start 30 % off, through the library and the `estimate` command alike.
+#[test]
+fn a_derived_variable_compared_with_its_record_estimates_what_only_it_shows() {
+    let (k, b, g) = LOAD_CELL_TRUTH;
+    let frame = load_cell_run(5);
     let text = LOAD_CELL
         .replace("value = 1.0\nfree = true\n[parameters.b]", "value = 0.98\nfree = true\n[parameters.b]");
     let text = text.replace("value = 0.1\nfree = true", "value = 0.14\nfree = true");
     let model = Model::parse(&text, "cell.toml").unwrap();
     let names: Vec<String> = ["x", "w", "cell"].iter().map(|s| s.to_string()).collect();
-    let runs = Runs::new(&model, std::slice::from_ref(&frame), h, Integrator::Rk4)
+    let runs = Runs::new(&model, std::slice::from_ref(&frame), 0.05, Integrator::Rk4)
         .unwrap()
         .comparing(&model, &names)
         .unwrap();
@@ -1377,18 +1386,8 @@ fn a_state_no_run_records_starts_steady_and_is_estimated() {
 /// variable is refused, naming both kinds.
 #[test]
 fn the_refinement_compares_a_derived_variable_with_its_record() {
-    let (k, b, g, h) = (1.4, 0.2, 0.8, 0.05);
-    let force = |t: f64| 0.8 * (0.7 * t).sin() + 0.5 * (1.9 * t).sin();
-    let rows = trajectory(&[0.0, 0.0], h, 801, 4, |t, x| {
-        vec![x[1], -k * x[0] - 0.3 * x[0].powi(3) - b * x[1] + force(t)]
-    });
-    let rows: Vec<Vec<f64>> = rows
-        .iter()
-        .enumerate()
-        .map(|(i, x)| vec![x[0], x[1], force(i as f64 * h), g * (k * x[0] + 0.3 * x[0].powi(3))])
-        .collect();
-    let frame =
-        noisy_frame("cell", h, &["x", "w", "F", "cell"], &rows, &[0.002, 0.004, 0.0, 0.01], &mut Lcg(2));
+    let (k, b, _) = LOAD_CELL_TRUTH;
+    let frame = load_cell_run(2);
     let model = r#"
 [model]
 name = "a spring to identify, on a load cell"
