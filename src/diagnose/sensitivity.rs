@@ -418,8 +418,9 @@ fn integrate(
                     }
                 }
             }
-            for (q, (j, _)) in parameters.iter().enumerate() {
-                row[*j] += p[read.len() + q];
+            // ∂g/∂p, after the states' directions
+            for (a, (j, _)) in parameters.iter().enumerate() {
+                row[*j] += p[read.len() + a];
             }
         }
         values_y[n..n + outputs].to_vec()
