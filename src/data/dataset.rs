@@ -33,6 +33,11 @@ use super::{DataError, Frame};
 pub struct Dataset {
     /// Model variable → "file column [unit]".
     pub columns: BTreeMap<String, String>,
+    /// Further records, read as `columns` are, for the models that name them (a propeller's
+    /// thrust, which a grey-box model compares with its derived `T_P` and a polynomial one
+    /// does not have): a command's model is not asked to know these names.
+    #[serde(default)]
+    pub extra: BTreeMap<String, String>,
     /// The files' column names in order, for files with no header row (every run's unless
     /// it names its own).
     #[serde(default)]
@@ -316,13 +321,19 @@ impl Dataset {
     }
 
     /// What the schema cannot say: one file column per model variable, a sensible window.
-    fn check(&self) -> Result<(), String> {
-        let mut seen: BTreeMap<String, &str> = BTreeMap::new();
-        for (var, spec) in &self.columns {
+    fn check<'a>(&'a self) -> Result<(), String> {
+        let mut seen: BTreeMap<String, String> = BTreeMap::new();
+        if let Some(var) = self.extra.keys().find(|v| self.columns.contains_key(*v)) {
+            return Err(format!("`{var}` is in both `columns` and `extra`: one variable, one column"));
+        }
+        let keyed = |table: &'static str, map: &'a BTreeMap<String, String>| {
+            map.iter().map(move |(v, s)| (format!("{table}.{v}"), s))
+        };
+        for (key, spec) in keyed("columns", &self.columns).chain(keyed("extra", &self.extra)) {
             let (column, _, _) = split_spec(spec);
-            if let Some(first) = seen.insert(column.clone(), var) {
+            if let Some(first) = seen.insert(column.clone(), key.clone()) {
                 return Err(format!(
-                    "`columns.{first}` and `columns.{var}` both read the file column `{column}`: one column is one variable"
+                    "`{first}` and `{key}` both read the file column `{column}`: one column is one variable"
                 ));
             }
         }
@@ -465,7 +476,7 @@ impl Dataset {
                 let f = sign * f * scale(unit.as_deref(), &col)?;
                 Ok(values.iter().map(|v| v * f).collect())
             };
-            for (var, spec) in self.columns.iter().filter(|(v, _)| v.as_str() != time) {
+            for (var, spec) in self.columns.iter().chain(&self.extra).filter(|(v, _)| v.as_str() != time) {
                 let values = convert(spec, var)?;
                 frame.push(var, values)?;
             }
@@ -741,6 +752,30 @@ skip = 3
         assert!(
             matches!(expand_environment("${X:-/tmp}", env), Err(Unexpanded::Syntax(m)) if m.contains(":-"))
         );
+    }
+
+    /// `[extra]` records are read and converted as `[columns]` are; a file column read twice,
+    /// or a name in both tables, is refused naming both keys.
+    #[test]
+    fn extra_records_are_read_as_columns_are() {
+        let dir = std::env::temp_dir().join(format!("termid-extra-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        write(&dir, "run.csv", "time,delta,thrust\n0,1,40.5\n0.1,2,41.0\n");
+        let set = |extra: &str| {
+            let text = format!(
+                "[columns]\nt = \"time [s]\"\n\"δ\" = \"delta [deg]\"\n\n[extra]\n{extra}\n\n[[runs]]\nfile = \"run.csv\"\n"
+            );
+            write(&dir, "set.toml", &text);
+            Dataset::load(&dir.join("set.toml"))
+        };
+        let (frames, _) = set("T_P = \"thrust [N]\"").unwrap().read(&dir, "t").unwrap();
+        assert_eq!(frames[0].require("T_P").unwrap(), &[40.5, 41.0]);
+        assert!((frames[0].require("δ").unwrap()[1] - 2f64.to_radians()).abs() < 1e-15);
+        let twice = set("T_P = \"delta [deg]\"").unwrap_err().to_string();
+        assert!(twice.contains("`columns.δ` and `extra.T_P` both read the file column `delta`"), "{twice}");
+        let both = set("\"δ\" = \"thrust [N]\"").unwrap_err().to_string();
+        assert!(both.contains("`δ` is in both `columns` and `extra`"), "{both}");
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]

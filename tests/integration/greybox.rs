@@ -1262,17 +1262,22 @@ fn a_derived_variable_compared_with_its_record_estimates_what_only_it_shows() {
         let p = fit.parameters.iter().find(|p| p.name == name).unwrap();
         assert!((p.value / truth - 1.0).abs() < 0.02, "{name}: {} vs {truth}\n{}", p.value, fit.text());
     }
-    // the command: `--states` names the derived variable beside the states
+    // the command: `--states` names the derived variable beside the states; the dataset file
+    // reads the cell as an `[extra]` record, which a model without it does not refuse
     let dir = crate::common::Scratch::new("estimate-derived");
-    let (model_path, data, out) = (dir.join("cell.toml"), dir.join("run.csv"), dir.join("fit.toml"));
+    let (model_path, set, out) = (dir.join("cell.toml"), dir.join("set.toml"), dir.join("fit.toml"));
     std::fs::write(&model_path, &text).unwrap();
-    frame.write_csv(&data).unwrap();
+    frame.write_csv(&dir.join("run.csv")).unwrap();
+    let columns = "[columns]\nt = \"t [s]\"\nx = \"x\"\nw = \"w\"\nF = \"F\"\n";
+    std::fs::write(&set, format!("{columns}\n[extra]\ncell = \"cell\"\n\n[[runs]]\nfile = \"run.csv\"\n"))
+        .unwrap();
+    let (model_arg, set_arg) = (model_path.to_str().unwrap(), set.to_str().unwrap());
     let (ok, report, err) = crate::common::termid(&[
         "estimate",
         "--model",
-        model_path.to_str().unwrap(),
-        "--data",
-        data.to_str().unwrap(),
+        model_arg,
+        "--dataset",
+        set_arg,
         "--states",
         "x,w,cell",
         "--out",
@@ -1283,6 +1288,20 @@ fn a_derived_variable_compared_with_its_record_estimates_what_only_it_shows() {
     let written = Model::load(&out).unwrap();
     let gain = written.parameter_values()["g"];
     assert!((gain / g - 1.0).abs() < 0.02, "g {gain}\n{report}");
+    // a model without the cell reads the same dataset; under `[columns]` it would be refused
+    let without = text.replace(
+        "name = \"cell\"\ndefinition = \"g*spring\"",
+        "name = \"reading\"\ndefinition = \"g*spring\"",
+    );
+    std::fs::write(&model_path, &without).unwrap();
+    let (ok, _, err) = crate::common::termid(&["validate", "--model", model_arg, "--dataset", set_arg]);
+    assert!(ok, "{err}");
+    std::fs::write(&set, format!("{columns}cell = \"cell\"\n\n[[runs]]\nfile = \"run.csv\"\n")).unwrap();
+    let (ok, _, err) = crate::common::termid(&["validate", "--model", model_arg, "--dataset", set_arg]);
+    assert!(
+        !ok && err.contains("`columns.cell` maps a column onto `cell`, which is not a variable"),
+        "{err}"
+    );
 }
 
 /// Nomoto's ship behind a steering lag δ_e that no run records (the rudder's effective angle,

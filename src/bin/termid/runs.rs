@@ -15,7 +15,7 @@ pub fn load_for(model: &Model, data: &[PathBuf], datasets: &[PathBuf]) -> Result
         let known = model.data_names();
         if let Some(var) = ds.columns.keys().find(|v| !known.contains(v)) {
             bail!(
-                "{}: `columns.{var}` maps a column onto `{var}`, which is not a variable of {} (states, inputs, parameters: {})",
+                "{}: `columns.{var}` maps a column onto `{var}`, which is not a variable of {} (states, inputs, parameters: {}); a record only some models name goes under [extra]",
                 path.display(),
                 model.path,
                 model.vocabulary.variables().iter().chain(model.vocabulary.parameters()).cloned().collect::<Vec<_>>().join(", ")
