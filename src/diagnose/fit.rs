@@ -308,10 +308,10 @@ impl Runs {
                     }
                 )));
             }
-            if let Some(f) = self.frames.iter().find(|f| f.column(n).is_none()) {
+            // compared where it is recorded: one basin logs a propeller's thrust, another not
+            if self.frames.iter().all(|f| f.column(n).is_none()) {
                 return Err(DiagnoseError::Setup(format!(
-                    "cannot compare the derived `{n}`: run {} has no column `{n}` (a dataset file names it under [columns])",
-                    f.origin()
+                    "cannot compare the derived `{n}`: no run has a column `{n}` (a dataset file names it under [extra])"
                 )));
             }
             outputs.push(Output {
@@ -466,12 +466,29 @@ impl Runs {
 
     /// Number of compared values.
     pub fn residual_count(&self) -> usize {
-        self.frames.iter().map(|f| f.len()).sum::<usize>() * (self.states.len() + self.outputs.len())
+        self.frames.iter().map(|f| self.recorded(f).map(|(_, n)| n).sum::<usize>()).sum()
+    }
+
+    /// The compared quantities' (states', then derived variables') names in run `f` with their
+    /// number of samples there: 0 for a derived variable the run does not record.
+    fn recorded<'a>(&'a self, f: &'a Frame) -> impl Iterator<Item = (&'a str, usize)> + 'a {
+        let names = self.states.iter().map(|(_, s)| s).chain(self.outputs.iter().map(|o| &o.name));
+        names.map(move |n| (n.as_str(), f.column(n).map_or(0, |c| c.len())))
     }
 
     /// The compared derived variables' names.
     pub fn observed(&self) -> Vec<String> {
         self.outputs.iter().map(|o| o.name.clone()).collect()
+    }
+
+    /// The compared derived variables that some runs do not record, with how many runs do:
+    /// those are compared in the runs that record them alone.
+    pub fn partly_recorded(&self) -> Vec<(String, usize)> {
+        self.outputs
+            .iter()
+            .map(|o| (o.name.clone(), self.frames.iter().filter(|f| f.column(&o.name).is_some()).count()))
+            .filter(|(_, n)| *n < self.frames.len())
+            .collect()
     }
 
     /// Simulates every run; `offsets` and `factors` by input index.
@@ -545,8 +562,9 @@ impl Runs {
         let mut out = Vec::new();
         let mut at = 0;
         for f in &self.frames {
-            for _ in 0..self.states.len() + self.outputs.len() {
-                let end = (at + f.len()).min(residuals.len());
+            // a derived variable the run does not record has an empty series there
+            for (_, len) in self.recorded(f) {
+                let end = (at + len).min(residuals.len());
                 out.push(residuals[at..end].to_vec());
                 at = end;
             }
@@ -633,8 +651,10 @@ impl Runs {
         let runs = errors
             .into_iter()
             .map(|(run, per)| {
+                // a derived variable the run does not record has no gap there
                 let per = per
                     .into_iter()
+                    .filter(|(_, _, d)| !d.is_empty())
                     .map(|(name, _, d)| {
                         let rms = (d.iter().map(|v| v * v).sum::<f64>() / d.len().max(1) as f64).sqrt();
                         (name, rms, d.iter().fold(0.0f64, |a, b| a.max(b.abs())))

@@ -1304,6 +1304,56 @@ fn a_derived_variable_compared_with_its_record_estimates_what_only_it_shows() {
     );
 }
 
+/// Two sources of the same spring, one with the load cell and one without (a basin that
+/// logs a propeller's thrust beside one that does not): the cell is compared in the run that
+/// records it, the other holds the fit to its motion alone, and the gain comes out within 2 %
+/// as from the cell's run alone; the command says in how many runs the cell was compared.
+#[test]
+fn a_derived_variable_is_compared_in_the_sources_that_record_it() {
+    let g = LOAD_CELL_TRUTH.2;
+    let text = LOAD_CELL
+        .replace("value = 1.0\nfree = true\n[parameters.b]", "value = 0.98\nfree = true\n[parameters.b]");
+    let dir = crate::common::Scratch::new("estimate-derived-sources");
+    let (model_path, out) = (dir.join("spring.toml"), dir.join("fit.toml"));
+    std::fs::write(&model_path, &text).unwrap();
+    let columns = "[columns]\nt = \"t [s]\"\nx = \"x\"\nw = \"w\"\nF = \"F\"\n";
+    let mut sets = Vec::new();
+    for (name, seed, extra) in [("cell", 5, "\n[extra]\ncell = \"cell\"\n"), ("plain", 9, "")] {
+        load_cell_run(seed).write_csv(&dir.join(format!("{name}.csv"))).unwrap();
+        let set = dir.join(format!("{name}.toml"));
+        std::fs::write(&set, format!("{columns}{extra}\n[[runs]]\nfile = \"{name}.csv\"\n")).unwrap();
+        sets.push(set);
+    }
+    let (ok, report, err) = crate::common::termid(&[
+        "estimate",
+        "--model",
+        model_path.to_str().unwrap(),
+        "--dataset",
+        sets[0].to_str().unwrap(),
+        "--dataset",
+        sets[1].to_str().unwrap(),
+        "--states",
+        "x,w,cell",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(err.contains("`cell` is compared in the 1 of 2 runs that record it"), "{err}");
+    let gain = Model::load(&out).unwrap().parameter_values()["g"];
+    assert!((gain / g - 1.0).abs() < 0.02, "g {gain}\n{report}");
+    // a source alone without it has nothing to compare it with
+    let (ok, _, err) = crate::common::termid(&[
+        "estimate",
+        "--model",
+        model_path.to_str().unwrap(),
+        "--dataset",
+        sets[1].to_str().unwrap(),
+        "--states",
+        "x,w,cell",
+    ]);
+    assert!(!ok && err.contains("no run has a column `cell`"), "{err}");
+}
+
 /// Nomoto's ship behind a steering lag δ_e that no run records (the rudder's effective angle,
 /// τ = 1.5 s); the file starts it at 0.
 const NOMOTO_LAGGED: &str = r#"
