@@ -1418,7 +1418,9 @@ class Model:
         coefficients; ``states`` the states compared (default: every state the runs have),
         and beside them any derived variable of the model (``[[derived]]``, a propeller's
         thrust) to compare with the runs' column of its name, evaluated along the
-        re-simulation; ``initial_values`` how each run's initial state enters (a noisy first sample would
+        re-simulation (in the runs that have that column; ``attrs["partly_recorded"]``: each
+        one some runs lack, with how many ``runs`` record it ``of`` how many);
+        ``initial_values`` how each run's initial state enters (a noisy first sample would
         bias the rest): ``"auto"`` (estimated free; where the fit leans on them, estimated
         again held to the recorded first samples by the records' noise, and that fit kept
         where it predicts the runs from their records better; ``attrs["held_again"]``),
@@ -1502,6 +1504,7 @@ class Model:
             "one_value": pd.DataFrame(report.get("one_value", []), columns=["name", "per", "runs", "mean", "sd", "chi_square", "p_value"]),
             "held_again": report.get("held_again"),
             "step_samples": report.get("step_samples", 1),
+            "partly_recorded": pd.DataFrame(report.get("partly_recorded", []), columns=["name", "runs", "of"]),
             "metrics": pd.DataFrame(report.get("metrics", []), columns=["run", "metric", "measured", "simulated"]),
             "metric_checks": pd.DataFrame(report.get("metric_checks", []), columns=["name", "passed", "refuses", "detail"]),
         }

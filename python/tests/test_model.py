@@ -370,6 +370,12 @@ def test_estimate_compares_a_derived_variable_with_its_record():
         assert abs(table.loc[name, "estimate"] / value - 1) < 0.01, table
     with pytest.raises(termid.TermidError, match="its derived variables cell"):
         start.estimate(run, states=["x", "torque"])
+    # beside a run without the cell's record, the cell is compared in the run that has it
+    other = truth.simulate(duration=20.0, inputs={"F": -0.3}, sample=0.05)[["t", "x", "w", "F"]]
+    table, _ = start.estimate([run, other], states=["x", "w", "cell"])
+    assert abs(table.loc["g", "estimate"] / 0.8 - 1) < 0.01, table
+    assert table.attrs["partly_recorded"].to_dict("records") == [{"name": "cell", "runs": 1, "of": 2}]
+    assert table.attrs["partly_recorded"].columns.tolist() == ["name", "runs", "of"]
 
 
 def test_estimate_reads_a_ships_metrics_off_its_fit():

@@ -234,6 +234,8 @@ pub struct Estimate {
     /// The step the fit re-simulated the runs at, in samples: 1, or the coarsest step that
     /// resolves them ([`EstimateSettings::coarsest`]); the costs are at every sample either way.
     pub step_samples: usize,
+    /// The compared derived variables some runs do not record: compared in those that do.
+    pub partly_recorded: Vec<super::PartlyRecorded>,
 }
 
 /// A parameter estimated once per run (or per source), over the runs (sources): a new run's
@@ -725,6 +727,7 @@ fn fit(
         one_value: Vec::new(),
         held_again: None,
         step_samples: samples,
+        partly_recorded: runs.partly_recorded(),
     })
 }
 
@@ -1047,6 +1050,9 @@ impl Estimate {
                 "fitted at a step of {} samples (the coarsest at which the start re-simulates the runs as at every sample, or the step asked for); costs at every sample\n",
                 self.step_samples
             ));
+        }
+        for p in &self.partly_recorded {
+            out.push_str(&format!("{}\n", p.line()));
         }
         out.push_str(&format!(
             "{:<12} {:>14} {:>14} {:>12} {:>22}\n",

@@ -84,6 +84,28 @@ pub(super) struct Output {
     pub scale: f64,
 }
 
+/// A compared derived variable that some runs do not record (one basin logs a propeller's
+/// thrust, another not): compared in the runs that do, the others held to their states alone.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct PartlyRecorded {
+    /// The derived variable.
+    pub name: String,
+    /// How many runs record it.
+    pub runs: usize,
+    /// Of how many.
+    pub of: usize,
+}
+
+impl PartlyRecorded {
+    /// What a report says of it.
+    pub fn line(&self) -> String {
+        format!(
+            "`{}` is compared in the {} of {} runs that record it (the others hold the fit to their states alone)",
+            self.name, self.runs, self.of
+        )
+    }
+}
+
 /// A model's right-hand side with further outputs after ẋ (or in its place, without
 /// `rates`): the derived quantities a fit compares with their records, the identified terms
 /// whose values the sensitivities need. Compiled as one library, what they share is computed
@@ -481,13 +503,16 @@ impl Runs {
         self.outputs.iter().map(|o| o.name.clone()).collect()
     }
 
-    /// The compared derived variables that some runs do not record, with how many runs do:
-    /// those are compared in the runs that record them alone.
-    pub fn partly_recorded(&self) -> Vec<(String, usize)> {
+    /// The compared derived variables that some runs do not record.
+    pub fn partly_recorded(&self) -> Vec<PartlyRecorded> {
         self.outputs
             .iter()
-            .map(|o| (o.name.clone(), self.frames.iter().filter(|f| f.column(&o.name).is_some()).count()))
-            .filter(|(_, n)| *n < self.frames.len())
+            .map(|o| PartlyRecorded {
+                name: o.name.clone(),
+                runs: self.frames.iter().filter(|f| f.column(&o.name).is_some()).count(),
+                of: self.frames.len(),
+            })
+            .filter(|p| p.runs < p.of)
             .collect()
     }
 

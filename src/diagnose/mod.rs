@@ -45,7 +45,7 @@ pub use estimate::{
     estimate, Estimate, EstimateSettings, EstimatedParameter, FromRecords, HeldAgain, InitialValues, Move,
     RunSpread, SourceParameter, LEANS, RUNS_DIFFER,
 };
-pub use fit::{simulate_runs, EstimateError, Runs};
+pub use fit::{simulate_runs, EstimateError, PartlyRecorded, Runs};
 pub use refine::{refine, RefineSettings, Refined, RefinedCoefficient};
 
 pub use hypotheses::{generic_hypotheses, Effect, Hypothesis};

@@ -1338,7 +1338,7 @@ fn a_derived_variable_is_compared_in_the_sources_that_record_it() {
         out.to_str().unwrap(),
     ]);
     assert!(ok, "{err}");
-    assert!(err.contains("`cell` is compared in the 1 of 2 runs that record it"), "{err}");
+    assert!(report.contains("`cell` is compared in the 1 of 2 runs that record it"), "{report}");
     let gain = Model::load(&out).unwrap().parameter_values()["g"];
     assert!((gain / g - 1.0).abs() < 0.02, "g {gain}\n{report}");
     // a source alone without it has nothing to compare it with

@@ -35,12 +35,6 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
     let mut runs = Runs::new(&model, &frames, dt, Integrator::Rk4)?;
     if let Some(states) = &cmd.states {
         runs = runs.comparing(&model, states)?;
-        for (name, n) in runs.partly_recorded() {
-            eprintln!(
-                "note: `{name}` is compared in the {n} of {} runs that record it (the others hold the fit to their states alone)",
-                runs.len()
-            );
-        }
     }
     let settings = EstimateSettings {
         coefficients: cmd.coefficients,
