@@ -1418,8 +1418,9 @@ class Model:
         coefficients; ``states`` the states compared (default: every state the runs have),
         and beside them any derived variable of the model (``[[derived]]``, a propeller's
         thrust) to compare with the runs' column of its name, evaluated along the
-        re-simulation (in the runs that have that column; ``attrs["partly_recorded"]``: each
-        one some runs lack, with how many ``runs`` record it ``of`` how many);
+        re-simulation; each state and derived variable is compared in the runs that have its
+        column (``attrs["partly_recorded"]``: each that some runs lack, with how many ``runs``
+        record it ``of`` how many);
         ``initial_values`` how each run's initial state enters (a noisy first sample would
         bias the rest): ``"auto"`` (estimated free; where the fit leans on them, estimated
         again held to the recorded first samples by the records' noise, and that fit kept

@@ -323,6 +323,9 @@ impl Dataset {
     /// What the schema cannot say: one file column per model variable, a sensible window.
     fn check<'a>(&'a self) -> Result<(), String> {
         let mut seen: BTreeMap<String, String> = BTreeMap::new();
+        if self.extra.keys().any(|v| v.trim().is_empty()) {
+            return Err("`extra` maps a column onto an empty name: give the variable's name".into());
+        }
         if let Some(var) = self.extra.keys().find(|v| self.columns.contains_key(*v)) {
             return Err(format!("`{var}` is in both `columns` and `extra`: one variable, one column"));
         }
@@ -755,7 +758,7 @@ skip = 3
     }
 
     /// `[extra]` records are read and converted as `[columns]` are; a file column read twice,
-    /// or a name in both tables, is refused naming both keys.
+    /// or a name in both tables, is refused naming both keys, an empty name as such.
     #[test]
     fn extra_records_are_read_as_columns_are() {
         let dir = std::env::temp_dir().join(format!("termid-extra-{}", std::process::id()));
@@ -775,6 +778,8 @@ skip = 3
         assert!(twice.contains("`columns.δ` and `extra.T_P` both read the file column `delta`"), "{twice}");
         let both = set("\"δ\" = \"thrust [N]\"").unwrap_err().to_string();
         assert!(both.contains("`δ` is in both `columns` and `extra`"), "{both}");
+        let empty = set("\"\" = \"thrust [N]\"").unwrap_err().to_string();
+        assert!(empty.contains("`extra` maps a column onto an empty name"), "{empty}");
         std::fs::remove_dir_all(&dir).ok();
     }
 

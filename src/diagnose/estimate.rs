@@ -234,7 +234,8 @@ pub struct Estimate {
     /// The step the fit re-simulated the runs at, in samples: 1, or the coarsest step that
     /// resolves them ([`EstimateSettings::coarsest`]); the costs are at every sample either way.
     pub step_samples: usize,
-    /// The compared derived variables some runs do not record: compared in those that do.
+    /// The compared states and derived variables some runs do not record: compared in those
+    /// that do.
     pub partly_recorded: Vec<super::PartlyRecorded>,
 }
 
@@ -451,7 +452,10 @@ impl Unknowns {
         let initial: Vec<(usize, usize)> = if settings.initial_values != InitialValues::Recorded {
             (0..runs.len())
                 .flat_map(|r| {
-                    let compared = runs.compared().iter().map(|(i, _)| *i);
+                    // a compared state this run does not record is one of its hidden ones
+                    let frame = &runs.frames()[r];
+                    let compared =
+                        runs.compared().iter().filter(|(_, n)| frame.column(n).is_some()).map(|(i, _)| *i);
                     let hidden = runs.hidden[r].iter().copied().filter(|_| !held);
                     compared.chain(hidden).map(move |i| (r, i))
                 })
@@ -672,9 +676,12 @@ fn fit(
             .map_err(|e| fit_failure(e, "at an iterate"))
     };
     let theta = u.start(runs);
-    let cost_before = cost_on(runs, &theta).ok_or(DiagnoseError::Refinement(EstimateError::Diverges(
-        "at the start (the free parameters' values in the file)",
-    )))?;
+    let Some(cost_before) = cost_on(runs, &theta) else {
+        let why = u.runs_at(runs, &theta).not_finite(&u.at(model, &theta)?);
+        return Err(DiagnoseError::Refinement(EstimateError::StartNotFinite(
+            why.unwrap_or_else(|| "a residual is not finite".into()),
+        )));
+    };
     let cost_before = if coarse { cost_on(every, &theta).unwrap_or(f64::NAN) } else { cost_before };
     let start = linearised(&theta)?;
     let Minimum { theta, lin, stopped, iterations } =

@@ -84,8 +84,9 @@ pub(super) struct Output {
     pub scale: f64,
 }
 
-/// A compared derived variable that some runs do not record (one basin logs a propeller's
-/// thrust, another not): compared in the runs that do, the others held to their states alone.
+/// A compared state or derived variable that some runs do not record (one basin logs a
+/// propeller's thrust, another not; one run lacks its gyro's yaw rate): compared in the runs
+/// that do, the others held to what they record.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct PartlyRecorded {
     /// The derived variable.
@@ -100,7 +101,7 @@ impl PartlyRecorded {
     /// What a report says of it.
     pub fn line(&self) -> String {
         format!(
-            "`{}` is compared in the {} of {} runs that record it (the others hold the fit to their states alone)",
+            "`{}` is compared in the {} of {} runs that record it (the others hold the fit to what they record)",
             self.name, self.runs, self.of
         )
     }
@@ -179,7 +180,8 @@ pub fn simulate_runs(runs: &Runs, model: &Model) -> Result<Vec<Trajectory>, SimE
 }
 
 impl Runs {
-    /// Prepares runs: every state the model has and the data have is compared.
+    /// Prepares runs: every state the model has that a run records is compared, in the runs
+    /// that record it.
     pub fn new(
         model: &Model,
         frames: &[Frame],
@@ -208,11 +210,13 @@ impl Runs {
             )));
         }
         let system = System::new(model, &Default::default(), false)?;
+        // a state is compared in the runs that record it: one run or basin without a record of
+        // it (a yaw rate without a gyro) does not take it from the others' comparison
         let states: Vec<(usize, String)> = system
             .states
             .iter()
             .enumerate()
-            .filter(|(_, s)| frames.iter().all(|f| f.column(s).is_some()))
+            .filter(|(_, s)| frames.iter().any(|f| f.column(s).is_some()))
             .map(|(i, s)| (i, s.clone()))
             .collect();
         if states.is_empty() {
@@ -303,6 +307,11 @@ impl Runs {
     /// `model` (`[[derived]]`: a propeller's thrust), each with the runs' column of its name,
     /// evaluated along the re-simulation.
     pub fn comparing(mut self, model: &Model, names: &[String]) -> Result<Runs, DiagnoseError> {
+        if names.iter().any(|n| n.trim().is_empty()) {
+            return Err(DiagnoseError::Setup(
+                "an empty name among the compared states (a stray comma?)".into(),
+            ));
+        }
         let derived = &model.spec().derived;
         let state = |n: &String| self.states.iter().any(|(_, s)| s == n);
         if names.iter().any(|n| derived.iter().any(|d| &d.name == n)) && !names.iter().any(state) {
@@ -503,13 +512,13 @@ impl Runs {
         self.outputs.iter().map(|o| o.name.clone()).collect()
     }
 
-    /// The compared derived variables that some runs do not record.
+    /// The compared states and derived variables that some runs do not record.
     pub fn partly_recorded(&self) -> Vec<PartlyRecorded> {
-        self.outputs
-            .iter()
-            .map(|o| PartlyRecorded {
-                name: o.name.clone(),
-                runs: self.frames.iter().filter(|f| f.column(&o.name).is_some()).count(),
+        let names = self.states.iter().map(|(_, s)| s).chain(self.outputs.iter().map(|o| &o.name));
+        names
+            .map(|name| PartlyRecorded {
+                name: name.clone(),
+                runs: self.frames.iter().filter(|f| f.column(name).is_some()).count(),
                 of: self.frames.len(),
             })
             .filter(|p| p.runs < p.of)
@@ -579,6 +588,32 @@ impl Runs {
             c.factor[i] = v;
         }
         simulate(&system, &self.x0[r], &mut c, &self.settings[r])
+    }
+
+    /// Why `model` leaves a residual on these runs that is not finite: its re-simulation's
+    /// failure, or the first compared quantity that is not finite (a derived variable outside
+    /// its domain, √ of a negative): which, in which run, from when. `None` where every
+    /// residual is finite.
+    pub(super) fn not_finite(&self, model: &Model) -> Option<String> {
+        let sims = match self.simulate(model, &[], &[]) {
+            Ok(sims) => sims,
+            Err(e) => return Some(e.to_string()),
+        };
+        for (f, sim) in self.frames.iter().zip(&sims) {
+            for (name, _, _, simulated) in self.compared_in(sim) {
+                let Some(meas) = f.column(name) else { continue };
+                let bad = (0..meas.len()).find(|&k| !simulated.get(k).is_some_and(|v| v.is_finite()));
+                if let Some(k) = bad {
+                    return Some(format!(
+                        "`{name}` is not finite in run {} at t = {} s (the model's value: {})",
+                        f.origin(),
+                        crate::identify::num(f.time()[k] - f.time()[0]),
+                        simulated.get(k).map_or("not reached".to_string(), |v| v.to_string())
+                    ));
+                }
+            }
+        }
+        None
     }
 
     /// [`Runs::residuals`] cut into their series, one per run and compared state or derived
@@ -860,6 +895,9 @@ pub enum EstimateError {
     /// The re-simulation left its bounds or gave a non-finite residual; where it did so.
     #[error("diverges {0}")]
     Diverges(&'static str),
+    /// The model at its start values does not re-simulate the runs to a finite residual: why.
+    #[error("gives no finite residual at the start (the free parameters' values in the file): {0}")]
+    StartNotFinite(String),
     /// JᵀJ has no inverse (a parameter the runs do not excite).
     #[error("has singular normal equations")]
     Singular,

@@ -745,41 +745,56 @@ coefficients = { "spring" = -1.0, "w" = -0.1, "F" = 1.0 }
         assert!((states..r0.len()).any(|row| jac[(row, 1)].abs() > 1e-3));
     }
 
-    /// A derived variable that some runs record and others do not (one basin logs a
-    /// propeller's thrust, another not) is compared in those that do: the others hold the fit
-    /// to their states alone, with no residual, slope or gap of it, and its sensitivities in
-    /// the run that records it still equal central differences.
+    /// A state or derived variable that some runs record and others do not (one basin logs
+    /// a propeller's thrust and a rate, another neither) is compared in those that do: the
+    /// others hold the fit to what they record, with no residual, slope or gap of the rest
+    /// (the unrecorded rate, which the motion reads, starts where it is steady), and the
+    /// sensitivities, with respect to that start too, still equal central differences.
     #[test]
-    fn a_derived_variable_is_compared_in_the_runs_that_record_it() {
+    fn states_and_derived_variables_are_compared_in_the_runs_that_record_them() {
         let model = Model::parse(SPRING, "spring.toml").unwrap();
         let mut with = forced(161, 0.0);
         let t = with.time().to_vec();
         with.push("load", t.iter().map(|t| 0.3 * (0.9 * t).cos()).collect()).unwrap();
-        let without = forced(121, 0.7);
+        let other = forced(121, 0.7);
+        let mut without = Frame::new("other", "t", other.time().to_vec()).unwrap();
+        for name in ["x", "F"] {
+            without.push(name, other.column(name).unwrap().to_vec()).unwrap();
+        }
         let names: Vec<String> = ["x", "w", "load"].iter().map(|s| s.to_string()).collect();
         let runs = Runs::new(&model, &[with, without], 0.05, Integrator::Rk4)
             .unwrap()
             .comparing(&model, &names)
             .unwrap();
-        let partly = runs.partly_recorded();
-        assert_eq!((partly.len(), partly[0].name.as_str(), partly[0].runs, partly[0].of), (1, "load", 1, 2));
+        let partly: Vec<(String, usize, usize)> =
+            runs.partly_recorded().into_iter().map(|p| (p.name, p.runs, p.of)).collect();
+        assert_eq!(partly, [("w".to_string(), 1, 2), ("load".to_string(), 1, 2)]);
+        assert_eq!(runs.hidden, [vec![], vec![1]]);
         let sims = runs.simulate(&model, &[], &[]).unwrap();
         let r = runs.residuals(&sims);
-        assert_eq!((r.len(), runs.residual_count()), (3 * 161 + 2 * 121, 3 * 161 + 2 * 121));
+        assert_eq!((r.len(), runs.residual_count()), (3 * 161 + 121, 3 * 161 + 121));
         let lengths: Vec<usize> = runs.series(&r).iter().map(Vec::len).collect();
-        assert_eq!(lengths, [161, 161, 161, 121, 121, 0]);
+        assert_eq!(lengths, [161, 161, 161, 121, 0, 0]);
         let gap = runs.gap(&sims);
         let compared = |run: usize| gap.runs[run].1.iter().map(|(n, _, _)| n.clone()).collect::<Vec<_>>();
-        assert_eq!((compared(0), compared(1)), (names.clone(), names[..2].to_vec()));
+        assert_eq!((compared(0), compared(1)), (names.clone(), names[..1].to_vec()));
         // `d` moves the load alone: slopes in the first run's load rows, none in the second run
-        let entries = vec![Free::Parameter("k".into()), Free::Parameter("d".into())];
+        let entries = vec![
+            Free::Parameter("k".into()),
+            Free::Parameter("d".into()),
+            Free::Initial { run: 1, state: 1 },
+        ];
         let (r0, jac) = residuals_and_jacobian(&runs, &model, &entries).unwrap();
         assert_eq!(r0, r);
         let h = 1e-6;
-        for (j, name, value) in [(0, "k", 1.0), (1, "d", 0.3)] {
+        for j in 0..entries.len() {
             let moved = |by: f64| {
-                let mut m = model.clone();
-                m.set_parameter(name, value + by);
+                let (mut m, mut runs) = (model.clone(), runs.clone());
+                match j {
+                    0 => assert!(m.set_parameter("k", 1.0 + by)),
+                    1 => assert!(m.set_parameter("d", 0.3 + by)),
+                    _ => runs.x0[1][1] += by,
+                }
                 runs.residuals(&runs.simulate(&m, &[], &[]).unwrap())
             };
             let (up, down) = (moved(h), moved(-h));
@@ -794,6 +809,8 @@ coefficients = { "spring" = -1.0, "w" = -0.1, "F" = 1.0 }
         }
         assert!((2 * 161..3 * 161).any(|row| jac[(row, 1)].abs() > 1e-3));
         assert!((3 * 161..r0.len()).all(|row| jac[(row, 1)] == 0.0));
+        // the unrecorded rate's start moves the other run's displacement
+        assert!((3 * 161..r0.len()).any(|row| jac[(row, 2)].abs() > 1e-3));
     }
 
     /// The coarsest step that resolves the runs resolves the compared derived variables too: a
@@ -847,6 +864,7 @@ coefficients = { "spring" = -1.0, "w" = -0.1, "F" = 1.0 }
             compare(&["x", "torque"])
         );
         assert!(compare(&["spring"]).contains("compare at least one state"), "{}", compare(&["spring"]));
+        assert!(compare(&["x", ""]).contains("an empty name"), "{}", compare(&["x", ""]));
         // a name given twice is compared once
         let mut f = runs.frames[0].clone();
         f.push("load", vec![0.2; f.len()]).unwrap();
