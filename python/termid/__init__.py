@@ -1411,8 +1411,11 @@ class Model:
         """The model file's free parameters (``free = true`` under ``[parameters.NAME]``, with an
         optional ``prior`` and ``bounds``) estimated from ``runs`` by output error: grey-box
         identification. Returns a DataFrame of each parameter's start, estimate, standard
-        error and prior (``attrs``: the cost before and after, why it stopped, the
-        parameters' covariance) and the model holding the estimates.
+        error, prior and ``from_runs``, the share of its precision the runs gave (1 − (std.
+        error / prior sd)²: near 0 the estimate is the prior's) (``attrs``: the cost before and
+        after, why it stopped, the parameters' covariance, and ``attrs["correlated"]`` the
+        pairs whose estimates correlate beyond ±0.95: the runs fix a combination of each, not
+        each alone) and the model holding the estimates.
 
         Parameters: ``coefficients`` also estimates the identified equations' term
         coefficients; ``states`` the states compared (default: every state the runs have),
@@ -1488,6 +1491,7 @@ class Model:
                     "prior_mean": float("nan") if p["prior"] is None else p["prior"][0],
                     "prior_sd": float("nan") if p["prior"] is None else p["prior"][1],
                     "at_bound": p["at_bound"],
+                    "from_runs": float("nan") if p.get("from_runs") is None else p["from_runs"],
                 }
                 for p in report["parameters"]
             ]
@@ -1505,6 +1509,7 @@ class Model:
             "one_value": pd.DataFrame(report.get("one_value", []), columns=["name", "per", "runs", "mean", "sd", "chi_square", "p_value"]),
             "held_again": report.get("held_again"),
             "step_samples": report.get("step_samples", 1),
+            "correlated": pd.DataFrame(report.get("correlated", []), columns=["a", "b", "correlation"]),
             "partly_recorded": pd.DataFrame(report.get("partly_recorded", []), columns=["name", "runs", "of"]),
             "metrics": pd.DataFrame(report.get("metrics", []), columns=["run", "metric", "measured", "simulated"]),
             "metric_checks": pd.DataFrame(report.get("metric_checks", []), columns=["name", "passed", "refuses", "detail"]),

@@ -373,9 +373,25 @@ def test_estimate_compares_a_derived_variable_with_its_record():
     # beside a run without the cell's record, the cell is compared in the run that has it
     other = truth.simulate(duration=20.0, inputs={"F": -0.3}, sample=0.05)[["t", "x", "w", "F"]]
     table, _ = start.estimate([run, other], states=["x", "w", "cell"])
+    assert table["from_runs"].isna().all(), table  # no priors: no share to tell
     assert abs(table.loc["g", "estimate"] / 0.8 - 1) < 0.01, table
     assert table.attrs["partly_recorded"].to_dict("records") == [{"name": "cell", "runs": 1, "of": 2}]
     assert table.attrs["partly_recorded"].columns.tolist() == ["name", "runs", "of"]
+
+
+def test_estimate_says_what_the_runs_decide():
+    """``from_runs``: the share of a parameter's precision the runs gave; the cell's gain,
+    with a prior and not compared, gets none of it and stays at its prior's mean; no pair of
+    estimates is tied (``attrs["correlated"]`` empty)."""
+    cell = lambda k, b, g: LOAD_CELL.replace("K", str(k)).replace("B", str(b)).replace("G", str(g))
+    truth = termid.Model.from_toml(cell(1.4, 0.2, 0.8))
+    run = truth.simulate(duration=30.0, inputs={"F": 0.5}, sample=0.05)[["t", "x", "w", "F"]]
+    text = cell(1.0, 0.14, 1.1).replace("value = 1.1\nfree = true", "value = 1.1\nfree = true\nprior = { value = 1.1, sd = 0.2 }")
+    table, _ = termid.Model.from_toml(text).estimate(run, states=["x", "w"])
+    assert table.loc["g", "from_runs"] < 0.01 and abs(table.loc["g", "estimate"] - 1.1) < 1e-6, table
+    assert abs(table.loc["g", "std_error"] - 0.2) < 1e-3, table
+    assert table[["from_runs"]].loc[["k", "b"]].isna().all().all(), table
+    assert table.attrs["correlated"].empty and list(table.attrs["correlated"].columns) == ["a", "b", "correlation"]
 
 
 def test_estimate_reads_a_ships_metrics_off_its_fit():

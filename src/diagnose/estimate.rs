@@ -179,7 +179,28 @@ pub struct EstimatedParameter {
     pub prior: Option<(f64, f64)>,
     /// Whether the estimate sits on one of its bounds (its standard error then understates).
     pub at_bound: bool,
+    /// The share of its precision the runs gave, 1 − (std. error / prior sd)², where it has a
+    /// prior: near 0 the runs do not show it and the estimate is the prior's.
+    pub from_runs: Option<f64>,
 }
+
+/// A pair of free parameters whose estimates the runs tie together (|correlation| ≥
+/// [`CORRELATED`]): the runs fix a combination of the two, not each.
+#[derive(Clone, Debug, Serialize)]
+pub struct Correlated {
+    /// The one parameter.
+    pub a: String,
+    /// The other.
+    pub b: String,
+    /// Their estimates' correlation.
+    pub correlation: f64,
+}
+
+/// The correlation beyond which two estimates are reported as tied ([`Correlated`]).
+pub const CORRELATED: f64 = 0.95;
+
+/// Below this share of its precision from the runs an estimate is reported as its prior's.
+pub const MOSTLY_PRIOR: f64 = 0.5;
 
 /// An output-error estimate's result.
 #[derive(Clone, Debug, Serialize)]
@@ -237,6 +258,8 @@ pub struct Estimate {
     /// The compared states and derived variables some runs do not record: compared in those
     /// that do.
     pub partly_recorded: Vec<super::PartlyRecorded>,
+    /// The pairs of free parameters the runs tie together.
+    pub correlated: Vec<Correlated>,
 }
 
 /// A parameter estimated once per run (or per source), over the runs (sources): a new run's
@@ -709,6 +732,7 @@ fn fit(
             .map(|i| (0..np).map(|j| 0.5 * (c[(i, j)] + c[(j, i)])).collect::<Vec<f64>>())
             .collect::<Vec<_>>()
     });
+    let correlated = matrix.as_ref().map_or_else(Vec::new, |m| correlated_pairs(&parameters, m));
     let per_source = u.source_parameters(runs, &theta, &std_errors);
     let (per_run, per_source_spread) = u.spreads(&per_source, &theta, covariance.as_ref());
     Ok(Estimate {
@@ -735,7 +759,25 @@ fn fit(
         held_again: None,
         step_samples: samples,
         partly_recorded: runs.partly_recorded(),
+        correlated,
     })
+}
+
+/// The pairs of `parameters` whose estimates correlate beyond [`CORRELATED`] in `covariance`
+/// (rows as `parameters`), the most correlated first.
+fn correlated_pairs(parameters: &[EstimatedParameter], covariance: &[Vec<f64>]) -> Vec<Correlated> {
+    let mut pairs = Vec::new();
+    for i in 0..parameters.len() {
+        for j in i + 1..parameters.len() {
+            let rho = covariance[i][j] / (covariance[i][i] * covariance[j][j]).sqrt();
+            if rho.abs() >= CORRELATED {
+                let (a, b) = (parameters[i].name.clone(), parameters[j].name.clone());
+                pairs.push(Correlated { a, b, correlation: rho });
+            }
+        }
+    }
+    pairs.sort_by(|x, y| y.correlation.abs().total_cmp(&x.correlation.abs()));
+    pairs
 }
 
 /// The settings no fit can run with, refused with why.
@@ -888,6 +930,10 @@ impl Unknowns {
                 std_error: std_errors[i],
                 prior: p.prior,
                 at_bound: theta[i] <= p.bounds.0 || theta[i] >= p.bounds.1,
+                from_runs: p
+                    .prior
+                    .map(|(_, sd)| (1.0 - (std_errors[i] / sd).powi(2)).clamp(0.0, 1.0))
+                    .filter(|share| share.is_finite()),
             })
             .collect()
     }
@@ -1062,19 +1108,45 @@ impl Estimate {
             out.push_str(&format!("{}\n", p.line()));
         }
         out.push_str(&format!(
-            "{:<12} {:>14} {:>14} {:>12} {:>22}\n",
-            "parameter", "start", "estimate", "std. error", "prior (mean ± sd)"
+            "{:<12} {:>14} {:>14} {:>12} {:>22} {:>9}\n",
+            "parameter", "start", "estimate", "std. error", "prior (mean ± sd)", "from runs"
         ));
         for p in &self.parameters {
             let prior = p.prior.map_or("—".into(), |(m, sd)| format!("{} ± {}", num(m), num(sd)));
             out.push_str(&format!(
-                "{:<12} {:>14} {:>14} {:>12} {:>22}{}\n",
+                "{:<12} {:>14} {:>14} {:>12} {:>22} {:>9}{}\n",
                 p.name,
                 num(p.start),
                 num(p.value),
                 sig(p.std_error, 3),
                 prior,
+                p.from_runs.map_or("—".into(), |s| format!("{:.0} %", 100.0 * s)),
                 if p.at_bound { "  at its bound: the standard error understates" } else { "" }
+            ));
+        }
+        // what the runs did not decide: a parameter they do not show, a pair they tie
+        let prior_s: Vec<String> = self
+            .parameters
+            .iter()
+            .filter_map(|p| {
+                p.from_runs.filter(|s| *s < MOSTLY_PRIOR).map(|s| format!("{} ({:.0} %)", p.name, 100.0 * s))
+            })
+            .collect();
+        if !prior_s.is_empty() {
+            out.push_str(&format!(
+                "the runs gave less than half the precision of {}: those estimates are mostly their priors' (the runs hardly show them)\n",
+                prior_s.join(", ")
+            ));
+        }
+        if !self.correlated.is_empty() {
+            let pairs: Vec<String> = self
+                .correlated
+                .iter()
+                .map(|c| format!("{} and {} ({:+.2})", c.a, c.b, c.correlation))
+                .collect();
+            out.push_str(&format!(
+                "estimates correlated beyond ±{CORRELATED} (the runs fix a combination of each pair, not each alone): {}\n",
+                pairs.join(", ")
             ));
         }
         if !self.coefficients.is_empty() {

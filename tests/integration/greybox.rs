@@ -392,7 +392,42 @@ fn a_prior_holds_what_the_runs_do_not_see() {
         let p = fit.parameters.iter().find(|p| p.name == name).unwrap();
         assert!((p.value - mean).abs() < 1e-3 * mean, "{}", fit.text());
         assert!((p.std_error / sd - 1.0).abs() < 1e-3, "{}", fit.text());
+        // and the report says the runs gave it nothing
+        assert!(p.from_runs.is_some_and(|s| s < 0.01), "{}", fit.text());
     }
+    assert!(
+        fit.text().contains("the runs gave less than half the precision of K (0 %), T (0 %)"),
+        "{}",
+        fit.text()
+    );
+}
+
+/// What the runs decide is reported beside the estimates: the spring's stiffness split in two
+/// parts that act only as their sum, each with a wide prior, is a pair the runs tie (their
+/// correlation −1 within 1 %: the runs fix k₁ + k₂ = 1.4 within 2 %, not each), while the
+/// damping, which the runs show, has nearly all its precision from them (≥ 99 %).
+#[test]
+fn a_pair_the_runs_tie_and_what_they_decide_are_reported() {
+    let text = LOAD_CELL
+        .replace(
+            "[parameters.k]\nvalue = 1.0\nfree = true",
+            "[parameters.k1]\nvalue = 0.5\nfree = true\nprior = { value = 0.5, sd = 10.0 }\n[parameters.k2]\nvalue = 0.5\nfree = true\nprior = { value = 0.5, sd = 10.0 }",
+        )
+        .replace("[parameters.b]\nvalue = 0.1\nfree = true", "[parameters.b]\nvalue = 0.1\nfree = true\nprior = { value = 0.1, sd = 1.0 }")
+        .replace("[parameters.g]\nvalue = 1.0\nfree = true", "[parameters.g]\nvalue = 1.0")
+        .replace("definition = \"k*x + 0.3*x^3\"", "definition = \"(k1 + k2)*x + 0.3*x^3\"");
+    assert_eq!(text.matches("prior =").count(), 3);
+    let model = Model::parse(&text, "split.toml").unwrap();
+    let runs = Runs::new(&model, &[load_cell_run(5)], 0.05, Integrator::Rk4).unwrap();
+    let fit = estimate(&model, &runs, &EstimateSettings::default()).unwrap();
+    let value = |name: &str| fit.parameters.iter().find(|p| p.name == name).unwrap();
+    let sum = value("k1").value + value("k2").value;
+    assert!((sum / LOAD_CELL_TRUTH.0 - 1.0).abs() < 0.02, "{sum}\n{}", fit.text());
+    assert_eq!(fit.correlated.len(), 1, "{}", fit.text());
+    let pair = &fit.correlated[0];
+    assert!((pair.a.as_str(), pair.b.as_str()) == ("k1", "k2") && pair.correlation < -0.99, "{}", fit.text());
+    assert!(value("b").from_runs.is_some_and(|s| s >= 0.99), "{}", fit.text());
+    assert!(fit.text().contains("estimates correlated beyond ±0.95"), "{}", fit.text());
 }
 
 /// `termid estimate --initial-values`: by default a fit that leans on its initial values (a
