@@ -1,5 +1,6 @@
 //! Every text and file a user hands termid, from one fuzzer input: the first byte picks the
-//! reader, the rest is the text. Any error is fine; a panic is a bug. Kind 7 is a model file's
+//! reader, the rest is the text. Any error is fine; a panic is a bug. Kind 5 reads a dataset
+//! file and a ship's particulars (`new-ship`). Kind 7 is a model file's
 //! back-end table (`backend = …`), loaded and then fitted on a short Lorenz run; kind 6 a
 //! statistics file of `termid moments`. Kinds 8-10 are binary files seeded from valid ones:
 //! a valid Arrow IPC file, Parquet file or statistics bytes (`EquationMoments::to_bytes`),
@@ -53,6 +54,12 @@ fuzz_target!(|data: &[u8]| {
         }
         5 => {
             let _ = toml::from_str::<Dataset>(text);
+            // a ship's particulars (`termid new-ship`): refused, or a model file that loads
+            if let Ok(p) = toml::from_str::<termid::ship::particulars::Particulars>(text) {
+                if let Ok(model) = p.model() {
+                    let _ = termid::plugins::parse(&model.to_toml(), "new_ship.toml");
+                }
+            }
         }
         6 => {
             // an equation's statistics (`identify --moments`), read and fitted with the

@@ -120,6 +120,20 @@ impl Particulars {
                 return Err(ParticularsError::Value { key, value, why: "must be a number > 0" });
             }
         }
+        if let Some(k) = self.kt.iter().find(|k| !k.is_finite()) {
+            return Err(ParticularsError::Value {
+                key: "kt",
+                value: *k,
+                why: "K_T(J)'s coefficients must be numbers",
+            });
+        }
+        if !(self.kt[0] > 0.0 && self.kt[0] < 1.0) {
+            return Err(ParticularsError::Value {
+                key: "kt",
+                value: self.kt[0],
+                why: "the propeller's K_T at J = 0 (kt's first) lies between 0 and 1 (0.2-0.5 is usual)",
+            });
+        }
         if !(0.3..=1.0).contains(&self.block_coefficient) {
             return Err(ParticularsError::Value {
                 key: "block_coefficient",
@@ -158,12 +172,15 @@ impl Particulars {
                 why: "the centre of gravity lies within the ship, |x_g| < L/2 (from midship, m)",
             });
         }
-        if self.rudder_limit >= 90.0 {
-            return Err(ParticularsError::Value {
-                key: "rudder_limit",
-                value: self.rudder_limit,
-                why: "a rudder's largest angle is below 90° (usually 35°)",
-            });
+        // the steering gear as a ship's model file may have it
+        use super::spec::{RUDDER_LIMIT, RUDDER_RATE};
+        for (key, value, (range, why)) in [
+            ("rudder_limit", self.rudder_limit, RUDDER_LIMIT),
+            ("rudder_rate", self.rudder_rate, RUDDER_RATE),
+        ] {
+            if !range.contains(&value) {
+                return Err(ParticularsError::Value { key, value, why });
+            }
         }
         Ok(())
     }
@@ -422,8 +439,8 @@ mod tests {
         }
     }
 
-    /// Particulars no displacement ship has (a unit slip, a key mistaken for another) are
-    /// refused naming the key; unusual but possible proportions pass with a caution.
+    /// Particulars no displacement ship has (a unit slip, a key mistaken for another) and a
+    /// steering gear or propeller a model file would refuse are refused naming the key; unusual but possible proportions pass with a caution.
     #[test]
     fn impossible_particulars_are_refused_and_unusual_ones_cautioned() {
         assert!(kvlcc2().check().is_ok());
@@ -439,6 +456,10 @@ mod tests {
         refused(|p| p.x_g = 25.0, "x_g");
         refused(|p| p.x_g = f64::NAN, "x_g");
         refused(|p| p.rudder_limit = 95.0, "rudder_limit");
+        // a model file would refuse the gear (and K_T) the template would be written with
+        refused(|p| p.rudder_rate = 7900.0, "rudder_rate");
+        refused(|p| p.kt[0] = f64::INFINITY, "kt");
+        refused(|p| p.kt[0] = -0.3, "kt");
         // a slender fast hull: a model, with a word on the formulas' range
         let mut slender = kvlcc2();
         (slender.beam, slender.block_coefficient) = (0.7, 0.45);

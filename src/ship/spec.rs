@@ -102,6 +102,15 @@ impl Default for ShipNames {
     }
 }
 
+/// A rudder's largest angle each way, ° (what a ship's model file and particulars may give),
+/// and why: beyond these no rudder works, and the servo's arithmetic loses its meaning.
+pub const RUDDER_LIMIT: (std::ops::RangeInclusive<f64>, &str) =
+    (0.1..=90.0, "a rudder turns at most 90° each way (35° is usual)");
+
+/// A rudder's rate, °/s, and why (as [`RUDDER_LIMIT`]).
+pub const RUDDER_RATE: (std::ops::RangeInclusive<f64>, &str) =
+    (0.01..=1000.0, "a rudder's rate lies between 0.01 and 1000 °/s (2.3 °/s at full scale is usual)");
+
 impl ShipSpec {
     /// The model's `[ship]` table, as written (`None`: not a ship model).
     pub fn of(model: &Model) -> Result<Option<ShipSpec>, ShipError> {
@@ -151,20 +160,9 @@ impl ShipSpec {
                 ));
             }
         }
-        // beyond these no rudder works, and the servo's arithmetic loses its meaning
-        for (key, value, range, what) in [
-            (
-                "rudder_limit",
-                spec.rudder_limit,
-                0.1..=90.0,
-                "a rudder turns at most 90° each way (35° is usual)",
-            ),
-            (
-                "rudder_rate",
-                spec.rudder_rate,
-                0.01..=1000.0,
-                "a rudder's rate lies between 0.01 and 1000 °/s (2.3 °/s at full scale is usual)",
-            ),
+        for (key, value, (range, what)) in [
+            ("rudder_limit", spec.rudder_limit, RUDDER_LIMIT),
+            ("rudder_rate", spec.rudder_rate, RUDDER_RATE),
         ] {
             if !range.contains(&value) {
                 return Err(key_err(&format!("{TABLE}.{key}"), format!("{value} is out of range: {what}")));

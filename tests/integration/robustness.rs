@@ -121,6 +121,43 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+
+    /// A ship's particulars (`termid new-ship`; the propeller's K_T(J) among them) with one value scaled by up to a thousand
+    /// either way, negated, or made NaN or infinite: refused naming the key, or a grey-box
+    /// model that loads as a ship and finds its straight run or says why; never a panic.
+    #[test]
+    fn particulars_never_panic(key in 1usize..16, factor in -3.0f64..3.0, how in 0u8..4) {
+        let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/kvlcc2_particulars.toml")).unwrap();
+        let mut particulars: termid::ship::particulars::Particulars = toml::from_str(&text).unwrap();
+        let [k0, k1, k2] = &mut particulars.kt;
+        let fields = [
+            k0, k1, k2, &mut particulars.lpp, &mut particulars.beam, &mut particulars.draught,
+            &mut particulars.block_coefficient, &mut particulars.x_g, &mut particulars.rudder_area,
+            &mut particulars.rudder_span, &mut particulars.propeller_diameter, &mut particulars.u0,
+            &mut particulars.rudder_rate, &mut particulars.rudder_limit, &mut particulars.density,
+        ];
+        let value = fields.into_iter().nth(key - 1).unwrap();
+        *value = match how {
+            0 => *value * 10f64.powf(factor),
+            1 => -*value * 10f64.powf(factor),
+            2 => f64::NAN,
+            _ => f64::INFINITY.copysign(factor),
+        };
+        match particulars.model() {
+            Ok(model) => {
+                // the file `new-ship` writes loads as any model file does
+                let text = model.to_toml();
+                let model = termid::plugins::parse(&text, "new_ship.toml").map_err(|e| TestCaseError::fail(e.to_string()))?;
+                let _ = termid::ship::Ship::new(&model, false).and_then(|s| s.straight_run());
+            }
+            // refused for a value, never by the model file it would have written
+            Err(e) => prop_assert!(matches!(e, termid::ship::particulars::ParticularsError::Value { .. }), "{e}"),
+        }
+    }
+}
+
 /// Two seconds of the Lorenz system at 0.01 s, with its derivative columns.
 fn lorenz_run(model: &Model) -> Frame {
     let system = termid::sim::System::new(model, &Default::default(), false).unwrap();
