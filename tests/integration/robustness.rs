@@ -124,6 +124,24 @@ proptest! {
 proptest! {
     #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
 
+    /// The grey-box model `new-ship` writes (priors, bounds, per-run nuisances, derived
+    /// variables, a propeller) with one line replaced by noise, deleted or duplicated: refused,
+    /// or a model that compiles, loads as a ship and finds its straight run or says why.
+    #[test]
+    fn mutated_grey_box_files_never_panic(line in 0usize..700, noise in "\\PC{0,30}", how in 0u8..3) {
+        let mut lines: Vec<String> = grey_box().lines().map(str::to_string).collect();
+        let k = line % lines.len();
+        match how {
+            0 => lines[k] = noise,
+            1 => { lines.remove(k); }
+            _ => { let l = lines[k].clone(); lines.insert(k, l); }
+        }
+        if let Ok(m) = termid::plugins::parse(&lines.join("\n"), "mutated.toml") {
+            let _ = m.compile_rhs(false);
+            let _ = termid::ship::Ship::new(&m, false).and_then(|s| s.straight_run());
+        }
+    }
+
     /// A ship's particulars (`termid new-ship`; the propeller's K_T(J) among them) with one value scaled by up to a thousand
     /// either way, negated, or made NaN or infinite: refused naming the key, or a grey-box
     /// model that loads as a ship and finds its straight run or says why; never a panic.
@@ -156,6 +174,18 @@ proptest! {
             Err(e) => prop_assert!(matches!(e, termid::ship::particulars::ParticularsError::Value { .. }), "{e}"),
         }
     }
+}
+
+/// The grey-box model file `new-ship` writes for KVLCC2's particulars.
+fn grey_box() -> &'static str {
+    static TEXT: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    TEXT.get_or_init(|| {
+        let text =
+            std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/kvlcc2_particulars.toml"))
+                .unwrap();
+        let particulars: termid::ship::particulars::Particulars = toml::from_str(&text).unwrap();
+        particulars.model().unwrap().to_toml()
+    })
 }
 
 /// Two seconds of the Lorenz system at 0.01 s, with its derivative columns.
