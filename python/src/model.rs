@@ -141,6 +141,32 @@ impl PyModel {
         Ok(PyModel { inner: termid::plugins::parse(text, &format!("{name}.toml")).map_err(fail)? })
     }
 
+    /// A grey-box MMG model for a ship from its main particulars (`text` a particulars file's
+    /// TOML, or JSON where `json`; `name` stands for it in messages), with each parameter's
+    /// estimate (JSON list: name, value, prior_sd (null where fixed), unit, source) and the
+    /// cautions where the proportions are unusual.
+    #[staticmethod]
+    #[pyo3(signature = (text, json = false, name = "<particulars>"))]
+    fn from_particulars(text: &str, json: bool, name: &str) -> PyResult<(Self, String, Vec<String>)> {
+        use termid::ship::particulars::Particulars;
+        let particulars = if json {
+            serde_json::from_str::<Particulars>(text).map_err(|e| refuse(format!("{name}: {e}")))?
+        } else {
+            Particulars::parse(text, name).map_err(fail)?
+        };
+        let model = particulars.model().map_err(|e| refuse(format!("{name}: {e}")))?;
+        let free = model.free_parameters();
+        let estimates: Vec<serde_json::Value> = particulars
+            .estimates()
+            .iter()
+            .map(|e| {
+                let sd = free.iter().find(|p| p.name == e.name).and_then(|p| p.prior).map(|(_, sd)| sd);
+                serde_json::json!({ "name": e.name, "value": e.value, "prior_sd": sd, "unit": e.unit, "source": e.source })
+            })
+            .collect();
+        Ok((PyModel { inner: model }, to_json(&estimates)?, particulars.cautions()))
+    }
+
     /// The names of the model files shipped inside the package.
     #[staticmethod]
     fn builtin_names() -> Vec<&'static str> {
@@ -194,6 +220,12 @@ impl PyModel {
     #[getter]
     fn parameters(&self) -> BTreeMap<String, f64> {
         self.inner.parameter_values()
+    }
+
+    /// The parameters the file declares free (`estimate` fits them), in its order.
+    #[getter]
+    fn free_parameters(&self) -> Vec<String> {
+        self.inner.free_parameters().into_iter().map(|p| p.name).collect()
     }
 
     /// The stored coefficients of an equation: (term, value, standard error).

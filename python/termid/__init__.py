@@ -720,6 +720,17 @@ class Recipe:
         return f"termid.Recipe(kept {kept[0] if kept else None!r} of {len(self.starts)} starts, {flags} checks not passed)"
 
 
+
+def _particulars(particulars: Union[Mapping[str, Any], str, os.PathLike]) -> Tuple[Any, str, List[str]]:
+    """The native model, estimates (JSON) and cautions for a particulars file or dict."""
+    if isinstance(particulars, Mapping):
+        return _termid.Model.from_particulars(json.dumps(dict(particulars)), True, "<dict>")
+    path = os.fspath(particulars)
+    if not os.path.exists(path):
+        raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), path)
+    with open(path, encoding="utf-8") as f:
+        return _termid.Model.from_particulars(f.read(), False, path)
+
 class Model:
     """A termid model file: states, inputs, parameters, derived variables and equations.
 
@@ -773,6 +784,53 @@ class Model:
         ['x', 'y', 'z']
         """
         return Model(_termid.Model.builtin(name))
+
+    @staticmethod
+    def from_particulars(particulars: Union[Mapping[str, Any], str, os.PathLike]) -> "Model":
+        """A grey-box MMG model for a ship nobody has tested yet, from its main particulars:
+        the hull's derivatives from Kijima et al. (1990) and Clarke et al. (1982), the rudder's
+        and propeller's from the MMG formulas (Yasukawa & Yoshimura 2015), each free with a
+        prior for :meth:`estimate` (as ``termid new-ship`` writes it). A warning says where the
+        proportions lie outside the formulas' merchant hulls.
+
+        Parameters: ``particulars`` a particulars file (TOML: ``name``, ``lpp``, ``beam``,
+        ``draught``, ``block_coefficient``, ``x_g``, ``rudder_area``, ``rudder_span``,
+        ``propeller_diameter``, ``u0``, ``rudder_rate``, ``rudder_limit``, ``density``,
+        optionally ``kt``; SI units, degrees) or a dict of the same keys. Each estimate with
+        its prior and source: :meth:`particulars_table`.
+
+        >>> ship = {"name": "KVLCC2", "lpp": 7.0, "beam": 1.27, "draught": 0.46,
+        ...         "block_coefficient": 0.81, "x_g": 0.25, "rudder_area": 0.0539,
+        ...         "rudder_span": 0.345, "propeller_diameter": 0.216, "u0": 1.17,
+        ...         "rudder_rate": 15.8, "rudder_limit": 35.0, "density": 1025.0}
+        >>> model = termid.Model.from_particulars(ship)
+        >>> model.states[:3], len(model.free_parameters) > 20
+        (['u', 'v', 'r'], True)
+        """
+        native, _, cautions = _particulars(particulars)
+        for caution in cautions:
+            warnings.warn(f"termid: {caution}", stacklevel=2)
+        return Model(native)
+
+    @staticmethod
+    def particulars_table(particulars: Union[Mapping[str, Any], str, os.PathLike]) -> pd.DataFrame:
+        """Each parameter :meth:`from_particulars` sets for a ship: its estimate, the prior's
+        sd (NaN where the value is fixed), its unit and the formula's source, by parameter.
+
+        Parameters: ``particulars`` as for :meth:`from_particulars`.
+
+        >>> ship = {"name": "KVLCC2", "lpp": 7.0, "beam": 1.27, "draught": 0.46,
+        ...         "block_coefficient": 0.81, "x_g": 0.25, "rudder_area": 0.0539,
+        ...         "rudder_span": 0.345, "propeller_diameter": 0.216, "u0": 1.17,
+        ...         "rudder_rate": 15.8, "rudder_limit": 35.0, "density": 1025.0}
+        >>> table = termid.Model.particulars_table(ship)
+        >>> round(float(table.loc["Y_v", "value"]), 3), table.loc["Y_v", "source"].startswith("Kijima")
+        (-0.412, True)
+        """
+        _, estimates, _ = _particulars(particulars)
+        table = pd.DataFrame(json.loads(estimates), columns=["name", "value", "prior_sd", "unit", "source"])
+        table["prior_sd"] = table["prior_sd"].astype(float)
+        return table.set_index("name")
 
     @staticmethod
     def builtin_names() -> List[str]:
@@ -888,6 +946,16 @@ class Model:
         {}
         """
         return dict(self._native.parameters)
+
+    @property
+    def free_parameters(self) -> List[str]:
+        """The parameters the model file declares free (``free = true``): those
+        :meth:`estimate` fits.
+
+        >>> termid.Model.builtin("nomoto").free_parameters
+        ['K', 'T']
+        """
+        return list(self._native.free_parameters)
 
     def set_parameter(self, name: str, value: Union[float, str]) -> None:
         """A parameter's value, or as text how each run sets it for identification

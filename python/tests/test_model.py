@@ -559,3 +559,36 @@ def test_validate_with_monte_carlo_marks_what_falls_outside_the_band():
         wide.validate(held, monte_carlo=20)
     with pytest.raises(termid.TermidError, match="would take .* of memory"):
         found.validate(held, monte_carlo=10**10)
+
+
+KVLCC2_PARTICULARS = os.path.join(os.path.dirname(__file__), "..", "..", "examples", "kvlcc2_particulars.toml")
+
+
+def test_a_new_ship_from_its_particulars():
+    """``Model.from_particulars``: the grey-box model ``termid new-ship`` writes, from the
+    particulars file or a dict of its keys alike; its estimates with their priors and sources
+    (Kijima's Y'_v for KVLCC2, -0.4121 worked by hand from the paper's expression, and the
+    fixed K_T coefficients without a prior); unusual proportions warned of; a value no ship has,
+    a missing key and a missing file refused by name."""
+    from_file = termid.Model.from_particulars(KVLCC2_PARTICULARS)
+    ship = {
+        "name": "KVLCC2", "lpp": 7.0, "beam": 1.27, "draught": 0.46, "block_coefficient": 0.81,
+        "x_g": 0.25, "rudder_area": 0.0539, "rudder_span": 0.345, "propeller_diameter": 0.216,
+        "u0": 1.17248, "rudder_rate": 15.8, "rudder_limit": 35.0, "density": 1025.0,
+    }
+    from_dict = termid.Model.from_particulars(ship)
+    assert from_dict.to_toml() == from_file.to_toml()
+    assert {"Y_v", "N_r", "ε", "κ", "γ_Rp", "δ_0"} <= set(from_dict.free_parameters), from_dict.free_parameters
+    table = termid.Model.particulars_table(ship)
+    assert abs(table.loc["Y_v", "value"] / -0.4121 - 1) < 0.005, table
+    assert table.loc["Y_v", "prior_sd"] > 0 and table.loc["Y_v", "source"].startswith("Kijima"), table
+    assert np.isnan(table.loc["k_0", "prior_sd"]), table
+    assert list(table.columns) == ["value", "prior_sd", "unit", "source"]
+    with pytest.warns(UserWarning, match="L/B = 10.000"):
+        termid.Model.from_particulars({**ship, "beam": 0.7, "block_coefficient": 0.45})
+    with pytest.raises(termid.TermidError, match="`lpp`"):
+        termid.Model.from_particulars({**ship, "lpp": -7.0})
+    with pytest.raises(termid.TermidError, match="missing field `beam`"):
+        termid.Model.from_particulars({k: v for k, v in ship.items() if k != "beam"})
+    with pytest.raises(FileNotFoundError):
+        termid.Model.from_particulars("no_such_particulars.toml")

@@ -91,6 +91,14 @@ pub enum ParticularsError {
     /// The template could not take the estimates.
     #[error(transparent)]
     Model(#[from] ModelError),
+    /// The particulars' text is not a particulars file (its key and line in `message`).
+    #[error("{file}: {message}")]
+    Syntax {
+        /// The file (or what stands for it).
+        file: String,
+        /// What is wrong, where.
+        message: String,
+    },
 }
 
 const KIJIMA: &str = "Kijima, Katsuno, Nakiri & Furukawa (1990), J. Soc. Nav. Arch. Japan 168";
@@ -101,6 +109,12 @@ const GEOMETRY: &str = "the particulars";
 const GENERIC: &str = "no formula from particulars: a generic full-form single-screw value, wide prior";
 
 impl Particulars {
+    /// Reads a particulars file's TOML `text`; `file` names it in messages.
+    pub fn parse(text: &str, file: &str) -> Result<Particulars, ParticularsError> {
+        toml::from_str(text)
+            .map_err(|e| ParticularsError::Syntax { file: file.into(), message: e.to_string() })
+    }
+
     /// Refuses particulars a ship cannot have.
     pub fn check(&self) -> Result<(), ParticularsError> {
         let positive = [

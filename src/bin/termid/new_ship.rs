@@ -14,8 +14,7 @@ pub fn run(cmd: NewShipCommand) -> Result<()> {
     )?;
     let text = termid::budget::read_text(&cmd.particulars)
         .with_context(|| format!("reading {}", cmd.particulars.display()))?;
-    let particulars: Particulars =
-        toml::from_str(&text).with_context(|| format!("{}", cmd.particulars.display()))?;
+    let particulars = Particulars::parse(&text, &cmd.particulars.display().to_string())?;
     let model = particulars.model().with_context(|| format!("{}", cmd.particulars.display()))?;
     println!("== {}: the MMG model's parameters from the particulars ==", particulars.name);
     println!("{:<8} {:>14} {:>12}  source", "name", "estimate", "prior sd");
