@@ -89,7 +89,7 @@ pub(super) struct Output {
 /// that do, the others held to what they record.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct PartlyRecorded {
-    /// The derived variable.
+    /// The state or derived variable.
     pub name: String,
     /// How many runs record it.
     pub runs: usize,
@@ -501,7 +501,7 @@ impl Runs {
     }
 
     /// The compared quantities' (states', then derived variables') names in run `f` with their
-    /// number of samples there: 0 for a derived variable the run does not record.
+    /// number of samples there: 0 for one the run does not record.
     fn recorded<'a>(&'a self, f: &'a Frame) -> impl Iterator<Item = (&'a str, usize)> + 'a {
         let names = self.states.iter().map(|(_, s)| s).chain(self.outputs.iter().map(|o| &o.name));
         names.map(move |n| (n.as_str(), f.column(n).map_or(0, |c| c.len())))
@@ -622,7 +622,7 @@ impl Runs {
         let mut out = Vec::new();
         let mut at = 0;
         for f in &self.frames {
-            // a derived variable the run does not record has an empty series there
+            // a quantity the run does not record has an empty series there
             for (_, len) in self.recorded(f) {
                 let end = (at + len).min(residuals.len());
                 out.push(residuals[at..end].to_vec());
@@ -711,7 +711,7 @@ impl Runs {
         let runs = errors
             .into_iter()
             .map(|(run, per)| {
-                // a derived variable the run does not record has no gap there
+                // a quantity the run does not record has no gap there
                 let per = per
                     .into_iter()
                     .filter(|(_, _, d)| !d.is_empty())

@@ -582,6 +582,14 @@ mod tests {
         f
     }
 
+    /// [`forced`] from phase 0 with a record of the spring's `load` beside it.
+    fn loaded(samples: usize) -> Frame {
+        let mut f = forced(samples, 0.0);
+        let load = f.time().iter().map(|t| 0.3 * (0.9 * t).cos()).collect();
+        f.push("load", load).unwrap();
+        f
+    }
+
     const DUFFING: &str = r#"
 [model]
 name = "duffing"
@@ -686,9 +694,8 @@ coefficients = { "spring" = -1.0, "w" = -0.1, "F" = 1.0 }
     #[test]
     fn a_derived_variables_sensitivities_equal_finite_differences() {
         let model = Model::parse(SPRING, "spring.toml").unwrap();
-        let mut f = forced(161, 0.0);
+        let f = loaded(161);
         let t = f.time().to_vec();
-        f.push("load", t.iter().map(|t| 0.3 * (0.9 * t).cos()).collect()).unwrap();
         let names: Vec<String> = ["x", "w", "load"].iter().map(|s| s.to_string()).collect();
         let runs = Runs::new(&model, &[f], 0.05, Integrator::Rk4).unwrap().comparing(&model, &names).unwrap();
         assert_eq!(runs.observed(), ["load"]);
@@ -753,9 +760,7 @@ coefficients = { "spring" = -1.0, "w" = -0.1, "F" = 1.0 }
     #[test]
     fn states_and_derived_variables_are_compared_in_the_runs_that_record_them() {
         let model = Model::parse(SPRING, "spring.toml").unwrap();
-        let mut with = forced(161, 0.0);
-        let t = with.time().to_vec();
-        with.push("load", t.iter().map(|t| 0.3 * (0.9 * t).cos()).collect()).unwrap();
+        let with = loaded(161);
         let other = forced(121, 0.7);
         let mut without = Frame::new("other", "t", other.time().to_vec()).unwrap();
         for name in ["x", "F"] {
