@@ -818,6 +818,58 @@ coefficients = { "spring" = -1.0, "w" = -0.1, "F" = 1.0 }
         assert!((3 * 161..r0.len()).any(|row| jac[(row, 2)].abs() > 1e-3));
     }
 
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig { cases: 64, ..Default::default() })]
+
+        /// Whatever each run records of the compared quantities (the displacement in one, the
+        /// rate and the load in another, any mix, so long as one run records each), the
+        /// residuals, their count, their series and the Jacobian's rows agree, and a run
+        /// counts what it records alone.
+        #[test]
+        fn residuals_series_and_slopes_agree_whatever_each_run_records(
+            records in proptest::collection::vec((proptest::bool::ANY, proptest::bool::ANY, proptest::bool::ANY), 1..4),
+        ) {
+            let model = Model::parse(SPRING, "spring.toml").unwrap();
+            let frames: Vec<Frame> = records
+                .iter()
+                .enumerate()
+                .map(|(k, &(x, w, load))| {
+                    let full = loaded(41 + 10 * k);
+                    let mut f = Frame::new(&format!("run{k}"), "t", full.time().to_vec()).unwrap();
+                    for (name, kept) in [("x", x), ("w", w), ("load", load), ("F", true)] {
+                        if kept {
+                            f.push(name, full.column(name).unwrap().to_vec()).unwrap();
+                        }
+                    }
+                    f
+                })
+                .collect();
+            let recorded = |q: usize| records.iter().any(|r| [r.0, r.1, r.2][q]);
+            let names: Vec<String> =
+                ["x", "w", "load"].iter().enumerate().filter(|(q, _)| recorded(*q)).map(|(_, n)| n.to_string()).collect();
+            let runs = match Runs::new(&model, &frames, 0.05, Integrator::Rk4).and_then(|r| r.comparing(&model, &names)) {
+                Ok(runs) => runs,
+                // no state recorded anywhere (the load alone): refused, as it must be
+                Err(e) => {
+                    proptest::prop_assert!(!recorded(0) && !recorded(1), "{e}");
+                    return Ok(());
+                }
+            };
+            let sims = runs.simulate(&model, &[], &[]).unwrap();
+            let r = runs.residuals(&sims);
+            let expected: usize = frames
+                .iter()
+                .map(|f| names.iter().filter(|n| f.column(n).is_some()).count() * f.len())
+                .sum();
+            proptest::prop_assert_eq!((r.len(), runs.residual_count()), (expected, expected));
+            proptest::prop_assert_eq!(runs.series(&r).iter().map(Vec::len).sum::<usize>(), expected);
+            let entries = vec![Free::Parameter("k".into()), Free::Parameter("d".into())];
+            let (r0, jac) = residuals_and_jacobian(&runs, &model, &entries).unwrap();
+            proptest::prop_assert_eq!((r0.len(), jac.nrows()), (expected, expected));
+            proptest::prop_assert_eq!(r0, r);
+        }
+    }
+
     /// The coarsest step that resolves the runs resolves the compared derived variables too: a
     /// load that follows a fast force the motion smooths out holds the step finer than the
     /// states alone would.
