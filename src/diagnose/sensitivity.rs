@@ -554,21 +554,29 @@ mod tests {
             let h = 1e-6;
             let (up, down) = (shifted(h), shifted(-h));
             for row in 0..r0.len() {
-                let fd = (up[row] - down[row]) / (2.0 * h);
                 let mine = (first(run)..first(run) + rows[run]).contains(&row);
                 assert!(mine || jac[(row, j)] == 0.0, "entry {j} moves row {row} of another run");
-                assert!(
-                    (jac[(row, j)] - fd).abs() < 1e-6 * (1.0 + fd.abs()),
-                    "row {row}, {j}: {} vs {fd}",
-                    jac[(row, j)]
-                );
             }
+            central(&jac, j, (&up, &down), h, 1e-6);
         }
         let lin = linearise(&runs, &model, &entries).unwrap();
         let r = DVector::from_column_slice(&r0);
         let (jtj, jtr) = (jac.transpose() * &jac, jac.transpose() * r);
         assert!((&lin.jtj - &jtj).amax() <= 1e-12 * jtj.amax(), "{} vs {}", lin.jtj, jtj);
         assert!((&lin.jtr - &jtr).amax() <= 1e-12 * jtr.amax(), "{} vs {}", lin.jtr, jtr);
+    }
+
+    /// Column `j` of the Jacobian `jac` equals the central differences of the residuals
+    /// moved by ±`h` (`up`, `down`), each row within `tolerance` × (1 + |difference|).
+    fn central(jac: &DMatrix<f64>, j: usize, (up, down): (&[f64], &[f64]), h: f64, tolerance: f64) {
+        for (row, (p, m)) in up.iter().zip(down).enumerate() {
+            let fd = (p - m) / (2.0 * h);
+            assert!(
+                (jac[(row, j)] - fd).abs() < tolerance * (1.0 + fd.abs()),
+                "row {row}, {j}: {} vs {fd}",
+                jac[(row, j)]
+            );
+        }
     }
 
     /// A run of a forced oscillator's states x, w and its force F, `samples` of 0.05 s from
@@ -643,15 +651,7 @@ coefficients = { "x" = -1.0, "w" = -0.1, "x^3" = -0.2, "F" = 1.0 }
                 let m = super::super::fit::apply(&model, &h, theta).unwrap();
                 runs.residuals(&runs.simulate(&m, &[], &[]).unwrap())
             };
-            let (a, b) = (sim(&up), sim(&down));
-            for (row, (p, m)) in a.iter().zip(&b).enumerate() {
-                let fd = (p - m) / (2.0 * step);
-                assert!(
-                    (jac[(row, j)] - fd).abs() < 1e-5 * (1.0 + fd.abs()),
-                    "row {row}, {j}: {} vs {fd}",
-                    jac[(row, j)]
-                );
-            }
+            central(&jac, j, (&sim(&up), &sim(&down)), step, 1e-5);
         }
     }
 
@@ -736,15 +736,7 @@ coefficients = { "spring" = -1.0, "w" = -0.1, "F" = 1.0 }
             residuals(&m, &runs)
         };
         for j in 0..entries.len() {
-            let (up, down) = (moved(j, h), moved(j, -h));
-            for row in 0..r0.len() {
-                let fd = (up[row] - down[row]) / (2.0 * h);
-                assert!(
-                    (jac[(row, j)] - fd).abs() < 1e-5 * (1.0 + fd.abs()),
-                    "row {row}, {j}: {} vs {fd}",
-                    jac[(row, j)]
-                );
-            }
+            central(&jac, j, (&moved(j, h), &moved(j, -h)), h, 1e-5);
         }
         // `d` moves the load alone, and does move it
         let states = 2 * t.len();
@@ -802,15 +794,7 @@ coefficients = { "spring" = -1.0, "w" = -0.1, "F" = 1.0 }
                 }
                 runs.residuals(&runs.simulate(&m, &[], &[]).unwrap())
             };
-            let (up, down) = (moved(h), moved(-h));
-            for row in 0..r0.len() {
-                let fd = (up[row] - down[row]) / (2.0 * h);
-                assert!(
-                    (jac[(row, j)] - fd).abs() < 1e-5 * (1.0 + fd.abs()),
-                    "row {row}, {j}: {} vs {fd}",
-                    jac[(row, j)]
-                );
-            }
+            central(&jac, j, (&moved(h), &moved(-h)), h, 1e-5);
         }
         assert!((2 * 161..3 * 161).any(|row| jac[(row, 1)].abs() > 1e-3));
         assert!((3 * 161..r0.len()).all(|row| jac[(row, 1)] == 0.0));
