@@ -196,10 +196,10 @@ pub fn spread_of(values: &[f64]) -> Option<Spread> {
     Some(Spread { count: v.len(), mean, sd, p05: percentile(&v, 0.05), p95: percentile(&v, 0.95) })
 }
 
-/// The spread of every number in a set of like JSON records (e.g. manoeuvre metrics), by
-/// its dotted path; arrays are left out.
-pub fn spread(records: &[serde_json::Value]) -> BTreeMap<String, Spread> {
-    fn leaves(prefix: &str, v: &serde_json::Value, out: &mut BTreeMap<String, Vec<f64>>) {
+/// Every number in a JSON record (e.g. a manoeuvre's metrics), by its dotted path; arrays are
+/// left out.
+pub fn numbers(record: &serde_json::Value) -> BTreeMap<String, f64> {
+    fn leaves(prefix: &str, v: &serde_json::Value, out: &mut BTreeMap<String, f64>) {
         match v {
             serde_json::Value::Object(map) => {
                 for (k, x) in map {
@@ -207,15 +207,120 @@ pub fn spread(records: &[serde_json::Value]) -> BTreeMap<String, Spread> {
                     leaves(&key, x, out);
                 }
             }
-            serde_json::Value::Number(n) => out.entry(prefix.to_string()).or_default().extend(n.as_f64()),
+            serde_json::Value::Number(n) => {
+                if let Some(x) = n.as_f64() {
+                    out.insert(prefix.to_string(), x);
+                }
+            }
             _ => {}
         }
     }
-    let mut all = BTreeMap::new();
+    let mut out = BTreeMap::new();
+    leaves("", record, &mut out);
+    out
+}
+
+/// The spread of every number in a set of like JSON records (e.g. manoeuvre metrics), by
+/// its dotted path ([`numbers`]).
+pub fn spread(records: &[serde_json::Value]) -> BTreeMap<String, Spread> {
+    let mut all: BTreeMap<String, Vec<f64>> = BTreeMap::new();
     for r in records {
-        leaves("", r, &mut all);
+        for (k, v) in numbers(r) {
+            all.entry(k).or_default().push(v);
+        }
     }
     all.into_iter().filter_map(|(k, v)| spread_of(&v).map(|s| (k, s))).collect()
+}
+
+/// One free parameter's effect on a prediction's numbers: half the change of each between the
+/// model with the parameter one standard deviation above its estimate and one below, the
+/// others at theirs. A central difference over the likely range: what a Monte-Carlo spread
+/// comes from, and which parameter a further test (a captive test, a run that excites it)
+/// would pin down.
+#[derive(Clone, Debug, Serialize)]
+pub struct ParameterEffect {
+    /// The parameter.
+    pub parameter: String,
+    /// Its standard deviation (the stored covariance's).
+    pub sd: f64,
+    /// Each number's half change, by its dotted path ([`numbers`]).
+    pub effects: BTreeMap<String, f64>,
+    /// Why a model one sd away made no prediction (then `effects` is empty).
+    pub failed: Option<String>,
+}
+
+/// Each free parameter's effect ([`ParameterEffect`]) on the numbers `predict` makes of a model
+/// (a manoeuvre's metrics), from the free parameters' covariance `model` stores
+/// (`[parameter_covariance]`); empty without one.
+pub fn parameter_effects<E: std::fmt::Display>(
+    model: &Model,
+    predict: impl Fn(&Model) -> Result<serde_json::Value, E>,
+) -> Vec<ParameterEffect> {
+    let Some(c) = model.spec().parameter_covariance.as_ref() else { return Vec::new() };
+    let values = model.parameter_values();
+    c.names
+        .iter()
+        .enumerate()
+        .filter_map(|(i, name)| {
+            let (value, sd) = (*values.get(name)?, c.matrix[i][i].max(0.0).sqrt());
+            let at = |v: f64| {
+                let mut m = model.clone();
+                m.set_parameter(name, v);
+                predict(&m).map(|r| numbers(&r)).map_err(|e| e.to_string())
+            };
+            let (effects, failed) = match (at(value + sd), at(value - sd)) {
+                (Ok(up), Ok(down)) => {
+                    let half =
+                        up.iter().filter_map(|(k, u)| Some((k.clone(), 0.5 * (u - down.get(k)?)))).collect();
+                    (half, None)
+                }
+                (Err(e), _) | (_, Err(e)) => (BTreeMap::new(), Some(e)),
+            };
+            Some(ParameterEffect { parameter: name.clone(), sd, effects, failed })
+        })
+        .collect()
+}
+
+/// What the spread of one number comes from, linearised in the free parameters
+/// ([`attribution`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct Attribution {
+    /// Its standard deviation from all the parameters' effects together, with their
+    /// correlations (near the Monte-Carlo sd where the prediction is about linear in the
+    /// parameters over their range).
+    pub linearised_sd: f64,
+    /// Each parameter's share of that variance that knowing it exactly would remove,
+    /// (Σⱼ ρᵢⱼ eⱼ)² / Var (e the effects, ρ the correlations): between 0 and 1, the largest
+    /// first; correlated parameters share theirs, so the shares need not sum to 1.
+    pub explained: Vec<(String, f64)>,
+}
+
+/// What the spread of number `key` comes from ([`Attribution`]), from `effects` and the
+/// parameters' correlations in `model`'s covariance. `None` where a parameter has no effect on
+/// it (a failed prediction), it does not vary, or there is no covariance.
+pub fn attribution(model: &Model, effects: &[ParameterEffect], key: &str) -> Option<Attribution> {
+    let c = model.spec().parameter_covariance.as_ref()?;
+    let index: Vec<usize> =
+        effects.iter().map(|e| c.names.iter().position(|n| *n == e.parameter)).collect::<Option<_>>()?;
+    let e: Vec<f64> = effects.iter().map(|x| x.effects.get(key).copied()).collect::<Option<_>>()?;
+    let rho = |a: usize, b: usize| {
+        let (sa, sb) = (effects[a].sd, effects[b].sd);
+        if sa > 0.0 && sb > 0.0 {
+            c.matrix[index[a]][index[b]] / (sa * sb)
+        } else {
+            f64::from(u8::from(a == b))
+        }
+    };
+    // R e: each parameter's covariance with the number, in units of its sd
+    let re: Vec<f64> = (0..e.len()).map(|a| (0..e.len()).map(|b| rho(a, b) * e[b]).sum()).collect();
+    let variance: f64 = e.iter().zip(&re).map(|(x, y)| x * y).sum();
+    if !(variance > 0.0 && variance.is_finite()) {
+        return None;
+    }
+    let mut explained: Vec<(String, f64)> =
+        effects.iter().zip(&re).map(|(x, r)| (x.parameter.clone(), (r * r / variance).min(1.0))).collect();
+    explained.sort_by(|a, b| b.1.total_cmp(&a.1));
+    Some(Attribution { linearised_sd: variance.sqrt(), explained })
 }
 
 /// Pointwise 5 % and 95 % curves of several signals sampled at the same times (shorter
@@ -268,6 +373,76 @@ pub fn correlation_time(residuals: &[Vec<f64>]) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Nomoto's K and T with a covariance (sd 0.01 and 0.5, correlation 0.1).
+    fn nomoto_with_covariance() -> Model {
+        let text = format!(
+            "{}\n[parameter_covariance]\nnames = [\"K\", \"T\"]\nmatrix = [[1e-4, 5e-4], [5e-4, 0.25]]\n",
+            include_str!("../models/nomoto.toml")
+        );
+        Model::parse(&text, "nomoto.toml").unwrap()
+    }
+
+    /// A step's yaw rate r(t) = Kδ(1 − e^(−t/T)) in closed form, at t = T's file value (10 s)
+    /// and at 200 s (steady: T no longer matters).
+    fn step_response(m: &Model) -> Result<serde_json::Value, String> {
+        let p = m.parameter_values();
+        let (k, t, delta) = (p["K"], p["T"], 0.1);
+        let r = |time: f64| k * delta * (1.0 - (-time / t).exp());
+        Ok(serde_json::json!({ "r": { "early": r(10.0), "steady": r(200.0) } }))
+    }
+
+    /// One sd of each parameter moves a prediction by half its central difference: the steady
+    /// rate by sd_K·δ (it is linear in K) and not by T; the early one by both, as the closed
+    /// form says; the linearised sd joins them with their correlation, and each one's share
+    /// of the variance is what knowing it exactly would remove. A parameter whose model one sd
+    /// away predicts nothing is named with why, and leaves no attribution.
+    #[test]
+    fn one_sd_of_each_parameter_moves_the_prediction_as_the_closed_form_says() {
+        let model = nomoto_with_covariance();
+        let effects = parameter_effects(&model, step_response);
+        let (k, t) = (&effects[0], &effects[1]);
+        assert_eq!((k.parameter.as_str(), t.parameter.as_str()), ("K", "T"));
+        assert!((k.sd - 0.01).abs() < 1e-15 && (t.sd - 0.5).abs() < 1e-15);
+        let steady_k = k.effects["r.steady"];
+        assert!((steady_k - 0.01 * 0.1 * (1.0 - (-20.0f64).exp())).abs() < 1e-15, "{steady_k}");
+        assert!(t.effects["r.steady"].abs() < 1e-9, "{:?}", t.effects);
+        let early = |kk: f64, tt: f64| kk * 0.1 * (1.0 - (-10.0 / tt).exp());
+        let early_t = 0.5 * (early(0.1, 10.5) - early(0.1, 9.5));
+        assert!((t.effects["r.early"] - early_t).abs() < 1e-15, "{:?}", t.effects);
+        let early_k = k.effects["r.early"];
+        let variance = early_k.powi(2) + early_t.powi(2) + 2.0 * 0.1 * early_k * early_t;
+        let early = attribution(&model, &effects, "r.early").unwrap();
+        assert!((early.linearised_sd - variance.sqrt()).abs() < 1e-15, "{early:?}");
+        // knowing K exactly removes (e_K + ρ e_T)² of the variance, T (e_T + ρ e_K)²
+        let share = |name: &str| early.explained.iter().find(|(n, _)| n == name).unwrap().1;
+        assert!((share("K") - (early_k + 0.1 * early_t).powi(2) / variance).abs() < 1e-12, "{early:?}");
+        assert!((share("T") - (early_t + 0.1 * early_k).powi(2) / variance).abs() < 1e-12, "{early:?}");
+        // the steady rate is K's alone: all of it K's, T's share its correlation's square
+        let steady = attribution(&model, &effects, "r.steady").unwrap();
+        assert_eq!(steady.explained[0].0, "K");
+        let (all, t_share) = (steady.explained[0].1, steady.explained[1].1);
+        assert!((all - 1.0).abs() < 1e-6 && (t_share - 0.01).abs() < 1e-6, "{steady:?}");
+        // T below 9.6 s predicts nothing: T's effect is a failure, said as such
+        let fragile = parameter_effects(&model, |m: &Model| {
+            if m.parameter_values()["T"] < 9.6 {
+                Err("the run diverges at t = 3 s".to_string())
+            } else {
+                step_response(m)
+            }
+        });
+        assert!(
+            fragile[1].effects.is_empty()
+                && fragile[1].failed.as_deref() == Some("the run diverges at t = 3 s")
+        );
+        assert!(attribution(&model, &fragile, "r.early").is_none());
+        // without a covariance, nothing to tell
+        assert!(parameter_effects(
+            &Model::parse(include_str!("../models/nomoto.toml"), "n.toml").unwrap(),
+            step_response
+        )
+        .is_empty());
+    }
 
     /// The values 0, 1, …, 100: the 5-95 % range is [5, 95], its ends inside.
     #[test]

@@ -306,6 +306,28 @@ impl PyModel {
         Ok((0..n).map(|_| PyModel { inner: sampler.draw(&mut normal) }).collect())
     }
 
+    /// What the spread of a prediction comes from: each free parameter one sd up and down (the
+    /// stored `[parameter_covariance]`), `predict` making the prediction's numbers of a model
+    /// (a callable taking a model, returning JSON text; an exception counts as that
+    /// parameter's failure). JSON: `effects` (each parameter's half changes) and
+    /// `attribution` (each number's linearised sd and the share of its variance each
+    /// parameter would remove); both empty without a covariance.
+    fn spread_from(&self, predict: Bound<'_, PyAny>) -> PyResult<String> {
+        let call = |m: &Model| -> Result<serde_json::Value, String> {
+            let out = predict.call1((PyModel { inner: m.clone() },)).map_err(|e| e.to_string())?;
+            let text: String = out.extract().map_err(|e: PyErr| e.to_string())?;
+            serde_json::from_str(&text).map_err(|e| e.to_string())
+        };
+        let effects = termid::uncertainty::parameter_effects(&self.inner, call);
+        let keys: std::collections::BTreeSet<&String> =
+            effects.iter().flat_map(|e| e.effects.keys()).collect();
+        let attribution: BTreeMap<&String, termid::uncertainty::Attribution> = keys
+            .into_iter()
+            .filter_map(|k| Some((k, termid::uncertainty::attribution(&self.inner, &effects, k)?)))
+            .collect();
+        to_json(&serde_json::json!({ "effects": effects, "attribution": attribution }))
+    }
+
     /// Sets the adaptive method's tolerances where given; refused where no step control works
     /// with them.
     #[pyo3(signature = (rtol = None, atol = None))]

@@ -1205,7 +1205,13 @@ class Model:
         (:meth:`draws` with ``seed``, each simulated as :meth:`simulate` with ``simulate``'s keywords): a
         DataFrame of the metrics, a row per draw that ran (``describe()`` gives mean, sd and
         percentiles); ``attrs``: ``nominal`` (the model's own metrics), ``draws``, ``failed``,
-        ``first_failure``. Where more than 5 % of the draws fail, the rest are
+        ``first_failure``; where the model holds its free parameters' covariance (an
+        :meth:`estimate`'s), what the spread comes from, each parameter one sd up and down, the
+        others at their estimates: ``parameter_effects`` (a parameter per row, the half change of
+        each metric), ``spread_from`` (a metric per row, the share of its variance that knowing
+        each parameter exactly would remove, linearised; correlated parameters share theirs)
+        and ``linearised_sd`` (each metric's sd from them together, near the draws' where the
+        metric is about linear in the parameters). Where more than 5 % of the draws fail, the rest are
         those that happened to stay stable, not a sample of the model's uncertainty: it raises
         :class:`TermidError` saying so instead of returning them (``draws`` gives them to
         whoever wants them still).
@@ -1229,6 +1235,26 @@ class Model:
             raise TermidError(refusal)
         table = pd.DataFrame(rows)
         table.attrs = {"nominal": nominal, "draws": n, "failed": failed, "first_failure": first}
+        # what the spread comes from: each free parameter one sd up and down (where the model
+        # holds the free parameters' covariance)
+        def predict(native: Any) -> str:
+            return json.dumps(Model(native).simulate(scenario, **simulate).attrs.get("metrics", {}))
+
+        found = json.loads(self._native.spread_from(predict))
+        effects = {e["parameter"]: e["effects"] for e in found["effects"] if e["failed"] is None}
+        table.attrs["parameter_effects"] = pd.DataFrame.from_dict(effects, orient="index")
+        table.attrs["spread_from"] = pd.DataFrame.from_dict(
+            {k: dict(a["explained"]) for k, a in found["attribution"].items()}, orient="index"
+        )
+        table.attrs["linearised_sd"] = pd.Series(
+            {k: a["linearised_sd"] for k, a in found["attribution"].items()}, dtype=float
+        )
+        for e in found["effects"]:
+            if e["failed"] is not None:
+                warnings.warn(
+                    f"termid: one sd from its estimate, `{e['parameter']}` leaves no prediction: {e['failed']}",
+                    stacklevel=2,
+                )
         return table
 
     def record(

@@ -7,11 +7,7 @@ use termid::model::Model;
 use termid::ship::basin::{dataset_toml, Basin, PAPER_RUNS};
 use termid::ship::{Manoeuvre, Metrics};
 
-use crate::common::{termid, Scratch};
-
-fn json(text: &str) -> serde_json::Value {
-    serde_json::from_str(text).unwrap_or_else(|e| panic!("{e}: {text}"))
-}
+use crate::common::{json, termid, Scratch};
 
 fn tactical(model: Option<&str>, delta: f64) -> f64 {
     let turn = format!("turning:{delta}");

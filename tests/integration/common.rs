@@ -87,6 +87,11 @@ pub fn termid(args: &[&str]) -> (bool, String, String) {
     )
 }
 
+/// A command's JSON report, or a panic that shows it.
+pub fn json(text: &str) -> serde_json::Value {
+    serde_json::from_str(text).unwrap_or_else(|e| panic!("{e}: {text}"))
+}
+
 /// Simulates the Lorenz model with `termid simulate` (RK4, Δt = 0.001) into `dir/lorenz.csv`.
 pub fn lorenz_csv(dir: &std::path::Path, duration: &str) -> std::path::PathBuf {
     let csv = dir.join("lorenz.csv");

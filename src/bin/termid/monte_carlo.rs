@@ -171,3 +171,48 @@ impl<T> Draws<T> {
         out
     }
 }
+
+/// What the spread of each metric comes from: the free parameters whose exact values would
+/// remove most of its variance (linearised, one sd of each up and down; the three largest
+/// shares), with the linearised sd beside the draws' (near each other where the prediction is
+/// about linear in the parameters); a parameter one sd away from which the manoeuvre fails,
+/// named. Empty without effects.
+pub fn effects_text(
+    model: &Model,
+    effects: &[termid::uncertainty::ParameterEffect],
+    spread: &BTreeMap<String, Spread>,
+) -> String {
+    if effects.is_empty() {
+        return String::new();
+    }
+    let mut out = String::from(
+        "\nwhat the spread comes from: the share of each metric's variance that knowing a free parameter exactly would remove (linearised from each parameter one sd up and down; correlated parameters share theirs), the three largest, and the linearised sd beside the draws'\n",
+    );
+    for (key, s) in spread {
+        let (name, unit, d) = termid::plugin::metric_label(key);
+        let e = d + 1;
+        let line = match termid::uncertainty::attribution(model, effects, key) {
+            Some(a) => {
+                let top: Vec<String> = a
+                    .explained
+                    .iter()
+                    .take(3)
+                    .map(|(p, share)| format!("{p} {:.0} %", 100.0 * share))
+                    .collect();
+                format!("{}   (linearised sd {:.e$}; draws {:.e$})", top.join(", "), a.linearised_sd, s.sd)
+            }
+            None => "--".to_string(),
+        };
+        out += &format!("  {:<28} {line}\n", termid::plot::labelled(&name, unit));
+    }
+    for e in effects {
+        if let Some(why) = &e.failed {
+            out += &format!(
+                "  warning: one sd from its estimate ({}), `{}` leaves no prediction: {why}\n",
+                termid::identify::num(e.sd),
+                e.parameter
+            );
+        }
+    }
+    out
+}

@@ -146,6 +146,19 @@ fn scenario_run(
             Ok((drawn.metrics, drawn.trajectory))
         })?),
     };
+    // what the draws' spread comes from: each free parameter one sd up and down
+    let effects = match (&mc, model.spec().parameter_covariance.as_ref()) {
+        (Some(_), Some(c)) => {
+            let bar = crate::progress::counter(2 * c.names.len() as u64, "each parameter ±1 sd");
+            let effects = termid::uncertainty::parameter_effects(model, |m| {
+                bar.inc(1);
+                scenario.run(m, &settings).map(|r| r.metrics)
+            });
+            bar.finish_and_clear();
+            effects
+        }
+        _ => Vec::new(),
+    };
     let mut outputs = termid::output::Outputs::new();
     if let Some(out) = &cmd.out {
         outputs.file(out, run.frame.to_csv().as_bytes())?;
@@ -170,6 +183,16 @@ fn scenario_run(
                 "monte_carlo".into(),
                 serde_json::to_value(mc.as_ref().map(|mc| mc.summary(&mc.spread(|r| vec![r.0.clone()]))))?,
             );
+            report.insert("parameter_effects".into(), serde_json::to_value(&effects)?);
+            // each metric's linearised sd and the share of it each parameter would remove
+            let from: serde_json::Map<String, serde_json::Value> = termid::uncertainty::numbers(&run.metrics)
+                .keys()
+                .filter_map(|k| {
+                    let a = termid::uncertainty::attribution(model, &effects, k)?;
+                    Some((k.clone(), serde_json::to_value(a).ok()?))
+                })
+                .collect();
+            report.insert("spread_from".into(), from.into());
             println!("{}", serde_json::to_string_pretty(&report)?)
         }
         Format::Text => {
@@ -178,7 +201,9 @@ fn scenario_run(
                 println!("{line}");
             }
             if let Some(mc) = &mc {
-                print!("{}", mc.text(&mc.spread(|r| vec![r.0.clone()]), &run.metrics));
+                let spread = mc.spread(|r| vec![r.0.clone()]);
+                print!("{}", mc.text(&spread, &run.metrics));
+                print!("{}", crate::monte_carlo::effects_text(model, &effects, &spread));
             }
             if let Some(out) = &cmd.out {
                 println!("wrote {} ({} rows; SI units, angles in rad)", out.display(), run.frame.len());
