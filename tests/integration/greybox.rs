@@ -598,6 +598,35 @@ fn monte_carlo_says_what_its_spread_comes_from() {
     assert!(text.contains("what the spread comes from") && text.contains("ε 100 %"), "{text}");
 }
 
+/// The same for a model under constant inputs (`simulate --input … --monte-carlo`): Nomoto's
+/// step response with K and T uncertain (sd 0.01 and 0.5, correlation 0.1). At t = 200 s
+/// ψ = Kδ(t − T(1 − e^(−t/T))) in closed form: one sd of K moves it by 0.01·δ·190, one of T by
+/// −K·δ·0.5, and the final yaw rate Kδ is K's alone (T's share its correlation's square).
+#[test]
+fn monte_carlo_under_constant_inputs_says_what_its_spread_comes_from() {
+    use crate::common::{json, termid};
+    let dir = crate::common::Scratch::new("spread-from-step");
+    let model = dir.join("nomoto.toml");
+    let covariance =
+        "\n[parameter_covariance]\nnames = [\"K\", \"T\"]\nmatrix = [[1e-4, 5e-4], [5e-4, 0.25]]\n";
+    let text = std::fs::read_to_string("models/nomoto.toml").unwrap();
+    std::fs::write(&model, format!("{text}{covariance}")).unwrap();
+    let model = model.to_str().unwrap();
+    let args = ["simulate", "--model", model, "--input", "δ=0.1", "--duration", "200", "--monte-carlo", "20"];
+    let (ok, out, err) = termid(&[&args[..], &["--format", "json"]].concat());
+    assert!(ok, "{err}");
+    let report = json(&out);
+    let effects = &report["parameter_effects"];
+    let effect = |k: usize, metric: &str| effects[k]["effects"][metric].as_f64().unwrap();
+    assert!((effect(0, "final ψ") - 0.01 * 0.1 * 190.0).abs() < 1e-6, "{effects}");
+    assert!((effect(1, "final ψ") + 0.1 * 0.1 * 0.5).abs() < 1e-6, "{effects}");
+    let rate = &report["spread_from"]["final r"]["explained"];
+    assert!(rate[0][0] == "K" && (rate[0][1].as_f64().unwrap() - 1.0).abs() < 1e-6, "{rate}");
+    assert!((rate[1][1].as_f64().unwrap() - 0.01).abs() < 1e-6, "{rate}");
+    let (_, text, _) = termid(&args);
+    assert!(text.contains("what the spread comes from") && text.contains("K 100 %, T 1 %"), "{text}");
+}
+
 /// `termid estimate` end to end on the shipped Nomoto file: a zigzag CSV in, the estimates
 /// with standard errors and covariance written, and `simulate --monte-carlo` drawing from
 /// that covariance.

@@ -172,6 +172,41 @@ impl<T> Draws<T> {
     }
 }
 
+/// Each free parameter's effect on the numbers `predict` makes of a model, one sd up and down
+/// (with a progress bar), where draws were made (`drawn`) and the model holds the free
+/// parameters' covariance; empty otherwise.
+pub fn parameter_effects(
+    model: &Model,
+    drawn: bool,
+    predict: impl Fn(&Model) -> Result<serde_json::Value>,
+) -> Vec<termid::uncertainty::ParameterEffect> {
+    let Some(c) = model.spec().parameter_covariance.as_ref().filter(|_| drawn) else { return Vec::new() };
+    let bar = crate::progress::counter(2 * c.names.len() as u64, "each parameter ±1 sd");
+    let effects = termid::uncertainty::parameter_effects(model, |m| {
+        bar.inc(1);
+        predict(m).map_err(|e| format!("{e:#}"))
+    });
+    bar.finish_and_clear();
+    effects
+}
+
+/// The JSON of what the spread of each number of `nominal` comes from: each parameter's
+/// effects and each number's attribution (`parameter_effects`, `spread_from`).
+pub fn effects_json(
+    model: &Model,
+    effects: &[termid::uncertainty::ParameterEffect],
+    nominal: &serde_json::Value,
+) -> (serde_json::Value, serde_json::Value) {
+    let from: serde_json::Map<String, serde_json::Value> = termid::uncertainty::numbers(nominal)
+        .keys()
+        .filter_map(|k| {
+            let a = termid::uncertainty::attribution(model, effects, k)?;
+            Some((k.clone(), serde_json::to_value(a).ok()?))
+        })
+        .collect();
+    (serde_json::to_value(effects).unwrap_or_default(), from.into())
+}
+
 /// What the spread of each metric comes from: the free parameters whose exact values would
 /// remove most of its variance (linearised, one sd of each up and down; the three largest
 /// shares), with the linearised sd beside the draws' (near each other where the prediction is

@@ -147,18 +147,9 @@ fn scenario_run(
         })?),
     };
     // what the draws' spread comes from: each free parameter one sd up and down
-    let effects = match (&mc, model.spec().parameter_covariance.as_ref()) {
-        (Some(_), Some(c)) => {
-            let bar = crate::progress::counter(2 * c.names.len() as u64, "each parameter ±1 sd");
-            let effects = termid::uncertainty::parameter_effects(model, |m| {
-                bar.inc(1);
-                scenario.run(m, &settings).map(|r| r.metrics)
-            });
-            bar.finish_and_clear();
-            effects
-        }
-        _ => Vec::new(),
-    };
+    let effects = crate::monte_carlo::parameter_effects(model, mc.is_some(), |m| {
+        Ok(scenario.run(m, &settings)?.metrics)
+    });
     let mut outputs = termid::output::Outputs::new();
     if let Some(out) = &cmd.out {
         outputs.file(out, run.frame.to_csv().as_bytes())?;
@@ -183,16 +174,10 @@ fn scenario_run(
                 "monte_carlo".into(),
                 serde_json::to_value(mc.as_ref().map(|mc| mc.summary(&mc.spread(|r| vec![r.0.clone()]))))?,
             );
-            report.insert("parameter_effects".into(), serde_json::to_value(&effects)?);
             // each metric's linearised sd and the share of it each parameter would remove
-            let from: serde_json::Map<String, serde_json::Value> = termid::uncertainty::numbers(&run.metrics)
-                .keys()
-                .filter_map(|k| {
-                    let a = termid::uncertainty::attribution(model, &effects, k)?;
-                    Some((k.clone(), serde_json::to_value(a).ok()?))
-                })
-                .collect();
-            report.insert("spread_from".into(), from.into());
+            let (effects, from) = crate::monte_carlo::effects_json(model, &effects, &run.metrics);
+            report.insert("parameter_effects".into(), effects);
+            report.insert("spread_from".into(), from);
             println!("{}", serde_json::to_string_pretty(&report)?)
         }
         Format::Text => {
@@ -275,6 +260,11 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
             Ok((final_states(&system, &t), t))
         })?),
     };
+    let effects = crate::monte_carlo::parameter_effects(model, mc.is_some(), |m| {
+        let system = termid::sim::System::new(m, &BTreeMap::new(), cmd.with_intercept)?;
+        let t = simulate(&system, &x0, controller(&system)?.as_mut(), &settings)?;
+        Ok(final_states(&system, &t))
+    });
     let frame = traj.to_frame("simulation", &model.spec().model.time)?;
     let mut outputs = termid::output::Outputs::new();
     if let Some(out) = &cmd.out {
@@ -315,15 +305,20 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
     let nominal = final_states(&system, &traj);
     let spread = mc.as_ref().map(|mc| mc.spread(|r| vec![r.0.clone()]));
     match cmd.format {
-        Format::Json => println!(
-            "{}",
-            serde_json::to_string_pretty(&serde_json::json!({
-                "model": model.path,
-                "samples": traj.time.len(),
-                "final_state": system.states.iter().zip(&last).map(|(s, v)| (s.clone(), *v)).collect::<BTreeMap<_, _>>(),
-                "monte_carlo": mc.as_ref().zip(spread.as_ref()).map(|(mc, s)| mc.summary(s)),
-            }))?
-        ),
+        Format::Json => {
+            let (effects, from) = crate::monte_carlo::effects_json(model, &effects, &nominal);
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&serde_json::json!({
+                    "model": model.path,
+                    "samples": traj.time.len(),
+                    "final_state": system.states.iter().zip(&last).map(|(s, v)| (s.clone(), *v)).collect::<BTreeMap<_, _>>(),
+                    "monte_carlo": mc.as_ref().zip(spread.as_ref()).map(|(mc, s)| mc.summary(s)),
+                    "parameter_effects": effects,
+                    "spread_from": from,
+                }))?
+            )
+        }
         Format::Text => {
             println!(
                 "{}: {} samples to t = {} s",
@@ -336,6 +331,7 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
             }
             if let Some((mc, spread)) = mc.as_ref().zip(spread.as_ref()) {
                 print!("{}", mc.text(spread, &nominal));
+                print!("{}", crate::monte_carlo::effects_text(model, &effects, spread));
             }
             if let Some(out) = &cmd.out {
                 println!("wrote {}", out.display());
