@@ -1455,14 +1455,15 @@ fn states_and_derived_variables_are_compared_in_the_sources_that_record_them() {
         std::fs::write(&set, format!("{columns}{extra}\n[[runs]]\nfile = \"{name}.csv\"\n")).unwrap();
         sets.push(set);
     }
-    let (ok, report, err) = crate::common::termid(&[
-        "estimate",
-        "--model",
-        model_path.to_str().unwrap(),
+    let (model_arg, with, without) =
+        (model_path.to_str().unwrap(), sets[0].to_str().unwrap(), sets[1].to_str().unwrap());
+    let estimate =
+        |more: &[&str]| crate::common::termid(&[&["estimate", "--model", model_arg][..], more].concat());
+    let (ok, report, err) = estimate(&[
         "--dataset",
-        sets[0].to_str().unwrap(),
+        with,
         "--dataset",
-        sets[1].to_str().unwrap(),
+        without,
         "--states",
         "x,w,cell",
         "--out",
@@ -1480,15 +1481,7 @@ fn states_and_derived_variables_are_compared_in_the_sources_that_record_them() {
         assert!((values[name] / truth - 1.0).abs() < 0.02, "{name} {}\n{report}", values[name]);
     }
     // a source alone without it has nothing to compare it with
-    let (ok, _, err) = crate::common::termid(&[
-        "estimate",
-        "--model",
-        model_path.to_str().unwrap(),
-        "--dataset",
-        sets[1].to_str().unwrap(),
-        "--states",
-        "x,cell",
-    ]);
+    let (ok, _, err) = estimate(&["--dataset", without, "--states", "x,cell"]);
     assert!(!ok && err.contains("no run has a column `cell`"), "{err}");
 }
 
