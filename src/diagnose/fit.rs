@@ -434,12 +434,7 @@ impl Runs {
             return Ok(out);
         }
         let setup = |e: crate::data::DataError| DiagnoseError::Setup(e.to_string());
-        let read: Vec<&String> = self
-            .inputs
-            .iter()
-            .chain(self.states.iter().map(|(_, name)| name))
-            .chain(self.outputs.iter().map(|o| &o.name))
-            .collect();
+        let read: Vec<&String> = self.inputs.iter().chain(self.compared_names()).collect();
         for (f, s) in out.frames.iter_mut().zip(&mut out.settings) {
             let mut slim = Frame::new(f.origin(), f.time_name(), f.time().to_vec()).map_err(setup)?;
             for name in &read {
@@ -503,8 +498,12 @@ impl Runs {
     /// The compared quantities' (states', then derived variables') names in run `f` with their
     /// number of samples there: 0 for one the run does not record.
     fn recorded<'a>(&'a self, f: &'a Frame) -> impl Iterator<Item = (&'a str, usize)> + 'a {
-        let names = self.states.iter().map(|(_, s)| s).chain(self.outputs.iter().map(|o| &o.name));
-        names.map(move |n| (n.as_str(), f.column(n).map_or(0, |c| c.len())))
+        self.compared_names().map(move |n| (n.as_str(), f.column(n).map_or(0, |c| c.len())))
+    }
+
+    /// The compared states' and then derived variables' names, as residuals order them.
+    fn compared_names(&self) -> impl Iterator<Item = &String> + '_ {
+        self.states.iter().map(|(_, s)| s).chain(self.outputs.iter().map(|o| &o.name))
     }
 
     /// The compared derived variables' names.
@@ -514,8 +513,7 @@ impl Runs {
 
     /// The compared states and derived variables that some runs do not record.
     pub fn partly_recorded(&self) -> Vec<PartlyRecorded> {
-        let names = self.states.iter().map(|(_, s)| s).chain(self.outputs.iter().map(|o| &o.name));
-        names
+        self.compared_names()
             .map(|name| PartlyRecorded {
                 name: name.clone(),
                 runs: self.frames.iter().filter(|f| f.column(name).is_some()).count(),
