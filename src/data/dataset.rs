@@ -314,8 +314,10 @@ impl Dataset {
         let file = path.display().to_string();
         let text = crate::budget::read_text(path)
             .map_err(|e| DataError::Io { file: file.clone(), message: e.to_string() })?;
-        let ds: Dataset = toml::from_str(&text)
-            .map_err(|e| DataError::Io { file: file.clone(), message: e.to_string() })?;
+        let ds: Dataset = toml::from_str(&text).map_err(|e| DataError::Io {
+            file: file.clone(),
+            message: crate::contain::toml_message(&e, &text),
+        })?;
         ds.check().map_err(|message| DataError::Io { file, message })?;
         Ok(ds)
     }

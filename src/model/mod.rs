@@ -358,8 +358,10 @@ impl Model {
                 message: format!("line {line} ends in a bare carriage return (CR, old Mac line ends): save the file with LF or CRLF line ends"),
             });
         }
-        let spec: ModelFile = toml::from_str(text)
-            .map_err(|e| ModelError::Syntax { file: file.into(), message: e.to_string() })?;
+        let spec: ModelFile = toml::from_str(text).map_err(|e| ModelError::Syntax {
+            file: file.into(),
+            message: crate::contain::toml_message(&e, text),
+        })?;
         Model::from_spec(spec, text, file)
     }
 

@@ -111,8 +111,10 @@ const GENERIC: &str = "no formula from particulars: a generic full-form single-s
 impl Particulars {
     /// Reads a particulars file's TOML `text`; `file` names it in messages.
     pub fn parse(text: &str, file: &str) -> Result<Particulars, ParticularsError> {
-        toml::from_str(text)
-            .map_err(|e| ParticularsError::Syntax { file: file.into(), message: e.to_string() })
+        toml::from_str(text).map_err(|e| ParticularsError::Syntax {
+            file: file.into(),
+            message: crate::contain::toml_message(&e, text),
+        })
     }
 
     /// Refuses particulars a ship cannot have.
