@@ -61,6 +61,9 @@ mod figures;
 // Grey-box: named parameters of a model file estimated by output error (Lorenz, Nomoto).
 #[path = "integration/greybox.rs"]
 mod greybox;
+// Systems the paper never saw through estimate's defaults: right, or flagged as failed.
+#[path = "integration/outside.rs"]
+mod outside;
 // The reference (docs/reference/) against the code: every key documented, nothing stale.
 #[path = "integration/reference.rs"]
 mod reference;

@@ -842,7 +842,7 @@ impl PyModel {
 
     /// The model file's free parameters estimated from runs by output error (JSON report),
     /// with the model holding the estimates.
-    #[pyo3(signature = (runs, coefficients = false, states = None, initial_values = "auto".to_string(), dt = None, iterations = 50, sources = vec![], per_source = vec![], per_run = vec![], coarse = false))]
+    #[pyo3(signature = (runs, coefficients = false, states = None, initial_values = "auto".to_string(), dt = None, iterations = 50, sources = vec![], per_source = vec![], per_run = vec![], coarse = false, segments = None))]
     #[allow(clippy::too_many_arguments)]
     fn estimate(
         &self,
@@ -857,10 +857,21 @@ impl PyModel {
         per_source: Vec<String>,
         per_run: Vec<String>,
         coarse: bool,
+        segments: Option<usize>,
     ) -> PyResult<(String, PyModel)> {
         let initial_values = termid::diagnose::InitialValues::parse(&initial_values)
             .map_err(|e| pyo3::exceptions::PyValueError::new_err(format!("initial_values {e}")))?;
         let frames = self.frames(runs)?;
+        // multiple shooting: each segment a run of its own, of its run's source
+        let (frames, sources) = match segments {
+            Some(count) if count < 2 => {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                    "segments {count}: cut each run into 2 or more, or leave it out"
+                )))
+            }
+            Some(count) => termid::diagnose::in_segments(&frames, &sources, count),
+            None => (frames, sources),
+        };
         // one RK4 step per sample by default: the recorded inputs are known at the samples
         let dt = dt.unwrap_or_else(|| termid::data::sample_step(&frames));
         let settings = termid::diagnose::EstimateSettings {

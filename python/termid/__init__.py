@@ -1501,6 +1501,7 @@ class Model:
         per_source: Sequence[str] = (),
         per_run: Sequence[str] = (),
         coarse: bool = False,
+        segments: Optional[int] = None,
     ) -> Tuple[pd.DataFrame, "Model"]:
         """The model file's free parameters (``free = true`` under ``[parameters.NAME]``, with an
         optional ``prior`` and ``bounds``) estimated from ``runs`` by output error: grey-box
@@ -1554,6 +1555,18 @@ class Model:
         holds the field's check of them (a ship's first overshoots within 1°), and a warning
         says where one fails.
 
+        ``attrs["unexplained"]`` is the share of the records' variance the fit leaves (each
+        compared quantity scaled by its spread over the runs), ``attrs["noise"]`` the share
+        that is their noise (from their second differences); more than 0.1 beyond the noise
+        the fit does not follow the records and a warning says so. Where the fit from the model file's values
+        leaves that much, it is made again from the parameters fitted on the runs cut into 16
+        segments, each from its own initial values (multiple shooting), and the better kept
+        (``attrs["segmented"]``: the segments, whether that fit was ``kept``, the other's
+        cost and share left): an output error has minima that are not the system's wherever
+        the start's phase drifts off the record's. ``segments`` cuts each run into that many
+        segments to fit (each reported as a run): where a motion's errors grow over a run (a
+        chaotic system) no whole-run fit follows it and the warning says to.
+
         >>> nomoto = termid.Model.builtin("nomoto")
         >>> truth = termid.Model.builtin("nomoto")
         >>> truth.set_parameter("K", 0.15); truth.set_parameter("T", 8.0)
@@ -1573,6 +1586,7 @@ class Model:
             list(per_source),
             list(per_run),
             coarse,
+            None if segments is None else int(segments),
         )
         report = json.loads(text)
         table = pd.DataFrame(
@@ -1595,6 +1609,9 @@ class Model:
             "cost_before": report["cost_before"],
             "cost_after": report["cost_after"],
             "stopped": report["stopped"],
+            "unexplained": report["unexplained"],
+            "noise": report["noise"],
+            "segmented": report.get("segmented"),
             "covariance": None if report["covariance"] is None else pd.DataFrame(report["covariance"], index=names, columns=names),
             "per_source": pd.DataFrame(report.get("per_source", []), columns=["name", "source", "run", "value", "std_error"]),
             "from_records": report.get("from_records"),
@@ -1616,6 +1633,24 @@ class Model:
         if report.get("metrics_failed"):
             warnings.warn(
                 f"termid: no metrics of the fit: the estimates do not re-simulate every run: {report['metrics_failed']}",
+                stacklevel=2,
+            )
+        if report["unexplained"] > 0.1 + report["noise"]:
+            # a minimum that is not the system's, or a structure that is not: the CLI flags it
+            searched = report.get("segmented") or {}
+            left = searched.get("segments_unexplained")
+            why = (
+                f"; fitted on segments of {searched['seconds']:.3g} s the model follows them "
+                f"({100 * left:.2g} % left): its errors build up over a run, from an effect the model "
+                "lacks that accumulates (an offset, a drift) or from a chaotic or unstable motion, "
+                "which only segments of its runs can fit (segments=N)"
+                if left is not None and left <= 0.1 + report["noise"]
+                else ": a minimum that is not the system's, or a structure that is not"
+            )
+            warnings.warn(
+                f"termid: the fit does not follow the records: it leaves {100 * report['unexplained']:.2g} % "
+                f"of their variance (attrs['unexplained']; their noise {100 * report['noise']:.2g} %){why}; "
+                "read the estimates as failed",
                 stacklevel=2,
             )
         leaning = report.get("from_records") or {}

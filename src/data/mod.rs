@@ -402,6 +402,24 @@ impl Frame {
         })
     }
 
+    /// The frame cut into `count` pieces of equal length (fewer where a piece would have
+    /// fewer than `shortest` rows; one at least), consecutive pieces sharing their boundary
+    /// row so that each starts where the last ends; each named by its origin and "[k/count]".
+    pub fn pieces(&self, count: usize, shortest: usize) -> Vec<Frame> {
+        let n = self.len();
+        let count = count.min(n / shortest.max(1)).max(1);
+        if count == 1 {
+            return vec![self.clone()];
+        }
+        (0..count)
+            .map(|k| {
+                let mut piece = self.slice(k * (n - 1) / count..(k + 1) * (n - 1) / count + 1);
+                piece.origin = format!("{} [{}/{count}]", self.origin, k + 1);
+                piece
+            })
+            .collect()
+    }
+
     /// Rows `range` as a new frame.
     pub fn slice(&self, range: std::ops::Range<usize>) -> Frame {
         Frame {

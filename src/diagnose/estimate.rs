@@ -202,6 +202,37 @@ pub const CORRELATED: f64 = 0.95;
 /// Below this share of its precision from the runs an estimate is reported as its prior's.
 pub const MOSTLY_PRIOR: f64 = 0.5;
 
+/// Beyond this share of the records' variance left ([`Estimate::unexplained`]) besides their
+/// noise a fit does not follow them: a minimum of the output error that is not the system's,
+/// or a structure that is not.
+pub const FOLLOWS: f64 = 0.1;
+
+/// Into how many segments the search for a start cuts each run, where the fit from the file's
+/// values does not follow its records ([`Segmented`]; fewer where a run is short).
+pub const SEGMENTS: usize = 16;
+
+/// The fit again from a start found on segments of the runs, where the fit from the model
+/// file's values did not follow the records.
+#[derive(Clone, Debug, Serialize)]
+pub struct Segmented {
+    /// How many segments the runs were cut into (0: the segments' fit failed).
+    pub segments: usize,
+    /// Their mean length, s.
+    pub seconds: f64,
+    /// Whether the fit from the segments' start is the one kept (its cost is the lower).
+    pub kept: bool,
+    /// The cost of the fit not kept.
+    pub other_cost: Option<f64>,
+    /// The share of the records' variance it leaves.
+    pub other_unexplained: Option<f64>,
+    /// The share of the segments' variance their own fit left: where it follows them and no
+    /// fit of the whole runs does, the motion's errors grow over a run (a chaotic or unstable
+    /// system) and shorter runs are what can be fitted.
+    pub segments_unexplained: Option<f64>,
+    /// Why the segments' fit, or the fit from its start, failed.
+    pub failed: Option<String>,
+}
+
 /// An output-error estimate's result.
 #[derive(Clone, Debug, Serialize)]
 pub struct Estimate {
@@ -212,6 +243,15 @@ pub struct Estimate {
     pub cost_before: f64,
     /// The same after.
     pub cost_after: f64,
+    /// The share of the records' variance the fit leaves: its cost per compared sample, each
+    /// quantity scaled by its spread over the runs (1: no better than each quantity's mean).
+    pub unexplained: f64,
+    /// The share of the records' variance that is their noise, as their second differences
+    /// show it ([`Runs::noise`]): what a fit that holds leaves.
+    pub noise: f64,
+    /// Where the fit from the model file's values did not follow the records ([`FOLLOWS`]):
+    /// the fit again from a start found on segments of the runs, and which was kept.
+    pub segmented: Option<Segmented>,
     /// Why it stopped.
     pub stopped: String,
     /// Levenberg-Marquardt iterations taken, both rounds.
@@ -228,7 +268,8 @@ pub struct Estimate {
     /// How many runs' initial values were estimated with them.
     pub initial_values: usize,
     /// How many of them are of states the runs do not record that the motion depends on (a
-    /// lag, an engine), started where they are steady at each run's first sample (free
+    /// lag, an engine), started where they are steady at each run's first sample or at the
+    /// model file's value, whichever re-simulates the run better (free
     /// initial values only: held, they stay there).
     pub hidden_initial_values: usize,
     /// Those estimated initial values: (run, state index in the model's system, value).
@@ -469,7 +510,7 @@ impl Unknowns {
             }
         }
         // each run's compared states, and where they are free the states it does not record
-        // that the motion depends on (started where they are steady: `Runs::new`); held, those
+        // that the motion depends on (started steady or at the file's value: `Runs::new`); held, those
         // stay there, as the records' steady approach says (free, with nothing to hold them,
         // they absorb what the model does not explain as the recorded ones do)
         let initial: Vec<(usize, usize)> = if settings.initial_values != InitialValues::Recorded {
@@ -622,7 +663,7 @@ pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Resu
         Some((samples, fit)) => Scales { fit, every: runs, samples: *samples },
         None => Scales { fit: runs, every: runs, samples: 1 },
     };
-    let each = with_initial_values(model, scales, settings, &[])?;
+    let each = searched(model, scales, settings, &[])?;
     // the file's declarations are tested; what the command asks for stays
     let asked = |name: &String| settings.per_run.contains(name) || settings.per_source.contains(name);
     let agree: Vec<RunSpread> = each
@@ -636,9 +677,92 @@ pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Resu
         return Ok(each);
     }
     let names: Vec<String> = agree.iter().map(|r| r.name.clone()).collect();
-    let mut one = with_initial_values(model, scales, settings, &names)?;
+    let mut one = searched(model, scales, settings, &names)?;
     one.one_value = agree;
     Ok(one)
+}
+
+/// [`with_initial_values`] from the model file's values and, where that fit does not follow
+/// the records ([`Estimate::follows`]), again from a start found on segments of the runs
+/// ([`segmented_start`]); the fit of the lower cost is kept and says what the other gave. An
+/// output error's cost has minima that are not the system's wherever the start's phase drifts
+/// off the record's (an oscillator, a predator and its prey): a fit from there stops in one and
+/// reports it as converged.
+fn searched(
+    model: &Model,
+    scales: &Scales<'_>,
+    settings: &EstimateSettings,
+    one: &[String],
+) -> Result<Estimate, DiagnoseError> {
+    let first = with_initial_values(model, scales, settings, one)?;
+    if first.follows() {
+        return Ok(first);
+    }
+    let again =
+        segmented_start(model, scales.every, settings, one).and_then(|(start, segments, seconds, left)| {
+            let mut again = with_initial_values(&start, scales, settings, one)?;
+            // the report's start is the file's value, where the search began
+            for (p, q) in again.parameters.iter_mut().zip(&first.parameters) {
+                p.start = q.start;
+            }
+            again.cost_before = first.cost_before;
+            Ok((again, segments, seconds, left))
+        });
+    let segmented = match again {
+        Ok((again, segments, seconds, left)) => {
+            let kept = again.cost_after < first.cost_after;
+            let (mut fit, other) = if kept { (again, first) } else { (first, again) };
+            fit.segmented = Some(Segmented {
+                segments,
+                seconds,
+                kept,
+                other_cost: Some(other.cost_after),
+                other_unexplained: Some(other.unexplained),
+                segments_unexplained: Some(left),
+                failed: None,
+            });
+            fit
+        }
+        Err(e) => Estimate {
+            segmented: Some(Segmented {
+                segments: 0,
+                seconds: 0.0,
+                kept: false,
+                other_cost: None,
+                other_unexplained: None,
+                segments_unexplained: None,
+                failed: Some(e.to_string()),
+            }),
+            ..first
+        },
+    };
+    Ok(segmented)
+}
+
+/// The free parameters' values fitted on the runs cut into [`SEGMENTS`] pieces each, every
+/// piece from its own free initial values (multiple shooting without the pieces joined: Bock
+/// 1981; a parameter per run is one per piece here, one per source stays so), set in `model`
+/// as a start: over a piece the start's simulation stays near the record, and the fit's cost
+/// is nearly the equation error's, without its minima that are not the system's. With the
+/// pieces' number, their mean length (s) and the share of their variance the fit left.
+fn segmented_start(
+    model: &Model,
+    runs: &Runs,
+    settings: &EstimateSettings,
+    one: &[String],
+) -> Result<(Model, usize, f64, f64), DiagnoseError> {
+    let (pieces, of) = runs.segments(model, SEGMENTS)?;
+    let sources = of.iter().map(|&r| settings.sources.get(r).copied().unwrap_or(0)).collect();
+    let settings =
+        EstimateSettings { initial_values: InitialValues::Free, sources, coarsest: None, ..settings.clone() };
+    let scales = Scales { fit: &pieces, every: &pieces, samples: 1 };
+    let fitted = fit(model, &scales, &settings, false, one)?;
+    let mut start = model.clone();
+    for p in &fitted.parameters {
+        start.set_parameter(&p.name, p.value);
+    }
+    let seconds = pieces.settings.iter().map(|s| s.duration).sum::<f64>() / pieces.len() as f64;
+    Ok((start, pieces.len(), seconds, fitted.unexplained))
 }
 
 /// [`estimate`] with the parameters `one` once for all runs, each run's initial values as
@@ -739,6 +863,9 @@ fn fit(
         model: u.written(model, &theta, &parameters, matrix.as_ref(), &per_run)?,
         cost_before,
         cost_after,
+        unexplained: cost_after / every.residual_count().max(1) as f64,
+        noise: every.noise_share(),
+        segmented: None,
         stopped,
         iterations,
         correlation_time: tau,
@@ -1080,6 +1207,12 @@ impl Estimate {
             .collect()
     }
 
+    /// Whether the fit follows its records: it leaves at most [`FOLLOWS`] of their variance
+    /// beyond their noise.
+    pub fn follows(&self) -> bool {
+        self.unexplained <= FOLLOWS + self.noise
+    }
+
     /// Whether any value was estimated per source (the report numbers the sources, so a
     /// caller names them).
     pub fn per_source_values(&self) -> bool {
@@ -1091,13 +1224,57 @@ impl Estimate {
     pub fn text(&self) -> String {
         use crate::identify::{num, sig};
         let mut out = format!(
-            "== output-error estimate of the free parameters ==\nre-simulation cost (scaled sum of squares) {} → {}; {} iterations; residual correlation time {} samples; stopped: {}\n",
+            "== output-error estimate of the free parameters ==\nre-simulation cost (scaled sum of squares) {} → {} ({} % of the records' variance left, their noise {} %); {} iterations; residual correlation time {} samples; stopped: {}\n",
             sig(self.cost_before, 4),
             sig(self.cost_after, 4),
+            sig(100.0 * self.unexplained, 2),
+            sig(100.0 * self.noise, 2),
             self.iterations,
             self.correlation_time.map_or("—".into(), |t| format!("{t:.0}")),
             self.stopped
         );
+        let share = |u: f64| format!("{} %", sig(100.0 * u, 2));
+        match &self.segmented {
+            Some(Segmented { failed: Some(why), .. }) => out.push_str(&format!(
+                "the fit from the file's values left {} of the records' variance; a start fitted on segments of the runs failed: {why}\n",
+                share(self.unexplained)
+            )),
+            Some(s) => {
+                let other = s.other_unexplained.map_or("—".into(), share);
+                let cost = s.other_cost.map_or("—".into(), |c| sig(c, 4));
+                let pieces = format!(
+                    "the runs cut into {} segments of {} s, each from its own initial values (multiple shooting)",
+                    s.segments,
+                    sig(s.seconds, 3)
+                );
+                out.push_str(&if s.kept {
+                    format!("the fit from the file's values did not follow the records (cost {cost}, {other} of their variance left): this one starts from the parameters fitted on {pieces}, and leaves {}\n", share(self.unexplained))
+                } else {
+                    format!("the fit leaves {} of the records' variance; started again from the parameters fitted on {pieces}, it reached cost {cost} ({other} left): no better, this one is kept\n", share(self.unexplained))
+                });
+            }
+            None => {}
+        }
+        let segments_follow = self
+            .segmented
+            .as_ref()
+            .and_then(|s| s.segments_unexplained)
+            .filter(|u| *u <= FOLLOWS + self.noise);
+        if let (false, Some(left), Some(s)) = (self.follows(), segments_follow, &self.segmented) {
+            out.push_str(&format!(
+                "FLAG the fit does not follow the records: it leaves {} of their variance, where fitted on segments of {} s the same model follows them ({} left): its errors build up over a run, from an effect the model lacks that accumulates (an offset, a drift) or from a chaotic or unstable motion, which only segments of its runs can fit (`--segments N`, Python `segments=`); read the estimates as failed\n",
+                share(self.unexplained),
+                sig(s.seconds, 3),
+                share(left)
+            ));
+        } else if !self.follows() {
+            out.push_str(&format!(
+                "FLAG the fit does not follow the records: it leaves {} of their variance (each compared quantity scaled by its spread over the runs; their noise is {}, and a fit that holds leaves at most {:.0} % more): a minimum of the output error that is not the system's, or a structure that is not; read the estimates as failed, see the runs re-simulated (`--svg`), start elsewhere (`--param`)\n",
+                share(self.unexplained),
+                share(self.noise),
+                100.0 * FOLLOWS
+            ));
+        }
         if self.step_samples > 1 {
             out.push_str(&format!(
                 "fitted at a step of {} samples (the coarsest at which the start re-simulates the runs as at every sample, or the step asked for); costs at every sample\n",
@@ -1210,7 +1387,7 @@ impl Estimate {
                 match self.hidden_initial_values {
                     0 => String::new(),
                     n => format!(
-                        "; {n} of states the runs do not record that the motion depends on, started where they are steady"
+                        "; {n} of states the runs do not record that the motion depends on, started where they are steady or at the file's value, whichever re-simulates the run better"
                     ),
                 }
             ));

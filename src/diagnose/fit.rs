@@ -19,6 +19,26 @@ use crate::sim::{
 };
 use crate::term::{Library, Term};
 
+/// The fewest samples [`Runs::segments`] gives a segment.
+pub const SEGMENT_SAMPLES: usize = 20;
+
+/// Records cut into `count` segments each (none shorter than [`SEGMENT_SAMPLES`]), each a run
+/// of its own from its first sample: multiple shooting, where a motion's errors grow over a
+/// run (a chaotic system) and no whole-run re-simulation follows its record. With each
+/// segment's source (of its run's; `sources` empty: one source, empty too).
+pub fn in_segments(frames: &[Frame], sources: &[usize], count: usize) -> (Vec<Frame>, Vec<usize>) {
+    let mut out = (Vec::new(), Vec::new());
+    for (r, f) in frames.iter().enumerate() {
+        for piece in f.pieces(count, SEGMENT_SAMPLES) {
+            out.0.push(piece);
+            if let Some(&s) = sources.get(r) {
+                out.1.push(s);
+            }
+        }
+    }
+    out
+}
+
 /// The measured runs prepared for re-simulation.
 #[derive(Clone)]
 pub struct Runs {
@@ -37,15 +57,17 @@ pub struct Runs {
     /// The model's derived quantities compared with their records (after the states).
     pub(super) outputs: Vec<Output>,
     /// Per run, the states (indices) it does not record that the motion depends on, started
-    /// where they are steady; an estimate frees them where it frees the runs' initial values.
+    /// where they are steady or at the file's value, whichever re-simulates the run better; an
+    /// estimate frees them where it frees the runs' initial values.
     pub(super) hidden: Vec<Vec<usize>>,
 }
 
 /// A run's initial state with its `hidden` states (unrecorded, read by the motion) where they
 /// are steady with the recorded ones and the inputs at the run's first sample (a lag of the
-/// hull's forces, an engine's rate: a run starts from a steady approach more often than not,
-/// and a file's initial value is no better a guess); all together where that has a solution,
-/// else each alone, else the `declared` value (a state whose own rate does not depend on it).
+/// hull's forces, an engine's rate: a run starts from a steady approach more often than not;
+/// `Runs::new` keeps the file's value where that re-simulates the run better); all together
+/// where that has a solution, else each alone, else the `declared` value (a state whose own
+/// rate does not depend on it).
 fn steady_hidden(system: &System, frame: &Frame, declared: Vec<f64>, hidden: &[usize]) -> Vec<f64> {
     if hidden.is_empty() {
         return declared;
@@ -260,7 +282,9 @@ impl Runs {
                     .collect()
             })
             .collect();
-        let x0 = frames
+        // each run's declared start (its first samples, the file's values of the rest) and
+        // that with its hidden states where they are steady
+        let starts = frames
             .iter()
             .zip(&params)
             .zip(&hidden)
@@ -275,7 +299,8 @@ impl Runs {
                         )
                     })
                     .collect();
-                Ok(steady_hidden(&system.with_parameters(p)?, f, declared, hidden))
+                let steady = steady_hidden(&system.with_parameters(p)?, f, declared.clone(), hidden);
+                Ok((declared, steady))
             })
             .collect::<Result<Vec<_>, DiagnoseError>>()?;
         let settings = frames
@@ -287,18 +312,51 @@ impl Runs {
                 Settings { integrator, dt: sample / sub, duration: t[t.len() - 1] - t[0], sample }
             })
             .collect();
-        Ok(Runs {
+        let mut runs = Runs {
             frames: frames.to_vec(),
             states,
             scale,
             units,
-            x0,
+            x0: starts.iter().map(|(_, steady)| steady.clone()).collect(),
             params,
             settings,
             intercepts: false,
             inputs: system.inputs.clone(),
             outputs: Vec::new(),
             hidden,
+        };
+        // a run starts where its hidden states are steady (a steady approach, a steering lag
+        // in a steady turn) unless the file's values re-simulate its record better: a state
+        // that is steady only where nothing happens (an epidemic's susceptibles, steady once
+        // none are left) starts where the file declares it
+        for (r, (declared, steady)) in starts.into_iter().enumerate() {
+            if declared != steady {
+                let mut cost = |x0: &[f64]| {
+                    runs.x0[r] = x0.to_vec();
+                    let sim = runs.simulate_one(&system, r, &[], &[]).ok();
+                    let c: f64 = sim.map_or(f64::NAN, |sim| runs.run_residuals(r, &sim).map(|e| e * e).sum());
+                    if c.is_nan() {
+                        f64::INFINITY
+                    } else {
+                        c
+                    }
+                };
+                let better = cost(&declared) < cost(&steady);
+                runs.x0[r] = if better { declared } else { steady };
+            }
+        }
+        Ok(runs)
+    }
+
+    /// Run `r`'s scaled residuals, simulated as `sim`: each compared quantity it records in
+    /// turn, (simulated − measured) / its scale at each sample.
+    fn run_residuals<'a>(&'a self, r: usize, sim: &'a Trajectory) -> impl Iterator<Item = f64> + 'a {
+        let f = &self.frames[r];
+        self.compared_in(sim).into_iter().flat_map(move |(name, _, sc, simulated)| {
+            let meas = f.column(name).unwrap_or(&[]);
+            meas.iter()
+                .enumerate()
+                .map(move |(k, m)| (simulated.get(k).copied().unwrap_or(f64::NAN) - m) / sc)
         })
     }
 
@@ -411,6 +469,22 @@ impl Runs {
         (sigma > 0.0 && sigma.is_finite()).then_some(sigma)
     }
 
+    /// The share of the compared records' variance that is their noise ([`Runs::noise`] of
+    /// each compared state in each run, scaled as its residuals are, over every compared
+    /// value; a derived variable's counts as none): what a fit that holds leaves.
+    pub fn noise_share(&self) -> f64 {
+        let mut sum = 0.0;
+        for (r, f) in self.frames.iter().enumerate() {
+            for ((i, name), scale) in self.states.iter().zip(&self.scale) {
+                let (Some(column), Some(sigma)) = (f.column(name), self.noise(r, *i)) else {
+                    continue;
+                };
+                sum += column.len() as f64 * (sigma / scale).powi(2);
+            }
+        }
+        sum / self.residual_count().max(1) as f64
+    }
+
     /// The runs re-simulated from other initial values, (run, state index, value), and with
     /// their own values of parameters, (run, parameter, value).
     pub fn with_initial(&self, values: &[(usize, usize, f64)], parameters: &[(usize, &str, f64)]) -> Runs {
@@ -422,6 +496,43 @@ impl Runs {
             out.params[r].insert(name.to_string(), v);
         }
         out
+    }
+
+    /// Each run cut into `pieces` segments of equal length (none shorter than
+    /// [`SEGMENT_SAMPLES`] samples: a short run gives fewer), each a run of its own from its
+    /// recorded first sample (a state it does not record from its run's initial value), with
+    /// its run's parameters, compared and scaled as these are; and the run each segment is
+    /// of. Multiple shooting's pieces: over a segment a model far from the truth stays near
+    /// the record, where over a whole run its phase drifts off and the fit's cost has minima
+    /// that are not the system's.
+    pub fn segments(&self, model: &Model, pieces: usize) -> Result<(Runs, Vec<usize>), DiagnoseError> {
+        let names = System::new(model, &Default::default(), false)?.states;
+        let mut out = Runs {
+            frames: Vec::new(),
+            x0: Vec::new(),
+            params: Vec::new(),
+            settings: Vec::new(),
+            hidden: Vec::new(),
+            ..self.clone()
+        };
+        let mut of = Vec::new();
+        for (r, f) in self.frames.iter().enumerate() {
+            for piece in f.pieces(pieces, SEGMENT_SAMPLES) {
+                let x0 = names
+                    .iter()
+                    .enumerate()
+                    .map(|(i, s)| piece.column(s).map_or(self.x0[r][i], |c| c[0]))
+                    .collect();
+                let t = piece.time();
+                out.settings.push(Settings { duration: t[t.len() - 1] - t[0], ..self.settings[r] });
+                out.frames.push(piece);
+                out.x0.push(x0);
+                out.params.push(self.params[r].clone());
+                out.hidden.push(self.hidden[r].clone());
+                of.push(r);
+            }
+        }
+        Ok((out, of))
     }
 
     /// The runs resampled (anti-aliased) to `factor` times their sample step and re-simulated
@@ -653,14 +764,8 @@ impl Runs {
     /// run (a sample the re-simulation did not reach is NaN).
     pub fn residuals(&self, sims: &[Trajectory]) -> Vec<f64> {
         let mut r = Vec::with_capacity(self.residual_count());
-        for (f, sim) in self.frames.iter().zip(sims) {
-            for (name, _, sc, simulated) in self.compared_in(sim) {
-                let meas = f.column(name).unwrap_or(&[]);
-                for (k, m) in meas.iter().enumerate() {
-                    let s = simulated.get(k).copied().unwrap_or(f64::NAN);
-                    r.push((s - m) / sc);
-                }
-            }
+        for (run, sim) in sims.iter().enumerate().take(self.frames.len()) {
+            r.extend(self.run_residuals(run, sim));
         }
         r
     }

@@ -43,9 +43,9 @@ use serde::Serialize;
 pub use choose::{choose_by_prediction, Chosen, Configuration, Prediction};
 pub use estimate::{
     estimate, Estimate, EstimateSettings, EstimatedParameter, FromRecords, HeldAgain, InitialValues, Move,
-    RunSpread, SourceParameter, LEANS, RUNS_DIFFER,
+    RunSpread, Segmented, SourceParameter, FOLLOWS, LEANS, RUNS_DIFFER, SEGMENTS,
 };
-pub use fit::{simulate_runs, EstimateError, PartlyRecorded, Runs};
+pub use fit::{in_segments, simulate_runs, EstimateError, PartlyRecorded, Runs, SEGMENT_SAMPLES};
 pub use refine::{refine, RefineSettings, Refined, RefinedCoefficient};
 
 pub use hypotheses::{generic_hypotheses, Effect, Hypothesis};

@@ -39,6 +39,52 @@ pub fn close(a: f64, b: f64, rel: f64) -> bool {
     (a - b).abs() <= rel * a.abs().max(b.abs()).max(1e-300)
 }
 
+/// Samples of ẋ = f(x, t) by classical RK4 with `sub` steps per sample interval `h`.
+pub fn trajectory(
+    x0: &[f64],
+    h: f64,
+    samples: usize,
+    sub: usize,
+    mut f: impl FnMut(f64, &[f64]) -> Vec<f64>,
+) -> Vec<Vec<f64>> {
+    let mut x = x0.to_vec();
+    let mut out = vec![x.clone()];
+    let dt = h / sub as f64;
+    let mut t = 0.0;
+    for _ in 1..samples {
+        for _ in 0..sub {
+            let k1 = f(t, &x);
+            let at = |k: &[f64], w: f64| x.iter().zip(k).map(|(a, b)| a + w * dt * b).collect::<Vec<_>>();
+            let k2 = f(t + 0.5 * dt, &at(&k1, 0.5));
+            let k3 = f(t + 0.5 * dt, &at(&k2, 0.5));
+            let k4 = f(t + dt, &at(&k3, 1.0));
+            for i in 0..x.len() {
+                x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+            }
+            t += dt;
+        }
+        out.push(x.clone());
+    }
+    out
+}
+
+/// A run of named columns with Gaussian noise of `sd[i]` on column i.
+pub fn noisy_frame(
+    name: &str,
+    h: f64,
+    names: &[&str],
+    rows: &[Vec<f64>],
+    sd: &[f64],
+    rng: &mut Lcg,
+) -> termid::data::Frame {
+    let t: Vec<f64> = (0..rows.len()).map(|i| i as f64 * h).collect();
+    let mut f = termid::data::Frame::new(name, "t", t).unwrap();
+    for (i, n) in names.iter().enumerate() {
+        f.push(n, rows.iter().map(|r| r[i] + sd[i] * rng.normal()).collect()).unwrap();
+    }
+    f
+}
+
 /// A small deterministic pseudo-random generator (tests must not depend on a seed source).
 pub struct Lcg(pub u64);
 impl Lcg {

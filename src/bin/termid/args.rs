@@ -124,6 +124,12 @@ pub struct EstimateCommand {
     /// reported at every sample.
     #[arg(long, conflicts_with = "dt")]
     pub coarse: bool,
+    /// Fit each run cut into this many segments, each from its own initial values (multiple
+    /// shooting; none shorter than 20 samples): where a motion's errors grow over a run (a
+    /// chaotic or unstable system) no whole-run re-simulation follows its record, while
+    /// segments short against that growth do. Each segment is reported as a run.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(2..))]
+    pub segments: Option<u32>,
     /// One figure per run (SVG) into this folder: each compared state measured, simulated with
     /// the model's values and with the estimates (each from the run's first sample, each
     /// source with its own values), and the residuals

@@ -30,6 +30,11 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
         );
     }
     let (frames, sources) = crate::runs::load_sources(&model, &cmd.data, &cmd.dataset)?;
+    // multiple shooting: each segment a run of its own, of its run's source
+    let (frames, sources) = match cmd.segments {
+        Some(count) => termid::diagnose::in_segments(&frames, &sources, count as usize),
+        None => (frames, sources),
+    };
     // one RK4 step per sample by default: the recorded input is known only at the samples
     let dt = cmd.dt.unwrap_or_else(|| termid::data::sample_step(&frames));
     let mut runs = Runs::new(&model, &frames, dt, Integrator::Rk4)?;

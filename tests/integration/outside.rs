@@ -1,0 +1,219 @@
+//! Systems the paper never saw, through `estimate`'s defaults: a predator and its prey started
+//! where the fit's phase drifts off, an epidemic whose susceptibles no run records, a chaotic
+//! run no whole-run fit follows. Each either comes back to the truth the test's own RK4 made
+//! or is flagged as failed; none is printed as if valid when it is not.
+
+use termid::diagnose::{estimate, in_segments, Estimate, EstimateSettings, Runs, FOLLOWS};
+use termid::model::Model;
+use termid::sim::Integrator;
+
+use crate::common::{noisy_frame, trajectory, Lcg};
+
+/// Each column's spread over `rows` times `share`: the records' noise.
+fn noise(rows: &[Vec<f64>], share: f64) -> Vec<f64> {
+    (0..rows[0].len())
+        .map(|i| {
+            let m = rows.iter().map(|r| r[i]).sum::<f64>() / rows.len() as f64;
+            share * (rows.iter().map(|r| (r[i] - m).powi(2)).sum::<f64>() / rows.len() as f64).sqrt()
+        })
+        .collect()
+}
+
+/// Each named estimate within `tolerance` of its truth.
+fn recovered(fit: &Estimate, truths: &[(&str, f64)], tolerance: f64) {
+    for (name, truth) in truths {
+        let p = fit.parameters.iter().find(|p| p.name == *name).unwrap();
+        assert!((p.value / truth - 1.0).abs() < tolerance, "{name}: {} vs {truth}\n{}", p.value, fit.text());
+    }
+}
+
+const LOTKA_VOLTERRA: &str = r#"
+[model]
+name = "Lotka-Volterra, a prey x and its predator y"
+intercept = false
+[[states]]
+name = "x"
+initial = 10.0
+[[states]]
+name = "y"
+initial = 5.0
+[parameters.a]
+value = 0.6
+free = true
+[parameters.b]
+value = 0.15
+free = true
+[parameters.c]
+value = 2.2
+free = true
+[parameters.d]
+value = 0.05
+free = true
+[equations.x_dot]
+state = "x"
+identify = false
+coefficients = { "a*x" = 1.0, "b*x*y" = -1.0 }
+[equations.y_dot]
+state = "y"
+identify = false
+coefficients = { "d*x*y" = 1.0, "c*y" = -1.0 }
+"#;
+
+/// A predator and its prey over six cycles, 3 % noise, every parameter started 33-47 % off:
+/// from the file's values the fit's cycles drift out of phase with the record's and it stops
+/// in a minimum that is not the system's (it leaves more of the records' variance than their
+/// mean does); started again from the parameters fitted on segments of the run, it comes back
+/// to the truth within 1.5 % and says which fit it kept.
+#[test]
+fn a_predator_and_its_prey_from_a_start_whose_phase_drifts_off() {
+    let (a, b, c, d) = (1.0, 0.1, 1.5, 0.075);
+    let h = 0.1;
+    let rows = trajectory(&[10.0, 5.0], h, 301, 10, |_, x| {
+        vec![a * x[0] - b * x[0] * x[1], d * x[0] * x[1] - c * x[1]]
+    });
+    let frame = noisy_frame("predators", h, &["x", "y"], &rows, &noise(&rows, 0.03), &mut Lcg(11));
+    let model = Model::parse(LOTKA_VOLTERRA, "lotka_volterra.toml").unwrap();
+    let runs = Runs::new(&model, &[frame], h, Integrator::Rk4).unwrap();
+    let fit = estimate(&model, &runs, &EstimateSettings::default()).unwrap();
+    let searched = fit.segmented.as_ref().expect("the file's start does not follow the records");
+    assert!(searched.kept, "{}", fit.text());
+    assert!(searched.other_unexplained.is_some_and(|u| u > FOLLOWS), "{}", fit.text());
+    assert!(fit.follows(), "{}", fit.text());
+    recovered(&fit, &[("a", a), ("b", b), ("c", c), ("d", d)], 0.015);
+    // the report's start is the file's, and it says what it did
+    assert_eq!(fit.parameters.iter().find(|p| p.name == "c").unwrap().start, 2.2);
+    assert!(fit.text().contains("multiple shooting"), "{}", fit.text());
+    assert!(!fit.text().contains("FLAG"), "{}", fit.text());
+}
+
+const SIR: &str = r#"
+[model]
+name = "SIR epidemic: susceptibles S, infected I"
+intercept = false
+[[states]]
+name = "S"
+initial = 990.0
+[[states]]
+name = "I"
+initial = 10.0
+[parameters.b]
+value = 0.0001
+free = true
+bounds = [0.0, 1.0]
+[parameters.g]
+value = 0.3
+free = true
+bounds = [0.0, 10.0]
+[equations.s_dot]
+state = "S"
+identify = false
+coefficients = { "b*S*I" = -1.0 }
+[equations.i_dot]
+state = "I"
+identify = false
+coefficients = { "b*S*I" = 1.0, "g*I" = -1.0 }
+"#;
+
+/// An epidemic recorded by its infected alone: the susceptibles, which no run records, are
+/// steady only once none are left, a start from which nothing happens; the run starts them
+/// at the file's 990, which re-simulates its record better, and the infection and recovery
+/// rates come back within 2 % from a start 4 and 3 times off (the susceptibles' initial value
+/// within 2 % too).
+#[test]
+fn an_epidemic_whose_susceptibles_no_run_records() {
+    let (b, g) = (4e-4, 0.1);
+    let h = 0.5;
+    let rows =
+        trajectory(&[990.0, 10.0], h, 201, 10, |_, x| vec![-b * x[0] * x[1], b * x[0] * x[1] - g * x[1]]);
+    let infected: Vec<Vec<f64>> = rows.iter().map(|r| vec![r[1]]).collect();
+    let frame = noisy_frame("outbreak", h, &["I"], &infected, &noise(&infected, 0.02), &mut Lcg(5));
+    let model = Model::parse(SIR, "sir.toml").unwrap();
+    let runs = Runs::new(&model, &[frame], h, Integrator::Rk4).unwrap();
+    assert_eq!(runs.initial(0, 0), 990.0, "the susceptibles start where the file declares them");
+    let fit = estimate(&model, &runs, &EstimateSettings::default()).unwrap();
+    assert!(fit.follows(), "{}", fit.text());
+    recovered(&fit, &[("b", b), ("g", g)], 0.02);
+    assert_eq!(fit.hidden_initial_values, 1, "{}", fit.text());
+    let s0 = fit.initial_states.iter().find(|(_, i, _)| *i == 0).unwrap().2;
+    assert!((s0 / 990.0 - 1.0).abs() < 0.02, "S(0) {s0}\n{}", fit.text());
+}
+
+const LORENZ: &str = r#"
+[model]
+name = "Lorenz system, σ, ρ and β free"
+intercept = false
+[[states]]
+name = "x"
+initial = -8.0
+min = -1000.0
+max = 1000.0
+[[states]]
+name = "y"
+initial = 7.0
+min = -1000.0
+max = 1000.0
+[[states]]
+name = "z"
+initial = 27.0
+min = -1000.0
+max = 1000.0
+[parameters."σ"]
+value = 5.0
+free = true
+[parameters."ρ"]
+value = 40.0
+free = true
+[parameters."β"]
+value = 1.5
+free = true
+[equations.x_dot]
+state = "x"
+identify = false
+coefficients = { "σ*(y - x)" = 1.0 }
+[equations.y_dot]
+state = "y"
+identify = false
+coefficients = { "x*(ρ - z)" = 1.0, "y" = -1.0 }
+[equations.z_dot]
+state = "z"
+identify = false
+coefficients = { "x*y" = 1.0, "β*z" = -1.0 }
+"#;
+
+/// Ten seconds of Lorenz's chaos (some nine Lyapunov times) with 1 % noise, started 40-50 %
+/// off: no whole-run re-simulation follows the record, however close its parameters, and the
+/// estimate is flagged as failed, saying that the same model follows the run in segments; fitted
+/// so (the run cut into 16 segments, each from its own initial values) σ, ρ and β come back
+/// within 1 %.
+#[test]
+fn a_chaotic_run_is_flagged_and_fitted_in_segments() {
+    let (sigma, rho, beta) = (10.0, 28.0, 8.0 / 3.0);
+    let h = 0.01;
+    let rows = trajectory(&[-8.0, 7.0, 27.0], h, 1001, 10, |_, x| {
+        vec![sigma * (x[1] - x[0]), x[0] * (rho - x[2]) - x[1], x[0] * x[1] - beta * x[2]]
+    });
+    let frame = noisy_frame("chaos", h, &["x", "y", "z"], &rows, &noise(&rows, 0.01), &mut Lcg(3));
+    let model = Model::parse(LORENZ, "lorenz_far.toml").unwrap();
+    let whole = estimate(
+        &model,
+        &Runs::new(&model, std::slice::from_ref(&frame), h, Integrator::Rk4).unwrap(),
+        &EstimateSettings::default(),
+    )
+    .unwrap();
+    assert!(!whole.follows(), "{}", whole.text());
+    let text = whole.text();
+    assert!(
+        text.contains("FLAG the fit does not follow the records") && text.contains("--segments"),
+        "{text}"
+    );
+    let (pieces, _) = in_segments(&[frame], &[], 16);
+    assert_eq!(pieces.len(), 16);
+    let fit = estimate(
+        &model,
+        &Runs::new(&model, &pieces, h, Integrator::Rk4).unwrap(),
+        &EstimateSettings::default(),
+    )
+    .unwrap();
+    assert!(fit.follows(), "{}", fit.text());
+    recovered(&fit, &[("σ", sigma), ("ρ", rho), ("β", beta)], 0.01);
+}
