@@ -1565,7 +1565,10 @@ class Model:
         cost and share left): an output error has minima that are not the system's wherever
         the start's phase drifts off the record's. ``segments`` cuts each run into that many
         segments to fit (each reported as a run): where a motion's errors grow over a run (a
-        chaotic system) no whole-run fit follows it and the warning says to.
+        chaotic system) no whole-run fit follows it and the warning says to. The runs are
+        integrated at a step that resolves the motion of the start and of the estimates (their
+        step halved until that holds, ``attrs["finer"]`` times): a step too long for a fast rate
+        biases the estimates towards what the integrator can follow.
 
         >>> nomoto = termid.Model.builtin("nomoto")
         >>> truth = termid.Model.builtin("nomoto")
@@ -1611,6 +1614,7 @@ class Model:
             "stopped": report["stopped"],
             "unexplained": report["unexplained"],
             "noise": report["noise"],
+            "finer": report["finer"],
             "segmented": report.get("segmented"),
             "covariance": None if report["covariance"] is None else pd.DataFrame(report["covariance"], index=names, columns=names),
             "per_source": pd.DataFrame(report.get("per_source", []), columns=["name", "source", "run", "value", "std_error"]),

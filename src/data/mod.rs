@@ -23,7 +23,7 @@ pub use five_point::FivePoint;
 pub use integral::{integral_rows, IntegralForm};
 pub use kalman::{KalmanSmoother, NoiseModel};
 pub use prepare::{prepare, Preparation};
-pub use resample::{check_gaps, interpolate_at, median_step, resample, sample_step};
+pub use resample::{check_gaps, evened, interpolate_at, median_step, resample, sample_step, uneven};
 pub use savitzky_golay::SavitzkyGolay;
 pub use smoothing_spline::SmoothingSpline;
 pub use stream::{Chunk, Chunks, RowSource};

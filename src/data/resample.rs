@@ -90,6 +90,38 @@ pub fn sample_step(frames: &[Frame]) -> f64 {
     frames.iter().map(|f| median_step(f.time())).fold(f64::INFINITY, f64::min)
 }
 
+/// Where a run's samples are not where a re-simulation compares them: the first row whose
+/// stamp lies more than a tenth of a step off t₀ + k·(t₁ − t₀) (a dropped sample, a clock that
+/// drifts from its first step), with that stamp and its place. `None` where every one is
+/// within it: a re-simulation sampled every t₁ − t₀ meets row k at its k-th sample.
+pub fn uneven(t: &[f64]) -> Option<(usize, f64, f64)> {
+    let step = *t.get(1)? - t[0];
+    (0..t.len())
+        .map(|k| (k, t[k], t[0] + k as f64 * step))
+        .find(|(_, at, place)| (at - place).abs() > 0.1 * step)
+}
+
+/// The run on a grid of its median step where its samples are uneven ([`uneven`]), with what
+/// to say of it; `None` where they are even.
+pub fn evened(frame: &Frame) -> Result<Option<(Frame, String)>, DataError> {
+    let Some((row, at, place)) = uneven(frame.time()) else {
+        return Ok(None);
+    };
+    let step = median_step(frame.time());
+    // stamps as a person reads them, not as the binary sums leave them
+    let short = |v: f64| (v * 1e9).round() / 1e9;
+    let note = format!(
+        "{}: samples not evenly spaced (row {}: t = {} s where a step of {} s from the first puts it at {} s): resampled onto its median step, {} s (linear between samples), as a re-simulation compares it sample by sample",
+        frame.origin(),
+        row + 1,
+        short(at),
+        short(frame.time()[1] - frame.time()[0]),
+        short(place),
+        short(step)
+    );
+    Ok(Some((resample(frame, step)?, note)))
+}
+
 /// Refuses a step in time more than `factor` times the median step (a logging gap or a jump).
 pub fn check_gaps(frame: &Frame, factor: f64) -> Result<(), DataError> {
     let t = frame.time();
@@ -168,6 +200,32 @@ pub fn resample(frame: &Frame, dt: f64) -> Result<Frame, DataError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A dropped sample (a step of two) is found where the first step no longer meets the
+    /// row, and the run is put back on its median step; a jitter of a few percent about the
+    /// grid is not, a first step that misreads the rate is.
+    #[test]
+    fn a_dropped_sample_is_found_and_evened() {
+        let jitter: Vec<f64> =
+            (0..50).map(|k| 0.1 * k as f64 + if k % 3 == 2 { 0.003 } else { 0.0 }).collect();
+        assert_eq!(uneven(&jitter), None);
+        // a first step 3 % long puts row 4 0.012 s off (row 49 0.15 s): the first step misreads the rate
+        let drift: Vec<f64> = (0..50).map(|k| 0.1 * k as f64 + if k == 1 { 0.003 } else { 0.0 }).collect();
+        assert_eq!(uneven(&drift).map(|(row, ..)| row), Some(4));
+        let dropped: Vec<f64> = (0..50).filter(|k| *k != 7).map(|k| 0.1 * k as f64).collect();
+        let (row, at, place) = uneven(&dropped).unwrap();
+        assert_eq!(row, 7);
+        assert!((at - 0.8).abs() < 1e-12 && (place - 0.7).abs() < 1e-12);
+        let mut f = Frame::new("gap.csv", "t", dropped.clone()).unwrap();
+        f.push("x", dropped.iter().map(|t| 2.0 * t).collect()).unwrap();
+        let (even, note) = evened(&f).unwrap().unwrap();
+        assert_eq!(even.len(), 50);
+        assert!(uneven(even.time()).is_none());
+        // linear between samples: the dropped one's value comes back
+        assert!((even.column("x").unwrap()[7] - 1.4).abs() < 1e-9);
+        assert!(note.contains("gap.csv") && note.contains("row 8"), "{note}");
+        assert!(evened(&frame(0.1, 50, |t| t)).unwrap().is_none());
+    }
 
     fn frame(dt: f64, n: usize, f: impl Fn(f64) -> f64) -> Frame {
         let t: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();

@@ -207,6 +207,13 @@ pub const MOSTLY_PRIOR: f64 = 0.5;
 /// or a structure that is not.
 pub const FOLLOWS: f64 = 0.1;
 
+/// The integration step's error an estimate accepts ([`Runs::step_error`]): a thousandth of
+/// each compared quantity's scale (RMS over the runs), far below any fit's residual.
+pub const STEP_RESOLVES: f64 = 1e-3;
+
+/// The most integration steps an estimate takes a sample by itself to resolve a motion.
+pub const MOST_STEPS_PER_SAMPLE: usize = 64;
+
 /// Into how many segments the search for a start cuts each run, where the fit from the file's
 /// values does not follow its records ([`Segmented`]; fewer where a run is short).
 pub const SEGMENTS: usize = 16;
@@ -293,6 +300,9 @@ pub struct Estimate {
     /// Where free initial values leaned ([`InitialValues::Auto`]): the other fit, with them
     /// held by the records' noise, and which of the two this is.
     pub held_again: Option<HeldAgain>,
+    /// How many times finer than asked the runs were integrated, their step halved until it
+    /// resolved the motion of the start and of the estimates ([`STEP_RESOLVES`]): 1 where it did.
+    pub finer: usize,
     /// The step the fit re-simulated the runs at, in samples: 1, or the coarsest step that
     /// resolves them ([`EstimateSettings::coarsest`]); the costs are at every sample either way.
     pub step_samples: usize,
@@ -651,7 +661,34 @@ impl Unknowns {
 /// only take up noise the other parameters would have used; one declared per source likewise,
 /// over two or more sources. Asked for per run or per source (the settings' `per_run`,
 /// `per_source`), it stays so.
+///
+/// The runs are integrated at a step that resolves the motion, of the start and of the
+/// estimates alike ([`Runs::step_error`] within [`STEP_RESOLVES`]): their own halved until it
+/// does (up to [`MOST_STEPS_PER_SAMPLE`] steps a sample). A step too long for a fast rate (a
+/// reaction's, a stiff spring's) biases every estimate towards what the integrator can follow.
 pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Result<Estimate, DiagnoseError> {
+    let finest =
+        |runs: &Runs| runs.settings.iter().all(|s| s.dt * MOST_STEPS_PER_SAMPLE as f64 <= s.sample * 1.0001);
+    let unresolved = |runs: &Runs, model: &Model| runs.step_error(model).is_some_and(|e| e > STEP_RESOLVES);
+    let mut finer = 1;
+    loop {
+        let at = runs.finer(finer);
+        if !finest(&at) && unresolved(&at, model) {
+            finer *= 2;
+            continue;
+        }
+        let mut fit = at_step(model, &at, settings)?;
+        if !finest(&at) && unresolved(&at.with_initial(&fit.initial_states, &fit.own_values()), &fit.model) {
+            finer *= 2;
+            continue;
+        }
+        fit.finer = finer;
+        return Ok(fit);
+    }
+}
+
+/// [`estimate`] at the runs' step.
+fn at_step(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Result<Estimate, DiagnoseError> {
     // a start that does not re-simulate the runs is fitted at every sample, where the fit says
     // where it diverges
     let coarse = settings.coarsest.and_then(|(tolerance, most)| {
@@ -866,6 +903,7 @@ fn fit(
         unexplained: cost_after / every.residual_count().max(1) as f64,
         noise: every.noise_share(),
         segmented: None,
+        finer: 1,
         stopped,
         iterations,
         correlation_time: tau,
@@ -1193,9 +1231,14 @@ fn data_weight(runs: &Runs, residuals: &[f64], k: usize) -> (f64, Option<f64>) {
 impl Estimate {
     /// `runs` (those fitted, at every sample) re-simulated as the fit has them: with the
     /// estimates, each run with its own values of what was estimated per run or per source, from
-    /// its estimated initial state (its recorded first sample where that was not estimated).
+    /// its estimated initial state (its recorded first sample where that was not estimated), at
+    /// the step the fit integrated them at ([`Estimate::finer`]).
     pub fn re_simulated(&self, runs: &Runs) -> Result<Vec<crate::sim::Trajectory>, crate::sim::SimError> {
-        runs.with_initial(&self.initial_states, &self.own_values()).simulate(&self.model, &[], &[])
+        runs.finer(self.finer).with_initial(&self.initial_states, &self.own_values()).simulate(
+            &self.model,
+            &[],
+            &[],
+        )
     }
 
     /// Each run's own value of every parameter estimated per run or per source, (run,
@@ -1273,6 +1316,12 @@ impl Estimate {
                 share(self.unexplained),
                 share(self.noise),
                 100.0 * FOLLOWS
+            ));
+        }
+        if self.finer > 1 {
+            out.push_str(&format!(
+                "integrated at 1/{} of the runs' step: the step asked for did not resolve the motion (the start's or the estimates'; a fast rate), and a step too long biases the estimates towards what it can follow\n",
+                self.finer
             ));
         }
         if self.step_samples > 1 {

@@ -231,6 +231,16 @@ impl Runs {
                 crate::identify::num(shortest / 20.0)
             )));
         }
+        // a re-simulation meets a run's k-th row at its k-th sample
+        for f in frames {
+            if let Some((row, at, place)) = crate::data::uneven(f.time()) {
+                return Err(DiagnoseError::Setup(format!(
+                    "{}: samples not evenly spaced (row {}: t = {at} s where the first step puts it at {place} s), and a re-simulation compares a run sample by sample: resample it (termid::data::evened; the CLI and the Python package do)",
+                    f.origin(),
+                    row + 1
+                )));
+            }
+        }
         let system = System::new(model, &Default::default(), false)?;
         // a state is compared in the runs that record it: one run or basin without a record of
         // it (a yaw rate without a gyro) does not take it from the others' comparison
@@ -572,23 +582,7 @@ impl Runs {
         let holds = |factor: usize| -> Option<Runs> {
             let coarse = self.coarser(factor).ok()?;
             let sims = coarse.simulate(model, &[], &[]).ok()?;
-            // each compared state and derived variable, over all runs
-            let pairs: Vec<_> =
-                fine.iter().zip(&sims).map(|(a, b)| (self.compared_in(a), coarse.compared_in(b))).collect();
-            (0..self.states.len() + self.outputs.len())
-                .all(|q| {
-                    let (mut sq, mut n) = (0.0, 0usize);
-                    for (a, b) in &pairs {
-                        for (k, v) in b[q].3.iter().enumerate() {
-                            if let Some(w) = a[q].3.get(k * factor) {
-                                sq += (v - w).powi(2);
-                                n += 1;
-                            }
-                        }
-                    }
-                    n > 0 && (sq / n as f64).sqrt() <= tolerance * self.compared_scale(q)
-                })
-                .then_some(coarse)
+            (self.largest_difference(fine, &sims, factor) <= tolerance).then_some(coarse)
         };
         // the first factor that does not hold ends the search
         let mut kept = (1, self.clone());
@@ -599,6 +593,57 @@ impl Runs {
             }
         }
         kept
+    }
+
+    /// The largest difference between two simulations of these runs, `a` at every sample and
+    /// `b` at every `stride`-th: RMS over the runs of each compared state and derived variable,
+    /// in units of its scale (infinite where they share no sample or one is not finite).
+    fn largest_difference(&self, a: &[Trajectory], b: &[Trajectory], stride: usize) -> f64 {
+        let pairs: Vec<_> =
+            a.iter().zip(b).map(|(a, b)| (self.compared_in(a), self.compared_in(b))).collect();
+        (0..self.states.len() + self.outputs.len())
+            .map(|q| {
+                let (mut sq, mut n) = (0.0, 0usize);
+                for (a, b) in &pairs {
+                    for (k, v) in b[q].3.iter().enumerate() {
+                        if let Some(w) = a[q].3.get(k * stride) {
+                            sq += (v - w).powi(2);
+                            n += 1;
+                        }
+                    }
+                }
+                let d = (sq / n as f64).sqrt() / self.compared_scale(q);
+                if d.is_nan() {
+                    f64::INFINITY
+                } else {
+                    d
+                }
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// These runs integrated `factor` times finer, their samples as they are (the recorded
+    /// inputs interpolated between them, as at every step).
+    pub fn finer(&self, factor: usize) -> Runs {
+        let mut out = self.clone();
+        for s in &mut out.settings {
+            s.dt /= factor.max(1) as f64;
+        }
+        out
+    }
+
+    /// How far the integration step is from resolving `model`'s motion on these runs: the
+    /// largest difference between their simulations at the step and at half of it (RMS over
+    /// the runs, in units of each compared quantity's scale; RK4's error falls sixteen-fold a
+    /// halving, so this is nearly the error at the step). Infinite where the simulation at the
+    /// step fails and at half of it does not; `None` where both fail (the model, not the step).
+    pub fn step_error(&self, model: &Model) -> Option<f64> {
+        let half = self.finer(2);
+        match (self.simulate(model, &[], &[]), half.simulate(model, &[], &[])) {
+            (Ok(at), Ok(fine)) => Some(self.largest_difference(&fine, &at, 1)),
+            (Err(_), Ok(_)) => Some(f64::INFINITY),
+            _ => None,
+        }
     }
 
     /// Number of compared values.

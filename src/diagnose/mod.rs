@@ -43,7 +43,8 @@ use serde::Serialize;
 pub use choose::{choose_by_prediction, Chosen, Configuration, Prediction};
 pub use estimate::{
     estimate, Estimate, EstimateSettings, EstimatedParameter, FromRecords, HeldAgain, InitialValues, Move,
-    RunSpread, Segmented, SourceParameter, FOLLOWS, LEANS, RUNS_DIFFER, SEGMENTS,
+    RunSpread, Segmented, SourceParameter, FOLLOWS, LEANS, MOST_STEPS_PER_SAMPLE, RUNS_DIFFER, SEGMENTS,
+    STEP_RESOLVES,
 };
 pub use fit::{in_segments, simulate_runs, EstimateError, PartlyRecorded, Runs, SEGMENT_SAMPLES};
 pub use refine::{refine, RefineSettings, Refined, RefinedCoefficient};

@@ -709,10 +709,16 @@ impl Model {
     /// CLI, the Python package): a plain file's ASCII column names that are the model's aliases
     /// (`delta`, `psi`) are read as the names they stand for, an input declared in rad that
     /// goes beyond a full turn is refused (it can only be degrees), and the run must agree with
-    /// the model's known kinematics ([`Model::check_kinematics`]). Returns what was renamed,
-    /// for the caller to say.
+    /// the model's known kinematics ([`Model::check_kinematics`]); a run whose samples are not
+    /// evenly spaced (a dropped sample) is resampled onto its median step, as a re-simulation
+    /// compares it sample by sample ([`crate::data::evened`]). Returns what was renamed or
+    /// resampled, for the caller to say.
     pub fn admit(&self, frame: &mut crate::data::Frame) -> Result<Vec<String>, crate::data::DataError> {
         let mut notes = Vec::new();
+        if let Some((even, note)) = crate::data::evened(frame)? {
+            *frame = even;
+            notes.push(note);
+        }
         for (alias, name) in &self.spec.aliases {
             if frame.column(alias).is_some() && frame.column(name).is_none() {
                 frame.rename(alias, name)?;
