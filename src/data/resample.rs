@@ -119,7 +119,14 @@ pub fn evened(frame: &Frame) -> Result<Option<(Frame, String)>, DataError> {
         short(place),
         short(step)
     );
-    Ok(Some((resample(frame, step)?, note)))
+    let even = resample(frame, step).map_err(|e| {
+        DataError::Setting(format!(
+            "{}: samples not evenly spaced (row {}), and the run cannot be resampled onto its median step: {e}",
+            frame.origin(),
+            row + 1
+        ))
+    })?;
+    Ok(Some((even, note)))
 }
 
 /// Refuses a step in time more than `factor` times the median step (a logging gap or a jump).
@@ -225,6 +232,10 @@ mod tests {
         assert!((even.column("x").unwrap()[7] - 1.4).abs() < 1e-9);
         assert!(note.contains("gap.csv") && note.contains("row 8"), "{note}");
         assert!(evened(&frame(0.1, 50, |t| t)).unwrap().is_none());
+        // too short to resample: refused, saying why
+        let short = Frame::new("short.csv", "t", vec![0.0, 0.1, 0.3]).unwrap();
+        let e = evened(&short).unwrap_err().to_string();
+        assert!(e.starts_with("short.csv: samples not evenly spaced (row 3)"), "{e}");
     }
 
     fn frame(dt: f64, n: usize, f: impl Fn(f64) -> f64) -> Frame {

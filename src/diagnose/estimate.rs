@@ -236,6 +236,9 @@ pub struct Segmented {
     /// fit of the whole runs does, the motion's errors grow over a run (a chaotic or unstable
     /// system) and shorter runs are what can be fitted.
     pub segments_unexplained: Option<f64>,
+    /// Why the file's values did not re-simulate whole runs, where they did not (the search
+    /// then started from the segments alone).
+    pub start_failed: Option<String>,
     /// Why the segments' fit, or the fit from its start, failed.
     pub failed: Option<String>,
 }
@@ -731,10 +734,16 @@ fn searched(
     settings: &EstimateSettings,
     one: &[String],
 ) -> Result<Estimate, DiagnoseError> {
-    let first = with_initial_values(model, scales, settings, one)?;
-    if first.follows() {
-        return Ok(first);
-    }
+    let first = match with_initial_values(model, scales, settings, one) {
+        Ok(first) if first.follows() => return Ok(first),
+        Ok(first) => first,
+        // a start that does not re-simulate whole runs (it leaves their bounds within a
+        // run) may still re-simulate segments of them
+        Err(DiagnoseError::Refinement(EstimateError::StartNotFinite(why))) => {
+            return from_segments(model, scales, settings, one, why)
+        }
+        Err(e) => return Err(e),
+    };
     let again =
         segmented_start(model, scales.every, settings, one).and_then(|(start, segments, seconds, left)| {
             let mut again = with_initial_values(&start, scales, settings, one)?;
@@ -756,6 +765,7 @@ fn searched(
                 other_cost: Some(other.cost_after),
                 other_unexplained: Some(other.unexplained),
                 segments_unexplained: Some(left),
+                start_failed: None,
                 failed: None,
             });
             fit
@@ -768,6 +778,7 @@ fn searched(
                 other_cost: None,
                 other_unexplained: None,
                 segments_unexplained: None,
+                start_failed: None,
                 failed: Some(e.to_string()),
             }),
             ..first
@@ -776,7 +787,49 @@ fn searched(
     Ok(segmented)
 }
 
-/// The free parameters' values fitted on the runs cut into [`SEGMENTS`] pieces each, every
+/// The estimate from the parameters fitted on segments of the runs, where the file's values
+/// do not re-simulate whole runs (`why`); refused with both reasons where that fails too.
+fn from_segments(
+    model: &Model,
+    scales: &Scales<'_>,
+    settings: &EstimateSettings,
+    one: &[String],
+    why: String,
+) -> Result<Estimate, DiagnoseError> {
+    let refused = |e: DiagnoseError| {
+        let e = match e {
+            DiagnoseError::Refinement(EstimateError::StartNotFinite(inner)) => inner,
+            e => e.to_string(),
+        };
+        DiagnoseError::Refinement(EstimateError::StartNotFinite(format!(
+            "{why}; nor do the runs cut into {} segments re-simulate from them: {e}",
+            4 * SEGMENTS
+        )))
+    };
+    let (start, segments, seconds, left) =
+        segmented_start(model, scales.every, settings, one).map_err(refused)?;
+    let mut fit = with_initial_values(&start, scales, settings, one).map_err(refused)?;
+    // the report's start is the file's value; the cost before is the segments' start's, the
+    // file's values having none
+    let file = model.parameter_values();
+    for p in &mut fit.parameters {
+        p.start = file.get(&p.name).copied().unwrap_or(p.start);
+    }
+    fit.segmented = Some(Segmented {
+        segments,
+        seconds,
+        kept: true,
+        other_cost: None,
+        other_unexplained: None,
+        segments_unexplained: Some(left),
+        start_failed: Some(why),
+        failed: None,
+    });
+    Ok(fit)
+}
+
+/// The free parameters' values fitted on the runs cut into [`SEGMENTS`] pieces each (four
+/// times as many, down to 5 samples, where the start leaves its bounds within one), every
 /// piece from its own free initial values (multiple shooting without the pieces joined: Bock
 /// 1981; a parameter per run is one per piece here, one per source stays so), set in `model`
 /// as a start: over a piece the start's simulation stays near the record, and the fit's cost
@@ -788,12 +841,26 @@ fn segmented_start(
     settings: &EstimateSettings,
     one: &[String],
 ) -> Result<(Model, usize, f64, f64), DiagnoseError> {
-    let (pieces, of) = runs.segments(model, SEGMENTS)?;
-    let sources = of.iter().map(|&r| settings.sources.get(r).copied().unwrap_or(0)).collect();
-    let settings =
-        EstimateSettings { initial_values: InitialValues::Free, sources, coarsest: None, ..settings.clone() };
-    let scales = Scales { fit: &pieces, every: &pieces, samples: 1 };
-    let fitted = fit(model, &scales, &settings, false, one)?;
+    // shorter pieces where the start leaves its bounds within one (a start far off)
+    let mut tries = [(SEGMENTS, 20), (4 * SEGMENTS, 5)].into_iter().peekable();
+    let (pieces, fitted) = loop {
+        let (count, shortest) = tries.next().unwrap_or((SEGMENTS, 20));
+        let (pieces, of) = runs.segments(model, count, shortest)?;
+        let sources = of.iter().map(|&r| settings.sources.get(r).copied().unwrap_or(0)).collect();
+        let settings = EstimateSettings {
+            initial_values: InitialValues::Free,
+            sources,
+            coarsest: None,
+            ..settings.clone()
+        };
+        let scales = Scales { fit: &pieces, every: &pieces, samples: 1 };
+        match fit(model, &scales, &settings, false, one) {
+            Err(DiagnoseError::Refinement(EstimateError::StartNotFinite(_))) if tries.peek().is_some() => {
+                continue
+            }
+            outcome => break (pieces, outcome?),
+        }
+    };
     let mut start = model.clone();
     for p in &fitted.parameters {
         start.set_parameter(&p.name, p.value);
@@ -1290,7 +1357,9 @@ impl Estimate {
                     s.segments,
                     sig(s.seconds, 3)
                 );
-                out.push_str(&if s.kept {
+                out.push_str(&if let Some(why) = &s.start_failed {
+                    format!("the file's values do not re-simulate the runs ({why}): this fit starts from the parameters fitted on {pieces}, and leaves {}\n", share(self.unexplained))
+                } else if s.kept {
                     format!("the fit from the file's values did not follow the records (cost {cost}, {other} of their variance left): this one starts from the parameters fitted on {pieces}, and leaves {}\n", share(self.unexplained))
                 } else {
                     format!("the fit leaves {} of the records' variance; started again from the parameters fitted on {pieces}, it reached cost {cost} ({other} left): no better, this one is kept\n", share(self.unexplained))

@@ -19,7 +19,8 @@ use crate::sim::{
 };
 use crate::term::{Library, Term};
 
-/// The fewest samples [`Runs::segments`] gives a segment.
+/// The fewest samples [`in_segments`] gives a segment: a run [`Runs::new`] takes has 20
+/// integration steps at least.
 pub const SEGMENT_SAMPLES: usize = 20;
 
 /// Records cut into `count` segments each (none shorter than [`SEGMENT_SAMPLES`]), each a run
@@ -508,14 +509,19 @@ impl Runs {
         out
     }
 
-    /// Each run cut into `pieces` segments of equal length (none shorter than
-    /// [`SEGMENT_SAMPLES`] samples: a short run gives fewer), each a run of its own from its
+    /// Each run cut into `pieces` segments of equal length (none shorter than `shortest`
+    /// samples: a short run gives fewer), each a run of its own from its
     /// recorded first sample (a state it does not record from its run's initial value), with
     /// its run's parameters, compared and scaled as these are; and the run each segment is
     /// of. Multiple shooting's pieces: over a segment a model far from the truth stays near
     /// the record, where over a whole run its phase drifts off and the fit's cost has minima
     /// that are not the system's.
-    pub fn segments(&self, model: &Model, pieces: usize) -> Result<(Runs, Vec<usize>), DiagnoseError> {
+    pub fn segments(
+        &self,
+        model: &Model,
+        pieces: usize,
+        shortest: usize,
+    ) -> Result<(Runs, Vec<usize>), DiagnoseError> {
         let names = System::new(model, &Default::default(), false)?.states;
         let mut out = Runs {
             frames: Vec::new(),
@@ -527,7 +533,7 @@ impl Runs {
         };
         let mut of = Vec::new();
         for (r, f) in self.frames.iter().enumerate() {
-            for piece in f.pieces(pieces, SEGMENT_SAMPLES) {
+            for piece in f.pieces(pieces, shortest) {
                 let x0 = names
                     .iter()
                     .enumerate()

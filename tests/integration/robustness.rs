@@ -174,7 +174,50 @@ proptest! {
             Err(e) => prop_assert!(matches!(e, termid::ship::particulars::ParticularsError::Value { .. }), "{e}"),
         }
     }
+
+    /// Time stamps of any spacing (steps from a tenth to three times the usual, rows dropped,
+    /// a clock off from its first step): a run is evened or refused with a reason, never a
+    /// panic, and an evened run is even and re-simulates (a model's `admit`, then `Runs`).
+    #[test]
+    fn uneven_time_stamps_are_evened_or_refused(steps in proptest::collection::vec(0.1f64..3.0, 2..80)) {
+        let mut t = vec![0.0];
+        for s in &steps {
+            t.push(t[t.len() - 1] + 0.05 * s);
+        }
+        let mut frame = Frame::new("stamps.csv", "t", t.clone()).unwrap();
+        frame.push("x", t.iter().map(|v| v.sin()).collect()).unwrap();
+        frame.push("w", t.iter().map(|v| v.cos()).collect()).unwrap();
+        frame.push("F", vec![0.0; t.len()]).unwrap();
+        let model = Model::parse(SPRING, "spring.toml").unwrap();
+        if model.admit(&mut frame).is_ok() {
+            prop_assert!(termid::data::uneven(frame.time()).is_none(), "{:?}", frame.time());
+            let step = frame.time()[1] - frame.time()[0];
+            if let Ok(runs) = termid::diagnose::Runs::new(&model, &[frame], step, termid::sim::Integrator::Rk4) {
+                prop_assert!(runs.simulate(&model, &[], &[]).is_ok());
+            }
+        }
+    }
 }
+
+/// A forced spring: a model with a state pair and an input, for records of any spacing.
+const SPRING: &str = r#"
+[model]
+name = "a forced spring"
+[[states]]
+name = "x"
+[[states]]
+name = "w"
+[[inputs]]
+name = "F"
+[equations.x_dot]
+state = "x"
+identify = false
+coefficients = { "w" = 1.0 }
+[equations.w_dot]
+state = "w"
+identify = false
+coefficients = { "x" = -1.0, "F" = 1.0 }
+"#;
 
 /// The grey-box model file `new-ship` writes for KVLCC2's particulars.
 fn grey_box() -> &'static str {
