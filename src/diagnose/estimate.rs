@@ -723,7 +723,8 @@ fn at_step(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Result<Es
 }
 
 /// [`with_initial_values`] from the model file's values and, where that fit does not follow
-/// the records ([`Estimate::follows`]), again from a start found on segments of the runs
+/// the records ([`Estimate::follows`]) or the file's values do not re-simulate whole runs
+/// (they leave their bounds within one), again from a start found on segments of the runs
 /// ([`segmented_start`]); the fit of the lower cost is kept and says what the other gave. An
 /// output error's cost has minima that are not the system's wherever the start's phase drifts
 /// off the record's (an oscillator, a predator and its prey): a fit from there stops in one and
@@ -736,42 +737,48 @@ fn searched(
 ) -> Result<Estimate, DiagnoseError> {
     let first = match with_initial_values(model, scales, settings, one) {
         Ok(first) if first.follows() => return Ok(first),
-        Ok(first) => first,
-        // a start that does not re-simulate whole runs (it leaves their bounds within a
-        // run) may still re-simulate segments of them
-        Err(DiagnoseError::Refinement(EstimateError::StartNotFinite(why))) => {
-            return from_segments(model, scales, settings, one, why)
-        }
+        Ok(first) => Ok(first),
+        Err(DiagnoseError::Refinement(EstimateError::StartNotFinite(why))) => Err(why),
         Err(e) => return Err(e),
     };
     let again =
         segmented_start(model, scales.every, settings, one).and_then(|(start, segments, seconds, left)| {
             let mut again = with_initial_values(&start, scales, settings, one)?;
             // the report's start is the file's value, where the search began
-            for (p, q) in again.parameters.iter_mut().zip(&first.parameters) {
-                p.start = q.start;
+            let file = model.parameter_values();
+            for p in &mut again.parameters {
+                p.start = file.get(&p.name).copied().unwrap_or(p.start);
             }
-            again.cost_before = first.cost_before;
-            Ok((again, segments, seconds, left))
-        });
-    let segmented = match again {
-        Ok((again, segments, seconds, left)) => {
-            let kept = again.cost_after < first.cost_after;
-            let (mut fit, other) = if kept { (again, first) } else { (first, again) };
-            fit.segmented = Some(Segmented {
+            let search = Segmented {
                 segments,
                 seconds,
-                kept,
-                other_cost: Some(other.cost_after),
-                other_unexplained: Some(other.unexplained),
+                kept: true,
+                other_cost: None,
+                other_unexplained: None,
                 segments_unexplained: Some(left),
                 start_failed: None,
                 failed: None,
-            });
-            fit
+            };
+            Ok((again, search))
+        });
+    match (first, again) {
+        (Ok(first), Ok((mut again, mut search))) => {
+            again.cost_before = first.cost_before;
+            search.kept = again.cost_after < first.cost_after;
+            let (mut fit, other) = if search.kept { (again, first) } else { (first, again) };
+            search.other_cost = Some(other.cost_after);
+            search.other_unexplained = Some(other.unexplained);
+            fit.segmented = Some(search);
+            Ok(fit)
         }
-        Err(e) => Estimate {
-            segmented: Some(Segmented {
+        // the cost before is the segments' start's, the file's values having none
+        (Err(why), Ok((mut again, mut search))) => {
+            search.start_failed = Some(why);
+            again.segmented = Some(search);
+            Ok(again)
+        }
+        (Ok(mut first), Err(e)) => {
+            first.segmented = Some(Segmented {
                 segments: 0,
                 seconds: 0.0,
                 kept: false,
@@ -780,52 +787,20 @@ fn searched(
                 segments_unexplained: None,
                 start_failed: None,
                 failed: Some(e.to_string()),
-            }),
-            ..first
-        },
-    };
-    Ok(segmented)
-}
-
-/// The estimate from the parameters fitted on segments of the runs, where the file's values
-/// do not re-simulate whole runs (`why`); refused with both reasons where that fails too.
-fn from_segments(
-    model: &Model,
-    scales: &Scales<'_>,
-    settings: &EstimateSettings,
-    one: &[String],
-    why: String,
-) -> Result<Estimate, DiagnoseError> {
-    let refused = |e: DiagnoseError| {
-        let e = match e {
-            DiagnoseError::Refinement(EstimateError::StartNotFinite(inner)) => inner,
-            e => e.to_string(),
-        };
-        DiagnoseError::Refinement(EstimateError::StartNotFinite(format!(
-            "{why}; nor do the runs cut into {} segments re-simulate from them: {e}",
-            4 * SEGMENTS
-        )))
-    };
-    let (start, segments, seconds, left) =
-        segmented_start(model, scales.every, settings, one).map_err(refused)?;
-    let mut fit = with_initial_values(&start, scales, settings, one).map_err(refused)?;
-    // the report's start is the file's value; the cost before is the segments' start's, the
-    // file's values having none
-    let file = model.parameter_values();
-    for p in &mut fit.parameters {
-        p.start = file.get(&p.name).copied().unwrap_or(p.start);
+            });
+            Ok(first)
+        }
+        (Err(why), Err(e)) => {
+            let e = match e {
+                DiagnoseError::Refinement(EstimateError::StartNotFinite(inner)) => inner,
+                e => e.to_string(),
+            };
+            Err(DiagnoseError::Refinement(EstimateError::StartNotFinite(format!(
+                "{why}; nor do the runs cut into {} segments re-simulate from them: {e}",
+                4 * SEGMENTS
+            ))))
+        }
     }
-    fit.segmented = Some(Segmented {
-        segments,
-        seconds,
-        kept: true,
-        other_cost: None,
-        other_unexplained: None,
-        segments_unexplained: Some(left),
-        start_failed: Some(why),
-        failed: None,
-    });
-    Ok(fit)
 }
 
 /// The free parameters' values fitted on the runs cut into [`SEGMENTS`] pieces each (four

@@ -525,11 +525,16 @@ impl Runs {
         let names = System::new(model, &Default::default(), false)?.states;
         let mut out = Runs {
             frames: Vec::new(),
+            states: self.states.clone(),
+            scale: self.scale.clone(),
+            units: self.units.clone(),
             x0: Vec::new(),
             params: Vec::new(),
             settings: Vec::new(),
+            intercepts: self.intercepts,
+            inputs: self.inputs.clone(),
+            outputs: self.outputs.clone(),
             hidden: Vec::new(),
-            ..self.clone()
         };
         let mut of = Vec::new();
         for (r, f) in self.frames.iter().enumerate() {

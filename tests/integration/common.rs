@@ -85,6 +85,69 @@ pub fn noisy_frame(
     f
 }
 
+/// Each column's spread over `rows` (population sd) times `share`: the records' noise.
+pub fn noise(rows: &[Vec<f64>], share: f64) -> Vec<f64> {
+    (0..rows[0].len())
+        .map(|i| {
+            let m = rows.iter().map(|r| r[i]).sum::<f64>() / rows.len() as f64;
+            share * (rows.iter().map(|r| (r[i] - m).powi(2)).sum::<f64>() / rows.len() as f64).sqrt()
+        })
+        .collect()
+}
+
+/// Lorenz's σ, ρ, β.
+pub const LORENZ_TRUTH: (f64, f64, f64) = (10.0, 28.0, 8.0 / 3.0);
+
+/// `samples` of Lorenz's system every `h` seconds from (−8, 7, 27), ten RK4 steps a sample.
+pub fn lorenz_rows(h: f64, samples: usize) -> Vec<Vec<f64>> {
+    let (sigma, rho, beta) = LORENZ_TRUTH;
+    trajectory(&[-8.0, 7.0, 27.0], h, samples, 10, |_, x| {
+        vec![sigma * (x[1] - x[0]), x[0] * (rho - x[2]) - x[1], x[0] * x[1] - beta * x[2]]
+    })
+}
+
+/// Lorenz's model with σ, ρ, β free, started 20 % off.
+pub const LORENZ_FREE: &str = r#"
+[model]
+name = "Lorenz system, σ, ρ and β free"
+intercept = false
+
+[[states]]
+name = "x"
+initial = -8.0
+[[states]]
+name = "y"
+initial = 7.0
+[[states]]
+name = "z"
+initial = 27.0
+
+[parameters."σ"]
+value = 8.0
+free = true
+bounds = [0.0, 100.0]
+[parameters."ρ"]
+value = 22.4
+free = true
+[parameters."β"]
+value = 3.2
+free = true
+bounds = [0.0, 10.0]
+
+[equations.x_dot]
+state = "x"
+identify = false
+coefficients = { "σ*y" = 1.0, "σ*x" = -1.0 }
+[equations.y_dot]
+state = "y"
+identify = false
+coefficients = { "ρ*x" = 1.0, "x*z" = -1.0, "y" = -1.0 }
+[equations.z_dot]
+state = "z"
+identify = false
+coefficients = { "x*y" = 1.0, "β*z" = -1.0 }
+"#;
+
 /// A small deterministic pseudo-random generator (tests must not depend on a seed source).
 pub struct Lcg(pub u64);
 impl Lcg {

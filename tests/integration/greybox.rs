@@ -7,7 +7,7 @@ use termid::diagnose::{estimate, Estimate, EstimateSettings, InitialValues, Runs
 use termid::model::Model;
 use termid::sim::Integrator;
 
-use crate::common::{noisy_frame, trajectory, Lcg};
+use crate::common::{lorenz_rows, noise, noisy_frame, trajectory, Lcg, LORENZ_FREE, LORENZ_TRUTH};
 
 /// Nomoto's T·ṙ + r = K·δ in a zigzag (the rudder put over to ∓`rudder` when the heading
 /// passes ±`rudder`; the test's own logic), from rest: the rows (ψ, r) every `h` seconds
@@ -84,62 +84,15 @@ fn runs_of(model: &Model, frames: &[Frame]) -> Runs {
     Runs::new(model, frames, sample, Integrator::Rk4).unwrap()
 }
 
-const LORENZ: &str = r#"
-[model]
-name = "Lorenz system, σ, ρ and β free"
-intercept = false
-
-[[states]]
-name = "x"
-initial = -8.0
-[[states]]
-name = "y"
-initial = 7.0
-[[states]]
-name = "z"
-initial = 27.0
-
-[parameters."σ"]
-value = 8.0
-free = true
-bounds = [0.0, 100.0]
-[parameters."ρ"]
-value = 22.4
-free = true
-[parameters."β"]
-value = 3.2
-free = true
-bounds = [0.0, 10.0]
-
-[equations.x_dot]
-state = "x"
-identify = false
-coefficients = { "σ*y" = 1.0, "σ*x" = -1.0 }
-[equations.y_dot]
-state = "y"
-identify = false
-coefficients = { "ρ*x" = 1.0, "x*z" = -1.0, "y" = -1.0 }
-[equations.z_dot]
-state = "z"
-identify = false
-coefficients = { "x*y" = 1.0, "β*z" = -1.0 }
-"#;
-
 /// Lorenz's σ, ρ, β from one trajectory with 1 % noise, started 20 % off: the trajectory cut
 /// into windows of half a Lyapunov time (a chaotic system's output error over longer horizons
 /// has many minima), each re-simulated from its own first sample.
 #[test]
 fn lorenz_parameters_from_one_noisy_trajectory() {
-    let (sigma, rho, beta) = (10.0, 28.0, 8.0 / 3.0);
+    let (sigma, rho, beta) = LORENZ_TRUTH;
     let h = 0.01;
-    let rows = trajectory(&[-8.0, 7.0, 27.0], h, 1001, 10, |_, x| {
-        vec![sigma * (x[1] - x[0]), x[0] * (rho - x[2]) - x[1], x[0] * x[1] - beta * x[2]]
-    });
-    let spread = |i: usize| {
-        let m = rows.iter().map(|r| r[i]).sum::<f64>() / rows.len() as f64;
-        (rows.iter().map(|r| (r[i] - m).powi(2)).sum::<f64>() / rows.len() as f64).sqrt()
-    };
-    let sd: Vec<f64> = (0..3).map(|i| 0.01 * spread(i)).collect();
+    let rows = lorenz_rows(h, 1001);
+    let sd = noise(&rows, 0.01);
     let mut rng = Lcg(7);
     let frames: Vec<Frame> = rows
         .chunks(51)
@@ -147,7 +100,7 @@ fn lorenz_parameters_from_one_noisy_trajectory() {
         .filter(|(_, w)| w.len() > 25)
         .map(|(k, w)| noisy_frame(&format!("window{k}"), h, &["x", "y", "z"], w, &sd, &mut rng))
         .collect();
-    let model = Model::parse(LORENZ, "lorenz_free.toml").unwrap();
+    let model = Model::parse(LORENZ_FREE, "lorenz_free.toml").unwrap();
     let runs = Runs::new(&model, &frames, h, Integrator::Rk4).unwrap();
     let fit = estimate(&model, &runs, &EstimateSettings::default()).unwrap();
     assert!(fit.cost_after < 0.05 * fit.cost_before, "{}", fit.text());

@@ -7,17 +7,7 @@ use termid::diagnose::{estimate, in_segments, Estimate, EstimateSettings, Runs, 
 use termid::model::Model;
 use termid::sim::Integrator;
 
-use crate::common::{noisy_frame, trajectory, Lcg};
-
-/// Each column's spread over `rows` times `share`: the records' noise.
-fn noise(rows: &[Vec<f64>], share: f64) -> Vec<f64> {
-    (0..rows[0].len())
-        .map(|i| {
-            let m = rows.iter().map(|r| r[i]).sum::<f64>() / rows.len() as f64;
-            share * (rows.iter().map(|r| (r[i] - m).powi(2)).sum::<f64>() / rows.len() as f64).sqrt()
-        })
-        .collect()
-}
+use crate::common::{lorenz_rows, noise, noisy_frame, trajectory, Lcg, LORENZ_FREE, LORENZ_TRUTH};
 
 /// Each named estimate within `tolerance` of its truth.
 fn recovered(fit: &Estimate, truths: &[(&str, f64)], tolerance: f64) {
@@ -25,6 +15,16 @@ fn recovered(fit: &Estimate, truths: &[(&str, f64)], tolerance: f64) {
         let p = fit.parameters.iter().find(|p| p.name == *name).unwrap();
         assert!((p.value / truth - 1.0).abs() < tolerance, "{name}: {} vs {truth}\n{}", p.value, fit.text());
     }
+}
+
+/// The prey's growth, the predation, the predators' death and their gain from it.
+const PREDATION: (f64, f64, f64, f64) = (1.0, 0.1, 1.5, 0.075);
+
+/// Thirty seconds of a predator and its prey every `h` seconds (six cycles), from 10 prey and
+/// 5 predators.
+fn predators(h: f64) -> Vec<Vec<f64>> {
+    let (a, b, c, d) = PREDATION;
+    trajectory(&[10.0, 5.0], h, 301, 10, |_, x| vec![a * x[0] - b * x[0] * x[1], d * x[0] * x[1] - c * x[1]])
 }
 
 const LOTKA_VOLTERRA: &str = r#"
@@ -66,11 +66,9 @@ coefficients = { "d*x*y" = 1.0, "c*y" = -1.0 }
 /// to the truth within 1.5 % and says which fit it kept.
 #[test]
 fn a_predator_and_its_prey_from_a_start_whose_phase_drifts_off() {
-    let (a, b, c, d) = (1.0, 0.1, 1.5, 0.075);
+    let (a, b, c, d) = PREDATION;
     let h = 0.1;
-    let rows = trajectory(&[10.0, 5.0], h, 301, 10, |_, x| {
-        vec![a * x[0] - b * x[0] * x[1], d * x[0] * x[1] - c * x[1]]
-    });
+    let rows = predators(h);
     let frame = noisy_frame("predators", h, &["x", "y"], &rows, &noise(&rows, 0.03), &mut Lcg(11));
     let model = Model::parse(LOTKA_VOLTERRA, "lotka_volterra.toml").unwrap();
     let runs = Runs::new(&model, &[frame], h, Integrator::Rk4).unwrap();
@@ -93,11 +91,9 @@ fn a_predator_and_its_prey_from_a_start_whose_phase_drifts_off() {
 /// how it started.
 #[test]
 fn a_start_that_leaves_its_bounds_within_a_run_is_searched_on_segments() {
-    let (a, b, c, d) = (1.0, 0.1, 1.5, 0.075);
+    let (a, b, c, d) = PREDATION;
     let h = 0.1;
-    let rows = trajectory(&[10.0, 5.0], h, 301, 10, |_, x| {
-        vec![a * x[0] - b * x[0] * x[1], d * x[0] * x[1] - c * x[1]]
-    });
+    let rows = predators(h);
     let frame = noisy_frame("predators", h, &["x", "y"], &rows, &noise(&rows, 0.03), &mut Lcg(11));
     let wild = LOTKA_VOLTERRA
         .replace("value = 0.6", "value = 2.5")
@@ -172,48 +168,6 @@ fn an_epidemic_whose_susceptibles_no_run_records() {
     assert!((s0 / 990.0 - 1.0).abs() < 0.02, "S(0) {s0}\n{}", fit.text());
 }
 
-const LORENZ: &str = r#"
-[model]
-name = "Lorenz system, σ, ρ and β free"
-intercept = false
-[[states]]
-name = "x"
-initial = -8.0
-min = -1000.0
-max = 1000.0
-[[states]]
-name = "y"
-initial = 7.0
-min = -1000.0
-max = 1000.0
-[[states]]
-name = "z"
-initial = 27.0
-min = -1000.0
-max = 1000.0
-[parameters."σ"]
-value = 5.0
-free = true
-[parameters."ρ"]
-value = 40.0
-free = true
-[parameters."β"]
-value = 1.5
-free = true
-[equations.x_dot]
-state = "x"
-identify = false
-coefficients = { "σ*(y - x)" = 1.0 }
-[equations.y_dot]
-state = "y"
-identify = false
-coefficients = { "x*(ρ - z)" = 1.0, "y" = -1.0 }
-[equations.z_dot]
-state = "z"
-identify = false
-coefficients = { "x*y" = 1.0, "β*z" = -1.0 }
-"#;
-
 /// Ten seconds of Lorenz's chaos (some nine Lyapunov times) with 1 % noise, started 40-50 %
 /// off: no whole-run re-simulation follows the record, however close its parameters, and the
 /// estimate is flagged as failed, saying that the same model follows the run in segments; fitted
@@ -221,13 +175,15 @@ coefficients = { "x*y" = 1.0, "β*z" = -1.0 }
 /// within 1 %.
 #[test]
 fn a_chaotic_run_is_flagged_and_fitted_in_segments() {
-    let (sigma, rho, beta) = (10.0, 28.0, 8.0 / 3.0);
+    let (sigma, rho, beta) = LORENZ_TRUTH;
     let h = 0.01;
-    let rows = trajectory(&[-8.0, 7.0, 27.0], h, 1001, 10, |_, x| {
-        vec![sigma * (x[1] - x[0]), x[0] * (rho - x[2]) - x[1], x[0] * x[1] - beta * x[2]]
-    });
+    let rows = lorenz_rows(h, 1001);
     let frame = noisy_frame("chaos", h, &["x", "y", "z"], &rows, &noise(&rows, 0.01), &mut Lcg(3));
-    let model = Model::parse(LORENZ, "lorenz_far.toml").unwrap();
+    let far = LORENZ_FREE
+        .replace("value = 8.0", "value = 5.0")
+        .replace("value = 22.4", "value = 40.0")
+        .replace("value = 3.2", "value = 1.5");
+    let model = Model::parse(&far, "lorenz_far.toml").unwrap();
     let whole = estimate(
         &model,
         &Runs::new(&model, std::slice::from_ref(&frame), h, Integrator::Rk4).unwrap(),
@@ -314,11 +270,9 @@ fn a_fast_rate_is_integrated_at_a_step_that_resolves_it() {
 /// says so, and the predator and its prey come back within 2 %.
 #[test]
 fn a_record_with_dropped_samples_is_evened_and_said() {
-    let (a, b, c, d) = (1.0, 0.1, 1.5, 0.075);
+    let (a, b, c, d) = PREDATION;
     let h = 0.1;
-    let rows = trajectory(&[10.0, 5.0], h, 301, 10, |_, x| {
-        vec![a * x[0] - b * x[0] * x[1], d * x[0] * x[1] - c * x[1]]
-    });
+    let rows = predators(h);
     let frame = noisy_frame("kept", h, &["x", "y"], &rows, &noise(&rows, 0.01), &mut Lcg(2));
     let kept: Vec<usize> = (0..rows.len()).filter(|k| k % 7 != 3).collect();
     let mut csv = String::from("t,x,y\n");
