@@ -220,7 +220,7 @@ pub const SEGMENTS: usize = 16;
 
 /// The fit again from a start found on segments of the runs, where the fit from the model
 /// file's values did not follow the records.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Default, Serialize)]
 pub struct Segmented {
     /// How many segments the runs were cut into (0: the segments' fit failed).
     pub segments: usize,
@@ -753,11 +753,8 @@ fn searched(
                 segments,
                 seconds,
                 kept: true,
-                other_cost: None,
-                other_unexplained: None,
                 segments_unexplained: Some(left),
-                start_failed: None,
-                failed: None,
+                ..Default::default()
             };
             Ok((again, search))
         });
@@ -778,16 +775,7 @@ fn searched(
             Ok(again)
         }
         (Ok(mut first), Err(e)) => {
-            first.segmented = Some(Segmented {
-                segments: 0,
-                seconds: 0.0,
-                kept: false,
-                other_cost: None,
-                other_unexplained: None,
-                segments_unexplained: None,
-                start_failed: None,
-                failed: Some(e.to_string()),
-            });
+            first.segmented = Some(Segmented { failed: Some(e.to_string()), ..Default::default() });
             Ok(first)
         }
         (Err(why), Err(e)) => {

@@ -471,34 +471,19 @@ fn monte_carlo_says_what_its_spread_comes_from() {
         "\n[parameter_covariance]\nnames = [\"ε\", \"γ_Rp\"]\nmatrix = [[0.01, 0.0], [0.0, 1e-8]]\n";
     std::fs::write(&model, format!("{text}{covariance}")).unwrap();
     let model = model.to_str().unwrap();
+    // the ±35° turn, with more options
+    let turn = |more: &[&str]| {
+        let mut args = vec!["simulate", "--model", model, "-m", "turning:35"];
+        args.extend(more);
+        termid(&args)
+    };
     let diameter = |epsilon: f64| {
-        let value = format!("ε={epsilon}");
-        let (ok, out, err) = termid(&[
-            "simulate",
-            "--model",
-            model,
-            "-m",
-            "turning:35",
-            "--param",
-            &value,
-            "--format",
-            "json",
-        ]);
+        let (ok, out, err) = turn(&["--param", &format!("ε={epsilon}"), "--format", "json"]);
         assert!(ok, "{err}");
         json(&out)["metrics"]["tactical_diameter_m"].as_f64().unwrap()
     };
     let effect = 0.5 * (diameter(1.09 + 0.1) - diameter(1.09 - 0.1));
-    let (ok, out, err) = termid(&[
-        "simulate",
-        "--model",
-        model,
-        "-m",
-        "turning:35",
-        "--monte-carlo",
-        "40",
-        "--format",
-        "json",
-    ]);
+    let (ok, out, err) = turn(&["--monte-carlo", "40", "--format", "json"]);
     assert!(ok, "{err}");
     let report = json(&out);
     let epsilon =
@@ -518,7 +503,7 @@ fn monte_carlo_says_what_its_spread_comes_from() {
     );
     assert!((linearised / effect.abs() - 1.0).abs() < 1e-6, "{linearised} vs {effect}");
     assert!((linearised / drawn - 1.0).abs() < 0.35, "{linearised} vs {drawn}");
-    let (_, text, _) = termid(&["simulate", "--model", model, "-m", "turning:35", "--monte-carlo", "40"]);
+    let (_, text, _) = turn(&["--monte-carlo", "40"]);
     assert!(text.contains("what the spread comes from") && text.contains("ε 100 %"), "{text}");
 }
 
