@@ -77,9 +77,9 @@ pub trait Plugin: Sync {
         vec![]
     }
     /// Those of [`Plugin::checks`] that read the runs themselves (a ship steering its zigzags
-    /// as recorded), by the same names: what a caller checks again with each run's own values
-    /// of a parameter estimated per run. Empty: none.
-    fn run_checks(&self, _model: &Model, _runs: &[Frame]) -> Vec<Check> {
+    /// as recorded), by the same names, each run with the model that holds its own values (of
+    /// a parameter estimated per run or per source). Empty: none.
+    fn run_checks(&self, _runs: &[(&Model, &Frame)]) -> Vec<Check> {
         vec![]
     }
     /// Checks of how closely a fit re-simulates what this field reads off its runs

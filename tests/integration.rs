@@ -67,3 +67,6 @@ mod outside;
 // The reference (docs/reference/) against the code: every key documented, nothing stale.
 #[path = "integration/reference.rs"]
 mod reference;
+// A ship at full scale through defaults set at model scale: bounds, manoeuvre times, checks.
+#[path = "integration/full_scale.rs"]
+mod full_scale;

@@ -169,67 +169,31 @@ pub(super) fn estimate_parameters(
 
 /// The plug-in's checks of the estimated model as written (with the file's values). Where
 /// parameters were estimated per source or per run (a basin's rudder zero), a check that reads
-/// the runs (steering them as recorded) holds only with their own values: the runs are checked
-/// in classes that share their values, and where every class has that check, those verdicts
-/// are merged (passed where every class passes; each class's numbers where they differ).
+/// the runs (steering them as recorded) holds only with their own values: those checks are
+/// made again with each run steered by the model that holds its own values.
 fn checks_with_own_values(fit: &Estimate, prepared: &[Frame]) -> Vec<Check> {
     let Some(plugin) = crate::plugins::of(&fit.model) else { return vec![] };
     let written = plugin.checks(&fit.model, prepared);
     if fit.per_source.is_empty() {
         return written;
     }
-    // each run's own values, as indices into per_source; runs alike form one class
-    let own = |r: usize| -> Vec<usize> {
-        (0..fit.per_source.len()).filter(|&k| fit.per_source[k].runs.contains(&r)).collect()
-    };
-    let mut classes: Vec<(Vec<usize>, Vec<usize>)> = Vec::new();
-    for r in 0..prepared.len() {
-        let key = own(r);
-        match classes.iter_mut().find(|(k, _)| *k == key) {
-            Some((_, runs)) => runs.push(r),
-            None => classes.push((key, vec![r])),
-        }
-    }
-    let each: Vec<(String, Vec<Check>)> = classes
-        .iter()
-        .map(|(values, members)| {
+    let own: Vec<Model> = (0..prepared.len())
+        .map(|r| {
             let mut model = fit.model.clone();
-            for p in values.iter().map(|&k| &fit.per_source[k]) {
+            for p in fit.per_source.iter().filter(|p| p.runs.contains(&r)) {
                 model.set_parameter(&p.name, p.value);
             }
-            // a class is one source's runs, or one run where a value is per run
-            let label = values
-                .iter()
-                .map(|&k| &fit.per_source[k])
-                .max_by_key(|p| p.run.is_some())
-                .map_or_else(String::new, |p| p.whose());
-            let runs: Vec<Frame> = members.iter().map(|&r| prepared[r].clone()).collect();
-            // the checks of the model alone (its turning circles) are the written model's
-            (label, plugin.run_checks(&model, &runs))
+            model
         })
         .collect();
+    let each: Vec<(&Model, &Frame)> = own.iter().zip(prepared).collect();
+    let mut again = plugin.run_checks(&each);
+    // the checks of the model alone (its turning circles) are the written model's
     written
         .into_iter()
-        .map(|c| {
-            let same: Vec<(&str, &Check)> = each
-                .iter()
-                .filter_map(|(label, cs)| cs.iter().find(|o| o.name == c.name).map(|o| (label.as_str(), o)))
-                .collect();
-            if same.len() < each.len() {
-                // not every class has it (a check of the model alone): the written model's own
-                return c;
-            }
-            let mut merged = c;
-            merged.passed = same.iter().all(|(_, o)| o.passed);
-            merged.refuses = same.iter().any(|(_, o)| o.refuses);
-            merged.detail = if same.iter().all(|(_, o)| o.detail == same[0].1.detail) {
-                same[0].1.detail.clone()
-            } else {
-                let parts: Vec<String> =
-                    same.iter().map(|(label, o)| format!("{label}: {}", o.detail)).collect();
-                parts.join("; ")
-            };
-            merged
+        .map(|c| match again.iter().position(|o| o.name == c.name) {
+            Some(k) => again.swap_remove(k),
+            None => c,
         })
         .collect()
 }

@@ -250,6 +250,11 @@ impl Ship {
         })
     }
 
+    /// The ship's time scale L/U0, s: a manoeuvre's default times are so many of it.
+    pub fn time_scale(&self) -> f64 {
+        self.spec.lpp / self.spec.u0
+    }
+
     /// Simulates a manoeuvre from the straight run. Metrics use every step; the trajectory
     /// is sampled at `settings.sample`.
     pub fn run(&self, manoeuvre: &Manoeuvre, settings: &Settings) -> Result<Run, ShipError> {

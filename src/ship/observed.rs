@@ -145,10 +145,13 @@ pub struct SteeringGear {
 impl SteeringGear {
     /// The gear that a ship model's zigzag runs show, their heading and rudder read by the
     /// model's names; `None` for another model or runs without a reversal to read.
-    pub fn of_runs(model: &crate::model::Model, runs: &[crate::data::Frame]) -> Option<SteeringGear> {
+    pub fn of_runs<'a>(
+        model: &crate::model::Model,
+        runs: impl IntoIterator<Item = &'a crate::data::Frame>,
+    ) -> Option<SteeringGear> {
         let spec = super::canonical_spec(model)?;
         let columns: Vec<_> = runs
-            .iter()
+            .into_iter()
             .filter_map(|f| Some((f.time(), f.column(&spec.names.psi)?, f.column(&spec.names.rudder)?)))
             .collect();
         steering_gear(&columns)

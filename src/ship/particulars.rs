@@ -407,8 +407,21 @@ impl Particulars {
                     p.prior = Some(PriorSpec { value: e.value, sd });
                 }
             }
-            for s in file.states.iter_mut().filter(|s| s.name == "u") {
-                s.initial = self.u0;
+            // the bounds that stop a diverging run, at the ship's own scale: the surge speed
+            // from a hundredth of the approach speed to ten times it, the sway speed within five
+            // times it, the yaw rate within r' = rL/U = 20 (a tight turn reaches r' ≈ 0.6)
+            let u0 = self.u0;
+            for s in file.states.iter_mut() {
+                let (min, max) = match s.name.as_str() {
+                    "u" => (0.01 * u0, 10.0 * u0),
+                    "v" => (-5.0 * u0, 5.0 * u0),
+                    "r" => (-20.0 * u0 / self.lpp, 20.0 * u0 / self.lpp),
+                    _ => continue,
+                };
+                (s.min, s.max) = (Some(min), Some(max));
+                if s.name == "u" {
+                    s.initial = u0;
+                }
             }
             if let Some(ship) = file.plugins.get_mut("ship").and_then(|t| t.as_table_mut()) {
                 for (key, value) in [

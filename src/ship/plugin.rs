@@ -145,7 +145,8 @@ impl Plugin for Manoeuvring {
         let rudder = if used > 0.0 { used.min(spec.rudder_limit) } else { spec.rudder_limit };
         match super::checks::physical_checks(model, rudder) {
             Ok(mut checks) => {
-                checks.extend(self.run_checks(model, runs));
+                let each: Vec<(&Model, &Frame)> = runs.iter().map(|f| (model, f)).collect();
+                checks.extend(self.run_checks(&each));
                 checks
             }
             Err(e) => vec![Check {
@@ -158,8 +159,8 @@ impl Plugin for Manoeuvring {
         }
     }
 
-    fn run_checks(&self, model: &Model, runs: &[Frame]) -> Vec<Check> {
-        super::checks::steering_check(model, runs).into_iter().collect()
+    fn run_checks(&self, runs: &[(&Model, &Frame)]) -> Vec<Check> {
+        super::checks::steering_check(runs).into_iter().collect()
     }
 
     fn metric_checks(&self, pairs: &[crate::plugin::MetricPair]) -> Vec<Check> {
@@ -218,15 +219,16 @@ impl Plugin for Manoeuvring {
             return Err(PluginError::Refused("--input does not apply to a ship manoeuvre: the manoeuvre drives the rudder; for recorded inputs use --manoeuvre replay:FILE.csv".into()));
         }
         let ship = Ship::new(model, request.with_intercept)?;
-        let manoeuvre = Manoeuvre::parse(request.text)?;
+        // the times a manoeuvre leaves to the ship, fixed at the nominal ship's scale: every
+        // Monte-Carlo draw runs the same manoeuvre, and the label states them
+        let manoeuvre = Manoeuvre::parse(request.text)?.at_scale(ship.time_scale());
         Ok(Box::new(ShipScenario { ship, manoeuvre, with_intercept: request.with_intercept }))
     }
 }
 
 /// A standard manoeuvre of a ship model.
 struct ShipScenario {
-    /// The nominal model's ship (its figure's roles).
-    #[cfg_attr(not(feature = "plot"), allow(dead_code))]
+    /// The nominal model's ship (its figure's roles, its time scale).
     ship: Ship,
     manoeuvre: Manoeuvre,
     with_intercept: bool,
@@ -238,7 +240,7 @@ impl Scenario for ShipScenario {
     }
 
     fn default_duration(&self) -> f64 {
-        self.manoeuvre.default_duration()
+        self.manoeuvre.default_duration(self.ship.time_scale())
     }
 
     fn run(&self, model: &Model, settings: &Settings) -> Result<Outcome, PluginError> {

@@ -213,6 +213,30 @@ impl ShipSpec {
                 ));
             }
         }
+        // a state's bounds stop a run as diverging: a ship's must leave room for its own
+        // manoeuvres at its approach speed (a template's model-scale bounds, copied for a ship
+        // at full scale, stop every run at once or a sound turn halfway)
+        let room = [
+            ("surge speed", &n.u, 0.1 * spec.u0, 1.2 * spec.u0, "at most 0.1·u0 and at least 1.2·u0"),
+            ("sway speed", &n.v, -spec.u0, spec.u0, "at least ±u0"),
+            ("yaw rate", &n.r, -2.0 * spec.u0 / spec.lpp, 2.0 * spec.u0 / spec.lpp, "at least ±2·u0/lpp"),
+        ];
+        for (role, name, low, high, rule) in room {
+            let name = model.vocabulary.canonical(name).unwrap_or_else(|| name.to_string());
+            let Some(k) = model.spec().states.iter().position(|s| s.name == name) else { continue };
+            let state = &model.spec().states[k];
+            let (min, max) = (state.min.unwrap_or(f64::NEG_INFINITY), state.max.unwrap_or(f64::INFINITY));
+            if min > low || max < high {
+                let key = if min > low { "min" } else { "max" };
+                return Err(key_err(
+                    &format!("states[{k}].{key}"),
+                    format!(
+                        "the bounds [{min}, {max}] of `{name}` (the ship's {role}) leave no room for its manoeuvres at u0 = {} m/s, lpp = {} m ({rule}): a run reaching them stops as diverging; widen them (`termid scale` rescales a model file's bounds with it)",
+                        spec.u0, spec.lpp
+                    ),
+                ));
+            }
+        }
         if let Some(name) = &n.propeller {
             let canonical = model.vocabulary.canonical(name).unwrap_or_else(|| name.to_string());
             if !model.spec().inputs.iter().any(|i| i.name == canonical) {

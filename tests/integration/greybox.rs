@@ -1052,12 +1052,18 @@ fn the_polynomial_template_from_two_basins_with_their_own_rudder_zero() {
     // the kept model holds the estimated coefficients and the file's zero; the report says so
     assert_eq!(recipe.kept().model.parameter_values()["δ_0"], 0.0);
     assert!(recipe.text().contains("output-error estimate of the free parameters"), "{}", recipe.text());
-    // the checks that steer the runs as recorded do so with each basin's own zero
-    assert!(
-        recipe.checks().iter().any(|c| c.detail.contains("source 1:") && c.detail.contains("source 2:")),
-        "{}",
-        recipe.text()
-    );
+    // the checks that steer the runs as recorded do so with each basin's own zero: with the
+    // file's zero for every run instead, the runs are steered further off
+    let steering = "steers its training zigzags as recorded";
+    let worst = |c: &termid::plugin::Check| -> f64 {
+        c.detail.split("within ").nth(1).unwrap().split('°').next().unwrap().parse().unwrap()
+    };
+    let own = recipe.checks().into_iter().find(|c| c.name == steering).unwrap();
+    assert!(own.passed && own.detail.contains("of 6 records'"), "{}", recipe.text());
+    let kept = &recipe.kept().model;
+    let each: Vec<(&Model, &Frame)> = frames.iter().map(|f| (kept, f)).collect();
+    let file_zero = termid::ship::checks::steering_check(&each).unwrap();
+    assert!(worst(&file_zero) > worst(&own) + 0.1, "{file_zero:?} against {own:?}");
 }
 
 /// The recipe with `--refine` on the polynomial template, which declares each run's rudder zero

@@ -138,7 +138,7 @@ fn default_model_manoeuvres_look_like_the_papers_ship() {
     }
     let spiral = Manoeuvre::parse("spiral:10/2/80").unwrap();
     let Metrics::Spiral(sp) = ship
-        .run(&spiral, &settings(Integrator::ModifiedEuler, 0.04, spiral.default_duration()))
+        .run(&spiral, &settings(Integrator::ModifiedEuler, 0.04, spiral.default_duration(ship.time_scale())))
         .unwrap()
         .metrics
     else {

@@ -61,8 +61,8 @@ impl super::Test for InitialTurning {
         format!("initial turning δ = {}° to Δψ = {}°", self.rudder_deg, self.heading_deg)
     }
 
-    fn default_duration(&self) -> f64 {
-        100.0
+    fn default_duration(&self, scale: f64) -> f64 {
+        super::scaled(100.0, 16.0, scale)
     }
 
     fn largest_rudder_deg(&self) -> Option<f64> {

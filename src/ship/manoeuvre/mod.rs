@@ -22,18 +22,32 @@ pub use zigzag::{ZigZag, ZigZagMetrics};
 use super::{Ship, ShipError, StraightRun};
 use crate::sim::{Controller, Trajectory};
 
+/// A default time of a manoeuvre: `lengths` of the ship's own time scale `scale` (L/U0, s) in
+/// whole seconds, and never less than `floor` seconds (the defaults at model scale). A ship at full scale
+/// turns √λ times slower than its model: a 120 s hold of a spiral that settles a 7 m model
+/// leaves a 320 m ship's yaw rate unsettled and draws a hysteresis loop it does not have.
+pub fn scaled(floor: f64, lengths: f64, scale: f64) -> f64 {
+    floor.max((lengths * scale).ceil())
+}
+
 /// What a manoeuvre is: parsed from its text, a label, a duration, the rudder it commands, a
 /// controller of the simulator and metrics read off the run. Each manoeuvre's file implements
 /// it; the registry below makes [`Manoeuvre`] and [`Metrics`] of them.
-pub trait Test: Sized {
+pub trait Test: Sized + Clone {
     /// Its metrics (serialised into reports and JSON).
     type Metrics: Serialize;
     /// From the text after `name:` (`20/20` of `zigzag:20/20`); `text` is all of it, for errors.
     fn parse(text: &str, rest: &str) -> Result<Self, ShipError>;
     /// A short label, e.g. `zigzag 20°/20° starboard`.
     fn label(&self) -> String;
-    /// A sensible duration in seconds when none is given.
-    fn default_duration(&self) -> f64;
+    /// A sensible duration in seconds when none is given, for a ship whose time scale L/U0 is
+    /// `scale` seconds (see [`scaled`]).
+    fn default_duration(&self, scale: f64) -> f64;
+    /// Itself with the times it leaves to the ship's time scale `scale` (L/U0, s) filled in,
+    /// for its label.
+    fn at_scale(&self, _scale: f64) -> Self {
+        self.clone()
+    }
     /// The largest rudder angle it commands, ° (none for a replay).
     fn largest_rudder_deg(&self) -> Option<f64>;
     /// The controller that drives the rudder from the straight run on.
@@ -84,10 +98,19 @@ macro_rules! manoeuvres {
                 }
             }
 
-            /// A sensible duration in seconds when none is given.
-            pub fn default_duration(&self) -> f64 {
+            /// A sensible duration in seconds when none is given, for a ship whose time scale
+            /// L/U0 is `scale` seconds ([`Ship::time_scale`]).
+            pub fn default_duration(&self, scale: f64) -> f64 {
                 match self {
-                    $( Manoeuvre::$variant(m) => <$test as Test>::default_duration(m), )+
+                    $( Manoeuvre::$variant(m) => <$test as Test>::default_duration(m, scale), )+
+                }
+            }
+
+            /// The manoeuvre with the times it leaves to the ship's time scale `scale` (L/U0,
+            /// s) filled in: what its label then states.
+            pub fn at_scale(&self, scale: f64) -> Manoeuvre {
+                match self {
+                    $( Manoeuvre::$variant(m) => Manoeuvre::$variant(<$test as Test>::at_scale(m, scale)), )+
                 }
             }
 

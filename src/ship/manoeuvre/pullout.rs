@@ -13,15 +13,16 @@ use crate::sim::{Ahead, Controller, Trajectory};
 pub struct PullOut {
     /// Rudder angle of the turn, degrees.
     pub rudder_deg: f64,
-    /// Time in the turn before the rudder returns, s.
-    pub turn_s: f64,
-    /// Time after the return, s.
-    pub after_s: f64,
+    /// Time in the turn before the rudder returns, s; `None`: long enough for the ship
+    /// ([`PullOut::times`]).
+    pub turn_s: Option<f64>,
+    /// Time after the return, s; `None` as `turn_s`.
+    pub after_s: Option<f64>,
 }
 
 impl Default for PullOut {
     fn default() -> Self {
-        PullOut { rudder_deg: 20.0, turn_s: 100.0, after_s: 100.0 }
+        PullOut { rudder_deg: 20.0, turn_s: None, after_s: None }
     }
 }
 
@@ -62,6 +63,14 @@ impl Controller for PullOutControl {
 }
 
 impl PullOut {
+    /// The time in the turn and after the return, s, for a ship whose time scale L/U0 is
+    /// `scale` s: as given, or 16 L/U each (at least 100 s), in which the turn steadies and
+    /// the yaw rate decays.
+    pub fn times(&self, scale: f64) -> (f64, f64) {
+        let default = super::scaled(100.0, 16.0, scale);
+        (self.turn_s.unwrap_or(default), self.after_s.unwrap_or(default))
+    }
+
     pub(crate) fn controller(&self, ship: &Ship, start: &StraightRun) -> RudderOnly<PullOutControl> {
         RudderOnly::new(
             ship,
@@ -70,7 +79,7 @@ impl PullOut {
                 servo: Servo::new(ship, start),
                 turn: self.rudder_deg.to_radians(),
                 back: start.input[ship.roles.rudder],
-                switch_at: self.turn_s,
+                switch_at: self.times(ship.time_scale()).0,
             },
         )
     }
@@ -78,7 +87,8 @@ impl PullOut {
     /// Metrics from a run sampled at every step.
     pub fn metrics(&self, ship: &Ship, run: &Trajectory) -> PullOutMetrics {
         let r = &run.states[ship.roles.r];
-        let i_sw = run.time.iter().position(|t| *t >= self.turn_s).unwrap_or(r.len() - 1);
+        let (turn, _) = self.times(ship.time_scale());
+        let i_sw = run.time.iter().position(|t| *t >= turn).unwrap_or(r.len() - 1);
         let r_turn = r[i_sw];
         let decay = r[i_sw..]
             .iter()
@@ -104,8 +114,14 @@ impl super::Test for PullOut {
         format!("pull-out from δ = {}°", self.rudder_deg)
     }
 
-    fn default_duration(&self) -> f64 {
-        self.turn_s + self.after_s
+    fn default_duration(&self, scale: f64) -> f64 {
+        let (turn, after) = self.times(scale);
+        turn + after
+    }
+
+    fn at_scale(&self, scale: f64) -> Self {
+        let (turn, after) = self.times(scale);
+        PullOut { turn_s: Some(turn), after_s: Some(after), ..self.clone() }
     }
 
     fn largest_rudder_deg(&self) -> Option<f64> {

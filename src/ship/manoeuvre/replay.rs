@@ -50,7 +50,7 @@ impl super::Test for Replayed {
         format!("replay of {}", self.frame.origin())
     }
 
-    fn default_duration(&self) -> f64 {
+    fn default_duration(&self, _scale: f64) -> f64 {
         self.duration()
     }
 

@@ -17,13 +17,13 @@ pub struct Spiral {
     pub max_deg: f64,
     /// Rudder step, degrees.
     pub step_deg: f64,
-    /// Time at each angle, s.
-    pub hold_s: f64,
+    /// Time at each angle, s; `None`: long enough for the ship ([`Spiral::hold`]).
+    pub hold_s: Option<f64>,
 }
 
 impl Default for Spiral {
     fn default() -> Self {
-        Spiral { max_deg: 20.0, step_deg: 2.0, hold_s: 120.0 }
+        Spiral { max_deg: 20.0, step_deg: 2.0, hold_s: None }
     }
 }
 
@@ -60,9 +60,15 @@ impl Spiral {
         down.into_iter().chain(up).collect()
     }
 
-    /// Length of the whole test, s.
-    pub fn duration(&self) -> f64 {
-        self.angles().len() as f64 * self.hold_s
+    /// Time at each angle, s, for a ship whose time scale L/U0 is `scale` s: as given, or 20
+    /// L/U (at least 120 s), in which a full-form hull's yaw rate settles.
+    pub fn hold(&self, scale: f64) -> f64 {
+        self.hold_s.unwrap_or_else(|| super::scaled(120.0, 20.0, scale))
+    }
+
+    /// Length of the whole test, s (the ship's time scale as for [`Spiral::hold`]).
+    pub fn duration(&self, scale: f64) -> f64 {
+        self.angles().len() as f64 * self.hold(scale)
     }
 
     pub(crate) fn controller(&self, ship: &Ship, start: &StraightRun) -> RudderOnly<SpiralControl> {
@@ -72,7 +78,7 @@ impl Spiral {
             SpiralControl {
                 servo: Servo::new(ship, start),
                 angles: self.angles().iter().map(|a| a.to_radians()).collect(),
-                hold: self.hold_s,
+                hold: self.hold(ship.time_scale()),
             },
         )
     }
@@ -84,8 +90,9 @@ impl Spiral {
         let r = &run.states[ship.roles.r];
         let mut points = Vec::new();
         let mut unsettled: f64 = 0.0;
+        let hold = self.hold(ship.time_scale());
         for (k, a) in angles.iter().enumerate() {
-            let (t0, t1) = (self.hold_s * (k as f64 + 0.8), self.hold_s * (k as f64 + 1.0));
+            let (t0, t1) = (hold * (k as f64 + 0.8), hold * (k as f64 + 1.0));
             let window: Vec<f64> = run
                 .time
                 .iter()
@@ -165,8 +172,9 @@ impl super::Test for Spiral {
             }
             s.max_deg = super::parse_num(text, v[0], "largest rudder angle")?;
             s.step_deg = super::parse_num(text, v[1], "rudder step")?;
-            s.hold_s = super::parse_num(text, v[2], "hold time")?;
-            if s.max_deg <= 0.0 || s.step_deg <= 0.0 || s.hold_s <= 0.0 || s.max_deg / s.step_deg > 200.0 {
+            let hold = super::parse_num(text, v[2], "hold time")?;
+            s.hold_s = Some(hold);
+            if s.max_deg <= 0.0 || s.step_deg <= 0.0 || hold <= 0.0 || s.max_deg / s.step_deg > 200.0 {
                 return Err(bad("largest angle, step and hold must be positive, with at most 200 steps"));
             }
             if s.step_deg > s.max_deg {
@@ -179,11 +187,16 @@ impl super::Test for Spiral {
     }
 
     fn label(&self) -> String {
-        format!("spiral ±{}° in {}° steps, {} s each", self.max_deg, self.step_deg, self.hold_s)
+        let each = self.hold_s.map_or_else(|| "20 L/U (at least 120 s)".to_string(), |h| format!("{h} s"));
+        format!("spiral ±{}° in {}° steps, {each} each", self.max_deg, self.step_deg)
     }
 
-    fn default_duration(&self) -> f64 {
-        self.duration()
+    fn default_duration(&self, scale: f64) -> f64 {
+        self.duration(scale)
+    }
+
+    fn at_scale(&self, scale: f64) -> Self {
+        Spiral { hold_s: Some(self.hold(scale)), ..self.clone() }
     }
 
     fn largest_rudder_deg(&self) -> Option<f64> {

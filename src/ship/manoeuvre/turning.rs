@@ -122,8 +122,9 @@ impl super::Test for TurningCircle {
         format!("turning circle δ = {}°", self.rudder_deg)
     }
 
-    fn default_duration(&self) -> f64 {
-        200.0
+    fn default_duration(&self, scale: f64) -> f64 {
+        // a 35° circle completes its 180° within about 20 L/U
+        super::scaled(200.0, 30.0, scale)
     }
 
     fn largest_rudder_deg(&self) -> Option<f64> {

@@ -234,19 +234,19 @@ impl super::Test for ZigZag {
     fn label(&self) -> String {
         format!(
             "zigzag {}°/{}° {}{}",
-            self.rudder_deg,
-            self.heading_deg,
+            hundredths(self.rudder_deg),
+            hundredths(self.heading_deg),
             if self.starboard_first { "starboard" } else { "port" },
             match self.about_deg {
                 Some(0.0) => ", rudder about 0".to_string(),
-                Some(a) => format!(", rudder about {a}°"),
+                Some(a) => format!(", rudder about {}°", hundredths(a)),
                 None => String::new(),
             }
         )
     }
 
-    fn default_duration(&self) -> f64 {
-        100.0
+    fn default_duration(&self, scale: f64) -> f64 {
+        super::scaled(100.0, 16.0, scale)
     }
 
     fn largest_rudder_deg(&self) -> Option<f64> {
@@ -259,6 +259,16 @@ impl super::Test for ZigZag {
 
     fn metrics(&self, ship: &Ship, run: &Trajectory) -> ZigZagMetrics {
         ZigZag::metrics(self, ship, run)
+    }
+}
+
+/// An angle to a hundredth of a degree, without trailing zeros (20, 0.3, 35.01): a zigzag read
+/// off a record is laid to angles like 35.0017°.
+fn hundredths(deg: f64) -> String {
+    let s = format!("{deg:.2}");
+    match s.trim_end_matches('0').trim_end_matches('.') {
+        "-0" => "0".into(),
+        t => t.into(),
     }
 }
 

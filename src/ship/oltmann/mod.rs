@@ -269,7 +269,7 @@ pub fn run(
             let settings = Settings {
                 integrator: Integrator::ModifiedEuler,
                 dt: data::DT,
-                duration: man.default_duration(),
+                duration: man.default_duration(s.time_scale()),
                 sample: data::SAMPLE,
             };
             let (metrics, trajectory) = match s.run(&man, &settings) {

@@ -1,0 +1,143 @@
+//! A ship at full scale through the defaults that were set at model scale: the grey-box model
+//! `new-ship` writes for a 320 m ship (and for one at 24 knots), the manoeuvres' default times,
+//! a model file whose bounds leave no room for its ship, and a zigzag whose rudder indicator
+//! reads a stop a little past the ship's limit. Froude's law is the reference: a ship λ times
+//! its model turns the same circle in ship lengths, √λ times slower.
+
+use termid::model::Model;
+use termid::ship::manoeuvre::Spiral;
+use termid::ship::particulars::Particulars;
+use termid::ship::{Manoeuvre, Metrics, Ship};
+use termid::sim::{Integrator, Settings};
+
+/// KVLCC2 from the SIMMAN model (L = 7 m) to the ship (L = 320 m).
+const LAMBDA: f64 = 320.0 / 7.0;
+
+fn model_scale() -> Particulars {
+    toml::from_str(&std::fs::read_to_string("examples/kvlcc2_particulars.toml").unwrap()).unwrap()
+}
+
+/// The particulars Froude-scaled by `lambda`: lengths × λ, areas × λ², speeds × √λ, the rudder's
+/// rate ÷ √λ.
+fn froude(p: &Particulars, lambda: f64) -> Particulars {
+    let s = lambda.sqrt();
+    Particulars {
+        name: format!("{} × {lambda:.1}", p.name),
+        lpp: p.lpp * lambda,
+        beam: p.beam * lambda,
+        draught: p.draught * lambda,
+        x_g: p.x_g * lambda,
+        rudder_area: p.rudder_area * lambda * lambda,
+        rudder_span: p.rudder_span * lambda,
+        propeller_diameter: p.propeller_diameter * lambda,
+        u0: p.u0 * s,
+        rudder_rate: p.rudder_rate / s,
+        ..p.clone()
+    }
+}
+
+/// A manoeuvre over the duration the ship plug-in gives it by default (as `termid simulate`
+/// does without `--duration`).
+fn run(model: &Model, text: &str) -> Metrics {
+    let ship = Ship::new(model, false).unwrap();
+    let manoeuvre = Manoeuvre::parse(text).unwrap();
+    let duration = manoeuvre.default_duration(ship.time_scale());
+    // the step the 7 m model is simulated at, at the ship's own time scale (Froude's law)
+    let dt = 0.04 * ship.time_scale() / (7.0 / 1.17248);
+    let settings = Settings { integrator: Integrator::Rk4, dt, duration, sample: dt };
+    ship.run(&manoeuvre, &settings).unwrap().metrics
+}
+
+fn tactical_diameter_in_lengths(model: &Model, lpp: f64) -> f64 {
+    let Metrics::Turning(t) = run(model, "turning:35") else { unreachable!() };
+    t.tactical_diameter_m.expect("the circle completes in the default time") / lpp
+}
+
+/// `new-ship` at 320 m writes a model that simulates as its 7 m model does, in ship lengths:
+/// its bounds are the ship's (a 7 m model's 10 m/s surge bound stopped a 24-knot ship at its
+/// first step), and the turning circle's default time is long enough for the ship's 35° turn.
+#[test]
+fn a_ship_from_its_particulars_at_full_scale_turns_as_its_model() {
+    let small = model_scale();
+    let at_model = tactical_diameter_in_lengths(&small.model().unwrap(), small.lpp);
+    let big = froude(&small, LAMBDA);
+    let at_ship = tactical_diameter_in_lengths(&big.model().unwrap(), big.lpp);
+    assert!(
+        (at_ship / at_model - 1.0).abs() < 2e-3,
+        "{at_ship} L at full scale, {at_model} L at model scale"
+    );
+    // a faster ship of the same hull: 24 knots, beyond the template's 10 m/s
+    let fast = Particulars { u0: 12.35, ..big };
+    let model = fast.model().unwrap();
+    let u = model.spec().states.iter().find(|s| s.name == "u").unwrap();
+    assert!(u.max.unwrap() >= 10.0 * fast.u0 && u.min.unwrap() <= 0.01 * fast.u0 + 1e-12, "{u:?}");
+    assert!(tactical_diameter_in_lengths(&model, fast.lpp) > 2.0);
+}
+
+/// A spiral's holds and a pull-out's times, left to the defaults, are so many of the ship's own
+/// time scale L/U (never less than the model-scale defaults): at full scale a 120 s hold left
+/// the yaw rate unsettled and drew a hysteresis loop of 2.3° for a course-stable ship.
+#[test]
+fn a_manoeuvres_default_times_follow_the_ships_time_scale() {
+    let big = froude(&model_scale(), LAMBDA);
+    let ship = Ship::new(&big.model().unwrap(), false).unwrap();
+    let scale = ship.time_scale();
+    assert!((scale - 320.0 / (1.17248 * LAMBDA.sqrt())).abs() < 1e-9);
+    let spiral = Spiral::default();
+    assert_eq!(spiral.hold(scale), (20.0 * scale).ceil());
+    assert_eq!(spiral.hold(320.0 / 7.0 / 8.0), 120.0, "at model scale the hold stays 120 s");
+    let label = Manoeuvre::Spiral(spiral).at_scale(scale).label();
+    assert!(label.contains(&format!("{} s each", (20.0 * scale).ceil())), "{label}");
+    // the pull-out steadies in its turn and decays after it
+    let Metrics::PullOut(p) = run(&big.model().unwrap(), "pullout:20") else { unreachable!() };
+    assert!(
+        p.decay_time_s.is_some() && p.residual_yaw_rate_deg_s.abs() < 0.05 * p.turning_yaw_rate_deg_s.abs(),
+        "{p:?}"
+    );
+    // a spiral about a small rudder angle, each hold the default: the course-stable hull
+    // draws no loop (the model-scale default 120 s drew 2.3° over ±20°)
+    let Metrics::Spiral(s) = run(&big.model().unwrap(), "spiral") else { unreachable!() };
+    assert!(s.loop_width_deg.unwrap_or(0.0) < 0.2 && s.unsettled_deg_s < 0.01, "{s:?}");
+}
+
+/// The polynomial template copied for the 320 m ship, its bounds left at the 7 m model's: the
+/// sway speed's ±5 m/s would stop a sound turn of a ship at 7.9 m/s, and the surge speed's 10 m/s
+/// a ship at 12 m/s at once. Refused at load, naming the key.
+#[test]
+fn a_ship_model_whose_bounds_leave_no_room_for_its_manoeuvres_is_refused_with_its_key() {
+    let text = std::fs::read_to_string("models/new_ship.toml").unwrap();
+    let ship = text.replace("lpp = 7.0", "lpp = 320.0");
+    let full = ship.replace("u0 = 1.17 ", "u0 = 7.91 ");
+    let e = termid::plugins::parse(&full, "full.toml").unwrap_err().to_string();
+    assert!(e.contains("full.toml:") && e.contains("`states[1].min`") && e.contains("sway speed"), "{e}");
+    let fast = ship.replace("u0 = 1.17 ", "u0 = 12.0 ");
+    let e = termid::plugins::parse(&fast, "fast.toml").unwrap_err().to_string();
+    assert!(e.contains("`states[0].max`") && e.contains("u0 = 12 m/s"), "{e}");
+    // widened, it loads
+    let widened = full.replacen("min = -5.0\nmax = 5.0", "min = -40.0\nmax = 40.0", 1);
+    termid::plugins::parse(&widened, "widened.toml").unwrap();
+}
+
+/// A basin's 35°/5° zigzag, its rudder indicator 0.3° off: the rudder at its 35° stop reads
+/// 35.3°, and the angles it held read 35.001° about +0.3°, a noise past the ship's limit. The
+/// check that the model steers its runs as recorded lays them as recorded (it refused the run:
+/// "beyond the ship's rudder limit").
+#[test]
+fn a_zigzag_laid_to_the_rudder_stop_is_steered_as_recorded() {
+    let truth = termid::plugins::load(std::path::Path::new("models/mmg_kvlcc2.toml")).unwrap();
+    let basin = termid::ship::basin::Basin::tracked();
+    let frames: Vec<_> = ["zigzag:35/5", "zigzag:35/5:port", "zigzag:20/20"]
+        .iter()
+        .enumerate()
+        .map(|(k, m)| {
+            let manoeuvre = Manoeuvre::parse(m).unwrap();
+            basin
+                .record(&truth, &manoeuvre, 1.17248, 60.0, 1 + k as u64, &format!("{k}.dat"))
+                .unwrap()
+                .measured
+        })
+        .collect();
+    let each: Vec<_> = frames.iter().map(|f| (&truth, f)).collect();
+    let check = termid::ship::checks::steering_check(&each).unwrap();
+    assert!(check.passed && check.detail.contains("of 3 records'"), "{check:?}");
+}
