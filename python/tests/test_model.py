@@ -326,6 +326,28 @@ def test_estimate_recovers_nomoto_k_and_t_from_a_noisy_run():
         termid.Model.builtin("lorenz").estimate(run.rename(columns={"ψ": "x", "r": "y", "δ": "z"}))
 
 
+def test_a_compass_heading_through_north_is_read_as_one_angle():
+    """A heading recorded as a compass reads it, in [0, 2π), wraps where the ship turns through
+    north: the estimate reads it as one continuous angle, warns that it did, and fits K and T
+    as from the continuous record."""
+    truth = termid.Model.builtin("nomoto")
+    truth.set_parameter("K", 0.15)
+    truth.set_parameter("T", 8.0)
+    t = np.arange(0.0, 90.0, 0.1)
+    laid = pd.DataFrame({"t": t, "ψ": 0.0, "r": 0.0, "δ": np.where((t // 15) % 2 == 0, 0.1, -0.1)})
+    run = truth.replay(laid)[0][["t", "ψ", "r", "δ"]]
+    rng = np.random.default_rng(5)
+    run["ψ"] += np.radians(0.1) * rng.standard_normal(len(run))
+    run["r"] += np.radians(0.05) * rng.standard_normal(len(run))
+    compass = run.assign(ψ=np.mod(run["ψ"], 2 * np.pi))
+    assert compass["ψ"].diff().abs().max() > np.pi
+    plain, _ = termid.Model.builtin("nomoto").estimate(run)
+    with pytest.warns(UserWarning, match="`ψ` jumps by a full turn"):
+        read, _ = termid.Model.builtin("nomoto").estimate(compass)
+    assert np.allclose(read["estimate"], plain["estimate"], rtol=1e-9), (read, plain)
+    assert abs(read.loc["K", "estimate"] / 0.15 - 1) < 0.05, read
+
+
 LOAD_CELL = """
 [model]
 name = "a forced spring on a load cell"

@@ -2,6 +2,7 @@
 //! to CSV with errors that name the file, row and column; and numerical derivatives behind
 //! the [`Differentiator`] interface.
 
+mod angle;
 #[cfg(feature = "columnar")]
 mod columnar;
 mod csv_io;
@@ -17,6 +18,7 @@ mod search;
 mod smoothing_spline;
 mod stream;
 
+pub use angle::{unwrap_turns, unwrapped, wrapped};
 pub use dataset::{velocities_from_track, Dataset, Delimiter, RunSpec, Track};
 pub use derivative::{differentiator, CentralDifference, Differentiator, Smoothed, DIFFERENTIATORS};
 pub use five_point::FivePoint;

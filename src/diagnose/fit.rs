@@ -242,6 +242,19 @@ impl Runs {
                 )));
             }
         }
+        // a state's angle that wraps at a full turn would be compared with one that turns on
+        for s in model.spec().states.iter().filter(|s| s.unit == "rad") {
+            for f in frames {
+                if let Some(row) = f.column(&s.name).and_then(crate::data::wrapped) {
+                    return Err(DiagnoseError::Setup(format!(
+                        "{}: `{}` jumps by more than half a turn at row {} (a compass wrapping at 360°), and a re-simulation turns on: unwrap it (termid::data::unwrapped; the CLI and the Python package do)",
+                        f.origin(),
+                        s.name,
+                        row + 1
+                    )));
+                }
+            }
+        }
         let system = System::new(model, &Default::default(), false)?;
         // a state is compared in the runs that record it: one run or basin without a record of
         // it (a yaw rate without a gyro) does not take it from the others' comparison

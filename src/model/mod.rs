@@ -711,8 +711,10 @@ impl Model {
     /// goes beyond a full turn is refused (it can only be degrees), and the run must agree with
     /// the model's known kinematics ([`Model::check_kinematics`]); a run whose samples are not
     /// evenly spaced (a dropped sample) is resampled onto its median step, as a re-simulation
-    /// compares it sample by sample ([`crate::data::evened`]). Returns what was renamed or
-    /// resampled, for the caller to say.
+    /// compares it sample by sample ([`crate::data::evened`]), and a state in rad that wraps at
+    /// a full turn (a compass's 359° → 0°) is made one continuous angle
+    /// ([`crate::data::unwrapped`]). Returns what was renamed, resampled or unwrapped, for the
+    /// caller to say.
     pub fn admit(&self, frame: &mut crate::data::Frame) -> Result<Vec<String>, crate::data::DataError> {
         let mut notes = Vec::new();
         if let Some((even, note)) = crate::data::evened(frame)? {
@@ -727,6 +729,14 @@ impl Model {
                     frame.origin()
                 ));
             }
+        }
+        // a heading recorded as a compass reads it (0-360°, or atan2's ±180°) wraps where the
+        // model's angle turns on
+        let angles: Vec<&str> =
+            self.spec.states.iter().filter(|s| s.unit == "rad").map(|s| s.name.as_str()).collect();
+        if let Some((whole, said)) = crate::data::unwrapped(frame, &angles)? {
+            *frame = whole;
+            notes.extend(said);
         }
         for input in self.spec.inputs.iter().filter(|i| i.unit == "rad") {
             let beyond = frame

@@ -391,6 +391,47 @@ fn the_estimate_command_holds_initial_values_where_the_fit_leans() {
     assert!(!ok && err.contains("none of auto, measured, free, recorded"), "{err}");
 }
 
+/// A heading recorded as a compass reads it, in [0, 2π): the zigzag about north wraps at every
+/// crossing. `estimate` reads it as one continuous angle and says so, and fits K and T as from
+/// the continuous record; `Runs::new`, which compares the records as given, refuses it with
+/// the row (it compared a ship turning on with one jumping back by a full turn: 352° "off").
+#[test]
+fn the_estimate_command_reads_a_compass_heading_through_north() {
+    let (k, t_const, h) = (0.15, 8.0, 0.1);
+    let (rows, deltas) = nomoto_zigzag(k, t_const, 10f64.to_radians(), h, 901);
+    let mut rng = Lcg(11);
+    let dir = crate::common::Scratch::new("estimate-compass");
+    let (mut continuous, mut compass) = (String::from("t,ψ,r,δ\n"), String::from("t,ψ,r,δ\n"));
+    for (i, row) in rows.iter().enumerate() {
+        let (psi, r) =
+            (row[0] + 0.1f64.to_radians() * rng.normal(), row[1] + 0.05f64.to_radians() * rng.normal());
+        let t = i as f64 * h;
+        continuous.push_str(&format!("{t},{psi},{r},{}\n", deltas[i]));
+        compass.push_str(&format!("{t},{},{r},{}\n", psi.rem_euclid(std::f64::consts::TAU), deltas[i]));
+    }
+    let estimate = |name: &str, text: &str| {
+        let (data, out) = (dir.join(format!("{name}.csv")), dir.join(format!("{name}.toml")));
+        std::fs::write(&data, text).unwrap();
+        let args = ["estimate", "--model", "models/nomoto.toml", "--data", data.to_str().unwrap()];
+        let (ok, stdout, err) =
+            crate::common::termid(&[&args[..], &["--out", out.to_str().unwrap()]].concat());
+        assert!(ok, "{err}");
+        (termid::plugins::load(&out).unwrap().parameter_values(), format!("{stdout}{err}"))
+    };
+    let (want, _) = estimate("continuous", &continuous);
+    let (got, said) = estimate("compass", &compass);
+    assert!(said.contains("`ψ` jumps by a full turn") && !said.contains("FLAG"), "{said}");
+    for p in ["K", "T"] {
+        assert!((got[p] / want[p] - 1.0).abs() < 1e-9, "{p}: {} against {}", got[p], want[p]);
+    }
+    assert!((got["K"] / k - 1.0).abs() < 0.05 && (got["T"] / t_const - 1.0).abs() < 0.05, "{got:?}");
+    // the library compares what it is given: a wrapped record is refused, with its row
+    let model = termid::plugins::load(std::path::Path::new("models/nomoto.toml")).unwrap();
+    let frame = Frame::parse_csv(&compass, "compass.csv", "t").unwrap();
+    let e = Runs::new(&model, &[frame], h, Integrator::Rk4).err().unwrap().to_string();
+    assert!(e.contains("compass.csv: `ψ` jumps by more than half a turn at row"), "{e}");
+}
+
 /// Keys that make no sense are refused with the file and key.
 #[test]
 fn free_parameter_keys_are_checked() {
