@@ -326,7 +326,10 @@ impl Scenario for ShipScenario {
                 let value = c.value.map_or("--".to_string(), |v| format!("{v:.2}"));
                 text.push(format!(
                     "  {:<34} {value:>8} {} (limit {} {})  {verdict}",
-                    c.name, c.unit, c.limit, c.unit
+                    c.name,
+                    c.unit,
+                    super::manoeuvre::hundredths(c.limit),
+                    c.unit
                 ));
             }
             extra.insert("imo".into(), serde_json::to_value(&imo).map_err(PluginError::failed)?);

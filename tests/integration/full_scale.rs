@@ -1,8 +1,8 @@
 //! A ship at full scale through the defaults that were set at model scale: the grey-box model
-//! `new-ship` writes for a 320 m ship (and for one at 24 knots), the manoeuvres' default times,
-//! a model file whose bounds leave no room for its ship, and a zigzag whose rudder indicator
-//! reads a stop a little past the ship's limit. Froude's law is the reference: a ship λ times
-//! its model turns the same circle in ship lengths, √λ times slower.
+//! `new-ship` writes for a 320 m ship (and for one at 24 knots, and for a container ship), the
+//! manoeuvres' default times, a model file whose bounds leave no room for its ship, and a zigzag
+//! whose rudder indicator reads a stop a little past the ship's limit. Froude's law is the
+//! reference: a ship λ times its model turns the same circle in ship lengths, √λ times slower.
 
 use termid::model::Model;
 use termid::ship::manoeuvre::Spiral;
@@ -140,4 +140,35 @@ fn a_zigzag_laid_to_the_rudder_stop_is_steered_as_recorded() {
     let each: Vec<_> = frames.iter().map(|f| (&truth, f)).collect();
     let check = termid::ship::checks::steering_check(&each).unwrap();
     assert!(check.passed && check.detail.contains("of 3 records'"), "{check:?}");
+}
+
+/// A container ship nobody has tested (KCS's particulars, 230 m at 24 knots) from `new-ship` to
+/// IMO's criteria: the 10°/10° first overshoot's limit at L/V = 18.6 s is 5 + L/V/2 = 14.31°
+/// (MSC.137(76) 5.4.1), printed as such (it printed 14.31174089068826).
+#[test]
+fn a_container_ship_from_its_particulars_meets_imos_limits_as_printed() {
+    let dir = crate::common::Scratch::new("kcs");
+    let particulars = dir.join("kcs.toml");
+    std::fs::write(
+        &particulars,
+        "name = \"KCS\"\nlpp = 230.0\nbeam = 32.2\ndraught = 10.8\nblock_coefficient = 0.651\nx_g = -3.4\n\
+         rudder_area = 54.45\nrudder_span = 9.9\npropeller_diameter = 7.9\nu0 = 12.35\nrudder_rate = 2.32\n\
+         rudder_limit = 35.0\n",
+    )
+    .unwrap();
+    let model = dir.join("kcs_greybox.toml");
+    let (ok, _, err) = crate::common::termid(&[
+        "new-ship",
+        "--particulars",
+        particulars.to_str().unwrap(),
+        "--out",
+        model.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let (ok, text, err) =
+        crate::common::termid(&["simulate", "--model", model.to_str().unwrap(), "-m", "zigzag:10/10"]);
+    assert!(ok, "{err}");
+    let limit = 5.0 + 0.5 * 230.0 / 12.35;
+    assert!(text.contains(&format!("(limit {limit:.2} °)")) && !text.contains("14.311"), "{text}");
+    assert!(text.contains("first overshoot") && !text.contains("not reached"), "{text}");
 }

@@ -22,6 +22,16 @@ pub use zigzag::{ZigZag, ZigZagMetrics};
 use super::{Ship, ShipError, StraightRun};
 use crate::sim::{Controller, Trajectory};
 
+/// A number to a hundredth, without trailing zeros (20, 0.3, 35.01, 14.31): a zigzag read off a
+/// record is laid to angles like 35.0017°, and IMO's overshoot limit at L/V = 18.6 s is 14.31°.
+pub(crate) fn hundredths(v: f64) -> String {
+    let s = format!("{v:.2}");
+    match s.trim_end_matches('0').trim_end_matches('.') {
+        "-0" => "0".into(),
+        t => t.into(),
+    }
+}
+
 /// A default time of a manoeuvre: `lengths` of the ship's own time scale `scale` (L/U0, s) in
 /// whole seconds, and never less than `floor` seconds (the defaults at model scale). A ship at full scale
 /// turns √λ times slower than its model: a 120 s hold of a spiral that settles a 7 m model

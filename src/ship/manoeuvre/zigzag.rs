@@ -234,12 +234,12 @@ impl super::Test for ZigZag {
     fn label(&self) -> String {
         format!(
             "zigzag {}°/{}° {}{}",
-            hundredths(self.rudder_deg),
-            hundredths(self.heading_deg),
+            super::hundredths(self.rudder_deg),
+            super::hundredths(self.heading_deg),
             if self.starboard_first { "starboard" } else { "port" },
             match self.about_deg {
                 Some(0.0) => ", rudder about 0".to_string(),
-                Some(a) => format!(", rudder about {}°", hundredths(a)),
+                Some(a) => format!(", rudder about {}°", super::hundredths(a)),
                 None => String::new(),
             }
         )
@@ -259,16 +259,6 @@ impl super::Test for ZigZag {
 
     fn metrics(&self, ship: &Ship, run: &Trajectory) -> ZigZagMetrics {
         ZigZag::metrics(self, ship, run)
-    }
-}
-
-/// An angle to a hundredth of a degree, without trailing zeros (20, 0.3, 35.01): a zigzag read
-/// off a record is laid to angles like 35.0017°.
-fn hundredths(deg: f64) -> String {
-    let s = format!("{deg:.2}");
-    match s.trim_end_matches('0').trim_end_matches('.') {
-        "-0" => "0".into(),
-        t => t.into(),
     }
 }
 
