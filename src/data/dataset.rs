@@ -85,6 +85,14 @@ pub struct Track {
     /// Earth-fixed velocity along the y axis, a column of the file.
     #[serde(default)]
     pub y_dot: Option<String>,
+    /// A satellite fix's latitude, a column of the file with its unit (`"lat [deg]"`): with
+    /// `longitude`, the positions `x` (north) and `y` (east) are computed from it, in metres
+    /// from the run's first fix ([`super::north_east`]).
+    #[serde(default)]
+    pub latitude: Option<String>,
+    /// The fix's longitude, a column of the file with its unit.
+    #[serde(default)]
+    pub longitude: Option<String>,
     /// Heading, measured from x towards y.
     pub heading: String,
     /// The surge velocity to compute.
@@ -486,6 +494,28 @@ impl Dataset {
                 frame.push(var, values)?;
             }
             if let Some(track) = &self.track {
+                // a satellite fix: the positions in m north and east of the run's first
+                let mut said = None;
+                match (&track.latitude, &track.longitude, &track.x, &track.y) {
+                    (None, None, _, _) => {}
+                    (Some(lat), Some(lon), Some(x), Some(y)) => {
+                        let (north, east) = super::north_east(&convert(lat, "latitude")?, &convert(lon, "longitude")?);
+                        let f = scale(Some("m"), x)?;
+                        frame.push(x, north.iter().map(|v| v * f).collect())?;
+                        frame.push(y, east.iter().map(|v| v * f).collect())?;
+                        said = Some(format!(
+                            "{origin}: {x} and {y} in m north and east of the first fix ({lat}, {lon}), on the plane touching the WGS-84 ellipsoid there"
+                        ));
+                    }
+                    _ => {
+                        return Err(DataError::Unit {
+                            file: origin.clone(),
+                            row: 0,
+                            column: track.heading.clone(),
+                            message: "[track] takes latitude and longitude together, with x and y to name the positions they give (x north, y east)".into(),
+                        })
+                    }
+                }
                 let col = |n: &str| frame.require(n).map(<[f64]>::to_vec);
                 let heading = col(&track.heading)?;
                 let (u, v) = match (&track.x, &track.y, &track.x_dot, &track.y_dot) {
@@ -515,6 +545,7 @@ impl Dataset {
                 };
                 frame.set(&track.u, u)?;
                 frame.set(&track.v, v)?;
+                notes.extend(said);
             }
             if run.from.is_some() || run.to.is_some() {
                 let t = &file_time;
@@ -658,6 +689,71 @@ skip = 4
             );
         }
         assert_eq!(f.column("r").unwrap()[0], 0.001);
+    }
+
+    /// A ship at sea logged by a satellite receiver: latitude and longitude in degrees (60° N,
+    /// 8 m/s on a heading of 30° with 5° of drift), read as metres north and east of the first
+    /// fix, and from them u and v. The fixes are written from the track by the ellipsoid's
+    /// radii of curvature at the first fix (M, N), which over 800 m bend the course by 1e-4 rad.
+    #[test]
+    fn a_satellite_fix_gives_the_track_in_metres() {
+        let dir = std::env::temp_dir().join(format!("termid-gnss-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (lat0, lon0) = (60f64.to_radians(), 5.3f64.to_radians());
+        let (a, e2) = (6_378_137.0, 6.694_379_990_14e-3);
+        let w = 1.0 - e2 * lat0.sin().powi(2);
+        let (m, n) = (a * (1.0 - e2) / w.powf(1.5), a / w.sqrt());
+        let (speed, heading, drift) = (8.0, 30f64.to_radians(), 5f64.to_radians());
+        let mut text = String::from("t,lat,lon,hdg\n");
+        for k in 0..=100 {
+            let t = f64::from(k);
+            let (north, east) = (speed * (heading + drift).cos() * t, speed * (heading + drift).sin() * t);
+            let (lat, lon) = (lat0 + north / m, lon0 + east / (n * lat0.cos()));
+            text.push_str(&format!("{t},{:.10},{:.10},30\n", lat.to_degrees(), lon.to_degrees()));
+        }
+        std::fs::write(dir.join("trial.csv"), text).unwrap();
+        let set: Dataset = toml::from_str(
+            r#"
+[columns]
+t = "t [s]"
+"ψ" = "hdg [deg]"
+[track]
+latitude = "lat [deg]"
+longitude = "lon [deg]"
+x = "x0"
+y = "y0"
+heading = "ψ"
+u = "u"
+v = "v"
+[[runs]]
+file = "trial.csv"
+"#,
+        )
+        .unwrap();
+        let (frames, notes) = set.read(&dir, "t").unwrap();
+        assert!(
+            notes.iter().any(|n| n.contains("x0 and y0 in m north and east of the first fix")),
+            "{notes:?}"
+        );
+        let f = &frames[0];
+        let (x0, y0) = (f.column("x0").unwrap(), f.column("y0").unwrap());
+        assert!(x0[0] == 0.0 && y0[0] == 0.0);
+        assert!((x0[100].hypot(y0[100]) - 800.0).abs() < 0.1, "{} {}", x0[100], y0[100]);
+        for k in [0, 50, 100] {
+            let (u, v) = (f.column("u").unwrap()[k], f.column("v").unwrap()[k]);
+            assert!(
+                (u - speed * drift.cos()).abs() < 5e-3 && (v - speed * drift.sin()).abs() < 5e-3,
+                "{k}: {u} {v}"
+            );
+        }
+        // a latitude without its longitude, or without the positions' names, is refused
+        let half = toml::from_str::<Dataset>(
+            "[columns]\nt = \"t [s]\"\n\"ψ\" = \"hdg [deg]\"\n[track]\nlatitude = \"lat [deg]\"\nx = \"x0\"\ny = \"y0\"\nheading = \"ψ\"\nu = \"u\"\nv = \"v\"\n[[runs]]\nfile = \"trial.csv\"\n",
+        )
+        .unwrap();
+        let e = half.read(&dir, "t").unwrap_err().to_string();
+        assert!(e.contains("latitude and longitude together"), "{e}");
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     /// A full-scale record as MARIN prints them (three significant digits: repeated time
