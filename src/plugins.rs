@@ -65,3 +65,21 @@ pub fn load(path: &std::path::Path) -> Result<Model, ModelError> {
         crate::budget::read_text(path).map_err(|error| ModelError::Io { file: file.clone(), error })?;
     parse(&text, &file)
 }
+
+/// The model at another scale with its plug-in's table ([`crate::model::dimension::rescaled`],
+/// then [`Plugin::rescale`]): Froude's law (`length` λ, `time` √λ, `mass` λ³) takes a basin's
+/// model to its ship, particulars, approach speed and steering gear with it (the coefficients
+/// alone left a ship's model at the basin's speed and rudder rate).
+pub fn rescaled(
+    model: &Model,
+    length: f64,
+    time: f64,
+    mass: f64,
+) -> Result<Model, crate::plugin::PluginError> {
+    let mut scaled = crate::model::dimension::rescaled(model, length, time, mass)
+        .map_err(crate::plugin::PluginError::failed)?;
+    if let Some(plugin) = of(&scaled) {
+        plugin.rescale(&mut scaled, length, time, mass)?;
+    }
+    Ok(scaled)
+}

@@ -206,6 +206,8 @@ pub fn coefficient_dimensions(model: &Model) -> Result<Vec<(String, Term, Dimens
 /// multiplied by `length`^a · `time`^b · `mass`^c — coefficients (with their standard errors,
 /// covariances and intercepts), parameters, and the states' initial values and bounds.
 /// Froude's law (`length` λ, `time` √λ, `mass` λ³) takes a model basin's model to its ship.
+/// A plug-in's own table (a ship's particulars) is its plug-in's to rescale:
+/// `termid::plugins::rescaled` does both.
 pub fn rescaled(model: &Model, length: f64, time: f64, mass: f64) -> Result<Model, super::ModelError> {
     let names = dimensions(model)
         .map_err(|e| super::ModelError::Syntax { file: model.path.clone(), message: e.to_string() })?;

@@ -17,10 +17,7 @@ pub fn run(cmd: ScaleCommand) -> Result<()> {
     crate::runs::check_outputs(&[("--out", &cmd.out)], &[("--model".into(), cmd.model.clone())])?;
     let model = termid::plugins::load(&cmd.model)?;
     let (length, time, mass) = (cmd.factor, cmd.factor.sqrt(), cmd.factor.powi(3));
-    let mut scaled = termid::model::dimension::rescaled(&model, length, time, mass)?;
-    if let Some(plugin) = termid::plugins::of(&scaled) {
-        plugin.rescale(&mut scaled, length, time, mass)?;
-    }
+    let mut scaled = termid::plugins::rescaled(&model, length, time, mass)?;
     scaled.add_note(format!(
         "rescaled by Froude's law from {} (lengths × {length}, times × {time:.6}, masses × {mass:.6e})",
         cmd.model.display()
