@@ -100,22 +100,28 @@ fn a_manoeuvres_default_times_follow_the_ships_time_scale() {
     assert!(s.loop_width_deg.unwrap_or(0.0) < 0.2 && s.unsettled_deg_s < 0.01, "{s:?}");
 }
 
-/// The polynomial template copied for the 320 m ship, its bounds left at the 7 m model's: the
-/// sway speed's ±5 m/s would stop a sound turn of a ship at 7.9 m/s, and the surge speed's 10 m/s
-/// a ship at 12 m/s at once. Refused at load, naming the key.
+/// The MMG KVLCC2 file (L = 7 m) edited for the 320 m ship, its bounds left at the 7 m model's:
+/// the sway speed's ±5 m/s would stop a sound turn of a ship at 7.9 m/s, and the surge speed's
+/// 10 m/s a ship at 12 m/s at once. Refused at load, naming the key. The polynomial template's
+/// bounds hold any ship's manoeuvres (u to 30 m/s): it loads for both.
 #[test]
 fn a_ship_model_whose_bounds_leave_no_room_for_its_manoeuvres_is_refused_with_its_key() {
-    let text = std::fs::read_to_string("models/new_ship.toml").unwrap();
+    let text = std::fs::read_to_string("models/mmg_kvlcc2.toml").unwrap();
     let ship = text.replace("lpp = 7.0", "lpp = 320.0");
-    let full = ship.replace("u0 = 1.17 ", "u0 = 7.91 ");
+    let full = ship.replace("u0 = 1.17248 ", "u0 = 7.91 ");
     let e = termid::plugins::parse(&full, "full.toml").unwrap_err().to_string();
     assert!(e.contains("full.toml:") && e.contains("`states[1].min`") && e.contains("sway speed"), "{e}");
-    let fast = ship.replace("u0 = 1.17 ", "u0 = 12.0 ");
+    let fast = ship.replace("u0 = 1.17248 ", "u0 = 12.0 ");
     let e = termid::plugins::parse(&fast, "fast.toml").unwrap_err().to_string();
     assert!(e.contains("`states[0].max`") && e.contains("u0 = 12 m/s"), "{e}");
     // widened, it loads
     let widened = full.replacen("min = -5.0\nmax = 5.0", "min = -40.0\nmax = 40.0", 1);
     termid::plugins::parse(&widened, "widened.toml").unwrap();
+    let template =
+        std::fs::read_to_string("models/new_ship.toml").unwrap().replace("lpp = 7.0", "lpp = 320.0");
+    for u0 in ["7.91", "12.0"] {
+        termid::plugins::parse(&template.replace("u0 = 1.17 ", &format!("u0 = {u0} ")), "ship.toml").unwrap();
+    }
 }
 
 /// A basin's 35°/5° zigzag, its rudder indicator 0.3° off: the rudder at its 35° stop reads
