@@ -211,6 +211,7 @@ pub fn steering_check(runs: &[(&Model, &Frame)]) -> Option<Check> {
     let gear = SteeringGear::of_runs(first, runs.iter().map(|(_, f)| *f))?;
     let name = "steers its training zigzags as recorded".to_string();
     let mut errors: Vec<(f64, String)> = Vec::new();
+    let mut unsteered: Vec<String> = Vec::new();
     for (model, frame) in runs {
         let label = run_label(frame.origin());
         let (Some(psi), Some(delta), Some(u)) =
@@ -243,37 +244,37 @@ pub fn steering_check(runs: &[(&Model, &Frame)]) -> Option<Check> {
         };
         let steered =
             Ship::new(&approach, false).and_then(|ship| ship.run(&Manoeuvre::ZigZag(zigzag), &settings));
-        let run = match steered {
-            Ok(run) => run.trajectory,
-            Err(e) => {
-                return Some(Check {
-                    name,
-                    passed: false,
-                    refuses: false,
-                    measure: None,
-                    detail: format!("{label}: the model does not steer it: {e}"),
-                })
+        match steered {
+            Ok(run) => {
+                if let Some(predicted) = observe_run(&run.trajectory, n).and_then(|o| o.first_overshoot_deg) {
+                    errors.push((predicted - measured, label));
+                }
             }
-        };
-        if let Some(predicted) = observe_run(&run, n).and_then(|o| o.first_overshoot_deg) {
-            errors.push((predicted - measured, label));
+            // the others are still read: which runs it steers, and how
+            Err(e) => unsteered.push(format!("{label}: the model does not steer it: {e}")),
         }
     }
-    let (worst, which) = errors.iter().max_by(|a, b| a.0.abs().total_cmp(&b.0.abs()))?.clone();
-    Some(Check {
-        name,
-        passed: worst.abs() <= 1.0,
-        refuses: false,
-        measure: None,
-        detail: format!(
-            "first overshoots within {:.2}° of {} records' (worst {which}: {worst:+.2}°), each steered from its approach, the rudder laid as recorded, by the records' steering gear ({:.2} s dead time, {:.0}°/s² to {:.1}°/s)",
-            worst.abs(),
-            errors.len(),
-            gear.delay_s,
-            gear.acceleration_deg_s2,
-            gear.rate_deg_s
-        ),
-    })
+    let gear_text = format!(
+        "each steered from its approach, the rudder laid as recorded, by the records' steering gear ({:.2} s dead time, {:.0}°/s² to {:.1}°/s)",
+        gear.delay_s, gear.acceleration_deg_s2, gear.rate_deg_s
+    );
+    let steered = errors.iter().max_by(|a, b| a.0.abs().total_cmp(&b.0.abs())).map(|(worst, which)| {
+        (
+            worst.abs() <= 1.0,
+            format!(
+                "first overshoots within {:.2}° of {} records' (worst {which}: {worst:+.2}°), {gear_text}",
+                worst.abs(),
+                errors.len()
+            ),
+        )
+    });
+    let (passed, detail) = match (steered, unsteered.is_empty()) {
+        (None, true) => return None,
+        (Some(numbers), true) => numbers,
+        (None, false) => (false, unsteered.join("; ")),
+        (Some((_, numbers)), false) => (false, format!("{}; {numbers}", unsteered.join("; "))),
+    };
+    Some(Check { name, passed, refuses: false, measure: None, detail })
 }
 
 /// `model` with its rudder limit at least `laid_deg`.
@@ -419,5 +420,21 @@ mod tests {
         let other = steering_check(&each(&loose, &runs)).unwrap();
         assert!(!other.passed && !other.refuses, "{other:?}");
         assert!(steering_check(&[]).is_none());
+        // a run whose model cannot steer it (its rudder acts on nothing) fails the check by
+        // name, and the run it steers is still read
+        let eq = model.equation("r_dot").unwrap().clone();
+        let mute = eq
+            .coefficients
+            .iter()
+            .map(|(t, v, s)| (t.clone(), if t.variables().iter().any(|n| n == "δ") { 0.0 } else { *v }, *s));
+        let mut rudderless = model.clone();
+        rudderless.set_coefficients("r_dot", mute.collect(), None);
+        let mixed = steering_check(&[(&model, &runs[0]), (&rudderless, &runs[1])]).unwrap();
+        assert!(!mixed.passed, "{mixed:?}");
+        assert!(
+            mixed.detail.starts_with("z: the model does not steer it: the rudder has no effect")
+                && mixed.detail.contains("of 1 records'"),
+            "{mixed:?}"
+        );
     }
 }
