@@ -3,6 +3,7 @@
 //! the [`Differentiator`] interface.
 
 mod angle;
+mod clock;
 #[cfg(feature = "columnar")]
 mod columnar;
 mod csv_io;
@@ -20,6 +21,7 @@ mod smoothing_spline;
 mod stream;
 
 pub use angle::{unwrap_turns, unwrapped, wrapped};
+pub use clock::clock_seconds;
 pub use dataset::{velocities_from_track, Dataset, Delimiter, RunSpec, Track};
 pub use derivative::{differentiator, CentralDifference, Differentiator, Smoothed, DIFFERENTIATORS};
 pub use five_point::FivePoint;

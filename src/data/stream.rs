@@ -333,8 +333,8 @@ impl RowSource for CsvRows<'_> {
 
 /// A cell's number. Read from the bytes (no UTF-8 check of the row: a number is ASCII), with
 /// Rust's own reading of text as the rule wherever the fast reader declines (`NaN`, `inf`,
-/// which the frame then refuses with their row, and anything that is not a number), and in a
-/// European file a decimal comma.
+/// which the frame then refuses with their row, and anything that is not a number), in a
+/// European file a decimal comma, and a time stamp as seconds ([`super::clock_seconds`]).
 fn number(cell: &[u8], semicolons: bool) -> Option<f64> {
     if let Ok(v) = lexical_core::parse::<f64>(cell) {
         return Some(v);
@@ -346,8 +346,12 @@ fn number(cell: &[u8], semicolons: bool) -> Option<f64> {
     }
     let text = std::str::from_utf8(cell).ok()?;
     match text.parse::<f64>() {
-        Err(_) if semicolons => text.replace(',', ".").parse::<f64>().ok(),
-        other => other.ok(),
+        Err(_) if semicolons => {
+            text.replace(',', ".").parse::<f64>().ok().or_else(|| super::clock_seconds(text))
+        }
+        // a logger's time stamp, in seconds (the run's time is read from its first)
+        Err(_) => super::clock_seconds(text),
+        Ok(v) => Some(v),
     }
 }
 

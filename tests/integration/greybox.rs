@@ -432,6 +432,50 @@ fn the_estimate_command_reads_a_compass_heading_through_north() {
     assert!(e.contains("compass.csv: `ψ` jumps by more than half a turn at row"), "{e}");
 }
 
+/// A run whose time is a logger's stamps, a clock's (`23:59:58.300`) or a date's
+/// (`2026-11-27T11:58:40.300Z`): read as seconds, the run fitted as from seconds since its
+/// start (it was refused: "`12:00:00.0` is not a number"); within 1e-4, as a date's seconds
+/// since 1970 resolve a step to 2e-7 s. A clock that passes midnight goes back in time:
+/// refused with its row.
+#[test]
+fn the_estimate_command_reads_a_loggers_time_stamps() {
+    let (k, t_const, h) = (0.15, 8.0, 0.1);
+    let (rows, deltas) = nomoto_zigzag(k, t_const, 10f64.to_radians(), h, 601);
+    let dir = crate::common::Scratch::new("estimate-stamps");
+    let clock = |s: f64| {
+        let (whole, ms) = ((s.floor() as u64) % 86_400, ((s - s.floor()) * 1000.0).round() as u64);
+        format!("{:02}:{:02}:{:02}.{ms:03}", whole / 3600, whole / 60 % 60, whole % 60)
+    };
+    let estimate = |name: &str, stamp: &dyn Fn(f64) -> String| {
+        let mut text = String::from("t,ψ,r,δ\n");
+        for (i, row) in rows.iter().enumerate() {
+            text.push_str(&format!("{},{},{},{}\n", stamp(i as f64 * h), row[0], row[1], deltas[i]));
+        }
+        let (data, out) = (dir.join(format!("{name}.csv")), dir.join(format!("{name}.toml")));
+        std::fs::write(&data, text).unwrap();
+        let args = ["estimate", "--model", "models/nomoto.toml", "--data", data.to_str().unwrap()];
+        let (ok, _, err) = crate::common::termid(&[&args[..], &["--out", out.to_str().unwrap()]].concat());
+        (ok, ok.then(|| termid::plugins::load(&out).unwrap().parameter_values()), err)
+    };
+    let (_, seconds, _) = estimate("seconds", &|t| format!("{t:.3}"));
+    let seconds = seconds.unwrap();
+    assert!(
+        (seconds["K"] / k - 1.0).abs() < 0.02 && (seconds["T"] / t_const - 1.0).abs() < 0.02,
+        "{seconds:?}"
+    );
+    let (ok, dated, err) = estimate("dated", &|t| format!("2026-11-27T{}Z", clock(43_120.3 + t)));
+    assert!(ok, "{err}");
+    let (ok, clocked, err) = estimate("clocked", &|t| clock(43_120.3 + t));
+    assert!(ok, "{err}");
+    for fit in [dated.unwrap(), clocked.unwrap()] {
+        for p in ["K", "T"] {
+            assert!((fit[p] / seconds[p] - 1.0).abs() < 1e-4, "{p}: {} against {}", fit[p], seconds[p]);
+        }
+    }
+    let (ok, _, err) = estimate("midnight", &|t| clock(86_380.0 + t));
+    assert!(!ok && err.contains("midnight.csv") && err.contains("row"), "{err}");
+}
+
 /// Keys that make no sense are refused with the file and key.
 #[test]
 fn free_parameter_keys_are_checked() {
