@@ -42,6 +42,17 @@ fn nomoto_zigzag_holding(
     (rows, recorded)
 }
 
+/// A zigzag's heading and yaw rate (`rows` of ψ, r) as a gyro reads them: 0.1° and 0.05 °/s
+/// of noise, from `seed`.
+fn gyro(rows: &[Vec<f64>], seed: u64) -> Vec<(f64, f64)> {
+    let mut rng = Lcg(seed);
+    rows.iter()
+        .map(|row| {
+            (row[0] + 0.1f64.to_radians() * rng.normal(), row[1] + 0.05f64.to_radians() * rng.normal())
+        })
+        .collect()
+}
+
 /// The MMG truth (`models/mmg_kvlcc2.toml`).
 fn mmg_truth() -> Model {
     termid::plugins::load(std::path::Path::new("models/mmg_kvlcc2.toml")).unwrap()
@@ -359,12 +370,9 @@ fn a_pair_the_runs_tie_and_what_they_decide_are_reported() {
 fn the_estimate_command_holds_initial_values_where_the_fit_leans() {
     let (k, t_const, h) = (0.15, 8.0, 0.1);
     let (rows, deltas) = nomoto_zigzag_holding(k, t_const, 20f64.to_radians(), 3f64.to_radians(), h, 1201);
-    let mut rng = Lcg(7);
     let dir = crate::common::Scratch::new("estimate-initial");
     let mut csv = String::from("t,ψ,r,δ\n");
-    for (i, row) in rows.iter().enumerate() {
-        let (psi, r) =
-            (row[0] + 0.1f64.to_radians() * rng.normal(), row[1] + 0.05f64.to_radians() * rng.normal());
+    for (i, (psi, r)) in gyro(&rows, 7).into_iter().enumerate() {
         csv.push_str(&format!("{},{psi},{r},{}\n", i as f64 * h, deltas[i]));
     }
     let data = dir.join("biased.csv");
@@ -399,12 +407,9 @@ fn the_estimate_command_holds_initial_values_where_the_fit_leans() {
 fn the_estimate_command_reads_a_compass_heading_through_north() {
     let (k, t_const, h) = (0.15, 8.0, 0.1);
     let (rows, deltas) = nomoto_zigzag(k, t_const, 10f64.to_radians(), h, 901);
-    let mut rng = Lcg(11);
     let dir = crate::common::Scratch::new("estimate-compass");
     let (mut continuous, mut compass) = (String::from("t,ψ,r,δ\n"), String::from("t,ψ,r,δ\n"));
-    for (i, row) in rows.iter().enumerate() {
-        let (psi, r) =
-            (row[0] + 0.1f64.to_radians() * rng.normal(), row[1] + 0.05f64.to_radians() * rng.normal());
+    for (i, (psi, r)) in gyro(&rows, 11).into_iter().enumerate() {
         let t = i as f64 * h;
         continuous.push_str(&format!("{t},{psi},{r},{}\n", deltas[i]));
         compass.push_str(&format!("{t},{},{r},{}\n", psi.rem_euclid(std::f64::consts::TAU), deltas[i]));
