@@ -6,11 +6,13 @@ use std::path::Path;
 
 use arrow_array::cast::AsArray;
 use arrow_array::types::{
-    Float32Type, Float64Type, Int16Type, Int32Type, Int64Type, Int8Type, UInt16Type, UInt32Type, UInt64Type,
-    UInt8Type,
+    DurationMicrosecondType, DurationMillisecondType, DurationNanosecondType, DurationSecondType,
+    Float32Type, Float64Type, Int16Type, Int32Type, Int64Type, Int8Type, TimestampMicrosecondType,
+    TimestampMillisecondType, TimestampNanosecondType, TimestampSecondType, UInt16Type, UInt32Type,
+    UInt64Type, UInt8Type,
 };
 use arrow_array::{Array, RecordBatch};
-use arrow_schema::DataType;
+use arrow_schema::{DataType, TimeUnit};
 
 use super::DataError;
 
@@ -208,8 +210,25 @@ fn append(
         ($t:ty) => {
             out.extend(array.as_primitive::<$t>().values().iter().map(|v| *v as f64))
         };
+        // a time stamp or a duration in seconds (since 1970 UTC for a stamp: a run's time is
+        // only used from its first), whole seconds and their fraction apart so that a
+        // nanosecond stamp's seconds keep their fraction
+        ($t:ty, $per_second:expr) => {
+            out.extend(array.as_primitive::<$t>().values().iter().map(|v| {
+                let (whole, part) = (v.div_euclid($per_second), v.rem_euclid($per_second));
+                whole as f64 + part as f64 / $per_second as f64
+            }))
+        };
     }
     match array.data_type() {
+        DataType::Timestamp(TimeUnit::Second, _) => push!(TimestampSecondType, 1i64),
+        DataType::Timestamp(TimeUnit::Millisecond, _) => push!(TimestampMillisecondType, 1_000i64),
+        DataType::Timestamp(TimeUnit::Microsecond, _) => push!(TimestampMicrosecondType, 1_000_000i64),
+        DataType::Timestamp(TimeUnit::Nanosecond, _) => push!(TimestampNanosecondType, 1_000_000_000i64),
+        DataType::Duration(TimeUnit::Second) => push!(DurationSecondType, 1i64),
+        DataType::Duration(TimeUnit::Millisecond) => push!(DurationMillisecondType, 1_000i64),
+        DataType::Duration(TimeUnit::Microsecond) => push!(DurationMicrosecondType, 1_000_000i64),
+        DataType::Duration(TimeUnit::Nanosecond) => push!(DurationNanosecondType, 1_000_000_000i64),
         DataType::Float64 => out.extend_from_slice(array.as_primitive::<Float64Type>().values()),
         DataType::Float32 => push!(Float32Type),
         DataType::Int64 => push!(Int64Type),
@@ -260,6 +279,34 @@ mod tests {
 
     /// A run written as Parquet (two row groups, f64, f32 and integer columns) and as Arrow
     /// IPC reads as the same frame as its CSV; nulls and text are refused with row and column.
+    /// A logger's time as Parquet keeps it: stamps in nanoseconds since 1970 (pandas'
+    /// datetime64), and a duration in milliseconds, read as seconds (they were refused as "not a
+    /// number"); 20 Hz stamps keep their twentieths at the epoch's magnitude.
+    #[test]
+    fn time_stamps_and_durations_read_as_seconds() {
+        use arrow_array::{DurationMillisecondArray, TimestampNanosecondArray};
+        let dir = std::env::temp_dir().join(format!("termid-stamps-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let start: i64 = 1_795_780_800_000_000_000; // 2026-11-27T12:00:00Z
+        let stamps: Vec<i64> = (0..40).map(|k| start + k * 50_000_000).collect();
+        let since: Vec<i64> = (0..40).map(|k| k * 50).collect();
+        write_parquet(
+            &dir.join("stamped.parquet"),
+            &[batch(vec![
+                ("t", Arc::new(TimestampNanosecondArray::from(stamps).with_timezone("UTC")) as ArrayRef),
+                ("elapsed", Arc::new(DurationMillisecondArray::from(since))),
+            ])],
+        );
+        let f = Frame::read(&dir.join("stamped.parquet"), "t").unwrap();
+        let t = f.time();
+        assert_eq!(t[0], 1_795_780_800.0);
+        for k in 1..40 {
+            assert!((t[k] - t[0] - 0.05 * k as f64).abs() < 1e-6, "row {k}: {}", t[k] - t[0]);
+            assert!((f.column("elapsed").unwrap()[k] - 0.05 * k as f64).abs() < 1e-12);
+        }
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
     #[test]
     fn parquet_and_arrow_read_as_csv_does() {
         let dir = std::env::temp_dir().join(format!("termid-columnar-{}", std::process::id()));
