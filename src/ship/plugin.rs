@@ -43,6 +43,9 @@ impl Plugin for Manoeuvring {
             )));
         }
         ship.u0 = value;
+        if let Some((key, why)) = ship.bounds_without_room(model) {
+            return Err(PluginError::Refused(format!("--param u0={value}: {}: `{key}`: {why}", model.path)));
+        }
         ship.store(model);
         Ok(true)
     }

@@ -127,6 +127,33 @@ impl ShipSpec {
         }
     }
 
+    /// Where a state's bounds leave no room for the ship's own manoeuvres at `u0`: the key
+    /// (`states[1].min`) and why. Bounds stop a run as diverging; a template's model-scale
+    /// bounds, copied for a ship at full scale (or an approach speed given on the command
+    /// line), stop every run at once or a sound turn halfway.
+    pub fn bounds_without_room(&self, model: &Model) -> Option<(String, String)> {
+        let (n, u0, lpp) = (&self.names, self.u0, self.lpp);
+        let room = [
+            ("surge speed", &n.u, 0.1 * u0, 1.2 * u0, "at most 0.1·u0 and at least 1.2·u0"),
+            ("sway speed", &n.v, -u0, u0, "at least ±u0"),
+            ("yaw rate", &n.r, -2.0 * u0 / lpp, 2.0 * u0 / lpp, "at least ±2·u0/lpp"),
+        ];
+        room.into_iter().find_map(|(role, name, low, high, rule)| {
+            let name = model.vocabulary.canonical(name).unwrap_or_else(|| name.to_string());
+            let k = model.spec().states.iter().position(|s| s.name == name)?;
+            let state = &model.spec().states[k];
+            let (min, max) = (state.min.unwrap_or(f64::NEG_INFINITY), state.max.unwrap_or(f64::INFINITY));
+            (min > low || max < high).then(|| {
+                (
+                    format!("states[{k}].{}", if min > low { "min" } else { "max" }),
+                    format!(
+                        "the bounds [{min}, {max}] of `{name}` (the ship's {role}) leave no room for its manoeuvres at u0 = {u0} m/s, lpp = {lpp} m ({rule}): a run reaching them stops as diverging; widen them (`termid scale` rescales a model file's bounds with it)"
+                    ),
+                )
+            })
+        })
+    }
+
     /// Checks the `[ship]` table of a model read from `text`: its schema, positive lengths and
     /// speeds, and role names the model declares. Errors are located in the file.
     pub fn check(model: &Model, text: &str) -> Result<(), ModelError> {
@@ -213,29 +240,8 @@ impl ShipSpec {
                 ));
             }
         }
-        // a state's bounds stop a run as diverging: a ship's must leave room for its own
-        // manoeuvres at its approach speed (a template's model-scale bounds, copied for a ship
-        // at full scale, stop every run at once or a sound turn halfway)
-        let room = [
-            ("surge speed", &n.u, 0.1 * spec.u0, 1.2 * spec.u0, "at most 0.1·u0 and at least 1.2·u0"),
-            ("sway speed", &n.v, -spec.u0, spec.u0, "at least ±u0"),
-            ("yaw rate", &n.r, -2.0 * spec.u0 / spec.lpp, 2.0 * spec.u0 / spec.lpp, "at least ±2·u0/lpp"),
-        ];
-        for (role, name, low, high, rule) in room {
-            let name = model.vocabulary.canonical(name).unwrap_or_else(|| name.to_string());
-            let Some(k) = model.spec().states.iter().position(|s| s.name == name) else { continue };
-            let state = &model.spec().states[k];
-            let (min, max) = (state.min.unwrap_or(f64::NEG_INFINITY), state.max.unwrap_or(f64::INFINITY));
-            if min > low || max < high {
-                let key = if min > low { "min" } else { "max" };
-                return Err(key_err(
-                    &format!("states[{k}].{key}"),
-                    format!(
-                        "the bounds [{min}, {max}] of `{name}` (the ship's {role}) leave no room for its manoeuvres at u0 = {} m/s, lpp = {} m ({rule}): a run reaching them stops as diverging; widen them (`termid scale` rescales a model file's bounds with it)",
-                        spec.u0, spec.lpp
-                    ),
-                ));
-            }
+        if let Some((key, message)) = spec.bounds_without_room(model) {
+            return Err(key_err(&key, message));
         }
         if let Some(name) = &n.propeller {
             let canonical = model.vocabulary.canonical(name).unwrap_or_else(|| name.to_string());

@@ -102,8 +102,9 @@ fn a_manoeuvres_default_times_follow_the_ships_time_scale() {
 
 /// The MMG KVLCC2 file (L = 7 m) edited for the 320 m ship, its bounds left at the 7 m model's:
 /// the sway speed's ±5 m/s would stop a sound turn of a ship at 7.9 m/s, and the surge speed's
-/// 10 m/s a ship at 12 m/s at once. Refused at load, naming the key. The polynomial template's
-/// bounds hold any ship's manoeuvres (u to 30 m/s): it loads for both.
+/// 10 m/s a ship at 12 m/s at once. Refused at load, naming the key, and so is `--param u0=12`
+/// on the 7 m file. The polynomial template's bounds hold any ship's manoeuvres (u to 30 m/s):
+/// it loads for both.
 #[test]
 fn a_ship_model_whose_bounds_leave_no_room_for_its_manoeuvres_is_refused_with_its_key() {
     let text = std::fs::read_to_string("models/mmg_kvlcc2.toml").unwrap();
@@ -117,6 +118,17 @@ fn a_ship_model_whose_bounds_leave_no_room_for_its_manoeuvres_is_refused_with_it
     // widened, it loads
     let widened = full.replacen("min = -5.0\nmax = 5.0", "min = -40.0\nmax = 40.0", 1);
     termid::plugins::parse(&widened, "widened.toml").unwrap();
+    // an approach speed given on the command line is held to the same rule
+    let (ok, _, err) = crate::common::termid(&[
+        "simulate",
+        "--model",
+        "models/mmg_kvlcc2.toml",
+        "-m",
+        "turning:35",
+        "--param",
+        "u0=12",
+    ]);
+    assert!(!ok && err.contains("--param u0=12") && err.contains("`states[0].max`"), "{err}");
     let template =
         std::fs::read_to_string("models/new_ship.toml").unwrap().replace("lpp = 7.0", "lpp = 320.0");
     for u0 in ["7.91", "12.0"] {
