@@ -700,9 +700,7 @@ skip = 4
         let dir = std::env::temp_dir().join(format!("termid-gnss-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let (lat0, lon0) = (60f64.to_radians(), 5.3f64.to_radians());
-        let (a, e2) = (6_378_137.0, 6.694_379_990_14e-3);
-        let w = 1.0 - e2 * lat0.sin().powi(2);
-        let (m, n) = (a * (1.0 - e2) / w.powf(1.5), a / w.sqrt());
+        let (m, n) = crate::data::radii_of_curvature(lat0);
         let (speed, heading, drift) = (8.0, 30f64.to_radians(), 5f64.to_radians());
         let mut text = String::from("t,lat,lon,hdg\n");
         for k in 0..=100 {

@@ -13,6 +13,14 @@ fn ecef(lat: f64, lon: f64) -> [f64; 3] {
     [n * lat.cos() * lon.cos(), n * lat.cos() * lon.sin(), n * (1.0 - E2) * lat.sin()]
 }
 
+/// The ellipsoid's radii of curvature at latitude `lat` (rad), m: the meridian's
+/// M = a(1 − e²)/(1 − e² sin²φ)^{3/2} and the prime vertical's N = a/(1 − e² sin²φ)^{1/2}. A
+/// small step north of dφ is M·dφ, one east of dλ is N·cos φ·dλ.
+pub fn radii_of_curvature(lat: f64) -> (f64, f64) {
+    let w = 1.0 - E2 * lat.sin().powi(2);
+    (A * (1.0 - E2) / w.powf(1.5), A / w.sqrt())
+}
+
 /// Positions north and east of the first fix, m, of fixes at latitudes `lat` and longitudes
 /// `lon` (rad): each fix's earth-fixed point turned into the first fix's local north and east
 /// (the east-north-up frame, height dropped).
@@ -36,18 +44,16 @@ pub fn north_east(lat: &[f64], lon: &[f64]) -> (Vec<f64>, Vec<f64>) {
 mod tests {
     use super::*;
 
-    /// One minute of arc north and east, against the ellipsoid's radii of curvature in closed
-    /// form: the meridian's M = a(1 − e²)/(1 − e² sin²φ)^{3/2} and the prime vertical's
-    /// N = a/(1 − e² sin²φ)^{1/2} (a minute of latitude at 45° is 1 852.20 m, the nautical mile's
-    /// origin). A parallel is a small circle: a minute east lies y² tan φ / 2N north of the
+    /// One minute of arc north and east (through the earth-fixed frame), against the
+    /// ellipsoid's radii of curvature in closed form (a minute of latitude at 45° is 1 852.20 m,
+    /// the nautical mile's origin). A parallel is a small circle: a minute east lies y² tan φ / 2N north of the
     /// tangent plane's east axis. Across the antimeridian too.
     #[test]
     fn a_minute_of_arc_is_the_ellipsoids_radius_of_curvature() {
         let minute = (1.0f64 / 60.0).to_radians();
         for lat_deg in [0.0f64, 45.0, 60.0, -33.9] {
             let lat = lat_deg.to_radians();
-            let w = 1.0 - E2 * lat.sin().powi(2);
-            let (m, n) = (A * (1.0 - E2) / w.powf(1.5), A / w.sqrt());
+            let (m, n) = radii_of_curvature(lat);
             let (x, y) = north_east(&[lat, lat + minute, lat], &[0.3, 0.3, 0.3 + minute]);
             assert!((x[1] - m * minute).abs() < 0.01 && y[1].abs() < 1e-6, "{lat_deg}: {x:?} {y:?}");
             let bend = y[2] * y[2] * lat.tan() / (2.0 * n);

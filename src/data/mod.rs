@@ -25,7 +25,7 @@ pub use clock::clock_seconds;
 pub use dataset::{velocities_from_track, Dataset, Delimiter, RunSpec, Track};
 pub use derivative::{differentiator, CentralDifference, Differentiator, Smoothed, DIFFERENTIATORS};
 pub use five_point::FivePoint;
-pub use geodetic::north_east;
+pub use geodetic::{north_east, radii_of_curvature};
 pub use integral::{integral_rows, IntegralForm};
 pub use kalman::{KalmanSmoother, NoiseModel};
 pub use prepare::{prepare, Preparation};

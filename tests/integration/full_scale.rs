@@ -227,9 +227,7 @@ fn a_sea_trial_logged_by_satellite_and_gyrocompass_predicts_the_ships_turning_ci
     // the log: the course turned to 355°, the track as latitude and longitude about 54° N (the
     // ellipsoid's radii of curvature at the first fix), the heading as the gyro reads it
     let (course, lat0, lon0) = (355f64.to_radians(), 54f64.to_radians(), 7f64.to_radians());
-    let (a, e2) = (6_378_137.0, 6.694_379_990_14e-3);
-    let w = 1.0 - e2 * lat0.sin().powi(2);
-    let (m, n) = (a * (1.0 - e2) / w.powf(1.5), a / w.sqrt());
+    let (m, n) = termid::data::radii_of_curvature(lat0);
     let dir = crate::common::Scratch::new("sea-trial");
     let mut set = String::from(
         "[columns]\nt = \"time [s]\"\n\"ψ\" = \"gyro [deg]\"\nr = \"rot [deg/s]\"\n\"δ\" = \"rudder [deg]\"\nn = \"rpm [1/min]\"\n\
