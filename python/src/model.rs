@@ -842,7 +842,7 @@ impl PyModel {
 
     /// The model file's free parameters estimated from runs by output error (JSON report),
     /// with the model holding the estimates.
-    #[pyo3(signature = (runs, coefficients = false, states = None, initial_values = "auto".to_string(), dt = None, iterations = 50, sources = vec![], per_source = vec![], per_run = vec![], coarse = false, segments = None))]
+    #[pyo3(signature = (runs, coefficients = false, states = None, initial_values = "auto".to_string(), dt = None, iterations = 50, sources = vec![], per_source = vec![], per_run = vec![], coarse = false, segments = None, free = vec![], hold = vec![]))]
     #[allow(clippy::too_many_arguments)]
     fn estimate(
         &self,
@@ -858,7 +858,10 @@ impl PyModel {
         per_run: Vec<String>,
         coarse: bool,
         segments: Option<usize>,
+        free: Vec<String>,
+        hold: Vec<String>,
     ) -> PyResult<(String, PyModel)> {
+        let model = self.inner.freed(&free, &hold).map_err(refuse)?;
         let initial_values = termid::diagnose::InitialValues::parse(&initial_values)
             .map_err(|e| pyo3::exceptions::PyValueError::new_err(format!("initial_values {e}")))?;
         let frames = self.frames(runs)?;
@@ -887,11 +890,11 @@ impl PyModel {
         let (fit, metrics) = py
             .detach(|| -> Result<_, termid::diagnose::DiagnoseError> {
                 let mut runs =
-                    termid::diagnose::Runs::new(&self.inner, &frames, dt, termid::sim::Integrator::Rk4)?;
+                    termid::diagnose::Runs::new(&model, &frames, dt, termid::sim::Integrator::Rk4)?;
                 if let Some(names) = &states {
-                    runs = runs.comparing(&self.inner, names)?;
+                    runs = runs.comparing(&model, names)?;
                 }
-                let fit = termid::diagnose::estimate(&self.inner, &runs, &settings)?;
+                let fit = termid::diagnose::estimate(&model, &runs, &settings)?;
                 // a fit whose estimates do not re-simulate every run has no metrics, and says why
                 let metrics = fit
                     .re_simulated(&runs)
@@ -909,7 +912,7 @@ impl PyModel {
             }
             Err(why) => report["metrics_failed"] = why.into(),
         }
-        Ok((report.to_string(), PyModel { inner: fit.model }))
+        Ok((report.to_string(), PyModel { inner: self.inner.declared_freedom(&fit.model) }))
     }
 
     /// The plug-in's physical checks (JSON list: name, passed, refuses, detail).

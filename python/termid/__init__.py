@@ -1502,6 +1502,8 @@ class Model:
         per_run: Sequence[str] = (),
         coarse: bool = False,
         segments: Optional[int] = None,
+        free: Sequence[str] = (),
+        hold: Sequence[str] = (),
     ) -> Tuple[pd.DataFrame, "Model"]:
         """The model file's free parameters (``free = true`` under ``[parameters.NAME]``, with an
         optional ``prior`` and ``bounds``) estimated from ``runs`` by output error: grey-box
@@ -1570,6 +1572,14 @@ class Model:
         step halved until that holds, ``attrs["finer"]`` times): a step too long for a fast rate
         biases the estimates towards what the integrator can follow.
 
+        ``free`` names held parameters to estimate too and ``hold`` free ones to hold, for
+        this estimate only (the model returned keeps the file's word on each): a sea trial
+        tracked by satellite fixes gives velocities over ground, which carry the current the
+        ship moves in; a model from ``new_ship`` declares that current (``c_N``, ``c_E``, m/s
+        towards north and east, ``medium = true``, held at 0 for simulation) and
+        ``free=["c_N", "c_E"]`` estimates it once per source (``termid estimate`` does so by
+        itself for a dataset file whose track is latitude and longitude).
+
         >>> nomoto = termid.Model.builtin("nomoto")
         >>> truth = termid.Model.builtin("nomoto")
         >>> truth.set_parameter("K", 0.15); truth.set_parameter("T", 8.0)
@@ -1590,6 +1600,8 @@ class Model:
             list(per_run),
             coarse,
             None if segments is None else int(segments),
+            list(free),
+            list(hold),
         )
         report = json.loads(text)
         table = pd.DataFrame(

@@ -700,3 +700,21 @@ def test_monte_carlo_says_what_its_spread_comes_from():
     plain = termid.Model.default()
     found = plain.identify([plain.record("zigzag:20/20", seed=1), plain.record("zigzag:20/20:port", seed=2)], "kalman")
     assert found.model.monte_carlo("zigzag:20/20", 5).attrs["spread_from"].empty
+
+
+def test_estimate_frees_and_holds_parameters_for_itself_alone():
+    """``hold`` keeps a free parameter at the file's value for one estimate, ``free`` estimates
+    a held one (a sea trial's current); the model returned keeps the file's word on each."""
+    truth = termid.Model.builtin("nomoto")
+    truth.set_parameter("K", 0.15)
+    truth.set_parameter("T", 8.0)
+    run = truth.simulate(duration=80.0, inputs={"δ": 0.1}, sample=0.1)[["t", "ψ", "r", "δ"]]
+    start = termid.Model.builtin("nomoto")
+    start.set_parameter("T", 8.0)
+    table, found = start.estimate(run, hold=["T"])
+    assert list(table.index) == ["K"] and abs(table.loc["K", "estimate"] - 0.15) < 1e-3, table
+    assert found.parameters["T"] == 8.0 and found.free_parameters == ["K", "T"]
+    with pytest.raises(termid.TermidError, match="both to be freed and held"):
+        start.estimate(run, free=["K"], hold=["K"])
+    with pytest.raises(termid.TermidError, match="no parameter `c_N`"):
+        start.estimate(run, free=["c_N"])

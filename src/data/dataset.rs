@@ -317,6 +317,12 @@ fn split_spec(spec: &str) -> (String, Option<String>, f64) {
 }
 
 impl Dataset {
+    /// Whether its runs are tracked over ground (satellite fixes, `[track] latitude`): their
+    /// velocities are the body's over the earth, with any current or wind it moves in.
+    pub fn over_ground(&self) -> bool {
+        self.track.as_ref().is_some_and(|t| t.latitude.is_some())
+    }
+
     /// Reads a dataset file.
     pub fn load(path: &Path) -> Result<Dataset, DataError> {
         let file = path.display().to_string();
@@ -728,6 +734,8 @@ file = "trial.csv"
 "#,
         )
         .unwrap();
+        // over ground: the velocities carry any current
+        assert!(set.over_ground());
         let (frames, notes) = set.read(&dir, "t").unwrap();
         assert!(
             notes.iter().any(|n| n.contains("x0 and y0 in m north and east of the first fix")),

@@ -1422,12 +1422,17 @@ impl Estimate {
         }
         // the written model keeps the file's value of a per-source parameter (a source's value
         // is a nuisance of its records): a prediction for one source must set it
-        if let Some(p) = self.per_source.iter().rfind(|p| p.run.is_none()) {
+        if let Some(last) = self.per_source.iter().rfind(|p| p.run.is_none()) {
+            let of_last: Vec<&SourceParameter> =
+                self.per_source.iter().filter(|p| p.run.is_none() && p.source == last.source).collect();
+            let names: Vec<String> = of_last.iter().map(|p| format!("`{}`", p.name)).collect();
+            let values: Vec<String> =
+                of_last.iter().map(|p| format!("{}={}", p.name, num(p.value))).collect();
             out.push_str(&format!(
-                "  (each source's own value, not written: the model keeps its file's `{0}`; predict source {1}'s runs with `--param {0}={2}`)\n",
-                p.name,
-                p.source + 1,
-                num(p.value)
+                "  (each source's own value, not written: the model keeps its file's {}; predict source {}'s runs with `--param {}`)\n",
+                names.join(", "),
+                last.source + 1,
+                values.join(" ")
             ));
         }
         for r in &self.per_run {

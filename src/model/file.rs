@@ -151,10 +151,17 @@ pub struct ParameterSpec {
     /// The estimate's standard error (written by `termid estimate`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub std_error: Option<f64>,
-    /// A free parameter that belongs to the records, not to the system: estimated once per
-    /// run or per source unless the command says otherwise (`--per-run`, `--per-source`).
+    /// A parameter that belongs to the records, not to the system: estimated once per run or
+    /// per source unless the command says otherwise (`--per-run`, `--per-source`). On a held
+    /// parameter it says how the parameter is estimated where a command frees it (`--free`: a
+    /// sea trial's current).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub nuisance: Option<Nuisance>,
+    /// A velocity of the medium the body moves through (a current, a wind): held at `value` in
+    /// simulation (still water, calm air) and estimated, as its `nuisance` says, from runs whose
+    /// track is over ground (satellite fixes), whose velocities carry it.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub medium: bool,
 }
 
 /// `nuisance = "run"` or `"source"` under `[parameters.NAME]`.

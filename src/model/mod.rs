@@ -161,12 +161,6 @@ fn check_free(name: &str, p: &ParameterSpec) -> Result<(), (String, String)> {
             ));
         }
     }
-    if p.nuisance.is_some() && !p.free {
-        return Err((
-            ".nuisance".into(),
-            format!("`{name}` is no free parameter: only a free one (`free = true`) is estimated per run or source"),
-        ));
-    }
     if p.free && p.per_run.is_some() {
         return Err((
             ".free".into(),
@@ -300,6 +294,62 @@ impl Model {
             }
             None => false,
         }
+    }
+
+    /// Frees a held parameter (`free = true`): an estimate then changes it, from its value,
+    /// with the file's prior and bounds where it gives them, and per run or per source where
+    /// its `nuisance` says so (a sea trial's current). `false`: the model has no such
+    /// parameter, or sets it per run (`per_run`), which no one estimate can stand for.
+    pub fn free(&mut self, name: &str) -> bool {
+        match self.spec.parameters.get_mut(name) {
+            Some(p) if p.per_run.is_none() => {
+                p.free = true;
+                true
+            }
+            _ => false,
+        }
+    }
+
+    /// The model for one estimate: `free` freed, `hold` held (`--free`, `--hold`). `Err` says
+    /// which name it cannot take.
+    pub fn freed(&self, free: &[String], hold: &[String]) -> Result<Model, String> {
+        if let Some(name) = hold.iter().find(|n| free.contains(n)) {
+            return Err(format!("`{name}` is both to be freed and held: choose one"));
+        }
+        let mut model = self.clone();
+        for name in free {
+            if !model.free(name) {
+                return Err(format!(
+                    "{} has no parameter `{name}` that one estimate can stand for (its parameters: {})",
+                    self.path,
+                    self.spec.parameters.keys().cloned().collect::<Vec<_>>().join(", ")
+                ));
+            }
+        }
+        for name in hold {
+            if !model.hold(name) {
+                return Err(format!("{} has no parameter `{name}`", self.path));
+            }
+        }
+        Ok(model)
+    }
+
+    /// `estimated` with each parameter free or held as this model (the file) declares it:
+    /// what [`Model::freed`] changed was for one estimate, not for the file written.
+    pub fn declared_freedom(&self, estimated: &Model) -> Model {
+        let mut out = estimated.clone();
+        for (name, p) in &self.spec.parameters {
+            if let Some(q) = out.spec.parameters.get_mut(name) {
+                q.free = p.free;
+            }
+        }
+        out
+    }
+
+    /// The held parameters that are a velocity of the medium (`medium = true`: a current):
+    /// what runs tracked over ground ask to be estimated.
+    pub fn held_medium(&self) -> Vec<String> {
+        self.spec.parameters.iter().filter(|(_, p)| p.medium && !p.free).map(|(n, _)| n.clone()).collect()
     }
 
     /// Holds a free parameter at its value (`free = false`): what an estimate leaves alone.
@@ -863,6 +913,33 @@ mass = 2.0
         let again = Model::parse(&m.to_toml(), "again.toml").unwrap();
         assert_eq!(again.spec, m.spec);
         assert_eq!(m.equation("x_dot").unwrap().candidates.len(), 2);
+    }
+
+    /// A velocity of the medium is held in the file and freed for one estimate; the model
+    /// written keeps the file's word on which parameters are free.
+    #[test]
+    fn an_estimate_frees_and_holds_parameters_for_itself_alone() {
+        let text = format!(
+            "{DECAY}[parameters.a]\nvalue = 1.0\nfree = true\n[parameters.c]\nvalue = 0.0\nunit = \"m/s\"\nnuisance = \"source\"\nmedium = true\n[parameters.k]\nvalue = 2.0\nper_run = \"first:x\"\n"
+        );
+        let file = Model::parse(&text, "decay.toml").unwrap();
+        assert_eq!(file.held_medium(), ["c"]);
+        let names = |m: &Model| m.free_parameters().into_iter().map(|p| p.name).collect::<Vec<_>>();
+        let one = file.freed(&["c".into()], &["a".into()]).unwrap();
+        assert_eq!(names(&one), ["c"]);
+        assert_eq!(one.free_parameters()[0].nuisance, Some(Nuisance::Source));
+        assert!(one.held_medium().is_empty());
+        assert_eq!(names(&file.declared_freedom(&one)), ["a"]);
+        for (free, hold, says) in [
+            (&["x"][..], &[][..], "no parameter `x`"),
+            (&["k"], &[], "no parameter `k` that one estimate can stand for"),
+            (&["c"], &["c"], "both to be freed and held"),
+            (&[], &["x"], "no parameter `x`"),
+        ] {
+            let strings = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+            let e = file.freed(&strings(free), &strings(hold)).unwrap_err();
+            assert!(e.contains(says), "{e}");
+        }
     }
 
     #[test]

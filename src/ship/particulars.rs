@@ -515,6 +515,47 @@ mod tests {
         assert!(near(c[0].1, -0.391, 0.01) && near(c[2].1, -0.136, 0.01), "{c:?}");
     }
 
+    /// In a steady current the ship's motion through the water is the still water's (Fossen
+    /// 2011, sec. 10.3): the template's states are over ground, so its u and v are the still
+    /// water's plus the current in the ship's axes, its track the still water's carried by the
+    /// current, its heading and yaw rate the same.
+    #[test]
+    fn a_steady_current_carries_the_ship_and_changes_nothing_else() {
+        use crate::sim::{simulate, Constant, Integrator, Settings, System};
+        let still = kvlcc2().model().unwrap();
+        let mut carried = still.clone();
+        let (c_n, c_e) = (0.3, -0.2);
+        assert!(carried.set_parameter("c_N", c_n) && carried.set_parameter("c_E", c_e));
+        let settings = Settings { integrator: Integrator::Rk4, dt: 0.01, duration: 40.0, sample: 0.1 };
+        let psi0: f64 = 0.4;
+        // the current in the ship's axes at heading ψ (x0 north, y0 east)
+        let c_u = |psi: f64| c_n * psi.cos() + c_e * psi.sin();
+        let c_v = |psi: f64| c_e * psi.cos() - c_n * psi.sin();
+        let run = |model: &Model, x0: &[f64]| {
+            let system = System::new(model, &Default::default(), false).unwrap();
+            // hard over to 20° at the propeller's rate of the approach
+            simulate(&system, x0, &mut Constant(vec![20f64.to_radians(), 10.0]), &settings).unwrap()
+        };
+        let a = run(&still, &[1.17, 0.0, 0.0, psi0, 0.0, 0.0]);
+        let b = run(&carried, &[1.17 + c_u(psi0), c_v(psi0), 0.0, psi0, 0.0, 0.0]);
+        let turned = a.states[3].last().unwrap() - psi0;
+        assert!(turned > 1.0, "the ship turns: {turned} rad");
+        for k in 0..a.time.len() {
+            let (t, psi) = (a.time[k], a.states[3][k]);
+            let pairs = [
+                (b.states[0][k] - c_u(psi), a.states[0][k]),
+                (b.states[1][k] - c_v(psi), a.states[1][k]),
+                (b.states[2][k], a.states[2][k]),
+                (b.states[3][k], psi),
+                (b.states[4][k] - c_n * t, a.states[4][k]),
+                (b.states[5][k] - c_e * t, a.states[5][k]),
+            ];
+            for (i, (got, want)) in pairs.into_iter().enumerate() {
+                assert!((got - want).abs() < 1e-6, "state {i} at t = {t}: {got} against {want}");
+            }
+        }
+    }
+
     #[test]
     fn the_model_file_has_free_parameters_with_priors_and_simulates() {
         let model = kvlcc2().model().unwrap();

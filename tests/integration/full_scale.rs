@@ -191,19 +191,13 @@ fn a_container_ship_from_its_particulars_meets_imos_limits_as_printed() {
     assert!(text.contains("first overshoot") && !text.contains("not reached"), "{text}");
 }
 
-/// A sea trial of the 320 m ship as a ship logs it: a satellite receiver's latitude and
-/// longitude at 1 Hz (5 cm), a gyrocompass in [0°, 360°) on a course of 355°, so that every
-/// zigzag swings through north, no log (u and v from the track), the propeller's rate. The
-/// truth is the MMG KVLCC2 Froude-scaled to the ship. Read through a dataset file (`[track]
-/// latitude`, `longitude`), the heading made one continuous angle, `new-ship`'s model from the
-/// ship's particulars estimated on the eight zigzags predicts the ±35° circles within 3 %
-/// (−2.2 % and −2.5 %; logged at 4 Hz, −1.2 % and −1.4 %: the model basin's 20 Hz gives 1.0-1.5
-/// %). The truth is `termid::plugins::rescaled`, which rescales the ship's table too (the
-/// coefficients alone left the ship at the basin's speed and rudder rate).
-#[test]
-fn a_sea_trial_logged_by_satellite_and_gyrocompass_predicts_the_ships_turning_circles() {
-    use termid::data::Dataset;
-    use termid::diagnose::{estimate, Runs};
+/// A sea trial of the MMG KVLCC2 Froude-scaled to 320 m as a ship logs it, written to `dir` as
+/// eight CSVs and `trial.toml`: the eight zigzags of both sides, satellite fixes as latitude and
+/// longitude about 54° N at 1 Hz (5 cm; the ellipsoid's radii of curvature at the first fix), a
+/// gyrocompass in [0°, 360°) on a course of 355°, so that every zigzag swings through north, no
+/// log (u and v from the track), the propeller's rate; the ship in a steady `current` (m/s
+/// towards north and east), which carries the fixes. Returns the truth.
+fn sea_trial(dir: &std::path::Path, current: (f64, f64)) -> Model {
     use termid::ship::basin::{Artefacts, Basin, Noise, ZIGZAGS_BOTH_SIDES};
 
     let small = termid::plugins::load(std::path::Path::new("models/mmg_kvlcc2.toml")).unwrap();
@@ -224,11 +218,8 @@ fn a_sea_trial_logged_by_satellite_and_gyrocompass_predicts_the_ships_turning_ci
         artefacts: Artefacts { midship_end_s: 60.0, ..Artefacts::default() },
     };
     let runs = trial.record_all(&truth, &ZIGZAGS_BOTH_SIDES, u0, 700.0, 5, None).unwrap();
-    // the log: the course turned to 355°, the track as latitude and longitude about 54° N (the
-    // ellipsoid's radii of curvature at the first fix), the heading as the gyro reads it
     let (course, lat0, lon0) = (355f64.to_radians(), 54f64.to_radians(), 7f64.to_radians());
     let (m, n) = termid::data::radii_of_curvature(lat0);
-    let dir = crate::common::Scratch::new("sea-trial");
     let mut set = String::from(
         "[columns]\nt = \"time [s]\"\n\"ψ\" = \"gyro [deg]\"\nr = \"rot [deg/s]\"\n\"δ\" = \"rudder [deg]\"\nn = \"rpm [1/min]\"\n\
          [track]\nlatitude = \"lat [deg]\"\nlongitude = \"lon [deg]\"\nx = \"x0\"\ny = \"y0\"\nheading = \"ψ\"\nu = \"u\"\nv = \"v\"\n",
@@ -238,12 +229,13 @@ fn a_sea_trial_logged_by_satellite_and_gyrocompass_predicts_the_ships_turning_ci
         let col = |c: &str| f.column(c).unwrap();
         let mut text = String::from("time,lat,lon,gyro,rot,rudder,rpm\n");
         for k in 0..f.len() {
-            let (x, y) = (col("x0")[k], col("y0")[k]);
-            let (north, east) = (x * course.cos() - y * course.sin(), x * course.sin() + y * course.cos());
+            let (t, x, y) = (f.time()[k], col("x0")[k], col("y0")[k]);
+            // the track through the water turned onto the course, and carried by the current
+            let north = x * course.cos() - y * course.sin() + current.0 * t;
+            let east = x * course.sin() + y * course.cos() + current.1 * t;
             let (lat, lon) = (lat0 + north / m, lon0 + east / (n * lat0.cos()));
             text.push_str(&format!(
-                "{},{:.9},{:.9},{:.3},{:.4},{:.2},{:.2}\n",
-                f.time()[k],
+                "{t},{:.9},{:.9},{:.3},{:.4},{:.2},{:.2}\n",
                 lat.to_degrees(),
                 lon.to_degrees(),
                 (col("ψ")[k] + course).to_degrees().rem_euclid(360.0),
@@ -257,7 +249,84 @@ fn a_sea_trial_logged_by_satellite_and_gyrocompass_predicts_the_ships_turning_ci
         set.push_str(&format!("[[runs]]\nfile = \"{file}\"\n"));
     }
     std::fs::write(dir.join("trial.toml"), set).unwrap();
+    truth
+}
 
+/// The same trial in a current of 0.5 m/s (a knot) setting south-west (from 40°): satellite
+/// fixes give the velocity over ground, which carries it. Held at still water, the grey-box
+/// fits the runs as well as it can by bending the hull and misses the +35° circle by 16 % (its
+/// check of the runs' overshoots flags it, but blames the structure). `termid estimate` on a
+/// dataset tracked by latitude and longitude estimates the current `new-ship`'s model declares
+/// (`c_N`, `c_E`, once for the trial) with the ship, says so, and writes the model in still
+/// water: the current within 0.02 m/s, the ±35° circles within 5 % (−3.5 %, −4.0 %).
+#[test]
+fn a_sea_trial_in_a_current_estimates_the_current_with_the_ship() {
+    use crate::common::{json, termid};
+
+    let dir = crate::common::Scratch::new("sea-trial-current");
+    let from = 40f64.to_radians();
+    let current = (-0.5 * from.cos(), -0.5 * from.sin());
+    let truth = sea_trial(&dir, current);
+    let start = froude(&model_scale(), LAMBDA).model().unwrap();
+    std::fs::write(dir.join("start.toml"), start.to_toml()).unwrap();
+    let path = |f: &str| dir.join(f).display().to_string();
+    let estimated = |hold: &[&str]| {
+        let (start, dataset, out) = (path("start.toml"), path("trial.toml"), path("estimated.toml"));
+        let mut args = vec!["estimate", "--model", &start, "--dataset", &dataset, "--states", "u,v,r,ψ"];
+        args.extend(["--format", "json", "--out", &out]);
+        args.extend(hold);
+        let (ok, out, err) = termid(&args);
+        assert!(ok, "{err}");
+        (json(&out), err, termid::plugins::load(&dir.join("estimated.toml")).unwrap())
+    };
+    let error = |model: &Model, rudder: f64| {
+        tactical_diameter_in_lengths(model, 320.0, rudder)
+            / tactical_diameter_in_lengths(&truth, 320.0, rudder)
+            - 1.0
+    };
+
+    let (report, said, model) = estimated(&[]);
+    assert!(
+        said.contains("tracked over ground (satellite fixes)") && said.contains("c_E, c_N are estimated"),
+        "{said}"
+    );
+    let value = |name: &str| {
+        report["per_source"].as_array().unwrap().iter().find(|p| p["name"] == name).unwrap()["value"]
+            .as_f64()
+            .unwrap()
+    };
+    assert!((value("c_N") - current.0).abs() < 0.02 && (value("c_E") - current.1).abs() < 0.02, "{report}");
+    // the model written is the ship's in still water, its current held for the next estimate
+    assert_eq!(model.parameter_values()["c_N"], 0.0);
+    assert!(!model.free_parameters().iter().any(|p| p.name == "c_N"));
+    for rudder in [35.0, -35.0] {
+        assert!(error(&model, rudder).abs() < 0.05, "δ = {rudder}°: {:+.3}", error(&model, rudder));
+    }
+
+    // a polynomial model takes the velocities over ground for the ship's own: said
+    let (_, _, said) =
+        termid(&["identify", "--model", "models/new_ship.toml", "--dataset", &path("trial.toml")]);
+    assert!(said.contains("tracked over ground") && said.contains("a current biases every term"), "{said}");
+
+    let (_, said, held) = estimated(&["--hold", "c_N,c_E"]);
+    assert!(!said.contains("tracked over ground"), "{said}");
+    assert!(error(&held, 35.0).abs() > 0.10, "held at still water: {:+.3}", error(&held, 35.0));
+}
+
+/// A sea trial of the 320 m ship as a ship logs it ([`sea_trial`], in still water). Read
+/// through a dataset file (`[track] latitude`, `longitude`), the heading made one continuous
+/// angle, `new-ship`'s model from the
+/// ship's particulars estimated on the eight zigzags predicts the ±35° circles within 3 %
+/// (−2.2 % and −2.5 %; logged at 4 Hz, −1.2 % and −1.4 %: the model basin's 20 Hz gives 1.0-1.5
+/// %). The truth is `termid::plugins::rescaled`, which rescales the ship's table too (the
+/// coefficients alone left the ship at the basin's speed and rudder rate).
+#[test]
+fn a_sea_trial_logged_by_satellite_and_gyrocompass_predicts_the_ships_turning_circles() {
+    use termid::data::Dataset;
+    use termid::diagnose::{estimate, Runs};
+
+    let dir = crate::common::Scratch::new("sea-trial");
+    let truth = sea_trial(&dir, (0.0, 0.0));
     let start = froude(&model_scale(), LAMBDA).model().unwrap();
     let (mut frames, _) = Dataset::load(&dir.join("trial.toml")).unwrap().read(&dir, "t").unwrap();
     let mut said = Vec::new();

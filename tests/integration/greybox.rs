@@ -493,7 +493,7 @@ fn free_parameter_keys_are_checked() {
             "parameters.K.prior",
         ),
         ("free = true\nbounds = [0.0, 5.0]", "free = true\nper_run = \"first:r\"", "parameters.K.free"),
-        ("free = true\nbounds = [0.0, 5.0]", "nuisance = \"run\"", "parameters.K.nuisance"),
+        ("free = true\nbounds = [0.0, 5.0]", "free = true\nmedium = 1", "expected a boolean"),
         (
             "free = true\nbounds = [0.0, 5.0]",
             "free = true\nnuisance = \"basin\"",

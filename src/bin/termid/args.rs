@@ -80,6 +80,16 @@ pub struct EstimateCommand {
     /// file declares them a nuisance (`nuisance = "run"`).
     #[arg(long, num_args = 1.., value_delimiter = ',')]
     pub per_source: Vec<String>,
+    /// Held parameters of the model file to estimate too, from their values (with the file's
+    /// prior and bounds where it gives them; per run or source as its `nuisance` says): a sea
+    /// trial's current `c_N,c_E` in a model `new-ship` wrote.
+    #[arg(long, num_args = 1.., value_delimiter = ',')]
+    pub free: Vec<String>,
+    /// Free parameters of the model file to hold at their values in this estimate; among them
+    /// a velocity of the medium (`medium = true`: a current), which runs tracked over ground
+    /// (satellite fixes) otherwise estimate.
+    #[arg(long, num_args = 1.., value_delimiter = ',')]
+    pub hold: Vec<String>,
     /// Free parameters estimated once per run (nuisances that change from run to run, such
     /// as the rudder's zero `δ_0` as a basin's indicator drifts; the model keeps the runs'
     /// mean). A model file declares its own with `nuisance = "run"`.

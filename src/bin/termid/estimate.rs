@@ -21,7 +21,24 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
     if let Some(dir) = &cmd.svg {
         termid::output::check_folder(dir)?;
     }
-    let model = crate::simulate::load_model(&Some(cmd.model.clone()))?;
+    let file = crate::simulate::load_model(&Some(cmd.model.clone()))?;
+    // runs tracked over ground carry the current the body moves in: the model's own
+    // velocity of the medium is estimated with it, unless the command holds it
+    let over_ground = crate::runs::over_ground(&cmd.dataset);
+    let mut free = cmd.free.clone();
+    let medium: Vec<String> =
+        file.held_medium().into_iter().filter(|n| !cmd.hold.contains(n) && !free.contains(n)).collect();
+    if !over_ground.is_empty() && !medium.is_empty() {
+        eprintln!(
+            "note: the runs of {} are tracked over ground (satellite fixes): their velocities carry the current they move in, so the model's {} {} estimated with it (the model written keeps its file's value; `--hold {}` holds it)",
+            over_ground.join(", "),
+            medium.join(", "),
+            if medium.len() == 1 { "is" } else { "are" },
+            medium.join(",")
+        );
+        free.extend(medium);
+    }
+    let model = file.freed(&free, &cmd.hold).map_err(|e| anyhow::anyhow!("--free/--hold: {e}"))?;
     // said before any run is read
     if model.free_parameters().is_empty() && !cmd.coefficients {
         anyhow::bail!(
@@ -73,7 +90,7 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
     };
     let mut outputs = termid::output::Outputs::new();
     if let Some(out) = &cmd.out {
-        outputs.file(out, fit.model.to_toml().as_bytes())?;
+        outputs.file(out, file.declared_freedom(&fit.model).to_toml().as_bytes())?;
     }
     let mut drawn = false;
     if let Some(dir) = &cmd.svg {

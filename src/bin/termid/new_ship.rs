@@ -33,11 +33,20 @@ pub fn run(cmd: NewShipCommand) -> Result<()> {
         eprintln!("caution: {caution}");
     }
     termid::output::write_file(&cmd.out, model.to_toml().as_bytes())?;
+    let medium = model.held_medium();
     println!(
-        "wrote {} ({} free parameters): `termid estimate --model {} --dataset …` fits them to the ship's runs",
+        "wrote {} ({} free parameters): `termid estimate --model {} --dataset …` fits them to the ship's runs{}",
         cmd.out.display(),
         free.len(),
-        cmd.out.display()
+        cmd.out.display(),
+        if medium.is_empty() {
+            String::new()
+        } else {
+            format!(
+                ", and a current ({}, held at 0) with them where the runs are tracked by satellite fixes",
+                medium.join(", ")
+            )
+        }
     );
     Ok(())
 }

@@ -58,6 +58,16 @@ pub fn load_sources(
     Ok((frames, sources))
 }
 
+/// The dataset files whose runs are tracked over ground (satellite fixes): their velocities
+/// carry the current the body moves in.
+pub fn over_ground(datasets: &[PathBuf]) -> Vec<String> {
+    datasets
+        .iter()
+        .filter(|d| Dataset::load(d).is_ok_and(|d| d.over_ground()))
+        .map(|d| d.display().to_string())
+        .collect()
+}
+
 /// The sources of [`load_sources`] as the per-source estimates number them (`source 1: …`),
 /// a line each.
 pub fn source_labels(data: &[PathBuf], datasets: &[PathBuf]) -> String {
