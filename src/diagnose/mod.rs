@@ -10,6 +10,7 @@ mod choose;
 mod estimate;
 mod fit;
 mod hypotheses;
+mod medium;
 mod refine;
 mod sensitivity;
 
@@ -47,6 +48,7 @@ pub use estimate::{
     STEP_RESOLVES,
 };
 pub use fit::{in_segments, simulate_runs, EstimateError, PartlyRecorded, Runs, SEGMENT_SAMPLES};
+pub use medium::medium;
 pub use refine::{refine, RefineSettings, Refined, RefinedCoefficient};
 
 pub use hypotheses::{generic_hypotheses, Effect, Hypothesis};

@@ -259,6 +259,8 @@ fn sea_trial(dir: &std::path::Path, current: (f64, f64)) -> Model {
 /// dataset tracked by latitude and longitude estimates the current `new-ship`'s model declares
 /// (`c_N`, `c_E`, once for the trial) with the ship, says so, and writes the model in still
 /// water: the current within 0.02 m/s, the ±35° circles within 5 % (−3.5 %, −4.0 %).
+/// `validate` on the same runs estimates the day's current alone first (the model held): each
+/// first overshoot within 0.7° where in still water they miss by up to 3.8°.
 #[test]
 fn a_sea_trial_in_a_current_estimates_the_current_with_the_ship() {
     use crate::common::{json, termid};
@@ -302,6 +304,31 @@ fn a_sea_trial_in_a_current_estimates_the_current_with_the_ship() {
     for rudder in [35.0, -35.0] {
         assert!(error(&model, rudder).abs() < 0.05, "δ = {rudder}°: {:+.3}", error(&model, rudder));
     }
+
+    // the model validated on the trial's runs in the day's current, estimated alone (the model
+    // held), each run's first overshoot within 1°; in still water they miss by degrees
+    let first_overshoots_missed_by = |extra: &[&str]| {
+        let (est, dataset) = (path("estimated.toml"), path("trial.toml"));
+        let mut args = vec!["validate", "--model", &est, "--dataset", &dataset, "--format", "json"];
+        args.extend(extra);
+        let (ok, out, err) = termid(&args);
+        assert!(ok, "{err}");
+        let worst = json(&out)["metrics"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| {
+                let first = |side: &str| m[side]["first_overshoot_deg"].as_f64().unwrap();
+                (first("simulated") - first("measured")).abs()
+            })
+            .fold(0.0, f64::max);
+        (worst, err)
+    };
+    let (worst, said) = first_overshoots_missed_by(&[]);
+    assert!(said.contains("so they carry the current they moved in: estimated alone"), "{said}");
+    assert!(worst < 1.0, "validated in the day's current: first overshoots within {worst:.2}°");
+    let (worst, _) = first_overshoots_missed_by(&["--hold", "c_N,c_E"]);
+    assert!(worst > 2.0, "validated in still water: first overshoots within {worst:.2}°");
 
     // a polynomial model takes the velocities over ground for the ship's own: said
     let (_, _, said) =

@@ -603,6 +603,11 @@ pub struct RunsArgs {
     /// runs of every one together (each with its own columns, units and scale).
     #[arg(long, action = clap::ArgAction::Append)]
     pub dataset: Vec<PathBuf>,
+    /// A velocity of the medium the model declares (`medium = true`: a current) to keep at its
+    /// file's value: runs a dataset file tracks by satellite fixes otherwise have it estimated
+    /// first, alone, the model held.
+    #[arg(long, num_args = 1.., value_delimiter = ',')]
+    pub hold: Vec<String>,
 }
 
 /// How measured runs are re-simulated, and where the figures go.

@@ -19,9 +19,13 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
     if let Some(dir) = &cmd.resim.svg {
         termid::output::check_folder(dir)?;
     }
-    let mut model = crate::simulate::load_model(&cmd.model)?;
-    model.set_tolerances(cmd.resim.rtol, cmd.resim.atol)?;
-    let runs = crate::runs::load_for(&model, &cmd.runs.data, &cmd.runs.dataset)?;
+    let mut file = crate::simulate::load_model(&cmd.model)?;
+    file.set_tolerances(cmd.resim.rtol, cmd.resim.atol)?;
+    let runs = crate::runs::load_for(&file, &cmd.runs.data, &cmd.runs.dataset)?;
+    // runs tracked over ground carry the day's current: estimated first with the runs' other
+    // nuisances (each run's own values), the model held; the model written is in still water
+    let current = crate::runs::medium_to_free(&file, &cmd.runs.dataset, &cmd.runs.hold)?;
+    let model = file.freed(&current, &[]).map_err(anyhow::Error::msg)?;
     let hypotheses = termid::plugins::of(&model)
         .and_then(|p| p.hypotheses(&model))
         .unwrap_or_else(|| generic_hypotheses(&model));
@@ -38,7 +42,11 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
         crate::figures::write(&mut outputs, dir, "diagnose", figures)?;
     }
     if let (Some(out), Some(m)) = (&cmd.out, &d.model) {
-        outputs.file(out, m.to_toml().as_bytes())?;
+        let mut written = file.declared_freedom(m);
+        for name in &current {
+            written.set_parameter(name, file.parameter_values()[name]);
+        }
+        outputs.file(out, written.to_toml().as_bytes())?;
     }
     outputs.commit()?;
     match cmd.format {
@@ -81,11 +89,12 @@ fn own_values(d: &Diagnosis, model: &termid::model::Model) -> String {
         let values: Vec<f64> = d.own_values.iter().filter(|p| p.name == name).map(|p| p.value * f).collect();
         let (lo, hi) =
             values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
+        let range = match values.len() {
+            1 => format!("{}{unit}", sig(lo, 3)),
+            n => format!("{n} values from {}{unit} to {}{unit}", sig(lo, 3), sig(hi, 3)),
+        };
         s += &format!(
-            "{name}, which the model file declares of each run or source, estimated first with the rest of the model held: {} values from {}{unit} to {}{unit}; each run is diagnosed with its own\n",
-            values.len(),
-            sig(lo, 3),
-            sig(hi, 3)
+            "{name}, which the model file declares of each run or source, estimated first with the rest of the model held: {range}; each run is diagnosed with its own\n"
         );
     }
     for r in &d.one_value {

@@ -55,13 +55,7 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
         )?,
         None => {
             let (frames, sources) = crate::runs::load_sources(&model, &cmd.data, &cmd.dataset)?;
-            let over_ground = crate::runs::over_ground(&cmd.dataset);
-            if !over_ground.is_empty() {
-                eprintln!(
-                    "warning: the runs of {} are tracked over ground (satellite fixes): their velocities carry any current the ship moved in, which this model takes for the ship's own motion (a current biases every term; a grey-box model from `termid new-ship` estimates it with the ship: `termid estimate`)",
-                    over_ground.join(", ")
-                );
-            }
+            crate::runs::warn_over_ground(&cmd.dataset);
             let held = cmd
                 .refine_validation
                 .as_ref()

@@ -68,6 +68,78 @@ pub fn over_ground(datasets: &[PathBuf]) -> Vec<String> {
         .collect()
 }
 
+/// Where `datasets` track the runs by satellite fixes, a warning that a regression of terms
+/// takes any current they carry for the body's own motion.
+pub fn warn_over_ground(datasets: &[PathBuf]) {
+    let over = over_ground(datasets);
+    if !over.is_empty() {
+        eprintln!(
+            "warning: the runs of {} are tracked over ground (satellite fixes): their velocities carry any current the ship moved in, which this model takes for the ship's own motion (a current biases every term; a grey-box model from `termid new-ship` estimates it with the ship: `termid estimate`)",
+            over.join(", ")
+        );
+    }
+}
+
+/// The model's held velocity of the medium (a current) but those `hold` names, which must be
+/// among them.
+fn medium_names(model: &Model, hold: &[String]) -> Result<Vec<String>> {
+    let medium = model.held_medium();
+    if let Some(name) = hold.iter().find(|n| !medium.contains(n)) {
+        bail!("--hold {name}: {} declares no velocity of the medium `{name}` (`medium = true`)", model.path);
+    }
+    Ok(medium.into_iter().filter(|n| !hold.contains(n)).collect())
+}
+
+/// Where `datasets` track the runs by satellite fixes, the model's held velocity of the medium
+/// (a current) but those `hold` names: to be estimated with the runs' other nuisances, said.
+pub fn medium_to_free(model: &Model, datasets: &[PathBuf], hold: &[String]) -> Result<Vec<String>> {
+    let (over, names) = (over_ground(datasets), medium_names(model, hold)?);
+    if over.is_empty() || names.is_empty() {
+        return Ok(vec![]);
+    }
+    eprintln!(
+        "note: the runs of {} are tracked over ground (satellite fixes), so they carry the current they moved in: {} estimated from them first, with the runs' own values, the model held (`--hold {}` keeps the file's value)",
+        over.join(", "),
+        names.join(", "),
+        names.join(",")
+    );
+    Ok(names)
+}
+
+/// Where `datasets` track the runs by satellite fixes, the model's held velocity of the medium
+/// (a current; but those `hold` names) estimated alone from them, the model held
+/// (`termid::diagnose::medium`), and said: each run's value, as `Runs::with_initial` takes
+/// them. Empty where there is none to estimate.
+pub fn medium_of_runs(
+    model: &Model,
+    frames: &[Frame],
+    sources: &[usize],
+    datasets: &[PathBuf],
+    hold: &[String],
+) -> Result<Vec<(usize, String, f64)>> {
+    let (over, names) = (over_ground(datasets), medium_names(model, hold)?);
+    if over.is_empty() || names.is_empty() {
+        return Ok(vec![]);
+    }
+    let Some(day) = termid::diagnose::medium(model, &names, frames, sources)? else { return Ok(vec![]) };
+    let values: Vec<String> = day
+        .per_source
+        .iter()
+        .map(|p| {
+            let unit = model.spec().parameters.get(&p.name).map_or("", |q| q.unit.as_str());
+            let (value, se) = (termid::identify::sig(p.value, 3), termid::identify::sig(p.std_error, 2));
+            format!("{} = {value} ± {se} {unit} ({})", p.name, p.whose())
+        })
+        .collect();
+    eprintln!(
+        "note: the runs of {} are tracked over ground (satellite fixes), so they carry the current they moved in: estimated alone from them, the model held, each run simulated with it ({}; `--hold {}` keeps the file's value)",
+        over.join(", "),
+        values.join(", "),
+        names.join(",")
+    );
+    Ok(day.own_values().into_iter().map(|(r, n, v)| (r, n.to_string(), v)).collect())
+}
+
 /// The sources of [`load_sources`] as the per-source estimates number them (`source 1: …`),
 /// a line each.
 pub fn source_labels(data: &[PathBuf], datasets: &[PathBuf]) -> String {

@@ -20,9 +20,14 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
     }
     let mut model = crate::simulate::load_model(&cmd.model)?;
     model.set_tolerances(cmd.resim.rtol, cmd.resim.atol)?;
-    let runs = crate::runs::load_for(&model, &cmd.runs.data, &cmd.runs.dataset)?;
+    let (runs, sources) = crate::runs::load_sources(&model, &cmd.runs.data, &cmd.runs.dataset)?;
+    // runs tracked over ground: the day's current is theirs, not the model's
+    let current = crate::runs::medium_of_runs(&model, &runs, &sources, &cmd.runs.dataset, &cmd.runs.hold)?;
+    let current: Vec<(usize, &str, f64)> = current.iter().map(|(r, n, v)| (*r, n.as_str(), *v)).collect();
     let (integrator, dt) = model.simulation(cmd.resim.integrator, cmd.resim.dt);
-    let data = Runs::new(&model, &runs, dt, integrator)?.with_intercepts(cmd.resim.with_intercept);
+    let data = Runs::new(&model, &runs, dt, integrator)?
+        .with_intercepts(cmd.resim.with_intercept)
+        .with_initial(&[], &current);
     let sims = data.simulate(&model, &[], &[])?;
     let gap = data.gap(&sims);
     // a plug-in's models: its metrics read off measurement and simulation alike
