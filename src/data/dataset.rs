@@ -93,6 +93,17 @@ pub struct Track {
     /// The fix's longitude, a column of the file with its unit.
     #[serde(default)]
     pub longitude: Option<String>,
+    /// A satellite receiver's speed over ground, a column of the file with its unit
+    /// (`"sog [kn]"`): with `course_over_ground`, the earth-fixed velocity (x north, y east)
+    /// the surge and sway velocities are turned from, instead of `x_dot`, `y_dot` or the
+    /// differenced fixes (a receiver measures it from the carrier's Doppler shift, finer
+    /// than its fixes).
+    #[serde(default)]
+    pub speed_over_ground: Option<String>,
+    /// The receiver's course over ground, a column of the file with its unit (`"cog [deg]"`),
+    /// from north towards east.
+    #[serde(default)]
+    pub course_over_ground: Option<String>,
     /// Heading, measured from x towards y.
     pub heading: String,
     /// The surge velocity to compute.
@@ -317,10 +328,11 @@ fn split_spec(spec: &str) -> (String, Option<String>, f64) {
 }
 
 impl Dataset {
-    /// Whether its runs are tracked over ground (satellite fixes, `[track] latitude`): their
+    /// Whether its runs are tracked over ground (satellite fixes, `[track] latitude` or
+    /// `speed_over_ground`): their
     /// velocities are the body's over the earth, with any current or wind it moves in.
     pub fn over_ground(&self) -> bool {
-        self.track.as_ref().is_some_and(|t| t.latitude.is_some())
+        self.track.as_ref().is_some_and(|t| t.latitude.is_some() || t.speed_over_ground.is_some())
     }
 
     /// Reads a dataset file.
@@ -524,7 +536,30 @@ impl Dataset {
                 }
                 let col = |n: &str| frame.require(n).map(<[f64]>::to_vec);
                 let heading = col(&track.heading)?;
-                let (u, v) = match (&track.x, &track.y, &track.x_dot, &track.y_dot) {
+                let over_ground = match (&track.speed_over_ground, &track.course_over_ground) {
+                    (None, None) => None,
+                    (Some(sog), Some(cog)) if track.x_dot.is_none() && track.y_dot.is_none() => {
+                        Some((sog, cog, convert(sog, "speed over ground")?, convert(cog, "course over ground")?))
+                    }
+                    _ => {
+                        return Err(DataError::Unit {
+                            file: origin.clone(),
+                            row: 0,
+                            column: track.heading.clone(),
+                            message: "[track] takes speed_over_ground and course_over_ground together, and not with x_dot and y_dot".into(),
+                        })
+                    }
+                };
+                let (u, v) = if let Some((sog, cog, speed, course)) = over_ground {
+                    notes.push(format!(
+                        "{origin}: {} and {} turned into the body frame from the velocity over ground ({sog}, {cog}) by {}",
+                        track.u, track.v, track.heading
+                    ));
+                    let north: Vec<f64> = speed.iter().zip(&course).map(|(s, c)| s * c.cos()).collect();
+                    let east: Vec<f64> = speed.iter().zip(&course).map(|(s, c)| s * c.sin()).collect();
+                    velocities_from_earth_fixed(&north, &east, &heading)
+                } else {
+                    match (&track.x, &track.y, &track.x_dot, &track.y_dot) {
                     (Some(x), Some(y), None, None) => {
                         notes.push(format!(
                             "{origin}: {} and {} computed from the track ({x}, {y}) and {} over ±{} samples",
@@ -547,6 +582,7 @@ impl Dataset {
                             column: track.heading.clone(),
                             message: "[track] takes either the positions x and y or the earth-fixed velocities x_dot and y_dot".into(),
                         })
+                    }
                     }
                 };
                 frame.set(&track.u, u)?;
@@ -708,12 +744,18 @@ skip = 4
         let (lat0, lon0) = (60f64.to_radians(), 5.3f64.to_radians());
         let (m, n) = crate::data::radii_of_curvature(lat0);
         let (speed, heading, drift) = (8.0, 30f64.to_radians(), 5f64.to_radians());
-        let mut text = String::from("t,lat,lon,hdg\n");
+        let mut text = String::from("t,lat,lon,hdg,sog,cog\n");
         for k in 0..=100 {
             let t = f64::from(k);
             let (north, east) = (speed * (heading + drift).cos() * t, speed * (heading + drift).sin() * t);
             let (lat, lon) = (lat0 + north / m, lon0 + east / (n * lat0.cos()));
-            text.push_str(&format!("{t},{:.10},{:.10},30\n", lat.to_degrees(), lon.to_degrees()));
+            // the receiver's speed (knots) and course over ground beside its fixes
+            let (sog, cog) = (speed * 3600.0 / 1852.0, (heading + drift).to_degrees());
+            text.push_str(&format!(
+                "{t},{:.10},{:.10},30,{sog:.6},{cog}\n",
+                lat.to_degrees(),
+                lon.to_degrees()
+            ));
         }
         std::fs::write(dir.join("trial.csv"), text).unwrap();
         let set: Dataset = toml::from_str(
@@ -752,6 +794,38 @@ file = "trial.csv"
                 "{k}: {u} {v}"
             );
         }
+        // the receiver's velocity over ground instead of the differenced fixes: exact
+        let doppler = r#"
+[columns]
+t = "t [s]"
+"ψ" = "hdg [deg]"
+[track]
+speed_over_ground = "sog [kn]"
+course_over_ground = "cog [deg]"
+heading = "ψ"
+u = "u"
+v = "v"
+[[runs]]
+file = "trial.csv"
+"#;
+        let set: Dataset = toml::from_str(doppler).unwrap();
+        assert!(set.over_ground());
+        let (frames, notes) = set.read(&dir, "t").unwrap();
+        assert!(
+            notes.iter().any(|n| n.contains("from the velocity over ground (sog [kn], cog [deg])")),
+            "{notes:?}"
+        );
+        for k in [0, 50, 100] {
+            let (u, v) = (frames[0].column("u").unwrap()[k], frames[0].column("v").unwrap()[k]);
+            assert!(
+                (u - speed * drift.cos()).abs() < 1e-5 && (v - speed * drift.sin()).abs() < 1e-5,
+                "{k}: {u} {v}"
+            );
+        }
+        let half: Dataset =
+            toml::from_str(&doppler.replace("course_over_ground = \"cog [deg]\"\n", "")).unwrap();
+        let e = half.read(&dir, "t").unwrap_err().to_string();
+        assert!(e.contains("speed_over_ground and course_over_ground together"), "{e}");
         // a latitude without its longitude, or without the positions' names, is refused
         let half = toml::from_str::<Dataset>(
             "[columns]\nt = \"t [s]\"\n\"ψ\" = \"hdg [deg]\"\n[track]\nlatitude = \"lat [deg]\"\nx = \"x0\"\ny = \"y0\"\nheading = \"ψ\"\nu = \"u\"\nv = \"v\"\n[[runs]]\nfile = \"trial.csv\"\n",

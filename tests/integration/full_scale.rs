@@ -289,7 +289,7 @@ fn a_sea_trial_in_a_current_estimates_the_current_with_the_ship() {
 
     let (report, said, model) = estimated(&[]);
     assert!(
-        said.contains("tracked over ground (satellite fixes)") && said.contains("c_E, c_N are estimated"),
+        said.contains("tracked over ground (by a satellite receiver)") && said.contains("c_E, c_N are estimated"),
         "{said}"
     );
     let value = |name: &str| {

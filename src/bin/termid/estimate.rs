@@ -30,7 +30,7 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
         file.held_medium().into_iter().filter(|n| !cmd.hold.contains(n) && !free.contains(n)).collect();
     if !over_ground.is_empty() && !medium.is_empty() {
         eprintln!(
-            "note: the runs of {} are tracked over ground (satellite fixes): their velocities carry the current they move in, so the model's {} {} estimated with it (the model written keeps its file's value; `--hold {}` holds it)",
+            "note: the runs of {} are tracked over ground (by a satellite receiver): their velocities carry the current they move in, so the model's {} {} estimated with it (the model written keeps its file's value; `--hold {}` holds it)",
             over_ground.join(", "),
             medium.join(", "),
             if medium.len() == 1 { "is" } else { "are" },

@@ -58,7 +58,7 @@ pub fn load_sources(
     Ok((frames, sources))
 }
 
-/// The dataset files whose runs are tracked over ground (satellite fixes): their velocities
+/// The dataset files whose runs are tracked over ground (by a satellite receiver): their velocities
 /// carry the current the body moves in.
 pub fn over_ground(datasets: &[PathBuf]) -> Vec<String> {
     datasets
@@ -74,7 +74,7 @@ pub fn warn_over_ground(datasets: &[PathBuf]) {
     let over = over_ground(datasets);
     if !over.is_empty() {
         eprintln!(
-            "warning: the runs of {} are tracked over ground (satellite fixes): their velocities carry any current the ship moved in, which this model takes for the ship's own motion (a current biases every term; a grey-box model from `termid new-ship` estimates it with the ship: `termid estimate`)",
+            "warning: the runs of {} are tracked over ground (by a satellite receiver): their velocities carry any current the ship moved in, which this model takes for the ship's own motion (a current biases every term; a grey-box model from `termid new-ship` estimates it with the ship: `termid estimate`)",
             over.join(", ")
         );
     }
@@ -98,7 +98,7 @@ pub fn medium_to_free(model: &Model, datasets: &[PathBuf], hold: &[String]) -> R
         return Ok(vec![]);
     }
     eprintln!(
-        "note: the runs of {} are tracked over ground (satellite fixes), so they carry the current they moved in: {} estimated from them first, with the runs' own values, the model held (`--hold {}` keeps the file's value)",
+        "note: the runs of {} are tracked over ground (by a satellite receiver), so they carry the current they moved in: {} estimated from them first, with the runs' own values, the model held (`--hold {}` keeps the file's value)",
         over.join(", "),
         names.join(", "),
         names.join(",")
@@ -132,7 +132,7 @@ pub fn medium_of_runs(
         })
         .collect();
     eprintln!(
-        "note: the runs of {} are tracked over ground (satellite fixes), so they carry the current they moved in: estimated alone from them, the model held, each run simulated with it ({}; `--hold {}` keeps the file's value)",
+        "note: the runs of {} are tracked over ground (by a satellite receiver), so they carry the current they moved in: estimated alone from them, the model held, each run simulated with it ({}; `--hold {}` keeps the file's value)",
         over.join(", "),
         values.join(", "),
         names.join(",")
