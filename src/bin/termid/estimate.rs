@@ -37,6 +37,8 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
             medium.join(",")
         );
         free.extend(medium);
+    } else if !file.spec().parameters.values().any(|p| p.medium) {
+        crate::runs::warn_over_ground(&cmd.dataset);
     }
     let model = file.freed(&free, &cmd.hold).map_err(|e| anyhow::anyhow!("--free/--hold: {e}"))?;
     // said before any run is read

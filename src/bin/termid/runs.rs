@@ -68,13 +68,14 @@ pub fn over_ground(datasets: &[PathBuf]) -> Vec<String> {
         .collect()
 }
 
-/// Where `datasets` track the runs by satellite fixes, a warning that a regression of terms
-/// takes any current they carry for the body's own motion.
+/// Where `datasets` track the runs by satellite fixes, a warning that a model without a
+/// velocity of the medium (a polynomial one) takes any current they carry for the body's own
+/// motion.
 pub fn warn_over_ground(datasets: &[PathBuf]) {
     let over = over_ground(datasets);
     if !over.is_empty() {
         eprintln!(
-            "warning: the runs of {} are tracked over ground (by a satellite receiver): their velocities carry any current the ship moved in, which this model takes for the ship's own motion (a current biases every term; a grey-box model from `termid new-ship` estimates it with the ship: `termid estimate`)",
+            "warning: the runs of {} are tracked over ground (by a satellite receiver): their velocities carry any current the ship moved in, which a model that reads them and declares no current (`medium = true`) takes for the ship's own motion, every term biased by it (a grey-box model from `termid new-ship` declares one, which `termid estimate` estimates with the ship)",
             over.join(", ")
         );
     }
@@ -121,7 +122,18 @@ pub fn medium_of_runs(
     if over.is_empty() || names.is_empty() {
         return Ok(vec![]);
     }
-    let Some(day) = termid::diagnose::medium(model, &names, frames, sources)? else { return Ok(vec![]) };
+    let day = match termid::diagnose::medium(model, &names, frames, sources) {
+        Ok(Some(day)) => day,
+        Ok(None) => return Ok(vec![]),
+        Err(e) => {
+            eprintln!(
+                "warning: the runs of {} are tracked over ground (by a satellite receiver), but the current they moved in could not be estimated ({e}): each run is simulated in the file's {}, which its errors below include",
+                over.join(", "),
+                names.join(", ")
+            );
+            return Ok(vec![]);
+        }
+    };
     let values: Vec<String> = day
         .per_source
         .iter()
