@@ -82,6 +82,32 @@ impl PyModel {
         Ok((frames, data, sims))
     }
 
+    /// `data` with each run in the velocity of the medium it moved in (a sea trial's current,
+    /// the model's held `medium` parameters estimated alone from the runs, the model held),
+    /// where `over_ground`; the estimates (JSON list: name, source, value, std_error; null
+    /// where none).
+    fn in_medium(
+        &self,
+        py: Python<'_>,
+        frames: &[Frame],
+        data: termid::diagnose::Runs,
+        over_ground: bool,
+    ) -> PyResult<(termid::diagnose::Runs, serde_json::Value)> {
+        if !over_ground {
+            return Ok((data, serde_json::Value::Null));
+        }
+        let names = self.inner.held_medium();
+        let sources = vec![0; frames.len()];
+        match py.detach(|| termid::diagnose::medium(&self.inner, &names, frames, &sources)).map_err(fail)? {
+            Some(day) => {
+                let values = serde_json::to_value(&day.per_source)
+                    .map_err(|e| refuse(format!("could not serialise: {e}")))?;
+                Ok((data.with_initial(&[], &day.own_values()), values))
+            }
+            None => Ok((data, serde_json::Value::Null)),
+        }
+    }
+
     /// Refused where the model stores no covariance to draw models from.
     fn drawable(&self) -> PyResult<()> {
         if termid::uncertainty::uncertain_equations(&self.inner).is_empty() {
@@ -608,7 +634,7 @@ impl PyModel {
 
     /// The model against held-out runs: the error of every compared state, and for a
     /// plug-in's models its metrics measured and simulated (JSON).
-    #[pyo3(signature = (runs, dt = None, integrator = None, with_intercept = false))]
+    #[pyo3(signature = (runs, dt = None, integrator = None, with_intercept = false, over_ground = false))]
     fn validate(
         &self,
         py: Python<'_>,
@@ -616,8 +642,11 @@ impl PyModel {
         dt: Option<f64>,
         integrator: Option<&str>,
         with_intercept: bool,
+        over_ground: bool,
     ) -> PyResult<String> {
-        let (frames, data, sims) = self.resimulate(py, runs, dt, integrator, with_intercept)?;
+        let (frames, data) = self.replayable(runs, dt, integrator, with_intercept)?;
+        let (data, medium) = self.in_medium(py, &frames, data, over_ground)?;
+        let sims = py.detach(|| data.simulate(&self.inner, &[], &[])).map_err(fail)?;
         let plugin = termid::plugins::of(&self.inner);
         let observe = |f: &Frame, s: Option<&Trajectory>| {
             plugin.and_then(|p| p.observe(&self.inner, f, s)).map(|o| o.json)
@@ -627,7 +656,7 @@ impl PyModel {
             .zip(&sims)
             .map(|(f, s)| serde_json::json!({"run": f.origin(), "measured": observe(f, None), "simulated": observe(f, Some(s))}))
             .collect();
-        to_json(&serde_json::json!({"gap": data.gap(&sims), "metrics": metrics}))
+        to_json(&serde_json::json!({"gap": data.gap(&sims), "metrics": metrics, "medium": medium}))
     }
 
     /// The model's uncertainty against held-out runs: every run simulated as `validate`
@@ -635,7 +664,7 @@ impl PyModel {
     /// run each metric's spread over the draws and whether the measured value lies outside its
     /// 5-95 % range (JSON: draws, failed, first_failure, refused, runs). Where too many draws
     /// fail, `refused` says why and no spread is given.
-    #[pyo3(signature = (runs, n, seed = 1, dt = None, integrator = None, with_intercept = false))]
+    #[pyo3(signature = (runs, n, seed = 1, dt = None, integrator = None, with_intercept = false, over_ground = false))]
     #[allow(clippy::too_many_arguments)]
     fn validate_monte_carlo(
         &self,
@@ -646,9 +675,11 @@ impl PyModel {
         dt: Option<f64>,
         integrator: Option<&str>,
         with_intercept: bool,
+        over_ground: bool,
     ) -> PyResult<String> {
         self.drawable()?;
         let (frames, data) = self.replayable(runs, dt, integrator, with_intercept)?;
+        let (data, _) = self.in_medium(py, &frames, data, over_ground)?;
         // each draw keeps every run's metrics (a few dozen numbers)
         termid::budget::check_values(
             n as f64 * frames.len() as f64 * 64.0,
@@ -842,7 +873,7 @@ impl PyModel {
 
     /// The model file's free parameters estimated from runs by output error (JSON report),
     /// with the model holding the estimates.
-    #[pyo3(signature = (runs, coefficients = false, states = None, initial_values = "auto".to_string(), dt = None, iterations = 50, sources = vec![], per_source = vec![], per_run = vec![], coarse = false, segments = None, free = vec![], hold = vec![]))]
+    #[pyo3(signature = (runs, coefficients = false, states = None, initial_values = "auto".to_string(), dt = None, iterations = 50, sources = vec![], per_source = vec![], per_run = vec![], coarse = false, segments = None, free = vec![], hold = vec![], over_ground = false))]
     #[allow(clippy::too_many_arguments)]
     fn estimate(
         &self,
@@ -860,7 +891,15 @@ impl PyModel {
         segments: Option<usize>,
         free: Vec<String>,
         hold: Vec<String>,
+        over_ground: bool,
     ) -> PyResult<(String, PyModel)> {
+        // runs tracked over ground: the model's held velocity of the medium estimated with it
+        let medium = self
+            .inner
+            .held_medium()
+            .into_iter()
+            .filter(|n| over_ground && !hold.contains(n) && !free.contains(n));
+        let free: Vec<String> = free.iter().cloned().chain(medium).collect();
         let model = self.inner.freed(&free, &hold).map_err(refuse)?;
         let initial_values = termid::diagnose::InitialValues::parse(&initial_values)
             .map_err(|e| pyo3::exceptions::PyValueError::new_err(format!("initial_values {e}")))?;

@@ -1302,6 +1302,7 @@ class Model:
         raw: bool = False,
         monte_carlo: int = 0,
         seed: int = 1,
+        over_ground: bool = False,
     ) -> Any:
         """Held-out ``runs`` against the model: a DataFrame of every run's and state's RMS and
         largest error (index run, state; the unit beside), ``attrs["cost"]`` the scaled sum of
@@ -1318,6 +1319,12 @@ class Model:
         ``outside``: one measurement in ten falls outside by chance). Where more than 5 % of
         the draws fail it raises :class:`TermidError` saying why, as :meth:`monte_carlo` does.
 
+        ``over_ground``: the runs are tracked by a satellite receiver, so their velocities carry
+        the day's current: the model's velocity of the medium (``medium = true``, a model from
+        :meth:`from_particulars` declares ``c_N``, ``c_E``) is estimated alone from them first,
+        the model held, and each run simulated in it (``attrs["medium"]``: name, source, value,
+        std_error), as ``termid validate`` does for a dataset tracked by latitude and longitude.
+
         >>> ship = termid.Model.default()
         >>> gap = ship.validate(ship.record("zigzag:20/20", truth=True))
         >>> gap.loc[("zigzag:20/20#0", "ψ"), "unit"], bool(gap.loc[("zigzag:20/20#0", "ψ"), "rms"] < 0.01)
@@ -1328,10 +1335,10 @@ class Model:
         ['measured', 'mean', 'sd', 'p05', 'p95', 'outside']
         """
         given = _runs(runs)
-        report = json.loads(self._native.validate(given, dt, integrator, with_intercept))
+        report = json.loads(self._native.validate(given, dt, integrator, with_intercept, over_ground))
         band = None
         if monte_carlo:
-            band = json.loads(self._native.validate_monte_carlo(given, monte_carlo, seed, dt, integrator, with_intercept))
+            band = json.loads(self._native.validate_monte_carlo(given, monte_carlo, seed, dt, integrator, with_intercept, over_ground))
             if band["refused"] is not None:
                 raise TermidError(band["refused"])
             report["monte_carlo"] = band
@@ -1345,6 +1352,11 @@ class Model:
             if m.get(source) is not None
         ]
         frame.attrs["metrics"] = pd.DataFrame(rows).set_index(["run", "source"]) if rows else pd.DataFrame()
+        medium = report.get("medium") or []
+        frame.attrs["medium"] = pd.DataFrame(
+            [{"name": p["name"], "source": p["source"], "value": p["value"], "std_error": p["std_error"]} for p in medium],
+            columns=["name", "source", "value", "std_error"],
+        )
         if band is not None:
             rows = [
                 {
@@ -1504,6 +1516,7 @@ class Model:
         segments: Optional[int] = None,
         free: Sequence[str] = (),
         hold: Sequence[str] = (),
+        over_ground: bool = False,
     ) -> Tuple[pd.DataFrame, "Model"]:
         """The model file's free parameters (``free = true`` under ``[parameters.NAME]``, with an
         optional ``prior`` and ``bounds``) estimated from ``runs`` by output error: grey-box
@@ -1577,8 +1590,10 @@ class Model:
         tracked by satellite fixes gives velocities over ground, which carry the current the
         ship moves in; a model from ``new_ship`` declares that current (``c_N``, ``c_E``, m/s
         towards north and east, ``medium = true``, held at 0 for simulation) and
-        ``free=["c_N", "c_E"]`` estimates it once per source (``termid estimate`` does so by
-        itself for a dataset file whose track is latitude and longitude).
+        ``free=["c_N", "c_E"]`` estimates it once per source; ``over_ground`` (true) frees every
+        velocity of the medium the model declares (``medium = true``) but those in ``hold``, as
+        ``termid estimate`` does by itself for a dataset file whose track is latitude and
+        longitude.
 
         >>> nomoto = termid.Model.builtin("nomoto")
         >>> truth = termid.Model.builtin("nomoto")
@@ -1602,6 +1617,7 @@ class Model:
             None if segments is None else int(segments),
             list(free),
             list(hold),
+            over_ground,
         )
         report = json.loads(text)
         table = pd.DataFrame(

@@ -93,7 +93,12 @@ class Model:
         self, runs: Sequence[Run], dt: Optional[float] = None, integrator: Optional[str] = None, with_intercept: bool = False
     ) -> List[NamedArrays]: ...
     def validate(
-        self, runs: Sequence[Run], dt: Optional[float] = None, integrator: Optional[str] = None, with_intercept: bool = False
+        self,
+        runs: Sequence[Run],
+        dt: Optional[float] = None,
+        integrator: Optional[str] = None,
+        with_intercept: bool = False,
+        over_ground: bool = False,
     ) -> str: ...
     def validate_monte_carlo(
         self,
@@ -103,6 +108,7 @@ class Model:
         dt: Optional[float] = None,
         integrator: Optional[str] = None,
         with_intercept: bool = False,
+        over_ground: bool = False,
     ) -> str: ...
     def diagnose(
         self, runs: Sequence[Run], dt: Optional[float] = None, integrator: Optional[str] = None, with_intercept: bool = False
@@ -140,6 +146,7 @@ class Model:
         segments: Optional[int] = None,
         free: Sequence[str] = ...,
         hold: Sequence[str] = ...,
+        over_ground: bool = False,
     ) -> Tuple[str, Model]: ...
     def checks(self, runs: Sequence[Run] = ...) -> str: ...
     def steering_gear(self, runs: Sequence[Run]) -> Optional[str]: ...

@@ -718,3 +718,53 @@ def test_estimate_frees_and_holds_parameters_for_itself_alone():
         start.estimate(run, free=["K"], hold=["K"])
     with pytest.raises(termid.TermidError, match="no parameter `c_N`"):
         start.estimate(run, free=["c_N"])
+
+
+DRIFTER = """
+[model]
+name = "drifter"
+[[states]]
+name = "x"
+[[states]]
+name = "w"
+[[inputs]]
+name = "v"
+[parameters."τ"]
+value = 2.0
+free = true
+[parameters.c]
+value = 0.0
+unit = "m/s"
+nuisance = "source"
+medium = true
+[equations.x_dot]
+state = "x"
+identify = false
+coefficients = { "w" = 1.0, "c" = 1.0 }
+[equations.w_dot]
+state = "w"
+identify = false
+coefficients = { "v/τ" = 1.0, "w/τ" = -1.0 }
+"""
+
+
+def test_runs_tracked_over_ground_get_the_days_current():
+    """A body whose track a stream of 0.4 m/s carries (``c``, ``medium = true``, held at 0):
+    ``over_ground=True`` estimates the stream alone before validating, and with the body's
+    τ in ``estimate``; the model returned stays in still water."""
+    truth = termid.Model.from_toml(DRIFTER.replace("value = 2.0", "value = 3.0"), "truth.toml")
+    truth.set_parameter("c", 0.4)
+    runs = [truth.simulate(duration=20.0, inputs={"v": v}, sample=0.1)[["t", "x", "w", "v"]] for v in (1.0, -0.5)]
+    start = termid.Model.from_toml(DRIFTER, "drifter.toml")
+    start.set_parameter("τ", 3.0)
+    still = start.validate(runs)
+    carried = start.validate(runs, over_ground=True)
+    assert list(carried.attrs["medium"]["name"]) == ["c"] and still.attrs["medium"].empty
+    assert abs(carried.attrs["medium"]["value"][0] - 0.4) < 1e-6, carried.attrs["medium"]
+    assert carried["rms"].max() < 1e-6 < 0.1 < still["rms"].max(), (carried, still)
+    start.set_parameter("τ", 2.0)
+    table, found = start.estimate(runs, over_ground=True)
+    assert abs(table.loc["τ", "estimate"] - 3.0) < 1e-4, table
+    current = table.attrs["per_source"]
+    assert abs(current.loc[current["name"] == "c", "value"].iloc[0] - 0.4) < 1e-4, current
+    assert found.parameters["c"] == 0.0 and found.free_parameters == ["τ"]
