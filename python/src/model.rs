@@ -745,7 +745,7 @@ impl PyModel {
 
     /// Where model and runs disagree and which effect explains it (JSON), with the model that
     /// has the effect added (None when no effect explains enough).
-    #[pyo3(signature = (runs, dt = None, integrator = None, with_intercept = false))]
+    #[pyo3(signature = (runs, dt = None, integrator = None, with_intercept = false, over_ground = false))]
     fn diagnose(
         &self,
         py: Python<'_>,
@@ -753,8 +753,12 @@ impl PyModel {
         dt: Option<f64>,
         integrator: Option<&str>,
         with_intercept: bool,
+        over_ground: bool,
     ) -> PyResult<(String, Option<PyModel>)> {
         let frames = self.frames(runs)?;
+        // runs tracked over ground: the day's current estimated first with the runs' own values
+        let medium = if over_ground { self.inner.held_medium() } else { vec![] };
+        let model = self.inner.freed(&medium, &[]).map_err(refuse)?;
         let hypotheses = termid::plugins::of(&self.inner)
             .and_then(|p| p.hypotheses(&self.inner))
             .unwrap_or_else(|| termid::diagnose::generic_hypotheses(&self.inner));
@@ -766,7 +770,7 @@ impl PyModel {
             ..Default::default()
         };
         let d = py
-            .detach(|| termid::diagnose::diagnose(&self.inner, &frames, &hypotheses, &settings))
+            .detach(|| termid::diagnose::diagnose(&model, &frames, &hypotheses, &settings))
             .map_err(fail)?;
         let effect = d.winner.map(|w| {
             let c = &d.candidates[w];
@@ -778,7 +782,7 @@ impl PyModel {
             "gap_after": d.gap_after, "candidates": d.candidates,
             "own_values": d.own_values, "one_value": d.one_value,
         });
-        Ok((to_json(&json)?, d.model.map(|inner| PyModel { inner })))
+        Ok((to_json(&json)?, d.model.map(|m| PyModel { inner: self.inner.as_declared(&m) })))
     }
 
     /// The library's recipe (several derivative starts, choice among back-ends by
@@ -951,7 +955,7 @@ impl PyModel {
             }
             Err(why) => report["metrics_failed"] = why.into(),
         }
-        Ok((report.to_string(), PyModel { inner: self.inner.declared_freedom(&fit.model) }))
+        Ok((report.to_string(), PyModel { inner: self.inner.as_declared(&fit.model) }))
     }
 
     /// The plug-in's physical checks (JSON list: name, passed, refuses, detail).

@@ -1390,6 +1390,7 @@ class Model:
         integrator: Optional[str] = None,
         with_intercept: bool = False,
         raw: bool = False,
+        over_ground: bool = False,
     ) -> Tuple[Any, Optional["Model"]]:
         """Where model and ``runs`` disagree, which effect explains it, and the model with it:
         a DataFrame of every run's and state's error before and after the effect (columns
@@ -1400,14 +1401,17 @@ class Model:
         ``nuisance = "run"``), each run is diagnosed with its own values, estimated first with
         the rest of the model held: ``attrs["own_values"]`` (a DataFrame of ``name``, ``run``,
         ``value``, ``std_error``; empty where none). ``raw``: the report as plain values;
-        ``dt``, ``integrator``, ``with_intercept`` as for :meth:`simulate`.
+        ``dt``, ``integrator``, ``with_intercept`` as for :meth:`simulate`. ``over_ground``: the
+        runs are tracked by a satellite receiver, so the model's velocity of the medium (a
+        current, ``medium = true``) is estimated among those own values; the model returned
+        keeps the file's (still water).
 
         >>> ship = termid.Model.default()
         >>> gaps, repaired = ship.diagnose(ship.record("zigzag:20/20", truth=True))
         >>> list(gaps.columns[:3])
         ['unit', 'rms_before', 'max_before']
         """
-        text, native = self._native.diagnose(_runs(runs), dt, integrator, with_intercept)
+        text, native = self._native.diagnose(_runs(runs), dt, integrator, with_intercept, over_ground)
         report = json.loads(text)
         model = Model(native) if native is not None else None
         if raw:

@@ -111,7 +111,12 @@ class Model:
         over_ground: bool = False,
     ) -> str: ...
     def diagnose(
-        self, runs: Sequence[Run], dt: Optional[float] = None, integrator: Optional[str] = None, with_intercept: bool = False
+        self,
+        runs: Sequence[Run],
+        dt: Optional[float] = None,
+        integrator: Optional[str] = None,
+        with_intercept: bool = False,
+        over_ground: bool = False,
     ) -> Tuple[str, Optional[Model]]: ...
     def recipe(
         self,

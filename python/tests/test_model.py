@@ -768,3 +768,8 @@ def test_runs_tracked_over_ground_get_the_days_current():
     current = table.attrs["per_source"]
     assert abs(current.loc[current["name"] == "c", "value"].iloc[0] - 0.4) < 1e-4, current
     assert found.parameters["c"] == 0.0 and found.free_parameters == ["τ"]
+    # diagnosed in the day's stream: nothing left to explain
+    gaps, _ = found.diagnose(runs, over_ground=True)
+    own = gaps.attrs["own_values"]
+    assert abs(own.loc[own["name"] == "c", "value"].iloc[0] - 0.4) < 1e-4, own
+    assert gaps["rms_before"].max() < 1e-3, gaps

@@ -334,13 +334,19 @@ impl Model {
         Ok(model)
     }
 
-    /// `estimated` with each parameter free or held as this model (the file) declares it:
-    /// what [`Model::freed`] changed was for one estimate, not for the file written.
-    pub fn declared_freedom(&self, estimated: &Model) -> Model {
+    /// `estimated` as this model (the file) declares it: each parameter free or held as here
+    /// (what [`Model::freed`] changed was for one estimate), and each velocity of the medium
+    /// (`medium = true`) at this model's value: a current belongs to the day's runs, not to
+    /// the body (a per-run estimate's mean is no more the model's than one run's value).
+    pub fn as_declared(&self, estimated: &Model) -> Model {
         let mut out = estimated.clone();
         for (name, p) in &self.spec.parameters {
             if let Some(q) = out.spec.parameters.get_mut(name) {
                 q.free = p.free;
+                if p.medium {
+                    q.value = p.value;
+                    q.std_error = p.std_error;
+                }
             }
         }
         out
@@ -929,7 +935,11 @@ mass = 2.0
         assert_eq!(names(&one), ["c"]);
         assert_eq!(one.free_parameters()[0].nuisance, Some(Nuisance::Source));
         assert!(one.held_medium().is_empty());
-        assert_eq!(names(&file.declared_freedom(&one)), ["a"]);
+        let mut estimated = one.clone();
+        estimated.set_parameter("c", 0.3);
+        let written = file.as_declared(&estimated);
+        assert_eq!(names(&written), ["a"]);
+        assert_eq!(written.parameter_values()["c"], 0.0);
         for (free, hold, says) in [
             (&["x"][..], &[][..], "no parameter `x`"),
             (&["k"], &[], "no parameter `k` that one estimate can stand for"),

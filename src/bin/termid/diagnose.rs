@@ -42,11 +42,7 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
         crate::figures::write(&mut outputs, dir, "diagnose", figures)?;
     }
     if let (Some(out), Some(m)) = (&cmd.out, &d.model) {
-        let mut written = file.declared_freedom(m);
-        for name in &current {
-            written.set_parameter(name, file.parameter_values()[name]);
-        }
-        outputs.file(out, written.to_toml().as_bytes())?;
+        outputs.file(out, file.as_declared(m).to_toml().as_bytes())?;
     }
     outputs.commit()?;
     match cmd.format {

@@ -92,7 +92,7 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
     };
     let mut outputs = termid::output::Outputs::new();
     if let Some(out) = &cmd.out {
-        outputs.file(out, file.declared_freedom(&fit.model).to_toml().as_bytes())?;
+        outputs.file(out, file.as_declared(&fit.model).to_toml().as_bytes())?;
     }
     let mut drawn = false;
     if let Some(dir) = &cmd.svg {
