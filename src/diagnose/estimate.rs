@@ -337,6 +337,9 @@ pub struct RunSpread {
     pub chi_square: Option<f64>,
     /// P(a χ² as large) where the runs' values were equal.
     pub p_value: Option<f64>,
+    /// A velocity of the medium (a current): the runs', so the model keeps its file's value
+    /// instead of their mean.
+    pub medium: bool,
 }
 
 /// Below this probability of a χ² as large, the runs' values differ: a parameter the file
@@ -370,6 +373,7 @@ impl RunSpread {
                     sd: s.sd,
                     chi_square: None,
                     p_value: None,
+                    medium: false,
                 })
             })
             .collect()
@@ -710,7 +714,7 @@ fn at_step(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Result<Es
         .per_run
         .iter()
         .chain(&each.per_source_spread)
-        .filter(|r| r.agree() && !asked(&r.name))
+        .filter(|r| r.agree() && !asked(&r.name) && !r.medium)
         .cloned()
         .collect();
     if agree.is_empty() {
@@ -1184,6 +1188,7 @@ impl Unknowns {
                 .collect();
             r.chi_square = covariance.and_then(|c| differences(theta, c, &values));
             r.p_value = r.chi_square.map(|q| crate::select::chi_square_pvalue(q, (r.runs - 1) as f64));
+            r.medium = self.groups.iter().any(|(p, _, _)| p.name == r.name && p.medium);
         }
         (per_run, per_source_spread)
     }
@@ -1209,7 +1214,7 @@ impl Unknowns {
         // written with them, so that Monte-Carlo draws of a new run vary it as a new run would
         let new_run: Vec<(String, f64, f64)> = per_run
             .iter()
-            .filter(|r| r.runs > 1)
+            .filter(|r| r.runs > 1 && !r.medium)
             .map(|r| (r.name.clone(), r.mean, r.sd * r.sd * (1.0 + 1.0 / r.runs as f64)))
             .collect();
         let mut estimated = self.at(model, theta)?;
@@ -1242,7 +1247,7 @@ impl Unknowns {
                 }
             }),
         );
-        for r in per_run {
+        for r in per_run.iter().filter(|r| !r.medium) {
             estimated.set_parameter(&r.name, r.mean);
         }
         Ok(estimated)
@@ -1436,11 +1441,24 @@ impl Estimate {
             ));
         }
         for r in &self.per_run {
+            let holds = if r.medium {
+                format!(
+                    "the model keeps its file's `{}`, a velocity of the medium being the runs' and not the body's; their mean {} over the {} runs, sd {}",
+                    r.name,
+                    num(r.mean),
+                    r.runs,
+                    sig(r.sd, 3)
+                )
+            } else {
+                format!(
+                    "the model holds their mean {} over the {} runs, sd {}: a new run's value is that uncertain",
+                    num(r.mean),
+                    r.runs,
+                    sig(r.sd, 3)
+                )
+            };
             out.push_str(&format!(
-                "  (each run's own value; the model holds their mean {} over the {} runs, sd {}: a new run's value is that uncertain; the runs' values {}: {})\n",
-                num(r.mean),
-                r.runs,
-                sig(r.sd, 3),
+                "  (each run's own value; {holds}; the runs' values {}: {})\n",
                 if r.agree() { "agree" } else { "differ" },
                 r.test()
             ));

@@ -39,11 +39,8 @@ mod tests {
     use super::*;
 
     /// A body drifting in a stream: ẋ = w + c, its own speed w relaxing to the input
-    /// (ẇ = (v − w)/τ), the stream c a held medium. Tracked over ground in a stream of
-    /// 0.4, the stream comes back alone, the body's τ (free in the file) untouched.
-    #[test]
-    fn a_stream_is_estimated_alone_from_runs_tracked_over_ground() {
-        let text = r#"
+    /// (ẇ = (v − w)/τ), the stream c a held medium.
+    const DRIFTER: &str = r#"
 [model]
 name = "drifter"
 [[states]]
@@ -68,15 +65,22 @@ state = "w"
 identify = false
 coefficients = { "v/τ" = 1.0, "w/τ" = -1.0 }
 "#;
-        let model = Model::parse(text, "drifter.toml").unwrap();
-        let mut stream = model.clone();
-        stream.set_parameter("c", 0.4);
-        let system = crate::sim::System::new(&stream, &Default::default(), false).unwrap();
-        let settings =
-            crate::sim::Settings { integrator: Integrator::Rk4, dt: 0.05, duration: 20.0, sample: 0.1 };
-        let frames: Vec<Frame> = [1.0, -0.5]
+
+    /// Two runs of the drifter with τ = 2 in a stream of `c` each (inputs 1 and −0.5).
+    fn carried(model: &Model, c: [f64; 2]) -> Vec<Frame> {
+        [1.0, -0.5]
             .iter()
-            .map(|&v| {
+            .zip(c)
+            .map(|(&v, c)| {
+                let mut stream = model.clone();
+                stream.set_parameter("c", c);
+                let system = crate::sim::System::new(&stream, &Default::default(), false).unwrap();
+                let settings = crate::sim::Settings {
+                    integrator: Integrator::Rk4,
+                    dt: 0.05,
+                    duration: 20.0,
+                    sample: 0.1,
+                };
                 let run =
                     crate::sim::simulate(&system, &[0.0, 0.0], &mut crate::sim::Constant(vec![v]), &settings)
                         .unwrap();
@@ -86,7 +90,15 @@ coefficients = { "v/τ" = 1.0, "w/τ" = -1.0 }
                 f.push("v", run.inputs[0].clone()).unwrap();
                 f
             })
-            .collect();
+            .collect()
+    }
+
+    /// Tracked over ground in a stream of 0.4, the stream comes back alone, the body's τ
+    /// (free in the file) untouched.
+    #[test]
+    fn a_stream_is_estimated_alone_from_runs_tracked_over_ground() {
+        let model = Model::parse(DRIFTER, "drifter.toml").unwrap();
+        let frames = carried(&model, [0.4, 0.4]);
         assert_eq!(model.held_medium(), ["c"]);
         let day = medium(&model, &model.held_medium(), &frames, &[0, 0]).unwrap().unwrap();
         let values = day.own_values();
@@ -95,5 +107,28 @@ coefficients = { "v/τ" = 1.0, "w/τ" = -1.0 }
         assert!(day.parameters.is_empty(), "τ held: {:?}", day.parameters);
         // nothing named: nothing to estimate
         assert!(medium(&model, &[], &frames, &[0, 0]).unwrap().is_none());
+    }
+
+    /// A stream that changed between the runs, estimated per run with the body: each run's
+    /// own, and the model written keeps the file's (still water), not their mean, with no
+    /// entry in the covariance that Monte-Carlo draws would vary.
+    #[test]
+    fn a_stream_estimated_per_run_is_not_the_models() {
+        let file = Model::parse(DRIFTER, "drifter.toml").unwrap();
+        let frames = carried(&file, [0.4, 0.1]);
+        let model = file.freed(&["c".into()], &[]).unwrap();
+        let runs = Runs::new(&model, &frames, 0.1, Integrator::Rk4).unwrap();
+        let settings = EstimateSettings { per_run: vec!["c".into()], ..Default::default() };
+        let fit = estimate(&model, &runs, &settings).unwrap();
+        let values: Vec<f64> = fit.own_values().iter().map(|v| v.2).collect();
+        assert!((values[0] - 0.4).abs() < 1e-4 && (values[1] - 0.1).abs() < 1e-4, "{values:?}");
+        assert!(
+            fit.per_run[0].medium && fit.text().contains("the model keeps its file's `c`"),
+            "{}",
+            fit.text()
+        );
+        assert_eq!(fit.model.parameter_values()["c"], 0.0);
+        let covariance = fit.model.spec().parameter_covariance.as_ref().unwrap();
+        assert_eq!(covariance.names, ["τ"]);
     }
 }

@@ -181,8 +181,11 @@ pub struct FreeParameter {
     pub prior: Option<(f64, f64)>,
     /// Its bounds (±∞ where none).
     pub bounds: (f64, f64),
-    /// Estimated once per run or per source by default (`nuisance`), if the file says so.
+    /// Estimated once per run or per source by default (`nuisance`), if the file says so; a
+    /// velocity of the medium, which is the runs' and not the body's, per source unless so.
     pub nuisance: Option<Nuisance>,
+    /// A velocity of the medium (`medium = true`: a current): the model keeps its file's value.
+    pub medium: bool,
 }
 
 impl Model {
@@ -197,7 +200,8 @@ impl Model {
                 value: p.value,
                 prior: p.prior.as_ref().map(|q| (q.value, q.sd)),
                 bounds: p.bounds.map_or((f64::NEG_INFINITY, f64::INFINITY), |[lo, hi]| (lo, hi)),
-                nuisance: p.nuisance,
+                nuisance: p.nuisance.or(p.medium.then_some(Nuisance::Source)),
+                medium: p.medium,
             })
             .collect()
     }
