@@ -113,6 +113,13 @@ pub struct Track {
     /// Samples each side of the central difference.
     #[serde(default = "two")]
     pub half_window: usize,
+    /// Where the track is measured, in m forward of and to starboard of the point the model's
+    /// motion is of (midship), at the records' scale: a satellite receiver's antenna, often
+    /// on the bridge far aft. The positions are moved to that point by the heading, the
+    /// velocities by the yaw rate (from the heading's differences): u − r·y, v + r·x at the
+    /// antenna.
+    #[serde(default)]
+    pub antenna: Option<[f64; 2]>,
 }
 
 fn two() -> usize {
@@ -140,6 +147,18 @@ pub fn velocities_from_track(
             (xd * c + yd * s, -xd * s + yd * c)
         })
         .unzip()
+}
+
+/// The rate of an angle by central differences over ± `half` samples (one-sided at the ends).
+fn rate_of(t: &[f64], angle: &[f64], half: usize) -> Vec<f64> {
+    let n = t.len().min(angle.len());
+    let half = half.max(1);
+    (0..n)
+        .map(|k| {
+            let (a, b) = (k.saturating_sub(half), (k + half).min(n - 1));
+            (angle[b] - angle[a]) / (t[b] - t[a]).max(f64::MIN_POSITIVE)
+        })
+        .collect()
 }
 
 /// `$NAME` and `${NAME}` replaced by `lookup(NAME)`; the first name it does not know is the error.
@@ -534,8 +553,44 @@ impl Dataset {
                         })
                     }
                 }
+                let heading = frame.require(&track.heading)?.to_vec();
+                // the antenna's offset at the model's scale, and the point's track from its
+                let antenna = match track.antenna {
+                    Some([ax, ay]) if ax.is_finite() && ay.is_finite() => {
+                        let f = scale(Some("m"), &track.heading)?;
+                        Some((ax * f, ay * f))
+                    }
+                    Some(a) => {
+                        return Err(DataError::Unit {
+                            file: origin.clone(),
+                            row: 0,
+                            column: track.heading.clone(),
+                            message: format!(
+                                "[track] antenna = {a:?}: two finite numbers, m forward and to starboard"
+                            ),
+                        })
+                    }
+                    None => None,
+                };
+                let mut moved_note = None;
+                if let (Some((ax, ay)), Some(x), Some(y)) = (antenna, &track.x, &track.y) {
+                    if let (Some(xs), Some(ys)) = (frame.column(x), frame.column(y)) {
+                        let (sn_cs, n) = (heading.iter().map(|h| h.sin_cos()), xs.len().min(ys.len()));
+                        let (mx, my): (Vec<f64>, Vec<f64>) = xs[..n]
+                            .iter()
+                            .zip(&ys[..n])
+                            .zip(sn_cs)
+                            .map(|((px, py), (sn, cs))| (px - (ax * cs - ay * sn), py - (ax * sn + ay * cs)))
+                            .unzip();
+                        frame.set(x, mx)?;
+                        frame.set(y, my)?;
+                        moved_note = Some(format!(
+                            "{origin}: the track ({x}, {y}) moved from the antenna, {ax} m forward and {ay} m to starboard, to the model's point by {}",
+                            track.heading
+                        ));
+                    }
+                }
                 let col = |n: &str| frame.require(n).map(<[f64]>::to_vec);
-                let heading = col(&track.heading)?;
                 let over_ground = match (&track.speed_over_ground, &track.course_over_ground) {
                     (None, None) => None,
                     (Some(sog), Some(cog)) if track.x_dot.is_none() && track.y_dot.is_none() => {
@@ -550,6 +605,7 @@ impl Dataset {
                         })
                     }
                 };
+                let over_ground_velocities = over_ground.is_some() || track.x_dot.is_some();
                 let (u, v) = if let Some((sog, cog, speed, course)) = over_ground {
                     notes.push(format!(
                         "{origin}: {} and {} turned into the body frame from the velocity over ground ({sog}, {cog}) by {}",
@@ -585,9 +641,31 @@ impl Dataset {
                     }
                     }
                 };
+                // velocities measured at the antenna (not differenced from the moved track):
+                // the ship's turning moves it, u_a = u − r·y_a, v_a = v + r·x_a
+                let (u, v) = match antenna {
+                    Some((ax, ay)) if over_ground_velocities => {
+                        let r = rate_of(frame.time(), &heading, track.half_window);
+                        notes.push(format!(
+                            "{origin}: {} and {} moved from the antenna ({ax} m forward, {ay} m to starboard) to the model's point by the heading's rate",
+                            track.u, track.v
+                        ));
+                        (
+                            u.iter().zip(&r).map(|(u, r)| u + r * ay).collect(),
+                            v.iter().zip(&r).map(|(v, r)| v - r * ax).collect(),
+                        )
+                    }
+                    _ => (u, v),
+                };
                 frame.set(&track.u, u)?;
                 frame.set(&track.v, v)?;
                 notes.extend(said);
+                notes.extend(moved_note);
+                if antenna.is_none() && (track.latitude.is_some() || track.speed_over_ground.is_some()) {
+                    notes.push(format!(
+                        "{origin}: the receiver's fixes taken as of the model's point (midship): an antenna elsewhere (on the bridge, far aft) moves the sway velocity by the yaw rate times its distance, which the hull's derivatives then absorb; `[track] antenna = [forward, starboard]` in m moves them"
+                    ));
+                }
             }
             if run.from.is_some() || run.to.is_some() {
                 let t = &file_time;
@@ -783,6 +861,8 @@ file = "trial.csv"
             notes.iter().any(|n| n.contains("x0 and y0 in m north and east of the first fix")),
             "{notes:?}"
         );
+        // no antenna given: the fixes are said to be taken as the ship's point
+        assert!(notes.iter().any(|n| n.contains("fixes taken as of the model's point")), "{notes:?}");
         let f = &frames[0];
         let (x0, y0) = (f.column("x0").unwrap(), f.column("y0").unwrap());
         assert!(x0[0] == 0.0 && y0[0] == 0.0);
@@ -826,6 +906,66 @@ file = "trial.csv"
             toml::from_str(&doppler.replace("course_over_ground = \"cog [deg]\"\n", "")).unwrap();
         let e = half.read(&dir, "t").unwrap_err().to_string();
         assert!(e.contains("speed_over_ground and course_over_ground together"), "{e}");
+        // the fixes of an antenna on the bridge, 100 m aft and 5 m to starboard, moved to
+        // the ship's point: it turns at 0.5°/s, the antenna sweeping 0.87 m/s more sideways
+        let (rate, (ax, ay)) = (0.5f64.to_radians(), (-100.0, 5.0));
+        let mut text = String::from("t,x,y,hdg,sog,cog\n");
+        for k in 0..=100 {
+            let t = f64::from(k);
+            // the ship's point on a circle at 8 m/s with 5° of drift, its heading turning
+            let psi = heading + rate * t;
+            let radius = speed / rate;
+            let (north, east) = (
+                radius * ((psi + drift).sin() - (heading + drift).sin()),
+                radius * ((heading + drift).cos() - (psi + drift).cos()),
+            );
+            let (an, ae) = (north + ax * psi.cos() - ay * psi.sin(), east + ax * psi.sin() + ay * psi.cos());
+            // the antenna's velocity over ground: the ship's, and the turning about the point
+            let (vn, ve) = (
+                speed * (psi + drift).cos() + rate * (-ax * psi.sin() - ay * psi.cos()),
+                speed * (psi + drift).sin() + rate * (ax * psi.cos() - ay * psi.sin()),
+            );
+            text.push_str(&format!("{t},{an},{ae},{psi},{},{}\n", vn.hypot(ve), ve.atan2(vn)));
+        }
+        std::fs::write(dir.join("turn.csv"), text).unwrap();
+        let read = |track: &str| {
+            let set: Dataset = toml::from_str(&format!(
+                "[columns]\nt = \"t [s]\"\n\"ψ\" = \"hdg [rad]\"\nx0 = \"x [m]\"\ny0 = \"y [m]\"\n[track]\n{track}heading = \"ψ\"\nu = \"u\"\nv = \"v\"\nantenna = [-100.0, 5.0]\n[[runs]]\nfile = \"turn.csv\"\n"
+            ))
+            .unwrap();
+            set.read(&dir, "t").unwrap()
+        };
+        let (positions, notes) = read("x = \"x0\"\ny = \"y0\"\n");
+        assert!(
+            notes.iter().any(|n| n.contains("moved from the antenna, -100 m forward and 5 m to starboard")),
+            "{notes:?}"
+        );
+        let (doppler, notes) =
+            read("speed_over_ground = \"sog [m/s]\"\ncourse_over_ground = \"cog [rad]\"\n");
+        assert!(
+            notes.iter().any(|n| n.contains("moved from the antenna (-100 m forward, 5 m to starboard)")),
+            "{notes:?}"
+        );
+        let f = &positions[0];
+        // (at the ends the difference is one-sided, a chord's direction a second ahead)
+        for k in [2, 50, 98] {
+            let psi = heading + rate * k as f64;
+            let radius = speed / rate;
+            let north = radius * ((psi + drift).sin() - (heading + drift).sin());
+            assert!((f.column("x0").unwrap()[k] - north).abs() < 1e-6, "{k}");
+            // differenced over ±2 s of a turn (a chord): within 2 mm/s; the Doppler velocity at
+            // the antenna moved by the heading's differenced rate (exact on a steady turn)
+            let (u, v) = (f.column("u").unwrap()[k], f.column("v").unwrap()[k]);
+            assert!(
+                (u - speed * drift.cos()).abs() < 2e-3 && (v - speed * drift.sin()).abs() < 2e-3,
+                "{k}: {u} {v}"
+            );
+            let (u, v) = (doppler[0].column("u").unwrap()[k], doppler[0].column("v").unwrap()[k]);
+            assert!(
+                (u - speed * drift.cos()).abs() < 1e-6 && (v - speed * drift.sin()).abs() < 1e-6,
+                "{k}: {u} {v}"
+            );
+        }
         // a latitude without its longitude, or without the positions' names, is refused
         let half = toml::from_str::<Dataset>(
             "[columns]\nt = \"t [s]\"\n\"ψ\" = \"hdg [deg]\"\n[track]\nlatitude = \"lat [deg]\"\nx = \"x0\"\ny = \"y0\"\nheading = \"ψ\"\nu = \"u\"\nv = \"v\"\n[[runs]]\nfile = \"trial.csv\"\n",

@@ -196,8 +196,9 @@ fn a_container_ship_from_its_particulars_meets_imos_limits_as_printed() {
 /// longitude about 54° N at 1 Hz (5 cm; the ellipsoid's radii of curvature at the first fix), a
 /// gyrocompass in [0°, 360°) on a course of 355°, so that every zigzag swings through north, no
 /// log (u and v from the track), the propeller's rate; the ship in a steady `current` (m/s
-/// towards north and east), which carries the fixes. Returns the truth.
-fn sea_trial(dir: &std::path::Path, current: (f64, f64)) -> Model {
+/// towards north and east), which carries the fixes; the receiver's antenna `antenna` m
+/// forward of midship (the dataset file says where). Returns the truth.
+fn sea_trial(dir: &std::path::Path, current: (f64, f64), antenna: f64) -> Model {
     use termid::ship::basin::{Artefacts, Basin, Noise, ZIGZAGS_BOTH_SIDES};
 
     let small = termid::plugins::load(std::path::Path::new("models/mmg_kvlcc2.toml")).unwrap();
@@ -229,7 +230,9 @@ fn sea_trial(dir: &std::path::Path, current: (f64, f64)) -> Model {
         let col = |c: &str| f.column(c).unwrap();
         let mut text = String::from("time,lat,lon,gyro,rot,rudder,rpm\n");
         for k in 0..f.len() {
-            let (t, x, y) = (f.time()[k], col("x0")[k], col("y0")[k]);
+            // the fix is the antenna's, on the ship's centre line
+            let (t, psi) = (f.time()[k], rec.truth.column("ψ").unwrap()[k]);
+            let (x, y) = (col("x0")[k] + antenna * psi.cos(), col("y0")[k] + antenna * psi.sin());
             // the track through the water turned onto the course, and carried by the current
             let north = x * course.cos() - y * course.sin() + current.0 * t;
             let east = x * course.sin() + y * course.cos() + current.1 * t;
@@ -248,6 +251,7 @@ fn sea_trial(dir: &std::path::Path, current: (f64, f64)) -> Model {
         std::fs::write(dir.join(&file), text).unwrap();
         set.push_str(&format!("[[runs]]\nfile = \"{file}\"\n"));
     }
+    let set = set.replace("[track]\n", &format!("[track]\nantenna = [{antenna:?}, 0.0]\n"));
     std::fs::write(dir.join("trial.toml"), set).unwrap();
     truth
 }
@@ -268,7 +272,7 @@ fn a_sea_trial_in_a_current_estimates_the_current_with_the_ship() {
     let dir = crate::common::Scratch::new("sea-trial-current");
     let from = 40f64.to_radians();
     let current = (-0.5 * from.cos(), -0.5 * from.sin());
-    let truth = sea_trial(&dir, current);
+    let truth = sea_trial(&dir, current, 0.0);
     let start = froude(&model_scale(), LAMBDA).model().unwrap();
     std::fs::write(dir.join("start.toml"), start.to_toml()).unwrap();
     let path = |f: &str| dir.join(f).display().to_string();
@@ -354,7 +358,7 @@ fn a_sea_trial_logged_by_satellite_and_gyrocompass_predicts_the_ships_turning_ci
     use termid::diagnose::{estimate, Runs};
 
     let dir = crate::common::Scratch::new("sea-trial");
-    let truth = sea_trial(&dir, (0.0, 0.0));
+    let truth = sea_trial(&dir, (0.0, 0.0), -130.0);
     let start = froude(&model_scale(), LAMBDA).model().unwrap();
     let (mut frames, _) = Dataset::load(&dir.join("trial.toml")).unwrap().read(&dir, "t").unwrap();
     let mut said = Vec::new();
@@ -367,7 +371,9 @@ fn a_sea_trial_logged_by_satellite_and_gyrocompass_predicts_the_ships_turning_ci
         .comparing(&start, &["u", "v", "r", "ψ"].map(String::from))
         .unwrap();
     let fit = estimate(&start, &runs, &Default::default()).unwrap();
-    assert!(fit.follows(), "{}", fit.text());
+    // the fixes moved from the bridge's antenna: the fit leaves the records' noise (taken as
+    // midship's, 0.80 % of their variance against 0.19 %, the hull bent to absorb it)
+    assert!(fit.follows() && fit.unexplained < 1.5 * fit.noise, "{}", fit.text());
     for rudder in [35.0, -35.0] {
         let (got, want) = (
             tactical_diameter_in_lengths(&fit.model, 320.0, rudder),
