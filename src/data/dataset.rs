@@ -149,14 +149,17 @@ pub fn velocities_from_track(
         .unzip()
 }
 
-/// The rate of an angle by central differences over ± `half` samples (one-sided at the ends).
+/// The rate of an angle by central differences over ± `half` samples (one-sided at the ends),
+/// each difference taken the short way round (a compass's 359° → 1° is 2°, not −358°).
 fn rate_of(t: &[f64], angle: &[f64], half: usize) -> Vec<f64> {
+    use std::f64::consts::{PI, TAU};
     let n = t.len().min(angle.len());
     let half = half.max(1);
     (0..n)
         .map(|k| {
             let (a, b) = (k.saturating_sub(half), (k + half).min(n - 1));
-            (angle[b] - angle[a]) / (t[b] - t[a]).max(f64::MIN_POSITIVE)
+            let turned = (angle[b] - angle[a] + PI).rem_euclid(TAU) - PI;
+            turned / (t[b] - t[a]).max(f64::MIN_POSITIVE)
         })
         .collect()
 }
@@ -908,7 +911,8 @@ file = "trial.csv"
         assert!(e.contains("speed_over_ground and course_over_ground together"), "{e}");
         // the fixes of an antenna on the bridge, 100 m aft and 5 m to starboard, moved to
         // the ship's point: it turns at 0.5°/s, the antenna sweeping 0.87 m/s more sideways
-        let (rate, (ax, ay)) = (0.5f64.to_radians(), (-100.0, 5.0));
+        // on a heading from 330°, which a compass reads through north (360° → 0°) at t = 60 s
+        let (rate, (ax, ay), heading) = (0.5f64.to_radians(), (-100.0, 5.0), 330f64.to_radians());
         let mut text = String::from("t,x,y,hdg,sog,cog\n");
         for k in 0..=100 {
             let t = f64::from(k);
@@ -925,7 +929,8 @@ file = "trial.csv"
                 speed * (psi + drift).cos() + rate * (-ax * psi.sin() - ay * psi.cos()),
                 speed * (psi + drift).sin() + rate * (ax * psi.cos() - ay * psi.sin()),
             );
-            text.push_str(&format!("{t},{an},{ae},{psi},{},{}\n", vn.hypot(ve), ve.atan2(vn)));
+            let compass = psi.rem_euclid(std::f64::consts::TAU);
+            text.push_str(&format!("{t},{an},{ae},{compass},{},{}\n", vn.hypot(ve), ve.atan2(vn)));
         }
         std::fs::write(dir.join("turn.csv"), text).unwrap();
         let read = |track: &str| {
@@ -948,7 +953,7 @@ file = "trial.csv"
         );
         let f = &positions[0];
         // (at the ends the difference is one-sided, a chord's direction a second ahead)
-        for k in [2, 50, 98] {
+        for k in [2, 50, 59, 60, 61, 98] {
             let psi = heading + rate * k as f64;
             let radius = speed / rate;
             let north = radius * ((psi + drift).sin() - (heading + drift).sin());
