@@ -898,13 +898,7 @@ impl PyModel {
         over_ground: bool,
     ) -> PyResult<(String, PyModel)> {
         // runs tracked over ground: the model's held velocity of the medium estimated with it
-        let medium = self
-            .inner
-            .held_medium()
-            .into_iter()
-            .filter(|n| over_ground && !hold.contains(n) && !free.contains(n));
-        let free: Vec<String> = free.iter().cloned().chain(medium).collect();
-        let model = self.inner.freed(&free, &hold).map_err(refuse)?;
+        let (model, _) = self.inner.freed_over_ground(&free, &hold, over_ground).map_err(refuse)?;
         let initial_values = termid::diagnose::InitialValues::parse(&initial_values)
             .map_err(|e| pyo3::exceptions::PyValueError::new_err(format!("initial_values {e}")))?;
         let frames = self.frames(runs)?;

@@ -338,6 +338,25 @@ impl Model {
         Ok(model)
     }
 
+    /// The model for one estimate of runs tracked over ground or not: as [`Model::freed`], and
+    /// where `over_ground`, every held velocity of the medium that `hold` does not name freed
+    /// too (their velocities carry it); those names beside.
+    pub fn freed_over_ground(
+        &self,
+        free: &[String],
+        hold: &[String],
+        over_ground: bool,
+    ) -> Result<(Model, Vec<String>), String> {
+        let medium: Vec<String> = match over_ground {
+            true => {
+                self.held_medium().into_iter().filter(|n| !hold.contains(n) && !free.contains(n)).collect()
+            }
+            false => vec![],
+        };
+        let all: Vec<String> = free.iter().chain(&medium).cloned().collect();
+        Ok((self.freed(&all, hold)?, medium))
+    }
+
     /// `estimated` as this model (the file) declares it: each parameter free or held as here
     /// (what [`Model::freed`] changed was for one estimate), and each velocity of the medium
     /// (`medium = true`) at this model's value: a current belongs to the day's runs, not to
@@ -939,6 +958,11 @@ mass = 2.0
         assert_eq!(names(&one), ["c"]);
         assert_eq!(one.free_parameters()[0].nuisance, Some(Nuisance::Source));
         assert!(one.held_medium().is_empty());
+        // runs tracked over ground free the medium unless held
+        let (over, freed) = file.freed_over_ground(&[], &[], true).unwrap();
+        assert_eq!((names(&over), freed), (vec!["a".to_string(), "c".to_string()], vec!["c".to_string()]));
+        let (held, freed) = file.freed_over_ground(&[], &["c".into()], true).unwrap();
+        assert_eq!((names(&held), freed.len()), (vec!["a".to_string()], 0));
         let mut estimated = one.clone();
         estimated.set_parameter("c", 0.3);
         let written = file.as_declared(&estimated);

@@ -25,10 +25,10 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
     // runs tracked over ground carry the current the body moves in: the model's own
     // velocity of the medium is estimated with it, unless the command holds it
     let over_ground = crate::runs::over_ground(&cmd.dataset);
-    let mut free = cmd.free.clone();
-    let medium: Vec<String> =
-        file.held_medium().into_iter().filter(|n| !cmd.hold.contains(n) && !free.contains(n)).collect();
-    if !over_ground.is_empty() && !medium.is_empty() {
+    let (model, medium) = file
+        .freed_over_ground(&cmd.free, &cmd.hold, !over_ground.is_empty())
+        .map_err(|e| anyhow::anyhow!("--free/--hold: {e}"))?;
+    if !medium.is_empty() {
         eprintln!(
             "note: the runs of {} are tracked over ground (by a satellite receiver): their velocities carry the current they move in, so the model's {} {} estimated with it (the model written keeps its file's value; `--hold {}` holds it)",
             over_ground.join(", "),
@@ -36,11 +36,9 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
             if medium.len() == 1 { "is" } else { "are" },
             medium.join(",")
         );
-        free.extend(medium);
-    } else if !file.spec().parameters.values().any(|p| p.medium) {
+    } else if !over_ground.is_empty() && !file.spec().parameters.values().any(|p| p.medium) {
         crate::runs::warn_over_ground(&cmd.dataset);
     }
-    let model = file.freed(&free, &cmd.hold).map_err(|e| anyhow::anyhow!("--free/--hold: {e}"))?;
     // said before any run is read
     if model.free_parameters().is_empty() && !cmd.coefficients {
         anyhow::bail!(
