@@ -350,9 +350,9 @@ fn split_spec(spec: &str) -> (String, Option<String>, f64) {
 }
 
 impl Dataset {
-    /// Whether its runs are tracked over ground (satellite fixes, `[track] latitude` or
-    /// `speed_over_ground`): their
-    /// velocities are the body's over the earth, with any current or wind it moves in.
+    /// Whether its runs are tracked over ground (a satellite receiver: `[track] latitude` or
+    /// `speed_over_ground`): their velocities are the body's over the earth, with any current
+    /// it moves in.
     pub fn over_ground(&self) -> bool {
         self.track.as_ref().is_some_and(|t| t.latitude.is_some() || t.speed_over_ground.is_some())
     }
@@ -594,7 +594,8 @@ impl Dataset {
                     }
                 }
                 let col = |n: &str| frame.require(n).map(<[f64]>::to_vec);
-                let over_ground = match (&track.speed_over_ground, &track.course_over_ground) {
+                // a receiver's Doppler velocity over ground, where given
+                let doppler = match (&track.speed_over_ground, &track.course_over_ground) {
                     (None, None) => None,
                     (Some(sog), Some(cog)) if track.x_dot.is_none() && track.y_dot.is_none() => {
                         Some((sog, cog, convert(sog, "speed over ground")?, convert(cog, "course over ground")?))
@@ -608,25 +609,26 @@ impl Dataset {
                         })
                     }
                 };
-                let over_ground_velocities = over_ground.is_some() || track.x_dot.is_some();
-                let (u, v) = if let Some((sog, cog, speed, course)) = over_ground {
-                    notes.push(format!(
-                        "{origin}: {} and {} turned into the body frame from the velocity over ground ({sog}, {cog}) by {}",
-                        track.u, track.v, track.heading
-                    ));
-                    let north: Vec<f64> = speed.iter().zip(&course).map(|(s, c)| s * c.cos()).collect();
-                    let east: Vec<f64> = speed.iter().zip(&course).map(|(s, c)| s * c.sin()).collect();
-                    velocities_from_earth_fixed(&north, &east, &heading)
-                } else {
-                    match (&track.x, &track.y, &track.x_dot, &track.y_dot) {
-                    (Some(x), Some(y), None, None) => {
+                // velocities measured (at the antenna), not differenced from the moved track
+                let measured = doppler.is_some() || track.x_dot.is_some();
+                let (u, v) = match (doppler, &track.x, &track.y, &track.x_dot, &track.y_dot) {
+                    (Some((sog, cog, speed, course)), ..) => {
+                        notes.push(format!(
+                            "{origin}: {} and {} turned into the body frame from the velocity over ground ({sog}, {cog}) by {}",
+                            track.u, track.v, track.heading
+                        ));
+                        let north: Vec<f64> = speed.iter().zip(&course).map(|(s, c)| s * c.cos()).collect();
+                        let east: Vec<f64> = speed.iter().zip(&course).map(|(s, c)| s * c.sin()).collect();
+                        velocities_from_earth_fixed(&north, &east, &heading)
+                    }
+                    (None, Some(x), Some(y), None, None) => {
                         notes.push(format!(
                             "{origin}: {} and {} computed from the track ({x}, {y}) and {} over ±{} samples",
                             track.u, track.v, track.heading, track.half_window
                         ));
                         velocities_from_track(frame.time(), &col(x)?, &col(y)?, &heading, track.half_window)
                     }
-                    (None, None, Some(xd), Some(yd)) => {
+                    (None, None, None, Some(xd), Some(yd)) => {
                         let (xd_values, yd_values) = (convert(xd, "ẋ")?, convert(yd, "ẏ")?);
                         notes.push(format!(
                             "{origin}: {} and {} turned into the body frame from ({xd}, {yd}) by {}",
@@ -642,12 +644,11 @@ impl Dataset {
                             message: "[track] takes either the positions x and y or the earth-fixed velocities x_dot and y_dot".into(),
                         })
                     }
-                    }
                 };
                 // velocities measured at the antenna (not differenced from the moved track):
                 // the ship's turning moves it, u_a = u − r·y_a, v_a = v + r·x_a
                 let (u, v) = match antenna {
-                    Some((ax, ay)) if over_ground_velocities => {
+                    Some((ax, ay)) if measured => {
                         let r = rate_of(frame.time(), &heading, track.half_window);
                         notes.push(format!(
                             "{origin}: {} and {} moved from the antenna ({ax} m forward, {ay} m to starboard) to the model's point by the heading's rate",
