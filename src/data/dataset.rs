@@ -136,32 +136,27 @@ pub fn velocities_from_track(
     heading: &[f64],
     half: usize,
 ) -> (Vec<f64>, Vec<f64>) {
-    let n = t.len().min(x.len()).min(y.len()).min(heading.len());
-    let half = half.max(1);
-    (0..n)
-        .map(|k| {
-            let (a, b) = (k.saturating_sub(half), (k + half).min(n - 1));
-            let h = (t[b] - t[a]).max(f64::MIN_POSITIVE);
-            let (xd, yd) = ((x[b] - x[a]) / h, (y[b] - y[a]) / h);
-            let (s, c) = heading[k].sin_cos();
-            (xd * c + yd * s, -xd * s + yd * c)
-        })
-        .unzip()
+    velocities_from_earth_fixed(&differenced(t, x, half), &differenced(t, y, half), heading)
 }
 
-/// The rate of an angle by central differences over ± `half` samples (one-sided at the ends),
-/// each difference taken the short way round (a compass's 359° → 1° is 2°, not −358°).
-fn rate_of(t: &[f64], angle: &[f64], half: usize) -> Vec<f64> {
-    use std::f64::consts::{PI, TAU};
-    let n = t.len().min(angle.len());
+/// The rate of `x` by central differences over ± `half` samples (one-sided at the ends).
+fn differenced(t: &[f64], x: &[f64], half: usize) -> Vec<f64> {
+    let n = t.len().min(x.len());
     let half = half.max(1);
     (0..n)
         .map(|k| {
             let (a, b) = (k.saturating_sub(half), (k + half).min(n - 1));
-            let turned = (angle[b] - angle[a] + PI).rem_euclid(TAU) - PI;
-            turned / (t[b] - t[a]).max(f64::MIN_POSITIVE)
+            (x[b] - x[a]) / (t[b] - t[a]).max(f64::MIN_POSITIVE)
         })
         .collect()
+}
+
+/// The rate of an angle as [`differenced`], taken the short way round (a compass's 359° → 1°
+/// is 2°, not −358°).
+fn rate_of(t: &[f64], angle: &[f64], half: usize) -> Vec<f64> {
+    let mut turning = angle.to_vec();
+    super::angle::unwrap_turns(&mut turning);
+    differenced(t, &turning, half)
 }
 
 /// `$NAME` and `${NAME}` replaced by `lookup(NAME)`; the first name it does not know is the error.
