@@ -81,21 +81,31 @@ pub fn warn_over_ground(datasets: &[PathBuf]) {
     }
 }
 
-/// The model's held velocity of the medium (a current) but those `hold` names, which must be
-/// among them.
-fn medium_names(model: &Model, hold: &[String]) -> Result<Vec<String>> {
+/// The dataset files that track their runs over ground, and the model's held velocity of the
+/// medium (a current) but those `hold` names, which must be among them: no names where no
+/// dataset is tracked over ground.
+fn medium_over_ground(
+    model: &Model,
+    datasets: &[PathBuf],
+    hold: &[String],
+) -> Result<(Vec<String>, Vec<String>)> {
     let medium = model.held_medium();
     if let Some(name) = hold.iter().find(|n| !medium.contains(n)) {
         bail!("--hold {name}: {} declares no velocity of the medium `{name}` (`medium = true`)", model.path);
     }
-    Ok(medium.into_iter().filter(|n| !hold.contains(n)).collect())
+    let over = over_ground(datasets);
+    let names = match over.is_empty() {
+        true => vec![],
+        false => medium.into_iter().filter(|n| !hold.contains(n)).collect(),
+    };
+    Ok((over, names))
 }
 
 /// Where `datasets` track the runs by satellite fixes, the model's held velocity of the medium
 /// (a current) but those `hold` names: to be estimated with the runs' other nuisances, said.
 pub fn medium_to_free(model: &Model, datasets: &[PathBuf], hold: &[String]) -> Result<Vec<String>> {
-    let (over, names) = (over_ground(datasets), medium_names(model, hold)?);
-    if over.is_empty() || names.is_empty() {
+    let (over, names) = medium_over_ground(model, datasets, hold)?;
+    if names.is_empty() {
         return Ok(vec![]);
     }
     eprintln!(
@@ -118,8 +128,8 @@ pub fn medium_of_runs(
     datasets: &[PathBuf],
     hold: &[String],
 ) -> Result<Vec<(usize, String, f64)>> {
-    let (over, names) = (over_ground(datasets), medium_names(model, hold)?);
-    if over.is_empty() || names.is_empty() {
+    let (over, names) = medium_over_ground(model, datasets, hold)?;
+    if names.is_empty() {
         return Ok(vec![]);
     }
     let day = match termid::diagnose::medium(model, &names, frames, sources) {
