@@ -295,6 +295,77 @@ fn covariance_of(moments: &Moments, selection: &Selection) -> Option<Vec<Vec<f64
     cov.iter().flatten().all(|v| v.is_finite()).then_some(cov)
 }
 
+/// Variance inflation above which the chosen terms are said to be nearly collinear: their
+/// coefficients' standard errors are 100 times what they would be for unrelated terms.
+const COLLINEAR_INFLATION: f64 = 1e4;
+
+/// A variable whose mean is this many standard deviations from 0 is said to be offset.
+const OFFSET_SPREADS: f64 = 30.0;
+
+/// A note where the chosen terms are nearly collinear in these data (a variance inflation
+/// VIF_j = C_jj·(C⁻¹)_jj above [`COLLINEAR_INFLATION`]): their coefficients then trade against
+/// each other, another choice among them fits about as well, and a back-end's pick among
+/// near-equivalent sets says little about the system. The usual cause in a library of
+/// products is a variable far from 0 against its spread (a temperature in kelvin, a pressure
+/// in pascal, a ship's speed): `z` and `z²`, `x` and `x·z` then move together; the note names
+/// such variables among the candidates and the remedy, terms about a reference value.
+fn collinearity_note(moments: &Moments, names: &[String], selection: &Selection) -> Option<String> {
+    let set: Vec<usize> = selection.terms.iter().map(|t| t.index).collect();
+    let k = set.len();
+    if k < 2 {
+        return None;
+    }
+    let intercept = selection.intercept.is_some();
+    let cross = |i: usize, j: usize| if intercept { moments.corrected(i, j) } else { moments.raw(i, j) };
+    let d: Vec<f64> = set.iter().map(|&i| cross(i, i).max(0.0).sqrt()).collect();
+    if d.iter().any(|v| v.is_nan() || *v <= 0.0) {
+        return None;
+    }
+    let r = nalgebra::DMatrix::from_fn(k, k, |i, j| cross(set[i], set[j]) / (d[i] * d[j]));
+    let inverse = r.try_inverse()?;
+    let (worst, inflation) = (0..k).map(|j| (j, inverse[(j, j)])).max_by(|a, b| a.1.total_cmp(&b.1))?;
+    if inflation.is_nan() || inflation <= COLLINEAR_INFLATION {
+        return None;
+    }
+    // its partner: the largest partial correlation −R⁻¹_ij / √(R⁻¹_ii R⁻¹_jj)
+    let partner = (0..k).filter(|&j| j != worst).max_by(|&a, &b| {
+        let partial = |j: usize| (inverse[(worst, j)] / (inverse[(j, j)] * inflation).sqrt()).abs();
+        partial(a).total_cmp(&partial(b))
+    })?;
+    let mut note = format!(
+        "`{}` is nearly a combination of the other chosen terms in these data (variance \
+         inflation {inflation:.1e}; most with `{}`): their coefficients trade against each other \
+         and another choice among the candidates may fit about as well",
+        names[set[worst]], names[set[partner]]
+    );
+    let means = moments.means();
+    // (name, |mean| / spread) of the candidates that are a variable alone; the ratio, not the
+    // values: in the integral form the columns are a variable's integrals over windows
+    let offset: Vec<(&String, f64)> = names
+        .iter()
+        .enumerate()
+        .filter(|(_, n)| n.chars().all(|c| c.is_alphanumeric() || c == '_'))
+        .filter_map(|(i, n)| {
+            let sd = (moments.corrected(i, i).max(0.0) / moments.weight()).sqrt();
+            let ratio = means[i].abs() / sd;
+            (sd > 0.0 && ratio > OFFSET_SPREADS).then_some((n, ratio))
+        })
+        .collect();
+    if let Some((v, _)) = offset.first() {
+        let listed: Vec<String> = offset
+            .iter()
+            .map(|(n, ratio)| format!("`{n}` (its mean {} times its spread)", report::sig(*ratio, 2)))
+            .collect();
+        note += &format!(
+            ". Far from 0 against their spread: {}; such a variable's powers and products move \
+             with the lower terms; written about a reference value c near its mean (`{v} - c`, \
+             `x*({v} - c)`) they do not",
+            listed.join(", ")
+        );
+    }
+    Some(note)
+}
+
 impl Identification<'_> {
     /// The per-run parameter values.
     pub fn run_parameters(&self, frame: &Frame) -> Result<BTreeMap<String, f64>, IdentifyError> {
@@ -610,8 +681,11 @@ pub(crate) fn fit_folds(
         moments.merge(f);
     }
     let problem = Problem { moments: &moments, names, forced, excluded, intercept };
-    let selection = backend.select_with_folds(&problem, folds)?;
+    let mut selection = backend.select_with_folds(&problem, folds)?;
     let covariance = covariance_of(&moments, &selection);
+    if let Some(note) = collinearity_note(&moments, names, &selection) {
+        selection.notes.push(note);
+    }
     // the residual pass for τ is left to the caller (`correlation_time`): selection itself
     // needs only the sufficient statistics, and is timed against the peers without it
     Ok(Fit {

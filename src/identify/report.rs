@@ -182,7 +182,7 @@ impl Fit {
             } else {
                 "+"
             };
-            out += &format!("\n    {sign} {}*{}", num(t.coefficient.abs()), t.term);
+            out += &format!("\n    {sign} {}{}", num(t.coefficient.abs()), times(&t.term));
             first = false;
         }
         out += "\n\n";
@@ -221,8 +221,42 @@ impl Fit {
     }
 }
 
+/// `*term` as a factor after a coefficient: nothing for the constant, a sum (a candidate
+/// such as `x*(z - 10000)`, multiplied out) or a negative term in parentheses, so the printed
+/// equation reads as it computes.
+fn times(term: &str) -> String {
+    if term == "1" {
+        return String::new();
+    }
+    let mut depth = 0i32;
+    let mut sum = term.starts_with('-');
+    for (i, c) in term.char_indices() {
+        match c {
+            '(' => depth += 1,
+            ')' => depth -= 1,
+            '+' | '-' if depth == 0 && i > 0 && term[..i].ends_with(' ') => sum = true,
+            _ => {}
+        }
+    }
+    if sum {
+        format!("*({term})")
+    } else {
+        format!("*{term}")
+    }
+}
+
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_sum_or_negative_term_is_parenthesised_after_its_coefficient() {
+        assert_eq!(super::times("x*z"), "*x*z");
+        assert_eq!(super::times("1"), "");
+        assert_eq!(super::times("-10000*x + x*z"), "*(-10000*x + x*z)");
+        assert_eq!(super::times("-x"), "*(-x)");
+        assert_eq!(super::times("1/(u + v)"), "*1/(u + v)");
+        assert_eq!(super::times("x^-1"), "*x^-1");
+    }
+
     use super::sig;
 
     #[test]

@@ -78,6 +78,47 @@ impl Stlsq {
         beta.iter().all(|b| b.is_finite()).then(|| beta.iter().copied().collect())
     }
 
+    /// `set` without the candidates that are linear combinations of those before them (the
+    /// forced ones first, then in the candidates' order), each left out with a note. Without
+    /// this a near-collinear group (a constant, z and z² where z lies far from 0) makes the
+    /// full fit's coefficients huge and opposite: the threshold path then drops the true terms
+    /// with them and ends with nothing, and no support of it can be swept to be scored.
+    /// Subsets of what is left sweep in order, so every support of the path can be scored.
+    fn independent(
+        &self,
+        sc: &Scaled,
+        pb: &Problem<'_>,
+        set: Vec<usize>,
+        notes: &mut Vec<String>,
+    ) -> Result<Vec<usize>, SelectError> {
+        let m = sc.m;
+        let (forced, free): (Vec<usize>, Vec<usize>) = set.into_iter().partition(|j| pb.forced.contains(j));
+        let mut a = sc.a.clone();
+        let mut kept = Vec::new();
+        for j in forced.into_iter().chain(free) {
+            let pivot = a[j * m + j];
+            if pivot.is_nan() || pivot <= self.pivot_tolerance {
+                if pb.forced.contains(&j) {
+                    return Err(SelectError::ForcedCollinear {
+                        term: pb.names[j].clone(),
+                        pivot,
+                        tolerance: self.pivot_tolerance,
+                    });
+                }
+                notes.push(format!(
+                    "`{}` left out of the candidates: collinear with those before it (its share of \
+                     variance not explained by them {pivot:.1e}, below pivot_tolerance {:.0e})",
+                    pb.names[j], self.pivot_tolerance
+                ));
+                continue;
+            }
+            sweep(&mut a, m, j);
+            kept.push(j);
+        }
+        // kept in the order checked: every subsequence sweeps in it with pivots no smaller
+        Ok(kept)
+    }
+
     /// STLSQ at one threshold from the support `set`: the support it settles on.
     fn settle(
         &self,
@@ -165,6 +206,7 @@ impl Selector for Stlsq {
         let set: Vec<usize> = (0..p)
             .filter(|j| !pb.excluded.contains(j) && (sc.d[*j] > 0.0 || pb.forced.contains(j)))
             .collect();
+        let set = self.independent(&sc, pb, set, &mut notes)?;
         let set = match self.threshold {
             Some(threshold) => self.settle(&sc, pb, set, threshold, &mut notes),
             None => self.path(&sc, pb, set, &mut notes),
@@ -266,6 +308,36 @@ mod tests {
         let all = Stlsq { threshold: Some(0.0), ..Stlsq::default() }.select(&pb).unwrap();
         assert_eq!(all.terms.len(), 6);
         assert!(Stlsq { threshold: Some(-1.0), ..Stlsq::default() }.validate().is_err());
+    }
+
+    /// A variable far from 0 against its spread (z = 10⁴ + sin): 1, z and z² are collinear to
+    /// round-off. y = 2·(z − 10⁴) + x (no intercept, the constant a candidate): z² is left out
+    /// with a note and the rest selected as without it; before, the full fit's huge opposite
+    /// coefficients led the threshold path to an empty support.
+    #[test]
+    fn a_collinear_candidate_is_left_out_not_the_true_terms() {
+        let (moments, names) = rows_of(500, 5, |t, _| {
+            let z = 1e4 + (9.0 * t).sin();
+            let x = (4.0 * t).cos();
+            (vec![1.0, z, z * z, x], 2.0 * z - 2e4 + x)
+        });
+        let pb = Problem { moments: &moments, names: &names, forced: &[], excluded: &[], intercept: false };
+        let s = Stlsq::default().select(&pb).unwrap();
+        let mut chosen: Vec<&str> = s.terms.iter().map(|t| t.term.as_str()).collect();
+        chosen.sort();
+        assert_eq!(chosen, ["x1", "x2", "x4"], "{:?} {:?}", s.terms, s.notes);
+        let b = |name: &str| s.terms.iter().find(|t| t.term == name).unwrap().coefficient;
+        assert!((b("x2") - 2.0).abs() < 1e-6 && (b("x4") - 1.0).abs() < 1e-6, "{:?}", s.terms);
+        assert!(
+            s.notes.iter().any(|n| n.starts_with("`x3` left out of the candidates: collinear")),
+            "{:?}",
+            s.notes
+        );
+        // forced, z² is swept first and kept; a candidate collinear with it gives way
+        let forced = Problem { forced: &[2], ..pb };
+        let s = Stlsq::default().select(&forced).unwrap();
+        assert!(s.terms.iter().any(|t| t.term == "x3"), "{:?}", s.terms);
+        assert!(s.notes.iter().any(|n| n.contains("left out of the candidates")), "{:?}", s.notes);
     }
 
     /// y = 2·x1 − 3·x3 + 0.1·x2 with noise a thousand times smaller than x2's part: x2's

@@ -708,6 +708,147 @@ fn lorenz_from_samples_with_the_defaults_and_unit_free_selection() {
     }
 }
 
+/// Right by default away from the origin and off a regular clock (what a logger writes):
+/// Lorenz sampled from a 1 ms simulation (the truth below) with z measured from 10 000
+/// below its zero (a temperature in kelvin, a pressure in pascal) and, in a second file, at
+/// uneven intervals of 2 to 18 ms. With z far from 0 against its spread, 1, z and z² are
+/// collinear to round-off and x, x·z nearly so: the threshold path used to drop the true terms
+/// with the collinear ones and print an empty equation; now a collinear candidate is left out
+/// with a note, dz/dt and dy/dt come out with their true terms, and every equation whose chosen
+/// terms trade against each other says so and names `z`. Written about a reference value
+/// (`x*(z - 10000)`), the library is well posed again. On the uneven clock the trapezoid's
+/// error (smooth in the states) bought spurious terms in x's and z's equations; the quadratic
+/// through each pair of intervals keeps exactly the true terms.
+#[test]
+fn lorenz_far_from_the_origin_and_on_an_uneven_clock() {
+    let dir = crate::common::Scratch::new("lorenz-offset");
+    let full = dir.join("full.csv");
+    let (ok, _, err) = termid(&[
+        "simulate",
+        "--model",
+        "models/lorenz.toml",
+        "--duration",
+        "20",
+        "--dt",
+        "0.001",
+        "--sample",
+        "0.001",
+        "--out",
+        full.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let rows: Vec<Vec<f64>> = std::fs::read_to_string(&full)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').take(4).map(|c| c.parse().unwrap()).collect())
+        .collect();
+    let write = |name: &str, picked: &mut dyn Iterator<Item = &Vec<f64>>, z0: f64| {
+        let body: Vec<String> =
+            picked.map(|r| format!("{:?},{:?},{:?},{:?}", r[0], r[1], r[2], r[3] + z0)).collect();
+        let path = dir.join(name);
+        std::fs::write(&path, format!("t,x,y,z\n{}\n", body.join("\n"))).unwrap();
+        path
+    };
+    let offset = write("offset.csv", &mut rows.iter().step_by(10), 1e4);
+    let mut g = crate::common::Lcg(3);
+    let mut next = 0usize;
+    let uneven_rows: Vec<&Vec<f64>> = rows
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| {
+            let keep = *k == next;
+            if keep {
+                next += 2 + (g.next() * 17.0) as usize;
+            }
+            keep
+        })
+        .map(|(_, r)| r)
+        .collect();
+    let uneven = write("uneven.csv", &mut uneven_rows.into_iter(), 0.0);
+    let terms = dir.join("terms.txt");
+    std::fs::write(&terms, "1\nx\ny\nz\nx*x\nx*y\nx*z\ny*y\ny*z\nz*z\n").unwrap();
+    let same = |found: &BTreeMap<String, f64>, want: &[(&str, f64)], tolerance: f64, what: &str| {
+        let names: Vec<&str> = found.keys().map(String::as_str).collect();
+        let mut wanted: Vec<&str> = want.iter().map(|w| w.0).collect();
+        wanted.sort();
+        assert_eq!(names, wanted, "{what}: {found:?}");
+        for (term, c) in want {
+            let got = found[*term];
+            assert!((got - c).abs() <= tolerance * c.abs(), "{what} {term}: {got} vs {c}");
+        }
+    };
+    // in the offset z: dy/dt = (28 + 10⁴)·x − y − x·z, dz/dt = x·y − 8/3·z + 8/3·10⁴
+    same(
+        &identify_with_defaults(&offset, "dy/dt", &terms),
+        &[("x", 10028.0), ("y", -1.0), ("x*z", -1.0)],
+        1e-3,
+        "dy/dt, z offset",
+    );
+    same(
+        &identify_with_defaults(&offset, "dz/dt", &terms),
+        &[("1", 8e4 / 3.0), ("z", -8.0 / 3.0), ("x*y", 1.0)],
+        1e-3,
+        "dz/dt, z offset",
+    );
+    for target in ["dx/dt", "dy/dt", "dz/dt"] {
+        let (ok, out, err) = termid(&[
+            "identify",
+            "--data",
+            offset.to_str().unwrap(),
+            "--target",
+            target,
+            "--terms-file",
+            terms.to_str().unwrap(),
+        ]);
+        assert!(ok, "{err}");
+        assert!(out.contains("`z^2` left out of the candidates: collinear"), "{target}: {out}");
+        assert!(
+            out.contains("nearly a combination of the other chosen terms")
+                && out.contains("Far from 0 against their spread: `z`"),
+            "{target}: {out}"
+        );
+    }
+    let about = dir.join("about.txt");
+    std::fs::write(
+        &about,
+        "1\nx\ny\nz - 10000\nx*x\nx*y\nx*(z - 10000)\ny*y\ny*(z - 10000)\n(z - 10000)^2\n",
+    )
+    .unwrap();
+    same(
+        &identify_with_defaults(&offset, "dx/dt", &about),
+        &[("x", -10.0), ("y", 10.0)],
+        1e-3,
+        "dx/dt about 10⁴",
+    );
+    let (ok, out, err) = termid(&[
+        "identify",
+        "--data",
+        offset.to_str().unwrap(),
+        "--target",
+        "dy/dt",
+        "--terms-file",
+        about.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    // a candidate that is a sum prints in parentheses after its coefficient
+    assert!(out.contains("*(-10000*x + x*z)"), "{out}");
+    assert!(!out.contains("nearly a combination"), "{out}");
+    let truth: [(&str, &[(&str, f64)]); 3] = [
+        ("dx/dt", &[("x", -10.0), ("y", 10.0)]),
+        ("dy/dt", &[("x", 28.0), ("y", -1.0), ("x*z", -1.0)]),
+        ("dz/dt", &[("x*y", 1.0), ("z", -8.0 / 3.0)]),
+    ];
+    for (target, want) in truth {
+        same(
+            &identify_with_defaults(&uneven, target, &terms),
+            want,
+            0.01,
+            &format!("{target}, uneven clock"),
+        );
+    }
+}
+
 /// Honest uncertainty (issue 25 §4): when most Monte-Carlo draws fail, no mean, sd or band is
 /// printed or drawn as if it described the model; what failed is said, and what helps.
 #[test]
