@@ -56,11 +56,10 @@ impl Frame {
         origin: &str,
         time: &str,
     ) -> Result<Frame, DataError> {
-        let time_index = header.iter().position(|h| h == time).ok_or_else(|| DataError::MissingColumn {
-            file: origin.into(),
-            column: time.into(),
-            available: header.join(", "),
-        })?;
+        let time_index = header
+            .iter()
+            .position(|h| h == time)
+            .ok_or_else(|| DataError::missing_time(origin, time, &header))?;
         let mut frame = Frame::new(origin, time, std::mem::take(&mut columns[time_index]))?;
         for (name, values) in header.iter().zip(columns) {
             if name != time {
@@ -177,10 +176,15 @@ mod tests {
         let f = Frame::parse_csv_untimed("# c\nx,y\n1,2\n\n3,4\n", "h.csv").unwrap();
         assert_eq!(f.column("row").unwrap(), [1.0, 2.0]);
         assert_eq!(f.column("y").unwrap(), [2.0, 4.0]);
-        assert!(matches!(
-            Frame::parse_csv("time,u\n0,1\n", "a.csv", "t"),
-            Err(DataError::MissingColumn { .. })
-        ));
+        let missing = Frame::parse_csv("time,u\n0,1\n", "a.csv", "t").unwrap_err();
+        assert!(matches!(missing, DataError::MissingTime { .. }));
+        assert!(missing.to_string().contains("`time` looks like time"), "{missing}");
+        let missing = Frame::parse_csv("Time [s],u\n0,1\n", "a.csv", "t").unwrap_err().to_string();
+        assert!(missing.contains("map it in a dataset file (`[columns] t = \"Time [s]\"`)"), "{missing}");
+        let missing = Frame::parse_csv("time,u\n0,1\n", "a.csv", "t").unwrap_err().to_string();
+        assert!(missing.contains("(`--time time`, a model file's `time`)"), "{missing}");
+        let missing = Frame::parse_csv("timer,u\n0,1\n", "a.csv", "t").unwrap_err().to_string();
+        assert!(!missing.contains("looks like time"), "{missing}");
         assert!(matches!(
             Frame::parse_csv("t,u\n0,1,2\n", "a.csv", "t"),
             Err(DataError::Ragged { row: 1, .. })

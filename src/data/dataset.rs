@@ -344,6 +344,64 @@ fn split_spec(spec: &str) -> (String, Option<String>, f64) {
     }
 }
 
+/// Renames the headers that carry their unit (`Time [s]`, `x [m]`, as spreadsheets and
+/// loggers export them) to their bare names, so the mapping names them as any column, and
+/// returns each such column's unit; a header whose bare name another header has keeps its
+/// whole text.
+fn bare_headers(names: &mut [String]) -> BTreeMap<String, String> {
+    let split: Vec<Option<(String, String)>> = names
+        .iter()
+        .map(|n| match split_spec(n) {
+            (bare, Some(unit), sign) if sign > 0.0 && !bare.is_empty() => Some((bare, unit)),
+            _ => None,
+        })
+        .collect();
+    let taken = |bare: &str, own: usize| {
+        names
+            .iter()
+            .enumerate()
+            .any(|(i, n)| i != own && (n == bare || split[i].as_ref().is_some_and(|(b, _)| b == bare)))
+    };
+    let renames: Vec<(usize, String, String)> = split
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| s.clone().filter(|(bare, _)| !taken(bare, i)).map(|(b, u)| (i, b, u)))
+        .collect();
+    let mut units = BTreeMap::new();
+    for (i, bare, unit) in renames {
+        names[i] = bare.clone();
+        units.insert(bare, unit);
+    }
+    units
+}
+
+/// A mapping's column, unit and sign, the unit from the file's header where the mapping
+/// gives none; a mapping whose unit is not the header's is refused. A header kept whole
+/// (`x [m]` beside an `x`) is named by its whole text, the unit its own.
+fn spec_with_header_unit(
+    spec: &str,
+    names: &[String],
+    header_units: &BTreeMap<String, String>,
+    origin: &str,
+) -> Result<(String, Option<String>, f64), DataError> {
+    let (col, unit, sign) = split_spec(spec);
+    // a header kept whole (its bare name shared) is named by its whole text
+    let whole = spec.trim().trim_start_matches('-').trim_start();
+    if names.iter().any(|n| n == whole) && col != whole {
+        return Ok((whole.to_string(), unit, sign));
+    }
+    match (unit, header_units.get(&col)) {
+        (Some(unit), Some(header)) if unit != *header => Err(DataError::Unit {
+            file: origin.into(),
+            row: 0,
+            column: col,
+            message: format!("the dataset file reads it in [{unit}], the file's header says [{header}]"),
+        }),
+        (None, Some(header)) => Ok((col, Some(header.clone()), sign)),
+        (unit, _) => Ok((col, unit, sign)),
+    }
+}
+
 impl Dataset {
     /// Whether its runs are tracked over ground (a satellite receiver: `[track] latitude` or
     /// `speed_over_ground`): their velocities are the body's over the earth, with any current
@@ -427,7 +485,7 @@ impl Dataset {
                 path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
                 Some("parquet" | "pq" | "arrow" | "feather" | "ipc")
             );
-            let (names, mut columns) = if columnar {
+            let (mut names, mut columns) = if columnar {
                 // columnar files name their own columns
                 super::csv_io::read_table(&path)?
             } else {
@@ -452,7 +510,13 @@ impl Dataset {
                     .join("\n");
                 super::csv_io::parse_table(&csv, &origin)?
             };
-            let (time_col, time_unit, _) = split_spec(self.columns.get(time).map_or(time, String::as_str));
+            let header_units = bare_headers(&mut names);
+            let (time_col, time_unit, _) = spec_with_header_unit(
+                self.columns.get(time).map_or(time, String::as_str),
+                &names,
+                &header_units,
+                &origin,
+            )?;
             let Some(time_index) = names.iter().position(|h| *h == time_col) else {
                 return Err(DataError::MissingColumn {
                     file: origin.clone(),
@@ -495,7 +559,7 @@ impl Dataset {
             }
             // one column of the file in SI at the model's scale, with the conversions said
             let mut convert = |spec: &str, var: &str| -> Result<Vec<f64>, DataError> {
-                let (col, unit, sign) = split_spec(spec);
+                let (col, unit, sign) = spec_with_header_unit(spec, &names, &header_units, &origin)?;
                 let values = raw.require(&col)?;
                 if unit.as_deref() == Some("rad") {
                     if let Some((i, v)) =
@@ -756,6 +820,33 @@ mod tests {
         let (frames, _) = set.read(&dir, "t").unwrap();
         assert_eq!(frames[0].time(), [0.0, 0.5]);
         assert_eq!(frames[0].column("δ").unwrap(), [1.5, -2.25]);
+    }
+
+    /// Headers that carry their unit, as spreadsheets export them: named by their bare name,
+    /// the unit read from the header where the mapping gives none, a mapping that says
+    /// another unit refused; a bare name two headers share keeps each header's whole text.
+    #[test]
+    fn headers_with_their_units() {
+        let dir = std::env::temp_dir().join(format!("termid-header-units-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        write(&dir, "h.csv", "Time [s],psi [deg],u [m/s],x [m],x\n0,90,1.5,1,2\n0.5,180,1.25,3,4\n");
+        let read = |columns: &str| {
+            let text = format!("[columns]\n{columns}\n[[runs]]\nfile = \"h.csv\"\n");
+            let set: Dataset = toml::from_str(&text).unwrap();
+            set.read(&dir, "t")
+        };
+        let (frames, notes) = read("t = \"Time\"\n\"ψ\" = \"psi\"\nu = \"u [m/s]\"\ny = \"x [m]\"").unwrap();
+        assert_eq!(frames[0].time(), [0.0, 0.5]);
+        let psi = frames[0].column("ψ").unwrap();
+        assert!((psi[0] - std::f64::consts::FRAC_PI_2).abs() < 1e-12, "{psi:?} {notes:?}");
+        assert_eq!(frames[0].column("u").unwrap(), [1.5, 1.25]);
+        assert_eq!(frames[0].column("y").unwrap(), [1.0, 3.0]);
+        let refused = read("t = \"Time\"\n\"ψ\" = \"psi [rad]\"").unwrap_err().to_string();
+        assert!(refused.contains("reads it in [rad], the file's header says [deg]"), "{refused}");
+        let shared = read("t = \"Time\"\ny = \"x\"").unwrap();
+        assert_eq!(shared.0[0].column("y").unwrap(), [2.0, 4.0]);
+        let shared = read("t = \"Time\"\ny = \"x [m]\"\nu = \"x\"").unwrap();
+        assert_eq!(shared.0[0].column("y").unwrap(), [1.0, 3.0]);
     }
 
     /// A basin file as HSVA writes them: Latin-1 header lines (a degree sign), no row of

@@ -85,6 +85,18 @@ pub enum DataError {
         /// The columns there are.
         available: String,
     },
+    /// The time column is absent.
+    #[error("{file}: no time column `{column}` (columns: {available}){hint}")]
+    MissingTime {
+        /// The file.
+        file: String,
+        /// The time column looked for.
+        column: String,
+        /// The columns there are.
+        available: String,
+        /// Where a column looks like time: which, and how to name it.
+        hint: String,
+    },
     /// A column name occurs twice.
     #[error("{file}: column `{column}` appears twice")]
     DuplicateColumn {
@@ -207,6 +219,41 @@ pub enum DataError {
     /// Unknown derivative method.
     #[error("unknown derivative method `{0}` (known: {1})")]
     UnknownMethod(String, String),
+}
+
+impl DataError {
+    /// No column `time` among `names` in `file`; a column that looks like time (`time`,
+    /// `Time [s]`, `timestamp`, `seconds`) is named, with how to choose it.
+    pub fn missing_time(file: &str, time: &str, names: &[impl AsRef<str>]) -> DataError {
+        let looks_like_time = |n: &str| {
+            let n = n.trim().to_lowercase();
+            ["time", "timestamp", "sec", "secs", "seconds", "t_s", "t [s]", "t(s)"].iter().any(|w| {
+                n == *w
+                    || n.starts_with(&format!("{w} "))
+                    || n.starts_with(&format!("{w}_"))
+                    || n.starts_with(&format!("{w}["))
+            })
+        };
+        let hint = names
+            .iter()
+            .map(AsRef::as_ref)
+            .find(|n| looks_like_time(n))
+            .map(|n| {
+                if n.chars().all(|c| c.is_alphanumeric() || c == '_') && !n.starts_with(|c: char| c.is_ascii_digit()) {
+                    format!("; `{n}` looks like time: name it as the time column (`--time {n}`, a model file's `time`)")
+                } else {
+                    // not a name terms can use: a dataset file maps it (its unit read too)
+                    format!("; `{n}` looks like time: map it in a dataset file (`[columns] {time} = \"{n}\"`)")
+                }
+            })
+            .unwrap_or_default();
+        DataError::MissingTime {
+            file: file.into(),
+            column: time.into(),
+            available: names.iter().map(AsRef::as_ref).collect::<Vec<_>>().join(", "),
+            hint,
+        }
+    }
 }
 
 impl DataError {

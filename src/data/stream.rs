@@ -79,11 +79,10 @@ impl Chunks {
         context: usize,
     ) -> Result<Chunks, DataError> {
         let names = source.names();
-        let time_index = names.iter().position(|n| n == time).ok_or_else(|| DataError::MissingColumn {
-            file: origin.into(),
-            column: time.into(),
-            available: names.join(", "),
-        })?;
+        let time_index = names
+            .iter()
+            .position(|n| n == time)
+            .ok_or_else(|| DataError::missing_time(origin, time, names))?;
         let held = vec![Vec::new(); names.len()];
         Ok(Chunks {
             source,
