@@ -93,7 +93,16 @@ impl Vocabulary {
     fn check_new(&self, name: &str) -> Result<String, TermError> {
         let name = normalise_name(name);
         if !is_identifier(&name) {
-            return Err(TermError::Declaration(format!("`{name}` is not a valid name")));
+            // a column header that carries its unit: a dataset file reads it by its bare name
+            let hint = match name.split_once('[') {
+                Some((bare, unit)) if unit.ends_with(']') && is_identifier(bare.trim()) => format!(
+                    " (a header with its unit: map it in a dataset file, `[columns] {} = \"{name}\"`, \
+                     which reads it by its bare name in SI)",
+                    bare.trim()
+                ),
+                _ => String::new(),
+            };
+            return Err(TermError::Declaration(format!("`{name}` is not a valid name{hint}")));
         }
         if self.is_declared(&name) || self.aliases.contains_key(&name) {
             return Err(TermError::Declaration(format!("`{name}` is declared twice")));
@@ -330,6 +339,14 @@ mod tests {
         assert_eq!(v.parse("u*∆u").unwrap(), v.parse("u*Δu").unwrap());
         assert_eq!(v.parse("u^2*delta^3").unwrap().to_string(), "u^2*δ^3");
         assert_eq!(v.parse("v^2*r/u").unwrap().to_string(), "r*v^2/u");
+    }
+
+    #[test]
+    fn a_header_with_its_unit_is_pointed_to_a_dataset_file() {
+        let e = Vocabulary::new().variable("x [m]").map(|_| ()).unwrap_err().to_string();
+        assert!(e.contains("`[columns] x = \"x [m]\"`"), "{e}");
+        let e = Vocabulary::new().variable("x y").map(|_| ()).unwrap_err().to_string();
+        assert!(e.ends_with("`x y` is not a valid name"), "{e}");
     }
 
     #[test]
