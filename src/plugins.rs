@@ -29,6 +29,17 @@ pub fn fit_metrics(
     (pairs, checks)
 }
 
+/// The hypotheses `diagnose` tests for `model`: its plug-in's, else the generic library with
+/// the products of its variables beyond its candidates
+/// ([`crate::diagnose::beyond_candidates`]).
+pub fn hypotheses(model: &Model) -> Vec<crate::diagnose::Hypothesis> {
+    of(model).and_then(|p| p.hypotheses(model)).unwrap_or_else(|| {
+        let mut out = crate::diagnose::generic_hypotheses(model);
+        out.extend(crate::diagnose::beyond_candidates(model));
+        out
+    })
+}
+
 /// The plug-in that adds derivative method `name`.
 pub fn with_derivative(name: &str) -> Option<&'static dyn Plugin> {
     PLUGINS.iter().copied().find(|p| p.derivative_methods().contains(&name))

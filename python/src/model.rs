@@ -759,9 +759,7 @@ impl PyModel {
         // runs tracked over ground: the day's current estimated first with the runs' own values
         let medium = if over_ground { self.inner.held_medium() } else { vec![] };
         let model = self.inner.freed(&medium, &[]).map_err(refuse)?;
-        let hypotheses = termid::plugins::of(&self.inner)
-            .and_then(|p| p.hypotheses(&self.inner))
-            .unwrap_or_else(|| termid::diagnose::generic_hypotheses(&self.inner));
+        let hypotheses = termid::plugins::hypotheses(&self.inner);
         let (integrator, dt) = method_of(&self.inner, integrator, dt)?;
         let settings = termid::diagnose::Settings {
             dt,

@@ -997,7 +997,8 @@ type Coefficients = Vec<(crate::term::Term, f64, Option<f64>)>;
 /// The model with a hypothesis's term coefficients added (inputs are changed in simulation).
 pub fn apply(model: &Model, h: &Hypothesis, theta: &[f64]) -> Result<Model, super::DiagnoseError> {
     let mut m = model.clone();
-    if let Effect::Terms { terms } = &h.effect {
+    let terms = h.terms();
+    if !terms.is_empty() {
         // each equation's coefficients changed together and stored once (a refinement
         // applies every identified term at every iteration)
         let mut changed: Vec<(&str, Coefficients, Option<f64>)> = Vec::new();
@@ -1022,6 +1023,9 @@ pub fn apply(model: &Model, h: &Hypothesis, theta: &[f64]) -> Result<Model, supe
         for (eq, coefs, intercept) in changed {
             m.set_coefficients(eq, coefs, intercept);
         }
+    }
+    if let Effect::Beyond { equation, term, .. } = &h.effect {
+        m.add_candidate(equation, m.vocabulary.parse(term)?);
     }
     Ok(m)
 }

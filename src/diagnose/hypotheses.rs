@@ -1,10 +1,12 @@
 //! The library of candidate effects. Generic: a constant in any equation, each candidate
-//! term the model lacks, an offset and a scale error on any input. Plug-ins add their own,
-//! with the names their users use (see `ship::hypotheses`).
+//! term the model lacks, an offset and a scale error on any input, and for a model no plug-in
+//! names, the products of its variables beyond its candidates. Plug-ins add their own, with
+//! the names their users use (see `ship::hypotheses`).
 
 use serde::Serialize;
 
 use crate::model::Model;
+use crate::term::Term;
 
 /// What a hypothesis adds to the model.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -14,6 +16,24 @@ pub enum Effect {
     Terms {
         /// (equation name, term text).
         terms: Vec<(String, String)>,
+    },
+    /// A term beyond its equation's candidates, the equation's own coefficients refitted
+    /// with it: it joins the candidates of the model written.
+    Beyond {
+        /// The equation.
+        equation: String,
+        /// The new term's text.
+        term: String,
+        /// The terms of the equation's coefficients, corrected with it.
+        refitted: Vec<String>,
+    },
+    /// An equation's coefficients refitted by output error, nothing added: the baseline a
+    /// term beyond the candidates must beat.
+    Refit {
+        /// The equation.
+        equation: String,
+        /// The terms of its coefficients.
+        refitted: Vec<String>,
     },
     /// The true input is the recorded one plus an offset.
     InputOffset {
@@ -47,7 +67,31 @@ impl Hypothesis {
                 };
                 e.candidates.contains(&term)
             }),
+            Effect::Refit { .. } => true,
             _ => false,
+        }
+    }
+
+    /// Whether a screening step cannot rank it: a refit moves every coefficient of an
+    /// equation, and one Gauss-Newton step from the identified values stops far short of
+    /// where it leads (a Duffing's refit: 3 % of the gap after one step, 80 % refined), so
+    /// these are always refined.
+    pub fn needs_refining(&self) -> bool {
+        matches!(self.effect, Effect::Refit { .. } | Effect::Beyond { .. })
+    }
+
+    /// The (equation, term) pairs whose coefficients it moves, in the order of its parameters;
+    /// empty for an input's error.
+    pub fn terms(&self) -> Vec<(String, String)> {
+        match &self.effect {
+            Effect::Terms { terms } => terms.clone(),
+            Effect::Beyond { equation, term, refitted } => {
+                std::iter::once(term).chain(refitted).map(|t| (equation.clone(), t.clone())).collect()
+            }
+            Effect::Refit { equation, refitted } => {
+                refitted.iter().map(|t| (equation.clone(), t.clone())).collect()
+            }
+            _ => vec![],
         }
     }
 
@@ -55,6 +99,8 @@ impl Hypothesis {
     pub fn parameters(&self) -> usize {
         match &self.effect {
             Effect::Terms { terms } => terms.len(),
+            Effect::Beyond { refitted, .. } => 1 + refitted.len(),
+            Effect::Refit { refitted, .. } => refitted.len(),
             _ => 1,
         }
     }
@@ -126,6 +172,90 @@ pub fn generic_hypotheses(model: &Model) -> Vec<Hypothesis> {
             name: format!("scale error on input {}", i.name),
             effect: Effect::InputScale { input: i.name.clone() },
         });
+    }
+    out
+}
+
+/// Highest degree of the products [`beyond_candidates`] offers (3 for up to this many
+/// variables in an equation's candidates, 2 for more: a cubic library of six variables would
+/// be 83 hypotheses an equation, each an output-error fit).
+const CUBIC_UP_TO: usize = 4;
+
+/// Effects beyond the model's own candidates: in each identified equation, every product of
+/// the states and inputs its candidates use, up to degree 3 (2 beyond four variables; an
+/// input to the first power), that is not a candidate already. Where the author's library
+/// lacks the term the system has (a Duffing oscillator's x³ in a quadratic library), the
+/// declared hypotheses cannot name it; this names it as `x^3 in v_dot, beyond the candidates`. Each
+/// equation's coefficients refitted alone come first: the baseline a new term must beat.
+pub fn beyond_candidates(model: &Model) -> Vec<Hypothesis> {
+    let spec = model.spec();
+    let dynamic: Vec<&str> = spec
+        .states
+        .iter()
+        .map(|s| s.name.as_str())
+        .chain(spec.inputs.iter().map(|i| i.name.as_str()))
+        .collect();
+    let inputs: Vec<&str> = spec.inputs.iter().map(|i| i.name.as_str()).collect();
+    let mut out = Vec::new();
+    for eq in model.equations().iter().filter(|e| e.identify) {
+        let mut vars: Vec<String> = eq
+            .candidates
+            .iter()
+            .flat_map(Term::variables)
+            .filter(|v| dynamic.contains(&v.as_str()))
+            .collect();
+        vars.sort();
+        vars.dedup();
+        let degree = if vars.len() <= CUBIC_UP_TO { 3 } else { 2 };
+        let mut products: Vec<Term> = vec![Term::constant(1.0)];
+        let mut all: Vec<Term> = Vec::new();
+        for _ in 0..degree {
+            // each product once: extend by variables at or after its last factor's
+            let mut next = Vec::new();
+            for p in &products {
+                let start = vars.iter().rposition(|v| p.variables().contains(v)).unwrap_or(0);
+                for v in &vars[start..] {
+                    // an input enters once: F²·v, where a forcing switches between ±a, is v
+                    // but where the replay ramps between samples, and "explains" that ramp
+                    if inputs.contains(&v.as_str()) && p.variables().contains(v) {
+                        continue;
+                    }
+                    if let Ok(t) = p.mul(&Term::var(v)) {
+                        if !next.contains(&t) {
+                            next.push(t);
+                        }
+                    }
+                }
+            }
+            all.extend(next.iter().cloned());
+            products = next;
+        }
+        // the equation's own coefficients move with the new term: identified without it, they
+        // have taken up what they could of its part (a Duffing's x³ fitted by a stiffer x), and
+        // the term alone on top of them explains a fraction of the gap it closes
+        let refitted: Vec<String> = eq.coefficients.iter().map(|(t, _, _)| t.to_string()).collect();
+        // the baseline each new term must beat: the coefficients refitted alone (a term that
+        // only re-weighs them, F²·v where F is ±a, explains what the refit does, with one
+        // parameter more)
+        if !refitted.is_empty() {
+            out.push(Hypothesis {
+                name: format!("{}'s coefficients refitted (output error)", eq.name),
+                effect: Effect::Refit { equation: eq.name.clone(), refitted: refitted.clone() },
+            });
+        }
+        for t in all {
+            if eq.candidates.contains(&t) || eq.coefficient(&t) != 0.0 {
+                continue;
+            }
+            out.push(Hypothesis {
+                name: format!("`{t}` in {}, beyond the candidates", eq.name),
+                effect: Effect::Beyond {
+                    equation: eq.name.clone(),
+                    term: t.to_string(),
+                    refitted: refitted.clone(),
+                },
+            });
+        }
     }
     out
 }

@@ -51,7 +51,7 @@ pub use fit::{in_segments, simulate_runs, EstimateError, PartlyRecorded, Runs, S
 pub use medium::medium;
 pub use refine::{refine, RefineSettings, Refined, RefinedCoefficient};
 
-pub use hypotheses::{generic_hypotheses, Effect, Hypothesis};
+pub use hypotheses::{beyond_candidates, generic_hypotheses, Effect, Hypothesis};
 
 use crate::data::{DataError, Frame};
 use crate::model::Model;
@@ -128,6 +128,12 @@ pub struct Candidate {
     pub delta_bic: f64,
     /// Made of declared candidate terms (see [`Hypothesis::declared`]).
     pub declared: bool,
+    /// A term beyond the candidates: the share of the gap it removes beyond its equation's
+    /// coefficients refitted alone. Below `min_explained` it may not win: the refit does the
+    /// work, and the term only fits what is left (on a model whose structure is right, the
+    /// re-simulation's round-off: 3 % of a gap of 0.03 % of the signal).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub beyond_refit: Option<f64>,
 }
 
 /// Settings.
@@ -269,7 +275,7 @@ pub fn diagnose(
     screened.sort_by(|a, b| a.2.total_cmp(&b.2));
     for (rank, (i, theta, cost)) in screened.into_iter().enumerate() {
         let h = &hypotheses[i];
-        let (theta, cost, se) = if rank < settings.refine {
+        let (theta, cost, se) = if rank < settings.refine || h.needs_refining() {
             match fit::levenberg_marquardt(&data, model, h, theta.clone()) {
                 Ok(e) => {
                     let se = e.std_errors();
@@ -291,7 +297,18 @@ pub fn diagnose(
             explained: 1.0 - cost / gap_before.cost.max(1e-300),
             delta_bic,
             declared: h.declared(model),
+            beyond_refit: None,
         });
+    }
+    // a term beyond the candidates is measured against its equation's refit alone
+    for i in 0..candidates.len() {
+        if let Effect::Beyond { equation, .. } = &candidates[i].effect {
+            let refit = candidates
+                .iter()
+                .find(|c| matches!(&c.effect, Effect::Refit { equation: e, .. } if e == equation));
+            let excess = candidates[i].explained - refit.map_or(0.0, |r| r.explained);
+            candidates[i].beyond_refit = Some(excess);
+        }
     }
     candidates.sort_by(|a, b| a.delta_bic.total_cmp(&b.delta_bic).then(a.cost.total_cmp(&b.cost)));
     // a catch-all (a constant, an input error) that only ties with the model's own physics
@@ -301,10 +318,14 @@ pub fn diagnose(
         candidates[..tied]
             .sort_by(|a, b| b.declared.cmp(&a.declared).then(a.delta_bic.total_cmp(&b.delta_bic)));
     }
+    // a term beyond the candidates that only adds to its equation's refit is passed over
     let winner = candidates
-        .first()
-        .filter(|c| c.explained >= settings.min_explained && c.delta_bic <= -settings.min_bic_drop)
-        .map(|_| 0);
+        .iter()
+        .position(|c| c.beyond_refit.is_none_or(|b| b >= settings.min_explained))
+        .filter(|&w| {
+            let c = &candidates[w];
+            c.explained >= settings.min_explained && c.delta_bic <= -settings.min_bic_drop
+        });
     let mut after_sims = Vec::new();
     let (gap_after, new_model) = match winner {
         Some(w) => {

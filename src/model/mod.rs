@@ -753,6 +753,21 @@ impl Model {
         Library::compile(&rhs, &self.vocabulary)
     }
 
+    /// Adds `term` to `equation`'s candidates (a term found beyond them: re-identifying the
+    /// model written keeps it among what it selects from); nothing where it is one already.
+    pub fn add_candidate(&mut self, equation: &str, term: Term) {
+        let text = term.to_string();
+        if let Some(eq) = self.equations.iter_mut().find(|e| e.name == equation) {
+            if eq.candidates.contains(&term) {
+                return;
+            }
+            eq.candidates.push(term);
+        }
+        if let Some(spec) = self.spec.equations.get_mut(equation) {
+            spec.candidates.push(text);
+        }
+    }
+
     /// Replaces an equation's coefficients (e.g. with an identification's result).
     pub fn set_coefficients(
         &mut self,

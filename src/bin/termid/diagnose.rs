@@ -2,7 +2,7 @@
 //! model with the effect added, and the gap before and after.
 
 use anyhow::{Context, Result};
-use termid::diagnose::{diagnose, generic_hypotheses, Diagnosis, Settings};
+use termid::diagnose::{diagnose, Diagnosis, Settings};
 
 use crate::args::{DiagnoseCommand, Format};
 use termid::identify::{num, sig};
@@ -26,9 +26,7 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
     // nuisances (each run's own values), the model held; the model written is in still water
     let current = crate::runs::medium_to_free(&file, &cmd.runs.dataset, &cmd.runs.hold)?;
     let model = file.freed(&current, &[]).map_err(anyhow::Error::msg)?;
-    let hypotheses = termid::plugins::of(&model)
-        .and_then(|p| p.hypotheses(&model))
-        .unwrap_or_else(|| generic_hypotheses(&model));
+    let hypotheses = termid::plugins::hypotheses(&model);
     let (integrator, dt) = model.simulation(cmd.resim.integrator, cmd.resim.dt);
     let settings =
         Settings { dt, integrator, with_intercepts: cmd.resim.with_intercept, ..Settings::default() };
@@ -49,7 +47,7 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
         Format::Json => println!("{}", serde_json::to_string_pretty(&json(&d))?),
         Format::Text => {
             print!("{}", own_values(&d, &model));
-            print!("{}", text(&d, cmd.out.as_deref(), hypotheses.len()))
+            print!("{}", text(&d, cmd.out.as_deref(), hypotheses.len(), &settings))
         }
     }
     Ok(())
@@ -108,17 +106,22 @@ fn own_values(d: &Diagnosis, model: &termid::model::Model) -> String {
     s
 }
 
-fn text(d: &Diagnosis, out: Option<&std::path::Path>, tested: usize) -> String {
+fn text(d: &Diagnosis, out: Option<&std::path::Path>, tested: usize, settings: &Settings) -> String {
     let mut s = format!("where: {}\n\n", d.location.words);
     s += &format!("{tested} hypotheses tested (output error, recorded inputs replayed); best first: by ΔBIC, and among those that explain nearly as much as the best, the model's own candidate terms first:\n");
     s += &format!("{:<58} {:>10} {:>12}  estimate ± std. error\n", "hypothesis", "explained", "ΔBIC");
     for c in d.candidates.iter().take(8) {
-        let est: Vec<String> = c
+        let mut est: Vec<String> = c
             .estimate
             .iter()
             .zip(&c.std_error)
             .map(|(e, se)| format!("{} ± {}", num(*e), num(*se)))
             .collect();
+        // a term beyond the candidates: its own coefficient, the refitted ones counted
+        if let termid::diagnose::Effect::Beyond { equation, refitted, .. } = &c.effect {
+            est.truncate(1);
+            est.push(format!("{equation}'s {} coefficients refitted", refitted.len()));
+        }
         s += &format!(
             "{:<58} {:>9.1}% {:>12.1}  {}\n",
             c.name,
@@ -137,7 +140,21 @@ fn text(d: &Diagnosis, out: Option<&std::path::Path>, tested: usize) -> String {
             }
             s += ".\n";
         }
-        None => s += "verdict: no hypothesis explains the gap significantly; the model is left unchanged.\n",
+        None => {
+            s += "verdict: no hypothesis explains the gap significantly; the model is left unchanged.\n";
+            // a best effect the data do hold but which closes too little of the gap: the cause
+            // is not among those tested
+            if let Some(c) = d.candidates.first().filter(|c| c.delta_bic <= -settings.min_bic_drop) {
+                s += &format!(
+                    "  The best, {}, is supported by the runs (ΔBIC {:.1}) but closes only {:.1} % of the gap \
+                     (at least {:.0} % to be the missing effect): the missing effect is none of those tested.\n",
+                    c.name,
+                    c.delta_bic,
+                    100.0 * c.explained,
+                    100.0 * settings.min_explained
+                );
+            }
+        }
     }
     s += &format!(
         "\n{:<8} {:>16} {:>16} {:>16} {:>16}\n",
