@@ -134,6 +134,7 @@ struct CompileKey {
     excluded: Vec<String>,
     parameters: Vec<String>,
     weights: Option<String>,
+    time: Option<String>,
 }
 
 /// What `fit` compiles from the texts alone: the columns' vocabulary, the parsed terms and
@@ -159,7 +160,7 @@ impl Compiled {
         }
         let mut vocabulary = Vocabulary::new();
         for name in &key.names {
-            if *name != key.target && Some(name) != key.weights.as_ref() {
+            if *name != key.target && Some(name) != key.weights.as_ref() && Some(name) != key.time.as_ref() {
                 vocabulary.variable(name).map_err(fail)?;
             }
         }
@@ -177,9 +178,11 @@ impl Compiled {
 }
 
 /// One equation from columns: `target` explained by the candidate `terms` (text in termid's
-/// term language over the column names) with a back-end given as JSON settings.
+/// term language over the column names) with a back-end given as JSON settings. A rate
+/// (`dx/dt`) is an equation of motion of the rows as a time series over the column `time`,
+/// by the `derivative` method (`integral` where none is named, as the command line does).
 #[pyfunction]
-#[pyo3(signature = (target, columns, terms, backend = "{\"method\": \"stepwise\"}", intercept = true, forced = vec![], excluded = vec![], parameters = BTreeMap::new(), weights = None))]
+#[pyo3(signature = (target, columns, terms, backend = "{\"method\": \"stepwise\"}", intercept = true, forced = vec![], excluded = vec![], parameters = BTreeMap::new(), weights = None, time = None, derivative = None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn fit(
     py: Python<'_>,
@@ -192,11 +195,16 @@ pub(crate) fn fit(
     excluded: Vec<String>,
     parameters: BTreeMap<String, f64>,
     weights: Option<String>,
+    time: Option<String>,
+    derivative: Option<String>,
 ) -> PyResult<PyFit> {
     let backend = backend_of(backend)?;
     let names: Vec<String> = columns.keys().iter().map(|k| k.extract()).collect::<PyResult<_>>()?;
-    let variables: Vec<String> =
-        names.iter().filter(|n| *n != target && Some(*n) != weights.as_ref()).cloned().collect();
+    let variables: Vec<String> = names
+        .iter()
+        .filter(|n| *n != target && Some(*n) != weights.as_ref() && Some(*n) != time.as_ref())
+        .cloned()
+        .collect();
     // the arrays used where they lie: read-only views, no copy (the rows are checked as
     // they are accumulated: a value that is not finite is refused with its row and term)
     let arrays = names
@@ -215,17 +223,59 @@ pub(crate) fn fit(
         excluded,
         parameters: parameters.keys().cloned().collect(),
         weights: weights.clone(),
+        time: time.clone(),
     };
     let compiled = Compiled::of(key)?;
     let Compiled { vocabulary, candidates, forced, excluded, design, .. } = &*compiled;
     let rules =
         parameters.iter().map(|(n, v)| (n.clone(), termid::identify::ParamValue::Value(*v))).collect();
-    let central = termid::data::CentralDifference;
-    let how = Identification { vocabulary, parameters: &rules, differentiator: &central, intercept, weights };
+    let rate = termid::identify::Target::parse(target);
+    let method = match (&rate, derivative.as_deref()) {
+        (termid::identify::Target::Derivative(_), name) => {
+            termid::recipe::derivative_method(name.unwrap_or("integral")).map_err(fail)?
+        }
+        (_, Some(name)) => {
+            return Err(refuse(format!(
+                "derivative = {name:?} estimates a rate: the target is one (`d{target}/dt`)"
+            )))
+        }
+        (_, None) => Box::new(termid::data::CentralDifference),
+    };
+    let how = Identification {
+        vocabulary,
+        parameters: &rules,
+        differentiator: method.as_ref(),
+        intercept,
+        weights,
+    };
     let selector = backend.build();
-    let fit = py
-        .detach(|| how.fit_columns("data", &slices, target, design, forced, excluded, selector.as_ref()))
-        .map_err(fail)?;
+    let fit = match &rate {
+        termid::identify::Target::Derivative(state) => {
+            // the rows as one run in time: a rate is estimated (or integrated) along it
+            let time =
+                time.as_deref().ok_or_else(|| refuse(format!("`{target}` is a rate: it needs the time")))?;
+            if state == time {
+                return Err(refuse(format!("`{target}`: `{time}` is the time, whose rate is 1")));
+            }
+            let at = |name: &str| slices.iter().find(|(n, _)| *n == name).map(|(_, v)| *v);
+            let t = at(time).ok_or_else(|| refuse(format!("no time column `{time}`")))?;
+            let mut frame = termid::data::Frame::new("data", time, t.to_vec()).map_err(fail)?;
+            for (name, values) in slices.iter().filter(|(n, _)| *n != time) {
+                frame.push(name, values.to_vec()).map_err(fail)?;
+            }
+            let frames = [frame];
+            py.detach(|| -> Result<Fit, termid::identify::IdentifyError> {
+                let mut fit = how.fit_design(&rate, design, forced, excluded, &frames, selector.as_ref())?;
+                // rows of a time series are not independent: the honest standard errors' factor
+                fit.correlation_time = how.correlation_time(&rate, candidates, &frames, &fit.selection)?;
+                Ok(fit)
+            })
+            .map_err(fail)?
+        }
+        termid::identify::Target::Column(_) => py
+            .detach(|| how.fit_columns("data", &slices, target, design, forced, excluded, selector.as_ref()))
+            .map_err(fail)?,
+    };
     let chosen: Vec<Term> = fit.selection.terms.iter().map(|t| candidates[t.index].clone()).collect();
     Ok(PyFit {
         chosen: Library::compile(&chosen, vocabulary).map_err(fail)?,

@@ -27,6 +27,7 @@ import functools
 import json
 import math
 import os
+import re
 import warnings
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
@@ -530,17 +531,43 @@ def _settings_text(backend: str, settings: Mapping[str, Any]) -> str:
         return json.dumps({"method": backend, **settings})
 
 
+_RATE = re.compile(r"^\s*d(.+)/dt\s*$")
+
+
+def _time_of(data: Data, columns: "_Columns", time: Optional[str], target: str) -> str:
+    """The name of the time of rows whose rate is fitted: ``time``, else a column ``t``, else
+    the DataFrame's index where it holds times (date-times or durations, in seconds from the
+    first; numbers, as seconds), added to ``columns`` as ``t``."""
+    if time is not None:
+        if time not in columns:
+            raise TermidError(f"no time column `{time}` (columns: {', '.join(columns)})")
+        return time
+    if "t" in columns:
+        return "t"
+    index = getattr(data, "index", None)
+    if isinstance(data, pd.DataFrame) and not isinstance(index, pd.RangeIndex):
+        values = index.to_numpy()
+        if values.dtype.kind in "mMfiu":
+            columns["t"] = np.ascontiguousarray(_seconds(str(index.name or "index"), values), dtype=np.float64)
+            return "t"
+    raise TermidError(
+        f"`{target}` is a rate: it needs the rows' time, a column `t`, time='name', or a DataFrame indexed by time"
+    )
+
+
 def fit(
     data: Data,
     target: str,
     terms: Union[str, Sequence[str], None] = None,
-    backend: str = "stepwise",
+    backend: Optional[str] = None,
     *,
-    intercept: bool = True,
+    intercept: Optional[bool] = None,
     forced: Sequence[str] = (),
     excluded: Sequence[str] = (),
     parameters: Optional[Mapping[str, float]] = None,
     weights: Optional[str] = None,
+    time: Optional[str] = None,
+    derivative: Optional[str] = None,
     **settings: Any,
 ) -> Fit:
     """Fits ``target`` (a column of ``data``) by the candidate ``terms`` (text over the other
@@ -548,39 +575,75 @@ def fit(
     ``fit(df, "y", ["x1", "x2", "x1*x2"], "stepwise", step_rule="last")`` (a back-end's
     settings: ``termid.settings(backend)``). A single string is one term.
 
+    A rate, ``fit(df, "dx/dt", terms)``, is an equation of motion of the rows as a time
+    series, with the command line's defaults for one: no derivative estimated (the integral
+    form) unless ``derivative`` names a method (:func:`derivatives`), the back-end
+    ``"stlsq"``, and the constant a candidate (``"1"``) rather than a forced intercept.
+
     Parameters: ``data`` a DataFrame, dict of arrays, Arrow table or record array;
-    ``target`` the column explained; ``terms`` the candidates; ``backend`` the selection
-    (:func:`backends`); ``intercept`` whether a constant b0 is fitted; ``forced`` terms kept
-    whatever their significance; ``excluded`` candidates left out; ``parameters`` values of
-    names the terms use that are not columns; ``weights`` a column of row weights.
+    ``target`` the column explained, or ``"dX/dt"`` the rate of column X; ``terms`` the
+    candidates; ``backend`` the selection (:func:`backends`; default ``"stepwise"``, for a
+    rate ``"stlsq"``); ``intercept`` whether a constant b0 is fitted (default: for a column
+    yes, for a rate no, ``"1"`` a candidate instead); ``forced`` terms kept whatever their
+    significance; ``excluded`` candidates left out; ``parameters`` values of names the terms
+    use that are not columns; ``weights`` a column of row weights; ``time`` the column of the
+    rows' time for a rate (default: ``t``, else a DataFrame's index of times); ``derivative``
+    how a rate is estimated (default: none, the integral form).
 
     >>> import pandas as pd
     >>> df = pd.DataFrame({"x1": [1.0, 2, 3, 4, 5], "x2": [2.0, 1, 4, 3, 6]}).eval("y = x1 + 2*x2")
     >>> fitted = termid.fit(df, "y", ["x1", "x2"], "stepwise", step_rule="last")
     >>> fitted.coefficients.round(6).to_dict()
     {'x2': 2.0, 'x1': 1.0}
+    >>> t = np.linspace(0.0, 10.0, 1001)
+    >>> decay = pd.DataFrame({"x": 3.0 * np.exp(-0.5 * t)}, index=pd.Index(t, name="t"))
+    >>> termid.fit(decay, "dx/dt", ["x", "x^2"]).coefficients.round(4).to_dict()
+    {'x': -0.5}
     """
     columns = _columns(data)
-    if target in columns.left_out:
-        raise TermidError(f"column `{target}` holds {columns.left_out[target]}, not numbers: it cannot be fitted")
-    if target not in columns:
-        raise TermidError(f"no column `{target}` to fit (columns: {', '.join(columns)})")
+    rate = _RATE.match(target)
+    time_name = None
+    if rate:
+        time_name = _time_of(data, columns, time, target)
+        state = rate.group(1).strip()
+        if state not in columns:
+            raise TermidError(f"`{target}`: no column `{state}` (columns: {', '.join(c for c in columns if c != time_name)})")
+        target = f"d{state}/dt"
+    elif time is not None or derivative is not None:
+        raise TermidError(
+            f"`{target}` is a column: `time` and `derivative` are for a rate (`d{target}/dt`)"
+        )
+    else:
+        if target in columns.left_out:
+            raise TermidError(f"column `{target}` holds {columns.left_out[target]}, not numbers: it cannot be fitted")
+        if target not in columns:
+            raise TermidError(f"no column `{target}` to fit (columns: {', '.join(columns)})")
     if isinstance(terms, str):
         # one term, not its characters
         terms = [terms]
     if terms is None:
-        terms = [c for c in columns if c not in (target, weights)]
+        terms = [c for c in columns if c not in (target, weights, time_name)]
+    terms = list(terms)
+    if backend is None:
+        backend = "stlsq" if rate else "stepwise"
+    if intercept is None:
+        intercept = not rate
+        # for a rate the constant is a candidate like any other, as on the command line
+        if rate and "1" not in (t.strip() for t in terms):
+            terms.append("1")
     try:
         native = _termid.fit(
             target,
             dict(columns),
-            list(terms),
+            terms,
             _settings_text(backend, settings),
             intercept,
             list(forced),
             list(excluded),
             dict(parameters or {}),
             weights,
+            time_name,
+            derivative,
         )
     except TermidError as e:
         raise _explained(e, columns.left_out) from None

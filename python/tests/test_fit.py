@@ -178,3 +178,53 @@ def test_a_target_that_is_not_a_number_is_named_with_its_row():
     df = pd.DataFrame({"x": [0.0, 1, 2, 3, 4, 5], "y": [1.0, 3.1, np.nan, 7.0, 9.0, 11.2]})
     with pytest.raises(termid.TermidError, match=r"row 3: the target `y` evaluates to NaN \(check the data there\)"):
         termid.fit(df, "y", "x")
+
+
+def _lorenz(t_end=20.0, dt=0.001, every=10):
+    """Lorenz (σ = 10, ρ = 28, β = 8/3) by RK4 at 1 ms, sampled every 10 ms."""
+    def rate(s):
+        x, y, z = s
+        return np.array([10.0 * (y - x), x * (28.0 - z) - y, x * y - 8.0 / 3.0 * z])
+
+    s = np.array([-8.0, 7.0, 27.0])
+    rows = [s]
+    for _ in range(int(round(t_end / dt))):
+        k1 = rate(s)
+        k2 = rate(s + 0.5 * dt * k1)
+        k3 = rate(s + 0.5 * dt * k2)
+        k4 = rate(s + dt * k3)
+        s = s + dt / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+        rows.append(s)
+    states = np.array(rows)[::every]
+    return np.arange(len(states)) * dt * every, states
+
+
+def test_a_rate_is_an_equation_of_motion_with_the_command_lines_defaults():
+    # the closed form: Lorenz's own coefficients, from its states alone, the time as a column,
+    # as the index (seconds), or as date-times; the constant a candidate, stlsq, the integral form
+    t, s = _lorenz()
+    library = ["x", "y", "z", "x*x", "x*y", "x*z", "y*y", "y*z", "z*z"]
+    df = pd.DataFrame({"t": t, "x": s[:, 0], "y": s[:, 1], "z": s[:, 2]})
+    fitted = termid.fit(df, "dy/dt", library)
+    assert fitted.raw["selection"]["backend"] == "stlsq"
+    assert "1" in fitted.raw["candidates"] and fitted.intercept is None
+    assert fitted.coefficients.sort_index().round(2).to_dict() == {"x": 28.0, "x*z": -1.0, "y": -1.0}
+    by_index = termid.fit(df.set_index("t"), "dz/dt", library)
+    assert by_index.coefficients.sort_index().round(3).to_dict() == {"x*y": 1.0, "z": -2.667}
+    stamped = df.drop(columns="t").set_index(pd.Timestamp("2026-11-28") + pd.to_timedelta(t, unit="s"))
+    with pytest.warns(UserWarning, match="read as seconds"):
+        by_clock = termid.fit(stamped, "dx/dt", library)
+    assert by_clock.coefficients.sort_index().round(3).to_dict() == {"x": -10.0, "y": 10.0}
+    # a derivative method named: five-point differences, the same terms (central ones' error
+    # of O(h²), smooth in the states, buys x·z and y·z: the integral form is the default)
+    five = termid.fit(df, "dx/dt", library, derivative="five-point")
+    assert five.coefficients.sort_index().round(3).to_dict() == {"x": -10.0, "y": 10.0}
+    central = termid.fit(df, "dx/dt", library, derivative="central")
+    assert "x*z" in central.coefficients.index
+    # what it needs, said
+    with pytest.raises(termid.TermidError, match="needs the rows' time"):
+        termid.fit(df.drop(columns="t"), "dx/dt", library)
+    with pytest.raises(termid.TermidError, match="no column `w`"):
+        termid.fit(df, "dw/dt", library)
+    with pytest.raises(termid.TermidError, match="are for a rate"):
+        termid.fit(df, "x", ["y"], derivative="central")
