@@ -295,6 +295,50 @@ fn covariance_of(moments: &Moments, selection: &Selection) -> Option<Vec<Vec<f64
     cov.iter().flatten().all(|v| v.is_finite()).then_some(cov)
 }
 
+/// Samples per characteristic period below which a rate's estimate is said to be coarse.
+const SAMPLES_PER_PERIOD: f64 = 16.0;
+
+/// A note where the rows sample `state`'s motion coarsely: fewer than [`SAMPLES_PER_PERIOD`]
+/// samples in its characteristic period T = 2π·σ(x)/σ(ẋ) (the period of a sinusoid of the
+/// same amplitudes; ẋ by central differences, pooled over the runs). Below it the error of
+/// quadrature or differencing is no longer small against the motion and enters the fit as
+/// spurious terms and biased coefficients: Lorenz's z at 17.7 samples a period keeps its
+/// two true terms within 0.02 %, at 12.5 six terms 15 % off, and nothing else in the fit says so.
+fn resolution_note(frames: &[Frame], state: &str) -> Option<String> {
+    let (mut n, mut sum, mut sum2, mut dn, mut dsum, mut dsum2, mut step) =
+        (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    for f in frames {
+        let (Some(x), t) = (f.column(state), f.time()) else { continue };
+        for (k, v) in x.iter().enumerate() {
+            n += 1.0;
+            sum += v;
+            sum2 += v * v;
+            if k > 0 && k + 1 < x.len() {
+                let d = (x[k + 1] - x[k - 1]) / (t[k + 1] - t[k - 1]);
+                dn += 1.0;
+                dsum += d;
+                dsum2 += d * d;
+                step += 0.5 * (t[k + 1] - t[k - 1]);
+            }
+        }
+    }
+    if dn < 2.0 {
+        return None;
+    }
+    let spread = |n: f64, s: f64, s2: f64| ((s2 - s * s / n) / n).max(0.0).sqrt();
+    let (sd, rate_sd, dt) = (spread(n, sum, sum2), spread(dn, dsum, dsum2), step / dn);
+    let samples = 2.0 * std::f64::consts::PI * sd / rate_sd / dt;
+    (samples.is_finite() && samples < SAMPLES_PER_PERIOD).then(|| {
+        format!(
+            "the rows sample `{state}` coarsely: {} samples in its characteristic period (2π·σ/σ of its \
+             rate, {} s); below about {SAMPLES_PER_PERIOD} the error of quadrature or differencing \
+             enters the fit as spurious terms and biased coefficients: sample faster, or read these as rough",
+            report::sig(samples, 3),
+            report::sig(samples * dt, 3)
+        )
+    })
+}
+
 /// Variance inflation above which the chosen terms are said to be nearly collinear: their
 /// coefficients' standard errors are 100 times what they would be for unrelated terms.
 const COLLINEAR_INFLATION: f64 = 1e4;
@@ -628,7 +672,19 @@ impl Identification<'_> {
             (design.columns_of(forced, "forced")?, design.columns_of(excluded, "excluded")?);
         // per run, for the back-ends that cross-validate; together they are "Komb. Daten"
         let folds = self.moments_of_runs(&design.library, candidates, target, frames)?;
-        fit_folds(&target.to_string(), design.names(), &forced, &excluded, self.intercept, &folds, backend)
+        let mut fit = fit_folds(
+            &target.to_string(),
+            design.names(),
+            &forced,
+            &excluded,
+            self.intercept,
+            &folds,
+            backend,
+        )?;
+        if let Target::Derivative(state) = target {
+            fit.selection.notes.extend(resolution_note(frames, state));
+        }
+        Ok(fit)
     }
 
     /// τ = 1 + 2 Σ ρₖ of the chosen equation's residuals, the autocorrelations ρₖ pooled over
