@@ -78,6 +78,22 @@ impl Stlsq {
         beta.iter().all(|b| b.is_finite()).then(|| beta.iter().copied().collect())
     }
 
+    /// Whether candidate `j`, at `pivot` after those swept before it, is collinear with them
+    /// (and so left out); a forced one that is cannot be fitted and is refused.
+    fn collinear(&self, pb: &Problem<'_>, j: usize, pivot: f64) -> Result<bool, SelectError> {
+        if !(pivot.is_nan() || pivot <= self.pivot_tolerance) {
+            return Ok(false);
+        }
+        if pb.forced.contains(&j) {
+            return Err(SelectError::ForcedCollinear {
+                term: pb.names[j].clone(),
+                pivot,
+                tolerance: self.pivot_tolerance,
+            });
+        }
+        Ok(true)
+    }
+
     /// `set` without the candidates that are linear combinations of those before them (the
     /// forced ones first, then in the candidates' order), each left out with a note. Without
     /// this a near-collinear group (a constant, z and z² where z lies far from 0) makes the
@@ -97,14 +113,7 @@ impl Stlsq {
         let mut kept = Vec::new();
         for j in forced.into_iter().chain(free) {
             let pivot = a[j * m + j];
-            if pivot.is_nan() || pivot <= self.pivot_tolerance {
-                if pb.forced.contains(&j) {
-                    return Err(SelectError::ForcedCollinear {
-                        term: pb.names[j].clone(),
-                        pivot,
-                        tolerance: self.pivot_tolerance,
-                    });
-                }
+            if self.collinear(pb, j, pivot)? {
                 notes.push(format!(
                     "`{}` left out of the candidates: collinear with those before it (its share of \
                      variance not explained by them {pivot:.1e}, below pivot_tolerance {:.0e})",
@@ -225,15 +234,7 @@ impl Selector for Stlsq {
         let mut fitted: Vec<usize> = Vec::new();
         let mut steps: Vec<Step> = Vec::new();
         for (j, _) in order {
-            let pivot = a[j * m + j];
-            if pivot.is_nan() || pivot <= self.pivot_tolerance {
-                if pb.forced.contains(&j) {
-                    return Err(SelectError::ForcedCollinear {
-                        term: pb.names[j].clone(),
-                        pivot,
-                        tolerance: self.pivot_tolerance,
-                    });
-                }
+            if self.collinear(pb, j, a[j * m + j])? {
                 notes.push(format!("`{}` left out: collinear with the terms before it", pb.names[j]));
                 continue;
             }

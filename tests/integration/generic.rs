@@ -708,6 +708,50 @@ fn lorenz_from_samples_with_the_defaults_and_unit_free_selection() {
     }
 }
 
+/// Lorenz simulated by `termid simulate` at 1 ms and sampled every `sample` s: its rows
+/// (t, x, y, z), the rates left out.
+fn lorenz_rows(dir: &std::path::Path, sample: &str) -> Vec<Vec<f64>> {
+    let full = dir.join(format!("full{sample}.csv"));
+    let (ok, _, err) = termid(&[
+        "simulate",
+        "--model",
+        "models/lorenz.toml",
+        "--duration",
+        "20",
+        "--dt",
+        "0.001",
+        "--sample",
+        sample,
+        "--out",
+        full.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    std::fs::read_to_string(&full)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').take(4).map(|c| c.parse().unwrap()).collect())
+        .collect()
+}
+
+/// `termid identify` of `target` in `data` with the candidates of `terms`, as text.
+fn identify_text(data: &std::path::Path, target: &str, terms: &std::path::Path) -> String {
+    let (ok, out, err) = termid(&[
+        "identify",
+        "--data",
+        data.to_str().unwrap(),
+        "--target",
+        target,
+        "--terms-file",
+        terms.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    out
+}
+
+/// The library of every monomial of x, y, z to degree 2, the constant among them.
+const LORENZ_QUADRATIC: &str = "1\nx\ny\nz\nx*x\nx*y\nx*z\ny*y\ny*z\nz*z\n";
+
 /// Right by default away from the origin and off a regular clock (what a logger writes):
 /// Lorenz sampled from a 1 ms simulation (the truth below) with z measured from 10 000
 /// below its zero (a temperature in kelvin, a pressure in pascal) and, in a second file, at
@@ -722,27 +766,7 @@ fn lorenz_from_samples_with_the_defaults_and_unit_free_selection() {
 #[test]
 fn lorenz_far_from_the_origin_and_on_an_uneven_clock() {
     let dir = crate::common::Scratch::new("lorenz-offset");
-    let full = dir.join("full.csv");
-    let (ok, _, err) = termid(&[
-        "simulate",
-        "--model",
-        "models/lorenz.toml",
-        "--duration",
-        "20",
-        "--dt",
-        "0.001",
-        "--sample",
-        "0.001",
-        "--out",
-        full.to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
-    let rows: Vec<Vec<f64>> = std::fs::read_to_string(&full)
-        .unwrap()
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').take(4).map(|c| c.parse().unwrap()).collect())
-        .collect();
+    let rows = lorenz_rows(&dir, "0.001");
     let write = |name: &str, picked: &mut dyn Iterator<Item = &Vec<f64>>, z0: f64| {
         let body: Vec<String> =
             picked.map(|r| format!("{:?},{:?},{:?},{:?}", r[0], r[1], r[2], r[3] + z0)).collect();
@@ -767,7 +791,7 @@ fn lorenz_far_from_the_origin_and_on_an_uneven_clock() {
         .collect();
     let uneven = write("uneven.csv", &mut uneven_rows.into_iter(), 0.0);
     let terms = dir.join("terms.txt");
-    std::fs::write(&terms, "1\nx\ny\nz\nx*x\nx*y\nx*z\ny*y\ny*z\nz*z\n").unwrap();
+    std::fs::write(&terms, LORENZ_QUADRATIC).unwrap();
     let same = |found: &BTreeMap<String, f64>, want: &[(&str, f64)], tolerance: f64, what: &str| {
         let names: Vec<&str> = found.keys().map(String::as_str).collect();
         let mut wanted: Vec<&str> = want.iter().map(|w| w.0).collect();
@@ -792,16 +816,7 @@ fn lorenz_far_from_the_origin_and_on_an_uneven_clock() {
         "dz/dt, z offset",
     );
     for target in ["dx/dt", "dy/dt", "dz/dt"] {
-        let (ok, out, err) = termid(&[
-            "identify",
-            "--data",
-            offset.to_str().unwrap(),
-            "--target",
-            target,
-            "--terms-file",
-            terms.to_str().unwrap(),
-        ]);
-        assert!(ok, "{err}");
+        let out = identify_text(&offset, target, &terms);
         assert!(out.contains("`z^2` left out of the candidates: collinear"), "{target}: {out}");
         assert!(
             out.contains("nearly a combination of the other chosen terms")
@@ -821,16 +836,7 @@ fn lorenz_far_from_the_origin_and_on_an_uneven_clock() {
         1e-3,
         "dx/dt about 10⁴",
     );
-    let (ok, out, err) = termid(&[
-        "identify",
-        "--data",
-        offset.to_str().unwrap(),
-        "--target",
-        "dy/dt",
-        "--terms-file",
-        about.to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
+    let out = identify_text(&offset, "dy/dt", &about);
     // a candidate that is a sum prints in parentheses after its coefficient
     assert!(out.contains("*(-10000*x + x*z)"), "{out}");
     assert!(!out.contains("nearly a combination"), "{out}");
@@ -857,40 +863,18 @@ fn lorenz_far_from_the_origin_and_on_an_uneven_clock() {
 fn coarse_samples_are_said() {
     let dir = crate::common::Scratch::new("lorenz-coarse");
     let terms = dir.join("terms.txt");
-    std::fs::write(&terms, "1\nx\ny\nz\nx*x\nx*y\nx*z\ny*y\ny*z\nz*z\n").unwrap();
+    std::fs::write(&terms, LORENZ_QUADRATIC).unwrap();
     for (sample, coarse) in [("0.06", true), ("0.02", false)] {
-        let full = dir.join(format!("full{sample}.csv"));
-        let (ok, _, err) = termid(&[
-            "simulate",
-            "--model",
-            "models/lorenz.toml",
-            "--duration",
-            "20",
-            "--dt",
-            "0.001",
-            "--sample",
-            sample,
-            "--out",
-            full.to_str().unwrap(),
-        ]);
-        assert!(ok, "{err}");
-        let states: Vec<String> = std::fs::read_to_string(&full)
-            .unwrap()
-            .lines()
-            .map(|l| l.split(',').take(4).collect::<Vec<_>>().join(","))
+        let states: Vec<String> = std::iter::once("t,x,y,z".to_string())
+            .chain(
+                lorenz_rows(&dir, sample)
+                    .iter()
+                    .map(|r| format!("{:?},{:?},{:?},{:?}", r[0], r[1], r[2], r[3])),
+            )
             .collect();
         let csv = dir.join(format!("xyz{sample}.csv"));
         std::fs::write(&csv, states.join("\n") + "\n").unwrap();
-        let (ok, out, err) = termid(&[
-            "identify",
-            "--data",
-            csv.to_str().unwrap(),
-            "--target",
-            "dz/dt",
-            "--terms-file",
-            terms.to_str().unwrap(),
-        ]);
-        assert!(ok, "{err}");
+        let out = identify_text(&csv, "dz/dt", &terms);
         assert_eq!(out.contains("the rows sample `z` coarsely"), coarse, "every {sample} s: {out}");
     }
 }
