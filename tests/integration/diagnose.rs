@@ -322,6 +322,13 @@ fn names_a_term_beyond_the_candidates() {
     let first = &v["candidates"][0];
     assert_eq!(first["effect"]["kind"].as_str(), Some("beyond"), "{first}");
     assert!(first["beyond_refit"].as_f64().unwrap() < 0.3, "{first}");
+    // and the text says they were passed over
+    let identified = dir.join("cubic_id.toml");
+    let mut args = vec!["diagnose", "--model", identified.to_str().unwrap(), "--data"];
+    args.extend(files.iter().map(String::as_str));
+    let (ok, text, err) = crate::common::termid(&args);
+    assert!(ok, "{err}");
+    assert!(text.contains("Passed over, ranked above it:"), "{text}");
 }
 
 /// Output-error refinement on a generic model: coefficients 20 % off (as a regression on

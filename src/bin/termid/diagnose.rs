@@ -139,6 +139,15 @@ fn text(d: &Diagnosis, out: Option<&std::path::Path>, tested: usize, settings: &
                 s += &format!(" (runner-up: {}, {:.1} %)", r.name, 100.0 * r.explained);
             }
             s += ".\n";
+            // ranked above it, terms beyond the candidates that add too little to the refit
+            if w > 0 {
+                s += &format!(
+                    "  Passed over, ranked above it: {w} term(s) beyond the candidates, each closing less than \
+                     {:.0} % of the gap beyond its equation's coefficients refitted alone (`beyond_refit`): they \
+                     fit what the refit leaves.\n",
+                    100.0 * settings.min_explained
+                );
+            }
         }
         None => {
             s += "verdict: no hypothesis explains the gap significantly; the model is left unchanged.\n";
