@@ -239,7 +239,7 @@ impl DataError {
             .map(AsRef::as_ref)
             .find(|n| looks_like_time(n))
             .map(|n| {
-                if n.chars().all(|c| c.is_alphanumeric() || c == '_') && !n.starts_with(|c: char| c.is_ascii_digit()) {
+                if crate::term::is_identifier(n) {
                     format!("; `{n}` looks like time: name it as the time column (`--time {n}`, a model file's `time`)")
                 } else {
                     // not a name terms can use: a dataset file maps it (its unit read too)
@@ -254,9 +254,7 @@ impl DataError {
             hint,
         }
     }
-}
 
-impl DataError {
     /// The error of a piece of a file said of the whole file: its row numbers moved on by
     /// `rows` (the piece's first row in the file).
     pub fn shifted(self, rows: usize) -> DataError {

@@ -185,8 +185,9 @@ const CUBIC_UP_TO: usize = 4;
 /// the states and inputs its candidates use, up to degree 3 (2 beyond four variables; an
 /// input to the first power), that is not a candidate already. Where the author's library
 /// lacks the term the system has (a Duffing oscillator's x³ in a quadratic library), the
-/// declared hypotheses cannot name it; this names it as `x^3 in v_dot, beyond the candidates`. Each
-/// equation's coefficients refitted alone come first: the baseline a new term must beat.
+/// declared hypotheses cannot name it; this names it as `x^3 in v_dot, beyond the
+/// candidates`. Each equation's coefficients refitted alone come first: the baseline a new
+/// term must beat.
 pub fn beyond_candidates(model: &Model) -> Vec<Hypothesis> {
     let spec = model.spec();
     let dynamic: Vec<&str> = spec
@@ -213,11 +214,12 @@ pub fn beyond_candidates(model: &Model) -> Vec<Hypothesis> {
             // each product once: extend by variables at or after its last factor's
             let mut next = Vec::new();
             for p in &products {
-                let start = vars.iter().rposition(|v| p.variables().contains(v)).unwrap_or(0);
+                let factors = p.variables();
+                let start = vars.iter().rposition(|v| factors.contains(v)).unwrap_or(0);
                 for v in &vars[start..] {
                     // an input enters once: F²·v, where a forcing switches between ±a, is v
                     // but where the replay ramps between samples, and "explains" that ramp
-                    if inputs.contains(&v.as_str()) && p.variables().contains(v) {
+                    if inputs.contains(&v.as_str()) && factors.contains(v) {
                         continue;
                     }
                     if let Ok(t) = p.mul(&Term::var(v)) {

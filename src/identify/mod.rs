@@ -305,29 +305,27 @@ const SAMPLES_PER_PERIOD: f64 = 16.0;
 /// spurious terms and biased coefficients: Lorenz's z at 17.7 samples a period keeps its
 /// two true terms within 0.02 %, at 12.5 six terms 15 % off, and nothing else in the fit says so.
 fn resolution_note(frames: &[Frame], state: &str) -> Option<String> {
-    let (mut n, mut sum, mut sum2, mut dn, mut dsum, mut dsum2, mut step) =
-        (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-    for f in frames {
-        let (Some(x), t) = (f.column(state), f.time()) else { continue };
-        for (k, v) in x.iter().enumerate() {
-            n += 1.0;
-            sum += v;
-            sum2 += v * v;
-            if k > 0 && k + 1 < x.len() {
-                let d = (x[k + 1] - x[k - 1]) / (t[k + 1] - t[k - 1]);
-                dn += 1.0;
-                dsum += d;
-                dsum2 += d * d;
-                step += 0.5 * (t[k + 1] - t[k - 1]);
-            }
-        }
-    }
-    if dn < 2.0 {
+    let runs: Vec<(&[f64], &[f64])> =
+        frames.iter().filter_map(|f| Some((f.column(state)?, f.time()))).collect();
+    let values: Vec<f64> = runs.iter().flat_map(|(x, _)| x.iter().copied()).collect();
+    // (central difference, half its span) at every inner sample
+    let (rates, steps): (Vec<f64>, Vec<f64>) = runs
+        .iter()
+        .flat_map(|(x, t)| {
+            (1..x.len().saturating_sub(1))
+                .map(move |k| ((x[k + 1] - x[k - 1]) / (t[k + 1] - t[k - 1]), 0.5 * (t[k + 1] - t[k - 1])))
+        })
+        .unzip();
+    if rates.len() < 2 {
         return None;
     }
-    let spread = |n: f64, s: f64, s2: f64| ((s2 - s * s / n) / n).max(0.0).sqrt();
-    let (sd, rate_sd, dt) = (spread(n, sum, sum2), spread(dn, dsum, dsum2), step / dn);
-    let samples = 2.0 * std::f64::consts::PI * sd / rate_sd / dt;
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let sd = |v: &[f64]| {
+        let m = mean(v);
+        (v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / v.len() as f64).sqrt()
+    };
+    let dt = mean(&steps);
+    let samples = 2.0 * std::f64::consts::PI * sd(&values) / sd(&rates) / dt;
     (samples.is_finite() && samples < SAMPLES_PER_PERIOD).then(|| {
         format!(
             "the rows sample `{state}` coarsely: {} samples in its characteristic period (2π·σ/σ of its \
@@ -388,7 +386,7 @@ fn collinearity_note(moments: &Moments, names: &[String], selection: &Selection)
     let offset: Vec<(&String, f64)> = names
         .iter()
         .enumerate()
-        .filter(|(_, n)| n.chars().all(|c| c.is_alphanumeric() || c == '_'))
+        .filter(|(_, n)| crate::term::is_identifier(n))
         .filter_map(|(i, n)| {
             let sd = (moments.corrected(i, i).max(0.0) / moments.weight()).sqrt();
             let ratio = means[i].abs() / sd;

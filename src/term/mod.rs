@@ -14,7 +14,7 @@ pub use compile::{Library, RowScratch, Source, Tangents};
 pub use error::TermError;
 pub use functions::{Function, FUNCTIONS};
 pub use parse::{parse_expr, BinOp, Expr, ExprKind};
-pub use vocabulary::{code_points, Derived, Vocabulary};
+pub use vocabulary::{code_points, is_identifier, Derived, Vocabulary};
 
 /// Parses and resolves a list of candidate terms, refusing a duplicate (two spellings of
 /// one canonical term, e.g. `v*r` and `r*v`) with an error that names both.

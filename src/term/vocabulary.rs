@@ -71,7 +71,9 @@ pub fn code_points(name: &str) -> String {
     name.chars().map(|c| format!("U+{:04X}", c as u32)).collect::<Vec<_>>().join(" ")
 }
 
-fn is_identifier(name: &str) -> bool {
+/// Whether `name` is one name of the term language (`u`, `x_dot`, `Δu`), as a variable, a
+/// parameter or a time column must be.
+pub fn is_identifier(name: &str) -> bool {
     // plain ASCII names (`c12`, `x_dot`) are identifiers of the grammar without asking it
     let mut chars = name.chars();
     let ascii = chars.next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_')

@@ -734,9 +734,10 @@ fn lorenz_rows(dir: &std::path::Path, sample: &str) -> Vec<Vec<f64>> {
         .collect()
 }
 
-/// `termid identify` of `target` in `data` with the candidates of `terms`, as text.
-fn identify_text(data: &std::path::Path, target: &str, terms: &std::path::Path) -> String {
-    let (ok, out, err) = termid(&[
+/// `termid identify` of `target` in `data` with the candidates of `terms` and `extra`
+/// options: what it prints.
+fn identify_text(data: &std::path::Path, target: &str, terms: &std::path::Path, extra: &[&str]) -> String {
+    let mut args = vec![
         "identify",
         "--data",
         data.to_str().unwrap(),
@@ -744,7 +745,9 @@ fn identify_text(data: &std::path::Path, target: &str, terms: &std::path::Path) 
         target,
         "--terms-file",
         terms.to_str().unwrap(),
-    ]);
+    ];
+    args.extend(extra);
+    let (ok, out, err) = termid(&args);
     assert!(ok, "{err}");
     out
 }
@@ -816,7 +819,7 @@ fn lorenz_far_from_the_origin_and_on_an_uneven_clock() {
         "dz/dt, z offset",
     );
     for target in ["dx/dt", "dy/dt", "dz/dt"] {
-        let out = identify_text(&offset, target, &terms);
+        let out = identify_text(&offset, target, &terms, &[]);
         assert!(out.contains("`z^2` left out of the candidates: collinear"), "{target}: {out}");
         assert!(
             out.contains("nearly a combination of the other chosen terms")
@@ -836,7 +839,7 @@ fn lorenz_far_from_the_origin_and_on_an_uneven_clock() {
         1e-3,
         "dx/dt about 10⁴",
     );
-    let out = identify_text(&offset, "dy/dt", &about);
+    let out = identify_text(&offset, "dy/dt", &about, &[]);
     // a candidate that is a sum prints in parentheses after its coefficient
     assert!(out.contains("*(-10000*x + x*z)"), "{out}");
     assert!(!out.contains("nearly a combination"), "{out}");
@@ -874,7 +877,7 @@ fn coarse_samples_are_said() {
             .collect();
         let csv = dir.join(format!("xyz{sample}.csv"));
         std::fs::write(&csv, states.join("\n") + "\n").unwrap();
-        let out = identify_text(&csv, "dz/dt", &terms);
+        let out = identify_text(&csv, "dz/dt", &terms, &[]);
         assert_eq!(out.contains("the rows sample `z` coarsely"), coarse, "every {sample} s: {out}");
     }
 }
@@ -973,18 +976,7 @@ fn identify_with_defaults(
     target: &str,
     terms: &std::path::Path,
 ) -> BTreeMap<String, f64> {
-    let (ok, json, err) = termid(&[
-        "identify",
-        "--data",
-        data.to_str().unwrap(),
-        "--target",
-        target,
-        "--terms-file",
-        terms.to_str().unwrap(),
-        "--format",
-        "json",
-    ]);
-    assert!(ok, "{err}");
+    let json = identify_text(data, target, terms, &["--format", "json"]);
     let v: serde_json::Value = serde_json::from_str(&json).unwrap();
     let mut out: BTreeMap<String, f64> = v["terms"]
         .as_array()
