@@ -151,6 +151,10 @@ pub struct Fit {
     /// errors are √τ times the reported ones.
     #[serde(default)]
     pub correlation_time: Option<f64>,
+    /// Each chosen term's closest rival among the candidates left out (how firmly the rows
+    /// chose it); [`Fit::notes`] names those within the noise.
+    #[serde(default)]
+    pub swaps: Vec<crate::select::Swap>,
 }
 
 /// An equation's candidate terms compiled for evaluation, with their names: all of a fit that
@@ -740,6 +744,7 @@ pub(crate) fn fit_folds(
     if let Some(note) = collinearity_note(&moments, names, &selection) {
         selection.notes.push(note);
     }
+    let swaps = crate::select::swaps(&problem, &selection);
     // the residual pass for τ is left to the caller (`correlation_time`): selection itself
     // needs only the sufficient statistics, and is timed against the peers without it
     Ok(Fit {
@@ -748,6 +753,7 @@ pub(crate) fn fit_folds(
         selection,
         covariance,
         correlation_time: None,
+        swaps,
     })
 }
 

@@ -87,10 +87,13 @@ pub struct FitReport {
     pub intercept_std_error: Option<f64>,
     /// Why the back-end stopped.
     pub stop: Stop,
-    /// The back-end's notes.
+    /// The back-end's notes and the fit's ([`Fit::notes`]).
     pub notes: Vec<String>,
     /// The residuals' correlation time, rows.
     pub correlation_time: Option<f64>,
+    /// Each chosen term's closest rival and the rise of the residual sum of squares in its
+    /// place, in residual variances.
+    pub swaps: Vec<crate::select::Swap>,
     /// The chosen coefficients' covariance.
     pub covariance: Option<Vec<Vec<f64>>>,
 }
@@ -131,8 +134,9 @@ impl Fit {
             intercept: s.intercept.as_ref().map(|b| b.value),
             intercept_std_error: s.intercept.as_ref().map(|b| b.std_error),
             stop: s.stop.clone(),
-            notes: s.notes.clone(),
+            notes: self.notes(),
             correlation_time: self.correlation_time,
+            swaps: self.swaps.clone(),
             covariance: self.covariance.clone(),
         }
     }
@@ -214,12 +218,57 @@ impl Fit {
             tau.sqrt()
         );
         }
-        for n in &s.notes {
+        for n in fit.notes() {
             out += &format!("note: {n}\n");
         }
         out
     }
+
+    /// The back-end's notes, then what the rows leave open: chosen terms a candidate left out
+    /// would replace within the noise (a rise of the residual sum of squares below
+    /// 4·τ residual variances: the choice between the two is the noise's), and
+    /// any that would fit clearly better (a path that passed them by).
+    pub fn notes(&self) -> Vec<String> {
+        let mut notes = self.selection.notes.clone();
+        let tau = self.correlation_time.unwrap_or(1.0).max(1.0);
+        let within = RIVAL_RISE * tau;
+        let pair =
+            |w: &crate::select::Swap| format!("`{}` from `{}` ({:+.2} s²)", w.chosen, w.instead, w.rise);
+        let close: Vec<String> = self.swaps.iter().filter(|w| w.rise.abs() < within).map(pair).collect();
+        if !close.is_empty() {
+            let noise = if tau > 1.5 {
+                format!("{}·τ with τ = {tau:.1}, about two standard errors of the noise", sig(RIVAL_RISE, 2))
+            } else {
+                "about two standard errors of the noise".into()
+            };
+            notes.push(format!(
+                "the rows hardly tell {}: swapped, the residual sum of squares changes by less than \
+                 {} residual variances s² ({noise}); the choice is the noise's, either may be the \
+                 system's term",
+                close.join(", "),
+                sig(within, 2),
+            ));
+        }
+        let better: Vec<String> = self
+            .swaps
+            .iter()
+            .filter(|w| w.rise <= -within)
+            .map(|w| format!("`{}` in place of `{}` ({:+.2} s²)", w.instead, w.chosen, w.rise))
+            .collect();
+        if !better.is_empty() {
+            notes.push(format!(
+                "a candidate left out fits clearly better than a chosen term: {} (the back-end's \
+                 path passed it by; best-subset compares whole sets)",
+                better.join(", ")
+            ));
+        }
+        notes
+    }
 }
+
+/// A rival whose swap changes the residual sum of squares by less than this many residual
+/// variances (times τ) is within the noise: about two standard errors (χ²₁'s 95 % point 3.84).
+const RIVAL_RISE: f64 = 4.0;
 
 /// `*term` as a factor after a coefficient: nothing for the constant, a sum (a candidate
 /// such as `x*(z - 10000)`, multiplied out) or a negative term in parentheses, so the printed

@@ -14,6 +14,7 @@ mod sparse;
 pub(crate) mod stepwise;
 mod stlsq;
 mod subset;
+mod swaps;
 
 use serde::{Deserialize, Serialize};
 
@@ -24,6 +25,7 @@ pub use sparse::{Candidate, Equality, LambdaChoice, SparseFit};
 pub use stepwise::{StepRule, Stepwise};
 pub use stlsq::Stlsq;
 pub(crate) use subset::{chi_square_pvalue, sweep};
+pub use swaps::{swaps, Swap};
 
 /// What a back-end is asked to do.
 #[derive(Clone, Copy, Debug)]
