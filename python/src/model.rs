@@ -11,7 +11,7 @@ use termid::data::{differentiator, Frame};
 use termid::identify::{EquationMoments, ModelIdentification};
 use termid::model::Model;
 use termid::select::Backend;
-use termid::sim::{Integrator, Settings, System, Trajectory};
+use termid::sim::{Settings, System, Trajectory};
 use termid::term::parse_terms;
 
 use crate::convert::{
@@ -536,7 +536,7 @@ impl PyModel {
         let (integrator, step) = method_of(&self.inner, integrator, dt)?;
         // as the command line: the adaptive method's output interval is free
         let sample = sample.unwrap_or(step);
-        let step = if dt.is_none() && integrator == Integrator::Dopri5 && sample.is_finite() && sample > 0.0 {
+        let step = if dt.is_none() && integrator.is_adaptive() && sample.is_finite() && sample > 0.0 {
             sample / (sample / step * (1.0 - 1e-9)).ceil().max(1.0)
         } else {
             step
@@ -545,6 +545,14 @@ impl PyModel {
         let run = py
             .detach(|| termid::sim::simulate(&system, &x0, &mut termid::sim::Constant(u), &settings))
             .map_err(fail)?;
+        if let Some(t) = run.stiff_from {
+            let message = std::ffi::CString::new(format!(
+                "the model is stiff from t = {} s on: continued with linearly implicit Rosenbrock steps (integrator=\"rosenbrock\" takes them from the start)",
+                termid::identify::sig(t, 4)
+            ))
+            .unwrap_or_default();
+            PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &message, 2)?;
+        }
         Ok(arrays(py, trajectory_columns(&self.time(), run)))
     }
 

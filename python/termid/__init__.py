@@ -1207,7 +1207,9 @@ class Model:
 
         Parameters: ``dt`` the integration step (default: the model file's method, else
         adaptive Dormand-Prince 5(4) with output every ``sample`` seconds); ``integrator``
-        ``dopri5``, ``rk4`` or ``b8``; ``with_intercept`` adds the identified constants;
+        ``dopri5`` (linearly implicit where it finds the model stiff, with a warning),
+        ``rosenbrock`` (stiff models), ``rk4`` or ``b8``; ``with_intercept`` adds the identified
+        constants;
         ``rtol``, ``atol`` the adaptive method's tolerances for this run (else the model's:
         :meth:`set_tolerances`).
 

@@ -242,6 +242,45 @@ def test_tolerances_set_from_python_are_the_simulations():
             lorenz.set_tolerances(**bad)
 
 
+ROBERTSON = """
+[model]
+name = "Robertson"
+intercept = false
+[simulation]
+atol = 1e-10
+[[states]]
+name = "a"
+initial = 1.0
+[[states]]
+name = "b"
+[[states]]
+name = "c"
+[equations.a_dot]
+state = "a"
+coefficients = { "a" = -0.04, "b*c" = 1e4 }
+[equations.b_dot]
+state = "b"
+coefficients = { "a" = 0.04, "b*c" = -1e4, "b^2" = -3e7 }
+[equations.c_dot]
+state = "c"
+coefficients = { "b^2" = 3e7 }
+"""
+
+
+def test_a_stiff_model_is_simulated_right_and_said_to_be():
+    # Robertson's kinetics at t = 40 against Hairer & Wanner's reference; the default method
+    # turns linearly implicit and warns, the asked-for Rosenbrock method does not warn
+    want = np.array([0.7158270687, 9.185534764e-6, 0.2841637457])
+    robertson = termid.Model.from_toml(ROBERTSON)
+    with pytest.warns(UserWarning, match="stiff from t ="):
+        run = robertson.simulate(duration=40.0, sample=1.0)
+    assert np.max(np.abs(run[["a", "b", "c"]].iloc[-1].to_numpy() - want) / want) < 2e-5
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        run = robertson.simulate(duration=40.0, sample=1.0, integrator="rosenbrock")
+    assert np.max(np.abs(run[["a", "b", "c"]].iloc[-1].to_numpy() - want) / want) < 2e-5
+
+
 def test_identification_releases_the_gil(ship, zigzags):
     # while the Rust side works, a Python thread keeps running (it ran at 4 % before)
     import threading

@@ -324,6 +324,7 @@ fn downsample(t: &Trajectory, every: usize) -> Trajectory {
         inputs: t.inputs.iter().map(pick).collect(),
         derivatives: t.derivatives.iter().map(pick).collect(),
         observed: t.observed.iter().map(|(n, c)| (n.clone(), pick(c))).collect(),
+        stiff_from: t.stiff_from,
     }
 }
 pub mod oltmann;

@@ -9,6 +9,7 @@
 //! ahead (`Controller::ahead`), the simulation loop passes the control times unasked, reading
 //! the watched state alone off the dense output (`first_outside`).
 
+use super::rosenbrock::{self, Rosenbrock};
 use super::system::{System, Workspace};
 use super::{SimError, Tolerances, Watch};
 
@@ -69,10 +70,35 @@ pub(super) struct Dopri5 {
     control: StepControl,
     /// Whether the inputs left their line at the last control time.
     broke: bool,
+    /// The linearly implicit steps, once taken (a stiff model; from the start where asked).
+    stiff: Option<Box<Rosenbrock>>,
+    /// Whether the explicit steps watch for stiffness and hand over to the implicit ones.
+    switch: bool,
+    /// Hairer's counters: accepted steps in a row held by stability, and not.
+    stability: (u32, u32),
+    /// Where the steps turned linearly implicit by themselves.
+    pub(super) stiff_from: Option<f64>,
 }
 
+/// h·|λ| above which an explicit step is held by stability rather than accuracy (the
+/// Dormand-Prince pair's stability region reaches about 3.3 along the negative axis), and the
+/// accepted steps in a row that make a model stiff (Hairer, Nørsett & Wanner, *Solving ODEs
+/// II*, IV.2, and their DOPRI5's test); six steps in a row below it clear the count.
+const STABILITY: f64 = 3.25;
+const STIFF_STEPS: u32 = 15;
+const CALM_STEPS: u32 = 6;
+
 impl Dopri5 {
-    pub(super) fn new(n: usize, m: usize, dt: f64, tol: Tolerances) -> Dopri5 {
+    /// `stiff`: linearly implicit steps from the start (else they are taken where the
+    /// explicit ones find the model stiff, where `switch`).
+    pub(super) fn new(
+        n: usize,
+        m: usize,
+        dt: f64,
+        tol: Tolerances,
+        stiff: Option<Rosenbrock>,
+        switch: bool,
+    ) -> Dopri5 {
         Dopri5 {
             k: std::array::from_fn(|_| vec![0.0; n]),
             stage: vec![0.0; n],
@@ -93,6 +119,10 @@ impl Dopri5 {
             dt,
             control: StepControl::default(),
             broke: false,
+            stiff: stiff.map(Box::new),
+            switch,
+            stability: (0, 0),
+            stiff_from: None,
         }
     }
 
@@ -248,6 +278,9 @@ impl Dopri5 {
     /// and ending at `reach` at the latest, retried smaller until accepted; keeps its dense
     /// output.
     fn free_step(&mut self, system: &System, ws: &mut Workspace, reach: f64) -> Result<(), SimError> {
+        if self.stiff.is_some() {
+            return self.implicit_step(system, ws, reach);
+        }
         if !self.fresh {
             let mut u = std::mem::take(&mut self.u);
             self.line(self.t, &mut u);
@@ -259,7 +292,7 @@ impl Dopri5 {
             (std::mem::take(&mut self.held), std::mem::take(&mut self.slope), self.held_t);
         let mut tries = 0usize;
         loop {
-            let h = self.h.min(reach - self.t).max(1e-12 * self.dt);
+            let h = self.h.min(reach - self.t);
             let (y, t) = (std::mem::take(&mut self.y), self.t);
             let input = |st: usize, u: &mut [f64]| {
                 for j in 0..u.len() {
@@ -269,6 +302,9 @@ impl Dopri5 {
             let err = self.attempt(system, ws, &y, h, input);
             self.y = y;
             if err <= 1.0 {
+                if self.switch {
+                    self.watch_stiffness(h);
+                }
                 // dense output before the last stage becomes the next step's first (Hairer's CONTD5)
                 let k = &self.k;
                 for (i, r) in self.dense.iter_mut().enumerate() {
@@ -290,14 +326,89 @@ impl Dopri5 {
                 self.k.swap(0, 6);
                 self.h = h * self.control.accept(err);
                 (self.held, self.slope) = (held, slope);
+                if self.switch && self.stability.0 >= STIFF_STEPS {
+                    self.stiff = Some(Box::new(Rosenbrock::new(system)?));
+                    self.stiff_from = Some(self.t);
+                    self.switch = false;
+                }
                 return Ok(());
             }
             self.h = self.control.reject(h, err);
             tries += 1;
-            if self.h < self.dt * 1e-10 || tries > 100_000 {
+            if self.h < smallest_step(self.t) || tries > 100_000 {
                 self.fresh = false;
                 (self.held, self.slope) = (held, slope);
                 return Err(self.stuck(system, self.t));
+            }
+        }
+    }
+
+    /// Hairer's test after an accepted explicit step of `h` (before its last stage becomes the
+    /// next one's first): h·|λ| ≈ h·‖k₇ − k₆‖ / ‖y₇ − y₆‖ from the last two stages, whose
+    /// points differ by h·Σ (a₇ⱼ − a₆ⱼ)·kⱼ.
+    fn watch_stiffness(&mut self, h: f64) {
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in 0..self.y.len() {
+            let dk = self.k[6][i] - self.k[5][i];
+            let dy: f64 = (0..6).map(|j| (A[6][j] - A[5][j]) * self.k[j][i]).sum::<f64>() * h;
+            num += dk * dk;
+            den += dy * dy;
+        }
+        let held = den > 0.0 && h * (num / den).sqrt() > STABILITY;
+        let (stiff, calm) = &mut self.stability;
+        if held {
+            (*stiff, *calm) = (*stiff + 1, 0);
+        } else {
+            *calm += 1;
+            if *calm >= CALM_STEPS {
+                *stiff = 0;
+            }
+        }
+    }
+
+    /// One linearly implicit step from (`t`, `y`) along the inputs' line ([`Rosenbrock`]),
+    /// retried smaller until accepted; keeps its dense output.
+    fn implicit_step(&mut self, system: &System, ws: &mut Workspace, reach: f64) -> Result<(), SimError> {
+        let Some(mut stiff) = self.stiff.take() else { return Ok(()) };
+        let (held, slope, held_t) = (self.held.clone(), self.slope.clone(), self.held_t);
+        let line = move |t: f64, u: &mut [f64]| {
+            for j in 0..u.len() {
+                u[j] = held[j] + slope[j] * (t - held_t);
+            }
+        };
+        let t = self.t;
+        stiff.prepare(system, ws, t, &self.y, &line, self.dt);
+        let tolerance = (self.tol.atol, self.tol.rtol);
+        let mut tries = 0usize;
+        loop {
+            let h = self.h.min(reach - t);
+            let err = stiff.attempt(
+                system,
+                ws,
+                (t, &self.y),
+                h,
+                &line,
+                &mut self.trial,
+                &mut self.dense,
+                tolerance,
+            );
+            if err <= 1.0 {
+                self.y.copy_from_slice(&self.trial);
+                self.k[0].copy_from_slice(stiff.end_rate());
+                self.fresh = true;
+                self.t += h;
+                self.span = h;
+                self.per_span = 1.0 / h;
+                self.h = h * rosenbrock::factor(err);
+                self.stiff = Some(stiff);
+                return Ok(());
+            }
+            self.h = h * rosenbrock::factor(err).min(0.9);
+            tries += 1;
+            if self.h < smallest_step(self.t) || tries > 100_000 {
+                self.fresh = false;
+                self.stiff = Some(stiff);
+                return Err(self.stuck(system, t));
             }
         }
     }
@@ -354,6 +465,14 @@ impl Dopri5 {
             system.states.iter().zip(self.y.iter()).map(|(n, v)| format!("{n} = {v:.6}")).collect::<Vec<_>>().join(", ")
         ))
     }
+}
+
+/// Below this step at time `t` the error control is stuck (a singularity, a state that is
+/// not finite): a step that no longer moves t past its last ten digits. Not tied to the
+/// control step: a stiff model's first steps are many decades shorter than the interval its
+/// run is sampled at (Robertson's kinetics to 10¹¹ s, sampled every 10⁸ s, starts with 10⁻⁶ s).
+fn smallest_step(t: f64) -> f64 {
+    (1e-10 * t.abs()).max(1e-150)
 }
 
 /// Step-size control (Hairer, Nørsett & Wanner II.4): the next step by the error's fifth root

@@ -15,6 +15,7 @@ use serde::{Deserialize, Serialize};
 
 use super::controller::Controller;
 use super::dopri5::Dopri5;
+use super::rosenbrock::Rosenbrock;
 use super::system::System;
 use super::SimError;
 use crate::data::Frame;
@@ -35,6 +36,11 @@ pub enum Integrator {
     ModifiedEuler,
     /// Classical Runge-Kutta, fourth order.
     Rk4,
+    /// Shampine & Reichelt's linearly implicit Rosenbrock 2(3) pair (MATLAB's `ode23s`),
+    /// adaptive, for stiff models from the start (`dopri5` turns to it where it finds one).
+    #[cfg_attr(feature = "cli", value(name = "rosenbrock", alias = "ode23s", alias = "stiff"))]
+    #[serde(alias = "ode23s", alias = "stiff")]
+    Rosenbrock,
 }
 
 impl Integrator {
@@ -44,18 +50,27 @@ impl Integrator {
             Integrator::Dopri5 => "dopri5",
             Integrator::ModifiedEuler => "b8",
             Integrator::Rk4 => "rk4",
+            Integrator::Rosenbrock => "rosenbrock",
         }
     }
 
-    /// By name: `dopri5` (or `adaptive`, `rk45`), `b8` (or `euler`) and `rk4`.
+    /// Whether its steps follow the error control (`dopri5`, `rosenbrock`) rather than the
+    /// control step.
+    pub fn is_adaptive(&self) -> bool {
+        matches!(self, Integrator::Dopri5 | Integrator::Rosenbrock)
+    }
+
+    /// By name: `dopri5` (or `adaptive`, `rk45`), `b8` (or `euler`), `rk4` and `rosenbrock`
+    /// (or `ode23s`, `stiff`).
     pub fn by_name(name: &str) -> Result<Integrator, SimError> {
         match name {
             "dopri5" | "adaptive" | "rk45" => Ok(Integrator::Dopri5),
             "b8" | "euler" | "modified-euler" => Ok(Integrator::ModifiedEuler),
             "rk4" => Ok(Integrator::Rk4),
-            other => {
-                Err(SimError::Settings(format!("unknown integrator `{other}` (known: dopri5, b8, rk4)")))
-            }
+            "rosenbrock" | "ode23s" | "stiff" => Ok(Integrator::Rosenbrock),
+            other => Err(SimError::Settings(format!(
+                "unknown integrator `{other}` (known: dopri5, b8, rk4, rosenbrock)"
+            ))),
         }
     }
 }
@@ -174,6 +189,9 @@ pub struct Trajectory {
     /// variables that a fit compares with their records); empty unless a caller evaluates
     /// them.
     pub observed: Vec<(String, Vec<f64>)>,
+    /// Where the adaptive method found the model stiff and went on with linearly implicit
+    /// steps (Rosenbrock), if it did.
+    pub stiff_from: Option<f64>,
 }
 
 impl Trajectory {
@@ -270,7 +288,7 @@ pub fn simulate(
     let mut u_next = vec![0.0; m];
     controller.input(0.0, &x, &mut u_now);
     let cap = steps / every + 1;
-    let adaptive = settings.integrator == Integrator::Dopri5;
+    let adaptive = settings.integrator.is_adaptive();
     let mut out = Trajectory {
         time: Vec::with_capacity(cap),
         state_names: system.states.clone(),
@@ -279,6 +297,7 @@ pub fn simulate(
         inputs: vec![Vec::with_capacity(cap); m],
         derivatives: vec![Vec::with_capacity(if adaptive { 0 } else { cap }); n],
         observed: Vec::new(),
+        stiff_from: None,
     };
     // A sample's derivative f(x(t), input(t)) is filled in by the next step when that step
     // evaluates the same thing (always for RK4's first stage; for B8 when the input is at rest,
@@ -312,7 +331,10 @@ pub fn simulate(
     let mut u_mid = vec![0.0; m];
     // the state before the step, kept for the error report; the buffers swap, nothing is copied
     let mut prev = x.clone();
-    let mut dopri = Dopri5::new(n, m, dt, system.tolerances);
+    let implicit =
+        (settings.integrator == Integrator::Rosenbrock).then(|| Rosenbrock::new(system)).transpose()?;
+    let switch = settings.integrator == Integrator::Dopri5;
+    let mut dopri = Dopri5::new(n, m, dt, system.tolerances, implicit, switch);
     let end = steps as f64 * dt;
     if adaptive {
         system.tolerances.check()?;
@@ -345,7 +367,7 @@ pub fn simulate(
                     x[i] = x_old[i] + dt * k[0][i];
                 }
             }
-            Integrator::Dopri5 => {
+            Integrator::Dopri5 | Integrator::Rosenbrock => {
                 // the samples' ẋ all at once after the run (below): the steps end between them
                 let start = t1 - dt;
                 dopri.advance(system, &mut ws, x_old, &mut x, (&u_now, &u_next), (start, dt), end)?;
@@ -467,6 +489,7 @@ pub fn simulate(
         system.derivatives(&x, &u_now, &mut ws, &mut tmp);
         fill(&tmp, &mut out);
     }
+    out.stiff_from = dopri.stiff_from;
     Ok(out)
 }
 

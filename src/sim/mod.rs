@@ -6,6 +6,7 @@
 mod controller;
 mod dopri5;
 mod integrator;
+mod rosenbrock;
 mod steady;
 mod system;
 

@@ -563,6 +563,8 @@ fn adaptive_integration_matches_dop853() {
         for (got, want) in run.last_state().iter().zip(expected) {
             assert!((got - want).abs() < 1e-8 * want.abs().max(1.0), "{name}: {got} vs {want}");
         }
+        // none of them is stiff: every step explicit
+        assert_eq!(run.stiff_from, None, "{name}");
         // the command's default, at the default tolerances
         let path = std::env::temp_dir().join(format!("termid-dop853-{name}-{}.toml", std::process::id()));
         std::fs::write(&path, &text).unwrap();
@@ -586,6 +588,112 @@ fn adaptive_integration_matches_dop853() {
             );
         }
         std::fs::remove_file(&path).ok();
+    }
+}
+
+/// Robertson's chemical kinetics (Hairer & Wanner, *Solving ODEs II*, IV.1): rates from
+/// 0.04 to 3·10⁷, the classic stiff test.
+const ROBERTSON: &str = r#"
+[model]
+name = "Robertson"
+intercept = false
+[[states]]
+name = "a"
+initial = 1.0
+[[states]]
+name = "b"
+[[states]]
+name = "c"
+[equations.a_dot]
+state = "a"
+coefficients = { "a" = -0.04, "b*c" = 1e4 }
+[equations.b_dot]
+state = "b"
+coefficients = { "a" = 0.04, "b*c" = -1e4, "b^2" = -3e7 }
+[equations.c_dot]
+state = "c"
+coefficients = { "b^2" = 3e7 }
+"#;
+
+/// Right by default on a stiff model: the explicit steps of the default method are held by
+/// stability (Robertson to 4·10⁵ s took four minutes and ended ten times off); it now finds
+/// the model stiff, goes on with linearly implicit steps and says so. Against numbers from
+/// outside: Robertson at t = 40 (Hairer & Wanner's reference 0.7158270687, 9.185534764e-6,
+/// 0.2841637457) and at 10¹¹ s (the IVP test set of Mazzia & Magherini, ROBER: 2.0833401e-8,
+/// 8.3333608e-14); van der Pol at μ = 1000, whose relaxation period is (3 − 2 ln 2)μ +
+/// 3α·μ^(−1/3) + O(ln μ/μ) = 1614.41 (α = 2.33811, Ai's first zero; Dorodnitsyn 1947).
+#[test]
+fn stiff_models_by_default() {
+    let run = |text: &str, method: Option<Integrator>, (dt, duration): (f64, f64)| {
+        let model = Model::parse(text, "stiff.toml").unwrap();
+        let system = System::new(&model, &BTreeMap::new(), false).unwrap();
+        let x0: Vec<f64> = model.spec().states.iter().map(|s| s.initial).collect();
+        let (integrator, _) = model.simulation(method, None);
+        let settings = Settings { integrator, dt, duration, sample: dt };
+        simulate(&system, &x0, &mut Constant(vec![]), &settings).unwrap()
+    };
+    let close = |got: &[f64], want: &[f64], rel: f64, what: &str| {
+        for (g, w) in got.iter().zip(want) {
+            assert!((g - w).abs() <= rel * w.abs(), "{what}: {got:?} vs {want:?}");
+        }
+    };
+    // a ten-thousandth of b's size: the absolute tolerance a model of small numbers sets
+    let robertson = format!("{ROBERTSON}[simulation]\natol = 1e-10\n");
+    let reference = [0.7158270687, 9.185534764e-6, 0.2841637457];
+    let by_default = run(&robertson, None, (1.0, 40.0));
+    close(&by_default.last_state(), &reference, 2e-5, "Robertson at 40 s, dopri5");
+    let switched = by_default.stiff_from.expect("dopri5 finds Robertson stiff");
+    assert!(switched < 1.0, "{switched}");
+    let implicit = run(&robertson, Some(Integrator::Rosenbrock), (1.0, 40.0));
+    close(&implicit.last_state(), &reference, 2e-5, "Robertson at 40 s, rosenbrock");
+    assert_eq!(implicit.stiff_from, None, "asked for: nothing to say");
+    let long = format!("{ROBERTSON}[simulation]\natol = 1e-14\n");
+    let end = run(&long, None, (1e8, 1e11)).last_state();
+    close(&end[..2], &[2.0833401e-8, 8.3333608e-14], 1e-3, "Robertson at 1e11 s");
+    // van der Pol through the command line: its period from the zero crossings, and the note
+    let dir = crate::common::Scratch::new("stiff");
+    let model = dir.join("vdp.toml");
+    std::fs::write(
+        &model,
+        "[model]\nname = \"van der Pol\"\nintercept = false\n[parameters.mu]\nvalue = 1000.0\n\
+         [[states]]\nname = \"x\"\ninitial = 2.0\n[[states]]\nname = \"y\"\n\
+         [equations.x_dot]\nstate = \"x\"\ncoefficients = { \"y\" = 1.0 }\n\
+         [equations.y_dot]\nstate = \"y\"\ncoefficients = { \"mu*y\" = 1.0, \"mu*x^2*y\" = -1.0, \"x\" = -1.0 }\n",
+    )
+    .unwrap();
+    let csv = dir.join("vdp.csv");
+    let (ok, out, err) = termid(&[
+        "simulate",
+        "--model",
+        model.to_str().unwrap(),
+        "--duration",
+        "5000",
+        "--dt",
+        "0.05",
+        "--sample",
+        "0.05",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("note: the model is stiff from t ="), "{out}");
+    let rows: Vec<(f64, f64)> = std::fs::read_to_string(&csv)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let c: Vec<f64> = l.split(',').take(2).map(|v| v.parse().unwrap()).collect();
+            (c[0], c[1])
+        })
+        .collect();
+    let downward: Vec<f64> = rows
+        .windows(2)
+        .filter(|w| w[0].1 > 0.0 && w[1].1 <= 0.0)
+        .map(|w| w[0].0 + (w[1].0 - w[0].0) * w[0].1 / (w[0].1 - w[1].1))
+        .collect();
+    assert!(downward.len() >= 3, "{downward:?}");
+    for period in downward.windows(2).map(|w| w[1] - w[0]) {
+        assert!((period - 1614.41).abs() < 0.2, "period {period} s: {downward:?}");
     }
 }
 

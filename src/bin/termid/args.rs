@@ -427,8 +427,10 @@ pub struct SimulateCommand {
     /// they apply). Any model: replay:FILE.csv.
     #[arg(long, short = 'm')]
     pub manoeuvre: Option<String>,
-    /// Integrator: dopri5 (adaptive Dormand-Prince 5(4) with error control), rk4 or b8
-    /// (Oltmann's modified Euler, eq. B8). Default: the model file's `[simulation]`, else dopri5.
+    /// Integrator: dopri5 (adaptive Dormand-Prince 5(4) with error control; where it finds the
+    /// model stiff it goes on with rosenbrock's steps, and says so), rosenbrock (adaptive,
+    /// linearly implicit: stiff models), rk4 or b8 (Oltmann's modified Euler, eq. B8). Default:
+    /// the model file's `[simulation]`, else dopri5.
     #[arg(long, value_enum)]
     pub integrator: Option<Integrator>,
     /// Control step, s: inputs are taken on its grid; the fixed step of rk4 and b8. Default:
@@ -613,8 +615,9 @@ pub struct RunsArgs {
 /// How measured runs are re-simulated, and where the figures go.
 #[derive(Debug, Args)]
 pub struct ResimArgs {
-    /// Integrator: dopri5 (adaptive), rk4 or b8 (the paper's modified Euler). Default: the
-    /// model file's `[simulation]`, else dopri5.
+    /// Integrator: dopri5 (adaptive; linearly implicit where the model is stiff), rosenbrock,
+    /// rk4 or b8 (the paper's modified Euler). Default: the model file's `[simulation]`, else
+    /// dopri5.
     #[arg(long, value_enum)]
     pub integrator: Option<Integrator>,
     /// Control step, s (default: the model file's, else 0.04).

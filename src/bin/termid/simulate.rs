@@ -57,7 +57,7 @@ pub fn run(cmd: SimulateCommand) -> Result<()> {
     // step at most as long that divides the interval, rather than an error
     let dt = match cmd.dt {
         Some(dt) => dt,
-        None if integrator == Integrator::Dopri5 && cmd.sample.is_finite() && cmd.sample > 0.0 => {
+        None if integrator.is_adaptive() && cmd.sample.is_finite() && cmd.sample > 0.0 => {
             let every = (cmd.sample / step * (1.0 - 1e-9)).ceil().max(1.0);
             cmd.sample / every
         }
@@ -316,6 +316,7 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
                     "monte_carlo": mc.as_ref().zip(spread.as_ref()).map(|(mc, s)| mc.summary(s)),
                     "parameter_effects": effects,
                     "spread_from": from,
+                    "stiff_from": traj.stiff_from,
                 }))?
             )
         }
@@ -328,6 +329,14 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
             );
             for (s, v) in system.states.iter().zip(&last) {
                 println!("  {s} = {}", termid::identify::sig(*v, 6));
+            }
+            if let Some(t) = traj.stiff_from {
+                println!(
+                    "note: the model is stiff from t = {} s on (the explicit steps were held by \
+                     stability, not accuracy): continued with linearly implicit Rosenbrock steps \
+                     (`--integrator rosenbrock` takes them from the start)",
+                    termid::identify::sig(t, 4)
+                );
             }
             if let Some((mc, spread)) = mc.as_ref().zip(spread.as_ref()) {
                 print!("{}", mc.text(spread, &nominal));

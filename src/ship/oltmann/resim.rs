@@ -107,6 +107,7 @@ pub fn original_samples(rec: &Recorded) -> Trajectory {
         inputs: rec.fine.inputs.iter().map(pick).collect(),
         derivatives: rec.fine.derivatives.iter().map(pick).collect(),
         observed: rec.fine.observed.iter().map(|(n, c)| (n.clone(), pick(c))).collect(),
+        stiff_from: rec.fine.stiff_from,
     }
 }
 
