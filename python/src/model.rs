@@ -919,6 +919,7 @@ impl PyModel {
             None => (frames, sources),
         };
         // one RK4 step per sample by default: the recorded inputs are known at the samples
+        let given = dt.is_some();
         let dt = dt.unwrap_or_else(|| termid::data::sample_step(&frames));
         let settings = termid::diagnose::EstimateSettings {
             coefficients,
@@ -930,10 +931,15 @@ impl PyModel {
             coarsest: coarse.then_some((termid::recipe::RESOLVED, termid::recipe::MOST_SAMPLES_PER_STEP)),
             ..Default::default()
         };
-        let (fit, metrics) = py
+        let (fit, metrics, stiff) = py
             .detach(|| -> Result<_, termid::diagnose::DiagnoseError> {
                 let mut runs =
                     termid::diagnose::Runs::new(&model, &frames, dt, termid::sim::Integrator::Rk4)?;
+                // a stiff model at the step its fastest mode allows, as the command line does
+                let mut stiff = None;
+                if !given {
+                    (runs, stiff) = runs.stable(&model);
+                }
                 if let Some(names) = &states {
                     runs = runs.comparing(&model, names)?;
                 }
@@ -943,9 +949,13 @@ impl PyModel {
                     .re_simulated(&runs)
                     .map(|sims| termid::plugins::fit_metrics(&fit.model, runs.frames(), &sims))
                     .map_err(|e| e.to_string());
-                Ok((fit, metrics))
+                Ok((fit, metrics, stiff))
             })
             .map_err(fail)?;
+        if let Some(note) = stiff {
+            let message = std::ffi::CString::new(note).unwrap_or_default();
+            PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &message, 2)?;
+        }
         let serialise = |e: serde_json::Error| refuse(format!("could not serialise: {e}"));
         let mut report = serde_json::to_value(&fit).map_err(serialise)?;
         match metrics {

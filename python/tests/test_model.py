@@ -281,6 +281,21 @@ def test_a_stiff_model_is_simulated_right_and_said_to_be():
     assert np.max(np.abs(run[["a", "b", "c"]].iloc[-1].to_numpy() - want) / want) < 2e-5
 
 
+def test_a_stiff_model_is_estimated_at_a_stable_step():
+    # Robertson's k1 from a run sampled every 0.5 s: RK4 at the samples diverges whatever k1
+    # is (|λ| up to 4200 /s); re-simulated at a whole fraction of the interval, with a warning
+    with_k1 = ROBERTSON.replace('"a" = -0.04, "b*c"', '"k1*a" = -1.0, "b*c"').replace(
+        '"a" = 0.04, "b*c" = -1e4', '"k1*a" = 1.0, "b*c" = -1e4'
+    )
+    truth = termid.Model.from_toml(with_k1 + "[parameters.k1]\nvalue = 0.04\n")
+    with pytest.warns(UserWarning, match="stiff from t ="):
+        run = truth.simulate(duration=100.0, sample=0.5)[["t", "a", "b", "c"]]
+    start = termid.Model.from_toml(with_k1 + "[parameters.k1]\nvalue = 0.06\nfree = true\n")
+    with pytest.warns(UserWarning, match="stiff against the runs' step"):
+        table, _ = start.estimate(run)
+    assert abs(table.loc["k1", "estimate"] / 0.04 - 1) < 1e-4, table
+
+
 def test_identification_releases_the_gil(ship, zigzags):
     # while the Rust side works, a Python thread keeps running (it ran at 4 % before)
     import threading

@@ -166,6 +166,20 @@ impl RightHandSide for WithOutputs<'_> {
     }
 }
 
+/// h·|λ| on the negative real axis below which a fixed step is stable: RK4's 2.785, the
+/// explicit Euler of Oltmann's B8 2; none for the adaptive methods, which find their own.
+fn stability_limit(integrator: Integrator) -> f64 {
+    match integrator {
+        Integrator::Rk4 => 2.78,
+        Integrator::ModifiedEuler => 2.0,
+        _ => f64::INFINITY,
+    }
+}
+
+/// The most steps per sample [`Runs::stable`] takes: beyond it the model wants an implicit
+/// method or a quasi-steady-state form, not a million explicit steps per run.
+const MOST_SUBSTEPS: f64 = 10_000.0;
+
 /// One compared quantity's errors in one run, model − measured: (name, unit, errors).
 type Compared = (String, String, Vec<f64>);
 
@@ -775,7 +789,10 @@ impl Runs {
     pub(super) fn not_finite(&self, model: &Model) -> Option<String> {
         let sims = match self.simulate(model, &[], &[]) {
             Ok(sims) => sims,
-            Err(e) => return Some(e.to_string()),
+            Err(e) => {
+                let why = self.stiffness(model).map_or(String::new(), |s| format!("; {s}"));
+                return Some(format!("{e}{why}"));
+            }
         };
         for (f, sim) in self.frames.iter().zip(&sims) {
             for (name, _, _, simulated) in self.compared_in(sim) {
@@ -792,6 +809,126 @@ impl Runs {
             }
         }
         None
+    }
+
+    /// Each run's fastest decaying mode of ∂f/∂x for `model` over its samples (their recorded
+    /// states, the start's values of the rest): (|λ| of the eigenvalue with Re λ < 0 largest in
+    /// size, /s; the time into the run where it is), `None` for a run with no such mode or a
+    /// method that is not a fixed step (the adaptive ones find their own).
+    fn fastest_decay(&self, model: &Model) -> Vec<Option<(f64, f64)>> {
+        let Ok(system) = System::new(model, &Default::default(), self.intercepts) else {
+            return vec![None; self.frames.len()];
+        };
+        let n = system.dim();
+        let Ok(mut tangents) = system.partials(&(0..n).collect::<Vec<_>>(), &[]) else {
+            return vec![None; self.frames.len()];
+        };
+        let mut ws = system.workspace();
+        let (mut dx, mut jac) = (vec![0.0; n], vec![0.0; n * n]);
+        let mut out = Vec::with_capacity(self.frames.len());
+        for (r, f) in self.frames.iter().enumerate() {
+            let fixed = matches!(self.settings[r].integrator, Integrator::Rk4 | Integrator::ModifiedEuler);
+            let inputs: Vec<&[f64]> = system.inputs.iter().filter_map(|i| f.column(i)).collect();
+            let system = match system.with_parameters(&self.params[r]) {
+                Ok(system) if fixed && inputs.len() == system.inputs.len() => system,
+                _ => {
+                    out.push(None);
+                    continue;
+                }
+            };
+            let columns: Vec<Option<&[f64]>> = system.states.iter().map(|s| f.column(s)).collect();
+            let mut fastest: Option<(f64, f64)> = None;
+            // two hundred samples of each run are enough to find where it is stiff
+            for k in (0..f.len()).step_by((f.len() / 200).max(1)) {
+                let x: Vec<f64> =
+                    columns.iter().enumerate().map(|(i, c)| c.map_or(self.x0[r][i], |c| c[k])).collect();
+                let u: Vec<f64> = inputs.iter().map(|c| c[k]).collect();
+                system.derivatives_and_partials(&x, &u, &mut ws, &mut tangents, &mut dx, &mut jac);
+                if jac.iter().any(|v| !v.is_finite()) {
+                    continue;
+                }
+                let speed = nalgebra::DMatrix::from_row_slice(n, n, &jac)
+                    .complex_eigenvalues()
+                    .iter()
+                    .filter(|l| l.re < 0.0)
+                    .map(|l| l.norm())
+                    .fold(0.0, f64::max);
+                if speed > 0.0 && fastest.is_none_or(|(s, _)| speed > s) {
+                    fastest = Some((speed, f.time()[k] - f.time()[0]));
+                }
+            }
+            out.push(fastest);
+        }
+        out
+    }
+
+    /// Where the runs' fixed step is beyond its method's stability for `model` (h·|λ| of the
+    /// fastest decaying mode above the method's limit): a stiff model's re-simulation then
+    /// oscillates and diverges whatever its parameters, which a bare "diverged" does not say.
+    pub(super) fn stiffness(&self, model: &Model) -> Option<String> {
+        let (r, (speed, t)) = self
+            .fastest_decay(model)
+            .into_iter()
+            .enumerate()
+            .filter_map(|(r, f)| f.map(|f| (r, f)))
+            .filter(|(r, (speed, _))| {
+                self.settings[*r].dt * speed > stability_limit(self.settings[*r].integrator)
+            })
+            .max_by(|a, b| a.1 .0.total_cmp(&b.1 .0))?;
+        let settings = &self.settings[r];
+        let limit = stability_limit(settings.integrator);
+        Some(format!(
+            "the model is stiff at this step: at t = {} s of run {}, ∂f/∂x has a decaying mode of \
+             |λ| = {} /s, and {} at {} s (h·|λ| = {}) is stable only below h·|λ| ≈ {limit}: its \
+             re-simulation needs steps of {} s or less (--dt), or the fast mode replaced by its \
+             steady state (a quasi-steady-state model)",
+            crate::identify::num(t),
+            self.frames[r].origin(),
+            crate::identify::sig(speed, 3),
+            settings.integrator.name(),
+            crate::identify::num(settings.dt),
+            crate::identify::sig(settings.dt * speed, 3),
+            crate::identify::sig(limit / speed, 2)
+        ))
+    }
+
+    /// These runs with each run's fixed step cut to a whole fraction at which `model`'s
+    /// re-simulation is stable (h·|λ| at most 80 % of the method's limit, RK4's 2.78, for the
+    /// fastest decaying mode over the run's samples), and what was done, if anything was: a
+    /// stiff model (chemical kinetics, a fast lag) re-simulated at its records' interval
+    /// diverges whatever its parameters. A run that would need more than 10 000 steps per
+    /// sample keeps its step (its re-simulation then says why it fails).
+    pub fn stable(&self, model: &Model) -> (Runs, Option<String>) {
+        let mut out = self.clone();
+        let mut cut: Option<(usize, f64, f64)> = None;
+        for (r, fastest) in self.fastest_decay(model).into_iter().enumerate() {
+            let Some((speed, _)) = fastest else { continue };
+            let s = &mut out.settings[r];
+            let limit = 0.8 * stability_limit(s.integrator);
+            let per_step = (s.dt * speed / limit).ceil();
+            if per_step <= 1.0 || per_step > MOST_SUBSTEPS {
+                continue;
+            }
+            // the samples fall on the finer grid: the step a whole fraction of the interval
+            let every = (s.sample / s.dt).round().max(1.0);
+            s.dt = s.sample / (every * per_step);
+            if cut.is_none_or(|(_, _, d)| s.dt < d) {
+                cut = Some((r, speed, s.dt));
+            }
+        }
+        let note = cut.map(|(r, speed, dt)| {
+            format!(
+                "the model is stiff against the runs' step (a decaying mode of |λ| = {} /s in run {}: \
+                 {} is stable only below h·|λ| ≈ {}): re-simulated at {} s, {} steps per sample",
+                crate::identify::sig(speed, 3),
+                self.frames[r].origin(),
+                self.settings[r].integrator.name(),
+                stability_limit(self.settings[r].integrator),
+                crate::identify::sig(dt, 2),
+                (self.settings[r].sample / dt).round()
+            )
+        });
+        (out, note)
     }
 
     /// [`Runs::residuals`] cut into their series, one per run and compared state or derived

@@ -271,7 +271,8 @@ pub(super) fn lost_checks(before: &[Check], after: &[Check]) -> Vec<String> {
 }
 
 /// `frames` made ready for an output-error fit of `model`: one RK4 step per sample (the
-/// recorded inputs are known only at the samples), comparing `states` (`None`: all).
+/// recorded inputs are known only at the samples; a whole fraction of it where the model is
+/// stiff there, [`Runs::stable`]), comparing `states` (`None`: all).
 pub(super) fn output_error_runs(
     model: &Model,
     frames: &[Frame],
@@ -280,6 +281,7 @@ pub(super) fn output_error_runs(
 ) -> Result<Runs, crate::diagnose::DiagnoseError> {
     let sample = crate::data::sample_step(frames);
     let runs = Runs::new(model, frames, sample, crate::sim::Integrator::Rk4)?.with_intercepts(intercept);
+    let (runs, _) = runs.stable(model);
     match states {
         Some(names) => runs.comparing(model, names),
         None => Ok(runs),

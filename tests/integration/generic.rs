@@ -697,6 +697,75 @@ fn stiff_models_by_default() {
     }
 }
 
+/// Output error on a stiff model, right by default: Robertson's rate constant k1 estimated
+/// from a run sampled every 0.5 s, where RK4 at the samples' interval (|λ| up to 4200 /s,
+/// h·|λ| = 2100) diverged whatever k1 was; the runs are now re-simulated at a whole fraction of
+/// the interval where RK4 is stable, and that is said. A step the user gives is kept, and its
+/// failure names the stiffness and the step that would do.
+#[test]
+fn a_stiff_model_is_estimated_by_output_error() {
+    let dir = crate::common::Scratch::new("stiff-estimate");
+    let text = |k1: &str| {
+        format!(
+            "[model]\nname = \"Robertson\"\nintercept = false\n[simulation]\natol = 1e-10\n\
+             [parameters.k1]\nvalue = {k1}\nfree = true\n[parameters.k2]\nvalue = 1e4\n\
+             [parameters.k3]\nvalue = 3e7\n\
+             [[states]]\nname = \"a\"\ninitial = 1.0\n[[states]]\nname = \"b\"\n[[states]]\nname = \"c\"\n\
+             [equations.a_dot]\nstate = \"a\"\ncoefficients = {{ \"k1*a\" = -1.0, \"k2*b*c\" = 1.0 }}\n\
+             [equations.b_dot]\nstate = \"b\"\ncoefficients = {{ \"k1*a\" = 1.0, \"k2*b*c\" = -1.0, \"k3*b^2\" = -1.0 }}\n\
+             [equations.c_dot]\nstate = \"c\"\ncoefficients = {{ \"k3*b^2\" = 1.0 }}\n"
+        )
+    };
+    let (truth, start) = (dir.join("truth.toml"), dir.join("start.toml"));
+    std::fs::write(&truth, text("0.04")).unwrap();
+    std::fs::write(&start, text("0.06")).unwrap();
+    let csv = dir.join("run.csv");
+    let (ok, _, err) = termid(&[
+        "simulate",
+        "--model",
+        truth.to_str().unwrap(),
+        "--duration",
+        "100",
+        "--dt",
+        "0.5",
+        "--sample",
+        "0.5",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let (ok, out, err) = termid(&[
+        "estimate",
+        "--model",
+        start.to_str().unwrap(),
+        "--data",
+        csv.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    assert!(ok, "{err}");
+    // the note beside the report: standard output one JSON document
+    assert!(err.contains("note: the model is stiff against the runs' step"), "{err}");
+    let json: serde_json::Value = serde_json::from_str(&out).unwrap_or_else(|e| panic!("{e}: {out}"));
+    let estimate = json["parameters"]
+        .as_array()
+        .and_then(|p| p.iter().find(|p| p["name"] == "k1"))
+        .and_then(|p| p["value"].as_f64())
+        .unwrap_or_else(|| panic!("{json}"));
+    assert!((estimate - 0.04).abs() < 1e-5, "k1 = {estimate}");
+    let (ok, _, err) = termid(&[
+        "estimate",
+        "--model",
+        start.to_str().unwrap(),
+        "--data",
+        csv.to_str().unwrap(),
+        "--dt",
+        "0.5",
+    ]);
+    assert!(!ok);
+    assert!(err.contains("the model is stiff at this step") && err.contains("|λ| = 4"), "{err}");
+}
+
 /// `--rtol` and `--atol` set the adaptive method's tolerances for one command: the pendulum at
 /// 1e-11 / 1e-12 ends on scipy's DOP853 at 1e-13 within 1e-8; tolerances no step control works
 /// with are refused by name.
