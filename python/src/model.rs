@@ -664,7 +664,16 @@ impl PyModel {
             .zip(&sims)
             .map(|(f, s)| serde_json::json!({"run": f.origin(), "measured": observe(f, None), "simulated": observe(f, Some(s))}))
             .collect();
-        to_json(&serde_json::json!({"gap": data.gap(&sims), "metrics": metrics, "medium": medium}))
+        // how long each run is predictable at all (a chaotic model parts from itself)
+        let horizon = py.detach(|| data.horizon(&self.inner, &sims));
+        let predictable: Vec<serde_json::Value> = frames
+            .iter()
+            .zip(&horizon)
+            .map(|(f, h)| serde_json::json!({"run": f.origin(), "seconds": h.map(|k| f.time()[k] - f.time()[0]), "of": f.time()[f.len() - 1] - f.time()[0]}))
+            .collect();
+        to_json(
+            &serde_json::json!({"gap": data.gap(&sims), "metrics": metrics, "medium": medium, "predictable_for": predictable}),
+        )
     }
 
     /// The model's uncertainty against held-out runs: every run simulated as `validate`

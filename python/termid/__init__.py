@@ -1374,7 +1374,10 @@ class Model:
         squares, and for a ship ``attrs["metrics"]`` (overshoots, tactical diameter, ...)
         measured and simulated, a DataFrame indexed by run and source. ``raw``: the
         report as plain values; ``dt``, ``integrator``, ``with_intercept`` as for
-        :meth:`simulate`.
+        :meth:`simulate`. ``attrs["predictable_for"]``: per run, the seconds after which a start a
+        millionth of each state's spread off parts from the model's own run by a tenth of a
+        spread (a chaotic motion such as Lorenz's), ``None`` where it never does; errors after
+        that are of that size whatever the model, and a warning says so.
 
         ``monte_carlo``: every run simulated also with that many models drawn from the stored
         covariances (:meth:`draws` with ``seed``), as ``termid validate --monte-carlo`` does:
@@ -1410,6 +1413,16 @@ class Model:
         if raw:
             return report
         frame = _gap_frame(report["gap"])
+        frame.attrs["predictable_for"] = {p["run"]: p["seconds"] for p in report.get("predictable_for", [])}
+        for p in report.get("predictable_for", []):
+            if p["seconds"] is not None:
+                warnings.warn(
+                    f"termid: {p['run']} is predictable for {p['seconds']:.3g} s of its {p['of']:.3g} s: a start a "
+                    "millionth of each state's spread off parts from the model's own run there (a chaotic or "
+                    "strongly unstable motion), so later errors are of that size whatever the model",
+                    UserWarning,
+                    stacklevel=2,
+                )
         rows = [
             {"run": m["run"], "source": source, **(m.get(source) or {})}
             for m in report.get("metrics", [])

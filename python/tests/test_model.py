@@ -218,6 +218,12 @@ def test_lorenz_simulated_and_identified_with_the_defaults():
     assert moved.x.iloc[0] == 1.0
     with pytest.raises(termid.TermidError, match="not a state"):
         lorenz.simulate(duration=1.0, initial={"w": 1.0})
+    # validated on its own run, the right model is predictable for about ln(1e5)/0.906 s
+    # (Lorenz's largest Lyapunov exponent), and that is said
+    with pytest.warns(UserWarning, match="is predictable for"):
+        gap = found.model.validate(run)
+    (seconds,) = gap.attrs["predictable_for"].values()
+    assert 0.5 * 12.7 < seconds < 1.5 * 12.7
 
 
 def test_tolerances_set_from_python_are_the_simulations():

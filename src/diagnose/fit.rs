@@ -180,6 +180,12 @@ fn stability_limit(integrator: Integrator) -> f64 {
 /// method or a quasi-steady-state form, not a million explicit steps per run.
 const MOST_SUBSTEPS: f64 = 10_000.0;
 
+/// [`Runs::horizon`]'s twin starts this share of each compared state's spread off, and has
+/// parted where it differs by [`PARTED`] of a spread.
+pub const PERTURBATION: f64 = 1e-6;
+/// See [`PERTURBATION`].
+pub const PARTED: f64 = 0.1;
+
 /// One compared quantity's errors in one run, model − measured: (name, unit, errors).
 type Compared = (String, String, Vec<f64>);
 
@@ -974,6 +980,35 @@ impl Runs {
             r.extend(self.run_residuals(run, sim));
         }
         r
+    }
+
+    /// How long each run's re-simulation by `model` is predictable at all: the sample at which
+    /// a twin started a millionth of each compared state's spread off (`sims` the nominal
+    /// ones) parts from it by a tenth of a spread, `None` where it never does within the run.
+    /// A chaotic model (Lorenz) or a strongly unstable one parts from itself so, and any
+    /// model's errors after that sample, however right the model, are of that size: they say
+    /// nothing about it.
+    pub fn horizon(&self, model: &Model, sims: &[Trajectory]) -> Vec<Option<usize>> {
+        let mut twin = self.clone();
+        for x0 in &mut twin.x0 {
+            for ((i, _), scale) in self.states.iter().zip(&self.scale) {
+                x0[*i] += PERTURBATION * scale;
+            }
+        }
+        let Ok(twins) = twin.simulate(model, &[], &[]) else { return vec![None; self.frames.len()] };
+        sims.iter()
+            .zip(&twins)
+            .map(|(a, b)| {
+                let parted = |k: usize| {
+                    self.states.iter().zip(&self.scale).any(|((i, _), scale)| {
+                        let (x, y) = (a.states[*i].get(k), b.states[*i].get(k));
+                        // a NaN twin has parted too
+                        x.zip(y).is_none_or(|(x, y)| (x - y).abs().is_nan() || (x - y).abs() > PARTED * scale)
+                    })
+                };
+                (0..a.time.len().min(b.time.len())).find(|&k| parted(k))
+            })
+            .collect()
     }
 
     /// RMS and max per compared state and derived variable, in its unit.

@@ -47,7 +47,9 @@ pub use estimate::{
     RunSpread, Segmented, SourceParameter, FOLLOWS, LEANS, MOST_STEPS_PER_SAMPLE, RUNS_DIFFER, SEGMENTS,
     STEP_RESOLVES,
 };
-pub use fit::{in_segments, simulate_runs, EstimateError, PartlyRecorded, Runs, SEGMENT_SAMPLES};
+pub use fit::{
+    in_segments, simulate_runs, EstimateError, PartlyRecorded, Runs, PARTED, PERTURBATION, SEGMENT_SAMPLES,
+};
 pub use medium::medium;
 pub use refine::{refine, RefineSettings, Refined, RefinedCoefficient};
 

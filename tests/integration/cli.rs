@@ -260,6 +260,8 @@ fn validate_sets_model_and_measurement_side_by_side() {
             < 0.05
     );
     assert!(svg.join("validate_z.svg").exists());
+    // a zigzag's replayed rudder does not part the ship from itself: predictable throughout
+    assert!(v["predictable_for"][0]["seconds"].is_null(), "{}", v["predictable_for"]);
     // the text says how its overshoots are read, and how that differs from `simulate`'s
     let (ok, out, err) = termid(&["validate", "--data", run.to_str().unwrap()]);
     assert!(

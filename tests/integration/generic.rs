@@ -591,6 +591,99 @@ fn adaptive_integration_matches_dop853() {
     }
 }
 
+/// Right or it says so: Lorenz identified from its own samples (coefficients within 10⁻⁴)
+/// validates on that run with errors as large as the attractor after ~10 s, since a start a
+/// millionth off parts from the model's own run there (its largest Lyapunov exponent 0.906 /s,
+/// Sprott 2003: 10⁵-fold in ln(10⁵)/0.906 = 12.7 s on average). `validate` says for how long
+/// the run is predictable at all and gives the errors over that stretch, where they are
+/// small; the forced, damped Duffing oscillator is predictable throughout.
+#[test]
+fn validate_says_how_long_a_chaotic_run_is_predictable() {
+    let dir = crate::common::Scratch::new("chaos");
+    let data = dir.join("l.csv");
+    let (ok, _, err) = termid(&[
+        "simulate",
+        "--model",
+        "models/lorenz.toml",
+        "--duration",
+        "20",
+        "--dt",
+        "0.001",
+        "--sample",
+        "0.01",
+        "--out",
+        data.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let found = dir.join("found.toml");
+    let (ok, _, err) = termid(&[
+        "identify",
+        "--model",
+        "models/lorenz.toml",
+        "--data",
+        data.to_str().unwrap(),
+        "--out",
+        found.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let (ok, out, err) = termid(&[
+        "validate",
+        "--model",
+        found.to_str().unwrap(),
+        "--data",
+        data.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let seconds = v["predictable_for"][0]["seconds"].as_f64().unwrap_or_else(|| panic!("{out}"));
+    let mean = (1e5f64).ln() / 0.906;
+    assert!(seconds > 0.5 * mean && seconds < 1.5 * mean, "{seconds} s");
+    let (ok, out, err) =
+        termid(&["validate", "--model", found.to_str().unwrap(), "--data", data.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(out.contains("is predictable for") && out.contains("whatever the model"), "{out}");
+    // the errors over the predictable stretch: a few thousandths of the states' size
+    let early = out.split("over the first").nth(1).unwrap_or_else(|| panic!("{out}"));
+    let x_max: f64 = early
+        .split("x ")
+        .nth(1)
+        .and_then(|c| c.split(" / ").nth(1))
+        .and_then(|m| m.split(',').next())
+        .and_then(|m| m.trim().parse().ok())
+        .unwrap_or_else(|| panic!("{early}"));
+    assert!(x_max < 0.05, "{early}");
+    // Duffing, forced and damped, is not chaotic here
+    let duffing = dir.join("d.csv");
+    let (ok, _, err) = termid(&[
+        "simulate",
+        "--model",
+        "models/duffing.toml",
+        "--input",
+        "F=0.5",
+        "--duration",
+        "60",
+        "--sample",
+        "0.05",
+        "--out",
+        duffing.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let (ok, out, err) = termid(&[
+        "validate",
+        "--model",
+        "models/duffing.toml",
+        "--data",
+        duffing.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert!(v["predictable_for"][0]["seconds"].is_null(), "{out}");
+}
+
 /// Robertson's chemical kinetics (Hairer & Wanner, *Solving ODEs II*, IV.1): rates from
 /// 0.04 to 3·10⁷, the classic stiff test.
 const ROBERTSON: &str = r#"

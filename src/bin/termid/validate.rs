@@ -30,6 +30,8 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
         .with_initial(&[], &current);
     let sims = data.simulate(&model, &[], &[])?;
     let gap = data.gap(&sims);
+    // how long each run is predictable at all: beyond it any model's errors are of its size
+    let horizon = data.horizon(&model, &sims);
     // a plug-in's models: its metrics read off measurement and simulation alike
     let plugin = termid::plugins::of(&model);
     let observe = |f: &termid::data::Frame, s: Option<&Trajectory>| plugin?.observe(&model, f, s);
@@ -98,6 +100,10 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
                     "simulated": m.as_ref().map(|m| &m.1.json),
                     "monte_carlo": mc.as_ref().zip(s.as_ref()).map(|(mc, s)| mc.summary(s)),
                 })).collect::<Vec<_>>(),
+                "predictable_for": runs.iter().zip(&horizon).map(|(f, h)| serde_json::json!({
+                    "run": f.origin(),
+                    "seconds": h.map(|k| f.time()[k] - f.time()[0]),
+                })).collect::<Vec<_>>(),
                 "within_band": (!verdicts.is_empty()).then(|| serde_json::json!({
                     "within": within,
                     "outside": outside,
@@ -115,6 +121,31 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
                 let cells: Vec<String> =
                     per.iter().map(|(s, r, m)| error_cell(s, *r, *m, model.unit(s))).collect();
                 println!("  {run}: {}", cells.join(", "));
+            }
+            for ((f, sim), k) in runs.iter().zip(&sims).zip(&horizon) {
+                let Some(k) = *k else { continue };
+                let (t, end) = (f.time()[k] - f.time()[0], f.time()[f.len() - 1] - f.time()[0]);
+                let cells: Vec<String> = gap
+                    .runs
+                    .iter()
+                    .find(|(run, _)| run == f.origin())
+                    .map(|(_, per)| {
+                        per.iter().filter_map(|(s, _, _)| early_error(f, sim, s, k, model.unit(s))).collect()
+                    })
+                    .unwrap_or_default();
+                println!(
+                    "  note: {} is predictable for {} s of its {} s: a start {} of each state's spread \
+                     off parts from the model's own run by {} of a spread there (a chaotic or \
+                     strongly unstable motion), so later errors are of that size whatever the \
+                     model; over the first {} s: {}",
+                    f.origin(),
+                    sig(t, 3),
+                    sig(end, 3),
+                    sig(termid::diagnose::PERTURBATION, 1),
+                    sig(termid::diagnose::PARTED, 1),
+                    sig(t, 3),
+                    cells.join(", ")
+                );
             }
             for (k, ((m, f), s)) in metrics.iter().zip(&runs).zip(&spreads).enumerate() {
                 let Some((a, b)) = m else { continue };
@@ -159,6 +190,22 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// `state`'s error cell over a run's first `rows` samples (before its motion parts from
+/// itself), where the run records it.
+fn early_error(
+    f: &termid::data::Frame,
+    sim: &Trajectory,
+    state: &str,
+    rows: usize,
+    unit: &str,
+) -> Option<String> {
+    let (meas, model) = (f.column(state)?, sim.column(state)?);
+    let d: Vec<f64> = meas.iter().zip(model).take(rows.max(1)).map(|(m, s)| s - m).collect();
+    let rms = (d.iter().map(|v| v * v).sum::<f64>() / d.len() as f64).sqrt();
+    let max = d.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    Some(error_cell(state, rms, max, unit))
 }
 
 /// One state's error, RMS / max, in its unit with angles in degrees: `ψ 1.55 / 2.74 °`.
