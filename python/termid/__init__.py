@@ -313,8 +313,9 @@ def _t_quantile(p_two_sided: float, df: float) -> float:
 
 class Summary:
     """A fit as statsmodels' ``summary()`` shows one: ``stats`` (rows, terms, R², adjusted R²,
-    F, AIC, BIC, the residuals' correlation time τ) and ``terms``, a DataFrame of each
-    coefficient with its standard error, the √τ-corrected one, t, p and confidence interval.
+    F, AIC, BIC, the residuals' correlation time τ), ``terms``, a DataFrame of each
+    coefficient with its standard error, the √τ-corrected one, t, p and confidence interval,
+    and ``notes``, what the numbers do not show (printed last, as statsmodels does).
 
     >>> df = pd.DataFrame({"x": [0.0, 1, 2, 3, 4], "y": [1.0, 3.1, 4.9, 7.0, 9.0]})
     >>> s = termid.fit(df, "y", "x").summary()
@@ -322,14 +323,19 @@ class Summary:
     (0.9995, ['(intercept)', 'x'])
     """
 
-    def __init__(self, stats: Dict[str, Any], terms: pd.DataFrame, equation: str):
+    def __init__(self, stats: Dict[str, Any], terms: pd.DataFrame, equation: str, notes: Sequence[str] = ()):
         self.stats = stats
         self.terms = terms
         self.equation = equation
+        self.notes = list(notes)
 
     def __str__(self) -> str:
         head = "  ".join(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}" for k, v in self.stats.items())
-        return f"{self.equation}\n{head}\n{self.terms.to_string(float_format=lambda v: f'{v:.6g}')}"
+        text = f"{self.equation}\n{head}\n{self.terms.to_string(float_format=lambda v: f'{v:.6g}')}"
+        # as statsmodels closes its summary: what the numbers above do not show
+        if self.notes:
+            text += "\n\nNotes:\n" + "\n".join(f"[{i}] {n}" for i, n in enumerate(self.notes, 1))
+        return text
 
     __repr__ = __str__
 
@@ -421,6 +427,33 @@ class Fit:
         return None if b0 is None else b0["value"]
 
     @property
+    def notes(self) -> List[str]:
+        """What the numbers do not show: terms the rows cannot tell from a candidate left out,
+        collinear or offset candidates, coarse samples (:meth:`summary` prints them last).
+
+        >>> df = pd.DataFrame({"x": [0.0, 1, 2, 3, 4, 5], "w": [0.1, 0.9, 2.1, 2.9, 4.1, 5.0],
+        ...                    "y": [0.4, 1.7, 3.8, 6.1, 8.4, 9.7]})
+        >>> [n[:33] for n in termid.fit(df, "y", ["x", "w"]).notes]
+        ['the rows hardly tell `w` from `x`']
+        """
+        return list(self.report.get("notes", []))
+
+    @property
+    def rivals(self) -> pd.DataFrame:
+        """How firmly each chosen term was chosen: its closest rival among the candidates left
+        out (``instead``) and the rise of the residual sum of squares with the rival in its
+        place (``rise``, in residual variances s²; negative: the rival fits better). A rise
+        within about 4·τ is the noise's choice, and :attr:`notes` says so.
+
+        >>> df = pd.DataFrame({"x": [0.0, 1, 2, 3, 4, 5], "w": [0.1, 0.9, 2.1, 2.9, 4.1, 5.0],
+        ...                    "y": [0.4, 1.7, 3.8, 6.1, 8.4, 9.7]})
+        >>> termid.fit(df, "y", ["x", "w"]).rivals.round(2).to_dict("index")
+        {'w': {'instead': 'x', 'rise': 1.11}}
+        """
+        rows = [{"term": w["chosen"], "instead": w["instead"], "rise": w["rise"]} for w in self.report.get("swaps", [])]
+        return pd.DataFrame(rows, columns=["term", "instead", "rise"]).set_index("term")
+
+    @property
     def chosen_step(self) -> Optional[int]:
         """The step the back-end's rule chose (1-based), None for back-ends without steps.
 
@@ -508,7 +541,7 @@ class Fit:
             "bic": -2.0 * llf + p * math.log(n) if n else float("nan"),
             "tau": float(tau) if tau else float("nan"),
         }
-        return Summary(stats, table, self.equation())
+        return Summary(stats, table, self.equation(), self.notes)
 
     def __repr__(self) -> str:
         return f"termid.Fit({self.equation(4)})"

@@ -1,4 +1,6 @@
 """One equation from columns: termid.fit against published numbers and closed forms."""
+import os
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -228,3 +230,17 @@ def test_a_rate_is_an_equation_of_motion_with_the_command_lines_defaults():
         termid.fit(df, "dw/dt", library)
     with pytest.raises(termid.TermidError, match="are for a rate"):
         termid.fit(df, "x", ["y"], derivative="central")
+
+
+def test_the_rows_that_cannot_choose_are_said():
+    """Hald's cement against Draper & Smith's sums of squares of its pairs: forward stepping's
+    {x4, x1} leaves 74.76, {x2, x1} 57.90, so x2 in x4's place is 2.25 residual variances
+    better (within the noise: a note), and x3 is x1's closest rival ({x4, x3}: 175.74)."""
+    hald = pd.read_csv(os.path.join(os.path.dirname(__file__), "..", "..", "tests", "data", "hald.csv"))
+    fitted = termid.fit(hald, "y", ["x1", "x2", "x3", "x4"])
+    rivals = fitted.rivals
+    assert rivals.loc["x4", "instead"] == "x2" and rivals.loc["x1", "instead"] == "x3"
+    assert rivals.loc["x4", "rise"] == pytest.approx((57.90 - 74.76) / 7.476, abs=2e-3)
+    assert rivals.loc["x1", "rise"] == pytest.approx((175.74 - 74.76) / 7.476, abs=2e-3)
+    assert any("hardly tell `x4` from `x2`" in n for n in fitted.notes)
+    assert "Notes:\n[1] the rows hardly tell" in str(fitted.summary())
