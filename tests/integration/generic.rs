@@ -708,6 +708,48 @@ state = "c"
 coefficients = { "b^2" = 3e7 }
 "#;
 
+/// Right or it says so: Robertson's reaction conserves a + b + c (= 1), so any candidate in c
+/// is one in a and b and a back-end keeps one way of writing the equation, leaving the rest
+/// (here b·c, the system's own term) out as collinear. The fit names the invariant; Lorenz,
+/// which has none, gets no such note.
+#[test]
+fn a_conservation_law_is_named() {
+    let dir = crate::common::Scratch::new("conserved");
+    let model = dir.join("robertson.toml");
+    std::fs::write(&model, format!("{ROBERTSON}[simulation]\natol = 1e-12\n")).unwrap();
+    let csv = dir.join("r.csv");
+    let (ok, _, err) = termid(&[
+        "simulate",
+        "--model",
+        model.to_str().unwrap(),
+        "--duration",
+        "40",
+        "--dt",
+        "0.01",
+        "--sample",
+        "0.01",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    // the states alone (the recorded rates would be columns too)
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let states: Vec<String> =
+        text.lines().map(|l| l.split(',').take(4).collect::<Vec<_>>().join(",")).collect();
+    std::fs::write(&csv, states.join("\n") + "\n").unwrap();
+    let terms = dir.join("terms.txt");
+    std::fs::write(&terms, "1\na\nb\nc\na*b\na*c\nb*c\na^2\nb^2\nc^2\n").unwrap();
+    let out = identify_text(&csv, "da/dt", &terms, &[]);
+    assert!(out.contains("`a + b + c` is the same in every row (a conservation law"), "{out}");
+    let lorenz = dir.join("l.csv");
+    let rows: Vec<String> =
+        lorenz_rows(&dir, "0.01").iter().map(|r| format!("{},{},{},{}", r[0], r[1], r[2], r[3])).collect();
+    std::fs::write(&lorenz, format!("t,x,y,z\n{}\n", rows.join("\n"))).unwrap();
+    let quadratic = dir.join("quadratic.txt");
+    std::fs::write(&quadratic, LORENZ_QUADRATIC).unwrap();
+    assert!(!identify_text(&lorenz, "dx/dt", &quadratic, &[]).contains("conservation law"));
+}
+
 /// Right by default on a stiff model: the explicit steps of the default method are held by
 /// stability (Robertson to 4·10⁵ s took four minutes and ended ten times off); it now finds
 /// the model stiff, goes on with linearly implicit steps and says so. Against numbers from
