@@ -20,13 +20,14 @@ use crate::convert::{
 use crate::moments::PyMoments;
 
 /// The repository's model files, inside the extension (no data files to install or find).
-const BUILTIN: [(&str, &str); 6] = [
+const BUILTIN: [(&str, &str); 7] = [
     ("oltmann1973", include_str!("../../models/oltmann1973.toml")),
     ("lorenz", include_str!("../../models/lorenz.toml")),
     ("duffing", include_str!("../../models/duffing.toml")),
     ("mmg_kvlcc2", include_str!("../../models/mmg_kvlcc2.toml")),
     ("new_ship", include_str!("../../models/new_ship.toml")),
     ("nomoto", include_str!("../../models/nomoto.toml")),
+    ("robertson", include_str!("../../models/robertson.toml")),
 ];
 
 /// A model file: states, inputs, parameters and equations, as termid reads and writes it.

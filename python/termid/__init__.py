@@ -873,8 +873,9 @@ class Model:
     def builtin(name: str) -> "Model":
         """A model file shipped inside the package: ``oltmann1973``, ``lorenz``, ``duffing``,
         ``mmg_kvlcc2`` (KVLCC2 in the MMG standard model), ``nomoto`` (Nomoto's steering model
-        with K and T free, for :meth:`estimate`) or ``new_ship`` (the template),
-        by ``name`` (:meth:`builtin_names`).
+        with K and T free, for :meth:`estimate`), ``robertson`` (Robertson's stiff chemical
+        kinetics, rate constants ``k1``, ``k2``, ``k3``) or ``new_ship`` (the template), by
+        ``name`` (:meth:`builtin_names`).
 
         >>> termid.Model.builtin("lorenz").states
         ['x', 'y', 'z']

@@ -248,36 +248,13 @@ def test_tolerances_set_from_python_are_the_simulations():
             lorenz.set_tolerances(**bad)
 
 
-ROBERTSON = """
-[model]
-name = "Robertson"
-intercept = false
-[simulation]
-atol = 1e-10
-[[states]]
-name = "a"
-initial = 1.0
-[[states]]
-name = "b"
-[[states]]
-name = "c"
-[equations.a_dot]
-state = "a"
-coefficients = { "a" = -0.04, "b*c" = 1e4 }
-[equations.b_dot]
-state = "b"
-coefficients = { "a" = 0.04, "b*c" = -1e4, "b^2" = -3e7 }
-[equations.c_dot]
-state = "c"
-coefficients = { "b^2" = 3e7 }
-"""
 
 
 def test_a_stiff_model_is_simulated_right_and_said_to_be():
     # Robertson's kinetics at t = 40 against Hairer & Wanner's reference; the default method
     # turns linearly implicit and warns, the asked-for Rosenbrock method does not warn
     want = np.array([0.7158270687, 9.185534764e-6, 0.2841637457])
-    robertson = termid.Model.from_toml(ROBERTSON)
+    robertson = termid.Model.builtin("robertson")
     with pytest.warns(UserWarning, match="stiff from t ="):
         run = robertson.simulate(duration=40.0, sample=1.0)
     assert np.max(np.abs(run[["a", "b", "c"]].iloc[-1].to_numpy() - want) / want) < 2e-5
@@ -290,15 +267,12 @@ def test_a_stiff_model_is_simulated_right_and_said_to_be():
 def test_a_stiff_model_is_estimated_at_a_stable_step():
     # Robertson's k1 from a run sampled every 0.5 s: RK4 at the samples diverges whatever k1
     # is (|λ| up to 4200 /s); re-simulated at a whole fraction of the interval, with a warning
-    with_k1 = ROBERTSON.replace('"a" = -0.04, "b*c"', '"k1*a" = -1.0, "b*c"').replace(
-        '"a" = 0.04, "b*c" = -1e4', '"k1*a" = 1.0, "b*c" = -1e4'
-    )
-    truth = termid.Model.from_toml(with_k1 + "[parameters.k1]\nvalue = 0.04\n")
+    truth = termid.Model.builtin("robertson")
     with pytest.warns(UserWarning, match="stiff from t ="):
         run = truth.simulate(duration=100.0, sample=0.5)[["t", "a", "b", "c"]]
-    start = termid.Model.from_toml(with_k1 + "[parameters.k1]\nvalue = 0.06\nfree = true\n")
+    start = termid.Model.from_toml(truth.to_toml().replace("value = 0.04", "value = 0.06"))
     with pytest.warns(UserWarning, match="stiff against the runs' step"):
-        table, _ = start.estimate(run)
+        table, _ = start.estimate(run, free=["k1"])
     assert abs(table.loc["k1", "estimate"] / 0.04 - 1) < 1e-4, table
 
 
@@ -330,7 +304,7 @@ def test_identification_releases_the_gil(ship, zigzags):
 
 
 def test_the_model_files_ship_inside_the_package(ship):
-    assert termid.Model.builtin_names() == ["oltmann1973", "lorenz", "duffing", "mmg_kvlcc2", "new_ship", "nomoto"]
+    assert termid.Model.builtin_names() == ["oltmann1973", "lorenz", "duffing", "mmg_kvlcc2", "new_ship", "nomoto", "robertson"]
     assert termid.Model.builtin("oltmann1973").to_toml() == ship.to_toml()
     path = os.path.join(os.path.dirname(__file__), "..", "..", "models", "lorenz.toml")
     assert termid.Model.builtin("lorenz").to_toml() == termid.Model.load(path).to_toml()

@@ -684,29 +684,13 @@ fn validate_says_how_long_a_chaotic_run_is_predictable() {
     assert!(v["predictable_for"][0]["seconds"].is_null(), "{out}");
 }
 
-/// Robertson's chemical kinetics (Hairer & Wanner, *Solving ODEs II*, IV.1): rates from
-/// 0.04 to 3·10⁷, the classic stiff test.
-const ROBERTSON: &str = r#"
-[model]
-name = "Robertson"
-intercept = false
-[[states]]
-name = "a"
-initial = 1.0
-[[states]]
-name = "b"
-[[states]]
-name = "c"
-[equations.a_dot]
-state = "a"
-coefficients = { "a" = -0.04, "b*c" = 1e4 }
-[equations.b_dot]
-state = "b"
-coefficients = { "a" = 0.04, "b*c" = -1e4, "b^2" = -3e7 }
-[equations.c_dot]
-state = "c"
-coefficients = { "b^2" = 3e7 }
-"#;
+/// Robertson's chemical kinetics (Hairer & Wanner, *Solving ODEs II*, IV.1), the classic
+/// stiff test, as `models/robertson.toml` writes it, with its absolute tolerance `atol`.
+fn robertson(atol: &str) -> String {
+    let text = std::fs::read_to_string("models/robertson.toml").unwrap();
+    assert!(text.contains("atol = 1e-10"), "the file's tolerance moved");
+    text.replace("atol = 1e-10", &format!("atol = {atol}"))
+}
 
 /// Right or it says so: Robertson's reaction conserves a + b + c (= 1), so any candidate in c
 /// is one in a and b and a back-end keeps one way of writing the equation, leaving the rest
@@ -716,7 +700,7 @@ coefficients = { "b^2" = 3e7 }
 fn a_conservation_law_is_named() {
     let dir = crate::common::Scratch::new("conserved");
     let model = dir.join("robertson.toml");
-    std::fs::write(&model, format!("{ROBERTSON}[simulation]\natol = 1e-12\n")).unwrap();
+    std::fs::write(&model, robertson("1e-12")).unwrap();
     let csv = dir.join("r.csv");
     let (ok, _, err) = termid(&[
         "simulate",
@@ -773,16 +757,16 @@ fn stiff_models_by_default() {
         }
     };
     // a ten-thousandth of b's size: the absolute tolerance a model of small numbers sets
-    let robertson = format!("{ROBERTSON}[simulation]\natol = 1e-10\n");
+    let file = robertson("1e-10");
     let reference = [0.7158270687, 9.185534764e-6, 0.2841637457];
-    let by_default = run(&robertson, None, (1.0, 40.0));
+    let by_default = run(&file, None, (1.0, 40.0));
     close(&by_default.last_state(), &reference, 2e-5, "Robertson at 40 s, dopri5");
     let switched = by_default.stiff_from.expect("dopri5 finds Robertson stiff");
     assert!(switched < 1.0, "{switched}");
-    let implicit = run(&robertson, Some(Integrator::Rosenbrock), (1.0, 40.0));
+    let implicit = run(&file, Some(Integrator::Rosenbrock), (1.0, 40.0));
     close(&implicit.last_state(), &reference, 2e-5, "Robertson at 40 s, rosenbrock");
     assert_eq!(implicit.stiff_from, None, "asked for: nothing to say");
-    let long = format!("{ROBERTSON}[simulation]\natol = 1e-14\n");
+    let long = robertson("1e-14");
     let end = run(&long, None, (1e8, 1e11)).last_state();
     close(&end[..2], &[2.0833401e-8, 8.3333608e-14], 1e-3, "Robertson at 1e11 s");
     // van der Pol through the command line: its period from the zero crossings, and the note
@@ -840,17 +824,8 @@ fn stiff_models_by_default() {
 #[test]
 fn a_stiff_model_is_estimated_by_output_error() {
     let dir = crate::common::Scratch::new("stiff-estimate");
-    let text = |k1: &str| {
-        format!(
-            "[model]\nname = \"Robertson\"\nintercept = false\n[simulation]\natol = 1e-10\n\
-             [parameters.k1]\nvalue = {k1}\nfree = true\n[parameters.k2]\nvalue = 1e4\n\
-             [parameters.k3]\nvalue = 3e7\n\
-             [[states]]\nname = \"a\"\ninitial = 1.0\n[[states]]\nname = \"b\"\n[[states]]\nname = \"c\"\n\
-             [equations.a_dot]\nstate = \"a\"\ncoefficients = {{ \"k1*a\" = -1.0, \"k2*b*c\" = 1.0 }}\n\
-             [equations.b_dot]\nstate = \"b\"\ncoefficients = {{ \"k1*a\" = 1.0, \"k2*b*c\" = -1.0, \"k3*b^2\" = -1.0 }}\n\
-             [equations.c_dot]\nstate = \"c\"\ncoefficients = {{ \"k3*b^2\" = 1.0 }}\n"
-        )
-    };
+    // k1 free, from the file's value or 0.06
+    let text = |k1: &str| robertson("1e-10").replace("value = 0.04", &format!("value = {k1}\nfree = true"));
     let (truth, start) = (dir.join("truth.toml"), dir.join("start.toml"));
     std::fs::write(&truth, text("0.04")).unwrap();
     std::fs::write(&start, text("0.06")).unwrap();
