@@ -450,7 +450,7 @@ class Fit:
         >>> termid.fit(df, "y", ["x", "w"]).rivals.round(2).to_dict("index")
         {'w': {'instead': 'x', 'rise': 1.11}}
         """
-        rows = [{"term": w["chosen"], "instead": w["instead"], "rise": w["rise"]} for w in self.report.get("swaps", [])]
+        rows = [{"term": w["chosen"], "instead": w["instead"], "rise": w["rise"]} for w in self.report.get("rivals", [])]
         return pd.DataFrame(rows, columns=["term", "instead", "rise"]).set_index("term")
 
     @property

@@ -154,7 +154,7 @@ pub struct Fit {
     /// Each chosen term's closest rival among the candidates left out (how firmly the rows
     /// chose it); [`Fit::notes`] names those within the noise.
     #[serde(default)]
-    pub swaps: Vec<crate::select::Swap>,
+    pub rivals: Vec<crate::select::Rival>,
 }
 
 /// An equation's candidate terms compiled for evaluation, with their names: all of a fit that
@@ -418,7 +418,8 @@ const INVARIANT: f64 = 1e-9;
 
 /// A note where a linear combination of the candidates that are a variable alone is the same
 /// in every row (a null vector of their covariance): a conservation law (a + b + c of a
-/// closed reaction, S + I + R of an epidemic) or a variable recorded twice. Any candidate in
+/// closed reaction, S + I + R of an epidemic), indicator columns of categories that add up to
+/// one, or a variable recorded twice. Any candidate in
 /// one of them is then one in the others, a back-end keeps one way of writing the equation and
 /// leaves the rest out as collinear, and the system's own terms may be among those left out.
 fn invariant_note(moments: &Moments, names: &[String]) -> Option<String> {
@@ -467,7 +468,8 @@ fn invariant_note(moments: &Moments, names: &[String]) -> Option<String> {
         .collect();
     (!laws.is_empty()).then(|| {
         format!(
-            "{} the same in every row (a conservation law, or a variable recorded twice): a \
+            "{} the same in every row (a conservation law, categories that add up to one, or a \
+             variable recorded twice): a \
              candidate in one of these variables is one in the others, so the equation is \
              written in fewer of them and a term left out as collinear may be the system's, \
              written in the others",
@@ -809,7 +811,7 @@ pub(crate) fn fit_folds(
         selection.notes.push(note);
     }
     selection.notes.extend(invariant_note(&moments, names));
-    let swaps = crate::select::swaps(&problem, &selection);
+    let rivals = crate::select::rivals(&problem, &selection);
     // the residual pass for τ is left to the caller (`correlation_time`): selection itself
     // needs only the sufficient statistics, and is timed against the peers without it
     Ok(Fit {
@@ -818,7 +820,7 @@ pub(crate) fn fit_folds(
         selection,
         covariance,
         correlation_time: None,
-        swaps,
+        rivals,
     })
 }
 

@@ -93,7 +93,7 @@ pub struct FitReport {
     pub correlation_time: Option<f64>,
     /// Each chosen term's closest rival and the rise of the residual sum of squares in its
     /// place, in residual variances.
-    pub swaps: Vec<crate::select::Swap>,
+    pub rivals: Vec<crate::select::Rival>,
     /// The chosen coefficients' covariance.
     pub covariance: Option<Vec<Vec<f64>>>,
 }
@@ -136,7 +136,7 @@ impl Fit {
             stop: s.stop.clone(),
             notes: self.notes(),
             correlation_time: self.correlation_time,
-            swaps: self.swaps.clone(),
+            rivals: self.rivals.clone(),
             covariance: self.covariance.clone(),
         }
     }
@@ -233,8 +233,8 @@ impl Fit {
         let tau = self.correlation_time.unwrap_or(1.0).max(1.0);
         let within = RIVAL_RISE * tau;
         let pair =
-            |w: &crate::select::Swap| format!("`{}` from `{}` ({:+.2} s²)", w.chosen, w.instead, w.rise);
-        let close: Vec<String> = self.swaps.iter().filter(|w| w.rise.abs() < within).map(pair).collect();
+            |w: &crate::select::Rival| format!("`{}` from `{}` ({:+.2} s²)", w.chosen, w.instead, w.rise);
+        let close: Vec<String> = self.rivals.iter().filter(|w| w.rise.abs() < within).map(pair).collect();
         if !close.is_empty() {
             let noise = if tau > 1.5 {
                 format!("{}·τ with τ = {tau:.1}, about two standard errors of the noise", sig(RIVAL_RISE, 2))
@@ -250,7 +250,7 @@ impl Fit {
             ));
         }
         let better: Vec<String> = self
-            .swaps
+            .rivals
             .iter()
             .filter(|w| w.rise <= -within)
             .map(|w| format!("`{}` in place of `{}` ({:+.2} s²)", w.instead, w.chosen, w.rise))

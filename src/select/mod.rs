@@ -10,22 +10,22 @@ mod efroymson;
 #[doc(hidden)]
 pub mod gram;
 mod moments;
+mod rivals;
 mod sparse;
 pub(crate) mod stepwise;
 mod stlsq;
 mod subset;
-mod swaps;
 
 use serde::{Deserialize, Serialize};
 
 pub use best_subset::{BestSubset, Criterion, Sizes};
 pub use efroymson::Efroymson;
 pub use moments::{gather, in_parallel, Accumulator, Moments};
+pub use rivals::{rivals, Rival};
 pub use sparse::{Candidate, Equality, LambdaChoice, SparseFit};
 pub use stepwise::{StepRule, Stepwise};
 pub use stlsq::Stlsq;
 pub(crate) use subset::{chi_square_pvalue, sweep};
-pub use swaps::{swaps, Swap};
 
 /// What a back-end is asked to do.
 #[derive(Clone, Copy, Debug)]

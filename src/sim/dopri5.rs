@@ -335,7 +335,7 @@ impl Dopri5 {
             }
             self.h = self.control.reject(h, err);
             tries += 1;
-            if self.h < smallest_step(self.t) || tries > 100_000 {
+            if self.h < smallest_step(self.t, self.dt) || tries > 100_000 {
                 self.fresh = false;
                 (self.held, self.slope) = (held, slope);
                 return Err(self.stuck(system, self.t));
@@ -405,7 +405,7 @@ impl Dopri5 {
             }
             self.h = h * rosenbrock::factor(err).min(0.9);
             tries += 1;
-            if self.h < smallest_step(self.t) || tries > 100_000 {
+            if self.h < smallest_step(self.t, self.dt) || tries > 100_000 {
                 self.fresh = false;
                 self.stiff = Some(stiff);
                 return Err(self.stuck(system, t));
@@ -467,12 +467,13 @@ impl Dopri5 {
     }
 }
 
-/// Below this step at time `t` the error control is stuck (a singularity, a state that is
-/// not finite): a step that no longer moves t past its last ten digits. Not tied to the
-/// control step: a stiff model's first steps are many decades shorter than the interval its
-/// run is sampled at (Robertson's kinetics to 10¹¹ s, sampled every 10⁸ s, starts with 10⁻⁶ s).
-fn smallest_step(t: f64) -> f64 {
-    (1e-10 * t.abs()).max(1e-150)
+/// Below this step at time `t` (control step `dt`) the error control is stuck (a
+/// singularity, a state that is not finite): ten decades below both the control step and the
+/// time run so far. Not below the control step alone: a stiff model's first steps are many
+/// decades shorter than the interval its run is sampled at (Robertson's kinetics to 10¹¹ s,
+/// sampled every 10⁸ s, starts with 10⁻⁶ s).
+fn smallest_step(t: f64, dt: f64) -> f64 {
+    (1e-10 * t.abs().min(dt)).max(1e-150)
 }
 
 /// Step-size control (Hairer, Nørsett & Wanner II.4): the next step by the error's fifth root

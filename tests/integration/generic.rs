@@ -1241,8 +1241,8 @@ fn a_choice_the_noise_made_is_said() {
     ]);
     assert!(ok, "{err}");
     let json: serde_json::Value = serde_json::from_str(&out).unwrap();
-    let swaps = json["swaps"].as_array().or_else(|| json[0]["swaps"].as_array()).expect("swaps");
-    let x1 = swaps.iter().find(|w| w["chosen"] == "x1").unwrap();
+    let rivals = json["rivals"].as_array().or_else(|| json[0]["rivals"].as_array()).expect("rivals");
+    let x1 = rivals.iter().find(|w| w["chosen"] == "x1").unwrap();
     // x3 in x1's place: {x4, x3} leaves 175.74
     assert_eq!(x1["instead"], "x3");
     assert!((x1["rise"].as_f64().unwrap() - (175.74 - 74.76) / 7.476).abs() < 0.01, "{x1}");

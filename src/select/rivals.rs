@@ -10,7 +10,7 @@ use super::{Problem, Selection};
 
 /// A chosen term's closest rival among the candidates left out.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Swap {
+pub struct Rival {
     /// The chosen term.
     pub chosen: String,
     /// The candidate left out that fits best in its place.
@@ -28,7 +28,7 @@ const PIVOT: f64 = 1e-10;
 /// Each chosen term that was not forced, with its best rival (none where no candidate can
 /// take its place). Least squares throughout: a back-end's shrunk or constrained
 /// coefficients are compared by the sets they chose.
-pub fn swaps(problem: &Problem<'_>, selection: &Selection) -> Vec<Swap> {
+pub fn rivals(problem: &Problem<'_>, selection: &Selection) -> Vec<Rival> {
     let Ok(scaled) = Scaled::new(problem) else { return Vec::new() };
     let set: Vec<usize> = selection.terms.iter().map(|t| t.index).collect();
     let Ok(full) = scaled.swept(&set, PIVOT) else { return Vec::new() };
@@ -59,7 +59,7 @@ pub fn swaps(problem: &Problem<'_>, selection: &Selection) -> Vec<Swap> {
             .map(|&c| (c, base - a[c * m + p].powi(2) / a[c * m + c]))
             .min_by(|x, y| x.1.total_cmp(&y.1));
         if let Some((c, share)) = best {
-            out.push(Swap {
+            out.push(Rival {
                 chosen: term.term.clone(),
                 instead: problem.names[c].clone(),
                 rise: (share - chosen_share) / variance,
@@ -85,8 +85,8 @@ mod tests {
         (Moments::of_columns(&x, &y, None), ["x1", "x2", "x3", "x4"].map(String::from).to_vec())
     }
 
-    fn rival<'a>(swaps: &'a [Swap], chosen: &str) -> &'a Swap {
-        swaps.iter().find(|s| s.chosen == chosen).unwrap()
+    fn rival<'a>(rivals: &'a [Rival], chosen: &str) -> &'a Rival {
+        rivals.iter().find(|s| s.chosen == chosen).unwrap()
     }
 
     /// Hald's cement, against the residual sums of squares of its pairs in Draper & Smith
@@ -101,7 +101,7 @@ mod tests {
         let mut selection = stepwise.select(&problem).unwrap();
         // forward stepping's second step is {x4, x1}: x2 in x4's place fits better
         selection.terms = selection.terms_at(2);
-        let s = swaps(&problem, &selection);
+        let s = rivals(&problem, &selection);
         let x4 = rival(&s, "x4");
         assert_eq!(x4.instead, "x2");
         assert!((x4.rise - (57.90 - 74.76) / (74.76 / 10.0)).abs() < 2e-3, "{x4:?}");
@@ -117,7 +117,7 @@ mod tests {
             t: 0.0,
         };
         selection.terms = vec![term(0), term(1)];
-        let s = swaps(&problem, &selection);
+        let s = rivals(&problem, &selection);
         let x2 = rival(&s, "x2");
         assert_eq!(x2.instead, "x4");
         assert!((x2.rise - (74.76 - 57.90) / 5.790).abs() < 2e-3, "{x2:?}");
@@ -126,7 +126,7 @@ mod tests {
         assert!((x1.rise - (415.44 - 57.90) / 5.790).abs() < 2e-2, "{x1:?}");
         // a forced term has no rival, and a forced or excluded candidate is none
         let forced = Problem { forced: &[1], excluded: &[3], ..problem };
-        let s = swaps(&forced, &selection);
+        let s = rivals(&forced, &selection);
         assert_eq!(s.len(), 1);
         assert_eq!(rival(&s, "x1").instead, "x3");
     }
