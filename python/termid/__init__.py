@@ -311,6 +311,12 @@ def _t_quantile(p_two_sided: float, df: float) -> float:
     return 0.5 * (lo + hi)
 
 
+def _rivals_frame(report: Mapping[str, Any]) -> pd.DataFrame:
+    """A fit report's rivals as a DataFrame indexed by the chosen term (instead, rise)."""
+    rows = [{"term": w["chosen"], "instead": w["instead"], "rise": w["rise"]} for w in report.get("rivals", [])]
+    return pd.DataFrame(rows, columns=["term", "instead", "rise"]).set_index("term")
+
+
 class Summary:
     """A fit as statsmodels' ``summary()`` shows one: ``stats`` (rows, terms, R², adjusted R²,
     F, AIC, BIC, the residuals' correlation time τ), ``terms``, a DataFrame of each
@@ -450,8 +456,7 @@ class Fit:
         >>> termid.fit(df, "y", ["x", "w"]).rivals.round(2).to_dict("index")
         {'w': {'instead': 'x', 'rise': 1.11}}
         """
-        rows = [{"term": w["chosen"], "instead": w["instead"], "rise": w["rise"]} for w in self.report.get("rivals", [])]
-        return pd.DataFrame(rows, columns=["term", "instead", "rise"]).set_index("term")
+        return _rivals_frame(self.report)
 
     @property
     def chosen_step(self) -> Optional[int]:
@@ -754,6 +759,26 @@ class Identified:
         ['x*y', 'z']
         """
         return pd.DataFrame(self.reports[equation].get("terms", []))
+
+    def notes(self, equation: str) -> List[str]:
+        """What ``equation``'s numbers do not show (as :attr:`Fit.notes`): terms the rows
+        cannot tell from a candidate left out, collinear or conserved variables, coarse samples.
+
+        >>> lorenz = termid.Model.builtin("lorenz")
+        >>> lorenz.identify(lorenz.simulate(duration=5.0)).notes("z_dot")
+        []
+        """
+        return list(self.reports[equation].get("notes", []))
+
+    def rivals(self, equation: str) -> pd.DataFrame:
+        """Each term chosen for ``equation`` with its closest rival among the candidates left
+        out and the rise of the residual sum of squares in its place (as :attr:`Fit.rivals`).
+
+        >>> lorenz = termid.Model.builtin("lorenz")
+        >>> sorted(lorenz.identify(lorenz.simulate(duration=5.0)).rivals("z_dot").index)
+        ['x*y', 'z']
+        """
+        return _rivals_frame(self.reports[equation])
 
     def chosen_step(self, equation: str) -> Optional[int]:
         """The step the back-end chose for ``equation`` (None for back-ends without steps).
