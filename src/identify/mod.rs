@@ -419,9 +419,9 @@ const INVARIANT: f64 = 1e-9;
 /// A note where a linear combination of the candidates that are a variable alone is the same
 /// in every row (a null vector of their covariance): a conservation law (a + b + c of a
 /// closed reaction, S + I + R of an epidemic), indicator columns of categories that add up to
-/// one, or a variable recorded twice. Any candidate in
-/// one of them is then one in the others, a back-end keeps one way of writing the equation and
-/// leaves the rest out as collinear, and the system's own terms may be among those left out.
+/// one, or a variable recorded twice. Any candidate in one of them is then one in the others,
+/// a back-end keeps one way of writing the equation and leaves the rest out as collinear, and
+/// the system's own terms may be among those left out.
 fn invariant_note(moments: &Moments, names: &[String]) -> Option<String> {
     let vars: Vec<usize> = (0..names.len()).filter(|&i| crate::term::is_identifier(&names[i])).collect();
     if vars.len() < 2 || vars.len() > 32 {

@@ -7,7 +7,9 @@
 //! control time and the next; where it broke at the control time before as well (a replayed
 //! record), the steps end on the next control time. Where the controller promised its inputs
 //! ahead (`Controller::ahead`), the simulation loop passes the control times unasked, reading
-//! the watched state alone off the dense output (`first_outside`).
+//! the watched state alone off the dense output (`first_outside`). Where the steps are held by
+//! stability rather than accuracy (Hairer's stiffness test), the same loop goes on with
+//! linearly implicit Rosenbrock steps (`rosenbrock.rs`) along the same input lines.
 
 use super::rosenbrock::{self, Rosenbrock};
 use super::system::{System, Workspace};

@@ -1,7 +1,9 @@
 //! Integration of any right-hand side. `Dopri5` is the default: Dormand & Prince's embedded
 //! Runge-Kutta 5(4) pair (Dormand & Prince 1980; Hairer, Nørsett & Wanner, *Solving ODEs I*,
 //! II.5) with error control, steps across control intervals while the inputs go on along a
-//! line (`dopri5.rs`) and output at the requested sample times. `ModifiedEuler` is Oltmann's
+//! line (`dopri5.rs`) and output at the requested sample times; where its steps are held by
+//! stability rather than accuracy (a stiff model) it goes on with `Rosenbrock`'s linearly
+//! implicit steps (`rosenbrock.rs`), which that method takes from the start. `ModifiedEuler` is Oltmann's
 //! eq. (B8): explicit Euler with the inputs taken at the *end* of the step, δ(t+Δt), so that v and r respond in the first step;
 //! the paper's model file asks for it. `Rk4` is the classical fourth-order method. Inputs are
 //! asked of the controller at the grid t = k·Δt alone, whatever the method, and interpolated

@@ -31,8 +31,6 @@ pub(super) struct Rosenbrock {
     u: Vec<f64>,
 }
 
-/// An accepted or rejected attempt: the error in units of the tolerances; on acceptance the
-/// new state is in `trial` and the dense output's coefficients may be read.
 impl Rosenbrock {
     pub(super) fn new(system: &System) -> Result<Rosenbrock, SimError> {
         let n = system.dim();
