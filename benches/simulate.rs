@@ -1,9 +1,11 @@
 //! A 100 s zigzag at Δt = 0.04 s (2 500 steps, 76 candidate terms' worth of equations per
-//! step) with the default model, as `termid simulate` runs it; and one right-hand side.
+//! step) with the default model, as `termid simulate` runs it; one right-hand side; and
+//! Robertson's stiff kinetics to 4·10⁵ s with the default method (which turns linearly
+//! implicit there).
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use termid::ship::{Manoeuvre, Ship};
-use termid::sim::{simulate, Integrator, Settings};
+use termid::sim::{simulate, Constant, Integrator, Settings, System};
 
 fn bench(c: &mut Criterion) {
     let ship = Ship::new(&termid::ship::default_model(), false).unwrap();
@@ -34,6 +36,13 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             ship.system.derivatives(black_box(&start.x), black_box(&input), &mut ws, black_box(&mut dx))
         })
+    });
+    let robertson = termid::model::Model::load(std::path::Path::new("models/robertson.toml")).unwrap();
+    let system = System::new(&robertson, &Default::default(), false).unwrap();
+    let x0: Vec<f64> = robertson.spec().states.iter().map(|s| s.initial).collect();
+    let s = Settings { integrator: Integrator::Dopri5, dt: 1000.0, duration: 4e5, sample: 1000.0 };
+    g.bench_function("robertson_4e5s_default", |b| {
+        b.iter(|| black_box(simulate(&system, &x0, &mut Constant(vec![]), &s).unwrap()))
     });
     g.finish();
 }
