@@ -546,12 +546,8 @@ impl PyModel {
         let run = py
             .detach(|| termid::sim::simulate(&system, &x0, &mut termid::sim::Constant(u), &settings))
             .map_err(fail)?;
-        if let Some(t) = run.stiff_from {
-            let message = std::ffi::CString::new(format!(
-                "the model is stiff from t = {} s on: continued with linearly implicit Rosenbrock steps (integrator=\"rosenbrock\" takes them from the start)",
-                termid::identify::sig(t, 4)
-            ))
-            .unwrap_or_default();
+        if let Some(note) = run.stiff_note() {
+            let message = std::ffi::CString::new(note).unwrap_or_default();
             PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &message, 2)?;
         }
         Ok(arrays(py, trajectory_columns(&self.time(), run)))

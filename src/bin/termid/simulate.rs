@@ -330,13 +330,8 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
             for (s, v) in system.states.iter().zip(&last) {
                 println!("  {s} = {}", termid::identify::sig(*v, 6));
             }
-            if let Some(t) = traj.stiff_from {
-                println!(
-                    "note: the model is stiff from t = {} s on (the explicit steps were held by \
-                     stability, not accuracy): continued with linearly implicit Rosenbrock steps \
-                     (`--integrator rosenbrock` takes them from the start)",
-                    termid::identify::sig(t, 4)
-                );
+            if let Some(note) = traj.stiff_note() {
+                println!("note: {note}");
             }
             if let Some((mc, spread)) = mc.as_ref().zip(spread.as_ref()) {
                 print!("{}", mc.text(spread, &nominal));
