@@ -9,6 +9,23 @@ fn identify_hald(args: &[&str]) -> (bool, String, String) {
     termid(&all)
 }
 
+/// Hald's cement against Draper & Smith's sums of squares of its pairs: forward stepping's
+/// {x4, x1} leaves 74.76, {x2, x1} 57.90, so x2 in x4's place is 2.25 residual variances
+/// better (within the noise: said), and x3 is x1's closest rival ({x4, x3}: 175.74).
+#[test]
+fn hald_x4_could_as_well_be_x2() {
+    let (ok, out, err) = identify_hald(&["--target", "y", "--terms", "x1", "x2", "x3", "x4"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("the rows hardly tell `x4` from `x2` (-2.25 s²)"), "{out}");
+    let (ok, out, err) =
+        identify_hald(&["--target", "y", "--terms", "x1", "x2", "x3", "x4", "--format", "json"]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let x1 = v["rivals"].as_array().and_then(|r| r.iter().find(|w| w["chosen"] == "x1")).expect("x1's rival");
+    assert_eq!(x1["instead"], "x3");
+    assert!((x1["rise"].as_f64().unwrap() - (175.74 - 74.76) / 7.476).abs() < 0.01, "{x1}");
+}
+
 #[test]
 fn identify_hald_json() {
     let (ok, out, err) = identify_hald(&[

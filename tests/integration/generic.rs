@@ -1172,9 +1172,8 @@ fn coarse_samples_are_said() {
 /// Right or it says so, where the rows cannot choose: with 5 % noise on Lorenz's states
 /// (deterministic), `y` and `y*z` explain dy/dt within the noise of each other (z's mean is
 /// 2.8 times its spread), and which one a back-end keeps is the noise's; the fit names the
-/// pair. On the clean rows every chosen term is far ahead of its rival and nothing is said.
-/// Hald's cement against Draper & Smith's sums of squares: forward stepping's {x4, x1} leaves
-/// 74.76, {x2, x1} 57.90, so x2 in x4's place is 2.25 residual variances better.
+/// pair. On the clean rows every chosen term is far ahead of its rival and nothing is said
+/// (Hald's cement through the command line: `cli::hald_x4_could_as_well_be_x2`).
 #[test]
 fn a_choice_the_noise_made_is_said() {
     let dir = crate::common::Scratch::new("lorenz-rivals");
@@ -1209,43 +1208,6 @@ fn a_choice_the_noise_made_is_said() {
             }
         }
     }
-    let (ok, out, err) = termid(&[
-        "identify",
-        "--data",
-        "tests/data/hald.csv",
-        "--no-time",
-        "--target",
-        "y",
-        "--terms",
-        "x1",
-        "x2",
-        "x3",
-        "x4",
-    ]);
-    assert!(ok, "{err}");
-    assert!(out.contains("the rows hardly tell `x4` from `x2` (-2.25 s²)"), "{out}");
-    let (ok, out, err) = termid(&[
-        "identify",
-        "--data",
-        "tests/data/hald.csv",
-        "--no-time",
-        "--target",
-        "y",
-        "--terms",
-        "x1",
-        "x2",
-        "x3",
-        "x4",
-        "--format",
-        "json",
-    ]);
-    assert!(ok, "{err}");
-    let json: serde_json::Value = serde_json::from_str(&out).unwrap();
-    let rivals = json["rivals"].as_array().or_else(|| json[0]["rivals"].as_array()).expect("rivals");
-    let x1 = rivals.iter().find(|w| w["chosen"] == "x1").unwrap();
-    // x3 in x1's place: {x4, x3} leaves 175.74
-    assert_eq!(x1["instead"], "x3");
-    assert!((x1["rise"].as_f64().unwrap() - (175.74 - 74.76) / 7.476).abs() < 0.01, "{x1}");
 }
 
 /// Honest uncertainty (issue 25 §4): when most Monte-Carlo draws fail, no mean, sd or band is
