@@ -27,7 +27,8 @@ use crate::data::Frame;
 #[serde(rename_all = "kebab-case")]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Integrator {
-    /// Dormand-Prince 5(4), adaptive with error control (the default).
+    /// Dormand-Prince 5(4), adaptive with error control (the default; linearly implicit steps
+    /// from where it finds the model stiff).
     #[default]
     #[cfg_attr(feature = "cli", value(name = "dopri5", alias = "adaptive", alias = "rk45"))]
     #[serde(alias = "adaptive", alias = "rk45")]
