@@ -60,11 +60,16 @@ impl PyModel {
         // what the command line says on standard error, a notebook shows as warnings
         let py = first.py();
         for note in notes {
-            let message = std::ffi::CString::new(note).unwrap_or_default();
-            PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &message, 2)?;
+            warn(py, note)?;
         }
         Ok(frames)
     }
+}
+
+/// What the command line says on standard error, as a `UserWarning` a notebook shows.
+fn warn(py: Python<'_>, note: String) -> PyResult<()> {
+    let message = std::ffi::CString::new(note).unwrap_or_default();
+    PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &message, 2)
 }
 
 impl PyModel {
@@ -547,8 +552,7 @@ impl PyModel {
             .detach(|| termid::sim::simulate(&system, &x0, &mut termid::sim::Constant(u), &settings))
             .map_err(fail)?;
         if let Some(note) = run.stiff_note() {
-            let message = std::ffi::CString::new(note).unwrap_or_default();
-            PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &message, 2)?;
+            warn(py, note)?;
         }
         Ok(arrays(py, trajectory_columns(&self.time(), run)))
     }
@@ -924,9 +928,6 @@ impl PyModel {
             Some(count) => termid::diagnose::in_segments(&frames, &sources, count),
             None => (frames, sources),
         };
-        // one RK4 step per sample by default: the recorded inputs are known at the samples
-        let given = dt.is_some();
-        let dt = dt.unwrap_or_else(|| termid::data::sample_step(&frames));
         let settings = termid::diagnose::EstimateSettings {
             coefficients,
             iterations,
@@ -939,13 +940,8 @@ impl PyModel {
         };
         let (fit, metrics, stiff) = py
             .detach(|| -> Result<_, termid::diagnose::DiagnoseError> {
-                let mut runs =
-                    termid::diagnose::Runs::new(&model, &frames, dt, termid::sim::Integrator::Rk4)?;
-                // a stiff model at the step its fastest mode allows, as the command line does
-                let mut stiff = None;
-                if !given {
-                    (runs, stiff) = runs.stable(&model);
-                }
+                // one RK4 step per sample by default, a whole fraction of it where the model is stiff
+                let (mut runs, stiff) = termid::diagnose::Runs::for_output_error(&model, &frames, dt)?;
                 if let Some(names) = &states {
                     runs = runs.comparing(&model, names)?;
                 }
@@ -959,8 +955,7 @@ impl PyModel {
             })
             .map_err(fail)?;
         if let Some(note) = stiff {
-            let message = std::ffi::CString::new(note).unwrap_or_default();
-            PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &message, 2)?;
+            warn(py, note)?;
         }
         let serialise = |e: serde_json::Error| refuse(format!("could not serialise: {e}"));
         let mut report = serde_json::to_value(&fit).map_err(serialise)?;

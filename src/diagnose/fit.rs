@@ -7,7 +7,7 @@ use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
 use super::hypotheses::{Effect, Hypothesis};
-use super::{DiagnoseError, Gap, Location};
+use super::{DiagnoseError, Gap, Location, RunGap};
 use std::collections::BTreeMap;
 
 use crate::data::Frame;
@@ -188,6 +188,25 @@ pub const PARTED: f64 = 0.1;
 
 /// One compared quantity's errors in one run, model − measured: (name, unit, errors).
 type Compared = (String, String, Vec<f64>);
+
+/// Each run's RMS and max |·| per compared quantity, from its errors.
+fn run_gaps(errors: Vec<(String, Vec<Compared>)>) -> Vec<RunGap> {
+    errors
+        .into_iter()
+        .map(|(run, per)| {
+            // a quantity the run does not record has no gap there
+            let per = per
+                .into_iter()
+                .filter(|(_, _, d)| !d.is_empty())
+                .map(|(name, _, d)| {
+                    let rms = (d.iter().map(|v| v * v).sum::<f64>() / d.len().max(1) as f64).sqrt();
+                    (name, rms, d.iter().fold(0.0f64, |a, b| a.max(b.abs())))
+                })
+                .collect();
+            (run, per)
+        })
+        .collect()
+}
 
 /// The spread of a column over every run (1 where it does not vary): what scales its residuals.
 fn spread(frames: &[Frame], name: &str) -> f64 {
@@ -898,6 +917,20 @@ impl Runs {
         ))
     }
 
+    /// Runs for an output-error fit of `model` by RK4: at `dt` where given, else one step per
+    /// sample (the recorded inputs are known only at the samples) cut to a whole fraction of
+    /// it where the model is stiff there ([`Runs::stable`]), with what was cut. A step given
+    /// is kept: where it is unstable, the re-simulation's failure says so.
+    pub fn for_output_error(
+        model: &Model,
+        frames: &[Frame],
+        dt: Option<f64>,
+    ) -> Result<(Runs, Option<String>), DiagnoseError> {
+        let step = dt.unwrap_or_else(|| crate::data::sample_step(frames));
+        let runs = Runs::new(model, frames, step, Integrator::Rk4)?;
+        Ok(if dt.is_some() { (runs, None) } else { runs.stable(model) })
+    }
+
     /// These runs with each run's fixed step cut to a whole fraction at which `model`'s
     /// re-simulation is stable (h·|λ| at most 80 % of the method's limit, RK4's 2.78, for the
     /// fastest decaying mode over the run's samples), and what was done, if anything was: a
@@ -1011,14 +1044,14 @@ impl Runs {
             .collect()
     }
 
-    /// RMS and max per compared state and derived variable, in its unit.
-    pub fn gap(&self, sims: &[Trajectory]) -> Gap {
-        // each run's errors (model − measured) of each compared quantity
-        let errors: Vec<(String, Vec<Compared>)> = self
-            .frames
+    /// Each run's errors (model − measured) of each compared quantity, over its first
+    /// `rows[r]` samples (every sample where `None`).
+    fn errors(&self, sims: &[Trajectory], rows: &[Option<usize>]) -> Vec<(String, Vec<Compared>)> {
+        self.frames
             .iter()
             .zip(sims)
-            .map(|(f, sim)| {
+            .zip(rows)
+            .map(|((f, sim), rows)| {
                 let per = self
                     .compared_in(sim)
                     .into_iter()
@@ -1026,6 +1059,7 @@ impl Runs {
                         let meas = f.column(name).unwrap_or(&[]);
                         let d: Vec<f64> = meas
                             .iter()
+                            .take(rows.unwrap_or(usize::MAX))
                             .enumerate()
                             .map(|(k, m)| simulated.get(k).copied().unwrap_or(f64::NAN) - m)
                             .collect();
@@ -1034,7 +1068,18 @@ impl Runs {
                     .collect();
                 (f.origin().to_string(), per)
             })
-            .collect();
+            .collect()
+    }
+
+    /// Each run's RMS and max per compared quantity over its first `rows[r]` samples (a run
+    /// before its motion parts from itself, [`Runs::horizon`]); every sample where `None`.
+    pub fn run_gaps(&self, sims: &[Trajectory], rows: &[Option<usize>]) -> Vec<RunGap> {
+        run_gaps(self.errors(sims, rows))
+    }
+
+    /// RMS and max per compared state and derived variable, in its unit.
+    pub fn gap(&self, sims: &[Trajectory]) -> Gap {
+        let errors = self.errors(sims, &vec![None; self.frames.len()]);
         // over all runs, sample after sample
         let quantities = errors.first().map_or(0, |(_, per)| per.len());
         let states = (0..quantities)
@@ -1052,22 +1097,7 @@ impl Runs {
             })
             .collect();
         let cost = self.residuals(sims).iter().map(|r| r * r).sum();
-        let runs = errors
-            .into_iter()
-            .map(|(run, per)| {
-                // a quantity the run does not record has no gap there
-                let per = per
-                    .into_iter()
-                    .filter(|(_, _, d)| !d.is_empty())
-                    .map(|(name, _, d)| {
-                        let rms = (d.iter().map(|v| v * v).sum::<f64>() / d.len().max(1) as f64).sqrt();
-                        (name, rms, d.iter().fold(0.0f64, |a, b| a.max(b.abs())))
-                    })
-                    .collect();
-                (run, per)
-            })
-            .collect();
-        Gap { states, runs, cost }
+        Gap { states, runs: run_gaps(errors), cost }
     }
 
     /// Where the gap is: leading state, onset, growth, and what it goes with.

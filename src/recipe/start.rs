@@ -279,9 +279,8 @@ pub(super) fn output_error_runs(
     states: Option<&[String]>,
     intercept: bool,
 ) -> Result<Runs, crate::diagnose::DiagnoseError> {
-    let sample = crate::data::sample_step(frames);
-    let runs = Runs::new(model, frames, sample, crate::sim::Integrator::Rk4)?.with_intercepts(intercept);
-    let (runs, _) = runs.stable(model);
+    let (runs, _) = Runs::for_output_error(model, frames, None)?;
+    let runs = runs.with_intercepts(intercept);
     match states {
         Some(names) => runs.comparing(model, names),
         None => Ok(runs),

@@ -3,7 +3,6 @@
 
 use anyhow::{Context, Result};
 use termid::diagnose::{estimate, EstimateSettings, Runs};
-use termid::sim::Integrator;
 
 use crate::args::{EstimateCommand, Format};
 
@@ -52,18 +51,11 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
         Some(count) => termid::diagnose::in_segments(&frames, &sources, count as usize),
         None => (frames, sources),
     };
-    // one RK4 step per sample by default: the recorded input is known only at the samples
-    let dt = cmd.dt.unwrap_or_else(|| termid::data::sample_step(&frames));
-    let mut runs = Runs::new(&model, &frames, dt, Integrator::Rk4)?;
-    // a stiff model is re-simulated at the step its fastest mode allows (a step the user gave
-    // is kept: where it is unstable, the failure says so)
-    if cmd.dt.is_none() {
-        let (stable, note) = runs.stable(&model);
-        if let Some(note) = note {
-            // beside the report, not in it: JSON on standard output stays one document
-            eprintln!("note: {note}");
-        }
-        runs = stable;
+    // one RK4 step per sample by default, a whole fraction of it where the model is stiff
+    let (mut runs, stiff) = Runs::for_output_error(&model, &frames, cmd.dt)?;
+    if let Some(note) = stiff {
+        // beside the report, not in it: JSON on standard output stays one document
+        eprintln!("note: {note}");
     }
     if let Some(states) = &cmd.states {
         runs = runs.comparing(&model, states)?;

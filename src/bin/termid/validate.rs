@@ -122,17 +122,14 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
                     per.iter().map(|(s, r, m)| error_cell(s, *r, *m, model.unit(s))).collect();
                 println!("  {run}: {}", cells.join(", "));
             }
-            for ((f, sim), k) in runs.iter().zip(&sims).zip(&horizon) {
+            // each run's errors before it parts from itself (a sample at least)
+            let first: Vec<Option<usize>> = horizon.iter().map(|k| k.map(|k| k.max(1))).collect();
+            let early = data.run_gaps(&sims, &first);
+            for ((f, k), (_, per)) in runs.iter().zip(&horizon).zip(&early) {
                 let Some(k) = *k else { continue };
                 let (t, end) = (f.time()[k] - f.time()[0], f.time()[f.len() - 1] - f.time()[0]);
-                let cells: Vec<String> = gap
-                    .runs
-                    .iter()
-                    .find(|(run, _)| run == f.origin())
-                    .map(|(_, per)| {
-                        per.iter().filter_map(|(s, _, _)| early_error(f, sim, s, k, model.unit(s))).collect()
-                    })
-                    .unwrap_or_default();
+                let cells: Vec<String> =
+                    per.iter().map(|(s, r, m)| error_cell(s, *r, *m, model.unit(s))).collect();
                 println!(
                     "  note: {} is predictable for {} s of its {} s: a start {} of each state's spread \
                      off parts from the model's own run by {} of a spread there (a chaotic or \
@@ -190,22 +187,6 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// `state`'s error cell over a run's first `rows` samples (before its motion parts from
-/// itself), where the run records it.
-fn early_error(
-    f: &termid::data::Frame,
-    sim: &Trajectory,
-    state: &str,
-    rows: usize,
-    unit: &str,
-) -> Option<String> {
-    let (meas, model) = (f.column(state)?, sim.column(state)?);
-    let d: Vec<f64> = meas.iter().zip(model).take(rows.max(1)).map(|(m, s)| s - m).collect();
-    let rms = (d.iter().map(|v| v * v).sum::<f64>() / d.len() as f64).sqrt();
-    let max = d.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    Some(error_cell(state, rms, max, unit))
 }
 
 /// One state's error, RMS / max, in its unit with angles in degrees: `ψ 1.55 / 2.74 °`.
