@@ -1,6 +1,7 @@
 //! Ingest speed (issue 16): a run of 20 numeric columns × 200 000 rows read from CSV and from
 //! Parquet into a frame, throughput counted in the numeric data's bytes (8 per value), and for
-//! CSV also in the bytes of its text (`csv-text`).
+//! CSV also in the bytes of its text (`csv-text`); and the search of every column for spikes
+//! that reading a rate's runs adds (`spikes`).
 //! `cargo bench --bench ingest`.
 
 use std::sync::Arc;
@@ -58,6 +59,9 @@ fn ingest(c: &mut Criterion) {
     g.throughput(Throughput::Bytes((ROWS * COLUMNS * 8) as u64));
     g.bench_function("csv", |b| b.iter(|| Frame::read(&csv, "t").unwrap()));
     g.bench_function("parquet", |b| b.iter(|| Frame::read(&pq, "t").unwrap()));
+    let frame = Frame::read(&pq, "t").unwrap();
+    let columns: Vec<&str> = frame.names()[1..].iter().map(String::as_str).collect();
+    g.bench_function("spikes", |b| b.iter(|| termid::data::despiked(&frame, &columns, 0).unwrap()));
     g.finish();
     std::fs::remove_dir_all(csv.parent().unwrap()).ok();
 }

@@ -2,7 +2,7 @@
 //! beside its target and is renamed over it only when all of a command's outputs are written
 //! ([`Outputs`]); a whole folder is built beside its target and swapped in under a lock
 //! ([`replace_folder`]). A full disk, a bad path or an error half-way leaves the old files as
-//! they were and no new ones.
+//! they were and no new ones. Numbers in what is written: [`sig`].
 
 use std::fs::File;
 use std::io::Write;
@@ -407,6 +407,21 @@ pub fn replace_folder<E: From<OutputError>>(
     std::mem::forget(fresh_guard);
     let _ = std::fs::remove_dir_all(&old);
     Ok(())
+}
+
+/// A measured quantity at `n` significant figures (an error, a spread: what its data
+/// support), fixed-point between 0.001 and 100 000 (`0.0206`, `1.55`, `2990`), else in
+/// scientific notation (`9.52e-5`).
+pub fn sig(x: f64, n: usize) -> String {
+    let n = n.max(1);
+    if x == 0.0 {
+        return "0".into();
+    }
+    if !x.is_finite() || !(1e-3..1e5).contains(&x.abs()) {
+        return format!("{x:.prec$e}", prec = n - 1);
+    }
+    let digits = (n as i32 - 1 - x.abs().log10().floor() as i32).max(0) as usize;
+    format!("{x:.digits$}")
 }
 
 #[cfg(test)]

@@ -30,6 +30,12 @@ pub(crate) fn refuse(text: impl Into<String>) -> PyErr {
     TermidError::new_err(text.into())
 }
 
+/// What the command line says on standard error, as a `UserWarning` a notebook shows.
+pub(crate) fn warn(py: Python<'_>, note: String) -> PyResult<()> {
+    let message = std::ffi::CString::new(note).unwrap_or_default();
+    PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &message, 2)
+}
+
 /// A run handed over from Python: its name, and its columns as float64 arrays.
 pub(crate) type Run<'py> = (String, Bound<'py, PyDict>);
 

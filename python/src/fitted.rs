@@ -9,7 +9,7 @@ use pyo3::types::PyDict;
 use termid::identify::{Fit, Identification};
 use termid::term::{parse_terms, Library, Source, Term, Vocabulary};
 
-use crate::convert::{backend_of, column, fail, in_place, refuse, to_json};
+use crate::convert::{backend_of, column, fail, in_place, refuse, to_json, warn};
 
 /// One equation fitted to columns: the back-end's steps and chosen terms (JSON) and the
 /// compiled chosen terms for `predict`.
@@ -182,7 +182,7 @@ impl Compiled {
 /// (`dx/dt`) is an equation of motion of the rows as a time series over the column `time`,
 /// by the `derivative` method (`integral` where none is named, as the command line does).
 #[pyfunction]
-#[pyo3(signature = (target, columns, terms, backend = "{\"method\": \"stepwise\"}", intercept = true, forced = vec![], excluded = vec![], parameters = BTreeMap::new(), weights = None, time = None, derivative = None))]
+#[pyo3(signature = (target, columns, terms, backend = "{\"method\": \"stepwise\"}", intercept = true, forced = vec![], excluded = vec![], parameters = BTreeMap::new(), weights = None, time = None, derivative = None, keep_spikes = false))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn fit(
     py: Python<'_>,
@@ -197,6 +197,7 @@ pub(crate) fn fit(
     weights: Option<String>,
     time: Option<String>,
     derivative: Option<String>,
+    keep_spikes: bool,
 ) -> PyResult<PyFit> {
     let backend = backend_of(backend)?;
     let names: Vec<String> = columns.keys().iter().map(|k| k.extract()).collect::<PyResult<_>>()?;
@@ -262,6 +263,17 @@ pub(crate) fn fit(
             let mut frame = termid::data::Frame::new("data", time, t.to_vec()).map_err(fail)?;
             for (name, values) in slices.iter().filter(|(n, _)| *n != time) {
                 frame.push(name, values.to_vec()).map_err(fail)?;
+            }
+            if !keep_spikes {
+                // a time series whose rate is taken: a glitch would be one (the command line's
+                // default too)
+                let columns: Vec<&str> = slices.iter().map(|(n, _)| *n).filter(|n| *n != time).collect();
+                if let Some((mended, notes)) = termid::data::despiked(&frame, &columns, 0).map_err(fail)? {
+                    frame = mended;
+                    for note in notes {
+                        warn(py, note)?;
+                    }
+                }
             }
             let frames = [frame];
             py.detach(|| -> Result<Fit, termid::identify::IdentifyError> {

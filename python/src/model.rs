@@ -15,7 +15,8 @@ use termid::sim::{Settings, System, Trajectory};
 use termid::term::parse_terms;
 
 use crate::convert::{
-    arrays, backend_of, fail, frame_columns, frame_of, method_of, refuse, to_json, trajectory_columns, Run,
+    arrays, backend_of, fail, frame_columns, frame_of, method_of, refuse, to_json, trajectory_columns, warn,
+    Run,
 };
 use crate::moments::PyMoments;
 
@@ -42,16 +43,24 @@ impl PyModel {
     /// units, kinematics); the notes say what was renamed.
     fn frames(&self, runs: Vec<Run<'_>>) -> PyResult<Vec<Frame>> {
         let time = &self.inner.spec().model.time;
-        let mut notes = Vec::new();
-        let mut frames = Vec::with_capacity(runs.len());
-        for (origin, columns) in &runs {
-            let mut frame = frame_of(origin, time, columns)?;
-            notes.extend(self.inner.admit(&mut frame).map_err(fail)?);
-            frames.push(frame);
-        }
+        let mut frames = runs
+            .iter()
+            .map(|(origin, columns)| frame_of(origin, time, columns))
+            .collect::<PyResult<Vec<_>>>()?;
         let Some((_, first)) = runs.first() else {
             return Err(refuse("no runs: give at least one"));
         };
+        // the runs are Rust's from here: admitted (a search of every column) with the GIL free
+        let mut notes = first
+            .py()
+            .detach(|| -> Result<Vec<String>, termid::data::DataError> {
+                let mut notes = Vec::new();
+                for frame in &mut frames {
+                    notes.extend(self.inner.admit(frame)?);
+                }
+                Ok(notes)
+            })
+            .map_err(fail)?;
         for (name, rule) in self.inner.parameter_rules() {
             if let Some(first) = frames.iter().find_map(|f| rule.noisy_first_sample(&name, f)) {
                 notes.push(first);
@@ -64,12 +73,6 @@ impl PyModel {
         }
         Ok(frames)
     }
-}
-
-/// What the command line says on standard error, as a `UserWarning` a notebook shows.
-fn warn(py: Python<'_>, note: String) -> PyResult<()> {
-    let message = std::ffi::CString::new(note).unwrap_or_default();
-    PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &message, 2)
 }
 
 impl PyModel {

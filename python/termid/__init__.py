@@ -606,6 +606,7 @@ def fit(
     weights: Optional[str] = None,
     time: Optional[str] = None,
     derivative: Optional[str] = None,
+    keep_spikes: bool = False,
     **settings: Any,
 ) -> Fit:
     """Fits ``target`` (a column of ``data``) by the candidate ``terms`` (text over the other
@@ -626,7 +627,10 @@ def fit(
     significance; ``excluded`` candidates left out; ``parameters`` values of names the terms
     use that are not columns; ``weights`` a column of row weights; ``time`` the column of the
     rows' time for a rate (default: ``t``, else a DataFrame's index of times); ``derivative``
-    how a rate is estimated (default: none, the integral form).
+    how a rate is estimated (default: none, the integral form); ``keep_spikes`` keeps a rate's
+    rows as recorded, where by default a sample or three of a column that leap away from their
+    neighbours and straight back (a glitch, not a motion) are replaced by the line through the
+    neighbours, with a warning.
 
     >>> import pandas as pd
     >>> df = pd.DataFrame({"x1": [1.0, 2, 3, 4, 5], "x2": [2.0, 1, 4, 3, 6]}).eval("y = x1 + 2*x2")
@@ -682,6 +686,7 @@ def fit(
             weights,
             time_name,
             derivative,
+            keep_spikes,
         )
     except TermidError as e:
         raise _explained(e, columns.left_out) from None

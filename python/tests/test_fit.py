@@ -1,5 +1,6 @@
 """One equation from columns: termid.fit against published numbers and closed forms."""
 import os
+import warnings
 
 import numpy as np
 import pandas as pd
@@ -230,6 +231,21 @@ def test_a_rate_is_an_equation_of_motion_with_the_command_lines_defaults():
         termid.fit(df, "dw/dt", library)
     with pytest.raises(termid.TermidError, match="are for a rate"):
         termid.fit(df, "x", ["y"], derivative="central")
+
+
+def test_a_glitch_is_mended_with_a_warning():
+    # one sample of x 30 off: as recorded it buys terms; mended (the default) Lorenz's own
+    t, s = _lorenz()
+    library = ["x", "y", "z", "x*x", "x*y", "x*z", "y*y", "y*z", "z*z"]
+    df = pd.DataFrame({"t": t, "x": s[:, 0], "y": s[:, 1], "z": s[:, 2]})
+    df.loc[len(df) // 2, "x"] += 30.0
+    with pytest.warns(UserWarning, match=f"`x` leaps away and straight back by .* at row {len(df) // 2 + 1} "):
+        fitted = termid.fit(df, "dx/dt", library)
+    assert fitted.coefficients.sort_index().round(3).to_dict() == {"x": -10.0, "y": 10.0}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        kept = termid.fit(df, "dx/dt", library, keep_spikes=True)
+    assert len(kept.coefficients) > 2
 
 
 def test_the_rows_that_cannot_choose_are_said():

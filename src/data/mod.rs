@@ -18,6 +18,7 @@ mod resample;
 mod savitzky_golay;
 mod search;
 mod smoothing_spline;
+mod spike;
 mod stream;
 
 pub use angle::{unwrap_turns, unwrapped, wrapped};
@@ -32,6 +33,7 @@ pub use prepare::{prepare, Preparation};
 pub use resample::{check_gaps, evened, interpolate_at, median_step, resample, sample_step, uneven};
 pub use savitzky_golay::SavitzkyGolay;
 pub use smoothing_spline::SmoothingSpline;
+pub use spike::{despiked, spikes, Spike};
 pub use stream::{Chunk, Chunks, RowSource};
 
 #[cfg(test)]
@@ -390,6 +392,42 @@ impl Frame {
             self.columns.remove(i);
         }
         self.push(name, values)
+    }
+
+    /// Replaces the values of column `name` where it stands (not the time column), checked as
+    /// [`Frame::push`] checks them.
+    pub fn overwrite(&mut self, name: &str, values: Vec<f64>) -> Result<(), DataError> {
+        let i = match self.names.iter().position(|n| n == name) {
+            Some(0) => {
+                return Err(DataError::DuplicateColumn { file: self.origin.clone(), column: name.into() })
+            }
+            Some(i) => i,
+            None => {
+                return Err(DataError::MissingColumn {
+                    file: self.origin.clone(),
+                    column: name.into(),
+                    available: self.names.join(", "),
+                })
+            }
+        };
+        if values.len() != self.len() {
+            return Err(DataError::Length {
+                file: self.origin.clone(),
+                column: name.into(),
+                expected: self.len(),
+                found: values.len(),
+            });
+        }
+        if let Some((row, &value)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(DataError::NonFinite {
+                file: self.origin.clone(),
+                row: row + 1,
+                column: name.into(),
+                value,
+            });
+        }
+        self.columns[i] = values;
+        Ok(())
     }
 
     /// Gives column `from` the name `to` (the time column too); refused where `to` is taken.

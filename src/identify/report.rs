@@ -17,20 +17,7 @@ pub fn num(x: f64) -> String {
     }
 }
 
-/// A measured quantity at `n` significant figures (an error, a spread: what its data
-/// support), fixed-point between 0.001 and 100 000 (`0.0206`, `1.55`, `2990`), else in
-/// scientific notation (`9.52e-5`).
-pub fn sig(x: f64, n: usize) -> String {
-    let n = n.max(1);
-    if x == 0.0 {
-        return "0".into();
-    }
-    if !x.is_finite() || !(1e-3..1e5).contains(&x.abs()) {
-        return format!("{x:.prec$e}", prec = n - 1);
-    }
-    let digits = (n as i32 - 1 - x.abs().log10().floor() as i32).max(0) as usize;
-    format!("{x:.digits$}")
-}
+pub use crate::output::sig;
 
 /// One step of the table, as reported.
 #[derive(Clone, Debug, Serialize)]

@@ -82,7 +82,7 @@ impl EquationMoments {
     /// the chunk size whatever the files' size. The same as [`EquationMoments::of_runs`] on
     /// the whole runs to round-off, for a derivative method with a fixed reach (central
     /// differences, five points, Savitzky-Golay; the chunks must carry at least that many
-    /// rows of context). Each chunk is admitted by the model ([`Model::admit`]) and checked
+    /// rows of context). Each chunk is admitted by the model ([`Model::admit_at`]) and checked
     /// for gaps in time; per-run parameters (`first:u`, `mean:u:4`) are read off each run's
     /// first chunk. Returns the notes of the runs' admission too.
     pub fn of_chunks(
@@ -126,10 +126,13 @@ impl EquationMoments {
             for chunk in chunks {
                 let mut chunk = chunk?;
                 let shift = |e: IdentifyError| e.shifted(chunk.first_row);
-                let admitted = model.admit(&mut chunk.frame).map_err(|e| shift(e.into()))?;
+                let admitted =
+                    model.admit_at(&mut chunk.frame, chunk.first_row).map_err(|e| shift(e.into()))?;
                 crate::data::check_gaps(&chunk.frame, 3.0).map_err(|e| shift(e.into()))?;
+                // a chunk's spikes are its own; what else admission says, every chunk repeats
+                notes.extend(admitted.spikes);
                 if run.is_none() {
-                    notes.extend(admitted);
+                    notes.extend(admitted.notes);
                     // a run's own parameters come from its start, which only its first chunk holds
                     let fixed = rules
                         .iter()

@@ -81,6 +81,11 @@ pub struct Meta {
     /// it helps.
     #[serde(default = "yes", skip_serializing_if = "is_true")]
     pub intercept: bool,
+    /// Whether the runs' spikes (a sample or three that leap away from their neighbours and
+    /// straight back) are kept as recorded; by default each is replaced by the line through
+    /// its neighbours, and said.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub keep_spikes: bool,
 }
 
 fn is_true(b: &bool) -> bool {

@@ -117,6 +117,15 @@ impl Equation {
     }
 }
 
+/// What [`Model::admit_at`] did to a run, for the caller to say.
+#[derive(Clone, Debug, Default)]
+pub struct Admitted {
+    /// Columns renamed, a run resampled, angles unwrapped.
+    pub notes: Vec<String>,
+    /// Spikes mended, one line per column.
+    pub spikes: Vec<String>,
+}
+
 /// A loaded, checked model.
 #[derive(Clone, Debug)]
 ///
@@ -799,6 +808,13 @@ impl Model {
         }
     }
 
+    /// The model with its runs' spikes kept as recorded where `keep` (a command line's
+    /// `--keep-spikes`), else as its file says.
+    pub fn keeping_spikes(mut self, keep: bool) -> Model {
+        self.spec.model.keep_spikes |= keep;
+        self
+    }
+
     /// Makes a measured run fit for this model, the checks every caller of a model needs (the
     /// CLI, the Python package): a plain file's ASCII column names that are the model's aliases
     /// (`delta`, `psi`) are read as the names they stand for, an input declared in rad that
@@ -807,9 +823,22 @@ impl Model {
     /// evenly spaced (a dropped sample) is resampled onto its median step, as a re-simulation
     /// compares it sample by sample ([`crate::data::evened`]), and a state in rad that wraps at
     /// a full turn (a compass's 359° → 0°) is made one continuous angle
-    /// ([`crate::data::unwrapped`]). Returns what was renamed, resampled or unwrapped, for the
-    /// caller to say.
+    /// ([`crate::data::unwrapped`]); a spike in a variable's record (a sample or three that leap
+    /// away and straight back) is replaced by the line through its neighbours
+    /// ([`crate::data::despiked`]) unless the file says `keep_spikes`. Returns what was renamed,
+    /// resampled, unwrapped or mended, for the caller to say.
     pub fn admit(&self, frame: &mut crate::data::Frame) -> Result<Vec<String>, crate::data::DataError> {
+        let admitted = self.admit_at(frame, 0)?;
+        Ok(admitted.notes.into_iter().chain(admitted.spikes).collect())
+    }
+
+    /// [`Model::admit`] for a piece of a run that starts at row `first_row` of its file (a
+    /// streamed chunk): the spikes mended are said apart, with their rows in the file.
+    pub fn admit_at(
+        &self,
+        frame: &mut crate::data::Frame,
+        first_row: usize,
+    ) -> Result<Admitted, crate::data::DataError> {
         let mut notes = Vec::new();
         if let Some((even, note)) = crate::data::evened(frame)? {
             *frame = even;
@@ -832,6 +861,16 @@ impl Model {
             *frame = whole;
             notes.extend(said);
         }
+        let mut spikes = Vec::new();
+        if !self.spec.model.keep_spikes {
+            let rates: Vec<String> = self.spec.states.iter().map(|s| format!("{}_dot", s.name)).collect();
+            let columns: Vec<&str> =
+                self.vocabulary.variables().iter().chain(&rates).map(String::as_str).collect();
+            if let Some((mended, said)) = crate::data::despiked(frame, &columns, first_row)? {
+                *frame = mended;
+                spikes = said;
+            }
+        }
         for input in self.spec.inputs.iter().filter(|i| i.unit == "rad") {
             let beyond = frame
                 .column(&input.name)
@@ -849,7 +888,7 @@ impl Model {
             }
         }
         self.check_kinematics(frame)?;
-        Ok(notes)
+        Ok(Admitted { notes, spikes })
     }
 
     /// Checks measured runs against the model's known kinematics: where an equation that is

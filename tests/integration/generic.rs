@@ -1429,3 +1429,82 @@ fn any_output_interval_for_the_adaptive_method() {
         &["not a whole multiple", "--dt 0.025"],
     );
 }
+
+/// A glitch is not a motion: Lorenz sampled every 10 ms with one sample of x 30 off and two
+/// of z 15 off (a corrupted telegram). Read as recorded, dx/dt takes spurious terms for the
+/// glitch; by default each spike is replaced by the line through its neighbours and said
+/// with its rows, and every equation has its true terms and coefficients again, from the
+/// plain runs and through the model file alike.
+#[test]
+fn a_glitch_in_a_record_is_mended_and_said() {
+    let dir = crate::common::Scratch::new("lorenz-spike");
+    let terms = dir.join("terms.txt");
+    std::fs::write(&terms, LORENZ_QUADRATIC).unwrap();
+    let mut rows = lorenz_rows(&dir, "0.01");
+    rows[700][1] += 30.0;
+    rows[1200][3] -= 15.0;
+    rows[1201][3] -= 15.0;
+    let body: Vec<String> =
+        rows.iter().map(|r| r.iter().map(|v| format!("{v:?}")).collect::<Vec<_>>().join(",")).collect();
+    let csv = dir.join("spiked.csv");
+    std::fs::write(&csv, format!("t,x,y,z\n{}\n", body.join("\n"))).unwrap();
+    let truth: [(&str, &[(&str, f64)]); 3] = [
+        ("dx/dt", &[("x", -10.0), ("y", 10.0)]),
+        ("dy/dt", &[("x", 28.0), ("y", -1.0), ("x*z", -1.0)]),
+        ("dz/dt", &[("x*y", 1.0), ("z", -8.0 / 3.0)]),
+    ];
+    let said = |err: &str| {
+        // the heights are from the line through the neighbours, which Lorenz's curvature bends
+        err.contains("`x` leaps away and straight back by 29.99 at row 701 (t = 7.000)")
+            && err.contains("`z` leaps away and straight back by 14.90 at rows 1201-1202 (t = 12.00)")
+    };
+    for (target, expected) in truth {
+        let args = ["identify", "--data", csv.to_str().unwrap(), "--target", target, "--terms-file"];
+        let (ok, out, err) = termid(&[&args[..], &[terms.to_str().unwrap(), "--format", "json"]].concat());
+        assert!(ok && said(&err), "{err}");
+        let v = crate::common::json(&out);
+        let found: BTreeMap<&str, f64> = v["terms"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|t| (t["term"].as_str().unwrap(), t["coefficient"].as_f64().unwrap()))
+            .collect();
+        assert_eq!(found.len(), expected.len(), "{target}: {found:?}");
+        for (term, c) in expected {
+            assert!((found[term] - c).abs() < 1e-3 * c.abs(), "{target} {term}: {found:?}");
+        }
+        if target == "dx/dt" {
+            let (ok, out, err) = termid(
+                &[&args[..], &[terms.to_str().unwrap(), "--format", "json", "--keep-spikes"]].concat(),
+            );
+            assert!(ok && !err.contains("leaps"), "{err}");
+            let kept = crate::common::json(&out)["terms"].as_array().unwrap().len();
+            assert!(kept > 2, "as recorded, the glitch buys terms: {out}");
+        }
+    }
+    // a model reads its runs the same way
+    let out = dir.join("lorenz_id.toml");
+    let (ok, _, err) = termid(&[
+        "identify",
+        "--model",
+        "models/lorenz.toml",
+        "--data",
+        csv.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok && said(&err), "{err}");
+    let m = Model::load(&out).unwrap();
+    for (target, expected) in truth {
+        let eq = m.equation(&format!("{}_dot", &target[1..2])).unwrap();
+        assert_eq!(eq.coefficients.len(), expected.len(), "{target}: {:?}", eq.coefficients);
+        for (term, c) in expected {
+            let got = eq.coefficients.iter().find(|(t, _, _)| t.to_string() == *term).map(|(_, v, _)| *v);
+            assert!(
+                got.is_some_and(|g| (g - c).abs() < 1e-3 * c.abs()),
+                "{target} {term}: {:?}",
+                eq.coefficients
+            );
+        }
+    }
+}

@@ -305,6 +305,12 @@ pub struct IdentifyCommand {
     /// (spline, kalman), so the regressors are smoothed as well as the targets.
     #[arg(long)]
     pub smooth: bool,
+    /// Keep the runs' spikes as recorded. By default a sample or three that leap away from
+    /// their neighbours and straight back, far beyond the record's own steps and noise (a
+    /// glitch, not a motion), are replaced by the line through their neighbours, and said.
+    /// With --model as the file's `keep_spikes = true`.
+    #[arg(long)]
+    pub keep_spikes: bool,
     /// Write a figure of the raw and prepared signals of every run into this folder.
     #[arg(long)]
     pub prepared_svg: Option<PathBuf>,

@@ -105,6 +105,10 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
         crate::runs::load(&cmd.data, &cmd.dataset, &cmd.time)?
     };
     let target = Target::parse(cmd.target.as_deref().unwrap_or_default());
+    if !cmd.keep_spikes && is_rate(&target, &frames, cmd.no_time) {
+        // the rows are a time series whose rates are taken: a glitch would be one
+        crate::runs::mend_spikes(&mut frames)?;
+    }
     match &target {
         Target::Derivative(s) if *s == cmd.time => {
             bail!("--target d{s}/dt: `{s}` is the time column, whose rate is 1; name a measured quantity")
