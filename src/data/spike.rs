@@ -221,4 +221,39 @@ mod tests {
         noisy[700] += 5.0;
         assert_eq!(spikes(&noisy).iter().map(|s| s.start).collect::<Vec<_>>(), vec![700]);
     }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig { cases: 256, failure_persistence: None, ..Default::default() })]
+        /// A smooth record (three sines of 20 samples a period or more) with or without white
+        /// noise has no spike; one sample lifted well beyond its steps, noise and span is
+        /// found, exactly there, with its height off the line through its neighbours.
+        #[test]
+        fn a_lifted_sample_is_found_where_it_is_and_nowhere_else(
+            waves in proptest::collection::vec((0.1f64..10.0, 0.001f64..0.05, 0.0f64..6.3), 3),
+            noisy in proptest::bool::ANY,
+            seed in 0u64..1000,
+            at in 5usize..495,
+            up in proptest::bool::ANY,
+        ) {
+            let clean: Vec<f64> = (0..500)
+                .map(|k| waves.iter().map(|(a, f, p)| a * (std::f64::consts::TAU * f * k as f64 + p).sin()).sum())
+                .collect();
+            let span = clean.iter().cloned().fold(f64::MIN, f64::max) - clean.iter().cloned().fold(f64::MAX, f64::min);
+            let sigma = if noisy { 0.002 * span } else { 0.0 };
+            let mut seed = seed;
+            // the sum of twelve uniforms: a normal deviate to 1e-3 in its middle
+            let mut x: Vec<f64> = clean
+                .iter()
+                .map(|c| c + sigma * (0..12).map(|_| crate::data::test_noise(&mut seed)).sum::<f64>())
+                .collect();
+            proptest::prop_assert!(spikes(&x).is_empty(), "{:?}", spikes(&x));
+            let steepest = clean.windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0, f64::max);
+            let height = 10.0 * steepest + 20.0 * sigma + 0.03 * span;
+            x[at] += if up { height } else { -height };
+            let found = spikes(&x);
+            proptest::prop_assert_eq!(found.iter().map(|s| (s.start, s.width)).collect::<Vec<_>>(), vec![(at, 1)]);
+            let line = (x[at - 1] + x[at + 1]) / 2.0;
+            proptest::prop_assert!((found[0].height - (x[at] - line).abs()).abs() < 1e-9);
+        }
+    }
 }
