@@ -279,7 +279,7 @@ pub(crate) fn fit(
             py.detach(|| -> Result<Fit, termid::identify::IdentifyError> {
                 let mut fit = how.fit_design(&rate, design, forced, excluded, &frames, selector.as_ref())?;
                 // rows of a time series are not independent: the honest standard errors' factor
-                fit.correlation_time = how.correlation_time(&rate, candidates, &frames, &fit.selection)?;
+                how.describe_residuals(&rate, candidates, &frames, &mut fit)?;
                 Ok(fit)
             })
             .map_err(fail)?

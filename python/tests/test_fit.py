@@ -248,6 +248,20 @@ def test_a_glitch_is_mended_with_a_warning():
     assert len(kept.coefficients) > 2
 
 
+def test_residuals_that_grow_with_the_rate_are_said_and_weights_mend_them():
+    # a 1 % error on x = exp(t/2) over 30 s: the largest rows decide the plain fit; weighted by
+    # 1/x² the integral form gives the rate 0.5
+    rng = np.random.default_rng(3)
+    t = np.arange(0.0, 30.0, 0.1)
+    x = np.exp(0.5 * t) * (1.0 + 0.01 * rng.standard_normal(t.size))
+    df = pd.DataFrame({"t": t, "x": x, "w": 1.0 / x**2})
+    plain = termid.fit(df, "dx/dt", ["x", "x^2"])
+    assert any("grow with the size of `dx/dt`" in n for n in plain.notes)
+    weighted = termid.fit(df, "dx/dt", ["x", "x^2"], weights="w")
+    assert list(weighted.coefficients.index) == ["x"]
+    assert abs(weighted.coefficients["x"] - 0.5) < 0.005
+
+
 def test_the_rows_that_cannot_choose_are_said():
     """Hald's cement against Draper & Smith's sums of squares of its pairs: forward stepping's
     {x4, x1} leaves 74.76, {x2, x1} 57.90, so x2 in x4's place is 2.25 residual variances

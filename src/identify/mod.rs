@@ -48,8 +48,8 @@ mod statistics;
 
 pub(crate) use model::RunStatistics;
 pub use model::{
-    coefficients_of, correlation_time_of, equation_design, fit_equation, fit_equation_design, identify_model,
-    IdentifiedModel, ModelIdentification,
+    coefficients_of, describe_residuals_of, equation_design, fit_equation, fit_equation_design,
+    identify_model, IdentifiedModel, ModelIdentification,
 };
 pub use report::{num, sig, FitReport, StepReport, TermReport};
 pub use statistics::{identify_from_moments, EquationMoments, RunMoments};
@@ -151,6 +151,11 @@ pub struct Fit {
     /// errors are √τ times the reported ones.
     #[serde(default)]
     pub correlation_time: Option<f64>,
+    /// How the residuals grow with the fit's size: their root mean square where |fitted| is
+    /// largest (a quarter of the rows) over that where it is smallest; [`Fit::notes`] says
+    /// where the largest rows decide the fit.
+    #[serde(default)]
+    pub residual_growth: Option<f64>,
     /// Each chosen term's closest rival among the candidates left out (how firmly the rows
     /// chose it); [`Fit::notes`] names those within the noise.
     #[serde(default)]
@@ -546,10 +551,9 @@ impl Identification<'_> {
         gather(library.len(), &rows, |k, part, acc| runs[k].push(library, terms, part, acc))
     }
 
-    /// One run's statistics in the integral form: the candidates evaluated on every row, then
-    /// integrated over windows of `w` intervals against the target's change over each; the
-    /// windows that start on `own` rows (all of a whole run; a piece's own, its context
-    /// after it holding their ends).
+    /// One run's statistics in the integral form ([`Identification::windows`]): the windows
+    /// that start on `own` rows (all of a whole run; a piece's own, its context after it
+    /// holding their ends).
     fn integral_moments(
         &self,
         library: &Library,
@@ -558,30 +562,12 @@ impl Identification<'_> {
         w: usize,
         own: std::ops::Range<usize>,
     ) -> Result<Moments, IdentifyError> {
-        if self.weights.is_some() {
-            return Err(IdentifyError::Setup(
-                "row weights do not apply to the integral form's windows".into(),
-            ));
-        }
-        let run = self.bind(library, target, frame)?;
-        let n = frame.len();
-        if n <= w + 1 {
-            return Err(IdentifyError::Setup(format!(
-                "{}: {n} rows are too few for the integral form's windows of {w} intervals",
-                frame.origin()
-            )));
-        }
-        let mut columns = vec![Vec::with_capacity(n); library.len()];
-        library.for_each_block(&run.sources, 0..n, |_, block| {
-            for (c, b) in columns.iter_mut().zip(block) {
-                c.extend_from_slice(b);
-            }
-        });
-        let (y, integrals) = crate::data::integral_rows(frame.time(), &run.y, &columns, w);
+        let Rows { y, columns: integrals, weights } = self.windows(library, target, frame, w)?;
         let starts = own.start.min(y.len())..own.end.min(y.len());
         let refs: Vec<&[f64]> = integrals.iter().map(|c| &c[starts.clone()]).collect();
+        let weights = weights.map(|w| w[starts.clone()].to_vec());
         let mut acc = Accumulator::new(library.len());
-        acc.push_columns(&refs, &y[starts], None);
+        acc.push_columns(&refs, &y[starts], weights.as_deref());
         if let Some(j) = acc.not_finite() {
             return Err(IdentifyError::Setup(format!(
                 "{}: the integral of candidate {} over some window is not finite",
@@ -590,6 +576,44 @@ impl Identification<'_> {
             )));
         }
         Ok(acc.finish())
+    }
+
+    /// The rows of the integral form of one run: the candidates evaluated on every sample,
+    /// integrated over each window of `w` intervals, against the target's change over it; with
+    /// each window's weight, the mean of its rows' (where the rows are weighted).
+    fn windows(
+        &self,
+        library: &Library,
+        target: &Target,
+        frame: &Frame,
+        w: usize,
+    ) -> Result<Rows, IdentifyError> {
+        let n = frame.len();
+        if n <= w + 1 {
+            return Err(IdentifyError::Setup(format!(
+                "{}: {n} rows are too few for the integral form's windows of {w} intervals",
+                frame.origin()
+            )));
+        }
+        let samples = self.samples(library, target, frame)?;
+        let (y, columns) = crate::data::integral_rows(frame.time(), &samples.y, &samples.columns, w);
+        let weights = samples
+            .weights
+            .map(|r| (0..y.len()).map(|k| r[k..=k + w].iter().sum::<f64>() / (w + 1) as f64).collect());
+        Ok(Rows { y, columns, weights })
+    }
+
+    /// The rows of one run as sampled: the target, the candidates evaluated on every sample,
+    /// the rows' weights.
+    fn samples(&self, library: &Library, target: &Target, frame: &Frame) -> Result<Rows, IdentifyError> {
+        let run = self.bind(library, target, frame)?;
+        let mut columns = vec![Vec::with_capacity(frame.len()); library.len()];
+        library.for_each_block(&run.sources, 0..frame.len(), |_, block| {
+            for (c, b) in columns.iter_mut().zip(block) {
+                c.extend_from_slice(b);
+            }
+        });
+        Ok(Rows { y: run.y, columns, weights: run.weights.map(<[f64]>::to_vec) })
     }
 
     /// A run made ready for accumulation: its target, its inputs with its own parameters, and
@@ -755,38 +779,80 @@ impl Identification<'_> {
         Ok(fit)
     }
 
-    /// τ = 1 + 2 Σ ρₖ of the chosen equation's residuals, the autocorrelations ρₖ pooled over
-    /// the runs and summed up to the first lag where they fall below zero (Geyer's initial
-    /// positive sequence, simplified; at most 1000 lags); `None` with no terms, row weights or
-    /// a run too short. One more pass over the rows.
-    pub fn correlation_time(
+    /// What the chosen equation's residuals say of the fit, in one more pass over the rows
+    /// (the integral form's windows where it is one): their correlation time τ = 1 + 2 Σ ρₖ,
+    /// the autocorrelations ρₖ pooled over the runs and summed up to the first lag where they
+    /// fall below zero (Geyer's initial positive sequence, simplified; at most 1000 lags;
+    /// `None` with row weights or a run too short), and how they grow with the fit's size
+    /// ([`Fit::residual_growth`]), set in `fit`.
+    pub fn describe_residuals(
         &self,
         target: &Target,
         candidates: &[Term],
         frames: &[Frame],
-        selection: &Selection,
-    ) -> Result<Option<f64>, IdentifyError> {
-        if selection.terms.is_empty() || self.weights.is_some() {
-            return Ok(None);
+        fit: &mut Fit,
+    ) -> Result<(), IdentifyError> {
+        let selection = &fit.selection;
+        if selection.terms.is_empty() {
+            return Ok(());
         }
         let chosen: Vec<Term> = selection.terms.iter().map(|t| candidates[t.index].clone()).collect();
         let library = Library::compile(&chosen, self.vocabulary)?;
         let b0 = selection.intercept.as_ref().map_or(0.0, |b| b.value);
         let mut residuals: Vec<Vec<f64>> = Vec::new();
+        // (|fitted|, residual) of every row
+        let mut sized: Vec<(f64, f64)> = Vec::new();
+        let window = match target {
+            Target::Derivative(_) => self.differentiator.integral_window(),
+            Target::Column(_) => None,
+        };
         for frame in frames {
-            let run = self.bind(&library, target, frame)?;
-            let mut e = run.y.iter().map(|y| y - b0).collect::<Vec<f64>>();
-            library.for_each_block(&run.sources, 0..frame.len(), |start, columns| {
-                for (t, column) in selection.terms.iter().zip(columns) {
-                    for (e, x) in e[start..].iter_mut().zip(*column) {
-                        *e -= t.coefficient * x;
-                    }
+            // the regression's own rows: the integral form's windows, else the samples
+            let Rows { y, columns, weights } = match window {
+                Some(w) => self.windows(&library, target, frame, w)?,
+                None => self.samples(&library, target, frame)?,
+            };
+            let mut e: Vec<f64> = y.iter().map(|y| y - b0).collect();
+            for (t, column) in selection.terms.iter().zip(&columns) {
+                for (e, x) in e.iter_mut().zip(column) {
+                    *e -= t.coefficient * x;
                 }
-            });
+            }
+            // each row as the fit weighed it
+            let scale = |k: usize| weights.as_ref().map_or(1.0, |w| w[k].sqrt());
+            sized.extend(e.iter().enumerate().map(|(k, e)| ((y[k] - e).abs(), scale(k) * e)));
             residuals.push(e);
         }
-        Ok(crate::uncertainty::correlation_time(&residuals))
+        fit.correlation_time =
+            if self.weights.is_some() { None } else { crate::uncertainty::correlation_time(&residuals) };
+        fit.residual_growth = growth(&mut sized);
+        Ok(())
     }
+}
+
+/// A run's rows as the regression takes them: the target, each candidate's column, and the
+/// rows' weights where they are weighted.
+struct Rows {
+    y: Vec<f64>,
+    columns: Vec<Vec<f64>>,
+    weights: Option<Vec<f64>>,
+}
+
+/// How the residuals grow with the fit's size: the root mean square of the residuals in the
+/// quarter of rows where |fitted| is largest over that in the quarter where it is smallest,
+/// from (|fitted|, residual) pairs; `None` below 40 rows, where the small rows fit exactly, or
+/// where the residuals are round-off and quadrature (a millionth of the fitted values).
+fn growth(sized: &mut [(f64, f64)]) -> Option<f64> {
+    let n = sized.len();
+    if n < 40 {
+        return None;
+    }
+    sized.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let rms = |v: &mut dyn Iterator<Item = f64>, n: usize| (v.map(|x| x * x).sum::<f64>() / n as f64).sqrt();
+    let residuals = |rows: &[(f64, f64)]| rms(&mut rows.iter().map(|r| r.1), rows.len());
+    let fitted = rms(&mut sized.iter().map(|r| r.0), n);
+    let (small, large) = (residuals(&sized[..n / 4]), residuals(&sized[n - n / 4..]));
+    (small > 0.0 && residuals(sized) > 1e-6 * fitted).then(|| large / small)
 }
 
 /// One equation fitted from its runs' statistics: merged for the selection ("Komb. Daten"),
@@ -812,7 +878,7 @@ pub(crate) fn fit_folds(
     }
     selection.notes.extend(invariant_note(&moments, names));
     let rivals = crate::select::rivals(&problem, &selection);
-    // the residual pass for τ is left to the caller (`correlation_time`): selection itself
+    // the residual pass for τ is left to the caller (`describe_residuals`): selection itself
     // needs only the sufficient statistics, and is timed against the peers without it
     Ok(Fit {
         target: target.to_string(),
@@ -820,6 +886,7 @@ pub(crate) fn fit_folds(
         selection,
         covariance,
         correlation_time: None,
+        residual_growth: None,
         rivals,
     })
 }

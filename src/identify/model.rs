@@ -50,8 +50,7 @@ pub fn identify_model(
             fit_equation(model, name, frames, how.differentiator, how.intercept, how.target.clone())
                 .map_err(in_equation)?;
         let terms = store_fit(&mut identified, name, &fit).map_err(in_equation)?;
-        fit.correlation_time =
-            correlation_time_of(&identified, frames, how.differentiator, &fit).map_err(in_equation)?;
+        describe_residuals_of(&identified, frames, how.differentiator, &mut fit).map_err(in_equation)?;
         if let Some(matrix) = &fit.covariance {
             let covariance = Covariance {
                 terms,
@@ -249,14 +248,14 @@ pub(super) fn model_equation<'m>(model: &'m Model, equation: &str) -> Result<&'m
     Ok(eq)
 }
 
-/// [`Identification::correlation_time`] of an equation fitted by [`fit_equation`], with the
+/// [`Identification::describe_residuals`] of an equation fitted by [`fit_equation`], with the
 /// same runs and derivative method.
-pub fn correlation_time_of(
+pub fn describe_residuals_of(
     model: &Model,
     frames: &[Frame],
     differentiator: &dyn Differentiator,
-    fit: &Fit,
-) -> Result<Option<f64>, IdentifyError> {
+    fit: &mut Fit,
+) -> Result<(), IdentifyError> {
     let rules = model.parameter_rules();
     let identification = Identification {
         vocabulary: &model.vocabulary,
@@ -267,7 +266,7 @@ pub fn correlation_time_of(
     };
     let candidates: Vec<Term> =
         fit.candidates.iter().map(|c| model.vocabulary.parse(c)).collect::<Result<_, _>>()?;
-    identification.correlation_time(&Target::parse(&fit.target), &candidates, frames, &fit.selection)
+    identification.describe_residuals(&Target::parse(&fit.target), &candidates, frames, fit)
 }
 
 /// The identified coefficients of a fit, as a model stores them (term, value, std. error).

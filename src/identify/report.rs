@@ -78,6 +78,9 @@ pub struct FitReport {
     pub notes: Vec<String>,
     /// The residuals' correlation time, rows.
     pub correlation_time: Option<f64>,
+    /// How many times larger the residuals are where the fit is largest than where it is
+    /// smallest (a quarter of the rows each).
+    pub residual_growth: Option<f64>,
     /// Each chosen term's closest rival and the rise of the residual sum of squares in its
     /// place, in residual variances.
     pub rivals: Vec<crate::select::Rival>,
@@ -123,6 +126,7 @@ impl Fit {
             stop: s.stop.clone(),
             notes: self.notes(),
             correlation_time: self.correlation_time,
+            residual_growth: self.residual_growth,
             rivals: self.rivals.clone(),
             covariance: self.covariance.clone(),
         }
@@ -236,6 +240,18 @@ impl Fit {
                 sig(within, 2),
             ));
         }
+        if let Some(g) = self.residual_growth.filter(|g| *g > RESIDUAL_GROWTH) {
+            notes.push(format!(
+                "the residuals grow with the size of `{}`: {} times larger (root mean square) in the \
+                 quarter of rows where the fit is largest than in the quarter where it is smallest; \
+                 least squares weighs every row alike, so the largest rows decide the terms and \
+                 coefficients. Where the records' error grows with their size (a percentage error, \
+                 counts), weight the rows by 1/size² (a column of weights: `--weight`, Python \
+                 `weights=`)",
+                self.target,
+                sig(g, 2)
+            ));
+        }
         let better: Vec<String> = self
             .rivals
             .iter()
@@ -252,6 +268,11 @@ impl Fit {
         notes
     }
 }
+
+/// How many times larger the residuals may be where the fit is largest than where it is
+/// smallest before the fit says the largest rows decide it (noise of one size everywhere gives
+/// about 1; Lotka-Volterra with 5 % relative noise 2.3).
+const RESIDUAL_GROWTH: f64 = 10.0;
 
 /// A rival whose swap changes the residual sum of squares by less than this many residual
 /// variances (times τ) is within the noise: about two standard errors (χ²₁'s 95 % point 3.84).

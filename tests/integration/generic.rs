@@ -1508,3 +1508,68 @@ fn a_glitch_in_a_record_is_mended_and_said() {
         }
     }
 }
+
+/// What the residuals of the integral form say is said of its own rows (its windows), not of
+/// the samples: white noise on x = 3·e^(−t/2) differenced over windows leaves residuals
+/// correlated at no lag but the window's own (where ρ = −½), so τ ≈ 1 (it was taken of the
+/// state minus its rate, the state's own correlation: dozens of rows). And residuals that
+/// grow with the rate, as a 1 % error on x = e^(t/2) over 30 s makes them (a dynamic range
+/// of 3·10⁶), are said, with the remedy: rows weighted by 1/x², which the integral form now
+/// takes (a window weighing as its rows on average), give the growth rate 0.5 within 1 %.
+#[test]
+fn the_integral_forms_residuals_are_its_windows() {
+    let dir = crate::common::Scratch::new("integral-residuals");
+    let terms = dir.join("terms.txt");
+    std::fs::write(&terms, "1\nx\nx^2\n").unwrap();
+    let mut g = crate::common::Lcg(5);
+    let write = |name: &str, rows: &[(f64, f64, f64)]| {
+        let path = dir.join(name);
+        let body: Vec<String> = rows.iter().map(|(t, x, w)| format!("{t:?},{x:?},{w:?}")).collect();
+        std::fs::write(&path, format!("t,x,w\n{}\n", body.join("\n"))).unwrap();
+        path
+    };
+    let decay: Vec<(f64, f64, f64)> = (0..1000)
+        .map(|k| {
+            let t = 0.01 * k as f64;
+            (t, 3.0 * (-0.5 * t).exp() + 0.03 * g.normal(), 1.0)
+        })
+        .collect();
+    let fit = |path: &std::path::Path, extra: &[&str]| {
+        let args = ["identify", "--data", path.to_str().unwrap(), "--target", "dx/dt", "--terms-file"];
+        let (ok, out, err) =
+            termid(&[&args[..], &[terms.to_str().unwrap(), "--format", "json"], extra].concat());
+        assert!(ok, "{err}");
+        crate::common::json(&out)
+    };
+    let v = fit(&write("decay.csv", &decay), &[]);
+    let tau = v["correlation_time"].as_f64().unwrap();
+    assert!((1.0..1.5).contains(&tau), "τ = {tau}: {v}");
+    let growth: Vec<(f64, f64, f64)> = (0..300)
+        .map(|k| {
+            let t = 0.1 * k as f64;
+            let x = (0.5 * t).exp() * (1.0 + 0.01 * g.normal());
+            (t, x, 1.0 / (x * x))
+        })
+        .collect();
+    let path = write("growth.csv", &growth);
+    let said = |v: &serde_json::Value| {
+        v["notes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|n| n.as_str().unwrap().contains("the residuals grow with the size of `dx/dt`"))
+    };
+    let plain = fit(&path, &[]);
+    assert!(said(&plain), "{plain}");
+    let weighted = fit(&path, &["--weight", "w"]);
+    let terms: Vec<(&str, f64)> = weighted["terms"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| (t["term"].as_str().unwrap(), t["coefficient"].as_f64().unwrap()))
+        .collect();
+    assert!(terms.len() == 1 && terms[0].0 == "x" && (terms[0].1 - 0.5).abs() < 0.005, "{weighted}");
+    assert!(!said(&weighted), "{weighted}");
+    // noise of one size everywhere: nothing to say
+    assert!(!said(&v), "{v}");
+}

@@ -218,8 +218,7 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
     })?;
     if !cmd.no_time {
         // rows of a time series are not independent; rows without time have no order to test
-        fit.correlation_time =
-            identification.correlation_time(&target, &candidates, &frames, &fit.selection)?;
+        identification.describe_residuals(&target, &candidates, &frames, &mut fit)?;
     }
     match cmd.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&serde_json::to_value(fit.report())?)?),
