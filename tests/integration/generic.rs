@@ -1306,16 +1306,21 @@ fn identify_with_defaults(
 ) -> BTreeMap<String, f64> {
     let json = identify_text(data, target, terms, &["--format", "json"]);
     let v: serde_json::Value = serde_json::from_str(&json).unwrap();
-    let mut out: BTreeMap<String, f64> = v["terms"]
-        .as_array()
-        .unwrap_or_else(|| panic!("{json}"))
-        .iter()
-        .map(|t| (t["term"].as_str().unwrap().to_string(), t["coefficient"].as_f64().unwrap()))
-        .collect();
+    let mut out = terms_of(&v);
     if let Some(b0) = v["intercept"].as_f64() {
         out.insert("1".into(), b0);
     }
     out
+}
+
+/// The chosen terms and their coefficients of an `identify --format json` report.
+fn terms_of(report: &serde_json::Value) -> BTreeMap<String, f64> {
+    report["terms"]
+        .as_array()
+        .unwrap_or_else(|| panic!("{report}"))
+        .iter()
+        .map(|t| (t["term"].as_str().unwrap().to_string(), t["coefficient"].as_f64().unwrap()))
+        .collect()
 }
 
 /// Right by default on a small true term (issue 25 §3, §5): Rössler's dz/dt = 0.2 + x·z − 5.7 z,
@@ -1462,23 +1467,17 @@ fn a_glitch_in_a_record_is_mended_and_said() {
         let args = ["identify", "--data", csv.to_str().unwrap(), "--target", target, "--terms-file"];
         let (ok, out, err) = termid(&[&args[..], &[terms.to_str().unwrap(), "--format", "json"]].concat());
         assert!(ok && said(&err), "{err}");
-        let v = crate::common::json(&out);
-        let found: BTreeMap<&str, f64> = v["terms"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|t| (t["term"].as_str().unwrap(), t["coefficient"].as_f64().unwrap()))
-            .collect();
+        let found = terms_of(&crate::common::json(&out));
         assert_eq!(found.len(), expected.len(), "{target}: {found:?}");
         for (term, c) in expected {
-            assert!((found[term] - c).abs() < 1e-3 * c.abs(), "{target} {term}: {found:?}");
+            assert!((found[*term] - c).abs() < 1e-3 * c.abs(), "{target} {term}: {found:?}");
         }
         if target == "dx/dt" {
             let (ok, out, err) = termid(
                 &[&args[..], &[terms.to_str().unwrap(), "--format", "json", "--keep-spikes"]].concat(),
             );
             assert!(ok && !err.contains("leaps"), "{err}");
-            let kept = crate::common::json(&out)["terms"].as_array().unwrap().len();
+            let kept = terms_of(&crate::common::json(&out)).len();
             assert!(kept > 2, "as recorded, the glitch buys terms: {out}");
         }
     }
@@ -1562,13 +1561,8 @@ fn the_integral_forms_residuals_are_its_windows() {
     let plain = fit(&path, &[]);
     assert!(said(&plain), "{plain}");
     let weighted = fit(&path, &["--weight", "w"]);
-    let terms: Vec<(&str, f64)> = weighted["terms"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|t| (t["term"].as_str().unwrap(), t["coefficient"].as_f64().unwrap()))
-        .collect();
-    assert!(terms.len() == 1 && terms[0].0 == "x" && (terms[0].1 - 0.5).abs() < 0.005, "{weighted}");
+    let terms = terms_of(&weighted);
+    assert!(terms.len() == 1 && terms.get("x").is_some_and(|c| (c - 0.5).abs() < 0.005), "{weighted}");
     assert!(!said(&weighted), "{weighted}");
     // noise of one size everywhere: nothing to say
     assert!(!said(&v), "{v}");
