@@ -241,6 +241,12 @@ pub struct Segmented {
     pub start_failed: Option<String>,
     /// Why the segments' fit, or the fit from its start, failed.
     pub failed: Option<String>,
+    /// Where the model fitted on the segments parts from itself within a run (a twin started
+    /// off by the records' noise, [`Runs::horizon_from`]): the shortest such
+    /// time, s, and that run's length, s. A chaotic or unstable motion, which no fit follows
+    /// over a whole run from its first sample.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub predictable_for: Option<(f64, f64)>,
 }
 
 /// An output-error estimate's result.
@@ -758,6 +764,9 @@ fn searched(
                 seconds,
                 kept: true,
                 segments_unexplained: Some(left),
+                // from its recorded start a run is as uncertain as the records' noise, which
+                // the segments' fit leaves
+                predictable_for: predictable_for(&start, scales.every, left.sqrt()),
                 ..Default::default()
             };
             Ok((again, search))
@@ -793,6 +802,21 @@ fn searched(
             ))))
         }
     }
+}
+
+/// The shortest time over which `model` stays predictable on a run of `runs` from a start
+/// `offset` of each state's spread off ([`Runs::horizon_from`]), s, with that run's length;
+/// `None` where it stays so throughout every run.
+fn predictable_for(model: &Model, runs: &Runs, offset: f64) -> Option<(f64, f64)> {
+    let sims = runs.simulate(model, &[], &[]).ok()?;
+    runs.horizon_from(model, &sims, offset)
+        .iter()
+        .zip(&sims)
+        .filter_map(|(k, s)| {
+            let (first, last) = (s.time.first()?, s.time.last()?);
+            k.map(|k| (s.time[k] - first, last - first))
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
 }
 
 /// The free parameters' values fitted on the runs cut into [`SEGMENTS`] pieces each (four
@@ -1340,7 +1364,19 @@ impl Estimate {
             .as_ref()
             .and_then(|s| s.segments_unexplained)
             .filter(|u| *u <= FOLLOWS + self.noise);
-        if let (false, Some(left), Some(s)) = (self.follows(), segments_follow, &self.segmented) {
+        let chaotic = self.segmented.as_ref().and_then(|s| s.predictable_for);
+        if let (false, Some(left), Some((parts, run))) = (self.follows(), segments_follow, chaotic) {
+            // segments of at most half the time it stays predictable
+            let count = (2.0 * run / parts).ceil().max(2.0);
+            out.push_str(&format!(
+                "FLAG the fit does not follow the records: it leaves {} of their variance, where fitted on segments of {} s the same model follows them ({} left); fitted so, the model parts from itself within a run (started off by the records' noise, after {} s of the run's {} s): a chaotic or unstable motion, which no fit follows over a whole run from its first sample, only over pieces shorter than that (`--segments {count}` or more, Python `segments={count}`); read these estimates as failed\n",
+                share(self.unexplained),
+                sig(self.segmented.as_ref().map_or(0.0, |s| s.seconds), 3),
+                share(left),
+                sig(parts, 3),
+                sig(run, 3)
+            ));
+        } else if let (false, Some(left), Some(s)) = (self.follows(), segments_follow, &self.segmented) {
             out.push_str(&format!(
                 "FLAG the fit does not follow the records: it leaves {} of their variance, where fitted on segments of {} s the same model follows them ({} left): its errors build up over a run, from an effect the model lacks that accumulates (an offset, a drift) or from a chaotic or unstable motion, which only segments of its runs can fit (`--segments N`, Python `segments=`); read the estimates as failed\n",
                 share(self.unexplained),

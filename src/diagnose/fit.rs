@@ -1022,10 +1022,16 @@ impl Runs {
     /// model's errors after that sample, however right the model, are of that size: they say
     /// nothing about it.
     pub fn horizon(&self, model: &Model, sims: &[Trajectory]) -> Vec<Option<usize>> {
+        self.horizon_from(model, sims, PERTURBATION)
+    }
+
+    /// [`Runs::horizon`] of a twin started `offset` of each compared state's spread off (the
+    /// records' noise: how long a run is predictable from its recorded start).
+    pub fn horizon_from(&self, model: &Model, sims: &[Trajectory], offset: f64) -> Vec<Option<usize>> {
         let mut twin = self.clone();
         for x0 in &mut twin.x0 {
             for ((i, _), scale) in self.states.iter().zip(&self.scale) {
-                x0[*i] += PERTURBATION * scale;
+                x0[*i] += offset * scale;
             }
         }
         let Ok(twins) = twin.simulate(model, &[], &[]) else { return vec![None; self.frames.len()] };
