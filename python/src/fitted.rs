@@ -267,8 +267,7 @@ pub(crate) fn fit(
             if !keep_spikes {
                 // a time series whose rate is taken: a glitch would be one (the command line's
                 // default too)
-                let columns: Vec<&str> = slices.iter().map(|(n, _)| *n).filter(|n| *n != time).collect();
-                if let Some((mended, notes)) = termid::data::despiked(&frame, &columns, 0).map_err(fail)? {
+                if let Some((mended, notes)) = termid::data::despiked_all(&frame).map_err(fail)? {
                     frame = mended;
                     for note in notes {
                         warn(py, note)?;

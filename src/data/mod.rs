@@ -33,7 +33,7 @@ pub use prepare::{prepare, Preparation};
 pub use resample::{check_gaps, evened, interpolate_at, median_step, resample, sample_step, uneven};
 pub use savitzky_golay::SavitzkyGolay;
 pub use smoothing_spline::SmoothingSpline;
-pub use spike::{despiked, spikes, Spike};
+pub use spike::{despiked, despiked_all, spikes, Spike};
 pub use stream::{Chunk, Chunks, RowSource};
 
 #[cfg(test)]
@@ -343,29 +343,7 @@ impl Frame {
         if self.names.iter().any(|n| n == name) {
             return Err(DataError::DuplicateColumn { file: self.origin.clone(), column: name.into() });
         }
-        if let Some(t) = self.columns.first() {
-            if t.len() != values.len() {
-                return Err(DataError::Length {
-                    file: self.origin.clone(),
-                    column: name.into(),
-                    expected: t.len(),
-                    found: values.len(),
-                });
-            }
-        }
-        // v − v is 0 for a number and NaN for NaN/±∞: one sum the compiler vectorises (the
-        // row-by-row search ran at a fifth of the speed); the row only when there is one
-        let finite = all_finite(&values);
-        if let Some((i, &v)) =
-            (!finite).then(|| values.iter().enumerate().find(|(_, v)| !v.is_finite())).flatten()
-        {
-            return Err(DataError::NonFinite {
-                file: self.origin.clone(),
-                row: i + 1,
-                column: name.into(),
-                value: v,
-            });
-        }
+        self.check(name, &values)?;
         if self.columns.is_empty() {
             if let Some(i) = (1..values.len()).find(|&i| values[i] <= values[i - 1]) {
                 return Err(DataError::TimeNotIncreasing {
@@ -379,6 +357,35 @@ impl Frame {
         }
         self.names.push(name.into());
         self.columns.push(values);
+        Ok(())
+    }
+
+    /// Refuses a column `name` of another length than the frame's, or with a value that is
+    /// not finite (naming its row).
+    fn check(&self, name: &str, values: &[f64]) -> Result<(), DataError> {
+        if let Some(t) = self.columns.first() {
+            if t.len() != values.len() {
+                return Err(DataError::Length {
+                    file: self.origin.clone(),
+                    column: name.into(),
+                    expected: t.len(),
+                    found: values.len(),
+                });
+            }
+        }
+        // v − v is 0 for a number and NaN for NaN/±∞: one sum the compiler vectorises (the
+        // row-by-row search ran at a fifth of the speed); the row only when there is one
+        let finite = all_finite(values);
+        if let Some((i, &v)) =
+            (!finite).then(|| values.iter().enumerate().find(|(_, v)| !v.is_finite())).flatten()
+        {
+            return Err(DataError::NonFinite {
+                file: self.origin.clone(),
+                row: i + 1,
+                column: name.into(),
+                value: v,
+            });
+        }
         Ok(())
     }
 
@@ -410,22 +417,7 @@ impl Frame {
                 })
             }
         };
-        if values.len() != self.len() {
-            return Err(DataError::Length {
-                file: self.origin.clone(),
-                column: name.into(),
-                expected: self.len(),
-                found: values.len(),
-            });
-        }
-        if let Some((row, &value)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(DataError::NonFinite {
-                file: self.origin.clone(),
-                row: row + 1,
-                column: name.into(),
-                value,
-            });
-        }
+        self.check(name, &values)?;
         self.columns[i] = values;
         Ok(())
     }

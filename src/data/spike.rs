@@ -159,6 +159,13 @@ pub fn despiked(
     Ok(out.map(|f| (f, notes)))
 }
 
+/// [`despiked`] in every column but the time: a run whose states are not known (a rate's
+/// identification without a model).
+pub fn despiked_all(frame: &Frame) -> Result<Option<(Frame, Vec<String>)>, DataError> {
+    let columns: Vec<&str> = frame.names()[1..].iter().map(String::as_str).collect();
+    despiked(frame, &columns, 0)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

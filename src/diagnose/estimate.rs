@@ -242,9 +242,9 @@ pub struct Segmented {
     /// Why the segments' fit, or the fit from its start, failed.
     pub failed: Option<String>,
     /// Where the model fitted on the segments parts from itself within a run (a twin started
-    /// off by the records' noise, [`Runs::horizon_from`]): the shortest such
-    /// time, s, and that run's length, s. A chaotic or unstable motion, which no fit follows
-    /// over a whole run from its first sample.
+    /// off by the records' noise, [`Runs::horizon_from`]): the shortest such time, s, and that
+    /// run's length, s. A chaotic or unstable motion, which no fit follows over a whole run
+    /// from its first sample.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub predictable_for: Option<(f64, f64)>,
 }

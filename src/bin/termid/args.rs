@@ -308,7 +308,7 @@ pub struct IdentifyCommand {
     /// Keep the runs' spikes as recorded. By default a sample or three that leap away from
     /// their neighbours and straight back, far beyond the record's own steps and noise (a
     /// glitch, not a motion), are replaced by the line through their neighbours, and said.
-    /// With --model as the file's `keep_spikes = true`.
+    /// With --model as the file's `keep_spikes = true` (which the model written keeps).
     #[arg(long)]
     pub keep_spikes: bool,
     /// Write a figure of the raw and prepared signals of every run into this folder.

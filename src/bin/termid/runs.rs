@@ -268,13 +268,11 @@ pub fn load(data: &[PathBuf], datasets: &[PathBuf], time: &str) -> Result<Vec<Fr
     Ok(frames)
 }
 
-/// Every run's spikes in any of its columns mended ([`termid::data::despiked`]), each said: the
-/// runs of a command without a model, which cannot tell its states from other columns.
+/// Every run's spikes in any of its columns mended ([`termid::data::despiked_all`]), each said:
+/// the runs of a command without a model, which cannot tell its states from other columns.
 pub fn mend_spikes(frames: &mut [Frame]) -> Result<()> {
     for f in frames {
-        let columns: Vec<String> = f.names()[1..].to_vec();
-        let columns: Vec<&str> = columns.iter().map(String::as_str).collect();
-        if let Some((mended, notes)) = termid::data::despiked(f, &columns, 0)? {
+        if let Some((mended, notes)) = termid::data::despiked_all(f)? {
             *f = mended;
             notes.iter().for_each(|n| say(n));
         }
