@@ -595,25 +595,18 @@ impl Identification<'_> {
                 frame.origin()
             )));
         }
-        let samples = self.samples(library, target, frame)?;
-        let (y, columns) = crate::data::integral_rows(frame.time(), &samples.y, &samples.columns, w);
-        let weights = samples
-            .weights
-            .map(|r| (0..y.len()).map(|k| r[k..=k + w].iter().sum::<f64>() / (w + 1) as f64).collect());
-        Ok(Rows { y, columns, weights })
-    }
-
-    /// The rows of one run as sampled: the target, the candidates evaluated on every sample,
-    /// the rows' weights.
-    fn samples(&self, library: &Library, target: &Target, frame: &Frame) -> Result<Rows, IdentifyError> {
         let run = self.bind(library, target, frame)?;
-        let mut columns = vec![Vec::with_capacity(frame.len()); library.len()];
-        library.for_each_block(&run.sources, 0..frame.len(), |_, block| {
-            for (c, b) in columns.iter_mut().zip(block) {
+        let mut samples = vec![Vec::with_capacity(n); library.len()];
+        library.for_each_block(&run.sources, 0..n, |_, block| {
+            for (c, b) in samples.iter_mut().zip(block) {
                 c.extend_from_slice(b);
             }
         });
-        Ok(Rows { y: run.y, columns, weights: run.weights.map(<[f64]>::to_vec) })
+        let (y, columns) = crate::data::integral_rows(frame.time(), &run.y, &samples, w);
+        let weights = run
+            .weights
+            .map(|r| (0..y.len()).map(|k| r[k..=k + w].iter().sum::<f64>() / (w + 1) as f64).collect());
+        Ok(Rows { y, columns, weights })
     }
 
     /// A run made ready for accumulation: its target, its inputs with its own parameters, and
@@ -807,17 +800,32 @@ impl Identification<'_> {
             Target::Column(_) => None,
         };
         for frame in frames {
-            // the regression's own rows: the integral form's windows, else the samples
-            let Rows { y, columns, weights } = match window {
-                Some(w) => self.windows(&library, target, frame, w)?,
-                None => self.samples(&library, target, frame)?,
-            };
-            let mut e: Vec<f64> = y.iter().map(|y| y - b0).collect();
-            for (t, column) in selection.terms.iter().zip(&columns) {
-                for (e, x) in e.iter_mut().zip(column) {
-                    *e -= t.coefficient * x;
+            // the regression's own rows: the integral form's windows, else the samples (in
+            // blocks, as the fit took them: no column of a long run held whole)
+            let (y, e, weights) = match window {
+                Some(w) => {
+                    let Rows { y, columns, weights } = self.windows(&library, target, frame, w)?;
+                    let mut e: Vec<f64> = y.iter().map(|y| y - b0).collect();
+                    for (t, column) in selection.terms.iter().zip(&columns) {
+                        for (e, x) in e.iter_mut().zip(column) {
+                            *e -= t.coefficient * x;
+                        }
+                    }
+                    (y, e, weights)
                 }
-            }
+                None => {
+                    let run = self.bind(&library, target, frame)?;
+                    let mut e: Vec<f64> = run.y.iter().map(|y| y - b0).collect();
+                    library.for_each_block(&run.sources, 0..frame.len(), |start, columns| {
+                        for (t, column) in selection.terms.iter().zip(columns) {
+                            for (e, x) in e[start..].iter_mut().zip(*column) {
+                                *e -= t.coefficient * x;
+                            }
+                        }
+                    });
+                    (run.y, e, run.weights.map(<[f64]>::to_vec))
+                }
+            };
             // each row as the fit weighed it
             let scale = |k: usize| weights.as_ref().map_or(1.0, |w| w[k].sqrt());
             sized.extend(e.iter().enumerate().map(|(k, e)| ((y[k] - e).abs(), scale(k) * e)));
