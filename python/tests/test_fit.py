@@ -239,7 +239,7 @@ def test_a_glitch_is_mended_with_a_warning():
     library = ["x", "y", "z", "x*x", "x*y", "x*z", "y*y", "y*z", "z*z"]
     df = pd.DataFrame({"t": t, "x": s[:, 0], "y": s[:, 1], "z": s[:, 2]})
     df.loc[len(df) // 2, "x"] += 30.0
-    with pytest.warns(UserWarning, match=f"`x` jumps off the line through its neighbours by .* at row {len(df) // 2 + 1} "):
+    with pytest.warns(UserWarning, match=f"`x` leaps away and straight back by .* at row {len(df) // 2 + 1} "):
         fitted = termid.fit(df, "dx/dt", library)
     assert fitted.coefficients.sort_index().round(3).to_dict() == {"x": -10.0, "y": 10.0}
     with warnings.catch_warnings():

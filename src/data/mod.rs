@@ -33,7 +33,7 @@ pub use prepare::{prepare, Preparation};
 pub use resample::{check_gaps, evened, interpolate_at, median_step, resample, sample_step, uneven};
 pub use savitzky_golay::SavitzkyGolay;
 pub use smoothing_spline::SmoothingSpline;
-pub use spike::{despiked, despiked_all, first_spike, spikes, Spike};
+pub use spike::{despiked, despiked_all, spikes, Spike};
 pub use stream::{Chunk, Chunks, RowSource};
 
 #[cfg(test)]

@@ -54,38 +54,21 @@ fn noise(x: &[f64]) -> f64 {
 }
 
 /// The spikes of one column, in order. A spike needs a sample on either side, so none is
-/// found in the first or last sample (see [`first_spike`]).
+/// found in the first or last sample.
 pub fn spikes(x: &[f64]) -> Vec<Spike> {
-    // the steps beside alone first: a clean record has no sample that passes them, and its
-    // noise and span (two passes and a copy) are not needed
-    if x.len() < 5 || search(x, 0.0).is_empty() {
+    let n = x.len();
+    if n < 5 {
         return Vec::new();
     }
-    search(x, floor(x))
-}
-
-/// The first sample of a state's record as a spike: off the line through the next two by more
-/// than 5 times the steps beside them, the record's noise and its span, as [`spikes`] asks of
-/// a sample inside. Only a state's: an input may step at its first sample (switched on with
-/// the record), and nothing after it tells the two apart; a state cannot, and its first sample
-/// starts every re-simulation of the run.
-pub fn first_spike(x: &[f64]) -> Option<Spike> {
-    if x.len() < 5 {
-        return None;
+    // the steps beside alone first: a clean record has no sample that passes them, and its
+    // noise and span (two passes and a copy) are not needed
+    if search(x, 0.0).is_empty() {
+        return Vec::new();
     }
-    let line = 2.0 * x[1] - x[2];
-    let height = (x[0] - line).abs();
-    let beside = (x[2] - x[1]).abs().max((x[3] - x[2]).abs());
-    (height > BESIDE * beside && height > floor(x)).then_some(Spike { start: 0, width: 1, height, beside })
-}
-
-/// What a leap must exceed beside the steps next to it: the record's noise and its span.
-fn floor(x: &[f64]) -> f64 {
-    let n = x.len();
     let mut order = x.to_vec();
     let high = *order.select_nth_unstable_by(n * 99 / 100, f64::total_cmp).1;
     let low = *order.select_nth_unstable_by(n / 100, f64::total_cmp).1;
-    (NOISE * noise(x)).max(SPAN * (high - low))
+    search(x, (NOISE * noise(x)).max(SPAN * (high - low)))
 }
 
 /// The spikes whose leaps exceed `floor` as well as the steps beside them.
@@ -129,13 +112,10 @@ fn search(x: &[f64], floor: f64) -> Vec<Spike> {
 
 /// The run with the spikes of `columns` replaced by the line (in time) through the samples
 /// either side, with one line to say per column; `None` where there is none. `first_row` is
-/// the frame's first row in its file (0 for a whole run, a chunk's offset when streamed);
-/// where it is 0, the first sample of each of `states` is looked at too ([`first_spike`]) and
-/// mended onto the line through the next two.
+/// the frame's first row in its file (0 for a whole run, a chunk's offset when streamed).
 pub fn despiked(
     frame: &Frame,
     columns: &[&str],
-    states: &[&str],
     first_row: usize,
 ) -> Result<Option<(Frame, Vec<String>)>, DataError> {
     let mut out: Option<Frame> = None;
@@ -143,18 +123,12 @@ pub fn despiked(
     let t = frame.time();
     for name in columns {
         let Some(column) = frame.column(name) else { continue };
-        let first = (first_row == 0 && states.contains(name)).then(|| first_spike(column)).flatten();
-        let found: Vec<Spike> = first.into_iter().chain(spikes(column)).collect();
+        let found = spikes(column);
         if found.is_empty() {
             continue;
         }
         let mut mended = column.to_vec();
         for s in &found {
-            if s.start == 0 {
-                // onto the line through the next two samples, in time
-                mended[0] = column[1] - (column[2] - column[1]) * (t[1] - t[0]) / (t[2] - t[1]);
-                continue;
-            }
             let (a, b) = (s.start - 1, s.start + s.width);
             for i in s.start..b {
                 let w = (t[i] - t[a]) / (t[b] - t[a]);
@@ -168,18 +142,13 @@ pub fn despiked(
             } else {
                 format!("rows {}-{}", first_row + s.start + 1, first_row + s.start + s.width)
             };
-            format!(
-                "{} at {rows} (t = {}{})",
-                sig(s.height),
-                sig(t[s.start]),
-                if s.start == 0 { ", the first sample" } else { "" }
-            )
+            format!("{} at {rows} (t = {})", sig(s.height), sig(t[s.start]))
         };
         let list: Vec<String> = found.iter().take(3).map(place).collect();
         let more = if found.len() > 3 { format!(" and {} more", found.len() - 3) } else { String::new() };
         let beside = found.iter().map(|s| s.beside).fold(0.0, f64::max);
         notes.push(format!(
-            "{}: `{name}` jumps off the line through its neighbours by {}{more}, where its steps beside are at most {} and its roughness {}: a glitch in the record, not a motion; replaced by that line (`keep_spikes` keeps it as recorded)",
+            "{}: `{name}` leaps away and straight back by {}{more}, where its steps beside are at most {} and its roughness {}: a glitch in the record, not a motion; replaced by the line through its neighbours (`keep_spikes` keeps it as recorded)",
             frame.origin(),
             list.join(", "),
             sig(beside),
@@ -194,7 +163,7 @@ pub fn despiked(
 /// identification without a model).
 pub fn despiked_all(frame: &Frame) -> Result<Option<(Frame, Vec<String>)>, DataError> {
     let columns: Vec<&str> = frame.names()[1..].iter().map(String::as_str).collect();
-    despiked(frame, &columns, &[], 0)
+    despiked(frame, &columns, 0)
 }
 
 #[cfg(test)]
@@ -219,7 +188,7 @@ mod tests {
         let mut f = Frame::new("run.csv", "t", t).unwrap();
         f.push("x", x).unwrap();
         f.push("u", truth.clone()).unwrap();
-        let (g, notes) = despiked(&f, &["x", "u"], &[], 0).unwrap().unwrap();
+        let (g, notes) = despiked(&f, &["x", "u"], 0).unwrap().unwrap();
         assert_eq!(g.names(), f.names(), "the columns keep their places");
         let mended = g.column("x").unwrap();
         // the line through the neighbours is within the curvature of a smooth signal
@@ -229,27 +198,7 @@ mod tests {
                 && notes[0].contains("by 29.99 at row 101 (t = 1.000), 4.101 at rows 251-252 (t = 2.500)"),
             "{notes:?}"
         );
-        assert!(despiked(&g, &["x", "u"], &[], 0).unwrap().is_none());
-    }
-
-    #[test]
-    fn a_states_first_sample_is_looked_at() {
-        let truth = lorenz_like(400);
-        let mut x = truth.clone();
-        x[0] += 12.0;
-        assert!(spikes(&x).is_empty(), "inside only");
-        let first = first_spike(&x).unwrap();
-        assert!(first.start == 0 && (first.height - 12.0).abs() < 0.05, "{first:?}");
-        let t: Vec<f64> = (0..400).map(|k| 0.01 * k as f64).collect();
-        let mut f = Frame::new("run.csv", "t", t).unwrap();
-        f.push("x", x.clone()).unwrap();
-        // an input may step with the record's first sample: only a state's is looked at
-        f.push("u", x).unwrap();
-        let (g, notes) = despiked(&f, &["x", "u"], &["x"], 0).unwrap().unwrap();
-        assert!((g.column("x").unwrap()[0] - truth[0]).abs() < 0.01 && g.column("u") == f.column("u"));
-        assert!(notes.len() == 1 && notes[0].contains("at row 1 (t = 0, the first sample)"), "{notes:?}");
-        // a streamed chunk's first row is not its run's
-        assert!(despiked(&f, &["x"], &["x"], 100).unwrap().is_none());
+        assert!(despiked(&g, &["x", "u"], 0).unwrap().is_none());
     }
 
     #[test]
@@ -305,7 +254,6 @@ mod tests {
                 .map(|c| c + sigma * (0..12).map(|_| crate::data::test_noise(&mut seed)).sum::<f64>())
                 .collect();
             proptest::prop_assert!(spikes(&x).is_empty(), "{:?}", spikes(&x));
-            proptest::prop_assert!(first_spike(&x).is_none(), "{:?}", first_spike(&x));
             let steepest = clean.windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0, f64::max);
             let height = 10.0 * steepest + 20.0 * sigma + 0.03 * span;
             x[at] += if up { height } else { -height };

@@ -866,8 +866,7 @@ impl Model {
             let rates: Vec<String> = self.spec.states.iter().map(|s| format!("{}_dot", s.name)).collect();
             let columns: Vec<&str> =
                 self.vocabulary.variables().iter().chain(&rates).map(String::as_str).collect();
-            let states: Vec<&str> = self.spec.states.iter().map(|s| s.name.as_str()).collect();
-            if let Some((mended, said)) = crate::data::despiked(frame, &columns, &states, first_row)? {
+            if let Some((mended, said)) = crate::data::despiked(frame, &columns, first_row)? {
                 *frame = mended;
                 spikes = said;
             }
