@@ -673,7 +673,7 @@ impl PyModel {
         let predictable: Vec<serde_json::Value> = frames
             .iter()
             .zip(&horizon)
-            .map(|(f, h)| serde_json::json!({"run": f.origin(), "seconds": h.map(|k| f.time()[k] - f.time()[0]), "of": f.time()[f.len() - 1] - f.time()[0]}))
+            .map(|(f, h)| serde_json::json!({"run": f.origin(), "seconds": h.map(|k| f.since_start(k)), "of": f.duration()}))
             .collect();
         to_json(
             &serde_json::json!({"gap": data.gap(&sims), "metrics": metrics, "medium": medium, "predictable_for": predictable}),

@@ -454,6 +454,16 @@ impl Frame {
         &self.columns[0]
     }
 
+    /// Seconds from the first row to row `k`.
+    pub fn since_start(&self, k: usize) -> f64 {
+        self.columns[0][k] - self.columns[0][0]
+    }
+
+    /// Seconds from the first row to the last.
+    pub fn duration(&self) -> f64 {
+        self.since_start(self.len() - 1)
+    }
+
     /// Number of rows.
     pub fn len(&self) -> usize {
         self.columns[0].len()

@@ -811,11 +811,8 @@ fn predictable_for(model: &Model, runs: &Runs, offset: f64) -> Option<(f64, f64)
     let sims = runs.simulate(model, &[], &[]).ok()?;
     runs.horizon_from(model, &sims, offset)
         .iter()
-        .zip(&sims)
-        .filter_map(|(k, s)| {
-            let (first, last) = (s.time.first()?, s.time.last()?);
-            k.map(|k| (s.time[k] - first, last - first))
-        })
+        .zip(&runs.frames)
+        .filter_map(|(k, f)| k.map(|k| (f.since_start(k), f.duration())))
         .min_by(|a, b| a.0.total_cmp(&b.0))
 }
 

@@ -827,7 +827,7 @@ impl Runs {
                     return Some(format!(
                         "`{name}` is not finite in run {} at t = {} s (the model's value: {})",
                         f.origin(),
-                        crate::identify::num(f.time()[k] - f.time()[0]),
+                        crate::identify::num(f.since_start(k)),
                         simulated.get(k).map_or("not reached".to_string(), |v| v.to_string())
                     ));
                 }
@@ -879,7 +879,7 @@ impl Runs {
                     .map(|l| l.norm())
                     .fold(0.0, f64::max);
                 if speed > 0.0 && fastest.is_none_or(|(s, _)| speed > s) {
-                    fastest = Some((speed, f.time()[k] - f.time()[0]));
+                    fastest = Some((speed, f.since_start(k)));
                 }
             }
             out.push(fastest);

@@ -450,23 +450,18 @@ fn invariant_note(moments: &Moments, names: &[String]) -> Option<String> {
                 if v.abs() < 1e-6 {
                     continue;
                 }
-                let sign = if v < 0.0 {
-                    " − "
-                } else if text.is_empty() {
-                    ""
-                } else {
-                    " + "
+                let sign = match (text.is_empty(), v < 0.0) {
+                    (true, false) => "",
+                    (true, true) => "−",
+                    (false, false) => " + ",
+                    (false, true) => " − ",
                 };
                 let weight = if (v.abs() - 1.0).abs() < 1e-3 {
                     String::new()
                 } else {
                     format!("{}·", report::sig(v.abs(), 3))
                 };
-                text += &format!(
-                    "{}{weight}{}",
-                    if text.is_empty() && v < 0.0 { "−" } else { sign },
-                    names[vars[i]]
-                );
+                text += &format!("{sign}{weight}{}", names[vars[i]]);
             }
             text.contains(' ').then(|| format!("`{text}`"))
         })
@@ -856,11 +851,13 @@ fn growth(sized: &mut [(f64, f64)]) -> Option<f64> {
         return None;
     }
     sized.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let rms = |v: &mut dyn Iterator<Item = f64>, n: usize| (v.map(|x| x * x).sum::<f64>() / n as f64).sqrt();
-    let residuals = |rows: &[(f64, f64)]| rms(&mut rows.iter().map(|r| r.1), rows.len());
-    let fitted = rms(&mut sized.iter().map(|r| r.0), n);
-    let (small, large) = (residuals(&sized[..n / 4]), residuals(&sized[n - n / 4..]));
-    (small > 0.0 && residuals(sized) > 1e-6 * fitted).then(|| large / small)
+    // root mean square of the residuals (or, `fitted`, of the fitted values) over rows
+    let rms = |rows: &[(f64, f64)], fitted: bool| {
+        let sq: f64 = rows.iter().map(|(f, e)| if fitted { f * f } else { e * e }).sum();
+        (sq / rows.len() as f64).sqrt()
+    };
+    let (small, large) = (rms(&sized[..n / 4], false), rms(&sized[n - n / 4..], false));
+    (small > 0.0 && rms(sized, false) > 1e-6 * rms(sized, true)).then(|| large / small)
 }
 
 /// One equation fitted from its runs' statistics: merged for the selection ("Komb. Daten"),

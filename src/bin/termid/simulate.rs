@@ -245,7 +245,7 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
         })
     };
     // a replay lasts as long as its recording; constant inputs have no natural end
-    let recorded = replayed.as_ref().map(|f| f.time()[f.len() - 1] - f.time()[0]);
+    let recorded = replayed.as_ref().map(|f| f.duration());
     let duration = cmd.duration.or(recorded).context(
         "give a manoeuvre (-m zigzag:20/20, -m turning:35, -m spiral, -m replay:FILE.csv; each has its own length) or --duration SECONDS for the model under constant inputs (--input NAME=VALUE), which has no natural end",
     )?;

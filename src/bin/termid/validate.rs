@@ -102,7 +102,7 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
                 })).collect::<Vec<_>>(),
                 "predictable_for": runs.iter().zip(&horizon).map(|(f, h)| serde_json::json!({
                     "run": f.origin(),
-                    "seconds": h.map(|k| f.time()[k] - f.time()[0]),
+                    "seconds": h.map(|k| f.since_start(k)),
                 })).collect::<Vec<_>>(),
                 "within_band": (!verdicts.is_empty()).then(|| serde_json::json!({
                     "within": within,
@@ -127,7 +127,7 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
             let early = data.run_gaps(&sims, &first);
             for ((f, k), (_, per)) in runs.iter().zip(&horizon).zip(&early) {
                 let Some(k) = *k else { continue };
-                let (t, end) = (f.time()[k] - f.time()[0], f.time()[f.len() - 1] - f.time()[0]);
+                let (t, end) = (f.since_start(k), f.duration());
                 let cells: Vec<String> =
                     per.iter().map(|(s, r, m)| error_cell(s, *r, *m, model.unit(s))).collect();
                 println!(
