@@ -231,12 +231,11 @@ impl Trajectory {
     /// What the run's user should know where the adaptive method found the model stiff.
     pub fn stiff_note(&self) -> Option<String> {
         self.stiff_from.map(|t| {
-            // four significant figures (the simulator sits below the report's formatting)
-            let digits = if t > 0.0 { (3 - t.log10().floor() as i32).clamp(0, 12) as usize } else { 0 };
             format!(
-                "the model is stiff from t = {t:.digits$} s on (the explicit steps were held by \
+                "the model is stiff from t = {} s on (the explicit steps were held by \
                  stability, not accuracy): continued with linearly implicit Rosenbrock steps (the \
-                 `rosenbrock` method takes them from the start)"
+                 `rosenbrock` method takes them from the start)",
+                crate::output::sig(t, 4)
             )
         })
     }
