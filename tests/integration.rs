@@ -22,6 +22,9 @@ mod ship;
 // Non-ship models (Lorenz, Duffing) through the same library and commands.
 #[path = "integration/generic.rs"]
 mod generic;
+// Inputs held between samples: found, integrated and replayed held.
+#[path = "integration/intersample.rs"]
+mod intersample;
 // The paper end to end (`termid reproduce`) through the library.
 #[path = "integration/reproduce.rs"]
 mod reproduce;

@@ -182,7 +182,7 @@ impl Compiled {
 /// (`dx/dt`) is an equation of motion of the rows as a time series over the column `time`,
 /// by the `derivative` method (`integral` where none is named, as the command line does).
 #[pyfunction]
-#[pyo3(signature = (target, columns, terms, backend = "{\"method\": \"stepwise\"}", intercept = true, forced = vec![], excluded = vec![], parameters = BTreeMap::new(), weights = None, time = None, derivative = None, keep_spikes = false))]
+#[pyo3(signature = (target, columns, terms, backend = "{\"method\": \"stepwise\"}", intercept = true, forced = vec![], excluded = vec![], parameters = BTreeMap::new(), weights = None, time = None, derivative = None, keep_spikes = false, intersample = "auto"))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn fit(
     py: Python<'_>,
@@ -198,7 +198,18 @@ pub(crate) fn fit(
     time: Option<String>,
     derivative: Option<String>,
     keep_spikes: bool,
+    intersample: &str,
 ) -> PyResult<PyFit> {
+    let intersample = match intersample {
+        "auto" => termid::data::Intersample::Auto,
+        "linear" => termid::data::Intersample::Linear,
+        "held" => termid::data::Intersample::Held,
+        other => {
+            return Err(refuse(format!(
+                "intersample = {other:?}: \"auto\" (held where a column shows a controller's command), \"linear\" or \"held\""
+            )))
+        }
+    };
     let backend = backend_of(backend)?;
     let names: Vec<String> = columns.keys().iter().map(|k| k.extract()).collect::<PyResult<_>>()?;
     let variables: Vec<String> = names
@@ -273,6 +284,11 @@ pub(crate) fn fit(
                         warn(py, note)?;
                     }
                 }
+            }
+            // every column but the state may be an input held between samples
+            let columns: Vec<&str> = variables.iter().map(String::as_str).filter(|n| n != state).collect();
+            for note in termid::data::mark_held(&mut frame, &columns, intersample).map_err(fail)? {
+                warn(py, note)?;
             }
             let frames = [frame];
             py.detach(|| -> Result<Fit, termid::identify::IdentifyError> {

@@ -607,6 +607,7 @@ def fit(
     time: Optional[str] = None,
     derivative: Optional[str] = None,
     keep_spikes: bool = False,
+    intersample: str = "auto",
     **settings: Any,
 ) -> Fit:
     """Fits ``target`` (a column of ``data``) by the candidate ``terms`` (text over the other
@@ -630,7 +631,11 @@ def fit(
     how a rate is estimated (default: none, the integral form); ``keep_spikes`` keeps a rate's
     rows as recorded, where by default a sample or three of a column that leap away from their
     neighbours and straight back (a glitch, not a motion) are replaced by the line through the
-    neighbours, with a warning.
+    neighbours, with a warning; ``intersample`` says how a rate's other columns behave between
+    samples: ``"auto"`` (default) takes a column that stays put and jumps at isolated samples
+    on a clock (a controller's command) as held from each sample to the next, integrated
+    piece by piece between its jumps, with a warning, ``"linear"`` as a line between samples,
+    ``"held"`` held wherever a column jumps at isolated samples, on a clock or not.
 
     >>> import pandas as pd
     >>> df = pd.DataFrame({"x1": [1.0, 2, 3, 4, 5], "x2": [2.0, 1, 4, 3, 6]}).eval("y = x1 + 2*x2")
@@ -687,6 +692,7 @@ def fit(
             time_name,
             derivative,
             keep_spikes,
+            intersample,
         )
     except TermidError as e:
         raise _explained(e, columns.left_out) from None

@@ -262,6 +262,32 @@ def test_residuals_that_grow_with_the_rate_are_said_and_weights_mend_them():
     assert abs(weighted.coefficients["x"] - 0.5) < 0.005
 
 
+def test_a_force_held_between_samples_is_integrated_as_held():
+    # ẍ = −4x − 0.3ẋ + 2F with F held for 50 samples at a time (a controller's command), in
+    # closed form from sample to sample: held (the default, with a warning) the true terms;
+    # as a line between samples the damping is off by over 1 %
+    rng = np.random.default_rng(4)
+    levels = rng.uniform(-2.0, 2.0, 61)
+    alpha, h = 0.15, 0.01
+    wd = np.sqrt(4.0 - alpha**2)
+    x, v, rows = 1.0, 0.0, []
+    for k in range(3001):
+        force = levels[k // 50]
+        rows.append((h * k, x, v, force))
+        y = x - force / 2.0
+        c, s, e = np.cos(wd * h), np.sin(wd * h), np.exp(-alpha * h)
+        x, v = force / 2.0 + e * (y * c + (v + alpha * y) / wd * s), e * (v * c - (alpha * v + 4.0 * y) / wd * s)
+    df = pd.DataFrame(rows, columns=["t", "x", "v", "F"])
+    library = ["x", "v", "F", "x^2", "x*F"]
+    with pytest.warns(UserWarning, match="`F` stays put .* on a clock of 50 samples"):
+        held = termid.fit(df, "dv/dt", library)
+    assert held.coefficients.sort_index().round(5).to_dict() == {"F": 2.0, "v": -0.3, "x": -4.0}
+    linear = termid.fit(df, "dv/dt", library, intersample="linear")
+    assert abs(linear.coefficients["v"] + 0.3) > 0.003
+    with pytest.raises(termid.TermidError, match="intersample"):
+        termid.fit(df, "dv/dt", library, intersample="zoh")
+
+
 def test_the_rows_that_cannot_choose_are_said():
     """Hald's cement against Draper & Smith's sums of squares of its pairs: forward stepping's
     {x4, x1} leaves 74.76, {x2, x1} 57.90, so x2 in x4's place is 2.25 residual variances

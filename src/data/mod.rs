@@ -11,6 +11,7 @@ mod dataset;
 mod derivative;
 mod five_point;
 mod geodetic;
+mod hold;
 mod integral;
 mod kalman;
 mod prepare;
@@ -27,7 +28,8 @@ pub use dataset::{velocities_from_track, Dataset, Delimiter, RunSpec, Track};
 pub use derivative::{differentiator, CentralDifference, Differentiator, Smoothed, DIFFERENTIATORS};
 pub use five_point::FivePoint;
 pub use geodetic::{north_east, radii_of_curvature};
-pub use integral::{integral_rows, IntegralForm};
+pub use hold::{held, mark_held, Hold, Intersample};
+pub use integral::{integral_rows, integral_rows_held, IntegralForm};
 pub use kalman::{KalmanSmoother, NoiseModel};
 pub use prepare::{prepare, Preparation};
 pub use resample::{check_gaps, evened, interpolate_at, median_step, resample, sample_step, uneven};
@@ -316,13 +318,16 @@ fn all_finite(values: &[f64]) -> bool {
     lanes.iter().sum::<f64>() == 0.0 && rest.iter().all(|v| v.is_finite())
 }
 
-/// Named f64 columns over a strictly increasing time column.
+/// Named f64 columns over a strictly increasing time column; each column either a line
+/// between its samples (the default) or held from each sample to the next ([`Frame::hold`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Frame {
     origin: String,
     time_name: String,
     names: Vec<String>,
     columns: Vec<Vec<f64>>,
+    /// The columns held between samples (a zero-order hold).
+    held: Vec<String>,
 }
 
 impl Frame {
@@ -331,8 +336,13 @@ impl Frame {
         if time.is_empty() {
             return Err(DataError::Empty { file: origin.into() });
         }
-        let mut f =
-            Frame { origin: origin.into(), time_name: time_name.into(), names: vec![], columns: vec![] };
+        let mut f = Frame {
+            origin: origin.into(),
+            time_name: time_name.into(),
+            names: vec![],
+            columns: vec![],
+            held: vec![],
+        };
         f.push(time_name, time)?;
         Ok(f)
     }
@@ -397,6 +407,7 @@ impl Frame {
             }
             self.names.remove(i);
             self.columns.remove(i);
+            self.held.retain(|h| h != name);
         }
         self.push(name, values)
     }
@@ -436,7 +447,45 @@ impl Frame {
             self.time_name = to.into();
         }
         self.names[i] = to.into();
+        for h in self.held.iter_mut().filter(|h| *h == from) {
+            *h = to.into();
+        }
         Ok(())
+    }
+
+    /// Takes column `name` as held from each sample to the next (a zero-order hold: its
+    /// integral and its replay into a simulation step, not a line, between samples); refused
+    /// for the time column and a column the frame does not have.
+    pub fn hold(&mut self, name: &str) -> Result<(), DataError> {
+        match self.names.iter().position(|n| n == name) {
+            Some(0) => Err(DataError::Setting(format!("{}: time `{name}` cannot be held", self.origin))),
+            Some(_) => {
+                if !self.is_held(name) {
+                    self.held.push(name.into());
+                }
+                Ok(())
+            }
+            None => Err(DataError::MissingColumn {
+                file: self.origin.clone(),
+                column: name.into(),
+                available: self.names.join(", "),
+            }),
+        }
+    }
+
+    /// Takes column `name` as a line between its samples again.
+    pub fn release(&mut self, name: &str) {
+        self.held.retain(|h| h != name);
+    }
+
+    /// Whether column `name` is held between samples ([`Frame::hold`]).
+    pub fn is_held(&self, name: &str) -> bool {
+        self.held.iter().any(|h| h == name)
+    }
+
+    /// The columns held between samples, in the order they were marked.
+    pub fn held(&self) -> &[String] {
+        &self.held
     }
 
     /// Where the frame came from (file name), for messages.
@@ -518,6 +567,7 @@ impl Frame {
             time_name: self.time_name.clone(),
             names: self.names.clone(),
             columns: self.columns.iter().map(|c| c[range.clone()].to_vec()).collect(),
+            held: self.held.clone(),
         }
     }
 }

@@ -234,6 +234,16 @@ impl Controller for Transformed {
             *o = *o * b + a;
         }
     }
+
+    fn before(&mut self, t: f64, out: &mut [f64]) -> bool {
+        let jumped = self.replay.before(t, out);
+        if jumped {
+            for ((o, a), b) in out.iter_mut().zip(&self.offset).zip(&self.factor) {
+                *o = *o * b + a;
+            }
+        }
+        jumped
+    }
 }
 
 /// Simulates every run of `runs` with `model` (for scripts and tests).

@@ -435,6 +435,7 @@ fn integrate(
         s[i * k + j] = 1.0;
     }
     let (mut u_now, mut u_next, mut u_mid) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
+    let mut u_before = vec![0.0; m];
     replay.input(0.0, &x, &mut u_now);
     let y = observe(&x, &s, &u_now, &mut sy);
     sample(0, &x, &s, &y, &sy);
@@ -443,11 +444,13 @@ fn integrate(
     for step in 1..=steps {
         let t1 = step as f64 * dt;
         replay.input(t1, &x, &mut u_next);
+        // as the simulator: a held input that jumps at t1 keeps its value before over the step
+        let u_end: &[f64] = if replay.before(t1, &mut u_before) { &u_before } else { &u_next };
         for j in 0..m {
-            u_mid[j] = 0.5 * (u_now[j] + u_next[j]);
+            u_mid[j] = 0.5 * (u_now[j] + u_end[j]);
         }
         rate(&x, &s, &u_now, &mut kx[0], &mut ks[0]);
-        for (stage, (w, u)) in [(0.5, &u_mid), (0.5, &u_mid), (1.0, &u_next)].into_iter().enumerate() {
+        for (stage, (w, u)) in [(0.5, &u_mid[..]), (0.5, &u_mid[..]), (1.0, u_end)].into_iter().enumerate() {
             for i in 0..n {
                 tx[i] = x[i] + w * dt * kx[stage][i];
             }

@@ -86,6 +86,15 @@ pub struct Meta {
     /// its neighbours, and said.
     #[serde(default, skip_serializing_if = "is_false")]
     pub keep_spikes: bool,
+    /// How the runs' inputs behave between samples: `auto` (the default: held where the record
+    /// shows a zero-order hold, [`crate::data::held`], else a line), `linear` or `held`.
+    /// Taken by the integral form's quadrature and by every replay into a simulation.
+    #[serde(default, skip_serializing_if = "is_auto")]
+    pub intersample: crate::data::Intersample,
+}
+
+fn is_auto(i: &crate::data::Intersample) -> bool {
+    *i == crate::data::Intersample::Auto
 }
 
 fn is_true(b: &bool) -> bool {

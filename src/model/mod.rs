@@ -815,6 +815,15 @@ impl Model {
         self
     }
 
+    /// The model with its runs' inputs taken between samples as `intersample` says where
+    /// given (a command line's `--intersample`), else as its file says.
+    pub fn with_intersample(mut self, intersample: Option<crate::data::Intersample>) -> Model {
+        if let Some(i) = intersample {
+            self.spec.model.intersample = i;
+        }
+        self
+    }
+
     /// Makes a measured run fit for this model, the checks every caller of a model needs (the
     /// CLI, the Python package): a plain file's ASCII column names that are the model's aliases
     /// (`delta`, `psi`) are read as the names they stand for, an input declared in rad that
@@ -825,8 +834,10 @@ impl Model {
     /// a full turn (a compass's 359° → 0°) is made one continuous angle
     /// ([`crate::data::unwrapped`]); a spike in a variable's record (a sample or three that leap
     /// away and straight back) is replaced by the line through its neighbours
-    /// ([`crate::data::despiked`]) unless the file says `keep_spikes`. Returns what was renamed,
-    /// resampled, unwrapped or mended, for the caller to say.
+    /// ([`crate::data::despiked`]) unless the file says `keep_spikes`; an input that stays put
+    /// between samples and jumps at isolated ones is marked held ([`crate::data::mark_held`],
+    /// as the file's `intersample` says). Returns what was renamed, resampled, unwrapped,
+    /// marked or mended, for the caller to say.
     pub fn admit(&self, frame: &mut crate::data::Frame) -> Result<Vec<String>, crate::data::DataError> {
         let admitted = self.admit_at(frame, 0)?;
         Ok(admitted.notes.into_iter().chain(admitted.spikes).collect())
@@ -871,6 +882,8 @@ impl Model {
                 spikes = said;
             }
         }
+        let inputs: Vec<&str> = self.spec.inputs.iter().map(|i| i.name.as_str()).collect();
+        notes.extend(crate::data::mark_held(frame, &inputs, self.spec.model.intersample)?);
         for input in self.spec.inputs.iter().filter(|i| i.unit == "rad") {
             let beyond = frame
                 .column(&input.name)

@@ -27,6 +27,13 @@ pub trait Controller {
     fn ahead(&self, _t: f64, _slope: &mut [f64]) -> Option<Ahead> {
         None
     }
+    /// The inputs just before control time `t`, asked right after [`Controller::input`] for
+    /// `t`, written into `out` where some jump at `t` (an input held between samples: its
+    /// value up to the sample, which the step ending at `t` takes instead of the new one);
+    /// false, the default, where none jumps (`out` left as it was).
+    fn before(&mut self, _t: f64, _out: &mut [f64]) -> bool {
+        false
+    }
     /// The control times up to `t` passed as [`Controller::ahead`] promised, unasked: the
     /// controller catches up to `t` as if it had been asked at each (a gear turned on to
     /// where the line says), so that the next ask moves it over one control step alone.
@@ -81,12 +88,19 @@ impl Controller for Constant {
     }
 }
 
-/// Inputs replayed from a recorded time series, linearly interpolated; held at the ends.
+/// Inputs replayed from a recorded time series: linearly interpolated between samples, or
+/// held from each sample to the next where the frame says the input is ([`Frame::hold`]: a
+/// step ending on a sample then takes the value before it, [`Controller::before`]); held at
+/// the ends.
 #[derive(Clone, Debug)]
 pub struct Replay {
     time: Vec<f64>,
     columns: Vec<Vec<f64>>,
+    held: Vec<bool>,
     cursor: usize,
+    /// Where the last lookup of a held input's sample ended (apart from the line's cursor,
+    /// which may stand one sample back).
+    sample: usize,
 }
 
 impl Replay {
@@ -97,13 +111,38 @@ impl Replay {
     pub fn new(frame: &Frame, inputs: &[String]) -> Result<Replay, DataError> {
         let columns =
             inputs.iter().map(|n| frame.require(n).map(<[f64]>::to_vec)).collect::<Result<_, _>>()?;
+        let held = inputs.iter().map(|n| frame.is_held(n)).collect();
         let t0 = frame.time()[0];
-        Ok(Replay { time: frame.time().iter().map(|t| t - t0).collect(), columns, cursor: 0 })
+        Ok(Replay {
+            time: frame.time().iter().map(|t| t - t0).collect(),
+            columns,
+            held,
+            cursor: 0,
+            sample: 0,
+        })
     }
 
     /// The recorded value of input `k` at time `t`.
     pub fn at(&mut self, k: usize, t: f64) -> f64 {
+        if self.held[k] {
+            let j = self.sample_at(t);
+            return self.columns[k][j];
+        }
         crate::data::interpolate_at(&self.time, &self.columns[k], t, &mut self.cursor)
+    }
+
+    /// The last sample at or before `t` (a control time within a millionth of a sample
+    /// interval of a sample is on it: the grid k·Δt and the record's times round apart).
+    fn sample_at(&mut self, t: f64) -> usize {
+        let n = self.time.len();
+        let close = 1e-6 * self.time[n - 1] / (n - 1).max(1) as f64;
+        if self.time[self.sample] > t + close {
+            self.sample = 0;
+        }
+        while self.sample + 1 < n && self.time[self.sample + 1] <= t + close {
+            self.sample += 1;
+        }
+        self.sample
     }
 }
 
@@ -112,6 +151,28 @@ impl Controller for Replay {
         for (k, o) in out.iter_mut().enumerate() {
             *o = self.at(k, t);
         }
+    }
+
+    fn before(&mut self, t: f64, out: &mut [f64]) -> bool {
+        if !self.held.contains(&true) {
+            return false;
+        }
+        let j = self.sample_at(t);
+        let n = self.time.len();
+        let close = 1e-6 * self.time[n - 1] / (n - 1).max(1) as f64;
+        if j == 0 || (self.time[j] - t).abs() > close {
+            return false;
+        }
+        let mut jumped = false;
+        for (k, o) in out.iter_mut().enumerate() {
+            if self.held[k] {
+                *o = self.columns[k][j - 1];
+                jumped |= self.columns[k][j] != self.columns[k][j - 1];
+            } else {
+                *o = self.at(k, t);
+            }
+        }
+        jumped
     }
 }
 
@@ -130,5 +191,27 @@ mod tests {
             r.input(t, &[], &mut out);
             assert_eq!(out[0], want, "t = {t}");
         }
+    }
+
+    /// A held input replays its sample's value up to the next sample, and just before a
+    /// sample where it jumps, the value before the jump; a linear one beside it is a line.
+    #[test]
+    fn a_held_input_steps_at_its_samples() {
+        let mut f = Frame::new("rig.csv", "t", vec![0.0, 0.1, 0.2, 0.3]).unwrap();
+        f.push("F", vec![1.0, 1.0, 4.0, 4.0]).unwrap();
+        f.push("u", vec![0.0, 1.0, 2.0, 3.0]).unwrap();
+        f.hold("F").unwrap();
+        let mut r = Replay::new(&f, &["F".to_string(), "u".to_string()]).unwrap();
+        let mut out = [0.0; 2];
+        for (t, want) in [(0.0, [1.0, 0.0]), (0.15, [1.0, 1.5]), (0.2, [4.0, 2.0]), (0.25, [4.0, 2.5])] {
+            r.input(t, &[], &mut out);
+            assert_eq!(out, want, "t = {t}");
+        }
+        r.input(0.2, &[], &mut out);
+        assert!(r.before(0.2 + 1e-12, &mut out));
+        assert_eq!(out[0], 1.0);
+        assert!((out[1] - 2.0).abs() < 1e-10, "{out:?}");
+        assert!(!r.before(0.1, &mut out), "no jump at 0.1");
+        assert!(!r.before(0.25, &mut out), "0.25 is no sample");
     }
 }

@@ -170,9 +170,9 @@ impl Dopri5 {
             self.fresh = false;
         }
         // the inputs at t0 are the last call's at its t1, which lie on the line (it was drawn
-        // through them where they left the one before): only the first call has none
-        let from_line = !first;
-        debug_assert!(first || self.on_line(t0, u.0), "advance continues the interval before");
+        // through them where they left the one before), but where an input held between
+        // samples jumped at t0 (the step before ended on its value before the jump)
+        let from_line = !first && self.on_line(t0, u.0);
         let breaks = !from_line || !self.on_line(t1, u.1);
         // how far a step may reach: past t1 while the line may hold on; to t1 where the line
         // broke at the control time before as well (a replayed record breaks it at every

@@ -301,6 +301,7 @@ pub fn simulate(
     let mut x = x0.to_vec();
     let mut u_now = vec![0.0; m];
     let mut u_next = vec![0.0; m];
+    let mut u_before = vec![0.0; m];
     controller.input(0.0, &x, &mut u_now);
     let cap = steps / every + 1;
     let adaptive = settings.integrator.is_adaptive();
@@ -362,15 +363,17 @@ pub fn simulate(
         step += 1;
         let t1 = step as f64 * dt;
         controller.input(t1, &x, &mut u_next);
+        // an input held between samples that jumps at t1 holds its value before over the step
+        let u_end: &[f64] = if controller.before(t1, &mut u_before) { &u_before } else { &u_next };
         // every method below writes all of x
         std::mem::swap(&mut prev, &mut x);
         let x_old: &[f64] = &prev;
         match settings.integrator {
             Integrator::ModifiedEuler => {
                 // eq. (B8): rudder at the end of the step
-                system.derivatives(x_old, &u_next, &mut ws, &mut k[0]);
+                system.derivatives(x_old, u_end, &mut ws, &mut k[0]);
                 if pending {
-                    if u_next == u_now {
+                    if u_end == u_now {
                         fill(&k[0], &mut out);
                     } else {
                         system.derivatives(x_old, &u_now, &mut ws, &mut tmp);
@@ -385,11 +388,11 @@ pub fn simulate(
             Integrator::Dopri5 | Integrator::Rosenbrock => {
                 // the samples' ẋ all at once after the run (below): the steps end between them
                 let start = t1 - dt;
-                dopri.advance(system, &mut ws, x_old, &mut x, (&u_now, &u_next), (start, dt), end)?;
+                dopri.advance(system, &mut ws, x_old, &mut x, (&u_now, u_end), (start, dt), end)?;
             }
             Integrator::Rk4 => {
                 for j in 0..m {
-                    u_mid[j] = 0.5 * (u_now[j] + u_next[j]);
+                    u_mid[j] = 0.5 * (u_now[j] + u_end[j]);
                 }
                 system.derivatives(x_old, &u_now, &mut ws, &mut k[0]);
                 if pending {
@@ -407,7 +410,7 @@ pub fn simulate(
                 for i in 0..n {
                     tmp[i] = x_old[i] + dt * k[2][i];
                 }
-                system.derivatives(&tmp, &u_next, &mut ws, &mut k[3]);
+                system.derivatives(&tmp, u_end, &mut ws, &mut k[3]);
                 for i in 0..n {
                     x[i] = x_old[i] + dt / 6.0 * (k[0][i] + 2.0 * k[1][i] + 2.0 * k[2][i] + k[3][i]);
                 }

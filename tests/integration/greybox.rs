@@ -12,7 +12,13 @@ use crate::common::{lorenz_rows, noise, noisy_frame, trajectory, Lcg, LORENZ_FRE
 /// Nomoto's T·ṙ + r = K·δ in a zigzag (the rudder put over to ∓`rudder` when the heading
 /// passes ±`rudder`; the test's own logic), from rest: the rows (ψ, r) every `h` seconds
 /// and the rudder as recorded at each (the value in force over the next interval).
-fn nomoto_zigzag(k: f64, t_const: f64, rudder: f64, h: f64, samples: usize) -> (Vec<Vec<f64>>, Vec<f64>) {
+pub(crate) fn nomoto_zigzag(
+    k: f64,
+    t_const: f64,
+    rudder: f64,
+    h: f64,
+    samples: usize,
+) -> (Vec<Vec<f64>>, Vec<f64>) {
     nomoto_zigzag_holding(k, t_const, rudder, 0.0, h, samples)
 }
 

@@ -311,6 +311,14 @@ pub struct IdentifyCommand {
     /// With --model as the file's `keep_spikes = true` (which the model written keeps).
     #[arg(long)]
     pub keep_spikes: bool,
+    /// How the runs' inputs behave between samples. `auto`: an input that stays put between
+    /// samples and jumps at isolated ones (a digital controller's command, a force stepped by
+    /// a rig) is taken as held from each sample to the next, and said; else a line. The
+    /// integral form integrates a held input piece by piece between its jumps, and a replay
+    /// into a simulation holds it over each step. With --model as the file's `intersample`
+    /// (which the model written keeps).
+    #[arg(long, value_enum)]
+    pub intersample: Option<termid::data::Intersample>,
     /// Write a figure of the raw and prepared signals of every run into this folder.
     #[arg(long)]
     pub prepared_svg: Option<PathBuf>,

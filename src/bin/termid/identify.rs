@@ -109,6 +109,15 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
         // the rows are a time series whose rates are taken: a glitch would be one
         crate::runs::mend_spikes(&mut frames)?;
     }
+    if let Target::Derivative(state) = &target {
+        // every column but the state whose rate is taken may be an input held between samples
+        let intersample = cmd.intersample.unwrap_or_default();
+        for f in &mut frames {
+            let columns: Vec<String> = f.names()[1..].iter().filter(|n| *n != state).cloned().collect();
+            let columns: Vec<&str> = columns.iter().map(String::as_str).collect();
+            termid::data::mark_held(f, &columns, intersample)?.iter().for_each(|n| crate::runs::say(n));
+        }
+    }
     match &target {
         Target::Derivative(s) if *s == cmd.time => {
             bail!("--target d{s}/dt: `{s}` is the time column, whose rate is 1; name a measured quantity")

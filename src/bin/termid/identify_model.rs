@@ -32,7 +32,8 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     if let Some(out) = &cmd.out {
         termid::output::check_file(out)?;
     }
-    let mut model = termid::plugins::load(&path)?.keeping_spikes(cmd.keep_spikes);
+    let mut model =
+        termid::plugins::load(&path)?.keeping_spikes(cmd.keep_spikes).with_intersample(cmd.intersample);
     if cmd.backend.is_some() {
         // the command line's back-end (with its stepwise options) replaces the file's
         model = model.with_backend(&configure_backend(&cmd)?)?;

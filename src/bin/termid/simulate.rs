@@ -236,7 +236,14 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
         .manoeuvre
         .as_deref()
         .and_then(|m| m.strip_prefix("replay:"))
-        .map(|file| crate::runs::replay_frame(std::path::Path::new(file), &model.spec().model.time))
+        .map(|file| -> Result<termid::data::Frame> {
+            let mut frame = crate::runs::replay_frame(std::path::Path::new(file), &model.spec().model.time)?;
+            // an input held between samples in the record is held in the replay
+            let inputs: Vec<&str> = system.inputs.iter().map(String::as_str).collect();
+            let notes = termid::data::mark_held(&mut frame, &inputs, model.spec().model.intersample)?;
+            notes.iter().for_each(|n| crate::runs::say(n));
+            Ok(frame)
+        })
         .transpose()?;
     let controller = |system: &termid::sim::System| -> Result<Box<dyn Controller>> {
         Ok(match &replayed {

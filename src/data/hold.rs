@@ -1,0 +1,327 @@
+//! Inputs held between samples (a zero-order hold: a digital controller's command, a force
+//! stepped by a test rig, a mode switch). Such an input is constant from each sample to the
+//! next and jumps at the samples; taken as a line between samples instead, it shifts every
+//! jump half an interval early and biases every coefficient near it (a mass-spring-damper
+//! driven by a force held for 0.5 s: damping −0.288 for −0.3).
+
+use serde::{Deserialize, Serialize};
+
+use super::{DataError, Frame};
+
+/// How a run's inputs behave between their samples (MATLAB's `InterSample`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+pub enum Intersample {
+    /// Held where the record shows a controller's command ([`held`], [`Hold::on_a_clock`]),
+    /// else a line between samples.
+    #[default]
+    Auto,
+    /// A line between samples, whatever the record shows.
+    Linear,
+    /// Held from each sample to the next wherever the record stays put between isolated
+    /// jumps ([`held`]), on a clock or not. (A record that changes at every sample cannot be
+    /// told from one that moves, and stays a line.)
+    Held,
+}
+
+impl Intersample {
+    /// The name a model file and the command line use.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Intersample::Auto => "auto",
+            Intersample::Linear => "linear",
+            Intersample::Held => "held",
+        }
+    }
+}
+
+/// What shows a record held between its samples.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hold {
+    /// Samples at which it jumps.
+    pub jumps: usize,
+    /// The share of intervals over which it does not change at all.
+    pub flat: f64,
+    /// The median jump, in units of the record's span.
+    pub jump: f64,
+    /// The greatest common divisor of the samples between its jumps: a controller's period
+    /// in samples where it is 2 or more (the jumps on its clock).
+    pub period: usize,
+}
+
+impl Hold {
+    /// Whether the jumps keep to a clock of two or more samples (nine jumps at least): then
+    /// they are a digital controller's, on the samples, and the record is held between them.
+    /// A record that jumps at isolated samples off any clock (a relay switched
+    /// by the motion, a rudder thrown at once when the heading passes its check) may jump
+    /// anywhere between two samples: a line between them is the better guess (its error
+    /// averages out over the jumps, the hold's is half an interval late on average).
+    pub fn on_a_clock(&self) -> bool {
+        self.period >= 2 && self.jumps >= CLOCK_JUMPS
+    }
+}
+
+/// Jumps needed to believe a clock: intervals between random jumps share a divisor of 2 or
+/// more by chance with odds of Σ p^−(jumps − 1) over the primes p, 0.4 % with 9 jumps.
+const CLOCK_JUMPS: usize = 9;
+
+/// Jumps with a changing interval beside them, at most this share: a held record changes at
+/// isolated samples; a moving one (a rudder turning at its rate, even printed to three digits
+/// and so flat between its counts) changes on consecutive intervals.
+const SIDE_BY_SIDE: f64 = 0.05;
+
+/// The median jump at least this share of the record's span: a slowly moving quantity
+/// rounded to its counts also changes at isolated samples, but by one count of many.
+const SPAN: f64 = 0.05;
+
+/// The median jump at least this share of the record's largest value: a steady quantity
+/// printed to three significant figures flickers by one count, which is its whole span
+/// (MARIN's propeller rate, 0.1 at 76 rpm), but 0.1-1 % of its value.
+const SIZE: f64 = 0.01;
+
+/// Whether `x` is held between its samples: it jumps at isolated samples (no two changing
+/// intervals side by side, but for 5 % of its jumps) by a fair share of its span (5 %) and of
+/// its size (1 % of its largest value), and stays put in between. `None` for a record that
+/// moves, never changes, or has under 20 intervals. A record that jumps at every sample
+/// (a random binary signal switched each sample) cannot be told from one that moves: it is
+/// not found; declare it held.
+pub fn held(x: &[f64]) -> Option<Hold> {
+    if x.len() < 21 {
+        return None;
+    }
+    let changes: Vec<bool> = x.windows(2).map(|w| w[1] != w[0]).collect();
+    let at: Vec<usize> = (0..changes.len()).filter(|&i| changes[i]).collect();
+    if at.is_empty() {
+        return None;
+    }
+    let beside = at
+        .iter()
+        .filter(|&&i| (i > 0 && changes[i - 1]) || changes.get(i + 1).copied().unwrap_or(false))
+        .count();
+    if beside as f64 > SIDE_BY_SIDE * at.len() as f64 {
+        return None;
+    }
+    let (low, high) = x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
+    let size = low.abs().max(high.abs());
+    let mut jumps: Vec<f64> = at.iter().map(|&i| (x[i + 1] - x[i]).abs()).collect();
+    let middle = jumps.len() / 2;
+    let median = *jumps.select_nth_unstable_by(middle, f64::total_cmp).1;
+    if median < SPAN * (high - low) || median < SIZE * size {
+        return None;
+    }
+    let period = at.windows(2).fold(0, |g, w| gcd(g, w[1] - w[0]));
+    Some(Hold {
+        jumps: at.len(),
+        flat: 1.0 - at.len() as f64 / changes.len() as f64,
+        jump: median / (high - low),
+        period,
+    })
+}
+
+fn gcd(a: usize, b: usize) -> usize {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}
+
+/// Marks the columns of `frame` named in `columns` that are held between samples, as
+/// `intersample` says, and says what `auto` found and why: held where a column jumps at
+/// isolated samples on a clock, a line (said) where it jumps off any. The columns a frame
+/// does not have are passed over.
+pub fn mark_held(
+    frame: &mut Frame,
+    columns: &[&str],
+    intersample: Intersample,
+) -> Result<Vec<String>, DataError> {
+    let mut notes = Vec::new();
+    for name in columns {
+        let Some(column) = frame.column(name) else { continue };
+        match intersample {
+            Intersample::Linear => frame.release(name),
+            Intersample::Held => {
+                if held(column).is_some() {
+                    frame.hold(name)?;
+                }
+            }
+            Intersample::Auto => {
+                let Some(h) = held(column) else { continue };
+                let how = format!(
+                    "{}: `{name}` stays put between samples ({:.0} % of intervals) and jumps at {} isolated samples (by {:.0} % of its span, median)",
+                    frame.origin(),
+                    100.0 * h.flat,
+                    h.jumps,
+                    100.0 * h.jump
+                );
+                if h.on_a_clock() {
+                    frame.hold(name)?;
+                    notes.push(format!(
+                        "{how}, every one on a clock of {} samples: a controller's command, taken as held from each sample to the next (a zero-order hold), not as a line between them; where it moves between its samples, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)",
+                        h.period
+                    ));
+                } else {
+                    frame.release(name);
+                    notes.push(format!(
+                        "{how}, on no clock: it may jump anywhere between two samples (a relay, a switch thrown by the motion), so it is taken as a line between them, which halves the error of a jump's time on average; where it is a command held from each sample to the next, say so (identify --intersample held; a model file's `intersample = \"held\"`; Python `intersample=\"held\"`)"
+                    ));
+                }
+            }
+        }
+    }
+    Ok(notes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A force held for 50 samples at a time, at random levels: held; the same force moving
+    /// as a line between the levels over 5 samples: not.
+    #[test]
+    fn steps_are_held_and_ramps_are_not() {
+        let mut seed = 3u64;
+        let levels: Vec<f64> = (0..40).map(|_| 4.0 * crate::data::test_noise(&mut seed)).collect();
+        let steps: Vec<f64> = (0..2000).map(|k| levels[k / 50]).collect();
+        let h = held(&steps).unwrap();
+        assert_eq!(h.jumps, 39);
+        assert!((h.flat - (1.0 - 39.0 / 1999.0)).abs() < 1e-12);
+        let ramps: Vec<f64> = (0..2000)
+            .map(|k| {
+                let (j, r) = (k / 50, k % 50);
+                if j == 0 || r >= 5 {
+                    levels[j]
+                } else {
+                    levels[j - 1] + (levels[j] - levels[j - 1]) * r as f64 / 5.0
+                }
+            })
+            .collect();
+        assert_eq!(held(&ramps), None);
+    }
+
+    /// A binary signal ±1 switched now and then (the classic identification input), and a
+    /// single step: held. A switch at every sample cannot be told from a motion: not.
+    #[test]
+    fn binary_signals_and_a_step_are_held() {
+        let mut seed = 5u64;
+        let (mut prbs, mut level) = (Vec::new(), 1.0);
+        while prbs.len() < 500 {
+            // held for 2 to 15 samples
+            let hold = 2 + ((crate::data::test_noise(&mut seed) + 0.5) * 14.0) as usize;
+            prbs.extend(std::iter::repeat_n(level, hold));
+            level = -level;
+        }
+        let switches = prbs.windows(2).filter(|w| w[0] != w[1]).count();
+        let h = held(&prbs).unwrap();
+        assert_eq!(h.jumps, switches);
+        assert_eq!(h.jump, 1.0);
+        let step: Vec<f64> = (0..100).map(|k| if k < 30 { 0.0 } else { 2.0 }).collect();
+        assert_eq!(held(&step).map(|h| h.jumps), Some(1));
+        let every: Vec<f64> = (0..100).map(|k| if k % 2 == 0 { 1.0 } else { -1.0 }).collect();
+        assert_eq!(held(&every), None);
+    }
+
+    /// Quantised records that are not held: a slow ramp in counts (isolated changes of one
+    /// count of many), a steady rate printed to three figures (76.0 / 76.1 / 75.9: its whole
+    /// span, 0.1 % of its value), a rudder turned at its rate and printed to 0.1° (changes
+    /// side by side), a constant.
+    #[test]
+    fn counts_and_printed_digits_are_not_held() {
+        let ramp: Vec<f64> = (0..1000).map(|k| (k as f64 / 3.3).floor()).collect();
+        assert_eq!(held(&ramp), None);
+        let mut seed = 8u64;
+        let rate: Vec<f64> = (0..1000)
+            .map(|_| {
+                let n = crate::data::test_noise(&mut seed);
+                76.0 + if n > 0.4 {
+                    0.1
+                } else if n < -0.4 {
+                    -0.1
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let flicker = held(&rate);
+        assert_eq!(flicker, None);
+        let rudder: Vec<f64> = (0..1000)
+            .map(|k| {
+                let t = 0.05 * k as f64;
+                (10.0f64.min(2.3 * t) * 10.0).round() / 10.0
+            })
+            .collect();
+        assert_eq!(held(&rudder), None);
+        assert_eq!(held(&[1.5; 100]), None);
+        assert_eq!(held(&[0.0, 1.0, 1.0]), None);
+    }
+
+    /// Marking: a command on a clock of 10 samples held, said; a switch at irregular samples
+    /// (a relay) left a line, said; a moving column neither. `linear` marks none, `held` both
+    /// switching columns, clock or not, and never the moving one.
+    #[test]
+    fn marks_as_asked() {
+        let t: Vec<f64> = (0..100).map(|k| 0.1 * k as f64).collect();
+        let mut f = Frame::new("rig.csv", "t", t.clone()).unwrap();
+        f.push("F", (0..100).map(|k| if (k / 10) % 2 == 0 { 1.0 } else { -1.0 }).collect()).unwrap();
+        let switches = [7, 19, 30, 48, 61, 77, 83, 95];
+        f.push(
+            "G",
+            (0..100)
+                .map(|k| if switches.iter().filter(|&&s| k >= s).count() % 2 == 0 { 0.0 } else { 5.0 })
+                .collect(),
+        )
+        .unwrap();
+        f.push("x", t.iter().map(|t| t.sin()).collect()).unwrap();
+        let mut g = f.clone();
+        let notes = mark_held(&mut f, &["F", "G", "x", "absent"], Intersample::Auto).unwrap();
+        assert!(f.is_held("F") && !f.is_held("G") && !f.is_held("x"));
+        assert_eq!(notes.len(), 2);
+        assert!(
+            notes[0].contains("rig.csv: `F` stays put") && notes[0].contains("9 isolated samples"),
+            "{}",
+            notes[0]
+        );
+        assert!(
+            notes[0].contains("on a clock of 10 samples") && notes[0].contains("taken as held"),
+            "{}",
+            notes[0]
+        );
+        assert!(
+            notes[1].contains("`G`")
+                && notes[1].contains("on no clock")
+                && notes[1].contains("--intersample held"),
+            "{}",
+            notes[1]
+        );
+        let mut linear = f.clone();
+        assert!(mark_held(&mut linear, &["F"], Intersample::Linear).unwrap().is_empty());
+        assert!(!linear.is_held("F"));
+        mark_held(&mut g, &["F", "G", "x"], Intersample::Held).unwrap();
+        assert!(g.is_held("F") && g.is_held("G") && !g.is_held("x"));
+    }
+
+    /// The clock: jumps every 50 samples from sample 37 keep a period of 50; six jumps do not
+    /// show one, and intervals of 3, 4 and 5 samples share none.
+    #[test]
+    fn a_clock_is_the_jumps_common_divisor() {
+        let levels = [0.0, 3.0, -1.0, 2.0, -2.0, 1.0, 4.0, -3.0, 0.5, 2.5, -0.5, 1.5, -2.5];
+        let clocked: Vec<f64> = (0..600).map(|k| levels[(k + 13) / 50]).collect();
+        let h = held(&clocked).unwrap();
+        assert_eq!((h.period, h.jumps), (50, 12));
+        assert!(h.on_a_clock());
+        assert!(!held(&clocked[..300]).unwrap().on_a_clock(), "6 jumps");
+        let mut at = 0;
+        let irregular: Vec<f64> = (0..200)
+            .map(|k| {
+                if [10, 13, 17, 22, 25, 29, 34, 37, 41, 46, 49].contains(&k) {
+                    at += 1;
+                }
+                levels[at]
+            })
+            .collect();
+        let h = held(&irregular).unwrap();
+        assert_eq!((h.period, h.jumps), (1, 11));
+        assert!(!h.on_a_clock());
+    }
+}
