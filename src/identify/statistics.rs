@@ -39,7 +39,7 @@ pub struct EquationMoments {
 
 /// A run read in pieces, as far as it has been read: its name, its own parameters (from its
 /// first piece) and each equation's statistics so far.
-type RunSoFar = (String, BTreeMap<String, ParamValue>, Vec<Option<Moments>>);
+type RunSoFar = (String, BTreeMap<String, ParamValue>, Vec<Option<Moments>>, Vec<String>);
 
 impl EquationMoments {
     /// The statistics of `equation` of `model` over `frames` (the target as
@@ -83,8 +83,9 @@ impl EquationMoments {
     /// the whole runs to round-off, for a derivative method with a fixed reach (central
     /// differences, five points, Savitzky-Golay; the chunks must carry at least that many
     /// rows of context). Each chunk is admitted by the model ([`Model::admit_at`]) and checked
-    /// for gaps in time; per-run parameters (`first:u`, `mean:u:4`) are read off each run's
-    /// first chunk. Returns the notes of the runs' admission too.
+    /// for gaps in time; per-run parameters (`first:u`, `mean:u:4`) and the inputs held between
+    /// samples ([`crate::data::mark_held`]) are read off each run's first chunk. Returns the
+    /// notes of the runs' admission too.
     pub fn of_chunks(
         model: &Model,
         equation: &str,
@@ -131,6 +132,17 @@ impl EquationMoments {
                 crate::data::check_gaps(&chunk.frame, 3.0).map_err(|e| shift(e.into()))?;
                 // a chunk's spikes are its own; what else admission says, every chunk repeats
                 notes.extend(admitted.spikes);
+                if let Some((.., held)) = &run {
+                    // the inputs held between samples as the run's first chunk found them, so
+                    // that no chunk takes an input otherwise for lack of jumps of its own
+                    for input in &model.spec().inputs {
+                        if held.contains(&input.name) {
+                            chunk.frame.hold(&input.name).map_err(|e| shift(e.into()))?;
+                        } else {
+                            chunk.frame.release(&input.name);
+                        }
+                    }
+                }
                 if run.is_none() {
                     notes.extend(admitted.notes);
                     // a run's own parameters come from its start, which only its first chunk holds
@@ -141,9 +153,10 @@ impl EquationMoments {
                     targets.get_or_insert_with(|| {
                         eqs.iter().map(|eq| default_target(eq, std::slice::from_ref(&chunk.frame))).collect()
                     });
-                    run = Some((chunk.frame.origin().to_string(), fixed, vec![None; eqs.len()]));
+                    let held = chunk.frame.held().to_vec();
+                    run = Some((chunk.frame.origin().to_string(), fixed, vec![None; eqs.len()], held));
                 }
-                let (Some((_, fixed, moments)), Some(targets)) = (run.as_mut(), targets.as_ref()) else {
+                let (Some((_, fixed, moments, _)), Some(targets)) = (run.as_mut(), targets.as_ref()) else {
                     unreachable!("set by the run's first chunk")
                 };
                 let how = Identification {
@@ -169,7 +182,7 @@ impl EquationMoments {
                     }
                 }
             }
-            if let Some((name, _, moments)) = run {
+            if let Some((name, _, moments, _)) = run {
                 for (list, m) in out.iter_mut().zip(moments) {
                     if let Some(moments) = m {
                         list.push(RunMoments { run: name.clone(), moments });

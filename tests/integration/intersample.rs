@@ -6,17 +6,19 @@
 use crate::common::{json, termid, Lcg, Scratch};
 
 /// The run: 3001 samples 0.01 s apart of x, v and F, F held at a random level in [−2, 2]
-/// for 50 samples at a time. Between samples, with F constant, x − F/2 is a damped
-/// oscillation: e^(−αt)(y₀ cos ω_d t + (v₀ + α y₀)/ω_d sin ω_d t), α = 0.15, ω_d² = 4 − α².
-fn held_force_run() -> String {
+/// from each sample where `changes` to the next where it does (every 50 samples: `held_force_run`).
+/// Between samples, with F constant, x − F/2 is a damped oscillation:
+/// e^(−αt)(y₀ cos ω_d t + (v₀ + α y₀)/ω_d sin ω_d t), α = 0.15, ω_d² = 4 − α².
+fn force_run(changes: impl Fn(usize) -> bool) -> String {
     let (alpha, h) = (0.15, 0.01);
     let wd = (4.0f64 - alpha * alpha).sqrt();
     let mut rng = Lcg(11);
-    let levels: Vec<f64> = (0..61).map(|_| 4.0 * rng.next() - 2.0).collect();
-    let (mut x, mut v) = (1.0, 0.0);
+    let (mut x, mut v, mut force) = (1.0, 0.0, 0.0);
     let mut csv = String::from("t,x,v,F\n");
     for k in 0..3001 {
-        let force = levels[k / 50];
+        if k == 0 || changes(k) {
+            force = 4.0 * rng.next() - 2.0;
+        }
         csv.push_str(&format!("{:?},{x:?},{v:?},{force:?}\n", 0.01 * k as f64));
         let y = x - force / 2.0;
         let (c, s, e) = ((wd * h).cos(), (wd * h).sin(), (-alpha * h).exp());
@@ -24,6 +26,11 @@ fn held_force_run() -> String {
         v = e * (v * c - (alpha * v + 4.0 * y) / wd * s);
     }
     csv
+}
+
+/// A controller that sets a new force every 50 samples.
+fn held_force_run() -> String {
+    force_run(|k| k % 50 == 0)
 }
 
 const MODEL: &str = r#"
@@ -203,4 +210,47 @@ fn a_switch_off_any_clock_stays_a_line() {
     let held = nomoto.replacen("intercept = false", "intercept = false\nintersample = \"held\"", 1);
     let (hold, _) = error("held", &held);
     assert!(line < 0.01 && hold > 2.0 * line, "as a line {line}, held {hold}");
+}
+
+/// Read in pieces (`termid moments --chunk-rows 1450`), the run's statistics are those of the
+/// whole file: a controller on a clock of 10 samples sets a new force at every tick for 15 s,
+/// then only at 20 s and 25 s. The first piece finds the force held (146 jumps on its clock);
+/// the second, rows 1432-3000 with its context, holds 8 jumps (1440-1490, 2000, 2500), too few
+/// to show a clock, and takes the force as the first did (it took it as a line: 1e-4 off).
+#[test]
+fn pieces_hold_the_force_as_the_whole_run_does() {
+    let dir = Scratch::new("held-force-pieces");
+    let data = dir.join("rig.csv");
+    std::fs::write(&data, force_run(|k| k % 10 == 0 && (k < 1500 || k == 2000 || k == 2500))).unwrap();
+    let model = dir.join("msd.toml");
+    let candidates =
+        "[equations.v_dot]\nstate = \"v\"\ncandidates = [\"x\", \"v\", \"F\", \"x^2\", \"x*F\"]\n";
+    std::fs::write(&model, format!("{MODEL}\n{candidates}")).unwrap();
+    let numbers = |rows: &str| -> Vec<f64> {
+        let out = dir.join(format!("{rows}.moments"));
+        let args = ["moments", "--model", model.to_str().unwrap(), "--equation", "v_dot", "--data"];
+        let (ok, _, err) = termid(
+            &[
+                &args[..],
+                &[
+                    data.to_str().unwrap(),
+                    "--derivative",
+                    "integral",
+                    "--chunk-rows",
+                    rows,
+                    "--out",
+                    out.to_str().unwrap(),
+                ],
+            ]
+            .concat(),
+        );
+        assert!(ok, "{err}");
+        let v = json(&std::fs::read_to_string(out).unwrap());
+        v["runs"][0]["moments"]["numbers"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+    };
+    let (whole, pieces) = (numbers("0"), numbers("1450"));
+    assert_eq!(whole.len(), pieces.len());
+    for (a, b) in whole.iter().zip(&pieces) {
+        assert!((a - b).abs() <= 1e-9 * a.abs().max(1.0), "{a} vs {b}");
+    }
 }
