@@ -182,7 +182,7 @@ impl Compiled {
 /// (`dx/dt`) is an equation of motion of the rows as a time series over the column `time`,
 /// by the `derivative` method (`integral` where none is named, as the command line does).
 #[pyfunction]
-#[pyo3(signature = (target, columns, terms, backend = "{\"method\": \"stepwise\"}", intercept = true, forced = vec![], excluded = vec![], parameters = BTreeMap::new(), weights = None, time = None, derivative = None, keep_spikes = false, intersample = "auto"))]
+#[pyo3(signature = (target, columns, terms, backend = "{\"method\": \"stepwise\"}", intercept = true, forced = vec![], excluded = vec![], parameters = BTreeMap::new(), weights = None, time = None, derivative = None, keep_spikes = false, intersample = "auto", delays = BTreeMap::new()))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn fit(
     py: Python<'_>,
@@ -199,6 +199,7 @@ pub(crate) fn fit(
     derivative: Option<String>,
     keep_spikes: bool,
     intersample: &str,
+    delays: BTreeMap<String, f64>,
 ) -> PyResult<PyFit> {
     let intersample = match intersample {
         "auto" => termid::data::Intersample::Auto,
@@ -290,11 +291,19 @@ pub(crate) fn fit(
             for note in termid::data::mark_held(&mut frame, &columns, intersample).map_err(fail)? {
                 warn(py, note)?;
             }
+            // columns acting later than recorded, read back (after the marking: a held column
+            // sample for sample)
+            for (name, seconds) in &delays {
+                frame = termid::data::delayed(&frame, name, *seconds, 0.0).map_err(fail)?;
+            }
             let frames = [frame];
+            let others: Vec<String> = columns.iter().map(|c| c.to_string()).collect();
             py.detach(|| -> Result<Fit, termid::identify::IdentifyError> {
                 let mut fit = how.fit_design(&rate, design, forced, excluded, &frames, selector.as_ref())?;
                 // rows of a time series are not independent: the honest standard errors' factor
                 how.describe_residuals(&rate, candidates, &frames, &mut fit)?;
+                // and a column acting later than recorded leaves its mark on them
+                how.say_delays(&rate, candidates, &frames, &others, &mut fit)?;
                 Ok(fit)
             })
             .map_err(fail)?

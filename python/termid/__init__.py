@@ -608,6 +608,7 @@ def fit(
     derivative: Optional[str] = None,
     keep_spikes: bool = False,
     intersample: str = "auto",
+    delays: Optional[Mapping[str, float]] = None,
     **settings: Any,
 ) -> Fit:
     """Fits ``target`` (a column of ``data``) by the candidate ``terms`` (text over the other
@@ -635,7 +636,10 @@ def fit(
     samples: ``"auto"`` (default) takes a column that stays put and jumps at isolated samples
     on a clock (a controller's command) as held from each sample to the next, integrated
     piece by piece between its jumps, with a warning, ``"linear"`` as a line between samples,
-    ``"held"`` held wherever a column jumps at isolated samples, on a clock or not.
+    ``"held"`` held wherever a column jumps at isolated samples, on a clock or not;
+    ``delays`` columns that act later than recorded (a dead time), in seconds, e.g.
+    ``{"F": 0.2}``: read that much earlier against the rest, the rows' first seconds left out
+    (without it, a rate's ``notes`` say a delay the residuals show).
 
     >>> import pandas as pd
     >>> df = pd.DataFrame({"x1": [1.0, 2, 3, 4, 5], "x2": [2.0, 1, 4, 3, 6]}).eval("y = x1 + 2*x2")
@@ -693,6 +697,7 @@ def fit(
             derivative,
             keep_spikes,
             intersample,
+            dict(delays or {}),
         )
     except TermidError as e:
         raise _explained(e, columns.left_out) from None

@@ -288,6 +288,31 @@ def test_a_force_held_between_samples_is_integrated_as_held():
         termid.fit(df, "dv/dt", library, intersample="zoh")
 
 
+def test_a_force_acting_late_is_said_and_fitted_with_its_delay():
+    # the same oscillator feeling the force 20 samples (0.2 s) after it is recorded: said in
+    # the notes; read 0.2 s earlier (delays=) the true terms
+    rng = np.random.default_rng(4)
+    levels = rng.uniform(-2.0, 2.0, 61)
+    alpha, h = 0.15, 0.01
+    wd = np.sqrt(4.0 - alpha**2)
+    x, v, rows = 1.0, 0.0, []
+    for k in range(3001):
+        rows.append((h * k, x, v, levels[k // 50]))
+        force = levels[max(k - 20, 0) // 50]
+        y = x - force / 2.0
+        c, s, e = np.cos(wd * h), np.sin(wd * h), np.exp(-alpha * h)
+        x, v = force / 2.0 + e * (y * c + (v + alpha * y) / wd * s), e * (v * c - (alpha * v + 4.0 * y) / wd * s)
+    df = pd.DataFrame(rows, columns=["t", "x", "v", "F"])
+    library = ["x", "v", "F", "x^2", "x*F"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plain = termid.fit(df, "dv/dt", library)
+        late = termid.fit(df, "dv/dt", library, delays={"F": 0.2})
+    assert any("`F` acts on dv/dt about 0.200 s after it is recorded" in n for n in plain.notes)
+    assert late.coefficients.sort_index().round(5).to_dict() == {"F": 2.0, "v": -0.3, "x": -4.0}
+    assert not any("acts on" in n for n in late.notes)
+
+
 def test_the_rows_that_cannot_choose_are_said():
     """Hald's cement against Draper & Smith's sums of squares of its pairs: forward stepping's
     {x4, x1} leaves 74.76, {x2, x1} 57.90, so x2 in x4's place is 2.25 residual variances

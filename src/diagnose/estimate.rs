@@ -1536,9 +1536,10 @@ impl Estimate {
             ));
             if let (Some(moved), Some(m)) = (f.moved, &f.largest) {
                 out.push_str(&format!(
-                    "the estimated initial values moved {} times the records' noise from their first samples (root mean square; at most {:+.1} times, {} of {})\n",
+                    "the estimated initial values moved {} times the records' noise from their first samples (root mean square; at most {} times, {} of {})\n",
                     sig(moved, 2),
-                    m.z,
+                    // signed, at the root mean square's precision (a move of −2e-5 is not −0.0)
+                    if m.z > 0.0 { format!("+{}", sig(m.z, 2)) } else { sig(m.z, 2) },
                     m.state,
                     m.run
                 ));

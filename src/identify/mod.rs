@@ -42,9 +42,12 @@ impl std::fmt::Display for Target {
 
 pub use crate::model::ParamValue;
 
+mod delay;
 mod model;
 mod report;
 mod statistics;
+
+pub use delay::Lag;
 
 pub(crate) use model::RunStatistics;
 pub use model::{

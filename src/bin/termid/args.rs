@@ -275,6 +275,11 @@ pub struct IdentifyCommand {
     /// Per-run parameters: `u0=2.01`, `u0=first:u` (first value of u in each run) or `u0=mean:u`.
     #[arg(long = "param", num_args = 1..)]
     pub params: Vec<String>,
+    /// Columns that act later than they are recorded (a dead time): `F=0.2` reads F 0.2 s
+    /// earlier against the rest, the runs' first 0.2 s left out. Without it, a rate's fit
+    /// whose residuals show such a delay says so.
+    #[arg(long = "delay", num_args = 1.., value_name = "NAME=SECONDS")]
+    pub delays: Vec<String>,
     /// Derived variables: `Δu=u-u0`.
     #[arg(long = "derive", num_args = 1..)]
     pub derived: Vec<String>,

@@ -88,6 +88,9 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
         return crate::moments::identify_from_files(cmd);
     }
     if cmd.model.is_some() {
+        if !cmd.delays.is_empty() {
+            bail!("--delay reads columns of plain runs earlier; a model file cannot declare an input's dead time yet: delay the column in the runs, or identify without --model");
+        }
         return crate::identify_model::run(cmd);
     }
     if cmd.refine.is_some() {
@@ -116,6 +119,17 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
             let columns: Vec<String> = f.names()[1..].iter().filter(|n| *n != state).cloned().collect();
             let columns: Vec<&str> = columns.iter().map(String::as_str).collect();
             termid::data::mark_held(f, &columns, intersample)?.iter().for_each(|n| crate::runs::say(n));
+        }
+    }
+    // after the marking: a held column is read back sample for sample
+    for d in &cmd.delays {
+        let (name, seconds) = split_pair(d, "--delay")?;
+        let seconds: f64 =
+            seconds.parse().ok().filter(|s: &f64| s.is_finite() && *s >= 0.0).with_context(|| {
+                format!("--delay `{d}`: `{seconds}` is no delay; give seconds, 0 or more (`F=0.2`)")
+            })?;
+        for f in &mut frames {
+            *f = termid::data::delayed(f, name, seconds, 0.0)?;
         }
     }
     match &target {
@@ -228,6 +242,12 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
     if !cmd.no_time {
         // rows of a time series are not independent; rows without time have no order to test
         identification.describe_residuals(&target, &candidates, &frames, &mut fit)?;
+        // a column acting later than recorded leaves its mark on the residuals
+        if let Target::Derivative(state) = &target {
+            let columns: Vec<String> =
+                frames[0].names()[1..].iter().filter(|n| *n != state).cloned().collect();
+            identification.say_delays(&target, &candidates, &frames, &columns, &mut fit)?;
+        }
     }
     match cmd.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&serde_json::to_value(fit.report())?)?),
