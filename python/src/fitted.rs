@@ -303,7 +303,7 @@ pub(crate) fn fit(
                 // rows of a time series are not independent: the honest standard errors' factor
                 how.describe_residuals(&rate, candidates, &frames, &mut fit)?;
                 // and a column acting later than recorded leaves its mark on them
-                how.say_delays(&rate, candidates, &frames, &others, &mut fit)?;
+                how.say_delays(&rate, candidates, &frames, &others, &mut fit, &|l| l.plain_remedy())?;
                 Ok(fit)
             })
             .map_err(fail)?

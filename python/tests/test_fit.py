@@ -308,7 +308,7 @@ def test_a_force_acting_late_is_said_and_fitted_with_its_delay():
         warnings.simplefilter("ignore")
         plain = termid.fit(df, "dv/dt", library)
         late = termid.fit(df, "dv/dt", library, delays={"F": 0.2})
-    assert any("`F` acts on dv/dt about 0.200 s after it is recorded" in n for n in plain.notes)
+    assert any("`F` acts on dv/dt about 0.200 s later than the rows have it" in n for n in plain.notes)
     assert late.coefficients.sort_index().round(5).to_dict() == {"F": 2.0, "v": -0.3, "x": -4.0}
     assert not any("acts on" in n for n in late.notes)
 

@@ -151,6 +151,9 @@ impl RightHandSide for WithOutputs<'_> {
     fn inputs(&self) -> Vec<String> {
         self.model.inputs()
     }
+    fn delays(&self) -> Vec<f64> {
+        self.model.delays()
+    }
     fn parameters(&self) -> BTreeMap<String, f64> {
         self.model.parameters()
     }

@@ -359,7 +359,15 @@ fn integrate(
     let m = system.inputs.len();
     let (steps, every) = settings.check(n)?;
     let dt = settings.dt;
-    let mut replay = Replay::new(&runs.frames[r], &system.inputs)?;
+    let mut recorded = Replay::new(&runs.frames[r], &system.inputs)?;
+    // inputs that act late reach the system that much later, as in the simulator
+    let mut late;
+    let replay: &mut dyn Controller = if system.delays.is_empty() {
+        &mut recorded
+    } else {
+        late = crate::sim::Delayed::new(&mut recorded, &system.delays);
+        &mut late
+    };
     let mut ws = system.workspace();
     // ∂f/∂x_c is zero for a state the right-hand side does not read
     let read: Vec<usize> = (0..n).filter(|&c| system.reads_state(c)).collect();

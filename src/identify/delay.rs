@@ -116,27 +116,31 @@ impl Identification<'_> {
 }
 
 impl Lag {
-    /// What the lag means for the fit of `target`, and how to fit it.
-    pub fn note(&self, target: &Target) -> String {
+    /// What the lag means for the fit of `target`, and `remedy`: how to fit it.
+    pub fn note(&self, target: &Target, remedy: &str) -> String {
         let s = crate::output::sig(self.seconds, 3);
         format!(
-            "`{}` acts on {target} about {s} s after it is recorded (a dead time, or a lag of about \
-             that): read {s} s earlier, the candidates all together leave {} % of the residual sum \
-             of squares they leave without (delays of 0 to {} s tried), so the coefficients \
-             above are biased; fit it so with --delay {}={s} (Python `delays={{\"{}\": {s}}}`)",
+            "`{}` acts on {target} about {s} s later than the rows have it (a dead time, or a lag \
+             of about that): read {s} s earlier, the candidates all together leave {} % of the \
+             residual sum of squares they leave without (delays of 0 to {} s tried), so the \
+             coefficients above are biased; {remedy}",
             self.column,
             crate::output::sig(100.0 * self.share, 2),
             crate::output::sig(self.longest, 3),
-            self.column,
-            self.column
         )
+    }
+
+    /// How plain runs fit it: `--delay` on the command line, `delays=` in Python.
+    pub fn plain_remedy(&self) -> String {
+        let s = crate::output::sig(self.seconds, 3);
+        format!("fit it so with --delay {}={s} (Python `delays={{\"{}\": {s}}}`)", self.column, self.column)
     }
 }
 
 impl Identification<'_> {
     /// [`Identification::scan_delays`] where the fit of a rate left its residuals correlated
     /// (a missed dead time leaves them smooth; white residuals have nothing to find), each
-    /// lag found said in the fit's notes.
+    /// lag found said in the fit's notes with its `remedy`.
     pub fn say_delays(
         &self,
         target: &Target,
@@ -144,31 +148,37 @@ impl Identification<'_> {
         frames: &[Frame],
         columns: &[String],
         fit: &mut super::Fit,
+        remedy: &dyn Fn(&Lag) -> String,
     ) -> Result<(), IdentifyError> {
         if !matches!(target, Target::Derivative(_)) || !fit.correlation_time.is_some_and(|t| t > 1.5) {
             return Ok(());
         }
         for lag in self.scan_delays(target, candidates, frames, columns)? {
-            fit.selection.notes.push(lag.note(target));
+            fit.selection.notes.push(lag.note(target, &remedy(&lag)));
         }
         Ok(())
     }
 }
 
 /// The residual sum of squares of the target on every regressor of `m` together (about the
-/// means where `intercept`), by a pseudo-inverse that passes over collinear directions.
+/// means where `intercept`), by a pseudo-inverse that passes over collinear directions and
+/// regressors that do not vary (the constant about its mean); the target's own sum of squares
+/// where the decomposition does not converge.
 fn full_rss(m: &Moments, intercept: bool) -> f64 {
     let p = m.regressors();
     let product = |i: usize, j: usize| if intercept { m.corrected(i, j) } else { m.raw(i, j) };
     let yy = product(p, p);
-    if p == 0 {
+    // scaled to unit diagonal, so that the tolerance means the same for every column
+    let used: Vec<usize> = (0..p).filter(|&i| product(i, i) > 0.0 && product(i, i).is_finite()).collect();
+    if used.is_empty() || !yy.is_finite() {
         return yy;
     }
-    // scaled to unit diagonal, so that the tolerance means the same for every column
-    let scale: Vec<f64> = (0..p).map(|i| product(i, i).sqrt().max(f64::MIN_POSITIVE)).collect();
-    let a = DMatrix::from_fn(p, p, |i, j| product(i, j) / (scale[i] * scale[j]));
-    let b = DVector::from_fn(p, |i, _| product(i, p) / scale[i]);
-    let Ok(pinv) = a.pseudo_inverse(1e-12) else { return yy };
+    let scale: Vec<f64> = used.iter().map(|&i| product(i, i).sqrt()).collect();
+    let k = used.len();
+    let a = DMatrix::from_fn(k, k, |r, c| product(used[r], used[c]) / (scale[r] * scale[c]));
+    let b = DVector::from_fn(k, |r, _| product(used[r], p) / scale[r]);
+    let Some(svd) = a.try_svd(true, true, 1e-15, 10_000) else { return yy };
+    let Ok(pinv) = svd.pseudo_inverse(1e-12) else { return yy };
     (yy - b.dot(&(pinv * &b))).max(0.0)
 }
 
@@ -185,6 +195,11 @@ mod tests {
         let mut both = crate::select::Accumulator::new(2);
         both.push_columns(&[&x, &z], &y, None);
         assert!(full_rss(&both.finish(), false) < 1e-20);
+        // about the means, the constant does not vary: passed over, not divided by zero
+        let ones = vec![1.0; 50];
+        let mut with_one = crate::select::Accumulator::new(3);
+        with_one.push_columns(&[&x, &z, &ones], &y, None);
+        assert!(full_rss(&with_one.finish(), true) < 1e-20);
         let mut one = crate::select::Accumulator::new(1);
         one.push_columns(&[&x], &y, None);
         let left = full_rss(&one.finish(), false);

@@ -205,6 +205,8 @@ pub fn fit_equation_design(
 ) -> Result<Fit, IdentifyError> {
     let eq = model_equation(model, equation)?;
     let target = target.unwrap_or_else(|| default_target(eq, frames));
+    // inputs with a dead time read back as they act
+    let frames = &*model.acting(frames)?;
     let rules = model.parameter_rules();
     let identification = Identification {
         vocabulary: &model.vocabulary,
@@ -266,7 +268,19 @@ pub fn describe_residuals_of(
     };
     let candidates: Vec<Term> =
         fit.candidates.iter().map(|c| model.vocabulary.parse(c)).collect::<Result<_, _>>()?;
-    identification.describe_residuals(&Target::parse(&fit.target), &candidates, frames, fit)
+    let frames = &*model.acting(frames)?;
+    let target = Target::parse(&fit.target);
+    identification.describe_residuals(&target, &candidates, frames, fit)?;
+    // an input acting later than the file says leaves its mark on the residuals
+    let inputs: Vec<String> = model.spec().inputs.iter().map(|i| i.name.clone()).collect();
+    identification.say_delays(&target, &candidates, frames, &inputs, fit, &|lag| {
+        let declared = model.spec().inputs.iter().find(|i| i.name == lag.column).map_or(0.0, |i| i.delay);
+        format!(
+            "declare it in the model file: `delay = {}` in the [[inputs]] entry of `{}`",
+            crate::output::sig(declared + lag.seconds, 3),
+            lag.column
+        )
+    })
 }
 
 /// The identified coefficients of a fit, as a model stores them (term, value, std. error).

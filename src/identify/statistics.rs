@@ -56,6 +56,8 @@ impl EquationMoments {
         }
         let eq = model_equation(model, equation)?;
         let target = target.unwrap_or_else(|| default_target(eq, frames));
+        // inputs with a dead time read back as they act
+        let frames = &*model.acting(frames)?;
         let rules = model.parameter_rules();
         let how = Identification {
             vocabulary: &model.vocabulary,
@@ -113,6 +115,12 @@ impl EquationMoments {
         }
         if runs.is_empty() {
             return Err(IdentifyError::Setup("no data: give at least one run".into()));
+        }
+        if let Some(late) = model.spec().inputs.iter().find(|i| i.delay > 0.0) {
+            return Err(IdentifyError::Setup(format!(
+                "{}: `{}` acts {} s late (its `delay`), which a piece of a run cannot read back without the rows before it: read the runs whole (--chunk-rows 0)",
+                model.path, late.name, late.delay
+            )));
         }
         let eqs = equations.iter().map(|e| model_equation(model, e)).collect::<Result<Vec<_>, _>>()?;
         let designs = eqs

@@ -137,6 +137,14 @@ pub struct InputSpec {
     /// Value when nothing else is given.
     #[serde(default)]
     pub initial: f64,
+    /// How much later than recorded it acts, s (a dead time): identification reads its
+    /// column that much earlier against the rest, simulation feeds it that much later.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub delay: f64,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 /// `[parameters.NAME]`.

@@ -511,6 +511,12 @@ impl Model {
         }
         for (i, s) in spec.inputs.iter().enumerate() {
             vocab.variable(&s.name).map_err(|e| key_err(&format!("inputs[{i}].name"), e.to_string()))?;
+            if !(s.delay >= 0.0 && s.delay.is_finite()) {
+                return Err(key_err(
+                    &format!("inputs[{i}].delay"),
+                    format!("{} is no dead time: give seconds, 0 or more", s.delay),
+                ));
+            }
         }
         for (name, p) in &spec.parameters {
             vocab.parameter(name).map_err(|e| key_err(&format!("parameters.{name}"), e.to_string()))?;
@@ -813,6 +819,30 @@ impl Model {
     pub fn keeping_spikes(mut self, keep: bool) -> Model {
         self.spec.model.keep_spikes |= keep;
         self
+    }
+
+    /// Runs as the model's equations see them: each input with a dead time (`delay` in its
+    /// `[[inputs]]` entry) read that much earlier against the rest, every run from its
+    /// longest delay on ([`crate::data::delayed`]); the runs themselves where none has one.
+    pub fn acting<'a>(
+        &self,
+        frames: &'a [crate::data::Frame],
+    ) -> Result<std::borrow::Cow<'a, [crate::data::Frame]>, crate::data::DataError> {
+        let late: Vec<(&str, f64)> =
+            self.spec.inputs.iter().filter(|i| i.delay > 0.0).map(|i| (i.name.as_str(), i.delay)).collect();
+        if late.is_empty() {
+            return Ok(std::borrow::Cow::Borrowed(frames));
+        }
+        let longest = late.iter().map(|(_, d)| *d).fold(0.0, f64::max);
+        let mut out = frames.to_vec();
+        for f in &mut out {
+            for (name, delay) in &late {
+                if f.column(name).is_some() {
+                    *f = crate::data::delayed(f, name, *delay, longest)?;
+                }
+            }
+        }
+        Ok(std::borrow::Cow::Owned(out))
     }
 
     /// The model with its runs' inputs taken between samples as `intersample` says where

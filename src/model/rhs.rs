@@ -13,6 +13,10 @@ impl crate::sim::RightHandSide for Model {
         &self.path
     }
 
+    fn delays(&self) -> Vec<f64> {
+        self.spec.inputs.iter().map(|i| i.delay).collect()
+    }
+
     fn tolerances(&self) -> crate::sim::Tolerances {
         let d = crate::sim::Tolerances::default();
         match &self.spec.simulation {

@@ -176,6 +176,77 @@ impl Controller for Replay {
     }
 }
 
+/// A controller's inputs acting later than it gives them (a dead time per input, s): asked at
+/// every control time as usual, it answers with what `inner` gave `delay` before (between
+/// two control times a line from the one's value to the other's value before any jump there;
+/// before the start, the first). A held input's jumps arrive whole, `delay` later.
+pub struct Delayed<'a> {
+    inner: &'a mut dyn Controller,
+    delays: Vec<f64>,
+    /// (control time, inputs given, inputs just before where they jumped there)
+    history: Vec<(f64, Vec<f64>, Option<Vec<f64>>)>,
+    scratch: Vec<f64>,
+}
+
+impl<'a> Delayed<'a> {
+    /// `inner`'s inputs, input k acting `delays[k]` seconds later.
+    pub fn new(inner: &'a mut dyn Controller, delays: &[f64]) -> Delayed<'a> {
+        Delayed { inner, delays: delays.to_vec(), history: Vec::new(), scratch: vec![0.0; delays.len()] }
+    }
+
+    /// Input `k` at time `s` as given (`left`: just before `s`, where it jumped there).
+    fn given(&self, k: usize, s: f64, left: bool) -> f64 {
+        let h = &self.history;
+        let close = 1e-9 * h.last().map_or(1.0, |e| e.0.abs().max(1.0));
+        if s <= h[0].0 + close {
+            return h[0].1[k];
+        }
+        // the last control time at or before s
+        let i = h.partition_point(|e| e.0 <= s + close) - 1;
+        let (t, value, before) = &h[i];
+        if (t - s).abs() <= close {
+            return if left { before.as_ref().unwrap_or(value)[k] } else { value[k] };
+        }
+        match h.get(i + 1) {
+            Some((t1, v1, b1)) => {
+                let end = b1.as_ref().unwrap_or(v1)[k];
+                value[k] + (end - value[k]) * (s - t) / (t1 - t)
+            }
+            None => value[k],
+        }
+    }
+}
+
+impl Controller for Delayed<'_> {
+    fn input(&mut self, t: f64, x: &[f64], out: &mut [f64]) {
+        self.inner.input(t, x, out);
+        let given = out.to_vec();
+        let before = self.inner.before(t, &mut self.scratch).then(|| self.scratch.clone());
+        if self.history.last().is_some_and(|e| e.0 >= t) {
+            // asked again at an earlier or the same time (a new run): start over
+            self.history.clear();
+        }
+        self.history.push((t, given, before));
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = self.given(k, t - self.delays.get(k).copied().unwrap_or(0.0), false);
+        }
+    }
+
+    fn before(&mut self, t: f64, out: &mut [f64]) -> bool {
+        let mut jumped = false;
+        for (k, o) in out.iter_mut().enumerate() {
+            let s = t - self.delays.get(k).copied().unwrap_or(0.0);
+            *o = self.given(k, s, true);
+            jumped |= *o != self.given(k, s, false);
+        }
+        jumped
+    }
+
+    fn done(&self, t: f64, x: &[f64]) -> bool {
+        self.inner.done(t, x)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -213,5 +284,32 @@ mod tests {
         assert!((out[1] - 2.0).abs() < 1e-10, "{out:?}");
         assert!(!r.before(0.1, &mut out), "no jump at 0.1");
         assert!(!r.before(0.25, &mut out), "0.25 is no sample");
+    }
+
+    /// Delayed by 0.2 s (two control steps of 0.1): the held input's jump at 0.2 s arrives at
+    /// 0.4 s whole (before it, the old value); the line delayed by 0.15 s is the line 0.15 s back
+    /// (the first value before the start).
+    #[test]
+    fn a_delayed_controller_answers_with_what_was_given_before() {
+        let t: Vec<f64> = (0..8).map(|k| 0.1 * k as f64).collect();
+        let mut f = Frame::new("rig.csv", "t", t.clone()).unwrap();
+        f.push("F", vec![1.0, 1.0, 4.0, 4.0, 4.0, 4.0, 4.0, 4.0]).unwrap();
+        f.push("u", t.iter().map(|t| 10.0 * t).collect()).unwrap();
+        f.hold("F").unwrap();
+        let mut replay = Replay::new(&f, &["F".to_string(), "u".to_string()]).unwrap();
+        let mut late = Delayed::new(&mut replay, &[0.2, 0.15]);
+        let mut out = [0.0; 2];
+        for (k, want) in [(0, [1.0, 0.0]), (1, [1.0, 0.0]), (2, [1.0, 0.5]), (3, [1.0, 1.5]), (4, [4.0, 2.5])]
+        {
+            let t = 0.1 * k as f64;
+            late.input(t, &[], &mut out);
+            assert_eq!(out[0], want[0], "t = {t}");
+            assert!((out[1] - want[1]).abs() < 1e-9, "t = {t}: {out:?}");
+            let jumped = late.before(t, &mut out);
+            assert_eq!(jumped, k == 4, "t = {t}");
+            if jumped {
+                assert_eq!(out[0], 1.0);
+            }
+        }
     }
 }

@@ -290,6 +290,21 @@ pub fn simulate(
     controller: &mut dyn Controller,
     settings: &Settings,
 ) -> Result<Trajectory, SimError> {
+    if !system.delays.is_empty() {
+        // inputs that act late: the controller's answers fed to the system that much later
+        let mut late = super::Delayed::new(controller, &system.delays);
+        return run(system, x0, &mut late, settings);
+    }
+    run(system, x0, controller, settings)
+}
+
+/// [`simulate`] with the controller as the system takes it.
+fn run(
+    system: &System,
+    x0: &[f64],
+    controller: &mut dyn Controller,
+    settings: &Settings,
+) -> Result<Trajectory, SimError> {
     let (n, m) = (system.dim(), system.inputs.len());
     // time, states, inputs and derivatives per sample
     let (steps, every) = settings.check(1 + 2 * n + m)?;

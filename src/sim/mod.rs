@@ -10,7 +10,7 @@ mod rosenbrock;
 mod steady;
 mod system;
 
-pub use controller::{Ahead, Constant, Controller, Replay, Watch};
+pub use controller::{Ahead, Constant, Controller, Delayed, Replay, Watch};
 pub use integrator::{simulate, Integrator, Settings, Tolerances, Trajectory};
 pub use steady::{solve_steady, SteadyProblem, Unknown};
 pub use system::{RightHandSide, System, Workspace};

@@ -16,6 +16,8 @@ pub struct System {
     pub bounds: Vec<(f64, f64)>,
     /// The adaptive integrator's tolerances (the model's own, else the defaults).
     pub tolerances: super::Tolerances,
+    /// How much later than given each input acts, s (empty where none does: a dead time).
+    pub delays: Vec<f64>,
     rhs: Library,
     /// (scratch slot, state index) and (scratch slot, input index) of the library inputs
     /// that change from row to row; parameters (scratch slot, parameter index) sit in the
@@ -55,6 +57,11 @@ pub trait RightHandSide {
     /// The adaptive integrator's tolerances this model asks for.
     fn tolerances(&self) -> super::Tolerances {
         super::Tolerances::default()
+    }
+    /// How much later than given each input acts, s, in `inputs` order (a dead time; none by
+    /// default).
+    fn delays(&self) -> Vec<f64> {
+        Vec::new()
     }
 }
 
@@ -110,11 +117,18 @@ impl System {
                 Slot::Param(i) => param_slots.push((slot(j)?, *i)),
             }
         }
+        let delays = model.delays();
+        let delays = if delays.iter().any(|d| *d > 0.0) {
+            (0..inputs.len()).map(|k| delays.get(k).copied().unwrap_or(0.0)).collect()
+        } else {
+            Vec::new()
+        };
         Ok(System {
             states,
             inputs,
             bounds,
             tolerances: model.tolerances(),
+            delays,
             rhs,
             state_slots,
             input_slots,

@@ -89,7 +89,7 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
     }
     if cmd.model.is_some() {
         if !cmd.delays.is_empty() {
-            bail!("--delay reads columns of plain runs earlier; a model file cannot declare an input's dead time yet: delay the column in the runs, or identify without --model");
+            bail!("--delay reads columns of plain runs earlier; with --model declare the dead time in the model file (`delay = SECONDS` in the input's [[inputs]] entry), as its simulation needs it too");
         }
         return crate::identify_model::run(cmd);
     }
@@ -246,7 +246,8 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
         if let Target::Derivative(state) = &target {
             let columns: Vec<String> =
                 frames[0].names()[1..].iter().filter(|n| *n != state).cloned().collect();
-            identification.say_delays(&target, &candidates, &frames, &columns, &mut fit)?;
+            identification
+                .say_delays(&target, &candidates, &frames, &columns, &mut fit, &|l| l.plain_remedy())?;
         }
     }
     match cmd.format {
