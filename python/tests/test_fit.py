@@ -262,22 +262,27 @@ def test_residuals_that_grow_with_the_rate_are_said_and_weights_mend_them():
     assert abs(weighted.coefficients["x"] - 0.5) < 0.005
 
 
-def test_a_force_held_between_samples_is_integrated_as_held():
-    # ẍ = −4x − 0.3ẋ + 2F with F held for 50 samples at a time (a controller's command), in
-    # closed form from sample to sample: held (the default, with a warning) the true terms;
-    # as a line between samples the damping is off by over 1 %
+def _driven_oscillator(late=0):
+    """ẍ = −4x − 0.3ẋ + 2F with F held for 50 samples at a time (a controller's command),
+    felt ``late`` samples after it is recorded, in closed form from sample to sample."""
     rng = np.random.default_rng(4)
     levels = rng.uniform(-2.0, 2.0, 61)
     alpha, h = 0.15, 0.01
     wd = np.sqrt(4.0 - alpha**2)
     x, v, rows = 1.0, 0.0, []
     for k in range(3001):
-        force = levels[k // 50]
-        rows.append((h * k, x, v, force))
+        rows.append((h * k, x, v, levels[k // 50]))
+        force = levels[max(k - late, 0) // 50]
         y = x - force / 2.0
         c, s, e = np.cos(wd * h), np.sin(wd * h), np.exp(-alpha * h)
         x, v = force / 2.0 + e * (y * c + (v + alpha * y) / wd * s), e * (v * c - (alpha * v + 4.0 * y) / wd * s)
-    df = pd.DataFrame(rows, columns=["t", "x", "v", "F"])
+    return pd.DataFrame(rows, columns=["t", "x", "v", "F"])
+
+
+def test_a_force_held_between_samples_is_integrated_as_held():
+    # held (the default, with a warning) the true terms; as a line between samples the
+    # damping is off by over 1 %
+    df = _driven_oscillator()
     library = ["x", "v", "F", "x^2", "x*F"]
     with pytest.warns(UserWarning, match="`F` stays put .* on a clock of 50 samples"):
         held = termid.fit(df, "dv/dt", library)
@@ -289,20 +294,9 @@ def test_a_force_held_between_samples_is_integrated_as_held():
 
 
 def test_a_force_acting_late_is_said_and_fitted_with_its_delay():
-    # the same oscillator feeling the force 20 samples (0.2 s) after it is recorded: said in
-    # the notes; read 0.2 s earlier (delays=) the true terms
-    rng = np.random.default_rng(4)
-    levels = rng.uniform(-2.0, 2.0, 61)
-    alpha, h = 0.15, 0.01
-    wd = np.sqrt(4.0 - alpha**2)
-    x, v, rows = 1.0, 0.0, []
-    for k in range(3001):
-        rows.append((h * k, x, v, levels[k // 50]))
-        force = levels[max(k - 20, 0) // 50]
-        y = x - force / 2.0
-        c, s, e = np.cos(wd * h), np.sin(wd * h), np.exp(-alpha * h)
-        x, v = force / 2.0 + e * (y * c + (v + alpha * y) / wd * s), e * (v * c - (alpha * v + 4.0 * y) / wd * s)
-    df = pd.DataFrame(rows, columns=["t", "x", "v", "F"])
+    # the force felt 20 samples (0.2 s) after it is recorded: said in the notes; read 0.2 s
+    # earlier (delays=) the true terms
+    df = _driven_oscillator(late=20)
     library = ["x", "v", "F", "x^2", "x*F"]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

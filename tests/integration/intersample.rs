@@ -91,6 +91,54 @@ fn coefficients(report: &serde_json::Value) -> Vec<(String, f64)> {
 /// Plain `identify` of dv/dt: the force found held (its clock of 50 samples said), the
 /// three true terms within 1e-5 of the closed form's by the integral form; asked to take it
 /// as a line, the damping 1 % off or worse; by central differences, the bias is said.
+/// The chosen terms (sorted) are the oscillator's own three within 1e-5: −4x − 0.3v + 2F.
+fn assert_true_terms(got: &[(String, f64)], context: &dyn std::fmt::Display) {
+    assert_eq!(got.len(), 3, "{got:?}: {context}");
+    for ((term, c), (name, w)) in got.iter().zip([("F", 2.0), ("v", -0.3), ("x", -4.0)]) {
+        assert!(term == name && (c - w).abs() < 1e-5, "{term} {c} vs {w}: {context}");
+    }
+}
+
+/// The model file with an identifiable v̇ (a quadratic library) or with the grey-box v̇ whose
+/// damping `c` is free; `extra` lines go into `[model]`, `input` lines into F's entry.
+fn model_text(grey: bool, extra: &str, input: &str) -> String {
+    let equation = if grey {
+        "[equations.v_dot]\nstate = \"v\"\nidentify = false\ncoefficients = { \"x\" = -4.0, \"c*v\" = -1.0, \"F\" = 2.0 }\n"
+    } else {
+        "[equations.v_dot]\nstate = \"v\"\ncandidates = [\"x\", \"v\", \"F\", \"x^2\", \"x*F\"]\n"
+    };
+    let text = MODEL.replacen("intercept = false", &format!("intercept = false\n{extra}"), 1).replacen(
+        "unit = \"N\"",
+        &format!("unit = \"N\"\n{input}"),
+        1,
+    );
+    format!("{text}\n{equation}")
+}
+
+/// `model` written into `dir` as `name`: its path.
+fn written(dir: &std::path::Path, name: &str, model: String) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, model).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+/// `termid estimate` of the grey-box `model` on `data`: the damping c estimated.
+fn estimated_damping(model: &str, data: &str, out: &str) -> f64 {
+    let (ok, _, err) = termid(&["estimate", "--model", model, "--data", data, "--out", out]);
+    assert!(ok, "{err}");
+    termid::model::Model::load(std::path::Path::new(out)).unwrap().parameter_values()["c"]
+}
+
+/// `termid validate` of `model` on `data`: the RMS error of the re-simulated x, m.
+fn validated_x(model: &str, data: &str) -> f64 {
+    let (ok, text, err) = termid(&["validate", "--model", model, "--data", data, "--format", "json"]);
+    assert!(ok, "{err}");
+    let v = json(&text);
+    // (name, unit, RMS, max) of each compared state
+    let states = v["gap"]["states"].as_array().unwrap_or_else(|| panic!("{v}")).clone();
+    states.iter().find(|s| s[0] == "x").unwrap()[2].as_f64().unwrap()
+}
+
 #[test]
 fn a_held_force_is_integrated_as_held() {
     let dir = Scratch::new("held-force");
@@ -105,12 +153,7 @@ fn a_held_force_is_integrated_as_held() {
     };
     let (held, said) = fit(&[]);
     assert!(said.contains("`F` stays put") && said.contains("on a clock of 50 samples"), "{said}");
-    let want = [("F", 2.0), ("v", -0.3), ("x", -4.0)];
-    let got = coefficients(&held);
-    assert_eq!(got.len(), 3, "{held}");
-    for ((term, c), (name, w)) in got.iter().zip(want) {
-        assert!(term == name && (c - w).abs() < 1e-5, "{term} {c} vs {w}: {held}");
-    }
+    assert_true_terms(&coefficients(&held), &held);
     let (linear, said) = fit(&["--intersample", "linear"]);
     assert!(!said.contains("stays put"), "{said}");
     let damping = coefficients(&linear).iter().find(|(t, _)| t == "v").map(|(_, c)| *c).unwrap();
@@ -127,64 +170,21 @@ fn a_held_force_is_integrated_as_held() {
 #[test]
 fn a_held_force_is_replayed_held() {
     let dir = Scratch::new("held-force-model");
-    let data = dir.join("rig.csv");
-    std::fs::write(&data, held_force_run()).unwrap();
-    let data = data.to_str().unwrap();
-    let model = dir.join("msd.toml");
-    let candidates =
-        "[equations.v_dot]\nstate = \"v\"\ncandidates = [\"x\", \"v\", \"F\", \"x^2\", \"x*F\"]\n";
-    std::fs::write(&model, format!("{MODEL}\n{candidates}")).unwrap();
-    let identified = dir.join("msd_id.toml");
-    let out = identified.to_str().unwrap();
-    let (ok, _, err) =
-        termid(&["identify", "--model", model.to_str().unwrap(), "--data", data, "--out", out]);
+    let data = written(&dir, "rig.csv", held_force_run());
+    let model = written(&dir, "msd.toml", model_text(false, "", ""));
+    let out = dir.join("msd_id.toml");
+    let out = out.to_str().unwrap();
+    let (ok, _, err) = termid(&["identify", "--model", &model, "--data", &data, "--out", out]);
     assert!(ok, "{err}");
     assert!(err.contains("on a clock of 50 samples"), "{err}");
-    let rms = || {
-        let (ok, text, err) = termid(&["validate", "--model", out, "--data", data, "--format", "json"]);
-        assert!(ok, "{err}");
-        let v = json(&text);
-        // (name, unit, RMS, max) of each compared state
-        let states = v["gap"]["states"].as_array().unwrap_or_else(|| panic!("{v}")).clone();
-        states.iter().find(|s| s[0] == "x").unwrap()[2].as_f64().unwrap()
-    };
-    let held = rms();
+    let held = validated_x(out, &data);
     assert!(held < 1e-5, "{held}");
-    let grey = dir.join("grey.toml");
-    let coefficients = "[equations.v_dot]\nstate = \"v\"\nidentify = false\ncoefficients = { \"x\" = -4.0, \"c*v\" = -1.0, \"F\" = 2.0 }\n";
-    std::fs::write(&grey, format!("{MODEL}\n{coefficients}")).unwrap();
-    let estimated = dir.join("grey_est.toml");
-    let (ok, _, err) = termid(&[
-        "estimate",
-        "--model",
-        grey.to_str().unwrap(),
-        "--data",
-        data,
-        "--out",
-        estimated.to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
-    let c = termid::model::Model::load(&estimated).unwrap().parameter_values()["c"];
+    let grey = written(&dir, "grey.toml", model_text(true, "", ""));
+    let c = estimated_damping(&grey, &data, out);
     assert!((c - 0.3).abs() < 1e-6, "{c}");
     // the same file told its force moves between samples: the replay draws lines
-    let linear = dir.join("grey_linear.toml");
-    std::fs::write(
-        &linear,
-        format!("{MODEL}\n{coefficients}")
-            .replace("intercept = false", "intercept = false\nintersample = \"linear\""),
-    )
-    .unwrap();
-    let (ok, _, err) = termid(&[
-        "estimate",
-        "--model",
-        linear.to_str().unwrap(),
-        "--data",
-        data,
-        "--out",
-        estimated.to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
-    let c = termid::model::Model::load(&estimated).unwrap().parameter_values()["c"];
+    let linear = written(&dir, "grey_linear.toml", model_text(true, "intersample = \"linear\"", ""));
+    let c = estimated_damping(&linear, &data, out);
     assert!((c - 0.3).abs() > 1e-4, "{c}");
 }
 
@@ -231,13 +231,10 @@ fn pieces_hold_the_force_as_the_whole_run_does() {
     let dir = Scratch::new("held-force-pieces");
     let data = dir.join("rig.csv");
     std::fs::write(&data, force_run(|k| k % 10 == 0 && (k < 1500 || k == 2000 || k == 2500))).unwrap();
-    let model = dir.join("msd.toml");
-    let candidates =
-        "[equations.v_dot]\nstate = \"v\"\ncandidates = [\"x\", \"v\", \"F\", \"x^2\", \"x*F\"]\n";
-    std::fs::write(&model, format!("{MODEL}\n{candidates}")).unwrap();
+    let model = written(&dir, "msd.toml", model_text(false, "", ""));
     let numbers = |rows: &str| -> Vec<f64> {
         let out = dir.join(format!("{rows}.moments"));
-        let args = ["moments", "--model", model.to_str().unwrap(), "--equation", "v_dot", "--data"];
+        let args = ["moments", "--model", model.as_str(), "--equation", "v_dot", "--data"];
         let (ok, _, err) = termid(
             &[
                 &args[..],
@@ -289,12 +286,7 @@ fn a_force_acting_late_is_said_and_fitted_with_its_delay() {
         "{notes}"
     );
     let late = fit(&["--delay", "F=0.2"]);
-    let want = [("F", 2.0), ("v", -0.3), ("x", -4.0)];
-    let got = coefficients(&late);
-    assert_eq!(got.len(), 3, "{late}");
-    for ((term, c), (name, w)) in got.iter().zip(want) {
-        assert!(term == name && (c - w).abs() < 1e-5, "{term} {c} vs {w}: {late}");
-    }
+    assert_true_terms(&coefficients(&late), &late);
     assert!(!late["notes"].to_string().contains("acts on"), "{late}");
     let (ok, _, err) = termid(&[
         "identify",
@@ -321,19 +313,9 @@ fn a_force_acting_late_is_said_and_fitted_with_its_delay() {
 #[test]
 fn a_model_declares_its_dead_time() {
     let dir = Scratch::new("late-force-model");
-    let data = dir.join("rig.csv");
-    std::fs::write(&data, force_run_late(|k| k % 50 == 0, 20)).unwrap();
-    let data = data.to_str().unwrap();
-    let candidates =
-        "[equations.v_dot]\nstate = \"v\"\ncandidates = [\"x\", \"v\", \"F\", \"x^2\", \"x*F\"]\n";
-    let write = |name: &str, text: String| {
-        let path = dir.join(name);
-        std::fs::write(&path, text).unwrap();
-        path.to_str().unwrap().to_string()
-    };
-    let late =
-        |text: &str, delay: &str| text.replacen("unit = \"N\"", &format!("unit = \"N\"\ndelay = {delay}"), 1);
-    let undeclared = write("msd.toml", format!("{MODEL}\n{candidates}"));
+    let data = written(&dir, "rig.csv", force_run_late(|k| k % 50 == 0, 20));
+    let data = data.as_str();
+    let undeclared = written(&dir, "msd.toml", model_text(false, "", ""));
     let out = dir.join("out.toml");
     let out = out.to_str().unwrap();
     let (ok, text, err) = termid(&["identify", "--model", &undeclared, "--data", data, "--out", out]);
@@ -343,7 +325,7 @@ fn a_model_declares_its_dead_time() {
             && text.contains("`delay = 0.200` in the [[inputs]] entry of `F`"),
         "{text}"
     );
-    let declared = write("msd_late.toml", late(&format!("{MODEL}\n{candidates}"), "0.2"));
+    let declared = written(&dir, "msd_late.toml", model_text(false, "", "delay = 0.2"));
     let (ok, text, err) = termid(&["identify", "--model", &declared, "--data", data, "--out", out]);
     assert!(ok, "{err}");
     assert!(!text.contains("acts on"), "{text}");
@@ -351,27 +333,18 @@ fn a_model_declares_its_dead_time() {
     let eq = model.equation("v_dot").unwrap();
     let mut got: Vec<(String, f64)> = eq.coefficients.iter().map(|(t, c, _)| (t.to_string(), *c)).collect();
     got.sort_by(|a, b| a.0.cmp(&b.0));
-    assert_eq!(got.len(), 3, "{got:?}");
-    for ((term, c), (name, w)) in got.iter().zip([("F", 2.0), ("v", -0.3), ("x", -4.0)]) {
-        assert!(term == name && (c - w).abs() < 1e-5, "{term} {c} vs {w}");
-    }
-    let (ok, text, err) = termid(&["validate", "--model", out, "--data", data, "--format", "json"]);
-    assert!(ok, "{err}");
-    let v = json(&text);
-    let x = v["gap"]["states"].as_array().unwrap().iter().find(|s| s[0] == "x").unwrap()[2].as_f64().unwrap();
-    assert!(x < 1e-5, "{v}");
-    let coefficients = "[equations.v_dot]\nstate = \"v\"\nidentify = false\ncoefficients = { \"x\" = -4.0, \"c*v\" = -1.0, \"F\" = 2.0 }\n";
-    let grey = write("grey.toml", late(&format!("{MODEL}\n{coefficients}"), "0.2"));
-    let (ok, _, err) = termid(&["estimate", "--model", &grey, "--data", data, "--out", out]);
-    assert!(ok, "{err}");
-    let c = termid::model::Model::load(std::path::Path::new(out)).unwrap().parameter_values()["c"];
+    assert_true_terms(&got, &out);
+    let x = validated_x(out, data);
+    assert!(x < 1e-5, "{x}");
+    let grey = written(&dir, "grey.toml", model_text(true, "", "delay = 0.2"));
+    let c = estimated_damping(&grey, data, out);
     assert!((c - 0.3).abs() < 1e-6, "{c}");
     let moments = dir.join("v.moments");
     let args =
         ["moments", "--model", &declared, "--equation", "v_dot", "--data", data, "--chunk-rows", "1000"];
     let (ok, _, err) = termid(&[&args[..], &["--out", moments.to_str().unwrap()]].concat());
     assert!(!ok && err.contains("--chunk-rows 0"), "{err}");
-    let negative = write("negative.toml", late(&format!("{MODEL}\n{candidates}"), "-0.1"));
+    let negative = written(&dir, "negative.toml", model_text(false, "", "delay = -0.1"));
     let (ok, _, err) = termid(&["identify", "--model", &negative, "--data", data]);
     assert!(!ok && err.contains("inputs[0].delay"), "{err}");
 }
