@@ -418,7 +418,11 @@ impl PyModel {
         let how = ModelIdentification { equations, differentiator: diff.as_ref(), intercept, target: None };
         // the work without the GIL: other Python threads run meanwhile
         let identified = py
-            .detach(|| termid::identify::identify_model(&model, &frames, &how, &mut |_| {}))
+            .detach(|| {
+                let mut identified = termid::identify::identify_model(&model, &frames, &how, &mut |_| {})?;
+                termid::identify::say_late_inputs(&mut identified, &frames, diff.as_ref())?;
+                Ok::<_, termid::identify::IdentifyError>(identified)
+            })
             .map_err(fail)?;
         let fits = identified
             .fits

@@ -52,7 +52,7 @@ pub use delay::Lag;
 pub(crate) use model::RunStatistics;
 pub use model::{
     coefficients_of, describe_residuals_of, equation_design, fit_equation, fit_equation_design,
-    identify_model, IdentifiedModel, ModelIdentification,
+    identify_model, say_late_inputs, IdentifiedModel, ModelIdentification,
 };
 pub use report::{num, sig, FitReport, StepReport, TermReport};
 pub use statistics::{identify_from_moments, EquationMoments, RunMoments};

@@ -269,18 +269,46 @@ pub fn describe_residuals_of(
     let candidates: Vec<Term> =
         fit.candidates.iter().map(|c| model.vocabulary.parse(c)).collect::<Result<_, _>>()?;
     let frames = &*model.acting(frames)?;
-    let target = Target::parse(&fit.target);
-    identification.describe_residuals(&target, &candidates, frames, fit)?;
-    // an input acting later than the file says leaves its mark on the residuals
+    identification.describe_residuals(&Target::parse(&fit.target), &candidates, frames, fit)
+}
+
+/// Says in each of `identified`'s fits an input of its model that acts later than the file
+/// declares ([`Identification::say_delays`] over the model's inputs, the same runs and
+/// derivative method): once for an identification a user reads, not in every fold of a
+/// cross-validation (the scan fits all candidates some 20 times).
+pub fn say_late_inputs(
+    identified: &mut IdentifiedModel,
+    frames: &[Frame],
+    differentiator: &dyn Differentiator,
+) -> Result<(), IdentifyError> {
+    let model = &identified.model;
+    let rules = model.parameter_rules();
+    let identification = Identification {
+        vocabulary: &model.vocabulary,
+        parameters: &rules,
+        differentiator,
+        intercept: true,
+        weights: None,
+    };
+    let frames = &*model.acting(frames)?;
     let inputs: Vec<String> = model.spec().inputs.iter().map(|i| i.name.clone()).collect();
-    identification.say_delays(&target, &candidates, frames, &inputs, fit, &|lag| {
+    let remedy = |lag: &super::Lag| {
         let declared = model.spec().inputs.iter().find(|i| i.name == lag.column).map_or(0.0, |i| i.delay);
         format!(
             "declare it in the model file: `delay = {}` in the [[inputs]] entry of `{}`",
             crate::output::sig(declared + lag.seconds, 3),
             lag.column
         )
-    })
+    };
+    for (name, fit) in &mut identified.fits {
+        let candidates: Vec<Term> =
+            fit.candidates.iter().map(|c| model.vocabulary.parse(c)).collect::<Result<_, _>>()?;
+        let target = Target::parse(&fit.target);
+        identification
+            .say_delays(&target, &candidates, frames, &inputs, fit, &remedy)
+            .map_err(|e| e.in_equation(name))?;
+    }
+    Ok(())
 }
 
 /// The identified coefficients of a fit, as a model stores them (term, value, std. error).

@@ -159,7 +159,7 @@ pub(super) fn identify_start(
         intercept: settings.intercept,
         target: settings.target.clone(),
     };
-    let (identified, chosen_text) = if settings.choose.is_empty() {
+    let (mut identified, chosen_text) = if settings.choose.is_empty() {
         (crate::identify::identify_model(model, &prepared, &how, &mut |_| {}).map_err(setup)?, None)
     } else {
         let prediction = Prediction { states: settings.compare.clone(), ..Default::default() };
@@ -174,6 +174,8 @@ pub(super) fn identify_start(
         let text = chosen.text();
         (chosen.identified, Some(text))
     };
+    // said once for the start (not in each fold the choice by prediction fitted)
+    crate::identify::say_late_inputs(&mut identified, &prepared, diff.as_ref()).map_err(setup)?;
     let mut model = identified.model;
     let mut start = Start {
         derivative: derivative.to_string(),
