@@ -250,6 +250,29 @@ pub(super) fn model_equation<'m>(model: &'m Model, equation: &str) -> Result<&'m
     Ok(eq)
 }
 
+/// `run` given the identification of `model`'s equations as [`fit_equation`] makes it (its
+/// vocabulary and per-run parameters, a fitted intercept) with `differentiator`: the residual
+/// passes over a fit already made.
+fn with_identification<T>(
+    model: &Model,
+    differentiator: &dyn Differentiator,
+    run: impl FnOnce(&Identification<'_>) -> T,
+) -> T {
+    let rules = model.parameter_rules();
+    run(&Identification {
+        vocabulary: &model.vocabulary,
+        parameters: &rules,
+        differentiator,
+        intercept: true,
+        weights: None,
+    })
+}
+
+/// The candidate terms of a fit of one of `model`'s equations, parsed again.
+fn candidates_of(model: &Model, fit: &Fit) -> Result<Vec<Term>, IdentifyError> {
+    Ok(fit.candidates.iter().map(|c| model.vocabulary.parse(c)).collect::<Result<_, _>>()?)
+}
+
 /// [`Identification::describe_residuals`] of an equation fitted by [`fit_equation`], with the
 /// same runs and derivative method.
 pub fn describe_residuals_of(
@@ -258,18 +281,11 @@ pub fn describe_residuals_of(
     differentiator: &dyn Differentiator,
     fit: &mut Fit,
 ) -> Result<(), IdentifyError> {
-    let rules = model.parameter_rules();
-    let identification = Identification {
-        vocabulary: &model.vocabulary,
-        parameters: &rules,
-        differentiator,
-        intercept: true,
-        weights: None,
-    };
-    let candidates: Vec<Term> =
-        fit.candidates.iter().map(|c| model.vocabulary.parse(c)).collect::<Result<_, _>>()?;
+    let candidates = candidates_of(model, fit)?;
     let frames = &*model.acting(frames)?;
-    identification.describe_residuals(&Target::parse(&fit.target), &candidates, frames, fit)
+    with_identification(model, differentiator, |how| {
+        how.describe_residuals(&Target::parse(&fit.target), &candidates, frames, fit)
+    })
 }
 
 /// Says in each of `identified`'s fits an input of its model that acts later than the file
@@ -282,14 +298,6 @@ pub fn say_late_inputs(
     differentiator: &dyn Differentiator,
 ) -> Result<(), IdentifyError> {
     let model = &identified.model;
-    let rules = model.parameter_rules();
-    let identification = Identification {
-        vocabulary: &model.vocabulary,
-        parameters: &rules,
-        differentiator,
-        intercept: true,
-        weights: None,
-    };
     let frames = &*model.acting(frames)?;
     let inputs: Vec<String> = model.spec().inputs.iter().map(|i| i.name.clone()).collect();
     let remedy = |lag: &super::Lag| {
@@ -300,14 +308,15 @@ pub fn say_late_inputs(
             lag.column
         )
     };
-    for (name, fit) in &mut identified.fits {
-        let candidates: Vec<Term> =
-            fit.candidates.iter().map(|c| model.vocabulary.parse(c)).collect::<Result<_, _>>()?;
-        let target = Target::parse(&fit.target);
-        identification
-            .say_delays(&target, &candidates, frames, &inputs, fit, &remedy)
-            .map_err(|e| e.in_equation(name))?;
-    }
+    with_identification(model, differentiator, |how| {
+        for (name, fit) in &mut identified.fits {
+            let candidates = candidates_of(model, fit)?;
+            let target = Target::parse(&fit.target);
+            how.say_delays(&target, &candidates, frames, &inputs, fit, &remedy)
+                .map_err(|e| e.in_equation(name))?;
+        }
+        Ok::<_, IdentifyError>(())
+    })?;
     Ok(())
 }
 
