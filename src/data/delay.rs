@@ -33,12 +33,7 @@ pub fn delayed(frame: &Frame, name: &str, seconds: f64, from: f64) -> Result<Fra
         .map(|&s| {
             let at = s - seconds;
             if frame.is_held(name) {
-                // the last sample at or before `at`
-                let close = 1e-9 * (t[t.len() - 1] - t[0]).max(1.0);
-                while sample + 1 < t.len() && t[sample + 1] <= at + close {
-                    sample += 1;
-                }
-                column[sample]
+                column[super::sample_at(t, at, &mut sample)]
             } else {
                 super::interpolate_at(t, column, at, &mut cursor)
             }

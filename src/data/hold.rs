@@ -25,17 +25,6 @@ pub enum Intersample {
     Held,
 }
 
-impl Intersample {
-    /// The name a model file and the command line use.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Intersample::Auto => "auto",
-            Intersample::Linear => "linear",
-            Intersample::Held => "held",
-        }
-    }
-}
-
 /// What shows a record held between its samples.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hold {

@@ -34,7 +34,9 @@ pub use hold::{held, mark_held, Hold, Intersample};
 pub use integral::{integral_rows, integral_rows_held, IntegralForm};
 pub use kalman::{KalmanSmoother, NoiseModel};
 pub use prepare::{prepare, Preparation};
-pub use resample::{check_gaps, evened, interpolate_at, median_step, resample, sample_step, uneven};
+pub use resample::{
+    check_gaps, evened, interpolate_at, median_step, on_sample, resample, sample_at, sample_step, uneven,
+};
 pub use savitzky_golay::SavitzkyGolay;
 pub use smoothing_spline::SmoothingSpline;
 pub use spike::{despiked, despiked_all, spikes, Spike};

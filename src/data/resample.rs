@@ -26,6 +26,27 @@ pub fn interpolate_at(t: &[f64], x: &[f64], s: f64, cursor: &mut usize) -> f64 {
     x[i] + w * (x[i + 1] - x[i])
 }
 
+/// The last sample of `t` at or before time `s` (a time within a millionth of a sample
+/// interval of a sample is on it: a grid k·Δt and a record's times round apart); the first
+/// before the record. `cursor` as for [`interpolate_at`]. What a column held between samples
+/// ([`super::Frame::hold`]) reads at `s`: shared by reading it back (a dead time) and by the
+/// simulator's input replay.
+pub fn sample_at(t: &[f64], s: f64, cursor: &mut usize) -> usize {
+    let (n, close) = (t.len(), on_sample(t));
+    if t[*cursor] > s + close {
+        *cursor = 0;
+    }
+    while *cursor + 1 < n && t[*cursor + 1] <= s + close {
+        *cursor += 1;
+    }
+    *cursor
+}
+
+/// How close to a sample of `t` a time is on it: a millionth of the mean sample interval.
+pub fn on_sample(t: &[f64]) -> f64 {
+    1e-6 * (t[t.len() - 1] - t[0]) / (t.len() - 1).max(1) as f64
+}
+
 /// (t, x) interpolated at every time of `at`.
 fn interpolate(t: &[f64], x: &[f64], at: &[f64]) -> Vec<f64> {
     let mut cursor = 0;

@@ -131,18 +131,9 @@ impl Replay {
         crate::data::interpolate_at(&self.time, &self.columns[k], t, &mut self.cursor)
     }
 
-    /// The last sample at or before `t` (a control time within a millionth of a sample
-    /// interval of a sample is on it: the grid k·Δt and the record's times round apart).
+    /// The last sample at or before `t` ([`crate::data::sample_at`]).
     fn sample_at(&mut self, t: f64) -> usize {
-        let n = self.time.len();
-        let close = 1e-6 * self.time[n - 1] / (n - 1).max(1) as f64;
-        if self.time[self.sample] > t + close {
-            self.sample = 0;
-        }
-        while self.sample + 1 < n && self.time[self.sample + 1] <= t + close {
-            self.sample += 1;
-        }
-        self.sample
+        crate::data::sample_at(&self.time, t, &mut self.sample)
     }
 }
 
@@ -158,9 +149,7 @@ impl Controller for Replay {
             return false;
         }
         let j = self.sample_at(t);
-        let n = self.time.len();
-        let close = 1e-6 * self.time[n - 1] / (n - 1).max(1) as f64;
-        if j == 0 || (self.time[j] - t).abs() > close {
+        if j == 0 || (self.time[j] - t).abs() > crate::data::on_sample(&self.time) {
             return false;
         }
         let mut jumped = false;
