@@ -25,6 +25,9 @@ mod generic;
 // Inputs held between samples: found, integrated and replayed held.
 #[path = "integration/intersample.rs"]
 mod intersample;
+// Records as loggers write them: a slower sensor's readings repeated between its updates.
+#[path = "integration/sensors.rs"]
+mod sensors;
 // The paper end to end (`termid reproduce`) through the library.
 #[path = "integration/reproduce.rs"]
 mod reproduce;

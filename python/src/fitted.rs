@@ -291,6 +291,11 @@ pub(crate) fn fit(
             for note in termid::data::mark_held(&mut frame, &columns, intersample).map_err(fail)? {
                 warn(py, note)?;
             }
+            // any column, the state too, may repeat a slower sensor's readings
+            let all: Vec<&str> = variables.iter().map(String::as_str).collect();
+            for note in termid::data::read_at_readings(&mut frame, &all, intersample).map_err(fail)? {
+                warn(py, note)?;
+            }
             // columns acting later than recorded, read back (after the marking: a held column
             // sample for sample)
             for (name, seconds) in &delays {

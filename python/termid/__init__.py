@@ -636,7 +636,10 @@ def fit(
     samples: ``"auto"`` (default) takes a column that stays put and jumps at isolated samples
     on a clock (a controller's command) as held from each sample to the next, integrated
     piece by piece between its jumps, with a warning, ``"linear"`` as a line between samples,
-    ``"held"`` held wherever a column jumps at isolated samples, on a clock or not;
+    ``"held"`` held wherever a column jumps at isolated samples, on a clock or not; under
+    ``"auto"`` and ``"held"`` a column (the state too) that changes only every few rows on a
+    clock, at most of its ticks (a slower sensor's readings filled forward), is read at its
+    readings and interpolated between them by cubics, with a warning;
     ``delays`` columns that act later than recorded (a dead time), in seconds, e.g.
     ``{"F": 0.2}``: read that much earlier against the rest, the rows' first seconds left out
     (without it, a rate's ``notes`` say a delay the residuals show).

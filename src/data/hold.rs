@@ -14,10 +14,12 @@ use super::{DataError, Frame};
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Intersample {
     /// Held where the record shows a controller's command ([`held`], [`Hold::on_a_clock`]),
-    /// else a line between samples.
+    /// else a line between samples; a column that repeats a slower sensor's readings between
+    /// them is read at its readings.
     #[default]
     Auto,
-    /// A line between samples, whatever the record shows.
+    /// A line between samples, whatever the record shows (a column that repeats a slower
+    /// sensor's readings between them is taken as its rows have it too).
     Linear,
     /// Held from each sample to the next wherever the record stays put between isolated
     /// jumps ([`held`]), on a clock or not. (A record that changes at every sample cannot be
@@ -53,7 +55,7 @@ impl Hold {
 
 /// Jumps needed to believe a clock: intervals between random jumps share a divisor of 2 or
 /// more by chance with odds of Σ p^−(jumps − 1) over the primes p, 0.4 % with 9 jumps.
-const CLOCK_JUMPS: usize = 9;
+pub(super) const CLOCK_JUMPS: usize = 9;
 
 /// Jumps with a changing interval beside them, at most this share: a held record changes at
 /// isolated samples; a moving one (a rudder turning at its rate, even printed to three digits
@@ -76,6 +78,28 @@ const SIZE: f64 = 0.01;
 /// (a random binary signal switched each sample) cannot be told from one that moves: it is
 /// not found; declare it held.
 pub fn held(x: &[f64]) -> Option<Hold> {
+    let at = isolated_changes(x)?;
+    let (low, high) = x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
+    let size = low.abs().max(high.abs());
+    let mut jumps: Vec<f64> = at.iter().map(|&i| (x[i + 1] - x[i]).abs()).collect();
+    let middle = jumps.len() / 2;
+    let median = *jumps.select_nth_unstable_by(middle, f64::total_cmp).1;
+    if median < SPAN * (high - low) || median < SIZE * size {
+        return None;
+    }
+    let period = at.windows(2).fold(0, |g, w| gcd(g, w[1] - w[0]));
+    Some(Hold {
+        jumps: at.len(),
+        flat: 1.0 - at.len() as f64 / (x.len() - 1) as f64,
+        jump: median / (high - low),
+        period,
+    })
+}
+
+/// The intervals over which `x` changes (interval i from sample i to i + 1), where it changes
+/// at isolated samples: no two changing intervals side by side but for 5 % of them. `None`
+/// for a record that moves from sample to sample, never changes, or has under 20 intervals.
+pub(super) fn isolated_changes(x: &[f64]) -> Option<Vec<usize>> {
     if x.len() < 21 {
         return None;
     }
@@ -88,27 +112,10 @@ pub fn held(x: &[f64]) -> Option<Hold> {
         .iter()
         .filter(|&&i| (i > 0 && changes[i - 1]) || changes.get(i + 1).copied().unwrap_or(false))
         .count();
-    if beside as f64 > SIDE_BY_SIDE * at.len() as f64 {
-        return None;
-    }
-    let (low, high) = x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
-    let size = low.abs().max(high.abs());
-    let mut jumps: Vec<f64> = at.iter().map(|&i| (x[i + 1] - x[i]).abs()).collect();
-    let middle = jumps.len() / 2;
-    let median = *jumps.select_nth_unstable_by(middle, f64::total_cmp).1;
-    if median < SPAN * (high - low) || median < SIZE * size {
-        return None;
-    }
-    let period = at.windows(2).fold(0, |g, w| gcd(g, w[1] - w[0]));
-    Some(Hold {
-        jumps: at.len(),
-        flat: 1.0 - at.len() as f64 / changes.len() as f64,
-        jump: median / (high - low),
-        period,
-    })
+    (beside as f64 <= SIDE_BY_SIDE * at.len() as f64).then_some(at)
 }
 
-fn gcd(a: usize, b: usize) -> usize {
+pub(super) fn gcd(a: usize, b: usize) -> usize {
     if b == 0 {
         a
     } else {

@@ -29,6 +29,12 @@ pub struct Lag {
 /// samples leaves most of the residual.
 const SHARE: f64 = 0.5;
 
+/// A fit that leaves at most this share of the target's sum of squares (its residuals'
+/// RMS a ten-thousandth of the target's spread: a clean record's rounding and derivative
+/// error) is not scanned: whatever is left is too small to bias a coefficient visibly, and
+/// its shape (smooth, so correlated) would be taken for a delay's.
+const NEGLIGIBLE: f64 = 1e-8;
+
 /// The rows a scan reads at most (about 20 passes over them): a delay shows in any stretch
 /// of the record it acts in, and 200 000 rows of Lorenz took 0.9 s to scan whole.
 const ROWS: usize = 20_000;
@@ -71,7 +77,7 @@ impl Identification<'_> {
         }
         let mut out = Vec::new();
         for column in columns.iter().filter(|c| library.inputs().contains(c)) {
-            let rss = |samples: usize| -> Result<f64, IdentifyError> {
+            let rss = |samples: usize| -> Result<(f64, f64), IdentifyError> {
                 let runs = frames
                     .iter()
                     .map(|f| delayed(f, column, samples as f64 * step, longest))
@@ -82,10 +88,16 @@ impl Identification<'_> {
                 }
                 Ok(full_rss(&m, self.intercept))
             };
+            let (none, total) = rss(0)?;
+            if none <= NEGLIGIBLE * total {
+                continue;
+            }
+            let rss = |samples: usize| -> Result<f64, IdentifyError> {
+                Ok(if samples == 0 { none } else { rss(samples)?.0 })
+            };
             let grid: Vec<usize> = GRID.iter().copied().filter(|&k| k as f64 * step <= longest).collect();
             let mut tried: Vec<(usize, f64)> =
                 grid.iter().map(|&k| Ok((k, rss(k)?))).collect::<Result<_, IdentifyError>>()?;
-            let none = tried[0].1;
             let best = (0..tried.len()).min_by(|&a, &b| tried[a].1.total_cmp(&tried[b].1)).unwrap_or(0);
             if best == 0 || tried[best].1 > SHARE * none {
                 continue;
@@ -162,24 +174,24 @@ impl Identification<'_> {
 
 /// The residual sum of squares of the target on every regressor of `m` together (about the
 /// means where `intercept`), by a pseudo-inverse that passes over collinear directions and
-/// regressors that do not vary (the constant about its mean); the target's own sum of squares
-/// where the decomposition does not converge.
-fn full_rss(m: &Moments, intercept: bool) -> f64 {
+/// regressors that do not vary (the constant about its mean), beside the target's own sum of
+/// squares (which it is where the decomposition does not converge).
+fn full_rss(m: &Moments, intercept: bool) -> (f64, f64) {
     let p = m.regressors();
     let product = |i: usize, j: usize| if intercept { m.corrected(i, j) } else { m.raw(i, j) };
     let yy = product(p, p);
     // scaled to unit diagonal, so that the tolerance means the same for every column
     let used: Vec<usize> = (0..p).filter(|&i| product(i, i) > 0.0 && product(i, i).is_finite()).collect();
     if used.is_empty() || !yy.is_finite() {
-        return yy;
+        return (yy, yy);
     }
     let scale: Vec<f64> = used.iter().map(|&i| product(i, i).sqrt()).collect();
     let k = used.len();
     let a = DMatrix::from_fn(k, k, |r, c| product(used[r], used[c]) / (scale[r] * scale[c]));
     let b = DVector::from_fn(k, |r, _| product(used[r], p) / scale[r]);
-    let Some(svd) = a.try_svd(true, true, 1e-15, 10_000) else { return yy };
-    let Ok(pinv) = svd.pseudo_inverse(1e-12) else { return yy };
-    (yy - b.dot(&(pinv * &b))).max(0.0)
+    let Some(svd) = a.try_svd(true, true, 1e-15, 10_000) else { return (yy, yy) };
+    let Ok(pinv) = svd.pseudo_inverse(1e-12) else { return (yy, yy) };
+    ((yy - b.dot(&(pinv * &b))).max(0.0), yy)
 }
 
 #[cfg(test)]
@@ -194,15 +206,18 @@ mod tests {
         let y: Vec<f64> = x.iter().zip(&z).map(|(x, z)| 2.0 * x + 3.0 * z).collect();
         let mut both = crate::select::Accumulator::new(2);
         both.push_columns(&[&x, &z], &y, None);
-        assert!(full_rss(&both.finish(), false) < 1e-20);
+        // nothing left but rounding, relative to Σy²
+        let (left, total) = full_rss(&both.finish(), false);
+        assert!(left < 1e-14 * total, "{left} of {total}");
         // about the means, the constant does not vary: passed over, not divided by zero
         let ones = vec![1.0; 50];
         let mut with_one = crate::select::Accumulator::new(3);
         with_one.push_columns(&[&x, &z, &ones], &y, None);
-        assert!(full_rss(&with_one.finish(), true) < 1e-20);
+        let (left, total) = full_rss(&with_one.finish(), true);
+        assert!(left < 1e-14 * total, "{left} of {total}");
         let mut one = crate::select::Accumulator::new(1);
         one.push_columns(&[&x], &y, None);
-        let left = full_rss(&one.finish(), false);
+        let (left, total) = full_rss(&one.finish(), false);
         // what x cannot take of 3z: 9 (Σz² − (Σxz)²/Σx²)
         let (sxx, sxz, szz): (f64, f64, f64) = (
             x.iter().map(|v| v * v).sum(),
@@ -211,5 +226,7 @@ mod tests {
         );
         let want = 9.0 * (szz - sxz * sxz / sxx);
         assert!((left - want).abs() < 1e-9 * want, "{left} vs {want}");
+        let yy: f64 = y.iter().map(|v| v * v).sum();
+        assert!((total - yy).abs() < 1e-12 * yy);
     }
 }

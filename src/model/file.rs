@@ -88,7 +88,9 @@ pub struct Meta {
     pub keep_spikes: bool,
     /// How the runs' inputs behave between samples: `auto` (the default: held where the record
     /// shows a zero-order hold, [`crate::data::held`], else a line), `linear` or `held`.
-    /// Taken by the integral form's quadrature and by every replay into a simulation.
+    /// Taken by the integral form's quadrature and by every replay into a simulation. Under
+    /// `auto` and `held` a column that repeats a slower sensor's readings between them is
+    /// read at its readings ([`crate::data::read_at_readings`]).
     #[serde(default, skip_serializing_if = "is_auto")]
     pub intersample: crate::data::Intersample,
 }

@@ -866,8 +866,9 @@ impl Model {
     /// away and straight back) is replaced by the line through its neighbours
     /// ([`crate::data::despiked`]) unless the file says `keep_spikes`; an input that stays put
     /// between samples and jumps at isolated ones is marked held ([`crate::data::mark_held`],
-    /// as the file's `intersample` says). Returns what was renamed, resampled, unwrapped,
-    /// marked or mended, for the caller to say.
+    /// as the file's `intersample` says), and a column that repeats a slower sensor's readings
+    /// between them is read at its readings ([`crate::data::read_at_readings`]). Returns what
+    /// was renamed, resampled, unwrapped, marked, re-read or mended, for the caller to say.
     pub fn admit(&self, frame: &mut crate::data::Frame) -> Result<Vec<String>, crate::data::DataError> {
         let admitted = self.admit_at(frame, 0)?;
         Ok(admitted.notes.into_iter().chain(admitted.spikes).collect())
@@ -914,6 +915,18 @@ impl Model {
         }
         let inputs: Vec<&str> = self.spec.inputs.iter().map(|i| i.name.as_str()).collect();
         notes.extend(crate::data::mark_held(frame, &inputs, self.spec.model.intersample)?);
+        // a state, its rate or an input (not a held command) that repeats a slower sensor's
+        // readings between them is read at them
+        let rates: Vec<String> = self.spec.states.iter().map(|s| format!("{}_dot", s.name)).collect();
+        let columns: Vec<&str> = self
+            .vocabulary
+            .variables()
+            .iter()
+            .chain(&rates)
+            .map(String::as_str)
+            .chain(inputs.iter().copied())
+            .collect();
+        notes.extend(crate::data::read_at_readings(frame, &columns, self.spec.model.intersample)?);
         for input in self.spec.inputs.iter().filter(|i| i.unit == "rad") {
             let beyond = frame
                 .column(&input.name)

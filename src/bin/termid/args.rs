@@ -320,8 +320,10 @@ pub struct IdentifyCommand {
     /// samples and jumps at isolated ones (a digital controller's command, a force stepped by
     /// a rig) is taken as held from each sample to the next, and said; else a line. The
     /// integral form integrates a held input piece by piece between its jumps, and a replay
-    /// into a simulation holds it over each step. With --model as the file's `intersample`
-    /// (which the model written keeps).
+    /// into a simulation holds it over each step. Any column (the state too) that changes only
+    /// every few rows on a clock, at most of its ticks, repeats a slower sensor's readings: it
+    /// is read at its readings and interpolated between them by cubics, and said (`linear`:
+    /// neither). With --model as the file's `intersample` (which the model written keeps).
     #[arg(long, value_enum)]
     pub intersample: Option<termid::data::Intersample>,
     /// Write a figure of the raw and prepared signals of every run into this folder.

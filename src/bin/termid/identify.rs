@@ -113,12 +113,17 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
         crate::runs::mend_spikes(&mut frames)?;
     }
     if let Target::Derivative(state) = &target {
-        // every column but the state whose rate is taken may be an input held between samples
+        // every column but the state whose rate is taken may be an input held between samples;
+        // any column, a slower sensor's readings repeated
         let intersample = cmd.intersample.unwrap_or_default();
         for f in &mut frames {
             let columns: Vec<String> = f.names()[1..].iter().filter(|n| *n != state).cloned().collect();
             let columns: Vec<&str> = columns.iter().map(String::as_str).collect();
             termid::data::mark_held(f, &columns, intersample)?.iter().for_each(|n| crate::runs::say(n));
+            // the state too may repeat a slower sensor's readings
+            let all: Vec<String> = f.names()[1..].to_vec();
+            let all: Vec<&str> = all.iter().map(String::as_str).collect();
+            termid::data::read_at_readings(f, &all, intersample)?.iter().for_each(|n| crate::runs::say(n));
         }
     }
     // after the marking: a held column is read back sample for sample

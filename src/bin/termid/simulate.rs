@@ -240,7 +240,10 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
             let mut frame = crate::runs::replay_frame(std::path::Path::new(file), &model.spec().model.time)?;
             // an input held between samples in the record is held in the replay
             let inputs: Vec<&str> = system.inputs.iter().map(String::as_str).collect();
-            let notes = termid::data::mark_held(&mut frame, &inputs, model.spec().model.intersample)?;
+            let intersample = model.spec().model.intersample;
+            let mut notes = termid::data::mark_held(&mut frame, &inputs, intersample)?;
+            // and one that repeats a slower sensor's readings, read at them
+            notes.extend(termid::data::read_at_readings(&mut frame, &inputs, intersample)?);
             notes.iter().for_each(|n| crate::runs::say(n));
             Ok(frame)
         })
