@@ -296,12 +296,19 @@ pub(crate) fn fit(
             for note in termid::data::read_at_readings(&mut frame, &all, intersample).map_err(fail)? {
                 warn(py, note)?;
             }
+            // a record that moves and leaps at one sample and stays (records joined): each piece
+            // a run of its own
+            let (mut frames, notes) = termid::data::cut_at_breaks(frame, &all).map_err(fail)?;
+            for note in notes {
+                warn(py, note)?;
+            }
             // columns acting later than recorded, read back (after the marking: a held column
             // sample for sample)
             for (name, seconds) in &delays {
-                frame = termid::data::delayed(&frame, name, *seconds, 0.0).map_err(fail)?;
+                for frame in &mut frames {
+                    *frame = termid::data::delayed(frame, name, *seconds, 0.0).map_err(fail)?;
+                }
             }
-            let frames = [frame];
             let others: Vec<String> = columns.iter().map(|c| c.to_string()).collect();
             py.detach(|| -> Result<Fit, termid::identify::IdentifyError> {
                 let mut fit = how.fit_design(&rate, design, forced, excluded, &frames, selector.as_ref())?;

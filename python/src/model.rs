@@ -58,6 +58,9 @@ impl PyModel {
                 for frame in &mut frames {
                     notes.extend(self.inner.admit(frame)?);
                 }
+                let (cut, more) = self.inner.cut_at_breaks(std::mem::take(&mut frames))?;
+                frames = cut;
+                notes.extend(more);
                 Ok(notes)
             })
             .map_err(fail)?;

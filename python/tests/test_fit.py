@@ -307,22 +307,22 @@ def test_a_force_acting_late_is_said_and_fitted_with_its_delay():
     assert not any("acts on" in n for n in late.notes)
 
 
-def _lorenz_log(repeated):
-    # Lorenz every 1 ms for 10 s (RK4), the columns `repeated` read every 10th row and
+def _lorenz_log(repeated, start=(-8.0, 7.0, 27.0), rows=10_001):
+    # Lorenz every 1 ms from `start` (RK4), the columns `repeated` read every 10th row and
     # written again until the next reading (a slower sensor merged and filled forward)
     def rate(s):
         x, y, z = s
         return np.array([10.0 * (y - x), x * (28.0 - z) - y, x * y - 8.0 / 3.0 * z])
 
-    h, s, rows = 0.001, np.array([-8.0, 7.0, 27.0]), []
-    for _ in range(10_001):
-        rows.append(s)
+    h, s, out = 0.001, np.array(start), []
+    for _ in range(rows):
+        out.append(s)
         k1 = rate(s)
         k2 = rate(s + 0.5 * h * k1)
         k3 = rate(s + 0.5 * h * k2)
         k4 = rate(s + h * k3)
         s = s + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-    df = pd.DataFrame(rows, columns=["x", "y", "z"])
+    df = pd.DataFrame(out, columns=["x", "y", "z"])
     df.insert(0, "t", 0.001 * np.arange(len(df)))
     for name in repeated:
         df[name] = df[name].iloc[::10].reindex(df.index).ffill()
@@ -341,6 +341,21 @@ def test_a_state_repeated_between_its_readings_is_read_at_them():
     assert got.keys() == want.keys() and all(abs(got[k] - w) < 1e-3 * abs(w) for k, w in want.items())
     rows = termid.fit(df, "dy/dt", library, intersample="linear").coefficients.to_dict()
     assert rows.keys() != want.keys() or any(abs(rows[k] - w) > 1e-2 * abs(w) for k, w in want.items())
+
+
+def test_records_joined_in_one_frame_are_cut_into_runs():
+    # two runs from different starts one after the other on one clock: cut where every
+    # state leaps, with a warning, and dy/dt's true terms within 0.01 %
+    first = _lorenz_log("", rows=3000)
+    second = _lorenz_log("", start=(5.0, -5.0, 10.0), rows=3000)
+    second["t"] += 3.0
+    df = pd.concat([first, second], ignore_index=True)
+    library = ["x", "y", "z", "x*y", "x*z", "y*z", "x^2", "y^2", "z^2"]
+    with pytest.warns(UserWarning, match="leap from row 3000 to row 3001 .* the run is cut there"):
+        fit = termid.fit(df, "dy/dt", library)
+    want = {"x": 28.0, "x*z": -1.0, "y": -1.0}
+    got = fit.coefficients.sort_index().to_dict()
+    assert got.keys() == want.keys() and all(abs(got[k] - w) < 1e-4 * abs(w) for k, w in want.items())
 
 
 def test_the_rows_that_cannot_choose_are_said():

@@ -3,6 +3,7 @@
 //! the [`Differentiator`] interface.
 
 mod angle;
+mod breaks;
 mod clock;
 #[cfg(feature = "columnar")]
 mod columnar;
@@ -25,6 +26,7 @@ mod spike;
 mod stream;
 
 pub use angle::{unwrap_turns, unwrapped, wrapped};
+pub use breaks::{breaks, cut_at_breaks, moving_breaks, Break};
 pub use clock::clock_seconds;
 pub use dataset::{velocities_from_track, Dataset, Delimiter, RunSpec, Track};
 pub use delay::delayed;

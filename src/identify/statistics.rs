@@ -138,6 +138,17 @@ impl EquationMoments {
                 let admitted =
                     model.admit_at(&mut chunk.frame, chunk.first_row).map_err(|e| shift(e.into()))?;
                 crate::data::check_gaps(&chunk.frame, 3.0).map_err(|e| shift(e.into()))?;
+                // a piece of a run is not cut into runs (the whole run is, where it breaks)
+                let motion = model.recorded_motion();
+                if let Some((row, name, leap)) = crate::data::moving_breaks(&chunk.frame, &motion).0.first() {
+                    return Err(IdentifyError::Setup(format!(
+                        "{}: `{name}` leaps by {} from row {} to row {} and stays (records joined in one file, a sensor re-zeroed), where a run read whole is cut into runs of its own; a piece of one cannot be: read the runs whole (--chunk-rows 0), or cut the file there",
+                        chunk.frame.origin(),
+                        crate::output::sig(*leap, 3),
+                        chunk.first_row + row,
+                        chunk.first_row + row + 1
+                    )));
+                }
                 // a chunk's spikes are its own; what else admission says, every chunk repeats
                 notes.extend(admitted.spikes);
                 if let Some((.., held)) = &run {

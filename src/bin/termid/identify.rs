@@ -125,6 +125,17 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
             let all: Vec<&str> = all.iter().map(String::as_str).collect();
             termid::data::read_at_readings(f, &all, intersample)?.iter().for_each(|n| crate::runs::say(n));
         }
+        // a record that moves and leaps at one sample and stays (records joined in one file):
+        // each piece a run
+        let mut pieces = Vec::new();
+        for f in frames {
+            let all: Vec<String> = f.names()[1..].to_vec();
+            let all: Vec<&str> = all.iter().map(String::as_str).collect();
+            let (cut, notes) = termid::data::cut_at_breaks(f, &all)?;
+            notes.iter().for_each(|n| crate::runs::say(n));
+            pieces.extend(cut);
+        }
+        frames = pieces;
     }
     // after the marking: a held column is read back sample for sample
     for d in &cmd.delays {

@@ -1,0 +1,249 @@
+//! Breaks in a state's record: a leap at one sample that stays, far beyond the steps beside it
+//! (two records joined in one file, a sensor re-zeroed, a knock). No motion whose rate is
+//! finite crosses one; taken as a motion, every rate and integral across it is wrong and so is
+//! every fit (Lorenz, two runs in one file: ten terms where two are). A run is cut there into
+//! runs of its own.
+
+use super::{DataError, Frame};
+
+/// A break: the state leaps by `leap` from row `row − 1` to row `row` and goes on from there.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Break {
+    /// The first row after the leap (0-based row of the frame).
+    pub row: usize,
+    /// The leap.
+    pub leap: f64,
+}
+
+/// Rows per break at least: a record that leaps more often is a staircase of its own (a
+/// counter, a state read off a coarse scale), not records joined.
+const ROWS_PER_BREAK: usize = 1000;
+
+/// The shortest piece kept as a run, in rows: fewer hold no rate worth fitting.
+const SHORTEST: usize = 21;
+
+/// How many times a break's step must be off its neighbours' mean more than any step two
+/// or three samples away is off theirs (a smooth record's steps change smoothly; a break's
+/// flanks are off by half as much, the other way).
+const BESIDE: f64 = 5.0;
+/// How many robust standard deviations of the steps' roughness it must exceed (Gaussian
+/// noise that far about once in 10⁷ samples).
+const NOISE: f64 = 8.0;
+/// The share of the record's span (1st to 99th percentile) it must exceed: a count of a
+/// record printed to a few figures is no break.
+const SPAN: f64 = 0.01;
+
+/// The breaks of one record: where its step from one sample to the next is off the mean of
+/// the steps either side (which a smooth record's is by a third difference, and noise by
+/// about 1.2 σ) far beyond the steps two and three samples away, the record's roughness so
+/// measured (never below its resolution, the smallest step it takes), and 1 % of its span. A glitch (away and straight back) is no break: its two
+/// steps are off alike. None in the first or last three steps.
+pub fn breaks(x: &[f64]) -> Vec<Break> {
+    let n = x.len();
+    if n < 9 {
+        return Vec::new();
+    }
+    let steps: Vec<f64> = x.windows(2).map(|w| w[1] - w[0]).collect();
+    // r[k]: step k off the mean of steps k − 1 and k + 1 (r[0] and the last unused)
+    let mut off = vec![0.0; steps.len()];
+    for k in 1..steps.len() - 1 {
+        off[k] = steps[k] - 0.5 * (steps[k - 1] + steps[k + 1]);
+    }
+    let candidates: Vec<usize> = (3..steps.len().saturating_sub(3))
+        .filter(|&k| {
+            let around = [k - 3, k - 2, k + 2, k + 3].iter().fold(0.0, |m: f64, &j| m.max(off[j].abs()));
+            off[k].abs() > BESIDE * around
+        })
+        .collect();
+    if candidates.is_empty() {
+        return Vec::new();
+    }
+    // the roughness and span only where something stood out (most records: nowhere)
+    let mut rough: Vec<f64> = off[1..steps.len() - 1].iter().map(|r| r.abs()).collect();
+    let middle = rough.len() / 2;
+    let sigma = 1.4826 * *rough.select_nth_unstable_by(middle, f64::total_cmp).1;
+    let mut order = x.to_vec();
+    let high = *order.select_nth_unstable_by(n * 99 / 100, f64::total_cmp).1;
+    let low = *order.select_nth_unstable_by(n / 100, f64::total_cmp).1;
+    // a record printed to a few figures steps by its counts: its resolution is its noise
+    let resolution = steps.iter().map(|s| s.abs()).filter(|s| *s > 0.0).fold(f64::INFINITY, f64::min);
+    let floor = (NOISE * sigma.max(resolution)).max(SPAN * (high - low));
+    candidates
+        .into_iter()
+        .filter(|&k| off[k].abs() > floor)
+        .map(|k| Break { row: k + 1, leap: steps[k] - 0.5 * (steps[k - 1] + steps[k + 1]) })
+        .collect()
+}
+
+/// The breaks of the `columns` of `frame` that cut it, as (row, column, leap) in row order,
+/// and what to say of the columns that leap too often to be records joined (more than one
+/// row in a thousand and more than three: a staircase of its own, a counter or a coarse
+/// scale), which cut nothing. Only records that move from sample to sample are looked at: a
+/// command stepped at isolated samples ([`super::held`], a step test's force) jumps by design.
+pub fn moving_breaks<'a>(frame: &Frame, columns: &[&'a str]) -> (Vec<(usize, &'a str, f64)>, Vec<String>) {
+    let n = frame.len();
+    let (mut found, mut notes) = (Vec::new(), Vec::new());
+    for name in columns {
+        let Some(column) = frame.column(name) else { continue };
+        if super::held(column).is_some() {
+            continue;
+        }
+        let b = breaks(column);
+        if b.len() > 3 && b.len() * ROWS_PER_BREAK > n {
+            notes.push(format!(
+                "{}: `{name}` leaps at {} rows and stays (from row {}), far beyond its steps beside: too often for records joined in one file; taken as recorded, its rate spikes there",
+                frame.origin(),
+                b.len(),
+                b[0].row + 1
+            ));
+            continue;
+        }
+        found.extend(b.iter().map(|b| (b.row, *name, b.leap)));
+    }
+    found.sort_by_key(|f| f.0);
+    (found, notes)
+}
+
+/// The run cut at the breaks of its `columns` ([`moving_breaks`]) into runs of their own (each
+/// named by its origin and its rows in it: "run.csv [rows 1001-2000]"), with what to say; the
+/// run itself where none breaks. A piece under 21 rows is left out (said).
+pub fn cut_at_breaks(frame: Frame, columns: &[&str]) -> Result<(Vec<Frame>, Vec<String>), DataError> {
+    let n = frame.len();
+    let sig = |x: f64| crate::output::sig(x, 3);
+    let (found, mut notes) = moving_breaks(&frame, columns);
+    if found.is_empty() {
+        return Ok((vec![frame], notes));
+    }
+    let mut cuts: Vec<usize> = found.iter().map(|f| f.0).collect();
+    cuts.dedup();
+    let t = frame.time();
+    for &row in &cuts {
+        let leaps: Vec<String> = found
+            .iter()
+            .filter(|f| f.0 == row)
+            .map(|(_, name, leap)| format!("`{name}` (by {})", sig(*leap)))
+            .collect();
+        let (verb, whose) = if leaps.len() == 1 { ("leaps", "its") } else { ("leap", "their") };
+        notes.push(format!(
+            "{}: {} {verb} from row {} to row {} (t = {} s), far beyond {whose} steps beside, and {} there: no motion crosses that in one sample (two records joined in one file, a sensor re-zeroed, a knock); the run is cut there into runs of its own",
+            frame.origin(),
+            leaps.join(", "),
+            row,
+            row + 1,
+            sig(t[row]),
+            if leaps.len() == 1 { "stays" } else { "stay" },
+        ));
+    }
+    let bounds: Vec<usize> = std::iter::once(0).chain(cuts).chain(std::iter::once(n)).collect();
+    let mut pieces = Vec::new();
+    for w in bounds.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let name = format!("{} [rows {}-{}]", frame.origin(), a + 1, b);
+        if b - a < SHORTEST {
+            notes.push(format!("{name}: {} rows between breaks, too few for a run: left out", b - a));
+            continue;
+        }
+        let mut piece = frame.slice(a..b);
+        piece.origin = name;
+        pieces.push(piece);
+    }
+    if pieces.is_empty() {
+        return Err(DataError::TooShort {
+            file: frame.origin().into(),
+            rows: bounds.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0),
+            needed: SHORTEST,
+            what: "a run between the breaks of its states (the longest piece's rows)".into(),
+        });
+    }
+    Ok((pieces, notes))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A smooth record that jumps by 5 at row 300 and goes on from the new level: one break,
+    /// at row 300, by 5 (and the steps there are the motion's).
+    #[test]
+    fn a_leap_that_stays_is_a_break() {
+        let x: Vec<f64> =
+            (0..600).map(|k| (0.02 * k as f64).sin() + if k >= 300 { 5.0 } else { 0.0 }).collect();
+        let b = breaks(&x);
+        assert_eq!(b.len(), 1, "{b:?}");
+        assert_eq!(b[0].row, 300);
+        assert!((b[0].leap - 5.0).abs() < 0.03, "{b:?}");
+        let smooth: Vec<f64> = (0..600).map(|k| (0.02 * k as f64).sin()).collect();
+        assert!(breaks(&smooth).is_empty());
+    }
+
+    /// Not breaks: a glitch (away and straight back), counts of a slow ramp, noise, a steady
+    /// rate printed to three figures (76.0, 76.1, 75.9: MARIN's propeller).
+    #[test]
+    fn glitches_counts_and_noise_are_not_breaks() {
+        let mut glitch: Vec<f64> = (0..600).map(|k| (0.02 * k as f64).sin()).collect();
+        glitch[200] += 3.0;
+        assert!(breaks(&glitch).is_empty());
+        let counts: Vec<f64> = (0..1000).map(|k| (k as f64 / 7.3).floor()).collect();
+        assert!(breaks(&counts).is_empty());
+        let mut seed = 9u64;
+        let noisy: Vec<f64> =
+            (0..5000).map(|k| (0.01 * k as f64).sin() + 0.05 * crate::data::test_noise(&mut seed)).collect();
+        assert!(breaks(&noisy).is_empty());
+        let flicker: Vec<f64> = (0..2000)
+            .map(|_| {
+                let n = crate::data::test_noise(&mut seed);
+                76.0 + if n > 0.45 {
+                    0.1
+                } else if n < -0.45 {
+                    -0.1
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        assert!(breaks(&flicker).is_empty());
+    }
+
+    /// Two records in one frame: cut into two runs named by their rows, said once with both
+    /// states that leap; a piece of 10 rows at the end left out, said; a column that is not a
+    /// state (a command stepped) cuts nothing.
+    #[test]
+    fn joined_records_are_cut_into_runs() {
+        let t: Vec<f64> = (0..610).map(|k| 0.1 * k as f64).collect();
+        let mut f = Frame::new("joined.csv", "t", t.clone()).unwrap();
+        let level = |k: usize| match k {
+            0..300 => 0.0,
+            300..600 => 4.0,
+            _ => -3.0,
+        };
+        f.push("x", (0..610).map(|k| (0.2 * t[k]).sin() + level(k)).collect()).unwrap();
+        f.push("y", (0..610).map(|k| (0.2 * t[k]).cos() - level(k)).collect()).unwrap();
+        f.push("F", (0..610).map(|k| if k % 100 < 50 { 1.0 } else { -1.0 }).collect()).unwrap();
+        let (runs, notes) = cut_at_breaks(f.clone(), &["x", "y"]).unwrap();
+        assert_eq!(runs.len(), 2);
+        assert_eq!(runs[0].origin(), "joined.csv [rows 1-300]");
+        assert_eq!((runs[1].origin(), runs[1].len()), ("joined.csv [rows 301-600]", 300));
+        assert_eq!(runs[1].time()[0], t[300]);
+        assert_eq!(notes.len(), 3, "{notes:?}");
+        assert!(
+            notes[0].contains("`x` (by 4.00), `y` (by -4.00) leap from row 300 to row 301 (t = 30.0 s)"),
+            "{}",
+            notes[0]
+        );
+        assert!(notes[2].contains("[rows 601-610]: 10 rows between breaks"), "{}", notes[2]);
+        let (whole, said) = cut_at_breaks(f, &["F"]).unwrap();
+        assert_eq!((whole.len(), said.len()), (1, 0));
+    }
+
+    /// A staircase (a state read off a coarse scale every 40 rows) leaps too often to be
+    /// records joined: cut nowhere, said.
+    #[test]
+    fn a_staircase_is_not_cut() {
+        let t: Vec<f64> = (0..4000).map(|k| 0.01 * k as f64).collect();
+        let mut f = Frame::new("scale.csv", "t", t).unwrap();
+        f.push("x", (0..4000).map(|k| (k / 40) as f64 + 0.001 * (0.01 * k as f64).sin()).collect()).unwrap();
+        let (runs, notes) = cut_at_breaks(f, &["x"]).unwrap();
+        assert_eq!(runs.len(), 1);
+        assert!(notes[0].contains("too often for records joined"), "{notes:?}");
+    }
+}
