@@ -33,21 +33,24 @@ const NOISE: f64 = 8.0;
 /// record printed to a few figures is no break.
 const SPAN: f64 = 0.01;
 
-/// The breaks of one record: where its step from one sample to the next is off the mean of
-/// the steps either side (which a smooth record's is by a third difference, and noise by
-/// about 1.2 σ) far beyond the steps two and three samples away, the record's roughness so
-/// measured (never below its resolution, the smallest step it takes), and 1 % of its span. A glitch (away and straight back) is no break: its two
+/// The breaks of one record `x` at times `t`: where its slope from one sample to the next is
+/// off the mean of the slopes either side (which a smooth record's is by a third difference,
+/// and noise by about 1.2 σ/Δt) far beyond the slopes two and three samples away and the
+/// record's roughness so measured, and the leap (that excess times the interval) beyond its
+/// resolution (the smallest step it takes) and 1 % of its span. A glitch (away and straight back) is no break: its two
 /// steps are off alike. None in the first or last three steps.
-pub fn breaks(x: &[f64]) -> Vec<Break> {
-    let n = x.len();
+pub fn breaks(t: &[f64], x: &[f64]) -> Vec<Break> {
+    let n = x.len().min(t.len());
     if n < 9 {
         return Vec::new();
     }
-    let steps: Vec<f64> = x.windows(2).map(|w| w[1] - w[0]).collect();
-    // r[k]: step k off the mean of steps k − 1 and k + 1 (r[0] and the last unused)
+    let steps: Vec<f64> = x[..n].windows(2).map(|w| w[1] - w[0]).collect();
+    // per second, so that a longer interval (a dropped sample) is no leap
+    let slopes: Vec<f64> = steps.iter().zip(t.windows(2)).map(|(s, w)| s / (w[1] - w[0])).collect();
+    // off[k]: slope k off the mean of slopes k − 1 and k + 1 (off[0] and the last unused)
     let mut off = vec![0.0; steps.len()];
     for k in 1..steps.len() - 1 {
-        off[k] = steps[k] - 0.5 * (steps[k - 1] + steps[k + 1]);
+        off[k] = slopes[k] - 0.5 * (slopes[k - 1] + slopes[k + 1]);
     }
     let candidates: Vec<usize> = (3..steps.len().saturating_sub(3))
         .filter(|&k| {
@@ -62,16 +65,19 @@ pub fn breaks(x: &[f64]) -> Vec<Break> {
     let mut rough: Vec<f64> = off[1..steps.len() - 1].iter().map(|r| r.abs()).collect();
     let middle = rough.len() / 2;
     let sigma = 1.4826 * *rough.select_nth_unstable_by(middle, f64::total_cmp).1;
-    let mut order = x.to_vec();
+    let mut order = x[..n].to_vec();
     let high = *order.select_nth_unstable_by(n * 99 / 100, f64::total_cmp).1;
     let low = *order.select_nth_unstable_by(n / 100, f64::total_cmp).1;
     // a record printed to a few figures steps by its counts: its resolution is its noise
     let resolution = steps.iter().map(|s| s.abs()).filter(|s| *s > 0.0).fold(f64::INFINITY, f64::min);
-    let floor = (NOISE * sigma.max(resolution)).max(SPAN * (high - low));
+    // the leap in the record's units: the slope's excess over its interval
+    let leap = |k: usize| off[k] * (t[k + 1] - t[k]);
     candidates
         .into_iter()
-        .filter(|&k| off[k].abs() > floor)
-        .map(|k| Break { row: k + 1, leap: steps[k] - 0.5 * (steps[k - 1] + steps[k + 1]) })
+        .filter(|&k| {
+            off[k].abs() > NOISE * sigma && leap(k).abs() > (NOISE * resolution).max(SPAN * (high - low))
+        })
+        .map(|k| Break { row: k + 1, leap: leap(k) })
         .collect()
 }
 
@@ -88,7 +94,7 @@ pub fn moving_breaks<'a>(frame: &Frame, columns: &[&'a str]) -> (Vec<(usize, &'a
         if super::held(column).is_some() {
             continue;
         }
-        let b = breaks(column);
+        let b = breaks(frame.time(), column);
         if b.len() > 3 && b.len() * ROWS_PER_BREAK > n {
             notes.push(format!(
                 "{}: `{name}` leaps at {} rows and stays (from row {}), far beyond its steps beside: too often for records joined in one file; taken as recorded, its rate spikes there",
@@ -162,18 +168,30 @@ pub fn cut_at_breaks(frame: Frame, columns: &[&str]) -> Result<(Vec<Frame>, Vec<
 mod tests {
     use super::*;
 
+    /// `n` samples 0.1 s apart.
+    fn clock(n: usize) -> Vec<f64> {
+        (0..n).map(|k| 0.1 * k as f64).collect()
+    }
+
     /// A smooth record that jumps by 5 at row 300 and goes on from the new level: one break,
     /// at row 300, by 5 (and the steps there are the motion's).
     #[test]
     fn a_leap_that_stays_is_a_break() {
         let x: Vec<f64> =
             (0..600).map(|k| (0.02 * k as f64).sin() + if k >= 300 { 5.0 } else { 0.0 }).collect();
-        let b = breaks(&x);
+        let b = breaks(&clock(x.len()), &x);
         assert_eq!(b.len(), 1, "{b:?}");
         assert_eq!(b[0].row, 300);
         assert!((b[0].leap - 5.0).abs() < 0.03, "{b:?}");
         let smooth: Vec<f64> = (0..600).map(|k| (0.02 * k as f64).sin()).collect();
-        assert!(breaks(&smooth).is_empty());
+        assert!(breaks(&clock(smooth.len()), &smooth).is_empty());
+        // a sample dropped from a record that moves fast (a step 4 % of its span): the
+        // interval is twice as long, the slope across it the motion's
+        let fast: Vec<f64> = (0..600).map(|k| (0.3 * k as f64).sin()).collect();
+        let (mut t, mut dropped) = (clock(600), fast.clone());
+        t.remove(300);
+        dropped.remove(300);
+        assert!(breaks(&t, &dropped).is_empty(), "{:?}", breaks(&t, &dropped));
     }
 
     /// Not breaks: a glitch (away and straight back), counts of a slow ramp, noise, a steady
@@ -182,13 +200,13 @@ mod tests {
     fn glitches_counts_and_noise_are_not_breaks() {
         let mut glitch: Vec<f64> = (0..600).map(|k| (0.02 * k as f64).sin()).collect();
         glitch[200] += 3.0;
-        assert!(breaks(&glitch).is_empty());
+        assert!(breaks(&clock(glitch.len()), &glitch).is_empty());
         let counts: Vec<f64> = (0..1000).map(|k| (k as f64 / 7.3).floor()).collect();
-        assert!(breaks(&counts).is_empty());
+        assert!(breaks(&clock(counts.len()), &counts).is_empty());
         let mut seed = 9u64;
         let noisy: Vec<f64> =
             (0..5000).map(|k| (0.01 * k as f64).sin() + 0.05 * crate::data::test_noise(&mut seed)).collect();
-        assert!(breaks(&noisy).is_empty());
+        assert!(breaks(&clock(noisy.len()), &noisy).is_empty());
         let flicker: Vec<f64> = (0..2000)
             .map(|_| {
                 let n = crate::data::test_noise(&mut seed);
@@ -201,7 +219,7 @@ mod tests {
                 }
             })
             .collect();
-        assert!(breaks(&flicker).is_empty());
+        assert!(breaks(&clock(flicker.len()), &flicker).is_empty());
     }
 
     /// Two records in one frame: cut into two runs named by their rows, said once with both
