@@ -61,6 +61,10 @@ pub(crate) fn sine_rate_error(t: &[f64], d: &[f64]) -> f64 {
     (sq / 1960.0).sqrt()
 }
 
+/// What an empty cell (or NaN) most often is, and what to do: sensors of several rates merged,
+/// the slower ones blank between their readings.
+const NO_READING: &str = "no reading there; where a slower sensor's column is blank between its readings (sensors of several rates merged), fill it forward (pandas' `ffill`): a column that repeats its readings is read at them; where readings were lost, cut the run there";
+
 /// Something wrong with a data set. Every variant names where.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -118,7 +122,7 @@ pub enum DataError {
         column: String,
     },
     /// A cell is not a number.
-    #[error("{file}: row {row}, column `{column}`: `{cell}` is not a number")]
+    #[error("{file}: row {row}, column `{column}`: {}", if cell.trim().is_empty() { NO_READING.to_string() } else { format!("`{cell}` is not a number") })]
     NotNumeric {
         /// The file.
         file: String,
@@ -130,7 +134,7 @@ pub enum DataError {
         cell: String,
     },
     /// NaN or infinite value.
-    #[error("{file}: row {row}, column `{column}`: value {value} is not finite")]
+    #[error("{file}: row {row}, column `{column}`: value {value} is not finite{}", if value.is_nan() { format!(" ({NO_READING})") } else { String::new() })]
     NonFinite {
         /// The file.
         file: String,

@@ -196,6 +196,18 @@ pub fn termid(args: &[&str]) -> (bool, String, String) {
     )
 }
 
+/// The terms an `identify --format json` report chose, with their coefficients, by term.
+pub fn chosen_terms(report: &serde_json::Value) -> Vec<(String, f64)> {
+    let mut out: Vec<(String, f64)> = report["terms"]
+        .as_array()
+        .unwrap_or_else(|| panic!("{report}"))
+        .iter()
+        .map(|t| (t["term"].as_str().unwrap().to_string(), t["coefficient"].as_f64().unwrap()))
+        .collect();
+    out.sort_by(|a, b| a.0.cmp(&b.0));
+    out
+}
+
 /// A command's JSON report, or a panic that shows it.
 pub fn json(text: &str) -> serde_json::Value {
     serde_json::from_str(text).unwrap_or_else(|e| panic!("{e}: {text}"))

@@ -4,7 +4,7 @@
 //! identified, validated and estimated exactly; taken as a line (the old default, or asked),
 //! biased. Acting 0.2 s after it is recorded (a dead time): said, and fitted with `--delay`.
 
-use crate::common::{json, termid, Lcg, Scratch};
+use crate::common::{chosen_terms, json, termid, Lcg, Scratch};
 
 /// The run: 3001 samples 0.01 s apart of x, v and F, F held at a random level in [−2, 2]
 /// from each sample where `changes` to the next where it does (every 50 samples: `held_force_run`).
@@ -76,18 +76,6 @@ identify = false
 coefficients = { "v" = 1.0 }
 "#;
 
-/// The coefficients an `identify --format json` report chose.
-fn coefficients(report: &serde_json::Value) -> Vec<(String, f64)> {
-    let mut out: Vec<(String, f64)> = report["terms"]
-        .as_array()
-        .unwrap_or_else(|| panic!("{report}"))
-        .iter()
-        .map(|t| (t["term"].as_str().unwrap().to_string(), t["coefficient"].as_f64().unwrap()))
-        .collect();
-    out.sort_by(|a, b| a.0.cmp(&b.0));
-    out
-}
-
 /// Plain `identify` of dv/dt: the force found held (its clock of 50 samples said), the
 /// three true terms within 1e-5 of the closed form's by the integral form; asked to take it
 /// as a line, the damping 1 % off or worse; by central differences, the bias is said.
@@ -153,10 +141,10 @@ fn a_held_force_is_integrated_as_held() {
     };
     let (held, said) = fit(&[]);
     assert!(said.contains("`F` stays put") && said.contains("on a clock of 50 samples"), "{said}");
-    assert_true_terms(&coefficients(&held), &held);
+    assert_true_terms(&chosen_terms(&held), &held);
     let (linear, said) = fit(&["--intersample", "linear"]);
     assert!(!said.contains("stays put"), "{said}");
-    let damping = coefficients(&linear).iter().find(|(t, _)| t == "v").map(|(_, c)| *c).unwrap();
+    let damping = chosen_terms(&linear).iter().find(|(t, _)| t == "v").map(|(_, c)| *c).unwrap();
     assert!((damping + 0.3).abs() > 0.003, "{linear}");
     let (central, _) = fit(&["--derivative", "central"]);
     let notes = central["notes"].to_string();
@@ -286,7 +274,7 @@ fn a_force_acting_late_is_said_and_fitted_with_its_delay() {
         "{notes}"
     );
     let late = fit(&["--delay", "F=0.2"]);
-    assert_true_terms(&coefficients(&late), &late);
+    assert_true_terms(&chosen_terms(&late), &late);
     assert!(!late["notes"].to_string().contains("acts on"), "{late}");
     let (ok, _, err) = termid(&[
         "identify",

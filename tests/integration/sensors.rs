@@ -5,7 +5,7 @@
 //! and the fits are wrong with nothing said; read at its readings, they are Lorenz's own.
 //! And two records in one file, the second from another start: cut into two runs, said.
 
-use crate::common::{json, lorenz_rows, termid, trajectory, Scratch, LORENZ_TRUTH};
+use crate::common::{chosen_terms, json, lorenz_rows, termid, trajectory, Scratch, LORENZ_TRUTH};
 
 /// Lorenz every 1 ms for 10 s, the columns `repeated` (of x, y, z) read every 10th row and
 /// repeated in between.
@@ -35,16 +35,20 @@ fn identify(data: &std::path::Path, rate: &str, extra: &[&str]) -> (serde_json::
     (report, said)
 }
 
-/// The chosen terms and coefficients of a report, by term.
-fn chosen(report: &serde_json::Value) -> Vec<(String, f64)> {
-    let mut out: Vec<(String, f64)> = report["terms"]
-        .as_array()
-        .unwrap_or_else(|| panic!("{report}"))
-        .iter()
-        .map(|t| (t["term"].as_str().unwrap().to_string(), t["coefficient"].as_f64().unwrap()))
-        .collect();
-    out.sort_by(|a, b| a.0.cmp(&b.0));
-    out
+/// `identify --model models/lorenz.toml` of `data`: the model it wrote, and what it said.
+fn identified_by_lorenz_model(dir: &std::path::Path, data: &std::path::Path) -> (toml::Value, String) {
+    let out = dir.join("identified.toml");
+    let (ok, _, err) = termid(&[
+        "identify",
+        "--model",
+        "models/lorenz.toml",
+        "--data",
+        data.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    (toml::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap(), err)
 }
 
 /// ẏ = ρx − y − xz with x read every 10th row: said (a clock of 10 rows), and the three true
@@ -61,7 +65,7 @@ fn a_state_repeated_between_its_readings_is_read_at_them() {
         "{notes}"
     );
     let (_, rho, _) = LORENZ_TRUTH;
-    let got = chosen(&report);
+    let got = chosen_terms(&report);
     let want = [("x", rho), ("x*z", -1.0), ("y", -1.0)];
     assert_eq!(got.len(), 3, "{got:?}");
     for ((term, c), (name, w)) in got.iter().zip(want) {
@@ -69,10 +73,41 @@ fn a_state_repeated_between_its_readings_is_read_at_them() {
     }
     let (rows, said) = identify(&data, "dy/dt", &["--intersample", "linear"]);
     assert!(!said.contains("changes only every"), "{said}");
-    let got = chosen(&rows);
+    let got = chosen_terms(&rows);
     let right = got.len() == 3
         && got.iter().zip(want).all(|((term, c), (name, w))| term == name && (c - w).abs() < 0.01 * w.abs());
     assert!(!right, "the staircase fitted as well as the readings: {got:?}");
+}
+
+/// The same log with `x` blank between its readings (sensors merged, not filled): refused at
+/// the first blank cell, saying what it most often is and what to do (fill it forward, which
+/// the test above reads right).
+#[test]
+fn a_blank_between_readings_is_refused_with_the_remedy() {
+    let dir = Scratch::new("blank-x");
+    let filled = std::fs::read_to_string(lorenz_log(&dir, "x")).unwrap();
+    let mut blank = String::new();
+    for (k, line) in filled.lines().enumerate() {
+        // data row k (the header is line 0): x read at rows 1, 11, 21, …
+        let cells: Vec<&str> = line.split(',').collect();
+        let x = if k == 0 || (k - 1) % 10 == 0 { cells[1] } else { "" };
+        blank.push_str(&format!("{},{x},{},{}\n", cells[0], cells[2], cells[3]));
+    }
+    let data = dir.join("blank.csv");
+    std::fs::write(&data, blank).unwrap();
+    let (ok, _, err) = termid(&[
+        "identify",
+        "--data",
+        data.to_str().unwrap(),
+        "--target",
+        "dy/dt",
+        "--terms",
+        "x",
+        "y",
+        "x*z",
+    ]);
+    assert!(!ok && err.contains("blank.csv: row 2, column `x`: no reading there"), "{err}");
+    assert!(err.contains("fill it forward"), "{err}");
 }
 
 /// Every state read every 10th row, through the Lorenz model file: each one said once per
@@ -82,21 +117,10 @@ fn a_state_repeated_between_its_readings_is_read_at_them() {
 fn a_model_reads_every_repeated_state_at_its_readings() {
     let dir = Scratch::new("repeated-xyz");
     let data = lorenz_log(&dir, "xyz");
-    let out = dir.join("identified.toml");
-    let (ok, _, err) = termid(&[
-        "identify",
-        "--model",
-        "models/lorenz.toml",
-        "--data",
-        data.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
+    let (model, err) = identified_by_lorenz_model(&dir, &data);
     for state in ["x", "y", "z"] {
         assert!(err.contains(&format!("`{state}` changes only every 10 rows")), "{err}");
     }
-    let model: toml::Value = toml::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
     let (sigma, rho, beta) = LORENZ_TRUTH;
     let truth = [
         ("x_dot", vec![("x", -sigma), ("y", sigma)]),
@@ -162,18 +186,16 @@ fn records_joined_in_one_file_are_cut_into_runs() {
         "{said}"
     );
     let (_, rho, _) = LORENZ_TRUTH;
-    let got = chosen(&report);
+    let got = chosen_terms(&report);
     assert_eq!(got.len(), 3, "{got:?}");
     for ((term, c), (name, w)) in got.iter().zip([("x", rho), ("x*z", -1.0), ("y", -1.0)]) {
         assert!(term == name && (c - w).abs() < 1e-4 * w.abs(), "{term} {c} vs {name} {w}");
     }
-    let out = dir.join("identified.toml");
-    let model = ["identify", "--model", "models/lorenz.toml", "--data", data.to_str().unwrap()];
-    let (ok, _, err) = termid(&[&model[..], &["--out", out.to_str().unwrap()]].concat());
-    assert!(ok && err.contains("the run is cut there"), "{err}");
-    let written: toml::Value = toml::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let (written, err) = identified_by_lorenz_model(&dir, &data);
+    assert!(err.contains("the run is cut there"), "{err}");
     let y_dot = written["equations"]["y_dot"]["coefficients"].as_table().unwrap();
     assert_eq!(y_dot.len(), 3, "{y_dot:?}");
+    let model = ["identify", "--model", "models/lorenz.toml", "--data", data.to_str().unwrap()];
     let (ok, _, err) = termid(&[&model[..], &["--derivative", "central", "--chunk-rows", "600"]].concat());
     assert!(
         !ok && err.contains("from row 1000 to row 1001 and stays") && err.contains("--chunk-rows 0"),
