@@ -869,6 +869,8 @@ impl Model {
     /// as the file's `intersample` says), and a column that repeats a slower sensor's readings
     /// between them is read at its readings ([`crate::data::read_at_readings`]). Returns what
     /// was renamed, resampled, unwrapped, marked, re-read or mended, for the caller to say.
+    /// Records joined in one run are cut into runs after, over all runs
+    /// ([`Model::cut_at_breaks`]: one run may become several).
     pub fn admit(&self, frame: &mut crate::data::Frame) -> Result<Vec<String>, crate::data::DataError> {
         let admitted = self.admit_at(frame, 0)?;
         Ok(admitted.notes.into_iter().chain(admitted.spikes).collect())
@@ -881,10 +883,10 @@ impl Model {
         &self,
         frames: Vec<crate::data::Frame>,
     ) -> Result<(Vec<crate::data::Frame>, Vec<String>), crate::data::DataError> {
-        let states = self.recorded_motion();
+        let motion = self.recorded_motion();
         let (mut out, mut notes) = (Vec::new(), Vec::new());
         for frame in frames {
-            let (pieces, said) = crate::data::cut_at_breaks(frame, &states)?;
+            let (pieces, said) = crate::data::cut_at_breaks(frame, &motion)?;
             out.extend(pieces);
             notes.extend(said);
         }
