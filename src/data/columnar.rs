@@ -353,7 +353,10 @@ mod tests {
         write_parquet(&dir.join("null.parquet"), &[first, with_null]);
         let e = Frame::read(&dir.join("null.parquet"), "t").unwrap_err().to_string();
         assert!(
-            e.contains("null.parquet") && e.contains("row 5") && e.contains("`r`") && e.contains("null"),
+            e.contains("null.parquet")
+                && e.contains("row 5")
+                && e.contains("`r`")
+                && e.contains("no reading there"),
             "{e}"
         );
         let text = batch(vec![

@@ -122,7 +122,7 @@ pub enum DataError {
         column: String,
     },
     /// A cell is not a number.
-    #[error("{file}: row {row}, column `{column}`: {}", if cell.trim().is_empty() { NO_READING.to_string() } else { format!("`{cell}` is not a number") })]
+    #[error("{file}: row {row}, column `{column}`: {}", if cell.trim().is_empty() || cell == "null" { NO_READING.to_string() } else { format!("`{cell}` is not a number") })]
     NotNumeric {
         /// The file.
         file: String,
