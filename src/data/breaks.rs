@@ -37,8 +37,8 @@ const SPAN: f64 = 0.01;
 /// off the mean of the slopes either side (which a smooth record's is by a third difference,
 /// and noise by about 1.2 σ/Δt) far beyond the slopes two and three samples away and the
 /// record's roughness so measured, and the leap (that excess times the interval) beyond its
-/// resolution (the smallest step it takes) and 1 % of its span. A glitch (away and straight back) is no break: its two
-/// steps are off alike. None in the first or last three steps.
+/// resolution (the smallest step it takes) and 1 % of its span. A glitch (away and straight
+/// back) is no break: its two steps are off alike. None in the first or last three steps.
 pub fn breaks(t: &[f64], x: &[f64]) -> Vec<Break> {
     let n = x.len().min(t.len());
     if n < 9 {
@@ -65,18 +65,14 @@ pub fn breaks(t: &[f64], x: &[f64]) -> Vec<Break> {
     let mut rough: Vec<f64> = off[1..steps.len() - 1].iter().map(|r| r.abs()).collect();
     let middle = rough.len() / 2;
     let sigma = 1.4826 * *rough.select_nth_unstable_by(middle, f64::total_cmp).1;
-    let mut order = x[..n].to_vec();
-    let high = *order.select_nth_unstable_by(n * 99 / 100, f64::total_cmp).1;
-    let low = *order.select_nth_unstable_by(n / 100, f64::total_cmp).1;
     // a record printed to a few figures steps by its counts: its resolution is its noise
     let resolution = steps.iter().map(|s| s.abs()).filter(|s| *s > 0.0).fold(f64::INFINITY, f64::min);
+    let span = super::spike::span(&x[..n]);
     // the leap in the record's units: the slope's excess over its interval
     let leap = |k: usize| off[k] * (t[k + 1] - t[k]);
     candidates
         .into_iter()
-        .filter(|&k| {
-            off[k].abs() > NOISE * sigma && leap(k).abs() > (NOISE * resolution).max(SPAN * (high - low))
-        })
+        .filter(|&k| off[k].abs() > NOISE * sigma && leap(k).abs() > (NOISE * resolution).max(SPAN * span))
         .map(|k| Break { row: k + 1, leap: leap(k) })
         .collect()
 }

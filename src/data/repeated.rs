@@ -19,6 +19,13 @@ pub struct Repeats {
     pub moving: f64,
 }
 
+impl Repeats {
+    /// The rows of a column of `len` rows that are readings.
+    pub fn readings(&self, len: usize) -> impl Iterator<Item = usize> {
+        (self.phase..len).step_by(self.period)
+    }
+}
+
 /// The share of readings at least that must differ from the last: a moving quantity changes
 /// at nearly every reading; a command held by a controller on its clock for several periods
 /// at a time changes at a few.
@@ -49,7 +56,7 @@ pub fn repeated(x: &[f64]) -> Option<Repeats> {
 /// first and last, the cubic through the four nearest readings (at their own times `t`): what
 /// a sensor read at those instants says of the rows in between, to O(h⁴) of a smooth quantity.
 pub fn between_readings(t: &[f64], x: &[f64], r: Repeats) -> Vec<f64> {
-    let nodes: Vec<usize> = (r.phase..x.len()).step_by(r.period).collect();
+    let nodes: Vec<usize> = r.readings(x.len()).collect();
     if nodes.len() < 4 {
         return x.to_vec();
     }
@@ -97,7 +104,7 @@ pub fn read_at_readings(
         let Some(column) = frame.column(name) else { continue };
         let Some(r) = repeated(column) else { continue };
         let mended = between_readings(frame.time(), column, r);
-        let readings = (r.phase..column.len()).step_by(r.period).count();
+        let readings = r.readings(column.len()).count();
         frame.overwrite(name, mended)?;
         notes.push(format!(
             "{}: `{name}` changes only every {} rows and repeats itself in between ({:.0} % of its {readings} readings differ from the one before): a slower sensor's readings written again until the next (a log kept faster than the sensor reads, or several sensors merged and filled forward), whose rate would read zero between readings and a spike at each; read at its readings and interpolated between them by cubics. Where it truly steps so, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)",

@@ -65,10 +65,16 @@ pub fn spikes(x: &[f64]) -> Vec<Spike> {
     if search(x, 0.0).is_empty() {
         return Vec::new();
     }
+    search(x, (NOISE * noise(x)).max(SPAN * span(x)))
+}
+
+/// A record's span from its 1st to its 99th percentile: its range, a glitch or two left out.
+pub(super) fn span(x: &[f64]) -> f64 {
+    let n = x.len();
     let mut order = x.to_vec();
     let high = *order.select_nth_unstable_by(n * 99 / 100, f64::total_cmp).1;
     let low = *order.select_nth_unstable_by(n / 100, f64::total_cmp).1;
-    search(x, (NOISE * noise(x)).max(SPAN * (high - low)))
+    high - low
 }
 
 /// The spikes whose leaps exceed `floor` as well as the steps beside them.

@@ -130,6 +130,7 @@ impl EquationMoments {
         let rules = model.parameter_rules();
         let (mut out, mut notes) = (vec![Vec::new(); eqs.len()], Vec::new());
         let mut targets: Option<Vec<Target>> = None;
+        let motion = model.recorded_motion();
         for chunks in runs {
             let mut run: Option<RunSoFar> = None;
             for chunk in chunks {
@@ -139,7 +140,6 @@ impl EquationMoments {
                     model.admit_at(&mut chunk.frame, chunk.first_row).map_err(|e| shift(e.into()))?;
                 crate::data::check_gaps(&chunk.frame, 3.0).map_err(|e| shift(e.into()))?;
                 // a piece of a run is not cut into runs (the whole run is, where it breaks)
-                let motion = model.recorded_motion();
                 if let Some((row, name, leap)) = crate::data::moving_breaks(&chunk.frame, &motion).0.first() {
                     return Err(IdentifyError::Setup(format!(
                         "{}: `{name}` leaps by {} from row {} to row {} and stays (records joined in one file, a sensor re-zeroed), where a run read whole is cut into runs of its own; a piece of one cannot be: read the runs whole (--chunk-rows 0), or cut the file there",

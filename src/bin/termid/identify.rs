@@ -116,21 +116,18 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
         // every column but the state whose rate is taken may be an input held between samples;
         // any column, a slower sensor's readings repeated
         let intersample = cmd.intersample.unwrap_or_default();
-        for f in &mut frames {
-            let columns: Vec<String> = f.names()[1..].iter().filter(|n| *n != state).cloned().collect();
-            let columns: Vec<&str> = columns.iter().map(String::as_str).collect();
-            termid::data::mark_held(f, &columns, intersample)?.iter().for_each(|n| crate::runs::say(n));
-            // the state too may repeat a slower sensor's readings
-            let all: Vec<String> = f.names()[1..].to_vec();
-            let all: Vec<&str> = all.iter().map(String::as_str).collect();
-            termid::data::read_at_readings(f, &all, intersample)?.iter().for_each(|n| crate::runs::say(n));
-        }
-        // a record that moves and leaps at one sample and stays (records joined in one file):
-        // each piece a run
         let mut pieces = Vec::new();
-        for f in frames {
+        for mut f in frames {
             let all: Vec<String> = f.names()[1..].to_vec();
             let all: Vec<&str> = all.iter().map(String::as_str).collect();
+            let inputs: Vec<&str> = all.iter().copied().filter(|n| n != state).collect();
+            termid::data::mark_held(&mut f, &inputs, intersample)?.iter().for_each(|n| crate::runs::say(n));
+            // the state too may repeat a slower sensor's readings
+            termid::data::read_at_readings(&mut f, &all, intersample)?
+                .iter()
+                .for_each(|n| crate::runs::say(n));
+            // a record that moves and leaps at one sample and stays (records joined in one
+            // file): each piece a run
             let (cut, notes) = termid::data::cut_at_breaks(f, &all)?;
             notes.iter().for_each(|n| crate::runs::say(n));
             pieces.extend(cut);
