@@ -288,11 +288,11 @@ pub(crate) fn fit(
             }
             // every column but the state may be an input held between samples
             let columns: Vec<&str> = variables.iter().map(String::as_str).filter(|n| n != state).collect();
-            for note in termid::data::mark_held(&mut frame, &columns, intersample).map_err(fail)? {
+            let all: Vec<&str> = variables.iter().map(String::as_str).collect();
+            for note in termid::data::mark_held(&mut frame, &columns, &all, intersample).map_err(fail)? {
                 warn(py, note)?;
             }
             // any column, the state too, may repeat a slower sensor's readings
-            let all: Vec<&str> = variables.iter().map(String::as_str).collect();
             for note in termid::data::read_at_readings(&mut frame, &all, intersample).map_err(fail)? {
                 warn(py, note)?;
             }

@@ -639,7 +639,9 @@ def fit(
     ``"held"`` held wherever a column jumps at isolated samples, on a clock or not; under
     ``"auto"`` and ``"held"`` a column (the state too) that changes only every few rows on a
     clock, at most of its ticks (a slower sensor's readings filled forward), is read at its
-    readings and interpolated between them by cubics, with a warning; a rate's rows where a
+    readings and interpolated between them by cubics, with a warning (but a column whose
+    changes step the rate of another there is a controller's command slower than the rows,
+    held; under ``"held"`` every column that changes at isolated rows is); a rate's rows where a
     column that moves leaps at one row and stays (records joined) are cut there into runs of
     their own, with a warning;
     ``delays`` columns that act later than recorded (a dead time), in seconds, e.g.

@@ -262,17 +262,18 @@ def test_residuals_that_grow_with_the_rate_are_said_and_weights_mend_them():
     assert abs(weighted.coefficients["x"] - 0.5) < 0.005
 
 
-def _driven_oscillator(late=0):
-    """ẍ = −4x − 0.3ẋ + 2F with F held for 50 samples at a time (a controller's command),
-    felt ``late`` samples after it is recorded, in closed form from sample to sample."""
-    rng = np.random.default_rng(4)
-    levels = rng.uniform(-2.0, 2.0, 61)
+def _driven_oscillator(late=0, levels=None):
+    """ẍ = −4x − 0.3ẋ + 2F with F held for 50 samples at a time (a controller's command), or
+    at ``levels`` (one a sample), felt ``late`` samples after it is recorded, in closed form
+    from sample to sample."""
+    if levels is None:
+        levels = np.random.default_rng(4).uniform(-2.0, 2.0, 61)[np.arange(3001) // 50]
     alpha, h = 0.15, 0.01
     wd = np.sqrt(4.0 - alpha**2)
     x, v, rows = 1.0, 0.0, []
     for k in range(3001):
-        rows.append((h * k, x, v, levels[k // 50]))
-        force = levels[max(k - late, 0) // 50]
+        rows.append((h * k, x, v, levels[k]))
+        force = levels[max(k - late, 0)]
         y = x - force / 2.0
         c, s, e = np.cos(wd * h), np.sin(wd * h), np.exp(-alpha * h)
         x, v = force / 2.0 + e * (y * c + (v + alpha * y) / wd * s), e * (v * c - (alpha * v + 4.0 * y) / wd * s)
@@ -291,6 +292,18 @@ def test_a_force_held_between_samples_is_integrated_as_held():
     assert abs(linear.coefficients["v"] + 0.3) > 0.003
     with pytest.raises(termid.TermidError, match="intersample"):
         termid.fit(df, "dv/dt", library, intersample="zoh")
+
+
+def test_a_command_slower_than_the_rows_is_held():
+    # a smooth command computed every 10 samples and held between: it moves by a little at
+    # every tick, as a slower sensor's readings would; the oscillator's rate steps where it
+    # changes, so it is held (with a warning) and the true terms come out
+    tick = 0.1 * (np.arange(3001) // 10)
+    levels = np.sin(0.7 * tick) + 0.5 * np.sin(1.9 * tick + 0.3) + 0.3 * np.sin(3.1 * tick)
+    df = _driven_oscillator(levels=levels)
+    with pytest.warns(UserWarning, match="the rate of `v` steps where it changes"):
+        fit = termid.fit(df, "dv/dt", ["x", "v", "F", "x^2", "x*F"])
+    assert fit.coefficients.sort_index().round(5).to_dict() == {"F": 2.0, "v": -0.3, "x": -4.0}
 
 
 def test_a_force_acting_late_is_said_and_fitted_with_its_delay():

@@ -81,13 +81,14 @@ pub fn breaks(t: &[f64], x: &[f64]) -> Vec<Break> {
 /// and what to say of the columns that leap too often to be records joined (more than one
 /// row in a thousand and more than three: a staircase of its own, a counter or a coarse
 /// scale), which cut nothing. Only records that move from sample to sample are looked at: a
-/// command stepped at isolated samples ([`super::held`], a step test's force) jumps by design.
+/// command stepped at isolated samples ([`super::held`], a step test's force) or marked held
+/// ([`Frame::is_held`]) jumps by design.
 pub fn moving_breaks<'a>(frame: &Frame, columns: &[&'a str]) -> (Vec<(usize, &'a str, f64)>, Vec<String>) {
     let n = frame.len();
     let (mut found, mut notes) = (Vec::new(), Vec::new());
     for name in columns {
         let Some(column) = frame.column(name) else { continue };
-        if super::held(column).is_some() {
+        if frame.is_held(name) || super::held(column).is_some() {
             continue;
         }
         let b = breaks(frame.time(), column);

@@ -6,6 +6,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::repeated::{kinks_at_changes, repeated};
 use super::{DataError, Frame};
 
 /// How a run's inputs behave between their samples (MATLAB's `InterSample`).
@@ -115,6 +116,29 @@ pub(super) fn isolated_changes(x: &[f64]) -> Option<Vec<usize>> {
     (beside as f64 <= SIDE_BY_SIDE * at.len() as f64).then_some(at)
 }
 
+/// Holds column `name` of `frame` where it repeats itself on a clock slower than the rows and
+/// a recorded state of `motion` (not `name` itself) kinks where it changes, and says so.
+fn commanded(frame: &mut Frame, name: &str, motion: &[&str]) -> Result<Option<String>, DataError> {
+    let Some(column) = frame.column(name) else { return Ok(None) };
+    let Some(r) = repeated(column) else { return Ok(None) };
+    let states: Vec<(&str, &[f64])> = motion
+        .iter()
+        .filter(|m| *m != &name && !frame.is_held(m))
+        .filter_map(|m| frame.column(m).map(|c| (*m, c)))
+        .collect();
+    let columns: Vec<&[f64]> = states.iter().map(|(_, c)| *c).collect();
+    let Some(i) = kinks_at_changes(column, r, &columns) else { return Ok(None) };
+    let note = format!(
+        "{}: `{name}` changes only every {} rows, by a little at {:.0} % of them, and the rate of `{}` steps where it changes: a controller's command slower than the log, held from each change to the next (a zero-order hold), not a slower sensor's readings of a smooth quantity; taken as held. Where it is a sensor's, say so (identify --intersample linear keeps every column as its rows have it; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)",
+        frame.origin(),
+        r.period,
+        100.0 * r.moving,
+        states[i].0,
+    );
+    frame.hold(name)?;
+    Ok(Some(note))
+}
+
 pub(super) fn gcd(a: usize, b: usize) -> usize {
     if b == 0 {
         a
@@ -125,11 +149,14 @@ pub(super) fn gcd(a: usize, b: usize) -> usize {
 
 /// Marks the columns of `frame` named in `columns` that are held between samples, as
 /// `intersample` says, and says what `auto` found and why: held where a column jumps at
-/// isolated samples on a clock, a line (said) where it jumps off any. The columns a frame
-/// does not have are passed over.
+/// isolated samples on a clock, a line (said) where it jumps off any; held too where it
+/// changes by a little at every tick of a clock slower than the rows and the recorded states
+/// `motion` kink there ([`crate::data::kinks_at_changes`]: a controller's command, not a
+/// slower sensor's readings). The columns a frame does not have are passed over.
 pub fn mark_held(
     frame: &mut Frame,
     columns: &[&str],
+    motion: &[&str],
     intersample: Intersample,
 ) -> Result<Vec<String>, DataError> {
     let mut notes = Vec::new();
@@ -138,12 +165,18 @@ pub fn mark_held(
         match intersample {
             Intersample::Linear => frame.release(name),
             Intersample::Held => {
-                if held(column).is_some() {
+                // a staircase on a clock, by steps large or small
+                if held(column).is_some() || repeated(column).is_some() {
                     frame.hold(name)?;
                 }
             }
             Intersample::Auto => {
-                let Some(h) = held(column) else { continue };
+                let Some(h) = held(column) else {
+                    if let Some(note) = commanded(frame, name, motion)? {
+                        notes.push(note);
+                    }
+                    continue;
+                };
                 let how = format!(
                     "{}: `{name}` stays put between samples ({:.0} % of intervals) and jumps at {} isolated samples (by {:.0} % of its span, median)",
                     frame.origin(),
@@ -270,7 +303,7 @@ mod tests {
         .unwrap();
         f.push("x", t.iter().map(|t| t.sin()).collect()).unwrap();
         let mut g = f.clone();
-        let notes = mark_held(&mut f, &["F", "G", "x", "absent"], Intersample::Auto).unwrap();
+        let notes = mark_held(&mut f, &["F", "G", "x", "absent"], &["x"], Intersample::Auto).unwrap();
         assert!(f.is_held("F") && !f.is_held("G") && !f.is_held("x"));
         assert_eq!(notes.len(), 2);
         assert!(
@@ -291,9 +324,9 @@ mod tests {
             notes[1]
         );
         let mut linear = f.clone();
-        assert!(mark_held(&mut linear, &["F"], Intersample::Linear).unwrap().is_empty());
+        assert!(mark_held(&mut linear, &["F"], &[], Intersample::Linear).unwrap().is_empty());
         assert!(!linear.is_held("F"));
-        mark_held(&mut g, &["F", "G", "x"], Intersample::Held).unwrap();
+        mark_held(&mut g, &["F", "G", "x"], &[], Intersample::Held).unwrap();
         assert!(g.is_held("F") && g.is_held("G") && !g.is_held("x"));
     }
 

@@ -52,6 +52,71 @@ pub fn repeated(x: &[f64]) -> Option<Repeats> {
     (moving >= MOVING).then_some(Repeats { period, phase: at[0] % period, moving })
 }
 
+/// A change held from its row steps the rate of a state it drives there and only there (a
+/// kink in the state); a sensor's reading of a smooth quantity steps nothing, the state's rate
+/// turns as smoothly at the change as between. Read in a window of half a period either side
+/// (the kink beside a quadratic in the row, or a line in windows of three rows), regressed on
+/// the change, at the change and half a period after (a window that holds no change's kink):
+/// the kink at the change is held where it is this many times the one between …
+const KINK_OVER_BETWEEN: f64 = 4.0;
+
+/// … and this many of its own standard errors.
+const KINK_SIGNIFICANT: f64 = 5.0;
+
+/// The least-squares weights over the rows −w … w about a row that give the kink there (the
+/// rate's step from it on) beside a polynomial in the row: a quadratic where the window has
+/// five rows or more, a line in three (the second difference).
+fn kink_weights(w: usize) -> Option<Vec<f64>> {
+    let rows = 2 * w + 1;
+    let columns = if w >= 2 { 4 } else { 3 };
+    let a = nalgebra::DMatrix::from_fn(rows, columns, |i, j| {
+        let s = i as f64 - w as f64;
+        if j == columns - 1 {
+            s.max(0.0)
+        } else {
+            s.powi(j as i32)
+        }
+    });
+    let inverse = (a.transpose() * &a).try_inverse()?;
+    Some((inverse * a.transpose()).row(columns - 1).iter().copied().collect())
+}
+
+/// Whether the motion kinks where `x`, repeated on a clock (`r`), changes: the rate of one of
+/// the states `motion` (each a recorded column that moves from row to row) steps with `x`'s
+/// change at the change's row (by five of its standard errors), and not half a period later
+/// (four times less there). Then `x` is a command held from each reading to the next (a
+/// controller's, slower than the log, that moves by a little at every tick), not a slower
+/// sensor's readings of a smooth quantity. The index in `motion` of the first state that shows
+/// it; `None` where none does (a state that does not move, or repeats itself, shows nothing;
+/// a kink drowned in the state's noise neither).
+pub fn kinks_at_changes(x: &[f64], r: Repeats, motion: &[&[f64]]) -> Option<usize> {
+    let (n, w) = (x.len(), r.period / 2);
+    // the rows where a change shows, with room for both windows
+    let changes: Vec<(usize, f64)> = r
+        .readings(n)
+        .filter(|&c| c >= w && c + 2 * w < n)
+        .map(|c| (c, x[c] - x[c - 1]))
+        .filter(|(_, d)| *d != 0.0)
+        .collect();
+    let squares: f64 = changes.iter().map(|(_, d)| d * d).sum();
+    let weights = kink_weights(w)?;
+    if changes.len() < CLOCK_JUMPS || squares == 0.0 {
+        return None;
+    }
+    motion.iter().position(|m| {
+        if m.len() != n || repeated(m).is_some() || super::held(m).is_some() {
+            return false;
+        }
+        let kink = |at: usize| weights.iter().zip(&m[at - w..=at + w]).map(|(w, m)| w * m).sum::<f64>();
+        let slope = |offset: usize| changes.iter().map(|&(c, d)| kink(c + offset) * d).sum::<f64>() / squares;
+        let (at, between) = (slope(0), slope(w));
+        let scatter: f64 = changes.iter().map(|&(c, d)| (kink(c) - at * d).powi(2)).sum::<f64>()
+            / (changes.len() - 1) as f64;
+        let error = (scatter / squares).sqrt();
+        at.abs() > KINK_OVER_BETWEEN * between.abs() && at.abs() > KINK_SIGNIFICANT * error
+    })
+}
+
 /// `x` at its readings (the rows `phase`, `phase + period`, …) and, between them and beyond the
 /// first and last, the cubic through the four nearest readings (at their own times `t`): what
 /// a sensor read at those instants says of the rows in between, to O(h⁴) of a smooth quantity.
@@ -107,7 +172,7 @@ pub fn read_at_readings(
         let readings = r.readings(column.len()).count();
         frame.overwrite(name, mended)?;
         notes.push(format!(
-            "{}: `{name}` changes only every {} rows and repeats itself in between ({:.0} % of its {readings} readings differ from the one before): a slower sensor's readings written again until the next (a log kept faster than the sensor reads, or several sensors merged and filled forward), whose rate would read zero between readings and a spike at each; read at its readings and interpolated between them by cubics. Where it truly steps so, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)",
+            "{}: `{name}` changes only every {} rows and repeats itself in between ({:.0} % of its {readings} readings differ from the one before): a slower sensor's readings written again until the next (a log kept faster than the sensor reads, or several sensors merged and filled forward), whose rate would read zero between readings and a spike at each; read at its readings and interpolated between them by cubics. Where it is a controller's command held from each reading to the next (whose kink in the motion the noise hides here), say so (identify --intersample held; a model file's `intersample = \"held\"`; Python `intersample=\"held\"`); where it truly changes only at those rows, `linear`",
             frame.origin(),
             r.period,
             100.0 * r.moving,
@@ -180,6 +245,76 @@ mod tests {
         let r = repeated(&x).unwrap();
         assert_eq!((r.period, r.phase), (5, 0));
         assert_eq!(between_readings(&t, &x, r)[100], reading(95));
+    }
+
+    /// ẋ = −x + u recorded every 0.01 s, u a smooth signal on a clock of `period` rows: held
+    /// by a controller from each tick to the next (`held`), or read by a slower sensor while
+    /// the system feels it smooth; x with uniform noise of `noise` (its size).
+    fn driven(period: usize, held: bool, noise: f64) -> (Vec<f64>, Vec<f64>) {
+        let (h, fine) = (0.01, 50);
+        let u = |t: f64| (0.7 * t).sin() + 0.5 * (1.9 * t + 0.3).sin();
+        let reading = |k: usize| u(h * (k - k % period) as f64);
+        let (mut x, mut state, mut seed) = (Vec::new(), 0.3, 11u64);
+        for k in 0..3000 {
+            x.push(state + noise * crate::data::test_noise(&mut seed));
+            let dt = h / fine as f64;
+            for i in 0..fine {
+                let s = h * k as f64 + dt * i as f64;
+                let at = |s: f64| if held { reading(k) } else { u(s) };
+                let f = |x: f64, s: f64| -x + at(s);
+                let k1 = f(state, s);
+                let k2 = f(state + 0.5 * dt * k1, s + 0.5 * dt);
+                let k3 = f(state + 0.5 * dt * k2, s + 0.5 * dt);
+                let k4 = f(state + dt * k3, s + dt);
+                state += dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+            }
+        }
+        ((0..3000).map(reading).collect(), x)
+    }
+
+    /// A command held on a clock of 2, 3, 4 or 10 rows that moves a little at every tick kinks
+    /// the state it drives there, clean or with noise of 0.1 % of its size; a slower sensor's
+    /// readings of what the system feels smooth do not, nor does a state it does not drive.
+    #[test]
+    fn a_held_command_kinks_what_it_drives_and_a_sensor_does_not() {
+        for period in [2, 3, 4, 10] {
+            for noise in [0.0, 1e-3] {
+                let (u, x) = driven(period, true, noise);
+                let r = repeated(&u).unwrap();
+                assert_eq!(r.period, period);
+                let other: Vec<f64> = (0..3000).map(|k| (0.002 * k as f64).cos()).collect();
+                assert_eq!(kinks_at_changes(&u, r, &[&other, &x]), Some(1), "period {period}, noise {noise}");
+                let (u, x) = driven(period, false, noise);
+                assert_eq!(kinks_at_changes(&u, r, &[&x, &other]), None, "period {period}, noise {noise}");
+            }
+        }
+    }
+
+    /// In a frame: the command kinked held (said), so not read at its readings after.
+    #[test]
+    fn a_command_that_kinks_the_motion_is_held_not_reread() {
+        let (u, x) = driven(10, true, 0.0);
+        let t: Vec<f64> = (0..3000).map(|k| 0.01 * k as f64).collect();
+        let mut f = Frame::new("rig.csv", "t", t).unwrap();
+        f.push("x", x).unwrap();
+        f.push("u", u.clone()).unwrap();
+        let notes = crate::data::mark_held(&mut f, &["u"], &["x", "u"], Intersample::Auto).unwrap();
+        assert!(f.is_held("u"));
+        assert!(
+            notes[0].contains("`u` changes only every 10 rows") && notes[0].contains("the rate of `x` steps"),
+            "{}",
+            notes[0]
+        );
+        assert!(read_at_readings(&mut f, &["u", "x"], Intersample::Auto).unwrap().is_empty());
+        assert_eq!(f.column("u").unwrap(), &u[..]);
+        // without the state it drives, nothing shows it: a sensor's, read at its readings
+        let mut g = f.clone();
+        g.release("u");
+        assert!(crate::data::mark_held(&mut g, &["u"], &[], Intersample::Auto).unwrap().is_empty());
+        assert!(!g.is_held("u"));
+        // asked to hold, a staircase by small steps is held
+        crate::data::mark_held(&mut g, &["u"], &[], Intersample::Held).unwrap();
+        assert!(g.is_held("u"));
     }
 
     /// In a frame: the repeated column re-read and said, a held one and a moving one left.

@@ -90,7 +90,9 @@ pub struct Meta {
     /// shows a zero-order hold, [`crate::data::held`], else a line), `linear` or `held`.
     /// Taken by the integral form's quadrature and by every replay into a simulation. Under
     /// `auto` and `held` a column that repeats a slower sensor's readings between them is
-    /// read at its readings ([`crate::data::read_at_readings`]).
+    /// read at its readings ([`crate::data::read_at_readings`]), but an input whose changes
+    /// step a state's rate (a controller's command: [`crate::data::kinks_at_changes`]), or
+    /// under `held` any input that changes at isolated rows, is held.
     #[serde(default, skip_serializing_if = "is_auto")]
     pub intersample: crate::data::Intersample,
 }

@@ -943,7 +943,8 @@ impl Model {
             }
         }
         let inputs: Vec<&str> = self.spec.inputs.iter().map(|i| i.name.as_str()).collect();
-        notes.extend(crate::data::mark_held(frame, &inputs, self.spec.model.intersample)?);
+        let states: Vec<&str> = self.spec.states.iter().map(|s| s.name.as_str()).collect();
+        notes.extend(crate::data::mark_held(frame, &inputs, &states, self.spec.model.intersample)?);
         // a state, its rate or an input (not a held command) that repeats a slower sensor's
         // readings between them is read at them
         let rates: Vec<String> = self.spec.states.iter().map(|s| format!("{}_dot", s.name)).collect();

@@ -18,14 +18,28 @@ fn force_run(changes: impl Fn(usize) -> bool) -> String {
 /// run's recorded F is the command, the oscillator feels the command of `late` samples before
 /// (the first one before the run began).
 fn force_run_late(changes: impl Fn(usize) -> bool, late: usize) -> String {
+    let mut rng = Lcg(11);
+    let mut level = 0.0;
+    let levels: Vec<f64> = (0..3001)
+        .map(|k| {
+            if k == 0 || changes(k) {
+                level = 4.0 * rng.next() - 2.0;
+            }
+            level
+        })
+        .collect();
+    commanded_run(&levels, late)
+}
+
+/// The run with the force `levels` recorded, each held from its sample to the next, acting
+/// `late` samples after.
+fn commanded_run(levels: &[f64], late: usize) -> String {
     let (alpha, h) = (0.15, 0.01);
     let wd = (4.0f64 - alpha * alpha).sqrt();
-    let mut rng = Lcg(11);
     let mut recorded: Vec<f64> = Vec::new();
     let (mut x, mut v) = (1.0, 0.0);
     let mut csv = String::from("t,x,v,F\n");
-    for k in 0..3001 {
-        let level = if k == 0 || changes(k) { 4.0 * rng.next() - 2.0 } else { recorded[k - 1] };
+    for (k, &level) in levels.iter().enumerate() {
         recorded.push(level);
         csv.push_str(&format!("{:?},{x:?},{v:?},{level:?}\n", 0.01 * k as f64));
         let force = recorded[k.saturating_sub(late)];
@@ -149,6 +163,37 @@ fn a_held_force_is_integrated_as_held() {
     let (central, _) = fit(&["--derivative", "central"]);
     let notes = central["notes"].to_string();
     assert!(notes.contains("`F` is held between samples, 60 jumps in all"), "{notes}");
+}
+
+/// A controller slower than the log: a smooth command computed every 10 samples and held
+/// in between, so that it moves by a little (under 5 % of its span) at every tick. Read as a
+/// slower sensor's readings (the default before), its cubics put each change half a period
+/// early: −3.934x + 1.961F − 0.3098v. The oscillator's rate steps where it changes, so it is
+/// a command: held, said, and the three terms exact, by plain `identify` and through a model
+/// file (held in the replay too: validated within 1e-5 m).
+#[test]
+fn a_command_slower_than_the_log_is_held() {
+    let dir = Scratch::new("slow-command");
+    let command = |t: f64| (0.7 * t).sin() + 0.5 * (1.9 * t + 0.3).sin() + 0.3 * (3.1 * t).sin();
+    let levels: Vec<f64> = (0..3001).map(|k| command(0.01 * (k - k % 10) as f64)).collect();
+    let data = written(&dir, "rig.csv", commanded_run(&levels, 0));
+    let args = ["identify", "--data", &data, "--target", "dv/dt", "--terms", "x", "v", "F", "x^2", "x*F"];
+    let (ok, out, said) = termid(&[&args[..], &["--format", "json"]].concat());
+    assert!(ok, "{said}");
+    assert!(
+        said.contains("`F` changes only every 10 rows, by a little")
+            && said.contains("the rate of `v` steps where it changes")
+            && said.contains("taken as held"),
+        "{said}"
+    );
+    assert_true_terms(&chosen_terms(&json(&out)), &said);
+    let model = written(&dir, "msd.toml", model_text(false, "", ""));
+    let out = dir.join("msd_id.toml");
+    let out = out.to_str().unwrap();
+    let (ok, _, err) = termid(&["identify", "--model", &model, "--data", &data, "--out", out]);
+    assert!(ok && err.contains("the rate of `v` steps"), "{err}");
+    let error = validated_x(out, &data);
+    assert!(error < 1e-5, "{error}");
 }
 
 /// Through a model file: identified, the written model validated against the run it came

@@ -121,7 +121,9 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
             let all: Vec<String> = f.names()[1..].to_vec();
             let all: Vec<&str> = all.iter().map(String::as_str).collect();
             let inputs: Vec<&str> = all.iter().copied().filter(|n| n != state).collect();
-            termid::data::mark_held(&mut f, &inputs, intersample)?.iter().for_each(|n| crate::runs::say(n));
+            termid::data::mark_held(&mut f, &inputs, &all, intersample)?
+                .iter()
+                .for_each(|n| crate::runs::say(n));
             // the state too may repeat a slower sensor's readings
             termid::data::read_at_readings(&mut f, &all, intersample)?
                 .iter()

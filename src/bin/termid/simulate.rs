@@ -241,7 +241,8 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
             // an input held between samples in the record is held in the replay
             let inputs: Vec<&str> = system.inputs.iter().map(String::as_str).collect();
             let intersample = model.spec().model.intersample;
-            let mut notes = termid::data::mark_held(&mut frame, &inputs, intersample)?;
+            let states: Vec<&str> = system.states.iter().map(String::as_str).collect();
+            let mut notes = termid::data::mark_held(&mut frame, &inputs, &states, intersample)?;
             // and one that repeats a slower sensor's readings, read at them
             notes.extend(termid::data::read_at_readings(&mut frame, &inputs, intersample)?);
             notes.iter().for_each(|n| crate::runs::say(n));
