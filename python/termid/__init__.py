@@ -640,8 +640,8 @@ def fit(
     ``"auto"`` and ``"held"`` a column (the state too) that changes only every few rows on a
     clock, at most of its ticks (a slower sensor's readings filled forward), is read at its
     readings and interpolated between them by cubics, with a warning (but a column whose
-    changes step the rate of another there is a controller's command slower than the rows,
-    held; under ``"held"`` every column that changes at isolated rows is); a rate's rows where a
+    changes step the rate of another there, or with which held the others' rates fit clearly
+    better, is a controller's command slower than the rows, held; under ``"held"`` every column that changes at isolated rows is); a rate's rows where a
     column that moves leaps at one row and stays (records joined) are cut there into runs of
     their own, with a warning;
     ``delays`` columns that act later than recorded (a dead time), in seconds, e.g.

@@ -6,7 +6,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::repeated::{kinks_at_changes, repeated};
+use super::repeated::{fits_better_held, kinks_at_changes, repeated};
 use super::{DataError, Frame};
 
 /// How a run's inputs behave between their samples (MATLAB's `InterSample`).
@@ -117,23 +117,49 @@ pub(super) fn isolated_changes(x: &[f64]) -> Option<Vec<usize>> {
 }
 
 /// Holds column `name` of `frame` where it repeats itself on a clock slower than the rows and
-/// a recorded state of `motion` (not `name` itself) kinks where it changes, and says so.
-fn commanded(frame: &mut Frame, name: &str, motion: &[&str]) -> Result<Option<String>, DataError> {
+/// a recorded state of `motion` (not `name` itself) kinks where it changes, or the states'
+/// rates fit clearly better with it held than read at its readings (over `name`, `motion`
+/// and `columns`), and says so.
+fn commanded(
+    frame: &mut Frame,
+    name: &str,
+    motion: &[&str],
+    columns: &[&str],
+) -> Result<Option<String>, DataError> {
     let Some(column) = frame.column(name) else { return Ok(None) };
     let Some(r) = repeated(column) else { return Ok(None) };
-    let states: Vec<(&str, &[f64])> = motion
-        .iter()
-        .filter(|m| *m != &name && !frame.is_held(m))
-        .filter_map(|m| frame.column(m).map(|c| (*m, c)))
-        .collect();
-    let columns: Vec<&[f64]> = states.iter().map(|(_, c)| *c).collect();
-    let Some(i) = kinks_at_changes(column, r, &columns) else { return Ok(None) };
-    let note = format!(
-        "{}: `{name}` changes only every {} rows, by a little at {:.0} % of them, and the rate of `{}` steps where it changes: a controller's command slower than the log, held from each change to the next (a zero-order hold), not a slower sensor's readings of a smooth quantity; taken as held. Where it is a sensor's, say so (identify --intersample linear keeps every column as its rows have it; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)",
+    let recorded = |names: &[&str]| -> Vec<(String, &[f64])> {
+        names
+            .iter()
+            .filter(|m| **m != name && !frame.is_held(m))
+            .filter_map(|m| frame.column(m).map(|c| (m.to_string(), c)))
+            .collect()
+    };
+    let states = recorded(motion);
+    let slices: Vec<&[f64]> = states.iter().map(|(_, c)| *c).collect();
+    let how = format!(
+        "{}: `{name}` changes only every {} rows, by a little at {:.0} % of them",
         frame.origin(),
         r.period,
-        100.0 * r.moving,
-        states[i].0,
+        100.0 * r.moving
+    );
+    let why = if let Some(i) = kinks_at_changes(column, r, &slices) {
+        format!("the rate of `{}` steps where it changes", states[i].0)
+    } else {
+        let mut all: Vec<&str> = motion.to_vec();
+        all.extend(columns.iter().filter(|c| !motion.contains(c)));
+        let others: Vec<&[f64]> = recorded(&all).into_iter().map(|(_, c)| c).collect();
+        let Some((i, share)) = fits_better_held(frame.time(), column, r, &slices, &others) else {
+            return Ok(None);
+        };
+        format!(
+            "the rate of `{}` is fitted better with it held from each change to the next than read at its readings ({:.1} % less left over, by a quadratic in the columns over windows of one period)",
+            states[i].0,
+            100.0 * (1.0 - share)
+        )
+    };
+    let note = format!(
+        "{how}, and {why}: a controller's command slower than the log, held from each change to the next (a zero-order hold), not a slower sensor's readings of a smooth quantity; taken as held. Where it is a sensor's, say so (identify --intersample linear keeps every column as its rows have it; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)"
     );
     frame.hold(name)?;
     Ok(Some(note))
@@ -172,7 +198,7 @@ pub fn mark_held(
             }
             Intersample::Auto => {
                 let Some(h) = held(column) else {
-                    if let Some(note) = commanded(frame, name, motion)? {
+                    if let Some(note) = commanded(frame, name, motion, columns)? {
                         notes.push(note);
                     }
                     continue;

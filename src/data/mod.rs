@@ -37,7 +37,9 @@ pub use hold::{held, mark_held, Hold, Intersample};
 pub use integral::{integral_rows, integral_rows_held, IntegralForm};
 pub use kalman::{KalmanSmoother, NoiseModel};
 pub use prepare::{prepare, Preparation};
-pub use repeated::{between_readings, kinks_at_changes, read_at_readings, repeated, Repeats};
+pub use repeated::{
+    between_readings, fits_better_held, kinks_at_changes, read_at_readings, repeated, Repeats,
+};
 pub use resample::{
     check_gaps, evened, interpolate_at, median_step, on_sample, resample, sample_at, sample_step, uneven,
 };

@@ -91,7 +91,9 @@ pub struct Meta {
     /// Taken by the integral form's quadrature and by every replay into a simulation. Under
     /// `auto` and `held` a column that repeats a slower sensor's readings between them is
     /// read at its readings ([`crate::data::read_at_readings`]), but an input whose changes
-    /// step a state's rate (a controller's command: [`crate::data::kinks_at_changes`]), or
+    /// step a state's rate, or with which held the states' rates fit clearly better (a
+    /// controller's command: [`crate::data::kinks_at_changes`],
+    /// [`crate::data::fits_better_held`]), or
     /// under `held` any input that changes at isolated rows, is held.
     #[serde(default, skip_serializing_if = "is_auto")]
     pub intersample: crate::data::Intersample,

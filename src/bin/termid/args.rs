@@ -323,7 +323,8 @@ pub struct IdentifyCommand {
     /// into a simulation holds it over each step. Any column (the state too) that changes only
     /// every few rows on a clock, at most of its ticks, repeats a slower sensor's readings: it
     /// is read at its readings and interpolated between them by cubics, and said; an input so
-    /// where a state's rate steps at its changes is a controller's command, held (`linear`:
+    /// where a state's rate steps at its changes, or fits clearly better with it held, is a
+    /// controller's command, held (`linear`:
     /// neither; `held`: every input that changes at isolated rows, by steps large or small).
     /// With --model as the file's `intersample` (which the model written keeps).
     #[arg(long, value_enum)]
