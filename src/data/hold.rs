@@ -159,7 +159,7 @@ fn commanded(
         )
     };
     let note = format!(
-        "{how}, and {why}: a controller's command slower than the log, held from each change to the next (a zero-order hold), not a slower sensor's readings of a smooth quantity; taken as held. Where it is a sensor's, say so (identify --intersample linear keeps every column as its rows have it; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)"
+        "{how}, and {why}: a controller's command slower than the log, held from each change to the next (a zero-order hold), not a slower sensor's readings of a smooth quantity; taken as held. Where it is a sensor's readings after all, give it interpolated between them (identify --intersample linear, a model file's `intersample = \"linear\"` or Python's `intersample=\"linear\"` would take its staircase as its rows have it)"
     );
     frame.hold(name)?;
     Ok(Some(note))
@@ -177,8 +177,9 @@ pub(super) fn gcd(a: usize, b: usize) -> usize {
 /// `intersample` says, and says what `auto` found and why: held where a column jumps at
 /// isolated samples on a clock, a line (said) where it jumps off any; held too where it
 /// changes by a little at every tick of a clock slower than the rows and the recorded states
-/// `motion` kink there ([`crate::data::kinks_at_changes`]: a controller's command, not a
-/// slower sensor's readings). The columns a frame does not have are passed over.
+/// `motion` kink there ([`crate::data::kinks_at_changes`]) or their rates fit clearly better
+/// with it held ([`crate::data::fits_better_held`]): a controller's command, not a slower
+/// sensor's readings. The columns a frame does not have are passed over.
 pub fn mark_held(
     frame: &mut Frame,
     columns: &[&str],

@@ -324,8 +324,8 @@ pub struct IdentifyCommand {
     /// every few rows on a clock, at most of its ticks, repeats a slower sensor's readings: it
     /// is read at its readings and interpolated between them by cubics, and said; an input so
     /// where a state's rate steps at its changes, or fits clearly better with it held, is a
-    /// controller's command, held (`linear`:
-    /// neither; `held`: every input that changes at isolated rows, by steps large or small).
+    /// controller's command, held (`linear`: neither; `held`: every input that changes at
+    /// isolated rows, by steps large or small).
     /// With --model as the file's `intersample` (which the model written keeps).
     #[arg(long, value_enum)]
     pub intersample: Option<termid::data::Intersample>,
