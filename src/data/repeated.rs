@@ -52,6 +52,12 @@ pub fn repeated(x: &[f64]) -> Option<Repeats> {
     (moving >= MOVING).then_some(Repeats { period, phase: at[0] % period, moving })
 }
 
+/// Whether a state's record can show what a command does to it: it moves from row to row by
+/// itself (neither repeats a slower sensor's readings nor is held between samples).
+fn moves_by_itself(m: &[f64]) -> bool {
+    repeated(m).is_none() && super::held(m).is_none()
+}
+
 /// A change held from its row steps the rate of a state it drives there and only there (a
 /// kink in the state); a sensor's reading of a smooth quantity steps nothing, the state's rate
 /// turns as smoothly at the change as between. Read in a window of half a period either side
@@ -104,7 +110,7 @@ pub fn kinks_at_changes(x: &[f64], r: Repeats, motion: &[&[f64]]) -> Option<usiz
         return None;
     }
     motion.iter().position(|m| {
-        if m.len() != n || repeated(m).is_some() || super::held(m).is_some() {
+        if m.len() != n || !moves_by_itself(m) {
             return false;
         }
         let kink = |at: usize| weights.iter().zip(&m[at - w..=at + w]).map(|(w, m)| w * m).sum::<f64>();
@@ -149,7 +155,9 @@ pub fn fits_better_held(
     others: &[&[f64]],
 ) -> Option<(usize, f64)> {
     let n = t.len().min(FIT_ROWS);
-    let read = between_readings(t, x, r);
+    // the cubics of the rows fitted, through the same four readings as over the whole record
+    let reach = (n + 2 * r.period + 1).min(t.len());
+    let read = between_readings(&t[..reach], &x[..reach], r);
     let w = r.period;
     let k = others.len() + 1;
     // the terms: a constant, each column (x first), and their products
@@ -190,18 +198,21 @@ pub fn fits_better_held(
         a
     };
     let (held, read) = (unit(design(true)), unit(design(false)));
-    let left = |a: &nalgebra::DMatrix<f64>, y: &nalgebra::DVector<f64>| -> Option<f64> {
-        let svd = a.clone().svd(true, true);
+    let (held_svd, read_svd) = (held.clone().svd(true, true), read.clone().svd(true, true));
+    let left = |a: &nalgebra::DMatrix<f64>,
+                svd: &nalgebra::SVD<f64, nalgebra::Dyn, nalgebra::Dyn>,
+                y: &nalgebra::DVector<f64>|
+     -> Option<f64> {
         let fit = svd.solve(y, 1e-12).ok()?;
         Some((y - a * fit).norm_squared())
     };
     let dof = (windows - terms.len()) as f64;
     motion.iter().enumerate().find_map(|(i, m)| {
-        if repeated(m).is_some() || super::held(m).is_some() {
+        if !moves_by_itself(m) {
             return None;
         }
         let y = nalgebra::DVector::from_fn(windows, |row, _| m[(row + 1) * w] - m[row * w]);
-        let (as_held, as_read) = (left(&held, &y)?, left(&read, &y)?);
+        let (as_held, as_read) = (left(&held, &held_svd, &y)?, left(&read, &read_svd, &y)?);
         let better =
             as_held <= (1.0 - BETTER_HELD) * as_read && as_read - as_held >= HELD_SIGNIFICANT * as_held / dof;
         better.then_some((i, as_held / as_read))
