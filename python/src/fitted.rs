@@ -296,9 +296,9 @@ pub(crate) fn fit(
             for note in termid::data::read_at_readings(&mut frame, &all, intersample).map_err(fail)? {
                 warn(py, note)?;
             }
-            // a record that moves and leaps at one sample and stays (records joined): each piece
-            // a run of its own
-            let (mut frames, notes) = termid::data::cut_at_breaks(frame, &all).map_err(fail)?;
+            // the state leaps at one sample and stays (records joined): each piece a run of its
+            // own; another column's leap alone is a step of an input
+            let (mut frames, notes) = termid::data::cut_at_breaks(frame, &[state], &columns).map_err(fail)?;
             for note in notes {
                 warn(py, note)?;
             }

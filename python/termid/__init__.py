@@ -635,15 +635,18 @@ def fit(
     neighbours, with a warning; ``intersample`` says how a rate's other columns behave between
     samples: ``"auto"`` (default) takes a column that stays put and jumps at isolated samples
     on a clock (a controller's command) as held from each sample to the next, integrated
-    piece by piece between its jumps, with a warning, ``"linear"`` as a line between samples,
+    piece by piece between its jumps, with a warning, one that jumps off any clock (a relay) as
+    switched somewhere between two samples, the windows that hold a jump left out of the fit,
+    with a warning, ``"linear"`` as a line between samples,
     ``"held"`` held wherever a column jumps at isolated samples, on a clock or not; under
     ``"auto"`` and ``"held"`` a column (the state too) that changes only every few rows on a
     clock, at most of its ticks (a slower sensor's readings filled forward), is read at its
     readings and interpolated between them by cubics, with a warning (but a column whose
     changes step the rate of another there, or with which held the others' rates fit clearly
-    better, is a controller's command slower than the rows, held; under ``"held"`` every column that changes at isolated rows is); a rate's rows where a
-    column that moves leaps at one row and stays (records joined) are cut there into runs of
-    their own, with a warning;
+    better, is a controller's command slower than the rows, held; under ``"held"`` every column that changes at isolated rows is); a rate's rows where
+    its state leaps at one row and stays (records joined) are cut there into runs of their
+    own, with a warning (another column's leap alone is a step of it: not cut, its windows
+    left out, with a warning);
     ``delays`` columns that act later than recorded (a dead time), in seconds, e.g.
     ``{"F": 0.2}``: read that much earlier against the rest, the rows' first seconds left out
     (without it, a rate's ``notes`` say a delay the residuals show).

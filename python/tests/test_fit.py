@@ -268,16 +268,58 @@ def _driven_oscillator(late=0, levels=None):
     from sample to sample."""
     if levels is None:
         levels = np.random.default_rng(4).uniform(-2.0, 2.0, 61)[np.arange(3001) // 50]
-    alpha, h = 0.15, 0.01
-    wd = np.sqrt(4.0 - alpha**2)
+    h = 0.01
     x, v, rows = 1.0, 0.0, []
     for k in range(3001):
         rows.append((h * k, x, v, levels[k]))
-        force = levels[max(k - late, 0)]
-        y = x - force / 2.0
-        c, s, e = np.cos(wd * h), np.sin(wd * h), np.exp(-alpha * h)
-        x, v = force / 2.0 + e * (y * c + (v + alpha * y) / wd * s), e * (v * c - (alpha * v + 4.0 * y) / wd * s)
+        x, v = _advance(x, v, levels[max(k - late, 0)], h)
     return pd.DataFrame(rows, columns=["t", "x", "v", "F"])
+
+
+def _advance(x, v, force, dt):
+    """The oscillator's (x, v) after ``dt`` s under a constant ``force``: x − F/2 a damped
+    oscillation, α = 0.15, ω_d² = 4 − α²."""
+    alpha = 0.15
+    wd = np.sqrt(4.0 - alpha**2)
+    y = x - force / 2.0
+    c, s, e = np.cos(wd * dt), np.sin(wd * dt), np.exp(-alpha * dt)
+    return force / 2.0 + e * (y * c + (v + alpha * y) / wd * s), e * (v * c - (alpha * v + 4.0 * y) / wd * s)
+
+
+def _relay_oscillator(noise=0.0):
+    """The oscillator on a relay, F = ±1 switched at random instants 0.3-1.5 s apart, anywhere
+    between two samples (solved up to each switch and on from it); F recorded with ``noise``."""
+    rng = np.random.default_rng(6)
+    h, x, v, level, rows = 0.01, 1.0, 0.0, 1.0, []
+    switch = rng.uniform(0.3, 1.5)
+    for k in range(3001):
+        t = h * k
+        rows.append((t, x, v, level + noise * rng.standard_normal()))
+        at = t
+        while switch < t + h:
+            x, v = _advance(x, v, level, switch - at)
+            at, level = switch, -level
+            switch += rng.uniform(0.3, 1.5)
+        x, v = _advance(x, v, level, t + h - at)
+    return pd.DataFrame(rows, columns=["t", "x", "v", "F"])
+
+
+def test_a_relay_switched_between_samples_is_left_out_of_the_windows():
+    # the instants of a relay's switches are not in the rows: the windows that hold one are
+    # left out (with a warning and a note), and the true terms come out; as a line across
+    # each switch the damping is off
+    df = _relay_oscillator()
+    library = ["x", "v", "F", "x^2", "x*F"]
+    with pytest.warns(UserWarning, match="`F` stays put .* on no clock"):
+        fit = termid.fit(df, "dv/dt", library)
+    assert fit.coefficients.sort_index().round(6).to_dict() == {"F": 2.0, "v": -0.3, "x": -4.0}
+    assert any("windows of the integral form" in n and "left out" in n for n in fit.notes)
+    linear = termid.fit(df, "dv/dt", library, intersample="linear")
+    assert abs(linear.coefficients["v"] + 0.3) > 1e-3
+    # measured with its noise, each switch is a step of the input: not cut, left out the same
+    with pytest.warns(UserWarning, match="a step of the input"):
+        noisy = termid.fit(_relay_oscillator(noise=0.01), "dv/dt", library)
+    assert noisy.coefficients.sort_index().to_dict() == pytest.approx({"F": 2.0, "v": -0.3, "x": -4.0}, rel=2e-3)
 
 
 def test_a_force_held_between_samples_is_integrated_as_held():

@@ -1,8 +1,8 @@
 //! Breaks in a state's record: a leap at one sample that stays, far beyond the steps beside it
 //! (two records joined in one file, a sensor re-zeroed, a knock). No motion whose rate is
 //! finite crosses one; taken as a motion, every rate and integral across it is wrong and so is
-//! every fit (Lorenz, two runs in one file: ten terms where two are). A run is cut there into
-//! runs of its own.
+//! every fit (Lorenz, two runs in one file: ten terms where two are). A run is cut where a
+//! state breaks into runs of its own; an input that leaps alone is a step of the input.
 
 use super::{DataError, Frame};
 
@@ -107,18 +107,69 @@ pub fn moving_breaks<'a>(frame: &Frame, columns: &[&'a str]) -> (Vec<(usize, &'a
     (found, notes)
 }
 
-/// The run cut at the breaks of its `columns` ([`moving_breaks`]) into runs of their own (each
-/// named by its origin and its rows in it: "run.csv [rows 1001-2000]"), with what to say; the
-/// run itself where none breaks. A piece under 21 rows is left out (said).
-pub fn cut_at_breaks(frame: Frame, columns: &[&str]) -> Result<(Vec<Frame>, Vec<String>), DataError> {
+/// The run cut where a recorded state leaps at one sample and stays ([`moving_breaks`] of
+/// `states` and `inputs`) into runs of their own (each named by its origin and its rows in it:
+/// "run.csv [rows 1001-2000]"), with what to say; the run itself where none breaks. A piece
+/// under 21 rows is left out (said). An input that leaps where no state does is a step of the
+/// input (a command switched on top of its motion, a measured force stepped with its noise):
+/// the system went on through it, so it cuts nothing and is said (were it a sensor re-zeroed,
+/// the rows after it are off by the leap); it is marked switched ([`Frame::switch`]), so that a
+/// rate's fit leaves out the windows that hold its leaps.
+pub fn cut_at_breaks(
+    mut frame: Frame,
+    states: &[&str],
+    inputs: &[&str],
+) -> Result<(Vec<Frame>, Vec<String>), DataError> {
     let n = frame.len();
     let sig = |x: f64| crate::output::sig(x, 3);
-    let (found, mut notes) = moving_breaks(&frame, columns);
-    if found.is_empty() {
-        return Ok((vec![frame], notes));
-    }
+    let (mut found, mut notes) = moving_breaks(&frame, states);
     let mut cuts: Vec<usize> = found.iter().map(|f| f.0).collect();
     cuts.dedup();
+    // an input's leaps, however many (they cut nothing: no staircase rule)
+    for input in inputs.iter().filter(|i| !states.contains(i) && !frame.is_held(i)) {
+        let Some(column) = frame.column(input).filter(|c| super::held(c).is_none()) else { continue };
+        found.extend(breaks(frame.time(), column).iter().map(|b| (b.row, *input, b.leap)));
+    }
+    // said in the frame's order of columns
+    let position = |c: &str| frame.names().iter().position(|n| n == c);
+    found.sort_by_key(|f| (f.0, position(f.1)));
+    // an input's leaps where no state leaps: one note per input
+    for input in inputs.iter().filter(|i| !states.contains(i)) {
+        let steps: Vec<&(usize, &str, f64)> =
+            found.iter().filter(|f| f.1 == *input && !cuts.contains(&f.0)).collect();
+        let Some(first) = steps.first() else { continue };
+        let still = match states {
+            [one] => format!("`{one}` does not leap"),
+            _ => "no state leaps".to_string(),
+        };
+        let at = if steps.len() == 1 {
+            format!(
+                "by {} from row {} to row {} (t = {} s)",
+                sig(first.2),
+                first.0,
+                first.0 + 1,
+                sig(frame.time()[first.0])
+            )
+        } else {
+            let rows: Vec<String> = steps.iter().take(4).map(|s| (s.0 + 1).to_string()).collect();
+            format!(
+                "at {} rows ({}{}; the first by {} at t = {} s)",
+                steps.len(),
+                rows.join(", "),
+                if steps.len() > 4 { ", …" } else { "" },
+                sig(first.2),
+                sig(frame.time()[first.0])
+            )
+        };
+        notes.push(format!(
+            "{}: `{input}` leaps {at} and stays, where {still} with it: a step of the input (a command switched), not cut there; a rate's fit leaves out the windows of the integral form that hold a leap; were it a sensor re-zeroed, the rows after it would be off by the leap",
+            frame.origin()
+        ));
+        frame.switch(input)?;
+    }
+    if cuts.is_empty() {
+        return Ok((vec![frame], notes));
+    }
     let t = frame.time();
     for &row in &cuts {
         let leaps: Vec<String> = found
@@ -234,7 +285,7 @@ mod tests {
         f.push("x", (0..610).map(|k| (0.2 * t[k]).sin() + level(k)).collect()).unwrap();
         f.push("y", (0..610).map(|k| (0.2 * t[k]).cos() - level(k)).collect()).unwrap();
         f.push("F", (0..610).map(|k| if k % 100 < 50 { 1.0 } else { -1.0 }).collect()).unwrap();
-        let (runs, notes) = cut_at_breaks(f.clone(), &["x", "y"]).unwrap();
+        let (runs, notes) = cut_at_breaks(f.clone(), &["x", "y"], &["F"]).unwrap();
         assert_eq!(runs.len(), 2);
         assert_eq!(runs[0].origin(), "joined.csv [rows 1-300]");
         assert_eq!((runs[1].origin(), runs[1].len()), ("joined.csv [rows 301-600]", 300));
@@ -246,8 +297,46 @@ mod tests {
             notes[0]
         );
         assert!(notes[2].contains("[rows 601-610]: 10 rows between breaks"), "{}", notes[2]);
-        let (whole, said) = cut_at_breaks(f, &["F"]).unwrap();
+        let (whole, said) = cut_at_breaks(f, &[], &["F"]).unwrap();
         assert_eq!((whole.len(), said.len()), (1, 0));
+    }
+
+    /// A measured input that moves (with its noise) and steps twice while the state goes on
+    /// smoothly: a step of the input, not records joined: not cut, said once with its rows,
+    /// and marked switched (a fit leaves out the windows that hold its steps). Where the state
+    /// leaps at the same row, the run is cut as before.
+    #[test]
+    fn an_input_that_steps_alone_cuts_nothing() {
+        let t: Vec<f64> = (0..600).map(|k| 0.1 * k as f64).collect();
+        let mut seed = 4u64;
+        let level = |k: usize| match k {
+            0..200 => 0.0,
+            200..400 => 3.0,
+            _ => 1.0,
+        };
+        let force: Vec<f64> =
+            (0..600).map(|k| level(k) + 0.01 * crate::data::test_noise(&mut seed)).collect();
+        let mut f = Frame::new("rig.csv", "t", t.clone()).unwrap();
+        f.push("x", t.iter().map(|t| (0.2 * t).sin()).collect()).unwrap();
+        f.push("F", force).unwrap();
+        let (runs, notes) = cut_at_breaks(f.clone(), &["x"], &["F"]).unwrap();
+        assert_eq!(runs.len(), 1);
+        assert!(runs[0].is_switched("F") && !runs[0].is_switched("x"));
+        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert!(
+            notes[0].contains("`F` leaps at 2 rows (201, 401; the first by 3.0")
+                && notes[0].contains("`x` does not leap"),
+            "{}",
+            notes[0]
+        );
+        assert_eq!(crate::data::switches(&t, runs[0].column("F").unwrap()), vec![200, 400]);
+        let mut joined = f;
+        joined
+            .overwrite("x", t.iter().enumerate().map(|(k, t)| (0.2 * t).sin() + level(k)).collect())
+            .unwrap();
+        let (runs, notes) = cut_at_breaks(joined, &["x"], &["F"]).unwrap();
+        assert_eq!(runs.len(), 3, "{notes:?}");
+        assert!(notes[0].contains("`x` (by 3.00), `F` (by 3.0"), "{}", notes[0]);
     }
 
     /// A staircase (a state read off a coarse scale every 40 rows) leaps too often to be
@@ -257,7 +346,7 @@ mod tests {
         let t: Vec<f64> = (0..4000).map(|k| 0.01 * k as f64).collect();
         let mut f = Frame::new("scale.csv", "t", t).unwrap();
         f.push("x", (0..4000).map(|k| (k / 40) as f64 + 0.001 * (0.01 * k as f64).sin()).collect()).unwrap();
-        let (runs, notes) = cut_at_breaks(f, &["x"]).unwrap();
+        let (runs, notes) = cut_at_breaks(f, &["x"], &[]).unwrap();
         assert_eq!(runs.len(), 1);
         assert!(notes[0].contains("too often for records joined"), "{notes:?}");
     }

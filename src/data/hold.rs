@@ -165,6 +165,17 @@ fn commanded(
     Ok(Some(note))
 }
 
+/// The rows at which a record switched between samples ([`Frame::switch`]) has switched: the
+/// row after each jump. A record that stays put between jumps ([`held`]) switches at every
+/// change; one that moves (a measured input stepped, with its noise) at its breaks
+/// ([`super::breaks`]).
+pub fn switches(t: &[f64], x: &[f64]) -> Vec<usize> {
+    match isolated_changes(x) {
+        Some(at) => at.into_iter().map(|i| i + 1).collect(),
+        None => super::breaks(t, x).into_iter().map(|b| b.row).collect(),
+    }
+}
+
 pub(super) fn gcd(a: usize, b: usize) -> usize {
     if b == 0 {
         a
@@ -218,9 +229,9 @@ pub fn mark_held(
                         h.period
                     ));
                 } else {
-                    frame.release(name);
+                    frame.switch(name)?;
                     notes.push(format!(
-                        "{how}, on no clock: it may jump anywhere between two samples (a relay, a switch thrown by the motion), so it is taken as a line between them, which halves the error of a jump's time on average; where it is a command held from each sample to the next, say so (identify --intersample held; a model file's `intersample = \"held\"`; Python `intersample=\"held\"`)"
+                        "{how}, on no clock: it may jump anywhere between two samples (a relay, a switch thrown by the motion), so a rate's fit leaves out the windows of the integral form that hold a jump (a point derivative and a replay take it as a line between the samples, which halves the error of a jump's time on average); where it is a command held from each sample to the next, say so (identify --intersample held; a model file's `intersample = \"held\"`; Python `intersample=\"held\"`)"
                     ));
                 }
             }

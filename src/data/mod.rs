@@ -33,7 +33,7 @@ pub use delay::delayed;
 pub use derivative::{differentiator, CentralDifference, Differentiator, Smoothed, DIFFERENTIATORS};
 pub use five_point::FivePoint;
 pub use geodetic::{north_east, radii_of_curvature};
-pub use hold::{held, mark_held, Hold, Intersample};
+pub use hold::{held, mark_held, switches, Hold, Intersample};
 pub use integral::{integral_rows, integral_rows_held, IntegralForm};
 pub use kalman::{KalmanSmoother, NoiseModel};
 pub use prepare::{prepare, Preparation};
@@ -333,7 +333,8 @@ fn all_finite(values: &[f64]) -> bool {
 }
 
 /// Named f64 columns over a strictly increasing time column; each column either a line
-/// between its samples (the default) or held from each sample to the next ([`Frame::hold`]).
+/// between its samples (the default), held from each sample to the next ([`Frame::hold`]), or
+/// switched at instants between two samples that the rows do not tell ([`Frame::switch`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Frame {
     origin: String,
@@ -342,6 +343,9 @@ pub struct Frame {
     columns: Vec<Vec<f64>>,
     /// The columns held between samples (a zero-order hold).
     held: Vec<String>,
+    /// The columns that switch somewhere between two samples (a relay, a step of a measured
+    /// input): a fit leaves out the windows that hold a switch.
+    switched: Vec<String>,
 }
 
 impl Frame {
@@ -356,6 +360,7 @@ impl Frame {
             names: vec![],
             columns: vec![],
             held: vec![],
+            switched: vec![],
         };
         f.push(time_name, time)?;
         Ok(f)
@@ -422,6 +427,7 @@ impl Frame {
             self.names.remove(i);
             self.columns.remove(i);
             self.held.retain(|h| h != name);
+            self.switched.retain(|h| h != name);
         }
         self.push(name, values)
     }
@@ -461,7 +467,7 @@ impl Frame {
             self.time_name = to.into();
         }
         self.names[i] = to.into();
-        for h in self.held.iter_mut().filter(|h| *h == from) {
+        for h in self.held.iter_mut().chain(self.switched.iter_mut()).filter(|h| *h == from) {
             *h = to.into();
         }
         Ok(())
@@ -471,14 +477,32 @@ impl Frame {
     /// integral and its replay into a simulation step, not a line, between samples); refused
     /// for the time column and a column the frame does not have.
     pub fn hold(&mut self, name: &str) -> Result<(), DataError> {
+        self.mark(name, "held")?;
+        self.switched.retain(|h| h != name);
+        if !self.is_held(name) {
+            self.held.push(name.into());
+        }
+        Ok(())
+    }
+
+    /// Takes column `name` as switching somewhere between two samples where it jumps (a relay
+    /// switched by the motion, a measured input stepped): the instant is not in the rows, so a
+    /// rate's fit leaves out the windows that hold a switch ([`crate::data::switches`]); a
+    /// replay draws a line across it. Refused as [`Frame::hold`] refuses.
+    pub fn switch(&mut self, name: &str) -> Result<(), DataError> {
+        self.mark(name, "switched")?;
+        self.held.retain(|h| h != name);
+        if !self.is_switched(name) {
+            self.switched.push(name.into());
+        }
+        Ok(())
+    }
+
+    /// Whether `name` may be marked: a column the frame has, not its time.
+    fn mark(&self, name: &str, how: &str) -> Result<(), DataError> {
         match self.names.iter().position(|n| n == name) {
-            Some(0) => Err(DataError::Setting(format!("{}: time `{name}` cannot be held", self.origin))),
-            Some(_) => {
-                if !self.is_held(name) {
-                    self.held.push(name.into());
-                }
-                Ok(())
-            }
+            Some(0) => Err(DataError::Setting(format!("{}: time `{name}` cannot be {how}", self.origin))),
+            Some(_) => Ok(()),
             None => Err(DataError::MissingColumn {
                 file: self.origin.clone(),
                 column: name.into(),
@@ -490,6 +514,7 @@ impl Frame {
     /// Takes column `name` as a line between its samples again.
     pub fn release(&mut self, name: &str) {
         self.held.retain(|h| h != name);
+        self.switched.retain(|h| h != name);
     }
 
     /// Whether column `name` is held between samples ([`Frame::hold`]).
@@ -500,6 +525,16 @@ impl Frame {
     /// The columns held between samples, in the order they were marked.
     pub fn held(&self) -> &[String] {
         &self.held
+    }
+
+    /// Whether column `name` switches between samples ([`Frame::switch`]).
+    pub fn is_switched(&self, name: &str) -> bool {
+        self.switched.iter().any(|h| h == name)
+    }
+
+    /// The columns that switch between samples, in the order they were marked.
+    pub fn switched(&self) -> &[String] {
+        &self.switched
     }
 
     /// Where the frame came from (file name), for messages.
@@ -582,6 +617,7 @@ impl Frame {
             names: self.names.clone(),
             columns: self.columns.iter().map(|c| c[range.clone()].to_vec()).collect(),
             held: self.held.clone(),
+            switched: self.switched.clone(),
         }
     }
 }

@@ -350,8 +350,8 @@ fn resolution_note(frames: &[Frame], state: &str) -> Option<String> {
 }
 
 /// Said where a rate is estimated at the samples (a point derivative, not the integral form)
-/// from runs with a candidate's input held between samples: at each of its jumps the rate
-/// jumps too, which differencing and smoothing spread over the samples beside it (a
+/// from runs with a candidate's input held or switched between samples: at each of its jumps
+/// the rate jumps too, which differencing and smoothing spread over the samples beside it (a
 /// mass-spring-damper driven by a force held for 0.5 s: damping −0.287 for −0.3 by central
 /// differences; the integral form integrates the held force piece by piece: exact).
 fn held_rate_note(
@@ -363,9 +363,10 @@ fn held_rate_note(
     let mut held: Vec<&str> = Vec::new();
     let mut jumps = 0;
     for f in frames {
-        for h in f.held().iter().filter(|h| library.inputs().contains(h)) {
+        let marked = f.held().iter().chain(f.switched());
+        for h in marked.filter(|h| library.inputs().contains(h)) {
             if let Some(c) = f.column(h) {
-                jumps += c.windows(2).filter(|w| w[1] != w[0]).count();
+                jumps += crate::data::switches(f.time(), c).len();
                 if !held.contains(&h.as_str()) {
                     held.push(h);
                 }
@@ -374,16 +375,100 @@ fn held_rate_note(
     }
     (!held.is_empty()).then(|| {
         format!(
-            "{} held between samples, {jumps} jumps in all: at each the rate of `{state}` jumps \
-             too, and the {} derivative spreads it over the samples beside, which biases the \
+            "{} held or switched between samples, {jumps} jumps in all: at each the rate of `{state}` \
+             jumps too, and the {} derivative spreads it over the samples beside, which biases the \
              coefficients; the integral form (`--derivative integral`, the default for a rate) \
-             integrates a held input piece by piece between its jumps",
+             integrates a held input piece by piece between its jumps and leaves out the windows \
+             that hold a switch",
             match held.as_slice() {
                 [one] => format!("`{one}` is"),
                 many =>
                     format!("{} are", many.iter().map(|h| format!("`{h}`")).collect::<Vec<_>>().join(", ")),
             },
             method.name()
+        )
+    })
+}
+
+/// The windows of `w` intervals of a run that hold a switch of an input the `library` reads
+/// ([`Frame::switch`]: a relay, a measured input stepped, at an instant between two samples
+/// the rows do not tell), as `keep[s]` false for the window from sample `s`, with the inputs
+/// and their switches. Left out, the rest are exact whatever the instants; a line across
+/// each switch (Simpson's rule over it) biases every coefficient (a mass-spring-damper on a
+/// relay switched 66 times in 60 s, sampled every 0.01 s: damping −0.3018 for −0.3). `None`
+/// where nothing switches; no `keep` where leaving them out would leave fewer than half the
+/// windows (a switch every few samples), which then stay.
+fn switched_windows<'a>(frame: &'a Frame, library: &Library, w: usize) -> Option<Switched<'a>> {
+    let n = frame.len();
+    let inputs: Vec<&str> = frame
+        .switched()
+        .iter()
+        .map(String::as_str)
+        .filter(|s| library.inputs().iter().any(|i| i == s))
+        .collect();
+    let mut at: Vec<usize> = inputs
+        .iter()
+        .filter_map(|s| frame.column(s))
+        .flat_map(|c| crate::data::switches(frame.time(), c))
+        .collect();
+    if at.is_empty() || n <= w {
+        return None;
+    }
+    at.sort_unstable();
+    at.dedup();
+    // the window from s holds samples s..=s + w: a switch between rows k − 1 and k if s < k ≤ s + w
+    let mut keep = vec![true; n - w];
+    for &k in &at {
+        keep[k.saturating_sub(w)..k.min(n - w)].iter_mut().for_each(|x| *x = false);
+    }
+    let kept = keep.iter().filter(|k| **k).count();
+    Some(Switched { keep: (2 * kept >= keep.len()).then_some(keep), inputs, switches: at.len() })
+}
+
+/// The windows of a run that hold a switch ([`switched_windows`]).
+struct Switched<'a> {
+    /// Whether each window is kept; `None` where too many hold a switch to leave them out.
+    keep: Option<Vec<bool>>,
+    /// The inputs that switch.
+    inputs: Vec<&'a str>,
+    /// Their switches, counted once where two fall on one interval.
+    switches: usize,
+}
+
+/// Said where a rate's fit in the integral form left out the windows that hold an input's
+/// switch ([`switched_windows`]), or could not (switches too close).
+fn switched_note(frames: &[Frame], library: &Library, w: usize) -> Option<String> {
+    let (mut names, mut switches, mut left, mut all, mut dense) = (Vec::<&str>::new(), 0, 0, 0, 0);
+    for f in frames {
+        let Some(Switched { keep, inputs, switches: at }) = switched_windows(f, library, w) else { continue };
+        for i in inputs {
+            if !names.contains(&i) {
+                names.push(i);
+            }
+        }
+        switches += at;
+        all += f.len() - w;
+        match keep {
+            Some(keep) => left += keep.iter().filter(|k| !**k).count(),
+            None => dense += 1,
+        }
+    }
+    if names.is_empty() {
+        return None;
+    }
+    let who = names.iter().map(|h| format!("`{h}`")).collect::<Vec<_>>().join(", ");
+    let times = if switches == 1 { "once".to_string() } else { format!("{switches} times") };
+    Some(if dense == 0 {
+        format!(
+            "{who} switched between samples {times} in all, at instants the rows do not tell: \
+             the {left} windows of the integral form (of {all}) that hold a switch are left out of the fit"
+        )
+    } else {
+        format!(
+            "{who} switched between samples {times} in all, too often to leave out the windows \
+             of the integral form that hold a switch in {dense} run(s) (more than half of them): taken there as \
+             a line across each switch, which biases the coefficients; a shorter window \
+             (`--derivative integral:W`, W even) leaves more"
         )
     })
 }
@@ -599,8 +684,9 @@ impl Identification<'_> {
         w: usize,
         own: std::ops::Range<usize>,
     ) -> Result<Moments, IdentifyError> {
-        let Rows { y, columns: integrals, weights } = self.windows(library, target, frame, w)?;
-        let starts = own.start.min(y.len())..own.end.min(y.len());
+        let Rows { y, columns: integrals, weights, starts } = self.windows(library, target, frame, w)?;
+        // the rows of the windows that start on `own` samples (some left out: a switch inside)
+        let starts = starts.partition_point(|s| *s < own.start)..starts.partition_point(|s| *s < own.end);
         let refs: Vec<&[f64]> = integrals.iter().map(|c| &c[starts.clone()]).collect();
         let weights = weights.map(|w| w[starts.clone()].to_vec());
         let mut acc = Accumulator::new(library.len());
@@ -671,10 +757,20 @@ impl Identification<'_> {
         } else {
             crate::data::integral_rows(frame.time(), &run.y, &samples, w)
         };
-        let weights = run
+        let weights: Option<Vec<f64>> = run
             .weights
             .map(|r| (0..y.len()).map(|k| r[k..=k + w].iter().sum::<f64>() / (w + 1) as f64).collect());
-        Ok(Rows { y, columns, weights })
+        let Some(Switched { keep: Some(keep), .. }) = switched_windows(frame, library, w) else {
+            let starts = (0..y.len()).collect();
+            return Ok(Rows { y, columns, weights, starts });
+        };
+        let kept = |v: Vec<f64>| v.into_iter().zip(&keep).filter(|(_, k)| **k).map(|(x, _)| x).collect();
+        Ok(Rows {
+            starts: (0..y.len()).filter(|&s| keep[s]).collect(),
+            y: kept(y),
+            columns: columns.into_iter().map(kept).collect(),
+            weights: weights.map(kept),
+        })
     }
 
     /// A run made ready for accumulation: its target, its inputs with its own parameters, and
@@ -836,13 +932,14 @@ impl Identification<'_> {
         )?;
         if let Target::Derivative(state) = target {
             fit.selection.notes.extend(resolution_note(frames, state));
-            if self.differentiator.integral_window().is_none() {
-                fit.selection.notes.extend(held_rate_note(
+            match self.differentiator.integral_window() {
+                Some(w) => fit.selection.notes.extend(switched_note(frames, &design.library, w)),
+                None => fit.selection.notes.extend(held_rate_note(
                     frames,
                     &design.library,
                     state,
                     self.differentiator,
-                ));
+                )),
             }
         }
         Ok(fit)
@@ -880,7 +977,7 @@ impl Identification<'_> {
             // blocks, as the fit took them: no column of a long run held whole)
             let (y, e, weights) = match window {
                 Some(w) => {
-                    let Rows { y, columns, weights } = self.windows(&library, target, frame, w)?;
+                    let Rows { y, columns, weights, .. } = self.windows(&library, target, frame, w)?;
                     let mut e: Vec<f64> = y.iter().map(|y| y - b0).collect();
                     for (t, column) in selection.terms.iter().zip(&columns) {
                         for (e, x) in e.iter_mut().zip(column) {
@@ -920,6 +1017,8 @@ struct Rows {
     y: Vec<f64>,
     columns: Vec<Vec<f64>>,
     weights: Option<Vec<f64>>,
+    /// The sample each window starts from (windows holding a switch are left out).
+    starts: Vec<usize>,
 }
 
 /// How the residuals grow with the fit's size: the root mean square of the residuals in the
@@ -1026,6 +1125,49 @@ mod tests {
         assert!((v - 2.2).abs() < 1e-15);
         assert!(ParamValue::Rule("mean:u:-1".into()).check_rule("u0").is_err());
         assert!(ParamValue::Rule("mean:u".into()).check_rule("u0").is_ok());
+    }
+
+    /// A relay's switches leave out exactly the windows that hold one (a window from sample s
+    /// holds samples s..=s + w); only where the library reads the relay; and none where that
+    /// would leave out more than half (a switch every 6 samples with windows of 8), said so.
+    #[test]
+    fn the_windows_that_hold_a_switch_are_left_out() {
+        let n = 100;
+        let mut vocab = Vocabulary::new();
+        for v in ["t", "x", "F"] {
+            vocab.variable(v).unwrap();
+        }
+        let frame = |switch_every: usize| {
+            let mut f = Frame::new("relay.csv", "t", (0..n).map(|k| 0.1 * k as f64).collect()).unwrap();
+            f.push("x", (0..n).map(|k| (0.1 * k as f64).sin()).collect()).unwrap();
+            f.push(
+                "F",
+                (0..n).map(|k| if (k / switch_every).is_multiple_of(2) { 1.0 } else { -1.0 }).collect(),
+            )
+            .unwrap();
+            f.switch("F").unwrap();
+            f
+        };
+        let reads =
+            Library::compile(&[vocab.parse("x").unwrap(), vocab.parse("F").unwrap()], &vocab).unwrap();
+        let sparse = frame(40);
+        let s = switched_windows(&sparse, &reads, 8).unwrap();
+        let keep = s.keep.unwrap();
+        // switches between samples 39/40 and 79/80: windows 32..=39 and 72..=79 hold them
+        let left: Vec<usize> = (0..keep.len()).filter(|&k| !keep[k]).collect();
+        assert_eq!(left, [(32..40).collect::<Vec<_>>(), (72..80).collect()].concat());
+        assert_eq!((s.inputs, s.switches), (vec!["F"], 2));
+        let blind = Library::compile(&[vocab.parse("x").unwrap()], &vocab).unwrap();
+        assert!(switched_windows(&sparse, &blind, 8).is_none());
+        let dense = frame(6);
+        assert!(switched_windows(&dense, &reads, 8).unwrap().keep.is_none());
+        let said = switched_note(&[dense], &reads, 8).unwrap();
+        assert!(said.contains("too often to leave out") && said.contains("in 1 run(s)"), "{said}");
+        let said = switched_note(&[sparse], &reads, 8).unwrap();
+        assert!(
+            said.contains("switched between samples 2 times") && said.contains("the 16 windows"),
+            "{said}"
+        );
     }
 
     /// A term that is not finite on some row is refused with the run, the row and the term,

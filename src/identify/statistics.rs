@@ -39,7 +39,10 @@ pub struct EquationMoments {
 
 /// A run read in pieces, as far as it has been read: its name, its own parameters (from its
 /// first piece) and each equation's statistics so far.
-type RunSoFar = (String, BTreeMap<String, ParamValue>, Vec<Option<Moments>>, Vec<String>);
+/// The columns held and switched between samples ([`crate::data::Frame::hold`],
+/// [`crate::data::Frame::switch`]).
+type Between = (Vec<String>, Vec<String>);
+type RunSoFar = (String, BTreeMap<String, ParamValue>, Vec<Option<Moments>>, Between);
 
 impl EquationMoments {
     /// The statistics of `equation` of `model` over `frames` (the target as
@@ -130,7 +133,7 @@ impl EquationMoments {
         let rules = model.parameter_rules();
         let (mut out, mut notes) = (vec![Vec::new(); eqs.len()], Vec::new());
         let mut targets: Option<Vec<Target>> = None;
-        let motion = model.recorded_motion();
+        let (states, _) = model.recorded_motion();
         for chunks in runs {
             let mut run: Option<RunSoFar> = None;
             for chunk in chunks {
@@ -139,8 +142,9 @@ impl EquationMoments {
                 let admitted =
                     model.admit_at(&mut chunk.frame, chunk.first_row).map_err(|e| shift(e.into()))?;
                 crate::data::check_gaps(&chunk.frame, 3.0).map_err(|e| shift(e.into()))?;
-                // a piece of a run is not cut into runs (the whole run is, where it breaks)
-                if let Some((row, name, leap)) = crate::data::moving_breaks(&chunk.frame, &motion).0.first() {
+                // a piece of a run is not cut into runs (the whole run is, where a state breaks;
+                // an input's step cuts nothing)
+                if let Some((row, name, leap)) = crate::data::moving_breaks(&chunk.frame, &states).0.first() {
                     return Err(IdentifyError::Setup(format!(
                         "{}: `{name}` leaps by {} from row {} to row {} and stays (records joined in one file, a sensor re-zeroed), where a run read whole is cut into runs of its own; a piece of one cannot be: read the runs whole (--chunk-rows 0), or cut the file there",
                         chunk.frame.origin(),
@@ -151,14 +155,18 @@ impl EquationMoments {
                 }
                 // a chunk's spikes are its own; what else admission says, every chunk repeats
                 notes.extend(admitted.spikes);
-                if let Some((.., held)) = &run {
-                    // the inputs held between samples as the run's first chunk found them, so
-                    // that no chunk takes an input otherwise for lack of jumps of its own
+                if let Some((.., (held, switched))) = &run {
+                    // the inputs held or switched between samples as the run's first chunk found
+                    // them, so that no chunk takes an input otherwise for lack of jumps of its own
+                    // (or a clock its few jumps keep by chance)
                     for input in &model.spec().inputs {
-                        if held.contains(&input.name) {
-                            chunk.frame.hold(&input.name).map_err(|e| shift(e.into()))?;
+                        let name = input.name.as_str();
+                        if held.iter().any(|h| h == name) {
+                            chunk.frame.hold(name).map_err(|e| shift(e.into()))?;
+                        } else if switched.iter().any(|h| h == name) {
+                            chunk.frame.switch(name).map_err(|e| shift(e.into()))?;
                         } else {
-                            chunk.frame.release(&input.name);
+                            chunk.frame.release(name);
                         }
                     }
                 }
@@ -172,8 +180,8 @@ impl EquationMoments {
                     targets.get_or_insert_with(|| {
                         eqs.iter().map(|eq| default_target(eq, std::slice::from_ref(&chunk.frame))).collect()
                     });
-                    let held = chunk.frame.held().to_vec();
-                    run = Some((chunk.frame.origin().to_string(), fixed, vec![None; eqs.len()], held));
+                    let between = (chunk.frame.held().to_vec(), chunk.frame.switched().to_vec());
+                    run = Some((chunk.frame.origin().to_string(), fixed, vec![None; eqs.len()], between));
                 }
                 let (Some((_, fixed, moments, _)), Some(targets)) = (run.as_mut(), targets.as_ref()) else {
                     unreachable!("set by the run's first chunk")

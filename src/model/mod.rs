@@ -876,31 +876,29 @@ impl Model {
         Ok(admitted.notes.into_iter().chain(admitted.spikes).collect())
     }
 
-    /// Admitted runs ([`Model::admit`]) cut where a recorded state or moving input leaps at one
-    /// sample and stays ([`crate::data::cut_at_breaks`]: records joined in one file, a sensor
-    /// re-zeroed), each piece a run of its own, with what to say.
+    /// Admitted runs ([`Model::admit`]) cut where a recorded state leaps at one sample and stays
+    /// ([`crate::data::cut_at_breaks`]: records joined in one file, a sensor re-zeroed), each
+    /// piece a run of its own, with what to say (an input that leaps alone is a step of it).
     pub fn cut_at_breaks(
         &self,
         frames: Vec<crate::data::Frame>,
     ) -> Result<(Vec<crate::data::Frame>, Vec<String>), crate::data::DataError> {
-        let motion = self.recorded_motion();
+        let (states, inputs) = self.recorded_motion();
         let (mut out, mut notes) = (Vec::new(), Vec::new());
         for frame in frames {
-            let (pieces, said) = crate::data::cut_at_breaks(frame, &motion)?;
+            let (pieces, said) = crate::data::cut_at_breaks(frame, &states, &inputs)?;
             out.extend(pieces);
             notes.extend(said);
         }
         Ok((out, notes))
     }
 
-    /// The columns of a run that record a motion: the states and the inputs.
-    pub fn recorded_motion(&self) -> Vec<&str> {
-        self.spec
-            .states
-            .iter()
-            .map(|s| s.name.as_str())
-            .chain(self.spec.inputs.iter().map(|i| i.name.as_str()))
-            .collect()
+    /// The columns of a run that record a motion: the states, and the inputs.
+    pub fn recorded_motion(&self) -> (Vec<&str>, Vec<&str>) {
+        (
+            self.spec.states.iter().map(|s| s.name.as_str()).collect(),
+            self.spec.inputs.iter().map(|i| i.name.as_str()).collect(),
+        )
     }
 
     /// [`Model::admit`] for a piece of a run that starts at row `first_row` of its file (a

@@ -318,9 +318,11 @@ pub struct IdentifyCommand {
     pub keep_spikes: bool,
     /// How the runs' inputs behave between samples. `auto`: an input that stays put between
     /// samples and jumps at isolated ones (a digital controller's command, a force stepped by
-    /// a rig) is taken as held from each sample to the next, and said; else a line. The
-    /// integral form integrates a held input piece by piece between its jumps, and a replay
-    /// into a simulation holds it over each step. Any column (the state too) that changes only
+    /// a rig) is taken as held from each sample to the next, and said; one that does so off
+    /// any clock (a relay) switches somewhere between two samples: the integral form leaves
+    /// out the windows that hold a jump, said; else a line. The integral form integrates a
+    /// held input piece by piece between its jumps, and a replay into a simulation holds it
+    /// over each step. Any column (the state too) that changes only
     /// every few rows on a clock, at most of its ticks, repeats a slower sensor's readings: it
     /// is read at its readings and interpolated between them by cubics, and said; an input so
     /// where a state's rate steps at its changes, or fits clearly better with it held, is a

@@ -128,9 +128,9 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
             termid::data::read_at_readings(&mut f, &all, intersample)?
                 .iter()
                 .for_each(|n| crate::runs::say(n));
-            // a record that moves and leaps at one sample and stays (records joined in one
-            // file): each piece a run
-            let (cut, notes) = termid::data::cut_at_breaks(f, &all)?;
+            // the state leaps at one sample and stays (records joined in one file): each piece
+            // a run; another column's leap alone is a step of an input
+            let (cut, notes) = termid::data::cut_at_breaks(f, &[state.as_str()], &inputs)?;
             notes.iter().for_each(|n| crate::runs::say(n));
             pieces.extend(cut);
         }
