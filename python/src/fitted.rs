@@ -272,35 +272,45 @@ pub(crate) fn fit(
             }
             let at = |name: &str| slices.iter().find(|(n, _)| *n == name).map(|(_, v)| *v);
             let t = at(time).ok_or_else(|| refuse(format!("no time column `{time}`")))?;
-            let mut frame = termid::data::Frame::new("data", time, t.to_vec()).map_err(fail)?;
+            let mut whole = termid::data::Frame::new("data", time, t.to_vec()).map_err(fail)?;
             for (name, values) in slices.iter().filter(|(n, _)| *n != time) {
-                frame.push(name, values.to_vec()).map_err(fail)?;
+                whole.push(name, values.to_vec()).map_err(fail)?;
             }
-            if !keep_spikes {
-                // a time series whose rate is taken: a glitch would be one (the command line's
-                // default too)
-                if let Some((mended, notes)) = termid::data::despiked_all(&frame).map_err(fail)? {
-                    frame = mended;
-                    for note in notes {
-                        warn(py, note)?;
-                    }
-                }
+            // a logger's dropout: each piece a run (integrated across, the motion in the gap
+            // would be taken as a line), as the command line cuts a file it reads
+            let (pieces, notes) = termid::data::cut_at_gaps(whole, 0).map_err(fail)?;
+            for note in notes {
+                warn(py, note)?;
             }
             // every column but the state may be an input held between samples
             let columns: Vec<&str> = variables.iter().map(String::as_str).filter(|n| n != state).collect();
             let all: Vec<&str> = variables.iter().map(String::as_str).collect();
-            for note in termid::data::mark_held(&mut frame, &columns, &all, intersample).map_err(fail)? {
-                warn(py, note)?;
-            }
-            // any column, the state too, may repeat a slower sensor's readings
-            for note in termid::data::read_at_readings(&mut frame, &all, intersample).map_err(fail)? {
-                warn(py, note)?;
-            }
-            // the state leaps at one sample and stays (records joined): each piece a run of its
-            // own; another column's leap alone is a step of an input
-            let (mut frames, notes) = termid::data::cut_at_breaks(frame, &[state], &columns).map_err(fail)?;
-            for note in notes {
-                warn(py, note)?;
+            let mut frames = Vec::new();
+            for mut frame in pieces {
+                if !keep_spikes {
+                    // a time series whose rate is taken: a glitch would be one (the command
+                    // line's default too)
+                    if let Some((mended, notes)) = termid::data::despiked_all(&frame).map_err(fail)? {
+                        frame = mended;
+                        for note in notes {
+                            warn(py, note)?;
+                        }
+                    }
+                }
+                for note in termid::data::mark_held(&mut frame, &columns, &all, intersample).map_err(fail)? {
+                    warn(py, note)?;
+                }
+                // any column, the state too, may repeat a slower sensor's readings
+                for note in termid::data::read_at_readings(&mut frame, &all, intersample).map_err(fail)? {
+                    warn(py, note)?;
+                }
+                // the state leaps at one sample and stays (records joined): each piece a run of
+                // its own; another column's leap alone is a step of an input
+                let (cut, notes) = termid::data::cut_at_breaks(frame, &[state], &columns).map_err(fail)?;
+                for note in notes {
+                    warn(py, note)?;
+                }
+                frames.extend(cut);
             }
             // columns acting later than recorded, read back (after the marking: a held column
             // sample for sample)

@@ -55,6 +55,14 @@ impl PyModel {
             .py()
             .detach(|| -> Result<Vec<String>, termid::data::DataError> {
                 let mut notes = Vec::new();
+                // a logger's dropout: each piece a run, as the command line cuts a file it reads
+                let mut pieces = Vec::new();
+                for frame in std::mem::take(&mut frames) {
+                    let (cut, said) = termid::data::cut_at_gaps(frame, 0)?;
+                    pieces.extend(cut);
+                    notes.extend(said);
+                }
+                frames = pieces;
                 for frame in &mut frames {
                     notes.extend(self.inner.admit(frame)?);
                 }

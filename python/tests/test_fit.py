@@ -423,6 +423,15 @@ def test_records_joined_in_one_frame_are_cut_into_runs():
         assert _lorenz_y_within(termid.fit(df, "dy/dt", _QUADRATIC), 1e-4)
 
 
+def test_a_loggers_dropouts_cut_the_rows_into_runs():
+    # rows 2000-2400 and 4000-4200 missing (0.4 s and 0.2 s without a sample): integrated
+    # across as a line before, with nothing said; now cut there, with a warning
+    df = _lorenz_log("", rows=6000)
+    df = df.drop(index=list(range(2000, 2401)) + list(range(4000, 4201))).reset_index(drop=True)
+    with pytest.warns(UserWarning, match="`t` jumps at 2 rows .* a gap in the record .* cut there"):
+        assert _lorenz_y_within(termid.fit(df, "dy/dt", _QUADRATIC), 1e-4)
+
+
 def test_the_rows_that_cannot_choose_are_said():
     """Hald's cement against Draper & Smith's sums of squares of its pairs: forward stepping's
     {x4, x1} leaves 74.76, {x2, x1} 57.90, so x2 in x4's place is 2.25 residual variances

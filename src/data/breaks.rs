@@ -2,7 +2,8 @@
 //! (two records joined in one file, a sensor re-zeroed, a knock). No motion whose rate is
 //! finite crosses one; taken as a motion, every rate and integral across it is wrong and so is
 //! every fit (Lorenz, two runs in one file: ten terms where two are). A run is cut where a
-//! state breaks into runs of its own; an input that leaps alone is a step of the input.
+//! state breaks into runs of its own; an input that leaps alone is a step of the input. So is
+//! a run cut at a gap in its time (a logger's dropout).
 
 use super::{DataError, Frame};
 
@@ -120,7 +121,6 @@ pub fn cut_at_breaks(
     states: &[&str],
     inputs: &[&str],
 ) -> Result<(Vec<Frame>, Vec<String>), DataError> {
-    let n = frame.len();
     let sig = |x: f64| crate::output::sig(x, 3);
     let (mut found, mut notes) = moving_breaks(&frame, states);
     let mut cuts: Vec<usize> = found.iter().map(|f| f.0).collect();
@@ -188,27 +188,137 @@ pub fn cut_at_breaks(
             if leaps.len() == 1 { "stays" } else { "stay" },
         ));
     }
-    let bounds: Vec<usize> = std::iter::once(0).chain(cuts).chain(std::iter::once(n)).collect();
-    let mut pieces = Vec::new();
-    for w in bounds.windows(2) {
-        let (a, b) = (w[0], w[1]);
-        let name = format!("{} [rows {}-{}]", frame.origin(), a + 1, b);
-        if b - a < SHORTEST {
-            notes.push(format!("{name}: {} rows between breaks, too few for a run: left out", b - a));
+    let pieces = into_pieces(&frame, &cuts, 0, "breaks", &mut notes)?;
+    Ok((pieces, notes))
+}
+
+/// `frame` cut before each row of `cuts` into runs of their own, each named by its origin and
+/// its rows in it, `margin` rows left out beside each cut; a piece under 21 rows left out,
+/// said in `notes` as between `what`.
+fn into_pieces(
+    frame: &Frame,
+    cuts: &[usize],
+    margin: usize,
+    what: &str,
+    notes: &mut Vec<String>,
+) -> Result<Vec<Frame>, DataError> {
+    let n = frame.len();
+    let bounds: Vec<usize> =
+        std::iter::once(0).chain(cuts.iter().copied()).chain(std::iter::once(n)).collect();
+    let (mut pieces, mut short) = (Vec::new(), Vec::new());
+    let mut longest = 0;
+    for (k, w) in bounds.windows(2).enumerate() {
+        // the margin only beside a cut, not at the run's own ends
+        let a = if k == 0 { w[0] } else { w[0] + margin };
+        let b = if k + 2 == bounds.len() { w[1] } else { w[1].saturating_sub(margin) };
+        let rows = b.saturating_sub(a);
+        longest = longest.max(rows);
+        if rows < SHORTEST {
+            short.push((a, b, rows));
             continue;
         }
         let mut piece = frame.slice(a..b);
-        piece.origin = name;
+        piece.origin = format!("{} [rows {}-{}]", frame.origin(), a + 1, b);
         pieces.push(piece);
+    }
+    match short.as_slice() {
+        [] => {}
+        [(a, b, rows)] => notes.push(format!(
+            "{} [rows {}-{b}]: {rows} row(s) between {what}, too few for a run: left out",
+            frame.origin(),
+            a + 1
+        )),
+        many => {
+            let some: Vec<String> = many.iter().take(3).map(|(a, b, _)| format!("{}-{b}", a + 1)).collect();
+            notes.push(format!(
+                "{}: {} pieces between {what} under {SHORTEST} rows each, too few for a run: left out (rows {}{}; {} rows in all)",
+                frame.origin(),
+                many.len(),
+                some.join(", "),
+                if many.len() > 3 { ", …" } else { "" },
+                many.iter().map(|s| s.2).sum::<usize>()
+            ))
+        }
     }
     if pieces.is_empty() {
         return Err(DataError::TooShort {
             file: frame.origin().into(),
-            rows: bounds.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0),
+            rows: longest,
             needed: SHORTEST,
-            what: "a run between the breaks of its states (the longest piece's rows)".into(),
+            what: format!("a run between its {what} (the longest piece's rows)"),
         });
     }
+    Ok(pieces)
+}
+
+/// An interval this many times the median or longer is a gap in the record (a dropout).
+pub const GAP: f64 = 3.0;
+
+/// Gaps in more than this share of the intervals make a log irregular (asynchronous, sampled
+/// on events), not a clock with dropouts.
+const IRREGULAR: f64 = 0.05;
+
+/// The gaps of a record's time `t`: the rows after intervals over [`GAP`] times the median (a
+/// logger's dropout), empty where there are none; where they are over 5 % of the intervals
+/// and more than three (an irregular log, whose spacing is its own), `Err` with the share of
+/// such intervals and the longest.
+pub fn gaps(t: &[f64]) -> Result<Vec<usize>, (f64, f64)> {
+    let median = super::median_step(t);
+    let rows: Vec<usize> = (1..t.len()).filter(|&i| t[i] - t[i - 1] > GAP * median).collect();
+    if rows.len() > 3 && rows.len() as f64 > IRREGULAR * (t.len() - 1) as f64 {
+        let longest = t.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
+        return Err((rows.len() as f64 / (t.len() - 1) as f64, longest));
+    }
+    Ok(rows)
+}
+
+/// The run cut at the gaps in its time ([`gaps`]: a logger's dropouts, where the record
+/// stops and goes on later) into runs of their own, `margin` rows left out beside each gap (rows
+/// a difference across the gap has spoiled), with what to say; an integral or a derivative
+/// across a gap would take the motion in it as a line. A log whose spacing is irregular
+/// throughout is taken as it is (said).
+pub fn cut_at_gaps(frame: Frame, margin: usize) -> Result<(Vec<Frame>, Vec<String>), DataError> {
+    let t = frame.time();
+    let sig = |x: f64| crate::output::sig(x, 3);
+    let median = super::median_step(t);
+    let cuts = match gaps(t) {
+        Ok(cuts) if cuts.is_empty() => return Ok((vec![frame], Vec::new())),
+        Ok(cuts) => cuts,
+        Err((share, longest)) => {
+            let note = format!(
+                "{}: `{}` steps irregularly ({:.0} % of its intervals over {GAP} times its median, {} s; the longest {} s): a log sampled on events, not a clock with dropouts; taken as it is, its spacing its own",
+                frame.origin(),
+                frame.time_name(),
+                100.0 * share,
+                sig(median),
+                sig(longest)
+            );
+            return Ok((vec![frame], vec![note]));
+        }
+    };
+    let step = |i: usize| sig(t[i] - t[i - 1]);
+    let at = match cuts.as_slice() {
+        [one] => format!("by {} s from row {} to row {} (t = {} s)", step(*one), one, one + 1, sig(t[*one])),
+        many => {
+            let rows: Vec<String> = many.iter().take(4).map(|r| (r + 1).to_string()).collect();
+            let longest = many.iter().map(|&i| t[i] - t[i - 1]).fold(0.0, f64::max);
+            format!(
+                "at {} rows ({}{}; the longest {} s)",
+                many.len(),
+                rows.join(", "),
+                if many.len() > 4 { ", …" } else { "" },
+                sig(longest)
+            )
+        }
+    };
+    let mut notes = vec![format!(
+        "{}: `{}` jumps {at}, where its usual step is {} s: a gap in the record (a logger's dropout); the run is cut there into runs of its own{}",
+        frame.origin(),
+        frame.time_name(),
+        sig(median),
+        if margin > 0 { format!(", {margin} rows beside each gap left out") } else { String::new() }
+    )];
+    let pieces = into_pieces(&frame, &cuts, margin, "gaps", &mut notes)?;
     Ok((pieces, notes))
 }
 
@@ -296,7 +406,7 @@ mod tests {
             "{}",
             notes[0]
         );
-        assert!(notes[2].contains("[rows 601-610]: 10 rows between breaks"), "{}", notes[2]);
+        assert!(notes[2].contains("[rows 601-610]: 10 row(s) between breaks"), "{}", notes[2]);
         let (whole, said) = cut_at_breaks(f, &[], &["F"]).unwrap();
         assert_eq!((whole.len(), said.len()), (1, 0));
     }
@@ -337,6 +447,56 @@ mod tests {
         let (runs, notes) = cut_at_breaks(joined, &["x"], &["F"]).unwrap();
         assert_eq!(runs.len(), 3, "{notes:?}");
         assert!(notes[0].contains("`x` (by 3.00), `F` (by 3.0"), "{}", notes[0]);
+    }
+
+    /// A clock of 0.1 s with two dropouts (0.5 s and 1.2 s): cut into three runs named by
+    /// their rows, said once; with a margin of 2, two rows beside each gap left out (not at
+    /// the run's ends). A log sampled on events (exponential intervals) is not cut, said; a
+    /// clock without dropouts, nothing said. Pieces too short are said together.
+    #[test]
+    fn a_run_is_cut_at_its_gaps() {
+        let mut t = clock(300);
+        t[100..].iter_mut().for_each(|v| *v += 0.4);
+        t[200..].iter_mut().for_each(|v| *v += 1.1);
+        let run = |t: Vec<f64>| {
+            let mut f = Frame::new("log.csv", "t", t.clone()).unwrap();
+            f.push("x", t.iter().map(|t| t.sin()).collect()).unwrap();
+            f
+        };
+        let (runs, notes) = cut_at_gaps(run(t.clone()), 0).unwrap();
+        let names: Vec<&str> = runs.iter().map(Frame::origin).collect();
+        assert_eq!(names, ["log.csv [rows 1-100]", "log.csv [rows 101-200]", "log.csv [rows 201-300]"]);
+        assert_eq!(notes.len(), 1);
+        assert!(notes[0].contains("`t` jumps at 2 rows (101, 201; the longest 1.20 s)"), "{}", notes[0]);
+        let (runs, _) = cut_at_gaps(run(t.clone()), 2).unwrap();
+        assert_eq!(runs.iter().map(Frame::len).collect::<Vec<_>>(), [98, 96, 98]);
+        assert_eq!(runs[1].time()[0], t[102]);
+        let mut seed = 12u64;
+        let mut at = 0.0;
+        let events: Vec<f64> = (0..500)
+            .map(|_| {
+                at += -0.1 * (crate::data::test_noise(&mut seed) + 0.5 + 1e-3).ln();
+                at
+            })
+            .collect();
+        let (runs, notes) = cut_at_gaps(run(events), 0).unwrap();
+        assert_eq!(runs.len(), 1);
+        assert!(
+            notes[0].contains("steps irregularly") && notes[0].contains("sampled on events"),
+            "{notes:?}"
+        );
+        assert_eq!(cut_at_gaps(run(clock(300)), 0).unwrap().1.len(), 0);
+        let mut t = clock(300);
+        for k in [50, 60, 70, 80] {
+            t[k..].iter_mut().for_each(|v| *v += 1.0);
+        }
+        let (runs, notes) = cut_at_gaps(run(t), 0).unwrap();
+        assert_eq!(runs.len(), 2);
+        assert!(
+            notes[1].contains("3 pieces between gaps under 21 rows each")
+                && notes[1].contains("30 rows in all"),
+            "{notes:?}"
+        );
     }
 
     /// A staircase (a state read off a coarse scale every 40 rows) leaps too often to be

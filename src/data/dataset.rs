@@ -539,8 +539,6 @@ impl Dataset {
             for (name, values) in names.iter().zip(columns).filter(|(n, _)| **n != time_col) {
                 raw.push(name, values)?;
             }
-            // a logging dropout would be differentiated across as if it were one step
-            super::check_gaps(&raw, 3.0)?;
             let scale = |unit: Option<&str>, column: &str| -> Result<f64, DataError> {
                 let Some(lambda) = self.froude else { return Ok(1.0) };
                 froude_factor(lambda, unit, &origin, column)
@@ -751,7 +749,13 @@ impl Dataset {
                 ));
                 frame = frame.slice(lo..hi);
             }
-            frames.push(frame);
+            // a logging dropout would be integrated or differentiated across as if the motion
+            // in it were a line: each piece a run, less the rows a track's differences across
+            // the gap spoiled
+            let margin = self.track.as_ref().map_or(0, |t| t.half_window);
+            let (pieces, said) = super::cut_at_gaps(frame, margin)?;
+            notes.extend(said);
+            frames.extend(pieces);
         }
         Ok((frames, notes))
     }

@@ -26,7 +26,7 @@ mod spike;
 mod stream;
 
 pub use angle::{unwrap_turns, unwrapped, wrapped};
-pub use breaks::{breaks, cut_at_breaks, moving_breaks, Break};
+pub use breaks::{breaks, cut_at_breaks, cut_at_gaps, gaps, moving_breaks, Break, GAP};
 pub use clock::clock_seconds;
 pub use dataset::{velocities_from_track, Dataset, Delimiter, RunSpec, Track};
 pub use delay::delayed;

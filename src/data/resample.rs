@@ -150,17 +150,17 @@ pub fn evened(frame: &Frame) -> Result<Option<(Frame, String)>, DataError> {
     Ok(Some((even, note)))
 }
 
-/// Refuses a step in time more than `factor` times the median step (a logging gap or a jump).
-pub fn check_gaps(frame: &Frame, factor: f64) -> Result<(), DataError> {
+/// Refuses a gap in time ([`super::gaps`]: a step over three times the median, in a record
+/// not irregular throughout), where a run cannot be cut ([`super::cut_at_gaps`] cuts one).
+pub fn check_gaps(frame: &Frame) -> Result<(), DataError> {
     let t = frame.time();
-    let median = median_step(t);
-    match (1..t.len()).find(|&i| t[i] - t[i - 1] > factor * median) {
+    match super::gaps(t).ok().and_then(|g| g.first().copied()) {
         Some(i) => Err(DataError::TimeGap {
             file: frame.origin().into(),
             row: i + 1,
             column: frame.time_name().into(),
             step: t[i] - t[i - 1],
-            median,
+            median: median_step(t),
         }),
         None => Ok(()),
     }
@@ -305,8 +305,8 @@ mod tests {
         let mut t: Vec<f64> = (0..20).map(|i| i as f64 * 0.05).collect();
         t[12..].iter_mut().for_each(|v| *v += 0.5);
         let f = Frame::new("run.csv", "time", t).unwrap();
-        let e = check_gaps(&f, 3.0).unwrap_err().to_string();
+        let e = check_gaps(&f).unwrap_err().to_string();
         assert!(e.contains("run.csv") && e.contains("row 13") && e.contains("`time`"), "{e}");
-        assert!(check_gaps(&frame(0.05, 20, |t| t), 3.0).is_ok());
+        assert!(check_gaps(&frame(0.05, 20, |t| t)).is_ok());
     }
 }

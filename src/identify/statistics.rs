@@ -139,9 +139,16 @@ impl EquationMoments {
             for chunk in chunks {
                 let mut chunk = chunk?;
                 let shift = |e: IdentifyError| e.shifted(chunk.first_row);
+                // a run read whole is cut at its gaps (before admission evens its samples); a
+                // piece of one cannot be
+                crate::data::check_gaps(&chunk.frame).map_err(|e| {
+                    IdentifyError::Setup(format!(
+                        "{}, where a run read whole is cut into runs of its own; a piece of one cannot be: read the runs whole (--chunk-rows 0), or cut the file there",
+                        e.shifted(chunk.first_row)
+                    ))
+                })?;
                 let admitted =
                     model.admit_at(&mut chunk.frame, chunk.first_row).map_err(|e| shift(e.into()))?;
-                crate::data::check_gaps(&chunk.frame, 3.0).map_err(|e| shift(e.into()))?;
                 // a piece of a run is not cut into runs (the whole run is, where a state breaks;
                 // an input's step cuts nothing)
                 if let Some((row, name, leap)) = crate::data::moving_breaks(&chunk.frame, &states).0.first() {

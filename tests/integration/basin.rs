@@ -324,8 +324,10 @@ fn preparation_resamples_and_refuses_what_it_cannot_do() {
     assert!(!ok && err.contains("short.dat") && err.contains("window of 21") && err.contains("`u`"), "{err}");
 }
 
+/// A dataset's run with a second of record missing is cut there into two runs, said with the
+/// row; a repeated time stamp is refused with its row.
 #[test]
-fn gaps_and_repeated_time_stamps_are_refused_with_their_row() {
+fn gaps_cut_runs_and_repeated_time_stamps_are_refused_with_their_row() {
     let dir = Scratch::new("basin-gaps");
     let truth = termid::ship::default_model();
     let basin = Basin::default();
@@ -345,15 +347,20 @@ fn gaps_and_repeated_time_stamps_are_refused_with_their_row() {
     let mut dup = lines.clone();
     dup.insert(4 + 51, lines[4 + 50].clone());
     std::fs::write(dir.join("dup.dat"), dup.join("\n")).unwrap();
-    for (file, row, what) in [("gap.dat", "row 101", "gap"), ("dup.dat", "row 52", "does not increase")] {
+    let validated = |file: &str| {
         std::fs::write(dir.join("set.toml"), dataset_toml(&[file])).unwrap();
         let set = dir.join("set.toml").display().to_string();
-        let (ok, _, err) = termid(&["validate", "--model", "models/oltmann1973.toml", "--dataset", &set]);
-        assert!(
-            !ok && err.contains(file) && err.contains(row) && err.contains(what) && err.contains("`time`"),
-            "{err}"
-        );
-    }
+        termid(&["validate", "--model", "models/oltmann1973.toml", "--dataset", &set])
+    };
+    let (ok, out, err) = validated("gap.dat");
+    assert!(ok && err.contains("gap.dat: `t` jumps by") && err.contains("from row 100 to row 101"), "{err}");
+    assert!(out.contains("gap.dat [rows 1-100]") && out.contains("gap.dat [rows 101-"), "{out}");
+    let (ok, _, err) = validated("dup.dat");
+    assert!(
+        !ok && err.contains("dup.dat") && err.contains("row 52") && err.contains("does not increase"),
+        "{err}"
+    );
+    assert!(err.contains("`time`"), "{err}");
 }
 
 /// A run at its own approach speed is re-simulated at that speed: with the true model and

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use termid::data::{check_gaps, Dataset, Frame};
+use termid::data::{Dataset, Frame};
 use termid::model::Model;
 
 /// The runs of a command with a model: as [`load`], then each dataset mapping checked to name
@@ -248,11 +248,13 @@ pub fn replay_frame(path: &Path, time: &str) -> Result<Frame> {
 
 pub fn load(data: &[PathBuf], datasets: &[PathBuf], time: &str) -> Result<Vec<Frame>> {
     check_once(&input_files(data, datasets))?;
-    let mut frames = data.iter().map(|p| Frame::read(p, time)).collect::<Result<Vec<_>, _>>()?;
-    for f in &frames {
-        // a logging dropout would be differentiated across as if it were one step (dataset
-        // files are checked as they are read, in their own column names)
-        check_gaps(f, 3.0)?;
+    let mut frames = Vec::new();
+    for path in data {
+        // a logging dropout would be integrated or differentiated across as if the motion in
+        // it were a line: each piece a run (dataset files are cut as they are read)
+        let (pieces, notes) = termid::data::cut_at_gaps(Frame::read(path, time)?, 0)?;
+        notes.iter().for_each(|n| say(n));
+        frames.extend(pieces);
     }
     for path in datasets {
         let ds = Dataset::load(path)?;
