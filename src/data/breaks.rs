@@ -88,10 +88,7 @@ pub fn moving_breaks<'a>(frame: &Frame, columns: &[&'a str]) -> (Vec<(usize, &'a
     let n = frame.len();
     let (mut found, mut notes) = (Vec::new(), Vec::new());
     for name in columns {
-        let Some(column) = frame.column(name) else { continue };
-        if frame.is_held(name) || super::held(column).is_some() {
-            continue;
-        }
+        let Some(column) = moving(frame, name) else { continue };
         let b = breaks(frame.time(), column);
         if b.len() > 3 && b.len() * ROWS_PER_BREAK > n {
             notes.push(format!(
@@ -106,6 +103,14 @@ pub fn moving_breaks<'a>(frame: &Frame, columns: &[&'a str]) -> (Vec<(usize, &'a
     }
     found.sort_by_key(|f| f.0);
     (found, notes)
+}
+
+/// Column `name` of `frame` where it records a motion that may break: not a command stepped
+/// at isolated samples ([`super::held`]) nor one marked held ([`Frame::is_held`]), which jump
+/// by design.
+fn moving<'f>(frame: &'f Frame, name: &str) -> Option<&'f [f64]> {
+    let column = frame.column(name)?;
+    (!frame.is_held(name) && super::held(column).is_none()).then_some(column)
 }
 
 /// The run cut where a recorded state leaps at one sample and stays ([`moving_breaks`] of
@@ -126,8 +131,8 @@ pub fn cut_at_breaks(
     let mut cuts: Vec<usize> = found.iter().map(|f| f.0).collect();
     cuts.dedup();
     // an input's leaps, however many (they cut nothing: no staircase rule)
-    for input in inputs.iter().filter(|i| !states.contains(i) && !frame.is_held(i)) {
-        let Some(column) = frame.column(input).filter(|c| super::held(c).is_none()) else { continue };
+    for input in inputs.iter().filter(|i| !states.contains(i)) {
+        let Some(column) = moving(&frame, input) else { continue };
         found.extend(breaks(frame.time(), column).iter().map(|b| (b.row, *input, b.leap)));
     }
     // said in the frame's order of columns
@@ -251,25 +256,38 @@ fn into_pieces(
     Ok(pieces)
 }
 
-/// An interval this many times the median or longer is a gap in the record (a dropout).
-pub const GAP: f64 = 3.0;
+/// An interval over this many times the median is a gap in the record (a dropout).
+const GAP: f64 = 3.0;
 
 /// Gaps in more than this share of the intervals make a log irregular (asynchronous, sampled
 /// on events), not a clock with dropouts.
 const IRREGULAR: f64 = 0.05;
 
-/// The gaps of a record's time `t`: the rows after intervals over [`GAP`] times the median (a
-/// logger's dropout), empty where there are none; where they are over 5 % of the intervals
-/// and more than three (an irregular log, whose spacing is its own), `Err` with the share of
-/// such intervals and the longest.
-pub fn gaps(t: &[f64]) -> Result<Vec<usize>, (f64, f64)> {
+/// What a record's time says of its gaps ([`gaps`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Gaps {
+    /// A clock with dropouts: the rows after intervals over three times the median (none: a
+    /// record without gaps).
+    Dropouts(Vec<usize>),
+    /// A log irregular throughout (asynchronous, sampled on events), whose spacing is its own.
+    Irregular {
+        /// The share of its intervals over three times the median.
+        share: f64,
+        /// The longest interval, in the time's units.
+        longest: f64,
+    },
+}
+
+/// The gaps of a record's time `t`: intervals over three times the median are dropouts,
+/// unless they are over 5 % of the intervals and more than three (an irregular log).
+pub fn gaps(t: &[f64]) -> Gaps {
     let median = super::median_step(t);
     let rows: Vec<usize> = (1..t.len()).filter(|&i| t[i] - t[i - 1] > GAP * median).collect();
     if rows.len() > 3 && rows.len() as f64 > IRREGULAR * (t.len() - 1) as f64 {
         let longest = t.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
-        return Err((rows.len() as f64 / (t.len() - 1) as f64, longest));
+        return Gaps::Irregular { share: rows.len() as f64 / (t.len() - 1) as f64, longest };
     }
-    Ok(rows)
+    Gaps::Dropouts(rows)
 }
 
 /// The run cut at the gaps in its time ([`gaps`]: a logger's dropouts, where the record
@@ -282,9 +300,9 @@ pub fn cut_at_gaps(frame: Frame, margin: usize) -> Result<(Vec<Frame>, Vec<Strin
     let sig = |x: f64| crate::output::sig(x, 3);
     let median = super::median_step(t);
     let cuts = match gaps(t) {
-        Ok(cuts) if cuts.is_empty() => return Ok((vec![frame], Vec::new())),
-        Ok(cuts) => cuts,
-        Err((share, longest)) => {
+        Gaps::Dropouts(cuts) if cuts.is_empty() => return Ok((vec![frame], Vec::new())),
+        Gaps::Dropouts(cuts) => cuts,
+        Gaps::Irregular { share, longest } => {
             let note = format!(
                 "{}: `{}` steps irregularly ({:.0} % of its intervals over {GAP} times its median, {} s; the longest {} s): a log sampled on events, not a clock with dropouts; taken as it is, its spacing its own",
                 frame.origin(),

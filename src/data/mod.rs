@@ -26,7 +26,7 @@ mod spike;
 mod stream;
 
 pub use angle::{unwrap_turns, unwrapped, wrapped};
-pub use breaks::{breaks, cut_at_breaks, cut_at_gaps, gaps, moving_breaks, Break, GAP};
+pub use breaks::{breaks, cut_at_breaks, cut_at_gaps, gaps, moving_breaks, Break, Gaps};
 pub use clock::clock_seconds;
 pub use dataset::{velocities_from_track, Dataset, Delimiter, RunSpec, Track};
 pub use delay::delayed;
@@ -332,6 +332,13 @@ fn all_finite(values: &[f64]) -> bool {
     lanes.iter().sum::<f64>() == 0.0 && rest.iter().all(|v| v.is_finite())
 }
 
+/// How a marked column behaves between its samples ([`Frame::hold`], [`Frame::switch`]).
+#[derive(Clone, Copy)]
+enum Between {
+    Held,
+    Switched,
+}
+
 /// Named f64 columns over a strictly increasing time column; each column either a line
 /// between its samples (the default), held from each sample to the next ([`Frame::hold`]), or
 /// switched at instants between two samples that the rows do not tell ([`Frame::switch`]).
@@ -477,12 +484,7 @@ impl Frame {
     /// integral and its replay into a simulation step, not a line, between samples); refused
     /// for the time column and a column the frame does not have.
     pub fn hold(&mut self, name: &str) -> Result<(), DataError> {
-        self.mark(name, "held")?;
-        self.switched.retain(|h| h != name);
-        if !self.is_held(name) {
-            self.held.push(name.into());
-        }
-        Ok(())
+        self.mark(name, Between::Held)
     }
 
     /// Takes column `name` as switching somewhere between two samples where it jumps (a relay
@@ -490,19 +492,36 @@ impl Frame {
     /// rate's fit leaves out the windows that hold a switch ([`crate::data::switches`]); a
     /// replay draws a line across it. Refused as [`Frame::hold`] refuses.
     pub fn switch(&mut self, name: &str) -> Result<(), DataError> {
-        self.mark(name, "switched")?;
-        self.held.retain(|h| h != name);
-        if !self.is_switched(name) {
-            self.switched.push(name.into());
-        }
-        Ok(())
+        self.mark(name, Between::Switched)
     }
 
-    /// Whether `name` may be marked: a column the frame has, not its time.
-    fn mark(&self, name: &str, how: &str) -> Result<(), DataError> {
+    /// Marks column `name` (one the frame has, not its time) as `how` it behaves between
+    /// samples, and as nothing else.
+    fn mark(&mut self, name: &str, how: Between) -> Result<(), DataError> {
         match self.names.iter().position(|n| n == name) {
-            Some(0) => Err(DataError::Setting(format!("{}: time `{name}` cannot be {how}", self.origin))),
-            Some(_) => Ok(()),
+            Some(0) => {
+                let what = match how {
+                    Between::Held => "held",
+                    Between::Switched => "switched",
+                };
+                Err(DataError::Setting(format!("{}: time `{name}` cannot be {what}", self.origin)))
+            }
+            Some(_) => {
+                let already = match how {
+                    Between::Held => self.is_held(name),
+                    Between::Switched => self.is_switched(name),
+                };
+                if already {
+                    // (kept where it was marked first)
+                    return Ok(());
+                }
+                self.release(name);
+                match how {
+                    Between::Held => self.held.push(name.into()),
+                    Between::Switched => self.switched.push(name.into()),
+                }
+                Ok(())
+            }
             None => Err(DataError::MissingColumn {
                 file: self.origin.clone(),
                 column: name.into(),

@@ -154,7 +154,11 @@ pub fn evened(frame: &Frame) -> Result<Option<(Frame, String)>, DataError> {
 /// not irregular throughout), where a run cannot be cut ([`super::cut_at_gaps`] cuts one).
 pub fn check_gaps(frame: &Frame) -> Result<(), DataError> {
     let t = frame.time();
-    match super::gaps(t).ok().and_then(|g| g.first().copied()) {
+    let first = match super::gaps(t) {
+        super::Gaps::Dropouts(rows) => rows.first().copied(),
+        super::Gaps::Irregular { .. } => None,
+    };
+    match first {
         Some(i) => Err(DataError::TimeGap {
             file: frame.origin().into(),
             row: i + 1,
