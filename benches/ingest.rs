@@ -61,7 +61,7 @@ fn ingest(c: &mut Criterion) {
     g.bench_function("parquet", |b| b.iter(|| Frame::read(&pq, "t").unwrap()));
     let frame = Frame::read(&pq, "t").unwrap();
     let columns: Vec<&str> = frame.names()[1..].iter().map(String::as_str).collect();
-    g.bench_function("spikes", |b| b.iter(|| termid::data::despiked(&frame, &columns, 0).unwrap()));
+    g.bench_function("spikes", |b| b.iter(|| termid::data::despiked(&frame, &columns).unwrap()));
     g.finish();
     std::fs::remove_dir_all(csv.parent().unwrap()).ok();
 }

@@ -52,6 +52,13 @@ fn monte_carlo_refusal(draws: usize, ran: usize, first_failure: Option<&str>) ->
     termid::uncertainty::refusal(draws, ran, first_failure)
 }
 
+/// The first of `names` that says it holds the time (`time`, `Time [s]`, `timestamp`, …):
+/// the command line's rule, for an error that names it.
+#[pyfunction]
+fn time_like(names: Vec<String>) -> Option<String> {
+    names.into_iter().find(|n| termid::data::looks_like_time(n))
+}
+
 #[pymodule]
 fn _termid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("TermidError", m.py().get_type::<TermidError>())?;
@@ -63,5 +70,6 @@ fn _termid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(default_settings, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
     m.add_function(wrap_pyfunction!(monte_carlo_refusal, m)?)?;
+    m.add_function(wrap_pyfunction!(time_like, m)?)?;
     Ok(())
 }

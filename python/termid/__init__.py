@@ -28,6 +28,7 @@ import json
 import math
 import os
 import re
+import sys
 import warnings
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
@@ -105,24 +106,48 @@ def _frame_in_place(data: pd.DataFrame) -> Optional[Dict[str, np.ndarray]]:
     return dict(zip(map(str, data.columns.tolist()), arrays))
 
 
-def _seconds(name: str, values: Any) -> Any:
-    """A column of durations (timedelta64) in seconds, or of instants (datetime64) in seconds
-    since its first; termid reads times in seconds, and the raw numbers would be nanoseconds.
-    Other columns pass unchanged."""
-    array = np.asarray(values)
+def _outside() -> int:
+    """The ``stacklevel`` of a warning that points at the user's line calling this package, however
+    deep inside it the warning is raised."""
+    level, frame = 1, sys._getframe(1)
+    while frame is not None and frame.f_code.co_filename == __file__:
+        level, frame = level + 1, frame.f_back
+    return level
+
+
+def _naive(values: Any) -> Any:
+    """Date-times with a time zone (pandas' ``datetime64[ns, tz]``, a column or an index) as
+    plain date-times in UTC: their differences are then the seconds that passed, a change to
+    or from daylight saving time no jump. Other values pass unchanged."""
+    if getattr(getattr(values, "dtype", None), "tz", None) is None:
+        return values
+    return pd.DatetimeIndex(values).tz_convert("UTC").tz_localize(None).to_numpy()
+
+
+def _seconds(what: str, values: Any) -> Any:
+    """A column of durations (timedelta64) in seconds, or of instants (datetime64, with a time
+    zone or without) in seconds since its first; termid reads times in seconds, and the raw
+    numbers would be nanoseconds. Other columns pass unchanged; ``what`` names them in the
+    warning and an error (``column `t` ``, ``the index``)."""
+    array = np.asarray(_naive(values))
     if array.dtype.kind not in "mM":
         return values
     kind = "durations" if array.dtype.kind == "m" else "date-times"
     if array.dtype.kind == "M":
         array = array - array[0] if len(array) else array.astype("timedelta64[ns]")
     if np.isnat(array).any():
-        raise TermidError(f"column `{name}`: a missing time (NaT) at row {int(np.argmax(np.isnat(array))) + 1}")
+        raise TermidError(f"{what}: a missing time (NaT) at row {int(np.argmax(np.isnat(array))) + 1}")
     warnings.warn(
-        f"termid: column `{name}` holds {kind}; read as seconds"
+        f"termid: {what} holds {kind}; read as seconds"
         + (" since its first value" if kind == "date-times" else ""),
-        stacklevel=4,
+        stacklevel=_outside(),
     )
     return array.astype("timedelta64[ns]").astype(np.int64) / 1e9
+
+
+def _is_time(values: Any) -> bool:
+    """Whether values (a column, an index) are instants or durations."""
+    return getattr(getattr(values, "dtype", None), "kind", "O") in "mM"
 
 
 def _once(names: Sequence[Any]) -> None:
@@ -141,9 +166,11 @@ def _once(names: Sequence[Any]) -> None:
 
 class _Columns(Dict[str, np.ndarray]):
     """Columns by name; ``left_out`` names the columns that hold no numbers (a run id, a
-    label) with their type: no term can use them, and an error that needs one says so."""
+    label) with their type: no term can use them, and an error that needs one says so;
+    ``times`` the columns that held instants or durations (now seconds)."""
 
     left_out: Dict[str, str] = {}
+    times: List[str] = []
 
 
 def _explained(error: TermidError, left_out: Mapping[str, str]) -> TermidError:
@@ -156,7 +183,7 @@ def _numeric(items: Any) -> "_Columns":
     out = _Columns()
     out.left_out = {}
     for name, values in items:
-        values = _seconds(name, values)
+        values = _seconds(f"column `{name}`", values)
         try:
             out[name] = np.ascontiguousarray(values, dtype=np.float64)
         except (TypeError, ValueError):
@@ -166,12 +193,24 @@ def _numeric(items: Any) -> "_Columns":
 
 def _columns(data: Data) -> "_Columns":
     """Columns as contiguous float64 arrays, without copying where the layout allows; time
-    columns (timedelta64, datetime64) in seconds; columns that hold no numbers left out."""
+    columns (timedelta64, datetime64) in seconds, named in ``times``; columns that hold no
+    numbers left out."""
+    found = _columns_of(data)
+    if isinstance(data, pd.DataFrame):
+        found.times = [str(c) for c, dt in zip(data.columns, data.dtypes) if getattr(dt, "kind", "O") in "mM"]
+    elif isinstance(data, Mapping):
+        found.times = [str(k) for k, v in data.items() if _is_time(np.asarray(_naive(v)))]
+    elif hasattr(data, "column_names") and hasattr(data, "schema"):  # pyarrow Table
+        found.times = [f.name for f in data.schema if str(f.type).startswith(("timestamp", "duration"))]
+    return found
+
+
+def _columns_of(data: Data) -> "_Columns":
     if isinstance(data, pd.DataFrame):
         _once(data.columns)
         if any(getattr(dt, "kind", "O") in "mM" for dt in data.dtypes):
             data = pd.DataFrame(
-                {str(c): _seconds(str(c), data.iloc[:, j].to_numpy()) for j, c in enumerate(data.columns)},
+                {str(c): _seconds(f"column `{c}`", data.iloc[:, j]) for j, c in enumerate(data.columns)},
                 index=data.index,
             )
         in_place = _frame_in_place(data)
@@ -212,15 +251,23 @@ def _columns(data: Data) -> "_Columns":
     return _numeric(items)
 
 
-def _runs(runs: Union[Data, Sequence[Data]], names: Optional[Sequence[str]] = None) -> List[Tuple[str, Dict[str, np.ndarray]]]:
+def _runs(
+    runs: Union[Data, Sequence[Data]], names: Optional[Sequence[str]] = None, time: Optional[str] = None
+) -> List[Tuple[str, Dict[str, np.ndarray]]]:
     """Runs as (name, columns); one run may be given alone. A DataFrame's ``attrs["name"]``
-    names it in messages, else ``run1``, ``run2``, ..."""
+    names it in messages, else ``run1``, ``run2``, ... A run without the column ``time`` (a
+    model's) has it from its index where that holds times (:func:`_index_time`)."""
     if isinstance(runs, (pd.DataFrame, Mapping)) or hasattr(runs, "column_names"):
         runs = [runs]
     out = []
     for k, run in enumerate(runs):
         name = names[k] if names else getattr(run, "attrs", {}).get("name", f"run{k + 1}")
-        out.append((str(name), _columns(run)))
+        columns = _columns(run)
+        if time is not None and time not in columns:
+            index = _index_time(run)
+            if index is not None:
+                columns[time] = index
+        out.append((str(name), columns))
     return out
 
 
@@ -572,24 +619,43 @@ def _settings_text(backend: str, settings: Mapping[str, Any]) -> str:
 _RATE = re.compile(r"^\s*d(.+)/dt\s*$")
 
 
+def _index_time(data: Data) -> Optional[np.ndarray]:
+    """A DataFrame's index as the rows' time in seconds where it holds times: date-times (in a
+    time zone or not; seconds from the first), durations, floats, or integers under a name (an
+    unnamed integer index is row labels, as a filtered frame keeps); else None."""
+    index = getattr(data, "index", None)
+    if not isinstance(data, pd.DataFrame) or isinstance(index, pd.RangeIndex):
+        return None
+    if not (_is_time(index) or index.dtype.kind in "f" + ("iu" if index.name is not None else "")):
+        return None
+    return np.ascontiguousarray(_seconds("the index" + (f" `{index.name}`" if index.name is not None else ""), index), dtype=np.float64)
+
+
 def _time_of(data: Data, columns: "_Columns", time: Optional[str], target: str) -> str:
     """The name of the time of rows whose rate is fitted: ``time``, else a column ``t``, else
-    the DataFrame's index where it holds times (date-times or durations, in seconds from the
-    first; numbers, as seconds), added to ``columns`` as ``t``."""
+    the DataFrame's index where it holds times (:func:`_index_time`, added to ``columns`` as
+    ``t``), else the one column of date-times or durations, with a warning."""
     if time is not None:
         if time not in columns:
             raise TermidError(f"no time column `{time}` (columns: {', '.join(columns)})")
         return time
     if "t" in columns:
         return "t"
-    index = getattr(data, "index", None)
-    if isinstance(data, pd.DataFrame) and not isinstance(index, pd.RangeIndex):
-        values = index.to_numpy()
-        if values.dtype.kind in "mMfiu":
-            columns["t"] = np.ascontiguousarray(_seconds(str(index.name or "index"), values), dtype=np.float64)
-            return "t"
+    index = _index_time(data)
+    if index is not None:
+        columns["t"] = index
+        return "t"
+    if len(columns.times) == 1:
+        warnings.warn(
+            f"termid: `{target}` is a rate: the rows' time is column `{columns.times[0]}`, the one of date-times or "
+            f"durations (time='name' names another)",
+            stacklevel=_outside(),
+        )
+        return columns.times[0]
+    like = _termid.time_like(list(columns))
     raise TermidError(
         f"`{target}` is a rate: it needs the rows' time, a column `t`, time='name', or a DataFrame indexed by time"
+        + (f"; `{like}` looks like time: time='{like}'" if like else "")
     )
 
 
@@ -628,7 +694,9 @@ def fit(
     yes, for a rate no, ``"1"`` a candidate instead); ``forced`` terms kept whatever their
     significance; ``excluded`` candidates left out; ``parameters`` values of names the terms
     use that are not columns; ``weights`` a column of row weights; ``time`` the column of the
-    rows' time for a rate (default: ``t``, else a DataFrame's index of times); ``derivative``
+    rows' time for a rate (default: ``t``, else a DataFrame's index of times: seconds,
+    durations, date-times in a time zone or not, integers only under a name; else the one
+    column of date-times, with a warning); ``derivative``
     how a rate is estimated (default: none, the integral form); ``keep_spikes`` keeps a rate's
     rows as recorded, where by default a sample or three of a column that leap away from their
     neighbours and straight back (a glitch, not a motion) are replaced by the line through the
@@ -1206,7 +1274,7 @@ class Model:
         >>> found.targets["z_dot"], found.model.coefficients("z_dot")["value"].round(2).tolist()
         ('dz/dt', [1.0, -2.67])
         """
-        data = _targeted(self._native, _runs(runs, names), derivative, target, list(equations))
+        data = _targeted(self._native, _runs(runs, names, self.time), derivative, target, list(equations))
         try:
             native, fits = self._native.identify(
                 data, derivative, list(equations), intercept, _backend(backend, settings)
@@ -1235,7 +1303,7 @@ class Model:
         ('r_dot', True)
         """
         wanted = [equation] if isinstance(equation, str) else list(equation)
-        data = _targeted(self._native, _runs(runs, names), derivative, target, wanted)
+        data = _targeted(self._native, _runs(runs, names, self.time), derivative, target, wanted)
         found = self._native.moments(wanted, data, derivative)
         return found[0] if isinstance(equation, str) else dict(zip(wanted, found))
 
@@ -1266,7 +1334,7 @@ class Model:
            x_dot  y_dot  z_dot
         0   10.0   23.0   -6.0
         """
-        frame = _frame(self._native.predict(_runs(run)[0], with_intercept))
+        frame = _frame(self._native.predict(_runs(run, time=self.time)[0], with_intercept))
         if isinstance(run, pd.DataFrame):
             frame.index = run.index
         return frame
@@ -1440,7 +1508,7 @@ class Model:
         >>> len(again) == len(ship.simulate("zigzag:20/20"))
         True
         """
-        return [_frame(c) for c in self._native.replay(_runs(runs), dt, integrator, with_intercept)]
+        return [_frame(c) for c in self._native.replay(_runs(runs, time=self.time), dt, integrator, with_intercept)]
 
     def validate(
         self,
@@ -1487,7 +1555,7 @@ class Model:
         >>> list(checked.attrs["band"].columns)
         ['measured', 'mean', 'sd', 'p05', 'p95', 'outside']
         """
-        given = _runs(runs)
+        given = _runs(runs, time=self.time)
         report = json.loads(self._native.validate(given, dt, integrator, with_intercept, over_ground))
         band = None
         if monte_carlo:
@@ -1574,7 +1642,7 @@ class Model:
         >>> list(gaps.columns[:3])
         ['unit', 'rms_before', 'max_before']
         """
-        text, native = self._native.diagnose(_runs(runs), dt, integrator, with_intercept, over_ground)
+        text, native = self._native.diagnose(_runs(runs, time=self.time), dt, integrator, with_intercept, over_ground)
         report = json.loads(text)
         model = Model(native) if native is not None else None
         if raw:
@@ -1647,9 +1715,9 @@ class Model:
         >>> "re-simulated at a step of 0.2" in stepped.text
         True
         """
-        held = _runs(held_out) if held_out is not None else []
+        held = _runs(held_out, time=self.time) if held_out is not None else []
         text_json, text, native = self._native.recipe(
-            _runs(runs),
+            _runs(runs, time=self.time),
             list(derivatives),
             smooth,
             intercept,
@@ -1771,7 +1839,7 @@ class Model:
         {'K': 0.15, 'T': 8.0}
         """
         text, native = self._native.estimate(
-            _runs(runs),
+            _runs(runs, time=self.time),
             coefficients,
             None if states is None else list(states),
             initial_values,
@@ -1874,7 +1942,7 @@ class Model:
         >>> {"name", "passed"} <= set(checks.columns)
         True
         """
-        return pd.DataFrame(json.loads(self._native.checks(_runs(runs) if runs is not None else [])))
+        return pd.DataFrame(json.loads(self._native.checks(_runs(runs, time=self.time) if runs is not None else [])))
 
     def steering_gear(self, runs: Union[Data, Sequence[Data]]) -> Optional[Dict[str, float]]:
         """The steering gear a ship model's zigzag ``runs`` show: ``delay_s`` (the dead time from
@@ -1889,7 +1957,7 @@ class Model:
         >>> abs(gear["rate_deg_s"] - 12.65) < 0.1, gear["delay_s"] < 0.05
         (True, True)
         """
-        text = self._native.steering_gear(_runs(runs))
+        text = self._native.steering_gear(_runs(runs, time=self.time))
         return None if text is None else json.loads(text)
 
     def sway_yaw(self, speed: Optional[float] = None) -> Optional[Dict[str, Any]]:

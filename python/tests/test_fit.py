@@ -218,6 +218,19 @@ def test_a_rate_is_an_equation_of_motion_with_the_command_lines_defaults():
     with pytest.warns(UserWarning, match="read as seconds"):
         by_clock = termid.fit(stamped, "dx/dt", library)
     assert by_clock.coefficients.sort_index().round(3).to_dict() == {"x": -10.0, "y": 10.0}
+    # a logger's clock in its time zone, across the change to summer time (02:00 → 03:00 on
+    # 2026-03-29 in Berlin): read in UTC, the hour that never was is no gap
+    zoned = stamped.set_index(pd.date_range("2026-03-29 01:59:59", periods=len(t), freq="10ms", tz="Europe/Berlin"))
+    assert zoned.index[-1].hour == 3
+    with pytest.warns(UserWarning, match="read as seconds"):
+        by_zone = termid.fit(zoned, "dx/dt", library)
+    assert by_zone.coefficients.sort_index().round(3).to_dict() == {"x": -10.0, "y": 10.0}
+    # the one column of date-times is the rows' time, said
+    logged = zoned.reset_index(names="logged")
+    with pytest.warns(UserWarning) as said:
+        by_column = termid.fit(logged, "dx/dt", library)
+    assert "the rows' time is column `logged`" in " ".join(str(w.message) for w in said)
+    assert by_column.coefficients.sort_index().round(3).to_dict() == {"x": -10.0, "y": 10.0}
     # a derivative method named: five-point differences, the same terms (central ones' error
     # of O(h²), smooth in the states, buys x·z and y·z: the integral form is the default)
     five = termid.fit(df, "dx/dt", library, derivative="five-point")
@@ -227,6 +240,11 @@ def test_a_rate_is_an_equation_of_motion_with_the_command_lines_defaults():
     # what it needs, said
     with pytest.raises(termid.TermidError, match="needs the rows' time"):
         termid.fit(df.drop(columns="t"), "dx/dt", library)
+    # a column named like time is named; row labels (a filtered frame's integers) are no time
+    with pytest.raises(termid.TermidError, match="`Time` looks like time: time='Time'"):
+        termid.fit(df.rename(columns={"t": "Time"}), "dx/dt", library)
+    with pytest.raises(termid.TermidError, match="needs the rows' time"):
+        termid.fit(df.drop(columns="t").iloc[::2], "dx/dt", library)
     with pytest.raises(termid.TermidError, match="no column `w`"):
         termid.fit(df, "dw/dt", library)
     with pytest.raises(termid.TermidError, match="are for a rate"):

@@ -148,12 +148,22 @@ def test_per_run_rule_is_set_and_checked(zigzags):
         ship.set_parameter("w0", 1.0)
 
 
+def _fall_back(seconds: pd.Series) -> pd.DatetimeIndex:
+    """The times in Berlin from ten seconds before the clocks went back an hour (2026-10-25)."""
+    return (pd.Timestamp("2026-10-25 00:59:50", tz="UTC") + pd.to_timedelta(seconds.to_numpy(), unit="s")).tz_convert("Europe/Berlin")
+
+
 def test_a_time_column_of_durations_or_dates_is_read_in_seconds(ship, zigzags):
     run = zigzags[0]
     base = ship.identify([run], target="column").model.coefficients("r_dot").set_index("term")["value"]
     for t in [pd.to_timedelta(run.t, unit="s"), pd.Timestamp("2026-11-25 12:00") + pd.to_timedelta(run.t, unit="s")]:
         with pytest.warns(UserWarning, match="read as seconds"):
             again = ship.identify([run.assign(t=t)], target="column")
+        found = again.model.coefficients("r_dot").set_index("term")["value"]
+        pd.testing.assert_series_equal(found, base)
+    # or the run's index holds the time, as in `fit` (in a time zone: read in UTC)
+    for index in [run.t, _fall_back(run.t)]:
+        again = ship.identify([run.drop(columns="t").set_index(index)], target="column")
         found = again.model.coefficients("r_dot").set_index("term")["value"]
         pd.testing.assert_series_equal(found, base)
 

@@ -95,7 +95,7 @@ pub fn moving_breaks<'a>(frame: &Frame, columns: &[&'a str]) -> (Vec<(usize, &'a
                 "{}: `{name}` leaps at {} rows and stays (from row {}), far beyond its steps beside: too often for records joined in one file; taken as recorded, its rate spikes there",
                 frame.origin(),
                 b.len(),
-                b[0].row + 1
+                frame.row(b[0].row)
             ));
             continue;
         }
@@ -151,12 +151,12 @@ pub fn cut_at_breaks(
             format!(
                 "by {} from row {} to row {} (t = {} s)",
                 sig(first.2),
-                first.0,
-                first.0 + 1,
+                frame.row(first.0 - 1),
+                frame.row(first.0),
                 sig(frame.time()[first.0])
             )
         } else {
-            let rows: Vec<String> = steps.iter().take(4).map(|s| (s.0 + 1).to_string()).collect();
+            let rows: Vec<String> = steps.iter().take(4).map(|s| frame.row(s.0).to_string()).collect();
             format!(
                 "at {} rows ({}{}; the first by {} at t = {} s)",
                 steps.len(),
@@ -187,8 +187,8 @@ pub fn cut_at_breaks(
             "{}: {} {verb} from row {} to row {} (t = {} s), far beyond {whose} steps beside, and {} there: no motion crosses that in one sample (two records joined in one file, a sensor re-zeroed, a knock); the run is cut there into runs of its own",
             frame.origin(),
             leaps.join(", "),
-            row,
-            row + 1,
+            frame.row(row - 1),
+            frame.row(row),
             sig(t[row]),
             if leaps.len() == 1 { "stays" } else { "stay" },
         ));
@@ -219,29 +219,36 @@ fn into_pieces(
         let rows = b.saturating_sub(a);
         longest = longest.max(rows);
         if rows < SHORTEST {
-            short.push((a, b, rows));
+            short.push((a, rows));
             continue;
         }
         let mut piece = frame.slice(a..b);
-        piece.origin = format!("{} [rows {}-{}]", frame.origin(), a + 1, b);
+        // a piece of a piece is named by its rows in the file alone
+        let file = frame.origin().split(" [rows ").next().unwrap_or_default();
+        piece.origin = format!("{file} [rows {}-{}]", frame.row(a), frame.row(b - 1));
         pieces.push(piece);
     }
     match short.as_slice() {
         [] => {}
-        [(a, b, rows)] => notes.push(format!(
-            "{} [rows {}-{b}]: {rows} row(s) between {what}, too few for a run: left out",
+        [(a, rows)] => notes.push(format!(
+            "{} [rows {}-{}]: {rows} row(s) between {what}, too few for a run: left out",
             frame.origin(),
-            a + 1
+            frame.row(*a),
+            frame.row(*a) + rows - 1
         )),
         many => {
-            let some: Vec<String> = many.iter().take(3).map(|(a, b, _)| format!("{}-{b}", a + 1)).collect();
+            let some: Vec<String> = many
+                .iter()
+                .take(3)
+                .map(|(a, rows)| format!("{}-{}", frame.row(*a), frame.row(*a) + rows - 1))
+                .collect();
             notes.push(format!(
                 "{}: {} pieces between {what} under {SHORTEST} rows each, too few for a run: left out (rows {}{}; {} rows in all)",
                 frame.origin(),
                 many.len(),
                 some.join(", "),
                 if many.len() > 3 { ", …" } else { "" },
-                many.iter().map(|s| s.2).sum::<usize>()
+                many.iter().map(|s| s.1).sum::<usize>()
             ))
         }
     }
@@ -316,9 +323,15 @@ pub fn cut_at_gaps(frame: Frame, margin: usize) -> Result<(Vec<Frame>, Vec<Strin
     };
     let step = |i: usize| sig(t[i] - t[i - 1]);
     let at = match cuts.as_slice() {
-        [one] => format!("by {} s from row {} to row {} (t = {} s)", step(*one), one, one + 1, sig(t[*one])),
+        [one] => format!(
+            "by {} s from row {} to row {} (t = {} s)",
+            step(*one),
+            frame.row(one - 1),
+            frame.row(*one),
+            sig(t[*one])
+        ),
         many => {
-            let rows: Vec<String> = many.iter().take(4).map(|r| (r + 1).to_string()).collect();
+            let rows: Vec<String> = many.iter().take(4).map(|r| frame.row(*r).to_string()).collect();
             let longest = many.iter().map(|&i| t[i] - t[i - 1]).fold(0.0, f64::max);
             format!(
                 "at {} rows ({}{}; the longest {} s)",
@@ -398,9 +411,9 @@ mod tests {
         assert!(breaks(&clock(flicker.len()), &flicker).is_empty());
     }
 
-    /// Two records in one frame: cut into two runs named by their rows, said once with both
-    /// states that leap; a piece of 10 rows at the end left out, said; a column that is not a
-    /// state (a command stepped) cuts nothing.
+    /// Two records in one frame: cut into two runs named by their rows (the file's, for a
+    /// piece of it), said once with both states that leap; a piece of 10 rows at the end left
+    /// out, said; a column that is not a state (a command stepped) cuts nothing.
     #[test]
     fn joined_records_are_cut_into_runs() {
         let t: Vec<f64> = (0..610).map(|k| 0.1 * k as f64).collect();
@@ -425,6 +438,13 @@ mod tests {
             notes[0]
         );
         assert!(notes[2].contains("[rows 601-610]: 10 row(s) between breaks"), "{}", notes[2]);
+        // a piece of the file (rows 201-610, as a gap or a trimmed window leaves it) names the
+        // file's rows, not its own
+        let (runs, notes) = cut_at_breaks(f.slice(200..610), &["x", "y"], &["F"]).unwrap();
+        assert_eq!(runs[1].origin(), "joined.csv [rows 301-600]");
+        assert!(notes[0].contains("leap from row 300 to row 301"), "{}", notes[0]);
+        let (pieces, _) = cut_at_breaks(runs[1].clone(), &["x", "y"], &["F"]).unwrap();
+        assert_eq!(pieces[0].origin(), "joined.csv [rows 301-600]");
         let (whole, said) = cut_at_breaks(f, &[], &["F"]).unwrap();
         assert_eq!((whole.len(), said.len()), (1, 0));
     }

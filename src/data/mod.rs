@@ -239,19 +239,22 @@ pub enum DataError {
     UnknownMethod(String, String),
 }
 
+/// Whether a column's name says it holds the time: `time`, `Time [s]`, `timestamp`,
+/// `seconds`, `t_s`, … (for an error that names it where the time column was not found).
+pub fn looks_like_time(name: &str) -> bool {
+    let n = name.trim().to_lowercase();
+    ["time", "timestamp", "sec", "secs", "seconds", "t_s", "t [s]", "t(s)"].iter().any(|w| {
+        n == *w
+            || n.starts_with(&format!("{w} "))
+            || n.starts_with(&format!("{w}_"))
+            || n.starts_with(&format!("{w}["))
+    })
+}
+
 impl DataError {
     /// No column `time` among `names` in `file`; a column that looks like time (`time`,
     /// `Time [s]`, `timestamp`, `seconds`) is named, with how to choose it.
     pub fn missing_time(file: &str, time: &str, names: &[impl AsRef<str>]) -> DataError {
-        let looks_like_time = |n: &str| {
-            let n = n.trim().to_lowercase();
-            ["time", "timestamp", "sec", "secs", "seconds", "t_s", "t [s]", "t(s)"].iter().any(|w| {
-                n == *w
-                    || n.starts_with(&format!("{w} "))
-                    || n.starts_with(&format!("{w}_"))
-                    || n.starts_with(&format!("{w}["))
-            })
-        };
         let hint = names
             .iter()
             .map(AsRef::as_ref)
@@ -353,6 +356,9 @@ pub struct Frame {
     /// The columns that switch somewhere between two samples (a relay, a step of a measured
     /// input): a fit leaves out the windows that hold a switch.
     switched: Vec<String>,
+    /// How many rows of its file come before its first (a piece cut from a run, a trimmed
+    /// window, a streamed chunk), so that what is said of a row names it as the file does.
+    first_row: usize,
 }
 
 impl Frame {
@@ -368,6 +374,7 @@ impl Frame {
             columns: vec![],
             held: vec![],
             switched: vec![],
+            first_row: 0,
         };
         f.push(time_name, time)?;
         Ok(f)
@@ -561,6 +568,18 @@ impl Frame {
         &self.origin
     }
 
+    /// The row of its file (counted from 1, as errors count them) that the frame's row `i`
+    /// (from 0) is: a piece of a run keeps its file's numbering.
+    pub fn row(&self, i: usize) -> usize {
+        self.first_row + i + 1
+    }
+
+    /// The frame as the rows of its file from row `first_row + 1` on (a streamed chunk).
+    pub fn starting_at(mut self, first_row: usize) -> Frame {
+        self.first_row = first_row;
+        self
+    }
+
     /// Name of the time column.
     pub fn time_name(&self) -> &str {
         &self.time_name
@@ -637,6 +656,7 @@ impl Frame {
             columns: self.columns.iter().map(|c| c[range.clone()].to_vec()).collect(),
             held: self.held.clone(),
             switched: self.switched.clone(),
+            first_row: self.first_row + range.start,
         }
     }
 }

@@ -213,7 +213,8 @@ pub fn resample(frame: &Frame, dt: f64) -> Result<Frame, DataError> {
     // every column, keep every factor-th sample
     let fine = (factor > 1)
         .then(|| (grid(dt / factor as f64), low_pass(0.8 * 0.5 / factor as f64, 0.2 * 0.5 / factor as f64)));
-    let mut out = Frame::new(frame.origin(), frame.time_name(), coarse.clone())?;
+    let mut out =
+        Frame::new(frame.origin(), frame.time_name(), coarse.clone())?.starting_at(frame.row(0) - 1);
     for name in &frame.names()[1..] {
         let x = frame.require(name)?;
         let values = match &fine {

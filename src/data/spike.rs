@@ -117,13 +117,9 @@ fn search(x: &[f64], floor: f64) -> Vec<Spike> {
 }
 
 /// The run with the spikes of `columns` replaced by the line (in time) through the samples
-/// either side, with one line to say per column; `None` where there is none. `first_row` is
-/// the frame's first row in its file (0 for a whole run, a chunk's offset when streamed).
-pub fn despiked(
-    frame: &Frame,
-    columns: &[&str],
-    first_row: usize,
-) -> Result<Option<(Frame, Vec<String>)>, DataError> {
+/// either side, with one line to say per column (the rows as its file counts them,
+/// [`Frame::row`]); `None` where there is none.
+pub fn despiked(frame: &Frame, columns: &[&str]) -> Result<Option<(Frame, Vec<String>)>, DataError> {
     let mut out: Option<Frame> = None;
     let mut notes = Vec::new();
     let t = frame.time();
@@ -144,9 +140,9 @@ pub fn despiked(
         let sig = |x: f64| crate::output::sig(x, 4);
         let place = |s: &Spike| {
             let rows = if s.width == 1 {
-                format!("row {}", first_row + s.start + 1)
+                format!("row {}", frame.row(s.start))
             } else {
-                format!("rows {}-{}", first_row + s.start + 1, first_row + s.start + s.width)
+                format!("rows {}-{}", frame.row(s.start), frame.row(s.start + s.width - 1))
             };
             format!("{} at {rows} (t = {})", sig(s.height), sig(t[s.start]))
         };
@@ -169,7 +165,7 @@ pub fn despiked(
 /// identification without a model).
 pub fn despiked_all(frame: &Frame) -> Result<Option<(Frame, Vec<String>)>, DataError> {
     let columns: Vec<&str> = frame.names()[1..].iter().map(String::as_str).collect();
-    despiked(frame, &columns, 0)
+    despiked(frame, &columns)
 }
 
 #[cfg(test)]
@@ -194,7 +190,7 @@ mod tests {
         let mut f = Frame::new("run.csv", "t", t).unwrap();
         f.push("x", x).unwrap();
         f.push("u", truth.clone()).unwrap();
-        let (g, notes) = despiked(&f, &["x", "u"], 0).unwrap().unwrap();
+        let (g, notes) = despiked(&f, &["x", "u"]).unwrap().unwrap();
         assert_eq!(g.names(), f.names(), "the columns keep their places");
         let mended = g.column("x").unwrap();
         // the line through the neighbours is within the curvature of a smooth signal
@@ -204,7 +200,7 @@ mod tests {
                 && notes[0].contains("by 29.99 at row 101 (t = 1.000), 4.101 at rows 251-252 (t = 2.500)"),
             "{notes:?}"
         );
-        assert!(despiked(&g, &["x", "u"], 0).unwrap().is_none());
+        assert!(despiked(&g, &["x", "u"]).unwrap().is_none());
     }
 
     #[test]

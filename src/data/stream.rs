@@ -133,7 +133,8 @@ impl Chunks {
         }
         // a chunk's first row must come after the previous chunk's last (the frame checks only
         // its own rows)
-        let chunk = Chunk { frame, own: self.given - from..own_end - from, first_row: from };
+        let chunk =
+            Chunk { frame: frame.starting_at(from), own: self.given - from..own_end - from, first_row: from };
         self.given = own_end;
         // keep only what the next chunk's context needs
         let keep_from = self.given.saturating_sub(self.context).max(self.held_from);

@@ -87,7 +87,7 @@ impl EquationMoments {
     /// the chunk size whatever the files' size. The same as [`EquationMoments::of_runs`] on
     /// the whole runs to round-off, for a derivative method with a fixed reach (central
     /// differences, five points, Savitzky-Golay; the chunks must carry at least that many
-    /// rows of context). Each chunk is admitted by the model ([`Model::admit_at`]) and checked
+    /// rows of context). Each chunk is admitted by the model ([`Model::admitted`]) and checked
     /// for gaps in time; per-run parameters (`first:u`, `mean:u:4`) and the inputs held between
     /// samples ([`crate::data::mark_held`]) are read off each run's first chunk. Returns the
     /// notes of the runs' admission too.
@@ -147,8 +147,7 @@ impl EquationMoments {
                         e.shifted(chunk.first_row)
                     ))
                 })?;
-                let admitted =
-                    model.admit_at(&mut chunk.frame, chunk.first_row).map_err(|e| shift(e.into()))?;
+                let admitted = model.admitted(&mut chunk.frame).map_err(|e| shift(e.into()))?;
                 // a piece of a run is not cut into runs (the whole run is, where a state breaks;
                 // an input's step cuts nothing)
                 if let Some((row, name, leap)) = crate::data::moving_breaks(&chunk.frame, &states).0.first() {
@@ -156,8 +155,8 @@ impl EquationMoments {
                         "{}: `{name}` leaps by {} from row {} to row {} and stays (records joined in one file, a sensor re-zeroed), where a run read whole is cut into runs of its own; a piece of one cannot be: read the runs whole (--chunk-rows 0), or cut the file there",
                         chunk.frame.origin(),
                         crate::output::sig(*leap, 3),
-                        chunk.first_row + row,
-                        chunk.first_row + row + 1
+                        chunk.frame.row(row - 1),
+                        chunk.frame.row(*row)
                     )));
                 }
                 // a chunk's spikes are its own; what else admission says, every chunk repeats

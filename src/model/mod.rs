@@ -117,7 +117,7 @@ impl Equation {
     }
 }
 
-/// What [`Model::admit_at`] did to a run, for the caller to say.
+/// What [`Model::admitted`] did to a run, for the caller to say.
 #[derive(Clone, Debug, Default)]
 pub struct Admitted {
     /// Columns renamed, a run resampled, angles unwrapped.
@@ -872,7 +872,7 @@ impl Model {
     /// Records joined in one run are cut into runs after, over all runs
     /// ([`Model::cut_at_breaks`]: one run may become several).
     pub fn admit(&self, frame: &mut crate::data::Frame) -> Result<Vec<String>, crate::data::DataError> {
-        let admitted = self.admit_at(frame, 0)?;
+        let admitted = self.admitted(frame)?;
         Ok(admitted.notes.into_iter().chain(admitted.spikes).collect())
     }
 
@@ -901,13 +901,9 @@ impl Model {
         )
     }
 
-    /// [`Model::admit`] for a piece of a run that starts at row `first_row` of its file (a
-    /// streamed chunk): the spikes mended are said apart, with their rows in the file.
-    pub fn admit_at(
-        &self,
-        frame: &mut crate::data::Frame,
-        first_row: usize,
-    ) -> Result<Admitted, crate::data::DataError> {
+    /// [`Model::admit`], the spikes mended said apart (a streamed chunk's are its own, where
+    /// the rest every chunk would repeat).
+    pub fn admitted(&self, frame: &mut crate::data::Frame) -> Result<Admitted, crate::data::DataError> {
         let mut notes = Vec::new();
         if let Some((even, note)) = crate::data::evened(frame)? {
             *frame = even;
@@ -935,7 +931,7 @@ impl Model {
             let rates: Vec<String> = self.spec.states.iter().map(|s| format!("{}_dot", s.name)).collect();
             let columns: Vec<&str> =
                 self.vocabulary.variables().iter().chain(&rates).map(String::as_str).collect();
-            if let Some((mended, said)) = crate::data::despiked(frame, &columns, first_row)? {
+            if let Some((mended, said)) = crate::data::despiked(frame, &columns)? {
                 *frame = mended;
                 spikes = said;
             }

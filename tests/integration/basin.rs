@@ -325,7 +325,7 @@ fn preparation_resamples_and_refuses_what_it_cannot_do() {
 }
 
 /// A dataset's run with a second of record missing is cut there into two runs, said with the
-/// row; a repeated time stamp is refused with its row.
+/// row (the file's, in a run trimmed by `from`); a repeated time stamp is refused with its row.
 #[test]
 fn gaps_cut_runs_and_repeated_time_stamps_are_refused_with_their_row() {
     let dir = Scratch::new("basin-gaps");
@@ -355,6 +355,13 @@ fn gaps_cut_runs_and_repeated_time_stamps_are_refused_with_their_row() {
     let (ok, out, err) = validated("gap.dat");
     assert!(ok && err.contains("gap.dat: `t` jumps by") && err.contains("from row 100 to row 101"), "{err}");
     assert!(out.contains("gap.dat [rows 1-100]") && out.contains("gap.dat [rows 101-"), "{out}");
+    // trimmed to start at data row 51: the rows named are still the file's
+    let from: f64 = lines[4 + 50].split_whitespace().next().unwrap().parse().unwrap();
+    std::fs::write(dir.join("set.toml"), format!("{}from = {from}\n", dataset_toml(&["gap.dat"]))).unwrap();
+    let set = dir.join("set.toml").display().to_string();
+    let (ok, out, err) = termid(&["validate", "--model", "models/oltmann1973.toml", "--dataset", &set]);
+    assert!(ok && err.contains("trimmed to") && err.contains("from row 100 to row 101"), "{err}");
+    assert!(out.contains("gap.dat [rows 51-100]") && out.contains("gap.dat [rows 101-"), "{out}");
     let (ok, _, err) = validated("dup.dat");
     assert!(
         !ok && err.contains("dup.dat") && err.contains("row 52") && err.contains("does not increase"),
