@@ -9,7 +9,7 @@ use pyo3::types::PyDict;
 use termid::identify::{Fit, Identification};
 use termid::term::{parse_terms, Library, Source, Term, Vocabulary};
 
-use crate::convert::{backend_of, column, fail, in_place, refuse, to_json, warn};
+use crate::convert::{backend_of, column, fail, frame_of, in_place, refuse, to_json, warn};
 
 /// One equation fitted to columns: the back-end's steps and chosen terms (JSON) and the
 /// compiled chosen terms for `predict`.
@@ -180,9 +180,11 @@ impl Compiled {
 /// One equation from columns: `target` explained by the candidate `terms` (text in termid's
 /// term language over the column names) with a back-end given as JSON settings. A rate
 /// (`dx/dt`) is an equation of motion of the rows as a time series over the column `time`,
-/// by the `derivative` method (`integral` where none is named, as the command line does).
+/// by the `derivative` method (`integral` where none is named, as the command line does),
+/// over `runs` (by name, each with the columns of `columns`, the first) where there are
+/// several; a column is explained by the rows of `columns` alone.
 #[pyfunction]
-#[pyo3(signature = (target, columns, terms, backend = "{\"method\": \"stepwise\"}", intercept = true, forced = vec![], excluded = vec![], parameters = BTreeMap::new(), weights = None, time = None, derivative = None, keep_spikes = false, intersample = "auto", delays = BTreeMap::new()))]
+#[pyo3(signature = (target, columns, terms, backend = "{\"method\": \"stepwise\"}", intercept = true, forced = vec![], excluded = vec![], parameters = BTreeMap::new(), weights = None, time = None, derivative = None, keep_spikes = false, intersample = "auto", delays = BTreeMap::new(), runs = vec![]))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn fit(
     py: Python<'_>,
@@ -200,6 +202,7 @@ pub(crate) fn fit(
     keep_spikes: bool,
     intersample: &str,
     delays: BTreeMap<String, f64>,
+    runs: Vec<(String, Bound<'_, PyDict>)>,
 ) -> PyResult<PyFit> {
     let intersample = match intersample {
         "auto" => termid::data::Intersample::Auto,
@@ -270,17 +273,20 @@ pub(crate) fn fit(
             if state == time {
                 return Err(refuse(format!("`{target}`: `{time}` is the time, whose rate is 1")));
             }
-            let at = |name: &str| slices.iter().find(|(n, _)| *n == name).map(|(_, v)| *v);
-            let t = at(time).ok_or_else(|| refuse(format!("no time column `{time}`")))?;
-            let mut whole = termid::data::Frame::new("data", time, t.to_vec()).map_err(fail)?;
-            for (name, values) in slices.iter().filter(|(n, _)| *n != time) {
-                whole.push(name, values.to_vec()).map_err(fail)?;
-            }
-            // a logger's dropout: each piece a run (integrated across, the motion in the gap
-            // would be taken as a line), as the command line cuts a file it reads
-            let (pieces, notes) = termid::data::cut_at_gaps(whole, 0).map_err(fail)?;
-            for note in notes {
-                warn(py, note)?;
+            let mut pieces = Vec::new();
+            let whole: Vec<termid::data::Frame> = if runs.is_empty() {
+                vec![frame_of("data", time, columns)?]
+            } else {
+                runs.iter().map(|(name, run)| frame_of(name, time, run)).collect::<PyResult<_>>()?
+            };
+            for run in whole {
+                // a logger's dropout: each piece a run (integrated across, the motion in the
+                // gap would be taken as a line), as the command line cuts a file it reads
+                let (cut, notes) = termid::data::cut_at_gaps(run, 0).map_err(fail)?;
+                for note in notes {
+                    warn(py, note)?;
+                }
+                pieces.extend(cut);
             }
             // every column but the state may be an input held between samples
             let columns: Vec<&str> = variables.iter().map(String::as_str).filter(|n| n != state).collect();

@@ -675,6 +675,7 @@ def fit(
     keep_spikes: bool = False,
     intersample: str = "auto",
     delays: Optional[Mapping[str, float]] = None,
+    by: Optional[str] = None,
     **settings: Any,
 ) -> Fit:
     """Fits ``target`` (a column of ``data``) by the candidate ``terms`` (text over the other
@@ -687,7 +688,9 @@ def fit(
     form) unless ``derivative`` names a method (:func:`derivatives`), the back-end
     ``"stlsq"``, and the constant a candidate (``"1"``) rather than a forced intercept.
 
-    Parameters: ``data`` a DataFrame, dict of arrays, Arrow table or record array;
+    Parameters: ``data`` a DataFrame, dict of arrays, Arrow table or record array, or a list
+    of them, one per run (experiments recorded apart: a rate is integrated along each, never
+    from one's end to the next's start; a DataFrame's ``attrs["name"]`` names it in warnings);
     ``target`` the column explained, or ``"dX/dt"`` the rate of column X; ``terms`` the
     candidates; ``backend`` the selection (:func:`backends`; default ``"stepwise"``, for a
     rate ``"stlsq"``); ``intercept`` whether a constant b0 is fitted (default: for a column
@@ -717,7 +720,9 @@ def fit(
     left out, with a warning);
     ``delays`` columns that act later than recorded (a dead time), in seconds, e.g.
     ``{"F": 0.2}``: read that much earlier against the rest, the rows' first seconds left out
-    (without it, a rate's ``notes`` say a delay the residuals show).
+    (without it, a rate's ``notes`` say a delay the residuals show); ``by`` a column that
+    tells the runs of ``data`` apart (runs one after another in one frame, the long format):
+    the rows of each of its values are a run of their own, as a list of runs would be.
 
     >>> import pandas as pd
     >>> df = pd.DataFrame({"x1": [1.0, 2, 3, 4, 5], "x2": [2.0, 1, 4, 3, 6]}).eval("y = x1 + 2*x2")
@@ -729,11 +734,18 @@ def fit(
     >>> termid.fit(decay, "dx/dt", ["x", "x^2"]).coefficients.round(4).to_dict()
     {'x': -0.5}
     """
-    columns = _columns(data)
     rate = _RATE.match(target)
+    runs = _fit_runs(data, by)
+    every = [_columns(run) for _, run in runs]
     time_name = None
     if rate:
-        time_name = _time_of(data, columns, time, target)
+        names = {_time_of(run, columns, time, target) for (_, run), columns in zip(runs, every)}
+        if len(names) > 1:
+            raise TermidError(f"`{target}`: the runs keep their time in different columns ({', '.join(sorted(names))}): name it, time='name'")
+        time_name = names.pop()
+    _alike(runs, every)
+    columns = every[0] if rate else _rows_of(every)
+    if rate:
         state = rate.group(1).strip()
         if state not in columns:
             raise TermidError(f"`{target}`: no column `{state}` (columns: {', '.join(c for c in columns if c != time_name)})")
@@ -776,10 +788,61 @@ def fit(
             keep_spikes,
             intersample,
             dict(delays or {}),
+            [(name, dict(c)) for (name, _), c in zip(runs, every)] if rate and len(runs) > 1 else [],
         )
     except TermidError as e:
+        if rate and len(runs) == 1 and "does not increase" in str(e):
+            # the commonest cause: runs one after another in one frame (a label column its tell)
+            label = next(iter(columns.left_out), "run")
+            raise TermidError(
+                f"{e}: runs one after another in one frame? give them as a list, fit([run1, run2], ...), or name the "
+                f"column that tells them apart, by='{label}'"
+            ) from None
         raise _explained(e, columns.left_out) from None
     return Fit(native, target)
+
+
+def _fit_runs(data: Union[Data, Sequence[Data]], by: Optional[str]) -> List[Tuple[str, Data]]:
+    """The runs of :func:`fit`'s ``data`` by name: one run (``data``), a list of runs (each
+    DataFrame's ``attrs["name"]``, else ``run1``, ...), or the rows of each value of column
+    ``by`` (``run=3``), in the order they first appear."""
+    if by is not None:
+        if isinstance(data, pd.DataFrame):
+            frame = data
+        elif isinstance(data, Mapping):
+            frame = pd.DataFrame(dict(data))
+        elif hasattr(data, "to_pandas"):
+            frame = data.to_pandas()
+        else:
+            raise TypeError(f"`by` tells apart the runs of a DataFrame, a dict of arrays or a table, not {type(data).__name__}")
+        if by not in frame.columns:
+            raise TermidError(f"no column `{by}` to tell the runs apart (columns: {', '.join(map(str, frame.columns))})")
+        return [(f"{by}={value}", rows.drop(columns=by)) for value, rows in frame.groupby(by, sort=False, dropna=False)]
+    if isinstance(data, (list, tuple)):
+        if not data:
+            raise TermidError("no runs to fit: the list is empty")
+        return [(str(getattr(run, "attrs", {}).get("name", f"run{k + 1}")), run) for k, run in enumerate(data)]
+    return [("data", data)]
+
+
+def _alike(runs: List[Tuple[str, Data]], every: List["_Columns"]) -> None:
+    """Refuses runs whose columns differ from the first's, saying which."""
+    first = set(every[0])
+    for (name, _), columns in zip(runs[1:], every[1:]):
+        missing, extra = sorted(first - set(columns)), sorted(set(columns) - first)
+        if missing or extra:
+            said = [f"without {', '.join(f'`{c}`' for c in missing)}"] if missing else []
+            said += [f"with {', '.join(f'`{c}`' for c in extra)} besides"] if extra else []
+            raise TermidError(f"run `{name}` has other columns than `{runs[0][0]}`: {'; '.join(said)}")
+
+
+def _rows_of(every: List["_Columns"]) -> "_Columns":
+    """The runs' rows one after another (a column explained by rows, which need no order)."""
+    if len(every) == 1:
+        return every[0]
+    out = _Columns((name, np.concatenate([c[name] for c in every])) for name in every[0])
+    out.left_out, out.times = every[0].left_out, every[0].times
+    return out
 
 
 def _gap_frame(gap: Mapping[str, Any]) -> pd.DataFrame:

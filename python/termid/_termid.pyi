@@ -202,6 +202,9 @@ def fit(
     time: Optional[str] = None,
     derivative: Optional[str] = None,
     keep_spikes: bool = False,
+    intersample: str = "auto",
+    delays: Dict[str, float] = ...,
+    runs: Sequence[Tuple[str, Columns]] = ...,
 ) -> Fit: ...
 def methods() -> Tuple[List[str], List[str]]: ...
 def version() -> str: ...

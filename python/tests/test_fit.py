@@ -251,6 +251,39 @@ def test_a_rate_is_an_equation_of_motion_with_the_command_lines_defaults():
         termid.fit(df, "x", ["y"], derivative="central")
 
 
+def _decay(x0, v0, t):
+    """ẍ = −4x − 0.3ẋ from (x0, v0), in closed form: a damped oscillation."""
+    sigma, omega = 0.15, np.sqrt(4.0 - 0.15**2)
+    b = (v0 + sigma * x0) / omega
+    x = np.exp(-sigma * t) * (x0 * np.cos(omega * t) + b * np.sin(omega * t))
+    v = np.exp(-sigma * t) * ((omega * b - sigma * x0) * np.cos(omega * t) - (omega * x0 + sigma * b) * np.sin(omega * t))
+    return pd.DataFrame({"t": t, "x": x, "v": v})
+
+
+def test_several_runs_are_fitted_together_never_across_their_seams():
+    # three experiments of one oscillator from other starts: as a list, or one frame told
+    # apart by a label column; the rate is integrated along each run, not from one to the next
+    t = np.arange(0.0, 15.0, 0.01)
+    runs = [_decay(x0, v0, t).assign(experiment=name) for x0, v0, name in [(1.0, 0.0, "a"), (-2.0, 1.0, "b"), (0.5, -3.0, "c")]]
+    truth = {"v": -0.3, "x": -4.0}
+    listed = termid.fit([r.drop(columns="experiment") for r in runs], "dv/dt", ["x", "v", "x^2", "x*v"])
+    assert listed.coefficients.sort_index().round(6).to_dict() == truth
+    long = pd.concat(runs, ignore_index=True)
+    grouped = termid.fit(long, "dv/dt", ["x", "v", "x^2", "x*v"], by="experiment")
+    assert grouped.coefficients.sort_index().round(6).to_dict() == truth
+    assert grouped.raw["selection"]["rows"] == listed.raw["selection"]["rows"]
+    # one frame whose time starts again is refused, the remedy named with its label column
+    with pytest.raises(termid.TermidError, match="row 1501.*by='experiment'"):
+        termid.fit(long, "dv/dt", ["x", "v"])
+    # a run without a column the first has is refused by name
+    with pytest.raises(termid.TermidError, match="run `run2` has other columns than `run1`: without `v`"):
+        termid.fit([runs[0], runs[1].drop(columns="v")], "dv/dt", ["x"])
+    # a column explained by the rows of every run together (rows need no order)
+    rows = termid.fit([r.assign(y=3 * r.x - r.v) for r in runs], "y", ["x", "v"])
+    assert rows.coefficients.sort_index().round(6).to_dict() == {"v": -1.0, "x": 3.0}
+    assert rows.raw["selection"]["rows"] == 3 * len(t)
+
+
 def test_a_glitch_is_mended_with_a_warning():
     # one sample of x 30 off: as recorded it buys terms; mended (the default) Lorenz's own
     t, s = _lorenz()
