@@ -791,12 +791,11 @@ def fit(
             [(name, dict(c)) for (name, _), c in zip(runs, every)] if rate and len(runs) > 1 else [],
         )
     except TermidError as e:
-        if rate and len(runs) == 1 and "does not increase" in str(e):
-            # the commonest cause: runs one after another in one frame (a label column its tell)
+        if rate and len(runs) == 1 and "starts again" in str(e):
+            # runs one after another in one frame (a label column its tell)
             label = next(iter(columns.left_out), "run")
             raise TermidError(
-                f"{e}: runs one after another in one frame? give them as a list, fit([run1, run2], ...), or name the "
-                f"column that tells them apart, by='{label}'"
+                f"{e}: give them as a list, fit([run1, run2], ...), or name the column that tells them apart, by='{label}'"
             ) from None
         raise _explained(e, columns.left_out) from None
     return Fit(native, target)

@@ -16,15 +16,21 @@ use arrow_schema::{DataType, TimeUnit};
 
 use super::DataError;
 
-/// The column names and numeric columns of a Parquet or Arrow IPC file.
-pub fn read_columns(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), DataError> {
+/// The numeric columns of a Parquet or Arrow IPC file by name, and those of text.
+pub(super) fn read_columns(path: &Path) -> Result<super::stream::Table, DataError> {
     super::stream::read_all(Batches::open(path)?)
 }
 
 /// A Parquet or Arrow IPC file's rows, record batch by record batch.
 pub(super) struct Batches {
     batches: Box<dyn Iterator<Item = Result<RecordBatch, String>>>,
+    /// Every column's name in the file.
+    header: Vec<String>,
+    /// The numeric columns: their names, and where they are in a batch.
     names: Vec<String>,
+    keep: Vec<usize>,
+    /// The columns of text (strings, a dictionary of them), with their type: left out.
+    text: Vec<(String, String)>,
     file: String,
     rows: usize,
     /// The first batch, read to learn the names.
@@ -67,13 +73,28 @@ impl Batches {
                 message: "the file holds no rows (no record batch)".into(),
             })?
             .map_err(|m| io(&m))?;
-        let names: Vec<String> = first.schema().fields().iter().map(|f| f.name().clone()).collect();
-        for (i, h) in names.iter().enumerate() {
-            if names[..i].contains(h) {
+        let schema = first.schema();
+        let header: Vec<String> = schema.fields().iter().map(|f| f.name().clone()).collect();
+        for (i, h) in header.iter().enumerate() {
+            if header[..i].contains(h) {
                 return Err(DataError::DuplicateColumn { file: file.clone(), column: h.clone() });
             }
         }
-        Ok(Batches { batches, names, file, rows: 0, first: Some(first) })
+        // a column of text (a run's label, a mode) is no reading: left out, as CSV's
+        let is_text = |t: &DataType| match t {
+            DataType::Utf8 | DataType::LargeUtf8 | DataType::Utf8View => true,
+            DataType::Dictionary(_, value) => {
+                matches!(**value, DataType::Utf8 | DataType::LargeUtf8 | DataType::Utf8View)
+            }
+            _ => false,
+        };
+        let keep: Vec<usize> = (0..header.len()).filter(|&c| !is_text(schema.field(c).data_type())).collect();
+        let text = (0..header.len())
+            .filter(|c| !keep.contains(c))
+            .map(|c| (header[c].clone(), format!("a column of type {}", schema.field(c).data_type())))
+            .collect();
+        let names = keep.iter().map(|&c| header[c].clone()).collect();
+        Ok(Batches { batches, header, names, keep, text, file, rows: 0, first: Some(first) })
     }
 }
 
@@ -174,19 +195,23 @@ impl super::stream::RowSource for Batches {
                 },
             };
             let schema = batch.schema();
-            if schema.fields().iter().map(|f| f.name()).ne(self.names.iter()) {
+            if schema.fields().iter().map(|f| f.name()).ne(self.header.iter()) {
                 return Err(DataError::Io {
                     file: self.file.clone(),
                     message: format!("the columns change after row {}", self.rows),
                 });
             }
-            for (k, (array, name)) in batch.columns().iter().zip(&self.names).enumerate() {
-                append(&mut columns[k], array.as_ref(), &self.file, name, self.rows)?;
+            for (k, (&c, name)) in self.keep.iter().zip(&self.names).enumerate() {
+                append(&mut columns[k], batch.column(c).as_ref(), &self.file, name, self.rows)?;
             }
             self.rows += batch.num_rows();
             n += batch.num_rows();
         }
         Ok(n)
+    }
+
+    fn text(&self) -> &[(String, String)] {
+        &self.text
     }
 }
 
@@ -278,7 +303,8 @@ mod tests {
     }
 
     /// A run written as Parquet (two row groups, f64, f32 and integer columns) and as Arrow
-    /// IPC reads as the same frame as its CSV; nulls and text are refused with row and column.
+    /// IPC reads as the same frame as its CSV; nulls are refused with row and column, a column
+    /// of text left out (refused with its type where it is asked for).
     /// A logger's time as Parquet keeps it: stamps in nanoseconds since 1970 (pandas'
     /// datetime64), and a duration in milliseconds, read as seconds (they were refused as "not a
     /// number"); 20 Hz stamps keep their twentieths at the epoch's magnitude.
@@ -364,7 +390,11 @@ mod tests {
             ("name", Arc::new(StringArray::from(vec!["a"]))),
         ]);
         write_parquet(&dir.join("text.parquet"), &[text]);
-        let e = Frame::read(&dir.join("text.parquet"), "t").unwrap_err().to_string();
+        // a column of text is left out, said; asked for, refused with its type
+        let f = Frame::read(&dir.join("text.parquet"), "t").unwrap();
+        assert_eq!(f.names(), ["t"]);
+        assert!(f.text_note().unwrap().contains("`name` (`a column of type Utf8` in row 1) holds text"));
+        let e = f.require("name").unwrap_err().to_string();
         assert!(e.contains("`name`") && e.contains("Utf8"), "{e}");
         // an Arrow file with its columns but no rows: said so, not "a CSV needs a header row"
         let file = std::fs::File::create(dir.join("empty.arrow")).unwrap();

@@ -1,7 +1,9 @@
-//! CSV in and out. A header row names the columns; every other cell must be a finite number.
+//! CSV in and out. A header row names the columns; a column whose first cell is text (a run's
+//! label, a mode) is left out, and every other cell must be a finite number.
 
 use std::path::Path;
 
+use super::stream::Table;
 use super::{DataError, Frame};
 
 impl Frame {
@@ -24,48 +26,52 @@ impl Frame {
 
     /// Parses CSV text without a time column (rows numbered 1..n in a column `row`).
     pub fn parse_csv_untimed(text: &str, origin: &str) -> Result<Frame, DataError> {
-        let (header, columns) = parse_table(text, origin)?;
-        if header.iter().any(|h| h == "row") {
+        let table = parse_table(text, origin)?;
+        if table.names.iter().chain(table.text.iter().map(|t| &t.0)).any(|h| h == "row") {
             return Err(DataError::DuplicateColumn { file: origin.into(), column: "row".into() });
         }
-        let rows = columns.first().map_or(0, Vec::len);
+        let rows = table.columns.first().map_or(0, Vec::len);
         let mut frame = Frame::new(origin, "row", (1..=rows).map(|r| r as f64).collect())?;
-        for (name, values) in header.iter().zip(columns) {
+        for (name, values) in table.names.iter().zip(table.columns) {
             frame.push(name, values)?;
         }
+        frame.text = table.text;
         Ok(frame)
     }
 
     /// Reads a run by its file's extension: Parquet (`.parquet`, `.pq`) and Arrow IPC
     /// (`.arrow`, `.feather`, `.ipc`) with the `columnar` feature, CSV otherwise.
     pub fn read(path: &Path, time: &str) -> Result<Frame, DataError> {
-        let (names, columns) = read_table(path)?;
-        Frame::from_table(names, columns, &path.display().to_string(), time)
+        Frame::from_table(read_table(path)?, &path.display().to_string(), time)
     }
 
     /// Parses CSV text; `origin` names it in errors.
     pub fn parse_csv(text: &str, origin: &str, time: &str) -> Result<Frame, DataError> {
-        let (header, columns) = parse_table(text, origin)?;
-        Frame::from_table(header, columns, origin, time)
+        Frame::from_table(parse_table(text, origin)?, origin, time)
     }
 
-    /// A frame of named columns, `time` among them.
-    fn from_table(
-        header: Vec<String>,
-        mut columns: Vec<Vec<f64>>,
-        origin: &str,
-        time: &str,
-    ) -> Result<Frame, DataError> {
-        let time_index = header
+    /// A frame of a table's named columns, `time` among them, knowing its columns of text.
+    fn from_table(table: Table, origin: &str, time: &str) -> Result<Frame, DataError> {
+        let Table { names, mut columns, text } = table;
+        if let Some((_, cell)) = text.iter().find(|(n, _)| n == time) {
+            return Err(DataError::NotNumeric {
+                file: origin.into(),
+                row: 1,
+                column: time.into(),
+                cell: cell.clone(),
+            });
+        }
+        let time_index = names
             .iter()
             .position(|h| h == time)
-            .ok_or_else(|| DataError::missing_time(origin, time, &header))?;
+            .ok_or_else(|| DataError::missing_time(origin, time, &names))?;
         let mut frame = Frame::new(origin, time, std::mem::take(&mut columns[time_index]))?;
-        for (name, values) in header.iter().zip(columns) {
+        for (name, values) in names.iter().zip(columns) {
             if name != time {
                 frame.push(name, values)?;
             }
         }
+        frame.text = text;
         Ok(frame)
     }
 
@@ -90,8 +96,9 @@ impl Frame {
     }
 }
 
-/// The names and numeric columns of a file: columnar by its extension, else CSV text.
-pub(super) fn read_table(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), DataError> {
+/// The numeric columns of a file by name, and its columns of text: columnar by its
+/// extension, else CSV text.
+pub(super) fn read_table(path: &Path) -> Result<Table, DataError> {
     let file = path.display().to_string();
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     if matches!(ext.as_deref(), Some("parquet" | "pq" | "arrow" | "feather" | "ipc")) {
@@ -148,7 +155,7 @@ pub(super) fn not_data(e: DataError, file: &str, head: impl FnOnce() -> Vec<u8>)
 }
 
 /// The header and the numeric columns of CSV text, every cell checked.
-pub(super) fn parse_table(text: &str, origin: &str) -> Result<(Vec<String>, Vec<Vec<f64>>), DataError> {
+pub(super) fn parse_table(text: &str, origin: &str) -> Result<Table, DataError> {
     super::stream::CsvRows::new(text.as_bytes(), origin)
         .and_then(super::stream::read_all)
         .map_err(|e| not_data(e, origin, || text.as_bytes()[..text.len().min(HEAD as usize)].to_vec()))
@@ -189,5 +196,41 @@ mod tests {
             Frame::parse_csv("t,u\n0,1,2\n", "a.csv", "t"),
             Err(DataError::Ragged { row: 1, .. })
         ));
+        // a time that starts again: runs one after another, said
+        let e = Frame::parse_csv("t,u\n0,1\n0.1,2\n0,3\n", "a.csv", "t").unwrap_err().to_string();
+        assert!(e.contains("row 3") && e.contains("it starts again: runs one after another?"), "{e}");
+    }
+
+    /// A column whose first cell is text (a run's label, a mode) is left out and said, and
+    /// refused with that cell where it is asked for; a row of units, a second header row
+    /// (most cells text), or a missing reading (`NA`) leave nothing out: their errors stand.
+    #[test]
+    fn text_columns_are_left_out() {
+        let f = Frame::parse_csv("t,u,run,mode\n0,1,a,ok\n0.1,2,a,ok\n0.2,3,b,3\n", "a.csv", "t").unwrap();
+        assert_eq!(f.names(), ["t", "u"]);
+        assert_eq!(f.column("u").unwrap(), [1.0, 2.0, 3.0]);
+        let note = f.text_note().unwrap();
+        assert!(note.contains("`run` (`a` in row 1), `mode` (`ok` in row 1) hold text"), "{note}");
+        assert_eq!(
+            f.require("run").unwrap_err().to_string(),
+            "a.csv: row 1, column `run`: `a` is not a number"
+        );
+        let f = Frame::parse_csv("t,u\n0,1\n", "a.csv", "t").unwrap();
+        assert_eq!(f.text_note(), None);
+        for (text, cell) in [
+            ("t,u,v,w\ns,m,m/s,N\n0,1,2,3\n", "`s` is not a number"),
+            ("t,u,v,w\n0,m,m/s,N\n0.1,1,2,3\n", "`m` is not a number"),
+            ("t,u,v,w\n,speed,heading,w\n0,1,2,3\n", "no reading there"),
+            ("t,u,v,w\n0,NA,1,2\n0.1,1,2,3\n", "`NA` is not a number"),
+            // asked for, a label column is refused at its first cell
+            ("t,u,v,w\n0,1,2,x\n0.1,1,2,3\n", "row 1, column `w`: `x` is not a number"),
+        ] {
+            let e = Frame::parse_csv(text, "a.csv", "t").map(|f| f.require("w").map(<[f64]>::to_vec));
+            let e = match e {
+                Err(e) | Ok(Err(e)) => e.to_string(),
+                Ok(Ok(w)) => panic!("{text}: read {w:?}"),
+            };
+            assert!(e.contains(cell), "{text}: {e}");
+        }
     }
 }

@@ -485,7 +485,7 @@ impl Dataset {
                 path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
                 Some("parquet" | "pq" | "arrow" | "feather" | "ipc")
             );
-            let (mut names, mut columns) = if columnar {
+            let super::stream::Table { mut names, mut columns, mut text } = if columnar {
                 // columnar files name their own columns
                 super::csv_io::read_table(&path)?
             } else {
@@ -511,12 +511,23 @@ impl Dataset {
                 super::csv_io::parse_table(&csv, &origin)?
             };
             let header_units = bare_headers(&mut names);
+            let mut text_names: Vec<String> = text.iter().map(|t| t.0.clone()).collect();
+            bare_headers(&mut text_names);
+            text.iter_mut().zip(text_names).for_each(|(t, bare)| t.0 = bare);
             let (time_col, time_unit, _) = spec_with_header_unit(
                 self.columns.get(time).map_or(time, String::as_str),
                 &names,
                 &header_units,
                 &origin,
             )?;
+            if let Some((_, cell)) = text.iter().find(|(n, _)| *n == time_col) {
+                return Err(DataError::NotNumeric {
+                    file: origin,
+                    row: 1,
+                    column: time_col,
+                    cell: cell.clone(),
+                });
+            }
             let Some(time_index) = names.iter().position(|h| *h == time_col) else {
                 return Err(DataError::MissingColumn {
                     file: origin.clone(),
@@ -539,6 +550,8 @@ impl Dataset {
             for (name, values) in names.iter().zip(columns).filter(|(n, _)| **n != time_col) {
                 raw.push(name, values)?;
             }
+            // a column the dataset maps that holds text is refused with its first cell
+            raw.text = text;
             let scale = |unit: Option<&str>, column: &str| -> Result<f64, DataError> {
                 let Some(lambda) = self.froude else { return Ok(1.0) };
                 froude_factor(lambda, unit, &origin, column)
@@ -759,6 +772,13 @@ impl Dataset {
         }
         Ok((frames, notes))
     }
+}
+
+/// Whether a cell names a unit termid knows (`m/s`, `[deg]`, `(s)`): a row of them is a
+/// second header row, not data.
+pub(super) fn is_unit(cell: &str) -> bool {
+    let bare = cell.trim().trim_start_matches(['[', '(']).trim_end_matches([']', ')']);
+    UNITS.iter().any(|(n, _, _)| *n == bare)
 }
 
 fn unit_row(

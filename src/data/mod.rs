@@ -160,7 +160,7 @@ pub enum DataError {
         found: usize,
     },
     /// Time that does not increase.
-    #[error("{file}: row {row}, column `{column}`: time {this} does not increase (previous row {previous})")]
+    #[error("{file}: row {row}, column `{column}`: time {this} does not increase (previous row {previous}){}", if *restart { "; it starts again: runs one after another? each must be a run of its own" } else { "" })]
     TimeNotIncreasing {
         /// The file.
         file: String,
@@ -172,6 +172,8 @@ pub enum DataError {
         this: f64,
         /// The previous row's time.
         previous: f64,
+        /// It goes back to the first row's time or before (a run that follows another).
+        restart: bool,
     },
     /// A column of the wrong length.
     #[error("{file}: column `{column}` has {found} values, the time column {expected}")]
@@ -289,8 +291,8 @@ impl DataError {
             DataError::Ragged { file, row, expected, found } => {
                 DataError::Ragged { file, row: row + rows, expected, found }
             }
-            DataError::TimeNotIncreasing { file, row, column, this, previous } => {
-                DataError::TimeNotIncreasing { file, row: row + rows, column, this, previous }
+            DataError::TimeNotIncreasing { file, row, column, this, previous, restart } => {
+                DataError::TimeNotIncreasing { file, row: row + rows, column, this, previous, restart }
             }
             DataError::Unit { file, row, column, message } if row > 0 => {
                 DataError::Unit { file, row: row + rows, column, message }
@@ -359,6 +361,8 @@ pub struct Frame {
     /// How many rows of its file come before its first (a piece cut from a run, a trimmed
     /// window, a streamed chunk), so that what is said of a row names it as the file does.
     first_row: usize,
+    /// The file's columns of text left out (a run's label, a mode), with their first cell.
+    text: Vec<(String, String)>,
 }
 
 impl Frame {
@@ -375,6 +379,7 @@ impl Frame {
             held: vec![],
             switched: vec![],
             first_row: 0,
+            text: vec![],
         };
         f.push(time_name, time)?;
         Ok(f)
@@ -395,6 +400,7 @@ impl Frame {
                     column: name.into(),
                     this: values[i],
                     previous: values[i - 1],
+                    restart: values[i] <= values[0],
                 });
             }
         }
@@ -568,6 +574,27 @@ impl Frame {
         &self.origin
     }
 
+    /// The columns of its file left out as text (a run's label, a mode), each with its first
+    /// cell: no term can use them.
+    pub fn text_columns(&self) -> &[(String, String)] {
+        &self.text
+    }
+
+    /// What to say of the columns left out as text, where there are any.
+    pub fn text_note(&self) -> Option<String> {
+        let named: Vec<String> =
+            self.text.iter().map(|(n, cell)| format!("`{n}` (`{cell}` in row 1)")).collect();
+        (!named.is_empty()).then(|| {
+            format!(
+                "{}: {} {} text, not numbers: left out (no term or model can read {})",
+                self.origin,
+                named.join(", "),
+                if named.len() == 1 { "holds" } else { "hold" },
+                if named.len() == 1 { "it" } else { "them" }
+            )
+        })
+    }
+
     /// The row of its file (counted from 1, as errors count them) that the frame's row `i`
     /// (from 0) is: a piece of a run keeps its file's numbering.
     pub fn row(&self, i: usize) -> usize {
@@ -622,6 +649,14 @@ impl Frame {
 
     /// A column by name, or an error naming the file and the columns there are.
     pub fn require(&self, name: &str) -> Result<&[f64], DataError> {
+        if let Some((_, cell)) = self.text.iter().find(|(n, _)| n == name) {
+            return Err(DataError::NotNumeric {
+                file: self.origin.clone(),
+                row: 1,
+                column: name.into(),
+                cell: cell.clone(),
+            });
+        }
         self.column(name).ok_or_else(|| DataError::MissingColumn {
             file: self.origin.clone(),
             column: name.into(),
@@ -657,6 +692,7 @@ impl Frame {
             held: self.held.clone(),
             switched: self.switched.clone(),
             first_row: self.first_row + range.start,
+            text: self.text.clone(),
         }
     }
 }

@@ -12,11 +12,23 @@ use super::{DataError, Frame};
 
 /// Where rows come from: a file's header, then its numeric rows in order.
 pub trait RowSource {
-    /// The column names.
+    /// The names of the numeric columns.
     fn names(&self) -> &[String];
     /// Appends up to `max` rows to `columns` (one vector per name); returns how many were
     /// read, 0 at the end of the file.
     fn read(&mut self, max: usize, columns: &mut [Vec<f64>]) -> Result<usize, DataError>;
+    /// The columns left out as text (a run's label, a comment), each with its first cell.
+    fn text(&self) -> &[(String, String)] {
+        &[]
+    }
+}
+
+/// A file's columns read whole: the numeric ones by name, and those left out as text
+/// ([`RowSource::text`]).
+pub(super) struct Table {
+    pub names: Vec<String>,
+    pub columns: Vec<Vec<f64>>,
+    pub text: Vec<(String, String)>,
 }
 
 /// A piece of a run.
@@ -79,6 +91,14 @@ impl Chunks {
         context: usize,
     ) -> Result<Chunks, DataError> {
         let names = source.names();
+        if let Some((_, cell)) = source.text().iter().find(|(n, _)| n == time) {
+            return Err(DataError::NotNumeric {
+                file: origin.into(),
+                row: 1,
+                column: time.into(),
+                cell: cell.clone(),
+            });
+        }
         let time_index = names
             .iter()
             .position(|n| n == time)
@@ -126,6 +146,7 @@ impl Chunks {
         let shift = |e: DataError| e.shifted(from);
         let mut frame =
             Frame::new(&self.origin, &self.time_name, slice(&self.held[self.time])).map_err(shift)?;
+        frame.text = self.source.text().to_vec();
         for (k, name) in self.source.names().iter().enumerate() {
             if k != self.time {
                 frame.push(name, slice(&self.held[k])).map_err(shift)?;
@@ -224,12 +245,22 @@ pub(super) fn csv_rows(path: &Path) -> Result<CsvRows<'static>, DataError> {
 /// rows), so a file reads the same in one piece or in chunks.
 pub(super) struct CsvRows<'a> {
     reader: csv::Reader<LineLimit<Box<dyn Read + 'a>>>,
+    /// Every column's name in the file.
+    header: Vec<String>,
+    /// The numeric columns: their names, and where they are in a row.
     names: Vec<String>,
+    keep: Vec<usize>,
+    text: Vec<(String, String)>,
     origin: String,
     semicolons: bool,
     row: usize,
     record: csv::ByteRecord,
+    /// The first row, read to tell text columns from numbers, is in `record`, not yet given.
+    pending: bool,
 }
+
+/// Cells that say a reading is missing, not that the column holds text.
+const MISSING: [&str; 8] = ["", "null", "NULL", "NA", "N/A", "#N/A", "None", "-"];
 
 impl<'a> CsvRows<'a> {
     /// Reads the header. A header of semicolons and no comma is a European spreadsheet's
@@ -281,13 +312,35 @@ impl<'a> CsvRows<'a> {
                 return Err(DataError::DuplicateColumn { file: origin.into(), column: h.clone() });
             }
         }
+        // a column whose first cell is text (a run's label, a mode, a comment) is no reading:
+        // left out, where a column of numbers refuses a cell that is not one, with its row
+        let mut record = csv::ByteRecord::new();
+        let pending = reader.read_byte_record(&mut record).map_err(|e| io(&e))?;
+        let is_text = |cell: &[u8]| {
+            let cell = String::from_utf8_lossy(cell.trim_ascii()).into_owned();
+            (!MISSING.contains(&cell.as_str()) && number(cell.as_bytes(), semicolons).is_none())
+                .then_some(cell)
+        };
+        let text: Vec<(usize, String)> = match pending && record.len() == names.len() {
+            true => record.iter().enumerate().filter_map(|(c, cell)| is_text(cell).map(|t| (c, t))).collect(),
+            false => Vec::new(),
+        };
+        // over half the cells text, or units throughout: a second header row (units, descriptions), not
+        // labels; the first row's error says so
+        let units = text.iter().all(|(_, cell)| super::dataset::is_unit(cell));
+        let text = if 2 * text.len() > names.len() || units { Vec::new() } else { text };
+        let keep: Vec<usize> = (0..names.len()).filter(|c| !text.iter().any(|(t, _)| t == c)).collect();
         Ok(CsvRows {
             reader,
-            names,
+            names: keep.iter().map(|&c| names[c].clone()).collect(),
+            keep,
+            text: text.into_iter().map(|(c, cell)| (names[c].clone(), cell)).collect(),
+            header: names,
             origin: origin.into(),
             semicolons,
             row: 0,
-            record: csv::ByteRecord::new(),
+            record,
+            pending,
         })
     }
 }
@@ -300,34 +353,40 @@ impl RowSource for CsvRows<'_> {
     fn read(&mut self, max: usize, columns: &mut [Vec<f64>]) -> Result<usize, DataError> {
         let mut n = 0;
         while n < max {
-            let more = self
-                .reader
-                .read_byte_record(&mut self.record)
-                .map_err(|e| DataError::Io { file: self.origin.clone(), message: e.to_string() })?;
+            let more = std::mem::take(&mut self.pending)
+                || self
+                    .reader
+                    .read_byte_record(&mut self.record)
+                    .map_err(|e| DataError::Io { file: self.origin.clone(), message: e.to_string() })?;
             if !more {
                 break;
             }
             self.row += 1;
-            if self.record.len() != self.names.len() {
+            if self.record.len() != self.header.len() {
                 return Err(DataError::Ragged {
                     file: self.origin.clone(),
                     row: self.row,
-                    expected: self.names.len(),
+                    expected: self.header.len(),
                     found: self.record.len(),
                 });
             }
-            for (c, cell) in self.record.iter().enumerate() {
+            for (k, &c) in self.keep.iter().enumerate() {
+                let cell = &self.record[c];
                 let v = number(cell, self.semicolons).ok_or_else(|| DataError::NotNumeric {
                     file: self.origin.clone(),
                     row: self.row,
-                    column: self.names[c].clone(),
+                    column: self.names[k].clone(),
                     cell: String::from_utf8_lossy(cell.trim_ascii()).into(),
                 })?;
-                columns[c].push(v);
+                columns[k].push(v);
             }
             n += 1;
         }
         Ok(n)
+    }
+
+    fn text(&self) -> &[(String, String)] {
+        &self.text
     }
 }
 
@@ -356,10 +415,10 @@ fn number(cell: &[u8], semicolons: bool) -> Option<f64> {
 }
 
 /// Every row of a source, as whole columns.
-pub(super) fn read_all(mut source: impl RowSource) -> Result<(Vec<String>, Vec<Vec<f64>>), DataError> {
+pub(super) fn read_all(mut source: impl RowSource) -> Result<Table, DataError> {
     let mut columns = vec![Vec::new(); source.names().len()];
     while source.read(65_536, &mut columns)? > 0 {}
-    Ok((source.names().to_vec(), columns))
+    Ok(Table { names: source.names().to_vec(), columns, text: source.text().to_vec() })
 }
 
 #[cfg(test)]

@@ -368,6 +368,40 @@ fn plain_and_dataset_files_get_the_same_checks() {
     );
 }
 
+/// A column of text (a run's label, as a logger or a spreadsheet writes it beside the
+/// readings) is left out, said, on the plain path and a dataset file's, where it refused the
+/// whole file; a dataset that maps a variable onto it is refused with its first cell.
+#[test]
+fn a_label_column_is_left_out_and_said() {
+    let dir = Scratch::new("hostile-label");
+    let text = std::fs::read_to_string(zigzag(&dir)).unwrap();
+    let labelled: Vec<String> = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| if i == 0 { format!("{l},run") } else { format!("{l},zz30-10") })
+        .collect();
+    let path = dir.join("labelled.csv");
+    std::fs::write(&path, labelled.join("\n")).unwrap();
+    let (code, out, err) = run_within(&["validate", "--data", s(&path)], Duration::from_secs(60), &[]);
+    assert!(
+        code == 0 && err.contains("`run` (`zz30-10` in row 1) holds text, not numbers: left out"),
+        "{err}"
+    );
+    assert!(out.contains("labelled.csv"), "{out}");
+    let ds = dir.join("runs.toml");
+    let dataset = |rudder: &str| {
+        format!("[columns]\nt = \"t [s]\"\n\"δ\" = \"{rudder}\"\nu = \"u [m/s]\"\nv = \"v [m/s]\"\nr = \"r [rad/s]\"\n\"ψ\" = \"ψ [rad]\"\n[[runs]]\nfile = \"labelled.csv\"\n")
+    };
+    std::fs::write(&ds, dataset("δ [rad]")).unwrap();
+    let (code, _, err) = run_within(&["validate", "--dataset", s(&ds)], Duration::from_secs(60), &[]);
+    assert_eq!(code, 0, "{err}");
+    std::fs::write(&ds, dataset("run")).unwrap();
+    refused(
+        &["validate", "--dataset", s(&ds)],
+        &["labelled.csv", "row 1, column `run`", "`zz30-10` is not a number"],
+    );
+}
+
 /// Item 10: model-file errors point at the key's own line, and a bad term's caret block is shown once.
 #[test]
 fn model_file_errors_name_the_right_line() {

@@ -252,7 +252,9 @@ pub fn load(data: &[PathBuf], datasets: &[PathBuf], time: &str) -> Result<Vec<Fr
     for path in data {
         // a logging dropout would be integrated or differentiated across as if the motion in
         // it were a line: each piece a run (dataset files are cut as they are read)
-        let (pieces, notes) = termid::data::cut_at_gaps(Frame::read(path, time)?, 0)?;
+        let frame = Frame::read(path, time)?;
+        frame.text_note().iter().for_each(|n| say(n));
+        let (pieces, notes) = termid::data::cut_at_gaps(frame, 0)?;
         notes.iter().for_each(|n| say(n));
         frames.extend(pieces);
     }
