@@ -642,7 +642,7 @@ impl Model {
                     Some(c)
                 }
             };
-            let mut backend = eq.backend.clone().unwrap_or_default();
+            let mut backend = eq.backend.clone().unwrap_or_else(Backend::for_rates);
             backend.validate().map_err(|e| key_err(&format!("equations.{name}.backend"), e.to_string()))?;
             if let Backend::Sparse(fit) = &mut backend {
                 // constraints name candidates: each must be one, and is kept by its canonical text

@@ -64,7 +64,7 @@ pub fn run(cmd: CompareCommand) -> Result<()> {
         let mut m = model.edit(|file| {
             for eq in &equations {
                 if let Some(e) = file.equations.get_mut(eq) {
-                    if e.backend.as_ref().map_or("stepwise", Backend::name) != *name {
+                    if e.backend.clone().unwrap_or_else(Backend::for_rates).name() != *name {
                         e.backend = Backend::by_name(name).ok();
                     }
                 }

@@ -232,11 +232,7 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
     // an ODE's defaults (a rate as target): sequential thresholding, scale-free, and the
     // constant as a candidate like any other rather than a forced intercept
     let ode = is_rate(&target, &frames, cmd.no_time);
-    let backend = if ode && cmd.backend.is_none() {
-        Backend::from(BackendName::Stlsq)
-    } else {
-        configure_backend(&cmd)?
-    };
+    let backend = if ode && cmd.backend.is_none() { Backend::for_rates() } else { configure_backend(&cmd)? };
     let intercept = intercept_of(&cmd, !ode);
     let mut candidates = candidates;
     let one = vocab.parse("1")?;
