@@ -248,6 +248,12 @@ impl PyModel {
         self.inner.spec().states.iter().map(|s| s.name.clone()).collect()
     }
 
+    /// The states' initial values (`[[states]] initial`), by name.
+    #[getter]
+    fn initial(&self) -> BTreeMap<String, f64> {
+        self.inner.spec().states.iter().map(|s| (s.name.clone(), s.initial)).collect()
+    }
+
     #[getter]
     fn inputs(&self) -> Vec<String> {
         self.inner.spec().inputs.iter().map(|s| s.name.clone()).collect()

@@ -801,6 +801,14 @@ def fit(
     return Fit(native, target)
 
 
+def _is_record(inputs: Any) -> bool:
+    """Whether :meth:`Model.simulate`'s ``inputs`` change in time (a table, columns of arrays)
+    rather than being constants by name."""
+    if isinstance(inputs, pd.DataFrame) or hasattr(inputs, "column_names") or hasattr(inputs, "to_pandas"):
+        return True
+    return isinstance(inputs, Mapping) and any(np.ndim(v) > 0 for v in inputs.values())
+
+
 def _fit_runs(data: Union[Data, Sequence[Data]], by: Optional[str]) -> List[Tuple[str, Data]]:
     """The runs of :func:`fit`'s ``data`` by name: one run (``data``), a list of runs (each
     DataFrame's ``attrs["name"]``, else ``run1``, ...), or the rows of each value of column
@@ -1410,7 +1418,7 @@ class Model:
         sample: Optional[float] = None,
         integrator: Optional[str] = None,
         with_intercept: bool = False,
-        inputs: Optional[Mapping[str, float]] = None,
+        inputs: Union[Mapping[str, float], Data, None] = None,
         initial: Optional[Mapping[str, float]] = None,
         rtol: Optional[float] = None,
         atol: Optional[float] = None,
@@ -1418,7 +1426,11 @@ class Model:
         """A plug-in's ``scenario`` (``zigzag:20/20``, ``turning:35``, ``spiral``): the run as a
         DataFrame (SI, radians), its metrics in ``df.attrs["metrics"]``. Without a scenario,
         any model (Lorenz, a pendulum): from its initial states (or ``initial``) with constant
-        ``inputs`` for ``duration`` seconds.
+        ``inputs`` for ``duration`` seconds, or under ``inputs`` that change in time: a
+        DataFrame (or table) of the inputs over its time (a column ``t``, the model's time, or
+        an index of times), replayed as :meth:`replay` replays a run's (held where the record
+        shows a controller's command), at its rows, for its span (or the first ``duration``
+        seconds of it).
 
         Parameters: ``dt`` the integration step (default: the model file's method, else
         adaptive Dormand-Prince 5(4) with output every ``sample`` seconds); ``integrator``
@@ -1448,6 +1460,12 @@ class Model:
                 inputs=inputs,
                 initial=initial,
             )
+        if inputs is not None and _is_record(inputs):
+            if scenario is not None:
+                raise TypeError("inputs and initial apply without a scenario; a scenario sets its own")
+            if sample is not None:
+                raise TypeError("inputs that change in time are simulated at their own rows: `sample` does not apply")
+            return self._under(inputs, initial, duration, dt, integrator, with_intercept)
         if scenario is None:
             if duration is None:
                 raise TypeError("simulate without a scenario needs a duration (seconds)")
@@ -1461,6 +1479,39 @@ class Model:
         frame = _frame(columns)
         frame.attrs.update(name=label, metrics=json.loads(metrics), report=list(text))
         return frame
+
+    def _under(
+        self,
+        inputs: Data,
+        initial: Optional[Mapping[str, float]],
+        duration: Optional[float],
+        dt: Optional[float],
+        integrator: Optional[str],
+        with_intercept: bool,
+    ) -> pd.DataFrame:
+        """:meth:`simulate` under a record of inputs: a run of them with the states at their
+        initial values, replayed from there."""
+        (name, columns), = _runs(inputs, time=self.time)
+        if self.time not in columns:
+            raise TermidError(
+                f"inputs that change in time need their time: a column `{self.time}` or an index of times "
+                f"(columns: {', '.join(columns)})"
+            )
+        unknown = [c for c in columns if c != self.time and c not in self.inputs]
+        if unknown:
+            raise TermidError(
+                f"{', '.join(f'`{c}`' for c in unknown)}: not an input of the model ({', '.join(self.inputs)})"
+            )
+        start = {**self._native.initial, **(initial or {})}
+        wrong = [s for s in start if s not in self.states]
+        if wrong:
+            raise TermidError(f"initial `{wrong[0]}`: not a state of the model ({', '.join(self.states)})")
+        frame = pd.DataFrame(dict(columns))
+        if duration is not None:
+            frame = frame[frame[self.time] <= frame[self.time].iloc[0] + duration]
+        frame = frame.assign(**{s: start[s] for s in self.states})
+        frame.attrs["name"] = name
+        return self.replay(frame, dt=dt, integrator=integrator, with_intercept=with_intercept)[0]
 
     def draws(self, n: int, *, seed: int = 1) -> List["Model"]:
         """``n`` models drawn from the stored covariances (seeded by ``seed``), as ``simulate

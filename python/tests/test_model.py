@@ -830,3 +830,24 @@ def test_runs_tracked_over_ground_get_the_days_current():
     own = gaps.attrs["own_values"]
     assert abs(own.loc[own["name"] == "c", "value"].iloc[0] - 0.4) < 1e-4, own
     assert gaps["rms_before"].max() < 1e-3, gaps
+
+
+def test_simulate_under_inputs_that_change_in_time():
+    # Nomoto's T·ṙ + r = K·δ under δ = a·sin(ωt) from rest, in closed form:
+    # r = K·a·(sin ωt − ωT·cos ωt + ωT·e^(−t/T)) / (1 + ω²T²)
+    nomoto = termid.Model.builtin("nomoto")
+    k, big_t = nomoto.parameters["K"], nomoto.parameters["T"]
+    a, w = 0.2, 0.3
+    t = np.arange(0.0, 60.0, 0.05)
+    rudder = pd.DataFrame({"δ": a * np.sin(w * t)}, index=pd.Index(t, name="t"))
+    run = nomoto.simulate(inputs=rudder)
+    exact = k * a * (np.sin(w * t) - w * big_t * np.cos(w * t) + w * big_t * np.exp(-t / big_t)) / (1 + (w * big_t) ** 2)
+    assert len(run) == len(t) and np.abs(run["r"].to_numpy() - exact).max() < 1e-6
+    # from other initial states, for the first seconds of the record; a dict of arrays too
+    again = nomoto.simulate(inputs={"t": t, "δ": rudder["δ"].to_numpy()}, initial={"ψ": 1.0}, duration=10.0)
+    assert again["t"].iloc[-1] == pytest.approx(10.0) and again["ψ"].iloc[0] == 1.0
+    # what does not fit is refused by name
+    with pytest.raises(termid.TermidError, match="need their time"):
+        nomoto.simulate(inputs=rudder.reset_index(drop=True))
+    with pytest.raises(termid.TermidError, match="`rpm`: not an input of the model"):
+        nomoto.simulate(inputs=rudder.assign(rpm=1.0))
