@@ -53,18 +53,7 @@ impl Frame {
     /// A frame of a table's named columns, `time` among them, knowing its columns of text.
     fn from_table(table: Table, origin: &str, time: &str) -> Result<Frame, DataError> {
         let Table { names, mut columns, text } = table;
-        if let Some((_, cell)) = text.iter().find(|(n, _)| n == time) {
-            return Err(DataError::NotNumeric {
-                file: origin.into(),
-                row: 1,
-                column: time.into(),
-                cell: cell.clone(),
-            });
-        }
-        let time_index = names
-            .iter()
-            .position(|h| h == time)
-            .ok_or_else(|| DataError::missing_time(origin, time, &names))?;
+        let time_index = super::stream::time_index(origin, time, &names, &text)?;
         let mut frame = Frame::new(origin, time, std::mem::take(&mut columns[time_index]))?;
         for (name, values) in names.iter().zip(columns) {
             if name != time {

@@ -521,12 +521,7 @@ impl Dataset {
                 &origin,
             )?;
             if let Some((_, cell)) = text.iter().find(|(n, _)| *n == time_col) {
-                return Err(DataError::NotNumeric {
-                    file: origin,
-                    row: 1,
-                    column: time_col,
-                    cell: cell.clone(),
-                });
+                return Err(DataError::text_column(&origin, &time_col, cell));
             }
             let Some(time_index) = names.iter().position(|h| *h == time_col) else {
                 return Err(DataError::MissingColumn {

@@ -254,6 +254,11 @@ pub fn looks_like_time(name: &str) -> bool {
 }
 
 impl DataError {
+    /// A column of text (its first cell `cell`, row 1) asked for as numbers.
+    pub fn text_column(file: &str, column: &str, cell: &str) -> DataError {
+        DataError::NotNumeric { file: file.into(), row: 1, column: column.into(), cell: cell.into() }
+    }
+
     /// No column `time` among `names` in `file`; a column that looks like time (`time`,
     /// `Time [s]`, `timestamp`, `seconds`) is named, with how to choose it.
     pub fn missing_time(file: &str, time: &str, names: &[impl AsRef<str>]) -> DataError {
@@ -650,12 +655,7 @@ impl Frame {
     /// A column by name, or an error naming the file and the columns there are.
     pub fn require(&self, name: &str) -> Result<&[f64], DataError> {
         if let Some((_, cell)) = self.text.iter().find(|(n, _)| n == name) {
-            return Err(DataError::NotNumeric {
-                file: self.origin.clone(),
-                row: 1,
-                column: name.into(),
-                cell: cell.clone(),
-            });
+            return Err(DataError::text_column(&self.origin, name, cell));
         }
         self.column(name).ok_or_else(|| DataError::MissingColumn {
             file: self.origin.clone(),

@@ -91,18 +91,7 @@ impl Chunks {
         context: usize,
     ) -> Result<Chunks, DataError> {
         let names = source.names();
-        if let Some((_, cell)) = source.text().iter().find(|(n, _)| n == time) {
-            return Err(DataError::NotNumeric {
-                file: origin.into(),
-                row: 1,
-                column: time.into(),
-                cell: cell.clone(),
-            });
-        }
-        let time_index = names
-            .iter()
-            .position(|n| n == time)
-            .ok_or_else(|| DataError::missing_time(origin, time, names))?;
+        let time_index = time_index(origin, time, names, source.text())?;
         let held = vec![Vec::new(); names.len()];
         Ok(Chunks {
             source,
@@ -412,6 +401,20 @@ fn number(cell: &[u8], semicolons: bool) -> Option<f64> {
         Err(_) => super::clock_seconds(text),
         Ok(v) => Some(v),
     }
+}
+
+/// Where the time column `time` is among the numeric columns `names`; refused where it is
+/// missing (a column that looks like time named) or is one of the columns of `text`.
+pub(super) fn time_index(
+    origin: &str,
+    time: &str,
+    names: &[String],
+    text: &[(String, String)],
+) -> Result<usize, DataError> {
+    if let Some((_, cell)) = text.iter().find(|(n, _)| n == time) {
+        return Err(DataError::text_column(origin, time, cell));
+    }
+    names.iter().position(|n| n == time).ok_or_else(|| DataError::missing_time(origin, time, names))
 }
 
 /// Every row of a source, as whole columns.
