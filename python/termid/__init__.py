@@ -174,9 +174,16 @@ class _Columns(Dict[str, np.ndarray]):
 
 
 def _explained(error: TermidError, left_out: Mapping[str, str]) -> TermidError:
-    """The error, with the type of a non-numeric column it names."""
+    """The error, with the type of a non-numeric column it names and how a term can use its
+    levels (one column of 0 and 1 per level)."""
     named = [f"`{n}` holds {kind}, not numbers" for n, kind in left_out.items() if f"`{n}`" in str(error)]
-    return TermidError(f"{error} (column {'; '.join(named)})") if named else error
+    if not named:
+        return error
+    levels = [n for n in left_out if f"`{n}`" in str(error)]
+    return TermidError(
+        f"{error} (column {'; '.join(named)}: a term uses its levels as columns of 0 and 1, "
+        f"pd.get_dummies(df, columns={levels!r}, dtype=float))"
+    )
 
 
 def _numeric(items: Any) -> "_Columns":
@@ -228,7 +235,9 @@ def _columns_of(data: Data) -> "_Columns":
             found = _Columns((str(c), block[:, j]) for j, c in enumerate(data.columns))
             found.left_out = {}
             return found
-        items = ((str(c), data[c].to_numpy()) for c in data.columns)
+        # each column as pandas keeps it, so that a left-out one is named by its own type
+        # (`category`, `string`), not numpy's `object`
+        items = ((str(c), data.iloc[:, j]) for j, c in enumerate(data.columns))
     elif isinstance(data, Mapping):
         items = ((str(k), v) for k, v in data.items())
     elif hasattr(data, "column_names") and hasattr(data, "column"):  # pyarrow Table

@@ -96,10 +96,16 @@ def test_a_label_column_is_left_out_unless_a_term_needs_it(hald):
     labelled = hald.assign(batch=[f"b{k}" for k in range(len(hald))])
     plain = termid.fit(hald, "y", ["x1", "x2"]).coefficients
     pd.testing.assert_series_equal(termid.fit(labelled, "y", ["x1", "x2"]).coefficients, plain)
-    with pytest.raises(termid.TermidError, match="`batch` holds object, not numbers"):
+    with pytest.raises(termid.TermidError, match=r"`batch` holds (str|object|string), not numbers"):
         termid.fit(labelled, "y", ["x1", "batch"])
     with pytest.raises(termid.TermidError, match="not numbers: it cannot be fitted"):
         termid.fit(labelled, "batch", ["x1"])
+    # a categorical column is named by its own type, with how a term can use its levels
+    kiln = hald.assign(kiln=pd.Categorical(["a", "b"] * (len(hald) // 2) + ["a"] * (len(hald) % 2)))
+    with pytest.raises(termid.TermidError, match=r"`kiln` holds category, not numbers: .*pd.get_dummies\(df, columns=\['kiln'\]"):
+        termid.fit(kiln, "y", ["x1", "kiln"])
+    dummies = pd.get_dummies(kiln, columns=["kiln"], dtype=float)
+    assert "kiln_b" in termid.fit(dummies, "y", ["x1", "kiln_b"], "stepwise", step_rule="last").coefficients.index
 
 
 def test_predictions_keep_the_index_and_errors_are_floats(hald, ship, zigzags):
