@@ -260,6 +260,12 @@ def _columns_of(data: Data) -> "_Columns":
     return _numeric(items)
 
 
+def _run_name(run: Data, k: int) -> str:
+    """The name of the ``k``-th run (from 0) in messages: a DataFrame's ``attrs["name"]``, else
+    ``run1``, ``run2``, ..."""
+    return str(getattr(run, "attrs", {}).get("name", f"run{k + 1}"))
+
+
 def _runs(
     runs: Union[Data, Sequence[Data]], names: Optional[Sequence[str]] = None, time: Optional[str] = None
 ) -> List[Tuple[str, Dict[str, np.ndarray]]]:
@@ -270,7 +276,7 @@ def _runs(
         runs = [runs]
     out = []
     for k, run in enumerate(runs):
-        name = names[k] if names else getattr(run, "attrs", {}).get("name", f"run{k + 1}")
+        name = names[k] if names else _run_name(run, k)
         columns = _columns(run)
         if time is not None and time not in columns:
             index = _index_time(run)
@@ -837,7 +843,7 @@ def _fit_runs(data: Union[Data, Sequence[Data]], by: Optional[str]) -> List[Tupl
     if isinstance(data, (list, tuple)):
         if not data:
             raise TermidError("no runs to fit: the list is empty")
-        return [(str(getattr(run, "attrs", {}).get("name", f"run{k + 1}")), run) for k, run in enumerate(data)]
+        return [(_run_name(run, k), run) for k, run in enumerate(data)]
     return [("data", data)]
 
 
