@@ -17,8 +17,8 @@ use arrow_schema::{DataType, TimeUnit};
 use super::DataError;
 
 /// The numeric columns of a Parquet or Arrow IPC file by name, and those of text.
-pub(super) fn read_columns(path: &Path) -> Result<super::stream::Table, DataError> {
-    super::stream::read_all(Batches::open(path)?)
+pub(super) fn read_columns(path: &Path, by: Option<&str>) -> Result<super::stream::Table, DataError> {
+    super::stream::read_all(Batches::open(path)?, &path.display().to_string(), by)
 }
 
 /// A Parquet or Arrow IPC file's rows, record batch by record batch.
@@ -35,6 +35,9 @@ pub(super) struct Batches {
     rows: usize,
     /// The first batch, read to learn the names.
     first: Option<RecordBatch>,
+    /// The column whose cells are kept as labels, and those kept.
+    label: Option<usize>,
+    labels: super::stream::Labels,
 }
 
 impl Batches {
@@ -94,7 +97,18 @@ impl Batches {
             .map(|c| (header[c].clone(), format!("a column of type {}", schema.field(c).data_type())))
             .collect();
         let names = keep.iter().map(|&c| header[c].clone()).collect();
-        Ok(Batches { batches, header, names, keep, text, file, rows: 0, first: Some(first) })
+        Ok(Batches {
+            batches,
+            header,
+            names,
+            keep,
+            text,
+            file,
+            rows: 0,
+            first: Some(first),
+            label: None,
+            labels: Default::default(),
+        })
     }
 }
 
@@ -204,6 +218,10 @@ impl super::stream::RowSource for Batches {
             for (k, (&c, name)) in self.keep.iter().zip(&self.names).enumerate() {
                 append(&mut columns[k], batch.column(c).as_ref(), &self.file, name, self.rows)?;
             }
+            if let Some(c) = self.label {
+                let name = &self.header[c];
+                label_cells(&mut self.labels, batch.column(c).as_ref(), &self.file, name, self.rows)?;
+            }
             self.rows += batch.num_rows();
             n += batch.num_rows();
         }
@@ -213,6 +231,59 @@ impl super::stream::RowSource for Batches {
     fn text(&self) -> &[(String, String)] {
         &self.text
     }
+
+    fn label_by(&mut self, name: &str) -> bool {
+        self.label = self.header.iter().position(|h| h == name);
+        self.label.is_some()
+    }
+
+    fn take_labels(&mut self) -> super::stream::Labels {
+        std::mem::take(&mut self.labels)
+    }
+}
+
+/// One batch's cells of a label column (text, a dictionary of text, or numbers) appended to
+/// `labels`; a null is a blank label.
+fn label_cells(
+    labels: &mut super::stream::Labels,
+    array: &dyn Array,
+    file: &str,
+    column: &str,
+    first_row: usize,
+) -> Result<(), DataError> {
+    let text = |i: usize| -> Option<String> {
+        match array.data_type() {
+            DataType::Utf8 => Some(array.as_string::<i32>().value(i).to_string()),
+            DataType::LargeUtf8 => Some(array.as_string::<i64>().value(i).to_string()),
+            DataType::Utf8View => Some(array.as_string_view().value(i).to_string()),
+            _ => None,
+        }
+    };
+    match array.data_type() {
+        DataType::Utf8 | DataType::LargeUtf8 | DataType::Utf8View => {
+            for i in 0..array.len() {
+                labels.push(&if array.is_null(i) { String::new() } else { text(i).unwrap_or_default() });
+            }
+        }
+        DataType::Dictionary(..) => {
+            let dict = array.as_any_dictionary();
+            let mut values = super::stream::Labels::default();
+            label_cells(&mut values, dict.values().as_ref(), file, column, first_row)?;
+            for (i, k) in dict.normalized_keys().into_iter().enumerate() {
+                let cell = match array.is_null(i) {
+                    true => "",
+                    false => values.rows.get(k).map_or("", |&v| values.values[v as usize].as_str()),
+                };
+                labels.push(cell);
+            }
+        }
+        _ => {
+            let mut numbers = Vec::with_capacity(array.len());
+            append(&mut numbers, array, file, column, first_row)?;
+            numbers.iter().for_each(|v| labels.push(&v.to_string()));
+        }
+    }
+    Ok(())
 }
 
 /// One batch's values of a column as f64, refusing nulls and non-numeric types with the row.

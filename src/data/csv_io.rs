@@ -42,7 +42,7 @@ impl Frame {
     /// Reads a run by its file's extension: Parquet (`.parquet`, `.pq`) and Arrow IPC
     /// (`.arrow`, `.feather`, `.ipc`) with the `columnar` feature, CSV otherwise.
     pub fn read(path: &Path, time: &str) -> Result<Frame, DataError> {
-        Frame::from_table(read_table(path)?, &path.display().to_string(), time)
+        Frame::from_table(read_table(path, None)?, &path.display().to_string(), time)
     }
 
     /// Parses CSV text; `origin` names it in errors.
@@ -51,8 +51,8 @@ impl Frame {
     }
 
     /// A frame of a table's named columns, `time` among them, knowing its columns of text.
-    fn from_table(table: Table, origin: &str, time: &str) -> Result<Frame, DataError> {
-        let Table { names, mut columns, text } = table;
+    pub(super) fn from_table(table: Table, origin: &str, time: &str) -> Result<Frame, DataError> {
+        let Table { names, mut columns, text, .. } = table;
         let time_index = super::stream::time_index(origin, time, &names, &text)?;
         let mut frame = Frame::new(origin, time, std::mem::take(&mut columns[time_index]))?;
         for (name, values) in names.iter().zip(columns) {
@@ -86,13 +86,13 @@ impl Frame {
 }
 
 /// The numeric columns of a file by name, and its columns of text: columnar by its
-/// extension, else CSV text.
-pub(super) fn read_table(path: &Path) -> Result<Table, DataError> {
+/// extension, else CSV text; with `by`, each row's cell of that column as its label.
+pub(super) fn read_table(path: &Path, by: Option<&str>) -> Result<Table, DataError> {
     let file = path.display().to_string();
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     if matches!(ext.as_deref(), Some("parquet" | "pq" | "arrow" | "feather" | "ipc")) {
         #[cfg(feature = "columnar")]
-        return super::columnar::read_columns(path);
+        return super::columnar::read_columns(path, by);
         #[cfg(not(feature = "columnar"))]
         return Err(DataError::Io {
             file,
@@ -102,7 +102,7 @@ pub(super) fn read_table(path: &Path) -> Result<Table, DataError> {
     // read as it is parsed: the numbers in memory, not the text as well
     crate::budget::file_size(path)
         .map_err(|e| DataError::Io { file: file.clone(), message: e.to_string() })?;
-    super::stream::read_all(super::stream::csv_rows(path)?).map_err(|e| {
+    super::stream::read_all(super::stream::csv_rows(path)?, &file, by).map_err(|e| {
         let head = || {
             use std::io::Read;
             let mut head = Vec::new();
@@ -146,7 +146,7 @@ pub(super) fn not_data(e: DataError, file: &str, head: impl FnOnce() -> Vec<u8>)
 /// The header and the numeric columns of CSV text, every cell checked.
 pub(super) fn parse_table(text: &str, origin: &str) -> Result<Table, DataError> {
     super::stream::CsvRows::new(text.as_bytes(), origin)
-        .and_then(super::stream::read_all)
+        .and_then(|rows| super::stream::read_all(rows, origin, None))
         .map_err(|e| not_data(e, origin, || text.as_bytes()[..text.len().min(HEAD as usize)].to_vec()))
 }
 

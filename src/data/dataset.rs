@@ -485,9 +485,9 @@ impl Dataset {
                 path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
                 Some("parquet" | "pq" | "arrow" | "feather" | "ipc")
             );
-            let super::stream::Table { mut names, mut columns, mut text } = if columnar {
+            let super::stream::Table { mut names, mut columns, mut text, .. } = if columnar {
                 // columnar files name their own columns
-                super::csv_io::read_table(&path)?
+                super::csv_io::read_table(&path, None)?
             } else {
                 let (text, latin1) = crate::budget::read_text_or_latin1(&path)
                     .map_err(|e| DataError::Io { file: origin.clone(), message: e.to_string() })?;

@@ -16,6 +16,7 @@ mod geodetic;
 mod hold;
 mod integral;
 mod kalman;
+mod long;
 mod prepare;
 mod repeated;
 mod resample;
@@ -36,6 +37,7 @@ pub use geodetic::{north_east, radii_of_curvature};
 pub use hold::{held, mark_held, switches, Hold, Intersample};
 pub use integral::{integral_rows, integral_rows_held, IntegralForm};
 pub use kalman::{KalmanSmoother, NoiseModel};
+pub use long::text_columns_of;
 pub use prepare::{prepare, Preparation};
 pub use repeated::{
     between_readings, fits_better_held, kinks_at_changes, read_at_readings, repeated, Repeats,
@@ -46,7 +48,7 @@ pub use resample::{
 pub use savitzky_golay::SavitzkyGolay;
 pub use smoothing_spline::SmoothingSpline;
 pub use spike::{despiked, despiked_all, spikes, Spike};
-pub use stream::{Chunk, Chunks, RowSource};
+pub use stream::{Chunk, Chunks, Labels, RowSource};
 
 #[cfg(test)]
 /// Uniform noise in [−½, ½) from a seeded LCG, for the tests of the derivative methods.
@@ -286,24 +288,30 @@ impl DataError {
     /// The error of a piece of a file said of the whole file: its row numbers moved on by
     /// `rows` (the piece's first row in the file).
     pub fn shifted(self, rows: usize) -> DataError {
+        self.renumbered(|row| row + rows)
+    }
+
+    /// The error of some rows of a file said of the whole file: each row number (from 1)
+    /// `row` said as `file_row(row)`.
+    pub fn renumbered(self, file_row: impl Fn(usize) -> usize) -> DataError {
         match self {
             DataError::NotNumeric { file, row, column, cell } => {
-                DataError::NotNumeric { file, row: row + rows, column, cell }
+                DataError::NotNumeric { file, row: file_row(row), column, cell }
             }
             DataError::NonFinite { file, row, column, value } => {
-                DataError::NonFinite { file, row: row + rows, column, value }
+                DataError::NonFinite { file, row: file_row(row), column, value }
             }
             DataError::Ragged { file, row, expected, found } => {
-                DataError::Ragged { file, row: row + rows, expected, found }
+                DataError::Ragged { file, row: file_row(row), expected, found }
             }
             DataError::TimeNotIncreasing { file, row, column, this, previous, restart } => {
-                DataError::TimeNotIncreasing { file, row: row + rows, column, this, previous, restart }
+                DataError::TimeNotIncreasing { file, row: file_row(row), column, this, previous, restart }
             }
             DataError::Unit { file, row, column, message } if row > 0 => {
-                DataError::Unit { file, row: row + rows, column, message }
+                DataError::Unit { file, row: file_row(row), column, message }
             }
             DataError::TimeGap { file, row, column, step, median } => {
-                DataError::TimeGap { file, row: row + rows, column, step, median }
+                DataError::TimeGap { file, row: file_row(row), column, step, median }
             }
             e => e,
         }
@@ -366,6 +374,9 @@ pub struct Frame {
     /// How many rows of its file come before its first (a piece cut from a run, a trimmed
     /// window, a streamed chunk), so that what is said of a row names it as the file does.
     first_row: usize,
+    /// Where its rows are not one stretch of its file (a run whose rows are interleaved with
+    /// others' in a long file), each row's place in the file (from 0), `first_row` aside.
+    file_rows: Option<Vec<usize>>,
     /// The file's columns of text left out (a run's label, a mode), with their first cell.
     text: Vec<(String, String)>,
 }
@@ -384,6 +395,7 @@ impl Frame {
             held: vec![],
             switched: vec![],
             first_row: 0,
+            file_rows: None,
             text: vec![],
         };
         f.push(time_name, time)?;
@@ -603,12 +615,27 @@ impl Frame {
     /// The row of its file (counted from 1, as errors count them) that the frame's row `i`
     /// (from 0) is: a piece of a run keeps its file's numbering.
     pub fn row(&self, i: usize) -> usize {
-        self.first_row + i + 1
+        match &self.file_rows {
+            Some(rows) => rows.get(i).map_or(self.first_row + i, |r| r + self.first_row) + 1,
+            None => self.first_row + i + 1,
+        }
     }
 
     /// The frame as the rows of its file from row `first_row + 1` on (a streamed chunk).
     pub fn starting_at(mut self, first_row: usize) -> Frame {
         self.first_row = first_row;
+        self
+    }
+
+    /// The frame as the rows `rows` of its file (from 0, one per row of the frame: a run's
+    /// rows among others' in a long file).
+    pub(crate) fn at_file_rows(mut self, rows: Vec<usize>) -> Frame {
+        let stretch = rows.windows(2).all(|w| w[1] == w[0] + 1);
+        self.first_row = match stretch {
+            true => rows.first().copied().unwrap_or(0),
+            false => 0,
+        };
+        self.file_rows = (!stretch).then_some(rows);
         self
     }
 
@@ -691,7 +718,8 @@ impl Frame {
             columns: self.columns.iter().map(|c| c[range.clone()].to_vec()).collect(),
             held: self.held.clone(),
             switched: self.switched.clone(),
-            first_row: self.first_row + range.start,
+            first_row: self.first_row + if self.file_rows.is_some() { 0 } else { range.start },
+            file_rows: self.file_rows.as_ref().map(|r| r[range.clone()].to_vec()),
             text: self.text.clone(),
         }
     }

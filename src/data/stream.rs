@@ -21,6 +21,38 @@ pub trait RowSource {
     fn text(&self) -> &[(String, String)] {
         &[]
     }
+    /// From now on, keeps each row's cell of column `name` (of numbers or of text) as a
+    /// label ([`Labels`]); false where the source has no such column or cannot.
+    fn label_by(&mut self, _name: &str) -> bool {
+        false
+    }
+    /// The labels kept since [`RowSource::label_by`].
+    fn take_labels(&mut self) -> Labels {
+        Labels::default()
+    }
+}
+
+/// One column's cells as labels (the run each row belongs to, in a file of several runs):
+/// its distinct values in the order they first appear, and each row's as an index into them.
+#[derive(Clone, Debug, Default)]
+pub struct Labels {
+    /// The distinct values, in the order they first appear.
+    pub values: Vec<String>,
+    /// Each row's value, as its place in `values`.
+    pub rows: Vec<u32>,
+    index: std::collections::HashMap<String, u32>,
+}
+
+impl Labels {
+    /// Adds a row's cell.
+    pub fn push(&mut self, cell: &str) {
+        let next = self.values.len() as u32;
+        let k = *self.index.entry(cell.to_string()).or_insert(next);
+        if k == next {
+            self.values.push(cell.to_string());
+        }
+        self.rows.push(k);
+    }
 }
 
 /// A file's columns read whole: the numeric ones by name, and those left out as text
@@ -29,6 +61,8 @@ pub(super) struct Table {
     pub names: Vec<String>,
     pub columns: Vec<Vec<f64>>,
     pub text: Vec<(String, String)>,
+    /// The cells of the column the rows were told apart by, where one was asked for.
+    pub labels: Option<Labels>,
 }
 
 /// A piece of a run.
@@ -63,23 +97,7 @@ impl Chunks {
     /// `size` rows, each with `context` rows of its neighbours on either side; `time` names
     /// the time column.
     pub fn open(path: &Path, time: &str, size: usize, context: usize) -> Result<Chunks, DataError> {
-        let origin = path.display().to_string();
-        let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-        let source: Box<dyn RowSource> =
-            if matches!(ext.as_deref(), Some("parquet" | "pq" | "arrow" | "feather" | "ipc")) {
-                #[cfg(feature = "columnar")]
-                {
-                    Box::new(super::columnar::Batches::open(path)?)
-                }
-                #[cfg(not(feature = "columnar"))]
-                return Err(DataError::Io {
-                    file: origin,
-                    message: "a columnar file: termid was built without the `columnar` feature".into(),
-                });
-            } else {
-                Box::new(csv_rows(path)?)
-            };
-        Chunks::new(source, &origin, time, size, context)
+        Chunks::new(rows_of(path)?, &path.display().to_string(), time, size, context)
     }
 
     /// Chunks of rows from any source.
@@ -223,6 +241,21 @@ impl<R: Read> Read for LineLimit<R> {
 }
 
 /// The CSV rows of the file at `path`, read as they are needed.
+/// The rows of the file `path`: Parquet or Arrow IPC by its extension, else CSV text.
+pub(super) fn rows_of(path: &Path) -> Result<Box<dyn RowSource>, DataError> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    if matches!(ext.as_deref(), Some("parquet" | "pq" | "arrow" | "feather" | "ipc")) {
+        #[cfg(feature = "columnar")]
+        return Ok(Box::new(super::columnar::Batches::open(path)?));
+        #[cfg(not(feature = "columnar"))]
+        return Err(DataError::Io {
+            file: path.display().to_string(),
+            message: "a columnar file: termid was built without the `columnar` feature".into(),
+        });
+    }
+    Ok(Box::new(csv_rows(path)?))
+}
+
 pub(super) fn csv_rows(path: &Path) -> Result<CsvRows<'static>, DataError> {
     let origin = path.display().to_string();
     let file = std::fs::File::open(path)
@@ -246,6 +279,9 @@ pub(super) struct CsvRows<'a> {
     record: csv::ByteRecord,
     /// The first row, read to tell text columns from numbers, is in `record`, not yet given.
     pending: bool,
+    /// The column whose cells are kept as labels, and those kept.
+    label: Option<usize>,
+    labels: Labels,
 }
 
 /// Cells that say a reading is missing, not that the column holds text.
@@ -330,6 +366,8 @@ impl<'a> CsvRows<'a> {
             row: 0,
             record,
             pending,
+            label: None,
+            labels: Labels::default(),
         })
     }
 }
@@ -369,6 +407,9 @@ impl RowSource for CsvRows<'_> {
                 })?;
                 columns[k].push(v);
             }
+            if let Some(c) = self.label {
+                self.labels.push(&String::from_utf8_lossy(self.record[c].trim_ascii()));
+            }
             n += 1;
         }
         Ok(n)
@@ -376,6 +417,15 @@ impl RowSource for CsvRows<'_> {
 
     fn text(&self) -> &[(String, String)] {
         &self.text
+    }
+
+    fn label_by(&mut self, name: &str) -> bool {
+        self.label = self.header.iter().position(|h| h == name);
+        self.label.is_some()
+    }
+
+    fn take_labels(&mut self) -> Labels {
+        std::mem::take(&mut self.labels)
     }
 }
 
@@ -417,11 +467,32 @@ pub(super) fn time_index(
     names.iter().position(|n| n == time).ok_or_else(|| DataError::missing_time(origin, time, names))
 }
 
-/// Every row of a source, as whole columns.
-pub(super) fn read_all(mut source: impl RowSource) -> Result<Table, DataError> {
+/// Every row of a source, as whole columns; with `by`, each row's cell of that column kept
+/// as its label (refused where the source has no such column).
+pub(super) fn read_all(
+    mut source: impl RowSource,
+    origin: &str,
+    by: Option<&str>,
+) -> Result<Table, DataError> {
+    if let Some(by) = by {
+        if !source.label_by(by) {
+            let available: Vec<&str> = source
+                .names()
+                .iter()
+                .chain(source.text().iter().map(|(n, _)| n))
+                .map(String::as_str)
+                .collect();
+            return Err(DataError::MissingColumn {
+                file: origin.into(),
+                column: by.into(),
+                available: available.join(", "),
+            });
+        }
+    }
     let mut columns = vec![Vec::new(); source.names().len()];
     while source.read(65_536, &mut columns)? > 0 {}
-    Ok(Table { names: source.names().to_vec(), columns, text: source.text().to_vec() })
+    let labels = by.map(|_| source.take_labels());
+    Ok(Table { names: source.names().to_vec(), columns, text: source.text().to_vec(), labels })
 }
 
 #[cfg(test)]

@@ -1615,3 +1615,79 @@ fn a_model_file_without_a_backend_keeps_every_true_term() {
         assert!((got / want - 1.0).abs() < 0.01, "{name}: {got} vs {want}");
     }
 }
+
+/// A file of several runs (a long table, as a data-frame library writes it) is refused whole
+/// where its time starts again, the refusal naming its label column; `--by` reads each
+/// label's rows as a run of its own, whether the runs follow one another or are interleaved
+/// row by row: three runs of ẍ = −4x − 0.3ẋ + 2F give the oscillator back exactly either way.
+#[test]
+fn a_long_file_of_several_runs_is_read_by_its_label() {
+    use crate::common::{chosen_terms, json, trajectory, Scratch};
+    let dir = Scratch::new("generic-long");
+    let force = |t: f64| (0.9 * t).sin() + 0.5 * (2.1 * t).cos();
+    let (h, n) = (0.01, 1500);
+    let runs: Vec<Vec<Vec<f64>>> = [[1.0, 0.0], [-2.0, 1.0], [0.5, -3.0]]
+        .iter()
+        .map(|x0| trajectory(x0, h, n, 10, |t, x| vec![x[1], -4.0 * x[0] - 0.3 * x[1] + 2.0 * force(t)]))
+        .collect();
+    let line = |i: usize, x: &[f64]| format!("{},{},{},{}", i as f64 * h, x[0], x[1], force(i as f64 * h));
+    let mut after = String::from("run,t,x,v,F\n");
+    for (k, run) in runs.iter().enumerate() {
+        for (i, x) in run.iter().enumerate() {
+            after += &format!("zz{k},{}\n", line(i, x));
+        }
+    }
+    let mut interleaved = String::from("t,x,v,F,vessel\n");
+    for i in 0..n {
+        for (k, run) in runs.iter().enumerate() {
+            interleaved += &format!("{},{}\n", line(i, &run[i]), k + 1);
+        }
+    }
+    std::fs::write(dir.join("after.csv"), after).unwrap();
+    std::fs::write(dir.join("interleaved.csv"), interleaved).unwrap();
+    let model = "[model]\nname = \"forced oscillator\"\nintercept = false\n\
+        [[states]]\nname = \"x\"\n[[states]]\nname = \"v\"\n[[inputs]]\nname = \"F\"\n\
+        [equations.x_dot]\nstate = \"x\"\nidentify = false\ncoefficients = { \"v\" = 1.0 }\n\
+        [equations.v_dot]\nstate = \"v\"\ncandidates = [\"x\", \"v\", \"F\", \"x^2\"]\n";
+    std::fs::write(dir.join("m.toml"), model).unwrap();
+    let p = |f: &str| dir.join(f).display().to_string();
+    let model = p("m.toml");
+    let identify = |data: &str, by: &[&str]| {
+        let mut args = vec!["identify", "--model", &model, "--format", "json", "--data", data];
+        args.extend_from_slice(by);
+        termid(&args)
+    };
+    let (ok, _, err) = identify(&p("after.csv"), &[]);
+    assert!(!ok && err.contains("row 1501, column `t`") && err.contains("`--by run`"), "{err}");
+    for (file, by) in [("after.csv", "run"), ("interleaved.csv", "vessel")] {
+        let (ok, out, err) = identify(&p(file), &["--by", by]);
+        assert!(ok, "{err}");
+        assert!(err.contains(&format!("3 runs told apart by `{by}`")), "{err}");
+        let found = chosen_terms(&json(&out)["v_dot"]);
+        let truth = [("F", 2.0), ("v", -0.3), ("x", -4.0)];
+        assert_eq!(
+            found.iter().map(|f| f.0.as_str()).collect::<Vec<_>>(),
+            truth.map(|t| t.0),
+            "{file}: {out}"
+        );
+        for ((_, got), (name, want)) in found.iter().zip(truth) {
+            assert!((got / want - 1.0).abs() < 1e-4, "{file} {name}: {got} vs {want}");
+        }
+    }
+    // what is wrong in one run is said at the file's row
+    let text = std::fs::read_to_string(dir.join("interleaved.csv")).unwrap();
+    let broken: Vec<String> = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            let mut cells: Vec<&str> = l.split(',').collect();
+            if i == 8 {
+                cells[1] = "NaN";
+            }
+            cells.join(",")
+        })
+        .collect();
+    std::fs::write(dir.join("broken.csv"), broken.join("\n")).unwrap();
+    let (ok, _, err) = identify(&p("broken.csv"), &["--by", "vessel"]);
+    assert!(!ok && err.contains("[vessel=2]: row 8, column `x`"), "{err}");
+}

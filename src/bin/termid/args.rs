@@ -75,6 +75,11 @@ pub struct EstimateCommand {
     /// is a source (a basin, a campaign) with its own columns, units and scale.
     #[arg(long, action = clap::ArgAction::Append)]
     pub dataset: Vec<PathBuf>,
+    /// A column of the --data files that names each row's run, where a file holds several
+    /// (a long table: runs one after another or interleaved row by row): each of its values
+    /// read as a run of its own.
+    #[arg(long, value_name = "COLUMN", requires = "data")]
+    pub by: Option<String>,
     /// Free parameters estimated once per source (nuisances, e.g. each basin's rudder
     /// indicator zero; not written to the model); the others once for all unless the model
     /// file declares them a nuisance (`nuisance = "run"`).
@@ -169,6 +174,11 @@ pub struct MomentsCommand {
     /// runs of every one together (each with its own columns, units and scale).
     #[arg(long, action = clap::ArgAction::Append)]
     pub dataset: Vec<PathBuf>,
+    /// A column of the --data files that names each row's run, where a file holds several
+    /// (a long table: runs one after another or interleaved row by row): each of its values
+    /// read as a run of its own.
+    #[arg(long, value_name = "COLUMN", requires = "data")]
+    pub by: Option<String>,
     /// Derivative method where the target is a state's derivative (the runs have no
     /// `<state>_dot` column): central, five-point, savitzky-golay[:W:Q], spline[:ALPHA], kalman,
     /// or integral[:W] (no rate: changes over windows of W samples against integrals).
@@ -235,6 +245,11 @@ pub struct IdentifyCommand {
     /// runs of every one together (each with its own columns, units and scale).
     #[arg(long, action = clap::ArgAction::Append)]
     pub dataset: Vec<PathBuf>,
+    /// A column of the --data files that names each row's run, where a file holds several
+    /// (a long table: runs one after another or interleaved row by row): each of its values
+    /// read as a run of its own.
+    #[arg(long, value_name = "COLUMN", requires = "data")]
+    pub by: Option<String>,
     /// With --model: identify from statistics written by `termid moments` instead of runs
     /// (several files are merged; each names its equation).
     #[arg(long, num_args = 1.., requires = "model", conflicts_with_all = ["data", "dataset", "refine", "choose"])]
@@ -537,6 +552,11 @@ pub struct CompareCommand {
     /// runs of every one together (each with its own columns, units and scale).
     #[arg(long, action = clap::ArgAction::Append)]
     pub dataset: Vec<PathBuf>,
+    /// A column of the --data files that names each row's run, where a file holds several
+    /// (a long table: runs one after another or interleaved row by row): each of its values
+    /// read as a run of its own.
+    #[arg(long, value_name = "COLUMN", requires = "data")]
+    pub by: Option<String>,
     /// Equations to compare (default: all identifiable ones).
     #[arg(long, num_args = 1..)]
     pub equation: Vec<String>,
@@ -631,6 +651,11 @@ pub struct RunsArgs {
     /// runs of every one together (each with its own columns, units and scale).
     #[arg(long, action = clap::ArgAction::Append)]
     pub dataset: Vec<PathBuf>,
+    /// A column of the --data files that names each row's run, where a file holds several
+    /// (a long table: runs one after another or interleaved row by row): each of its values
+    /// read as a run of its own.
+    #[arg(long, value_name = "COLUMN", requires = "data")]
+    pub by: Option<String>,
     /// A velocity of the medium the model declares (`medium = true`: a current) to keep at its
     /// file's value: runs a dataset file tracks by satellite fixes otherwise have it estimated
     /// first, alone, the model held.

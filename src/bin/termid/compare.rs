@@ -45,7 +45,7 @@ pub fn run(cmd: CompareCommand) -> Result<()> {
     }
     let model = crate::simulate::load_model(&cmd.model)?;
     let time = model.spec().model.time.clone();
-    let frames = crate::runs::load_for(&model, &cmd.data, &cmd.dataset)?;
+    let frames = crate::runs::load_for(&model, &cmd.data, cmd.by.as_deref(), &cmd.dataset)?;
     crate::runs::warn_over_ground(&cmd.dataset);
     let equations: Vec<String> =
         if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };

@@ -21,7 +21,7 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
     }
     let mut file = crate::simulate::load_model(&cmd.model)?;
     file.set_tolerances(cmd.resim.rtol, cmd.resim.atol)?;
-    let runs = crate::runs::load_for(&file, &cmd.runs.data, &cmd.runs.dataset)?;
+    let runs = crate::runs::load_for(&file, &cmd.runs.data, cmd.runs.by.as_deref(), &cmd.runs.dataset)?;
     // runs tracked over ground carry the day's current: estimated first with the runs' other
     // nuisances (each run's own values), the model held; the model written is in still water
     let current = crate::runs::medium_to_free(&file, &cmd.runs.dataset, &cmd.runs.hold)?;

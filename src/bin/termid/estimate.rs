@@ -45,7 +45,7 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
             model.path
         );
     }
-    let (frames, sources) = crate::runs::load_sources(&model, &cmd.data, &cmd.dataset)?;
+    let (frames, sources) = crate::runs::load_sources(&model, &cmd.data, cmd.by.as_deref(), &cmd.dataset)?;
     // multiple shooting: each segment a run of its own, of its run's source
     let (frames, sources) = match cmd.segments {
         Some(count) => termid::diagnose::in_segments(&frames, &sources, count as usize),

@@ -100,12 +100,12 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
         let mut frames =
             cmd.data.iter().map(|p| Frame::read_csv_untimed(p)).collect::<Result<Vec<_>, _>>()?;
         if !cmd.dataset.is_empty() {
-            frames.extend(crate::runs::load(&[], &cmd.dataset, &cmd.time)?);
+            frames.extend(crate::runs::load(&[], None, &cmd.dataset, &cmd.time)?);
         }
         frames
     } else {
         // the same reading (and check for gaps in time) as every other command
-        crate::runs::load(&cmd.data, &cmd.dataset, &cmd.time)?
+        crate::runs::load(&cmd.data, cmd.by.as_deref(), &cmd.dataset, &cmd.time)?
     };
     let target = Target::parse(cmd.target.as_deref().unwrap_or_default());
     if !cmd.keep_spikes && is_rate(&target, &frames, cmd.no_time) {

@@ -55,12 +55,13 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
             STARTS_AGREE,
         )?,
         None => {
-            let (frames, sources) = crate::runs::load_sources(&model, &cmd.data, &cmd.dataset)?;
+            let (frames, sources) =
+                crate::runs::load_sources(&model, &cmd.data, cmd.by.as_deref(), &cmd.dataset)?;
             crate::runs::warn_over_ground(&cmd.dataset);
             let held = cmd
                 .refine_validation
                 .as_ref()
-                .map(|p| crate::runs::load_for(&model, &[], std::slice::from_ref(p)))
+                .map(|p| crate::runs::load_for(&model, &[], None, std::slice::from_ref(p)))
                 .transpose()?;
             let settings = RecipeSettings {
                 equations: cmd.equation.clone(),

@@ -20,7 +20,7 @@ pub fn run(cmd: MomentsCommand) -> Result<()> {
     let diff = differentiator(&cmd.derivative)?;
     let moments = match diff.reach() {
         // plain files with a local derivative: read in pieces, one pass, bounded memory
-        Some(reach) if cmd.chunk_rows > 0 && cmd.dataset.is_empty() => {
+        Some(reach) if cmd.chunk_rows > 0 && cmd.dataset.is_empty() && cmd.by.is_none() => {
             let runs = cmd
                 .data
                 .iter()
@@ -33,7 +33,7 @@ pub fn run(cmd: MomentsCommand) -> Result<()> {
             moments
         }
         _ => {
-            let frames = crate::runs::load_for(&model, &cmd.data, &cmd.dataset)?;
+            let frames = crate::runs::load_for(&model, &cmd.data, cmd.by.as_deref(), &cmd.dataset)?;
             EquationMoments::of_runs(&model, &cmd.equation, &frames, diff.as_ref(), None)?
         }
     };
@@ -138,6 +138,7 @@ pub fn in_pieces(cmd: &IdentifyCommand, refine: bool) -> Result<Option<usize>> {
     let local = differentiator(&cmd.derivative).ok().and_then(|d| d.reach()).is_some();
     let whole_runs_needed = [
         (!cmd.dataset.is_empty(), "--dataset"),
+        (cmd.by.is_some(), "--by"),
         (cmd.resample.is_some(), "--resample"),
         (cmd.smooth, "--smooth"),
         (cmd.prepared_svg.is_some(), "--prepared-svg"),

@@ -9,7 +9,12 @@ use termid::model::Model;
 
 /// The runs of a command with a model: as [`load`], then each dataset mapping checked to name
 /// one of the model's variables and each run checked against the model's known kinematics.
-pub fn load_for(model: &Model, data: &[PathBuf], datasets: &[PathBuf]) -> Result<Vec<Frame>> {
+pub fn load_for(
+    model: &Model,
+    data: &[PathBuf],
+    by: Option<&str>,
+    datasets: &[PathBuf],
+) -> Result<Vec<Frame>> {
     for path in datasets {
         let ds = Dataset::load(path)?;
         let known = model.data_names();
@@ -22,7 +27,7 @@ pub fn load_for(model: &Model, data: &[PathBuf], datasets: &[PathBuf]) -> Result
             );
         }
     }
-    let mut frames = load(data, datasets, &model.spec().model.time)?;
+    let mut frames = load(data, by, datasets, &model.spec().model.time)?;
     for f in &mut frames {
         for note in model.admit(f)? {
             say(&note);
@@ -46,6 +51,7 @@ pub fn load_for(model: &Model, data: &[PathBuf], datasets: &[PathBuf]) -> Result
 pub fn load_sources(
     model: &Model,
     data: &[PathBuf],
+    by: Option<&str>,
     datasets: &[PathBuf],
 ) -> Result<(Vec<Frame>, Vec<usize>)> {
     check_once(&input_files(data, datasets))?;
@@ -53,7 +59,7 @@ pub fn load_sources(
     let data_source = (!data.is_empty()).then_some((data, &[][..]));
     let dataset_sources = datasets.iter().map(|d| (&[][..], std::slice::from_ref(d)));
     for (k, (data, datasets)) in data_source.into_iter().chain(dataset_sources).enumerate() {
-        let more = load_for(model, data, datasets)?;
+        let more = load_for(model, data, by, datasets)?;
         sources.extend(std::iter::repeat_n(k, more.len()));
         frames.extend(more);
     }
@@ -246,17 +252,30 @@ pub fn replay_frame(path: &Path, time: &str) -> Result<Frame> {
     Ok(frame)
 }
 
-pub fn load(data: &[PathBuf], datasets: &[PathBuf], time: &str) -> Result<Vec<Frame>> {
+/// The runs of `data` files (each a run, or with `by` the runs its column `by` names) and of
+/// `datasets` files, each cut at a logger's dropout, what reading did said.
+pub fn load(data: &[PathBuf], by: Option<&str>, datasets: &[PathBuf], time: &str) -> Result<Vec<Frame>> {
     check_once(&input_files(data, datasets))?;
     let mut frames = Vec::new();
     for path in data {
-        // a logging dropout would be integrated or differentiated across as if the motion in
-        // it were a line: each piece a run (dataset files are cut as they are read)
-        let frame = Frame::read(path, time)?;
-        frame.text_note().iter().for_each(|n| say(n));
-        let (pieces, notes) = termid::data::cut_at_gaps(frame, 0)?;
-        notes.iter().for_each(|n| say(n));
-        frames.extend(pieces);
+        let runs = match by {
+            Some(by) => {
+                let runs = Frame::read_by(path, time, by)?;
+                say(&told_apart(path, by, &runs));
+                runs
+            }
+            None => vec![Frame::read(path, time).map_err(|e| with_remedy(e, path))?],
+        };
+        if let Some(note) = runs.first().and_then(Frame::text_note) {
+            say(&note);
+        }
+        for frame in runs {
+            // a logging dropout would be integrated or differentiated across as if the motion
+            // in it were a line: each piece a run (dataset files are cut as they are read)
+            let (pieces, notes) = termid::data::cut_at_gaps(frame, 0)?;
+            notes.iter().for_each(|n| say(n));
+            frames.extend(pieces);
+        }
     }
     for path in datasets {
         let ds = Dataset::load(path)?;
@@ -272,6 +291,43 @@ pub fn load(data: &[PathBuf], datasets: &[PathBuf], time: &str) -> Result<Vec<Fr
         bail!("no runs: give --data FILE… or --dataset FILE");
     }
     Ok(frames)
+}
+
+/// What `--by` made of a file: its runs, by label and length.
+fn told_apart(path: &Path, by: &str, runs: &[Frame]) -> String {
+    let named: Vec<String> = runs
+        .iter()
+        .take(6)
+        .map(|f| {
+            format!(
+                "{} ({} rows)",
+                f.origin().rsplit_once(&format!("[{by}=")).map_or("", |(_, v)| v.trim_end_matches(']')),
+                f.len()
+            )
+        })
+        .collect();
+    let more = if runs.len() > named.len() {
+        format!(", and {} more", runs.len() - named.len())
+    } else {
+        String::new()
+    };
+    let count = if runs.len() == 1 { "1 run".to_string() } else { format!("{} runs", runs.len()) };
+    format!("{}: {count} told apart by `{by}`: {}{more}", path.display(), named.join(", "))
+}
+
+/// A time that starts again in a file read as one run: the file's columns of text named as
+/// what `--by` would tell its runs apart by.
+fn with_remedy(e: termid::data::DataError, path: &Path) -> anyhow::Error {
+    let restart = matches!(e, termid::data::DataError::TimeNotIncreasing { restart: true, .. });
+    let labels = if restart { termid::data::text_columns_of(path) } else { Vec::new() };
+    let remedy = match labels.as_slice() {
+        _ if !restart => return e.into(),
+        [] => "`--by COLUMN` reads each value of a column that names the row's run as a run of its own"
+            .to_string(),
+        [one] => format!("`--by {one}` reads each value of `{one}` as a run of its own"),
+        many => format!("`--by COLUMN` reads each value of one ({}) as a run of its own", many.join(", ")),
+    };
+    anyhow::anyhow!("{e}; {remedy}")
 }
 
 /// Every run's spikes in any of its columns mended ([`termid::data::despiked_all`]), each said:

@@ -20,7 +20,8 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
     }
     let mut model = crate::simulate::load_model(&cmd.model)?;
     model.set_tolerances(cmd.resim.rtol, cmd.resim.atol)?;
-    let (runs, sources) = crate::runs::load_sources(&model, &cmd.runs.data, &cmd.runs.dataset)?;
+    let (runs, sources) =
+        crate::runs::load_sources(&model, &cmd.runs.data, cmd.runs.by.as_deref(), &cmd.runs.dataset)?;
     // runs tracked over ground: the day's current is theirs, not the model's
     let current = crate::runs::medium_of_runs(&model, &runs, &sources, &cmd.runs.dataset, &cmd.runs.hold)?;
     let current: Vec<(usize, &str, f64)> = current.iter().map(|(r, n, v)| (*r, n.as_str(), *v)).collect();

@@ -1,0 +1,123 @@
+//! A file of several runs in one table (a long table, as a data-frame library writes it): the
+//! runs one after another or interleaved row by row, told apart by a column that names each
+//! row's run. Each run becomes a frame of its own, its rows numbered as the file numbers them.
+
+use std::path::Path;
+
+use super::stream::Table;
+use super::{DataError, Frame};
+
+impl Frame {
+    /// The runs of the file `path`, told apart by its column `by` (text or numbers): a frame
+    /// per value, in the order the values first appear, with that value's rows in the file's
+    /// order, named `FILE [by=value]`, the label itself not among its columns. A row without
+    /// a label is refused, and every error names the file's row.
+    pub fn read_by(path: &Path, time: &str, by: &str) -> Result<Vec<Frame>, DataError> {
+        let file = path.display().to_string();
+        if by == time {
+            return Err(DataError::Io {
+                file,
+                message: format!("`{by}` is the time column: the runs are told apart by a column that names each row's run"),
+            });
+        }
+        let mut table = super::csv_io::read_table(path, Some(by))?;
+        let labels = table.labels.take().unwrap_or_default();
+        if let Some(k) = table.names.iter().position(|n| n == by) {
+            table.names.remove(k);
+            table.columns.remove(k);
+        }
+        table.text.retain(|(n, _)| n != by);
+        if let Some(row) = labels.rows.iter().position(|&k| labels.values[k as usize].is_empty()) {
+            return Err(DataError::Io {
+                file,
+                message: format!(
+                    "row {}, column `{by}`: no label, so no run to put the row in (every row of a file of several runs names its run)",
+                    row + 1
+                ),
+            });
+        }
+        let mut groups: Vec<Vec<usize>> = vec![Vec::new(); labels.values.len()];
+        for (i, &k) in labels.rows.iter().enumerate() {
+            groups[k as usize].push(i);
+        }
+        groups
+            .into_iter()
+            .zip(&labels.values)
+            .map(|(rows, value)| {
+                let run = Table {
+                    names: table.names.clone(),
+                    columns: table.columns.iter().map(|c| rows.iter().map(|&i| c[i]).collect()).collect(),
+                    text: table.text.clone(),
+                    labels: None,
+                };
+                let origin = format!("{file} [{by}={value}]");
+                let at_file = |e: DataError| e.renumbered(|row| rows.get(row - 1).map_or(row, |&i| i + 1));
+                Ok(Frame::from_table(run, &origin, time).map_err(at_file)?.at_file_rows(rows))
+            })
+            .collect()
+    }
+}
+
+/// The columns of text in the file `path` (a run's label, a mode: what the runs of a file
+/// of several could be told apart by); none where it cannot be read.
+pub fn text_columns_of(path: &Path) -> Vec<String> {
+    super::stream::rows_of(path)
+        .map_or_else(|_| Vec::new(), |rows| rows.text().iter().map(|(n, _)| n.clone()).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn file(name: &str, text: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("termid-long-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        path
+    }
+
+    /// Runs one after another and runs interleaved row by row come apart alike, each in the
+    /// file's order, the label left out, every row named as the file numbers it.
+    #[test]
+    fn a_long_file_comes_apart_by_its_label() {
+        let after = file("after.csv", "run,t,x\na,0,1\na,1,2\na,2,3\nb,0,10\nb,1,20\n");
+        let runs = Frame::read_by(&after, "t", "run").unwrap();
+        assert_eq!(runs.len(), 2);
+        assert!(runs[0].origin().ends_with("after.csv [run=a]"), "{}", runs[0].origin());
+        assert_eq!(runs[0].names(), ["t", "x"]);
+        assert_eq!(runs[0].column("x").unwrap(), [1.0, 2.0, 3.0]);
+        assert_eq!(runs[1].column("x").unwrap(), [10.0, 20.0]);
+        assert_eq!((runs[1].row(0), runs[1].row(1)), (4, 5));
+        assert!(runs[0].text_columns().is_empty());
+
+        // two vessels logged at each time stamp, a numeric label
+        let mixed =
+            file("mixed.csv", "t,ship,x,note\n0,1,1,calm\n0,2,5,calm\n1,1,2,calm\n1,2,6,calm\n2,1,3,calm\n");
+        let runs = Frame::read_by(&mixed, "t", "ship").unwrap();
+        assert!(runs[1].origin().ends_with("[ship=2]"));
+        assert_eq!(runs[0].column("x").unwrap(), [1.0, 2.0, 3.0]);
+        assert_eq!(runs[1].column("x").unwrap(), [5.0, 6.0]);
+        assert_eq!((runs[0].row(2), runs[1].row(1)), (5, 4));
+        assert_eq!(runs[1].slice(1..2).row(0), 4);
+        assert_eq!(runs[0].text_columns()[0].0, "note");
+    }
+
+    /// What is wrong in one run is said at the file's row; a missing label, or no such
+    /// column, is refused.
+    #[test]
+    fn errors_name_the_files_rows() {
+        let back = file("back.csv", "t,run,x\n0,a,1\n0,b,1\n1,a,2\n0.5,a,3\n1,b,2\n");
+        let e = Frame::read_by(&back, "t", "run").unwrap_err().to_string();
+        assert!(e.contains("[run=a]: row 4, column `t`"), "{e}");
+        let nan = file("nan.csv", "t,run,x\n0,a,1\n0,b,1\n1,a,2\n1,b,NaN\n");
+        let e = Frame::read_by(&nan, "t", "run").unwrap_err().to_string();
+        assert!(e.contains("[run=b]: row 4, column `x`"), "{e}");
+        let blank = file("blank.csv", "t,run,x\n0,a,1\n1,,2\n");
+        let e = Frame::read_by(&blank, "t", "run").unwrap_err().to_string();
+        assert!(e.contains("row 2, column `run`: no label"), "{e}");
+        let e = Frame::read_by(&blank, "t", "experiment").unwrap_err().to_string();
+        assert!(e.contains("no column `experiment` (columns: t, x, run)"), "{e}");
+        assert!(Frame::read_by(&blank, "t", "t").is_err());
+    }
+}
