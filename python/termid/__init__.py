@@ -16,7 +16,9 @@ can simulate. This package calls termid's Rust library in the same process.
     ['term', 'value', 'std_error']
 
 Data is given as pandas DataFrames, dicts of numpy arrays or pyarrow Tables (columns named
-as the model's variables, SI units, angles in radians). Errors are :class:`TermidError`
+as the model's variables, SI units, angles in radians); several runs as a list of them, or a
+pandas grouping of one long frame (``df.groupby("experiment")``: each value's rows a run of
+their own, named ``experiment=e1``). Errors are :class:`TermidError`
 carrying termid's located message (file, row, column, or a caret under a term).
 """
 
@@ -34,6 +36,7 @@ from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import pandas as pd
+from pandas.core.groupby import DataFrameGroupBy
 
 try:
     from . import _termid
@@ -176,6 +179,12 @@ class _Columns(Dict[str, np.ndarray]):
 def _explained(error: TermidError, left_out: Mapping[str, str]) -> TermidError:
     """The error, with the type of a non-numeric column it names and how a term can use its
     levels (one column of 0 and 1 per level)."""
+    if "starts again" in str(error):
+        # runs one after another in one frame (a label column its tell)
+        label = next(iter(left_out), "run")
+        return TermidError(
+            f"{error}: give them as a list of runs, or grouped by the column that names each row's run, df.groupby('{label}')"
+        )
     named = [f"`{n}` holds {kind}, not numbers" for n, kind in left_out.items() if f"`{n}`" in str(error)]
     if not named:
         return error
@@ -266,12 +275,35 @@ def _run_name(run: Data, k: int) -> str:
     return str(getattr(run, "attrs", {}).get("name", f"run{k + 1}"))
 
 
+def _grouped(runs: Any) -> Optional[List[Tuple[str, pd.DataFrame]]]:
+    """A pandas grouping's groups as runs (``df.groupby("experiment")``: the rows of each value
+    a run of their own), named ``experiment=e1``, the columns grouped by left out; ``None``
+    for anything but a grouping."""
+    if not isinstance(runs, DataFrameGroupBy):
+        return None
+    keys = runs.keys
+    by = [keys] if isinstance(keys, str) else [k for k in keys if isinstance(k, str)] if isinstance(keys, (list, tuple)) else []
+    label = ",".join(by) or "group"
+    out = []
+    for value, rows in runs:
+        value = value[0] if isinstance(value, tuple) and len(value) == 1 else value
+        shown = ",".join(map(str, value)) if isinstance(value, tuple) else str(value)
+        out.append((f"{label}={shown}", rows.drop(columns=[k for k in by if k in rows.columns])))
+    if not out:
+        raise TermidError("no runs: the grouping has no groups (no rows)")
+    return out
+
+
 def _runs(
     runs: Union[Data, Sequence[Data]], names: Optional[Sequence[str]] = None, time: Optional[str] = None
 ) -> List[Tuple[str, Dict[str, np.ndarray]]]:
     """Runs as (name, columns); one run may be given alone. A DataFrame's ``attrs["name"]``
     names it in messages, else ``run1``, ``run2``, ... A run without the column ``time`` (a
     model's) has it from its index where that holds times (:func:`_index_time`)."""
+    grouped = _grouped(runs)
+    if grouped is not None:
+        names = names or [name for name, _ in grouped]
+        runs = [run for _, run in grouped]
     if isinstance(runs, (pd.DataFrame, Mapping)) or hasattr(runs, "column_names"):
         runs = [runs]
     out = []
@@ -827,7 +859,12 @@ def _is_record(inputs: Any) -> bool:
 def _fit_runs(data: Union[Data, Sequence[Data]], by: Optional[str]) -> List[Tuple[str, Data]]:
     """The runs of :func:`fit`'s ``data`` by name: one run (``data``), a list of runs (each
     DataFrame's ``attrs["name"]``, else ``run1``, ...), or the rows of each value of column
-    ``by`` (``run=3``), in the order they first appear."""
+    ``by`` (``run=3``), in the order they first appear, or a pandas grouping's groups."""
+    grouped = _grouped(data)
+    if grouped is not None:
+        if by is not None:
+            raise TypeError("`by` tells apart the runs of one DataFrame; the grouping has told them apart already")
+        return grouped
     if by is not None:
         if isinstance(data, pd.DataFrame):
             frame = data

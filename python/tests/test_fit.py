@@ -266,6 +266,24 @@ def _decay(x0, v0, t):
     return pd.DataFrame({"t": t, "x": x, "v": v})
 
 
+_OSCILLATOR = """
+[model]
+name = "damped oscillator"
+intercept = false
+[[states]]
+name = "x"
+[[states]]
+name = "v"
+[equations.x_dot]
+state = "x"
+identify = false
+coefficients = { "v" = 1.0 }
+[equations.v_dot]
+state = "v"
+candidates = ["x", "v", "x^2", "x*v"]
+"""
+
+
 def test_several_runs_are_fitted_together_never_across_their_seams():
     # three experiments of one oscillator from other starts: as a list, or one frame told
     # apart by a label column; the rate is integrated along each run, not from one to the next
@@ -281,6 +299,15 @@ def test_several_runs_are_fitted_together_never_across_their_seams():
     # one frame whose time starts again is refused, the remedy named with its label column
     with pytest.raises(termid.TermidError, match="row 1501.*by='experiment'"):
         termid.fit(long, "dv/dt", ["x", "v"])
+    # a pandas grouping is runs named by its values, for fit and for a model alike
+    assert termid.fit(long.groupby("experiment"), "dv/dt", ["x", "v", "x^2"]).coefficients.sort_index().round(6).to_dict() == truth
+    model = termid.Model.from_toml(_OSCILLATOR)
+    found = model.identify(long.groupby("experiment")).model.coefficients("v_dot")
+    assert dict(zip(found["term"], found["value"].round(6))) == {"x": -4.0, "v": -0.3}
+    gaps = model.identify(long.groupby("experiment")).model.validate(long.groupby("experiment"))
+    assert sorted(gaps.index.get_level_values("run").unique()) == ["experiment=a", "experiment=b", "experiment=c"]
+    with pytest.raises(termid.TermidError, match=r"row 1501.*df.groupby\('experiment'\)"):
+        model.identify(long)
     # a run without a column the first has is refused by name
     with pytest.raises(termid.TermidError, match="run `run2` has other columns than `run1`: without `v`"):
         termid.fit([runs[0], runs[1].drop(columns="v")], "dv/dt", ["x"])
