@@ -26,7 +26,7 @@ impl Frame {
 
     /// Parses CSV text without a time column (rows numbered 1..n in a column `row`).
     pub fn parse_csv_untimed(text: &str, origin: &str) -> Result<Frame, DataError> {
-        let table = parse_table(text, origin)?;
+        let table = parse_table(text, origin, None)?;
         if table.names.iter().chain(table.text.iter().map(|t| &t.0)).any(|h| h == "row") {
             return Err(DataError::DuplicateColumn { file: origin.into(), column: "row".into() });
         }
@@ -47,7 +47,7 @@ impl Frame {
 
     /// Parses CSV text; `origin` names it in errors.
     pub fn parse_csv(text: &str, origin: &str, time: &str) -> Result<Frame, DataError> {
-        Frame::from_table(parse_table(text, origin)?, origin, time)
+        Frame::from_table(parse_table(text, origin, None)?, origin, time)
     }
 
     /// A frame of a table's named columns, `time` among them, knowing its columns of text.
@@ -144,9 +144,9 @@ pub(super) fn not_data(e: DataError, file: &str, head: impl FnOnce() -> Vec<u8>)
 }
 
 /// The header and the numeric columns of CSV text, every cell checked.
-pub(super) fn parse_table(text: &str, origin: &str) -> Result<Table, DataError> {
+pub(super) fn parse_table(text: &str, origin: &str, by: Option<&str>) -> Result<Table, DataError> {
     super::stream::CsvRows::new(text.as_bytes(), origin)
-        .and_then(|rows| super::stream::read_all(rows, origin, None))
+        .and_then(|rows| super::stream::read_all(rows, origin, by))
         .map_err(|e| not_data(e, origin, || text.as_bytes()[..text.len().min(HEAD as usize)].to_vec()))
 }
 

@@ -25,6 +25,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
+use super::stream::Table;
 use super::{DataError, Frame};
 
 /// The dataset file.
@@ -290,6 +291,11 @@ pub struct RunSpec {
     /// This run's own `regular_time`.
     #[serde(default)]
     pub regular_time: Option<bool>,
+    /// A column that names each row's run, where the file holds several (a long table): each
+    /// of its values read as a run of its own (`FILE [by=value]`), `from`, `to` and the rest
+    /// applied to each.
+    #[serde(default)]
+    pub by: Option<String>,
 }
 
 /// Column separators.
@@ -481,291 +487,338 @@ impl Dataset {
         for run in &self.runs {
             let path = base.join(&run.file);
             let origin = path.display().to_string();
-            let columnar = matches!(
-                path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
-                Some("parquet" | "pq" | "arrow" | "feather" | "ipc")
-            );
-            let super::stream::Table { mut names, mut columns, mut text, .. } = if columnar {
-                // columnar files name their own columns
-                super::csv_io::read_table(&path, None)?
-            } else {
-                let (text, latin1) = crate::budget::read_text_or_latin1(&path)
-                    .map_err(|e| DataError::Io { file: origin.clone(), message: e.to_string() })?;
-                if latin1 {
-                    notes.push(format!("{origin}: not UTF-8, read as Latin-1 (Windows-1252)"));
+            let table = self.table_of(run, &path, &origin, &mut notes)?;
+            let parts = match &run.by {
+                Some(by) => {
+                    let (parts, note) = super::long::split(table, by, &origin)?;
+                    notes.push(note);
+                    parts.into_iter().map(|(origin, table, rows)| (origin, table, Some(rows))).collect()
                 }
-                let header = run.header.as_ref().or(self.header.as_ref()).map(|h| h.join(","));
-                let body: Vec<&str> = text.lines().skip(run.skip).collect();
-                let csv: String = header
-                    .iter()
-                    .cloned()
-                    .chain(body.iter().map(|l| match run.delimiter {
-                        Delimiter::Comma => l.to_string(),
-                        // a semicolon-separated file is a European spreadsheet's: its commas
-                        // are decimal commas
-                        Delimiter::Semicolon => l.replace(',', ".").replace(';', ","),
-                        Delimiter::Whitespace => l.split_whitespace().collect::<Vec<_>>().join(","),
-                    }))
-                    .collect::<Vec<_>>()
-                    .join("\n");
-                super::csv_io::parse_table(&csv, &origin)?
+                None => vec![(origin.clone(), table, None)],
             };
-            let header_units = bare_headers(&mut names);
-            let mut text_names: Vec<String> = text.iter().map(|t| t.0.clone()).collect();
-            bare_headers(&mut text_names);
-            text.iter_mut().zip(text_names).for_each(|(t, bare)| t.0 = bare);
-            let (time_col, time_unit, _) = spec_with_header_unit(
-                self.columns.get(time).map_or(time, String::as_str),
-                &names,
-                &header_units,
-                &origin,
-            )?;
-            if let Some((_, cell)) = text.iter().find(|(n, _)| *n == time_col) {
-                return Err(DataError::text_column(&origin, &time_col, cell));
-            }
-            let Some(time_index) = names.iter().position(|h| *h == time_col) else {
-                return Err(DataError::MissingColumn {
-                    file: origin.clone(),
-                    column: time_col.clone(),
-                    available: names.join(", "),
-                });
-            };
-            let stamps = std::mem::take(&mut columns[time_index]);
-            let stamps = if run.regular_time.unwrap_or(self.regular_time) {
-                let (line, step) = regular_time(&stamps, &origin, &time_col)?;
-                notes.push(format!(
-                    "{origin}: time stamps replaced by a regular rate of {step:.6} per row (largest change {:.3})",
-                    stamps.iter().zip(&line).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max)
-                ));
-                line
-            } else {
-                stamps
-            };
-            let mut raw = Frame::new(&origin, &time_col, stamps)?;
-            for (name, values) in names.iter().zip(columns).filter(|(n, _)| **n != time_col) {
-                raw.push(name, values)?;
-            }
-            // a column the dataset maps that holds text is refused with its first cell
-            raw.text = text;
-            let scale = |unit: Option<&str>, column: &str| -> Result<f64, DataError> {
-                let Some(lambda) = self.froude else { return Ok(1.0) };
-                froude_factor(lambda, unit, &origin, column)
-            };
-            let time_factor = factor(time_unit.as_deref(), &origin, time)?;
-            let time_scale = scale(time_unit.as_deref(), &time_col)?;
-            // the file's time in s, for `from` and `to`
-            let file_time: Vec<f64> = raw.time().iter().map(|t| t * time_factor).collect();
-            let mut frame = Frame::new(&origin, time, file_time.iter().map(|t| t * time_scale).collect())?;
-            if let Some(lambda) = self.froude {
-                notes.push(format!(
-                    "{origin}: Froude-scaled from a geosim {lambda} times larger (lengths ÷ {lambda}, times ÷ {:.4}, rates × {:.4})",
-                    lambda.sqrt(),
-                    lambda.sqrt()
-                ));
-            }
-            // one column of the file in SI at the model's scale, with the conversions said
-            let mut convert = |spec: &str, var: &str| -> Result<Vec<f64>, DataError> {
-                let (col, unit, sign) = spec_with_header_unit(spec, &names, &header_units, &origin)?;
-                let values = raw.require(&col)?;
-                if unit.as_deref() == Some("rad") {
-                    if let Some((i, v)) =
-                        values.iter().enumerate().find(|(_, v)| v.abs() > 2.0 * std::f64::consts::PI)
-                    {
-                        return Err(DataError::Unit {
+            for (origin, table, rows) in parts {
+                let at_file = |e: DataError| match &rows {
+                    Some(rows) => e.at_file_rows(rows),
+                    None => e,
+                };
+                let (mut frame, file_time) =
+                    self.frame_of(run, table, &origin, time, &mut notes).map_err(at_file)?;
+                if let Some(rows) = rows {
+                    frame = frame.at_file_rows(rows);
+                }
+                if run.from.is_some() || run.to.is_some() {
+                    let t = &file_time;
+                    let lo = run.from.map_or(0, |a| t.iter().position(|v| *v >= a).unwrap_or(t.len()));
+                    let hi = run.to.map_or(t.len(), |b| t.iter().rposition(|v| *v <= b).map_or(0, |i| i + 1));
+                    if hi <= lo + 2 {
+                        return Err(DataError::TooShort {
                             file: origin.clone(),
-                            row: i + 1,
-                            column: col.clone(),
-                            message: format!(
-                                "declared [rad] but reaches {v}: that can only be degrees; declare [deg]"
-                            ),
+                            rows: hi.saturating_sub(lo),
+                            needed: 3,
+                            what: "the trimmed window".into(),
                         });
                     }
-                }
-                let f = factor(unit.as_deref(), &origin, &col)?;
-                if f != 1.0 {
                     notes.push(format!(
-                        "{origin}: `{col}` [{}] → {var} in SI (× {f:.6e})",
-                        unit.as_deref().unwrap_or("")
+                        "{origin}: trimmed to {} ≤ t ≤ {} ({} of {} samples)",
+                        t[lo],
+                        t[hi - 1],
+                        hi - lo,
+                        t.len()
                     ));
+                    frame = frame.slice(lo..hi);
                 }
-                if sign < 0.0 {
-                    notes.push(format!("{origin}: `{col}` negated → {var}"));
-                }
-                let f = sign * f * scale(unit.as_deref(), &col)?;
-                Ok(values.iter().map(|v| v * f).collect())
-            };
-            for (var, spec) in self.columns.iter().chain(&self.extra).filter(|(v, _)| v.as_str() != time) {
-                let values = convert(spec, var)?;
-                frame.push(var, values)?;
-            }
-            if let Some(track) = &self.track {
-                // a satellite fix: the positions in m north and east of the run's first
-                let mut said = None;
-                match (&track.latitude, &track.longitude, &track.x, &track.y) {
-                    (None, None, _, _) => {}
-                    (Some(lat), Some(lon), Some(x), Some(y)) => {
-                        let (north, east) = super::north_east(&convert(lat, "latitude")?, &convert(lon, "longitude")?);
-                        let f = scale(Some("m"), x)?;
-                        frame.push(x, north.iter().map(|v| v * f).collect())?;
-                        frame.push(y, east.iter().map(|v| v * f).collect())?;
-                        said = Some(format!(
-                            "{origin}: {x} and {y} in m north and east of the first fix ({lat}, {lon}), on the plane touching the WGS-84 ellipsoid there"
-                        ));
-                    }
-                    _ => {
-                        return Err(DataError::Unit {
-                            file: origin.clone(),
-                            row: 0,
-                            column: track.heading.clone(),
-                            message: "[track] takes latitude and longitude together, with x and y to name the positions they give (x north, y east)".into(),
-                        })
-                    }
-                }
-                let heading = frame.require(&track.heading)?.to_vec();
-                // the antenna's offset at the model's scale, and the point's track from its
-                let antenna = match track.antenna {
-                    Some([ax, ay]) if ax.is_finite() && ay.is_finite() => {
-                        let f = scale(Some("m"), &track.heading)?;
-                        Some((ax * f, ay * f))
-                    }
-                    Some(a) => {
-                        return Err(DataError::Unit {
-                            file: origin.clone(),
-                            row: 0,
-                            column: track.heading.clone(),
-                            message: format!(
-                                "[track] antenna = {a:?}: two finite numbers, m forward and to starboard"
-                            ),
-                        })
-                    }
-                    None => None,
-                };
-                let mut moved_note = None;
-                if let (Some((ax, ay)), Some(x), Some(y)) = (antenna, &track.x, &track.y) {
-                    if let (Some(xs), Some(ys)) = (frame.column(x), frame.column(y)) {
-                        let (sn_cs, n) = (heading.iter().map(|h| h.sin_cos()), xs.len().min(ys.len()));
-                        let (mx, my): (Vec<f64>, Vec<f64>) = xs[..n]
-                            .iter()
-                            .zip(&ys[..n])
-                            .zip(sn_cs)
-                            .map(|((px, py), (sn, cs))| (px - (ax * cs - ay * sn), py - (ax * sn + ay * cs)))
-                            .unzip();
-                        frame.set(x, mx)?;
-                        frame.set(y, my)?;
-                        moved_note = Some(format!(
-                            "{origin}: the track ({x}, {y}) moved from the antenna, {ax} m forward and {ay} m to starboard, to the model's point by {}",
-                            track.heading
-                        ));
-                    }
-                }
-                let col = |n: &str| frame.require(n).map(<[f64]>::to_vec);
-                // a receiver's Doppler velocity over ground, where given
-                let doppler = match (&track.speed_over_ground, &track.course_over_ground) {
-                    (None, None) => None,
-                    (Some(sog), Some(cog)) if track.x_dot.is_none() && track.y_dot.is_none() => {
-                        Some((sog, cog, convert(sog, "speed over ground")?, convert(cog, "course over ground")?))
-                    }
-                    _ => {
-                        return Err(DataError::Unit {
-                            file: origin.clone(),
-                            row: 0,
-                            column: track.heading.clone(),
-                            message: "[track] takes speed_over_ground and course_over_ground together, and not with x_dot and y_dot".into(),
-                        })
-                    }
-                };
-                // velocities measured (at the antenna), not differenced from the moved track
-                let measured = doppler.is_some() || track.x_dot.is_some();
-                let (u, v) = match (doppler, &track.x, &track.y, &track.x_dot, &track.y_dot) {
-                    (Some((sog, cog, speed, course)), ..) => {
-                        notes.push(format!(
-                            "{origin}: {} and {} turned into the body frame from the velocity over ground ({sog}, {cog}) by {}",
-                            track.u, track.v, track.heading
-                        ));
-                        let north: Vec<f64> = speed.iter().zip(&course).map(|(s, c)| s * c.cos()).collect();
-                        let east: Vec<f64> = speed.iter().zip(&course).map(|(s, c)| s * c.sin()).collect();
-                        velocities_from_earth_fixed(&north, &east, &heading)
-                    }
-                    (None, Some(x), Some(y), None, None) => {
-                        notes.push(format!(
-                            "{origin}: {} and {} computed from the track ({x}, {y}) and {} over ±{} samples",
-                            track.u, track.v, track.heading, track.half_window
-                        ));
-                        velocities_from_track(frame.time(), &col(x)?, &col(y)?, &heading, track.half_window)
-                    }
-                    (None, None, None, Some(xd), Some(yd)) => {
-                        let (xd_values, yd_values) = (convert(xd, "ẋ")?, convert(yd, "ẏ")?);
-                        notes.push(format!(
-                            "{origin}: {} and {} turned into the body frame from ({xd}, {yd}) by {}",
-                            track.u, track.v, track.heading
-                        ));
-                        velocities_from_earth_fixed(&xd_values, &yd_values, &heading)
-                    }
-                    _ => {
-                        return Err(DataError::Unit {
-                            file: origin.clone(),
-                            row: 0,
-                            column: track.heading.clone(),
-                            message: "[track] takes either the positions x and y or the earth-fixed velocities x_dot and y_dot".into(),
-                        })
-                    }
-                };
-                // velocities measured at the antenna (not differenced from the moved track):
-                // the ship's turning moves it, u_a = u − r·y_a, v_a = v + r·x_a
-                let (u, v) = match antenna {
-                    Some((ax, ay)) if measured => {
-                        let r = rate_of(frame.time(), &heading, track.half_window);
-                        notes.push(format!(
-                            "{origin}: {} and {} moved from the antenna ({ax} m forward, {ay} m to starboard) to the model's point by the heading's rate",
-                            track.u, track.v
-                        ));
-                        (
-                            u.iter().zip(&r).map(|(u, r)| u + r * ay).collect(),
-                            v.iter().zip(&r).map(|(v, r)| v - r * ax).collect(),
-                        )
-                    }
-                    _ => (u, v),
-                };
-                frame.set(&track.u, u)?;
-                frame.set(&track.v, v)?;
+                // a logging dropout would be integrated or differentiated across as if the
+                // motion in it were a line: each piece a run, less the rows a track's
+                // differences across the gap spoiled
+                let margin = self.track.as_ref().map_or(0, |t| t.half_window);
+                let (pieces, said) = super::cut_at_gaps(frame, margin)?;
                 notes.extend(said);
-                notes.extend(moved_note);
-                if antenna.is_none() && (track.latitude.is_some() || track.speed_over_ground.is_some()) {
-                    notes.push(format!(
-                        "{origin}: the receiver's fixes taken as of the model's point (midship): an antenna elsewhere (on the bridge, far aft) moves the sway velocity by the yaw rate times its distance, which the hull's derivatives then absorb; `[track] antenna = [forward, starboard]` in m moves them"
-                    ));
-                }
+                frames.extend(pieces);
             }
-            if run.from.is_some() || run.to.is_some() {
-                let t = &file_time;
-                let lo = run.from.map_or(0, |a| t.iter().position(|v| *v >= a).unwrap_or(t.len()));
-                let hi = run.to.map_or(t.len(), |b| t.iter().rposition(|v| *v <= b).map_or(0, |i| i + 1));
-                if hi <= lo + 2 {
-                    return Err(DataError::TooShort {
-                        file: origin.clone(),
-                        rows: hi.saturating_sub(lo),
-                        needed: 3,
-                        what: "the trimmed window".into(),
-                    });
-                }
-                notes.push(format!(
-                    "{origin}: trimmed to {} ≤ t ≤ {} ({} of {} samples)",
-                    t[lo],
-                    t[hi - 1],
-                    hi - lo,
-                    t.len()
-                ));
-                frame = frame.slice(lo..hi);
-            }
-            // a logging dropout would be integrated or differentiated across as if the motion
-            // in it were a line: each piece a run, less the rows a track's differences across
-            // the gap spoiled
-            let margin = self.track.as_ref().map_or(0, |t| t.half_window);
-            let (pieces, said) = super::cut_at_gaps(frame, margin)?;
-            notes.extend(said);
-            frames.extend(pieces);
         }
         Ok((frames, notes))
+    }
+
+    /// A run's file as a table: its numeric columns, its columns of text and, where the run
+    /// names a column `by`, each row's label.
+    fn table_of(
+        &self,
+        run: &RunSpec,
+        path: &Path,
+        origin: &str,
+        notes: &mut Vec<String>,
+    ) -> Result<Table, DataError> {
+        let columnar = matches!(
+            path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
+            Some("parquet" | "pq" | "arrow" | "feather" | "ipc")
+        );
+        Ok(if columnar {
+            // columnar files name their own columns
+            super::csv_io::read_table(path, run.by.as_deref())?
+        } else {
+            let (text, latin1) = crate::budget::read_text_or_latin1(path)
+                .map_err(|e| DataError::Io { file: origin.into(), message: e.to_string() })?;
+            if latin1 {
+                notes.push(format!("{origin}: not UTF-8, read as Latin-1 (Windows-1252)"));
+            }
+            let header = run.header.as_ref().or(self.header.as_ref()).map(|h| h.join(","));
+            let body: Vec<&str> = text.lines().skip(run.skip).collect();
+            let csv: String = header
+                .iter()
+                .cloned()
+                .chain(body.iter().map(|l| match run.delimiter {
+                    Delimiter::Comma => l.to_string(),
+                    // a semicolon-separated file is a European spreadsheet's: its commas
+                    // are decimal commas
+                    Delimiter::Semicolon => l.replace(',', ".").replace(';', ","),
+                    Delimiter::Whitespace => l.split_whitespace().collect::<Vec<_>>().join(","),
+                }))
+                .collect::<Vec<_>>()
+                .join("\n");
+            super::csv_io::parse_table(&csv, origin, run.by.as_deref())?
+        })
+    }
+
+    /// A run's frame from its file's table (the file's rows, or one label's): its columns
+    /// mapped onto the model's variables in SI at the model's scale, with the file's time in
+    /// s (before any Froude scaling) for the run's window.
+    fn frame_of(
+        &self,
+        run: &RunSpec,
+        table: Table,
+        origin: &str,
+        time: &str,
+        notes: &mut Vec<String>,
+    ) -> Result<(Frame, Vec<f64>), DataError> {
+        let origin = origin.to_string();
+        let Table { mut names, mut columns, mut text, .. } = table;
+        let header_units = bare_headers(&mut names);
+        let mut text_names: Vec<String> = text.iter().map(|t| t.0.clone()).collect();
+        bare_headers(&mut text_names);
+        text.iter_mut().zip(text_names).for_each(|(t, bare)| t.0 = bare);
+        let (time_col, time_unit, _) = spec_with_header_unit(
+            self.columns.get(time).map_or(time, String::as_str),
+            &names,
+            &header_units,
+            &origin,
+        )?;
+        if let Some((_, cell)) = text.iter().find(|(n, _)| *n == time_col) {
+            return Err(DataError::text_column(&origin, &time_col, cell));
+        }
+        let Some(time_index) = names.iter().position(|h| *h == time_col) else {
+            return Err(DataError::MissingColumn {
+                file: origin.clone(),
+                column: time_col.clone(),
+                available: names.join(", "),
+            });
+        };
+        let stamps = std::mem::take(&mut columns[time_index]);
+        let stamps = if run.regular_time.unwrap_or(self.regular_time) {
+            let (line, step) = regular_time(&stamps, &origin, &time_col)?;
+            notes.push(format!(
+                "{origin}: time stamps replaced by a regular rate of {step:.6} per row (largest change {:.3})",
+                stamps.iter().zip(&line).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max)
+            ));
+            line
+        } else {
+            stamps
+        };
+        let mut raw = Frame::new(&origin, &time_col, stamps)?;
+        for (name, values) in names.iter().zip(columns).filter(|(n, _)| **n != time_col) {
+            raw.push(name, values)?;
+        }
+        // a column the dataset maps that holds text is refused with its first cell
+        raw.text = text;
+        let scale = |unit: Option<&str>, column: &str| -> Result<f64, DataError> {
+            let Some(lambda) = self.froude else { return Ok(1.0) };
+            froude_factor(lambda, unit, &origin, column)
+        };
+        let time_factor = factor(time_unit.as_deref(), &origin, time)?;
+        let time_scale = scale(time_unit.as_deref(), &time_col)?;
+        // the file's time in s, for `from` and `to`
+        let file_time: Vec<f64> = raw.time().iter().map(|t| t * time_factor).collect();
+        let mut frame = Frame::new(&origin, time, file_time.iter().map(|t| t * time_scale).collect())?;
+        if let Some(lambda) = self.froude {
+            notes.push(format!(
+                "{origin}: Froude-scaled from a geosim {lambda} times larger (lengths ÷ {lambda}, times ÷ {:.4}, rates × {:.4})",
+                lambda.sqrt(),
+                lambda.sqrt()
+            ));
+        }
+        // one column of the file in SI at the model's scale, with the conversions said
+        let mut convert = |spec: &str, var: &str| -> Result<Vec<f64>, DataError> {
+            let (col, unit, sign) = spec_with_header_unit(spec, &names, &header_units, &origin)?;
+            let values = raw.require(&col)?;
+            if unit.as_deref() == Some("rad") {
+                if let Some((i, v)) =
+                    values.iter().enumerate().find(|(_, v)| v.abs() > 2.0 * std::f64::consts::PI)
+                {
+                    return Err(DataError::Unit {
+                        file: origin.clone(),
+                        row: i + 1,
+                        column: col.clone(),
+                        message: format!(
+                            "declared [rad] but reaches {v}: that can only be degrees; declare [deg]"
+                        ),
+                    });
+                }
+            }
+            let f = factor(unit.as_deref(), &origin, &col)?;
+            if f != 1.0 {
+                notes.push(format!(
+                    "{origin}: `{col}` [{}] → {var} in SI (× {f:.6e})",
+                    unit.as_deref().unwrap_or("")
+                ));
+            }
+            if sign < 0.0 {
+                notes.push(format!("{origin}: `{col}` negated → {var}"));
+            }
+            let f = sign * f * scale(unit.as_deref(), &col)?;
+            Ok(values.iter().map(|v| v * f).collect())
+        };
+        for (var, spec) in self.columns.iter().chain(&self.extra).filter(|(v, _)| v.as_str() != time) {
+            let values = convert(spec, var)?;
+            frame.push(var, values)?;
+        }
+        if let Some(track) = &self.track {
+            // a satellite fix: the positions in m north and east of the run's first
+            let mut said = None;
+            match (&track.latitude, &track.longitude, &track.x, &track.y) {
+                (None, None, _, _) => {}
+                (Some(lat), Some(lon), Some(x), Some(y)) => {
+                    let (north, east) = super::north_east(&convert(lat, "latitude")?, &convert(lon, "longitude")?);
+                    let f = scale(Some("m"), x)?;
+                    frame.push(x, north.iter().map(|v| v * f).collect())?;
+                    frame.push(y, east.iter().map(|v| v * f).collect())?;
+                    said = Some(format!(
+                        "{origin}: {x} and {y} in m north and east of the first fix ({lat}, {lon}), on the plane touching the WGS-84 ellipsoid there"
+                    ));
+                }
+                _ => {
+                    return Err(DataError::Unit {
+                        file: origin.clone(),
+                        row: 0,
+                        column: track.heading.clone(),
+                        message: "[track] takes latitude and longitude together, with x and y to name the positions they give (x north, y east)".into(),
+                    })
+                }
+            }
+            let heading = frame.require(&track.heading)?.to_vec();
+            // the antenna's offset at the model's scale, and the point's track from its
+            let antenna = match track.antenna {
+                Some([ax, ay]) if ax.is_finite() && ay.is_finite() => {
+                    let f = scale(Some("m"), &track.heading)?;
+                    Some((ax * f, ay * f))
+                }
+                Some(a) => {
+                    return Err(DataError::Unit {
+                        file: origin.clone(),
+                        row: 0,
+                        column: track.heading.clone(),
+                        message: format!(
+                            "[track] antenna = {a:?}: two finite numbers, m forward and to starboard"
+                        ),
+                    })
+                }
+                None => None,
+            };
+            let mut moved_note = None;
+            if let (Some((ax, ay)), Some(x), Some(y)) = (antenna, &track.x, &track.y) {
+                if let (Some(xs), Some(ys)) = (frame.column(x), frame.column(y)) {
+                    let (sn_cs, n) = (heading.iter().map(|h| h.sin_cos()), xs.len().min(ys.len()));
+                    let (mx, my): (Vec<f64>, Vec<f64>) = xs[..n]
+                        .iter()
+                        .zip(&ys[..n])
+                        .zip(sn_cs)
+                        .map(|((px, py), (sn, cs))| (px - (ax * cs - ay * sn), py - (ax * sn + ay * cs)))
+                        .unzip();
+                    frame.set(x, mx)?;
+                    frame.set(y, my)?;
+                    moved_note = Some(format!(
+                        "{origin}: the track ({x}, {y}) moved from the antenna, {ax} m forward and {ay} m to starboard, to the model's point by {}",
+                        track.heading
+                    ));
+                }
+            }
+            let col = |n: &str| frame.require(n).map(<[f64]>::to_vec);
+            // a receiver's Doppler velocity over ground, where given
+            let doppler = match (&track.speed_over_ground, &track.course_over_ground) {
+                (None, None) => None,
+                (Some(sog), Some(cog)) if track.x_dot.is_none() && track.y_dot.is_none() => {
+                    Some((sog, cog, convert(sog, "speed over ground")?, convert(cog, "course over ground")?))
+                }
+                _ => {
+                    return Err(DataError::Unit {
+                        file: origin.clone(),
+                        row: 0,
+                        column: track.heading.clone(),
+                        message: "[track] takes speed_over_ground and course_over_ground together, and not with x_dot and y_dot".into(),
+                    })
+                }
+            };
+            // velocities measured (at the antenna), not differenced from the moved track
+            let measured = doppler.is_some() || track.x_dot.is_some();
+            let (u, v) = match (doppler, &track.x, &track.y, &track.x_dot, &track.y_dot) {
+                (Some((sog, cog, speed, course)), ..) => {
+                    notes.push(format!(
+                        "{origin}: {} and {} turned into the body frame from the velocity over ground ({sog}, {cog}) by {}",
+                        track.u, track.v, track.heading
+                    ));
+                    let north: Vec<f64> = speed.iter().zip(&course).map(|(s, c)| s * c.cos()).collect();
+                    let east: Vec<f64> = speed.iter().zip(&course).map(|(s, c)| s * c.sin()).collect();
+                    velocities_from_earth_fixed(&north, &east, &heading)
+                }
+                (None, Some(x), Some(y), None, None) => {
+                    notes.push(format!(
+                        "{origin}: {} and {} computed from the track ({x}, {y}) and {} over ±{} samples",
+                        track.u, track.v, track.heading, track.half_window
+                    ));
+                    velocities_from_track(frame.time(), &col(x)?, &col(y)?, &heading, track.half_window)
+                }
+                (None, None, None, Some(xd), Some(yd)) => {
+                    let (xd_values, yd_values) = (convert(xd, "ẋ")?, convert(yd, "ẏ")?);
+                    notes.push(format!(
+                        "{origin}: {} and {} turned into the body frame from ({xd}, {yd}) by {}",
+                        track.u, track.v, track.heading
+                    ));
+                    velocities_from_earth_fixed(&xd_values, &yd_values, &heading)
+                }
+                _ => {
+                    return Err(DataError::Unit {
+                        file: origin.clone(),
+                        row: 0,
+                        column: track.heading.clone(),
+                        message: "[track] takes either the positions x and y or the earth-fixed velocities x_dot and y_dot".into(),
+                    })
+                }
+            };
+            // velocities measured at the antenna (not differenced from the moved track):
+            // the ship's turning moves it, u_a = u − r·y_a, v_a = v + r·x_a
+            let (u, v) = match antenna {
+                Some((ax, ay)) if measured => {
+                    let r = rate_of(frame.time(), &heading, track.half_window);
+                    notes.push(format!(
+                        "{origin}: {} and {} moved from the antenna ({ax} m forward, {ay} m to starboard) to the model's point by the heading's rate",
+                        track.u, track.v
+                    ));
+                    (
+                        u.iter().zip(&r).map(|(u, r)| u + r * ay).collect(),
+                        v.iter().zip(&r).map(|(v, r)| v - r * ax).collect(),
+                    )
+                }
+                _ => (u, v),
+            };
+            frame.set(&track.u, u)?;
+            frame.set(&track.v, v)?;
+            notes.extend(said);
+            notes.extend(moved_note);
+            if antenna.is_none() && (track.latitude.is_some() || track.speed_over_ground.is_some()) {
+                notes.push(format!(
+                    "{origin}: the receiver's fixes taken as of the model's point (midship): an antenna elsewhere (on the bridge, far aft) moves the sway velocity by the yaw rate times its distance, which the hull's derivatives then absorb; `[track] antenna = [forward, starboard]` in m moves them"
+                ));
+            }
+        }
+        Ok((frame, file_time))
     }
 }
 

@@ -12,7 +12,8 @@ impl Frame {
     /// per value, in the order the values first appear, with that value's rows in the file's
     /// order, named `FILE [by=value]`, the label itself not among its columns. A row without
     /// a label is refused, and every error names the file's row.
-    pub fn read_by(path: &Path, time: &str, by: &str) -> Result<Vec<Frame>, DataError> {
+    /// Returns the runs and what to say of them (how many, their labels and lengths).
+    pub fn read_by(path: &Path, time: &str, by: &str) -> Result<(Vec<Frame>, String), DataError> {
         let file = path.display().to_string();
         if by == time {
             return Err(DataError::Io {
@@ -20,42 +21,74 @@ impl Frame {
                 message: format!("`{by}` is the time column: the runs are told apart by a column that names each row's run"),
             });
         }
-        let mut table = super::csv_io::read_table(path, Some(by))?;
-        let labels = table.labels.take().unwrap_or_default();
-        if let Some(k) = table.names.iter().position(|n| n == by) {
-            table.names.remove(k);
-            table.columns.remove(k);
-        }
-        table.text.retain(|(n, _)| n != by);
-        if let Some(row) = labels.rows.iter().position(|&k| labels.values[k as usize].is_empty()) {
-            return Err(DataError::Io {
-                file,
-                message: format!(
-                    "row {}, column `{by}`: no label, so no run to put the row in (every row of a file of several runs names its run)",
-                    row + 1
-                ),
-            });
-        }
-        let mut groups: Vec<Vec<usize>> = vec![Vec::new(); labels.values.len()];
-        for (i, &k) in labels.rows.iter().enumerate() {
-            groups[k as usize].push(i);
-        }
-        groups
+        let table = super::csv_io::read_table(path, Some(by))?;
+        let (parts, note) = split(table, by, &file)?;
+        let runs = parts
             .into_iter()
-            .zip(&labels.values)
-            .map(|(rows, value)| {
-                let run = Table {
-                    names: table.names.clone(),
-                    columns: table.columns.iter().map(|c| rows.iter().map(|&i| c[i]).collect()).collect(),
-                    text: table.text.clone(),
-                    labels: None,
-                };
-                let origin = format!("{file} [{by}={value}]");
-                let at_file = |e: DataError| e.renumbered(|row| rows.get(row - 1).map_or(row, |&i| i + 1));
-                Ok(Frame::from_table(run, &origin, time).map_err(at_file)?.at_file_rows(rows))
+            .map(|(origin, run, rows)| {
+                let frame = Frame::from_table(run, &origin, time).map_err(|e| e.at_file_rows(&rows))?;
+                Ok(frame.at_file_rows(rows))
             })
-            .collect()
+            .collect::<Result<_, DataError>>()?;
+        Ok((runs, note))
     }
+}
+
+/// A table's rows told apart by its column `by`, whose labels it holds: a table per value, in
+/// the order the values first appear, named `FILE [by=value]`, with the rows of the file it
+/// holds (from 0), the label column left out; and what to say of them. A row without a label
+/// is refused.
+#[allow(clippy::type_complexity)]
+pub(super) fn split(
+    mut table: Table,
+    by: &str,
+    file: &str,
+) -> Result<(Vec<(String, Table, Vec<usize>)>, String), DataError> {
+    let labels = table.labels.take().unwrap_or_default();
+    if let Some(k) = table.names.iter().position(|n| n == by) {
+        table.names.remove(k);
+        table.columns.remove(k);
+    }
+    table.text.retain(|(n, _)| n != by);
+    if let Some(row) = labels.rows.iter().position(|&k| labels.values[k as usize].is_empty()) {
+        return Err(DataError::Io {
+            file: file.into(),
+            message: format!(
+                "row {}, column `{by}`: no label, so no run to put the row in (every row of a file of several runs names its run)",
+                row + 1
+            ),
+        });
+    }
+    let mut groups: Vec<Vec<usize>> = vec![Vec::new(); labels.values.len()];
+    for (i, &k) in labels.rows.iter().enumerate() {
+        groups[k as usize].push(i);
+    }
+    let named: Vec<String> = groups
+        .iter()
+        .zip(&labels.values)
+        .take(6)
+        .map(|(rows, value)| format!("{value} ({} rows)", rows.len()))
+        .collect();
+    let more = match groups.len() > named.len() {
+        true => format!(", and {} more", groups.len() - named.len()),
+        false => String::new(),
+    };
+    let count = if groups.len() == 1 { "1 run".to_string() } else { format!("{} runs", groups.len()) };
+    let note = format!("{file}: {count} told apart by `{by}`: {}{more}", named.join(", "));
+    let parts = groups
+        .into_iter()
+        .zip(&labels.values)
+        .map(|(rows, value)| {
+            let run = Table {
+                names: table.names.clone(),
+                columns: table.columns.iter().map(|c| rows.iter().map(|&i| c[i]).collect()).collect(),
+                text: table.text.clone(),
+                labels: None,
+            };
+            (format!("{file} [{by}={value}]"), run, rows)
+        })
+        .collect();
+    Ok((parts, note))
 }
 
 /// The columns of text in the file `path` (a run's label, a mode: what the runs of a file
@@ -82,7 +115,8 @@ mod tests {
     #[test]
     fn a_long_file_comes_apart_by_its_label() {
         let after = file("after.csv", "run,t,x\na,0,1\na,1,2\na,2,3\nb,0,10\nb,1,20\n");
-        let runs = Frame::read_by(&after, "t", "run").unwrap();
+        let (runs, note) = Frame::read_by(&after, "t", "run").unwrap();
+        assert!(note.ends_with("after.csv: 2 runs told apart by `run`: a (3 rows), b (2 rows)"), "{note}");
         assert_eq!(runs.len(), 2);
         assert!(runs[0].origin().ends_with("after.csv [run=a]"), "{}", runs[0].origin());
         assert_eq!(runs[0].names(), ["t", "x"]);
@@ -94,7 +128,7 @@ mod tests {
         // two vessels logged at each time stamp, a numeric label
         let mixed =
             file("mixed.csv", "t,ship,x,note\n0,1,1,calm\n0,2,5,calm\n1,1,2,calm\n1,2,6,calm\n2,1,3,calm\n");
-        let runs = Frame::read_by(&mixed, "t", "ship").unwrap();
+        let (runs, _) = Frame::read_by(&mixed, "t", "ship").unwrap();
         assert!(runs[1].origin().ends_with("[ship=2]"));
         assert_eq!(runs[0].column("x").unwrap(), [1.0, 2.0, 3.0]);
         assert_eq!(runs[1].column("x").unwrap(), [5.0, 6.0]);

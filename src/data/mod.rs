@@ -291,6 +291,12 @@ impl DataError {
         self.renumbered(|row| row + rows)
     }
 
+    /// The error of a run whose rows are `rows` of its file (from 0; a run among others in a
+    /// long file) said of the file.
+    pub fn at_file_rows(self, rows: &[usize]) -> DataError {
+        self.renumbered(|row| rows.get(row.wrapping_sub(1)).map_or(row, |&i| i + 1))
+    }
+
     /// The error of some rows of a file said of the whole file: each row number (from 1)
     /// `row` said as `file_row(row)`.
     pub fn renumbered(self, file_row: impl Fn(usize) -> usize) -> DataError {

@@ -1674,6 +1674,18 @@ fn a_long_file_of_several_runs_is_read_by_its_label() {
             assert!((got / want - 1.0).abs() < 1e-4, "{file} {name}: {got} vs {want}");
         }
     }
+    // a dataset file's run told apart the same way, its window and units applied to each
+    let dataset = "[columns]\nt = \"t [s]\"\nx = \"x [m]\"\nv = \"v [m/s]\"\nF = \"F\"\n\
+        [[runs]]\nfile = \"after.csv\"\nby = \"run\"\nfrom = 1.0\n";
+    std::fs::write(dir.join("runs.toml"), dataset).unwrap();
+    let (ok, out, err) =
+        termid(&["identify", "--model", &model, "--format", "json", "--dataset", &p("runs.toml")]);
+    assert!(
+        ok && err.contains("3 runs told apart by `run`") && err.contains("[run=zz2]: trimmed to 1 ≤ t"),
+        "{err}"
+    );
+    let found = chosen_terms(&json(&out)["v_dot"]);
+    assert!(found.iter().any(|(t, c)| t == "x" && (c + 4.0).abs() < 4e-4), "{out}");
     // what is wrong in one run is said at the file's row
     let text = std::fs::read_to_string(dir.join("interleaved.csv")).unwrap();
     let broken: Vec<String> = text

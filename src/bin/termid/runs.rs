@@ -260,8 +260,8 @@ pub fn load(data: &[PathBuf], by: Option<&str>, datasets: &[PathBuf], time: &str
     for path in data {
         let runs = match by {
             Some(by) => {
-                let runs = Frame::read_by(path, time, by)?;
-                say(&told_apart(path, by, &runs));
+                let (runs, note) = Frame::read_by(path, time, by)?;
+                say(&note);
                 runs
             }
             None => vec![Frame::read(path, time).map_err(|e| with_remedy(e, path))?],
@@ -291,28 +291,6 @@ pub fn load(data: &[PathBuf], by: Option<&str>, datasets: &[PathBuf], time: &str
         bail!("no runs: give --data FILE… or --dataset FILE");
     }
     Ok(frames)
-}
-
-/// What `--by` made of a file: its runs, by label and length.
-fn told_apart(path: &Path, by: &str, runs: &[Frame]) -> String {
-    let named: Vec<String> = runs
-        .iter()
-        .take(6)
-        .map(|f| {
-            format!(
-                "{} ({} rows)",
-                f.origin().rsplit_once(&format!("[{by}=")).map_or("", |(_, v)| v.trim_end_matches(']')),
-                f.len()
-            )
-        })
-        .collect();
-    let more = if runs.len() > named.len() {
-        format!(", and {} more", runs.len() - named.len())
-    } else {
-        String::new()
-    };
-    let count = if runs.len() == 1 { "1 run".to_string() } else { format!("{} runs", runs.len()) };
-    format!("{}: {count} told apart by `{by}`: {}{more}", path.display(), named.join(", "))
 }
 
 /// A time that starts again in a file read as one run: the file's columns of text named as
