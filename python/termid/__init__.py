@@ -876,7 +876,7 @@ def _fit_runs(data: Union[Data, Sequence[Data]], by: Optional[str]) -> List[Tupl
             raise TypeError(f"`by` tells apart the runs of a DataFrame, a dict of arrays or a table, not {type(data).__name__}")
         if by not in frame.columns:
             raise TermidError(f"no column `{by}` to tell the runs apart (columns: {', '.join(map(str, frame.columns))})")
-        return [(f"{by}={value}", rows.drop(columns=by)) for value, rows in frame.groupby(by, sort=False, dropna=False)]
+        return _grouped(frame.groupby(by, sort=False, dropna=False)) or []
     if isinstance(data, (list, tuple)):
         if not data:
             raise TermidError("no runs to fit: the list is empty")

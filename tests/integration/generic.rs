@@ -1568,6 +1568,12 @@ fn the_integral_forms_residuals_are_its_windows() {
     assert!(!said(&v), "{v}");
 }
 
+/// A forced oscillator's model file: ẋ = v given, v̇ from the candidates x, v, F, x², x³; no intercept.
+const FORCED_OSCILLATOR: &str = "[model]\nname = \"forced oscillator\"\nintercept = false\n\
+    [[states]]\nname = \"x\"\n[[states]]\nname = \"v\"\n[[inputs]]\nname = \"F\"\n\
+    [equations.x_dot]\nstate = \"x\"\nidentify = false\ncoefficients = { \"v\" = 1.0 }\n\
+    [equations.v_dot]\nstate = \"v\"\ncandidates = [\"x\", \"v\", \"F\", \"x^2\", \"x^3\"]\n";
+
 /// A model file that names no back-end takes the one an equation of motion takes on the
 /// command line and in Python (sequential thresholding), not the paper's stepwise regression:
 /// a forced oscillator ẍ = −4x − 0.2ẋ + F sampled with 2 % noise keeps its damping, where the
@@ -1591,11 +1597,7 @@ fn a_model_file_without_a_backend_keeps_every_true_term() {
     sd[2] = 0.0;
     let run = noisy_frame("run.csv", 0.01, &["x", "v", "F"], &rows, &sd, &mut Lcg(7));
     run.write_csv(&dir.join("run.csv")).unwrap();
-    let model = "[model]\nname = \"forced oscillator\"\nintercept = false\n\
-        [[states]]\nname = \"x\"\n[[states]]\nname = \"v\"\n[[inputs]]\nname = \"F\"\n\
-        [equations.x_dot]\nstate = \"x\"\nidentify = false\ncoefficients = { \"v\" = 1.0 }\n\
-        [equations.v_dot]\nstate = \"v\"\ncandidates = [\"x\", \"v\", \"F\", \"x^2\", \"x^3\"]\n";
-    std::fs::write(dir.join("m.toml"), model).unwrap();
+    std::fs::write(dir.join("m.toml"), FORCED_OSCILLATOR).unwrap();
     let p = |f: &str| dir.join(f).display().to_string();
     let (ok, out, err) =
         termid(&["identify", "--model", &p("m.toml"), "--data", &p("run.csv"), "--format", "json"]);
@@ -1645,11 +1647,7 @@ fn a_long_file_of_several_runs_is_read_by_its_label() {
     }
     std::fs::write(dir.join("after.csv"), after).unwrap();
     std::fs::write(dir.join("interleaved.csv"), interleaved).unwrap();
-    let model = "[model]\nname = \"forced oscillator\"\nintercept = false\n\
-        [[states]]\nname = \"x\"\n[[states]]\nname = \"v\"\n[[inputs]]\nname = \"F\"\n\
-        [equations.x_dot]\nstate = \"x\"\nidentify = false\ncoefficients = { \"v\" = 1.0 }\n\
-        [equations.v_dot]\nstate = \"v\"\ncandidates = [\"x\", \"v\", \"F\", \"x^2\"]\n";
-    std::fs::write(dir.join("m.toml"), model).unwrap();
+    std::fs::write(dir.join("m.toml"), FORCED_OSCILLATOR).unwrap();
     let p = |f: &str| dir.join(f).display().to_string();
     let model = p("m.toml");
     let identify = |data: &str, by: &[&str]| {

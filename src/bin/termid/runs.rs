@@ -296,10 +296,10 @@ pub fn load(data: &[PathBuf], by: Option<&str>, datasets: &[PathBuf], time: &str
 /// A time that starts again in a file read as one run: the file's columns of text named as
 /// what `--by` would tell its runs apart by.
 fn with_remedy(e: termid::data::DataError, path: &Path) -> anyhow::Error {
-    let restart = matches!(e, termid::data::DataError::TimeNotIncreasing { restart: true, .. });
-    let labels = if restart { termid::data::text_columns_of(path) } else { Vec::new() };
-    let remedy = match labels.as_slice() {
-        _ if !restart => return e.into(),
+    if !matches!(e, termid::data::DataError::TimeNotIncreasing { restart: true, .. }) {
+        return e.into();
+    }
+    let remedy = match termid::data::text_columns_of(path).as_slice() {
         [] => "`--by COLUMN` reads each value of a column that names the row's run as a run of its own"
             .to_string(),
         [one] => format!("`--by {one}` reads each value of `{one}` as a run of its own"),
