@@ -176,15 +176,30 @@ class _Columns(Dict[str, np.ndarray]):
     times: List[str] = []
 
 
+def _runs_told_apart(method: Any) -> Any:
+    """A method on runs whose error is a frame's time that starts again (runs one after
+    another in one frame) says how to hand them over: a list, or grouped by the frame's label
+    column (its first column that holds no numbers)."""
+
+    @functools.wraps(method)
+    def told(*args: Any, **kwargs: Any) -> Any:
+        try:
+            return method(*args, **kwargs)
+        except TermidError as e:
+            if "starts again" not in str(e):
+                raise
+            frames = [a for a in (*args, *kwargs.values()) if isinstance(a, pd.DataFrame)]
+            label = next((str(c) for f in frames for c in f.columns if not pd.api.types.is_numeric_dtype(f[c])), "run")
+            raise TermidError(
+                f"{e}: give them as a list of runs, or grouped by the column that names each row's run, df.groupby('{label}')"
+            ) from None
+
+    return told
+
+
 def _explained(error: TermidError, left_out: Mapping[str, str]) -> TermidError:
     """The error, with the type of a non-numeric column it names and how a term can use its
     levels (one column of 0 and 1 per level)."""
-    if "starts again" in str(error):
-        # runs one after another in one frame (a label column its tell)
-        label = next(iter(left_out), "run")
-        return TermidError(
-            f"{error}: give them as a list of runs, or grouped by the column that names each row's run, df.groupby('{label}')"
-        )
     named = [f"`{n}` holds {kind}, not numbers" for n, kind in left_out.items() if f"`{n}`" in str(error)]
     if not named:
         return error
@@ -1367,6 +1382,7 @@ class Model:
         self._native.set_coefficients(equation, rows, intercept)
 
     # ---- identification
+    @_runs_told_apart
     def identify(
         self,
         runs: Union[Data, Sequence[Data]],
@@ -1406,6 +1422,7 @@ class Model:
             raise _explained(e, left_out) from None
         return Identified(Model(native), fits)
 
+    @_runs_told_apart
     def moments(
         self,
         equation: Union[str, Sequence[str]],
@@ -1664,6 +1681,7 @@ class Model:
         frame.attrs["name"] = f"{manoeuvre}#{seed}"
         return frame
 
+    @_runs_told_apart
     def replay(self, runs: Union[Data, Sequence[Data]], *, dt: Optional[float] = None, integrator: Optional[str] = None, with_intercept: bool = False) -> List[pd.DataFrame]:
         """Each of ``runs`` re-simulated from its recorded initial state with its recorded
         inputs (``dt``, ``integrator``, ``with_intercept`` as for :meth:`simulate`).
@@ -1675,6 +1693,7 @@ class Model:
         """
         return [_frame(c) for c in self._native.replay(_runs(runs, time=self.time), dt, integrator, with_intercept)]
 
+    @_runs_told_apart
     def validate(
         self,
         runs: Union[Data, Sequence[Data]],
@@ -1778,6 +1797,7 @@ class Model:
             }
         return frame
 
+    @_runs_told_apart
     def diagnose(
         self,
         runs: Union[Data, Sequence[Data]],
@@ -1826,6 +1846,7 @@ class Model:
         }
         return before, model
 
+    @_runs_told_apart
     def recipe(
         self,
         runs: Union[Data, Sequence[Data]],
@@ -1900,6 +1921,7 @@ class Model:
         )
         return Recipe(Model(native), json.loads(text_json), text)
 
+    @_runs_told_apart
     def estimate(
         self,
         runs: Union[Data, Sequence[Data]],
@@ -2099,6 +2121,7 @@ class Model:
             )
         return table, Model(native)
 
+    @_runs_told_apart
     def checks(self, runs: Union[Data, Sequence[Data], None] = None) -> pd.DataFrame:
         """The plug-in's physical checks (stability, damping signs, turning circles), with
         ``runs`` to compare against where a check needs them.
@@ -2109,6 +2132,7 @@ class Model:
         """
         return pd.DataFrame(json.loads(self._native.checks(_runs(runs, time=self.time) if runs is not None else [])))
 
+    @_runs_told_apart
     def steering_gear(self, runs: Union[Data, Sequence[Data]]) -> Optional[Dict[str, float]]:
         """The steering gear a ship model's zigzag ``runs`` show: ``delay_s`` (the dead time from
         the heading passing the check angle to the rudder starting back), ``acceleration_deg_s2``
