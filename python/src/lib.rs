@@ -59,6 +59,18 @@ fn time_like(names: Vec<String>) -> Option<String> {
     names.into_iter().find(|n| termid::data::looks_like_time(n))
 }
 
+/// Whether rows labelled `labels` (each row's value as an index) are several runs
+/// interleaved, the readings `columns` far smoother along each value's rows: the number of
+/// runs and of changes where they are (the command line's rule).
+#[pyfunction]
+fn interleaved(
+    labels: Vec<u32>,
+    columns: Vec<numpy::PyReadonlyArray1<'_, f64>>,
+) -> PyResult<Option<(usize, usize)>> {
+    let columns: Vec<&[f64]> = columns.iter().map(|c| c.as_slice()).collect::<Result<_, _>>()?;
+    Ok(termid::data::interleaved(&labels, &columns))
+}
+
 #[pymodule]
 fn _termid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("TermidError", m.py().get_type::<TermidError>())?;
@@ -71,5 +83,6 @@ fn _termid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(version, m)?)?;
     m.add_function(wrap_pyfunction!(monte_carlo_refusal, m)?)?;
     m.add_function(wrap_pyfunction!(time_like, m)?)?;
+    m.add_function(wrap_pyfunction!(interleaved, m)?)?;
     Ok(())
 }

@@ -233,7 +233,29 @@ def _columns(data: Data) -> "_Columns":
         found.times = [str(k) for k, v in data.items() if _is_time(np.asarray(_naive(v)))]
     elif hasattr(data, "column_names") and hasattr(data, "schema"):  # pyarrow Table
         found.times = [f.name for f in data.schema if str(f.type).startswith(("timestamp", "duration"))]
+    if isinstance(data, pd.DataFrame) and found.left_out:
+        _refuse_interleaved(data, found)
     return found
+
+
+def _refuse_interleaved(data: pd.DataFrame, found: "_Columns") -> None:
+    """Refuses the rows of several runs interleaved in one frame (two vessels logged in turn,
+    time increasing throughout), which would read as one run whose readings leap at every row:
+    a column left out that names each row's run (the command line's rule,
+    :func:`_termid.interleaved`)."""
+    readings = [np.ascontiguousarray(v, dtype=np.float64) for v in found.values()]
+    for name in found.left_out:
+        codes, values = pd.factorize(data[name])
+        if len(values) < 2 or (codes < 0).any():
+            continue
+        told = _termid.interleaved(codes.astype(np.uint32).tolist(), readings)
+        if told is not None:
+            runs, changes = told
+            raise TermidError(
+                f"the rows are those of {runs} runs interleaved (`{name}` changes at {changes} of {len(codes)} rows, "
+                f"and the readings run smoothly along each value's rows, not along the frame's): give them as a list of "
+                f"runs, or grouped, df.groupby('{name}')"
+            )
 
 
 def _columns_of(data: Data) -> "_Columns":

@@ -306,6 +306,12 @@ def test_several_runs_are_fitted_together_never_across_their_seams():
     assert dict(zip(found["term"], found["value"].round(6))) == {"x": -4.0, "v": -0.3}
     gaps = model.identify(long.groupby("experiment")).model.validate(long.groupby("experiment"))
     assert sorted(gaps.index.get_level_values("run").unique()) == ["experiment=a", "experiment=b", "experiment=c"]
+    # two runs logged in turn, their time increasing throughout, would read as one run whose
+    # readings leap at every row: refused, the label column named
+    turns = pd.concat([runs[0], runs[1].assign(t=runs[1].t + 0.005)]).sort_values("t", ignore_index=True)
+    with pytest.raises(termid.TermidError, match=r"2 runs interleaved \(`experiment` changes at 2999 of 3000 rows.*df.groupby\('experiment'\)"):
+        termid.fit(turns, "dv/dt", ["x", "v"])
+    assert termid.fit(turns.groupby("experiment"), "dv/dt", ["x", "v", "x^2"]).coefficients.sort_index().round(6).to_dict() == truth
     for method in (model.identify, model.validate):
         with pytest.raises(termid.TermidError, match=r"row 1501.*df.groupby\('experiment'\)"):
             method(long)

@@ -35,9 +35,8 @@ pub(super) struct Batches {
     rows: usize,
     /// The first batch, read to learn the names.
     first: Option<RecordBatch>,
-    /// The column whose cells are kept as labels, and those kept.
-    label: Option<usize>,
-    labels: super::stream::Labels,
+    /// The columns whose cells are kept as labels (where they are in a batch), and those kept.
+    labels: Vec<(usize, String, super::stream::Labels)>,
 }
 
 impl Batches {
@@ -106,8 +105,7 @@ impl Batches {
             file,
             rows: 0,
             first: Some(first),
-            label: None,
-            labels: Default::default(),
+            labels: Vec::new(),
         })
     }
 }
@@ -218,9 +216,8 @@ impl super::stream::RowSource for Batches {
             for (k, (&c, name)) in self.keep.iter().zip(&self.names).enumerate() {
                 append(&mut columns[k], batch.column(c).as_ref(), &self.file, name, self.rows)?;
             }
-            if let Some(c) = self.label {
-                let name = &self.header[c];
-                label_cells(&mut self.labels, batch.column(c).as_ref(), &self.file, name, self.rows)?;
+            for (c, name, labels) in &mut self.labels {
+                label_cells(labels, batch.column(*c).as_ref(), &self.file, name, self.rows)?;
             }
             self.rows += batch.num_rows();
             n += batch.num_rows();
@@ -233,12 +230,13 @@ impl super::stream::RowSource for Batches {
     }
 
     fn label_by(&mut self, name: &str) -> bool {
-        self.label = self.header.iter().position(|h| h == name);
-        self.label.is_some()
+        let Some(c) = self.header.iter().position(|h| h == name) else { return false };
+        self.labels.push((c, name.to_string(), Default::default()));
+        true
     }
 
-    fn take_labels(&mut self) -> super::stream::Labels {
-        std::mem::take(&mut self.labels)
+    fn take_labels(&mut self) -> Vec<(String, super::stream::Labels)> {
+        std::mem::take(&mut self.labels).into_iter().map(|(_, name, labels)| (name, labels)).collect()
     }
 }
 

@@ -41,8 +41,11 @@ impl Frame {
 
     /// Reads a run by its file's extension: Parquet (`.parquet`, `.pq`) and Arrow IPC
     /// (`.arrow`, `.feather`, `.ipc`) with the `columnar` feature, CSV otherwise.
+    /// Rows of several runs interleaved (told by a column of text) are refused, naming it.
     pub fn read(path: &Path, time: &str) -> Result<Frame, DataError> {
-        Frame::from_table(read_table(path, None)?, &path.display().to_string(), time)
+        let (table, file) = (read_table(path, None)?, path.display().to_string());
+        super::long::refuse_interleaved(&table, &file)?;
+        Frame::from_table(table, &file, time)
     }
 
     /// Parses CSV text; `origin` names it in errors.

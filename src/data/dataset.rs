@@ -494,7 +494,10 @@ impl Dataset {
                     notes.push(note);
                     parts.into_iter().map(|(origin, table, rows)| (origin, table, Some(rows))).collect()
                 }
-                None => vec![(origin.clone(), table, None)],
+                None => {
+                    super::long::refuse_interleaved(&table, &origin)?;
+                    vec![(origin.clone(), table, None)]
+                }
             };
             for (origin, table, rows) in parts {
                 let at_file = |e: DataError| match &rows {

@@ -44,7 +44,8 @@ pub(super) fn split(
     by: &str,
     file: &str,
 ) -> Result<(Vec<(String, Table, Vec<usize>)>, String), DataError> {
-    let labels = table.labels.take().unwrap_or_default();
+    let k = table.labels.iter().position(|(n, _)| n == by).unwrap_or(table.labels.len());
+    let labels = if k < table.labels.len() { table.labels.remove(k).1 } else { Default::default() };
     if let Some(k) = table.names.iter().position(|n| n == by) {
         table.names.remove(k);
         table.columns.remove(k);
@@ -83,12 +84,66 @@ pub(super) fn split(
                 names: table.names.clone(),
                 columns: table.columns.iter().map(|c| rows.iter().map(|&i| c[i]).collect()).collect(),
                 text: table.text.clone(),
-                labels: None,
+                labels: Vec::new(),
             };
             (format!("{file} [{by}={value}]"), run, rows)
         })
         .collect();
     Ok((parts, note))
+}
+
+/// Refuses the rows of several runs interleaved in one table read as one run (two vessels
+/// logged in turn, time increasing throughout), naming the column of text that tells them
+/// apart ([`interleaved`]).
+pub(super) fn refuse_interleaved(table: &Table, file: &str) -> Result<(), DataError> {
+    let columns: Vec<&[f64]> = table.columns.iter().map(Vec::as_slice).collect();
+    for (column, labels) in &table.labels {
+        if let Some((runs, changes)) = interleaved(&labels.rows, &columns) {
+            let rows = labels.rows.len();
+            return Err(DataError::Interleaved {
+                file: file.into(),
+                column: column.clone(),
+                runs,
+                changes,
+                rows,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Whether rows labelled `labels` (each row's value, as an index) are those of several runs
+/// interleaved: a few values that change at over a tenth of the rows, and the readings
+/// (`columns`; a column that always increases, the time, aside) far smoother along each
+/// value's rows than along all of them, which a mode or a status that flips within one run
+/// does not make them. The number of runs and of changes where they are.
+pub fn interleaved(labels: &[u32], columns: &[&[f64]]) -> Option<(usize, usize)> {
+    let rows = labels.len();
+    let runs = labels.iter().max().map_or(0, |&k| k as usize + 1);
+    let changes = labels.windows(2).filter(|w| w[0] != w[1]).count();
+    if runs < 2 || runs > 50.min(rows / 20) || changes * 10 < rows {
+        return None;
+    }
+    // Σ of squared second differences: a reading's roughness along some of its rows
+    let rough = |x: &[f64], at: &mut dyn Iterator<Item = usize>| {
+        let v: Vec<f64> = at.map(|i| x[i]).collect();
+        v.windows(3).map(|w| (w[2] - 2.0 * w[1] + w[0]).powi(2)).sum::<f64>()
+    };
+    let mut groups: Vec<Vec<usize>> = vec![Vec::new(); runs];
+    for (i, &k) in labels.iter().enumerate() {
+        groups[k as usize].push(i);
+    }
+    let readings: Vec<&[f64]> =
+        columns.iter().copied().filter(|c| c.len() == rows && c.windows(2).any(|w| w[1] <= w[0])).collect();
+    let smoother = readings
+        .iter()
+        .filter(|x| {
+            let along_file = rough(x, &mut (0..rows));
+            let along_runs: f64 = groups.iter().map(|g| rough(x, &mut g.iter().copied())).sum();
+            along_file > 100.0 * along_runs
+        })
+        .count();
+    (!readings.is_empty() && 2 * smoother > readings.len()).then_some((runs, changes))
 }
 
 /// The columns of text in the file `path` (a run's label, a mode: what the runs of a file
@@ -135,6 +190,28 @@ mod tests {
         assert_eq!((runs[0].row(2), runs[1].row(1)), (5, 4));
         assert_eq!(runs[1].slice(1..2).row(0), 4);
         assert_eq!(runs[0].text_columns()[0].0, "note");
+    }
+
+    /// Two runs logged in turn, time increasing throughout, are refused as one run, their
+    /// label column named; a status that flips within one run is no such label.
+    #[test]
+    fn runs_interleaved_are_refused_as_one() {
+        let mut two = String::from("t,x,ship\n");
+        let mut flips = String::from("t,x,status\n");
+        for i in 0..400 {
+            let t = i as f64 * 0.01;
+            two += &format!("{t},{},a\n{},{},b\n", t.sin(), t + 0.005, 5.0 + (t + 0.005).cos());
+            flips += &format!("{t},{},{}\n", t.sin(), if (i * 7) % 3 == 0 { "ok" } else { "slow" });
+        }
+        let e = Frame::read(&file("two.csv", &two), "t").unwrap_err().to_string();
+        assert!(
+            e.contains("2 runs interleaved (`ship` changes at 799 of 800 rows") && e.contains("--by ship"),
+            "{e}"
+        );
+        let (runs, _) = Frame::read_by(&file("two.csv", &two), "t", "ship").unwrap();
+        assert_eq!(runs.len(), 2);
+        let one = Frame::read(&file("flips.csv", &flips), "t").unwrap();
+        assert_eq!(one.len(), 400);
     }
 
     /// What is wrong in one run is said at the file's row; a missing label, or no such

@@ -37,7 +37,7 @@ pub use geodetic::{north_east, radii_of_curvature};
 pub use hold::{held, mark_held, switches, Hold, Intersample};
 pub use integral::{integral_rows, integral_rows_held, IntegralForm};
 pub use kalman::{KalmanSmoother, NoiseModel};
-pub use long::text_columns_of;
+pub use long::{interleaved, text_columns_of};
 pub use prepare::{prepare, Preparation};
 pub use repeated::{
     between_readings, fits_better_held, kinks_at_changes, read_at_readings, repeated, Repeats,
@@ -212,6 +212,20 @@ pub enum DataError {
         column: String,
         /// What is wrong.
         message: String,
+    },
+    /// The rows of several runs interleaved (two vessels logged in turn), read as one run.
+    #[error("{file}: the rows are those of {runs} runs interleaved (`{column}` changes at {changes} of {rows} rows, and the readings run smoothly along each value's rows, not along the file's): read each as a run of its own, `--by {column}` (a dataset file's run: `by = \"{column}\"`; Python: df.groupby('{column}'))")]
+    Interleaved {
+        /// The file.
+        file: String,
+        /// The column of text that names each row's run.
+        column: String,
+        /// How many values it takes.
+        runs: usize,
+        /// At how many rows it changes.
+        changes: usize,
+        /// The file's rows.
+        rows: usize,
     },
     /// A step in time far beyond the run's usual spacing.
     #[error("{file}: row {row}, column `{column}`: time jumps by {step:.4} (usual step {median:.4}): a gap in the record")]

@@ -22,13 +22,14 @@ pub trait RowSource {
         &[]
     }
     /// From now on, keeps each row's cell of column `name` (of numbers or of text) as a
-    /// label ([`Labels`]); false where the source has no such column or cannot.
+    /// label ([`Labels`]), besides those asked for before; false where the source has no such
+    /// column or cannot.
     fn label_by(&mut self, _name: &str) -> bool {
         false
     }
-    /// The labels kept since [`RowSource::label_by`].
-    fn take_labels(&mut self) -> Labels {
-        Labels::default()
+    /// The labels kept since [`RowSource::label_by`], by column.
+    fn take_labels(&mut self) -> Vec<(String, Labels)> {
+        Vec::new()
     }
 }
 
@@ -61,8 +62,9 @@ pub(super) struct Table {
     pub names: Vec<String>,
     pub columns: Vec<Vec<f64>>,
     pub text: Vec<(String, String)>,
-    /// The cells of the column the rows were told apart by, where one was asked for.
-    pub labels: Option<Labels>,
+    /// The cells of the columns of text, and of the column the rows are told apart by where
+    /// one was asked for, by column.
+    pub labels: Vec<(String, Labels)>,
 }
 
 /// A piece of a run.
@@ -279,9 +281,8 @@ pub(super) struct CsvRows<'a> {
     record: csv::ByteRecord,
     /// The first row, read to tell text columns from numbers, is in `record`, not yet given.
     pending: bool,
-    /// The column whose cells are kept as labels, and those kept.
-    label: Option<usize>,
-    labels: Labels,
+    /// The columns whose cells are kept as labels (where they are in a row), and those kept.
+    labels: Vec<(usize, String, Labels)>,
 }
 
 /// Cells that say a reading is missing, not that the column holds text.
@@ -366,8 +367,7 @@ impl<'a> CsvRows<'a> {
             row: 0,
             record,
             pending,
-            label: None,
-            labels: Labels::default(),
+            labels: Vec::new(),
         })
     }
 }
@@ -407,8 +407,8 @@ impl RowSource for CsvRows<'_> {
                 })?;
                 columns[k].push(v);
             }
-            if let Some(c) = self.label {
-                self.labels.push(&String::from_utf8_lossy(self.record[c].trim_ascii()));
+            for (c, _, labels) in &mut self.labels {
+                labels.push(&String::from_utf8_lossy(self.record[*c].trim_ascii()));
             }
             n += 1;
         }
@@ -420,12 +420,13 @@ impl RowSource for CsvRows<'_> {
     }
 
     fn label_by(&mut self, name: &str) -> bool {
-        self.label = self.header.iter().position(|h| h == name);
-        self.label.is_some()
+        let Some(c) = self.header.iter().position(|h| h == name) else { return false };
+        self.labels.push((c, name.to_string(), Labels::default()));
+        true
     }
 
-    fn take_labels(&mut self) -> Labels {
-        std::mem::take(&mut self.labels)
+    fn take_labels(&mut self) -> Vec<(String, Labels)> {
+        std::mem::take(&mut self.labels).into_iter().map(|(_, name, labels)| (name, labels)).collect()
     }
 }
 
@@ -467,8 +468,8 @@ pub(super) fn time_index(
     names.iter().position(|n| n == time).ok_or_else(|| DataError::missing_time(origin, time, names))
 }
 
-/// Every row of a source, as whole columns; with `by`, each row's cell of that column kept
-/// as its label (refused where the source has no such column).
+/// Every row of a source, as whole columns, the cells of its columns of text kept as labels;
+/// with `by`, those of that column too (refused where the source has no such column).
 pub(super) fn read_all(
     mut source: impl RowSource,
     origin: &str,
@@ -489,9 +490,14 @@ pub(super) fn read_all(
             });
         }
     }
+    let text: Vec<String> =
+        source.text().iter().map(|(n, _)| n.clone()).filter(|n| Some(n.as_str()) != by).collect();
+    for name in text {
+        source.label_by(&name);
+    }
     let mut columns = vec![Vec::new(); source.names().len()];
     while source.read(65_536, &mut columns)? > 0 {}
-    let labels = by.map(|_| source.take_labels());
+    let labels = source.take_labels();
     Ok(Table { names: source.names().to_vec(), columns, text: source.text().to_vec(), labels })
 }
 
