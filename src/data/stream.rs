@@ -47,11 +47,23 @@ pub struct Labels {
 impl Labels {
     /// Adds a row's cell.
     pub fn push(&mut self, cell: &str) {
-        let next = self.values.len() as u32;
-        let k = *self.index.entry(cell.to_string()).or_insert(next);
-        if k == next {
-            self.values.push(cell.to_string());
+        // most rows repeat the row before's value (a run's rows together): compared first,
+        // then a value seen before looked up without a copy of its text
+        if let Some(&last) = self.rows.last() {
+            if self.values[last as usize] == cell {
+                self.rows.push(last);
+                return;
+            }
         }
+        let k = match self.index.get(cell) {
+            Some(&k) => k,
+            None => {
+                let k = self.values.len() as u32;
+                self.index.insert(cell.to_string(), k);
+                self.values.push(cell.to_string());
+                k
+            }
+        };
         self.rows.push(k);
     }
 }
