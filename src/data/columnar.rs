@@ -16,11 +16,6 @@ use arrow_schema::{DataType, TimeUnit};
 
 use super::DataError;
 
-/// The numeric columns of a Parquet or Arrow IPC file by name, and those of text.
-pub(super) fn read_columns(path: &Path, by: Option<&str>) -> Result<super::stream::Table, DataError> {
-    super::stream::read_all(Batches::open(path)?, &path.display().to_string(), by)
-}
-
 /// A Parquet or Arrow IPC file's rows, record batch by record batch.
 pub(super) struct Batches {
     batches: Box<dyn Iterator<Item = Result<RecordBatch, String>>>,

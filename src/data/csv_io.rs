@@ -92,20 +92,13 @@ impl Frame {
 /// extension, else CSV text; with `by`, each row's cell of that column as its label.
 pub(super) fn read_table(path: &Path, by: Option<&str>) -> Result<Table, DataError> {
     let file = path.display().to_string();
-    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    if matches!(ext.as_deref(), Some("parquet" | "pq" | "arrow" | "feather" | "ipc")) {
-        #[cfg(feature = "columnar")]
-        return super::columnar::read_columns(path, by);
-        #[cfg(not(feature = "columnar"))]
-        return Err(DataError::Io {
-            file,
-            message: "a columnar file: termid was built without the `columnar` feature".into(),
-        });
+    if super::stream::is_columnar(path) {
+        return super::stream::read_all(super::stream::rows_of(path)?.as_mut(), &file, by);
     }
     // read as it is parsed: the numbers in memory, not the text as well
     crate::budget::file_size(path)
         .map_err(|e| DataError::Io { file: file.clone(), message: e.to_string() })?;
-    super::stream::read_all(super::stream::csv_rows(path)?, &file, by).map_err(|e| {
+    super::stream::read_all(&mut super::stream::csv_rows(path)?, &file, by).map_err(|e| {
         let head = || {
             use std::io::Read;
             let mut head = Vec::new();
@@ -149,7 +142,7 @@ pub(super) fn not_data(e: DataError, file: &str, head: impl FnOnce() -> Vec<u8>)
 /// The header and the numeric columns of CSV text, every cell checked.
 pub(super) fn parse_table(text: &str, origin: &str, by: Option<&str>) -> Result<Table, DataError> {
     super::stream::CsvRows::new(text.as_bytes(), origin)
-        .and_then(|rows| super::stream::read_all(rows, origin, by))
+        .and_then(|mut rows| super::stream::read_all(&mut rows, origin, by))
         .map_err(|e| not_data(e, origin, || text.as_bytes()[..text.len().min(HEAD as usize)].to_vec()))
 }
 

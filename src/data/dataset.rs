@@ -551,11 +551,7 @@ impl Dataset {
         origin: &str,
         notes: &mut Vec<String>,
     ) -> Result<Table, DataError> {
-        let columnar = matches!(
-            path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
-            Some("parquet" | "pq" | "arrow" | "feather" | "ipc")
-        );
-        Ok(if columnar {
+        Ok(if super::stream::is_columnar(path) {
             // columnar files name their own columns
             super::csv_io::read_table(path, run.by.as_deref())?
         } else {

@@ -44,8 +44,10 @@ pub(super) fn split(
     by: &str,
     file: &str,
 ) -> Result<(Vec<(String, Table, Vec<usize>)>, String), DataError> {
-    let k = table.labels.iter().position(|(n, _)| n == by).unwrap_or(table.labels.len());
-    let labels = if k < table.labels.len() { table.labels.remove(k).1 } else { Default::default() };
+    let labels = match table.labels.iter().position(|(n, _)| n == by) {
+        Some(k) => table.labels.remove(k).1,
+        None => Default::default(),
+    };
     if let Some(k) = table.names.iter().position(|n| n == by) {
         table.names.remove(k);
         table.columns.remove(k);
@@ -60,10 +62,7 @@ pub(super) fn split(
             ),
         });
     }
-    let mut groups: Vec<Vec<usize>> = vec![Vec::new(); labels.values.len()];
-    for (i, &k) in labels.rows.iter().enumerate() {
-        groups[k as usize].push(i);
-    }
+    let groups = rows_of_each(&labels.rows, labels.values.len());
     let named: Vec<String> = groups
         .iter()
         .zip(&labels.values)
@@ -129,10 +128,7 @@ pub fn interleaved(labels: &[u32], columns: &[&[f64]]) -> Option<(usize, usize)>
         let v: Vec<f64> = at.map(|i| x[i]).collect();
         v.windows(3).map(|w| (w[2] - 2.0 * w[1] + w[0]).powi(2)).sum::<f64>()
     };
-    let mut groups: Vec<Vec<usize>> = vec![Vec::new(); runs];
-    for (i, &k) in labels.iter().enumerate() {
-        groups[k as usize].push(i);
-    }
+    let groups = rows_of_each(labels, runs);
     let readings: Vec<&[f64]> =
         columns.iter().copied().filter(|c| c.len() == rows && c.windows(2).any(|w| w[1] <= w[0])).collect();
     let smoother = readings
@@ -144,6 +140,15 @@ pub fn interleaved(labels: &[u32], columns: &[&[f64]]) -> Option<(usize, usize)>
         })
         .count();
     (!readings.is_empty() && 2 * smoother > readings.len()).then_some((runs, changes))
+}
+
+/// The rows (from 0) of each of `values` labels, in order, from each row's label.
+fn rows_of_each(labels: &[u32], values: usize) -> Vec<Vec<usize>> {
+    let mut rows = vec![Vec::new(); values];
+    for (i, &k) in labels.iter().enumerate() {
+        rows[k as usize].push(i);
+    }
+    rows
 }
 
 /// The columns of text in the file `path` (a run's label, a mode: what the runs of a file

@@ -254,11 +254,15 @@ impl<R: Read> Read for LineLimit<R> {
     }
 }
 
-/// The CSV rows of the file at `path`, read as they are needed.
+/// Whether the file `path` is Parquet or Arrow IPC by its extension (else CSV text).
+pub(super) fn is_columnar(path: &Path) -> bool {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    matches!(ext.as_deref(), Some("parquet" | "pq" | "arrow" | "feather" | "ipc"))
+}
+
 /// The rows of the file `path`: Parquet or Arrow IPC by its extension, else CSV text.
 pub(super) fn rows_of(path: &Path) -> Result<Box<dyn RowSource>, DataError> {
-    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    if matches!(ext.as_deref(), Some("parquet" | "pq" | "arrow" | "feather" | "ipc")) {
+    if is_columnar(path) {
         #[cfg(feature = "columnar")]
         return Ok(Box::new(super::columnar::Batches::open(path)?));
         #[cfg(not(feature = "columnar"))]
@@ -270,6 +274,7 @@ pub(super) fn rows_of(path: &Path) -> Result<Box<dyn RowSource>, DataError> {
     Ok(Box::new(csv_rows(path)?))
 }
 
+/// The CSV rows of the file at `path`, read as they are needed.
 pub(super) fn csv_rows(path: &Path) -> Result<CsvRows<'static>, DataError> {
     let origin = path.display().to_string();
     let file = std::fs::File::open(path)
@@ -483,7 +488,7 @@ pub(super) fn time_index(
 /// Every row of a source, as whole columns, the cells of its columns of text kept as labels;
 /// with `by`, those of that column too (refused where the source has no such column).
 pub(super) fn read_all(
-    mut source: impl RowSource,
+    source: &mut dyn RowSource,
     origin: &str,
     by: Option<&str>,
 ) -> Result<Table, DataError> {
