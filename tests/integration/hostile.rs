@@ -309,6 +309,27 @@ fn simulate_options_are_honoured_or_refused() {
     }
 }
 
+/// An option that needs `--model` is refused without one, whatever else is given: clap let
+/// `identify --terms-file q.txt --out m.toml` run without it (the conflict of `--model` with
+/// `--terms` bypassed the requirement), and nothing was written, nothing said.
+#[test]
+fn options_that_need_a_model_are_refused_without_one() {
+    let plain =
+        ["identify", "--data", "tests/data/hald.csv", "--no-time", "--target", "y", "--terms", "x1", "x2"];
+    for extra in
+        [&["--out", "never.toml"][..], &["--equation", "y"], &["--keep-unphysical"], &["--chunk-rows", "10"]]
+    {
+        let mut args = plain.to_vec();
+        args.extend(extra);
+        refused(&args, &["--model"]);
+    }
+    assert!(!std::path::Path::new("never.toml").exists());
+    refused(
+        &["identify", "--data", "tests/data/hald.csv", "--model", "models/lorenz.toml", "--terms", "x"],
+        &["--terms cannot be used with --model"],
+    );
+}
+
 /// Item 9: data the dataset path refuses is refused on the plain path too; a refinement of no
 /// state, a rate in degrees declared in radians and a mapping to an unknown variable.
 #[test]

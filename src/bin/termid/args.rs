@@ -252,7 +252,7 @@ pub struct IdentifyCommand {
     pub by: Option<String>,
     /// With --model: identify from statistics written by `termid moments` instead of runs
     /// (several files are merged; each names its equation).
-    #[arg(long, num_args = 1.., requires = "model", conflicts_with_all = ["data", "dataset", "refine", "choose"])]
+    #[arg(long, num_args = 1.., requires = "model")]
     pub moments: Vec<PathBuf>,
     /// Name of the time column.
     #[arg(long, default_value = "t")]
@@ -270,7 +270,7 @@ pub struct IdentifyCommand {
     #[arg(long, num_args = 1.., required_unless_present_any = ["terms_file", "model"])]
     pub terms: Vec<String>,
     /// Take vocabulary, candidates, forced terms and back-end from a model file.
-    #[arg(long, conflicts_with_all = ["terms", "terms_file", "params", "derived", "aliases"])]
+    #[arg(long)]
     pub model: Option<PathBuf>,
     /// With --model: the equation(s) to identify (default: all that are identifiable).
     #[arg(long, num_args = 1.., requires = "model")]
@@ -437,7 +437,7 @@ pub struct IdentifyCommand {
     #[arg(long)]
     pub intercept: bool,
     /// Weighted least squares with the row weights in this column.
-    #[arg(long, conflicts_with = "model")]
+    #[arg(long)]
     pub weight: Option<String>,
     /// Stepwise: stop when the next term's share of the total sum of squares is below this.
     #[arg(allow_negative_numbers = true, long, default_value_t = 0.0)]
@@ -451,6 +451,58 @@ pub struct IdentifyCommand {
     /// Output format.
     #[arg(long, value_enum, default_value = "text")]
     pub format: Format,
+}
+
+impl IdentifyCommand {
+    /// Options given together that cannot be: checked here, not declared to clap, since a
+    /// conflict declared on an option that another `requires` makes clap pass that
+    /// requirement unchecked (its issue 4520: `identify --terms x --out m.toml` ran without
+    /// `--model` and wrote nothing, without a word).
+    pub fn refuse_conflicts(&self) -> Result<(), String> {
+        let with_model = [
+            (
+                "--terms",
+                !self.terms.is_empty(),
+                "the candidates are each equation's `candidates` in the model file",
+            ),
+            (
+                "--terms-file",
+                self.terms_file.is_some(),
+                "the candidates are each equation's `candidates` in the model file",
+            ),
+            (
+                "--param",
+                !self.params.is_empty(),
+                "declare parameters in the model file (`[parameters.NAME]`, `per_run = \"mean:u\"`)",
+            ),
+            (
+                "--derive",
+                !self.derived.is_empty(),
+                "declare derived variables in the model file (`[[derived]]`)",
+            ),
+            ("--alias", !self.aliases.is_empty(), "declare aliases in the model file (`[aliases]`)"),
+            ("--weight", self.weight.is_some(), "row weights apply to one equation without a model file"),
+        ];
+        if self.model.is_some() {
+            if let Some((flag, _, why)) = with_model.iter().find(|(_, given, _)| *given) {
+                return Err(format!("{flag} cannot be used with --model: {why}"));
+            }
+        }
+        if !self.moments.is_empty() {
+            let runs = [
+                ("--data", !self.data.is_empty()),
+                ("--dataset", !self.dataset.is_empty()),
+                ("--refine", self.refine.is_some()),
+                ("--choose", self.choose.is_some()),
+            ];
+            if let Some((flag, _)) = runs.iter().find(|(_, given)| *given) {
+                return Err(format!(
+                    "{flag} cannot be used with --moments: the statistics stand for the runs, and re-simulating or leaving runs out needs the runs themselves"
+                ));
+            }
+        }
+        Ok(())
+    }
 }
 
 /// `termid simulate`.
@@ -686,4 +738,52 @@ pub struct ResimArgs {
     /// Include each equation's stored intercept b0 in the simulation.
     #[arg(long)]
     pub with_intercept: bool,
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::CommandFactory;
+
+    /// clap skips an option's `requires` where the required option conflicts with one given
+    /// (its issue 4520), so no option another requires may declare or be named in a conflict:
+    /// such pairs are refused after parsing instead ([`super::IdentifyCommand::refuse_conflicts`]).
+    #[test]
+    fn no_option_another_requires_is_in_a_conflict() {
+        let source = include_str!("args.rs");
+        let required: Vec<&str> =
+            source.split("requires = \"").skip(1).filter_map(|rest| rest.split('"').next()).collect();
+        assert!(required.contains(&"model") && required.contains(&"data"), "{required:?}");
+        let cli = super::Cli::command();
+        for sub in cli.get_subcommands() {
+            for arg in sub.get_arguments() {
+                let conflicts: Vec<String> =
+                    sub.get_arg_conflicts_with(arg).iter().map(|a| a.get_id().to_string()).collect();
+                let named = |id: &str| required.contains(&id);
+                assert!(
+                    conflicts.is_empty()
+                        || !(named(arg.get_id().as_str()) || conflicts.iter().any(|c| named(c))),
+                    "{} --{} conflicts with {conflicts:?}, and others require one of them",
+                    sub.get_name(),
+                    arg.get_id()
+                );
+            }
+        }
+    }
+
+    /// What clap would have refused is refused after parsing, with the reason.
+    #[test]
+    fn identify_refuses_options_that_do_not_go_together() {
+        let parse = |line: &str| match super::Cli::try_parse_from(line.split_whitespace()) {
+            Ok(super::Cli { command: super::Command::Identify(cmd) }) => cmd.refuse_conflicts(),
+            other => panic!("{line}: {other:?}"),
+        };
+        use clap::Parser;
+        assert!(parse("termid identify --data d.csv --target dx/dt --terms x").is_ok());
+        let e = parse("termid identify --data d.csv --model m.toml --terms x").unwrap_err();
+        assert!(e.contains("--terms cannot be used with --model"), "{e}");
+        let e = parse("termid identify --data d.csv --model m.toml --weight w").unwrap_err();
+        assert!(e.starts_with("--weight"), "{e}");
+        let e = parse("termid identify --model m.toml --moments a.json --data d.csv").unwrap_err();
+        assert!(e.starts_with("--data cannot be used with --moments"), "{e}");
+    }
 }
