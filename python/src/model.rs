@@ -213,6 +213,25 @@ impl PyModel {
         Ok((PyModel { inner: model }, to_json(&estimates)?, particulars.cautions()))
     }
 
+    /// The model of a system named by its columns (`termid::model::Outline`): an equation
+    /// for each state's rate over the same `candidates`, or every monomial of the states and
+    /// inputs to `degree` where none is named.
+    #[staticmethod]
+    #[pyo3(signature = (states, inputs, candidates, degree, time, name))]
+    fn from_states(
+        states: Vec<String>,
+        inputs: Vec<String>,
+        candidates: Vec<String>,
+        degree: u32,
+        time: String,
+        name: String,
+    ) -> PyResult<Self> {
+        let outline =
+            termid::model::Outline { name, time, states, inputs, candidates, degree, backend: None };
+        let model = outline.model("Model.from_states").map_err(fail)?;
+        Ok(PyModel { inner: model })
+    }
+
     /// The names of the model files shipped inside the package.
     #[staticmethod]
     fn builtin_names() -> Vec<&'static str> {
@@ -412,7 +431,8 @@ impl PyModel {
 
     /// Every identifiable equation (or the named ones) from runs; returns the identified model
     /// and each fit as JSON.
-    #[pyo3(signature = (runs, derivative = None, equations = vec![], intercept = None, backend = None))]
+    #[pyo3(signature = (runs, derivative = None, equations = vec![], intercept = None, backend = None, start_as_first = false))]
+    #[allow(clippy::too_many_arguments)]
     fn identify(
         &self,
         py: Python<'_>,
@@ -421,6 +441,7 @@ impl PyModel {
         equations: Vec<String>,
         intercept: Option<bool>,
         backend: Option<&str>,
+        start_as_first: bool,
     ) -> PyResult<(PyModel, Vec<(String, String)>)> {
         // the defaults of `termid identify`: central differences for a plug-in's model (a
         // ship, as the paper), the integral form for any other; the model file's intercept
@@ -446,7 +467,12 @@ impl PyModel {
             .iter()
             .map(|(n, f)| Ok((n.clone(), to_json(&f.report())?)))
             .collect::<PyResult<_>>()?;
-        Ok((PyModel { inner: identified.model }, fits))
+        let model = match frames.first().filter(|_| start_as_first) {
+            // a model made from columns: simulated from where the first run starts
+            Some(first) => identified.model.starting_as(first).map_err(fail)?,
+            None => identified.model,
+        };
+        Ok((PyModel { inner: model }, fits))
     }
 
     /// The sufficient statistics of each of `equations` over runs (mergeable, picklable); the

@@ -913,7 +913,14 @@ def _fit_runs(data: Union[Data, Sequence[Data]], by: Optional[str]) -> List[Tupl
             raise TypeError(f"`by` tells apart the runs of a DataFrame, a dict of arrays or a table, not {type(data).__name__}")
         if by not in frame.columns:
             raise TermidError(f"no column `{by}` to tell the runs apart (columns: {', '.join(map(str, frame.columns))})")
-        return _grouped(frame.groupby(by, sort=False, dropna=False)) or []
+        blank = np.flatnonzero(frame[by].isna().to_numpy())
+        if len(blank):
+            # as the command line's --by: a row that names no run belongs to none
+            raise TermidError(
+                f"row {blank[0] + 1} (index {frame.index[blank[0]]!r}), column `{by}`: no label, so no run to put "
+                f"the row in (every row of a table of several runs names its run; {len(blank)} rows so): drop or label them"
+            )
+        return _grouped(frame.groupby(by, sort=False)) or []
     if isinstance(data, (list, tuple)):
         if not data:
             raise TermidError("no runs to fit: the list is empty")
@@ -1105,6 +1112,11 @@ def _particulars(particulars: Union[Mapping[str, Any], str, os.PathLike]) -> Tup
     with open(path, encoding="utf-8") as f:
         return _termid.Model.from_particulars(f.read(), False, path)
 
+def _unpickled(text: str, path: str, from_states: bool) -> "Model":
+    """A pickled :class:`Model` read back: its file's text, and whether it was made from states."""
+    return Model(_termid.Model.parse(text, path), from_states)
+
+
 class Model:
     """A termid model file: states, inputs, parameters, derived variables and equations.
 
@@ -1115,8 +1127,10 @@ class Model:
     termid.Model("Lorenz system (σ = 10, ρ = 28, β = 8/3)": 3 equations, 3 states)
     """
 
-    def __init__(self, native: Any):
+    def __init__(self, native: Any, from_states: bool = False):
         self._native = native
+        # made by from_states: identify starts its states where the first run starts
+        self._from_states = from_states
 
     # ---- files
     @staticmethod
@@ -1146,6 +1160,44 @@ class Model:
         ['x_dot', 'y_dot', 'z_dot']
         """
         return Model(_termid.Model.parse(text, name))
+
+    @staticmethod
+    def from_states(
+        states: Sequence[str],
+        inputs: Sequence[str] = (),
+        terms: Optional[Sequence[str]] = None,
+        *,
+        degree: int = 2,
+        time: str = "t",
+        name: Optional[str] = None,
+    ) -> "Model":
+        """A model of a system known only by its columns, to identify whole (as SINDy fits a
+        system): an equation for each state's rate, each over the same candidates — ``terms``
+        (text in termid's term language over the states and inputs), or every monomial of the
+        states and ``inputs`` to ``degree``, the constant among them — selected by sequential
+        thresholding (or :meth:`identify`'s ``backend``), as ``termid identify --states`` makes
+        it. ``inputs`` are the columns that drive the states (a force, a setpoint), known from
+        the runs. :meth:`identify` starts the identified model's states where the first run
+        starts, so that :meth:`simulate` retraces that run's beginning; :meth:`save` writes it.
+
+        Parameters: ``states`` the state columns; ``inputs`` the input columns; ``terms`` the
+        candidates (default: the polynomial library); ``degree`` the polynomial library's;
+        ``time`` the time column; ``name`` the model's (default: the states).
+
+        >>> truth = termid.Model.builtin("lorenz").simulate(duration=10.0, sample=0.01)
+        >>> found = termid.Model.from_states(["x", "y", "z"]).identify(truth[["t", "x", "y", "z"]])
+        >>> found.model.coefficients("z_dot")[["term", "value"]].round(3).values.tolist()
+        [['x*y', 1.0], ['z', -2.667]]
+        >>> again = found.model.simulate(duration=1.0, sample=0.01)
+        >>> float(abs(again["x"].iloc[-1] - truth["x"].iloc[100])) < 1e-3
+        True
+        """
+        if isinstance(states, str) or isinstance(inputs, str) or isinstance(terms, str):
+            raise TypeError("states, inputs and terms are lists of names (['x', 'y']), not one string")
+        native = _termid.Model.from_states(
+            list(states), list(inputs), list(terms or []), int(degree), time, name or ", ".join(states)
+        )
+        return Model(native, from_states=True)
 
     @staticmethod
     def builtin(name: str) -> "Model":
@@ -1233,9 +1285,9 @@ class Model:
         """
         return self._native.to_toml()
 
-    def __reduce__(self) -> Tuple[Any, Tuple[str, str]]:
+    def __reduce__(self) -> Tuple[Any, Tuple[str, str, bool]]:
         # pickled as its file's text (a process pool, Dask), read back as it was written
-        return (Model.from_toml, (self.to_toml(), self._native.path))
+        return (_unpickled, (self.to_toml(), self._native.path, self._from_states))
 
     def save(self, path: Union[str, os.PathLike]) -> None:
         """Writes the model file to ``path`` (identified coefficients with their standard
@@ -1437,12 +1489,12 @@ class Model:
         data = _targeted(self._native, _runs(runs, names, self.time), derivative, target, list(equations))
         try:
             native, fits = self._native.identify(
-                data, derivative, list(equations), intercept, _backend(backend, settings)
+                data, derivative, list(equations), intercept, _backend(backend, settings), self._from_states
             )
         except TermidError as e:
             left_out = {n: k for _, cols in data for n, k in getattr(cols, "left_out", {}).items()}
             raise _explained(e, left_out) from None
-        return Identified(Model(native), fits)
+        return Identified(Model(native, self._from_states), fits)
 
     @_runs_told_apart
     def moments(

@@ -296,6 +296,10 @@ def test_several_runs_are_fitted_together_never_across_their_seams():
     grouped = termid.fit(long, "dv/dt", ["x", "v", "x^2", "x*v"], by="experiment")
     assert grouped.coefficients.sort_index().round(6).to_dict() == truth
     assert grouped.raw["selection"]["rows"] == listed.raw["selection"]["rows"]
+    # a row that names no run belongs to none: refused with its row, as the command line does
+    unlabelled = long.assign(experiment=long.experiment.where(long.index != 1600))
+    with pytest.raises(termid.TermidError, match=r"row 1601 \(index 1600\), column `experiment`: no label"):
+        termid.fit(unlabelled, "dv/dt", ["x", "v"], by="experiment")
     # one frame whose time starts again is refused, the remedy named with its label column
     with pytest.raises(termid.TermidError, match="row 1501.*by='experiment'"):
         termid.fit(long, "dv/dt", ["x", "v"])

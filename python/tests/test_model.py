@@ -1,5 +1,6 @@
 """Model files from Python: load, write, identify, predict, simulate, validate."""
 import os
+import pickle
 import re
 import warnings
 
@@ -851,3 +852,33 @@ def test_simulate_under_inputs_that_change_in_time():
         nomoto.simulate(inputs=rudder.reset_index(drop=True))
     with pytest.raises(termid.TermidError, match="`rpm`: not an input of the model"):
         nomoto.simulate(inputs=rudder.assign(rpm=1.0))
+
+
+def test_a_system_from_its_columns():
+    # Duffing's ẍ + 2ζω ẋ + ω² x + α x³ = F with ζ = 0.05, ω = 1, α = 0.2 (the shipped
+    # model file's truth), driven by a force that changes in time, identified whole from its
+    # columns: every monomial of x, v and F to degree 3
+    duffing = termid.Model.builtin("duffing")
+    t = np.arange(0.0, 60.0, 0.01)
+    force = pd.DataFrame({"t": t, "F": 0.8 * np.sin(0.7 * t) + 0.5 * np.sin(1.9 * t + 1.0)})
+    run = duffing.simulate(inputs=force, initial={"x": 1.0, "v": 0.5})
+    model = termid.Model.from_states(["x", "v"], ["F"], degree=3)
+    assert model.equations == ["x_dot", "v_dot"] and len(model.coefficients("v_dot")) == 0
+    found = model.identify(run[["t", "x", "v", "F"]])
+    v_dot = found.model.coefficients("v_dot").set_index("term")["value"]
+    assert sorted(v_dot.index) == ["F", "v", "x", "x^3"]
+    for term, truth in {"F": 1.0, "v": -0.1, "x": -1.0, "x^3": -0.2}.items():
+        assert v_dot[term] == pytest.approx(truth, rel=1e-3)
+    x_dot = found.model.coefficients("x_dot").set_index("term")["value"]
+    assert list(x_dot.index) == ["v"] and x_dot["v"] == pytest.approx(1.0, rel=1e-4)
+    # it starts where the run starts, and survives a pickle as a model made from states
+    again = found.model.simulate(inputs=force, duration=5.0)
+    assert again["x"].iloc[0] == 1.0 and np.abs(again["x"].to_numpy() - run["x"].to_numpy()[: len(again)]).max() < 1e-3
+    assert pickle.loads(pickle.dumps(found.model))._from_states
+    # what cannot be a system is refused by name
+    with pytest.raises(termid.TermidError, match="`F` is named twice"):
+        termid.Model.from_states(["x", "F"], ["F"])
+    with pytest.raises(termid.TermidError, match="candidate `x\\*G`"):
+        termid.Model.from_states(["x"], terms=["x", "x*G"])
+    with pytest.raises(TypeError):
+        termid.Model.from_states("xv")

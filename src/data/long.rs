@@ -151,6 +151,12 @@ fn rows_of_each(labels: &[u32], values: usize) -> Vec<Vec<usize>> {
     rows
 }
 
+/// The columns of numbers in the file `path`, the time among them, as its header has them
+/// (what a model made from the file's columns may name).
+pub fn columns_of(path: &Path) -> Result<Vec<String>, DataError> {
+    Ok(super::stream::rows_of(path)?.names().to_vec())
+}
+
 /// The columns of text in the file `path` (a run's label, a mode: what the runs of a file
 /// of several could be told apart by); none where it cannot be read.
 pub fn text_columns_of(path: &Path) -> Vec<String> {

@@ -37,7 +37,7 @@ pub use geodetic::{north_east, radii_of_curvature};
 pub use hold::{held, mark_held, switches, Hold, Intersample};
 pub use integral::{integral_rows, integral_rows_held, IntegralForm};
 pub use kalman::{KalmanSmoother, NoiseModel};
-pub use long::{interleaved, text_columns_of};
+pub use long::{columns_of, interleaved, text_columns_of};
 pub use prepare::{prepare, Preparation};
 pub use repeated::{
     between_readings, fits_better_held, kinks_at_changes, read_at_readings, repeated, Repeats,

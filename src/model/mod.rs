@@ -8,6 +8,7 @@ mod covariance;
 pub mod dimension;
 mod file;
 mod locate;
+mod outline;
 mod param;
 mod rhs;
 
@@ -20,6 +21,7 @@ pub use file::{
     ParameterCovarianceSpec, ParameterSpec, PriorSpec, StateSpec,
 };
 pub use locate::line_of_key;
+pub use outline::{Outline, MOST_MONOMIALS};
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -57,6 +59,14 @@ pub enum ModelError {
         line: usize,
         /// The key's dotted path.
         key: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A system named by its columns ([`Outline`]) that cannot be one.
+    #[error("{origin}: {message}")]
+    Outline {
+        /// What stands for the system (`--states x,y,z`).
+        origin: String,
         /// What is wrong.
         message: String,
     },

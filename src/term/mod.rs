@@ -7,6 +7,7 @@ mod compile;
 mod error;
 mod functions;
 mod parse;
+mod polynomial;
 mod vocabulary;
 
 pub use canon::{Atom, Monomial, Term};
@@ -14,6 +15,7 @@ pub use compile::{Library, RowScratch, Source, Tangents};
 pub use error::TermError;
 pub use functions::{Function, FUNCTIONS};
 pub use parse::{parse_expr, BinOp, Expr, ExprKind};
+pub use polynomial::{polynomial, polynomial_len};
 pub use vocabulary::{code_points, is_identifier, Derived, Vocabulary};
 
 /// Parses and resolves a list of candidate terms, refusing a duplicate (two spellings of

@@ -1701,3 +1701,71 @@ fn a_long_file_of_several_runs_is_read_by_its_label() {
     let (ok, _, err) = identify(&p("broken.csv"), &["--by", "vessel"]);
     assert!(!ok && err.contains("[vessel=2]: row 8, column `x`"), "{err}");
 }
+
+/// `identify --states` identifies every state's rate of a system nobody wrote a model file
+/// for, from its columns alone (the polynomial library to --degree over the states and every
+/// other column as an input, said), and writes a model file that starts where the run starts
+/// and re-simulates it: the forced oscillator ẍ = −4x − 0.2ẋ + F from noise-free samples.
+#[test]
+fn a_whole_system_from_its_columns() {
+    use crate::common::{json, trajectory, Scratch};
+    let dir = Scratch::new("generic-states");
+    let force = |t: f64| 2.0 * (0.6 * t).sin() + 1.5 * (1.7 * t + 1.0).sin();
+    let mut text = String::from("t,x,v,F\n");
+    for (i, r) in
+        trajectory(&[1.0, 0.5], 0.01, 3_000, 10, |t, x| vec![x[1], -4.0 * x[0] - 0.2 * x[1] + force(t)])
+            .iter()
+            .enumerate()
+    {
+        let t = i as f64 * 0.01;
+        text += &format!("{t},{},{},{}\n", r[0], r[1], force(t));
+    }
+    std::fs::write(dir.join("run.csv"), text).unwrap();
+    let p = |f: &str| dir.join(f).display().to_string();
+    let (data, out) = (p("run.csv"), p("m.toml"));
+    let (ok, report, err) = termid(&[
+        "identify", "--data", &data, "--states", "x,v", "--degree", "3", "--out", &out, "--format", "json",
+    ]);
+    assert!(ok, "{err}");
+    assert!(err.contains("the inputs are F (every other column"), "{err}");
+    assert!(json(&report)["v_dot"].is_object(), "{report}");
+    let model = termid::model::Model::load(std::path::Path::new(&out)).unwrap();
+    let terms = |equation: &str| {
+        let e = model.equation(equation).unwrap();
+        let mut found: Vec<(String, f64)> =
+            e.coefficients.iter().map(|(t, c, _)| (t.to_string(), *c)).collect();
+        found.sort_by(|a, b| a.0.cmp(&b.0));
+        (found, e.candidates.len())
+    };
+    let (x_dot, candidates) = terms("x_dot");
+    assert_eq!(candidates, 20, "every monomial of x, v, F to degree 3: C(6, 3)");
+    assert_eq!(x_dot.len(), 1);
+    assert!(x_dot[0].0 == "v" && (x_dot[0].1 - 1.0).abs() < 1e-4, "{x_dot:?}");
+    let (v_dot, _) = terms("v_dot");
+    let truth = [("F", 1.0), ("v", -0.2), ("x", -4.0)];
+    assert_eq!(v_dot.len(), 3, "{v_dot:?}");
+    for ((term, value), (want, exact)) in v_dot.iter().zip(truth) {
+        assert!(term == want && (value - exact).abs() < 1e-3 * exact.abs(), "{v_dot:?}");
+    }
+    // it starts where the run starts and re-simulates it under its recorded force
+    let initial: Vec<f64> = model.spec().states.iter().map(|s| s.initial).collect();
+    assert_eq!(initial, [1.0, 0.5]);
+    let (ok, text, err) = termid(&["validate", "--model", &out, "--data", &data, "--format", "json"]);
+    assert!(ok, "{err}");
+    // each state's RMS and largest error of the re-simulation
+    let x = &json(&text)["gap"]["states"][0];
+    assert!(x[0] == "x" && x[2].as_f64().is_some_and(|rms| rms < 1e-3), "{text}");
+    // what a system of columns cannot be is refused by name
+    for (extra, says) in [
+        (&["--states", "x,w"][..], "`w` is not a column of"),
+        (&["--states", "x,v", "--target", "dv/dt"], "--target cannot be used with --states"),
+        (&["--states", "x,v", "--inputs", "x"], "`x` is named twice"),
+        (&["--states", "x,v", "--terms", "x*G"], "unknown variable `G`"),
+        (&["--states", "x,v", "--degree", "0"], "degree 0"),
+    ] {
+        let mut args = vec!["identify", "--data", &data];
+        args.extend_from_slice(extra);
+        let (ok, _, err) = termid(&args);
+        assert!(!ok && err.contains(says), "{extra:?}: {err}");
+    }
+}

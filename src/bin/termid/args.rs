@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{ArgGroup, Args, Parser, Subcommand, ValueEnum};
 use termid::select::BackendName;
 use termid::sim::Integrator;
 
@@ -234,6 +234,7 @@ pub enum RuleName {
 
 /// `termid identify`.
 #[derive(Clone, Debug, Args)]
+#[command(group(ArgGroup::new("system").args(["model", "states"]).multiple(true)))]
 #[command(
     after_help = "Examples:\n  termid identify --data tests/data/hald.csv --no-time --target y --terms x1 x2 x3 x4\n  termid simulate --model models/lorenz.toml --duration 20 --sample 0.01 --out lorenz.csv\n  termid identify --model models/lorenz.toml --data lorenz.csv --out lorenz_id.toml\n  termid identify --model examples/data/ship.toml --dataset examples/data/runs.toml --derivative kinematic,kalman \\\n      --smooth --no-intercept --choose sparse,best-subset --compare u,v,r,ψ --refine u,v,r,ψ --out ship_id.toml\nBack-ends: stepwise (the paper's STPRG), efroymson, best-subset, sparse, stlsq.\nDerivatives: integral[:W] (no rate), central, five-point, savitzky-golay[:W:Q], spline[:ALPHA], kalman[:RATIO]; kinematic (ship models).\nRuns: CSV (model names, SI; aliases and semicolons read), Parquet, Arrow IPC, or a dataset file (README)."
 )]
@@ -264,19 +265,35 @@ pub struct IdentifyCommand {
     /// a column `X_dot` beside `X`) is an equation of motion: stlsq, the constant a candidate
     /// term. With --model the default is each equation's `<state>_dot` column, else the
     /// state's derivative.
-    #[arg(long, required_unless_present = "model")]
+    #[arg(long, required_unless_present_any = ["model", "states"])]
     pub target: Option<String>,
     /// Candidate terms, e.g. --terms "u*v" "u*r" "u^2*δ".
-    #[arg(long, num_args = 1.., required_unless_present_any = ["terms_file", "model"])]
+    #[arg(long, num_args = 1.., required_unless_present_any = ["terms_file", "model", "states"])]
     pub terms: Vec<String>,
     /// Take vocabulary, candidates, forced terms and back-end from a model file.
     #[arg(long)]
     pub model: Option<PathBuf>,
-    /// With --model: the equation(s) to identify (default: all that are identifiable).
-    #[arg(long, num_args = 1.., requires = "model")]
+    /// Every state's rate at once without a model file: these columns are the states
+    /// (comma-separated), each rate over the same candidates (--terms, --terms-file, or every
+    /// monomial of the states and inputs to --degree), the rest as with --model: --out writes
+    /// the model file (each state starting where the first run starts), which `termid
+    /// simulate --model` runs.
+    #[arg(long, num_args = 1.., value_delimiter = ',')]
+    pub states: Vec<String>,
+    /// With --states: the columns that drive the states, known from the records
+    /// (comma-separated; given without names: none). Default: every other column of the runs.
+    #[arg(long, num_args = 0.., value_delimiter = ',', requires = "states")]
+    pub inputs: Option<Vec<String>>,
+    /// With --states and no candidates named: the degree of the polynomial library (every
+    /// monomial of the states and inputs, the constant among them). Default 2.
+    #[arg(long, requires = "states")]
+    pub degree: Option<u32>,
+    /// With --model or --states: the equation(s) to identify (default: all that are
+    /// identifiable).
+    #[arg(long, num_args = 1.., requires = "system")]
     pub equation: Vec<String>,
-    /// With --model: write the model with the identified coefficients to this file.
-    #[arg(long, requires = "model")]
+    /// With --model or --states: write the model with the identified coefficients to this file.
+    #[arg(long, requires = "system")]
     pub out: Option<PathBuf>,
     /// A file of candidate terms, one per line (`#` starts a comment).
     #[arg(long)]
@@ -405,12 +422,12 @@ pub struct IdentifyCommand {
     /// declares its own with `nuisance = "run"`.
     #[arg(long, num_args = 1.., value_delimiter = ',', requires = "model")]
     pub per_run: Vec<String>,
-    /// With --model: choose among these back-ends and model files (comma-separated, or `all`
+    /// With --model or --states: choose among these back-ends and model files (comma-separated, or `all`
     /// back-ends; a model file is another candidate library for the same equations) by what
     /// they predict: each run is re-simulated by the model identified on the other runs; of
     /// those within one standard error of the smallest error, the first listed is identified
     /// on all runs. The table it chose from is printed.
-    #[arg(long, value_name = "BACKENDS", requires = "model")]
+    #[arg(long, value_name = "BACKENDS", requires = "system")]
     pub choose: Option<String>,
     /// With --choose: the states compared in the held-out runs (default: the states of the
     /// identified equations), e.g. `u,v,r,ψ`.
@@ -418,15 +435,15 @@ pub struct IdentifyCommand {
     pub compare: Option<String>,
     /// Write the model even when it fails a physical check of its plug-in (a ship's: damping
     /// signs, turning circles that complete, plausible speed loss and drift).
-    #[arg(long, requires = "model")]
+    #[arg(long, requires = "system")]
     pub keep_unphysical: bool,
-    /// With --model and plain --data files: read them in pieces of this many rows, one pass
+    /// With --model or --states and plain --data files: read them in pieces of this many rows, one pass
     /// and bounded memory whatever their size (statistics merged as `termid moments` and
     /// `identify --moments` would). Needs a derivative of fixed reach (central, five-point,
     /// savitzky-golay, integral) and none of --dataset, --resample, --smooth, --prepared-svg, --refine,
     /// --choose, --target. Default: in pieces of 262144 rows when the files together exceed
     /// 256 MiB and these hold; 0 reads them whole.
-    #[arg(allow_negative_numbers = true, long, value_name = "ROWS", requires = "model")]
+    #[arg(allow_negative_numbers = true, long, value_name = "ROWS", requires = "system")]
     pub chunk_rows: Option<usize>,
     /// Fit without an intercept b0.
     #[arg(long, conflicts_with = "intercept")]
@@ -486,6 +503,44 @@ impl IdentifyCommand {
         if self.model.is_some() {
             if let Some((flag, _, why)) = with_model.iter().find(|(_, given, _)| *given) {
                 return Err(format!("{flag} cannot be used with --model: {why}"));
+            }
+            if !self.states.is_empty() {
+                return Err("--states cannot be used with --model: the model file declares its states".into());
+            }
+        }
+        if !self.states.is_empty() {
+            let single = [
+                ("--target", self.target.is_some(), "--states identifies the rate of every state named"),
+                ("--no-time", self.no_time, "the rates of states need the time"),
+                ("--weight", self.weight.is_some(), "row weights apply to one equation without a model file"),
+                (
+                    "--param",
+                    !self.params.is_empty(),
+                    "a model made from columns has no parameters; write a model file",
+                ),
+                (
+                    "--derive",
+                    !self.derived.is_empty(),
+                    "a model made from columns has no derived variables; write a model file",
+                ),
+                (
+                    "--alias",
+                    !self.aliases.is_empty(),
+                    "a model made from columns has no aliases; write a model file",
+                ),
+                (
+                    "--moments",
+                    !self.moments.is_empty(),
+                    "statistics files are written for a model file's equations",
+                ),
+            ];
+            if let Some((flag, _, why)) = single.iter().find(|(_, given, _)| *given) {
+                return Err(format!("{flag} cannot be used with --states: {why}"));
+            }
+            if self.degree.is_some() && (!self.terms.is_empty() || self.terms_file.is_some()) {
+                return Err(
+                    "--degree cannot be used with --terms or --terms-file: the candidates are named".into()
+                );
             }
         }
         if !self.moments.is_empty() {

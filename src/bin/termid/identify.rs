@@ -88,7 +88,7 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
     if !cmd.moments.is_empty() {
         return crate::moments::identify_from_files(cmd);
     }
-    if cmd.model.is_some() {
+    if cmd.model.is_some() || !cmd.states.is_empty() {
         if !cmd.delays.is_empty() {
             bail!("--delay reads columns of plain runs earlier; with --model declare the dead time in the model file (`delay = SECONDS` in the input's [[inputs]] entry), as its simulation needs it too");
         }
@@ -211,19 +211,7 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
         let (alias, target) = split_pair(a, "alias")?;
         vocab.alias(alias, target)?;
     }
-    let mut texts = cmd.terms.clone();
-    if let Some(path) = &cmd.terms_file {
-        let text = termid::budget::read_text(path).with_context(|| format!("reading {}", path.display()))?;
-        for (k, line) in text.lines().enumerate() {
-            let term = line.split('#').next().unwrap_or("").trim();
-            if term.is_empty() {
-                continue;
-            }
-            // each line checked here, so an error names the file and line
-            vocab.parse(term).map_err(|e| anyhow::anyhow!("{}:{}:\n{e}", path.display(), k + 1))?;
-            texts.push(term.to_string());
-        }
-    }
+    let texts = candidate_texts(&cmd, &vocab)?;
     if texts.is_empty() {
         bail!("no candidate terms: give --terms or --terms-file");
     }
@@ -267,6 +255,24 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
         Format::Text => print!("{}", fit.text()),
     }
     Ok(())
+}
+
+/// The candidate terms of `--terms` and then of `--terms-file` (one a line, `#` a comment),
+/// the file's each checked against `vocab` here so that an error names the file and line.
+pub fn candidate_texts(cmd: &IdentifyCommand, vocab: &Vocabulary) -> Result<Vec<String>> {
+    let mut texts = cmd.terms.clone();
+    if let Some(path) = &cmd.terms_file {
+        let text = termid::budget::read_text(path).with_context(|| format!("reading {}", path.display()))?;
+        for (k, line) in text.lines().enumerate() {
+            let term = line.split('#').next().unwrap_or("").trim();
+            if term.is_empty() {
+                continue;
+            }
+            vocab.parse(term).map_err(|e| anyhow::anyhow!("{}:{}:\n{e}", path.display(), k + 1))?;
+            texts.push(term.to_string());
+        }
+    }
+    Ok(texts)
 }
 
 /// A figure per run of each prepared signal against the raw one (angles in degrees where

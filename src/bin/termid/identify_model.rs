@@ -3,7 +3,7 @@
 //! model file's free parameters, checks, the starts' agreement); this file reads the command
 //! line, prints and writes.
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use termid::identify::Target;
 use termid::recipe::{ParameterOptions, ParameterStage, RecipeSettings, RefineOptions};
 use termid::select::Backend;
@@ -27,13 +27,16 @@ fn asked_parameters(cmd: &IdentifyCommand) -> Option<bool> {
 /// (the validation runs where given) is kept — output error finds different local minima from
 /// different starts.
 pub fn run(cmd: IdentifyCommand) -> Result<()> {
-    let path = cmd.model.clone().context("--model")?;
     // outputs that cannot be written are refused before any work
     if let Some(out) = &cmd.out {
         termid::output::check_file(out)?;
     }
-    let mut model =
-        termid::plugins::load(&path)?.keeping_spikes(cmd.keep_spikes).with_intersample(cmd.intersample);
+    let mut model = match &cmd.model {
+        Some(path) => termid::plugins::load(path)?,
+        None => crate::outline::model(&cmd)?,
+    }
+    .keeping_spikes(cmd.keep_spikes)
+    .with_intersample(cmd.intersample);
     if cmd.backend.is_some() {
         // the command line's back-end (with its stepwise options) replaces the file's
         model = model.with_backend(&configure_backend(&cmd)?)?;
@@ -58,6 +61,10 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
             let (frames, sources) =
                 crate::runs::load_sources(&model, &cmd.data, cmd.by.as_deref(), &cmd.dataset)?;
             crate::runs::warn_over_ground(&cmd.dataset);
+            if let Some(first) = frames.first().filter(|_| cmd.model.is_none()) {
+                // a model made from columns: simulated from where the first run starts
+                model = model.starting_as(first)?;
+            }
             let held = cmd
                 .refine_validation
                 .as_ref()

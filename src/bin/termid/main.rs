@@ -10,6 +10,7 @@ mod identify_model;
 mod moments;
 mod monte_carlo;
 mod new_ship;
+mod outline;
 mod progress;
 mod reproduce;
 mod runs;

@@ -1,0 +1,89 @@
+//! `identify --states`: the model file of a system named by its runs' columns
+//! ([`termid::model::Outline`]), which `identify_model` then identifies as it does any file.
+
+use anyhow::{bail, Result};
+use termid::data::Dataset;
+use termid::model::{Model, Outline};
+use termid::term::is_identifier;
+
+use crate::args::IdentifyCommand;
+
+/// The model of the states `--states` names: the inputs `--inputs` names, or every other
+/// column of the first file (said); the candidates `--terms`/`--terms-file`, or the
+/// polynomial library to `--degree`.
+pub fn model(cmd: &IdentifyCommand) -> Result<Model> {
+    let (first, columns) = columns(cmd)?;
+    let column = |name: &str, flag: &str| -> Result<()> {
+        if !columns.iter().any(|c| c == name) {
+            bail!("{flag}: `{name}` is not a column of {first} (its columns: {})", columns.join(", "));
+        }
+        Ok(())
+    };
+    for s in &cmd.states {
+        column(s, "--states")?;
+    }
+    let inputs = match &cmd.inputs {
+        Some(named) => {
+            for i in named {
+                column(i, "--inputs")?;
+            }
+            named.clone()
+        }
+        None => {
+            let rates: Vec<String> = cmd.states.iter().map(|s| format!("{s}_dot")).collect();
+            let others = columns.iter().filter(|c| {
+                **c != cmd.time
+                    && !cmd.states.contains(c)
+                    && !rates.contains(c)
+                    && Some(c.as_str()) != cmd.by.as_deref()
+            });
+            let (usable, unnamed): (Vec<&String>, Vec<&String>) = others.partition(|c| is_identifier(c));
+            if !unnamed.is_empty() {
+                let list: Vec<String> = unnamed.iter().map(|c| format!("`{c}`")).collect();
+                eprintln!(
+                    "note: {} left out of the inputs: not a name a term can use (a dataset file maps a column onto a name)",
+                    list.join(", ")
+                );
+            }
+            if !usable.is_empty() {
+                let list: Vec<&str> = usable.iter().map(|c| c.as_str()).collect();
+                eprintln!(
+                    "note: the inputs are {} (every other column of {first}): --inputs names them, `--inputs` alone takes none",
+                    list.join(", ")
+                );
+            }
+            usable.into_iter().cloned().collect()
+        }
+    };
+    let mut outline = Outline {
+        name: cmd.states.join(", "),
+        time: cmd.time.clone(),
+        states: cmd.states.clone(),
+        inputs,
+        candidates: Vec::new(),
+        degree: cmd.degree.unwrap_or(2),
+        backend: None,
+    };
+    let origin = format!("--states {}", cmd.states.join(","));
+    let vocabulary = outline.vocabulary(&origin)?;
+    for t in &cmd.terms {
+        vocabulary.parse(t).map_err(|e| anyhow::anyhow!("--terms `{t}`:\n{e}"))?;
+    }
+    outline.candidates = crate::identify::candidate_texts(cmd, &vocabulary)?;
+    Ok(outline.model(&origin)?)
+}
+
+/// The first source's name and the names of its columns: a `--data` file's numeric
+/// columns, a dataset file's variables.
+fn columns(cmd: &IdentifyCommand) -> Result<(String, Vec<String>)> {
+    if let Some(path) = cmd.data.first() {
+        return Ok((path.display().to_string(), termid::data::columns_of(path)?));
+    }
+    let Some(path) = cmd.dataset.first() else {
+        bail!("--states needs runs: give --data or --dataset");
+    };
+    let dataset = Dataset::load(path)?;
+    let mut names: Vec<String> = vec![cmd.time.clone()];
+    names.extend(dataset.columns.keys().cloned());
+    Ok((path.display().to_string(), names))
+}
