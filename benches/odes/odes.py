@@ -138,6 +138,26 @@ def termid_fit(termid, csv, target, terms_file, states, extra):
     return {k: v for k, v in found.items() if v != 0.0}, None
 
 
+def termid_whole(termid, csv, states, terms_file, exact, extra):
+    """Every equation at once, as a user without a model file would: `identify --states`,
+    its default library (the polynomial to degree 3) unless the system needs more (the
+    pendulum's sin and cos: its library file)."""
+    args = [termid, "identify", "--data", str(csv), "--states", ",".join(states), "--inputs", "--format", "json"]
+    args += ["--terms-file", str(terms_file)] if terms_file else []
+    out = subprocess.run(args + ([] if exact else extra), capture_output=True, text=True)
+    if out.returncode != 0:
+        return None, out.stderr.strip().splitlines()[-1] if out.stderr.strip() else "failed"
+    report = json.loads(out.stdout)
+    found = {}
+    for s in states:
+        fit = report[f"{s}_dot"]
+        terms = {canonical(t["term"], states): t["coefficient"] for t in fit["terms"]}
+        if fit.get("intercept") is not None:
+            terms[canonical("1", states)] = terms.get(canonical("1", states), 0.0) + fit["intercept"]
+        found[s] = {k: v for k, v in terms.items() if v != 0.0}
+    return found, None
+
+
 def pysindy_fit(system, t, u, rates):
     import pysindy as ps
 
@@ -160,6 +180,12 @@ def main():
     ap.add_argument("--systems", default="", help="comma-separated names (default: all)")
     ap.add_argument("--no-pysindy", action="store_true")
     ap.add_argument("--seed", type=int, default=2026)
+    ap.add_argument(
+        "--whole",
+        action="store_true",
+        help="termid identifies each system whole (`identify --states`, its default library) "
+        "instead of one equation at a time with the library file",
+    )
     ap.add_argument(
         "--termid-args",
         default="",
@@ -193,12 +219,21 @@ def main():
         for mode, tol in MODES.items():
             start = time.perf_counter()
             ok, why = True, ""
+            extra = [] if mode == "exact" else args.termid_args.split()
+            whole, whole_err = (None, None)
+            if args.whole:
+                library = folder / "library.txt" if sys_.trig else None
+                whole, whole_err = termid_whole(
+                    args.termid, folder / f"{mode}.csv", sys_.states, library, mode == "exact", extra
+                )
             for s in sys_.states:
                 target = f"{s}_dot" if mode == "exact" else f"d{s}/dt"
-                extra = [] if mode == "exact" else args.termid_args.split()
-                found, err = termid_fit(
-                    args.termid, folder / f"{mode}.csv", target, folder / "library.txt", sys_.states, extra
-                )
+                if args.whole:
+                    found, err = (whole[s], None) if whole is not None else (None, whole_err)
+                else:
+                    found, err = termid_fit(
+                        args.termid, folder / f"{mode}.csv", target, folder / "library.txt", sys_.states, extra
+                    )
                 if found is None:
                     ok, why = False, f"{s}: {err}"
                     break

@@ -467,6 +467,13 @@ impl PyModel {
             .iter()
             .map(|(n, f)| Ok((n.clone(), to_json(&f.report())?)))
             .collect::<PyResult<_>>()?;
+        if termid::plugins::of(&identified.model).is_none() {
+            // any system: its equations must retrace the runs (a field's model has its checks)
+            let check = py.detach(|| termid::recipe::retrace_check(&identified.model, &frames));
+            if let Some(c) = check.filter(|c| !c.passed) {
+                warn(py, c.line())?;
+            }
+        }
         let model = match frames.first().filter(|_| start_as_first) {
             // a model made from columns: simulated from where the first run starts
             Some(first) => identified.model.starting_as(first).map_err(fail)?,

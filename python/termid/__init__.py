@@ -1167,7 +1167,7 @@ class Model:
         inputs: Sequence[str] = (),
         terms: Optional[Sequence[str]] = None,
         *,
-        degree: int = 2,
+        degree: int = 3,
         time: str = "t",
         name: Optional[str] = None,
     ) -> "Model":
@@ -1181,7 +1181,7 @@ class Model:
         starts, so that :meth:`simulate` retraces that run's beginning; :meth:`save` writes it.
 
         Parameters: ``states`` the state columns; ``inputs`` the input columns; ``terms`` the
-        candidates (default: the polynomial library); ``degree`` the polynomial library's;
+        candidates (default: the polynomial library); ``degree`` the polynomial library's (3, as the ODE benchmark that chose termid's defaults);
         ``time`` the time column; ``name`` the model's (default: the states).
 
         >>> truth = termid.Model.builtin("lorenz").simulate(duration=10.0, sample=0.01)

@@ -882,3 +882,40 @@ def test_a_system_from_its_columns():
         termid.Model.from_states(["x"], terms=["x", "x*G"])
     with pytest.raises(TypeError):
         termid.Model.from_states("xv")
+
+
+_LOTKA_VOLTERRA = """[model]
+name = "Lotka-Volterra"
+intercept = false
+[simulation]
+rtol = 1e-10
+atol = 1e-10
+[[states]]
+name = "x"
+initial = 4.0
+[[states]]
+name = "z"
+initial = 1.0
+[equations.x_dot]
+state = "x"
+coefficients = { "x" = 1.0, "x*z" = -0.5 }
+[equations.z_dot]
+state = "z"
+coefficients = { "z" = -1.5, "x*z" = 0.25 }
+"""
+
+
+def test_equations_that_run_away_from_their_run_are_said_to():
+    # Lotka-Volterra sampled ten times a period, noise-free: the cubic library's rates fit the
+    # rows with spurious terms that cancel on the samples, and the system they make runs away
+    # from the run's start within 5 s; sampled five times faster, the truth comes back
+    truth = termid.Model.from_toml(_LOTKA_VOLTERRA)
+    coarse = truth.simulate(duration=19.5, sample=0.5)[["t", "x", "z"]]
+    with pytest.warns(UserWarning, match=r"FAIL the equations retrace their runs without running away: run1: re-simulated"):
+        termid.Model.from_states(["x", "z"]).identify(coarse)
+    fine = truth.simulate(duration=19.9, sample=0.1)[["t", "x", "z"]]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        found = termid.Model.from_states(["x", "z"]).identify(fine)
+    x_dot = found.model.coefficients("x_dot").set_index("term")["value"]
+    assert x_dot.to_dict() == pytest.approx({"x": 1.0, "x*z": -0.5}, rel=1e-3)

@@ -7,10 +7,12 @@
 
 mod parameters;
 mod report;
+mod retrace;
 mod start;
 
 pub use parameters::{ParameterOptions, ParameterStage};
 pub use report::Primes;
+pub use retrace::retrace_check;
 pub use start::{derivative_method, prepare_runs, Start};
 
 use rayon::prelude::*;

@@ -117,7 +117,9 @@ impl Recipe {
         }
         let checks = self.checks();
         if !checks.is_empty() {
-            out += "== physical checks ==\n";
+            // a field's checks are physical; any system's, that its equations retrace the runs
+            let physical = crate::plugins::of(&self.kept().model).is_some();
+            out += if physical { "== physical checks ==\n" } else { "== checks ==\n" };
             for c in &checks {
                 out += &format!("{}\n", c.line());
             }

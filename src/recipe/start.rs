@@ -257,9 +257,12 @@ fn refine_start(
 }
 
 /// What the field knows must hold: the plug-in's physical checks of a model on the runs as
-/// prepared.
+/// prepared; for a system of no field's, that its equations retrace the runs.
 fn checks_of(model: &Model, prepared: &[Frame]) -> Vec<Check> {
-    crate::plugins::of(model).map(|p| p.checks(model, prepared)).unwrap_or_default()
+    match crate::plugins::of(model) {
+        Some(plugin) => plugin.checks(model, prepared),
+        None => super::retrace::retrace_check(model, prepared).into_iter().collect(),
+    }
 }
 
 /// The refusing checks that `after` fails and `before` passed: what a later stage (a

@@ -557,12 +557,22 @@ fn report(system: &System, t: f64, x: &[f64], prev: &[f64]) -> Result<(), SimErr
             .states
             .iter()
             .zip(prev)
-            .map(|(n, v)| format!("{n} = {v:.6}"))
+            .map(|(n, v)| format!("{n} = {}", shown(*v)))
             .collect::<Vec<_>>()
             .join(", ");
         return Err(SimError::Diverged { t, state: system.states[i].clone(), value: v, why, snapshot });
     }
     Ok(())
+}
+
+/// A state's value in a message: six decimals, or six significant digits in powers of ten
+/// where the state has run far away (a diverged run's 10¹⁰² would print as 103 digits).
+pub(crate) fn shown(v: f64) -> String {
+    if v.is_finite() && v.abs() < 1e9 {
+        format!("{v:.6}")
+    } else {
+        format!("{v:.6e}")
+    }
 }
 
 #[cfg(test)]

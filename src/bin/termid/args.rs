@@ -236,7 +236,7 @@ pub enum RuleName {
 #[derive(Clone, Debug, Args)]
 #[command(group(ArgGroup::new("system").args(["model", "states"]).multiple(true)))]
 #[command(
-    after_help = "Examples:\n  termid identify --data tests/data/hald.csv --no-time --target y --terms x1 x2 x3 x4\n  termid simulate --model models/lorenz.toml --duration 20 --sample 0.01 --out lorenz.csv\n  termid identify --model models/lorenz.toml --data lorenz.csv --out lorenz_id.toml\n  termid identify --model examples/data/ship.toml --dataset examples/data/runs.toml --derivative kinematic,kalman \\\n      --smooth --no-intercept --choose sparse,best-subset --compare u,v,r,ψ --refine u,v,r,ψ --out ship_id.toml\nBack-ends: stepwise (the paper's STPRG), efroymson, best-subset, sparse, stlsq.\nDerivatives: integral[:W] (no rate), central, five-point, savitzky-golay[:W:Q], spline[:ALPHA], kalman[:RATIO]; kinematic (ship models).\nRuns: CSV (model names, SI; aliases and semicolons read), Parquet, Arrow IPC, or a dataset file (README)."
+    after_help = "Examples:\n  termid identify --data tests/data/hald.csv --no-time --target y --terms x1 x2 x3 x4\n  termid simulate --model models/lorenz.toml --duration 20 --sample 0.01 --out lorenz.csv\n  termid identify --model models/lorenz.toml --data lorenz.csv --out lorenz_id.toml\n  termid identify --data lorenz.csv --states x,y,z --out lorenz_whole.toml\n  termid identify --model examples/data/ship.toml --dataset examples/data/runs.toml --derivative kinematic,kalman \\\n      --smooth --no-intercept --choose sparse,best-subset --compare u,v,r,ψ --refine u,v,r,ψ --out ship_id.toml\nBack-ends: stepwise (the paper's STPRG), efroymson, best-subset, sparse, stlsq.\nDerivatives: integral[:W] (no rate), central, five-point, savitzky-golay[:W:Q], spline[:ALPHA], kalman[:RATIO]; kinematic (ship models).\nRuns: CSV (model names, SI; aliases and semicolons read), Parquet, Arrow IPC, or a dataset file (README)."
 )]
 pub struct IdentifyCommand {
     /// CSV files with a header row; several are combined (the paper's "Komb. Daten").
@@ -285,7 +285,8 @@ pub struct IdentifyCommand {
     #[arg(long, num_args = 0.., value_delimiter = ',', requires = "states")]
     pub inputs: Option<Vec<String>>,
     /// With --states and no candidates named: the degree of the polynomial library (every
-    /// monomial of the states and inputs, the constant among them). Default 2.
+    /// monomial of the states and inputs, the constant among them). Default 3, the ODE
+    /// benchmark's (benches/odes).
     #[arg(long, requires = "states")]
     pub degree: Option<u32>,
     /// With --model or --states: the equation(s) to identify (default: all that are
@@ -433,8 +434,9 @@ pub struct IdentifyCommand {
     /// identified equations), e.g. `u,v,r,ψ`.
     #[arg(long, value_name = "STATES", requires = "choose")]
     pub compare: Option<String>,
-    /// Write the model even when it fails a physical check of its plug-in (a ship's: damping
-    /// signs, turning circles that complete, plausible speed loss and drift).
+    /// Write the model even when it fails a check: a physical check of its plug-in (a ship's:
+    /// damping signs, turning circles that complete, plausible speed loss and drift), or, for
+    /// a system of no plug-in's, that its equations retrace the runs without running away.
     #[arg(long, requires = "system")]
     pub keep_unphysical: bool,
     /// With --model or --states and plain --data files: read them in pieces of this many rows, one pass

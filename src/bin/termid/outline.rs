@@ -61,7 +61,7 @@ pub fn model(cmd: &IdentifyCommand) -> Result<Model> {
         states: cmd.states.clone(),
         inputs,
         candidates: Vec::new(),
-        degree: cmd.degree.unwrap_or(2),
+        degree: cmd.degree.unwrap_or(3),
         backend: None,
     };
     let origin = format!("--states {}", cmd.states.join(","));
