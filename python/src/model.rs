@@ -222,10 +222,16 @@ impl PyModel {
         states: Vec<String>,
         inputs: Vec<String>,
         candidates: Vec<String>,
-        degree: u32,
+        degree: Option<u32>,
         time: String,
         name: String,
     ) -> PyResult<Self> {
+        if degree.is_some() && !candidates.is_empty() {
+            return Err(refuse(
+                "Model.from_states: a degree is the polynomial library's, and the candidates are named (terms=...)",
+            ));
+        }
+        let degree = degree.unwrap_or(termid::model::DEFAULT_DEGREE);
         let outline =
             termid::model::Outline { name, time, states, inputs, candidates, degree, backend: None };
         let model = outline.model("Model.from_states").map_err(fail)?;

@@ -1167,7 +1167,7 @@ class Model:
         inputs: Sequence[str] = (),
         terms: Optional[Sequence[str]] = None,
         *,
-        degree: int = 3,
+        degree: Optional[int] = None,
         time: str = "t",
         name: Optional[str] = None,
     ) -> "Model":
@@ -1181,7 +1181,8 @@ class Model:
         starts, so that :meth:`simulate` retraces that run's beginning; :meth:`save` writes it.
 
         Parameters: ``states`` the state columns; ``inputs`` the input columns; ``terms`` the
-        candidates (default: the polynomial library); ``degree`` the polynomial library's (3, as the ODE benchmark that chose termid's defaults);
+        candidates (default: the polynomial library); ``degree`` the polynomial library's (default 3, as the ODE benchmark that chose termid's
+        defaults; not with ``terms``);
         ``time`` the time column; ``name`` the model's (default: the states).
 
         >>> truth = termid.Model.builtin("lorenz").simulate(duration=10.0, sample=0.01)
@@ -1195,7 +1196,12 @@ class Model:
         if isinstance(states, str) or isinstance(inputs, str) or isinstance(terms, str):
             raise TypeError("states, inputs and terms are lists of names (['x', 'y']), not one string")
         native = _termid.Model.from_states(
-            list(states), list(inputs), list(terms or []), int(degree), time, name or ", ".join(states)
+            list(states),
+            list(inputs),
+            list(terms or []),
+            None if degree is None else int(degree),
+            time,
+            name or ", ".join(states),
         )
         return Model(native, from_states=True)
 

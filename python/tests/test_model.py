@@ -882,6 +882,8 @@ def test_a_system_from_its_columns():
         termid.Model.from_states(["x"], terms=["x", "x*G"])
     with pytest.raises(TypeError):
         termid.Model.from_states("xv")
+    with pytest.raises(termid.TermidError, match="the candidates are named"):
+        termid.Model.from_states(["x"], terms=["x"], degree=2)
 
 
 _LOTKA_VOLTERRA = """[model]

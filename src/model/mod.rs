@@ -21,7 +21,7 @@ pub use file::{
     ParameterCovarianceSpec, ParameterSpec, PriorSpec, StateSpec,
 };
 pub use locate::line_of_key;
-pub use outline::{Outline, MOST_MONOMIALS};
+pub use outline::{Outline, DEFAULT_DEGREE, MOST_MONOMIALS};
 
 use std::collections::BTreeMap;
 use std::path::Path;

@@ -61,7 +61,7 @@ pub fn model(cmd: &IdentifyCommand) -> Result<Model> {
         states: cmd.states.clone(),
         inputs,
         candidates: Vec::new(),
-        degree: cmd.degree.unwrap_or(3),
+        degree: cmd.degree.unwrap_or(termid::model::DEFAULT_DEGREE),
         backend: None,
     };
     let origin = format!("--states {}", cmd.states.join(","));
