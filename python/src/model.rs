@@ -437,8 +437,7 @@ impl PyModel {
 
     /// Every identifiable equation (or the named ones) from runs; returns the identified model
     /// and each fit as JSON.
-    #[pyo3(signature = (runs, derivative = None, equations = vec![], intercept = None, backend = None, start_as_first = false))]
-    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (runs, derivative = None, equations = vec![], intercept = None, backend = None))]
     fn identify(
         &self,
         py: Python<'_>,
@@ -447,7 +446,6 @@ impl PyModel {
         equations: Vec<String>,
         intercept: Option<bool>,
         backend: Option<&str>,
-        start_as_first: bool,
     ) -> PyResult<(PyModel, Vec<(String, String)>)> {
         // the defaults of `termid identify`: central differences for a plug-in's model (a
         // ship, as the paper), the integral form for any other; the model file's intercept
@@ -480,12 +478,15 @@ impl PyModel {
                 warn(py, c.line())?;
             }
         }
-        let model = match frames.first().filter(|_| start_as_first) {
-            // a model made from columns: simulated from where the first run starts
-            Some(first) => identified.model.starting_as(first).map_err(fail)?,
-            None => identified.model,
-        };
-        Ok((PyModel { inner: model }, fits))
+        Ok((PyModel { inner: identified.model }, fits))
+    }
+
+    /// The model with each state's initial value the run's first sample of it (a model made
+    /// from columns: simulated from where its first run starts).
+    fn starting_as(&self, run: Run<'_>) -> PyResult<PyModel> {
+        let (origin, columns) = run;
+        let frame = frame_of(&origin, &self.inner.spec().model.time, &columns)?;
+        Ok(PyModel { inner: self.inner.starting_as(&frame).map_err(fail)? })
     }
 
     /// The sufficient statistics of each of `equations` over runs (mergeable, picklable); the

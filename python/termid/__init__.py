@@ -1177,8 +1177,8 @@ class Model:
         states and ``inputs`` to ``degree``, the constant among them — selected by sequential
         thresholding (or :meth:`identify`'s ``backend``), as ``termid identify --states`` makes
         it. ``inputs`` are the columns that drive the states (a force, a setpoint), known from
-        the runs. :meth:`identify` starts the identified model's states where the first run
-        starts, so that :meth:`simulate` retraces that run's beginning; :meth:`save` writes it.
+        the runs. :meth:`identify` (and :meth:`recipe`) starts the identified model's states where the
+        first run starts, so that :meth:`simulate` retraces that run's beginning; :meth:`save` writes it.
 
         Parameters: ``states`` the state columns; ``inputs`` the input columns; ``terms`` the
         candidates (default: the polynomial library); ``degree`` the polynomial library's (default 3, as the ODE benchmark that chose termid's
@@ -1495,11 +1495,13 @@ class Model:
         data = _targeted(self._native, _runs(runs, names, self.time), derivative, target, list(equations))
         try:
             native, fits = self._native.identify(
-                data, derivative, list(equations), intercept, _backend(backend, settings), self._from_states
+                data, derivative, list(equations), intercept, _backend(backend, settings)
             )
         except TermidError as e:
             left_out = {n: k for _, cols in data for n, k in getattr(cols, "left_out", {}).items()}
             raise _explained(e, left_out) from None
+        if self._from_states and data:
+            native = native.starting_as(data[0])
         return Identified(Model(native, self._from_states), fits)
 
     @_runs_told_apart
@@ -1982,8 +1984,9 @@ class Model:
         True
         """
         held = _runs(held_out, time=self.time) if held_out is not None else []
+        data = _runs(runs, time=self.time)
         text_json, text, native = self._native.recipe(
-            _runs(runs, time=self.time),
+            data,
             list(derivatives),
             smooth,
             intercept,
@@ -1999,7 +2002,9 @@ class Model:
             list(per_source),
             list(per_run),
         )
-        return Recipe(Model(native), json.loads(text_json), text)
+        if self._from_states and data:
+            native = native.starting_as(data[0])
+        return Recipe(Model(native, self._from_states), json.loads(text_json), text)
 
     @_runs_told_apart
     def estimate(

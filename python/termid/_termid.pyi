@@ -66,8 +66,8 @@ class Model:
         equations: Sequence[str] = ...,
         intercept: Optional[bool] = None,
         backend: Optional[str] = None,
-        start_as_first: bool = False,
     ) -> Tuple[Model, List[Tuple[str, str]]]: ...
+    def starting_as(self, run: Run) -> Model: ...
     def moments(self, equations: Sequence[str], runs: Sequence[Run], derivative: Optional[str] = None) -> List[Moments]: ...
     def identify_from_moments(
         self, moments: Sequence[Moments], intercept: Optional[bool] = None

@@ -875,6 +875,10 @@ def test_a_system_from_its_columns():
     again = found.model.simulate(inputs=force, duration=5.0)
     assert again["x"].iloc[0] == 1.0 and np.abs(again["x"].to_numpy() - run["x"].to_numpy()[: len(again)]).max() < 1e-3
     assert pickle.loads(pickle.dumps(found.model))._from_states
+    # the whole recipe too, its checks those of any system (that the equations retrace the run)
+    recipe = model.recipe(run[["t", "x", "v", "F"]], ["integral"], smooth=False, refine=None)
+    assert recipe.model.simulate(inputs=force, duration=1.0)["x"].iloc[0] == 1.0
+    assert "ok   the equations retrace their runs without running away" in recipe.text
     # what cannot be a system is refused by name
     with pytest.raises(termid.TermidError, match="`F` is named twice"):
         termid.Model.from_states(["x", "F"], ["F"])
