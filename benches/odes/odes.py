@@ -131,11 +131,16 @@ def termid_fit(termid, csv, target, terms_file, states, extra):
     )
     if out.returncode != 0:
         return None, out.stderr.strip().splitlines()[-1] if out.stderr.strip() else "failed"
-    report = json.loads(out.stdout)
-    found = {canonical(t["term"], states): t["coefficient"] for t in report["terms"]}
-    if report.get("intercept") is not None:
-        found[canonical("1", states)] = found.get(canonical("1", states), 0.0) + report["intercept"]
-    return {k: v for k, v in found.items() if v != 0.0}, None
+    return found_terms(json.loads(out.stdout), states), None
+
+
+def found_terms(fit, states):
+    """One equation's fit report as its nonzero coefficients by canonical term, an intercept
+    as the constant's."""
+    found = {canonical(t["term"], states): t["coefficient"] for t in fit["terms"]}
+    if fit.get("intercept") is not None:
+        found[canonical("1", states)] = found.get(canonical("1", states), 0.0) + fit["intercept"]
+    return {k: v for k, v in found.items() if v != 0.0}
 
 
 def termid_whole(termid, csv, states, terms_file, exact, extra):
@@ -148,14 +153,7 @@ def termid_whole(termid, csv, states, terms_file, exact, extra):
     if out.returncode != 0:
         return None, out.stderr.strip().splitlines()[-1] if out.stderr.strip() else "failed"
     report = json.loads(out.stdout)
-    found = {}
-    for s in states:
-        fit = report[f"{s}_dot"]
-        terms = {canonical(t["term"], states): t["coefficient"] for t in fit["terms"]}
-        if fit.get("intercept") is not None:
-            terms[canonical("1", states)] = terms.get(canonical("1", states), 0.0) + fit["intercept"]
-        found[s] = {k: v for k, v in terms.items() if v != 0.0}
-    return found, None
+    return {s: found_terms(report[f"{s}_dot"], states) for s in states}, None
 
 
 def pysindy_fit(system, t, u, rates):

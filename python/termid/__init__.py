@@ -1291,6 +1291,13 @@ class Model:
         """
         return self._native.to_toml()
 
+    def _identified(self, native: Any, runs: List[Tuple[str, Dict[str, np.ndarray]]]) -> "Model":
+        """The model ``native`` identified from ``runs`` by this one: made from states, it
+        starts where the first run starts."""
+        if self._from_states and runs:
+            native = native.starting_as(runs[0])
+        return Model(native, self._from_states)
+
     def __reduce__(self) -> Tuple[Any, Tuple[str, str, bool]]:
         # pickled as its file's text (a process pool, Dask), read back as it was written
         return (_unpickled, (self.to_toml(), self._native.path, self._from_states))
@@ -1500,9 +1507,7 @@ class Model:
         except TermidError as e:
             left_out = {n: k for _, cols in data for n, k in getattr(cols, "left_out", {}).items()}
             raise _explained(e, left_out) from None
-        if self._from_states and data:
-            native = native.starting_as(data[0])
-        return Identified(Model(native, self._from_states), fits)
+        return Identified(self._identified(native, data), fits)
 
     @_runs_told_apart
     def moments(
@@ -2002,9 +2007,7 @@ class Model:
             list(per_source),
             list(per_run),
         )
-        if self._from_states and data:
-            native = native.starting_as(data[0])
-        return Recipe(Model(native, self._from_states), json.loads(text_json), text)
+        return Recipe(self._identified(native, data), json.loads(text_json), text)
 
     @_runs_told_apart
     def estimate(

@@ -464,7 +464,7 @@ impl Dopri5 {
         SimError::Settings(format!(
             "the adaptive integrator could not meet its tolerances at t = {t:?} s (step {:?} s): the model is stiff or diverging there; state {}",
             self.h,
-            system.states.iter().zip(self.y.iter()).map(|(n, v)| format!("{n} = {}", super::integrator::shown(*v))).collect::<Vec<_>>().join(", ")
+            super::integrator::snapshot(&system.states, &self.y)
         ))
     }
 }

@@ -553,26 +553,18 @@ fn report(system: &System, t: f64, x: &[f64], prev: &[f64]) -> Result<(), SimErr
         } else {
             continue;
         };
-        let snapshot = system
-            .states
-            .iter()
-            .zip(prev)
-            .map(|(n, v)| format!("{n} = {}", shown(*v)))
-            .collect::<Vec<_>>()
-            .join(", ");
+        let snapshot = snapshot(&system.states, prev);
         return Err(SimError::Diverged { t, state: system.states[i].clone(), value: v, why, snapshot });
     }
     Ok(())
 }
 
-/// A state's value in a message: six decimals, or six significant digits in powers of ten
-/// where the state has run far away (a diverged run's 10¹⁰² would print as 103 digits).
-pub(crate) fn shown(v: f64) -> String {
-    if v.is_finite() && v.abs() < 1e9 {
-        format!("{v:.6}")
-    } else {
-        format!("{v:.6e}")
-    }
+/// The states' values in a message (`x = 1.000000, y = 2.5e102`): six decimals each, or six
+/// significant digits in powers of ten where a state has run far away (a diverged run's
+/// 10¹⁰² would print as 103 digits).
+pub(crate) fn snapshot(names: &[String], values: &[f64]) -> String {
+    let shown = |v: f64| if v.is_finite() && v.abs() < 1e9 { format!("{v:.6}") } else { format!("{v:.6e}") };
+    names.iter().zip(values).map(|(n, v)| format!("{n} = {}", shown(*v))).collect::<Vec<_>>().join(", ")
 }
 
 #[cfg(test)]

@@ -503,9 +503,7 @@ impl IdentifyCommand {
             ("--weight", self.weight.is_some(), "row weights apply to one equation without a model file"),
         ];
         if self.model.is_some() {
-            if let Some((flag, _, why)) = with_model.iter().find(|(_, given, _)| *given) {
-                return Err(format!("{flag} cannot be used with --model: {why}"));
-            }
+            refuse_given("--model", &with_model)?;
             if !self.states.is_empty() {
                 return Err("--states cannot be used with --model: the model file declares its states".into());
             }
@@ -536,9 +534,7 @@ impl IdentifyCommand {
                     "statistics files are written for a model file's equations",
                 ),
             ];
-            if let Some((flag, _, why)) = single.iter().find(|(_, given, _)| *given) {
-                return Err(format!("{flag} cannot be used with --states: {why}"));
-            }
+            refuse_given("--states", &single)?;
             if self.degree.is_some() && (!self.terms.is_empty() || self.terms_file.is_some()) {
                 return Err(
                     "--degree cannot be used with --terms or --terms-file: the candidates are named".into()
@@ -546,19 +542,27 @@ impl IdentifyCommand {
             }
         }
         if !self.moments.is_empty() {
-            let runs = [
-                ("--data", !self.data.is_empty()),
-                ("--dataset", !self.dataset.is_empty()),
-                ("--refine", self.refine.is_some()),
-                ("--choose", self.choose.is_some()),
-            ];
-            if let Some((flag, _)) = runs.iter().find(|(_, given)| *given) {
-                return Err(format!(
-                    "{flag} cannot be used with --moments: the statistics stand for the runs, and re-simulating or leaving runs out needs the runs themselves"
-                ));
-            }
+            let why = "the statistics stand for the runs, and re-simulating or leaving runs out needs the runs themselves";
+            refuse_given(
+                "--moments",
+                &[
+                    ("--data", !self.data.is_empty(), why),
+                    ("--dataset", !self.dataset.is_empty(), why),
+                    ("--refine", self.refine.is_some(), why),
+                    ("--choose", self.choose.is_some(), why),
+                ],
+            )?;
         }
         Ok(())
+    }
+}
+
+/// The first of `options` (flag, given, why) that is given, refused as one that cannot go
+/// with the option `with`.
+fn refuse_given(with: &str, options: &[(&str, bool, &str)]) -> Result<(), String> {
+    match options.iter().find(|(_, given, _)| *given) {
+        Some((flag, _, why)) => Err(format!("{flag} cannot be used with {with}: {why}")),
+        None => Ok(()),
     }
 }
 
