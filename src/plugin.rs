@@ -27,6 +27,18 @@ impl PluginError {
     }
 }
 
+/// What the recipe does where its caller names no derivative starts, smoothing or refinement
+/// (plain data a plug-in returns; [`RecipeDefaults::of`] gives a model's).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RecipeDefaults {
+    /// One start per derivative method.
+    pub derivatives: Vec<String>,
+    /// Whether the states are smoothed by each start's method.
+    pub smooth: bool,
+    /// The states the refinement compares (`None`: no refinement; empty: every state).
+    pub refine: Option<Vec<String>>,
+}
+
 /// A field's extension of the core.
 pub trait Plugin: Sync {
     /// The model-file table it owns (`ship`); a model with that table is this plug-in's.
@@ -56,6 +68,12 @@ pub trait Plugin: Sync {
         _smooth: bool,
     ) -> Result<Frame, PluginError> {
         Err(PluginError::Refused(format!("no derivative method `{method}`")))
+    }
+    /// What the recipe does for a model of this field where its caller names no derivative
+    /// starts, smoothing or refinement (`None`: any system's,
+    /// [`RecipeDefaults::of`]).
+    fn recipe_defaults(&self, _model: &Model) -> Option<RecipeDefaults> {
+        None
     }
     /// The effects `diagnose` tries for a model of this field (`None`: the generic ones).
     fn hypotheses(&self, _model: &Model) -> Option<Vec<Hypothesis>> {

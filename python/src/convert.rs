@@ -30,10 +30,12 @@ pub(crate) fn refuse(text: impl Into<String>) -> PyErr {
     TermidError::new_err(text.into())
 }
 
-/// What the command line says on standard error, as a `UserWarning` a notebook shows.
+/// What the command line says on standard error, as a `UserWarning` a notebook shows, pointed
+/// at the user's line that called the package (the package's `_outside`), not at its own.
 pub(crate) fn warn(py: Python<'_>, note: String) -> PyResult<()> {
-    let message = std::ffi::CString::new(note).unwrap_or_default();
-    PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &message, 2)
+    let message = std::ffi::CString::new(format!("termid: {note}")).unwrap_or_default();
+    let level = py.import("termid")?.getattr("_outside")?.call0()?.extract::<i32>()?;
+    PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &message, level)
 }
 
 /// A run handed over from Python: its name, and its columns as float64 arrays.

@@ -435,6 +435,13 @@ impl PyModel {
         }
     }
 
+    /// The recipe's derivative starts, smoothing and refined states (`None`: no refinement;
+    /// empty: every state) where its caller names none: the model's field's, else any system's.
+    fn recipe_defaults(&self) -> (Vec<String>, bool, Option<Vec<String>>) {
+        let d = termid::recipe::RecipeDefaults::of(&self.inner);
+        (d.derivatives, d.smooth, d.refine)
+    }
+
     /// Every identifiable equation (or the named ones) from runs; returns the identified model
     /// and each fit as JSON.
     #[pyo3(signature = (runs, derivative = None, equations = vec![], intercept = None, backend = None))]
@@ -940,9 +947,19 @@ impl PyModel {
                                    "parameters": parameters})
             })
             .collect();
+        // a refinement that failed leaves the regression's model: said with the rest
+        let warnings: Vec<String> =
+            recipe
+                .warnings()
+                .into_iter()
+                .chain(recipe.kept().refine_error.iter().map(|e| {
+                    format!("the output-error refinement failed: {e}; the model is the regression's")
+                }))
+                .collect();
         let json = serde_json::json!({
             "starts": starts,
             "failed": recipe.failed,
+            "warnings": warnings,
             "checks": recipe.checks(),
             "refusals": recipe.refusals(),
             "report": recipe.json().map_err(fail)?,

@@ -1073,7 +1073,9 @@ class Recipe:
     its estimate with the model file's free parameters was ``"kept"``, ``"rejected"`` by the
     checks or ``"failed"``, None where not run), the kept model's
     ``checks`` (with the starts' agreement: a failing one flags a prediction the runs
-    cannot pin down), ``refusals`` (why it must not be written, if any), the ``report`` as
+    cannot pin down), ``refusals`` (why it must not be written, if any), ``warnings`` (what
+    the recipe warned about: failed starts, disagreeing starts, a refinement rejected or
+    failed), ``failed`` (each failed start and why), the ``report`` as
     plain values and as ``text``, and the kept start's estimate of the model file's free
     ``parameters`` (the report's ``parameter_estimate``: each parameter, and under
     ``per_source`` each source's or run's; None where not run or not kept).
@@ -1091,6 +1093,7 @@ class Recipe:
         self.checks = pd.DataFrame(report["checks"])
         self.refusals: List[str] = list(report["refusals"])
         self.failed = list(report["failed"])
+        self.warnings: List[str] = list(report["warnings"])
         self.report = report["report"]
         self.parameters: Optional[Mapping[str, Any]] = self.report.get("parameter_estimate")
         self.text = text
@@ -1242,7 +1245,7 @@ class Model:
         """
         native, _, cautions = _particulars(particulars)
         for caution in cautions:
-            warnings.warn(f"termid: {caution}", stacklevel=2)
+            warnings.warn(f"termid: {caution}", stacklevel=_outside())
         return Model(native)
 
     @staticmethod
@@ -1740,7 +1743,7 @@ class Model:
             if e["failed"] is not None:
                 warnings.warn(
                     f"termid: one sd from its estimate, `{e['parameter']}` leaves no prediction: {e['failed']}",
-                    stacklevel=2,
+                    stacklevel=_outside(),
                 )
         return table
 
@@ -1845,7 +1848,7 @@ class Model:
                     "millionth of each state's spread off parts from the model's own run there (a chaotic or "
                     "strongly unstable motion), so later errors are of that size whatever the model",
                     UserWarning,
-                    stacklevel=2,
+                    stacklevel=_outside(),
                 )
         rows = [
             {"run": m["run"], "source": source, **(m.get(source) or {})}
@@ -1937,13 +1940,13 @@ class Model:
     def recipe(
         self,
         runs: Union[Data, Sequence[Data]],
-        derivatives: Sequence[str] = ("kinematic", "kalman", "savitzky-golay", "central"),
+        derivatives: Optional[Sequence[str]] = None,
         *,
-        smooth: bool = True,
+        smooth: Optional[bool] = None,
         intercept: Optional[bool] = False,
         choose: Sequence[str] = (),
         compare: Sequence[str] = (),
-        refine: Optional[Sequence[str]] = ("u", "v", "r", "ψ"),
+        refine: Union[Sequence[str], str, None] = "auto",
         refine_iterations: int = 100,
         refine_prior: float = 1e-4,
         held_out: Union[Data, Sequence[Data], None] = None,
@@ -1957,8 +1960,8 @@ class Model:
         several ``--derivative`` starts) from ``runs``: each start prepares them by one derivative method
         in ``derivatives`` (``smooth``: states smoothed by it), identified (or chosen among the
         back-ends ``choose`` by leave-one-run-out prediction of the states ``compare``),
-        refined by output error on the states ``refine`` (None: no refinement; an empty list:
-        every state) with ``refine_iterations`` (in each of two rounds where the free parameters
+        refined by output error on the states ``refine`` (None: no refinement; ``"all"`` or an
+        empty list: every state) with ``refine_iterations`` (in each of two rounds where the free parameters
         are refined too) and the regression as a prior of weight
         ``refine_prior``, re-simulated at ``refine_step`` seconds (None: the coarsest step, up
         to 8 samples, at which the runs still hold their compared states and inputs; the costs
@@ -1976,7 +1979,15 @@ class Model:
         ``refine`` (implied by ``per_source`` and ``per_run``), False not; ``per_source`` names
         those estimated once per source, ``sources`` numbering each run's source (basin),
         ``per_run`` those estimated once per run; the kept start's estimate in ``parameters``
-        of the result. Defaults are the new-ship recipe's.
+        of the result.
+
+        ``derivatives``, ``smooth`` and ``refine`` (``"auto"``) left out are the model's
+        field's: for a ship the new-ship recipe's (``kinematic``, ``kalman``,
+        ``savitzky-golay`` and ``central`` starts, smoothed, refined on u, v, r, ψ); for any
+        other system one start by the integral form, neither smoothed nor refined (as
+        ``termid identify`` does). A start that fails, starts that disagree, a refinement
+        rejected by the checks or failed, and a model that fails its checks (``refusals``) are
+        each warned about.
 
         >>> ship = termid.Model.default()
         >>> ship.set_parameter("u0", "mean:u:4")
@@ -1990,10 +2001,13 @@ class Model:
         """
         held = _runs(held_out, time=self.time) if held_out is not None else []
         data = _runs(runs, time=self.time)
+        field_derivatives, field_smooth, field_refine = self._native.recipe_defaults()
+        if isinstance(refine, str):
+            refine = field_refine if refine == "auto" else [] if refine == "all" else [s.strip() for s in refine.split(",") if s.strip()]
         text_json, text, native = self._native.recipe(
             data,
-            list(derivatives),
-            smooth,
+            list(field_derivatives if derivatives is None else derivatives),
+            field_smooth if smooth is None else smooth,
             intercept,
             list(choose),
             list(compare),
@@ -2007,7 +2021,16 @@ class Model:
             list(per_source),
             list(per_run),
         )
-        return Recipe(self._identified(native, data), json.loads(text_json), text)
+        found = Recipe(self._identified(native, data), json.loads(text_json), text)
+        # what the command line prints as warnings (or refuses to write) is said here too
+        for why in found.warnings:
+            warnings.warn(f"termid: {why}", stacklevel=_outside())
+        if found.refusals:
+            warnings.warn(
+                "termid: the identified model fails its checks (Recipe.refusals):\n  " + "\n  ".join(found.refusals),
+                stacklevel=_outside(),
+            )
+        return found
 
     @_runs_told_apart
     def estimate(
@@ -2171,11 +2194,11 @@ class Model:
             if not check["passed"]:
                 # the fit misses what the field judges its runs by (a ship's overshoots): said as
                 # the CLI says it
-                warnings.warn(f"termid: FLAG {check['name']}: {check['detail']}", stacklevel=2)
+                warnings.warn(f"termid: FLAG {check['name']}: {check['detail']}", stacklevel=_outside())
         if report.get("metrics_failed"):
             warnings.warn(
                 f"termid: no metrics of the fit: the estimates do not re-simulate every run: {report['metrics_failed']}",
-                stacklevel=2,
+                stacklevel=_outside(),
             )
         if report["unexplained"] > 0.1 + report["noise"]:
             # a minimum that is not the system's, or a structure that is not: the CLI flags it
@@ -2193,7 +2216,7 @@ class Model:
                 f"termid: the fit does not follow the records: it leaves {100 * report['unexplained']:.2g} % "
                 f"of their variance (attrs['unexplained']; their noise {100 * report['noise']:.2g} %){why}; "
                 "read the estimates as failed",
-                stacklevel=2,
+                stacklevel=_outside(),
             )
         leaning = report.get("from_records") or {}
         if leaning.get("leans"):
@@ -2205,7 +2228,7 @@ class Model:
                 f"the records' noise from the first samples; from those the cost is "
                 f"{'beyond bounds' if cost is None else f'{cost:.4g}'} against {report['cost_after']:.4g} "
                 "(attrs['from_records']); the model does not explain everything the runs show",
-                stacklevel=2,
+                stacklevel=_outside(),
             )
         return table, Model(native)
 

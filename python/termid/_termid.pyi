@@ -125,6 +125,7 @@ class Model:
         with_intercept: bool = False,
         over_ground: bool = False,
     ) -> Tuple[str, Optional[Model]]: ...
+    def recipe_defaults(self) -> Tuple[List[str], bool, Optional[List[str]]]: ...
     def recipe(
         self,
         runs: Sequence[Run],

@@ -875,10 +875,21 @@ def test_a_system_from_its_columns():
     again = found.model.simulate(inputs=force, duration=5.0)
     assert again["x"].iloc[0] == 1.0 and np.abs(again["x"].to_numpy() - run["x"].to_numpy()[: len(again)]).max() < 1e-3
     assert pickle.loads(pickle.dumps(found.model))._from_states
-    # the whole recipe too, its checks those of any system (that the equations retrace the run)
-    recipe = model.recipe(run[["t", "x", "v", "F"]], ["integral"], smooth=False, refine=None)
+    # the whole recipe too, by any system's defaults (the integral form, neither smoothed nor
+    # refined), its checks those of any system (that the equations retrace the run)
+    recipe = model.recipe(run[["t", "x", "v", "F"]])
+    assert list(recipe.starts["derivative"]) == ["integral"] and recipe.warnings == []
     assert recipe.model.simulate(inputs=force, duration=1.0)["x"].iloc[0] == 1.0
     assert "ok   the equations retrace their runs without running away" in recipe.text
+    v_dot = recipe.model.coefficients("v_dot").set_index("term")["value"]
+    assert v_dot["x"] == pytest.approx(-1.0, rel=1e-3) and v_dot["F"] == pytest.approx(1.0, rel=1e-3)
+    # a ship's starts and states are refused or warned about by name, not run as failures
+    with pytest.raises(termid.TermidError, match="refine: `u` is neither a state"):
+        model.recipe(run[["t", "x", "v", "F"]], refine=["u", "v"])
+    with pytest.warns(UserWarning, match="the start from derivative `kinematic` fails") as said:
+        both = model.recipe(run[["t", "x", "v", "F"]], ["kinematic", "integral"], refine="all", refine_iterations=3)
+    assert list(both.starts["derivative"]) == ["integral"] and both.failed[0][0] == "kinematic"
+    assert {w.filename for w in said} == {__file__}
     # what cannot be a system is refused by name
     with pytest.raises(termid.TermidError, match="`F` is named twice"):
         termid.Model.from_states(["x", "F"], ["F"])
@@ -917,8 +928,10 @@ def test_equations_that_run_away_from_their_run_are_said_to():
     # from the run's start within 5 s; sampled five times faster, the truth comes back
     truth = termid.Model.from_toml(_LOTKA_VOLTERRA)
     coarse = truth.simulate(duration=19.5, sample=0.5)[["t", "x", "z"]]
-    with pytest.warns(UserWarning, match=r"FAIL the equations retrace their runs without running away: run1: re-simulated"):
+    with pytest.warns(UserWarning, match=r"termid: FAIL the equations retrace their runs without running away: run1: re-simulated") as said:
         termid.Model.from_states(["x", "z"]).identify(coarse)
+    # said at the user's line, not at the package's
+    assert [w.filename for w in said] == [__file__]
     fine = truth.simulate(duration=19.9, sample=0.1)[["t", "x", "z"]]
     with warnings.catch_warnings():
         warnings.simplefilter("error")

@@ -10,6 +10,7 @@ mod report;
 mod retrace;
 mod start;
 
+pub use crate::plugin::RecipeDefaults;
 pub use parameters::{ParameterOptions, ParameterStage};
 pub use report::Primes;
 pub use retrace::retrace_check;
@@ -80,6 +81,22 @@ impl Default for RecipeSettings {
             agree: 0.10,
             parameters: None,
         }
+    }
+}
+
+/// What the recipe does where its caller names no derivative starts, smoothing or refinement:
+/// a field's own way (a plug-in's [`Plugin::recipe_defaults`](crate::plugin::Plugin::recipe_defaults):
+/// a ship's four starts refined on its velocities and heading), else any system's: one start
+/// by the integral form, which recovers polynomial systems from noise-free and noisy samples
+/// alike, not smoothed and not refined (an output error over a chaotic run has no one minimum).
+impl RecipeDefaults {
+    /// The defaults for `model`: its plug-in's, else any system's.
+    pub fn of(model: &Model) -> RecipeDefaults {
+        crate::plugins::of(model).and_then(|p| p.recipe_defaults(model)).unwrap_or_else(|| RecipeDefaults {
+            derivatives: vec!["integral".into()],
+            smooth: false,
+            refine: None,
+        })
     }
 }
 
@@ -159,6 +176,10 @@ pub fn identify(
             settings.derivatives.join(",")
         )));
     }
+    if let Some(states) = settings.refine.as_ref().and_then(|r| r.states.as_ref()) {
+        compared_known(model, "refine", states)?;
+    }
+    compared_known(model, "compare", &settings.compare)?;
     if let Some(options) = &settings.parameters {
         // said before any work
         let free: Vec<String> = model.free_parameters().iter().map(|p| p.name.clone()).collect();
@@ -207,6 +228,26 @@ pub fn identify(
         starts.par_iter_mut().for_each(|s| start::refine_instead(s, settings));
     }
     Recipe::of(starts, failed, held.is_some(), settings.agree)
+}
+
+/// Refuses, before any work, a name among the states a refinement or a choice compares
+/// (`what`: which) that is neither a state nor a derived variable of `model` (compared with
+/// the runs' column of its name: a propeller's thrust).
+pub fn compared_known(model: &Model, what: &str, names: &[String]) -> Result<(), RecipeError> {
+    let spec = model.spec();
+    let known: Vec<&str> = spec
+        .states
+        .iter()
+        .map(|s| s.name.as_str())
+        .chain(spec.derived.iter().map(|d| d.name.as_str()))
+        .collect();
+    match names.iter().find(|n| !known.contains(&n.as_str())) {
+        Some(name) => Err(RecipeError::Setup(format!(
+            "{what}: `{name}` is neither a state nor a derived variable of the model ({})",
+            known.join(", ")
+        ))),
+        None => Ok(()),
+    }
 }
 
 /// Whether the plausible starts agree with the kept one (`kept`) on each measure of its checks.
@@ -305,5 +346,51 @@ impl Recipe {
         }
         out.push('\n');
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lorenz() -> Model {
+        crate::plugins::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/models/lorenz.toml")))
+            .unwrap()
+    }
+
+    #[test]
+    fn defaults_are_the_field_s_else_any_system_s() {
+        // a ship: the new-ship recipe's four starts, smoothed, refined on velocities and heading
+        let ship = RecipeDefaults::of(&crate::plugins::default_model());
+        assert_eq!(ship.derivatives, ["kinematic", "kalman", "savitzky-golay", "central"]);
+        assert!(ship.smooth);
+        assert_eq!(ship.refine.as_deref(), Some(&["u".to_string(), "v".into(), "r".into(), "ψ".into()][..]));
+        // any other system: the integral form, one start, neither smoothed nor refined
+        let any = RecipeDefaults::of(&lorenz());
+        assert_eq!(any, RecipeDefaults { derivatives: vec!["integral".into()], smooth: false, refine: None });
+    }
+
+    #[test]
+    fn a_compared_name_the_model_lacks_is_refused_before_any_work() {
+        let model = lorenz();
+        let settings = RecipeSettings {
+            refine: Some(RefineOptions {
+                states: Some(vec!["u".into()]),
+                prior: 0.0,
+                iterations: 1,
+                step: None,
+            }),
+            ..Default::default()
+        };
+        // no runs at all: the names are refused before the runs are looked at
+        let e = identify(&model, &[], None, &settings).unwrap_err().to_string();
+        assert!(
+            e.contains("refine: `u` is neither a state nor a derived variable of the model (x, y, z)"),
+            "{e}"
+        );
+        let settings = RecipeSettings { compare: vec!["x".into(), "psi".into()], ..Default::default() };
+        let e = identify(&model, &[], None, &settings).unwrap_err().to_string();
+        assert!(e.starts_with("compare: `psi`"), "{e}");
+        assert!(compared_known(&model, "refine", &["x".into(), "z".into()]).is_ok());
     }
 }

@@ -7,7 +7,7 @@ use crate::model::dimension::{nondimensional, Nondimensional};
 use crate::model::Model;
 use crate::select::Stop;
 
-use super::Recipe;
+use super::{ParameterStage, Recipe};
 
 /// The kept model's coefficients in the prime system of its plug-in, each with the field's
 /// name for it: the reference length, speed and density and the rows.
@@ -83,6 +83,25 @@ impl Recipe {
             })
             .chain(self.checks().iter().filter(|c| !c.passed && c.refuses).map(|c| c.line()))
             .collect()
+    }
+
+    /// What a caller says beside the report, a sentence each: every start that failed, each
+    /// measure the plausible starts disagree on, the kept start's refinement rejected by the
+    /// checks, its free parameters not kept. (A refinement that failed is the caller's to
+    /// raise: the kept start's `refine_error`.)
+    pub fn warnings(&self) -> Vec<String> {
+        let kept = self.kept();
+        let failed =
+            self.failed.iter().map(|(method, e)| format!("the start from derivative `{method}` fails: {e}"));
+        let disagree = self.agreement.iter().filter(|c| !c.passed).map(|c| c.line());
+        let rejected = kept.rejected.iter().map(|(_, lost)| {
+            format!(
+                "the refinement is rejected: the refined model fails physical checks the regression's passes ({}); the regression's model is kept",
+                lost.join("; ")
+            )
+        });
+        let parameters = kept.parameters.as_ref().and_then(ParameterStage::warning);
+        failed.chain(disagree).chain(rejected).chain(parameters).collect()
     }
 
     /// The kept start's coefficients in the prime system, where its plug-in has one.

@@ -54,6 +54,20 @@ impl Plugin for Manoeuvring {
         &[KINEMATIC]
     }
 
+    fn recipe_defaults(&self, model: &Model) -> Option<crate::plugin::RecipeDefaults> {
+        // the new-ship recipe ("Starting a new ship"): every preparation a start, the states
+        // smoothed by it, refined on the velocities and heading (positions integrate every
+        // earlier error and would dominate the cost)
+        let states = model.spec().states.iter().map(|s| s.name.as_str()).collect::<Vec<_>>();
+        Some(crate::plugin::RecipeDefaults {
+            derivatives: [KINEMATIC, "kalman", "savitzky-golay", "central"].map(String::from).to_vec(),
+            smooth: true,
+            refine: Some(
+                ["u", "v", "r", "ψ"].into_iter().filter(|s| states.contains(s)).map(String::from).collect(),
+            ),
+        })
+    }
+
     fn prepare(
         &self,
         method: &str,

@@ -5,7 +5,7 @@
 
 use anyhow::{bail, Result};
 use termid::identify::Target;
-use termid::recipe::{ParameterOptions, ParameterStage, RecipeSettings, RefineOptions};
+use termid::recipe::{ParameterOptions, RecipeSettings, RefineOptions};
 use termid::select::Backend;
 
 use crate::args::{Format, IdentifyCommand};
@@ -41,7 +41,7 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
         // the command line's back-end (with its stepwise options) replaces the file's
         model = model.with_backend(&configure_backend(&cmd)?)?;
     }
-    let refine = cmd.refine.as_deref().map(|list| refine_states(list, &model)).transpose()?;
+    let refine = cmd.refine.as_deref().map(|list| compared_states("--refine", list, &model)).transpose()?;
     let methods: Vec<String> =
         cmd.derivative.split(',').map(str::trim).filter(|m| !m.is_empty()).map(String::from).collect();
     if methods.len() > 1 && refine.is_none() {
@@ -82,7 +82,12 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
                     Some(list) => backend_variants(&model, list)?,
                     None => vec![],
                 },
-                compare: match cmd.compare.as_deref().map(|l| refine_states(l, &model)).transpose()? {
+                compare: match cmd
+                    .compare
+                    .as_deref()
+                    .map(|l| compared_states("--compare", l, &model))
+                    .transpose()?
+                {
                     Some(Some(states)) => states,
                     _ => vec![],
                 },
@@ -126,25 +131,13 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
             recipe
         }
     };
-    for (method, e) in &recipe.failed {
-        eprintln!("warning: the start from --derivative {method} fails: {e}");
-    }
     if recipe.starts.len() > 1 && matches!(cmd.format, Format::Text) {
         print!("{}", recipe.starts_text());
     }
-    for c in recipe.agreement.iter().filter(|c| !c.passed) {
-        eprintln!("warning: {}", c.line());
-    }
-    let kept = recipe.kept();
-    if let Some((_, lost)) = &kept.rejected {
-        eprintln!(
-            "warning: the refinement is rejected: the refined model fails physical checks the regression's passes ({}); the regression's model is kept",
-            lost.join("; ")
-        );
-    }
-    if let Some(why) = kept.parameters.as_ref().and_then(ParameterStage::warning) {
+    for why in recipe.warnings() {
         eprintln!("warning: {why}");
     }
+    let kept = recipe.kept();
     // checked before anything is written
     let refused = recipe.refusals();
     let write = refused.is_empty() || cmd.keep_unphysical;
@@ -226,29 +219,17 @@ fn backend_variants(model: &termid::model::Model, list: &str) -> Result<Vec<(Str
         .collect()
 }
 
-/// The states `--refine` names (`None`: all), each checked to be one of the model's states or
-/// derived variables (compared with the runs' column of its name).
-fn refine_states(list: &str, model: &termid::model::Model) -> Result<Option<Vec<String>>> {
+/// The states `--refine` or `--compare` (`flag`) names (`None`: all), each checked to be one
+/// of the model's states or derived variables (compared with the runs' column of its name).
+fn compared_states(flag: &str, list: &str, model: &termid::model::Model) -> Result<Option<Vec<String>>> {
     if list.trim() == "all" {
         return Ok(None);
     }
-    let spec = model.spec();
-    let known: Vec<&str> = spec
-        .states
-        .iter()
-        .map(|s| s.name.as_str())
-        .chain(spec.derived.iter().map(|d| d.name.as_str()))
-        .collect();
     let names: Vec<String> =
         list.split(',').map(str::trim).filter(|n| !n.is_empty()).map(String::from).collect();
     if names.is_empty() {
-        bail!("--refine `{list}` names no state: list the states to compare, e.g. --refine u,v,r, or `all`");
+        bail!("{flag} `{list}` names no state: list the states to compare, e.g. {flag} u,v,r, or `all`");
     }
-    if let Some(name) = names.iter().find(|n| !known.contains(&n.as_str())) {
-        bail!(
-            "--refine {list}: `{name}` is neither a state nor a derived variable of the model ({})",
-            known.join(", ")
-        );
-    }
+    termid::recipe::compared_known(model, &format!("{flag} {list}"), &names)?;
     Ok(Some(names))
 }
