@@ -348,11 +348,30 @@ def _runs(
         name = names[k] if names else _run_name(run, k)
         columns = _columns(run)
         if time is not None and time not in columns:
-            index = _index_time(run)
-            if index is not None:
-                columns[time] = index
+            _time_from(str(name), run, columns, time)
         out.append((str(name), columns))
     return out
+
+
+def _time_from(name: str, run: Data, columns: "_Columns", time: str) -> None:
+    """A run without its model's time column ``time`` takes it from its index where that holds
+    times (:func:`_index_time`), else from its one column of date-times or durations (said);
+    else it is refused, a column that looks like time named (as :func:`fit` does)."""
+    index = _index_time(run)
+    if index is not None:
+        columns[time] = index
+    elif len(columns.times) == 1:
+        warnings.warn(
+            f"termid: {name}: the rows' time `{time}` is column `{columns.times[0]}`, the one of date-times or durations",
+            stacklevel=_outside(),
+        )
+        columns[time] = columns.pop(columns.times[0])
+    else:
+        like = _termid.time_like(list(columns))
+        raise TermidError(
+            f"{name}: no time column `{time}` (columns: {', '.join(columns)})"
+            + (f"; `{like}` looks like time: name it `{time}`, df.rename(columns={{'{like}': '{time}'}})" if like else "")
+        )
 
 
 def _frame(columns: Sequence[Tuple[str, np.ndarray]]) -> pd.DataFrame:
@@ -1650,12 +1669,14 @@ class Model:
     ) -> pd.DataFrame:
         """:meth:`simulate` under a record of inputs: a run of them with the states at their
         initial values, replayed from there."""
-        (name, columns), = _runs(inputs, time=self.time)
+        (name, columns), = _runs(inputs)
         if self.time not in columns:
-            raise TermidError(
-                f"inputs that change in time need their time: a column `{self.time}` or an index of times "
-                f"(columns: {', '.join(columns)})"
-            )
+            try:
+                _time_from(name, inputs, columns, self.time)
+            except TermidError as e:
+                raise TermidError(
+                    f"inputs that change in time need their time, a column `{self.time}` or an index of times: {e}"
+                ) from None
         unknown = [c for c in columns if c != self.time and c not in self.inputs]
         if unknown:
             raise TermidError(

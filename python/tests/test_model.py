@@ -938,3 +938,18 @@ def test_equations_that_run_away_from_their_run_are_said_to():
         found = termid.Model.from_states(["x", "z"]).identify(fine)
     x_dot = found.model.coefficients("x_dot").set_index("term")["value"]
     assert x_dot.to_dict() == pytest.approx({"x": 1.0, "x*z": -0.5}, rel=1e-3)
+
+
+def test_a_run_without_its_model_s_time_column():
+    # a model's runs take their time from a time index or from their one column of date-times
+    # (said), as `fit` does; a column that only looks like time is named in the refusal
+    lorenz = termid.Model.builtin("lorenz")
+    run = lorenz.simulate(duration=5.0, dt=0.01)[["t", "x", "y", "z"]]
+    model = termid.Model.from_states(["x", "y", "z"])
+    stamped = run.assign(stamp=pd.Timestamp("2024-03-01 12:00") + pd.to_timedelta(run["t"], unit="s")).drop(columns="t")
+    with pytest.warns(UserWarning, match="run1: the rows' time `t` is column `stamp`"):
+        found = model.identify(stamped)
+    z_dot = found.model.coefficients("z_dot").set_index("term")["value"]
+    assert z_dot.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
+    with pytest.raises(termid.TermidError, match=r"no time column `t` .*`time` looks like time: name it `t`, df.rename\(columns=\{'time': 't'\}\)"):
+        model.identify(run.rename(columns={"t": "time"}))

@@ -1768,6 +1768,11 @@ fn a_whole_system_from_its_columns() {
         let (ok, _, err) = termid(&args);
         assert!(!ok && err.contains(says), "{extra:?}: {err}");
     }
+    // a time column by another name is refused with its name, not taken for an input first
+    let renamed = std::fs::read_to_string(&data).unwrap().replacen("t,", "time,", 1);
+    std::fs::write(dir.join("time.csv"), renamed).unwrap();
+    let (ok, _, err) = termid(&["identify", "--data", &p("time.csv"), "--states", "x,v"]);
+    assert!(!ok && err.contains("`time` looks like time") && !err.contains("the inputs are"), "{err}");
 }
 
 /// Equations whose rates fit the rows may still run away when integrated: Lotka-Volterra

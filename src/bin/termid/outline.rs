@@ -13,6 +13,10 @@ use crate::args::IdentifyCommand;
 /// polynomial library to `--degree`.
 pub fn model(cmd: &IdentifyCommand) -> Result<Model> {
     let (first, columns) = columns(cmd)?;
+    // refused before any column is taken for an input (a time column by another name would be)
+    if !columns.contains(&cmd.time) {
+        return Err(termid::data::DataError::missing_time(&first, &cmd.time, &columns).into());
+    }
     let column = |name: &str, flag: &str| -> Result<()> {
         if !columns.iter().any(|c| c == name) {
             bail!("{flag}: `{name}` is not a column of {first} (its columns: {})", columns.join(", "));
