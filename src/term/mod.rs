@@ -18,6 +18,31 @@ pub use parse::{parse_expr, BinOp, Expr, ExprKind};
 pub use polynomial::{polynomial, polynomial_len};
 pub use vocabulary::{code_points, is_identifier, Derived, Vocabulary};
 
+/// Candidate terms as a user lists them: each text split at its commas outside parentheses
+/// (a term never holds one there; a call's arguments do), each trimmed, blanks dropped:
+/// `["x, x*y", "atan2(y, x)"]` is three terms.
+pub fn listed<S: AsRef<str>>(texts: &[S]) -> Vec<String> {
+    let mut out = Vec::new();
+    for text in texts {
+        let (mut depth, mut from) = (0i32, 0);
+        let text = text.as_ref();
+        for (k, c) in text.char_indices() {
+            match c {
+                '(' => depth += 1,
+                ')' => depth -= 1,
+                ',' if depth == 0 => {
+                    out.push(text[from..k].trim().to_string());
+                    from = k + 1;
+                }
+                _ => {}
+            }
+        }
+        out.push(text[from..].trim().to_string());
+    }
+    out.retain(|t| !t.is_empty());
+    out
+}
+
 /// Parses and resolves a list of candidate terms, refusing a duplicate (two spellings of
 /// one canonical term, e.g. `v*r` and `r*v`) with an error that names both.
 ///
@@ -49,4 +74,19 @@ pub fn parse_terms<S: AsRef<str>>(texts: &[S], vocab: &Vocabulary) -> Result<Vec
         terms.push(term);
     }
     Ok(terms)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_list_splits_at_commas_outside_calls() {
+        assert_eq!(
+            listed(&["x, x*y", "atan2(y, x)", " ", "sin(x),cos(max(x, y))"]),
+            ["x", "x*y", "atan2(y, x)", "sin(x)", "cos(max(x, y))"]
+        );
+        // a comma too many is a blank, dropped; an unbalanced parenthesis is the parser's to locate
+        assert_eq!(listed(&["x,,y,", "f(x"]), ["x", "y", "f(x"]);
+    }
 }

@@ -1768,6 +1768,26 @@ fn a_whole_system_from_its_columns() {
         let (ok, _, err) = termid(&args);
         assert!(!ok && err.contains(says), "{extra:?}: {err}");
     }
+    // candidates listed with commas, as states are (a call's own commas kept)
+    let (ok, report, err) = termid(&[
+        "identify",
+        "--data",
+        &data,
+        "--states",
+        "x,v",
+        "--terms",
+        "x,v, F,atan2(x, v)",
+        "--format",
+        "json",
+    ]);
+    assert!(ok, "{err}");
+    let listed: Vec<String> = json(&report)["v_dot"]["candidates"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_str().unwrap().to_string())
+        .collect();
+    assert_eq!(listed, ["x", "v", "F", "atan2(x, v)"], "{report}");
     // a time column by another name is refused with its name, not taken for an input first
     let renamed = std::fs::read_to_string(&data).unwrap().replacen("t,", "time,", 1);
     std::fs::write(dir.join("time.csv"), renamed).unwrap();

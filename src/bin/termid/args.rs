@@ -267,7 +267,8 @@ pub struct IdentifyCommand {
     /// state's derivative.
     #[arg(long, required_unless_present_any = ["model", "states"])]
     pub target: Option<String>,
-    /// Candidate terms, e.g. --terms "u*v" "u*r" "u^2*δ".
+    /// Candidate terms, e.g. --terms "u*v" "u*r" "u^2*δ", or comma-separated: --terms u*v,u*r
+    /// (a comma inside a call's parentheses stays: "atan2(v, u)").
     #[arg(long, num_args = 1.., required_unless_present_any = ["terms_file", "model", "states"])]
     pub terms: Vec<String>,
     /// Take vocabulary, candidates, forced terms and back-end from a model file.

@@ -59,6 +59,8 @@ fn is_rate(target: &Target, frames: &[Frame], no_time: bool) -> bool {
 
 pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
     cmd.refuse_conflicts().map_err(anyhow::Error::msg)?;
+    // `--terms x,x*y` as `--states x,y` lists names
+    cmd.terms = termid::term::listed(&cmd.terms);
     resolve_derivative(&mut cmd)?;
     if let Some(dir) = &cmd.prepared_svg {
         termid::output::check_folder(dir)?;
