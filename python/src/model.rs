@@ -31,6 +31,9 @@ const BUILTIN: [(&str, &str); 7] = [
     ("robertson", include_str!("../../models/robertson.toml")),
 ];
 
+/// Each identified equation's fit report (name, JSON).
+type Fits = Vec<(String, String)>;
+
 /// A model file: states, inputs, parameters and equations, as termid reads and writes it.
 #[pyclass(module = "termid._termid", name = "Model")]
 #[derive(Clone)]
@@ -453,7 +456,7 @@ impl PyModel {
         equations: Vec<String>,
         intercept: Option<bool>,
         backend: Option<&str>,
-    ) -> PyResult<(PyModel, Vec<(String, String)>)> {
+    ) -> PyResult<(PyModel, Fits, String)> {
         // the defaults of `termid identify`: central differences for a plug-in's model (a
         // ship, as the paper), the integral form for any other; the model file's intercept
         let derivative = derivative.unwrap_or_else(|| self.default_derivative());
@@ -478,14 +481,18 @@ impl PyModel {
             .iter()
             .map(|(n, f)| Ok((n.clone(), to_json(&f.report())?)))
             .collect::<PyResult<_>>()?;
-        if termid::plugins::of(&identified.model).is_none() {
-            // any system: its equations must retrace the runs (a field's model has its checks)
-            let check = py.detach(|| termid::recipe::retrace_check(&identified.model, &frames));
-            if let Some(c) = check.filter(|c| !c.passed) {
-                warn(py, c.line())?;
+        // any system: its equations must retrace the runs (a field's model has its checks,
+        // `Model.checks`, which read more than the runs)
+        let checks: Vec<termid::plugin::Check> = match termid::plugins::of(&identified.model) {
+            Some(_) => vec![],
+            None => {
+                py.detach(|| termid::recipe::retrace_check(&identified.model, &frames)).into_iter().collect()
             }
+        };
+        for c in checks.iter().filter(|c| !c.passed) {
+            warn(py, c.line())?;
         }
-        Ok((PyModel { inner: identified.model }, fits))
+        Ok((PyModel { inner: identified.model }, fits, to_json(&checks)?))
     }
 
     /// The model with each state's initial value the run's first sample of it (a model made
@@ -1054,8 +1061,11 @@ impl PyModel {
     #[pyo3(signature = (runs = vec![]))]
     fn checks(&self, runs: Vec<Run<'_>>) -> PyResult<String> {
         let frames = if runs.is_empty() { Vec::new() } else { self.frames(runs)? };
-        let checks =
-            termid::plugins::of(&self.inner).map(|p| p.checks(&self.inner, &frames)).unwrap_or_default();
+        // a field's model has its field's checks; any other, that its equations retrace the runs
+        let checks = match termid::plugins::of(&self.inner) {
+            Some(p) => p.checks(&self.inner, &frames),
+            None => termid::recipe::retrace_check(&self.inner, &frames).into_iter().collect(),
+        };
         to_json(&checks)
     }
 

@@ -1007,17 +1007,23 @@ def _targeted(
 
 
 class Identified:
-    """What ``Model.identify`` returns: the identified model and each equation's fit report
-    (``steps`` and ``terms`` as DataFrames).
+    """What ``Model.identify`` returns: the identified model, each equation's fit report
+    (``steps`` and ``terms`` as DataFrames) and, for a model of no field's, its ``checks``
+    (name, passed, refuses, detail): that the equations retrace the runs without running away,
+    and how long they follow them (a ship's are :meth:`Model.checks`).
 
     >>> lorenz = termid.Model.builtin("lorenz")
-    >>> lorenz.identify(lorenz.simulate(duration=5.0))
+    >>> found = lorenz.identify(lorenz.simulate(duration=5.0))
+    >>> found
     termid.Identified('Lorenz system (σ = 10, ρ = 28, β = 8/3)': x_dot ← dx/dt, y_dot ← dy/dt, z_dot ← dz/dt)
+    >>> bool(found.checks["passed"].all())
+    True
     """
 
-    def __init__(self, model: "Model", fits: Sequence[Tuple[str, str]]):
+    def __init__(self, model: "Model", fits: Sequence[Tuple[str, str]], checks: Sequence[Mapping[str, Any]] = ()):
         self.model = model
         self.reports: Dict[str, Dict[str, Any]] = {name: json.loads(text) for name, text in fits}
+        self.checks = pd.DataFrame(list(checks), columns=["name", "passed", "refuses", "detail"])
 
     def steps(self, equation: str) -> pd.DataFrame:
         """The step table of ``equation``'s fit, one row per step.
@@ -1523,13 +1529,13 @@ class Model:
         """
         data = _targeted(self._native, _runs(runs, names, self.time), derivative, target, list(equations))
         try:
-            native, fits = self._native.identify(
+            native, fits, checks = self._native.identify(
                 data, derivative, list(equations), intercept, _backend(backend, settings)
             )
         except TermidError as e:
             left_out = {n: k for _, cols in data for n, k in getattr(cols, "left_out", {}).items()}
             raise _explained(e, left_out) from None
-        return Identified(self._identified(native, data), fits)
+        return Identified(self._identified(native, data), fits, json.loads(checks))
 
     @_runs_told_apart
     def moments(
@@ -2256,7 +2262,9 @@ class Model:
     @_runs_told_apart
     def checks(self, runs: Union[Data, Sequence[Data], None] = None) -> pd.DataFrame:
         """The plug-in's physical checks (stability, damping signs, turning circles), with
-        ``runs`` to compare against where a check needs them.
+        ``runs`` to compare against where a check needs them; for a model of no field's, with
+        ``runs``, that its equations retrace them without running away (and how long they
+        follow them).
 
         >>> checks = termid.Model.default().checks()
         >>> {"name", "passed"} <= set(checks.columns)
