@@ -59,6 +59,13 @@ fn time_like(names: Vec<String>) -> Option<String> {
     names.into_iter().find(|n| termid::data::looks_like_time(n))
 }
 
+/// Candidate terms as a user lists them: each text split at its commas outside parentheses
+/// (the command line's `--terms x,x*y`).
+#[pyfunction]
+fn listed(texts: Vec<String>) -> Vec<String> {
+    termid::term::listed(&texts)
+}
+
 /// Whether rows labelled `labels` (each row's value as an index) are several runs
 /// interleaved, the readings `columns` far smoother along each value's rows: the number of
 /// runs and of changes where they are (the command line's rule).
@@ -83,6 +90,7 @@ fn _termid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(version, m)?)?;
     m.add_function(wrap_pyfunction!(monte_carlo_refusal, m)?)?;
     m.add_function(wrap_pyfunction!(time_like, m)?)?;
+    m.add_function(wrap_pyfunction!(listed, m)?)?;
     m.add_function(wrap_pyfunction!(interleaved, m)?)?;
     Ok(())
 }

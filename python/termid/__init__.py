@@ -795,7 +795,7 @@ def fit(
     of them, one per run (experiments recorded apart: a rate is integrated along each, never
     from one's end to the next's start; a DataFrame's ``attrs["name"]`` names it in warnings);
     ``target`` the column explained, or ``"dX/dt"`` the rate of column X; ``terms`` the
-    candidates; ``backend`` the selection (:func:`backends`; default ``"stepwise"``, for a
+    candidates (a list, or one text listing them with commas: ``"x*y, z"``); ``backend`` the selection (:func:`backends`; default ``"stepwise"``, for a
     rate ``"stlsq"``); ``intercept`` whether a constant b0 is fitted (default: for a column
     yes, for a rate no, ``"1"`` a candidate instead); ``forced`` terms kept whatever their
     significance; ``excluded`` candidates left out; ``parameters`` values of names the terms
@@ -863,8 +863,8 @@ def fit(
         if target not in columns:
             raise TermidError(f"no column `{target}` to fit (columns: {', '.join(columns)})")
     if isinstance(terms, str):
-        # one term, not its characters
-        terms = [terms]
+        # one term, not its characters; several where commas list them ("x*y, z")
+        terms = _termid.listed([terms])
     if terms is None:
         terms = [c for c in columns if c not in (target, weights, time_name)]
     terms = list(terms)

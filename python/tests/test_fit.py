@@ -84,6 +84,9 @@ def test_frame_columns_are_read_in_place_and_mixed_types_converted(hald):
 def test_one_term_as_a_string_is_one_term(hald):
     # a string is one term, not its characters ("unknown variable `x`" before)
     assert list(termid.fit(hald, "y", "x1").coefficients.index) == ["x1"]
+    # commas list several, as the command line's --terms x1,x2 (a call's own commas kept)
+    listed = termid.fit(hald, "y", "x1, x2,atan2(x3, x4)", backend="best-subset")
+    assert listed.report["candidates"] == ["x1", "x2", "atan2(x3, x4)"]
 
 
 def test_a_column_named_twice_is_refused(hald):
