@@ -481,13 +481,14 @@ impl PyModel {
             .iter()
             .map(|(n, f)| Ok((n.clone(), to_json(&f.report())?)))
             .collect::<PyResult<_>>()?;
-        // any system: its equations must retrace the runs (a field's model has its checks,
-        // `Model.checks`, which read more than the runs)
+        // any system: its equations must retrace the runs, its terms hold on each half of them
+        // (a field's model has its checks, `Model.checks`, which read more than the runs)
         let checks: Vec<termid::plugin::Check> = match termid::plugins::of(&identified.model) {
             Some(_) => vec![],
-            None => {
-                py.detach(|| termid::recipe::retrace_check(&identified.model, &frames)).into_iter().collect()
-            }
+            None => py.detach(|| {
+                let retrace = termid::recipe::retrace_check(&identified.model, &frames);
+                retrace.into_iter().chain(termid::recipe::halves_check(&identified, &frames, &how)).collect()
+            }),
         };
         for c in checks.iter().filter(|c| !c.passed) {
             warn(py, c.line())?;

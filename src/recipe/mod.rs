@@ -5,12 +5,14 @@
 //! best; and, where the plausible starts disagree on a manoeuvre the runs did not cover, a flag
 //! saying that prediction is uncertain.
 
+mod halves;
 mod parameters;
 mod report;
 mod retrace;
 mod start;
 
 pub use crate::plugin::RecipeDefaults;
+pub use halves::halves_check;
 pub use parameters::{ParameterOptions, ParameterStage};
 pub use report::Primes;
 pub use retrace::retrace_check;

@@ -176,6 +176,11 @@ pub(super) fn identify_start(
     };
     // said once for the start (not in each fold the choice by prediction fitted)
     crate::identify::say_late_inputs(&mut identified, &prepared, diff.as_ref()).map_err(setup)?;
+    // any system's terms checked on each half of the runs (a field's model has its own checks)
+    let halves = match crate::plugins::of(model) {
+        Some(_) => None,
+        None => super::halves::halves_check(&identified, &prepared, &how),
+    };
     let mut model = identified.model;
     let mut start = Start {
         derivative: derivative.to_string(),
@@ -191,6 +196,7 @@ pub(super) fn identify_start(
     };
     let in_place = settings.parameters_in_place(validation.is_some());
     start.checks = checks_of(&model, &prepared);
+    start.checks.extend(halves);
     if !in_place {
         refine_start(&mut start, &mut model, &prepared, validation.as_deref(), settings);
     }
@@ -246,7 +252,9 @@ fn refine_start(
             let lost = lost_checks(&start.checks, &after);
             if lost.is_empty() {
                 *model = r.model.clone();
-                start.checks = after;
+                // which terms the rows chose, checked before, a refinement leaves as it was
+                let kept = start.checks.iter().filter(|c| c.name == super::halves::NAME).cloned();
+                start.checks = after.into_iter().chain(kept).collect::<Vec<_>>();
                 start.refined = Some(r);
             } else {
                 start.rejected = Some((r, lost));

@@ -1865,7 +1865,8 @@ fn equations_that_run_away_from_their_run_are_refused() {
 /// equation of θ can turn back as θ does, and the fit that explains almost nothing says so;
 /// from θ and ω with the sine among the candidates the truth comes back, followed
 /// throughout; with the cubic library alone the re-simulation is said to part from the run
-/// early (a cubic standing in for the sine at these angles).
+/// early (a cubic standing in for the sine at these angles), and a term the halves of the
+/// run do not both choose is flagged.
 #[test]
 fn a_rate_the_candidates_cannot_explain_is_said_to() {
     use crate::common::{json, Scratch};
@@ -1922,6 +1923,7 @@ fn a_rate_the_candidates_cannot_explain_is_said_to() {
         "{out}"
     );
     assert!(found["physical_checks"][0]["detail"].as_str().unwrap().ends_with("span throughout"), "{out}");
+    assert_eq!(found["physical_checks"][1]["passed"], true, "{out}");
     assert!(!out.contains("of the variance of"), "{out}");
     let (ok, out, err) = termid(&["identify", "--data", &p("both.csv"), "--states", "theta,omega"]);
     assert!(ok, "{err}");
@@ -1929,4 +1931,11 @@ fn a_rate_the_candidates_cannot_explain_is_said_to() {
     let follows = out.split("they follow them within a tenth of each state's span for ").nth(1).unwrap();
     let seconds: f64 = follows.split(' ').next().unwrap().parse().unwrap();
     assert!(seconds < 2.1 && follows.contains(" s of 30.0 s (") && follows.contains("both.csv)"), "{out}");
+    // and its θ² (no symmetric pendulum has one) is not chosen from the second half of the run,
+    // whose swings have decayed: flagged, not refused
+    assert!(
+        out.contains("FLAG the terms hold on each half of the runs")
+            && out.contains("`omega_dot`: `theta^2`"),
+        "{out}"
+    );
 }

@@ -1,0 +1,138 @@
+//! Whether identified terms hold on each half of the runs: the equations identified again
+//! from the first and from the second half of every run, the terms chosen from all the rows
+//! but not from both halves named. Noise that biases the regressors (errors in the states
+//! themselves) makes a regression choose terms the system lacks with t-values of 4 to 6;
+//! they rarely come back from both halves, where the system's own terms do.
+
+use crate::data::Frame;
+use crate::identify::{identify_model, IdentifiedModel, ModelIdentification};
+use crate::model::Model;
+use crate::plugin::Check;
+
+/// The check's name, by which a later stage keeps it (a refinement changes coefficients, not
+/// which terms the rows chose).
+pub(super) const NAME: &str = "the terms hold on each half of the runs";
+
+/// The fewest rows of a half a run is cut for: below it a half cannot choose among a
+/// library's candidates at all.
+const FEWEST_ROWS: usize = 50;
+
+/// The check that each equation of `identified` (from `frames` by `how`) chooses its terms
+/// from the first and from the second half of every run too: flagged (not refusing) where a
+/// term is chosen from all the rows but not from both halves. `None` where it cannot apply: a
+/// run too short to halve, or a half that cannot be identified.
+pub fn halves_check(
+    identified: &IdentifiedModel,
+    frames: &[Frame],
+    how: &ModelIdentification<'_>,
+) -> Option<Check> {
+    if frames.is_empty() || frames.iter().any(|f| f.len() < 2 * FEWEST_ROWS) {
+        return None;
+    }
+    let model: &Model = &identified.model;
+    let half = |second: bool| -> Option<IdentifiedModel> {
+        let cut: Vec<Frame> = frames
+            .iter()
+            .map(|f| {
+                let middle = f.len() / 2;
+                if second {
+                    f.slice(middle..f.len())
+                } else {
+                    f.slice(0..middle)
+                }
+            })
+            .collect();
+        identify_model(model, &cut, how, &mut |_| {}).ok()
+    };
+    let (first, second) = (half(false)?, half(true)?);
+    let chosen = |found: &IdentifiedModel, name: &str| -> Vec<String> {
+        found
+            .fits
+            .iter()
+            .find(|(n, _)| n == name)
+            .map_or_else(Vec::new, |(_, f)| f.selection.terms.iter().map(|t| t.term.clone()).collect())
+    };
+    let mut unsteady = Vec::new();
+    for (name, fit) in &identified.fits {
+        let (a, b) = (chosen(&first, name), chosen(&second, name));
+        let lost: Vec<String> = fit
+            .selection
+            .terms
+            .iter()
+            .filter(|t| !(a.contains(&t.term) && b.contains(&t.term)))
+            .map(|t| format!("`{}`", t.term))
+            .collect();
+        if !lost.is_empty() {
+            unsteady.push(format!("`{name}`: {}", lost.join(", ")));
+        }
+    }
+    let detail = if unsteady.is_empty() {
+        "each equation chooses the same terms from the first and from the second half of every run"
+            .to_string()
+    } else {
+        format!(
+            "chosen from all the rows but not from both halves of every run: {}; terms the noise chose \
+             (errors in the states bias the regressors), or that one half does not excite: read them \
+             as uncertain (more or longer runs, less noise, fewer candidates)",
+            unsteady.join("; ")
+        )
+    };
+    Some(Check { name: NAME.into(), passed: unsteady.is_empty(), refuses: false, detail, measure: None })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// ẋ = −x + u from one run: where u drives the whole run the halves choose both terms
+    /// again; where it acts in the first half only, the second cannot choose `u` (it does not
+    /// excite it), and the check names it.
+    #[test]
+    fn a_term_one_half_does_not_choose_is_named() {
+        let model = Model::parse(
+            "[model]\nname = \"lag\"\nintercept = false\n[[states]]\nname = \"x\"\n[[inputs]]\nname = \"u\"\n\
+             [equations.x_dot]\nstate = \"x\"\ncandidates = [\"x\", \"u\", \"x^2\"]\n",
+            "lag.toml",
+        )
+        .unwrap();
+        // exact samples of ẋ = −x + u under u = sin(0.7 t) (+ a step), by fine Euler steps
+        let run = |u: &dyn Fn(f64) -> f64| {
+            let (dt, fine) = (0.05, 200);
+            let (mut x, mut t, mut ts, mut xs, mut us) = (0.5, 0.0, vec![], vec![], vec![]);
+            for _ in 0..400 {
+                ts.push(t);
+                xs.push(x);
+                us.push(u(t));
+                for _ in 0..fine {
+                    x += dt / fine as f64 * (-x + u(t));
+                    t += dt / fine as f64;
+                }
+            }
+            let mut f = Frame::new("run.csv", "t", ts).unwrap();
+            f.push("x", xs).unwrap();
+            f.push("u", us).unwrap();
+            f
+        };
+        let diff = super::super::derivative_method("integral").unwrap();
+        let how = ModelIdentification {
+            equations: vec![],
+            differentiator: diff.as_ref(),
+            intercept: false,
+            target: None,
+        };
+        let check = |frame: Frame| {
+            let frames = [frame];
+            let identified = identify_model(&model, &frames, &how, &mut |_| {}).unwrap();
+            halves_check(&identified, &frames, &how).unwrap()
+        };
+        let whole = check(run(&|t| (0.7 * t).sin() + 1.0));
+        assert!(whole.passed && !whole.refuses, "{}", whole.detail);
+        let first_half = check(run(&|t| if t < 8.0 { (0.7 * t).sin() + 1.0 } else { 0.0 }));
+        assert!(!first_half.passed && !first_half.refuses, "{}", first_half.detail);
+        assert!(first_half.detail.contains("`x_dot`: `u`"), "{}", first_half.detail);
+        // a run too short to halve is not judged
+        let short = run(&|t| t).slice(0..60);
+        let identified = identify_model(&model, std::slice::from_ref(&short), &how, &mut |_| {}).unwrap();
+        assert!(halves_check(&identified, &[short], &how).is_none());
+    }
+}
