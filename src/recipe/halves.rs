@@ -44,7 +44,9 @@ pub fn halves_check(
             .collect();
         identify_model(model, &cut, how, &mut |_| {}).ok()
     };
-    let (first, second) = (half(false)?, half(true)?);
+    // side by side: each half is one run's worth of work per run, which leaves a core idle
+    let (first, second) = rayon::join(|| half(false), || half(true));
+    let (first, second) = (first?, second?);
     let chosen = |found: &IdentifiedModel, name: &str| -> Vec<String> {
         found
             .fits
