@@ -955,12 +955,16 @@ impl PyModel {
                                    "parameters": parameters})
             })
             .collect();
-        // a refinement that failed leaves the regression's model: said with the rest
+        // a refinement that failed leaves the regression's model, and a flag of the kept start
+        // (the command line's report prints it) is warned of as `identify` warns: said with the rest
+        let kept = recipe.kept();
+        let flags = kept.checks.iter().filter(|c| !c.passed && !c.refuses).map(|c| c.line());
         let warnings: Vec<String> =
             recipe
                 .warnings()
                 .into_iter()
-                .chain(recipe.kept().refine_error.iter().map(|e| {
+                .chain(flags)
+                .chain(kept.refine_error.iter().map(|e| {
                     format!("the output-error refinement failed: {e}; the model is the regression's")
                 }))
                 .collect();

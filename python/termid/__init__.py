@@ -1100,7 +1100,7 @@ class Recipe:
     ``checks`` (with the starts' agreement: a failing one flags a prediction the runs
     cannot pin down), ``refusals`` (why it must not be written, if any), ``warnings`` (what
     the recipe warned about: failed starts, disagreeing starts, a refinement rejected or
-    failed), ``failed`` (each failed start and why), the ``report`` as
+    failed, the kept model's flags), ``failed`` (each failed start and why), the ``report`` as
     plain values and as ``text``, and the kept start's estimate of the model file's free
     ``parameters`` (the report's ``parameter_estimate``: each parameter, and under
     ``per_source`` each source's or run's; None where not run or not kept).
@@ -2013,8 +2013,8 @@ class Model:
         ``savitzky-golay`` and ``central`` starts, smoothed, refined on u, v, r, ψ); for any
         other system one start by the integral form, neither smoothed nor refined (as
         ``termid identify`` does). A start that fails, starts that disagree, a refinement
-        rejected by the checks or failed, and a model that fails its checks (``refusals``) are
-        each warned about.
+        rejected by the checks or failed, a check that flags the kept model, and a model that
+        fails its checks (``refusals``) are each warned about.
 
         >>> ship = termid.Model.default()
         >>> ship.set_parameter("u0", "mean:u:4")
