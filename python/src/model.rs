@@ -485,10 +485,7 @@ impl PyModel {
         // (a field's model has its checks, `Model.checks`, which read more than the runs)
         let checks: Vec<termid::plugin::Check> = match termid::plugins::of(&identified.model) {
             Some(_) => vec![],
-            None => py.detach(|| {
-                let retrace = termid::recipe::retrace_check(&identified.model, &frames);
-                retrace.into_iter().chain(termid::recipe::halves_check(&identified, &frames, &how)).collect()
-            }),
+            None => py.detach(|| termid::recipe::system_checks(&identified, &frames, &how)),
         };
         for c in checks.iter().filter(|c| !c.passed) {
             warn(py, c.line())?;
@@ -1067,11 +1064,7 @@ impl PyModel {
     fn checks(&self, runs: Vec<Run<'_>>) -> PyResult<String> {
         let frames = if runs.is_empty() { Vec::new() } else { self.frames(runs)? };
         // a field's model has its field's checks; any other, that its equations retrace the runs
-        let checks = match termid::plugins::of(&self.inner) {
-            Some(p) => p.checks(&self.inner, &frames),
-            None => termid::recipe::retrace_check(&self.inner, &frames).into_iter().collect(),
-        };
-        to_json(&checks)
+        to_json(&termid::recipe::checks_of(&self.inner, &frames))
     }
 
     /// The steering gear a ship model's zigzag runs show (JSON: delay_s, acceleration_deg_s2,

@@ -190,12 +190,8 @@ const CUBIC_UP_TO: usize = 4;
 /// term must beat.
 pub fn beyond_candidates(model: &Model) -> Vec<Hypothesis> {
     let spec = model.spec();
-    let dynamic: Vec<&str> = spec
-        .states
-        .iter()
-        .map(|s| s.name.as_str())
-        .chain(spec.inputs.iter().map(|i| i.name.as_str()))
-        .collect();
+    // the states and inputs
+    let dynamic: Vec<&str> = model.vocabulary.variables().iter().map(String::as_str).collect();
     let inputs: Vec<&str> = spec.inputs.iter().map(|i| i.name.as_str()).collect();
     let mut out = Vec::new();
     for eq in model.equations().iter().filter(|e| e.identify) {

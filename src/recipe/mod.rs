@@ -16,7 +16,7 @@ pub use halves::halves_check;
 pub use parameters::{ParameterOptions, ParameterStage};
 pub use report::Primes;
 pub use retrace::retrace_check;
-pub use start::{derivative_method, prepare_runs, Start};
+pub use start::{checks_of, derivative_method, prepare_runs, Start};
 
 use rayon::prelude::*;
 
@@ -230,6 +230,19 @@ pub fn identify(
         starts.par_iter_mut().for_each(|s| start::refine_instead(s, settings));
     }
     Recipe::of(starts, failed, held.is_some(), settings.agree)
+}
+
+/// The checks of a system of no field's identified from `frames` by `how`: that its equations
+/// retrace the runs without running away, and that its terms hold on each half of them.
+pub fn system_checks(
+    identified: &crate::identify::IdentifiedModel,
+    frames: &[Frame],
+    how: &crate::identify::ModelIdentification<'_>,
+) -> Vec<Check> {
+    retrace_check(&identified.model, frames)
+        .into_iter()
+        .chain(halves_check(identified, frames, how))
+        .collect()
 }
 
 /// Refuses, before any work, a name among the states a refinement or a choice compares

@@ -28,16 +28,11 @@ const MOST_SAMPLES: usize = 20_000;
 /// recorded range over the run. `None` where it cannot apply: an equation without
 /// coefficients (not identified), a run that lacks a state or an input.
 pub fn retrace_check(model: &Model, runs: &[Frame]) -> Option<Check> {
-    let spec = model.spec();
     if model.equations().iter().any(|e| e.coefficients.is_empty() && e.intercept.is_none()) {
         return None;
     }
-    let names: Vec<&str> = spec
-        .states
-        .iter()
-        .map(|s| s.name.as_str())
-        .chain(spec.inputs.iter().map(|i| i.name.as_str()))
-        .collect();
+    // the states and inputs
+    let names = model.vocabulary.variables();
     if runs.is_empty() || runs.iter().any(|r| names.iter().any(|n| r.column(n).is_none())) {
         return None;
     }

@@ -176,10 +176,9 @@ pub(super) fn identify_start(
     };
     // said once for the start (not in each fold the choice by prediction fitted)
     crate::identify::say_late_inputs(&mut identified, &prepared, diff.as_ref()).map_err(setup)?;
-    // any system's terms checked on each half of the runs (a field's model has its own checks)
-    let halves = match crate::plugins::of(model) {
-        Some(_) => None,
-        None => super::halves::halves_check(&identified, &prepared, &how),
+    let checks = match crate::plugins::of(model) {
+        Some(_) => checks_of(&identified.model, &prepared),
+        None => super::system_checks(&identified, &prepared, &how),
     };
     let mut model = identified.model;
     let mut start = Start {
@@ -195,8 +194,7 @@ pub(super) fn identify_start(
         prepared: vec![],
     };
     let in_place = settings.parameters_in_place(validation.is_some());
-    start.checks = checks_of(&model, &prepared);
-    start.checks.extend(halves);
+    start.checks = checks;
     if !in_place {
         refine_start(&mut start, &mut model, &prepared, validation.as_deref(), settings);
     }
@@ -266,7 +264,7 @@ fn refine_start(
 
 /// What the field knows must hold: the plug-in's physical checks of a model on the runs as
 /// prepared; for a system of no field's, that its equations retrace the runs.
-fn checks_of(model: &Model, prepared: &[Frame]) -> Vec<Check> {
+pub fn checks_of(model: &Model, prepared: &[Frame]) -> Vec<Check> {
     match crate::plugins::of(model) {
         Some(plugin) => plugin.checks(model, prepared),
         None => super::retrace::retrace_check(model, prepared).into_iter().collect(),
