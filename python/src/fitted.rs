@@ -248,7 +248,8 @@ pub(crate) fn fit(
     let rate = termid::identify::Target::parse(target);
     let method = match (&rate, derivative.as_deref()) {
         (termid::identify::Target::Derivative(_), name) => {
-            termid::recipe::derivative_method(name.unwrap_or("integral")).map_err(fail)?
+            termid::recipe::derivative_method(name.unwrap_or(termid::recipe::ANY_SYSTEM_DERIVATIVE))
+                .map_err(fail)?
         }
         (_, Some(name)) => {
             return Err(refuse(format!(

@@ -429,13 +429,9 @@ impl PyModel {
     }
 
     /// The defaults of `termid identify`: central differences for a plug-in's model (a ship,
-    /// as the paper), the integral form for any other.
+    /// as the paper), the weak form for any other.
     fn default_derivative(&self) -> &'static str {
-        if termid::plugins::of(&self.inner).is_some() {
-            "central"
-        } else {
-            "integral"
-        }
+        termid::recipe::default_derivative(Some(&self.inner))
     }
 
     /// The recipe's derivative starts, smoothing and refined states (`None`: no refinement;

@@ -787,7 +787,7 @@ def fit(
     settings: ``termid.settings(backend)``). A single string is one term.
 
     A rate, ``fit(df, "dx/dt", terms)``, is an equation of motion of the rows as a time
-    series, with the command line's defaults for one: no derivative estimated (the integral
+    series, with the command line's defaults for one: no derivative estimated (the weak
     form) unless ``derivative`` names a method (:func:`derivatives`), the back-end
     ``"stlsq"``, and the constant a candidate (``"1"``) rather than a forced intercept.
 
@@ -803,7 +803,7 @@ def fit(
     rows' time for a rate (default: ``t``, else a DataFrame's index of times: seconds,
     durations, date-times in a time zone or not, integers only under a name; else the one
     column of date-times, with a warning); ``derivative``
-    how a rate is estimated (default: none, the integral form); ``keep_spikes`` keeps a rate's
+    how a rate is estimated (default: none, the weak form); ``keep_spikes`` keeps a rate's
     rows as recorded, where by default a sample or three of a column that leap away from their
     neighbours and straight back (a glitch, not a motion) are replaced by the line through the
     neighbours, with a warning; ``intersample`` says how a rate's other columns behave between
@@ -1517,8 +1517,8 @@ class Model:
         ``target``: ``"column"`` explains the runs' rate columns (``r_dot``), ``"derivative"``
         the states' derivatives estimated by ``derivative``; by default the rate columns where
         the runs have them and no ``derivative`` is named, else the derivatives
-        (:attr:`Identified.targets` says which). ``derivative`` defaults to ``integral`` (the
-        integral form: no derivative estimated; central differences for a ship, as the
+        (:attr:`Identified.targets` says which). ``derivative`` defaults to ``weak`` (the
+        weak form: no derivative estimated; central differences for a ship, as the
         paper); ``intercept`` to the model file's (``[model] intercept``); ``names`` name the
         runs (default: each DataFrame's ``attrs["name"]``, else ``run1``, ...).
 
@@ -2011,7 +2011,7 @@ class Model:
         ``derivatives``, ``smooth`` and ``refine`` (``"auto"``) left out are the model's
         field's: for a ship the new-ship recipe's (``kinematic``, ``kalman``,
         ``savitzky-golay`` and ``central`` starts, smoothed, refined on u, v, r, ψ); for any
-        other system one start by the integral form, neither smoothed nor refined (as
+        other system one start by the weak form, neither smoothed nor refined (as
         ``termid identify`` does). A start that fails, starts that disagree, a refinement
         rejected by the checks or failed, a check that flags the kept model, and a model that
         fails its checks (``refusals``) are each warned about.

@@ -213,7 +213,7 @@ def _lorenz(t_end=20.0, dt=0.001, every=10):
 
 def test_a_rate_is_an_equation_of_motion_with_the_command_lines_defaults():
     # the closed form: Lorenz's own coefficients, from its states alone, the time as a column,
-    # as the index (seconds), or as date-times; the constant a candidate, stlsq, the integral form
+    # as the index (seconds), or as date-times; the constant a candidate, stlsq, the weak form
     t, s = _lorenz()
     library = ["x", "y", "z", "x*x", "x*y", "x*z", "y*y", "y*z", "z*z"]
     df = pd.DataFrame({"t": t, "x": s[:, 0], "y": s[:, 1], "z": s[:, 2]})
@@ -241,7 +241,7 @@ def test_a_rate_is_an_equation_of_motion_with_the_command_lines_defaults():
     assert "the rows' time is column `logged`" in " ".join(str(w.message) for w in said)
     assert by_column.coefficients.sort_index().round(3).to_dict() == {"x": -10.0, "y": 10.0}
     # a derivative method named: five-point differences, the same terms (central ones' error
-    # of O(h²), smooth in the states, buys x·z and y·z: the integral form is the default)
+    # of O(h²), smooth in the states, buys x·z and y·z: the weak form is the default)
     five = termid.fit(df, "dx/dt", library, derivative="five-point")
     assert five.coefficients.sort_index().round(3).to_dict() == {"x": -10.0, "y": 10.0}
     central = termid.fit(df, "dx/dt", library, derivative="central")
@@ -348,7 +348,7 @@ def test_a_glitch_is_mended_with_a_warning():
 
 def test_residuals_that_grow_with_the_rate_are_said_and_weights_mend_them():
     # a 1 % error on x = exp(t/2) over 30 s: the largest rows decide the plain fit; weighted by
-    # 1/x² the integral form gives the rate 0.5
+    # 1/x² the weak form gives the rate 0.5
     rng = np.random.default_rng(3)
     t = np.arange(0.0, 30.0, 0.1)
     x = np.exp(0.5 * t) * (1.0 + 0.01 * rng.standard_normal(t.size))
@@ -411,7 +411,7 @@ def test_a_relay_switched_between_samples_is_left_out_of_the_windows():
     with pytest.warns(UserWarning, match="`F` stays put .* on no clock"):
         fit = termid.fit(df, "dv/dt", library)
     assert fit.coefficients.sort_index().round(6).to_dict() == {"F": 2.0, "v": -0.3, "x": -4.0}
-    assert any("windows of the integral form" in n and "left out" in n for n in fit.notes)
+    assert any("windows of the weak or integral form" in n and "left out" in n for n in fit.notes)
     linear = termid.fit(df, "dv/dt", library, intersample="linear")
     assert abs(linear.coefficients["v"] + 0.3) > 1e-3
     # measured with its noise, each switch is a step of the input: not cut, left out the same

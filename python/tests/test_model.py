@@ -875,10 +875,10 @@ def test_a_system_from_its_columns():
     again = found.model.simulate(inputs=force, duration=5.0)
     assert again["x"].iloc[0] == 1.0 and np.abs(again["x"].to_numpy() - run["x"].to_numpy()[: len(again)]).max() < 1e-3
     assert pickle.loads(pickle.dumps(found.model))._from_states
-    # the whole recipe too, by any system's defaults (the integral form, neither smoothed nor
+    # the whole recipe too, by any system's defaults (the weak form, neither smoothed nor
     # refined), its checks those of any system (that the equations retrace the run)
     recipe = model.recipe(run[["t", "x", "v", "F"]])
-    assert list(recipe.starts["derivative"]) == ["integral"] and recipe.warnings == []
+    assert list(recipe.starts["derivative"]) == ["weak"] and recipe.warnings == []
     assert recipe.model.simulate(inputs=force, duration=1.0)["x"].iloc[0] == 1.0
     assert "ok   the equations retrace their runs without running away" in recipe.text
     v_dot = recipe.model.coefficients("v_dot").set_index("term")["value"]

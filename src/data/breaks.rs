@@ -167,7 +167,7 @@ pub fn cut_at_breaks(
             )
         };
         notes.push(format!(
-            "{}: `{input}` leaps {at} and stays, where {still} with it: a step of the input (a command switched), not cut there; a rate's fit leaves out the windows of the integral form that hold a leap (a replay, as `estimate` and `validate` make, takes it as a line between the two samples: when between them it stepped is not recorded); were it a sensor re-zeroed, the rows after it would be off by the leap",
+            "{}: `{input}` leaps {at} and stays, where {still} with it: a step of the input (a command switched), not cut there; a rate's fit leaves out the windows of the weak or integral form that hold a leap (a replay, as `estimate` and `validate` make, takes it as a line between the two samples: when between them it stepped is not recorded); were it a sensor re-zeroed, the rows after it would be off by the leap",
             frame.origin()
         ));
         frame.switch(input)?;

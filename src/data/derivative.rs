@@ -26,10 +26,11 @@ pub trait Differentiator: Send + Sync {
     fn reach(&self) -> Option<usize> {
         None
     }
-    /// `Some(W)` for the integral form ([`super::IntegralForm`]): no rate is estimated; the
-    /// identification regresses changes over windows of W intervals on the candidates'
-    /// integrals. `None` for every derivative method.
-    fn integral_window(&self) -> Option<usize> {
+    /// `Some` for the integral forms ([`super::IntegralForm`], [`super::WeakForm`]): no rate
+    /// is estimated; the identification regresses the target's change over each window
+    /// (weighed by the window's test function) on the candidates' integrals over it. `None`
+    /// for every derivative method.
+    fn window(&self) -> Option<Window> {
         None
     }
     /// The signal as the method estimates it, with its rate. Methods that smooth (spline,
@@ -37,6 +38,46 @@ pub trait Differentiator: Send + Sync {
     fn smooth(&self, t: &[f64], x: &[f64]) -> Result<Smoothed, DataError> {
         Ok(Smoothed { value: x.to_vec(), rate: self.differentiate(t, x)? })
     }
+}
+
+/// The windows of an integral form: their length and the test function every row is
+/// weighed with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Window {
+    /// Sample intervals per window.
+    pub intervals: usize,
+    /// The function of time each window weighs the equation with.
+    pub test: TestFunction,
+    /// Whether a run shorter than four windows takes the integral form's windows instead (a
+    /// default window; one the user chose is kept, and a run too short for it refused).
+    pub shrinks: bool,
+}
+
+impl Window {
+    /// The window on a run of `rows` samples: where it [`Window::shrinks`] and four windows
+    /// do not fit, the integral form's default ([`super::IntegralForm`]): a bump over a few
+    /// coarse samples resolves neither φ nor the run (Lotka-Volterra at ten samples a period,
+    /// 40 samples: a wrong model that stays bounded, where the integral form's runs away and
+    /// is refused).
+    pub fn on_rows(self, rows: usize) -> Window {
+        if !self.shrinks || rows > 4 * self.intervals {
+            return self;
+        }
+        let flat = super::IntegralForm::default().window;
+        Window { intervals: flat, test: TestFunction::Flat, shrinks: false }
+    }
+}
+
+/// The test function φ of a window [a, b]: the equation ẋ = Σ c_j θ_j multiplied by φ and
+/// integrated over the window, ∫ φ ẋ dt = Σ c_j ∫ φ θ_j dt.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TestFunction {
+    /// φ = 1: the left side is x(b) − x(a), the integral form.
+    Flat,
+    /// φ = (1 − s²)^p with s = (2t − a − b)/(b − a): φ vanishes at both ends, so the left side
+    /// is −∫ φ′ x dt, a smooth average of x where x(b) − x(a) takes two noisy samples (the
+    /// weak form; Messenger & Bortz 2021).
+    Bump(u32),
 }
 
 /// Second-order central differences, exact for quadratics also on uneven spacing; the
@@ -114,6 +155,18 @@ pub static DIFFERENTIATORS: &[(&str, &str, MakeDifferentiator)] = &[
             Some(Box::new(super::IntegralForm { window: *w as usize }))
         }
         _ => None,
+    }),
+    ("weak", "[:WINDOW[:POWER]] (default 32:8, the integral form on runs under 129 samples; no derivative, the weak form)", |o| {
+        let whole = |v: f64, low: f64, high: f64| v.fract() == 0.0 && v >= low && v <= high;
+        let d = super::WeakForm::default();
+        match o {
+            [] => Some(Box::new(d)),
+            [w] if whole(*w, 2.0, 10_000.0) => Some(Box::new(super::WeakForm { window: Some(*w as usize), ..d })),
+            [w, p] if whole(*w, 2.0, 10_000.0) && whole(*p, 1.0, 64.0) => {
+                Some(Box::new(super::WeakForm { window: Some(*w as usize), power: *p as u32 }))
+            }
+            _ => None,
+        }
     }),
     ("kalman", "[:RATIO] (default: maximum likelihood)", |o| match o {
         [] => Some(Box::new(super::KalmanSmoother { ratio: None })),

@@ -231,7 +231,7 @@ pub fn mark_held(
                 } else {
                     frame.switch(name)?;
                     notes.push(format!(
-                        "{how}, on no clock: it may jump anywhere between two samples (a relay, a switch thrown by the motion), so a rate's fit leaves out the windows of the integral form that hold a jump (a point derivative and a replay take it as a line between the samples, which halves the error of a jump's time on average); where it is a command held from each sample to the next, say so (identify --intersample held; a model file's `intersample = \"held\"`; Python `intersample=\"held\"`)"
+                        "{how}, on no clock: it may jump anywhere between two samples (a relay, a switch thrown by the motion), so a rate's fit leaves out the windows of the weak or integral form that hold a jump (a point derivative and a replay take it as a line between the samples, which halves the error of a jump's time on average); where it is a command held from each sample to the next, say so (identify --intersample held; a model file's `intersample = \"held\"`; Python `intersample=\"held\"`)"
                     ));
                 }
             }

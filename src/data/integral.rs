@@ -5,7 +5,7 @@
 //! rule leaves an error of O(h⁴) where central differences leave O(h²) that is smooth in the
 //! states (and so fitted by spurious terms). Chosen as `--derivative integral[:W]`.
 
-use super::{DataError, Differentiator};
+use super::{DataError, Differentiator, TestFunction, Window};
 
 /// The integral form over windows of `window` sample intervals.
 #[derive(Clone, Copy, Debug)]
@@ -26,7 +26,7 @@ impl Differentiator for IntegralForm {
     }
 
     /// No rate: the integral form's target is the signal itself, whose changes over windows
-    /// the identification takes ([`Differentiator::integral_window`]).
+    /// the identification takes ([`Differentiator::window`]).
     fn differentiate(&self, _t: &[f64], x: &[f64]) -> Result<Vec<f64>, DataError> {
         Ok(x.to_vec())
     }
@@ -43,26 +43,40 @@ impl Differentiator for IntegralForm {
         Some(self.window)
     }
 
-    fn integral_window(&self) -> Option<usize> {
-        Some(self.window)
+    fn window(&self) -> Option<Window> {
+        Some(Window { intervals: self.window, test: TestFunction::Flat, shrinks: false })
     }
 }
 
-/// The rows of the integral form: for every window of `w` intervals starting at a sample,
-/// x at its end less x at its start, and each column integrated over it (composite Simpson
-/// on an even grid with `w` even, on uneven samples the quadratic through each pair of
-/// intervals, with `w` odd the trapezoidal rule on the samples' own spacing).
-pub fn integral_rows(t: &[f64], x: &[f64], columns: &[Vec<f64>], w: usize) -> (Vec<f64>, Vec<Vec<f64>>) {
-    let n = t.len();
+/// The rows of the integral form: for every window of `window.intervals` intervals starting
+/// at a sample, the left side (x at its end less x at its start; with a bump test function
+/// −∫ φ′ x dt) and each column integrated over it weighed by φ. A flat window is integrated
+/// by composite Simpson on an even grid with an even window, on uneven samples by the
+/// quadratic through each pair of intervals, with an odd window by the trapezoid on the
+/// samples' own spacing; a bump by the trapezoid, whose error falls with every derivative of
+/// the integrand that vanishes at the ends (Euler-Maclaurin), as φ's do.
+pub fn integral_rows(
+    t: &[f64],
+    x: &[f64],
+    columns: &[Vec<f64>],
+    window: Window,
+) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let (n, w) = (t.len(), window.intervals);
     if w == 0 || n <= w {
         return (Vec::new(), vec![Vec::new(); columns.len()]);
     }
     let h = (t[n - 1] - t[0]) / (n - 1) as f64;
     let even = t.windows(2).all(|p| ((p[1] - p[0]) - h).abs() <= 1e-6 * h);
     let rows = n - w;
-    let simpson = even && w.is_multiple_of(2);
-    let weights = |k: usize| -> Vec<f64> {
-        if simpson {
+    let bump = match window.test {
+        TestFunction::Flat => None,
+        TestFunction::Bump(p) => Some(p),
+    };
+    let simpson = even && w.is_multiple_of(2) && bump.is_none();
+    // (quadrature weights × φ, −quadrature weights × φ′) of the window from sample k
+    let weights = |k: usize| -> (Vec<f64>, Vec<f64>) {
+        let span = &t[k..=k + w];
+        let q = if simpson {
             (0..=w)
                 .map(|i| {
                     h / 3.0
@@ -74,29 +88,104 @@ pub fn integral_rows(t: &[f64], x: &[f64], columns: &[Vec<f64>], w: usize) -> (V
                         }
                 })
                 .collect()
-        } else if w.is_multiple_of(2) {
-            uneven_simpson(&t[k..=k + w])
+        } else if w.is_multiple_of(2) && bump.is_none() {
+            uneven_simpson(span)
         } else {
-            trapezoid(&t[k..=k + w])
+            trapezoid(span)
+        };
+        match bump {
+            None => (q, Vec::new()),
+            Some(p) if even => {
+                let (phi, slope) = bump_values(span, p);
+                let left = q.iter().zip(&slope).map(|(q, d)| -q * d).collect();
+                (q.iter().zip(&phi).map(|(q, f)| q * f).collect(), left)
+            }
+            // on uneven samples the trapezoid keeps only its O(h²): the quadratic through
+            // each pair, its product with φ and φ′ integrated exactly
+            Some(p) => {
+                let (a, b) = (span[0], span[w]);
+                let left = product_piece(span, &|x| -bump_at(x, a, b, p).1);
+                (product_piece(span, &|x| bump_at(x, a, b, p).0), left)
+            }
         }
     };
-    let fixed = simpson.then(|| weights(0));
-    let y: Vec<f64> = (0..rows).map(|k| x[k + w] - x[k]).collect();
+    let mut y = vec![0.0; rows];
     let mut out = vec![vec![0.0; rows]; columns.len()];
-    for k in 0..rows {
-        let own;
-        let wk = match &fixed {
-            Some(f) => f,
-            None => {
-                own = weights(k);
-                &own
+    if even {
+        // one set of weights for every window: a convolution, summed weight by weight over
+        // all rows (the same additions in the same order as window by window, vectorised)
+        let (wk, lk) = weights(0);
+        let convolve = |o: &mut [f64], c: &[f64], weights: &[f64]| {
+            for (i, a) in weights.iter().enumerate() {
+                for (o, c) in o.iter_mut().zip(&c[i..i + rows]) {
+                    *o += a * c;
+                }
             }
+        };
+        match bump {
+            None => y.iter_mut().enumerate().for_each(|(k, y)| *y = x[k + w] - x[k]),
+            Some(_) => convolve(&mut y, x, &lk),
+        }
+        for (o, c) in out.iter_mut().zip(columns) {
+            convolve(o, c, &wk);
+        }
+        return (y, out);
+    }
+    for k in 0..rows {
+        let (wk, lk) = weights(k);
+        y[k] = match bump {
+            None => x[k + w] - x[k],
+            Some(_) => lk.iter().zip(&x[k..=k + w]).map(|(a, b)| a * b).sum(),
         };
         for (o, c) in out.iter_mut().zip(columns) {
             o[k] = wk.iter().zip(&c[k..=k + w]).map(|(a, b)| a * b).sum();
         }
     }
     (y, out)
+}
+
+/// Rows per independent row of a window form on an even grid: the left side's noise from
+/// white noise in x is Σ aᵢ εₖ₊ᵢ with aᵢ = −φ′(tᵢ) h, so the rows k and k + m share it with
+/// correlation ρₘ = Σ aᵢ aᵢ₊ₘ / Σ aᵢ²; their integrated correlation time 1 + 2 Σ ρₘ summed up
+/// to the first negative ρₘ (Geyer's initial positive sequence). 1 for a flat window (its left
+/// side x(b) − x(a) shares noise with no other row but the one a window away, negatively).
+/// Without it, overlapping windows count each noise W-fold and the criteria keep spurious
+/// terms (on the ODE benchmark's noisy runs, benches/odes: 16 of 37 recovered, 34 with it).
+pub fn row_overlap(window: Window) -> f64 {
+    let TestFunction::Bump(p) = window.test else { return 1.0 };
+    let w = window.intervals;
+    if w < 2 {
+        return 1.0;
+    }
+    let t: Vec<f64> = (0..=w).map(|i| i as f64).collect();
+    let (_, a) = bump_values(&t, p);
+    let energy: f64 = a.iter().map(|v| v * v).sum();
+    if energy <= 0.0 {
+        return 1.0;
+    }
+    let mut tau = 1.0;
+    for m in 1..=w {
+        let rho = a.iter().zip(&a[m..]).map(|(x, y)| x * y).sum::<f64>() / energy;
+        if rho < 0.0 {
+            break;
+        }
+        tau += 2.0 * rho;
+    }
+    tau
+}
+
+/// φ = (1 − s²)^p and dφ/dt at samples `t` of one window, s running from −1 at its first
+/// sample to 1 at its last.
+fn bump_values(t: &[f64], p: u32) -> (Vec<f64>, Vec<f64>) {
+    let (a, b) = (t[0], t[t.len() - 1]);
+    let ds = 2.0 / (b - a);
+    t.iter()
+        .map(|ti| {
+            let s = ((2.0 * ti - a - b) / (b - a)).clamp(-1.0, 1.0);
+            let base = 1.0 - s * s;
+            (base.powi(p as i32), -2.0 * p as f64 * s * base.powi(p as i32 - 1) * ds)
+        })
+        .unzip()
 }
 
 /// [`integral_rows`] where some columns jump at samples (an input held between them:
@@ -112,9 +201,10 @@ pub fn integral_rows_held(
     columns: &[Vec<f64>],
     before: &[Vec<f64>],
     jumps: &[bool],
-    w: usize,
+    window: Window,
 ) -> (Vec<f64>, Vec<Vec<f64>>) {
-    let (y, mut out) = integral_rows(t, x, columns, w);
+    let w = window.intervals;
+    let (mut y, mut out) = integral_rows(t, x, columns, window);
     // jumps before each sample, to find the windows with one inside at a glance
     let mut count = vec![0usize; jumps.len() + 1];
     for (k, j) in jumps.iter().enumerate() {
@@ -128,8 +218,20 @@ pub fn integral_rows_held(
         for (o, _) in out.iter_mut().zip(columns) {
             o[k] = 0.0;
         }
+        let (start, end) = (t[k], t[k + w]);
+        if let TestFunction::Bump(_) = window.test {
+            // x has a kink at each jump: −∫ φ′ x piece by piece too
+            y[k] = 0.0;
+        }
         for b in (k + 1..=k + w).filter(|&b| jumps[b] || b == k + w) {
-            let weights = piece(&t[a..=b]);
+            let weights = match window.test {
+                TestFunction::Flat => piece(&t[a..=b]),
+                TestFunction::Bump(p) => {
+                    let slope = product_piece(&t[a..=b], &|x| bump_at(x, start, end, p).1);
+                    y[k] -= slope.iter().zip(&x[a..=b]).map(|(w, v)| w * v).sum::<f64>();
+                    product_piece(&t[a..=b], &|x| bump_at(x, start, end, p).0)
+                }
+            };
             for ((o, c), l) in out.iter_mut().zip(columns).zip(before) {
                 let inside: f64 = weights[..b - a].iter().zip(&c[a..b]).map(|(w, v)| w * v).sum();
                 o[k] += inside + weights[b - a] * l[b];
@@ -138,6 +240,56 @@ pub fn integral_rows_held(
         }
     }
     (y, out)
+}
+
+/// Weights wᵢ = ∫ g Lᵢ dt over one smooth piece of samples `t` for a weight g known in
+/// closed form (the bump φ or its rate φ′): each pair of intervals by the quadratic through its
+/// three samples (the last interval of an odd number by the line through two), the product
+/// with g integrated by Gauss-Legendre of six points per interval (exact to degree 11, g·Lᵢ's
+/// degree 2p + 2: exact to p = 4, beyond it an error of g's twelfth derivative over one
+/// interval, far below the quadratic's). A held input is constant on its piece and a state
+/// smooth on it, so their integrals keep the quadratic's accuracy however g curves, where a
+/// rule on the samples of g·θ across a jump or a kink would not.
+fn product_piece(t: &[f64], g: &dyn Fn(f64) -> f64) -> Vec<f64> {
+    const NODES: [(f64, f64); 6] = [
+        (-0.932_469_514_203_152, 0.171_324_492_379_170),
+        (-0.661_209_386_466_265, 0.360_761_573_048_139),
+        (-0.238_619_186_083_197, 0.467_913_934_572_691),
+        (0.238_619_186_083_197, 0.467_913_934_572_691),
+        (0.661_209_386_466_265, 0.360_761_573_048_139),
+        (0.932_469_514_203_152, 0.171_324_492_379_170),
+    ];
+    let integrate = |a: f64, b: f64, l: &dyn Fn(f64) -> f64| -> f64 {
+        let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
+        NODES.iter().map(|(x, w)| w * half * g(mid + half * x) * l(mid + half * x)).sum()
+    };
+    let m = t.len() - 1;
+    let mut out = vec![0.0; m + 1];
+    let paired = m - m % 2;
+    for i in (0..paired).step_by(2) {
+        let (a, b, c) = (t[i], t[i + 1], t[i + 2]);
+        let basis: [&dyn Fn(f64) -> f64; 3] = [
+            &|x| (x - b) * (x - c) / ((a - b) * (a - c)),
+            &|x| (x - a) * (x - c) / ((b - a) * (b - c)),
+            &|x| (x - a) * (x - b) / ((c - a) * (c - b)),
+        ];
+        for (j, l) in basis.iter().enumerate() {
+            out[i + j] += integrate(a, b, *l) + integrate(b, c, *l);
+        }
+    }
+    if m % 2 == 1 {
+        let (a, b) = (t[m - 1], t[m]);
+        out[m - 1] += integrate(a, b, &|x| (b - x) / (b - a));
+        out[m] += integrate(a, b, &|x| (x - a) / (b - a));
+    }
+    out
+}
+
+/// φ = (1 − s²)^p and dφ/dt at time `x` of the window [`start`, `end`].
+fn bump_at(x: f64, start: f64, end: f64, p: u32) -> (f64, f64) {
+    let s = ((2.0 * x - start - end) / (end - start)).clamp(-1.0, 1.0);
+    let base = 1.0 - s * s;
+    (base.powi(p as i32), -2.0 * p as f64 * s * base.powi(p as i32 - 1) * 2.0 / (end - start))
 }
 
 /// Quadrature weights over one smooth piece of samples `t`: Simpson's rule over an even
@@ -225,6 +377,10 @@ fn trapezoid(t: &[f64]) -> Vec<f64> {
 mod tests {
     use super::*;
 
+    pub(crate) fn flat(intervals: usize) -> Window {
+        Window { intervals, test: TestFunction::Flat, shrinks: false }
+    }
+
     /// Simpson's rule integrates cubics exactly: x = t⁴/4 with θ = t³ gives the window's
     /// change exactly; the trapezoid on uneven samples is exact for a linear θ.
     #[test]
@@ -232,7 +388,7 @@ mod tests {
         let t: Vec<f64> = (0..41).map(|k| 0.05 * k as f64).collect();
         let x: Vec<f64> = t.iter().map(|t| t.powi(4) / 4.0).collect();
         let theta = vec![t.iter().map(|t| t.powi(3)).collect::<Vec<f64>>()];
-        let (y, cols) = integral_rows(&t, &x, &theta, 4);
+        let (y, cols) = integral_rows(&t, &x, &theta, flat(4));
         assert_eq!(y.len(), 37);
         for (a, b) in y.iter().zip(&cols[0]) {
             assert!((a - b).abs() < 1e-13, "{a} vs {b}");
@@ -240,7 +396,7 @@ mod tests {
         let t: Vec<f64> = (0..30).map(|k| (k as f64).powf(1.3) * 0.01).collect();
         let x: Vec<f64> = t.iter().map(|t| 1.5 * t * t + 2.0 * t).collect();
         let theta = vec![t.iter().map(|t| 3.0 * t + 2.0).collect::<Vec<f64>>()];
-        let (y, cols) = integral_rows(&t, &x, &theta, 3);
+        let (y, cols) = integral_rows(&t, &x, &theta, flat(3));
         for (a, b) in y.iter().zip(&cols[0]) {
             assert!((a - b).abs() < 1e-12, "{a} vs {b}");
         }
@@ -249,7 +405,7 @@ mod tests {
         // trapezoid is kept: exact for θ linear only)
         let x: Vec<f64> = t.iter().map(|t| t.powi(3) / 3.0).collect();
         let theta = vec![t.iter().map(|t| t * t).collect::<Vec<f64>>()];
-        let (y, cols) = integral_rows(&t, &x, &theta, 4);
+        let (y, cols) = integral_rows(&t, &x, &theta, flat(4));
         for (a, b) in y.iter().zip(&cols[0]) {
             assert!((a - b).abs() < 1e-12, "{a} vs {b}");
         }
@@ -294,11 +450,11 @@ mod tests {
                 .map(|(k, t)| level(k.saturating_sub(1)) * t.powi(power))
                 .collect::<Vec<f64>>()];
             for w in [4, 5, 8] {
-                let (y, cols) = integral_rows_held(&t, &x, &theta, &before, &jumps, w);
+                let (y, cols) = integral_rows_held(&t, &x, &theta, &before, &jumps, flat(w));
                 for (k, (a, b)) in y.iter().zip(&cols[0]).enumerate() {
                     assert!((a - b).abs() < 1e-12, "w = {w}, window {k}: {a} vs {b}");
                 }
-                let (_, smeared) = integral_rows(&t, &x, &theta, w);
+                let (_, smeared) = integral_rows(&t, &x, &theta, flat(w));
                 let worst = y.iter().zip(&smeared[0]).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
                 assert!(worst > 1e-3, "w = {w}: {worst}");
             }

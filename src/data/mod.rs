@@ -25,17 +25,20 @@ mod search;
 mod smoothing_spline;
 mod spike;
 mod stream;
+mod weak;
 
 pub use angle::{unwrap_turns, unwrapped, wrapped};
 pub use breaks::{breaks, cut_at_breaks, cut_at_gaps, gaps, moving_breaks, Break, Gaps};
 pub use clock::clock_seconds;
 pub use dataset::{velocities_from_track, Dataset, Delimiter, RunSpec, Track};
 pub use delay::delayed;
-pub use derivative::{differentiator, CentralDifference, Differentiator, Smoothed, DIFFERENTIATORS};
+pub use derivative::{
+    differentiator, CentralDifference, Differentiator, Smoothed, TestFunction, Window, DIFFERENTIATORS,
+};
 pub use five_point::FivePoint;
 pub use geodetic::{north_east, radii_of_curvature};
 pub use hold::{held, mark_held, switches, Hold, Intersample};
-pub use integral::{integral_rows, integral_rows_held, IntegralForm};
+pub use integral::{integral_rows, integral_rows_held, row_overlap, IntegralForm};
 pub use kalman::{KalmanSmoother, NoiseModel};
 pub use long::{columns_of, interleaved, text_columns_of};
 pub use prepare::{prepare, Preparation};
@@ -49,6 +52,7 @@ pub use savitzky_golay::SavitzkyGolay;
 pub use smoothing_spline::SmoothingSpline;
 pub use spike::{despiked, despiked_all, spikes, Spike};
 pub use stream::{Chunk, Chunks, Labels, RowSource};
+pub use weak::WeakForm;
 
 #[cfg(test)]
 /// Uniform noise in [−½, ½) from a seeded LCG, for the tests of the derivative methods.

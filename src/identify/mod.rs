@@ -148,10 +148,11 @@ pub struct Fit {
     /// (no terms, no residual degrees of freedom, or a singular cross-product matrix).
     #[serde(default)]
     pub covariance: Option<Vec<Vec<f64>>>,
-    /// Integrated autocorrelation time of the residuals, in rows (1 for independent rows).
-    /// The covariance assumes independent rows; residuals of a sampled time series are not,
-    /// and the effective number of rows is `rows / correlation_time`, so honest standard
-    /// errors are √τ times the reported ones.
+    /// Integrated autocorrelation time of the residuals, in rows (1 for independent rows),
+    /// beyond the rows' overlap the statistics count already (a weak form's windows,
+    /// [`crate::select::Moments::overlap`]). The covariance assumes it is 1; residuals of a
+    /// sampled time series are correlated, and the effective number of rows is
+    /// `rows / correlation_time`, so honest standard errors are √τ times the reported ones.
     #[serde(default)]
     pub correlation_time: Option<f64>,
     /// How the residuals grow with the fit's size: their root mean square where |fitted| is
@@ -398,9 +399,9 @@ fn held_rate_note(
         format!(
             "{} held or switched between samples, {jumps} jumps in all: at each the rate of `{state}` \
              jumps too, and the {} derivative spreads it over the samples beside, which biases the \
-             coefficients; the integral form (`--derivative integral`, the default for a rate) \
-             integrates a held input piece by piece between its jumps and leaves out the windows \
-             that hold a switch",
+             coefficients; the weak form (`--derivative weak`, the default for a rate) and the \
+             integral form integrate a held input piece by piece between its jumps and leave out \
+             the windows that hold a switch",
             match held.as_slice() {
                 [one] => format!("`{one}` is"),
                 many =>
@@ -482,13 +483,13 @@ fn switched_note(frames: &[Frame], library: &Library, w: usize) -> Option<String
     Some(if dense == 0 {
         format!(
             "{who} switched between samples {times} in all, at instants the rows do not tell: \
-             the {left} windows of the integral form (of {all}) that hold a switch are left out of the fit"
+             the {left} windows of the weak or integral form (of {all}) that hold a switch are left out of the fit"
         )
     } else {
         format!(
             "{who} switched between samples {times} in all, too often to leave out the windows \
-             of the integral form that hold a switch in {dense} run(s) (more than half of them): taken there as \
-             a line across each switch, which biases the coefficients; a shorter window \
+             of the weak or integral form that hold a switch in {dense} run(s) (more than half of them): taken \
+             there as a line across each switch, which biases the coefficients; a shorter window \
              (`--derivative integral:W`, W even) leaves more"
         )
     })
@@ -667,8 +668,10 @@ impl Identification<'_> {
         frame: &Frame,
         rows: std::ops::Range<usize>,
     ) -> Result<Moments, IdentifyError> {
-        if let (Some(w), Target::Derivative(_)) = (self.differentiator.integral_window(), target) {
-            return self.integral_moments(library, target, frame, w, rows);
+        if let (Some(window), Target::Derivative(_)) = (self.differentiator.window(), target) {
+            // a piece of a run takes the run's windows, however short the piece with its context
+            let window = crate::data::Window { shrinks: false, ..window };
+            return self.integral_moments(library, target, frame, window, rows);
         }
         let run = self.bind(library, target, frame)?;
         let offset = rows.start;
@@ -686,8 +689,11 @@ impl Identification<'_> {
         target: &Target,
         frames: &[Frame],
     ) -> Result<Vec<Moments>, IdentifyError> {
-        if let (Some(w), Target::Derivative(_)) = (self.differentiator.integral_window(), target) {
-            return frames.iter().map(|f| self.integral_moments(library, target, f, w, 0..f.len())).collect();
+        if let (Some(window), Target::Derivative(_)) = (self.differentiator.window(), target) {
+            return frames
+                .iter()
+                .map(|f| self.integral_moments(library, target, f, window, 0..f.len()))
+                .collect();
         }
         let runs = frames.iter().map(|f| self.bind(library, target, f)).collect::<Result<Vec<_>, _>>()?;
         let rows: Vec<usize> = frames.iter().map(Frame::len).collect();
@@ -702,10 +708,10 @@ impl Identification<'_> {
         library: &Library,
         target: &Target,
         frame: &Frame,
-        w: usize,
+        window: crate::data::Window,
         own: std::ops::Range<usize>,
     ) -> Result<Moments, IdentifyError> {
-        let Rows { y, columns: integrals, weights, starts } = self.windows(library, target, frame, w)?;
+        let Rows { y, columns: integrals, weights, starts } = self.windows(library, target, frame, window)?;
         // the rows of the windows that start on `own` samples (some left out: a switch inside)
         let starts = starts.partition_point(|s| *s < own.start)..starts.partition_point(|s| *s < own.end);
         let refs: Vec<&[f64]> = integrals.iter().map(|c| &c[starts.clone()]).collect();
@@ -719,7 +725,7 @@ impl Identification<'_> {
                 j + 1
             )));
         }
-        Ok(acc.finish())
+        Ok(acc.finish().with_overlap(crate::data::row_overlap(window.on_rows(frame.len()))))
     }
 
     /// The rows of the integral form of one run: the candidates evaluated on every sample,
@@ -730,12 +736,13 @@ impl Identification<'_> {
         library: &Library,
         target: &Target,
         frame: &Frame,
-        w: usize,
+        window: crate::data::Window,
     ) -> Result<Rows, IdentifyError> {
-        let n = frame.len();
+        let window = window.on_rows(frame.len());
+        let (n, w) = (frame.len(), window.intervals);
         if n <= w + 1 {
             return Err(IdentifyError::Setup(format!(
-                "{}: {n} rows are too few for the integral form's windows of {w} intervals",
+                "{}: {n} rows are too few for windows of {w} intervals (--derivative)",
                 frame.origin()
             )));
         }
@@ -774,9 +781,9 @@ impl Identification<'_> {
             };
             let sources = library.bind(&column, &|p| params.get(p).copied())?;
             let before = evaluate(&sources);
-            crate::data::integral_rows_held(frame.time(), &run.y, &samples, &before, &jumps, w)
+            crate::data::integral_rows_held(frame.time(), &run.y, &samples, &before, &jumps, window)
         } else {
-            crate::data::integral_rows(frame.time(), &run.y, &samples, w)
+            crate::data::integral_rows(frame.time(), &run.y, &samples, window)
         };
         let weights: Option<Vec<f64>> = run
             .weights
@@ -954,8 +961,8 @@ impl Identification<'_> {
         if let Target::Derivative(state) = target {
             fit.selection.notes.extend(unexplained_note(&fit.selection, state));
             fit.selection.notes.extend(resolution_note(frames, state));
-            match self.differentiator.integral_window() {
-                Some(w) => fit.selection.notes.extend(switched_note(frames, &design.library, w)),
+            match self.differentiator.window() {
+                Some(w) => fit.selection.notes.extend(switched_note(frames, &design.library, w.intervals)),
                 None => fit.selection.notes.extend(held_rate_note(
                     frames,
                     &design.library,
@@ -968,7 +975,7 @@ impl Identification<'_> {
     }
 
     /// What the chosen equation's residuals say of the fit, in one more pass over the rows
-    /// (the integral form's windows where it is one): their correlation time τ = 1 + 2 Σ ρₖ,
+    /// (the weak or integral form's windows where it is one): their correlation time τ = 1 + 2 Σ ρₖ,
     /// the autocorrelations ρₖ pooled over the runs and summed up to the first lag where they
     /// fall below zero (Geyer's initial positive sequence, simplified; at most 1000 lags;
     /// `None` with row weights or a run too short), and how they grow with the fit's size
@@ -991,11 +998,11 @@ impl Identification<'_> {
         // (|fitted|, residual) of every row
         let mut sized: Vec<(f64, f64)> = Vec::new();
         let window = match target {
-            Target::Derivative(_) => self.differentiator.integral_window(),
+            Target::Derivative(_) => self.differentiator.window(),
             Target::Column(_) => None,
         };
         for frame in frames {
-            // the regression's own rows: the integral form's windows, else the samples (in
+            // the regression's own rows: the weak or integral form's windows, else the samples (in
             // blocks, as the fit took them: no column of a long run held whole)
             let (y, e, weights) = match window {
                 Some(w) => {
@@ -1026,8 +1033,15 @@ impl Identification<'_> {
             sized.extend(e.iter().enumerate().map(|(k, e)| ((y[k] - e).abs(), scale(k) * e)));
             residuals.push(e);
         }
-        fit.correlation_time =
-            if self.weights.is_some() { None } else { crate::uncertainty::correlation_time(&residuals) };
+        // the statistics count a weak form's overlapping windows already (Moments::overlap):
+        // what is left is the residuals' correlation beyond it
+        let longest = frames.iter().map(Frame::len).max().unwrap_or(0);
+        let counted = window.map_or(1.0, |w| crate::data::row_overlap(w.on_rows(longest)));
+        fit.correlation_time = if self.weights.is_some() {
+            None
+        } else {
+            crate::uncertainty::correlation_time(&residuals).map(|t| (t / counted).max(1.0))
+        };
         fit.residual_growth = growth(&mut sized);
         Ok(())
     }

@@ -346,6 +346,7 @@ impl EquationMoments {
             "target": self.target,
             "candidates": self.candidates,
             "runs": self.runs.iter().map(|r| (&r.run, r.moments.count())).collect::<Vec<_>>(),
+            "overlaps": self.runs.iter().map(|r| r.moments.overlap()).collect::<Vec<_>>(),
         })
         .to_string();
         let mut out =
@@ -374,6 +375,9 @@ impl EquationMoments {
             target: String,
             candidates: Vec<String>,
             runs: Vec<(String, usize)>,
+            /// Each run's rows per independent row (a weak form's windows; 1 where absent).
+            #[serde(default)]
+            overlaps: Vec<f64>,
         }
         let header: Header = header
             .and_then(|h| serde_json::from_slice(h).ok())
@@ -384,13 +388,15 @@ impl EquationMoments {
             return Err(broken("the numbers do not fit the candidates and runs"));
         }
         let mut runs = Vec::with_capacity(header.runs.len());
-        for (run, count) in header.runs {
+        let overlaps = header.overlaps.iter().copied().chain(std::iter::repeat(1.0));
+        for ((run, count), overlap) in header.runs.into_iter().zip(overlaps) {
             let (these, rest) = numbers.split_at(per_run * 8);
             numbers = rest;
             let values: Vec<f64> =
                 these.chunks_exact(8).map(|b| f64::from_le_bytes(b.try_into().unwrap_or_default())).collect();
             let moments = Moments::from_numbers(p, count, &values)
                 .filter(Moments::is_consistent)
+                .map(|m| m.with_overlap(overlap))
                 .ok_or_else(|| broken(&format!("the statistics of run `{run}` are not whole")))?;
             runs.push(RunMoments { run, moments });
         }

@@ -16,7 +16,9 @@ pub use halves::halves_check;
 pub use parameters::{ParameterOptions, ParameterStage};
 pub use report::Primes;
 pub use retrace::retrace_check;
-pub use start::{checks_of, derivative_method, prepare_runs, Start};
+pub use start::{
+    checks_of, default_derivative, derivative_method, prepare_runs, Start, ANY_SYSTEM_DERIVATIVE,
+};
 
 use rayon::prelude::*;
 
@@ -89,13 +91,12 @@ impl Default for RecipeSettings {
 /// What the recipe does where its caller names no derivative starts, smoothing or refinement:
 /// a field's own way (a plug-in's [`Plugin::recipe_defaults`](crate::plugin::Plugin::recipe_defaults):
 /// a ship's four starts refined on its velocities and heading), else any system's: one start
-/// by the integral form, which recovers polynomial systems from noise-free and noisy samples
-/// alike, not smoothed and not refined (an output error over a chaotic run has no one minimum).
+/// by the weak form ([`ANY_SYSTEM_DERIVATIVE`]), not smoothed and not refined (an output error over a chaotic run has no one minimum).
 impl RecipeDefaults {
     /// The defaults for `model`: its plug-in's, else any system's.
     pub fn of(model: &Model) -> RecipeDefaults {
         crate::plugins::of(model).and_then(|p| p.recipe_defaults(model)).unwrap_or_else(|| RecipeDefaults {
-            derivatives: vec!["integral".into()],
+            derivatives: vec![ANY_SYSTEM_DERIVATIVE.into()],
             smooth: false,
             refine: None,
         })
@@ -382,7 +383,7 @@ mod tests {
         assert_eq!(ship.refine.as_deref(), Some(&["u".to_string(), "v".into(), "r".into(), "ψ".into()][..]));
         // any other system: the integral form, one start, neither smoothed nor refined
         let any = RecipeDefaults::of(&lorenz());
-        assert_eq!(any, RecipeDefaults { derivatives: vec!["integral".into()], smooth: false, refine: None });
+        assert_eq!(any, RecipeDefaults { derivatives: vec!["weak".into()], smooth: false, refine: None });
     }
 
     #[test]

@@ -28,6 +28,10 @@ pub struct Moments {
     /// matrix is symmetric, and mirroring every chunk's products cost more than reading
     /// (i, j) as (j, i).
     comoment: Vec<f64>,
+    /// Rows per independent row: 1 where each row's noise is its own; more where the rows
+    /// share their noise by construction (a weak form's overlapping windows), so that the
+    /// back-ends count `count / overlap` rows' worth of evidence.
+    overlap: f64,
 }
 
 /// How statistics are written: the regressors, the rows, and [`Moments::numbers`] (the lower
@@ -37,18 +41,29 @@ struct Packed {
     p: usize,
     count: usize,
     numbers: Vec<f64>,
+    #[serde(default = "independent", skip_serializing_if = "is_independent")]
+    overlap: f64,
+}
+
+fn independent() -> f64 {
+    1.0
+}
+
+fn is_independent(overlap: &f64) -> bool {
+    *overlap == 1.0
 }
 
 impl From<Moments> for Packed {
     fn from(m: Moments) -> Packed {
-        Packed { p: m.p, count: m.count, numbers: m.numbers() }
+        Packed { p: m.p, count: m.count, numbers: m.numbers(), overlap: m.overlap }
     }
 }
 
 impl TryFrom<Packed> for Moments {
     type Error = String;
     fn try_from(p: Packed) -> Result<Moments, String> {
-        Moments::from_numbers(p.p, p.count, &p.numbers).ok_or_else(|| {
+        let overlap = p.overlap;
+        Moments::from_numbers(p.p, p.count, &p.numbers).map(|m| m.with_overlap(overlap)).ok_or_else(|| {
             format!("{} numbers do not make the statistics of {} regressors", p.numbers.len(), p.p)
         })
     }
@@ -65,6 +80,7 @@ impl PartialEq for Moments {
         };
         self.p == other.p
             && self.count == other.count
+            && self.overlap == other.overlap
             && self.weight == other.weight
             && self.mean == other.mean
             && lower(&self.comoment) == lower(&other.comoment)
@@ -75,13 +91,13 @@ impl Moments {
     /// Empty statistics for `p` regressors.
     pub fn new(p: usize) -> Moments {
         let m = p + 1;
-        Moments { p, count: 0, weight: 0.0, mean: vec![0.0; m], comoment: vec![0.0; m * m] }
+        Moments { p, count: 0, weight: 0.0, mean: vec![0.0; m], comoment: vec![0.0; m * m], overlap: 1.0 }
     }
 
     /// Empty statistics whose vectors are not allocated yet (an accumulator's, until its first
     /// chunk).
     fn unallocated(p: usize) -> Moments {
-        Moments { p, count: 0, weight: 0.0, mean: Vec::new(), comoment: Vec::new() }
+        Moments { p, count: 0, weight: 0.0, mean: Vec::new(), comoment: Vec::new(), overlap: 1.0 }
     }
 
     /// The numbers that determine the statistics, in a fixed order: the weight, the p + 1
@@ -146,6 +162,23 @@ impl Moments {
         self.count
     }
 
+    /// Rows per independent row (1 unless set by [`Moments::with_overlap`]).
+    pub fn overlap(&self) -> f64 {
+        self.overlap
+    }
+
+    /// These statistics with rows that share their noise over `overlap` rows each (≥ 1;
+    /// anything else, 1): the back-ends take `count / overlap` rows as the evidence.
+    pub fn with_overlap(mut self, overlap: f64) -> Moments {
+        self.overlap = if overlap.is_finite() && overlap >= 1.0 { overlap } else { 1.0 };
+        self
+    }
+
+    /// The rows' worth of independent evidence, `count / overlap`.
+    pub fn independent_rows(&self) -> f64 {
+        self.count as f64 / self.overlap
+    }
+
     /// Sum of the weights (= rows when unweighted).
     pub fn weight(&self) -> f64 {
         self.weight
@@ -170,6 +203,14 @@ impl Moments {
     /// Adds another set of statistics over the same variables (e.g. another file).
     pub fn merge(&mut self, other: &Moments) {
         assert_eq!(self.p, other.p, "moments of different regressor sets");
+        let (rows, independent) =
+            (self.count + other.count, self.independent_rows() + other.independent_rows());
+        let overlap = if independent > 0.0 { rows as f64 / independent } else { 1.0 };
+        self.merge_rows(other);
+        self.overlap = overlap.max(1.0);
+    }
+
+    fn merge_rows(&mut self, other: &Moments) {
         if other.weight == 0.0 {
             self.count += other.count;
             return;
@@ -209,6 +250,8 @@ impl Moments {
         let rest_w = self.weight - part.weight;
         let mut rest = Moments::new(self.p);
         rest.count = self.count.saturating_sub(part.count);
+        let independent = self.independent_rows() - part.independent_rows();
+        rest.overlap = if independent > 0.0 { (rest.count as f64 / independent).max(1.0) } else { 1.0 };
         rest.weight = rest_w;
         if rest_w <= 0.0 {
             return rest;
@@ -621,6 +664,44 @@ mod tests {
         // squared error of y ≈ 0.5 + 0.3 x1 − 0.2 x2 on rows 12..30, directly
         let direct: f64 = (12..30).map(|r| (y[r] - 0.5 - 0.3 * x[r] + 0.2 * x[30 + r]).powi(2)).sum();
         assert!((b.squared_error(&[0, 1], &[0.3, -0.2], 0.5) - direct).abs() < 1e-9 * direct);
+    }
+
+    /// Rows that share their noise: runs of 100 rows at overlap 4 and 300 at overlap 1 are 325
+    /// independent rows together (overlap 400 / 325), 300 without the first again; the overlap
+    /// survives the JSON form, and the back-ends' row count is divided by it.
+    #[test]
+    fn overlapping_rows_count_as_their_independent_rows() {
+        let run = |rows: usize, overlap: f64| {
+            let x: Vec<f64> = (0..rows).map(|i| (i as f64 * 0.37).sin()).collect();
+            let y: Vec<f64> = (0..rows).map(|i| (i as f64 * 0.11).cos()).collect();
+            let mut acc = Accumulator::new(1);
+            acc.push(&x, &y, None);
+            acc.finish().with_overlap(overlap)
+        };
+        let (a, b) = (run(100, 4.0), run(300, 1.0));
+        let mut both = a.clone();
+        both.merge(&b);
+        assert_eq!(both.count(), 400);
+        assert!((both.independent_rows() - 325.0).abs() < 1e-9, "{}", both.independent_rows());
+        assert!((both.without(&a).overlap() - 1.0).abs() < 1e-12);
+        let text = serde_json::to_string(&a).unwrap();
+        assert_eq!(serde_json::from_str::<Moments>(&text).unwrap(), a);
+        assert!(!serde_json::to_string(&b).unwrap().contains("overlap"));
+        assert_eq!(run(10, 0.5).overlap(), 1.0);
+        let names = ["x".to_string()];
+        let problem = |m: &Moments| {
+            super::super::subset::Scaled::new(&super::super::Problem {
+                moments: m,
+                names: &names,
+                forced: &[],
+                excluded: &[],
+                intercept: true,
+            })
+            .unwrap()
+            .n_eff
+        };
+        assert_eq!(problem(&a), 99.0 / 4.0);
+        assert_eq!(problem(&b), 299.0);
     }
 
     #[test]

@@ -62,7 +62,8 @@ pub(crate) struct Scaled {
     pub total: f64,
     /// Rows.
     pub n: usize,
-    /// n − 1 with an intercept, else n.
+    /// n − 1 with an intercept, else n; divided by the rows' overlap
+    /// ([`super::Moments::overlap`]).
     pub n_eff: f64,
     /// Means (target last).
     pub means: Vec<f64>,
@@ -100,7 +101,8 @@ impl Scaled {
             d,
             total,
             n,
-            n_eff: if pb.intercept { n as f64 - 1.0 } else { n as f64 },
+            // rows that share their noise count for less (a weak form's overlapping windows)
+            n_eff: (if pb.intercept { n as f64 - 1.0 } else { n as f64 }) / mo.overlap(),
             means: mo.means().to_vec(),
             weight: mo.weight(),
             intercept: pb.intercept,

@@ -210,7 +210,7 @@ fn a_held_force_is_integrated_as_held() {
 /// slower sensor's readings (the default before), its cubics put each change half a period
 /// early: −3.934x + 1.961F − 0.3098v. The oscillator's rate steps where it changes, so it is
 /// a command: held, said, and the three terms exact, by plain `identify` and through a model
-/// file (held in the replay too: validated within 1e-5 m).
+/// file (held in the replay too: validated within 2e-5 m).
 #[test]
 fn a_command_slower_than_the_log_is_held() {
     let dir = Scratch::new("slow-command");
@@ -230,8 +230,10 @@ fn a_command_slower_than_the_log_is_held() {
     let out = out.to_str().unwrap();
     let (ok, _, err) = termid(&["identify", "--model", &model, "--data", &data, "--out", out]);
     assert!(ok && err.contains("the rate of `v` steps"), "{err}");
+    // (the weak form's windows integrate the held command to 2e-5 m; the integral form's
+    // flat ones to 1e-5 m)
     let error = validated_x(out, &data);
-    assert!(error < 1e-5, "{error}");
+    assert!(error < 2e-5, "{error}");
     // with noise of ±1 % of x's and v's spread, which hides the kink, the fit tells: held, the
     // three terms within 0.5 % (read at the readings, the damping was 3 % off)
     let noisy = written(&dir, "noisy.csv", commanded_run(&levels, 0, 0.02));

@@ -26,13 +26,10 @@ fn resolve_derivative(cmd: &mut IdentifyCommand) -> Result<()> {
     if cmd.derivative != "auto" {
         return Ok(());
     }
-    let plugin = match &cmd.model {
-        Some(path) => termid::plugins::load(path).map(|m| termid::plugins::of(&m).is_some()).unwrap_or(false),
-        None => false,
-    };
-    // the integral form reads in pieces as well as whole (its windows reach a fixed number
-    // of samples ahead)
-    cmd.derivative = if plugin { "central" } else { "integral" }.into();
+    let model = cmd.model.as_ref().and_then(|path| termid::plugins::load(path).ok());
+    // the weak form reads in pieces as well as whole (its windows reach a fixed number of
+    // samples ahead)
+    cmd.derivative = termid::recipe::default_derivative(model.as_ref()).into();
     Ok(())
 }
 
