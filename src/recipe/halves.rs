@@ -4,7 +4,7 @@
 //! themselves) makes a regression choose terms the system lacks with t-values of 4 to 6;
 //! they rarely come back from both halves, where the system's own terms do.
 
-use crate::data::Frame;
+use crate::data::{Frame, TestFunction, WeakForm};
 use crate::identify::{identify_model, IdentifiedModel, ModelIdentification};
 use crate::model::Model;
 use crate::plugin::Check;
@@ -30,6 +30,14 @@ pub fn halves_check(
         return None;
     }
     let model: &Model = &identified.model;
+    let kept = windows_kept(how.differentiator, frames);
+    let how = ModelIdentification {
+        differentiator: kept.as_ref().map_or(how.differentiator, |k| k as &dyn crate::data::Differentiator),
+        equations: how.equations.clone(),
+        target: how.target.clone(),
+        ..*how
+    };
+    let how = &how;
     let half = |second: bool| -> Option<IdentifiedModel> {
         let cut: Vec<Frame> = frames
             .iter()
@@ -80,6 +88,18 @@ pub fn halves_check(
         )
     };
     Some(Check { name: NAME.into(), passed: unsteady.is_empty(), refuses: false, detail, measure: None })
+}
+
+/// The weak form the halves take where the whole runs took a default one's windows: each
+/// half keeps them, where the default would turn to the integral form's on a half too short
+/// for four windows and the halves would choose by another method than the whole. `None`:
+/// the halves take `differentiator` as it is.
+fn windows_kept(differentiator: &dyn crate::data::Differentiator, frames: &[Frame]) -> Option<WeakForm> {
+    let whole = differentiator.window().filter(|w| frames.iter().all(|f| f.len() > 4 * w.intervals))?;
+    match whole.test {
+        TestFunction::Bump(power) if whole.shrinks => Some(WeakForm { window: Some(whole.intervals), power }),
+        _ => None,
+    }
 }
 
 #[cfg(test)]
@@ -136,5 +156,20 @@ mod tests {
         let short = run(&|t| t).slice(0..60);
         let identified = identify_model(&model, std::slice::from_ref(&short), &how, &mut |_| {}).unwrap();
         assert!(halves_check(&identified, &[short], &how).is_none());
+    }
+
+    /// Runs of 200 samples take the default weak form whole; their halves of 100 keep its
+    /// windows of 32 instead of turning to the integral form; runs too short for them whole,
+    /// or a window the user chose, leave the method as it is.
+    #[test]
+    fn the_halves_keep_the_whole_runs_windows() {
+        let run = |n: usize| Frame::new("r.csv", "t", (0..n).map(|k| k as f64).collect()).unwrap();
+        let default = crate::data::WeakForm::default();
+        let kept = windows_kept(&default, &[run(200), run(300)]).unwrap();
+        assert_eq!((kept.window, kept.power), (Some(32), 8));
+        assert!(windows_kept(&default, &[run(200), run(120)]).is_none());
+        let chosen = WeakForm { window: Some(16), power: 4 };
+        assert!(windows_kept(&chosen, &[run(200)]).is_none());
+        assert!(windows_kept(&crate::data::IntegralForm::default(), &[run(200)]).is_none());
     }
 }
