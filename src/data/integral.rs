@@ -32,9 +32,7 @@ impl Differentiator for IntegralForm {
     }
 
     fn smooth(&self, _t: &[f64], _x: &[f64]) -> Result<super::Smoothed, DataError> {
-        Err(DataError::Setting(
-            "the integral form estimates no rate, so there is nothing to smooth or draw: leave out --smooth and --prepared-svg, or choose a derivative method".into(),
-        ))
+        Err(nothing_to_smooth("integral"))
     }
 
     /// A window reaches `window` samples ahead: a run read in pieces with that much context
@@ -48,13 +46,21 @@ impl Differentiator for IntegralForm {
     }
 }
 
+/// Refuses to smooth or draw the rates of a form that estimates none (`form`: its name).
+pub(super) fn nothing_to_smooth(form: &str) -> DataError {
+    DataError::Setting(format!(
+        "the {form} form estimates no rate, so there is nothing to smooth or draw: leave out --smooth and --prepared-svg, or choose a derivative method"
+    ))
+}
+
 /// The rows of the integral form: for every window of `window.intervals` intervals starting
 /// at a sample, the left side (x at its end less x at its start; with a bump test function
 /// −∫ φ′ x dt) and each column integrated over it weighed by φ. A flat window is integrated
 /// by composite Simpson on an even grid with an even window, on uneven samples by the
 /// quadratic through each pair of intervals, with an odd window by the trapezoid on the
-/// samples' own spacing; a bump by the trapezoid, whose error falls with every derivative of
-/// the integrand that vanishes at the ends (Euler-Maclaurin), as φ's do.
+/// samples' own spacing; a bump on an even grid by the trapezoid, whose error falls with every
+/// derivative of the integrand that vanishes at the ends (Euler-Maclaurin), as φ's do, on
+/// uneven samples by the quadratic through each pair of samples integrated against φ and φ′.
 pub fn integral_rows(
     t: &[f64],
     x: &[f64],
@@ -178,14 +184,7 @@ pub fn row_overlap(window: Window) -> f64 {
 /// sample to 1 at its last.
 fn bump_values(t: &[f64], p: u32) -> (Vec<f64>, Vec<f64>) {
     let (a, b) = (t[0], t[t.len() - 1]);
-    let ds = 2.0 / (b - a);
-    t.iter()
-        .map(|ti| {
-            let s = ((2.0 * ti - a - b) / (b - a)).clamp(-1.0, 1.0);
-            let base = 1.0 - s * s;
-            (base.powi(p as i32), -2.0 * p as f64 * s * base.powi(p as i32 - 1) * ds)
-        })
-        .unzip()
+    t.iter().map(|x| bump_at(*x, a, b, p)).unzip()
 }
 
 /// [`integral_rows`] where some columns jump at samples (an input held between them:

@@ -44,9 +44,7 @@ impl Differentiator for WeakForm {
     }
 
     fn smooth(&self, _t: &[f64], _x: &[f64]) -> Result<super::Smoothed, DataError> {
-        Err(DataError::Setting(
-            "the weak form estimates no rate, so there is nothing to smooth or draw: leave out --smooth and --prepared-svg, or choose a derivative method".into(),
-        ))
+        Err(super::integral::nothing_to_smooth("weak"))
     }
 
     /// A window reaches `window` samples ahead.

@@ -459,9 +459,10 @@ struct Switched<'a> {
 
 /// Said where a rate's fit in the integral form left out the windows that hold an input's
 /// switch ([`switched_windows`]), or could not (switches too close).
-fn switched_note(frames: &[Frame], library: &Library, w: usize) -> Option<String> {
+fn switched_note(frames: &[Frame], library: &Library, window: crate::data::Window) -> Option<String> {
     let (mut names, mut switches, mut left, mut all, mut dense) = (Vec::<&str>::new(), 0, 0, 0, 0);
     for f in frames {
+        let w = window.on_rows(f.len()).intervals;
         let Some(Switched { keep, inputs, switches: at }) = switched_windows(f, library, w) else { continue };
         for i in inputs {
             if !names.contains(&i) {
@@ -962,7 +963,7 @@ impl Identification<'_> {
             fit.selection.notes.extend(unexplained_note(&fit.selection, state));
             fit.selection.notes.extend(resolution_note(frames, state));
             match self.differentiator.window() {
-                Some(w) => fit.selection.notes.extend(switched_note(frames, &design.library, w.intervals)),
+                Some(w) => fit.selection.notes.extend(switched_note(frames, &design.library, w)),
                 None => fit.selection.notes.extend(held_rate_note(
                     frames,
                     &design.library,
@@ -1197,9 +1198,11 @@ mod tests {
         assert!(switched_windows(&sparse, &blind, 8).is_none());
         let dense = frame(6);
         assert!(switched_windows(&dense, &reads, 8).unwrap().keep.is_none());
-        let said = switched_note(&[dense], &reads, 8).unwrap();
+        let said =
+            switched_note(&[dense], &reads, crate::data::IntegralForm::default().window().unwrap()).unwrap();
         assert!(said.contains("too often to leave out") && said.contains("in 1 run(s)"), "{said}");
-        let said = switched_note(&[sparse], &reads, 8).unwrap();
+        let said =
+            switched_note(&[sparse], &reads, crate::data::IntegralForm::default().window().unwrap()).unwrap();
         assert!(
             said.contains("switched between samples 2 times") && said.contains("the 16 windows"),
             "{said}"
