@@ -63,8 +63,13 @@ impl Window {
         if !self.shrinks || rows > 4 * self.intervals {
             return self;
         }
-        let flat = super::IntegralForm::default().window;
-        Window { intervals: flat, test: TestFunction::Flat, shrinks: false }
+        Window::fallback()
+    }
+
+    /// The integral form's default windows, which a default window gives way to on a run it
+    /// does not suit.
+    pub fn fallback() -> Window {
+        Window { intervals: super::IntegralForm::default().window, test: TestFunction::Flat, shrinks: false }
     }
 }
 
@@ -156,7 +161,7 @@ pub static DIFFERENTIATORS: &[(&str, &str, MakeDifferentiator)] = &[
         }
         _ => None,
     }),
-    ("weak", "[:WINDOW[:POWER]] (default 32:8, the integral form on runs under 129 samples; no derivative, the weak form)", |o| {
+    ("weak", "[:WINDOW[:POWER]] (default 32:8, the integral form's on runs under 129 samples or of dense switches; no derivative, the weak form)", |o| {
         let whole = |v: f64, low: f64, high: f64| v.fract() == 0.0 && v >= low && v <= high;
         let d = super::WeakForm::default();
         match o {

@@ -447,6 +447,24 @@ fn switched_windows<'a>(frame: &'a Frame, library: &Library, w: usize) -> Option
     Some(Switched { keep: (2 * kept >= keep.len()).then_some(keep), inputs, switches: at.len() })
 }
 
+/// The windows run `frame` takes: `window` as chosen; a default one ([`Window::shrinks`]) the
+/// integral form's where the run is too short for four of its windows ([`Window::on_rows`]) or
+/// where more than half of them would hold a switch of an input of `library` (they could not
+/// all be left out, and a switch taken as a line biases the fit; the integral form's shorter
+/// windows leave them out).
+///
+/// [`Window::shrinks`]: crate::data::Window::shrinks
+/// [`Window::on_rows`]: crate::data::Window::on_rows
+fn run_window(frame: &Frame, library: &Library, window: crate::data::Window) -> crate::data::Window {
+    let on = window.on_rows(frame.len());
+    let dense = || switched_windows(frame, library, window.intervals).is_some_and(|s| s.keep.is_none());
+    if window.shrinks && on == window && dense() {
+        crate::data::Window::fallback()
+    } else {
+        on
+    }
+}
+
 /// The windows of a run that hold a switch ([`switched_windows`]).
 struct Switched<'a> {
     /// Whether each window is kept; `None` where too many hold a switch to leave them out.
@@ -462,7 +480,7 @@ struct Switched<'a> {
 fn switched_note(frames: &[Frame], library: &Library, window: crate::data::Window) -> Option<String> {
     let (mut names, mut switches, mut left, mut all, mut dense) = (Vec::<&str>::new(), 0, 0, 0, 0);
     for f in frames {
-        let w = window.on_rows(f.len()).intervals;
+        let w = run_window(f, library, window).intervals;
         let Some(Switched { keep, inputs, switches: at }) = switched_windows(f, library, w) else { continue };
         for i in inputs {
             if !names.contains(&i) {
@@ -712,6 +730,7 @@ impl Identification<'_> {
         window: crate::data::Window,
         own: std::ops::Range<usize>,
     ) -> Result<Moments, IdentifyError> {
+        let window = run_window(frame, library, window);
         let Rows { y, columns: integrals, weights, starts } = self.windows(library, target, frame, window)?;
         // the rows of the windows that start on `own` samples (some left out: a switch inside)
         let starts = starts.partition_point(|s| *s < own.start)..starts.partition_point(|s| *s < own.end);
@@ -726,7 +745,7 @@ impl Identification<'_> {
                 j + 1
             )));
         }
-        Ok(acc.finish().with_overlap(crate::data::row_overlap(window.on_rows(frame.len()))))
+        Ok(acc.finish().with_overlap(crate::data::row_overlap(window)))
     }
 
     /// The rows of the integral form of one run: the candidates evaluated on every sample,
@@ -739,7 +758,7 @@ impl Identification<'_> {
         frame: &Frame,
         window: crate::data::Window,
     ) -> Result<Rows, IdentifyError> {
-        let window = window.on_rows(frame.len());
+        let window = run_window(frame, library, window);
         let (n, w) = (frame.len(), window.intervals);
         if n <= w + 1 {
             return Err(IdentifyError::Setup(format!(
@@ -1036,8 +1055,11 @@ impl Identification<'_> {
         }
         // the statistics count a weak form's overlapping windows already (Moments::overlap):
         // what is left is the residuals' correlation beyond it
-        let longest = frames.iter().map(Frame::len).max().unwrap_or(0);
-        let counted = window.map_or(1.0, |w| crate::data::row_overlap(w.on_rows(longest)));
+        let longest = frames.iter().max_by_key(|f| f.len());
+        let counted = match (window, longest) {
+            (Some(w), Some(f)) => crate::data::row_overlap(run_window(f, &library, w)),
+            _ => 1.0,
+        };
         fit.correlation_time = if self.weights.is_some() {
             None
         } else {

@@ -95,7 +95,11 @@ pub fn halves_check(
 /// for four windows and the halves would choose by another method than the whole. `None`:
 /// the halves take `differentiator` as it is.
 fn windows_kept(differentiator: &dyn crate::data::Differentiator, frames: &[Frame]) -> Option<WeakForm> {
-    let whole = differentiator.window().filter(|w| frames.iter().all(|f| f.len() > 4 * w.intervals))?;
+    // (a run with switches may have taken the integral form's windows whole: the halves then
+    // take the default as it is, and decide as the whole did)
+    let whole = differentiator
+        .window()
+        .filter(|w| frames.iter().all(|f| f.len() > 4 * w.intervals && f.switched().is_empty()))?;
     match whole.test {
         TestFunction::Bump(power) if whole.shrinks => Some(WeakForm { window: Some(whole.intervals), power }),
         _ => None,

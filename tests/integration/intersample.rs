@@ -59,10 +59,15 @@ fn advance(x: f64, v: f64, force: f64, dt: f64) -> (f64, f64) {
 /// between two samples (3001 samples 0.01 s apart, solved in closed form up to each switch
 /// and on from it); F recorded with uniform noise of ± `noise` / 2 (a measured force).
 fn relay_run(noise: f64) -> String {
+    relay_every(noise, 0.3, 1.2)
+}
+
+/// [`relay_run`] with the relay switched after `shortest` + `spread`·U(0, 1) seconds each time.
+fn relay_every(noise: f64, shortest: f64, spread: f64) -> String {
     let (mut rng, mut noisy) = (Lcg(17), Lcg(23));
     let h = 0.01;
     let (mut x, mut v, mut level) = (1.0, 0.0, 1.0);
-    let mut next = 0.3 + 1.2 * rng.next();
+    let mut next = shortest + spread * rng.next();
     let mut csv = String::from("t,x,v,F\n");
     for k in 0..3001 {
         let t = h * k as f64;
@@ -72,7 +77,7 @@ fn relay_run(noise: f64) -> String {
         while next < t + h {
             (x, v) = advance(x, v, level, next - at);
             (at, level) = (next, -level);
-            next += 0.3 + 1.2 * rng.next();
+            next += shortest + spread * rng.next();
         }
         (x, v) = advance(x, v, level, t + h - at);
     }
@@ -341,6 +346,27 @@ fn a_switch_between_samples_is_left_out_of_the_windows() {
         "{said}"
     );
     assert_true_terms_within(&chosen_terms(&report), &|w| 2e-3 * w.abs(), &said);
+}
+
+/// A relay switched every 0.15 to 0.45 s (15 to 45 samples): more than half of the weak
+/// form's windows of 32 would hold a switch, too many to leave out, so the default takes the
+/// integral form's windows of 8 on this run and leaves out those that hold one: −4, −0.3, 2
+/// within 10⁻⁷. The weak form's windows asked for (`weak:32`) take each switch as a line, said.
+#[test]
+fn a_relay_too_fast_for_the_weak_forms_windows_takes_the_integral_forms() {
+    let dir = Scratch::new("fast-relay");
+    let data = dir.join("relay.csv");
+    std::fs::write(&data, relay_every(0.0, 0.15, 0.3)).unwrap();
+    let (report, said) = identified_rate(data.to_str().unwrap(), &[]);
+    let notes = report["notes"].to_string();
+    assert!(
+        notes.contains("windows of the weak or integral form (of 2993) that hold a switch are left out"),
+        "{notes}"
+    );
+    assert_true_terms_within(&chosen_terms(&report), &|_| 1e-7, &said);
+    let (weak, _) = identified_rate(data.to_str().unwrap(), &["--derivative", "weak:32"]);
+    let notes = weak["notes"].to_string();
+    assert!(notes.contains("too often to leave out"), "{notes}");
 }
 
 /// Read in pieces (`termid moments --chunk-rows 1450`), the run's statistics are those of the
