@@ -78,31 +78,29 @@ pub fn integral_rows(
         TestFunction::Flat => None,
         TestFunction::Bump(p) => Some(p),
     };
-    let simpson = even && w.is_multiple_of(2) && bump.is_none();
+    let simpson = even && w.is_multiple_of(2);
     // (quadrature weights × φ, −quadrature weights × φ′) of the window from sample k
     let weights = |k: usize| -> (Vec<f64>, Vec<f64>) {
         let span = &t[k..=k + w];
-        let q = if simpson {
-            (0..=w)
-                .map(|i| {
-                    h / 3.0
-                        * match i {
-                            0 => 1.0,
-                            i if i == w => 1.0,
-                            i if i % 2 == 1 => 4.0,
-                            _ => 2.0,
-                        }
-                })
-                .collect()
-        } else if w.is_multiple_of(2) && bump.is_none() {
-            uneven_simpson(span)
-        } else {
-            trapezoid(span)
-        };
         match bump {
-            None => (q, Vec::new()),
+            None if simpson => {
+                let q = (0..=w)
+                    .map(|i| {
+                        h / 3.0
+                            * match i {
+                                0 => 1.0,
+                                i if i == w => 1.0,
+                                i if i % 2 == 1 => 4.0,
+                                _ => 2.0,
+                            }
+                    })
+                    .collect();
+                (q, Vec::new())
+            }
+            None if w.is_multiple_of(2) => (uneven_simpson(span), Vec::new()),
+            None => (trapezoid(span), Vec::new()),
             Some(p) if even => {
-                let (phi, slope) = bump_values(span, p);
+                let (q, (phi, slope)) = (trapezoid(span), bump_values(span, p));
                 let left = q.iter().zip(&slope).map(|(q, d)| -q * d).collect();
                 (q.iter().zip(&phi).map(|(q, f)| q * f).collect(), left)
             }

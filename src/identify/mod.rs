@@ -730,8 +730,8 @@ impl Identification<'_> {
         window: crate::data::Window,
         own: std::ops::Range<usize>,
     ) -> Result<Moments, IdentifyError> {
-        let window = run_window(frame, library, window);
-        let Rows { y, columns: integrals, weights, starts } = self.windows(library, target, frame, window)?;
+        let Rows { y, columns: integrals, weights, starts, window } =
+            self.windows(library, target, frame, window)?;
         // the rows of the windows that start on `own` samples (some left out: a switch inside)
         let starts = starts.partition_point(|s| *s < own.start)..starts.partition_point(|s| *s < own.end);
         let refs: Vec<&[f64]> = integrals.iter().map(|c| &c[starts.clone()]).collect();
@@ -810,7 +810,7 @@ impl Identification<'_> {
             .map(|r| (0..y.len()).map(|k| r[k..=k + w].iter().sum::<f64>() / (w + 1) as f64).collect());
         let Some(Switched { keep: Some(keep), .. }) = switched_windows(frame, library, w) else {
             let starts = (0..y.len()).collect();
-            return Ok(Rows { y, columns, weights, starts });
+            return Ok(Rows { y, columns, weights, starts, window });
         };
         let kept = |v: Vec<f64>| v.into_iter().zip(&keep).filter(|(_, k)| **k).map(|(x, _)| x).collect();
         Ok(Rows {
@@ -818,6 +818,7 @@ impl Identification<'_> {
             y: kept(y),
             columns: columns.into_iter().map(kept).collect(),
             weights: weights.map(kept),
+            window,
         })
     }
 
@@ -1021,12 +1022,20 @@ impl Identification<'_> {
             Target::Derivative(_) => self.differentiator.window(),
             Target::Column(_) => None,
         };
+        // the statistics count a weak form's overlapping windows already (Moments::overlap):
+        // the residuals' correlation is told beyond the overlap of the longest run's windows
+        let (mut longest, mut counted) = (0, 1.0);
         for frame in frames {
             // the regression's own rows: the weak or integral form's windows, else the samples (in
             // blocks, as the fit took them: no column of a long run held whole)
             let (y, e, weights) = match window {
                 Some(w) => {
-                    let Rows { y, columns, weights, .. } = self.windows(&library, target, frame, w)?;
+                    let Rows { y, columns, weights, window: taken, .. } =
+                        self.windows(&library, target, frame, w)?;
+                    // (the last of the longest, as before)
+                    if frame.len() >= longest {
+                        (longest, counted) = (frame.len(), crate::data::row_overlap(taken));
+                    }
                     let mut e: Vec<f64> = y.iter().map(|y| y - b0).collect();
                     for (t, column) in selection.terms.iter().zip(&columns) {
                         for (e, x) in e.iter_mut().zip(column) {
@@ -1053,13 +1062,6 @@ impl Identification<'_> {
             sized.extend(e.iter().enumerate().map(|(k, e)| ((y[k] - e).abs(), scale(k) * e)));
             residuals.push(e);
         }
-        // the statistics count a weak form's overlapping windows already (Moments::overlap):
-        // what is left is the residuals' correlation beyond it
-        let longest = frames.iter().max_by_key(|f| f.len());
-        let counted = match (window, longest) {
-            (Some(w), Some(f)) => crate::data::row_overlap(run_window(f, &library, w)),
-            _ => 1.0,
-        };
         fit.correlation_time = if self.weights.is_some() {
             None
         } else {
@@ -1078,6 +1080,8 @@ struct Rows {
     weights: Option<Vec<f64>>,
     /// The sample each window starts from (windows holding a switch are left out).
     starts: Vec<usize>,
+    /// The windows the run took ([`run_window`]).
+    window: crate::data::Window,
 }
 
 /// How the residuals grow with the fit's size: the root mean square of the residuals in the
@@ -1220,11 +1224,9 @@ mod tests {
         assert!(switched_windows(&sparse, &blind, 8).is_none());
         let dense = frame(6);
         assert!(switched_windows(&dense, &reads, 8).unwrap().keep.is_none());
-        let said =
-            switched_note(&[dense], &reads, crate::data::IntegralForm::default().window().unwrap()).unwrap();
+        let said = switched_note(&[dense], &reads, crate::data::Window::fallback()).unwrap();
         assert!(said.contains("too often to leave out") && said.contains("in 1 run(s)"), "{said}");
-        let said =
-            switched_note(&[sparse], &reads, crate::data::IntegralForm::default().window().unwrap()).unwrap();
+        let said = switched_note(&[sparse], &reads, crate::data::Window::fallback()).unwrap();
         assert!(
             said.contains("switched between samples 2 times") && said.contains("the 16 windows"),
             "{said}"
