@@ -241,6 +241,18 @@ impl PyModel {
         Ok(PyModel { inner: model })
     }
 
+    /// The outline the model was made from (JSON), while its library may still be written
+    /// about the runs' reference values; pickling keeps it.
+    fn outline_json(&self) -> PyResult<Option<String>> {
+        self.inner.outline().map(|o| serde_json::to_string(o).map_err(fail)).transpose()
+    }
+
+    /// The model with the outline `json` ([`PyModel::outline_json`]) it was made from.
+    fn with_outline(&self, json: &str) -> PyResult<PyModel> {
+        let outline: termid::model::Outline = serde_json::from_str(json).map_err(fail)?;
+        Ok(PyModel { inner: self.inner.clone().with_outline(outline) })
+    }
+
     /// The names of the model files shipped inside the package.
     #[staticmethod]
     fn builtin_names() -> Vec<&'static str> {

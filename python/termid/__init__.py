@@ -637,10 +637,17 @@ class Fit:
         >>> fitted = termid.fit(pd.DataFrame({"x": [0.0, 1, 2, 3], "y": [1.0, 3, 5, 7]}), "y", "x")
         >>> fitted.equation(3)
         'y = 1 + 2 x'
+        >>> termid.fit(pd.DataFrame({"x": [0.0, 1, 2, 3], "y": [1.0, 3, 5, 7]}), "y", ["1", "x - 1"]).equation(3)
+        'y = 3 + 2 (-1 + x)'
         """
         parts = [] if self.intercept is None else [f"{self.intercept:.{precision}g}"]
         for term, value in self.coefficients.items():
-            parts.append(f"{value:.{precision}g} {term}")
+            # the constant candidate is its coefficient alone; a sum is one term, in parentheses
+            if term == "1":
+                parts.append(f"{value:.{precision}g}")
+            else:
+                shown = f"({term})" if re.search(r".[+-] ", term) else term
+                parts.append(f"{value:.{precision}g} {shown}")
         return f"{self.target} = " + (" + ".join(parts) if parts else "0").replace("+ -", "- ")
 
     def summary(self, alpha: float = 0.05) -> Summary:
@@ -1140,9 +1147,13 @@ def _particulars(particulars: Union[Mapping[str, Any], str, os.PathLike]) -> Tup
     with open(path, encoding="utf-8") as f:
         return _termid.Model.from_particulars(f.read(), False, path)
 
-def _unpickled(text: str, path: str, from_states: bool) -> "Model":
-    """A pickled :class:`Model` read back: its file's text, and whether it was made from states."""
-    return Model(_termid.Model.parse(text, path), from_states)
+def _unpickled(text: str, path: str, from_states: bool, outline: Optional[str] = None) -> "Model":
+    """A pickled :class:`Model` read back: its file's text, whether it was made from states,
+    and the outline it was made from (its library not yet about the runs' reference values)."""
+    native = _termid.Model.parse(text, path)
+    if outline is not None:
+        native = native.with_outline(outline)
+    return Model(native, from_states)
 
 
 class Model:
@@ -1207,6 +1218,9 @@ class Model:
         it. ``inputs`` are the columns that drive the states (a force, a setpoint), known from
         the runs. :meth:`identify` (and :meth:`recipe`) starts the identified model's states where the
         first run starts, so that :meth:`simulate` retraces that run's beginning; :meth:`save` writes it.
+        A state or input the runs hold more than 30 spreads from 0 (a temperature in kelvin) is
+        written about a round reference value in the library, as the paper's Δu = u - u0: a
+        parameter ``T0``, a derived ``ΔT = T - T0`` and the monomials of ``ΔT`` (a note says so).
 
         Parameters: ``states`` the state columns; ``inputs`` the input columns; ``terms`` the
         candidates (default: the polynomial library); ``degree`` the polynomial library's (default 3, as the ODE benchmark that chose termid's
@@ -1326,9 +1340,9 @@ class Model:
             native = native.starting_as(runs[0])
         return Model(native, self._from_states)
 
-    def __reduce__(self) -> Tuple[Any, Tuple[str, str, bool]]:
+    def __reduce__(self) -> Tuple[Any, Tuple[str, str, bool, Optional[str]]]:
         # pickled as its file's text (a process pool, Dask), read back as it was written
-        return (_unpickled, (self.to_toml(), self._native.path, self._from_states))
+        return (_unpickled, (self.to_toml(), self._native.path, self._from_states, self._native.outline_json()))
 
     def save(self, path: Union[str, os.PathLike]) -> None:
         """Writes the model file to ``path`` (identified coefficients with their standard

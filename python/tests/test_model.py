@@ -901,6 +901,45 @@ def test_a_system_from_its_columns():
         termid.Model.from_states(["x"], terms=["x"], degree=2)
 
 
+_THERMAL = """[model]
+name = "a heated body"
+intercept = false
+[[states]]
+name = "T"
+initial = 301.0
+[[inputs]]
+name = "P"
+[parameters.Ta]
+value = 300.0
+[[derived]]
+name = "rise"
+definition = "T - Ta"
+[equations.T_dot]
+state = "T"
+coefficients = { "rise" = -0.5, "P" = 2.0 }
+"""
+
+
+def test_a_system_far_from_zero_is_identified_about_a_reference_value():
+    # a temperature in kelvin read to 0.01 K: T, T^2 and 1 are collinear about 300 K, and the
+    # library of a model made from columns is written about a round reference value instead
+    # (T0 = 300, ΔT = T - T0, as the paper's Δu), also after a pickle
+    t = np.arange(0.0, 60.0, 0.02)
+    power = pd.DataFrame({"t": t, "P": np.sin(0.7 * t) + 0.6 * np.sin(1.9 * t + 0.5)})
+    run = termid.Model.from_toml(_THERMAL).simulate(inputs=power)[["t", "T"]]
+    run["T"] += 0.01 * np.random.default_rng(5).standard_normal(len(run))
+    run["P"] = power["P"].to_numpy()[: len(run)]
+    model = pickle.loads(pickle.dumps(termid.Model.from_states(["T"], ["P"], degree=2)))
+    found = model.identify(run)
+    assert "written about reference values" in " ".join(found.notes("T_dot"))
+    coefficients = found.model.coefficients("T_dot").set_index("term")["value"]
+    assert sorted(coefficients.index) == ["P", "ΔT"]
+    assert coefficients["ΔT"] == pytest.approx(-0.5, rel=2e-3) and coefficients["P"] == pytest.approx(2.0, rel=2e-3)
+    assert found.model.parameters == {"T0": 300.0}
+    recipe = model.recipe(run)
+    assert sorted(recipe.model.coefficients("T_dot")["term"]) == ["P", "ΔT"]
+
+
 _LOTKA_VOLTERRA = """[model]
 name = "Lotka-Volterra"
 intercept = false

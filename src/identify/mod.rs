@@ -518,9 +518,6 @@ fn switched_note(frames: &[Frame], library: &Library, window: crate::data::Windo
 /// coefficients' standard errors are 100 times what they would be for unrelated terms.
 const COLLINEAR_INFLATION: f64 = 1e4;
 
-/// A variable whose mean is this many standard deviations from 0 is said to be offset.
-const OFFSET_SPREADS: f64 = 30.0;
-
 /// A note where the chosen terms are nearly collinear in these data (a variance inflation
 /// VIF_j = C_jj·(C⁻¹)_jj above [`COLLINEAR_INFLATION`]): their coefficients then trade against
 /// each other, another choice among them fits about as well, and a back-end's pick among
@@ -567,7 +564,7 @@ fn collinearity_note(moments: &Moments, names: &[String], selection: &Selection)
         .filter_map(|(i, n)| {
             let sd = (moments.corrected(i, i).max(0.0) / moments.weight()).sqrt();
             let ratio = means[i].abs() / sd;
-            (sd > 0.0 && ratio > OFFSET_SPREADS).then_some((n, ratio))
+            (sd > 0.0 && ratio > crate::model::OFFSET_SPREADS).then_some((n, ratio))
         })
         .collect();
     if let Some((v, _)) = offset.first() {

@@ -41,6 +41,9 @@ pub fn identify_model(
     progress: &mut dyn FnMut(&str),
 ) -> Result<IdentifiedModel, IdentifyError> {
     let names = equations_of(model, how)?;
+    // a model made from columns of variables far from 0: its library about reference values
+    let about = model.about_references(frames).map_err(|e| IdentifyError::Setup(e.to_string()))?;
+    let model = about.as_ref().map_or(model, |(m, _)| m);
     let mut identified = model.clone();
     let mut fits = Vec::new();
     for name in &names {
@@ -61,6 +64,7 @@ pub fn identify_model(
                 .set_covariance(name, covariance)
                 .map_err(|e| IdentifyError::Setup(format!("`{name}`: its coefficients' covariance {e}")))?;
         }
+        fit.selection.notes.extend(about.as_ref().map(|(_, note)| note.clone()));
         fits.push((name.clone(), fit));
     }
     Ok(IdentifiedModel { model: identified, fits })

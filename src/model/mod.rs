@@ -21,7 +21,7 @@ pub use file::{
     ParameterCovarianceSpec, ParameterSpec, PriorSpec, StateSpec,
 };
 pub use locate::line_of_key;
-pub use outline::{Outline, DEFAULT_DEGREE, MOST_MONOMIALS};
+pub use outline::{Outline, DEFAULT_DEGREE, MOST_MONOMIALS, OFFSET_SPREADS};
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -152,6 +152,10 @@ pub struct Model {
     pub vocabulary: Vocabulary,
     /// The equations, in the order of the states they integrate.
     equations: Vec<Equation>,
+    /// The outline it was made from, where it was ([`Outline::model`]) and its polynomial
+    /// library is not yet written about the runs' reference values
+    /// ([`Model::about_references`]). Not in the file.
+    outline: Option<std::sync::Arc<Outline>>,
 }
 
 /// The control step when neither the command nor the model file gives one, s.
@@ -305,7 +309,8 @@ impl Model {
         change(&mut spec);
         let text = toml::to_string_pretty(&spec)
             .map_err(|e| ModelError::Syntax { file: self.path.clone(), message: e.to_string() })?;
-        Model::from_spec(spec, &text, &self.path)
+        let model = Model::from_spec(spec, &text, &self.path)?;
+        Ok(Model { outline: self.outline.clone(), ..model })
     }
 
     /// Sets a parameter's value (`false`: the model has no such parameter).
@@ -722,7 +727,7 @@ impl Model {
                 ));
             }
         }
-        Ok(Model { path: file.into(), spec, vocabulary: vocab, equations })
+        Ok(Model { path: file.into(), spec, vocabulary: vocab, equations, outline: None })
     }
 
     /// The unit the file declares for a state, input or parameter (empty where none or

@@ -5,7 +5,9 @@
 
 use std::collections::BTreeMap;
 
-use super::{EquationSpec, InputSpec, Meta, Model, ModelError, ModelFile, StateSpec};
+use super::file::DerivedSpec;
+use super::{EquationSpec, InputSpec, Meta, Model, ModelError, ModelFile, ParameterSpec, StateSpec};
+use crate::data::Frame;
 use crate::select::Backend;
 use crate::term::{polynomial, polynomial_len};
 
@@ -18,9 +20,15 @@ pub const MOST_MONOMIALS: u128 = 1000;
 /// whose 37 systems identified whole with it come back as often as equation by equation.
 pub const DEFAULT_DEGREE: u32 = 3;
 
+/// A variable whose mean is this many standard deviations from 0 is offset: its powers and
+/// products move with the lower terms (x and x², 1 and x nearly collinear: at 30 spreads the
+/// correlation of x with x² is 0.9997), and a polynomial library in it says little. Such a
+/// variable is written about a reference value near its mean, as the paper's Δu = u − u₀.
+pub const OFFSET_SPREADS: f64 = 30.0;
+
 /// The outline of a system named by its columns: what [`Outline::model`] makes a model
 /// file of.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Outline {
     /// What the model is called (`[model] name`).
     pub name: String,
@@ -142,7 +150,158 @@ impl Outline {
             plugins: BTreeMap::new(),
         };
         let text = toml::to_string_pretty(&spec).map_err(|e| refuse(e.to_string()))?;
-        Model::from_spec(spec, &text, origin)
+        let model = Model::from_spec(spec, &text, origin)?;
+        Ok(Model { outline: Some(std::sync::Arc::new(self.clone())), ..model })
+    }
+}
+
+/// A variable the runs hold far from 0 ([`OFFSET_SPREADS`]): the reference value it is
+/// written about and how many spreads its mean sits from 0.
+struct Offset {
+    name: String,
+    reference: f64,
+    spreads: f64,
+}
+
+/// The variable `name` in `frames` if it is offset: its reference value the mean rounded to
+/// the decade above its spread (so it reads round, `300` for 302.3 ± 1.9, and stays within
+/// five spreads of the mean).
+fn offset(name: &str, frames: &[Frame]) -> Option<Offset> {
+    let columns: Vec<&[f64]> = frames.iter().filter_map(|f| f.column(name)).collect();
+    let n = columns.iter().map(|c| c.len()).sum::<usize>() as f64;
+    if n < 2.0 {
+        return None;
+    }
+    let mean = columns.iter().flat_map(|c| c.iter()).sum::<f64>() / n;
+    let variance = columns.iter().flat_map(|c| c.iter()).map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    let spread = variance.sqrt();
+    let spreads = mean.abs() / spread;
+    if !(spread > 0.0 && spreads.is_finite() && spreads > OFFSET_SPREADS) {
+        return None;
+    }
+    let decade = spread.log10().ceil() as i32;
+    // divided by 10^-k rather than times 10^k, so 302.1 is the nearest double to 302.1
+    let reference = if decade >= 0 {
+        (mean / 10f64.powi(decade)).round() * 10f64.powi(decade)
+    } else {
+        (mean * 10f64.powi(-decade)).round() / 10f64.powi(-decade)
+    };
+    Some(Offset { name: name.to_string(), reference, spreads })
+}
+
+impl Model {
+    /// The outline the model was made from, while its library may still be written about
+    /// reference values ([`Model::about_references`]); not in the file.
+    pub fn outline(&self) -> Option<&Outline> {
+        self.outline.as_deref()
+    }
+
+    /// The model as made from `outline` (a model read back from its file's text, as a
+    /// pickled one is, made from columns).
+    pub fn with_outline(self, outline: Outline) -> Model {
+        Model { outline: Some(std::sync::Arc::new(outline)), ..self }
+    }
+
+    /// A model made from columns ([`Outline::model`]) with its polynomial library written
+    /// about reference values where the runs hold a state or an input far from 0
+    /// ([`OFFSET_SPREADS`]: a temperature in kelvin, a pressure in pascal, a ship's speed):
+    /// a parameter `T0` (the mean, rounded), a derived `ΔT = T - T0`, and the monomials of
+    /// `ΔT` in place of `T`'s — the paper's `Δu = u - u0`. With a sentence saying so. `None`:
+    /// no such variable, named candidates, or a model not made from columns (its file's
+    /// candidates are its author's).
+    pub fn about_references(&self, frames: &[Frame]) -> Result<Option<(Model, String)>, ModelError> {
+        let Some(outline) = self.outline.as_ref().filter(|o| o.candidates.is_empty()) else {
+            return Ok(None);
+        };
+        let names: Vec<String> = outline.states.iter().chain(&outline.inputs).cloned().collect();
+        let offsets: Vec<Offset> = names.iter().filter_map(|n| offset(n, frames)).collect();
+        if offsets.is_empty() {
+            return Ok(None);
+        }
+        let spec = self.spec();
+        let mut taken: Vec<String> = names.clone();
+        taken.extend(spec.parameters.keys().cloned());
+        taken.extend(spec.derived.iter().map(|d| d.name.clone()));
+        taken.extend(spec.aliases.keys().cloned());
+        // (variable, parameter, derived) for each offset variable that has free names for both
+        let mut written = Vec::new();
+        for o in &offsets {
+            let free = |options: [String; 3], taken: &[String]| {
+                options.into_iter().find(|n| crate::term::is_identifier(n) && !taken.contains(n))
+            };
+            let v = &o.name;
+            let Some(parameter) = free([format!("{v}0"), format!("{v}_0"), format!("{v}_ref")], &taken)
+            else {
+                continue;
+            };
+            taken.push(parameter.clone());
+            let Some(derived) = free([format!("Δ{v}"), format!("Δ_{v}"), format!("{v}_dev")], &taken)
+            else {
+                continue;
+            };
+            taken.push(derived.clone());
+            written.push((o, parameter, derived));
+        }
+        if written.is_empty() {
+            return Ok(None);
+        }
+        let about: Vec<String> = names
+            .iter()
+            .map(|n| written.iter().find(|(o, ..)| o.name == *n).map_or(n.clone(), |(_, _, d)| d.clone()))
+            .collect();
+        let library = polynomial(&names, outline.degree);
+        let centred = polynomial(&about, outline.degree);
+        let said: Vec<String> = written
+            .iter()
+            .map(|(o, p, d)| {
+                format!(
+                    "`{}` (its mean {} spreads from 0) as {d} = {} - {p}, {p} = {}",
+                    o.name,
+                    crate::output::sig(o.spreads, 2),
+                    o.name,
+                    o.reference
+                )
+            })
+            .collect();
+        let note = format!(
+            "the candidates are written about reference values: {}; far from 0 a variable's powers and products move with the lower terms (its square with itself and the constant) and the fit cannot tell them apart",
+            said.join("; ")
+        );
+        let mut model = self.edit(|file| {
+            for (o, parameter, derived) in &written {
+                let unit = file.states.iter().find(|s| s.name == o.name).map(|s| s.unit.clone());
+                let unit =
+                    unit.or_else(|| file.inputs.iter().find(|i| i.name == o.name).map(|i| i.unit.clone()));
+                file.parameters.insert(
+                    parameter.clone(),
+                    ParameterSpec {
+                        value: o.reference,
+                        unit: unit.unwrap_or_default(),
+                        per_run: None,
+                        free: false,
+                        prior: None,
+                        bounds: None,
+                        std_error: None,
+                        nuisance: None,
+                        medium: false,
+                    },
+                );
+                file.derived.push(DerivedSpec {
+                    name: derived.clone(),
+                    definition: format!("{} - {parameter}", o.name),
+                });
+            }
+            for equation in file.equations.values_mut() {
+                if equation.candidates == library {
+                    equation.candidates = centred.clone();
+                }
+            }
+            file.model.provenance =
+                format!("every monomial of {} to degree {}", about.join(", "), outline.degree);
+            file.model.notes.push(note.clone());
+        })?;
+        model.outline = None;
+        Ok(Some((model, note)))
     }
 }
 
@@ -212,5 +371,70 @@ mod tests {
             e.contains("candidate `x*q`") && e.contains('^') && e.contains("unknown variable `q`"),
             "{e}"
         );
+    }
+
+    /// A run of Lorenz-like columns: x and y about 0, z about `z0` with spread about 1.
+    fn run(z0: f64, names: [&str; 3]) -> Frame {
+        let t: Vec<f64> = (0..400).map(|k| k as f64 * 0.01).collect();
+        let mut f = Frame::new("run", "t", t.clone()).unwrap();
+        f.push(names[0], t.iter().map(|t| (3.0 * t).sin()).collect()).unwrap();
+        f.push(names[1], t.iter().map(|t| (2.0 * t).cos()).collect()).unwrap();
+        f.push(names[2], t.iter().map(|t| z0 + 1.4 * (1.3 * t).sin()).collect()).unwrap();
+        f
+    }
+
+    /// A state far from 0 (z about 302, spread 1) is written about a round reference value,
+    /// as the paper's Δu: a parameter `z0` = 300, a derived `Δz = z - z0`, every monomial of
+    /// z in its equations' candidates one of Δz (the same count, the same order), the model
+    /// re-parses, and a second call changes nothing. Close to 0 (z about 3), with named
+    /// candidates, or for a model file not made from columns, nothing is written anew.
+    #[test]
+    fn a_state_far_from_zero_is_written_about_a_reference_value() {
+        let model = lorenz().model("--states x,y,z").unwrap();
+        let (about, note) = model.about_references(&[run(302.3, ["x", "y", "z"])]).unwrap().unwrap();
+        assert!(note.contains("`z`") && note.contains("Δz = z - z0, z0 = 300"), "{note}");
+        assert_eq!(about.parameter_values()["z0"], 300.0);
+        let derived = &about.spec().derived;
+        assert_eq!((derived[0].name.as_str(), derived[0].definition.as_str()), ("Δz", "z - z0"));
+        let candidates = &about.equation("y_dot").unwrap().candidates;
+        let texts: Vec<String> = candidates.iter().map(|c| c.to_string()).collect();
+        assert_eq!(texts, ["1", "x", "y", "Δz", "x^2", "x*y", "x*Δz", "y^2", "y*Δz", "Δz^2"]);
+        assert!(about.spec().model.provenance.contains("x, y, Δz to degree 2"));
+        assert!(about.about_references(&[run(302.3, ["x", "y", "z"])]).unwrap().is_none());
+        Model::parse(&about.to_toml(), "again.toml").unwrap();
+        // the reference rounds to the decade above the spread: 0.014 → 0.1
+        let fine = Frame::new("run", "t", vec![0.0, 1.0, 2.0, 3.0]).unwrap();
+        let mut fine = fine;
+        for (name, v) in [("x", [0.0, 1.0, 0.0, -1.0]), ("y", [1.0, 0.0, -1.0, 0.0])] {
+            fine.push(name, v.to_vec()).unwrap();
+        }
+        fine.push("z", vec![-7.23, -7.25, -7.24, -7.22]).unwrap();
+        let (fine, _) = model.about_references(&[fine]).unwrap().unwrap();
+        assert_eq!(fine.parameter_values()["z0"], -7.2);
+        // nothing to write anew
+        assert!(model.about_references(&[run(3.0, ["x", "y", "z"])]).unwrap().is_none());
+        let named = Outline { candidates: vec!["x".into(), "z".into()], ..lorenz() }.model("x").unwrap();
+        assert!(named.about_references(&[run(302.3, ["x", "y", "z"])]).unwrap().is_none());
+        let read = Model::parse(&model.to_toml(), "lorenz.toml").unwrap();
+        assert!(read.about_references(&[run(302.3, ["x", "y", "z"])]).unwrap().is_none());
+        // the outline is carried through edits and can be given back (a pickled model)
+        let edited = model.starting_as(&run(302.3, ["x", "y", "z"])).unwrap();
+        assert!(edited.outline().is_some());
+        assert!(read
+            .with_outline(lorenz())
+            .about_references(&[run(302.3, ["x", "y", "z"])])
+            .unwrap()
+            .is_some());
+    }
+
+    /// The names a reference value takes give way to the model's own: a state called `z0`
+    /// makes the parameter `z_0`.
+    #[test]
+    fn reference_names_give_way_to_the_models_own() {
+        let outline = Outline { states: vec!["x".into(), "z0".into(), "z".into()], ..lorenz() };
+        let model = outline.model("--states x,z0,z").unwrap();
+        let (about, _) = model.about_references(&[run(302.3, ["x", "z0", "z"])]).unwrap().unwrap();
+        assert_eq!(about.parameter_values()["z_0"], 300.0);
+        assert_eq!(about.spec().derived[0].definition, "z - z_0");
     }
 }

@@ -209,6 +209,25 @@ pub fn identify(
             )));
         }
     }
+    // a model made from columns of variables far from 0: its library about reference values,
+    // decided once on the runs as recorded, so that every start and configuration has it
+    let about = model.about_references(frames).map_err(|e| RecipeError::Setup(e.to_string()))?;
+    let centred_settings;
+    let (model, settings) = match &about {
+        Some((centred, _)) => {
+            let choose = settings
+                .choose
+                .iter()
+                .map(|(name, m)| {
+                    Ok((name.clone(), m.about_references(frames)?.map_or_else(|| m.clone(), |(c, _)| c)))
+                })
+                .collect::<Result<Vec<_>, crate::model::ModelError>>()
+                .map_err(|e| RecipeError::Setup(e.to_string()))?;
+            centred_settings = RecipeSettings { choose, ..settings.clone() };
+            (centred, &centred_settings)
+        }
+        None => (model, settings),
+    };
     let mut starts = Vec::new();
     let mut failed = Vec::new();
     // the starts are independent: side by side, they fill the cores the per-run work leaves idle
@@ -219,7 +238,12 @@ pub fn identify(
         .collect();
     for (method, result) in settings.derivatives.iter().zip(results) {
         match result {
-            Ok(s) => starts.push(s),
+            Ok(mut s) => {
+                for (_, fit) in &mut s.fits {
+                    fit.selection.notes.extend(about.as_ref().map(|(_, note)| note.clone()));
+                }
+                starts.push(s)
+            }
             Err(e) if settings.derivatives.len() > 1 => failed.push((method.clone(), e.to_string())),
             Err(e) => return Err(e),
         }

@@ -1717,6 +1717,115 @@ fn a_long_file_of_several_runs_is_read_by_its_label() {
     assert!(!ok && err.contains("[vessel=2]: row 8, column `x`"), "{err}");
 }
 
+/// Right by default far from 0: a temperature in kelvin read to 0.01 K, dT/dt =
+/// −0.5 (T − 300) + 2 P(t), and Lorenz with z read from 10 000 below its zero. Over every
+/// monomial of T and P, T, T² and 1 are collinear (T sits some 170 spreads from 0): the fit
+/// kept T² and traded it against T and 1 (in one such run −0.517 T + 152.6 + 2.9e-5 T²); `--states` writes
+/// the library about a round reference value, as the paper's Δu = u − u₀ (a parameter T0 = 300,
+/// a derived ΔT = T − T0), says so, and comes back with the system's two terms; the file
+/// re-simulates the run. Named candidates stay as written. Lorenz's terms come back about z's
+/// reference z0 (Lorenz's constants moved by z0 − 10⁴: dy/dt = (28 − (z0 − 10⁴))·x − y − x·Δz).
+#[test]
+fn a_system_far_from_zero_is_identified_about_a_reference_value() {
+    use crate::common::{json, trajectory, Scratch};
+    let dir = Scratch::new("generic-offset");
+    let power = |t: f64| (0.7 * t).sin() + 0.6 * (1.9 * t + 0.5).sin();
+    let mut text = String::from("t,T,P\n");
+    let run = trajectory(&[301.0], 0.02, 3_000, 10, |t, x| vec![-0.5 * (x[0] - 300.0) + 2.0 * power(t)]);
+    let mut noise = crate::common::Lcg(5);
+    for (i, r) in run.iter().enumerate() {
+        let t = i as f64 * 0.02;
+        text += &format!("{t},{},{}\n", r[0] + 0.01 * noise.normal(), power(t));
+    }
+    std::fs::write(dir.join("run.csv"), text).unwrap();
+    let p = |f: &str| dir.join(f).display().to_string();
+    let (data, out) = (p("run.csv"), p("m.toml"));
+    let (ok, report, err) = termid(&[
+        "identify", "--data", &data, "--states", "T", "--inputs", "P", "--degree", "2", "--out", &out,
+        "--format", "json",
+    ]);
+    assert!(ok, "{err}");
+    let notes = json(&report)["T_dot"]["notes"].to_string();
+    assert!(
+        notes.contains("written about reference values") && notes.contains("ΔT = T - T0, T0 = 300"),
+        "{notes}"
+    );
+    let model = termid::model::Model::load(std::path::Path::new(&out)).unwrap();
+    assert_eq!(model.parameter_values()["T0"], 300.0);
+    let chosen = |model: &termid::model::Model, equation: &str| -> BTreeMap<String, f64> {
+        let e = model.equation(equation).unwrap();
+        e.coefficients
+            .iter()
+            .map(|(t, c, _)| (t.to_string(), *c))
+            .chain(e.intercept.map(|b| ("1".into(), b)))
+            .collect()
+    };
+    let found = chosen(&model, "T_dot");
+    assert_eq!(found.keys().collect::<Vec<_>>(), ["P", "ΔT"], "{found:?}");
+    assert!((found["ΔT"] + 0.5).abs() < 1e-3 && (found["P"] - 2.0).abs() < 4e-3, "{found:?}");
+    let (ok, text, err) = termid(&["validate", "--model", &out, "--data", &data, "--format", "json"]);
+    assert!(ok, "{err}");
+    let rms = json(&text)["gap"]["states"][0][2].as_f64().unwrap();
+    assert!(rms < 0.02, "{text}");
+    let (ok, report, err) = termid(&[
+        "identify",
+        "--data",
+        &data,
+        "--states",
+        "T",
+        "--inputs",
+        "P",
+        "--terms",
+        "1,T,P,T^2,T*P,P^2",
+        "--format",
+        "json",
+    ]);
+    assert!(ok, "{err}");
+    let listed = json(&report)["T_dot"]["candidates"].to_string();
+    assert!(listed.contains("\"T^2\"") && !listed.contains('Δ'), "{listed}");
+    // Lorenz with z from 10 000 below its zero
+    let rows = lorenz_rows(&dir, "0.001");
+    let body: Vec<String> = rows
+        .iter()
+        .step_by(10)
+        .map(|r| format!("{:?},{:?},{:?},{:?}", r[0], r[1], r[2], r[3] + 1e4))
+        .collect();
+    std::fs::write(dir.join("lorenz.csv"), format!("t,x,y,z\n{}\n", body.join("\n"))).unwrap();
+    let lorenz = p("lorenz.toml");
+    let (ok, _, err) = termid(&[
+        "identify",
+        "--data",
+        &p("lorenz.csv"),
+        "--states",
+        "x,y,z",
+        "--degree",
+        "2",
+        "--out",
+        &lorenz,
+    ]);
+    assert!(ok, "{err}");
+    let model = termid::model::Model::load(std::path::Path::new(&lorenz)).unwrap();
+    let moved = model.parameter_values()["z0"] - 1e4;
+    let truth: [(&str, Vec<(&str, f64)>); 3] = [
+        ("x_dot", vec![("x", -10.0), ("y", 10.0)]),
+        ("y_dot", vec![("x", 28.0 - moved), ("x*Δz", -1.0), ("y", -1.0)]),
+        ("z_dot", vec![("1", -8.0 / 3.0 * moved), ("x*y", 1.0), ("Δz", -8.0 / 3.0)]),
+    ];
+    for (equation, want) in truth {
+        let found = chosen(&model, equation);
+        let names: Vec<&str> = found.keys().map(String::as_str).collect();
+        let wanted: Vec<&str> = want.iter().map(|w| w.0).collect();
+        assert_eq!(names, wanted, "{equation}: {found:?}");
+        for (term, c) in want {
+            assert!(
+                (found[term] - c).abs() <= 1e-3 * c.abs().max(1.0),
+                "{equation} {term}: {} vs {c}",
+                found[term]
+            );
+        }
+    }
+}
+
 /// `identify --states` identifies every state's rate of a system nobody wrote a model file
 /// for, from its columns alone (the polynomial library to --degree over the states and every
 /// other column as an input, said), and writes a model file that starts where the run starts

@@ -286,8 +286,9 @@ pub struct IdentifyCommand {
     #[arg(long, num_args = 0.., value_delimiter = ',', requires = "states")]
     pub inputs: Option<Vec<String>>,
     /// With --states and no candidates named: the degree of the polynomial library (every
-    /// monomial of the states and inputs, the constant among them). Default 3, the ODE
-    /// benchmark's (benches/odes).
+    /// monomial of the states and inputs, the constant among them; a variable the runs hold
+    /// more than 30 spreads from 0 written about a round reference value, ΔT = T - T0, said).
+    /// Default 3, the ODE benchmark's (benches/odes).
     #[arg(long, requires = "states")]
     pub degree: Option<u32>,
     /// With --model or --states: the equation(s) to identify (default: all that are

@@ -180,6 +180,19 @@ pub fn identify_in_pieces(cmd: &IdentifyCommand, model: &termid::model::Model, r
     let reach = diff.reach().context("a derivative of fixed reach")?;
     let names: Vec<String> =
         if cmd.equation.is_empty() { model.identifiable() } else { cmd.equation.clone() };
+    // a model made from columns of variables far from 0: its library about reference values
+    // read from the first piece (a mean within a few spreads serves, and a whole pass would
+    // read the files twice)
+    let about = match (model.outline(), cmd.data.first()) {
+        (Some(_), Some(first)) => {
+            match termid::data::Chunks::open(first, &model.spec().model.time, rows.max(1), 0)?.next() {
+                Some(piece) => model.about_references(&[piece?.frame])?,
+                None => None,
+            }
+        }
+        _ => None,
+    };
+    let model = about.as_ref().map_or(model, |(m, _)| m);
     let runs = cmd
         .data
         .iter()
@@ -199,12 +212,16 @@ pub fn identify_in_pieces(cmd: &IdentifyCommand, model: &termid::model::Model, r
         parts,
         crate::identify::intercept_of(cmd, model.spec().model.intercept),
     )?;
+    let mut fits = identified.fits;
+    for (_, fit) in &mut fits {
+        fit.selection.notes.extend(about.as_ref().map(|(_, note)| note.clone()));
+    }
     let checks =
         termid::plugins::of(&identified.model).map(|p| p.checks(&identified.model, &[])).unwrap_or_default();
     Ok(Start {
         derivative: cmd.derivative.clone(),
         model: identified.model,
-        fits: identified.fits,
+        fits,
         chosen_text: None,
         refined: None,
         rejected: None,
