@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import errno
 import functools
+import inspect
 import json
 import math
 import os
@@ -177,12 +178,21 @@ class _Columns(Dict[str, np.ndarray]):
 
 
 def _runs_told_apart(method: Any) -> Any:
-    """A method on runs whose error is a frame's time that starts again (runs one after
-    another in one frame) says how to hand them over: a list, or grouped by the frame's label
-    column (its first column that holds no numbers)."""
+    """A method on runs takes them as :func:`fit` does: ``by="run"`` names the column that
+    tells the runs of one table apart (its ``runs``, and a recipe's ``held_out``). Its error
+    on a frame's time that starts again (runs one after another in one frame) says how to
+    hand them over: a list, grouped, or ``by`` the frame's label column (its first column that
+    holds no numbers)."""
+    signature = inspect.signature(method)
 
     @functools.wraps(method)
-    def told(*args: Any, **kwargs: Any) -> Any:
+    def told(*args: Any, by: Optional[str] = None, **kwargs: Any) -> Any:
+        if by is not None:
+            bound = signature.bind_partial(*args, **kwargs)
+            for name in ("runs", "held_out"):
+                if bound.arguments.get(name) is not None and (name == "runs" or isinstance(bound.arguments[name], pd.DataFrame)):
+                    bound.arguments[name] = _split_by(bound.arguments[name], by)
+            args, kwargs = bound.args, bound.kwargs
         try:
             return method(*args, **kwargs)
         except TermidError as e:
@@ -191,9 +201,23 @@ def _runs_told_apart(method: Any) -> Any:
             frames = [a for a in (*args, *kwargs.values()) if isinstance(a, pd.DataFrame)]
             label = next((str(c) for f in frames for c in f.columns if not pd.api.types.is_numeric_dtype(f[c])), "run")
             raise TermidError(
-                f"{e}: give them as a list of runs, or grouped by the column that names each row's run, df.groupby('{label}')"
+                f"{e}: give them as a list of runs, grouped by the column that names each row's run, "
+                f"df.groupby('{label}'), or by='{label}'"
             ) from None
 
+    # `by` shown in the method's signature, before its keywords of any name
+    parameters = list(signature.parameters.values())
+    at = next((k for k, p in enumerate(parameters) if p.kind is inspect.Parameter.VAR_KEYWORD), len(parameters))
+    parameters.insert(at, inspect.Parameter("by", inspect.Parameter.KEYWORD_ONLY, default=None, annotation="Optional[str]"))
+    told.__signature__ = signature.replace(parameters=parameters)  # type: ignore[attr-defined]
+    said = "``by``: the column that tells apart the runs of one table (as for :func:`fit`)."
+    doc = method.__doc__ or ""
+    example = re.search(r"^( *)>>>", doc, re.M)
+    told.__doc__ = (
+        doc[: example.start()] + f"{example.group(1)}{said}\n\n" + doc[example.start() :]
+        if example
+        else f"{doc}\n\n{said}"
+    )
     return told
 
 
@@ -919,34 +943,41 @@ def _is_record(inputs: Any) -> bool:
     return isinstance(inputs, Mapping) and any(np.ndim(v) > 0 for v in inputs.values())
 
 
+def _split_by(data: Any, by: str) -> DataFrameGroupBy:
+    """The rows of ``data`` (a DataFrame, a dict of arrays, a table) grouped by the values of
+    column ``by``, each a run, in the order they first appear (as the command line's
+    ``--by``); a row that names no run is refused."""
+    if _grouped(data) is not None:
+        raise TypeError("`by` tells apart the runs of one DataFrame; the grouping has told them apart already")
+    if isinstance(data, pd.DataFrame):
+        frame = data
+    elif isinstance(data, Mapping):
+        frame = pd.DataFrame(dict(data))
+    elif hasattr(data, "to_pandas"):
+        frame = data.to_pandas()
+    else:
+        raise TypeError(f"`by` tells apart the runs of a DataFrame, a dict of arrays or a table, not {type(data).__name__}")
+    if by not in frame.columns:
+        raise TermidError(f"no column `{by}` to tell the runs apart (columns: {', '.join(map(str, frame.columns))})")
+    blank = np.flatnonzero(frame[by].isna().to_numpy())
+    if len(blank):
+        # as the command line's --by: a row that names no run belongs to none
+        raise TermidError(
+            f"row {blank[0] + 1} (index {frame.index[blank[0]]!r}), column `{by}`: no label, so no run to put "
+            f"the row in (every row of a table of several runs names its run; {len(blank)} rows so): drop or label them"
+        )
+    return frame.groupby(by, sort=False)
+
+
 def _fit_runs(data: Union[Data, Sequence[Data]], by: Optional[str]) -> List[Tuple[str, Data]]:
     """The runs of :func:`fit`'s ``data`` by name: one run (``data``), a list of runs (each
     DataFrame's ``attrs["name"]``, else ``run1``, ...), or the rows of each value of column
     ``by`` (``run=3``), in the order they first appear, or a pandas grouping's groups."""
+    if by is not None:
+        return _grouped(_split_by(data, by)) or []
     grouped = _grouped(data)
     if grouped is not None:
-        if by is not None:
-            raise TypeError("`by` tells apart the runs of one DataFrame; the grouping has told them apart already")
         return grouped
-    if by is not None:
-        if isinstance(data, pd.DataFrame):
-            frame = data
-        elif isinstance(data, Mapping):
-            frame = pd.DataFrame(dict(data))
-        elif hasattr(data, "to_pandas"):
-            frame = data.to_pandas()
-        else:
-            raise TypeError(f"`by` tells apart the runs of a DataFrame, a dict of arrays or a table, not {type(data).__name__}")
-        if by not in frame.columns:
-            raise TermidError(f"no column `{by}` to tell the runs apart (columns: {', '.join(map(str, frame.columns))})")
-        blank = np.flatnonzero(frame[by].isna().to_numpy())
-        if len(blank):
-            # as the command line's --by: a row that names no run belongs to none
-            raise TermidError(
-                f"row {blank[0] + 1} (index {frame.index[blank[0]]!r}), column `{by}`: no label, so no run to put "
-                f"the row in (every row of a table of several runs names its run; {len(blank)} rows so): drop or label them"
-            )
-        return _grouped(frame.groupby(by, sort=False)) or []
     if isinstance(data, (list, tuple)):
         if not data:
             raise TermidError("no runs to fit: the list is empty")

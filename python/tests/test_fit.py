@@ -1,4 +1,5 @@
 """One equation from columns: termid.fit against published numbers and closed forms."""
+import inspect
 import os
 import warnings
 
@@ -313,6 +314,13 @@ def test_several_runs_are_fitted_together_never_across_their_seams():
     assert dict(zip(found["term"], found["value"].round(6))) == {"x": -4.0, "v": -0.3}
     gaps = model.identify(long.groupby("experiment")).model.validate(long.groupby("experiment"))
     assert sorted(gaps.index.get_level_values("run").unique()) == ["experiment=a", "experiment=b", "experiment=c"]
+    # or told apart by their column, `by=`, as for fit (a model's every method on runs)
+    found = model.identify(long, by="experiment").model
+    assert dict(zip(found.coefficients("v_dot")["term"], found.coefficients("v_dot")["value"].round(6))) == truth
+    assert found.validate(long, by="experiment").equals(gaps)
+    assert "by" in str(inspect.signature(termid.Model.recipe))
+    with pytest.raises(termid.TermidError, match="no column `vessel` to tell the runs apart"):
+        model.identify(long, by="vessel")
     # two runs logged in turn, their time increasing throughout, would read as one run whose
     # readings leap at every row: refused, the label column named
     turns = pd.concat([runs[0], runs[1].assign(t=runs[1].t + 0.005)]).sort_values("t", ignore_index=True)
@@ -320,7 +328,7 @@ def test_several_runs_are_fitted_together_never_across_their_seams():
         termid.fit(turns, "dv/dt", ["x", "v"])
     assert termid.fit(turns.groupby("experiment"), "dv/dt", ["x", "v", "x^2"]).coefficients.sort_index().round(6).to_dict() == truth
     for method in (model.identify, model.validate):
-        with pytest.raises(termid.TermidError, match=r"row 1501.*df.groupby\('experiment'\)"):
+        with pytest.raises(termid.TermidError, match=r"row 1501.*df.groupby\('experiment'\), or by='experiment'"):
             method(long)
     # a run without a column the first has is refused by name
     with pytest.raises(termid.TermidError, match="run `run2` has other columns than `run1`: without `v`"):
