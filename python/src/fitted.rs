@@ -289,10 +289,8 @@ pub(crate) fn fit(
                 }
                 pieces.extend(cut);
             }
-            // every column but the state may be an input held between samples
-            let columns: Vec<&str> = variables.iter().map(String::as_str).filter(|n| n != state).collect();
             let all: Vec<&str> = variables.iter().map(String::as_str).collect();
-            let mut frames = Vec::new();
+            let mut despiked = Vec::new();
             for mut frame in pieces {
                 if !keep_spikes {
                     // a time series whose rate is taken: a glitch would be one (the command
@@ -304,20 +302,14 @@ pub(crate) fn fit(
                         }
                     }
                 }
-                for note in termid::data::mark_held(&mut frame, &columns, &all, intersample).map_err(fail)? {
-                    warn(py, note)?;
-                }
-                // any column, the state too, may repeat a slower sensor's readings
-                for note in termid::data::read_at_readings(&mut frame, &all, intersample).map_err(fail)? {
-                    warn(py, note)?;
-                }
-                // the state leaps at one sample and stays (records joined): each piece a run of
-                // its own; another column's leap alone is a step of an input
-                let (cut, notes) = termid::data::cut_at_breaks(frame, &[state], &columns).map_err(fail)?;
-                for note in notes {
-                    warn(py, note)?;
-                }
-                frames.extend(cut);
+                despiked.push(frame);
+            }
+            // every column but the state may be an input held between samples; any column a
+            // slower sensor's readings; the state's leap a cut between runs joined
+            let (mut frames, notes) =
+                termid::data::runs_of_rate(despiked, state, &all, intersample).map_err(fail)?;
+            for note in notes {
+                warn(py, note)?;
             }
             // columns acting later than recorded, read back (after the marking: a held column
             // sample for sample)
@@ -326,7 +318,7 @@ pub(crate) fn fit(
                     *frame = termid::data::delayed(frame, name, *seconds, 0.0).map_err(fail)?;
                 }
             }
-            let others: Vec<String> = columns.iter().map(|c| c.to_string()).collect();
+            let others: Vec<String> = all.iter().filter(|c| **c != state).map(|c| c.to_string()).collect();
             py.detach(|| -> Result<Fit, termid::identify::IdentifyError> {
                 let mut fit = how.fit_design(&rate, design, forced, excluded, &frames, selector.as_ref())?;
                 // rows of a time series are not independent: the honest standard errors' factor

@@ -5,7 +5,30 @@
 
 use super::derivative::Differentiator;
 use super::resample::resample;
-use super::{DataError, Frame};
+use super::{cut_at_breaks, mark_held, read_at_readings, DataError, Frame, Intersample};
+
+/// The runs of one rate, `state`'s, as its fit reads them: every other of `columns` an input
+/// that may be held between samples ([`mark_held`]), any of them (the state too) a slower
+/// sensor's readings, read at them ([`read_at_readings`]), and a run cut where the state leaps
+/// and stays (records joined in one file: [`cut_at_breaks`]; another column's leap alone is a
+/// step of an input). With what was done, a sentence each.
+pub fn runs_of_rate(
+    frames: Vec<Frame>,
+    state: &str,
+    columns: &[&str],
+    intersample: Intersample,
+) -> Result<(Vec<Frame>, Vec<String>), DataError> {
+    let inputs: Vec<&str> = columns.iter().copied().filter(|n| *n != state).collect();
+    let (mut runs, mut notes) = (Vec::new(), Vec::new());
+    for mut frame in frames {
+        notes.extend(mark_held(&mut frame, &inputs, columns, intersample)?);
+        notes.extend(read_at_readings(&mut frame, columns, intersample)?);
+        let (cut, said) = cut_at_breaks(frame, &[state], &inputs)?;
+        notes.extend(said);
+        runs.extend(cut);
+    }
+    Ok((runs, notes))
+}
 
 /// What to do to each run.
 pub struct Preparation<'a> {

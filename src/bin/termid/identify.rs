@@ -113,28 +113,18 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
         crate::runs::mend_spikes(&mut frames)?;
     }
     if let Target::Derivative(state) = &target {
-        // every column but the state whose rate is taken may be an input held between samples;
-        // any column, a slower sensor's readings repeated
+        // every column but the state may be an input held between samples; any column a slower
+        // sensor's readings; the state's leap a cut between runs joined in one file
         let intersample = cmd.intersample.unwrap_or_default();
-        let mut pieces = Vec::new();
-        for mut f in frames {
+        let mut runs = Vec::new();
+        for f in frames {
             let all: Vec<String> = f.names()[1..].to_vec();
             let all: Vec<&str> = all.iter().map(String::as_str).collect();
-            let inputs: Vec<&str> = all.iter().copied().filter(|n| n != state).collect();
-            termid::data::mark_held(&mut f, &inputs, &all, intersample)?
-                .iter()
-                .for_each(|n| crate::runs::say(n));
-            // the state too may repeat a slower sensor's readings
-            termid::data::read_at_readings(&mut f, &all, intersample)?
-                .iter()
-                .for_each(|n| crate::runs::say(n));
-            // the state leaps at one sample and stays (records joined in one file): each piece
-            // a run; another column's leap alone is a step of an input
-            let (cut, notes) = termid::data::cut_at_breaks(f, &[state.as_str()], &inputs)?;
+            let (cut, notes) = termid::data::runs_of_rate(vec![f], state, &all, intersample)?;
             notes.iter().for_each(|n| crate::runs::say(n));
-            pieces.extend(cut);
+            runs.extend(cut);
         }
-        frames = pieces;
+        frames = runs;
     }
     // after the marking: a held column is read back sample for sample
     for d in &cmd.delays {
