@@ -134,26 +134,81 @@ def termid_fit(termid, csv, target, terms_file, states, extra):
     return found_terms(json.loads(out.stdout), states), None
 
 
-def found_terms(fit, states):
+def found_terms(fit, states, about=None, tol=0.0):
     """One equation's fit report as its nonzero coefficients by canonical term, an intercept
-    as the constant's."""
-    found = {canonical(t["term"], states): t["coefficient"] for t in fit["terms"]}
+    as the constant's. `about` maps a derived name to (state, reference) where termid wrote
+    its library about a reference value (`Δz = z - z0`, a state far from 0): such terms are
+    multiplied out into the states' monomials, and a monomial whose contributions cancel to
+    within `tol` of their size is no term."""
+    about = about or {}
+    if not any(name in t["term"] for t in fit["terms"] for name in about):
+        found = {canonical(t["term"], states): t["coefficient"] for t in fit["terms"]}
+        if fit.get("intercept") is not None:
+            found[canonical("1", states)] = found.get(canonical("1", states), 0.0) + fit["intercept"]
+        return {k: v for k, v in found.items() if v != 0.0}
+    total, size = {}, {}
+
+    def add(exps, c):
+        key = ("monomial", tuple(exps))
+        total[key] = total.get(key, 0.0) + c
+        size[key] = size.get(key, 0.0) + abs(c)
+
+    terms = [(t["term"], t["coefficient"]) for t in fit["terms"]]
     if fit.get("intercept") is not None:
-        found[canonical("1", states)] = found.get(canonical("1", states), 0.0) + fit["intercept"]
-    return {k: v for k, v in found.items() if v != 0.0}
+        terms.append(("1", fit["intercept"]))
+    for term, c in terms:
+        # the term as a polynomial {exponents: coefficient}, factor by factor
+        poly = {tuple([0] * len(states)): c}
+        for factor in ([] if term == "1" else term.split("*")):
+            name, _, power = factor.partition("^")
+            k = int(power or 1)
+            state, shift = about.get(name, (name, 0.0))
+            i = states.index(state)
+            # (s - shift)^k = Σ C(k, j) s^j (−shift)^(k−j)
+            nxt = {}
+            for exps, value in poly.items():
+                for j in range(k + 1):
+                    e = list(exps)
+                    e[i] += j
+                    nxt[tuple(e)] = nxt.get(tuple(e), 0.0) + value * math.comb(k, j) * (-shift) ** (k - j)
+            poly = nxt
+        for exps, value in poly.items():
+            add(exps, value)
+    return {k: v for k, v in total.items() if abs(v) > tol * size[k]}
 
 
-def termid_whole(termid, csv, states, terms_file, exact, extra):
+def references(model_path):
+    """The derived names termid wrote a library about (`Δz = z - z0`): {name: (state, z0)}."""
+    spec = tomllib.loads(model_path.read_text())
+    values = {n: p["value"] for n, p in spec.get("parameters", {}).items()}
+    out = {}
+    for d in spec.get("derived", []):
+        state, _, ref = (part.strip() for part in d["definition"].partition(" - "))
+        if ref in values:
+            out[d["name"]] = (state, values[ref])
+    return out
+
+
+def termid_whole(termid, csv, states, terms_file, exact, extra, tol):
     """Every equation at once, as a user without a model file would: `identify --states`,
     its default library (the polynomial to degree 3) unless the system needs more (the
-    pendulum's sin and cos: its library file)."""
+    pendulum's sin and cos: its library file). A library written about a state's reference
+    value is multiplied out (`found_terms`)."""
+    model = csv.with_suffix(".identified.toml")
     args = [termid, "identify", "--data", str(csv), "--states", ",".join(states), "--inputs", "--format", "json"]
     args += ["--terms-file", str(terms_file)] if terms_file else []
+    args += ["--out", str(model), "--keep-unphysical"]
+    model.unlink(missing_ok=True)
     out = subprocess.run(args + ([] if exact else extra), capture_output=True, text=True)
-    if out.returncode != 0:
-        return None, out.stderr.strip().splitlines()[-1] if out.stderr.strip() else "failed"
+    failed = out.stderr.strip().splitlines()[-1] if out.stderr.strip() else "failed"
+    if out.returncode != 0 and "fails its checks" not in out.stderr:
+        return None, failed
+    if "fails its checks" in out.stderr:
+        # refused (it was written, --keep-unphysical, to read its references): a failure
+        return None, next((l for l in out.stderr.splitlines() if "FAIL" in l), failed)
     report = json.loads(out.stdout)
-    return {s: found_terms(report[f"{s}_dot"], states) for s in states}, None
+    about = references(model) if model.exists() else {}
+    return {s: found_terms(report[f"{s}_dot"], states, about, tol) for s in states}, None
 
 
 def pysindy_fit(system, t, u, rates):
@@ -222,7 +277,7 @@ def main():
             if args.whole:
                 library = folder / "library.txt" if sys_.trig else None
                 whole, whole_err = termid_whole(
-                    args.termid, folder / f"{mode}.csv", sys_.states, library, mode == "exact", extra
+                    args.termid, folder / f"{mode}.csv", sys_.states, library, mode == "exact", extra, tol
                 )
             for s in sys_.states:
                 target = f"{s}_dot" if mode == "exact" else f"d{s}/dt"

@@ -1249,7 +1249,7 @@ class Model:
         it. ``inputs`` are the columns that drive the states (a force, a setpoint), known from
         the runs. :meth:`identify` (and :meth:`recipe`) starts the identified model's states where the
         first run starts, so that :meth:`simulate` retraces that run's beginning; :meth:`save` writes it.
-        A state or input the runs hold more than 30 spreads from 0 (a temperature in kelvin) is
+        A state or input the runs hold more than 10 spreads from 0 (a temperature in kelvin) is
         written about a round reference value in the library, as the paper's Δu = u - u0: a
         parameter ``T0``, a derived ``ΔT = T - T0`` and the monomials of ``ΔT`` (a note says so).
 

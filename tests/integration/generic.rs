@@ -1723,7 +1723,8 @@ fn a_long_file_of_several_runs_is_read_by_its_label() {
 /// kept T² and traded it against T and 1 (in one such run −0.517 T + 152.6 + 2.9e-5 T²); `--states` writes
 /// the library about a round reference value, as the paper's Δu = u − u₀ (a parameter T0 = 300,
 /// a derived ΔT = T − T0), says so, and comes back with the system's two terms; the file
-/// re-simulates the run. Named candidates stay as written. Lorenz's terms come back about z's
+/// re-simulates the run. Named candidates stay as written. Two runs at ambients of 300 and 350 K
+/// (13 spreads from 0) come back as −0.5 ΔT + 0.5 ΔTa + 2 P. Lorenz's terms come back about z's
 /// reference z0 (Lorenz's constants moved by z0 − 10⁴: dy/dt = (28 − (z0 − 10⁴))·x − y − x·Δz).
 #[test]
 fn a_system_far_from_zero_is_identified_about_a_reference_value() {
@@ -1783,6 +1784,43 @@ fn a_system_far_from_zero_is_identified_about_a_reference_value() {
     assert!(ok, "{err}");
     let listed = json(&report)["T_dot"]["candidates"].to_string();
     assert!(listed.contains("\"T^2\"") && !listed.contains('Δ'), "{listed}");
+    // two runs at ambients Ta of 300 and 350 K, dT/dt = −0.5 (T − Ta) + 2 P: T and Ta sit 13
+    // spreads from 0 (the library of them kept six terms for three)
+    let mut runs = Vec::new();
+    for (k, ambient) in [300.0, 350.0].into_iter().enumerate() {
+        let run = trajectory(&[ambient + 1.0], 0.02, 3_000, 10, |t, x| {
+            vec![-0.5 * (x[0] - ambient) + 2.0 * power(t)]
+        });
+        let mut text = String::from("t,T,P,Ta\n");
+        for (i, r) in run.iter().enumerate() {
+            let t = i as f64 * 0.02;
+            text += &format!("{t},{},{},{ambient}\n", r[0] + 0.01 * noise.normal(), power(t));
+        }
+        let path = p(&format!("ambient{k}.csv"));
+        std::fs::write(&path, text).unwrap();
+        runs.push(path);
+    }
+    let ambient = p("ambient.toml");
+    let (ok, _, err) = termid(&[
+        "identify", "--data", &runs[0], &runs[1], "--states", "T", "--inputs", "P,Ta", "--degree", "2",
+        "--out", &ambient,
+    ]);
+    assert!(ok, "{err}");
+    let model = termid::model::Model::load(std::path::Path::new(&ambient)).unwrap();
+    let found = chosen(&model, "T_dot");
+    let (t0, ta0) = (model.parameter_values()["T0"], model.parameter_values()["Ta0"]);
+    // −0.5 (ΔT + T0) + 0.5 (ΔTa + Ta0) + 2 P: a constant only where the references differ
+    let mut want = vec![("P", 2.0), ("ΔT", -0.5), ("ΔTa", 0.5)];
+    if t0 != ta0 {
+        want.insert(0, ("1", 0.5 * (ta0 - t0)));
+    }
+    assert_eq!(
+        found.keys().map(String::as_str).collect::<Vec<_>>(),
+        want.iter().map(|w| w.0).collect::<Vec<_>>()
+    );
+    for (term, c) in want {
+        assert!((found[term] - c).abs() <= 2e-3 * c.abs(), "{term}: {found:?}");
+    }
     // Lorenz with z from 10 000 below its zero
     let rows = lorenz_rows(&dir, "0.001");
     let body: Vec<String> = rows

@@ -287,7 +287,7 @@ pub struct IdentifyCommand {
     pub inputs: Option<Vec<String>>,
     /// With --states and no candidates named: the degree of the polynomial library (every
     /// monomial of the states and inputs, the constant among them; a variable the runs hold
-    /// more than 30 spreads from 0 written about a round reference value, ΔT = T - T0, said).
+    /// more than 10 spreads from 0 written about a round reference value, ΔT = T - T0, said).
     /// Default 3, the ODE benchmark's (benches/odes).
     #[arg(long, requires = "states")]
     pub degree: Option<u32>,
