@@ -241,6 +241,17 @@ impl PyModel {
         Ok(PyModel { inner: model })
     }
 
+    /// The model made from columns with its library written about the runs' reference values
+    /// where they hold a variable far from 0 (`termid::model::Model::about_references`), and
+    /// the sentence that says so; the model as it is where there is nothing to write anew.
+    fn about_references(&self, runs: Vec<Run<'_>>) -> PyResult<(PyModel, Option<String>)> {
+        let frames = self.frames(runs)?;
+        Ok(match self.inner.about_references(&frames).map_err(fail)? {
+            Some((model, note)) => (PyModel { inner: model }, Some(note)),
+            None => (PyModel { inner: self.inner.clone() }, None),
+        })
+    }
+
     /// The outline the model was made from (JSON), while its library may still be written
     /// about the runs' reference values; pickling keeps it.
     fn outline_json(&self) -> PyResult<Option<String>> {
@@ -307,6 +318,14 @@ impl PyModel {
     #[getter]
     fn identifiable(&self) -> Vec<String> {
         self.inner.identifiable()
+    }
+
+    /// An equation's candidate terms, as the file spells them.
+    fn candidates(&self, equation: &str) -> PyResult<Vec<String>> {
+        let e = self.inner.equation(equation).ok_or_else(|| {
+            refuse(format!("no equation `{equation}` (equations: {})", self.equations().join(", ")))
+        })?;
+        Ok(e.candidates.iter().map(|t| t.to_string()).collect())
     }
 
     #[getter]

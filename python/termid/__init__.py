@@ -1451,6 +1451,16 @@ class Model:
         """
         return list(self._native.identifiable)
 
+    def candidates(self, equation: str) -> List[str]:
+        """The candidate terms of ``equation`` that :meth:`identify` selects from.
+
+        Parameters: ``equation`` its name (``x_dot``).
+
+        >>> termid.Model.from_states(["x"], degree=2).candidates("x_dot")
+        ['1', 'x', 'x^2']
+        """
+        return list(self._native.candidates(equation))
+
     @property
     def parameters(self) -> Dict[str, float]:
         """The named parameters and their values.
@@ -1842,6 +1852,32 @@ class Model:
         frame = _frame(exact if truth else measured)
         frame.attrs["name"] = f"{manoeuvre}#{seed}"
         return frame
+
+    @_runs_told_apart
+    def about_references(self, runs: Union[Data, Sequence[Data]], names: Optional[Sequence[str]] = None) -> "Model":
+        """The model made from states (:meth:`from_states`) with its polynomial library written
+        about round reference values where ``runs`` hold a state or input more than 10 spreads
+        from 0 (``T0``, ``ΔT = T - T0``; a note as a warning), as :meth:`identify` and
+        :meth:`recipe` write it by themselves; the model as it is otherwise. For statistics
+        gathered in parts (:meth:`moments` on shards, Dask), which keep the library as it is
+        written: decide it once, on a sample, before the parts are sent out.
+
+        Parameters: ``runs`` the runs (or a sample of them) the references are taken from;
+        ``names`` name the runs.
+
+        >>> import warnings
+        >>> t = np.arange(0.0, 20.0, 0.05)
+        >>> run = pd.DataFrame({"t": t, "T": 300 + np.sin(t), "P": np.cos(t)})
+        >>> with warnings.catch_warnings():
+        ...     warnings.simplefilter("ignore")
+        ...     about = termid.Model.from_states(["T"], ["P"], degree=2).about_references(run)
+        >>> about.parameters, about.candidates("T_dot")[:4]
+        ({'T0': 300.0}, ['1', 'ΔT', 'P', 'ΔT^2'])
+        """
+        native, note = self._native.about_references(_runs(runs, names, self.time))
+        if note is not None:
+            warnings.warn(f"termid: {note}", stacklevel=_outside())
+        return Model(native, self._from_states)
 
     @_runs_told_apart
     def replay(self, runs: Union[Data, Sequence[Data]], *, dt: Optional[float] = None, integrator: Optional[str] = None, with_intercept: bool = False) -> List[pd.DataFrame]:

@@ -938,6 +938,14 @@ def test_a_system_far_from_zero_is_identified_about_a_reference_value():
     assert found.model.parameters == {"T0": 300.0}
     recipe = model.recipe(run)
     assert sorted(recipe.model.coefficients("T_dot")["term"]) == ["P", "ΔT"]
+    # statistics gathered in parts keep the library as written: decided once, on a sample
+    with pytest.warns(UserWarning, match="ΔT = T - T0, T0 = 300"):
+        about = model.about_references(run.iloc[:500])
+    assert about.candidates("T_dot")[:3] == ["1", "ΔT", "P"]
+    parts = [about.moments("T_dot", run.iloc[k : k + 1500]) for k in (0, 1500)]
+    merged = about.identify_from_moments(parts).model.coefficients("T_dot").set_index("term")["value"]
+    assert sorted(merged.index) == ["P", "ΔT"] and merged["ΔT"] == pytest.approx(-0.5, rel=5e-3)
+    assert model.moments("T_dot", run).candidates[:3] == ["1", "T", "P"]
 
 
 _LOTKA_VOLTERRA = """[model]
