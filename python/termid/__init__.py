@@ -1268,6 +1268,8 @@ class Model:
         """
         if isinstance(states, str) or isinstance(inputs, str) or isinstance(terms, str):
             raise TypeError("states, inputs and terms are lists of names (['x', 'y']), not one string")
+        if degree is not None and (isinstance(degree, bool) or int(degree) != degree or degree < 0):
+            raise TermidError(f"Model.from_states: degree {degree!r} is no degree: give a whole number, 1 or more")
         native = _termid.Model.from_states(
             list(states),
             list(inputs),

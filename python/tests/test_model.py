@@ -899,6 +899,9 @@ def test_a_system_from_its_columns():
         termid.Model.from_states("xv")
     with pytest.raises(termid.TermidError, match="the candidates are named"):
         termid.Model.from_states(["x"], terms=["x"], degree=2)
+    for degree in (-1, 2.5, True):
+        with pytest.raises(termid.TermidError, match="is no degree: give a whole number"):
+            termid.Model.from_states(["x"], degree=degree)
 
 
 _THERMAL = """[model]

@@ -687,7 +687,7 @@ impl Identification<'_> {
         if let (Some(window), Target::Derivative(_)) = (self.differentiator.window(), target) {
             // a piece of a run takes the run's windows, however short the piece with its context
             let window = crate::data::Window { shrinks: false, ..window };
-            return self.integral_moments(library, target, frame, window, rows);
+            return self.integral_moments(library, terms, target, frame, window, rows);
         }
         let run = self.bind(library, target, frame)?;
         let offset = rows.start;
@@ -708,7 +708,7 @@ impl Identification<'_> {
         if let (Some(window), Target::Derivative(_)) = (self.differentiator.window(), target) {
             return frames
                 .iter()
-                .map(|f| self.integral_moments(library, target, f, window, 0..f.len()))
+                .map(|f| self.integral_moments(library, terms, target, f, window, 0..f.len()))
                 .collect();
         }
         let runs = frames.iter().map(|f| self.bind(library, target, f)).collect::<Result<Vec<_>, _>>()?;
@@ -722,25 +722,41 @@ impl Identification<'_> {
     fn integral_moments(
         &self,
         library: &Library,
+        terms: &[Term],
         target: &Target,
         frame: &Frame,
         window: crate::data::Window,
         own: std::ops::Range<usize>,
     ) -> Result<Moments, IdentifyError> {
-        let Rows { y, columns: integrals, weights, starts, window } =
+        let Rows { y, columns: integrals, weights, starts: first_rows, window } =
             self.windows(library, target, frame, window)?;
         // the rows of the windows that start on `own` samples (some left out: a switch inside)
-        let starts = starts.partition_point(|s| *s < own.start)..starts.partition_point(|s| *s < own.end);
+        let starts =
+            first_rows.partition_point(|s| *s < own.start)..first_rows.partition_point(|s| *s < own.end);
         let refs: Vec<&[f64]> = integrals.iter().map(|c| &c[starts.clone()]).collect();
         let weights = weights.map(|w| w[starts.clone()].to_vec());
         let mut acc = Accumulator::new(library.len());
-        acc.push_columns(&refs, &y[starts], weights.as_deref());
+        acc.push_columns(&refs, &y[starts.clone()], weights.as_deref());
         if let Some(j) = acc.not_finite() {
-            return Err(IdentifyError::Setup(format!(
-                "{}: the integral of candidate {} over some window is not finite",
-                frame.origin(),
-                j + 1
-            )));
+            // named as a point derivative's row is: the term (or the target) and the row its
+            // window starts on (no such value: the sums overflowed; the largest named)
+            let values = refs.get(j).copied().unwrap_or(&y[starts.clone()]);
+            let i = values.iter().position(|v| !v.is_finite()).unwrap_or_else(|| {
+                (0..values.len()).max_by(|&a, &b| values[a].abs().total_cmp(&values[b].abs())).unwrap_or(0)
+            });
+            let term = match (terms.get(j), target) {
+                (Some(t), _) if j < library.len() => t.to_string(),
+                (None, _) if j < library.len() => format!("{}", j + 1),
+                (_, Target::Derivative(s)) => format!("d{s}/dt"),
+                (_, Target::Column(c)) => c.clone(),
+            };
+            return Err(IdentifyError::NonFinite {
+                file: frame.origin().into(),
+                row: first_rows.get(starts.start + i).map_or(1, |r| r + 1),
+                target: j >= library.len(),
+                term,
+                value: values.get(i).copied().unwrap_or(f64::NAN),
+            });
         }
         Ok(acc.finish().with_overlap(crate::data::row_overlap(window)))
     }
@@ -1262,6 +1278,35 @@ mod tests {
                 IdentifyError::NonFinite { file, row, term, value, target: false } => {
                     assert_eq!((file.as_str(), row, term.as_str()), ("run7.csv", zero_at + 1, "y/x"));
                     assert!(value.is_infinite());
+                }
+                e => panic!("{e}"),
+            }
+            // in the weak form, the row the first window holding it starts on
+            let weak = crate::data::WeakForm::default();
+            let id = Identification {
+                vocabulary: &vocab,
+                parameters: &params,
+                differentiator: &weak,
+                intercept: true,
+                weights: None,
+            };
+            let mut f = Frame::new("run7.csv", "t", t.clone()).unwrap();
+            f.push("x", (0..n).map(|i| if i == zero_at { 0.0 } else { 1.0 + i as f64 }).collect()).unwrap();
+            f.push("y", t.iter().map(|t| t.sin() + 2.0).collect()).unwrap();
+            let err = id
+                .fit(
+                    &Target::Derivative("y".into()),
+                    &terms,
+                    &[],
+                    &[],
+                    &[f],
+                    &crate::select::Stepwise::default(),
+                )
+                .unwrap_err();
+            match err {
+                IdentifyError::NonFinite { file, row, term, target: false, .. } => {
+                    assert_eq!((file.as_str(), term.as_str()), ("run7.csv", "y/x"));
+                    assert!(row <= zero_at + 1 && row + 32 > zero_at, "{row} for {zero_at}");
                 }
                 e => panic!("{e}"),
             }
