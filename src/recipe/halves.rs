@@ -17,18 +17,37 @@ pub(super) const NAME: &str = "the terms hold on each half of the runs";
 /// library's candidates at all.
 const FEWEST_ROWS: usize = 50;
 
+/// How the rows are halved: each run cut in the middle, or, where a run is too short for
+/// that, every other run against the rest (many short runs: each half still holds half of
+/// the rows).
+#[derive(Clone, Copy, PartialEq)]
+enum Halving {
+    EachRun,
+    EveryOtherRun,
+}
+
 /// The check that each equation of `identified` (from `frames` by `how`) chooses its terms
-/// from the first and from the second half of every run too: flagged (not refusing) where a
-/// term is chosen from all the rows but not from both halves. `None` where it cannot apply: a
-/// run too short to halve, or a half that cannot be identified.
+/// from the first and from the second half of every run too (runs too short to halve: from
+/// every other run and from the rest): flagged (not refusing) where a term is chosen from all
+/// the rows but not from both halves. `None` where it cannot apply: a single run too short to
+/// halve, too few rows in a half, or a half that cannot be identified.
 pub fn halves_check(
     identified: &IdentifiedModel,
     frames: &[Frame],
     how: &ModelIdentification<'_>,
 ) -> Option<Check> {
-    if frames.is_empty() || frames.iter().any(|f| f.len() < 2 * FEWEST_ROWS) {
+    let halving = if frames.is_empty() {
         return None;
-    }
+    } else if frames.iter().all(|f| f.len() >= 2 * FEWEST_ROWS) {
+        Halving::EachRun
+    } else {
+        // every run a half's worth of rows at least: FEWEST_ROWS in each of both
+        let rows = |parity: usize| frames.iter().skip(parity).step_by(2).map(Frame::len).sum::<usize>();
+        if frames.len() < 2 || rows(0) < 2 * FEWEST_ROWS || rows(1) < 2 * FEWEST_ROWS {
+            return None;
+        }
+        Halving::EveryOtherRun
+    };
     let model: &Model = &identified.model;
     let kept = windows_kept(how.differentiator, frames);
     let how = ModelIdentification {
@@ -39,17 +58,20 @@ pub fn halves_check(
     };
     let how = &how;
     let half = |second: bool| -> Option<IdentifiedModel> {
-        let cut: Vec<Frame> = frames
-            .iter()
-            .map(|f| {
-                let middle = f.len() / 2;
-                if second {
-                    f.slice(middle..f.len())
-                } else {
-                    f.slice(0..middle)
-                }
-            })
-            .collect();
+        let cut: Vec<Frame> = match halving {
+            Halving::EachRun => frames
+                .iter()
+                .map(|f| {
+                    let middle = f.len() / 2;
+                    if second {
+                        f.slice(middle..f.len())
+                    } else {
+                        f.slice(0..middle)
+                    }
+                })
+                .collect(),
+            Halving::EveryOtherRun => frames.iter().skip(usize::from(second)).step_by(2).cloned().collect(),
+        };
         identify_model(model, &cut, how, &mut |_| {}).ok()
     };
     // side by side: each half is one run's worth of work per run, which leaves a core idle
@@ -76,14 +98,21 @@ pub fn halves_check(
             unsteady.push(format!("`{name}`: {}", lost.join(", ")));
         }
     }
+    let halves = match halving {
+        Halving::EachRun => "the first and from the second half of every run",
+        Halving::EveryOtherRun => "every other run and from the rest (the runs too short to halve)",
+    };
     let detail = if unsteady.is_empty() {
-        "each equation chooses the same terms from the first and from the second half of every run"
-            .to_string()
+        format!("each equation chooses the same terms from {halves}")
     } else {
         format!(
-            "chosen from all the rows but not from both halves of every run: {}; terms the noise chose \
+            "chosen from all the rows but not from both {}: {}; terms the noise chose \
              (errors in the states bias the regressors), or that one half does not excite: read them \
              as uncertain (more or longer runs, less noise, fewer candidates)",
+            match halving {
+                Halving::EachRun => "halves of every run",
+                Halving::EveryOtherRun => "every other run and the rest",
+            },
             unsteady.join("; ")
         )
     };
@@ -160,6 +189,27 @@ mod tests {
         let short = run(&|t| t).slice(0..60);
         let identified = identify_model(&model, std::slice::from_ref(&short), &how, &mut |_| {}).unwrap();
         assert!(halves_check(&identified, &[short], &how).is_none());
+        // runs too short to halve, six of them: every other run against the rest
+        let whole = run(&|t| (0.7 * t).sin() + 1.0);
+        let pieces: Vec<Frame> = (0..6).map(|k| whole.slice(60 * k..60 * k + 60)).collect();
+        let identified = identify_model(&model, &pieces, &how, &mut |_| {}).unwrap();
+        let check = halves_check(&identified, &pieces, &how).unwrap();
+        assert!(
+            check.passed && check.detail.contains("from every other run and from the rest"),
+            "{}",
+            check.detail
+        );
+        // where u drives every other run only (it is 0 in the rest), the rest cannot choose it
+        let late: Vec<Frame> = (0..6)
+            .map(|k| if k % 2 == 0 { whole.slice(60 * k..60 * k + 60) } else { run(&|_| 0.0).slice(0..60) })
+            .collect();
+        let identified = identify_model(&model, &late, &how, &mut |_| {}).unwrap();
+        let check = halves_check(&identified, &late, &how).unwrap();
+        assert!(
+            !check.passed && check.detail.contains("every other run and the rest: `x_dot`: `u`"),
+            "{}",
+            check.detail
+        );
     }
 
     /// Runs of 200 samples take the default weak form whole; their halves of 100 keep its
