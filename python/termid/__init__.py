@@ -662,7 +662,7 @@ class Fit:
         >>> fitted.equation(3)
         'y = 1 + 2 x'
         >>> termid.fit(pd.DataFrame({"x": [0.0, 1, 2, 3], "y": [1.0, 3, 5, 7]}), "y", ["1", "x - 1"]).equation(3)
-        'y = 3 + 2 (-1 + x)'
+        'y = 3 + 2 (x - 1)'
         """
         parts = [] if self.intercept is None else [f"{self.intercept:.{precision}g}"]
         for term, value in self.coefficients.items():

@@ -222,8 +222,10 @@ impl Term {
                 if k == 1 {
                     return Ok(self.clone());
                 }
-                // factor out the leading coefficient (by division, so the group's is exactly 1)
-                let lead = first.coef;
+                // factor out the leading coefficient (by division, so the group's is exactly 1):
+                // the first variable monomial's, so `(T - 300)^2` stays as written rather than
+                // `90000*(1 - 0.0033…*T)^2`
+                let lead = self.monomials.iter().find(|m| !m.factors.is_empty()).unwrap_or(first).coef;
                 let group = Term::normalise(
                     self.monomials
                         .iter()
@@ -368,7 +370,11 @@ impl fmt::Display for Term {
         if self.monomials.is_empty() {
             return write!(f, "0");
         }
-        for (i, m) in self.monomials.iter().enumerate() {
+        // a sum's constant written last, as one writes `T - 300` (the order is the printer's;
+        // the canonical order, by which terms compare, keeps it first)
+        let (constant, rest): (Vec<&Monomial>, Vec<&Monomial>) =
+            self.monomials.iter().partition(|m| m.factors.is_empty());
+        for (i, m) in rest.into_iter().chain(constant).enumerate() {
             match (i, m.coef < 0.0) {
                 (0, true) => write!(f, "-")?,
                 (0, false) => {}
@@ -384,6 +390,19 @@ impl fmt::Display for Term {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A sum prints its constant last and a power of a sum keeps the sum as written (its first
+    /// variable's coefficient factored out), as one writes a variable about a reference value.
+    #[test]
+    fn a_sum_about_a_reference_value_prints_as_written() {
+        let (t, c) = (Term::var("T"), Term::constant(300.0));
+        let about = t.add(&c.scale(-1.0).unwrap()).unwrap();
+        assert_eq!(about.to_string(), "T - 300");
+        assert_eq!(about.powi(2).unwrap().to_string(), "(T - 300)^2");
+        assert_eq!(about.powi(-1).unwrap().to_string(), "1/(T - 300)");
+        let reversed = c.add(&t.scale(-1.0).unwrap()).unwrap().powi(-3).unwrap();
+        assert_eq!(reversed.to_string(), "-1/(T - 300)^3");
+    }
 
     #[test]
     fn products_merge_and_sort() {
