@@ -243,13 +243,11 @@ impl PyModel {
 
     /// The model made from columns with its library written about the runs' reference values
     /// where they hold a variable far from 0 (`termid::model::Model::about_references`), and
-    /// the sentence that says so; the model as it is where there is nothing to write anew.
+    /// the sentence that says so (none where there is nothing to write anew); decided either way.
     fn about_references(&self, runs: Vec<Run<'_>>) -> PyResult<(PyModel, Option<String>)> {
         let frames = self.frames(runs)?;
-        Ok(match self.inner.about_references(&frames).map_err(fail)? {
-            Some((model, note)) => (PyModel { inner: model }, Some(note)),
-            None => (PyModel { inner: self.inner.clone() }, None),
-        })
+        let (model, note) = self.inner.about_references(&frames).map_err(fail)?;
+        Ok((PyModel { inner: model }, note))
     }
 
     /// The outline the model was made from (JSON), while its library may still be written

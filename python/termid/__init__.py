@@ -1860,7 +1860,8 @@ class Model:
         """The model made from states (:meth:`from_states`) with its polynomial library written
         about round reference values where ``runs`` hold a state or input more than 10 spreads
         from 0 (``T0``, ``ΔT = T - T0``; a note as a warning), as :meth:`identify` and
-        :meth:`recipe` write it by themselves; the model as it is otherwise. For statistics
+        :meth:`recipe` write it by themselves; either way the library is decided, not again
+        on later runs. For statistics
         gathered in parts (:meth:`moments` on shards, Dask), which keep the library as it is
         written: decide it once, on a sample, before the parts are sent out.
 

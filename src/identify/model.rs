@@ -42,8 +42,8 @@ pub fn identify_model(
 ) -> Result<IdentifiedModel, IdentifyError> {
     let names = equations_of(model, how)?;
     // a model made from columns of variables far from 0: its library about reference values
-    let about = model.about_references(frames).map_err(|e| IdentifyError::Setup(e.to_string()))?;
-    let model = about.as_ref().map_or(model, |(m, _)| m);
+    let (model, note) = model.about_references(frames).map_err(|e| IdentifyError::Setup(e.to_string()))?;
+    let model = &model;
     let mut identified = model.clone();
     let mut fits = Vec::new();
     for name in &names {
@@ -64,7 +64,7 @@ pub fn identify_model(
                 .set_covariance(name, covariance)
                 .map_err(|e| IdentifyError::Setup(format!("`{name}`: its coefficients' covariance {e}")))?;
         }
-        fit.selection.notes.extend(about.as_ref().map(|(_, note)| note.clone()));
+        fit.selection.notes.extend(note.clone());
         fits.push((name.clone(), fit));
     }
     Ok(IdentifiedModel { model: identified, fits })

@@ -208,17 +208,20 @@ impl Model {
     /// about reference values where the runs hold a state or an input far from 0
     /// ([`OFFSET_SPREADS`]: a temperature in kelvin, a pressure in pascal, a ship's speed):
     /// a parameter `T0` (the mean, rounded), a derived `ΔT = T - T0`, and the monomials of
-    /// `ΔT` in place of `T`'s — the paper's `Δu = u - u0`. With a sentence saying so. `None`:
-    /// no such variable, named candidates, or a model not made from columns (its file's
-    /// candidates are its author's).
-    pub fn about_references(&self, frames: &[Frame]) -> Result<Option<(Model, String)>, ModelError> {
+    /// `ΔT` in place of `T`'s — the paper's `Δu = u - u0`. With a sentence saying so; none
+    /// where there is no such variable, the candidates are named, or the model was not made
+    /// from columns (its file's candidates are its author's). The model returned is settled
+    /// either way (no outline): decided once on the whole runs, it is not decided again on
+    /// parts of them (a half's smaller spread would put a variable farther from 0).
+    pub fn about_references(&self, frames: &[Frame]) -> Result<(Model, Option<String>), ModelError> {
+        let settled = || Model { outline: None, ..self.clone() };
         let Some(outline) = self.outline.as_ref().filter(|o| o.candidates.is_empty()) else {
-            return Ok(None);
+            return Ok((settled(), None));
         };
         let names: Vec<String> = outline.states.iter().chain(&outline.inputs).cloned().collect();
         let offsets: Vec<Offset> = names.iter().filter_map(|n| offset(n, frames)).collect();
         if offsets.is_empty() {
-            return Ok(None);
+            return Ok((settled(), None));
         }
         let spec = self.spec();
         let mut taken: Vec<String> = names.clone();
@@ -245,7 +248,7 @@ impl Model {
             written.push((o, parameter, derived));
         }
         if written.is_empty() {
-            return Ok(None);
+            return Ok((settled(), None));
         }
         let about: Vec<String> = names
             .iter()
@@ -303,7 +306,7 @@ impl Model {
             file.model.notes.push(note.clone());
         })?;
         model.outline = None;
-        Ok(Some((model, note)))
+        Ok((model, Some(note)))
     }
 }
 
@@ -393,7 +396,8 @@ mod tests {
     #[test]
     fn a_state_far_from_zero_is_written_about_a_reference_value() {
         let model = lorenz().model("--states x,y,z").unwrap();
-        let (about, note) = model.about_references(&[run(302.3, ["x", "y", "z"])]).unwrap().unwrap();
+        let (about, note) = model.about_references(&[run(302.3, ["x", "y", "z"])]).unwrap();
+        let note = note.unwrap();
         assert!(note.contains("`z`") && note.contains("Δz = z - z0, z0 = 300"), "{note}");
         assert_eq!(about.parameter_values()["z0"], 300.0);
         let derived = &about.spec().derived;
@@ -402,7 +406,7 @@ mod tests {
         let texts: Vec<String> = candidates.iter().map(|c| c.to_string()).collect();
         assert_eq!(texts, ["1", "x", "y", "Δz", "x^2", "x*y", "x*Δz", "y^2", "y*Δz", "Δz^2"]);
         assert!(about.spec().model.provenance.contains("x, y, Δz to degree 2"));
-        assert!(about.about_references(&[run(302.3, ["x", "y", "z"])]).unwrap().is_none());
+        assert!(about.about_references(&[run(302.3, ["x", "y", "z"])]).unwrap().1.is_none());
         Model::parse(&about.to_toml(), "again.toml").unwrap();
         // the reference rounds to the decade above the spread: 0.014 → 0.1
         let fine = Frame::new("run", "t", vec![0.0, 1.0, 2.0, 3.0]).unwrap();
@@ -411,14 +415,14 @@ mod tests {
             fine.push(name, v.to_vec()).unwrap();
         }
         fine.push("z", vec![-7.23, -7.25, -7.24, -7.22]).unwrap();
-        let (fine, _) = model.about_references(&[fine]).unwrap().unwrap();
+        let (fine, _) = model.about_references(&[fine]).unwrap();
         assert_eq!(fine.parameter_values()["z0"], -7.2);
         // nothing to write anew
-        assert!(model.about_references(&[run(3.0, ["x", "y", "z"])]).unwrap().is_none());
+        assert!(model.about_references(&[run(3.0, ["x", "y", "z"])]).unwrap().1.is_none());
         let named = Outline { candidates: vec!["x".into(), "z".into()], ..lorenz() }.model("x").unwrap();
-        assert!(named.about_references(&[run(302.3, ["x", "y", "z"])]).unwrap().is_none());
+        assert!(named.about_references(&[run(302.3, ["x", "y", "z"])]).unwrap().1.is_none());
         let read = Model::parse(&model.to_toml(), "lorenz.toml").unwrap();
-        assert!(read.about_references(&[run(302.3, ["x", "y", "z"])]).unwrap().is_none());
+        assert!(read.about_references(&[run(302.3, ["x", "y", "z"])]).unwrap().1.is_none());
         // the outline is carried through edits and can be given back (a pickled model)
         let edited = model.starting_as(&run(302.3, ["x", "y", "z"])).unwrap();
         assert!(edited.outline().is_some());
@@ -426,7 +430,13 @@ mod tests {
             .with_outline(lorenz())
             .about_references(&[run(302.3, ["x", "y", "z"])])
             .unwrap()
+            .1
             .is_some());
+        // decided once: close to 0 on these runs, the model is settled, and a part of them
+        // farther from 0 against its own spread does not write it anew
+        let (kept, none) = model.about_references(&[run(3.0, ["x", "y", "z"])]).unwrap();
+        assert!(none.is_none() && kept.outline().is_none());
+        assert!(kept.about_references(&[run(302.3, ["x", "y", "z"])]).unwrap().1.is_none());
     }
 
     /// The names a reference value takes give way to the model's own: a state called `z0`
@@ -435,7 +445,7 @@ mod tests {
     fn reference_names_give_way_to_the_models_own() {
         let outline = Outline { states: vec!["x".into(), "z0".into(), "z".into()], ..lorenz() };
         let model = outline.model("--states x,z0,z").unwrap();
-        let (about, _) = model.about_references(&[run(302.3, ["x", "z0", "z"])]).unwrap().unwrap();
+        let (about, _) = model.about_references(&[run(302.3, ["x", "z0", "z"])]).unwrap();
         assert_eq!(about.parameter_values()["z_0"], 300.0);
         assert_eq!(about.spec().derived[0].definition, "z - z_0");
     }

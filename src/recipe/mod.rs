@@ -211,23 +211,16 @@ pub fn identify(
     }
     // a model made from columns of variables far from 0: its library about reference values,
     // decided once on the runs as recorded, so that every start and configuration has it
-    let about = model.about_references(frames).map_err(|e| RecipeError::Setup(e.to_string()))?;
-    let centred_settings;
-    let (model, settings) = match &about {
-        Some((centred, _)) => {
-            let choose = settings
-                .choose
-                .iter()
-                .map(|(name, m)| {
-                    Ok((name.clone(), m.about_references(frames)?.map_or_else(|| m.clone(), |(c, _)| c)))
-                })
-                .collect::<Result<Vec<_>, crate::model::ModelError>>()
-                .map_err(|e| RecipeError::Setup(e.to_string()))?;
-            centred_settings = RecipeSettings { choose, ..settings.clone() };
-            (centred, &centred_settings)
-        }
-        None => (model, settings),
-    };
+    let setup = |e: crate::model::ModelError| RecipeError::Setup(e.to_string());
+    let (model, note) = model.about_references(frames).map_err(setup)?;
+    let model = &model;
+    let choose = settings
+        .choose
+        .iter()
+        .map(|(name, m)| Ok((name.clone(), m.about_references(frames)?.0)))
+        .collect::<Result<Vec<_>, crate::model::ModelError>>()
+        .map_err(setup)?;
+    let settings = &RecipeSettings { choose, ..settings.clone() };
     let mut starts = Vec::new();
     let mut failed = Vec::new();
     // the starts are independent: side by side, they fill the cores the per-run work leaves idle
@@ -240,7 +233,7 @@ pub fn identify(
         match result {
             Ok(mut s) => {
                 for (_, fit) in &mut s.fits {
-                    fit.selection.notes.extend(about.as_ref().map(|(_, note)| note.clone()));
+                    fit.selection.notes.extend(note.clone());
                 }
                 starts.push(s)
             }

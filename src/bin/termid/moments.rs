@@ -183,16 +183,16 @@ pub fn identify_in_pieces(cmd: &IdentifyCommand, model: &termid::model::Model, r
     // a model made from columns of variables far from 0: its library about reference values
     // read from the first piece (a mean within a few spreads serves, and a whole pass would
     // read the files twice)
-    let about = match (model.outline(), cmd.data.first()) {
+    let (model, note) = match (model.outline(), cmd.data.first()) {
         (Some(_), Some(first)) => {
             match termid::data::Chunks::open(first, &model.spec().model.time, rows.max(1), 0)?.next() {
                 Some(piece) => model.about_references(&[piece?.frame])?,
-                None => None,
+                None => (model.clone(), None),
             }
         }
-        _ => None,
+        _ => (model.clone(), None),
     };
-    let model = about.as_ref().map_or(model, |(m, _)| m);
+    let model = &model;
     let runs = cmd
         .data
         .iter()
@@ -214,7 +214,7 @@ pub fn identify_in_pieces(cmd: &IdentifyCommand, model: &termid::model::Model, r
     )?;
     let mut fits = identified.fits;
     for (_, fit) in &mut fits {
-        fit.selection.notes.extend(about.as_ref().map(|(_, note)| note.clone()));
+        fit.selection.notes.extend(note.clone());
     }
     let checks =
         termid::plugins::of(&identified.model).map(|p| p.checks(&identified.model, &[])).unwrap_or_default();
