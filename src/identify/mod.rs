@@ -589,7 +589,8 @@ const INVARIANT: f64 = 1e-9;
 /// A note where a linear combination of the candidates that are a variable alone is the same
 /// in every row (a null vector of their covariance): a conservation law (a + b + c of a
 /// closed reaction, S + I + R of an epidemic), indicator columns of categories that add up to
-/// one, or a variable recorded twice. Any candidate in one of them is then one in the others,
+/// one, a variable recorded twice, or a fast state that follows the others at once (x of
+/// dx/dt = −200 (x − y): x − y + ẏ/200 ≈ 0 at every row). Any candidate in one of them is then one in the others,
 /// a back-end keeps one way of writing the equation and leaves the rest out as collinear, and
 /// the system's own terms may be among those left out.
 fn invariant_note(moments: &Moments, names: &[String]) -> Option<String> {
@@ -633,8 +634,8 @@ fn invariant_note(moments: &Moments, names: &[String]) -> Option<String> {
         .collect();
     (!laws.is_empty()).then(|| {
         format!(
-            "{} the same in every row (a conservation law, categories that add up to one, or a \
-             variable recorded twice): a \
+            "{} the same in every row (a conservation law, categories that add up to one, a \
+             variable recorded twice, or a fast state that follows the others at once): a \
              candidate in one of these variables is one in the others, so the equation is \
              written in fewer of them and a term left out as collinear may be the system's, \
              written in the others",
