@@ -74,7 +74,12 @@ pub enum IdentifyError {
     #[error(
         "{file}: row {row}: {} `{term}` evaluates to {value} (check {})",
         if *target { "the target" } else { "term" },
-        if *target { "the data there" } else { "its denominators and the data there" }
+        match (*target, value.is_nan()) {
+            (true, _) => "the data there",
+            (false, true) => "its denominators, roots and logarithms and the data there",
+            (false, false) => "its denominators and the data there: a division by zero, or a \
+                               power or exponential past the largest number",
+        }
     )]
     NonFinite {
         /// The run.

@@ -534,7 +534,10 @@ fn messages_say_what_is_wrong() {
     assert!(err.len() < 500, "the term was echoed whole ({} bytes)", err.len());
     // overflow is named as such, underflow to one value too; neither is called collinear
     let args = hald(&["x1^5000", "x2"], &[]);
-    refused(&args.iter().map(String::as_str).collect::<Vec<_>>(), &["`x1^5000` evaluates to inf"]);
+    refused(
+        &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        &["`x1^5000` evaluates to inf", "a power or exponential past the largest number"],
+    );
     let args = hald(&["(x1/100)^5000", "x2"], &[]);
     let out = succeeds(&args.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(out.contains("one value on every row") && !out.contains("collinear"), "{out}");

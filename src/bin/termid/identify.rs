@@ -18,10 +18,11 @@ fn split_pair<'a>(text: &'a str, what: &str) -> Result<(&'a str, &'a str)> {
 
 /// The derivative method `auto` stands for: central differences for a model with a plug-in's
 /// table (a ship: the paper's own), else no derivative at all (whole or in pieces): the
-/// integral form, which recovers polynomial systems from noise-free
-/// and noisy samples alike where central differences leave an error that is smooth in the
-/// states and that spurious terms then fit (Lorenz at 1 % noise: every equation exact with
-/// it, x's with a dozen spurious terms from central differences or the Kalman smoother).
+/// weak form ([`termid::recipe::ANY_SYSTEM_DERIVATIVE`]), which recovers polynomial systems
+/// from noise-free and noisy samples alike where central differences leave an error that is
+/// smooth in the states and that spurious terms then fit (Lorenz at 1 % noise: every equation
+/// exact without a derivative, x's with a dozen spurious terms from central differences or the
+/// Kalman smoother).
 fn resolve_derivative(cmd: &mut IdentifyCommand) -> Result<()> {
     if cmd.derivative != "auto" {
         return Ok(());
