@@ -6,6 +6,7 @@
 //! saying that prediction is uncertain.
 
 mod halves;
+mod noise;
 mod parameters;
 mod report;
 mod retrace;
@@ -13,6 +14,7 @@ mod start;
 
 pub use crate::plugin::RecipeDefaults;
 pub use halves::halves_check;
+pub use noise::noise_check;
 pub use parameters::{ParameterOptions, ParameterStage};
 pub use report::Primes;
 pub use retrace::retrace_check;
@@ -251,7 +253,8 @@ pub fn identify(
 }
 
 /// The checks of a system of no field's identified from `frames` by `how`: that its equations
-/// retrace the runs without running away, and that its terms hold on each half of them.
+/// retrace the runs without running away, that its terms hold on each half of them, and that
+/// the records' noise leaves them unbiased.
 pub fn system_checks(
     identified: &crate::identify::IdentifiedModel,
     frames: &[Frame],
@@ -260,6 +263,7 @@ pub fn system_checks(
     retrace_check(&identified.model, frames)
         .into_iter()
         .chain(halves_check(identified, frames, how))
+        .chain(noise_check(&identified.model, frames))
         .collect()
 }
 

@@ -278,11 +278,15 @@ fn refine_start(
 }
 
 /// What the field knows must hold: the plug-in's physical checks of a model on the runs as
-/// prepared; for a system of no field's, that its equations retrace the runs.
+/// prepared; for a system of no field's, that its equations retrace the runs and that the
+/// runs' noise leaves its terms unbiased.
 pub fn checks_of(model: &Model, prepared: &[Frame]) -> Vec<Check> {
     match crate::plugins::of(model) {
         Some(plugin) => plugin.checks(model, prepared),
-        None => super::retrace::retrace_check(model, prepared).into_iter().collect(),
+        None => super::retrace::retrace_check(model, prepared)
+            .into_iter()
+            .chain(super::noise::noise_check(model, prepared))
+            .collect(),
     }
 }
 
