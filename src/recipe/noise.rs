@@ -90,16 +90,18 @@ pub fn noise_check(model: &Model, runs: &[Frame]) -> Option<Check> {
 
 /// `variable`'s white noise pooled over the runs that record it (each run's variance by its
 /// rows) over its standard deviation over all their rows, and whether every run's noise was
-/// measured (not only bounded: a coarse record). `None` where no run records it, or it does
-/// not vary.
+/// measured (not only bounded: a coarse record). `None` where no run records it long enough
+/// to measure, or it does not vary.
 fn share(variable: &str, runs: &[Frame]) -> Option<(f64, bool)> {
     let (mut noise, mut rows, mut measured) = (0.0, 0usize, true);
     let (mut n, mut mean, mut m2) = (0usize, 0.0, 0.0);
     for x in runs.iter().filter_map(|f| f.column(variable)) {
-        let found = crate::data::white_noise(x)?;
-        noise += found.sd * found.sd * x.len() as f64;
-        rows += x.len();
-        measured &= found.measured;
+        // a run too short for fourth differences still spreads the variable
+        if let Some(found) = crate::data::white_noise(x) {
+            noise += found.sd * found.sd * x.len() as f64;
+            rows += x.len();
+            measured &= found.measured;
+        }
         // Welford over all rows: runs about different levels spread the variable too
         for &v in x {
             n += 1;
