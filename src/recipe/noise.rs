@@ -21,71 +21,97 @@ const SHARE: f64 = 0.02;
 /// The check on `model`'s identified rate equations over `runs`: for each recorded variable
 /// that a candidate holds nonlinearly, its white noise ([`crate::data::white_noise`], pooled
 /// over the runs) against its spread over all rows; flagged (never refusing) where one is
-/// measured above 2 % of its spread. `None` where no candidate is nonlinear in a recorded variable
-/// or no such variable is in the runs.
+/// measured above 2 % of its spread. `None` where no candidate is nonlinear in a recorded
+/// variable or no such variable is in the runs.
 pub fn noise_check(model: &Model, runs: &[Frame]) -> Option<Check> {
-    let vocabulary = &model.vocabulary;
-    let mut held: Vec<String> = Vec::new();
-    for equation in model.equations().iter().filter(|e| e.identify) {
-        for term in &equation.candidates {
-            for v in vocabulary.variables() {
-                if !held.contains(v) && nonlinear_in(term, v, vocabulary) {
-                    held.push(v.clone());
-                }
-            }
-        }
-    }
-    // in the order the model declares them
-    let shares: Vec<(String, f64, bool)> = vocabulary
-        .variables()
-        .iter()
-        .filter(|v| held.contains(v))
-        .filter_map(|v| share(v, runs).map(|(s, measured)| (v.clone(), s, measured)))
-        .collect();
+    let candidates = model.equations().iter().filter(|e| e.identify).flat_map(|e| &e.candidates);
+    let shares = shares(candidates, &model.vocabulary, runs);
     if shares.is_empty() {
         return None;
     }
-    let over: Vec<&(String, f64, bool)> =
-        shares.iter().filter(|(_, s, measured)| *measured && *s > SHARE).collect();
-    let listed = |list: &[&(String, f64, bool)]| {
-        list.iter()
-            .map(|(v, s, measured)| {
-                format!(
-                    "`{v}` {}{} %",
-                    if *measured { "" } else { "at most " },
-                    crate::output::sig(100.0 * s, 2)
-                )
-            })
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    let all: Vec<&(String, f64, bool)> = shares.iter().collect();
-    let percent = crate::output::sig(100.0 * SHARE, 2);
+    let over: Vec<&Share> = shares.iter().filter(|s| s.over()).collect();
     let (passed, detail) = if over.is_empty() {
+        let all: Vec<&Share> = shares.iter().collect();
         (
             true,
             format!(
                 "white noise of {} of the spread of the variables the candidates hold nonlinearly \
-                 (from their fourth differences), under {percent} %",
-                listed(&all)
+                 (from their fourth differences), under {} %",
+                listed(&all),
+                crate::output::sig(100.0 * SHARE, 2)
             ),
         )
     } else {
-        (
-            false,
-            format!(
-                "white noise of {} of the spread of the variables the candidates hold nonlinearly \
-                 (from their fourth differences), over {percent} %: noise in a candidate's \
-                 variables biases the fit (errors in variables), terms that take up the bias \
-                 enter and both halves of the runs choose them alike (the ODE benchmark at 5 %: \
-                 25 of 37 systems recovered, two of the others passing every other check): read \
-                 the terms as uncertain; fewer candidates (those the physics suggests) or records \
-                 with less noise",
-                listed(&over)
-            ),
-        )
+        (false, flagged(&over))
     };
     Some(Check { name: NAME.into(), passed, refuses: false, detail, measure: None })
+}
+
+/// The note for one equation's `candidates` fitted to a rate over `runs` (a fit without a
+/// model: `identify --target dx/dt --terms …`, Python `fit`), where a variable they hold
+/// nonlinearly is measured noisier than the check allows; `None` otherwise.
+pub fn noise_note(candidates: &[Term], vocabulary: &Vocabulary, runs: &[Frame]) -> Option<String> {
+    let shares = shares(candidates, vocabulary, runs);
+    let over: Vec<&Share> = shares.iter().filter(|s| s.over()).collect();
+    (!over.is_empty()).then(|| format!("the records' noise may bias the terms: {}", flagged(&over)))
+}
+
+/// A variable's noise as a share of its spread.
+struct Share {
+    variable: String,
+    share: f64,
+    /// Measured, not only bounded ([`crate::data::Noise::measured`]).
+    measured: bool,
+}
+
+impl Share {
+    fn over(&self) -> bool {
+        self.measured && self.share > SHARE
+    }
+}
+
+/// The noise shares of the recorded variables that some of `candidates` hold nonlinearly, in
+/// the order `vocabulary` declares them.
+fn shares<'a>(
+    candidates: impl IntoIterator<Item = &'a Term>,
+    vocabulary: &Vocabulary,
+    runs: &[Frame],
+) -> Vec<Share> {
+    let candidates: Vec<&Term> = candidates.into_iter().collect();
+    vocabulary
+        .variables()
+        .iter()
+        .filter(|v| candidates.iter().any(|t| nonlinear_in(t, v, vocabulary)))
+        .filter_map(|v| {
+            share(v, runs).map(|(share, measured)| Share { variable: v.clone(), share, measured })
+        })
+        .collect()
+}
+
+/// `` `x` 5.0 %, `y` at most 0.1 % ``.
+fn listed(shares: &[&Share]) -> String {
+    shares
+        .iter()
+        .map(|s| {
+            let bound = if s.measured { "" } else { "at most " };
+            format!("`{}` {bound}{} %", s.variable, crate::output::sig(100.0 * s.share, 2))
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// What noise over the limit means, for the variables `over` it.
+fn flagged(over: &[&Share]) -> String {
+    format!(
+        "white noise of {} of the spread of the variables the candidates hold nonlinearly (from \
+         their fourth differences), over {} %: noise in a candidate's variables biases the fit \
+         (errors in variables), terms that take up the bias enter and both halves of the runs \
+         choose them alike (the ODE benchmark at 5 %: 25 of 37 systems recovered, two of the \
+         others passing every other check): read the terms as uncertain; fewer candidates \
+         (those the physics suggests) or records with less noise",
+        listed(over),
+        crate::output::sig(100.0 * SHARE, 2)
+    )
 }
 
 /// `variable`'s white noise pooled over the runs that record it (each run's variance by its

@@ -238,6 +238,8 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
                 frames[0].names()[1..].iter().filter(|n| *n != state).cloned().collect();
             identification
                 .say_delays(&target, &candidates, &frames, &columns, &mut fit, &|l| l.plain_remedy())?;
+            // noise on a variable a candidate holds nonlinearly biases the fit itself
+            fit.selection.notes.extend(termid::recipe::noise_note(&candidates, &vocab, &frames));
         }
     }
     match cmd.format {
