@@ -32,15 +32,7 @@ pub fn noise_check(model: &Model, runs: &[Frame]) -> Option<Check> {
     let over: Vec<&Share> = shares.iter().filter(|s| s.over()).collect();
     let (passed, detail) = if over.is_empty() {
         let all: Vec<&Share> = shares.iter().collect();
-        (
-            true,
-            format!(
-                "white noise of {} of the spread of the variables the candidates hold nonlinearly \
-                 (from their fourth differences), under {} %",
-                listed(&all),
-                crate::output::sig(100.0 * SHARE, 2)
-            ),
-        )
+        (true, format!("{}, under {} %", measured(&all), crate::output::sig(100.0 * SHARE, 2)))
     } else {
         (false, flagged(&over))
     };
@@ -88,28 +80,31 @@ fn shares<'a>(
         .collect()
 }
 
-/// `` `x` 5.0 %, `y` at most 0.1 % ``.
-fn listed(shares: &[&Share]) -> String {
-    shares
+/// What was measured: `` white noise of `x` 5.0 %, `y` at most 0.1 % of the spread … ``.
+fn measured(shares: &[&Share]) -> String {
+    let listed: Vec<String> = shares
         .iter()
         .map(|s| {
             let bound = if s.measured { "" } else { "at most " };
             format!("`{}` {bound}{} %", s.variable, crate::output::sig(100.0 * s.share, 2))
         })
-        .collect::<Vec<_>>()
-        .join(", ")
+        .collect();
+    format!(
+        "white noise of {} of the spread of the variables the candidates hold nonlinearly (from \
+         their fourth differences)",
+        listed.join(", ")
+    )
 }
 
 /// What noise over the limit means, for the variables `over` it.
 fn flagged(over: &[&Share]) -> String {
     format!(
-        "white noise of {} of the spread of the variables the candidates hold nonlinearly (from \
-         their fourth differences), over {} %: noise in a candidate's variables biases the fit \
+        "{}, over {} %: noise in a candidate's variables biases the fit \
          (errors in variables), terms that take up the bias enter and both halves of the runs \
          choose them alike (the ODE benchmark at 5 %: 25 of 37 systems recovered, two of the \
          others passing every other check): read the terms as uncertain; fewer candidates \
          (those the physics suggests) or records with less noise",
-        listed(over),
+        measured(over),
         crate::output::sig(100.0 * SHARE, 2)
     )
 }
