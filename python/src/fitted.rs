@@ -326,7 +326,7 @@ pub(crate) fn fit(
                 // and a column acting later than recorded leaves its mark on them
                 how.say_delays(&rate, candidates, &frames, &others, &mut fit, &|l| l.plain_remedy())?;
                 // and noise on a variable a candidate holds nonlinearly biases the fit itself
-                fit.selection.notes.extend(termid::recipe::noise_note(candidates, vocabulary, &frames));
+                fit.selection.notes.extend(termid::identify::noise_note(candidates, vocabulary, &frames));
                 Ok(fit)
             })
             .map_err(fail)?

@@ -45,3 +45,22 @@ def test_moments_add_and_compare(ship, zigzags):
     assert sum(parts[1:], parts[0]) == merged
     assert merged != parts[0] and parts[0] == termid.Moments.from_frame(zigzags[0], ship, "r_dot")
     assert (parts[0] == "statistics") is False
+
+
+def test_statistics_carry_the_noise_that_biases_the_terms():
+    """Lorenz with white noise of 5 % of each state's spread, its statistics gathered in two
+    shards and sent between processes (pickled): the terms identified from them are said to
+    be biased by the noise, as from the rows; at 0.5 % they are not."""
+    import numpy as np
+
+    lorenz = termid.Model.builtin("lorenz")
+    run = lorenz.simulate(duration=20.0, sample=0.01)
+    rng = np.random.default_rng(5)
+    for share, said in [(0.05, True), (0.005, False)]:
+        noisy = run.copy()
+        for c in "xyz":
+            noisy[c] += share * run[c].std() * rng.standard_normal(len(run))
+        halves = [noisy.iloc[: len(noisy) // 2], noisy.iloc[len(noisy) // 2 :]]
+        parts = [pickle.loads(pickle.dumps(termid.Moments.from_frame(h, lorenz, "y_dot"))) for h in halves]
+        notes = " ".join(lorenz.identify_from_moments(parts).notes("y_dot"))
+        assert ("the records' noise may bias the terms: white noise of `x` " in notes) == said, notes

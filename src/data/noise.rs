@@ -37,6 +37,83 @@ pub fn white_noise(x: &[f64]) -> Option<Noise> {
     Some(Noise { sd: s4, measured: s4 >= WHITE * s3 })
 }
 
+/// A variable's white noise and spread gathered over records read whole or in pieces and
+/// merged in any grouping: what the identification's noise note and check compare (a plain
+/// value, written with an equation's statistics).
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct NoiseTally {
+    /// Σ σ² × rows over the records whose noise was found ([`white_noise`]).
+    pub noise: f64,
+    /// The rows of those records.
+    pub noise_rows: usize,
+    /// Whether every record's noise was measured, not only bounded ([`Noise::measured`]).
+    pub measured: bool,
+    /// All rows seen, their mean and their sum of squared deviations (Welford).
+    pub rows: usize,
+    /// The mean of the rows seen.
+    pub mean: f64,
+    /// Their sum of squared deviations from `mean`.
+    pub m2: f64,
+}
+
+impl NoiseTally {
+    /// The tally of the `own` rows of `x`, a record or a piece of one with its neighbours'
+    /// rows around (its fourth differences read across them).
+    pub fn of(x: &[f64], own: std::ops::Range<usize>) -> NoiseTally {
+        let rows = x.get(own).unwrap_or_default();
+        let mut tally = NoiseTally { measured: true, ..NoiseTally::default() };
+        // a record too short for fourth differences still spreads the variable
+        if let Some(found) = white_noise(x) {
+            tally.noise = found.sd * found.sd * rows.len() as f64;
+            tally.noise_rows = rows.len();
+            tally.measured = found.measured;
+        }
+        for &v in rows {
+            tally.rows += 1;
+            let d = v - tally.mean;
+            tally.mean += d / tally.rows as f64;
+            tally.m2 += d * (v - tally.mean);
+        }
+        tally
+    }
+
+    /// Both tallies as one (Chan's update of the mean and the squared deviations: records
+    /// about different levels spread the variable too).
+    pub fn merge(&mut self, other: &NoiseTally) {
+        let rows = self.rows + other.rows;
+        if rows > 0 {
+            let d = other.mean - self.mean;
+            let (a, b) = (self.rows as f64, other.rows as f64);
+            self.m2 += other.m2 + d * d * a * b / rows as f64;
+            self.mean += d * b / rows as f64;
+        }
+        self.rows = rows;
+        // (where no record's noise was found, its flag says nothing)
+        self.measured = match (self.noise_rows, other.noise_rows) {
+            (0, _) => other.measured,
+            (_, 0) => self.measured,
+            _ => self.measured && other.measured,
+        };
+        self.noise += other.noise;
+        self.noise_rows += other.noise_rows;
+    }
+
+    /// The noise's standard deviation over the spread of all rows, and whether every record's
+    /// noise was measured; `None` where none was long enough to measure or nothing varies.
+    pub fn share(&self) -> Option<(f64, bool)> {
+        let spread = (self.m2 / self.rows.max(1) as f64).sqrt();
+        (self.noise_rows > 0 && spread > 0.0 && spread.is_finite())
+            .then(|| ((self.noise / self.noise_rows as f64).sqrt() / spread, self.measured))
+    }
+
+    /// Whether rows could have given it: counts that fit, sums not negative, numbers finite.
+    pub fn is_consistent(&self) -> bool {
+        self.noise_rows <= self.rows
+            && [self.noise, self.m2].iter().all(|v| v.is_finite() && *v >= 0.0)
+            && self.mean.is_finite()
+    }
+}
+
 /// 1.4826 times the median absolute value: the standard deviation of Gaussian values about 0.
 fn robust_sd(mut values: Vec<f64>) -> f64 {
     values.iter_mut().for_each(|v| *v = v.abs());
@@ -73,5 +150,37 @@ mod tests {
         assert!(!white_noise(&coarse).unwrap().measured);
         assert_eq!(white_noise(&[1.0; 100]), Some(Noise { sd: 0.0, measured: true }));
         assert_eq!(white_noise(&[1.0; 10]), None);
+    }
+
+    /// A noisy record tallied in pieces (each read across its neighbours' rows, as a run read
+    /// in pieces is) and merged gives the whole record's spread to round-off and its noise
+    /// within 2 %; a piece too short to measure adds its spread alone.
+    #[test]
+    fn a_tally_in_pieces_is_the_tally_of_the_whole() {
+        let mut state = 7u64;
+        let mut uniform = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let x: Vec<f64> =
+            (0..10_000).map(|k| 3.0 * (k as f64 * 0.01).sin() + 5.0 + 0.1 * uniform()).collect();
+        let whole = NoiseTally::of(&x, 0..x.len());
+        let mut pieces = NoiseTally::default();
+        for start in (0..x.len()).step_by(1000) {
+            let (from, to) = (start.saturating_sub(6), (start + 1006).min(x.len()));
+            pieces
+                .merge(&NoiseTally::of(&x[from..to], start - from..start - from + 1000.min(x.len() - start)));
+        }
+        assert_eq!(pieces.rows, whole.rows);
+        assert!((pieces.mean / whole.mean - 1.0).abs() < 1e-12 && (pieces.m2 / whole.m2 - 1.0).abs() < 1e-12);
+        let (a, b) = (whole.share().unwrap(), pieces.share().unwrap());
+        assert!(a.1 && b.1 && (a.0 / b.0 - 1.0).abs() < 0.02, "{a:?} {b:?}");
+        let mut short = whole.clone();
+        short.merge(&NoiseTally::of(&[100.0; 5], 0..5));
+        assert_eq!(
+            (short.noise, short.noise_rows, short.rows),
+            (whole.noise, whole.noise_rows, whole.rows + 5)
+        );
+        assert!(short.m2 > whole.m2 && short.is_consistent());
     }
 }

@@ -44,6 +44,7 @@ pub use crate::model::ParamValue;
 
 mod delay;
 mod model;
+pub(crate) mod noise;
 mod report;
 mod statistics;
 
@@ -54,6 +55,7 @@ pub use model::{
     coefficients_of, describe_residuals_of, equation_design, fit_equation, fit_equation_design,
     identify_model, say_late_inputs, IdentifiedModel, ModelIdentification,
 };
+pub use noise::noise_note;
 pub use report::{num, sig, FitReport, StepReport, TermReport};
 pub use statistics::{identify_from_moments, EquationMoments, RunMoments};
 

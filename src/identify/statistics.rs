@@ -10,8 +10,9 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 use super::model::{default_target, model_equation};
+use super::noise::held_nonlinearly;
 use super::{fit_folds, Design, Fit, Identification, IdentifyError, ParamValue, Target};
-use crate::data::{Differentiator, Frame};
+use crate::data::{Differentiator, Frame, NoiseTally};
 use crate::model::Model;
 use crate::select::Moments;
 
@@ -22,6 +23,11 @@ pub struct RunMoments {
     pub run: String,
     /// Its statistics, candidates in the order of [`EquationMoments::candidates`].
     pub moments: Moments,
+    /// The white noise and spread of each recorded variable the candidates hold nonlinearly,
+    /// for the note that the noise may bias the terms ([`super::noise_note`]); empty in
+    /// statistics written before termid gathered them.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub noise: BTreeMap<String, NoiseTally>,
 }
 
 /// The statistics of one equation's candidates over a set of runs.
@@ -37,12 +43,20 @@ pub struct EquationMoments {
     pub runs: Vec<RunMoments>,
 }
 
-/// A run read in pieces, as far as it has been read: its name, its own parameters (from its
-/// first piece) and each equation's statistics so far.
-/// The columns held and switched between samples ([`crate::data::Frame::hold`],
-/// [`crate::data::Frame::switch`]).
-type Between = (Vec<String>, Vec<String>);
-type RunSoFar = (String, BTreeMap<String, ParamValue>, Vec<Option<Moments>>, Between);
+/// A run read in pieces, as far as it has been read.
+struct RunSoFar {
+    /// Its name (its file).
+    name: String,
+    /// Its own parameters, from its first piece.
+    fixed: BTreeMap<String, ParamValue>,
+    /// Each equation's statistics so far.
+    moments: Vec<Option<Moments>>,
+    /// Each equation's noise tallies so far.
+    noise: Vec<BTreeMap<String, NoiseTally>>,
+    /// The columns held and switched between samples as its first piece found them
+    /// ([`crate::data::Frame::hold`], [`crate::data::Frame::switch`]).
+    between: (Vec<String>, Vec<String>),
+}
 
 impl EquationMoments {
     /// The statistics of `equation` of `model` over `frames` (the target as
@@ -71,6 +85,7 @@ impl EquationMoments {
         };
         let design = Design::new(&eq.candidates, &model.vocabulary)?;
         let folds = how.moments_of_runs(&design.library, design.candidates(), &target, frames)?;
+        let noisy = held_nonlinearly(&eq.candidates, &model.vocabulary);
         Ok(EquationMoments {
             equation: equation.into(),
             target: target.to_string(),
@@ -78,7 +93,14 @@ impl EquationMoments {
             runs: frames
                 .iter()
                 .zip(folds)
-                .map(|(f, m)| RunMoments { run: f.origin().into(), moments: m })
+                .map(|(f, m)| RunMoments {
+                    run: f.origin().into(),
+                    moments: m,
+                    noise: noisy
+                        .iter()
+                        .filter_map(|v| Some((v.clone(), NoiseTally::of(f.column(v)?, 0..f.len()))))
+                        .collect(),
+                })
                 .collect(),
         })
     }
@@ -130,6 +152,8 @@ impl EquationMoments {
             .iter()
             .map(|eq| Design::new(&eq.candidates, &model.vocabulary))
             .collect::<Result<Vec<_>, _>>()?;
+        let noisy: Vec<Vec<String>> =
+            eqs.iter().map(|eq| held_nonlinearly(&eq.candidates, &model.vocabulary)).collect();
         let rules = model.parameter_rules();
         let (mut out, mut notes) = (vec![Vec::new(); eqs.len()], Vec::new());
         let mut targets: Option<Vec<Target>> = None;
@@ -161,7 +185,7 @@ impl EquationMoments {
                 }
                 // a chunk's spikes are its own; what else admission says, every chunk repeats
                 notes.extend(admitted.spikes);
-                if let Some((.., (held, switched))) = &run {
+                if let Some(RunSoFar { between: (held, switched), .. }) = &run {
                     // the inputs held or switched between samples as the run's first chunk found
                     // them, so that no chunk takes an input otherwise for lack of jumps of its own
                     // (or a clock its few jumps keep by chance)
@@ -187,11 +211,30 @@ impl EquationMoments {
                         eqs.iter().map(|eq| default_target(eq, std::slice::from_ref(&chunk.frame))).collect()
                     });
                     let between = (chunk.frame.held().to_vec(), chunk.frame.switched().to_vec());
-                    run = Some((chunk.frame.origin().to_string(), fixed, vec![None; eqs.len()], between));
+                    run = Some(RunSoFar {
+                        name: chunk.frame.origin().to_string(),
+                        fixed,
+                        moments: vec![None; eqs.len()],
+                        noise: vec![BTreeMap::new(); eqs.len()],
+                        between,
+                    });
                 }
-                let (Some((_, fixed, moments, _)), Some(targets)) = (run.as_mut(), targets.as_ref()) else {
+                let (Some(RunSoFar { fixed, moments, noise, .. }), Some(targets)) =
+                    (run.as_mut(), targets.as_ref())
+                else {
                     unreachable!("set by the run's first chunk")
                 };
+                // each piece's noise read across its neighbours' rows, its spread over its own
+                for (variables, tallies) in noisy.iter().zip(noise.iter_mut()) {
+                    for v in variables {
+                        if let Some(x) = chunk.frame.column(v) {
+                            tallies
+                                .entry(v.clone())
+                                .or_default()
+                                .merge(&NoiseTally::of(x, chunk.own.clone()));
+                        }
+                    }
+                }
                 let how = Identification {
                     vocabulary: &model.vocabulary,
                     parameters: fixed,
@@ -215,10 +258,10 @@ impl EquationMoments {
                     }
                 }
             }
-            if let Some((name, _, moments, _)) = run {
-                for (list, m) in out.iter_mut().zip(moments) {
+            if let Some(RunSoFar { name, moments, noise, .. }) = run {
+                for ((list, m), noise) in out.iter_mut().zip(moments).zip(noise) {
                     if let Some(moments) = m {
-                        list.push(RunMoments { run: name.clone(), moments });
+                        list.push(RunMoments { run: name.clone(), moments, noise });
                     }
                 }
             }
@@ -321,6 +364,9 @@ impl EquationMoments {
                     }
                 }
             }
+            if let Some((v, _)) = r.noise.iter().find(|(_, t)| !t.is_consistent()) {
+                return refuse(&r.run, format!("the noise tally of `{v}` is not whole"));
+            }
             if let Some(first) = self.runs[..k].iter().find(|o| o.run == r.run && o.moments == r.moments) {
                 return Err(IdentifyError::Setup(format!(
                     "{origin}: run `{}` appears twice with the same statistics: it would be counted twice",
@@ -347,6 +393,7 @@ impl EquationMoments {
             "candidates": self.candidates,
             "runs": self.runs.iter().map(|r| (&r.run, r.moments.count())).collect::<Vec<_>>(),
             "overlaps": self.runs.iter().map(|r| r.moments.overlap()).collect::<Vec<_>>(),
+            "noise": self.runs.iter().map(|r| &r.noise).collect::<Vec<_>>(),
         })
         .to_string();
         let mut out =
@@ -378,6 +425,9 @@ impl EquationMoments {
             /// Each run's rows per independent row (a weak form's windows; 1 where absent).
             #[serde(default)]
             overlaps: Vec<f64>,
+            /// Each run's noise tallies (none where absent).
+            #[serde(default)]
+            noise: Vec<BTreeMap<String, NoiseTally>>,
         }
         let header: Header = header
             .and_then(|h| serde_json::from_slice(h).ok())
@@ -389,7 +439,8 @@ impl EquationMoments {
         }
         let mut runs = Vec::with_capacity(header.runs.len());
         let overlaps = header.overlaps.iter().copied().chain(std::iter::repeat(1.0));
-        for ((run, count), overlap) in header.runs.into_iter().zip(overlaps) {
+        let noises = header.noise.into_iter().chain(std::iter::repeat_with(BTreeMap::new));
+        for (((run, count), overlap), noise) in header.runs.into_iter().zip(overlaps).zip(noises) {
             let (these, rest) = numbers.split_at(per_run * 8);
             numbers = rest;
             let values: Vec<f64> =
@@ -398,7 +449,7 @@ impl EquationMoments {
                 .filter(Moments::is_consistent)
                 .map(|m| m.with_overlap(overlap))
                 .ok_or_else(|| broken(&format!("the statistics of run `{run}` are not whole")))?;
-            runs.push(RunMoments { run, moments });
+            runs.push(RunMoments { run, moments, noise });
         }
         let m = EquationMoments {
             equation: header.equation,
@@ -408,6 +459,23 @@ impl EquationMoments {
         };
         m.check(origin)?;
         Ok(m)
+    }
+
+    /// The note that the records' noise may bias the terms ([`super::noise_note`]), from
+    /// the noise tallied with the statistics, pooled over the runs.
+    pub fn noise_note(&self, model: &Model) -> Option<String> {
+        let eq = model_equation(model, &self.equation).ok()?;
+        let pooled: Vec<(String, NoiseTally)> = held_nonlinearly(&eq.candidates, &model.vocabulary)
+            .into_iter()
+            .map(|v| {
+                let mut all = NoiseTally::default();
+                for t in self.runs.iter().filter_map(|r| r.noise.get(&v)) {
+                    all.merge(t);
+                }
+                (v, all)
+            })
+            .collect();
+        super::noise::note(&super::noise::shares(&pooled))
     }
 
     /// Identifies the equation from the statistics with the model's forced and excluded terms
@@ -472,7 +540,8 @@ pub fn identify_from_moments(
     let mut fits = Vec::new();
     for m in &merged {
         let in_equation = |e: IdentifyError| e.in_equation(&m.equation);
-        let fit = m.fit(model, intercept).map_err(in_equation)?;
+        let mut fit = m.fit(model, intercept).map_err(in_equation)?;
+        fit.selection.notes.extend(m.noise_note(model));
         super::model::store_fit(&mut identified, &m.equation, &fit).map_err(in_equation)?;
         fits.push((m.equation.clone(), fit));
     }

@@ -14,7 +14,7 @@ mod start;
 
 pub use crate::plugin::RecipeDefaults;
 pub use halves::halves_check;
-pub use noise::{noise_check, noise_note};
+pub use noise::noise_check;
 pub use parameters::{ParameterOptions, ParameterStage};
 pub use report::Primes;
 pub use retrace::retrace_check;

@@ -2217,6 +2217,32 @@ fn noise_that_biases_the_terms_is_measured_and_said() {
     assert!(notes.contains("the records' noise may bias the terms: white noise of `x` "), "{notes}");
     // candidates linear in the variables are not biased so, and not said to be
     assert!(!one("x,y,z").contains("the records' noise"));
+    // the model identified, read again in pieces (`--chunk-rows`) and from statistics written
+    // apart (`termid moments`): no rows kept, so the noise tallied with the statistics says it
+    let model = dir.join("lu.toml").display().to_string();
+    let (ok, _, err) =
+        termid(&["identify", "--data", &data, "--states", "x,y,z", "--inputs", "--out", &model]);
+    assert!(ok, "{err}");
+    let pieces = &["--derivative", "central", "--chunk-rows", "500", "--format", "json"];
+    let (ok, report, err) =
+        termid(&[&["identify", "--model", &model, "--data", &data], &pieces[..]].concat());
+    assert!(ok, "{err}");
+    let notes = json(&report)["y_dot"]["notes"].to_string();
+    assert!(notes.contains("the records' noise may bias the terms: white noise of `x` "), "{notes}");
+    assert!((share_of(&notes, "z") - 5.0).abs() < 0.5, "{notes}");
+    let moments = dir.join("y.json").display().to_string();
+    let (ok, _, err) = termid(
+        &[
+            &["moments", "--model", &model, "--data", &data, "--equation", "y_dot", "--out", &moments],
+            &pieces[..4],
+        ]
+        .concat(),
+    );
+    assert!(ok, "{err}");
+    let (ok, report, err) =
+        termid(&["identify", "--model", &model, "--moments", &moments, "--format", "json"]);
+    assert!(ok, "{err}");
+    assert!(json(&report)["y_dot"]["notes"].to_string().contains("the records' noise may bias the terms"));
     let detail = noisy["detail"].as_str().unwrap();
     assert!(noisy["passed"] == false && noisy["refuses"] == false, "{noisy}");
     for state in ["x", "y", "z"] {
@@ -2225,6 +2251,10 @@ fn noise_that_biases_the_terms_is_measured_and_said() {
     let quiet = check(0.01);
     let detail = quiet["detail"].as_str().unwrap();
     assert!(quiet["passed"] == true, "{quiet}");
+    let data = dir.join("lu0.01.csv").display().to_string();
+    let (ok, report, err) =
+        termid(&[&["identify", "--model", &model, "--data", &data], &pieces[..]].concat());
+    assert!(ok && !report.contains("the records' noise"), "{err}");
     for state in ["x", "y", "z"] {
         assert!((share_of(detail, state) - 1.0).abs() < 0.15, "{detail}");
     }

@@ -239,7 +239,7 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
             identification
                 .say_delays(&target, &candidates, &frames, &columns, &mut fit, &|l| l.plain_remedy())?;
             // noise on a variable a candidate holds nonlinearly biases the fit itself
-            fit.selection.notes.extend(termid::recipe::noise_note(&candidates, &vocab, &frames));
+            fit.selection.notes.extend(termid::identify::noise_note(&candidates, &vocab, &frames));
         }
     }
     match cmd.format {
