@@ -80,7 +80,8 @@ impl NoiseTally {
     /// Both tallies as one (Chan's update of the mean and the squared deviations: records
     /// about different levels spread the variable too).
     pub fn merge(&mut self, other: &NoiseTally) {
-        let rows = self.rows + other.rows;
+        // (counts read from a file may be anything)
+        let rows = self.rows.saturating_add(other.rows);
         if rows > 0 {
             let d = other.mean - self.mean;
             let (a, b) = (self.rows as f64, other.rows as f64);
@@ -95,7 +96,7 @@ impl NoiseTally {
             _ => self.measured && other.measured,
         };
         self.noise += other.noise;
-        self.noise_rows += other.noise_rows;
+        self.noise_rows = self.noise_rows.saturating_add(other.noise_rows);
     }
 
     /// The noise's standard deviation over the spread of all rows, and whether every record's

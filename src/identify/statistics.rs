@@ -692,6 +692,9 @@ mod tests {
         assert!(e.contains("s.moments") && e.contains("do not make the statistics of 10 regressors"), "{e}");
         let e = EquationMoments::from_json("{\"equation\": 3}", "s.moments").unwrap_err().to_string();
         assert!(e.contains("s.moments"), "{e}");
+        let text = x.to_json().replacen("\"m2\":", "\"m2\":-", 1);
+        let e = EquationMoments::from_json(&text, "s.moments").unwrap_err().to_string();
+        assert!(e.contains("s.moments") && e.contains("the noise tally of `x` is not whole"), "{e}");
     }
 
     proptest::proptest! {
@@ -722,8 +725,22 @@ mod tests {
                 let k = ((at * list.len() as f64) as usize).min(list.len() - 1);
                 list[k] = serde_json::Value::from(*x);
             }
+            // and the noise tallies' numbers, counts included
+            let tallies = v["runs"][0]["noise"].as_object_mut().unwrap();
+            for (at, x) in &numbers {
+                let field = ["m2", "rows", "noise_rows", "mean", "noise"][(at * 15.0) as usize % 5];
+                let tally = tallies.values_mut().nth((at * 3.0) as usize).unwrap();
+                tally[field] = if field.ends_with("rows") {
+                    serde_json::Value::from(x.abs().min(u64::MAX as f64) as u64)
+                } else {
+                    serde_json::Value::from(*x)
+                };
+            }
             let text = v.to_string();
-            let read = std::panic::catch_unwind(|| EquationMoments::from_json(&text, "s.json").map(|r| r.fit(&lorenz, true).map(|_| ())));
+            let read = std::panic::catch_unwind(|| {
+                EquationMoments::from_json(&text, "s.json")
+                    .map(|r| (r.noise_note(&lorenz), r.fit(&lorenz, true).map(|_| ()), r.clone().merge(r).map(|b| b.noise_note(&lorenz))))
+            });
             proptest::prop_assert!(read.is_ok(), "from_json panicked");
         }
     }
