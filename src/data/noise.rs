@@ -42,31 +42,42 @@ pub fn white_noise(x: &[f64]) -> Option<Noise> {
 /// value, written with an equation's statistics).
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct NoiseTally {
-    /// Σ σ² × rows over the records whose noise was found ([`white_noise`]).
+    /// Σ σ² × rows over the records whose noise was measured ([`white_noise`]).
     pub noise: f64,
     /// The rows of those records.
     pub noise_rows: usize,
-    /// Whether every record's noise was measured, not only bounded ([`Noise::measured`]).
-    pub measured: bool,
-    /// All rows seen, their mean and their sum of squared deviations (Welford).
+    /// Σ σ² × rows over the records whose noise was only bounded ([`Noise::measured`]: the
+    /// motion shows through).
+    pub bound: f64,
+    /// The rows of those records.
+    pub bound_rows: usize,
+    /// All rows seen.
     pub rows: usize,
     /// The mean of the rows seen.
     pub mean: f64,
-    /// Their sum of squared deviations from `mean`.
+    /// Their sum of squared deviations from `mean` (Welford).
     pub m2: f64,
 }
+
+/// The share of the rows whose noise was measured from which the tally measures it: a short
+/// run or a few coarse ones among long fine ones do not turn a measurement into a bound.
+const MEASURED_ROWS: f64 = 0.9;
 
 impl NoiseTally {
     /// The tally of the `own` rows of `x`, a record or a piece of one with its neighbours'
     /// rows around (its fourth differences read across them).
     pub fn of(x: &[f64], own: std::ops::Range<usize>) -> NoiseTally {
         let rows = x.get(own).unwrap_or_default();
-        let mut tally = NoiseTally { measured: true, ..NoiseTally::default() };
+        let mut tally = NoiseTally::default();
         // a record too short for fourth differences still spreads the variable
         if let Some(found) = white_noise(x) {
-            tally.noise = found.sd * found.sd * rows.len() as f64;
-            tally.noise_rows = rows.len();
-            tally.measured = found.measured;
+            let (sum, count) = if found.measured {
+                (&mut tally.noise, &mut tally.noise_rows)
+            } else {
+                (&mut tally.bound, &mut tally.bound_rows)
+            };
+            *sum = found.sd * found.sd * rows.len() as f64;
+            *count = rows.len();
         }
         for &v in rows {
             tally.rows += 1;
@@ -89,28 +100,33 @@ impl NoiseTally {
             self.mean += d * b / rows as f64;
         }
         self.rows = rows;
-        // (where no record's noise was found, its flag says nothing)
-        self.measured = match (self.noise_rows, other.noise_rows) {
-            (0, _) => other.measured,
-            (_, 0) => self.measured,
-            _ => self.measured && other.measured,
-        };
         self.noise += other.noise;
         self.noise_rows = self.noise_rows.saturating_add(other.noise_rows);
+        self.bound += other.bound;
+        self.bound_rows = self.bound_rows.saturating_add(other.bound_rows);
     }
 
-    /// The noise's standard deviation over the spread of all rows, and whether every record's
-    /// noise was measured; `None` where none was long enough to measure or nothing varies.
+    /// The noise's standard deviation over the spread of all rows, and whether it was
+    /// measured: from the records whose noise was measured where they hold 90 % of the rows
+    /// whose noise was found, else from all of them as a bound (`false`). `None` where no
+    /// record was long enough to tell or nothing varies.
     pub fn share(&self) -> Option<(f64, bool)> {
         let spread = (self.m2 / self.rows.max(1) as f64).sqrt();
-        (self.noise_rows > 0 && spread > 0.0 && spread.is_finite())
-            .then(|| ((self.noise / self.noise_rows as f64).sqrt() / spread, self.measured))
+        let found = self.noise_rows as f64 + self.bound_rows as f64;
+        if found == 0.0 || !(spread > 0.0 && spread.is_finite()) {
+            return None;
+        }
+        Some(if self.noise_rows as f64 >= MEASURED_ROWS * found {
+            ((self.noise / self.noise_rows as f64).sqrt() / spread, true)
+        } else {
+            (((self.noise + self.bound) / found).sqrt() / spread, false)
+        })
     }
 
     /// Whether rows could have given it: counts that fit, sums not negative, numbers finite.
     pub fn is_consistent(&self) -> bool {
-        self.noise_rows <= self.rows
-            && [self.noise, self.m2].iter().all(|v| v.is_finite() && *v >= 0.0)
+        self.noise_rows.checked_add(self.bound_rows).is_some_and(|n| n <= self.rows)
+            && [self.noise, self.bound, self.m2].iter().all(|v| v.is_finite() && *v >= 0.0)
             && self.mean.is_finite()
     }
 }

@@ -19,35 +19,58 @@ const FEWEST_ROWS: usize = 50;
 
 /// How the rows are halved: each run cut in the middle, or, where a run is too short for
 /// that, every other run against the rest (many short runs: each half still holds half of
-/// the rows).
+/// the rows), or both (the long runs cut, the short ones given to the halves in turn).
 #[derive(Clone, Copy, PartialEq)]
 enum Halving {
     EachRun,
     EveryOtherRun,
+    Both,
+}
+
+impl Halving {
+    /// `frames` in two halves, and how they were cut: each run long enough to halve cut in
+    /// the middle, the runs too short for that given to the halves in turn.
+    fn of(frames: &[Frame]) -> (Halving, [Vec<Frame>; 2]) {
+        let mut halves = [Vec::new(), Vec::new()];
+        let (mut turn, mut cut, mut whole) = (0, false, false);
+        for f in frames {
+            if f.len() >= 2 * FEWEST_ROWS {
+                let middle = f.len() / 2;
+                halves[0].push(f.slice(0..middle));
+                halves[1].push(f.slice(middle..f.len()));
+                cut = true;
+            } else {
+                halves[turn].push(f.clone());
+                turn = 1 - turn;
+                whole = true;
+            }
+        }
+        let halving = match (cut, whole) {
+            (_, false) => Halving::EachRun,
+            (false, true) => Halving::EveryOtherRun,
+            (true, true) => Halving::Both,
+        };
+        (halving, halves)
+    }
 }
 
 /// The check that each equation of `identified` (from `frames` by `how`) chooses its terms
 /// from the first and from the second half of every run too (runs too short to halve: from
-/// every other run and from the rest): flagged (not refusing) where a term is chosen from all
-/// the rows but not from both halves. `None` where it cannot apply: a single run too short to
-/// halve, too few rows in a half, or a half that cannot be identified.
+/// every other one of them and from the rest): flagged (not refusing) where a term is chosen
+/// from all the rows but not from both halves. `None` where it cannot apply: a single run too
+/// short to halve, too few rows in a half, or a half that cannot be identified.
 pub fn halves_check(
     identified: &IdentifiedModel,
     frames: &[Frame],
     how: &ModelIdentification<'_>,
 ) -> Option<Check> {
-    let halving = if frames.is_empty() {
+    let (halving, halves) = Halving::of(frames);
+    // runs given whole to a half: a run's worth of rows in each, twice FEWEST_ROWS
+    let rows = |half: &[Frame]| half.iter().map(Frame::len).sum::<usize>();
+    let least = if halving == Halving::EachRun { FEWEST_ROWS } else { 2 * FEWEST_ROWS };
+    if halves.iter().any(|h| h.is_empty() || rows(h) < least) {
         return None;
-    } else if frames.iter().all(|f| f.len() >= 2 * FEWEST_ROWS) {
-        Halving::EachRun
-    } else {
-        // every run a half's worth of rows at least: FEWEST_ROWS in each of both
-        let rows = |parity: usize| frames.iter().skip(parity).step_by(2).map(Frame::len).sum::<usize>();
-        if frames.len() < 2 || rows(0) < 2 * FEWEST_ROWS || rows(1) < 2 * FEWEST_ROWS {
-            return None;
-        }
-        Halving::EveryOtherRun
-    };
+    }
     let model: &Model = &identified.model;
     let kept = windows_kept(how.differentiator, frames);
     let how = ModelIdentification {
@@ -57,25 +80,9 @@ pub fn halves_check(
         ..*how
     };
     let how = &how;
-    let half = |second: bool| -> Option<IdentifiedModel> {
-        let cut: Vec<Frame> = match halving {
-            Halving::EachRun => frames
-                .iter()
-                .map(|f| {
-                    let middle = f.len() / 2;
-                    if second {
-                        f.slice(middle..f.len())
-                    } else {
-                        f.slice(0..middle)
-                    }
-                })
-                .collect(),
-            Halving::EveryOtherRun => frames.iter().skip(usize::from(second)).step_by(2).cloned().collect(),
-        };
-        identify_model(model, &cut, how, &mut |_| {}).ok()
-    };
+    let half = |cut: &[Frame]| identify_model(model, cut, how, &mut |_| {}).ok();
     // side by side: each half is one run's worth of work per run, which leaves a core idle
-    let (first, second) = rayon::join(|| half(false), || half(true));
+    let (first, second) = rayon::join(|| half(&halves[0]), || half(&halves[1]));
     let (first, second) = (first?, second?);
     let chosen = |found: &IdentifiedModel, name: &str| -> Vec<String> {
         found
@@ -98,12 +105,16 @@ pub fn halves_check(
             unsteady.push(format!("`{name}`: {}", lost.join(", ")));
         }
     }
-    let halves = match halving {
+    let from = match halving {
         Halving::EachRun => "the first and from the second half of every run",
         Halving::EveryOtherRun => "every other run and from the rest (the runs too short to halve)",
+        Halving::Both => {
+            "the first and from the second half of every run long enough to halve, the shorter runs \
+             given to the halves in turn"
+        }
     };
     let detail = if unsteady.is_empty() {
-        format!("each equation chooses the same terms from {halves}")
+        format!("each equation chooses the same terms from {from}")
     } else {
         format!(
             "chosen from all the rows but not from both {}: {}; terms the noise chose \
@@ -112,6 +123,7 @@ pub fn halves_check(
             match halving {
                 Halving::EachRun => "halves of every run",
                 Halving::EveryOtherRun => "every other run and the rest",
+                Halving::Both => "halves of the runs (the shorter runs given to them in turn)",
             },
             unsteady.join("; ")
         )
@@ -207,6 +219,16 @@ mod tests {
         let check = halves_check(&identified, &late, &how).unwrap();
         assert!(
             !check.passed && check.detail.contains("every other run and the rest: `x_dot`: `u`"),
+            "{}",
+            check.detail
+        );
+        // a long run beside a short one (it once left the check out): the long one halved, the
+        // short one given to a half
+        let mixed = [whole.clone(), whole.slice(0..30)];
+        let identified = identify_model(&model, &mixed, &how, &mut |_| {}).unwrap();
+        let check = halves_check(&identified, &mixed, &how).unwrap();
+        assert!(
+            check.passed && check.detail.contains("the shorter runs given to the halves in turn"),
             "{}",
             check.detail
         );
