@@ -109,6 +109,23 @@ fn syntax_error(input: &str, mut e: pest::error::Error<Rule>) -> TermError {
             );
         }
     }
+    // what other languages write: Python's and Fortran's `**`, a module's `np.sin`
+    let after = &input[at.min(input.len())..];
+    if after.starts_with('*') && before.ends_with('*') {
+        return TermError::at(input, at - 1, at + 1, "powers are written `u^2`, not `u**2`".to_string());
+    }
+    if after.starts_with('.') && before.ends_with(|c: char| c.is_alphanumeric() || c == '_') {
+        let module = before.rsplit(|c: char| !(c.is_alphanumeric() || c == '_')).next().unwrap_or_default();
+        return TermError::at(
+            input,
+            at - module.len(),
+            at + 1,
+            format!(
+                "`{module}.`: functions are named alone (`sin(x)`, not `np.sin(x)`): {}",
+                super::functions::FUNCTIONS.iter().map(|f| f.name).collect::<Vec<_>>().join(", ")
+            ),
+        );
+    }
     if let pest::error::ErrorVariant::ParsingError { positives, .. } = &mut e.variant {
         let mut seen = Vec::new();
         positives.retain(|r| {
@@ -299,14 +316,20 @@ mod tests {
 
     #[test]
     fn syntax_errors_have_carets() {
-        for (text, col) in [("u**v", 3), ("u*(v", 5), ("u^v", 3), ("", 1), ("u v", 3)] {
+        for (text, col) in [("u**v", 2), ("u*(v", 5), ("u^v", 3), ("", 1), ("u v", 3)] {
             let err = parse_expr(text).unwrap_err();
             let msg = err.to_string();
             assert!(msg.contains('^'), "{text}: {msg}");
             assert_eq!(err.line_col(), Some((1, col)), "{text}: {msg}");
         }
-        let msg = parse_expr("u**v").unwrap_err().to_string();
+        let msg = parse_expr("u*)").unwrap_err().to_string();
         assert!(msg.contains("expected"), "{msg}");
         assert!(!msg.contains("Rule"), "{msg}");
+        // what Python writes, said in termid's words
+        let msg = parse_expr("x**2").unwrap_err().to_string();
+        assert!(msg.contains("powers are written `u^2`, not `u**2`"), "{msg}");
+        let err = parse_expr("2*np.sin(x)").unwrap_err();
+        assert!(err.to_string().contains("`np.`: functions are named alone"), "{err}");
+        assert_eq!(err.line_col(), Some((1, 3)));
     }
 }

@@ -54,7 +54,8 @@ fn duplicate_candidates_name_both_spellings() {
 fn caret_messages() {
     let v = ship();
     let cases = [
-        ("u**v", "1:3", "expected"),
+        ("u**v", "1:2", "powers are written `u^2`, not `u**2`"),
+        ("np.sin(u)", "1:1", "functions are named alone (`sin(x)`, not `np.sin(x)`)"),
         ("u*(v", "1:5", "expected"),
         ("u*w", "1:3", "unknown variable `w`"),
         ("sqr(u)", "1:1", "unknown function `sqr`; known: abs, sign, sqrt"),

@@ -64,7 +64,7 @@ fn errors_name_file_line_and_key() {
     let line = text.lines().position(|l| l.contains("u*r**delta")).unwrap() + 1;
     assert!(matches!(e, ModelError::Term { .. }));
     assert!(msg.starts_with(&format!("ship.toml:{line}: `equations.u_dot.candidates[")), "{msg}");
-    assert!(msg.contains('^') && msg.contains("1:5"), "{msg}");
+    assert!(msg.contains('^') && msg.contains("1:4"), "{msg}");
 
     let e = termid::plugins::parse(&with("rudder_rate = 12.65", "rudder_rate = \"fast\""), "ship.toml")
         .unwrap_err();
