@@ -102,7 +102,22 @@ impl Vocabulary {
                      which reads it by its bare name in SI)",
                     bare.trim()
                 ),
-                _ => String::new(),
+                _ => {
+                    // `x.pos`, `y pos`, `z-pos`: the same with `_`, where that makes a name
+                    let bare: String = name
+                        .trim()
+                        .chars()
+                        .map(|c| if c.is_alphanumeric() || c == '_' || c == '∆' { c } else { '_' })
+                        .collect();
+                    if is_identifier(&bare) {
+                        format!(
+                            " (a name is letters, digits and `_`, not a digit first: call it `{bare}`, the column \
+                             renamed or mapped in a dataset file, `[columns] {bare} = \"{name}\"`)"
+                        )
+                    } else {
+                        " (a name is letters, digits and `_`, not a digit first)".to_string()
+                    }
+                }
             };
             return Err(TermError::Declaration(format!("`{name}` is not a valid name{hint}")));
         }
@@ -348,7 +363,11 @@ mod tests {
         let e = Vocabulary::new().variable("x [m]").map(|_| ()).unwrap_err().to_string();
         assert!(e.contains("`[columns] x = \"x [m]\"`"), "{e}");
         let e = Vocabulary::new().variable("x y").map(|_| ()).unwrap_err().to_string();
-        assert!(e.ends_with("`x y` is not a valid name"), "{e}");
+        assert!(e.contains("`x y` is not a valid name") && e.contains("call it `x_y`"), "{e}");
+        let e = Vocabulary::new().variable("x.pos").map(|_| ()).unwrap_err().to_string();
+        assert!(e.contains("`[columns] x_pos = \"x.pos\"`"), "{e}");
+        let e = Vocabulary::new().variable("2x").map(|_| ()).unwrap_err().to_string();
+        assert!(e.ends_with("not a digit first)"), "{e}");
     }
 
     #[test]
