@@ -42,7 +42,7 @@ pub use hold::{held, mark_held, switches, Hold, Intersample};
 pub use integral::{integral_rows, integral_rows_held, row_overlap, IntegralForm};
 pub use kalman::{KalmanSmoother, NoiseModel};
 pub use long::{columns_of, interleaved, text_columns_of};
-pub use noise::{white_noise, Noise, NoiseTally};
+pub use noise::{quantum, white_noise, Noise, NoiseTally};
 pub use prepare::{prepare, runs_of_rate, Preparation};
 pub use repeated::{
     between_readings, fits_better_held, kinks_at_changes, read_at_readings, repeated, Repeats,

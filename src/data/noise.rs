@@ -3,6 +3,8 @@
 //! Where the motion shows through (a coarse record) the noise cannot be told from it; noise
 //! correlated over more than a few samples shows less than it is.
 
+use super::Frame;
+
 /// Σ C(4, k)² = C(8, 4): the variance of the fourth difference of white noise of unit variance.
 const FOURTH: f64 = 70.0;
 
@@ -61,6 +63,30 @@ fn over(x: &[f64], lag: usize) -> Noise {
     Noise { sd: s4, measured: s4 >= WHITE * s3 }
 }
 
+/// The step of the grid a record's values sit on, where the record is read so coarsely that
+/// it moves one step at a time (a motion printed with few digits, an encoder's counts): its
+/// rounding is then noise of step/√12 that the differences do not see (they are mostly 0, or
+/// a staircase). `None` where the values move by other amounts, or by single steps over fewer
+/// than ten levels (a command switched between levels is no rounding).
+pub fn quantum(x: &[f64]) -> Option<f64> {
+    let steps: Vec<f64> = x.windows(2).map(|w| (w[1] - w[0]).abs()).filter(|d| *d > 0.0).collect();
+    if steps.len() < 20 || steps.iter().any(|d| !d.is_finite()) {
+        return None;
+    }
+    let q = steps.iter().copied().fold(f64::INFINITY, f64::min);
+    let mut single = 0;
+    for d in &steps {
+        let n = (d / q).round();
+        // decimal digits read as binary numbers leave a relative error of ~1e-15 of the values
+        if (d / q - n).abs() > 1e-6 * n.max(1.0) {
+            return None;
+        }
+        single += usize::from(n == 1.0);
+    }
+    let (low, high) = x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
+    (single as f64 >= 0.8 * steps.len() as f64 && (high - low) / q >= 9.0).then_some(q)
+}
+
 /// A variable's white noise and spread gathered over records read whole or in pieces and
 /// merged in any grouping: what the identification's noise note and check compare (a plain
 /// value, written with an equation's statistics).
@@ -88,13 +114,26 @@ pub struct NoiseTally {
 const MEASURED_ROWS: f64 = 0.9;
 
 impl NoiseTally {
-    /// The tally of the `own` rows of `x`, a record or a piece of one with its neighbours'
-    /// rows around (its fourth differences read across them).
-    pub fn of(x: &[f64], own: std::ops::Range<usize>) -> NoiseTally {
+    /// The tally of column `name` over the `own` rows of `frame`, a run or a piece of one with
+    /// its neighbours' rows around (its fourth differences read across them); `None` where
+    /// the frame has no such column. A column held or switched between samples (a command:
+    /// [`Frame::held`]) is not taken for a motion rounded to its levels.
+    pub fn of(frame: &Frame, name: &str, own: std::ops::Range<usize>) -> Option<NoiseTally> {
+        let command = frame.held().iter().chain(frame.switched()).any(|c| c == name);
+        Some(Self::of_values(frame.column(name)?, own, !command))
+    }
+
+    /// The tally of the `own` rows of `x`, its rounding counted where `rounded` allows.
+    fn of_values(x: &[f64], own: std::ops::Range<usize>, rounded: bool) -> NoiseTally {
         let rows = x.get(own).unwrap_or_default();
         let mut tally = NoiseTally::default();
-        // a record too short for fourth differences still spreads the variable
-        if let Some(found) = white_noise(x) {
+        // a record too short for fourth differences still spreads the variable; one read so
+        // coarsely that it moves a step at a time carries its rounding's noise, which its
+        // differences misread (a staircase's: a sine printed to a tenth of its amplitude reads
+        // 1.8 times its rounding's σ)
+        let rounding = quantum(x).filter(|_| rounded).map(|q| Noise { sd: q / 12f64.sqrt(), measured: true });
+        let found = rounding.or_else(|| white_noise(x));
+        if let Some(found) = found {
             let (sum, count) = if found.measured {
                 (&mut tally.noise, &mut tally.noise_rows)
             } else {
@@ -204,6 +243,25 @@ mod tests {
         assert!(found.measured && (0.45..0.6).contains(&(found.sd / 0.05)), "{found:?}");
         assert!((over(&correlated, 1).sd / 0.05 - 0.36).abs() < 0.03);
         assert_eq!(white_noise(&[1.0; 100]), Some(Noise { sd: 0.0, measured: true }));
+        // the sine printed to a tenth of its amplitude moves a step at a time: its rounding
+        // is noise of 0.1/√12 the differences read as 0; a command switched between three
+        // levels, or steps of more than one, are no rounding
+        let printed: Vec<f64> = clean.iter().map(|v| (v * 10.0).round() / 10.0).collect();
+        assert!((quantum(&printed).unwrap() - 0.1).abs() < 1e-12);
+        let tally = NoiseTally::of_values(&printed, 0..printed.len(), true);
+        let (share, measured) = tally.share().unwrap();
+        let sd = share * std::f64::consts::FRAC_1_SQRT_2;
+        assert!(
+            measured && (sd / (0.1 / 12f64.sqrt()) - 1.0).abs() < 0.05,
+            "{sd} {:?}",
+            white_noise(&printed)
+        );
+        assert_eq!(quantum(&(0..300).map(|k| ((k / 20) % 3) as f64).collect::<Vec<_>>()), None);
+        assert_eq!(
+            quantum(&(0..300).map(|k| (k / 10) as f64 * 2.5 + (k % 2) as f64 * 0.4).collect::<Vec<_>>()),
+            None
+        );
+        assert_eq!(quantum(&noisy), None);
         assert_eq!(white_noise(&[1.0; 10]), None);
     }
 
@@ -220,19 +278,22 @@ mod tests {
         };
         let x: Vec<f64> =
             (0..10_000).map(|k| 3.0 * (k as f64 * 0.01).sin() + 5.0 + 0.1 * uniform()).collect();
-        let whole = NoiseTally::of(&x, 0..x.len());
+        let whole = NoiseTally::of_values(&x, 0..x.len(), true);
         let mut pieces = NoiseTally::default();
         for start in (0..x.len()).step_by(1000) {
             let (from, to) = (start.saturating_sub(6), (start + 1006).min(x.len()));
-            pieces
-                .merge(&NoiseTally::of(&x[from..to], start - from..start - from + 1000.min(x.len() - start)));
+            pieces.merge(&NoiseTally::of_values(
+                &x[from..to],
+                start - from..start - from + 1000.min(x.len() - start),
+                true,
+            ));
         }
         assert_eq!(pieces.rows, whole.rows);
         assert!((pieces.mean / whole.mean - 1.0).abs() < 1e-12 && (pieces.m2 / whole.m2 - 1.0).abs() < 1e-12);
         let (a, b) = (whole.share().unwrap(), pieces.share().unwrap());
         assert!(a.1 && b.1 && (a.0 / b.0 - 1.0).abs() < 0.05, "{a:?} {b:?}");
         let mut short = whole.clone();
-        short.merge(&NoiseTally::of(&[100.0; 5], 0..5));
+        short.merge(&NoiseTally::of_values(&[100.0; 5], 0..5, true));
         assert_eq!(
             (short.noise, short.noise_rows, short.rows),
             (whole.noise, whole.noise_rows, whole.rows + 5)

@@ -61,8 +61,8 @@ pub(crate) fn tallies(variables: &[String], runs: &[Frame]) -> Vec<(String, Nois
         .iter()
         .map(|v| {
             let mut all = NoiseTally::default();
-            for x in runs.iter().filter_map(|f| f.column(v)) {
-                all.merge(&NoiseTally::of(x, 0..x.len()));
+            for tally in runs.iter().filter_map(|f| NoiseTally::of(f, v, 0..f.len())) {
+                all.merge(&tally);
             }
             (v.clone(), all)
         })
@@ -90,7 +90,7 @@ pub(crate) fn measured(shares: &[&Share]) -> String {
         .collect();
     format!(
         "white noise of {} of the spread of the variables the candidates hold nonlinearly (from \
-         their fourth differences)",
+         their fourth differences, or their rounding where they move a step at a time)",
         listed.join(", ")
     )
 }

@@ -98,7 +98,7 @@ impl EquationMoments {
                     moments: m,
                     noise: noisy
                         .iter()
-                        .filter_map(|v| Some((v.clone(), NoiseTally::of(f.column(v)?, 0..f.len()))))
+                        .filter_map(|v| Some((v.clone(), NoiseTally::of(f, v, 0..f.len())?)))
                         .collect(),
                 })
                 .collect(),
@@ -227,11 +227,8 @@ impl EquationMoments {
                 // each piece's noise read across its neighbours' rows, its spread over its own
                 for (variables, tallies) in noisy.iter().zip(noise.iter_mut()) {
                     for v in variables {
-                        if let Some(x) = chunk.frame.column(v) {
-                            tallies
-                                .entry(v.clone())
-                                .or_default()
-                                .merge(&NoiseTally::of(x, chunk.own.clone()));
+                        if let Some(piece) = NoiseTally::of(&chunk.frame, v, chunk.own.clone()) {
+                            tallies.entry(v.clone()).or_default().merge(&piece);
                         }
                     }
                 }
