@@ -2175,15 +2175,22 @@ fn noise_that_biases_the_terms_is_measured_and_said() {
             (run.iter().map(|r| (r[i] - mean).powi(2)).sum::<f64>() / run.len() as f64).sqrt()
         })
         .collect();
-    let check = |share: f64| -> serde_json::Value {
-        let mut noise = Lcg(17);
+    // the run's states, each sample as `record` reads it, written as a file of its own
+    let write = |name: &str, record: &mut dyn FnMut(&[f64]) -> Vec<f64>| -> String {
         let mut text = String::from("t,x,y,z\n");
         for (k, r) in run.iter().enumerate() {
-            let s: Vec<f64> = (0..3).map(|i| r[i] + share * spread[i] * noise.normal()).collect();
+            let s = record(r);
             text += &format!("{},{},{},{}\n", k as f64 * 0.006, s[0], s[1], s[2]);
         }
-        let data = dir.join(format!("lu{share}.csv")).display().to_string();
-        std::fs::write(&data, text).unwrap();
+        let path = dir.join(name).display().to_string();
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    let check = |share: f64| -> serde_json::Value {
+        let mut noise = Lcg(17);
+        let data = write(&format!("lu{share}.csv"), &mut |r| {
+            (0..3).map(|i| r[i] + share * spread[i] * noise.normal()).collect()
+        });
         let (ok, report, err) =
             termid(&["identify", "--data", &data, "--states", "x,y,z", "--inputs", "--format", "json"]);
         assert!(ok, "{err}");
@@ -2208,16 +2215,16 @@ fn noise_that_biases_the_terms_is_measured_and_said() {
     let noisy = check(0.05);
     // one equation without a model (`--target dx/dt --terms`): said in its notes
     let data = dir.join("lu0.05.csv").display().to_string();
-    let one = |terms: &str| {
+    let one = |data: &str, terms: &str| {
         let (ok, report, err) =
-            termid(&["identify", "--data", &data, "--target", "dx/dt", "--terms", terms, "--format", "json"]);
+            termid(&["identify", "--data", data, "--target", "dx/dt", "--terms", terms, "--format", "json"]);
         assert!(ok, "{err}");
         json(&report)["notes"].to_string()
     };
-    let notes = one("x,y,x*y,x^2*y,x*z");
+    let notes = one(&data, "x,y,x*y,x^2*y,x*z");
     assert!(notes.contains("the records' noise may bias the terms: white noise of `x` "), "{notes}");
     // candidates linear in the variables are not biased so, and not said to be
-    assert!(!one("x,y,z").contains("the records' noise"));
+    assert!(!one(&data, "x,y,z").contains("the records' noise"));
     // the model identified, read again in pieces (`--chunk-rows`) and from statistics written
     // apart (`termid moments`): no rows kept, so the noise tallied with the statistics says it
     let model = dir.join("lu.toml").display().to_string();
@@ -2251,53 +2258,19 @@ fn noise_that_biases_the_terms_is_measured_and_said() {
     }
     // the same noise filtered by a sensor (correlated 0.8 from one sample to the next, its
     // variance kept): read over one sample it showed 1.8 % and passed, the terms wrong
-    let mut noise = Lcg(29);
-    let mut filtered = [0.0; 3];
-    let mut text = String::from("t,x,y,z\n");
-    for (k, r) in run.iter().enumerate() {
+    let (mut noise, mut filtered) = (Lcg(29), [0.0; 3]);
+    let sensor = write("filtered.csv", &mut |r| {
         for (i, f) in filtered.iter_mut().enumerate() {
             *f = 0.8 * *f + 0.6 * 0.05 * spread[i] * noise.normal();
         }
-        let s: Vec<f64> = (0..3).map(|i| r[i] + filtered[i]).collect();
-        text += &format!("{},{},{},{}\n", k as f64 * 0.006, s[0], s[1], s[2]);
-    }
-    let sensor = dir.join("filtered.csv").display().to_string();
-    std::fs::write(&sensor, text).unwrap();
-    let (ok, report, err) = termid(&[
-        "identify",
-        "--data",
-        &sensor,
-        "--target",
-        "dx/dt",
-        "--terms",
-        "x,y,x*y,x^2*y,x*z",
-        "--format",
-        "json",
-    ]);
-    assert!(ok, "{err}");
-    let notes = json(&report)["notes"].to_string();
+        (0..3).map(|i| r[i] + filtered[i]).collect()
+    });
+    let notes = one(&sensor, "x,y,x*y,x^2*y,x*z");
     assert!(notes.contains("the records' noise may bias the terms: white noise of `x` 2."), "{notes}");
     // the run printed to whole units: it moves a unit at a time, its rounding noise of 1/√12
     // (3.7 % of x's spread) that the differences misread as at most 2.3 %, unflagged
-    let mut text = String::from("t,x,y,z\n");
-    for (k, r) in run.iter().enumerate() {
-        text += &format!("{},{},{},{}\n", k as f64 * 0.006, r[0].round(), r[1].round(), r[2].round());
-    }
-    let printed = dir.join("printed.csv").display().to_string();
-    std::fs::write(&printed, text).unwrap();
-    let (ok, report, err) = termid(&[
-        "identify",
-        "--data",
-        &printed,
-        "--target",
-        "dx/dt",
-        "--terms",
-        "x,y,x*y,x^2*y,x*z",
-        "--format",
-        "json",
-    ]);
-    assert!(ok, "{err}");
-    let notes = json(&report)["notes"].to_string();
+    let printed = write("printed.csv", &mut |r| r.iter().map(|v| v.round()).collect());
+    let notes = one(&printed, "x,y,x*y,x^2*y,x*z");
     let rounding = 100.0 / 12f64.sqrt() / spread[0];
     assert!((share_of(&notes, "x") / rounding - 1.0).abs() < 0.03, "{rounding}: {notes}");
     let quiet = check(0.01);
