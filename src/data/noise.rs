@@ -151,6 +151,14 @@ impl NoiseTally {
         tally
     }
 
+    /// The tallies as one ([`NoiseTally::merge`] in turn).
+    pub fn pooled(tallies: impl IntoIterator<Item = NoiseTally>) -> NoiseTally {
+        tallies.into_iter().fold(NoiseTally::default(), |mut all, t| {
+            all.merge(&t);
+            all
+        })
+    }
+
     /// Both tallies as one (Chan's update of the mean and the squared deviations: records
     /// about different levels spread the variable too).
     pub fn merge(&mut self, other: &NoiseTally) {

@@ -60,11 +60,7 @@ pub(crate) fn tallies(variables: &[String], runs: &[Frame]) -> Vec<(String, Nois
     variables
         .iter()
         .map(|v| {
-            let mut all = NoiseTally::default();
-            for tally in runs.iter().filter_map(|f| NoiseTally::of(f, v, 0..f.len())) {
-                all.merge(&tally);
-            }
-            (v.clone(), all)
+            (v.clone(), NoiseTally::pooled(runs.iter().filter_map(|f| NoiseTally::of(f, v, 0..f.len()))))
         })
         .collect()
 }

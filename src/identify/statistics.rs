@@ -224,11 +224,16 @@ impl EquationMoments {
                 else {
                     unreachable!("set by the run's first chunk")
                 };
-                // each piece's noise read across its neighbours' rows, its spread over its own
+                // each piece's noise read across its neighbours' rows, its spread over its own;
+                // a variable once a piece, whichever equations hold it
+                let mut read: BTreeMap<&str, Option<NoiseTally>> = BTreeMap::new();
                 for (variables, tallies) in noisy.iter().zip(noise.iter_mut()) {
                     for v in variables {
-                        if let Some(piece) = NoiseTally::of(&chunk.frame, v, chunk.own.clone()) {
-                            tallies.entry(v.clone()).or_default().merge(&piece);
+                        let piece = read
+                            .entry(v)
+                            .or_insert_with(|| NoiseTally::of(&chunk.frame, v, chunk.own.clone()));
+                        if let Some(piece) = piece {
+                            tallies.entry(v.clone()).or_default().merge(piece);
                         }
                     }
                 }
@@ -465,10 +470,7 @@ impl EquationMoments {
         let pooled: Vec<(String, NoiseTally)> = held_nonlinearly(&eq.candidates, &model.vocabulary)
             .into_iter()
             .map(|v| {
-                let mut all = NoiseTally::default();
-                for t in self.runs.iter().filter_map(|r| r.noise.get(&v)) {
-                    all.merge(t);
-                }
+                let all = NoiseTally::pooled(self.runs.iter().filter_map(|r| r.noise.get(&v)).cloned());
                 (v, all)
             })
             .collect();
