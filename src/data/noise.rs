@@ -17,8 +17,10 @@ const THIRD: f64 = 20.0;
 const WHITE: f64 = 0.8;
 
 /// The noise over two samples over that over one from which the noise is taken to be
-/// correlated from sample to sample (white noise reads alike over both).
-const CORRELATED: f64 = 1.1;
+/// correlated from sample to sample: white noise reads alike over both, a motion leaking into
+/// the two-sample reading raised it by up to 1.18 (FitzHugh-Nagumo at 1 %), noise filtered to
+/// a correlation of 0.5 from sample to sample by about 1.3.
+const CORRELATED: f64 = 1.2;
 
 /// The white noise on a record.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,15 +31,18 @@ pub struct Noise {
     /// coarse: its third differences spread more than white noise would give beside its
     /// fourth), `sd` bounds the noise from above and does not measure it.
     pub measured: bool,
+    /// Whether it reads more over two samples than over one: noise correlated from sample to
+    /// sample, of which `sd` is a lower bound.
+    pub correlated: bool,
 }
 
 /// The white noise on `x`: its fourth differences' median absolute value (robust to a few
-/// glitches) scaled to σ, over one sample, and over two where that reads a tenth more and
+/// glitches) scaled to σ, over one sample, and over two where that reads a fifth more and
 /// the motion does not show through it either. Noise correlated from sample to sample (a filtered
 /// sensor's) shows less over one sample than it is; over two, more of it (on the ODE
 /// benchmark's 37 systems, noise of 5 % of the spread filtered to a correlation of 0.8 from
 /// sample to sample reads 1.7-1.9 % over one sample, 2.4-2.7 % over both; white noise of 1 %
-/// reads 0.99-1.06 %, with both 0.99-1.18 %). `None` for a record under 20 samples or one not
+/// reads 0.99-1.06 % either way). `None` for a record under 20 samples or one not
 /// finite. A held or quantised record whose differences are mostly 0 gives 0.
 pub fn white_noise(x: &[f64]) -> Option<Noise> {
     if x.len() < 20 || x.iter().any(|v| !v.is_finite()) {
@@ -49,8 +54,8 @@ pub fn white_noise(x: &[f64]) -> Option<Noise> {
     }
     let two = over(x, 2);
     // (a margin, so that white noise keeps its one-sample reading, not the larger of two
-    // readings that scatter alike)
-    Some(if two.measured && two.sd > CORRELATED * one.sd { two } else { one })
+    // readings that scatter alike, nor one the motion raised)
+    Some(if two.measured && two.sd > CORRELATED * one.sd { Noise { correlated: true, ..two } } else { one })
 }
 
 /// The noise read off the differences of `x` over `lag` samples.
@@ -60,7 +65,7 @@ fn over(x: &[f64], lag: usize) -> Noise {
         .collect();
     let fourth: Vec<f64> = (0..third.len() - lag).map(|k| third[k + lag] - third[k]).collect();
     let (s3, s4) = (robust_sd(third) / THIRD.sqrt(), robust_sd(fourth) / FOURTH.sqrt());
-    Noise { sd: s4, measured: s4 >= WHITE * s3 }
+    Noise { sd: s4, measured: s4 >= WHITE * s3, correlated: false }
 }
 
 /// The step of the grid a record's values sit on, where the record is read so coarsely that
@@ -96,6 +101,9 @@ pub struct NoiseTally {
     pub noise: f64,
     /// The rows of those records.
     pub noise_rows: usize,
+    /// The rows of those whose noise read correlated ([`Noise::correlated`]).
+    #[serde(default)]
+    pub correlated_rows: usize,
     /// Σ σ² × rows over the records whose noise was only bounded ([`Noise::measured`]: the
     /// motion shows through).
     pub bound: f64,
@@ -131,7 +139,11 @@ impl NoiseTally {
         // coarsely that it moves a step at a time carries its rounding's noise, which its
         // differences misread (a staircase's: a sine printed to a tenth of its amplitude reads
         // 1.8 times its rounding's σ)
-        let rounding = quantum(x).filter(|_| rounded).map(|q| Noise { sd: q / 12f64.sqrt(), measured: true });
+        let rounding = quantum(x).filter(|_| rounded).map(|q| Noise {
+            sd: q / 12f64.sqrt(),
+            measured: true,
+            correlated: false,
+        });
         let found = rounding.or_else(|| white_noise(x));
         if let Some(found) = found {
             let (sum, count) = if found.measured {
@@ -141,6 +153,9 @@ impl NoiseTally {
             };
             *sum = found.sd * found.sd * rows.len() as f64;
             *count = rows.len();
+            if found.measured && found.correlated {
+                tally.correlated_rows = rows.len();
+            }
         }
         for &v in rows {
             tally.rows += 1;
@@ -173,6 +188,7 @@ impl NoiseTally {
         self.rows = rows;
         self.noise += other.noise;
         self.noise_rows = self.noise_rows.saturating_add(other.noise_rows);
+        self.correlated_rows = self.correlated_rows.saturating_add(other.correlated_rows);
         self.bound += other.bound;
         self.bound_rows = self.bound_rows.saturating_add(other.bound_rows);
     }
@@ -194,9 +210,16 @@ impl NoiseTally {
         })
     }
 
+    /// Whether the noise measured read correlated from sample to sample in most of its rows:
+    /// the share is then a lower bound.
+    pub fn correlated(&self) -> bool {
+        self.correlated_rows as f64 > 0.5 * self.noise_rows as f64
+    }
+
     /// Whether rows could have given it: counts that fit, sums not negative, numbers finite.
     pub fn is_consistent(&self) -> bool {
         self.noise_rows.checked_add(self.bound_rows).is_some_and(|n| n <= self.rows)
+            && self.correlated_rows <= self.noise_rows
             && [self.noise, self.bound, self.m2].iter().all(|v| v.is_finite() && *v >= 0.0)
             && self.mean.is_finite()
     }
@@ -248,9 +271,10 @@ mod tests {
             })
             .collect();
         let found = white_noise(&correlated).unwrap();
-        assert!(found.measured && (0.45..0.6).contains(&(found.sd / 0.05)), "{found:?}");
+        assert!(found.measured && found.correlated && (0.45..0.6).contains(&(found.sd / 0.05)), "{found:?}");
+        assert!(!white_noise(&noisy).unwrap().correlated);
         assert!((over(&correlated, 1).sd / 0.05 - 0.36).abs() < 0.03);
-        assert_eq!(white_noise(&[1.0; 100]), Some(Noise { sd: 0.0, measured: true }));
+        assert_eq!(white_noise(&[1.0; 100]), Some(Noise { sd: 0.0, measured: true, correlated: false }));
         // the sine printed to a tenth of its amplitude moves a step at a time: its rounding
         // is noise of 0.1/√12 the differences read as 0; a command switched between three
         // levels, or steps of more than one, are no rounding

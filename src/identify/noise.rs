@@ -32,6 +32,9 @@ pub(crate) struct Share {
     share: f64,
     /// Measured, not only bounded ([`crate::data::Noise::measured`]).
     measured: bool,
+    /// Measured on noise correlated from sample to sample: a lower bound
+    /// ([`crate::data::Noise::correlated`]).
+    pub(crate) at_least: bool,
 }
 
 impl Share {
@@ -70,7 +73,12 @@ pub(crate) fn shares(tallies: &[(String, NoiseTally)]) -> Vec<Share> {
     tallies
         .iter()
         .filter_map(|(v, t)| {
-            t.share().map(|(share, measured)| Share { variable: v.clone(), share, measured })
+            t.share().map(|(share, measured)| Share {
+                variable: v.clone(),
+                share,
+                measured,
+                at_least: measured && t.correlated(),
+            })
         })
         .collect()
 }
@@ -80,13 +88,23 @@ pub(crate) fn measured(shares: &[&Share]) -> String {
     let listed: Vec<String> = shares
         .iter()
         .map(|s| {
-            let bound = if s.measured { "" } else { "at most " };
+            let bound = match (s.measured, s.at_least) {
+                (false, _) => "at most ",
+                (true, true) => "at least ",
+                (true, false) => "",
+            };
             format!("`{}` {bound}{} %", s.variable, crate::output::sig(100.0 * s.share, 2))
         })
         .collect();
+    let correlated = if shares.iter().any(|s| s.at_least) {
+        "; \"at least\": it reads more over two samples than over one, correlated from sample to \
+         sample (a filtered sensor's), and more still over longer"
+    } else {
+        ""
+    };
     format!(
         "white noise of {} of the spread of the variables the candidates hold nonlinearly (from \
-         their fourth differences, or their rounding where they move a step at a time)",
+         their fourth differences, or their rounding where they move a step at a time){correlated}",
         listed.join(", ")
     )
 }

@@ -2266,7 +2266,11 @@ fn noise_that_biases_the_terms_is_measured_and_said() {
         (0..3).map(|i| r[i] + filtered[i]).collect()
     });
     let notes = one(&sensor, "x,y,x*y,x^2*y,x*z");
-    assert!(notes.contains("the records' noise may bias the terms: white noise of `x` 2."), "{notes}");
+    assert!(
+        notes.contains("the records' noise may bias the terms: white noise of `x` at least 2."),
+        "{notes}"
+    );
+    assert!(notes.contains("it reads more over two samples than over one"), "{notes}");
     // the run printed to whole units: it moves a unit at a time, its rounding noise of 1/√12
     // (3.7 % of x's spread) that the differences misread as at most 2.3 %, unflagged
     let printed = write("printed.csv", &mut |r| r.iter().map(|v| v.round()).collect());
