@@ -68,7 +68,7 @@ pub fn halves_check(
     // runs given whole to a half: a run's worth of rows in each, twice FEWEST_ROWS
     let rows = |half: &[Frame]| half.iter().map(Frame::len).sum::<usize>();
     let least = if halving == Halving::EachRun { FEWEST_ROWS } else { 2 * FEWEST_ROWS };
-    if halves.iter().any(|h| h.is_empty() || rows(h) < least) {
+    if halves.iter().any(|h| rows(h) < least) {
         return None;
     }
     let model: &Model = &identified.model;
