@@ -44,6 +44,7 @@ pub fn identify_model(
     // a model made from columns of variables far from 0: its library about reference values
     let (model, note) = model.about_references(frames).map_err(|e| IdentifyError::Setup(e.to_string()))?;
     let model = &model;
+    let held = held_inputs(model, frames);
     let mut identified = model.clone();
     let mut fits = Vec::new();
     for name in &names {
@@ -65,9 +66,48 @@ pub fn identify_model(
                 .map_err(|e| IdentifyError::Setup(format!("`{name}`: its coefficients' covariance {e}")))?;
         }
         fit.selection.notes.extend(note.clone());
+        fit.selection.notes.extend(held_note(model, name, &held));
         fits.push((name.clone(), fit));
     }
     Ok(IdentifiedModel { model: identified, fits })
+}
+
+/// The inputs of `model` that hold one value through every run of `frames`, with it.
+fn held_inputs(model: &Model, frames: &[Frame]) -> Vec<(String, f64)> {
+    model
+        .spec()
+        .inputs
+        .iter()
+        .filter_map(|input| {
+            let mut values = frames.iter().filter_map(|f| f.column(&input.name)).flatten();
+            let first = *values.next()?;
+            values.all(|v| *v == first).then(|| (input.name.clone(), first))
+        })
+        .collect()
+}
+
+/// What equation `name` is told where its candidates use an input that holds one value in
+/// every run ([`held_inputs`]): its effect cannot be told from a constant's. One step test
+/// of ẋ = −x/τ + K·u/τ gave ẋ = 0.80 − 0.20 x, `u` left out as collinear and nothing said
+/// about what that means: a model of no input, right at that u alone.
+fn held_note(model: &Model, name: &str, held: &[(String, f64)]) -> Option<String> {
+    let equation = model.equation(name)?;
+    let used: Vec<&(String, f64)> = held
+        .iter()
+        .filter(|(input, _)| equation.candidates.iter().any(|c| c.variables().contains(input)))
+        .collect();
+    if used.is_empty() {
+        return None;
+    }
+    let each: Vec<String> = used.iter().map(|(input, v)| format!("`{input}` = {v}")).collect();
+    Some(format!(
+        "{} in every run: what {} cannot be told from a constant (the terms in {}, or the constant \
+         standing for them, hold at {} only); runs at other values tell it",
+        each.join(", "),
+        if used.len() == 1 { "it does" } else { "they do" },
+        if used.len() == 1 { "it" } else { "them" },
+        if used.len() == 1 { "that value" } else { "those values" },
+    ))
 }
 
 /// The equations `how` identifies: those it names, else every identifiable one; a target

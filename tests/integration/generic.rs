@@ -2380,3 +2380,42 @@ fn many_states_with_few_rows_of_evidence_keep_their_terms() {
         }
     }
 }
+
+/// Step tests of ẋ = −x/τ + K·u/τ (τ = 5 s, K = 2), the input held in each: from three at
+/// u = 1, 2, 3 the equation is ẋ = 0.4 u − 0.2 x; from one at u = 2 the input cannot be told
+/// from a constant (ẋ = 0.8 − 0.2 x, `u` left out as collinear): that is said, not left to a
+/// note on collinearity.
+#[test]
+fn an_input_held_at_one_value_in_every_run_is_said() {
+    use crate::common::{json, Scratch};
+    let dir = Scratch::new("generic-held-input");
+    let step = |u: f64| -> String {
+        let mut text = String::from("t,x,u\n");
+        for k in 0..300 {
+            let t = k as f64 * 0.1;
+            text += &format!("{t},{},{u}\n", 2.0 * u * (1.0 - (-t / 5.0).exp()));
+        }
+        let path = dir.join(format!("step{u}.csv")).display().to_string();
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    let steps: Vec<String> = [1.0, 2.0, 3.0].into_iter().map(step).collect();
+    let identify = |runs: &[String]| {
+        let mut args = vec!["identify", "--states", "x", "--format", "json"];
+        for r in runs {
+            args.extend(["--data", r.as_str()]);
+        }
+        let (ok, report, err) = termid(&args);
+        assert!(ok, "{err}");
+        json(&report)["x_dot"].clone()
+    };
+    let said = "`u` = 2 in every run: what it does cannot be told from a constant";
+    let all = identify(&steps);
+    let terms = terms_of(&all);
+    assert!((terms["u"] - 0.4).abs() < 1e-3 && (terms["x"] + 0.2).abs() < 1e-3, "{terms:?}");
+    assert!(!all["notes"].to_string().contains("in every run: what it does"), "{all}");
+    let one = identify(&steps[1..2]);
+    let terms = terms_of(&one);
+    assert!((terms["1"] - 0.8).abs() < 1e-3 && !terms.contains_key("u"), "{terms:?}");
+    assert!(one["notes"].to_string().contains(said), "{one}");
+}
