@@ -113,19 +113,38 @@ impl Stlsq {
         let m = sc.m;
         let (forced, free): (Vec<usize>, Vec<usize>) = set.into_iter().partition(|j| pb.forced.contains(j));
         let mut a = sc.a.clone();
-        let mut kept = Vec::new();
+        let (mut kept, mut out) = (Vec::new(), Vec::new());
         for j in forced.into_iter().chain(free) {
             let pivot = a[j * m + j];
             if self.collinear(pb, j, pivot)? {
-                notes.push(format!(
-                    "`{}` left out of the candidates: collinear with those before it (its share of \
-                     variance not explained by them {pivot:.1e}, below pivot_tolerance {:.0e})",
-                    pb.names[j], self.pivot_tolerance
-                ));
+                out.push((j, pivot));
                 continue;
             }
             sweep(&mut a, m, j);
             kept.push(j);
+        }
+        // one note for them all: a large library on a short run leaves out dozens (Lorenz-96's
+        // cubic one, 24 for each of ten equations, a note each)
+        match out.as_slice() {
+            [] => {}
+            [(j, pivot)] => notes.push(format!(
+                "`{}` left out of the candidates: collinear with those before it (its share of \
+                 variance not explained by them {pivot:.1e}, below pivot_tolerance {:.0e})",
+                pb.names[*j], self.pivot_tolerance
+            )),
+            _ => {
+                let names: Vec<String> = out.iter().map(|(j, _)| format!("`{}`", pb.names[*j])).collect();
+                let (low, high) = out
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), (_, p)| (l.min(*p), h.max(*p)));
+                notes.push(format!(
+                    "{} ({}) left out of the candidates: collinear with those before them (their shares of \
+                     variance not explained by them {low:.1e} to {high:.1e}, below pivot_tolerance {:.0e})",
+                    names.join(", "),
+                    out.len(),
+                    self.pivot_tolerance
+                ));
+            }
         }
         // kept in the order checked: every subsequence sweeps in it with pivots no smaller
         Ok(kept)
