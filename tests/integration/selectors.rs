@@ -388,3 +388,25 @@ fn cross_validated_choices_recover_the_support() {
     let e = bs.select(&pb).unwrap_err();
     assert!(e.to_string().contains("cross-validation needs at least two runs"), "{e}");
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+    /// Sequential thresholding with as many candidates as rows or more (their noise shared
+    /// over `overlap` rows): a support the rows determine, never one with as many terms as
+    /// their independent evidence, and no refusal where they hold a few rows' worth (the least
+    /// BIC of the threshold path was once a support the final fit could not determine).
+    #[test]
+    fn stlsq_keeps_to_what_the_rows_determine(
+        n in 12usize..60, extra in 0usize..30, seed in any::<u64>(), noise in 0.0f64..2.0, overlap in 1.0f64..6.0
+    ) {
+        let p = n + extra - 9;
+        let (cols, y) = planted(seed, n, p, &[(0, 2.0), (2, -1.0)], noise);
+        let m = moments_of(&cols, &y).with_overlap(overlap);
+        let names = names(p);
+        let pb = Problem { moments: &m, names: &names, forced: &[], excluded: &[], intercept: true };
+        match Backend::by_name("stlsq").unwrap().build().select(&pb) {
+            Ok(s) => prop_assert!((s.terms.len() as f64) <= (n as f64 - 1.0) / overlap - 1.0 + 1e-9, "{} terms: {:?}", s.terms.len(), s.notes),
+            Err(e) => prop_assert!((n as f64 - 1.0) / overlap < 4.0 && matches!(e, SelectError::TooFewRows { .. }), "{e}"),
+        }
+    }
+}
