@@ -4,7 +4,9 @@
 //! compared in correlation scale (β_j·d_j/d_y), so no threshold depends on the candidates'
 //! units. Without a fixed `threshold` the whole path of thresholds is walked and the support
 //! with the smallest Bayesian information criterion kept: a fixed threshold drops every small
-//! true term (a Rössler constant, a light damping) and keeps large spurious ones.
+//! true term (a Rössler constant, a light damping) and keeps large spurious ones. Where the
+//! candidates are many for the rows, forward selection by the same criterion can do better
+//! than every support of the path, and is taken where it does by far.
 //! The reported fit is ordinary least squares on the final support, entered in order of
 //! decreasing |β| so the step table shows what each term adds.
 
@@ -189,7 +191,6 @@ impl Stlsq {
     /// Residual shares below 10⁻¹³ are round-off and count as equal.
     fn path(&self, sc: &Scaled, pb: &Problem<'_>, set: Vec<usize>, notes: &mut Vec<String>) -> Vec<usize> {
         const STEPS: usize = 60;
-        let n = sc.n_eff.max(2.0);
         let low = self.floor;
         let top =
             self.solve(sc, &set).map_or(1.0, |b| b.iter().fold(0.0f64, |m, v| m.max(v.abs()))).max(2.0 * low);
@@ -219,11 +220,7 @@ impl Stlsq {
                 }
                 continue;
             }
-            let share = match sc.swept(&current, self.pivot_tolerance) {
-                Ok(a) => sc.residual_share(&a).max(1e-13),
-                Err(_) => continue,
-            };
-            let bic = n * share.ln() + current.len() as f64 * n.ln();
+            let Some(bic) = self.bic(sc, &current) else { continue };
             if best.as_ref().is_none_or(|(b, _)| bic < *b) {
                 best = Some((bic, current.clone()));
             }
@@ -250,8 +247,8 @@ impl Stlsq {
     /// Forward selection by the BIC from the forced terms over the candidates `allowed`: the
     /// candidate that lowers the residual most (of those whose standardised coefficient would
     /// be at least the floor) enters while it lowers the BIC; then STLSQ at the floor from
-    /// what entered. Not distorted
-    /// by an ill-conditioned full fit, where the threshold path is (see [`Stlsq::prune`]).
+    /// what entered. Not distorted by an ill-conditioned full fit, where the threshold path is
+    /// (see [`Stlsq::prune`]).
     fn forward(
         &self,
         sc: &Scaled,
