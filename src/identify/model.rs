@@ -90,7 +90,7 @@ fn held_inputs(model: &Model, frames: &[Frame]) -> Vec<(String, f64)> {
 /// every run ([`held_inputs`]): its effect cannot be told from a constant's. One step test
 /// of ẋ = −x/τ + K·u/τ gave ẋ = 0.80 − 0.20 x, `u` left out as collinear and nothing said
 /// about what that means: a model of no input, right at that u alone.
-fn held_note(model: &Model, name: &str, held: &[(String, f64)]) -> Option<String> {
+pub(super) fn held_note(model: &Model, name: &str, held: &[(String, f64)]) -> Option<String> {
     let equation = model.equation(name)?;
     let used: Vec<&(String, f64)> = held
         .iter()

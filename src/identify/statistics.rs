@@ -477,6 +477,28 @@ impl EquationMoments {
         super::noise::note(&super::noise::shares(&pooled))
     }
 
+    /// The model's inputs that hold one value through every run, with it, as far as the
+    /// statistics tell: no spread in the tallies of the recorded input (where the candidates
+    /// hold it nonlinearly), else in its own candidate column (exact where the rows are the
+    /// samples; a weak form's windows weigh even a constant unevenly at a run's ends). What
+    /// the note on such an input says of runs read whole ([`super::identify_model`]).
+    pub fn held_inputs(&self, model: &Model) -> Vec<(String, f64)> {
+        let Some((first, rest)) = self.runs.split_first() else { return Vec::new() };
+        let mut all = first.moments.clone();
+        for r in rest {
+            all.merge(&r.moments);
+        }
+        let held = |name: &str| -> Option<f64> {
+            if self.runs.iter().all(|r| r.noise.contains_key(name)) {
+                let tally = NoiseTally::pooled(self.runs.iter().filter_map(|r| r.noise.get(name)).cloned());
+                return (tally.rows > 0 && tally.m2 == 0.0).then_some(tally.mean);
+            }
+            let k = self.candidates.iter().position(|c| c == name)?;
+            (all.corrected(k, k) == 0.0).then(|| all.means()[k])
+        };
+        model.spec().inputs.iter().filter_map(|i| Some((i.name.clone(), held(&i.name)?))).collect()
+    }
+
     /// Identifies the equation from the statistics with the model's forced and excluded terms
     /// and back-end, as [`super::fit_equation`] would from the rows.
     pub fn fit(&self, model: &Model, intercept: bool) -> Result<Fit, IdentifyError> {
@@ -541,6 +563,7 @@ pub fn identify_from_moments(
         let in_equation = |e: IdentifyError| e.in_equation(&m.equation);
         let mut fit = m.fit(model, intercept).map_err(in_equation)?;
         fit.selection.notes.extend(m.noise_note(model));
+        fit.selection.notes.extend(super::model::held_note(model, &m.equation, &m.held_inputs(model)));
         super::model::store_fit(&mut identified, &m.equation, &fit).map_err(in_equation)?;
         fits.push((m.equation.clone(), fit));
     }

@@ -2384,7 +2384,7 @@ fn many_states_with_few_rows_of_evidence_keep_their_terms() {
 /// Step tests of ẋ = −x/τ + K·u/τ (τ = 5 s, K = 2), the input held in each: from three at
 /// u = 1, 2, 3 the equation is ẋ = 0.4 u − 0.2 x; from one at u = 2 the input cannot be told
 /// from a constant (ẋ = 0.8 − 0.2 x, `u` left out as collinear): that is said, not left to a
-/// note on collinearity.
+/// note on collinearity, also where the runs are read in pieces.
 #[test]
 fn an_input_held_at_one_value_in_every_run_is_said() {
     use crate::common::{json, Scratch};
@@ -2418,4 +2418,16 @@ fn an_input_held_at_one_value_in_every_run_is_said() {
     let terms = terms_of(&one);
     assert!((terms["1"] - 0.8).abs() < 1e-3 && !terms.contains_key("u"), "{terms:?}");
     assert!(one["notes"].to_string().contains(said), "{one}");
+    // read in pieces, from statistics alone: said as well, and not of steps at several values
+    let pieces = |runs: &[String]| {
+        let mut args = vec!["identify", "--states", "x", "--chunk-rows", "100", "--format", "json"];
+        for r in runs {
+            args.extend(["--data", r.as_str()]);
+        }
+        let (ok, report, err) = termid(&args);
+        assert!(ok, "{err}");
+        json(&report)["x_dot"]["notes"].to_string()
+    };
+    assert!(pieces(&steps[1..2]).contains(said));
+    assert!(!pieces(&steps).contains("in every run: what it does"));
 }
