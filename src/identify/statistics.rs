@@ -480,8 +480,8 @@ impl EquationMoments {
     /// The model's inputs that hold one value through every run, with it, as far as the
     /// statistics tell: no spread in the tallies of the recorded input (where the candidates
     /// hold it nonlinearly), else in its own candidate column (exact where the rows are the
-    /// samples; a weak form's windows weigh even a constant unevenly at a run's ends). What
-    /// the note on such an input says of runs read whole ([`super::identify_model`]).
+    /// samples; a weak form's windows weigh even a constant unevenly at a run's ends). Fits
+    /// from statistics say of them what [`super::identify_model`] says of runs read whole.
     pub fn held_inputs(&self, model: &Model) -> Vec<(String, f64)> {
         let Some((first, rest)) = self.runs.split_first() else { return Vec::new() };
         let mut all = first.moments.clone();

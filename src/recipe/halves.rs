@@ -85,16 +85,13 @@ pub fn halves_check(
     let (first, second) = rayon::join(|| half(&halves[0]), || half(&halves[1]));
     let (first, second) = (first?, second?);
     let chosen = |found: &IdentifiedModel, name: &str| -> Vec<String> {
-        found
-            .fits
-            .iter()
-            .find(|(n, _)| n == name)
-            .map_or_else(Vec::new, |(_, f)| f.selection.terms.iter().map(|t| t.term.clone()).collect())
+        fit_of(found, name)
+            .map_or_else(Vec::new, |f| f.selection.terms.iter().map(|t| t.term.clone()).collect())
     };
     // a half's rows of independent evidence (a weak form's windows overlap) for an equation
     let overlap = how.differentiator.window().map_or(1.0, crate::data::row_overlap);
     let evidence = |found: &IdentifiedModel, name: &str| {
-        found.fits.iter().find(|(n, _)| n == name).map_or(0.0, |(_, f)| f.selection.rows as f64 / overlap)
+        fit_of(found, name).map_or(0.0, |f| f.selection.rows as f64 / overlap)
     };
     let (mut unsteady, mut thin) = (Vec::new(), Vec::new());
     for (name, fit) in &identified.fits {
@@ -170,6 +167,11 @@ pub fn halves_check(
         detail,
         measure: None,
     })
+}
+
+/// Equation `name`'s fit in `found`.
+fn fit_of<'a>(found: &'a IdentifiedModel, name: &str) -> Option<&'a crate::identify::Fit> {
+    found.fits.iter().find(|(n, _)| n == name).map(|(_, f)| f)
 }
 
 /// The weak form the halves take where the whole runs took a default one's windows: each
