@@ -483,17 +483,18 @@ impl EquationMoments {
     /// samples; a weak form's windows weigh even a constant unevenly at a run's ends). Fits
     /// from statistics say of them what [`super::identify_model`] says of runs read whole.
     pub fn held_inputs(&self, model: &Model) -> Vec<(String, f64)> {
-        let Some((first, rest)) = self.runs.split_first() else { return Vec::new() };
-        let mut all = first.moments.clone();
-        for r in rest {
-            all.merge(&r.moments);
-        }
         let held = |name: &str| -> Option<f64> {
             if self.runs.iter().all(|r| r.noise.contains_key(name)) {
                 let tally = NoiseTally::pooled(self.runs.iter().filter_map(|r| r.noise.get(name)).cloned());
                 return (tally.rows > 0 && tally.m2 == 0.0).then_some(tally.mean);
             }
+            // (the runs' statistics merged only where an input needs them)
             let k = self.candidates.iter().position(|c| c == name)?;
+            let (first, rest) = self.runs.split_first()?;
+            let mut all = first.moments.clone();
+            for r in rest {
+                all.merge(&r.moments);
+            }
             (all.corrected(k, k) == 0.0).then(|| all.means()[k])
         };
         model.spec().inputs.iter().filter_map(|i| Some((i.name.clone(), held(&i.name)?))).collect()
