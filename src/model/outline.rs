@@ -61,7 +61,10 @@ impl Outline {
         let mut vocabulary = crate::term::Vocabulary::new();
         for (k, name) in names.iter().enumerate() {
             if **name == self.time {
-                return Err(refuse(format!("`{name}` is the time, neither a state nor an input")));
+                return Err(refuse(format!(
+                    "`{name}` is the time, neither a state nor an input (a forcing that follows the clock, \
+                     sin(ωt) or a ramp, is an input: write it as a column of its own)"
+                )));
             }
             if names[..k].contains(name) {
                 return Err(refuse(format!("`{name}` is named twice: a name is a state or an input, once")));

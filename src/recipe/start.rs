@@ -281,9 +281,13 @@ fn refine_start(
 /// prepared; for a system of no field's, that its equations retrace the runs and that the
 /// runs' noise leaves its terms unbiased.
 pub fn checks_of(model: &Model, prepared: &[Frame]) -> Vec<Check> {
+    // a file's equation without coefficients is taken as one not identified yet, not re-simulated
+    let identified = || model.equations().iter().all(|e| !e.coefficients.is_empty() || e.intercept.is_some());
     match crate::plugins::of(model) {
         Some(plugin) => plugin.checks(model, prepared),
-        None => super::retrace::retrace_check(model, prepared)
+        None => identified()
+            .then(|| super::retrace::retrace_check(model, prepared))
+            .flatten()
             .into_iter()
             .chain(super::noise::noise_check(model, prepared))
             .collect(),

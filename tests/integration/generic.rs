@@ -2116,6 +2116,50 @@ fn a_rate_the_candidates_cannot_explain_is_said_to() {
     );
 }
 
+/// A forcing that follows the clock (ẋ = −x + sin t, x alone recorded): no equation of x
+/// alone holds, the identification chooses no term, and the re-simulation of ẋ = 0 says how
+/// soon it leaves the run (it was not re-simulated at all: an equation without terms was
+/// taken for one not identified). The time refused as an input names the remedy, a column
+/// of its own, with which the forcing is found.
+#[test]
+fn a_forcing_that_follows_the_clock_is_said_to_be_missing() {
+    use crate::common::Scratch;
+    let dir = Scratch::new("generic-clock");
+    let p = |f: &str| dir.join(f).display().to_string();
+    // x(t) = (sin t − cos t)/2 + 3/2 e^(−t), x(0) = 1
+    let rows = (0..3000).map(|k| {
+        let t = k as f64 * 0.01;
+        (t, 0.5 * (t.sin() - t.cos()) + 1.5 * (-t).exp(), t.sin())
+    });
+    let (mut alone, mut forced) = (String::from("t,x\n"), String::from("t,x,u\n"));
+    for (t, x, u) in rows {
+        alone += &format!("{t},{x}\n");
+        forced += &format!("{t},{x},{u}\n");
+    }
+    std::fs::write(p("alone.csv"), alone).unwrap();
+    std::fs::write(p("forced.csv"), forced).unwrap();
+    let (ok, out, err) = termid(&["identify", "--data", &p("alone.csv"), "--states", "x", "--inputs"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("explain 0 % of the variance of `x`'s rate"), "{out}");
+    let follows = out.split("they follow them within a tenth of each state's span for ").nth(1).unwrap();
+    let seconds: f64 = follows.split(' ').next().unwrap().parse().unwrap();
+    assert!(seconds < 1.0 && follows.contains(" s of 30.0 s ("), "{out}");
+    let (ok, _, err) = termid(&["identify", "--data", &p("alone.csv"), "--states", "x", "--inputs", "t"]);
+    assert!(!ok && err.contains("`t` is the time") && err.contains("a column of its own"), "{err}");
+    let (ok, out, err) =
+        termid(&["identify", "--data", &p("forced.csv"), "--states", "x", "--format", "json"]);
+    assert!(ok, "{err}");
+    let found = crate::common::json(&out);
+    let terms = found["x_dot"]["terms"].as_array().unwrap();
+    let coefficient =
+        |name: &str| terms.iter().find(|t| t["term"] == name).map(|t| t["coefficient"].as_f64().unwrap());
+    assert_eq!(terms.len(), 2, "{out}");
+    assert!(
+        (coefficient("x").unwrap() + 1.0).abs() < 1e-4 && (coefficient("u").unwrap() - 1.0).abs() < 1e-4,
+        "{out}"
+    );
+}
+
 /// A stiff pair: x follows y at a rate of 200/s (dx/dt = −200 (x − y)), y is driven slowly
 /// (dy/dt = −0.5 y + u), sampled every 0.02 s, four samples per x's time constant. Both
 /// equations come back with their own terms, the note on the near-constant combination of
