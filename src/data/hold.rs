@@ -14,8 +14,8 @@ use super::{DataError, Frame};
 #[serde(rename_all = "kebab-case")]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Intersample {
-    /// Held where the record shows a controller's command ([`held`], [`Hold::on_a_clock`]),
-    /// else a line between samples; a column that repeats a slower sensor's readings between
+    /// Held where the record shows a controller's command ([`held`], [`Hold::on_a_clock`]) or
+    /// a generator's stepped each sample ([`white`]), else a line between samples; a column that repeats a slower sensor's readings between
     /// them is read at its readings.
     #[default]
     Auto,
@@ -23,8 +23,8 @@ pub enum Intersample {
     /// sensor's readings between them is taken as its rows have it too).
     Linear,
     /// Held from each sample to the next wherever the record stays put between isolated
-    /// jumps ([`held`]), on a clock or not. (A record that changes at every sample cannot be
-    /// told from one that moves, and stays a line.)
+    /// jumps ([`held`]), on a clock or not, or changes at every sample unforeseen by the last
+    /// ([`white`]). (A record that moves smoothly from sample to sample stays a line.)
     Held,
 }
 
@@ -76,8 +76,7 @@ const SIZE: f64 = 0.01;
 /// intervals side by side, but for 5 % of its jumps) by a fair share of its span (5 %) and of
 /// its size (1 % of its largest value), and stays put in between. `None` for a record that
 /// moves, never changes, or has under 20 intervals. A record that jumps at every sample
-/// (a random binary signal switched each sample) cannot be told from one that moves: it is
-/// not found; declare it held.
+/// (a random binary signal switched each sample) is not found here: [`white`] finds it.
 pub fn held(x: &[f64]) -> Option<Hold> {
     let at = isolated_changes(x)?;
     let (low, high) = x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
@@ -95,6 +94,32 @@ pub fn held(x: &[f64]) -> Option<Hold> {
         jump: median / (high - low),
         period,
     })
+}
+
+/// Lag-one autocorrelations within this of 0 read as white: a record that changes at every
+/// sample by as much as its spread, each change unforeseen by the last (a random excitation
+/// stepped each sample). A motion sampled at its rate correlates near 1; a sine needs fewer
+/// than 6 samples a period to fall under 0.5, and under −0.5 (3 a period) it is left alone.
+const WHITE: f64 = 0.5;
+
+/// Whether `x` changes at every sample by as much as its spread, uncorrelated from one sample
+/// to the next (its lag-one autocorrelation within ±0.5; 20 intervals at least), by 1 % of its
+/// size or more (a steady value printed to three figures flickers by a count): a random
+/// excitation a digital generator steps each sample (white noise, a binary signal switched
+/// at random each sample), or the noise of a value held steady. No interpolation between the
+/// samples can follow it; a generator holds each value to the next sample. Its lag-one
+/// autocorrelation where it is so.
+pub fn white(x: &[f64]) -> Option<f64> {
+    if x.len() < 21 {
+        return None;
+    }
+    let mean = x.iter().sum::<f64>() / x.len() as f64;
+    let variance: f64 = x.iter().map(|v| (v - mean).powi(2)).sum();
+    let lagged: f64 = x.windows(2).map(|w| (w[0] - mean) * (w[1] - mean)).sum();
+    let rho = lagged / variance;
+    let size = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let spread = (variance / x.len() as f64).sqrt();
+    (spread >= SIZE * size && variance.is_finite() && rho.abs() < WHITE).then_some(rho)
 }
 
 /// The intervals over which `x` changes (interval i from sample i to i + 1), where it changes
@@ -203,12 +228,26 @@ pub fn mark_held(
         match intersample {
             Intersample::Linear => frame.release(name),
             Intersample::Held => {
-                // a staircase on a clock, by steps large or small
-                if held(column).is_some() || repeated(column).is_some() {
+                // a staircase on a clock, by steps large or small, or one stepped every sample
+                if held(column).is_some() || repeated(column).is_some() || white(column).is_some() {
                     frame.hold(name)?;
                 }
             }
             Intersample::Auto => {
+                if let Some(rho) = white(column) {
+                    frame.hold(name)?;
+                    notes.push(format!(
+                        "{}: `{name}` changes at every sample by as much as its spread, each change \
+                         unforeseen by the last (its correlation from one sample to the next {rho:.2}): a random \
+                         excitation a generator steps each sample, or the noise of a value held steady; no line \
+                         between the samples can follow it, so it is taken as held from each sample to the next \
+                         (a zero-order hold); where it is a motion sampled too coarsely, sample faster or say so \
+                         (identify --intersample linear; a model file's `intersample = \"linear\"`; Python \
+                         `intersample=\"linear\"`)",
+                        frame.origin()
+                    ));
+                    continue;
+                }
                 let Some(h) = held(column) else {
                     if let Some(note) = commanded(frame, name, motion, columns)? {
                         notes.push(note);
@@ -243,6 +282,28 @@ pub fn mark_held(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A generator's excitation stepped at every sample (uniform noise, a random binary
+    /// signal) is white; a motion sampled at its rate, a sine of 2.5 samples a period (its
+    /// samples alternate), a steady value flickering by a count of its print, a constant:
+    /// not.
+    #[test]
+    fn an_excitation_stepped_at_every_sample_is_white() {
+        let mut seed = 11u64;
+        let noise: Vec<f64> = (0..500).map(|_| crate::data::test_noise(&mut seed)).collect();
+        assert!(white(&noise).is_some_and(|rho| rho.abs() < 0.1));
+        let binary: Vec<f64> = noise.iter().map(|v| 5.0 + v.signum()).collect();
+        assert!(white(&binary).is_some());
+        let sine = |per: f64| -> Vec<f64> {
+            (0..500).map(|k| (std::f64::consts::TAU * k as f64 / per).sin()).collect()
+        };
+        assert_eq!(white(&sine(100.0)), None);
+        assert_eq!(white(&sine(2.5)), None);
+        let flicker: Vec<f64> = noise.iter().map(|v| if *v > 0.0 { 76.1 } else { 76.0 }).collect();
+        assert_eq!(white(&flicker), None);
+        assert_eq!(white(&[2.0; 500]), None);
+        assert_eq!(white(&noise[..20]), None);
+    }
 
     /// A force held for 50 samples at a time, at random levels: held; the same force moving
     /// as a line between the levels over 5 samples: not.

@@ -45,27 +45,101 @@ pub struct Noise {
 /// reads 0.99-1.06 % either way). `None` for a record under 20 samples or one not
 /// finite. A held or quantised record whose differences are mostly 0 gives 0.
 pub fn white_noise(x: &[f64]) -> Option<Noise> {
+    white_noise_beside(x, &[])
+}
+
+/// [`white_noise`] of a record whose motion may kink at every sample where inputs held from
+/// each sample to the next (`stepped`, a generator's white excitation) step: what their
+/// values explain of its differences (a linear regression on the values each difference
+/// spans) is motion, not noise. ẋ = −x + 2u with u white and held read "at least 12 %" of
+/// a record that had none.
+pub fn white_noise_beside(x: &[f64], stepped: &[&[f64]]) -> Option<Noise> {
     if x.len() < 20 || x.iter().any(|v| !v.is_finite()) {
         return None;
     }
-    let one = over(x, 1);
+    let one = over(x, 1, stepped);
     if !one.measured || x.len() < 4 * 2 + 20 {
         return Some(one);
     }
-    let two = over(x, 2);
+    let two = over(x, 2, stepped);
     // (a margin, so that white noise keeps its one-sample reading, not the larger of two
     // readings that scatter alike, nor one the motion raised)
     Some(if two.measured && two.sd > CORRELATED * one.sd { Noise { correlated: true, ..two } } else { one })
 }
 
-/// The noise read off the differences of `x` over `lag` samples.
-fn over(x: &[f64], lag: usize) -> Noise {
+/// The noise read off the differences of `x` over `lag` samples, less what the `stepped`
+/// inputs' values explain of them.
+fn over(x: &[f64], lag: usize, stepped: &[&[f64]]) -> Noise {
     let third: Vec<f64> = (0..x.len() - 3 * lag)
         .map(|k| x[k + 3 * lag] - 3.0 * x[k + 2 * lag] + 3.0 * x[k + lag] - x[k])
         .collect();
     let fourth: Vec<f64> = (0..third.len() - lag).map(|k| third[k + lag] - third[k]).collect();
+    let (third, fourth) = match stepped {
+        [] => (third, fourth),
+        _ => (
+            explained(&third, stepped, 3 * lag).map_or(third, |r| r.residuals),
+            explained(&fourth, stepped, 4 * lag).map_or(fourth, |r| r.residuals),
+        ),
+    };
     let (s3, s4) = (robust_sd(third) / THIRD.sqrt(), robust_sd(fourth) / FOURTH.sqrt());
     Noise { sd: s4, measured: s4 >= WHITE * s3, correlated: false }
+}
+
+/// A difference series regressed on the values of inputs that each of its terms spans.
+struct Explained {
+    /// What is left of the differences.
+    residuals: Vec<f64>,
+    /// The regression's F statistic (explained over residual variance per degree of freedom).
+    f: f64,
+}
+
+/// `d` (d[k] a difference of a record over samples k ..= k + span) regressed on the values
+/// `u[k ..= k + span]` of each input in `inputs` (and a constant): a state driven by inputs
+/// held from each sample to the next changes its rate at each of their steps, so its
+/// differences are a fixed combination of the input values they span, give or take the
+/// state's own slower terms. `None` where the rows do not determine the regression.
+fn explained(d: &[f64], inputs: &[&[f64]], span: usize) -> Option<Explained> {
+    let p = 1 + inputs.len() * (span + 1);
+    let n = d.len().min(inputs.iter().map(|u| u.len().saturating_sub(span)).min()?);
+    if n <= 2 * p {
+        return None;
+    }
+    let row = |k: usize| {
+        std::iter::once(1.0).chain(inputs.iter().flat_map(move |u| u[k..=k + span].iter().copied()))
+    };
+    let mut a = nalgebra::DMatrix::<f64>::zeros(p, p);
+    let mut b = nalgebra::DVector::<f64>::zeros(p);
+    for (k, dk) in d[..n].iter().enumerate() {
+        let r = nalgebra::DVector::from_iterator(p, row(k));
+        b.axpy(*dk, &r, 1.0);
+        a.ger(1.0, &r, &r, 1.0);
+    }
+    let beta = a.cholesky()?.solve(&b);
+    let residuals: Vec<f64> =
+        (0..n).map(|k| d[k] - row(k).zip(beta.iter()).map(|(r, b)| r * b).sum::<f64>()).collect();
+    let mean = d[..n].iter().sum::<f64>() / n as f64;
+    let total: f64 = d[..n].iter().map(|v| (v - mean).powi(2)).sum();
+    let left: f64 = residuals.iter().map(|r| r * r).sum();
+    let f = ((total - left).max(0.0) / (p - 1) as f64) / (left / (n - p) as f64).max(f64::MIN_POSITIVE);
+    Some(Explained { residuals, f })
+}
+
+/// The F statistic beyond which a record is taken to follow an input's steps: the kinks of a
+/// state it drives stand far above what chance gives (F ≈ 1), noise on a value held steady
+/// drives nothing.
+const FOLLOWS: f64 = 30.0;
+
+/// Whether some record of `frame` other than `name` (a column held and stepped at every
+/// sample) follows its steps: its fourth differences regress on the values they span.
+fn followed(frame: &Frame, name: &str, u: &[f64]) -> bool {
+    frame.names().iter().skip(1).filter(|c| *c != name && !frame.is_held(c)).any(|c| {
+        frame.column(c).is_some_and(|x| {
+            let fourth: Vec<f64> = (0..x.len().saturating_sub(4))
+                .map(|k| x[k + 4] - 4.0 * x[k + 3] + 6.0 * x[k + 2] - 4.0 * x[k + 1] + x[k])
+                .collect();
+            explained(&fourth, &[u], 4).is_some_and(|e| e.f > FOLLOWS)
+        })
+    })
 }
 
 /// The step of the grid a record's values sit on, where the record is read so coarsely that
@@ -126,13 +200,42 @@ impl NoiseTally {
     /// its neighbours' rows around (its fourth differences read across them); `None` where
     /// the frame has no such column. A column held or switched between samples (a command:
     /// [`Frame::held`]) is not taken for a motion rounded to its levels.
+    ///
+    /// Inputs held and stepped at every sample ([`super::white`]: a generator's white
+    /// excitation) kink the records they drive at each step, which is motion: what their
+    /// values explain of a record's differences is not counted as its noise. Such an input
+    /// that a record follows is its generator's exact values, without noise; one that none
+    /// follows is taken for the noise of a value held steady, and measured.
     pub fn of(frame: &Frame, name: &str, own: std::ops::Range<usize>) -> Option<NoiseTally> {
-        let command = frame.held().iter().chain(frame.switched()).any(|c| c == name);
-        Some(Self::of_values(frame.column(name)?, own, !command))
+        let x = frame.column(name)?;
+        // (a column stepped at every sample that no record follows is a value's noise, and may
+        // be rounded)
+        let command =
+            frame.held().iter().chain(frame.switched()).any(|c| c == name) && super::white(x).is_none();
+        let stepped: Vec<(&String, &[f64])> = frame
+            .held()
+            .iter()
+            .filter_map(|c| frame.column(c).map(|u| (c, u)))
+            .filter(|(_, u)| super::white(u).is_some())
+            .collect();
+        if stepped.iter().any(|(c, u)| *c == name && followed(frame, name, u)) {
+            let spread = Self::of_values(x, own, false, &[]);
+            return Some(NoiseTally {
+                noise: 0.0,
+                noise_rows: spread.rows,
+                correlated_rows: 0,
+                bound: 0.0,
+                bound_rows: 0,
+                ..spread
+            });
+        }
+        let others: Vec<&[f64]> = stepped.iter().filter(|(c, _)| *c != name).map(|(_, u)| *u).collect();
+        Some(Self::of_values(x, own, !command, &others))
     }
 
-    /// The tally of the `own` rows of `x`, its rounding counted where `rounded` allows.
-    fn of_values(x: &[f64], own: std::ops::Range<usize>, rounded: bool) -> NoiseTally {
+    /// The tally of the `own` rows of `x`, its rounding counted where `rounded` allows, less
+    /// what inputs stepped at every sample explain ([`white_noise_beside`]).
+    fn of_values(x: &[f64], own: std::ops::Range<usize>, rounded: bool, stepped: &[&[f64]]) -> NoiseTally {
         let rows = x.get(own).unwrap_or_default();
         let mut tally = NoiseTally::default();
         // a record too short for fourth differences still spreads the variable; one read so
@@ -144,7 +247,7 @@ impl NoiseTally {
             measured: true,
             correlated: false,
         });
-        let found = rounding.or_else(|| white_noise(x));
+        let found = rounding.or_else(|| white_noise_beside(x, stepped));
         if let Some(found) = found {
             let (sum, count) = if found.measured {
                 (&mut tally.noise, &mut tally.noise_rows)
@@ -273,14 +376,14 @@ mod tests {
         let found = white_noise(&correlated).unwrap();
         assert!(found.measured && found.correlated && (0.45..0.6).contains(&(found.sd / 0.05)), "{found:?}");
         assert!(!white_noise(&noisy).unwrap().correlated);
-        assert!((over(&correlated, 1).sd / 0.05 - 0.36).abs() < 0.03);
+        assert!((over(&correlated, 1, &[]).sd / 0.05 - 0.36).abs() < 0.03);
         assert_eq!(white_noise(&[1.0; 100]), Some(Noise { sd: 0.0, measured: true, correlated: false }));
         // the sine printed to a tenth of its amplitude moves a step at a time: its rounding
         // is noise of 0.1/√12 the differences read as 0; a command switched between three
         // levels, or steps of more than one, are no rounding
         let printed: Vec<f64> = clean.iter().map(|v| (v * 10.0).round() / 10.0).collect();
         assert!((quantum(&printed).unwrap() - 0.1).abs() < 1e-12);
-        let tally = NoiseTally::of_values(&printed, 0..printed.len(), true);
+        let tally = NoiseTally::of_values(&printed, 0..printed.len(), true, &[]);
         let (share, measured) = tally.share().unwrap();
         let sd = share * std::f64::consts::FRAC_1_SQRT_2;
         assert!(
@@ -297,6 +400,46 @@ mod tests {
         assert_eq!(white_noise(&[1.0; 10]), None);
     }
 
+    /// ẋ = −x + 2u under u white and held from each sample to the next (exact steps): the
+    /// state kinks at every step, which read as noise of 12 % of its spread; less what u's
+    /// values explain of its differences, nothing, and 1 % where it carries 1 %. The input,
+    /// which the state follows, is its generator's exact values; noise on a value held
+    /// steady (no record follows it) is measured as before.
+    #[test]
+    fn a_state_driven_by_steps_at_every_sample_is_no_noise() {
+        let mut seed = 5u64;
+        let n = 3000;
+        let u: Vec<f64> = (0..n).map(|_| crate::data::test_noise(&mut seed)).collect();
+        let a = (-0.01f64).exp();
+        let mut x = vec![0.0; n];
+        for k in 0..n - 1 {
+            x[k + 1] = a * x[k] + 2.0 * (1.0 - a) * u[k];
+        }
+        let sd = |v: &[f64]| {
+            let m = v.iter().sum::<f64>() / v.len() as f64;
+            (v.iter().map(|y| (y - m).powi(2)).sum::<f64>() / v.len() as f64).sqrt()
+        };
+        assert!(white_noise(&x).unwrap().sd > 0.05 * sd(&x));
+        assert!(white_noise_beside(&x, &[&u]).unwrap().sd < 1e-4 * sd(&x));
+        let e: Vec<f64> =
+            (0..n).map(|_| 0.01 * sd(&x) * 12f64.sqrt() * crate::data::test_noise(&mut seed)).collect();
+        let noisy: Vec<f64> = x.iter().zip(&e).map(|(x, e)| x + e).collect();
+        let read = white_noise_beside(&noisy, &[&u]).unwrap().sd / sd(&x);
+        assert!((read - 0.01).abs() < 0.001, "{read}");
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 0.01).collect();
+        let mut frame = Frame::new("run.csv", "t", t).unwrap();
+        frame.push("x", noisy).unwrap();
+        frame.push("u", u.clone()).unwrap();
+        frame.push("w", (0..n).map(|_| 2.0 + 0.2 * crate::data::test_noise(&mut seed)).collect()).unwrap();
+        frame.hold("u").unwrap();
+        frame.hold("w").unwrap();
+        let share = |name: &str| NoiseTally::of(&frame, name, 0..n).unwrap().share().unwrap().0;
+        assert!((share("x") - 0.01).abs() < 0.001, "{}", share("x"));
+        assert_eq!(share("u"), 0.0);
+        // `w`, stepped alike, drives nothing: noise about 2, measured (a uniform's own reading)
+        assert!(share("w") > 0.9, "{}", share("w"));
+    }
+
     /// A noisy record tallied in pieces (each read across its neighbours' rows, as a run read
     /// in pieces is) and merged gives the whole record's spread to round-off and its noise
     /// within 5 % (a piece of 1 000 rows reads it within a few per cent); a piece too short
@@ -310,7 +453,7 @@ mod tests {
         };
         let x: Vec<f64> =
             (0..10_000).map(|k| 3.0 * (k as f64 * 0.01).sin() + 5.0 + 0.1 * uniform()).collect();
-        let whole = NoiseTally::of_values(&x, 0..x.len(), true);
+        let whole = NoiseTally::of_values(&x, 0..x.len(), true, &[]);
         let mut pieces = NoiseTally::default();
         for start in (0..x.len()).step_by(1000) {
             let (from, to) = (start.saturating_sub(6), (start + 1006).min(x.len()));
@@ -318,6 +461,7 @@ mod tests {
                 &x[from..to],
                 start - from..start - from + 1000.min(x.len() - start),
                 true,
+                &[],
             ));
         }
         assert_eq!(pieces.rows, whole.rows);
@@ -325,7 +469,7 @@ mod tests {
         let (a, b) = (whole.share().unwrap(), pieces.share().unwrap());
         assert!(a.1 && b.1 && (a.0 / b.0 - 1.0).abs() < 0.05, "{a:?} {b:?}");
         let mut short = whole.clone();
-        short.merge(&NoiseTally::of_values(&[100.0; 5], 0..5, true));
+        short.merge(&NoiseTally::of_values(&[100.0; 5], 0..5, true, &[]));
         assert_eq!(
             (short.noise, short.noise_rows, short.rows),
             (whole.noise, whole.noise_rows, whole.rows + 5)
