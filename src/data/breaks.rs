@@ -87,9 +87,20 @@ pub fn breaks(t: &[f64], x: &[f64]) -> Vec<Break> {
 pub fn moving_breaks<'a>(frame: &Frame, columns: &[&'a str]) -> (Vec<(usize, &'a str, f64)>, Vec<String>) {
     let n = frame.len();
     let (mut found, mut notes) = (Vec::new(), Vec::new());
+    // a command held or switched steps the rates of the states it drives at its jumps, and a
+    // pulse of one sample moves them by a step that stays: no break where one jumps
+    let jumps: Vec<usize> = frame
+        .held()
+        .iter()
+        .chain(frame.switched())
+        .filter_map(|c| frame.column(c))
+        .flat_map(|x| x.windows(2).enumerate().filter(|(_, w)| w[1] != w[0]).map(|(i, _)| i + 1))
+        .collect();
+    let by_a_command = |row: usize| jumps.iter().any(|&j| j.abs_diff(row) <= 1);
     for name in columns {
         let Some(column) = moving(frame, name) else { continue };
-        let b = breaks(frame.time(), column);
+        let mut b = breaks(frame.time(), column);
+        b.retain(|b| !by_a_command(b.row));
         if b.len() > 3 && b.len() * ROWS_PER_BREAK > n {
             notes.push(format!(
                 "{}: `{name}` leaps at {} rows and stays (from row {}), far beyond its steps beside: too often for records joined in one file; taken as recorded, its rate spikes there",

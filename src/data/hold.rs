@@ -6,7 +6,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::repeated::{fits_better_held, kinks_at_changes, repeated};
+use super::repeated::{fits_better_held, fits_better_held_than_a_line, kinks_at_changes, repeated};
 use super::{DataError, Frame};
 
 /// How a run's inputs behave between their samples (MATLAB's `InterSample`).
@@ -123,7 +123,9 @@ pub fn white(x: &[f64]) -> Option<f64> {
 }
 
 /// The intervals over which `x` changes (interval i from sample i to i + 1), where it changes
-/// at isolated samples: no two changing intervals side by side but for 5 % of them. `None`
+/// at isolated samples: no two changing intervals side by side but for 5 % of them, or any
+/// where it takes at most four values and stays put over half its intervals or more (a
+/// binary signal switched twice in a row; one switched at every sample is not held). `None`
 /// for a record that moves from sample to sample, never changes, or has under 20 intervals.
 pub(super) fn isolated_changes(x: &[f64]) -> Option<Vec<usize>> {
     if x.len() < 21 {
@@ -138,7 +140,27 @@ pub(super) fn isolated_changes(x: &[f64]) -> Option<Vec<usize>> {
         .iter()
         .filter(|&&i| (i > 0 && changes[i - 1]) || changes.get(i + 1).copied().unwrap_or(false))
         .count();
-    (beside as f64 <= SIDE_BY_SIDE * at.len() as f64).then_some(at)
+    let mostly_flat = 2 * at.len() <= changes.len();
+    (beside as f64 <= SIDE_BY_SIDE * at.len() as f64 || (mostly_flat && few_levels(x))).then_some(at)
+}
+
+/// Levels a record switched between may take at most and still change on consecutive
+/// intervals: a binary or ternary signal (a random telegraph, on and off) switched twice in a
+/// row is a command, while a motion read to counts passes through many of them.
+const FEW_LEVELS: usize = 4;
+
+/// Whether `x` takes at most [`FEW_LEVELS`] values.
+fn few_levels(x: &[f64]) -> bool {
+    let mut levels: Vec<f64> = Vec::with_capacity(FEW_LEVELS + 1);
+    for v in x {
+        if !levels.contains(v) {
+            if levels.len() == FEW_LEVELS {
+                return false;
+            }
+            levels.push(*v);
+        }
+    }
+    true
 }
 
 /// Holds column `name` of `frame` where it repeats itself on a clock slower than the rows and
@@ -185,6 +207,43 @@ fn commanded(
     };
     let note = format!(
         "{how}, and {why}: a controller's command slower than the log, held from each change to the next (a zero-order hold), not a slower sensor's readings of a smooth quantity; taken as held. Where it is a sensor's readings after all, give it interpolated between them (identify --intersample linear, a model file's `intersample = \"linear\"` or Python's `intersample=\"linear\"` would take its staircase as its rows have it)"
+    );
+    frame.hold(name)?;
+    Ok(Some(note))
+}
+
+/// Holds column `name` of `frame` (a record that jumps at isolated samples on no clock) where
+/// a recorded state of `motion` (not `name`) has its rate fitted clearly better with it held
+/// from each sample to the next than as a line between them ([`fits_better_held_than_a_line`],
+/// over `motion` and `columns`): a generator's command switched at random samples, not a
+/// relay thrown between them; and says so, after `how` it jumps.
+fn held_on_the_samples(
+    frame: &mut Frame,
+    name: &str,
+    motion: &[&str],
+    columns: &[&str],
+    how: &str,
+) -> Result<Option<String>, DataError> {
+    let Some(column) = frame.column(name) else { return Ok(None) };
+    let recorded = |names: &[&str]| -> Vec<(String, &[f64])> {
+        names
+            .iter()
+            .filter(|m| **m != name && !frame.is_held(m))
+            .filter_map(|m| frame.column(m).map(|c| (m.to_string(), c)))
+            .collect()
+    };
+    let states = recorded(motion);
+    let slices: Vec<&[f64]> = states.iter().map(|(_, c)| *c).collect();
+    let mut all: Vec<&str> = motion.to_vec();
+    all.extend(columns.iter().filter(|c| !motion.contains(c)));
+    let others: Vec<&[f64]> = recorded(&all).into_iter().map(|(_, c)| c).collect();
+    let Some((i, share)) = fits_better_held_than_a_line(frame.time(), column, &slices, &others) else {
+        return Ok(None);
+    };
+    let note = format!(
+        "{how}, on no clock, but the rate of `{}` is fitted better with it held from each sample to the next than as a line between them ({:.1} % less left over, by a quadratic in the columns over windows of eight samples): a generator's command switched at random samples (a random telegraph, a PRBS), not a relay thrown between them; taken as held. Where it switches between the samples, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)",
+        states[i].0,
+        100.0 * (1.0 - share)
     );
     frame.hold(name)?;
     Ok(Some(note))
@@ -255,12 +314,18 @@ pub fn mark_held(
                     continue;
                 };
                 let how = format!(
-                    "{}: `{name}` stays put between samples ({:.0} % of intervals) and jumps at {} isolated samples (by {:.0} % of its span, median)",
+                    "{}: `{name}` stays put between samples ({:.0} % of intervals) and jumps at {} samples (by {:.0} % of its span, median)",
                     frame.origin(),
                     100.0 * h.flat,
                     h.jumps,
                     100.0 * h.jump
                 );
+                if !h.on_a_clock() {
+                    if let Some(note) = held_on_the_samples(frame, name, motion, columns, &how)? {
+                        notes.push(note);
+                        continue;
+                    }
+                }
                 if h.on_a_clock() {
                     frame.hold(name)?;
                     notes.push(format!(
@@ -406,7 +471,7 @@ mod tests {
         assert!(f.is_held("F") && !f.is_held("G") && !f.is_held("x"));
         assert_eq!(notes.len(), 2);
         assert!(
-            notes[0].contains("rig.csv: `F` stays put") && notes[0].contains("9 isolated samples"),
+            notes[0].contains("rig.csv: `F` stays put") && notes[0].contains("jumps at 9 samples"),
             "{}",
             notes[0]
         );

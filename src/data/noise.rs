@@ -212,12 +212,8 @@ impl NoiseTally {
         // be rounded)
         let command =
             frame.held().iter().chain(frame.switched()).any(|c| c == name) && super::white(x).is_none();
-        let stepped: Vec<(&String, &[f64])> = frame
-            .held()
-            .iter()
-            .filter_map(|c| frame.column(c).map(|u| (c, u)))
-            .filter(|(_, u)| super::white(u).is_some())
-            .collect();
+        let stepped: Vec<(&String, &[f64])> =
+            frame.held().iter().filter_map(|c| frame.column(c).map(|u| (c, u))).collect();
         if stepped.iter().any(|(c, u)| *c == name && followed(frame, name, u)) {
             let spread = Self::of_values(x, own, false, &[]);
             return Some(NoiseTally {

@@ -158,7 +158,38 @@ pub fn fits_better_held(
     // the cubics of the rows fitted, through the same four readings as over the whole record
     let reach = (n + 2 * r.period + 1).min(t.len());
     let read = between_readings(&t[..reach], &x[..reach], r);
-    let w = r.period;
+    held_or_else(t, x, &read, r.period, motion, others)
+}
+
+/// Windows of this many samples for [`fits_better_held_than_a_line`]: the integral form's
+/// short windows.
+const LINE_WINDOW: usize = 8;
+
+/// Whether a state's rate is fitted better with `x` (a record that jumps between levels off
+/// any clock) held from each sample to the next than as a line between the samples, as in
+/// [`fits_better_held`] over windows of eight samples: a generator's command switched at
+/// random samples (a random telegraph, a PRBS of random lengths) steps the rate at the
+/// samples, a relay thrown by the motion between them, where a line errs less on average.
+pub fn fits_better_held_than_a_line(
+    t: &[f64],
+    x: &[f64],
+    motion: &[&[f64]],
+    others: &[&[f64]],
+) -> Option<(usize, f64)> {
+    held_or_else(t, x, x, LINE_WINDOW, motion, others)
+}
+
+/// The comparison of [`fits_better_held`] with `x` held against `x` as `read` (over the
+/// first [`FIT_ROWS`] rows), in windows of `w` samples.
+fn held_or_else(
+    t: &[f64],
+    x: &[f64],
+    read: &[f64],
+    w: usize,
+    motion: &[&[f64]],
+    others: &[&[f64]],
+) -> Option<(usize, f64)> {
+    let n = t.len().min(FIT_ROWS);
     let k = others.len() + 1;
     // the terms: a constant, each column (x first), and their products
     let mut terms: Vec<(Option<usize>, Option<usize>)> = vec![(None, None)];
@@ -166,8 +197,12 @@ pub fn fits_better_held(
     if k <= PRODUCTS_UP_TO {
         terms.extend((0..k).flat_map(|i| (i..k).map(move |j| (Some(i), Some(j)))));
     }
-    let windows = (n - 1) / w;
-    if windows < 3 * terms.len() || others.iter().any(|c| c.len() < n) || motion.iter().any(|m| m.len() < n) {
+    let windows = n.saturating_sub(1) / w.max(1);
+    if windows < 3 * terms.len()
+        || read.len() < n
+        || others.iter().any(|c| c.len() < n)
+        || motion.iter().any(|m| m.len() < n)
+    {
         return None;
     }
     let design = |held: bool| {

@@ -521,3 +521,39 @@ fn a_force_stepped_at_every_sample_is_held() {
     assert_eq!(noise["passed"], true, "{out}");
     assert_true_terms_within(&chosen_terms(&found["v_dot"]), &|_| 1e-4, &out);
 }
+
+/// A binary force a generator switches at random samples (a random telegraph: each sample
+/// flips it with probability 0.2, twice in a row at times), held from each sample to the next.
+/// Changing on consecutive samples it was not taken for a command at all: a line between the
+/// samples (on a probe of the kind the damping −0.292, `v` said to "leap at 47 rows" where each
+/// one-sample pulse moved it by a step, the force's switches read as noise of "at least 71 %",
+/// flagged; switched with probability 0.05, −0.288 and nothing said). Now a
+/// signal of few levels is a command however often it switches; on no clock, the rate of a
+/// state fitted clearly better with it held than as a line tells a generator's from a relay's
+/// (which stays a line: `a_switch_off_any_clock_stays_a_line`): held, said; exact; the pulses'
+/// steps in `v` are no breaks; the noise check passes.
+#[test]
+fn a_force_switched_at_random_samples_is_held() {
+    let dir = Scratch::new("telegraph-force");
+    let data = dir.join("rig.csv");
+    let mut rng = Lcg(17);
+    let mut level = 1.0;
+    let levels: Vec<f64> = (0..3001)
+        .map(|_| {
+            if rng.next() < 0.2 {
+                level = -level;
+            }
+            level
+        })
+        .collect();
+    std::fs::write(&data, commanded_run(&levels, 0, 0.0)).unwrap();
+    let path = data.to_str().unwrap();
+    let (ok, out, err) = termid(&["identify", "--data", path, "--states", "x,v", "--format", "json"]);
+    assert!(ok, "{err}");
+    assert!(err.contains("on no clock, but the rate of") && err.contains("taken as held"), "{err}");
+    assert!(!err.contains("leaps"), "{err}");
+    let found = json(&out);
+    assert_true_terms_within(&chosen_terms(&found["v_dot"]), &|_| 1e-4, &out);
+    let checks = found["physical_checks"].as_array().unwrap();
+    assert!(checks.iter().all(|c| c["passed"] == true), "{out}");
+}
