@@ -323,6 +323,14 @@ def _columns_of(data: Data) -> "_Columns":
         return _columns(data.collect())
     elif isinstance(data, np.ndarray) and data.dtype.names:  # a numpy record array
         items = ((str(n), data[n]) for n in data.dtype.names)
+    elif isinstance(data, np.ndarray):
+        # (pysindy's `fit(X, t=dt)` takes the columns by position; termid reads them by name)
+        raise TypeError(
+            f"a run must be a pandas DataFrame, a dict of arrays or a pyarrow Table, not a {data.ndim}-D "
+            "numpy array, whose columns have no names: name them, "
+            "pd.DataFrame(X, columns=['x', 'y']).assign(t=t) (the time a column, or the index), "
+            "or {'t': t, 'x': X[:, 0], 'y': X[:, 1]}"
+        )
     else:
         raise TypeError(
             f"a run must be a pandas DataFrame, a dict of arrays or a pyarrow Table, not {type(data).__name__}"
@@ -365,7 +373,7 @@ def _runs(
     if grouped is not None:
         names = names or [name for name, _ in grouped]
         runs = [run for _, run in grouped]
-    if isinstance(runs, (pd.DataFrame, Mapping)) or hasattr(runs, "column_names"):
+    if isinstance(runs, (pd.DataFrame, Mapping, np.ndarray)) or hasattr(runs, "column_names"):
         runs = [runs]
     out = []
     for k, run in enumerate(runs):

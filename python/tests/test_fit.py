@@ -456,6 +456,24 @@ def test_a_force_held_between_samples_is_integrated_as_held():
         termid.fit(df, "dv/dt", library, intersample="zoh")
 
 
+def test_a_force_a_generator_steps_at_every_sample_is_held():
+    # white excitation, a new level every sample: held with a warning, the true terms (as a
+    # line between the samples the damping was 2 % off), no noise said of the exact records
+    df = _driven_oscillator(levels=np.random.default_rng(8).uniform(-2.0, 2.0, 3001))
+    library = ["x", "v", "F", "x^2", "x*F"]
+    with pytest.warns(UserWarning, match="`F` changes at every sample by as much as its spread"):
+        held = termid.fit(df, "dv/dt", library)
+    assert held.coefficients.sort_index().round(4).to_dict() == {"F": 2.0, "v": -0.3, "x": -4.0}
+    assert not any("noise" in n for n in held.notes), held.notes
+    linear = termid.fit(df, "dv/dt", library, intersample="linear")
+    assert abs(linear.coefficients["v"] + 0.3) > 0.003
+
+
+def test_an_array_without_column_names_is_refused_with_the_remedy():
+    with pytest.raises(TypeError, match=r"2-D numpy array, whose columns have no names: name them, pd.DataFrame"):
+        termid.Model.from_states(["x"]).identify(np.zeros((50, 2)))
+
+
 def test_a_command_slower_than_the_rows_is_held():
     # a smooth command computed every 10 samples and held between: it moves by a little at
     # every tick, as a slower sensor's readings would; the oscillator's rate steps where it

@@ -248,8 +248,11 @@ fn held_or_else(
         }
         let y = nalgebra::DVector::from_fn(windows, |row, _| m[(row + 1) * w] - m[row * w]);
         let (as_held, as_read) = (left(&held, &held_svd, &y)?, left(&read, &read_svd, &y)?);
-        let better =
-            as_held <= (1.0 - BETTER_HELD) * as_read && as_read - as_held >= HELD_SIGNIFICANT * as_held / dof;
+        // (a state fitted exactly either way, to round-off, one whose rate the column does not
+        // drive, tells nothing)
+        let better = as_read > 1e-24 * y.norm_squared()
+            && as_held <= (1.0 - BETTER_HELD) * as_read
+            && as_read - as_held >= HELD_SIGNIFICANT * as_held / dof;
         better.then_some((i, as_held / as_read))
     })
 }
@@ -321,6 +324,35 @@ pub fn read_at_readings(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A binary command switched at random samples and held: a state it drives (ẏ = u,
+    /// integrated exactly) is fitted better held than as a line; a state it does not drive, a
+    /// ramp fitted exactly either way, tells nothing (it read 0 / 0, "NaN % less", held).
+    #[test]
+    fn a_state_fitted_exactly_either_way_tells_nothing() {
+        let mut seed = 9u64;
+        let mut level = 1.0;
+        let u: Vec<f64> = (0..2000)
+            .map(|_| {
+                if crate::data::test_noise(&mut seed) > 0.3 {
+                    level = -level;
+                }
+                level
+            })
+            .collect();
+        let t: Vec<f64> = (0..2000).map(|k| k as f64 * 0.01).collect();
+        let y: Vec<f64> = u
+            .iter()
+            .scan(0.0, |y, v| {
+                let now = *y;
+                *y += 0.01 * v;
+                Some(now)
+            })
+            .collect();
+        let found = fits_better_held_than_a_line(&t, &u, &[&y], &[&y]);
+        assert!(found.is_some_and(|(i, share)| i == 0 && share < 0.01), "{found:?}");
+        assert_eq!(fits_better_held_than_a_line(&t, &u, &[&t], &[&t]), None);
+    }
 
     /// sin t read every 10th row of 0.01 s and repeated between: found (period 10 from row 3),
     /// and rebuilt to within the cubic's error between readings h = 0.1 s apart (at most
