@@ -87,16 +87,22 @@ pub fn breaks(t: &[f64], x: &[f64]) -> Vec<Break> {
 pub fn moving_breaks<'a>(frame: &Frame, columns: &[&'a str]) -> (Vec<(usize, &'a str, f64)>, Vec<String>) {
     let n = frame.len();
     let (mut found, mut notes) = (Vec::new(), Vec::new());
-    // a command held or switched steps the rates of the states it drives at its jumps, and a
-    // pulse of one sample moves them by a step that stays: no break where one jumps
-    let jumps: Vec<usize> = frame
+    // a command held or switched for one or two samples and back (a telegraph's pulse) moves
+    // the states it drives by a step that stays: no break there (one stepped at every sample,
+    // white, pulses everywhere, and its states' steps are all alike rough: none stands out)
+    let pulses: Vec<usize> = frame
         .held()
         .iter()
         .chain(frame.switched())
         .filter_map(|c| frame.column(c))
-        .flat_map(|x| x.windows(2).enumerate().filter(|(_, w)| w[1] != w[0]).map(|(i, _)| i + 1))
+        .filter(|x| super::white(x).is_none())
+        .flat_map(|x| {
+            (1..x.len().saturating_sub(1)).filter(move |&i| {
+                x[i] != x[i - 1] && (x[i + 1] != x[i] || x.get(i + 2).is_some_and(|v| *v != x[i]))
+            })
+        })
         .collect();
-    let by_a_command = |row: usize| jumps.iter().any(|&j| j.abs_diff(row) <= 1);
+    let by_a_command = |row: usize| pulses.iter().any(|&j| j.abs_diff(row) <= 2);
     for name in columns {
         let Some(column) = moving(frame, name) else { continue };
         let mut b = breaks(frame.time(), column);

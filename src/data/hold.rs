@@ -15,8 +15,8 @@ use super::{DataError, Frame};
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Intersample {
     /// Held where the record shows a controller's command ([`held`], [`Hold::on_a_clock`]) or
-    /// a generator's stepped each sample ([`white`]), else a line between samples; a column that repeats a slower sensor's readings between
-    /// them is read at its readings.
+    /// a generator's stepped each sample ([`white`]), else a line between samples; a column
+    /// that repeats a slower sensor's readings between them is read at its readings.
     #[default]
     Auto,
     /// A line between samples, whatever the record shows (a column that repeats a slower
@@ -163,6 +163,29 @@ fn few_levels(x: &[f64]) -> bool {
     true
 }
 
+/// Columns by name.
+type Named<'f> = Vec<(String, &'f [f64])>;
+
+/// The recorded columns a held-or-not test of column `name` reads: the states of `motion`
+/// (by name) and every column of `motion` and `columns`, each but `name` and those held.
+fn beside<'f>(
+    frame: &'f Frame,
+    name: &str,
+    motion: &[&str],
+    columns: &[&str],
+) -> (Named<'f>, Vec<&'f [f64]>) {
+    let recorded = |names: &[&str]| -> Named<'f> {
+        names
+            .iter()
+            .filter(|m| **m != name && !frame.is_held(m))
+            .filter_map(|m| frame.column(m).map(|c| (m.to_string(), c)))
+            .collect()
+    };
+    let mut all: Vec<&str> = motion.to_vec();
+    all.extend(columns.iter().filter(|c| !motion.contains(c)));
+    (recorded(motion), recorded(&all).into_iter().map(|(_, c)| c).collect())
+}
+
 /// Holds column `name` of `frame` where it repeats itself on a clock slower than the rows and
 /// a recorded state of `motion` (not `name` itself) kinks where it changes, or the states'
 /// rates fit clearly better with it held than read at its readings (over `name`, `motion`
@@ -175,14 +198,7 @@ fn commanded(
 ) -> Result<Option<String>, DataError> {
     let Some(column) = frame.column(name) else { return Ok(None) };
     let Some(r) = repeated(column) else { return Ok(None) };
-    let recorded = |names: &[&str]| -> Vec<(String, &[f64])> {
-        names
-            .iter()
-            .filter(|m| **m != name && !frame.is_held(m))
-            .filter_map(|m| frame.column(m).map(|c| (m.to_string(), c)))
-            .collect()
-    };
-    let states = recorded(motion);
+    let (states, others) = beside(frame, name, motion, columns);
     let slices: Vec<&[f64]> = states.iter().map(|(_, c)| *c).collect();
     let how = format!(
         "{}: `{name}` changes only every {} rows, by a little at {:.0} % of them",
@@ -193,9 +209,6 @@ fn commanded(
     let why = if let Some(i) = kinks_at_changes(column, r, &slices) {
         format!("the rate of `{}` steps where it changes", states[i].0)
     } else {
-        let mut all: Vec<&str> = motion.to_vec();
-        all.extend(columns.iter().filter(|c| !motion.contains(c)));
-        let others: Vec<&[f64]> = recorded(&all).into_iter().map(|(_, c)| c).collect();
         let Some((i, share)) = fits_better_held(frame.time(), column, r, &slices, &others) else {
             return Ok(None);
         };
@@ -225,18 +238,8 @@ fn held_on_the_samples(
     how: &str,
 ) -> Result<Option<String>, DataError> {
     let Some(column) = frame.column(name) else { return Ok(None) };
-    let recorded = |names: &[&str]| -> Vec<(String, &[f64])> {
-        names
-            .iter()
-            .filter(|m| **m != name && !frame.is_held(m))
-            .filter_map(|m| frame.column(m).map(|c| (m.to_string(), c)))
-            .collect()
-    };
-    let states = recorded(motion);
+    let (states, others) = beside(frame, name, motion, columns);
     let slices: Vec<&[f64]> = states.iter().map(|(_, c)| *c).collect();
-    let mut all: Vec<&str> = motion.to_vec();
-    all.extend(columns.iter().filter(|c| !motion.contains(c)));
-    let others: Vec<&[f64]> = recorded(&all).into_iter().map(|(_, c)| c).collect();
     let Some((i, share)) = fits_better_held_than_a_line(frame.time(), column, &slices, &others) else {
         return Ok(None);
     };

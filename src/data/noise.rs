@@ -48,11 +48,11 @@ pub fn white_noise(x: &[f64]) -> Option<Noise> {
     white_noise_beside(x, &[])
 }
 
-/// [`white_noise`] of a record whose motion may kink at every sample where inputs held from
-/// each sample to the next (`stepped`, a generator's white excitation) step: what their
-/// values explain of its differences (a linear regression on the values each difference
-/// spans) is motion, not noise. ẋ = −x + 2u with u white and held read "at least 12 %" of
-/// a record that had none.
+/// [`white_noise`] of a record whose motion kinks where inputs held from each sample to the
+/// next (`stepped`: a controller's command, a generator's excitation, a telegraph) step:
+/// what their values explain of its differences (a linear regression on the values each
+/// difference spans) is motion, not noise. ẋ = −x + 2u with u white and held read "at
+/// least 12 %" of a record that had none.
 pub fn white_noise_beside(x: &[f64], stepped: &[&[f64]]) -> Option<Noise> {
     if x.len() < 20 || x.iter().any(|v| !v.is_finite()) {
         return None;
@@ -129,8 +129,9 @@ fn explained(d: &[f64], inputs: &[&[f64]], span: usize) -> Option<Explained> {
 /// drives nothing.
 const FOLLOWS: f64 = 30.0;
 
-/// Whether some record of `frame` other than `name` (a column held and stepped at every
-/// sample) follows its steps: its fourth differences regress on the values they span.
+/// Whether some record of `frame` other than `name` (a column held from each sample to the
+/// next, `u`) and not held itself follows its steps: its fourth differences regress on the
+/// values they span.
 fn followed(frame: &Frame, name: &str, u: &[f64]) -> bool {
     frame.names().iter().skip(1).filter(|c| *c != name && !frame.is_held(c)).any(|c| {
         frame.column(c).is_some_and(|x| {
@@ -201,11 +202,12 @@ impl NoiseTally {
     /// the frame has no such column. A column held or switched between samples (a command:
     /// [`Frame::held`]) is not taken for a motion rounded to its levels.
     ///
-    /// Inputs held and stepped at every sample ([`super::white`]: a generator's white
-    /// excitation) kink the records they drive at each step, which is motion: what their
-    /// values explain of a record's differences is not counted as its noise. Such an input
-    /// that a record follows is its generator's exact values, without noise; one that none
-    /// follows is taken for the noise of a value held steady, and measured.
+    /// Inputs held from each sample to the next (a command, a generator's excitation stepped
+    /// at every sample, [`super::white`], or switched at random ones) kink the records they
+    /// drive at each step, which is motion: what their values explain of a record's
+    /// differences is not counted as its noise. Such an input that a record follows is its
+    /// generator's exact values, without noise; one that none follows is measured (one
+    /// stepped at every sample is then the noise of a value held steady).
     pub fn of(frame: &Frame, name: &str, own: std::ops::Range<usize>) -> Option<NoiseTally> {
         let x = frame.column(name)?;
         // (a column stepped at every sample that no record follows is a value's noise, and may
@@ -215,14 +217,14 @@ impl NoiseTally {
         let stepped: Vec<(&String, &[f64])> =
             frame.held().iter().filter_map(|c| frame.column(c).map(|u| (c, u))).collect();
         if stepped.iter().any(|(c, u)| *c == name && followed(frame, name, u)) {
-            let spread = Self::of_values(x, own, false, &[]);
+            let tally = Self::of_values(x, own, false, &[]);
             return Some(NoiseTally {
                 noise: 0.0,
-                noise_rows: spread.rows,
+                noise_rows: tally.rows,
                 correlated_rows: 0,
                 bound: 0.0,
                 bound_rows: 0,
-                ..spread
+                ..tally
             });
         }
         let others: Vec<&[f64]> = stepped.iter().filter(|(c, _)| *c != name).map(|(_, u)| *u).collect();
@@ -230,7 +232,7 @@ impl NoiseTally {
     }
 
     /// The tally of the `own` rows of `x`, its rounding counted where `rounded` allows, less
-    /// what inputs stepped at every sample explain ([`white_noise_beside`]).
+    /// what the held inputs `stepped` explain ([`white_noise_beside`]).
     fn of_values(x: &[f64], own: std::ops::Range<usize>, rounded: bool, stepped: &[&[f64]]) -> NoiseTally {
         let rows = x.get(own).unwrap_or_default();
         let mut tally = NoiseTally::default();
