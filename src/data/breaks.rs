@@ -462,8 +462,20 @@ mod tests {
         assert!(notes[0].contains("leap from row 300 to row 301"), "{}", notes[0]);
         let (pieces, _) = cut_at_breaks(runs[1].clone(), &["x", "y"], &["F"]).unwrap();
         assert_eq!(pieces[0].origin(), "joined.csv [rows 301-600]");
-        let (whole, said) = cut_at_breaks(f, &[], &["F"]).unwrap();
+        let (whole, said) = cut_at_breaks(f.clone(), &[], &["F"]).unwrap();
         assert_eq!((whole.len(), said.len()), (1, 0));
+        // a held input stepped at every sample beside (white) hides no break; a telegraph's
+        // pulse of one sample at the break does
+        let mut seed = 2u64;
+        let mut white = f.clone();
+        white.push("W", (0..610).map(|_| crate::data::test_noise(&mut seed)).collect()).unwrap();
+        white.hold("W").unwrap();
+        assert_eq!(cut_at_breaks(white, &["x", "y"], &["F", "W"]).unwrap().0.len(), 2);
+        let mut pulsed = f;
+        pulsed.push("P", (0..610).map(|k| if k == 300 { 1.0 } else { 0.0 }).collect()).unwrap();
+        pulsed.hold("P").unwrap();
+        let (runs, notes) = cut_at_breaks(pulsed, &["x", "y"], &["F", "P"]).unwrap();
+        assert_eq!(runs.len(), 1, "{notes:?}");
     }
 
     /// A measured input that moves (with its noise) and steps twice while the state goes on

@@ -103,8 +103,8 @@ pub fn held(x: &[f64]) -> Option<Hold> {
 const WHITE: f64 = 0.5;
 
 /// Whether `x` changes at every sample by as much as its spread, uncorrelated from one sample
-/// to the next (its lag-one autocorrelation within ±0.5; 20 intervals at least), by 1 % of its
-/// size or more (a steady value printed to three figures flickers by a count): a random
+/// to the next (its lag-one autocorrelation within ±0.5, changing over a third of its
+/// intervals or more: a random binary signal changes over half; 20 intervals at least), by 1 % of its size or more (a steady value printed to three figures flickers by a count): a random
 /// excitation a digital generator steps each sample (white noise, a binary signal switched
 /// at random each sample), or the noise of a value held steady. No interpolation between the
 /// samples can follow it; a generator holds each value to the next sample. Its lag-one
@@ -119,7 +119,10 @@ pub fn white(x: &[f64]) -> Option<f64> {
     let rho = lagged / variance;
     let size = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let spread = (variance / x.len() as f64).sqrt();
-    (spread >= SIZE * size && variance.is_finite() && rho.abs() < WHITE).then_some(rho)
+    // (a spike now and then is uncorrelated too, but stays put in between)
+    let changing = x.windows(2).filter(|w| w[1] != w[0]).count();
+    (spread >= SIZE * size && variance.is_finite() && rho.abs() < WHITE && 3 * changing >= x.len() - 1)
+        .then_some(rho)
 }
 
 /// The intervals over which `x` changes (interval i from sample i to i + 1), where it changes
@@ -371,6 +374,8 @@ mod tests {
         assert_eq!(white(&flicker), None);
         assert_eq!(white(&[2.0; 500]), None);
         assert_eq!(white(&noise[..20]), None);
+        let spike: Vec<f64> = (0..500).map(|k| if k == 300 { 1.0 } else { 0.0 }).collect();
+        assert_eq!(white(&spike), None);
     }
 
     /// A force held for 50 samples at a time, at random levels: held; the same force moving
