@@ -72,16 +72,39 @@ pub fn identify_model(
     Ok(IdentifiedModel { model: identified, fits })
 }
 
-/// The inputs of `model` that hold one value through every run of `frames`, with it.
-fn held_inputs(model: &Model, frames: &[Frame]) -> Vec<(String, f64)> {
+/// An input that holds one value through every run: its name, the value, and whether it
+/// varies about it by its noise alone (recorded with a sensor's noise, not exactly).
+pub(super) type Held = (String, f64, bool);
+
+/// The share of an input's spread that its white noise may be and the input still be read
+/// as held at its mean: what varies beyond the noise is then a tenth of its variance at most.
+const NOISE_ALONE: f64 = 0.95;
+
+/// Whether `tally` reads a variable that varies by its white noise alone (measured, not
+/// correlated, at least 95 % of its spread): a value held steady, recorded with its noise.
+pub(super) fn noise_alone(tally: &crate::data::NoiseTally) -> bool {
+    tally.share().is_some_and(|(share, measured)| measured && share >= NOISE_ALONE) && !tally.correlated()
+}
+
+/// The inputs of `model` that hold one value through every run of `frames`: exactly, or
+/// varying by their noise alone about their mean ([`noise_alone`]; a held input a record
+/// follows reads no noise, [`crate::data::NoiseTally::of`], and is not so).
+fn held_inputs(model: &Model, frames: &[Frame]) -> Vec<Held> {
     model
         .spec()
         .inputs
         .iter()
         .filter_map(|input| {
-            let mut values = frames.iter().filter_map(|f| f.column(&input.name)).flatten();
+            let name = &input.name;
+            let mut values = frames.iter().filter_map(|f| f.column(name)).flatten();
             let first = *values.next()?;
-            values.all(|v| *v == first).then(|| (input.name.clone(), first))
+            if values.all(|v| *v == first) {
+                return Some((name.clone(), first, false));
+            }
+            let tally = crate::data::NoiseTally::pooled(
+                frames.iter().filter_map(|f| crate::data::NoiseTally::of(f, name, 0..f.len())),
+            );
+            noise_alone(&tally).then(|| (name.clone(), tally.mean, true))
         })
         .collect()
 }
@@ -89,17 +112,29 @@ fn held_inputs(model: &Model, frames: &[Frame]) -> Vec<(String, f64)> {
 /// What equation `name` is told where its candidates use an input that holds one value in
 /// every run ([`held_inputs`]): its effect cannot be told from a constant's. One step test
 /// of ẋ = −x/τ + K·u/τ gave ẋ = 0.80 − 0.20 x, `u` left out as collinear and nothing said
-/// about what that means: a model of no input, right at that u alone.
-pub(super) fn held_note(model: &Model, name: &str, held: &[(String, f64)]) -> Option<String> {
+/// about what that means: a model of no input, right at that u alone; recorded with its
+/// noise (2 ± 0.5 %), the noise check's flag alone said anything.
+pub(super) fn held_note(model: &Model, name: &str, held: &[Held]) -> Option<String> {
     let equation = model.equation(name)?;
-    let used: Vec<&(String, f64)> = held
+    let used: Vec<&Held> = held
         .iter()
-        .filter(|(input, _)| equation.candidates.iter().any(|c| c.variables().contains(input)))
+        .filter(|(input, ..)| {
+            equation
+                .candidates
+                .iter()
+                .any(|c| c.variables().iter().any(|v| model.vocabulary.depends_on(v, input)))
+        })
         .collect();
     if used.is_empty() {
         return None;
     }
-    let each: Vec<String> = used.iter().map(|(input, v)| format!("`{input}` = {v}")).collect();
+    let each: Vec<String> = used
+        .iter()
+        .map(|(input, v, noisy)| match noisy {
+            false => format!("`{input}` = {v}"),
+            true => format!("`{input}` ≈ {} (varying by its noise alone)", crate::output::sig(*v, 4)),
+        })
+        .collect();
     Some(format!(
         "{} in every run: what {} cannot be told from a constant (the terms in {}, or the constant \
          standing for them, hold at {} only); runs at other values tell it",

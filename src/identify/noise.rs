@@ -130,12 +130,7 @@ pub(crate) fn nonlinear_in(term: &Term, variable: &str, vocabulary: &Vocabulary)
         vocabulary.variables().iter().any(|v| v == name)
             || vocabulary.derived_definition(name).is_some_and(|d| !d.is_constant())
     };
-    let uses = |name: &str| -> bool {
-        name == variable
-            || vocabulary
-                .derived_definition(name)
-                .is_some_and(|d| d.variables().iter().any(|v| v == variable))
-    };
+    let uses = |name: &str| vocabulary.depends_on(name, variable);
     term.monomials().iter().any(|m| {
         let mut degree = 0;
         let mut others = 0;

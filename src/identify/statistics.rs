@@ -479,14 +479,17 @@ impl EquationMoments {
 
     /// The model's inputs that hold one value through every run, with it, as far as the
     /// statistics tell: no spread in the tallies of the recorded input (where the candidates
-    /// hold it nonlinearly), else in its own candidate column (exact where the rows are the
+    /// hold it nonlinearly), or a spread of its noise alone, else in its own candidate column (exact where the rows are the
     /// samples; a weak form's windows weigh even a constant unevenly at a run's ends). Fits
     /// from statistics say of them what [`super::identify_model`] says of runs read whole.
-    pub fn held_inputs(&self, model: &Model) -> Vec<(String, f64)> {
-        let held = |name: &str| -> Option<f64> {
+    pub fn held_inputs(&self, model: &Model) -> Vec<super::model::Held> {
+        let held = |name: &str| -> Option<(f64, bool)> {
             if self.runs.iter().all(|r| r.noise.contains_key(name)) {
                 let tally = NoiseTally::pooled(self.runs.iter().filter_map(|r| r.noise.get(name)).cloned());
-                return (tally.rows > 0 && tally.m2 == 0.0).then_some(tally.mean);
+                if tally.rows > 0 && tally.m2 == 0.0 {
+                    return Some((tally.mean, false));
+                }
+                return super::model::noise_alone(&tally).then_some((tally.mean, true));
             }
             // (the runs' statistics merged only where an input needs them)
             let k = self.candidates.iter().position(|c| c == name)?;
@@ -495,9 +498,14 @@ impl EquationMoments {
             for r in rest {
                 all.merge(&r.moments);
             }
-            (all.corrected(k, k) == 0.0).then(|| all.means()[k])
+            (all.corrected(k, k) == 0.0).then(|| (all.means()[k], false))
         };
-        model.spec().inputs.iter().filter_map(|i| Some((i.name.clone(), held(&i.name)?))).collect()
+        model
+            .spec()
+            .inputs
+            .iter()
+            .filter_map(|i| held(&i.name).map(|(value, noisy)| (i.name.clone(), value, noisy)))
+            .collect()
     }
 
     /// Identifies the equation from the statistics with the model's forced and excluded terms

@@ -197,6 +197,15 @@ impl Vocabulary {
         self.index.get(name).copied().flatten().map(|k| &self.derived[k].definition)
     }
 
+    /// Whether `name` (a variable or a derived variable) is `variable` or is defined through
+    /// it, however deep the derived variables go (`Δu = u - u0` depends on `u`).
+    pub fn depends_on(&self, name: &str, variable: &str) -> bool {
+        name == variable
+            || self
+                .derived_definition(name)
+                .is_some_and(|d| d.variables().iter().any(|v| v != name && self.depends_on(v, variable)))
+    }
+
     /// A declared name that `name` looks like but is not (a Cyrillic `х` for `x`, a
     /// decomposed `é` for a composed one): for an error that names the look-alike.
     pub fn look_alike(&self, name: &str) -> Option<String> {

@@ -2474,6 +2474,28 @@ fn an_input_held_at_one_value_in_every_run_is_said() {
     };
     assert!(pieces(&steps[1..2]).contains(said));
     assert!(!pieces(&steps).contains("in every run: what it does"));
+    // the input recorded with a sensor's noise (±0.5 % of its value): said as held at its
+    // mean (before, only the noise check's flag said anything); three such steps are not
+    let mut rng = crate::common::Lcg(21);
+    let noisy: Vec<String> = steps
+        .iter()
+        .map(|path| {
+            let text = std::fs::read_to_string(path).unwrap();
+            let mut out = String::from("t,x,u\n");
+            for line in text.lines().skip(1) {
+                let v: Vec<f64> = line.split(',').map(|c| c.parse().unwrap()).collect();
+                out += &format!("{},{},{}\n", v[0], v[1], v[2] + 0.01 * rng.normal());
+            }
+            let noisy = path.replace(".csv", "_noisy.csv");
+            std::fs::write(&noisy, out).unwrap();
+            noisy
+        })
+        .collect();
+    let about = "(varying by its noise alone) in every run: what it does cannot be told";
+    let one = identify(&noisy[1..2])["notes"].to_string();
+    assert!(one.contains(about) && one.contains("`u` ≈ 2.00"), "{one}");
+    assert!(pieces(&noisy[1..2]).contains(about));
+    assert!(!identify(&noisy)["notes"].to_string().contains("in every run: what it does"));
 }
 
 /// A short stretch of a motion, less than one period (Duffing's ẍ = −x − x³ − 0.1ẋ over 2 s
