@@ -479,9 +479,10 @@ impl EquationMoments {
 
     /// The model's inputs that hold one value through every run, with it, as far as the
     /// statistics tell: no spread in the tallies of the recorded input (where the candidates
-    /// hold it nonlinearly), or a spread of its noise alone, else in its own candidate column (exact where the rows are the
-    /// samples; a weak form's windows weigh even a constant unevenly at a run's ends). Fits
-    /// from statistics say of them what [`super::identify_model`] says of runs read whole.
+    /// hold it nonlinearly), or a spread of its noise alone, else none in its own candidate
+    /// column (exact where the rows are the samples; a weak form's windows weigh even a
+    /// constant unevenly at a run's ends). Fits from statistics say of them what
+    /// [`super::identify_model`] says of runs read whole.
     pub fn held_inputs(&self, model: &Model) -> Vec<super::model::Held> {
         let held = |name: &str| -> Option<(f64, bool)> {
             if self.runs.iter().all(|r| r.noise.contains_key(name)) {
