@@ -144,8 +144,8 @@ const PRODUCTS_UP_TO: usize = 10;
 /// it held over each interval, and with `x` read at its readings. Held leaves at least 0.5 %
 /// less of the residual sum of squares, and 25 residual variances less, where it is held:
 /// where a noisy record hides the kink of [`kinks_at_changes`], the
-/// fit still sees half a period's shift over every period. The state's index in `motion` and
-/// the share held leaves of what read leaves; `None` where neither is clearly better or the
+/// fit still sees half a period's shift over every period. The index in `motion` of the
+/// state held fits best against read, and the share held leaves of what read leaves; `None` where neither is clearly better or the
 /// record is too short for the columns.
 pub fn fits_better_held(
     t: &[f64],
@@ -242,7 +242,9 @@ fn held_or_else(
         Some((y - a * fit).norm_squared())
     };
     let dof = (windows - terms.len()) as f64;
-    motion.iter().enumerate().find_map(|(i, m)| {
+    // the state that tells most (the one the column drives, where another follows it: `v`
+    // under a force, not `x`)
+    let telling = motion.iter().enumerate().filter_map(|(i, m)| {
         if !moves_by_itself(m) {
             return None;
         }
@@ -254,7 +256,8 @@ fn held_or_else(
             && as_held <= (1.0 - BETTER_HELD) * as_read
             && as_read - as_held >= HELD_SIGNIFICANT * as_held / dof;
         better.then_some((i, as_held / as_read))
-    })
+    });
+    telling.min_by(|a, b| a.1.total_cmp(&b.1))
 }
 
 /// `x` at its readings (the rows `phase`, `phase + period`, …) and, between them and beyond the
