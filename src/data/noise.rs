@@ -217,15 +217,8 @@ impl NoiseTally {
         let stepped: Vec<(&String, &[f64])> =
             frame.held().iter().filter_map(|c| frame.column(c).map(|u| (c, u))).collect();
         if stepped.iter().any(|(c, u)| *c == name && followed(frame, name, u)) {
-            let tally = Self::of_values(x, own, false, &[]);
-            return Some(NoiseTally {
-                noise: 0.0,
-                noise_rows: tally.rows,
-                correlated_rows: 0,
-                bound: 0.0,
-                bound_rows: 0,
-                ..tally
-            });
+            let spread = Self::spread(x.get(own).unwrap_or_default());
+            return Some(NoiseTally { noise_rows: spread.rows, ..spread });
         }
         let others: Vec<&[f64]> = stepped.iter().filter(|(c, _)| *c != name).map(|(_, u)| *u).collect();
         Some(Self::of_values(x, own, !command, &others))
@@ -258,6 +251,14 @@ impl NoiseTally {
                 tally.correlated_rows = rows.len();
             }
         }
+        let spread = Self::spread(rows);
+        NoiseTally { rows: spread.rows, mean: spread.mean, m2: spread.m2, ..tally }
+    }
+
+    /// The tally of `rows` with no noise found: their count, mean and squared deviations
+    /// (Welford).
+    fn spread(rows: &[f64]) -> NoiseTally {
+        let mut tally = NoiseTally::default();
         for &v in rows {
             tally.rows += 1;
             let d = v - tally.mean;

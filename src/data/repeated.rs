@@ -145,8 +145,8 @@ const PRODUCTS_UP_TO: usize = 10;
 /// less of the residual sum of squares, and 25 residual variances less, where it is held:
 /// where a noisy record hides the kink of [`kinks_at_changes`], the
 /// fit still sees half a period's shift over every period. The index in `motion` of the
-/// state held fits best against read, and the share held leaves of what read leaves; `None` where neither is clearly better or the
-/// record is too short for the columns.
+/// state held fits best against read, and the share held leaves of what read leaves; `None`
+/// where neither is clearly better or the record is too short for the columns.
 pub fn fits_better_held(
     t: &[f64],
     x: &[f64],

@@ -208,6 +208,14 @@ pub fn chosen_terms(report: &serde_json::Value) -> Vec<(String, f64)> {
     out
 }
 
+/// The physical check of a JSON report whose name holds `part`, or a panic that shows the report.
+pub fn check_named<'a>(report: &'a serde_json::Value, part: &str) -> &'a serde_json::Value {
+    report["physical_checks"]
+        .as_array()
+        .and_then(|checks| checks.iter().find(|c| c["name"].as_str().is_some_and(|n| n.contains(part))))
+        .unwrap_or_else(|| panic!("no check named like `{part}`: {report}"))
+}
+
 /// A command's JSON report, or a panic that shows it.
 pub fn json(text: &str) -> serde_json::Value {
     serde_json::from_str(text).unwrap_or_else(|e| panic!("{e}: {text}"))

@@ -2374,13 +2374,7 @@ fn many_states_with_few_rows_of_evidence_keep_their_terms() {
         let (ok, report, err) = termid(&args);
         assert!(ok, "{err}");
         let report = json(&report);
-        let halves = report["physical_checks"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|c| c["name"] == "the terms hold on each half of the runs")
-            .unwrap()
-            .clone();
+        let halves = crate::common::check_named(&report, "the terms hold on each half of the runs").clone();
         (report, halves)
     };
     // the first 7 s from the quadratic library (66 candidates): the whole's 104 rows' worth

@@ -512,13 +512,7 @@ fn a_force_stepped_at_every_sample_is_held() {
     let (ok, out, err) = termid(&["identify", "--data", path, "--states", "x,v", "--format", "json"]);
     assert!(ok, "{err}");
     let found = json(&out);
-    let noise = found["physical_checks"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|c| c["name"].as_str().unwrap().contains("noise"))
-        .unwrap_or_else(|| panic!("{out}"));
-    assert_eq!(noise["passed"], true, "{out}");
+    assert_eq!(crate::common::check_named(&found, "noise")["passed"], true, "{out}");
     assert_true_terms_within(&chosen_terms(&found["v_dot"]), &|_| 1e-4, &out);
 }
 
