@@ -27,6 +27,9 @@ const SHORTEST: usize = 21;
 /// or three samples away is off theirs (a smooth record's steps change smoothly; a break's
 /// flanks are off by half as much, the other way).
 const BESIDE: f64 = 5.0;
+/// The share of a break's own excess each step beside it must be off the other way at least
+/// (a leap's are off by half; a kink's are off by as much on one side and none on the other).
+const FLANK: f64 = 0.25;
 /// How many robust standard deviations of the steps' roughness it must exceed (Gaussian
 /// noise that far about once in 10⁷ samples).
 const NOISE: f64 = 8.0;
@@ -56,7 +59,10 @@ pub fn breaks(t: &[f64], x: &[f64]) -> Vec<Break> {
     let candidates: Vec<usize> = (3..steps.len().saturating_sub(3))
         .filter(|&k| {
             let around = [k - 3, k - 2, k + 2, k + 3].iter().fold(0.0, |m: f64, &j| m.max(off[j].abs()));
-            off[k].abs() > BESIDE * around
+            // a leap's flanks are off by half as much the other way, both; a kink's (a rudder
+            // starting to turn at its rate) are off by as much, or nothing on one side
+            let flank = |j: usize| -off[j] * off[k].signum() >= FLANK * off[k].abs();
+            off[k].abs() > BESIDE * around && flank(k - 1) && flank(k + 1)
         })
         .collect();
     if candidates.is_empty() {
@@ -426,6 +432,32 @@ mod tests {
             })
             .collect();
         assert!(breaks(&clock(flicker.len()), &flicker).is_empty());
+    }
+
+    /// Not breaks: a rudder turned at its rate from one angle to the next, 1.5° a sample,
+    /// starting and stopping between samples and standing in between (its kinks are off
+    /// alike on both sides, or on one side only), noise-free; a leap on its way still is.
+    #[test]
+    fn a_rudder_turned_at_its_rate_is_no_break() {
+        let rate = 15.0;
+        let angle = |t: f64| {
+            // from 10° to −10° starting at 5.23 s, back at 20.57 s, and so on every 15.34 s
+            let cycle = (t - 5.23).rem_euclid(30.68);
+            let turned = |since: f64| (rate * since).min(20.0);
+            if t < 5.23 {
+                10.0
+            } else if cycle < 15.34 {
+                10.0 - turned(cycle)
+            } else {
+                -10.0 + turned(cycle - 15.34)
+            }
+        };
+        let t = clock(3000);
+        let rudder: Vec<f64> = t.iter().map(|&s| angle(s)).collect();
+        assert!(breaks(&t, &rudder).is_empty(), "{:?}", breaks(&t, &rudder));
+        let mut knocked = rudder;
+        knocked[1200..].iter_mut().for_each(|d| *d += 2.0);
+        assert_eq!(breaks(&t, &knocked).iter().map(|b| b.row).collect::<Vec<_>>(), [1200]);
     }
 
     /// Two records in one frame: cut into two runs named by their rows (the file's, for a

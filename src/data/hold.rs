@@ -78,7 +78,38 @@ const SIZE: f64 = 0.01;
 /// moves, never changes, or has under 20 intervals. A record that jumps at every sample
 /// (a random binary signal switched each sample) is not found here: [`white`] finds it.
 pub fn held(x: &[f64]) -> Option<Hold> {
-    let at = isolated_changes(x)?;
+    sized(x, isolated_changes(x)?)
+}
+
+/// Whether `x` is stepped between many levels at random samples and held in between (an
+/// APRBS: a new random level with some odds at each sample, so now and then on consecutive
+/// samples): it stays put over a third of its intervals or more (one switched at every other
+/// sample on average correlates by a half from sample to sample, not [`white`]) and jumps by
+/// a fair share of its span and size (as [`held`]), its changes side by side or not, but those
+/// side by side turning back as often as not (a third of them keep their direction between
+/// random levels; a motion read to coarse counts keeps it from count to count). Whether the
+/// states' rates are stepped by it too is for [`mark_held`]'s fit of them to tell. `None`
+/// as for [`held`].
+pub fn stepped(x: &[f64]) -> Option<Hold> {
+    if x.len() < 21 {
+        return None;
+    }
+    let at: Vec<usize> = (0..x.len() - 1).filter(|&i| x[i + 1] != x[i]).collect();
+    (!at.is_empty() && 3 * at.len() <= 2 * (x.len() - 1)).then_some(())?;
+    // changes side by side keeping their direction: a third of them between random levels,
+    // nearly all where a motion passes count after count (one pair more allowed where few)
+    let side_by_side = at.windows(2).filter(|w| w[1] == w[0] + 1);
+    let (pairs, kept) = side_by_side.fold((0, 0), |(n, k), w| {
+        let (a, b) = (x[w[0] + 1] - x[w[0]], x[w[1] + 1] - x[w[1]]);
+        (n + 1, k + usize::from(a.signum() == b.signum()))
+    });
+    (2 * kept <= pairs + 2).then_some(())?;
+    sized(x, at)
+}
+
+/// What shows `x` held between its changes `at` (the intervals over which it changes): its
+/// median jump a fair share of its span and of its size; `None` where not.
+fn sized(x: &[f64], at: Vec<usize>) -> Option<Hold> {
     let (low, high) = x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
     let size = low.abs().max(high.abs());
     let mut jumps: Vec<f64> = at.iter().map(|&i| (x[i + 1] - x[i]).abs()).collect();
@@ -247,12 +278,23 @@ fn held_on_the_samples(
         return Ok(None);
     };
     let note = format!(
-        "{how}, on no clock, but the rate of `{}` is fitted better with it held from each sample to the next than as a line between them ({:.1} % less left over, by a quadratic in the columns over windows of eight samples): a generator's command switched at random samples (a random telegraph, a PRBS), not a relay thrown between them; taken as held. Where it switches between the samples, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)",
+        "{how}, on no clock, but the rate of `{}` is fitted better with it held from each sample to the next than as a line between them ({:.1} % less left over, by a quadratic in the columns over windows of eight samples): a generator's command switched at random samples (a random telegraph, a PRBS, an APRBS), not a relay thrown between them; taken as held. Where it switches between the samples, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)",
         states[i].0,
         100.0 * (1.0 - share)
     );
     frame.hold(name)?;
     Ok(Some(note))
+}
+
+/// How column `name` of `frame` stays put between samples and jumps at them (`h`).
+fn stays_put(frame: &Frame, name: &str, h: Hold) -> String {
+    format!(
+        "{}: `{name}` stays put between samples ({:.0} % of intervals) and jumps at {} samples (by {:.0} % of its span, median)",
+        frame.origin(),
+        100.0 * h.flat,
+        h.jumps,
+        100.0 * h.jump
+    )
 }
 
 /// The rows at which a record switched between samples ([`Frame::switch`]) has switched: the
@@ -293,8 +335,13 @@ pub fn mark_held(
         match intersample {
             Intersample::Linear => frame.release(name),
             Intersample::Held => {
-                // a staircase on a clock, by steps large or small, or one stepped every sample
-                if held(column).is_some() || repeated(column).is_some() || white(column).is_some() {
+                // a staircase on a clock, by steps large or small, at random samples, or one
+                // stepped every sample
+                if stepped(column).is_some()
+                    || held(column).is_some()
+                    || repeated(column).is_some()
+                    || white(column).is_some()
+                {
                     frame.hold(name)?;
                 }
             }
@@ -314,18 +361,20 @@ pub fn mark_held(
                     continue;
                 }
                 let Some(h) = held(column) else {
+                    let steps = stepped(column);
                     if let Some(note) = commanded(frame, name, motion, columns)? {
                         notes.push(note);
+                    } else if let Some(h) = steps {
+                        // changes side by side: held where the rates say so, else a line (a
+                        // motion read to coarse counts is no relay to leave out windows for)
+                        let how = stays_put(frame, name, h);
+                        if let Some(note) = held_on_the_samples(frame, name, motion, columns, &how)? {
+                            notes.push(note);
+                        }
                     }
                     continue;
                 };
-                let how = format!(
-                    "{}: `{name}` stays put between samples ({:.0} % of intervals) and jumps at {} samples (by {:.0} % of its span, median)",
-                    frame.origin(),
-                    100.0 * h.flat,
-                    h.jumps,
-                    100.0 * h.jump
-                );
+                let how = stays_put(frame, name, h);
                 if !h.on_a_clock() {
                     if let Some(note) = held_on_the_samples(frame, name, motion, columns, &how)? {
                         notes.push(note);
@@ -376,6 +425,42 @@ mod tests {
         assert_eq!(white(&noise[..20]), None);
         let spike: Vec<f64> = (0..500).map(|k| if k == 300 { 1.0 } else { 0.0 }).collect();
         assert_eq!(white(&spike), None);
+    }
+
+    /// An APRBS (a new random level with odds of one in five at each sample, so at times on
+    /// consecutive samples) is stepped, not held at isolated samples; a rudder turned at
+    /// 1.5 counts a sample between ±10 counts and standing in between (its changes side by
+    /// side keep their direction) and a binary signal switched at every sample (no sample
+    /// where it stays put) are not.
+    #[test]
+    fn random_levels_at_random_samples_are_stepped() {
+        let mut seed = 5u64;
+        let mut level = 0.0;
+        let aprbs: Vec<f64> = (0..2000)
+            .map(|_| {
+                if crate::data::test_noise(&mut seed) > 0.3 {
+                    level = 2.0 * crate::data::test_noise(&mut seed);
+                }
+                level
+            })
+            .collect();
+        assert_eq!(held(&aprbs), None);
+        let h = stepped(&aprbs).unwrap();
+        assert!(h.flat > 0.7 && h.flat < 0.9 && h.period == 1, "{h:?}");
+        let rudder: Vec<f64> = (0..2000)
+            .map(|k| {
+                let phase = (k % 200) as f64;
+                let swing = (1.5 * phase).min(20.0);
+                if k % 400 < 200 {
+                    (10.0 - swing).round()
+                } else {
+                    (-10.0 + swing).round()
+                }
+            })
+            .collect();
+        assert_eq!(stepped(&rudder), None);
+        let alternating: Vec<f64> = (0..2000).map(|k| (k % 2) as f64).collect();
+        assert_eq!(stepped(&alternating), None);
     }
 
     /// A force held for 50 samples at a time, at random levels: held; the same force moving

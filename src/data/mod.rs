@@ -38,7 +38,7 @@ pub use derivative::{
 };
 pub use five_point::FivePoint;
 pub use geodetic::{north_east, radii_of_curvature};
-pub use hold::{held, mark_held, switches, white, Hold, Intersample};
+pub use hold::{held, mark_held, stepped, switches, white, Hold, Intersample};
 pub use integral::{integral_rows, integral_rows_held, row_overlap, IntegralForm};
 pub use kalman::{KalmanSmoother, NoiseModel};
 pub use long::{columns_of, interleaved, text_columns_of};
