@@ -131,6 +131,11 @@ const BETTER_HELD: f64 = 0.005;
 /// independent).
 const HELD_SIGNIFICANT: f64 = 25.0;
 
+/// … and by at least this share of the state's squared changes over the windows: where
+/// holding the column matters less, a line between its samples costs nothing (a force held
+/// on a state it drives: 10⁻⁴ to 10⁻²).
+const MATTERS: f64 = 1e-6;
+
 /// The rows the fit reads at most: the start of a long record shows it.
 const FIT_ROWS: usize = 20_000;
 
@@ -142,7 +147,8 @@ const PRODUCTS_UP_TO: usize = 10;
 /// period regressed on the integrals over them of a constant, `x` and the columns `others`
 /// (the state among them) and, up to ten columns, their products — with `x` as its rows have
 /// it held over each interval, and with `x` read at its readings. Held leaves at least 0.5 %
-/// less of the residual sum of squares, and 25 residual variances less, where it is held:
+/// less of the residual sum of squares, 25 residual variances less, and a millionth of the
+/// state's squared changes less, where it is held:
 /// where a noisy record hides the kink of [`kinks_at_changes`], the
 /// fit still sees half a period's shift over every period. The index in `motion` of the
 /// state held fits best against read, and the share held leaves of what read leaves; `None`
@@ -250,9 +256,9 @@ fn held_or_else(
         }
         let y = nalgebra::DVector::from_fn(windows, |row, _| m[(row + 1) * w] - m[row * w]);
         let (as_held, as_read) = (left(&held, &held_svd, &y)?, left(&read, &read_svd, &y)?);
-        // (a state fitted exactly either way, to round-off, one whose rate the column does not
-        // drive, tells nothing)
-        let better = as_read > 1e-24 * y.norm_squared()
+        // (a state the column does not drive, fitted to its quadrature's error either way,
+        // tells nothing: a heading under a rudder read to whole degrees, 6·10⁻¹⁰ better held)
+        let better = as_read - as_held >= MATTERS * y.norm_squared()
             && as_held <= (1.0 - BETTER_HELD) * as_read
             && as_read - as_held >= HELD_SIGNIFICANT * as_held / dof;
         better.then_some((i, as_held / as_read))
