@@ -17,18 +17,49 @@ pub fn wrapped(angle: &[f64]) -> Option<usize> {
 /// (runs compared together are scaled by their pooled spread, which whole turns between them
 /// would inflate).
 pub fn unwrap_turns(angle: &mut [f64]) {
+    unwrap_turns_of(angle, TAU);
+}
+
+/// [`unwrap_turns`] for an angle whose full turn is `turn` (2π in radians, 360 in degrees).
+fn unwrap_turns_of(angle: &mut [f64], turn: f64) {
     let mut turns = 0.0;
     for k in 1..angle.len() {
         let jump = angle[k] + turns - angle[k - 1];
-        if jump.abs() > PI {
-            turns -= TAU * (jump / TAU).round();
+        if jump.abs() > 0.5 * turn {
+            turns -= turn * (jump / turn).round();
         }
         angle[k] += turns;
     }
-    let start = TAU * (angle.first().copied().unwrap_or(0.0) / TAU).round();
+    let start = turn * (angle.first().copied().unwrap_or(0.0) / turn).round();
     for a in angle.iter_mut() {
         *a -= start;
     }
+}
+
+/// The full turn (2π or 360) of a record that reads like an angle on a dial, in radians or
+/// degrees, its units not declared: it stays within one turn (2 % over, for noise), spans
+/// three quarters of it or more, jumps by more than half of it at least once, and moves by
+/// less than a quarter of it at every other step (a pendulum swinging over the top, read
+/// by atan2 in ±π, a wind direction in 0-360°). A record that so jumps by any other span (a
+/// counter that rolls over, a relaxation reset) is no angle: `None`.
+pub fn turn_of(x: &[f64]) -> Option<f64> {
+    let (low, high) = x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
+    [TAU, 360.0].into_iter().find(|&turn| {
+        let span = high - low;
+        let steps = x.windows(2).map(|w| (w[1] - w[0]).abs());
+        let (wraps, moves) =
+            steps.fold(
+                (0, true),
+                |(n, ok), s| {
+                    if s > 0.5 * turn {
+                        (n + 1, ok)
+                    } else {
+                        (n, ok && s < 0.25 * turn)
+                    }
+                },
+            );
+        span <= 1.02 * turn && span >= 0.75 * turn && wraps > 0 && moves
+    })
 }
 
 /// The run with its angle columns `angles` (rad) unwrapped where they wrap ([`wrapped`]), with
@@ -47,6 +78,35 @@ pub fn unwrapped(frame: &Frame, angles: &[&str]) -> Result<Option<(Frame, Vec<St
             row + 1,
             column[row].to_degrees(),
             column[row - 1].to_degrees()
+        ));
+        out.get_or_insert_with(|| frame.clone()).set(name, angle)?;
+    }
+    Ok(out.map(|f| (f, notes)))
+}
+
+/// The run with the columns `names` whose units are not known unwrapped where they read as
+/// an angle on a dial ([`turn_of`]), with what to say of each; `None` where none does.
+pub fn unwrapped_dials(frame: &Frame, names: &[&str]) -> Result<Option<(Frame, Vec<String>)>, DataError> {
+    let mut out: Option<Frame> = None;
+    let mut notes = Vec::new();
+    for name in names {
+        let Some(column) = frame.column(name) else { continue };
+        let Some(turn) = turn_of(column) else { continue };
+        let row = (1..column.len()).find(|&k| (column[k] - column[k - 1]).abs() > 0.5 * turn).unwrap_or(0);
+        let mut angle = column.to_vec();
+        unwrap_turns_of(&mut angle, turn);
+        notes.push(format!(
+            "{}: `{name}` stays within {} and jumps by about that at {} (row {}: {:.4} after {:.4}), as an angle read on a dial wraps at a full turn: read as one continuous angle, in {} (forces that turn with it are periodic in it, which no polynomial is: sin({name}) and cos({name}) among the candidates hold them)",
+            frame.origin(),
+            if turn == TAU { "2π" } else { "360" },
+            match column.windows(2).filter(|w| (w[1] - w[0]).abs() > 0.5 * turn).count() {
+                1 => "one row".to_string(),
+                n => format!("{n} rows"),
+            },
+            row + 1,
+            column[row],
+            column[row - 1],
+            if turn == TAU { "radians" } else { "degrees" }
         ));
         out.get_or_insert_with(|| frame.clone()).set(name, angle)?;
     }
@@ -74,6 +134,29 @@ mod tests {
         }
         unwrap_turns(&mut port);
         assert!(port.iter().zip(&want).all(|(a, b)| (a - b).abs() < 1e-12));
+    }
+
+    /// A pendulum over the top read by atan2 (±π) and a wind direction in 0-360° read as
+    /// angles on a dial, and unwrapped back to their turning; a counter that rolls over at
+    /// 100, a swing of ±1 rad that never wraps, a record that leaps by a turn but moves by
+    /// more than a quarter of one elsewhere: not.
+    #[test]
+    fn an_angle_on_a_dial_is_found_by_its_full_turns() {
+        let truth: Vec<f64> = (0..3000).map(|k| 0.01 * k as f64 + 2.0 * (0.003 * k as f64).sin()).collect();
+        let dial: Vec<f64> = truth.iter().map(|a| a.sin().atan2(a.cos())).collect();
+        assert_eq!(turn_of(&dial), Some(TAU));
+        let mut back = dial.clone();
+        unwrap_turns_of(&mut back, TAU);
+        assert!(back.iter().zip(&truth).all(|(a, b)| (a - b).abs() < 1e-9));
+        let wind: Vec<f64> = truth.iter().map(|a| a.to_degrees().rem_euclid(360.0)).collect();
+        assert_eq!(turn_of(&wind), Some(360.0));
+        let counter: Vec<f64> = (0..3000).map(|k| f64::from(k % 100)).collect();
+        assert_eq!(turn_of(&counter), None);
+        let swing: Vec<f64> = (0..3000).map(|k| (0.01 * k as f64).sin()).collect();
+        assert_eq!(turn_of(&swing), None);
+        let mut leaps = dial;
+        leaps[1500] = leaps[1499] + 2.0;
+        assert_eq!(turn_of(&leaps), None);
     }
 
     #[test]

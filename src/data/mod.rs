@@ -28,7 +28,7 @@ mod spike;
 mod stream;
 mod weak;
 
-pub use angle::{unwrap_turns, unwrapped, wrapped};
+pub use angle::{turn_of, unwrap_turns, unwrapped, unwrapped_dials, wrapped};
 pub use breaks::{breaks, cut_at_breaks, cut_at_gaps, gaps, moving_breaks, Break, Gaps};
 pub use clock::clock_seconds;
 pub use dataset::{velocities_from_track, Dataset, Delimiter, RunSpec, Track};

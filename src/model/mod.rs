@@ -941,6 +941,18 @@ impl Model {
             *frame = whole;
             notes.extend(said);
         }
+        // so does any column of unknown units that reads like an angle on a dial (a pendulum
+        // over the top by atan2, a wind direction): a polynomial of it, its rate, would see
+        // a full turn's leap at every wrap
+        let unknown: Vec<&str> = (self.spec.states.iter().map(|s| (&s.name, &s.unit)))
+            .chain(self.spec.inputs.iter().map(|i| (&i.name, &i.unit)))
+            .filter(|(_, unit)| unit.is_empty())
+            .map(|(name, _)| name.as_str())
+            .collect();
+        if let Some((whole, said)) = crate::data::unwrapped_dials(frame, &unknown)? {
+            *frame = whole;
+            notes.extend(said);
+        }
         let mut spikes = Vec::new();
         if !self.spec.model.keep_spikes {
             let rates: Vec<String> = self.spec.states.iter().map(|s| format!("{}_dot", s.name)).collect();

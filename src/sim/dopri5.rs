@@ -462,7 +462,7 @@ impl Dopri5 {
 
     fn stuck(&self, system: &System, t: f64) -> SimError {
         SimError::Settings(format!(
-            "the adaptive integrator could not meet its tolerances at t = {t:?} s (step {:?} s): the model is stiff or diverging there; state {}",
+            "the adaptive integrator could not meet its tolerances at t = {t:.6} s (step {:.3e} s): the model is stiff or diverging there; state {}",
             self.h,
             super::integrator::snapshot(&system.states, &self.y)
         ))

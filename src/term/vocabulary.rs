@@ -247,6 +247,8 @@ impl Vocabulary {
             ExprKind::Num(v) => Ok(Term::constant(*v)),
             ExprKind::Var(name) => match self.canonical(name) {
                 Some(c) => Ok(Term::var(&c)),
+                // π by name, where no variable takes the name (`sin(θ*pi/180)` for degrees)
+                None if name == "pi" || name == "π" => Ok(Term::constant(std::f64::consts::PI)),
                 None if function(name).is_some() => {
                     Err(at(format!("`{name}` is a function: write `{name}(…)`")))
                 }
@@ -377,6 +379,18 @@ mod tests {
         assert!(e.contains("`[columns] x_pos = \"x.pos\"`"), "{e}");
         let e = Vocabulary::new().variable("2x").map(|_| ()).unwrap_err().to_string();
         assert!(e.ends_with("not a digit first)"), "{e}");
+    }
+
+    /// `pi` and `π` are π (degrees written as they are read), unless the model names a
+    /// variable so.
+    #[test]
+    fn pi_is_pi_unless_a_variable_takes_the_name() {
+        let v = ship();
+        assert_eq!(v.parse("sin(δ*pi/180)").unwrap(), v.parse("sin(0.017453292519943295*δ)").unwrap());
+        assert_eq!(v.parse("π*u").unwrap(), v.parse("3.141592653589793*u").unwrap());
+        let mut named = ship();
+        named.variable("pi").unwrap();
+        assert_eq!(named.parse("pi*u").unwrap().variables(), ["pi", "u"]);
     }
 
     #[test]
