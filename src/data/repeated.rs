@@ -274,27 +274,8 @@ pub fn between_readings(t: &[f64], x: &[f64], r: Repeats) -> Vec<f64> {
     if nodes.len() < 4 {
         return x.to_vec();
     }
-    let mut out = Vec::with_capacity(x.len());
-    let mut i = 0;
-    for (row, &s) in t.iter().enumerate() {
-        // the reading at or before the row (the first where the row comes before it)
-        while i + 1 < nodes.len() && nodes[i + 1] <= row {
-            i += 1;
-        }
-        let first = i.saturating_sub(1).min(nodes.len() - 4);
-        let four = &nodes[first..first + 4];
-        // Lagrange's cubic through the four readings
-        let value: f64 = four
-            .iter()
-            .map(|&a| {
-                let weight: f64 =
-                    four.iter().filter(|&&b| b != a).map(|&b| (s - t[b]) / (t[a] - t[b])).product();
-                weight * x[a]
-            })
-            .sum();
-        out.push(value);
-    }
-    out
+    let (at, read): (Vec<f64>, Vec<f64>) = nodes.iter().map(|&i| (t[i], x[i])).unzip();
+    super::resample::cubic_at(&at, &read, t)
 }
 
 /// The columns of `frame` named in `columns` that are a slower sensor's readings repeated

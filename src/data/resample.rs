@@ -53,6 +53,33 @@ fn interpolate(t: &[f64], x: &[f64], at: &[f64]) -> Vec<f64> {
     at.iter().map(|&s| interpolate_at(t, x, s, &mut cursor)).collect()
 }
 
+/// (t, x) at every time of `at` (increasing) by the cubic through the four samples nearest it
+/// (the two either side, or the first or last four): Lagrange's, at the samples' own times,
+/// exact to O(h⁴) for a smooth record where a line errs by O(h²). Fewer than four samples: a
+/// line.
+pub fn cubic_at(t: &[f64], x: &[f64], at: &[f64]) -> Vec<f64> {
+    if t.len() < 4 {
+        return interpolate(t, x, at);
+    }
+    let mut i = 0;
+    at.iter()
+        .map(|&s| {
+            // the sample at or before s (the first where s comes before it)
+            while i + 1 < t.len() && t[i + 1] <= s {
+                i += 1;
+            }
+            let first = i.saturating_sub(1).min(t.len() - 4);
+            (first..first + 4)
+                .map(|a| {
+                    let weight: f64 =
+                        (first..first + 4).filter(|&b| b != a).map(|b| (s - t[b]) / (t[a] - t[b])).product();
+                    weight * x[a]
+                })
+                .sum()
+        })
+        .collect()
+}
+
 /// Low-pass FIR taps: cut-off `fc` and transition `width`, both in cycles per sample.
 fn low_pass(fc: f64, width: f64) -> Vec<f64> {
     let half = (2.75 / width).ceil() as i64; // Blackman: ~5.5 / width taps
@@ -132,7 +159,7 @@ pub fn evened(frame: &Frame) -> Result<Option<(Frame, String)>, DataError> {
     // stamps as a person reads them, not as the binary sums leave them
     let short = |v: f64| (v * 1e9).round() / 1e9;
     let note = format!(
-        "{}: samples not evenly spaced (row {}: t = {} s where a step of {} s from the first puts it at {} s): resampled onto its median step, {} s (linear between samples), as a re-simulation compares it sample by sample",
+        "{}: samples not evenly spaced (row {}: t = {} s where a step of {} s from the first puts it at {} s): resampled onto its median step, {} s (by the cubic through the four nearest samples; a line for a column that steps or leaps), as a re-simulation compares it sample by sample",
         frame.origin(),
         row + 1,
         short(at),
@@ -140,13 +167,28 @@ pub fn evened(frame: &Frame) -> Result<Option<(Frame, String)>, DataError> {
         short(place),
         short(step)
     );
-    let even = resample(frame, step).map_err(|e| {
+    let mut even = resample(frame, step).map_err(|e| {
         DataError::Setting(format!(
             "{}: samples not evenly spaced (row {}), and the run cannot be resampled onto its median step: {e}",
             frame.origin(),
             row + 1
         ))
     })?;
+    // a record that moves smoothly by the cubic through its four nearest samples (a line's
+    // O(h²) error biased Lorenz's damping of y 0.6 % at a jitter of 20 %); one that steps,
+    // leaps or changes at every sample stays a line, which does not ring across a jump
+    for name in &frame.names()[1..] {
+        let x = frame.require(name)?;
+        let steps = super::held(x).is_some()
+            || super::stepped(x).is_some()
+            || super::white(x).is_some()
+            || super::repeated(x).is_some()
+            || !super::breaks(frame.time(), x).is_empty();
+        if !steps {
+            let smooth = cubic_at(frame.time(), x, even.time());
+            even.set(name, smooth)?;
+        }
+    }
     Ok(Some((even, note)))
 }
 
@@ -233,6 +275,25 @@ pub fn resample(frame: &Frame, dt: f64) -> Result<Frame, DataError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Samples 0.1 s apart with a jitter of ±20 %: a sine evened by the cubic through its
+    /// four nearest samples within 10⁻⁵ (a line would err by 10⁻³), a force held at levels
+    /// that step between samples by a line (no overshoot beside a step).
+    #[test]
+    fn a_jittered_record_is_evened_by_cubics_and_a_stepped_one_by_lines() {
+        let mut seed = 4u64;
+        let t: Vec<f64> =
+            (0..400).map(|k| 0.1 * k as f64 + 0.02 * (crate::data::test_noise(&mut seed) * 2.0)).collect();
+        let mut f = Frame::new("jitter.csv", "t", t.clone()).unwrap();
+        f.push("x", t.iter().map(|s| s.sin()).collect()).unwrap();
+        f.push("F", t.iter().map(|s| if (s / 5.0).floor() as i64 % 2 == 0 { 1.0 } else { -1.0 }).collect())
+            .unwrap();
+        let (even, note) = evened(&f).unwrap().unwrap();
+        assert!(note.contains("cubic"), "{note}");
+        let worst = even.time().iter().zip(even.column("x").unwrap()).map(|(s, x)| (x - s.sin()).abs());
+        assert!(worst.fold(0.0, f64::max) < 1e-5);
+        assert!(even.column("F").unwrap().iter().all(|v| (-1.0..=1.0).contains(v)));
+    }
 
     /// A dropped sample (a step of two) is found where the first step no longer meets the
     /// row, and the run is put back on its median step; a jitter of a few percent about the

@@ -2595,3 +2595,48 @@ fn an_angle_that_wraps_on_a_dial_is_read_as_one_angle() {
         }
     }
 }
+
+/// Lorenz logged with jittered timestamps (each sample 8-12 ms after the last, as a logger
+/// on events stamps them; the states read exactly at those times): evened onto the median
+/// step by the cubic through the four nearest samples, said, and every true term within
+/// 10⁻⁴ (a line between the samples left y's damping 0.6 % off).
+#[test]
+fn a_log_with_jittered_timestamps_is_evened_by_cubics() {
+    use crate::common::{chosen_terms, json, lorenz_rows, Lcg, Scratch};
+    let fine = lorenz_rows(0.001, 20_001);
+    let mut rng = Lcg(31);
+    let (mut csv, mut k) = (String::from("t,x,y,z\n"), 0usize);
+    while k < fine.len() {
+        let row = &fine[k];
+        csv += &format!("{:?},{:?},{:?},{:?}\n", 0.001 * k as f64, row[0], row[1], row[2]);
+        k += 8 + (rng.next() * 5.0) as usize;
+    }
+    let dir = Scratch::new("generic-jitter");
+    let data = dir.join("logged.csv");
+    std::fs::write(&data, csv).unwrap();
+    let (ok, out, err) = termid(&[
+        "identify",
+        "--data",
+        data.to_str().unwrap(),
+        "--states",
+        "x,y,z",
+        "--inputs",
+        "--format",
+        "json",
+    ]);
+    assert!(ok, "{err}");
+    assert!(err.contains("samples not evenly spaced") && err.contains("by the cubic through"), "{err}");
+    let found = json(&out);
+    let truths: [(&str, &[(&str, f64)]); 3] = [
+        ("x_dot", &[("x", -10.0), ("y", 10.0)]),
+        ("y_dot", &[("x", 28.0), ("x*z", -1.0), ("y", -1.0)]),
+        ("z_dot", &[("x*y", 1.0), ("z", -8.0 / 3.0)]),
+    ];
+    for (rate, want) in truths {
+        let got = chosen_terms(&found[rate]);
+        assert_eq!(got.len(), want.len(), "{rate}: {got:?}");
+        for ((term, c), (name, truth)) in got.iter().zip(want) {
+            assert!(term == name && (c - truth).abs() < 1e-4 * truth.abs(), "{term} {c}: {out}");
+        }
+    }
+}
