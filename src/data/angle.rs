@@ -65,49 +65,62 @@ pub fn turn_of(x: &[f64]) -> Option<f64> {
 /// The run with its angle columns `angles` (rad) unwrapped where they wrap ([`wrapped`]), with
 /// what to say of each; `None` where none wraps.
 pub fn unwrapped(frame: &Frame, angles: &[&str]) -> Result<Option<(Frame, Vec<String>)>, DataError> {
-    let mut out: Option<Frame> = None;
-    let mut notes = Vec::new();
-    for name in angles {
-        let Some(column) = frame.column(name) else { continue };
-        let Some(row) = wrapped(column) else { continue };
-        let mut angle = column.to_vec();
-        unwrap_turns(&mut angle);
-        notes.push(format!(
-            "{}: `{name}` jumps by a full turn (row {}: {:.1}° after {:.1}°), as a compass wraps at 360°: read as one continuous angle",
-            frame.origin(),
-            row + 1,
-            column[row].to_degrees(),
-            column[row - 1].to_degrees()
-        ));
-        out.get_or_insert_with(|| frame.clone()).set(name, angle)?;
-    }
-    Ok(out.map(|f| (f, notes)))
+    unwrapped_by(frame, angles, |name, column| {
+        let row = wrapped(column)?;
+        Some((
+            TAU,
+            format!(
+                "{}: `{name}` jumps by a full turn (row {}: {:.1}° after {:.1}°), as a compass wraps at 360°: read as one continuous angle",
+                frame.origin(),
+                row + 1,
+                column[row].to_degrees(),
+                column[row - 1].to_degrees()
+            ),
+        ))
+    })
 }
 
 /// The run with the columns `names` whose units are not known unwrapped where they read as
 /// an angle on a dial ([`turn_of`]), with what to say of each; `None` where none does.
 pub fn unwrapped_dials(frame: &Frame, names: &[&str]) -> Result<Option<(Frame, Vec<String>)>, DataError> {
+    unwrapped_by(frame, names, |name, column| {
+        let turn = turn_of(column)?;
+        let wraps: Vec<usize> =
+            (1..column.len()).filter(|&k| (column[k] - column[k - 1]).abs() > 0.5 * turn).collect();
+        let row = *wraps.first()?;
+        let (full, unit) = if turn == TAU { ("2π", "radians") } else { ("360", "degrees") };
+        Some((
+            turn,
+            format!(
+                "{}: `{name}` stays within {full} and jumps by about that at {} (row {}: {:.4} after {:.4}), as an angle read on a dial wraps at a full turn: read as one continuous angle, in {unit} (forces that turn with it are periodic in it, which no polynomial is: sin({name}) and cos({name}) among the candidates hold them)",
+                frame.origin(),
+                match wraps.len() {
+                    1 => "one row".to_string(),
+                    n => format!("{n} rows"),
+                },
+                row + 1,
+                column[row],
+                column[row - 1]
+            ),
+        ))
+    })
+}
+
+/// The run with each column of `names` that `wraps` finds wrapping (its full turn and what
+/// to say) unwrapped; `None` where none wraps.
+fn unwrapped_by(
+    frame: &Frame,
+    names: &[&str],
+    wraps: impl Fn(&str, &[f64]) -> Option<(f64, String)>,
+) -> Result<Option<(Frame, Vec<String>)>, DataError> {
     let mut out: Option<Frame> = None;
     let mut notes = Vec::new();
     for name in names {
         let Some(column) = frame.column(name) else { continue };
-        let Some(turn) = turn_of(column) else { continue };
-        let row = (1..column.len()).find(|&k| (column[k] - column[k - 1]).abs() > 0.5 * turn).unwrap_or(0);
+        let Some((turn, note)) = wraps(name, column) else { continue };
         let mut angle = column.to_vec();
         unwrap_turns_of(&mut angle, turn);
-        notes.push(format!(
-            "{}: `{name}` stays within {} and jumps by about that at {} (row {}: {:.4} after {:.4}), as an angle read on a dial wraps at a full turn: read as one continuous angle, in {} (forces that turn with it are periodic in it, which no polynomial is: sin({name}) and cos({name}) among the candidates hold them)",
-            frame.origin(),
-            if turn == TAU { "2π" } else { "360" },
-            match column.windows(2).filter(|w| (w[1] - w[0]).abs() > 0.5 * turn).count() {
-                1 => "one row".to_string(),
-                n => format!("{n} rows"),
-            },
-            row + 1,
-            column[row],
-            column[row - 1],
-            if turn == TAU { "radians" } else { "degrees" }
-        ));
+        notes.push(note);
         out.get_or_insert_with(|| frame.clone()).set(name, angle)?;
     }
     Ok(out.map(|f| (f, notes)))

@@ -39,7 +39,9 @@ const SPAN: f64 = 0.01;
 
 /// The breaks of one record `x` at times `t`: where its slope from one sample to the next is
 /// off the mean of the slopes either side (which a smooth record's is by a third difference,
-/// and noise by about 1.2 σ/Δt) far beyond the slopes two and three samples away and the
+/// and noise by about 1.2 σ/Δt), both slopes beside it off the other way by a quarter of
+/// that or more (by half for a leap; a kink, a motion starting at its rate between two
+/// samples, is off as much on one side or not at all), far beyond the slopes two and three samples away and the
 /// record's roughness so measured, and the leap (that excess times the interval) beyond its
 /// resolution (the smallest step it takes) and 1 % of its span. A glitch (away and straight
 /// back) is no break: its two steps are off alike. None in the first or last three steps.

@@ -23,8 +23,9 @@ pub enum Intersample {
     /// sensor's readings between them is taken as its rows have it too).
     Linear,
     /// Held from each sample to the next wherever the record stays put between isolated
-    /// jumps ([`held`]), on a clock or not, or changes at every sample unforeseen by the last
-    /// ([`white`]). (A record that moves smoothly from sample to sample stays a line.)
+    /// jumps ([`held`]), on a clock or not, steps to random levels at random samples
+    /// ([`stepped`]), or changes at every sample unforeseen by the last ([`white`]). (A record
+    /// that moves smoothly from sample to sample stays a line.)
     Held,
 }
 
@@ -322,7 +323,9 @@ pub(super) fn gcd(a: usize, b: usize) -> usize {
 /// changes by a little at every tick of a clock slower than the rows and the recorded states
 /// `motion` kink there ([`crate::data::kinks_at_changes`]) or their rates fit clearly better
 /// with it held ([`crate::data::fits_better_held`]): a controller's command, not a slower
-/// sensor's readings. The columns a frame does not have are passed over.
+/// sensor's readings; and held where it steps to random levels at random samples ([`stepped`],
+/// an APRBS) and a state's rate fits clearly better so than with a line between its samples.
+/// The columns a frame does not have are passed over.
 pub fn mark_held(
     frame: &mut Frame,
     columns: &[&str],

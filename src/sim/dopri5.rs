@@ -462,7 +462,8 @@ impl Dopri5 {
 
     fn stuck(&self, system: &System, t: f64) -> SimError {
         SimError::Settings(format!(
-            "the adaptive integrator could not meet its tolerances at t = {t:.6} s (step {:.3e} s): the model is stiff or diverging there; state {}",
+            "the adaptive integrator could not meet its tolerances at t = {} s (step {:.3e} s): the model is stiff or diverging there; state {}",
+            if t.abs() >= 1e-3 { format!("{t:.6}") } else { format!("{t:.3e}") },
             self.h,
             super::integrator::snapshot(&system.states, &self.y)
         ))
