@@ -148,11 +148,11 @@ const PRODUCTS_UP_TO: usize = 10;
 /// (the state among them) and, up to ten columns, their products — with `x` as its rows have
 /// it held over each interval, and with `x` read at its readings. Held leaves at least 0.5 %
 /// less of the residual sum of squares, 25 residual variances less, and a millionth of the
-/// state's squared changes less, where it is held:
-/// where a noisy record hides the kink of [`kinks_at_changes`], the
-/// fit still sees half a period's shift over every period. The index in `motion` of the
-/// state held fits best against read, and the share held leaves of what read leaves; `None`
-/// where neither is clearly better or the record is too short for the columns.
+/// state's squared changes less, where it is held: where a noisy record hides the kink of
+/// [`kinks_at_changes`], the fit still sees half a period's shift over every period. The
+/// index in `motion` of the state held fits best against read, and the share held leaves of
+/// what read leaves; `None` where neither is clearly better or the record is too short for
+/// the columns.
 pub fn fits_better_held(
     t: &[f64],
     x: &[f64],
