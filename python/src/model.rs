@@ -549,14 +549,16 @@ impl PyModel {
         Ok(all.map_err(fail)?.into_iter().map(|inner| PyMoments { inner }).collect())
     }
 
-    /// The model identified from statistics (merged per equation in the order given).
+    /// The model identified from statistics (merged per equation in the order given), with
+    /// the checks statistics allow (a model of no field's: its terms on each half of the runs,
+    /// the runs' noise), failed ones warned of.
     #[pyo3(signature = (moments, intercept = None))]
     fn identify_from_moments(
         &self,
         py: Python<'_>,
         moments: Vec<PyRef<'_, PyMoments>>,
         intercept: Option<bool>,
-    ) -> PyResult<(PyModel, Vec<(String, String)>)> {
+    ) -> PyResult<(PyModel, Fits, String)> {
         let intercept = intercept.unwrap_or(self.inner.spec().model.intercept);
         let parts = moments
             .iter()
@@ -564,14 +566,26 @@ impl PyModel {
             .map(|(k, m)| (format!("statistics {}", k + 1), m.inner.clone()))
             .collect();
         let model = &self.inner;
-        let identified =
-            py.detach(|| termid::identify::identify_from_moments(model, parts, intercept)).map_err(fail)?;
+        let (identified, checks) = py
+            .detach(|| {
+                let merged = termid::identify::merged_by_equation(parts)?;
+                let identified = termid::identify::identify_from_merged(model, &merged, intercept)?;
+                let checks = match termid::plugins::of(&identified.model) {
+                    Some(_) => vec![],
+                    None => termid::recipe::moments_checks(&identified, &merged, model, intercept),
+                };
+                Ok::<_, termid::identify::IdentifyError>((identified, checks))
+            })
+            .map_err(fail)?;
         let fits = identified
             .fits
             .iter()
             .map(|(n, f)| Ok((n.clone(), to_json(&f.report())?)))
             .collect::<PyResult<_>>()?;
-        Ok((PyModel { inner: identified.model }, fits))
+        for c in checks.iter().filter(|c| !c.passed) {
+            warn(py, c.line())?;
+        }
+        Ok((PyModel { inner: identified.model }, fits, to_json(&checks)?))
     }
 
     /// ẋ of every state on every row of a run (the identified equations' one-step prediction).

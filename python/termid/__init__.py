@@ -1630,7 +1630,10 @@ class Model:
     def identify_from_moments(self, moments: Union["Moments", Sequence["Moments"]], intercept: Optional[bool] = None) -> Identified:
         """The model identified from statistics, merged per equation in the order given:
         the same model as from the rows together. ``moments``: one or a list (of several
-        equations, or of parts to merge); ``intercept`` as for :meth:`identify`.
+        equations, or of parts to merge); ``intercept`` as for :meth:`identify`. A model of no
+        field's is checked as statistics allow (``checks``: its terms on each half of the runs,
+        the runs' noise; failed checks warned of); whether it retraces the runs needs them
+        (:meth:`checks`).
 
         >>> ship = termid.Model.default()
         >>> parts = [ship.moments("r_dot", ship.simulate(z)) for z in ("zigzag:20/20", "zigzag:10/10")]
@@ -1640,8 +1643,8 @@ class Model:
         """
         if isinstance(moments, _termid.Moments):
             moments = [moments]
-        native, fits = self._native.identify_from_moments(list(moments), intercept)
-        return Identified(Model(native), fits)
+        native, fits, checks = self._native.identify_from_moments(list(moments), intercept)
+        return Identified(Model(native), fits, json.loads(checks))
 
     # ---- prediction and simulation
     def predict(self, run: Data, with_intercept: bool = False) -> pd.DataFrame:

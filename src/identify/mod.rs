@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 use crate::data::{DataError, Differentiator, Frame};
-use crate::select::{gather, Accumulator, Moments, Problem, SelectError, Selection, Selector};
+use crate::select::{gather, gather_halved, Accumulator, Moments, Problem, SelectError, Selection, Selector};
 use crate::term::{Library, Source, Term, TermError, Vocabulary};
 
 /// What the equation explains.
@@ -57,7 +57,9 @@ pub use model::{
 };
 pub use noise::noise_note;
 pub use report::{num, sig, FitReport, StepReport, TermReport};
-pub use statistics::{identify_from_moments, EquationMoments, RunMoments};
+pub use statistics::{
+    identify_from_merged, identify_from_moments, merged_by_equation, EquationMoments, RunMoments,
+};
 
 /// Why identification failed.
 #[derive(Debug, thiserror::Error)]
@@ -237,6 +239,19 @@ impl BoundRun<'_> {
         rows: std::ops::Range<usize>,
         acc: &mut Accumulator,
     ) -> Result<(), IdentifyError> {
+        self.push_split(library, terms, rows, acc, None)
+    }
+
+    /// [`BoundRun::push`], the rows also added to the accumulators of the run's halves where
+    /// they cross its middle (`split`).
+    fn push_split(
+        &self,
+        library: &Library,
+        terms: &[Term],
+        rows: std::ops::Range<usize>,
+        acc: &mut Accumulator,
+        mut split: Option<crate::select::Split<'_>>,
+    ) -> Result<(), IdentifyError> {
         let mut bad: Option<IdentifyError> = None;
         library.for_each_block(&self.sources, rows, |start, columns| {
             if bad.is_some() {
@@ -245,7 +260,18 @@ impl BoundRun<'_> {
             let len = columns.first().map_or(0, |c| c.len());
             let rows = start..start + len;
             let y = &self.y[rows.clone()];
-            acc.push_columns(columns, y, self.weights.map(|w| &w[rows]));
+            acc.push_columns(columns, y, self.weights.map(|w| &w[rows.clone()]));
+            if let Some(split) = split.as_mut() {
+                // the block's rows before the middle to the first half, the others to the second
+                let cut = split.middle.clamp(start, start + len) - start;
+                for (half, part) in [(&mut *split.first, 0..cut), (&mut *split.second, cut..len)] {
+                    if !part.is_empty() {
+                        let cols: Vec<&[f64]> = columns.iter().map(|c| &c[part.clone()]).collect();
+                        let at = start + part.start..start + part.end;
+                        half.push_columns(&cols, &self.y[at.clone()], self.weights.map(|w| &w[at]));
+                    }
+                }
+            }
             // the accumulator notices a value that is not finite in passing; find it only then
             if let Some(j) = acc.not_finite() {
                 let (values, term) = match columns.get(j) {
@@ -692,17 +718,67 @@ impl Identification<'_> {
         frame: &Frame,
         rows: std::ops::Range<usize>,
     ) -> Result<Moments, IdentifyError> {
+        Ok(self.moments_of_parts(library, terms, target, frame, std::slice::from_ref(&rows))?.remove(0))
+    }
+
+    /// [`Identification::moments_of_rows`] of several ranges of a piece's rows, the derivative
+    /// (or the weak form's windows) taken once: the halves of a piece, for the check that a
+    /// run read in pieces chooses the same terms from each half of it.
+    pub fn moments_of_parts(
+        &self,
+        library: &Library,
+        terms: &[Term],
+        target: &Target,
+        frame: &Frame,
+        parts: &[std::ops::Range<usize>],
+    ) -> Result<Vec<Moments>, IdentifyError> {
         if let (Some(window), Target::Derivative(_)) = (self.differentiator.window(), target) {
             // a piece of a run takes the run's windows, however short the piece with its context
             let window = crate::data::Window { shrinks: false, ..window };
-            return self.integral_moments(library, terms, target, frame, window, rows);
+            return self.integral_moments(library, terms, target, frame, window, parts);
         }
         let run = self.bind(library, target, frame)?;
-        let offset = rows.start;
-        let mut parts = gather(library.len(), &[rows.len()], |_, part, acc| {
+        let rows: Vec<usize> = parts.iter().map(|p| p.len()).collect();
+        gather(library.len(), &rows, |k, part, acc| {
+            let offset = parts[k].start;
             run.push(library, terms, part.start + offset..part.end + offset, acc)
-        })?;
-        Ok(parts.remove(0))
+        })
+    }
+
+    /// The statistics of each run, and of its first and second half (rows `0..n/2`, `n/2..n`;
+    /// the windows of the weak or integral form by the row they start on), gathered in
+    /// parallel: the run's as [`Identification::moments_of_runs`] gives them, to the bit.
+    pub(crate) fn moments_and_halves_of_runs(
+        &self,
+        library: &Library,
+        terms: &[Term],
+        target: &Target,
+        frames: &[Frame],
+    ) -> Result<Vec<(Moments, [Moments; 2])>, IdentifyError> {
+        if let (Some(window), Target::Derivative(_)) = (self.differentiator.window(), target) {
+            return frames
+                .iter()
+                .map(|f| {
+                    let (n, middle) = (f.len(), f.len() / 2);
+                    let mut m = self.integral_moments(
+                        library,
+                        terms,
+                        target,
+                        f,
+                        window,
+                        &[0..n, 0..middle, middle..n],
+                    )?;
+                    let second = m.pop().unwrap_or_else(|| Moments::new(library.len()));
+                    let first = m.pop().unwrap_or_else(|| Moments::new(library.len()));
+                    Ok((m.pop().unwrap_or_else(|| Moments::new(library.len())), [first, second]))
+                })
+                .collect();
+        }
+        let runs = frames.iter().map(|f| self.bind(library, target, f)).collect::<Result<Vec<_>, _>>()?;
+        let rows: Vec<usize> = frames.iter().map(Frame::len).collect();
+        gather_halved(library.len(), &rows, |k, part, acc, split| {
+            runs[k].push_split(library, terms, part, acc, split)
+        })
     }
 
     /// The statistics of each run, gathered in parallel (parts of runs on all threads).
@@ -716,7 +792,18 @@ impl Identification<'_> {
         if let (Some(window), Target::Derivative(_)) = (self.differentiator.window(), target) {
             return frames
                 .iter()
-                .map(|f| self.integral_moments(library, terms, target, f, window, 0..f.len()))
+                .map(|f| {
+                    Ok(self
+                        .integral_moments(
+                            library,
+                            terms,
+                            target,
+                            f,
+                            window,
+                            std::slice::from_ref(&(0..f.len())),
+                        )?
+                        .remove(0))
+                })
                 .collect();
         }
         let runs = frames.iter().map(|f| self.bind(library, target, f)).collect::<Result<Vec<_>, _>>()?;
@@ -724,9 +811,9 @@ impl Identification<'_> {
         gather(library.len(), &rows, |k, part, acc| runs[k].push(library, terms, part, acc))
     }
 
-    /// One run's statistics in the integral form ([`Identification::windows`]): the windows
-    /// that start on `own` rows (all of a whole run; a piece's own, its context after it
-    /// holding their ends).
+    /// One run's statistics in the integral form ([`Identification::windows`]), one per part
+    /// of its rows: the windows that start on the part's rows (all of a whole run; a piece's
+    /// own, its context after it holding their ends; a half's).
     fn integral_moments(
         &self,
         library: &Library,
@@ -734,39 +821,44 @@ impl Identification<'_> {
         target: &Target,
         frame: &Frame,
         window: crate::data::Window,
-        own: std::ops::Range<usize>,
-    ) -> Result<Moments, IdentifyError> {
+        parts: &[std::ops::Range<usize>],
+    ) -> Result<Vec<Moments>, IdentifyError> {
         let Rows { y, columns: integrals, weights, starts: first_rows, window } =
             self.windows(library, target, frame, window)?;
-        // the rows of the windows that start on `own` samples (some left out: a switch inside)
-        let starts =
-            first_rows.partition_point(|s| *s < own.start)..first_rows.partition_point(|s| *s < own.end);
-        let refs: Vec<&[f64]> = integrals.iter().map(|c| &c[starts.clone()]).collect();
-        let weights = weights.map(|w| w[starts.clone()].to_vec());
-        let mut acc = Accumulator::new(library.len());
-        acc.push_columns(&refs, &y[starts.clone()], weights.as_deref());
-        if let Some(j) = acc.not_finite() {
-            // named as a point derivative's row is: the term (or the target) and the row its
-            // window starts on (no such value: the sums overflowed; the largest named)
-            let values = refs.get(j).copied().unwrap_or(&y[starts.clone()]);
-            let i = values.iter().position(|v| !v.is_finite()).unwrap_or_else(|| {
-                (0..values.len()).max_by(|&a, &b| values[a].abs().total_cmp(&values[b].abs())).unwrap_or(0)
-            });
-            let term = match (terms.get(j), target) {
-                (Some(t), _) if j < library.len() => t.to_string(),
-                (None, _) if j < library.len() => format!("{}", j + 1),
-                (_, Target::Derivative(s)) => format!("d{s}/dt"),
-                (_, Target::Column(c)) => c.clone(),
-            };
-            return Err(IdentifyError::NonFinite {
-                file: frame.origin().into(),
-                row: first_rows.get(starts.start + i).map_or(1, |r| r + 1),
-                target: j >= library.len(),
-                term,
-                value: values.get(i).copied().unwrap_or(f64::NAN),
-            });
-        }
-        Ok(acc.finish().with_overlap(crate::data::row_overlap(window)))
+        let part = |own: &std::ops::Range<usize>| {
+            // the rows of the windows that start on `own` samples (some left out: a switch inside)
+            let starts =
+                first_rows.partition_point(|s| *s < own.start)..first_rows.partition_point(|s| *s < own.end);
+            let refs: Vec<&[f64]> = integrals.iter().map(|c| &c[starts.clone()]).collect();
+            let weights = weights.as_ref().map(|w| w[starts.clone()].to_vec());
+            let mut acc = Accumulator::new(library.len());
+            acc.push_columns(&refs, &y[starts.clone()], weights.as_deref());
+            if let Some(j) = acc.not_finite() {
+                // named as a point derivative's row is: the term (or the target) and the row its
+                // window starts on (no such value: the sums overflowed; the largest named)
+                let values = refs.get(j).copied().unwrap_or(&y[starts.clone()]);
+                let i = values.iter().position(|v| !v.is_finite()).unwrap_or_else(|| {
+                    (0..values.len())
+                        .max_by(|&a, &b| values[a].abs().total_cmp(&values[b].abs()))
+                        .unwrap_or(0)
+                });
+                let term = match (terms.get(j), target) {
+                    (Some(t), _) if j < library.len() => t.to_string(),
+                    (None, _) if j < library.len() => format!("{}", j + 1),
+                    (_, Target::Derivative(s)) => format!("d{s}/dt"),
+                    (_, Target::Column(c)) => c.clone(),
+                };
+                return Err(IdentifyError::NonFinite {
+                    file: frame.origin().into(),
+                    row: first_rows.get(starts.start + i).map_or(1, |r| r + 1),
+                    target: j >= library.len(),
+                    term,
+                    value: values.get(i).copied().unwrap_or(f64::NAN),
+                });
+            }
+            Ok(acc.finish().with_overlap(crate::data::row_overlap(window)))
+        };
+        parts.iter().map(part).collect()
     }
 
     /// The rows of the integral form of one run: the candidates evaluated on every sample,

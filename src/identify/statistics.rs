@@ -24,7 +24,8 @@ pub struct RunMoments {
     /// Its statistics, candidates in the order of [`EquationMoments::candidates`].
     pub moments: Moments,
     /// The white noise and spread of each recorded variable the candidates hold nonlinearly,
-    /// for the note that the noise may bias the terms ([`super::noise_note`]); empty in
+    /// for the check that the noise leaves the terms unbiased
+    /// ([`crate::recipe::noise_check_of_moments`]); empty in
     /// statistics written before termid gathered them.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub noise: BTreeMap<String, NoiseTally>,
@@ -41,6 +42,25 @@ pub struct EquationMoments {
     pub candidates: Vec<String>,
     /// Each run's statistics.
     pub runs: Vec<RunMoments>,
+    /// The statistics of the first and of the second half of every run (a run read in pieces
+    /// cut at the boundary of half a piece nearest its middle), each pooled over the runs
+    /// gathered together (a shard: merging appends them, as it appends runs): for the check
+    /// that the terms hold on each half of the runs
+    /// ([`crate::recipe::halves_check_of_moments`]). `None` in statistics written before
+    /// termid gathered them, and in those merged with such.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub halves: Option<Vec<[Moments; 2]>>,
+}
+
+/// `run`'s halves pooled into `all`'s.
+fn pool(all: &mut Option<[Moments; 2]>, run: &[Moments; 2]) {
+    match all {
+        Some([a, b]) => {
+            a.merge(&run[0]);
+            b.merge(&run[1]);
+        }
+        none => *none = Some(run.clone()),
+    }
 }
 
 /// A run read in pieces, as far as it has been read.
@@ -50,12 +70,83 @@ struct RunSoFar {
     /// Its own parameters, from its first piece.
     fixed: BTreeMap<String, ParamValue>,
     /// Each equation's statistics so far.
-    moments: Vec<Option<Moments>>,
+    moments: Vec<Stretches>,
     /// Each equation's noise tallies so far.
     noise: Vec<BTreeMap<String, NoiseTally>>,
     /// The columns held and switched between samples as its first piece found them
     /// ([`crate::data::Frame::hold`], [`crate::data::Frame::switch`]).
     between: (Vec<String>, Vec<String>),
+}
+
+/// A run's statistics as it is read in pieces: those of consecutive stretches of its rows
+/// (halves of pieces at first; as they grow many, neighbours merged in pairs, and later
+/// pieces gathered as many to a stretch), so that its halves can be told apart once its
+/// length is known.
+#[derive(Default)]
+struct Stretches {
+    stretches: Vec<Moments>,
+    /// The halves of pieces a stretch gathers.
+    each: usize,
+    /// Those the last stretch holds so far.
+    last: usize,
+}
+
+impl Stretches {
+    /// The most stretches kept: the halves are then cut within a 64th of the run's middle.
+    const MOST: usize = 64;
+
+    fn push(&mut self, m: Moments) {
+        match self.stretches.last_mut() {
+            Some(open) if self.last < self.each => {
+                open.merge(&m);
+                self.last += 1;
+            }
+            _ => {
+                self.stretches.push(m);
+                self.last = 1;
+            }
+        }
+        self.each = self.each.max(1);
+        if self.stretches.len() > Self::MOST {
+            // every stretch but the last holds `each`: merged in pairs, they hold twice as many
+            let all = std::mem::take(&mut self.stretches);
+            let mut all = all.into_iter();
+            while let Some(mut a) = all.next() {
+                if let Some(b) = all.next() {
+                    a.merge(&b);
+                }
+                self.stretches.push(a);
+            }
+            // (an odd number of them: the new one is left alone, the last, holding one)
+            self.each *= 2;
+        }
+    }
+
+    /// The run's first and second half, cut at the boundary of stretches nearest its middle;
+    /// `None` where nothing was read.
+    fn halves(self) -> Option<[Moments; 2]> {
+        let total: usize = self.stretches.iter().map(Moments::count).sum();
+        let mut before = 0;
+        let cut = (0..=self.stretches.len())
+            .map(|k| {
+                let at = (k, before);
+                before += self.stretches.get(k).map_or(0, Moments::count);
+                at
+            })
+            .min_by_key(|&(_, rows)| rows.abs_diff(total - rows))
+            .map(|(k, _)| k)?;
+        let merged = |part: &[Moments]| {
+            let mut all = part
+                .first()
+                .cloned()
+                .or_else(|| self.stretches.first().map(|m| Moments::new(m.regressors())))?;
+            for m in part.iter().skip(1) {
+                all.merge(m);
+            }
+            Some(all)
+        };
+        Some([merged(&self.stretches[..cut])?, merged(&self.stretches[cut..])?])
+    }
 }
 
 impl EquationMoments {
@@ -84,24 +175,32 @@ impl EquationMoments {
             weights: None,
         };
         let design = Design::new(&eq.candidates, &model.vocabulary)?;
-        let folds = how.moments_of_runs(&design.library, design.candidates(), &target, frames)?;
+        // the whole runs' statistics gathered as a fit of the rows gathers them (statistics
+        // identify as the rows, to the bit), with their halves'
+        let all = how.moments_and_halves_of_runs(&design.library, design.candidates(), &target, frames)?;
         let noisy = held_nonlinearly(&eq.candidates, &model.vocabulary);
-        Ok(EquationMoments {
-            equation: equation.into(),
-            target: target.to_string(),
-            candidates: design.names().to_vec(),
-            runs: frames
-                .iter()
-                .zip(folds)
-                .map(|(f, m)| RunMoments {
+        let mut halves = None;
+        let runs = frames
+            .iter()
+            .zip(all)
+            .map(|(f, (moments, run_halves))| {
+                pool(&mut halves, &run_halves);
+                RunMoments {
                     run: f.origin().into(),
-                    moments: m,
+                    moments,
                     noise: noisy
                         .iter()
                         .filter_map(|v| Some((v.clone(), NoiseTally::of(f, v, 0..f.len())?)))
                         .collect(),
-                })
-                .collect(),
+                }
+            })
+            .collect();
+        Ok(EquationMoments {
+            equation: equation.into(),
+            target: target.to_string(),
+            candidates: design.names().to_vec(),
+            runs,
+            halves: Some(halves.into_iter().collect()),
         })
     }
 
@@ -156,6 +255,7 @@ impl EquationMoments {
             eqs.iter().map(|eq| held_nonlinearly(&eq.candidates, &model.vocabulary)).collect();
         let rules = model.parameter_rules();
         let (mut out, mut notes) = (vec![Vec::new(); eqs.len()], Vec::new());
+        let mut halves: Vec<Option<[Moments; 2]>> = vec![None; eqs.len()];
         let mut targets: Option<Vec<Target>> = None;
         let (states, _) = model.recorded_motion();
         for chunks in runs {
@@ -214,7 +314,7 @@ impl EquationMoments {
                     run = Some(RunSoFar {
                         name: chunk.frame.origin().to_string(),
                         fixed,
-                        moments: vec![None; eqs.len()],
+                        moments: (0..eqs.len()).map(|_| Stretches::default()).collect(),
                         noise: vec![BTreeMap::new(); eqs.len()],
                         between,
                     });
@@ -244,25 +344,30 @@ impl EquationMoments {
                     intercept: true,
                     weights: None,
                 };
+                // each piece in halves, so that the run's halves can be told apart at its end
+                let own = chunk.own.clone();
+                let middle = own.start + own.len() / 2;
                 for ((design, target), so_far) in designs.iter().zip(targets).zip(moments.iter_mut()) {
-                    let m = how
-                        .moments_of_rows(
+                    let halves = how
+                        .moments_of_parts(
                             &design.library,
                             design.candidates(),
                             target,
                             &chunk.frame,
-                            chunk.own.clone(),
+                            &[own.start..middle, middle..own.end],
                         )
                         .map_err(shift)?;
-                    match so_far {
-                        Some(all) => all.merge(&m),
-                        none => *none = Some(m),
+                    for m in halves {
+                        so_far.push(m);
                     }
                 }
             }
             if let Some(RunSoFar { name, moments, noise, .. }) = run {
-                for ((list, m), noise) in out.iter_mut().zip(moments).zip(noise) {
-                    if let Some(moments) = m {
+                for (((list, pooled), m), noise) in out.iter_mut().zip(&mut halves).zip(moments).zip(noise) {
+                    if let Some(run_halves) = m.halves() {
+                        pool(pooled, &run_halves);
+                        let [mut moments, second] = run_halves;
+                        moments.merge(&second);
                         list.push(RunMoments { run: name.clone(), moments, noise });
                     }
                 }
@@ -274,14 +379,27 @@ impl EquationMoments {
             .zip(targets)
             .zip(designs)
             .zip(out)
-            .map(|(((equation, target), design), runs)| EquationMoments {
+            .zip(halves)
+            .map(|((((equation, target), design), runs), halves)| EquationMoments {
                 equation: equation.clone(),
                 target: target.to_string(),
                 candidates: design.names().to_vec(),
                 runs,
+                halves: Some(halves.into_iter().collect()),
             })
             .collect();
         Ok((all, notes))
+    }
+
+    /// The equation, target and candidates of these statistics, without runs.
+    pub(crate) fn clone_empty(&self) -> EquationMoments {
+        EquationMoments {
+            equation: self.equation.clone(),
+            target: self.target.clone(),
+            candidates: self.candidates.clone(),
+            runs: Vec::new(),
+            halves: None,
+        }
     }
 
     /// The statistics of both sets of runs: refused where they are of another equation,
@@ -301,6 +419,14 @@ impl EquationMoments {
             )));
         }
         self.runs.extend(other.runs);
+        self.halves = match (self.halves.take(), other.halves) {
+            (Some(mut a), Some(b)) => {
+                a.extend(b);
+                Some(a)
+            }
+            // (statistics written before termid gathered halves: the halves of only some runs)
+            _ => None,
+        };
         self.check("merged statistics")?;
         Ok(self)
     }
@@ -376,6 +502,19 @@ impl EquationMoments {
                 )));
             }
         }
+        if let Some(halves) = &self.halves {
+            let whole = |m: &Moments| {
+                m.is_consistent() && m.regressors() == self.candidates.len() && m.weight() == m.count() as f64
+            };
+            let sum = |rows: &mut dyn Iterator<Item = usize>| rows.fold(0usize, usize::saturating_add);
+            let rows = sum(&mut self.runs.iter().map(|r| r.moments.count()));
+            let halved = sum(&mut halves.iter().flatten().map(Moments::count));
+            if !halves.iter().flatten().all(whole) || halved != rows {
+                return Err(IdentifyError::Setup(format!(
+                    "{origin}: the statistics of the runs' halves ({halved} rows) cannot come from their {rows} rows"
+                )));
+            }
+        }
         Ok(())
     }
 
@@ -396,16 +535,16 @@ impl EquationMoments {
             "runs": self.runs.iter().map(|r| (&r.run, r.moments.count())).collect::<Vec<_>>(),
             "overlaps": self.runs.iter().map(|r| r.moments.overlap()).collect::<Vec<_>>(),
             "noise": self.runs.iter().map(|r| &r.noise).collect::<Vec<_>>(),
+            "halves": self.halves.as_ref().map(|all| all.iter().map(|h| h.each_ref().map(|m| (m.count(), m.overlap()))).collect::<Vec<_>>()),
         })
         .to_string();
         let mut out =
             Vec::with_capacity(8 + header.len() + self.runs.len() * 8 * (self.candidates.len() + 2).pow(2));
         out.extend_from_slice(&(header.len() as u64).to_le_bytes());
         out.extend_from_slice(header.as_bytes());
-        for r in &self.runs {
-            for v in r.moments.numbers() {
-                out.extend_from_slice(&v.to_le_bytes());
-            }
+        let halves = self.halves.iter().flatten().flatten();
+        for v in self.runs.iter().map(|r| &r.moments).chain(halves).flat_map(Moments::numbers) {
+            out.extend_from_slice(&v.to_le_bytes());
         }
         out
     }
@@ -430,51 +569,56 @@ impl EquationMoments {
             /// Each run's noise tallies (none where absent).
             #[serde(default)]
             noise: Vec<BTreeMap<String, NoiseTally>>,
+            /// The halves' rows and overlaps, their numbers after the runs' (none where absent).
+            #[serde(default)]
+            halves: Option<Vec<[(usize, f64); 2]>>,
         }
         let header: Header = header
             .and_then(|h| serde_json::from_slice(h).ok())
             .ok_or_else(|| broken("the header is not readable"))?;
         let p = header.candidates.len();
-        let per_run = 1 + (p + 1) + (p + 1) * (p + 2) / 2;
-        if numbers.len() != header.runs.len() * per_run * 8 {
+        let per_set = 1 + (p + 1) + (p + 1) * (p + 2) / 2;
+        let sets =
+            header.runs.len().saturating_add(header.halves.as_ref().map_or(0, |h| h.len().saturating_mul(2)));
+        if numbers.len() != sets * per_set * 8 {
             return Err(broken("the numbers do not fit the candidates and runs"));
         }
+        let mut next = |count: usize, overlap: f64, whose: &str| {
+            let (these, rest) = numbers.split_at(per_set * 8);
+            numbers = rest;
+            let values: Vec<f64> =
+                these.chunks_exact(8).map(|b| f64::from_le_bytes(b.try_into().unwrap_or_default())).collect();
+            Moments::from_numbers(p, count, &values)
+                .filter(Moments::is_consistent)
+                .map(|m| m.with_overlap(overlap))
+                .ok_or_else(|| broken(&format!("the statistics of {whose} are not whole")))
+        };
         let mut runs = Vec::with_capacity(header.runs.len());
         let overlaps = header.overlaps.iter().copied().chain(std::iter::repeat(1.0));
         let noises = header.noise.into_iter().chain(std::iter::repeat_with(BTreeMap::new));
         for (((run, count), overlap), noise) in header.runs.into_iter().zip(overlaps).zip(noises) {
-            let (these, rest) = numbers.split_at(per_run * 8);
-            numbers = rest;
-            let values: Vec<f64> =
-                these.chunks_exact(8).map(|b| f64::from_le_bytes(b.try_into().unwrap_or_default())).collect();
-            let moments = Moments::from_numbers(p, count, &values)
-                .filter(Moments::is_consistent)
-                .map(|m| m.with_overlap(overlap))
-                .ok_or_else(|| broken(&format!("the statistics of run `{run}` are not whole")))?;
+            let moments = next(count, overlap, &format!("run `{run}`"))?;
             runs.push(RunMoments { run, moments, noise });
         }
+        let halves = match header.halves {
+            Some(all) => Some(
+                all.into_iter()
+                    .map(|[(a, oa), (b, ob)]| {
+                        Ok([next(a, oa, "the runs' halves")?, next(b, ob, "the runs' halves")?])
+                    })
+                    .collect::<Result<Vec<_>, IdentifyError>>()?,
+            ),
+            None => None,
+        };
         let m = EquationMoments {
             equation: header.equation,
             target: header.target,
             candidates: header.candidates,
             runs,
+            halves,
         };
         m.check(origin)?;
         Ok(m)
-    }
-
-    /// The note that the records' noise may bias the terms ([`super::noise_note`]), from
-    /// the noise tallied with the statistics, pooled over the runs.
-    pub fn noise_note(&self, model: &Model) -> Option<String> {
-        let eq = model_equation(model, &self.equation).ok()?;
-        let pooled: Vec<(String, NoiseTally)> = held_nonlinearly(&eq.candidates, &model.vocabulary)
-            .into_iter()
-            .map(|v| {
-                let all = NoiseTally::pooled(self.runs.iter().filter_map(|r| r.noise.get(&v)).cloned());
-                (v, all)
-            })
-            .collect();
-        super::noise::note(&super::noise::shares(&pooled))
     }
 
     /// The model's inputs that hold one value through every run, with it, as far as the
@@ -547,15 +691,41 @@ impl EquationMoments {
 }
 
 /// Identifies a model's equations from statistics: the parts of each equation are merged in
-/// the order given (shards of runs, from any number of machines), then each equation is
-/// fitted with the model's forced and excluded terms and back-end and stored in a copy of the
-/// model, as [`super::identify_model`] would from the rows. Each part comes with the name an
-/// error calls it by (its file).
+/// the order given (shards of runs, from any number of machines: [`merged_by_equation`]),
+/// then each equation is fitted with the model's forced and excluded terms and back-end and
+/// stored in a copy of the model, as [`super::identify_model`] would from the rows. Each part
+/// comes with the name an error calls it by (its file).
 pub fn identify_from_moments(
     model: &Model,
     parts: Vec<(String, EquationMoments)>,
     intercept: bool,
 ) -> Result<super::IdentifiedModel, IdentifyError> {
+    identify_from_merged(model, &merged_by_equation(parts)?, intercept)
+}
+
+/// [`identify_from_moments`] of statistics merged already, one value per equation.
+pub fn identify_from_merged(
+    model: &Model,
+    merged: &[EquationMoments],
+    intercept: bool,
+) -> Result<super::IdentifiedModel, IdentifyError> {
+    let mut identified = model.clone();
+    let mut fits = Vec::new();
+    for m in merged {
+        let in_equation = |e: IdentifyError| e.in_equation(&m.equation);
+        let mut fit = m.fit(model, intercept).map_err(in_equation)?;
+        fit.selection.notes.extend(super::model::held_note(model, &m.equation, &m.held_inputs(model)));
+        super::model::store_fit(&mut identified, &m.equation, &fit).map_err(in_equation)?;
+        fits.push((m.equation.clone(), fit));
+    }
+    Ok(super::IdentifiedModel { model: identified, fits })
+}
+
+/// The parts of each equation's statistics merged in the order given, one value per
+/// equation (in the order the equations first come); each part named as errors call it.
+pub fn merged_by_equation(
+    parts: Vec<(String, EquationMoments)>,
+) -> Result<Vec<EquationMoments>, IdentifyError> {
     let mut merged: Vec<EquationMoments> = Vec::new();
     for (origin, m) in parts {
         match merged.iter().position(|e| e.equation == m.equation) {
@@ -567,17 +737,7 @@ pub fn identify_from_moments(
             None => merged.push(m),
         }
     }
-    let mut identified = model.clone();
-    let mut fits = Vec::new();
-    for m in &merged {
-        let in_equation = |e: IdentifyError| e.in_equation(&m.equation);
-        let mut fit = m.fit(model, intercept).map_err(in_equation)?;
-        fit.selection.notes.extend(m.noise_note(model));
-        fit.selection.notes.extend(super::model::held_note(model, &m.equation, &m.held_inputs(model)));
-        super::model::store_fit(&mut identified, &m.equation, &fit).map_err(in_equation)?;
-        fits.push((m.equation.clone(), fit));
-    }
-    Ok(super::IdentifiedModel { model: identified, fits })
+    Ok(merged)
 }
 
 #[cfg(test)]
@@ -694,6 +854,63 @@ mod tests {
         }
     }
 
+    /// A run read in pieces carries its halves' statistics: those of the run read whole (to
+    /// round-off, the middle on a boundary of half a piece), through bytes and JSON, appended
+    /// as statistics merge; a long run keeps few stretches, its halves cut within a 64th of
+    /// its middle.
+    #[test]
+    fn a_run_read_in_pieces_carries_its_halves() {
+        let lorenz = Model::load(Path::new("models/lorenz.toml")).unwrap();
+        let frame = runs(&lorenz).remove(0).slice(0..600);
+        let whole = EquationMoments::of_runs(
+            &lorenz,
+            "y_dot",
+            std::slice::from_ref(&frame),
+            &CentralDifference,
+            None,
+        )
+        .unwrap();
+        let path = std::env::temp_dir().join(format!("termid-halves-{}.csv", std::process::id()));
+        frame.write_csv(&path).unwrap();
+        let chunks = crate::data::Chunks::open(&path, "t", 100, 4).unwrap();
+        let (pieces, _) =
+            EquationMoments::of_chunks(&lorenz, "y_dot", vec![chunks], &CentralDifference).unwrap();
+        let (a, b) = (&whole.halves.as_ref().unwrap()[0], &pieces.halves.as_ref().unwrap()[0]);
+        assert_eq!(frame.len() % 100, 0);
+        for (x, y) in a.iter().zip(b.iter()) {
+            assert_eq!((x.count(), y.count()), (frame.len() / 2, frame.len() / 2));
+            for (u, v) in x.numbers().iter().zip(y.numbers()) {
+                assert!((u - v).abs() <= 1e-9 * u.abs().max(1.0), "{u} vs {v}");
+            }
+        }
+        std::fs::remove_file(&path).ok();
+        assert_eq!(EquationMoments::from_bytes(&pieces.to_bytes(), "p").unwrap(), pieces);
+        assert_eq!(EquationMoments::from_json(&pieces.to_json(), "p").unwrap(), pieces);
+        // halves that do not add up to their runs are refused
+        let mut broken = pieces.clone();
+        broken.halves.as_mut().unwrap()[0][1] = a[1].without(&a[1]);
+        let e = EquationMoments::from_json(&broken.to_json(), "p").unwrap_err().to_string();
+        assert!(e.contains("the statistics of the runs' halves"), "{e}");
+        // merged with statistics that lack them (written before termid gathered them): none
+        let old = EquationMoments { halves: None, ..whole.clone() };
+        let renamed = EquationMoments {
+            runs: vec![RunMoments { run: "other".into(), ..pieces.runs[0].clone() }],
+            ..pieces.clone()
+        };
+        assert!(old.merge(renamed.clone()).unwrap().halves.is_none());
+        let both = whole.clone().merge(renamed).unwrap();
+        assert_eq!(both.halves.unwrap().iter().map(|h| h[0].count()).sum::<usize>(), 600);
+        let mut stretches = Stretches::default();
+        let one = |v: f64| Moments::of_columns(&[v], &[2.0 * v], None);
+        for k in 0..1001 {
+            stretches.push(one(k as f64));
+        }
+        assert!(stretches.stretches.len() <= Stretches::MOST);
+        let [first, second] = stretches.halves().unwrap();
+        assert!(first.count().abs_diff(second.count()) <= 1001 / 32, "{} {}", first.count(), second.count());
+        assert!(first.means()[0] < 500.0 && second.means()[0] > 500.0);
+    }
+
     #[test]
     fn broken_bytes_are_refused() {
         let lorenz = Model::load(Path::new("models/lorenz.toml")).unwrap();
@@ -771,7 +988,7 @@ mod tests {
             let text = v.to_string();
             let read = std::panic::catch_unwind(|| {
                 EquationMoments::from_json(&text, "s.json")
-                    .map(|r| (r.noise_note(&lorenz), r.fit(&lorenz, true).map(|_| ()), r.clone().merge(r).map(|b| b.noise_note(&lorenz))))
+                    .map(|r| (crate::recipe::noise_check_of_moments(std::slice::from_ref(&r)), r.fit(&lorenz, true).map(|_| ()), r.clone().merge(r).map(|b| crate::recipe::noise_check_of_moments(&[b]))))
             });
             proptest::prop_assert!(read.is_ok(), "from_json panicked");
         }

@@ -5,7 +5,9 @@
 //! they rarely come back from both halves, where the system's own terms do.
 
 use crate::data::{Frame, TestFunction, WeakForm};
-use crate::identify::{identify_model, IdentifiedModel, ModelIdentification};
+use std::collections::BTreeMap;
+
+use crate::identify::{identify_model, EquationMoments, IdentifiedModel, ModelIdentification, RunMoments};
 use crate::model::Model;
 use crate::plugin::Check;
 
@@ -83,24 +85,77 @@ pub fn halves_check(
     let half = |cut: &[Frame]| identify_model(model, cut, how, &mut |_| {}).ok();
     // side by side: each half is one run's worth of work per run, which leaves a core idle
     let (first, second) = rayon::join(|| half(&halves[0]), || half(&halves[1]));
-    let (first, second) = (first?, second?);
-    let chosen = |found: &IdentifiedModel, name: &str| -> Vec<String> {
-        fit_of(found, name)
-            .map_or_else(Vec::new, |f| f.selection.terms.iter().map(|t| t.term.clone()).collect())
-    };
     // a half's rows of independent evidence (a weak form's windows overlap) for an equation
     let overlap = how.differentiator.window().map_or(1.0, crate::data::row_overlap);
-    let evidence = |found: &IdentifiedModel, name: &str| {
-        fit_of(found, name).map_or(0.0, |f| f.selection.rows as f64 / overlap)
+    let chosen = |found: IdentifiedModel| -> Chosen {
+        found
+            .fits
+            .into_iter()
+            .map(|(name, f)| {
+                let terms = f.selection.terms.iter().map(|t| t.term.clone()).collect();
+                (name, (terms, f.selection.rows as f64 / overlap))
+            })
+            .collect()
     };
+    Some(verdict(identified, halving, [chosen(first?), chosen(second?)]))
+}
+
+/// [`halves_check`] of equations identified from their statistics (runs read in pieces, or
+/// gathered where the rows are: [`EquationMoments`]): each equation fitted again, with
+/// `model`'s back-end, from the statistics of the first and of the second half of every run
+/// ([`EquationMoments::halves`], pooled per shard: a back-end that leaves runs out leaves
+/// shards out, and cannot fit halves of one shard). `None` where it cannot apply: statistics
+/// without halves, a half of fewer rows than runs read whole need, or a half that cannot be
+/// fitted.
+pub fn halves_check_of_moments(
+    identified: &IdentifiedModel,
+    moments: &[EquationMoments],
+    model: &Model,
+    intercept: bool,
+) -> Option<Check> {
+    let mut halves: [Chosen; 2] = Default::default();
+    for m in moments {
+        let shards = m.halves.as_ref()?;
+        for (k, chosen) in halves.iter_mut().enumerate() {
+            let mut part = m.clone_empty();
+            part.runs = shards
+                .iter()
+                .enumerate()
+                .map(|(s, h)| RunMoments {
+                    run: format!("half {} of shard {}", k + 1, s + 1),
+                    moments: h[k].clone(),
+                    noise: BTreeMap::new(),
+                })
+                .collect();
+            let rows: usize = part.runs.iter().map(|r| r.moments.count()).sum();
+            if rows < FEWEST_ROWS {
+                return None;
+            }
+            let fit = part.fit(model, intercept).ok()?;
+            let terms = fit.selection.terms.iter().map(|t| t.term.clone()).collect();
+            let evidence = part.runs.iter().map(|r| r.moments.independent_rows()).sum();
+            chosen.insert(m.equation.clone(), (terms, evidence));
+        }
+    }
+    Some(verdict(identified, Halving::EachRun, halves))
+}
+
+/// What a half chose: each equation's terms, with the half's rows' worth of independent
+/// evidence for it (a weak form's windows overlap).
+type Chosen = BTreeMap<String, (Vec<String>, f64)>;
+
+/// The check, from the terms each half chose: passed where every term chosen from all the
+/// rows was chosen from both halves too.
+fn verdict(identified: &IdentifiedModel, halving: Halving, halves: [Chosen; 2]) -> Check {
+    let none = (Vec::new(), 0.0);
     let (mut unsteady, mut thin) = (Vec::new(), Vec::new());
     for (name, fit) in &identified.fits {
-        let (a, b) = (chosen(&first, name), chosen(&second, name));
+        let (a, b) = (halves[0].get(name).unwrap_or(&none), halves[1].get(name).unwrap_or(&none));
         let lost: Vec<String> = fit
             .selection
             .terms
             .iter()
-            .filter(|t| !(a.contains(&t.term) && b.contains(&t.term)))
+            .filter(|t| !(a.0.contains(&t.term) && b.0.contains(&t.term)))
             .map(|t| format!("`{}`", t.term))
             .collect();
         if lost.is_empty() {
@@ -110,7 +165,7 @@ pub fn halves_check(
         // rows are noisy (Lorenz-96's ten rates over 7 s at 1 %, 66 candidates: halves of 50
         // rows' worth chose 20 to 45 terms each, where the whole's 104 chose the four true
         // ones): what it left out says nothing (noise-free, such halves choose alike)
-        let least = evidence(&first, name).min(evidence(&second, name));
+        let least = a.1.min(b.1);
         if least < fit.candidates.len() as f64 {
             thin.push((name.clone(), least, fit.candidates.len()));
         } else {
@@ -160,18 +215,13 @@ pub fn halves_check(
             unsteady.join("; ")
         ) + &not_confirmed.map(|n| format!("; {n}")).unwrap_or_default()
     };
-    Some(Check {
+    Check {
         name: NAME.into(),
         passed: unsteady.is_empty() && thin.is_empty(),
         refuses: false,
         detail,
         measure: None,
-    })
-}
-
-/// Equation `name`'s fit in `found`.
-fn fit_of<'a>(found: &'a IdentifiedModel, name: &str) -> Option<&'a crate::identify::Fit> {
-    found.fits.iter().find(|(n, _)| n == name).map(|(_, f)| f)
+    }
 }
 
 /// The weak form the halves take where the whole runs took a default one's windows: each

@@ -13,8 +13,8 @@ mod retrace;
 mod start;
 
 pub use crate::plugin::RecipeDefaults;
-pub use halves::halves_check;
-pub use noise::noise_check;
+pub use halves::{halves_check, halves_check_of_moments};
+pub use noise::{noise_check, noise_check_of_moments};
 pub use parameters::{ParameterOptions, ParameterStage};
 pub use report::Primes;
 pub use retrace::retrace_check;
@@ -264,6 +264,22 @@ pub fn system_checks(
         .into_iter()
         .chain(halves_check(identified, frames, how))
         .chain(noise_check(&identified.model, frames))
+        .collect()
+}
+
+/// [`system_checks`] of equations identified from their statistics (runs read in pieces, or
+/// gathered where the rows are): that their terms hold on each half of the runs and that the
+/// records' noise leaves them unbiased. Whether they retrace the runs needs the runs
+/// themselves (`validate` re-simulates them).
+pub fn moments_checks(
+    identified: &crate::identify::IdentifiedModel,
+    moments: &[crate::identify::EquationMoments],
+    model: &Model,
+    intercept: bool,
+) -> Vec<Check> {
+    halves_check_of_moments(identified, moments, model, intercept)
+        .into_iter()
+        .chain(noise_check_of_moments(moments))
         .collect()
 }
 

@@ -1,8 +1,9 @@
 //! The check that the records' noise is small enough to leave a system's terms unbiased
 //! ([`crate::identify::noise_note`] says it of one equation's fit).
 
-use crate::data::Frame;
+use crate::data::{Frame, NoiseTally};
 use crate::identify::noise::{flagged, held_nonlinearly, measured, shares, tallies, Share, SHARE};
+use crate::identify::EquationMoments;
 use crate::model::Model;
 use crate::plugin::Check;
 
@@ -16,7 +17,30 @@ pub(super) const NAME: &str = "the records' noise leaves the terms unbiased";
 /// variable or no such variable is in the runs.
 pub fn noise_check(model: &Model, runs: &[Frame]) -> Option<Check> {
     let candidates = model.equations().iter().filter(|e| e.identify).flat_map(|e| &e.candidates);
-    let shares = shares(&tallies(&held_nonlinearly(candidates, &model.vocabulary), runs));
+    noise_check_of(&tallies(&held_nonlinearly(candidates, &model.vocabulary), runs))
+}
+
+/// [`noise_check`] of equations identified from their statistics: the noise tallied with
+/// them ([`crate::identify::RunMoments::noise`]), each variable's from the first equation
+/// whose candidates hold it (the others tallied the same rows).
+pub fn noise_check_of_moments(moments: &[EquationMoments]) -> Option<Check> {
+    let mut pooled: Vec<(String, NoiseTally)> = Vec::new();
+    for m in moments {
+        let variables: std::collections::BTreeSet<&String> =
+            m.runs.iter().flat_map(|r| r.noise.keys()).collect();
+        for v in variables {
+            if !pooled.iter().any(|(p, _)| p == v) {
+                let all = NoiseTally::pooled(m.runs.iter().filter_map(|r| r.noise.get(v)).cloned());
+                pooled.push((v.clone(), all));
+            }
+        }
+    }
+    noise_check_of(&pooled)
+}
+
+/// The check on the noise `tallies` of the variables the candidates hold nonlinearly.
+fn noise_check_of(tallies: &[(String, NoiseTally)]) -> Option<Check> {
+    let shares = shares(tallies);
     if shares.is_empty() {
         return None;
     }

@@ -20,7 +20,7 @@ use serde::{Deserialize, Serialize};
 
 pub use best_subset::{BestSubset, Criterion, Sizes};
 pub use efroymson::Efroymson;
-pub use moments::{gather, in_parallel, Accumulator, Moments};
+pub use moments::{gather, gather_halved, in_parallel, Accumulator, Moments, Split};
 pub use rivals::{rivals, Rival};
 pub use sparse::{Candidate, Equality, LambdaChoice, SparseFit};
 pub use stepwise::{StepRule, Stepwise};

@@ -520,6 +520,69 @@ pub fn gather<E: Send>(
     runs: &[usize],
     feed: impl Fn(usize, Range<usize>, &mut Accumulator) -> Result<(), E> + Sync,
 ) -> Result<Vec<Moments>, E> {
+    let parts = gathered_parts(p, runs, false, |k, rows, acc, _| feed(k, rows, acc))?;
+    // a run's first part becomes its statistics, the others are merged into it
+    let mut out: Vec<Option<Moments>> = runs.iter().map(|_| None).collect();
+    for (k, _, part, _) in parts {
+        match &mut out[k] {
+            Some(m) => m.merge(&part),
+            none => *none = Some(part),
+        }
+    }
+    Ok(out.into_iter().map(|m| m.unwrap_or_else(|| Moments::new(p))).collect())
+}
+
+/// Where a part of a run holds the run's middle: the accumulators of its rows before the
+/// middle and from it on, which `feed` fills besides the part's own ([`gather_halved`]).
+pub struct Split<'a> {
+    /// The run's row the second half starts on.
+    pub middle: usize,
+    /// The rows before it.
+    pub first: &'a mut Accumulator,
+    /// The rows from it on.
+    pub second: &'a mut Accumulator,
+}
+
+/// [`gather`] with each run's halves (rows `0..n/2` and `n/2..n`): the run's statistics as
+/// `gather` gives them, to the bit, and its halves merged from the same parts; the one part
+/// that holds the middle is fed its [`Split`] too (its rows accumulated a second time), where
+/// a separate pass over the halves would accumulate every row twice.
+pub fn gather_halved<E: Send>(
+    p: usize,
+    runs: &[usize],
+    feed: impl Fn(usize, Range<usize>, &mut Accumulator, Option<Split<'_>>) -> Result<(), E> + Sync,
+) -> Result<Vec<(Moments, [Moments; 2])>, E> {
+    let parts = gathered_parts(p, runs, true, feed)?;
+    let mut out: Vec<[Option<Moments>; 3]> = runs.iter().map(|_| [None, None, None]).collect();
+    let into = |slot: &mut Option<Moments>, m: &Moments| match slot {
+        Some(all) => all.merge(m),
+        none => *none = Some(m.clone()),
+    };
+    for (k, rows, part, split) in parts {
+        let [whole, first, second] = &mut out[k];
+        into(whole, &part);
+        match split {
+            Some([a, b]) => {
+                into(first, &a);
+                into(second, &b);
+            }
+            None if rows.end <= runs[k] / 2 => into(first, &part),
+            None => into(second, &part),
+        }
+    }
+    let or_none = |m: Option<Moments>| m.unwrap_or_else(|| Moments::new(p));
+    Ok(out.into_iter().map(|[w, a, b]| (or_none(w), [or_none(a), or_none(b)])).collect())
+}
+
+/// Each part's statistics in run and row order, and, where `halves` asks and the part holds
+/// its run's middle, those of its rows before and from the middle.
+#[allow(clippy::type_complexity)]
+fn gathered_parts<E: Send>(
+    p: usize,
+    runs: &[usize],
+    halves: bool,
+    feed: impl Fn(usize, Range<usize>, &mut Accumulator, Option<Split<'_>>) -> Result<(), E> + Sync,
+) -> Result<Vec<(usize, Range<usize>, Moments, Option<[Moments; 2]>)>, E> {
     use rayon::prelude::*;
     let jobs: Vec<(usize, Range<usize>)> = runs
         .iter()
@@ -531,25 +594,24 @@ pub fn gather<E: Send>(
         .collect();
     let part = |(k, rows): &(usize, Range<usize>)| {
         let mut acc = Accumulator::new(p);
-        feed(*k, rows.clone(), &mut acc)?;
-        Ok(acc.finish())
+        let middle = runs[*k] / 2;
+        if halves && rows.start < middle && middle < rows.end {
+            let (mut first, mut second) = (Accumulator::new(p), Accumulator::new(p));
+            feed(*k, rows.clone(), &mut acc, Some(Split { middle, first: &mut first, second: &mut second }))?;
+            Ok((*k, rows.clone(), acc.finish(), Some([first.finish(), second.finish()])))
+        } else {
+            feed(*k, rows.clone(), &mut acc, None)?;
+            Ok((*k, rows.clone(), acc.finish(), None))
+        }
     };
-    // the same parts in the same order either way: the same result, round-off included
-    let parts: Vec<Result<Moments, E>> = if in_parallel(runs.iter().sum(), p) {
+    // the same parts in the same order either way: the same result, round-off included; the
+    // first error in that order
+    let parts: Vec<Result<_, E>> = if in_parallel(runs.iter().sum(), p) {
         jobs.par_iter().map(part).collect()
     } else {
         jobs.iter().map(part).collect()
     };
-    // a run's first part becomes its statistics, the others are merged into it
-    let mut out: Vec<Option<Moments>> = runs.iter().map(|_| None).collect();
-    for ((k, _), part) in jobs.iter().zip(parts) {
-        let part = part?;
-        match &mut out[*k] {
-            Some(m) => m.merge(&part),
-            none => *none = Some(part),
-        }
-    }
-    Ok(out.into_iter().map(|m| m.unwrap_or_else(|| Moments::new(p))).collect())
+    parts.into_iter().collect()
 }
 
 impl Moments {
@@ -735,6 +797,53 @@ mod tests {
                 }
             }
             assert_eq!(parallel.count(), n);
+        }
+    }
+
+    /// Runs gathered with their halves: each run's statistics are `gather`'s to the bit, its
+    /// halves those of its rows before and from its middle (a run of one part, of many parts
+    /// with the middle inside one, and of one row).
+    #[test]
+    fn runs_gathered_with_their_halves_keep_the_whole_to_the_bit() {
+        let runs = [1_000usize, 250_001, 1];
+        let x: Vec<Vec<f64>> =
+            runs.iter().map(|&n| (0..n * 2).map(|i| ((i * 7919) % 1009) as f64 * 1e-3).collect()).collect();
+        let y: Vec<Vec<f64>> =
+            runs.iter().map(|&n| (0..n).map(|i| (i as f64 * 0.01).sin()).collect()).collect();
+        let rows_of = |k: usize, rows: Range<usize>| -> (Vec<f64>, Vec<f64>) {
+            let n = runs[k];
+            let cols: Vec<f64> =
+                (0..2).flat_map(|j| x[k][j * n + rows.start..j * n + rows.end].to_vec()).collect();
+            (cols, y[k][rows].to_vec())
+        };
+        let feed = |k: usize, rows: Range<usize>, acc: &mut Accumulator| {
+            let (cols, ys) = rows_of(k, rows);
+            acc.push(&cols, &ys, None);
+            Ok::<(), ()>(())
+        };
+        let whole = gather(2, &runs, feed).unwrap();
+        let halved = gather_halved(2, &runs, |k, rows, acc, split| {
+            feed(k, rows.clone(), acc)?;
+            if let Some(Split { middle, first, second }) = split {
+                feed(k, rows.start..middle, first)?;
+                feed(k, middle..rows.end, second)?;
+            }
+            Ok::<(), ()>(())
+        })
+        .unwrap();
+        for (k, ((w, [a, b]), expected)) in halved.iter().zip(&whole).enumerate() {
+            assert_eq!(w, expected, "run {k}");
+            let n = runs[k];
+            assert_eq!((a.count(), b.count()), (n / 2, n - n / 2));
+            for (half, rows) in [(a, 0..n / 2), (b, n / 2..n)] {
+                let mut acc = Accumulator::new(2);
+                let (cols, ys) = rows_of(k, rows);
+                acc.push(&cols, &ys, None);
+                let direct = acc.finish();
+                for (u, v) in half.numbers().iter().zip(direct.numbers()) {
+                    assert!((u - v).abs() <= 1e-9 * u.abs().max(1.0), "run {k}: {u} vs {v}");
+                }
+            }
         }
     }
 

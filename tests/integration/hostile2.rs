@@ -119,6 +119,9 @@ fn statistics_of_many_runs_read_back() {
         })
         .collect();
     v["runs"] = runs.into();
+    // (the halves of one run cannot be the halves of ten thousand: left out, as files written
+    // before termid gathered them leave them)
+    v.as_object_mut().unwrap().remove("halves");
     let many = dir.join("many.moments");
     std::fs::write(&many, v.to_string()).unwrap();
     assert!(std::fs::metadata(&many).unwrap().len() > 1 << 20);

@@ -51,13 +51,13 @@ pub fn run(cmd: MomentsCommand) -> Result<()> {
 }
 
 /// `identify --moments`: the statistics files read, then merged per equation (in the order
-/// given) and identified by the library.
+/// given), identified by the library and checked.
 pub fn identify(
     model: &termid::model::Model,
     files: &[std::path::PathBuf],
     equations: &[String],
     intercept: bool,
-) -> Result<(termid::model::Model, Vec<(String, termid::identify::Fit)>)> {
+) -> Result<(termid::identify::IdentifiedModel, Vec<termid::plugin::Check>)> {
     let parts = files
         .iter()
         .map(|path| {
@@ -82,12 +82,28 @@ pub fn identify(
     }
     let parts: Vec<_> =
         parts.into_iter().filter(|(_, m)| equations.is_empty() || equations.contains(&m.equation)).collect();
-    let identified = termid::identify::identify_from_moments(model, parts, intercept)?;
-    Ok((identified.model, identified.fits))
+    let merged = termid::identify::merged_by_equation(parts)?;
+    identified_and_checked(model, merged, intercept)
+}
+
+/// The model identified from each equation's merged statistics, with the checks a model of no
+/// field's takes from them (a field's, its own physical checks; no runs at hand).
+fn identified_and_checked(
+    model: &termid::model::Model,
+    merged: Vec<EquationMoments>,
+    intercept: bool,
+) -> Result<(termid::identify::IdentifiedModel, Vec<termid::plugin::Check>)> {
+    let identified = termid::identify::identify_from_merged(model, &merged, intercept)?;
+    let checks = match termid::plugins::of(&identified.model) {
+        Some(plugin) => plugin.checks(&identified.model, &[]),
+        None => termid::recipe::moments_checks(&identified, &merged, model, intercept),
+    };
+    Ok((identified, checks))
 }
 
 /// `identify --model M --moments FILES`: equations identified from merged statistics, as
-/// from the runs they were computed on (no residual pass: no correlation time, no checks).
+/// from the runs they were computed on (no residual pass: no correlation time), checked as
+/// statistics allow (their halves, their noise; not whether they retrace the runs).
 pub fn identify_from_files(cmd: IdentifyCommand) -> Result<()> {
     let path = cmd.model.clone().context("--model")?;
     if let Some(out) = &cmd.out {
@@ -98,7 +114,8 @@ pub fn identify_from_files(cmd: IdentifyCommand) -> Result<()> {
         model = model.with_backend(&crate::identify::configure_backend(&cmd)?)?;
     }
     let intercept = crate::identify::intercept_of(&cmd, model.spec().model.intercept);
-    let (mut model, fits) = crate::moments::identify(&model, &cmd.moments, &cmd.equation, intercept)?;
+    let (identified, checks) = crate::moments::identify(&model, &cmd.moments, &cmd.equation, intercept)?;
+    let (mut model, fits) = (identified.model, identified.fits);
     if let Some(out) = &cmd.out {
         let sources = cmd.moments.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
         model.mark_identified(&format!("the statistics {sources}"));
@@ -106,16 +123,28 @@ pub fn identify_from_files(cmd: IdentifyCommand) -> Result<()> {
     }
     match cmd.format {
         Format::Json => {
-            let all: serde_json::Map<String, serde_json::Value> = fits
+            let mut all: serde_json::Map<String, serde_json::Value> = fits
                 .iter()
                 .map(|(n, f)| Ok((n.clone(), serde_json::to_value(f.report())?)))
                 .collect::<Result<_>>()?;
+            if !checks.is_empty() {
+                // (the key a recipe's report gives every check)
+                all.insert("physical_checks".into(), serde_json::to_value(&checks)?);
+            }
             println!("{}", serde_json::to_string_pretty(&all)?);
         }
         Format::Text => {
             for (name, fit) in &fits {
                 println!("== {name} ==");
                 print!("{}", fit.text());
+                println!();
+            }
+            if !checks.is_empty() {
+                let physical = termid::plugins::of(&model).is_some();
+                println!("{}", if physical { "== physical checks ==" } else { "== checks ==" });
+                for c in &checks {
+                    println!("{}", c.line());
+                }
                 println!();
             }
             if let Some(out) = &cmd.out {
@@ -205,19 +234,19 @@ pub fn identify_in_pieces(cmd: &IdentifyCommand, model: &termid::model::Model, r
     for n in notes {
         crate::runs::say(&n);
     }
-    let origin = cmd.data.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
-    let parts = all.into_iter().map(|m| (origin.clone(), m)).collect();
-    let identified = termid::identify::identify_from_moments(
-        model,
-        parts,
-        crate::identify::intercept_of(cmd, model.spec().model.intercept),
-    )?;
+    let intercept = crate::identify::intercept_of(cmd, model.spec().model.intercept);
+    let (identified, checks) = identified_and_checked(model, all, intercept)?;
     let mut fits = identified.fits;
     for (_, fit) in &mut fits {
         fit.selection.notes.extend(note.clone());
     }
-    let checks =
-        termid::plugins::of(&identified.model).map(|p| p.checks(&identified.model, &[])).unwrap_or_default();
+    if termid::plugins::of(&identified.model).is_none() {
+        // what runs read whole are checked for and these cannot be: said, not passed over
+        let files = cmd.data.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(" ");
+        crate::runs::say(&format!(
+            "whether the equations retrace their runs is not checked: the runs were read in pieces and not kept (`termid validate --model <out> --data {files}` re-simulates them)"
+        ));
+    }
     Ok(Start {
         derivative: cmd.derivative.clone(),
         model: identified.model,
