@@ -69,3 +69,34 @@ def test_statistics_carry_the_noise_that_biases_the_terms():
         noise = checks.loc["the records' noise leaves the terms unbiased"]
         assert (not noise["passed"]) == said and "white noise of `x` " in noise["detail"], noise["detail"]
         assert any("the records' noise" in str(w.message) for w in caught) == said
+
+
+def test_statistics_carry_the_halves_the_terms_must_hold_on():
+    """ẋ = −x + u with u acting over the first 8 s of 20 only: statistics of two shards (each a
+    run), merged and identified, flag `u` as chosen from all the rows but not from the second
+    halves (warned of), as a fit of the rows does; with u throughout, the check passes."""
+    import numpy as np
+    import pandas as pd
+
+    def run(u, x):
+        t = np.arange(400) * 0.05
+        xs, fine = [], 200
+        for k in range(400):
+            xs.append(x)
+            for j in range(fine):
+                s = t[k] + j * 0.05 / fine
+                x += 0.05 / fine * (-x + u(s))
+        return pd.DataFrame({"t": t, "x": xs, "u": [u(s) for s in t]})
+
+    model = termid.Model.from_states(["x"], inputs=["u"])
+    early = lambda s: np.sin(0.7 * s) * (1 - s / 8) if s < 8 else 0.0
+    throughout = lambda s: np.sin(0.7 * s) + 0.3 * np.cos(1.9 * s)
+    for u, passed in [(early, False), (throughout, True)]:
+        shards = [model.moments("x_dot", run(u, x0), derivative="central") for x0 in (0.5, -0.3)]
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            found = model.identify_from_moments(shards[0] + shards[1])
+        halves = found.checks.set_index("name").loc["the terms hold on each half of the runs"]
+        assert bool(halves["passed"]) == passed, halves["detail"]
+        assert passed or "`x_dot`: `u`" in halves["detail"], halves["detail"]
+        assert any("each half" in str(w.message) for w in caught) != passed
