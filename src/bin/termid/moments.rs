@@ -116,6 +116,9 @@ pub fn identify_from_files(cmd: IdentifyCommand) -> Result<()> {
     let intercept = crate::identify::intercept_of(&cmd, model.spec().model.intercept);
     let (identified, checks) = crate::moments::identify(&model, &cmd.moments, &cmd.equation, intercept)?;
     let (mut model, fits) = (identified.model, identified.fits);
+    if termid::plugins::of(&model).is_none() {
+        unretraced("the statistics hold no rows", "<the runs>");
+    }
     if let Some(out) = &cmd.out {
         let sources = cmd.moments.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
         model.mark_identified(&format!("the statistics {sources}"));
@@ -153,6 +156,14 @@ pub fn identify_from_files(cmd: IdentifyCommand) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Says what runs read whole are checked for and a model identified from statistics cannot be
+/// (`why`): whether its equations retrace the runs (`files`).
+fn unretraced(why: &str, files: &str) {
+    crate::runs::say(&format!(
+        "whether the equations retrace their runs is not checked: {why} (`termid validate --model <out> --data {files}` re-simulates them)"
+    ));
 }
 
 /// Files together larger than this are read in pieces by `identify --model` where they can be.
@@ -241,11 +252,8 @@ pub fn identify_in_pieces(cmd: &IdentifyCommand, model: &termid::model::Model, r
         fit.selection.notes.extend(note.clone());
     }
     if termid::plugins::of(&identified.model).is_none() {
-        // what runs read whole are checked for and these cannot be: said, not passed over
         let files = cmd.data.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(" ");
-        crate::runs::say(&format!(
-            "whether the equations retrace their runs is not checked: the runs were read in pieces and not kept (`termid validate --model <out> --data {files}` re-simulates them)"
-        ));
+        unretraced("the runs were read in pieces and not kept", &files);
     }
     Ok(Start {
         derivative: cmd.derivative.clone(),
