@@ -572,7 +572,7 @@ impl PyModel {
                 let identified = termid::identify::identify_from_merged(model, &merged, intercept)?;
                 let checks = match termid::plugins::of(&identified.model) {
                     Some(_) => vec![],
-                    None => termid::recipe::moments_checks(&identified, &merged, model, intercept),
+                    None => termid::recipe::moments_checks(&identified, &merged, model, intercept, &[]),
                 };
                 Ok::<_, termid::identify::IdentifyError>((identified, checks))
             })

@@ -26,6 +26,7 @@ mod search;
 mod smoothing_spline;
 mod spike;
 mod stream;
+mod thin;
 mod weak;
 
 pub use angle::{turn_of, unwrap_turns, unwrapped, unwrapped_dials, wrapped};
@@ -55,6 +56,7 @@ pub use savitzky_golay::SavitzkyGolay;
 pub use smoothing_spline::SmoothingSpline;
 pub use spike::{despiked, despiked_all, spikes, Spike};
 pub use stream::{Chunk, Chunks, Labels, RowSource};
+pub use thin::Thinned;
 pub use weak::WeakForm;
 
 #[cfg(test)]

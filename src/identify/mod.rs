@@ -58,7 +58,7 @@ pub use model::{
 pub use noise::noise_note;
 pub use report::{num, sig, FitReport, StepReport, TermReport};
 pub use statistics::{
-    identify_from_merged, identify_from_moments, merged_by_equation, EquationMoments, RunMoments,
+    identify_from_merged, identify_from_moments, merged_by_equation, EquationMoments, Pieces, RunMoments,
 };
 
 /// Why identification failed.

@@ -76,6 +76,24 @@ struct RunSoFar {
     /// The columns held and switched between samples as its first piece found them
     /// ([`crate::data::Frame::hold`], [`crate::data::Frame::switch`]).
     between: (Vec<String>, Vec<String>),
+    /// The model's variables over the run, kept small.
+    kept: crate::data::Thinned,
+}
+
+/// The most rows of a run read in pieces kept for a check that re-simulates it: what that
+/// check re-simulates of a run read whole (`crate::recipe::retrace`).
+const KEPT_ROWS: usize = 20_000;
+
+/// What a pass over runs read in pieces gathers ([`EquationMoments::of_chunks_each`]).
+pub struct Pieces {
+    /// Each equation's statistics, in the order asked for.
+    pub moments: Vec<EquationMoments>,
+    /// What admitting the runs said.
+    pub notes: Vec<String>,
+    /// Each run's states and inputs as kept: at most 20 000 rows, each the average of as many
+    /// consecutive rows of the run ([`crate::data::Thinned`]), for a check that re-simulates
+    /// the runs.
+    pub runs: Vec<Frame>,
 }
 
 /// A run's statistics as it is read in pieces: those of consecutive stretches of its rows
@@ -218,19 +236,19 @@ impl EquationMoments {
         runs: Vec<crate::data::Chunks>,
         differentiator: &dyn Differentiator,
     ) -> Result<(EquationMoments, Vec<String>), IdentifyError> {
-        let (mut all, notes) = Self::of_chunks_each(model, &[equation.to_string()], runs, differentiator)?;
-        Ok((all.remove(0), notes))
+        let mut pieces = Self::of_chunks_each(model, &[equation.to_string()], runs, differentiator)?;
+        Ok((pieces.moments.remove(0), pieces.notes))
     }
 
     /// [`EquationMoments::of_chunks`] for several equations in the same pass over the rows
     /// (each chunk read, admitted and checked once): one statistics value per equation, in
-    /// the order given.
+    /// the order given, and each run's states and inputs kept small.
     pub fn of_chunks_each(
         model: &Model,
         equations: &[String],
         runs: Vec<crate::data::Chunks>,
         differentiator: &dyn Differentiator,
-    ) -> Result<(Vec<EquationMoments>, Vec<String>), IdentifyError> {
+    ) -> Result<Pieces, IdentifyError> {
         if differentiator.reach().is_none() {
             return Err(IdentifyError::Setup(format!(
                 "the derivative method `{}` needs whole runs: read in chunks, use central, five-point or savitzky-golay",
@@ -256,6 +274,7 @@ impl EquationMoments {
         let rules = model.parameter_rules();
         let (mut out, mut notes) = (vec![Vec::new(); eqs.len()], Vec::new());
         let mut halves: Vec<Option<[Moments; 2]>> = vec![None; eqs.len()];
+        let mut kept_runs = Vec::new();
         let mut targets: Option<Vec<Target>> = None;
         let (states, _) = model.recorded_motion();
         for chunks in runs {
@@ -311,19 +330,34 @@ impl EquationMoments {
                         eqs.iter().map(|eq| default_target(eq, std::slice::from_ref(&chunk.frame))).collect()
                     });
                     let between = (chunk.frame.held().to_vec(), chunk.frame.switched().to_vec());
+                    let variables: Vec<String> = model
+                        .vocabulary
+                        .variables()
+                        .iter()
+                        .filter(|v| chunk.frame.column(v).is_some())
+                        .cloned()
+                        .collect();
+                    let kept = crate::data::Thinned::new(
+                        chunk.frame.origin(),
+                        chunk.frame.time_name(),
+                        variables,
+                        KEPT_ROWS,
+                    );
                     run = Some(RunSoFar {
                         name: chunk.frame.origin().to_string(),
                         fixed,
                         moments: (0..eqs.len()).map(|_| Stretches::default()).collect(),
                         noise: vec![BTreeMap::new(); eqs.len()],
                         between,
+                        kept,
                     });
                 }
-                let (Some(RunSoFar { fixed, moments, noise, .. }), Some(targets)) =
+                let (Some(RunSoFar { fixed, moments, noise, kept, .. }), Some(targets)) =
                     (run.as_mut(), targets.as_ref())
                 else {
                     unreachable!("set by the run's first chunk")
                 };
+                kept.push(&chunk.frame, chunk.own.clone()).map_err(|e| shift(e.into()))?;
                 // each piece's noise read across its neighbours' rows, its spread over its own;
                 // a variable once a piece, whichever equations hold it
                 let mut read: BTreeMap<&str, Option<NoiseTally>> = BTreeMap::new();
@@ -362,7 +396,8 @@ impl EquationMoments {
                     }
                 }
             }
-            if let Some(RunSoFar { name, moments, noise, .. }) = run {
+            if let Some(RunSoFar { name, moments, noise, kept, .. }) = run {
+                kept_runs.push(kept.frame()?);
                 for (((list, pooled), m), noise) in out.iter_mut().zip(&mut halves).zip(moments).zip(noise) {
                     if let Some(run_halves) = m.halves() {
                         pool(pooled, &run_halves);
@@ -388,7 +423,7 @@ impl EquationMoments {
                 halves: Some(halves.into_iter().collect()),
             })
             .collect();
-        Ok((all, notes))
+        Ok(Pieces { moments: all, notes, runs: kept_runs })
     }
 
     /// The equation, target and candidates of these statistics, without runs.

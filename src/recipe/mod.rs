@@ -268,17 +268,21 @@ pub fn system_checks(
 }
 
 /// [`system_checks`] of equations identified from their statistics (runs read in pieces, or
-/// gathered where the rows are): that their terms hold on each half of the runs and that the
-/// records' noise leaves them unbiased. Whether they retrace the runs needs the runs
-/// themselves (`validate` re-simulates them).
+/// gathered where the rows are): that they retrace the runs as kept (`runs`: a run read in
+/// pieces averaged to at most 20 000 rows, [`crate::identify::Pieces::runs`]; none for
+/// statistics alone, which hold no rows), that their terms hold on each half of the runs, and
+/// that the records' noise leaves them unbiased.
 pub fn moments_checks(
     identified: &crate::identify::IdentifiedModel,
     moments: &[crate::identify::EquationMoments],
     model: &Model,
     intercept: bool,
+    runs: &[Frame],
 ) -> Vec<Check> {
-    halves_check_of_moments(identified, moments, model, intercept)
+    let retrace = if runs.is_empty() { None } else { retrace_check(&identified.model, runs) };
+    retrace
         .into_iter()
+        .chain(halves_check_of_moments(identified, moments, model, intercept))
         .chain(noise_check_of_moments(moments))
         .collect()
 }

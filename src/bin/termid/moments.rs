@@ -83,20 +83,22 @@ pub fn identify(
     let parts: Vec<_> =
         parts.into_iter().filter(|(_, m)| equations.is_empty() || equations.contains(&m.equation)).collect();
     let merged = termid::identify::merged_by_equation(parts)?;
-    identified_and_checked(model, merged, intercept)
+    identified_and_checked(model, merged, intercept, &[])
 }
 
 /// The model identified from each equation's merged statistics, with the checks a model of no
-/// field's takes from them (a field's, its own physical checks; no runs at hand).
+/// field's takes from them and from the runs as kept (`runs`, if any; a field's model, its own
+/// physical checks).
 fn identified_and_checked(
     model: &termid::model::Model,
     merged: Vec<EquationMoments>,
     intercept: bool,
+    runs: &[termid::data::Frame],
 ) -> Result<(termid::identify::IdentifiedModel, Vec<termid::plugin::Check>)> {
     let identified = termid::identify::identify_from_merged(model, &merged, intercept)?;
     let checks = match termid::plugins::of(&identified.model) {
         Some(plugin) => plugin.checks(&identified.model, &[]),
-        None => termid::recipe::moments_checks(&identified, &merged, model, intercept),
+        None => termid::recipe::moments_checks(&identified, &merged, model, intercept, runs),
     };
     Ok((identified, checks))
 }
@@ -117,7 +119,10 @@ pub fn identify_from_files(cmd: IdentifyCommand) -> Result<()> {
     let (identified, checks) = crate::moments::identify(&model, &cmd.moments, &cmd.equation, intercept)?;
     let (mut model, fits) = (identified.model, identified.fits);
     if termid::plugins::of(&model).is_none() {
-        unretraced("the statistics hold no rows", "<the runs>");
+        // what runs read whole are checked for and statistics cannot be: said, not passed over
+        crate::runs::say(
+            "whether the equations retrace their runs is not checked: the statistics hold no rows (`termid validate --model <out> --data <the runs>` re-simulates them)",
+        );
     }
     if let Some(out) = &cmd.out {
         let sources = cmd.moments.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
@@ -156,14 +161,6 @@ pub fn identify_from_files(cmd: IdentifyCommand) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// Says what runs read whole are checked for and a model identified from statistics cannot be
-/// (`why`): whether its equations retrace the runs (`files`).
-fn unretraced(why: &str, files: &str) {
-    crate::runs::say(&format!(
-        "whether the equations retrace their runs is not checked: {why} (`termid validate --model <out> --data {files}` re-simulates them)"
-    ));
 }
 
 /// Files together larger than this are read in pieces by `identify --model` where they can be.
@@ -214,7 +211,8 @@ pub fn in_pieces(cmd: &IdentifyCommand, refine: bool) -> Result<Option<usize>> {
 
 /// `identify --model` on runs read in pieces: each equation's statistics in one pass over
 /// the files (as `termid moments` writes them), identified as `identify --moments` would, and
-/// checked (the physical checks at the model's rudder limit: the runs are not kept).
+/// checked (the physical checks at the model's rudder limit; a model of no field's on the
+/// runs as kept, averaged to at most 20 000 rows, and on its statistics).
 pub fn identify_in_pieces(cmd: &IdentifyCommand, model: &termid::model::Model, rows: usize) -> Result<Start> {
     let diff = differentiator(&cmd.derivative)?;
     let reach = diff.reach().context("a derivative of fixed reach")?;
@@ -239,21 +237,17 @@ pub fn identify_in_pieces(cmd: &IdentifyCommand, model: &termid::model::Model, r
         .map(|p| termid::data::Chunks::open(p, &model.spec().model.time, rows.max(1), 2 * reach + 2))
         .collect::<Result<Vec<_>, _>>()?;
     let label = format!("statistics of {} in pieces of {rows} rows ({})", names.join(", "), cmd.derivative);
-    let (all, notes) = crate::progress::with_spinner(&label, || {
+    let pieces = crate::progress::with_spinner(&label, || {
         termid::identify::EquationMoments::of_chunks_each(model, &names, runs, diff.as_ref())
     })?;
-    for n in notes {
-        crate::runs::say(&n);
+    for n in &pieces.notes {
+        crate::runs::say(n);
     }
     let intercept = crate::identify::intercept_of(cmd, model.spec().model.intercept);
-    let (identified, checks) = identified_and_checked(model, all, intercept)?;
+    let (identified, checks) = identified_and_checked(model, pieces.moments, intercept, &pieces.runs)?;
     let mut fits = identified.fits;
     for (_, fit) in &mut fits {
         fit.selection.notes.extend(note.clone());
-    }
-    if termid::plugins::of(&identified.model).is_none() {
-        let files = cmd.data.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(" ");
-        unretraced("the runs were read in pieces and not kept", &files);
     }
     Ok(Start {
         derivative: cmd.derivative.clone(),
