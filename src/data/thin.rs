@@ -85,10 +85,11 @@ impl Thinned {
         }
     }
 
-    /// The run as kept (the rows gathered last, fewer than the others average, as one more
-    /// row).
+    /// The run as kept, its samples evenly spaced: the rows gathered last, fewer than a kept
+    /// row averages, left out (a re-simulation compares a run sample by sample), unless
+    /// nothing else was kept.
     pub fn frame(mut self) -> Result<Frame, DataError> {
-        if self.gathered > 0 {
+        if self.gathered > 0 && self.columns[0].is_empty() {
             self.keep();
         }
         let mut columns = self.columns.into_iter();
@@ -106,7 +107,8 @@ mod tests {
 
     /// A run of 1001 rows read in pieces of 97, kept as at most 100 rows: between 50 and 100
     /// kept, each the average of the rows it gathers (a line stays the line, its time evenly
-    /// spaced but for the last row), and the same however the run is cut into pieces.
+    /// spaced, the last few rows that fill no kept row left out), and the same however the
+    /// run is cut into pieces; a run shorter than a kept row is kept as one.
     #[test]
     fn a_long_run_is_kept_as_averages_of_its_rows() {
         let n = 1001;
@@ -127,9 +129,13 @@ mod tests {
             assert!((x - (3.0 * t - 1.0)).abs() < 1e-9, "{t} {x}");
         }
         let dt: Vec<f64> = frame.time().windows(2).map(|w| w[1] - w[0]).collect();
-        assert!(dt[..dt.len() - 1].iter().all(|d| (d - dt[0]).abs() < 1e-9), "{dt:?}");
+        assert!(dt.iter().all(|d| (d - dt[0]).abs() < 1e-9), "{dt:?}");
+        assert!((n - 1) as f64 * 0.1 - frame.time()[frame.len() - 1] < 1.5 * dt[0], "{dt:?}");
         assert_eq!(kept(1).column("u"), frame.column("u"));
         assert_eq!(kept(n).time(), frame.time());
+        let mut one = Thinned::new("run.csv", "t", vec!["x".into()], 100);
+        one.push(&run, 0..1).unwrap();
+        assert_eq!(one.frame().unwrap().len(), 1);
         // a piece without a kept column is refused
         let mut thin = Thinned::new("run.csv", "t", vec!["y".into()], 100);
         assert!(thin.push(&run, 0..10).is_err());
