@@ -85,6 +85,11 @@ fuzz_target!(|data: &[u8]| {
                     "/../models/lorenz.toml"
                 ))) {
                     let _ = m.fit(&model, true);
+                    // and checked on its halves and noise, as `identify --moments` does
+                    let all = std::slice::from_ref(&m);
+                    if let Ok(found) = termid::identify::identify_from_merged(&model, all, true) {
+                        let _ = termid::recipe::moments_checks(&found, all, &model, true, &[]);
+                    }
                 }
             }
         }
@@ -166,6 +171,10 @@ fn damaged_file(kind: u8, edits: &[u8]) {
             }
             if let Ok(read) = termid::identify::EquationMoments::from_bytes(&b, "fuzz.bin") {
                 let _ = read.fit(&model, true);
+                let all = std::slice::from_ref(&read);
+                if let Ok(found) = termid::identify::identify_from_merged(&model, all, true) {
+                    let _ = termid::recipe::moments_checks(&found, all, &model, true, &[]);
+                }
             }
             return;
         }

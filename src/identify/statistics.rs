@@ -52,6 +52,14 @@ pub struct EquationMoments {
     pub halves: Option<Vec<[Moments; 2]>>,
 }
 
+/// Whether statistics of `model` gather their runs' halves: for a model of no field's, whose
+/// checks read them ([`crate::recipe::halves_check_of_moments`]); a field's model (a table of a
+/// plug-in in its file) is checked by its field, which reads no halves, and its statistics
+/// (fleets of short runs, where the halves cost a fifth more) are spared them.
+fn halved(model: &Model) -> bool {
+    model.spec().plugins.is_empty()
+}
+
 /// `run`'s halves pooled into `all`'s.
 fn pool(all: &mut Option<[Moments; 2]>, run: &[Moments; 2]) {
     match all {
@@ -194,15 +202,27 @@ impl EquationMoments {
         };
         let design = Design::new(&eq.candidates, &model.vocabulary)?;
         // the whole runs' statistics gathered as a fit of the rows gathers them (statistics
-        // identify as the rows, to the bit), with their halves'
-        let all = how.moments_and_halves_of_runs(&design.library, design.candidates(), &target, frames)?;
+        // identify as the rows, to the bit), with their halves' where the model's checks read
+        // them
+        let (library, candidates) = (&design.library, design.candidates());
+        let all: Vec<(Moments, Option<[Moments; 2]>)> = if halved(model) {
+            let all = how.moments_and_halves_of_runs(library, candidates, &target, frames)?;
+            all.into_iter().map(|(m, h)| (m, Some(h))).collect()
+        } else {
+            how.moments_of_runs(library, candidates, &target, frames)?
+                .into_iter()
+                .map(|m| (m, None))
+                .collect()
+        };
         let noisy = held_nonlinearly(&eq.candidates, &model.vocabulary);
         let mut halves = None;
         let runs = frames
             .iter()
             .zip(all)
             .map(|(f, (moments, run_halves))| {
-                pool(&mut halves, &run_halves);
+                if let Some(run_halves) = &run_halves {
+                    pool(&mut halves, run_halves);
+                }
                 RunMoments {
                     run: f.origin().into(),
                     moments,
@@ -218,7 +238,7 @@ impl EquationMoments {
             target: target.to_string(),
             candidates: design.names().to_vec(),
             runs,
-            halves: Some(halves.into_iter().collect()),
+            halves: halved(model).then(|| halves.into_iter().collect()),
         })
     }
 
@@ -420,7 +440,7 @@ impl EquationMoments {
                 target: target.to_string(),
                 candidates: design.names().to_vec(),
                 runs,
-                halves: Some(halves.into_iter().collect()),
+                halves: halved(model).then(|| halves.into_iter().collect()),
             })
             .collect();
         Ok(Pieces { moments: all, notes, runs: kept_runs })

@@ -4,9 +4,9 @@
 //! themselves) makes a regression choose terms the system lacks with t-values of 4 to 6;
 //! they rarely come back from both halves, where the system's own terms do.
 
-use crate::data::{Frame, TestFunction, WeakForm};
 use std::collections::BTreeMap;
 
+use crate::data::{Frame, TestFunction, WeakForm};
 use crate::identify::{identify_model, EquationMoments, IdentifiedModel, ModelIdentification, RunMoments};
 use crate::model::Model;
 use crate::plugin::Check;
