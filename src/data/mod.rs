@@ -56,7 +56,7 @@ pub use savitzky_golay::SavitzkyGolay;
 pub use smoothing_spline::SmoothingSpline;
 pub use spike::{despiked, despiked_all, spikes, Spike};
 pub use stream::{Chunk, Chunks, Labels, RowSource};
-pub use thin::Thinned;
+pub use thin::{Coarsened, Thinned};
 pub use weak::WeakForm;
 
 #[cfg(test)]

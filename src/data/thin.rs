@@ -1,5 +1,6 @@
 //! A run read in pieces, kept small: consecutive rows averaged, twice as many to a kept row
-//! each time the kept rows outgrow their bound, so that a check that re-simulates the run
+//! each time the kept rows outgrow their bound ([`Coarsened`], which also keeps a run's
+//! statistics as stretches whose halves can be told apart), so that a check that re-simulates the run
 //! (whether identified equations retrace it) has it at a bounded cost, without the whole run
 //! in memory. The average is a box filter over the rows it gathers: what it keeps of the
 //! inputs is what a re-simulation at that step can follow.
@@ -8,6 +9,73 @@ use std::ops::Range;
 
 use super::{DataError, Frame};
 
+/// A long sequence kept as at most `most` items: consecutive ones merged, twice as many to a
+/// kept item each time the kept ones outgrow their bound (every kept item but the last holds
+/// [`Coarsened::each`] of the sequence's; the last gathers towards as many).
+#[derive(Clone, Debug)]
+pub struct Coarsened<T> {
+    kept: Vec<T>,
+    each: usize,
+    /// The items of the sequence the last kept one holds.
+    last: usize,
+    most: usize,
+}
+
+impl<T> Coarsened<T> {
+    /// Nothing kept yet, to keep at most `most` items (at least two).
+    pub fn new(most: usize) -> Coarsened<T> {
+        Coarsened { kept: Vec::new(), each: 1, last: 0, most: most.max(2) }
+    }
+
+    /// The sequence's next item, merged into the last kept one (`merge`) while that holds
+    /// fewer than [`Coarsened::each`].
+    pub fn push(&mut self, item: T, merge: impl Fn(&mut T, T)) {
+        match self.kept.last_mut() {
+            Some(open) if self.last < self.each => {
+                merge(open, item);
+                self.last += 1;
+            }
+            _ => {
+                self.kept.push(item);
+                self.last = 1;
+            }
+        }
+        if self.kept.len() > self.most {
+            // every kept item but the last holds `each`: merged in pairs, they hold twice as
+            // many; of an odd number, the last (the new one, holding one) is left alone
+            let all = std::mem::take(&mut self.kept);
+            let mut all = all.into_iter();
+            while let Some(mut a) = all.next() {
+                if let Some(b) = all.next() {
+                    merge(&mut a, b);
+                }
+                self.kept.push(a);
+            }
+            self.each *= 2;
+        }
+    }
+
+    /// The items of the sequence each kept one holds (the last: [`Coarsened::last`]).
+    pub fn each(&self) -> usize {
+        self.each
+    }
+
+    /// The items of the sequence the last kept one holds.
+    pub fn last(&self) -> usize {
+        self.last
+    }
+
+    /// The kept items, in order.
+    pub fn kept(&self) -> &[T] {
+        &self.kept
+    }
+
+    /// The kept items, in order, by value.
+    pub fn into_kept(self) -> Vec<T> {
+        self.kept
+    }
+}
+
 /// A run's columns as kept so far.
 #[derive(Clone, Debug)]
 pub struct Thinned {
@@ -15,32 +83,15 @@ pub struct Thinned {
     time_name: String,
     /// The columns kept besides the time.
     names: Vec<String>,
-    /// The kept rows, column by column, the time first.
-    columns: Vec<Vec<f64>>,
-    /// The run's rows each kept row averages.
-    each: usize,
-    /// The sums of the rows gathered for the next kept row, the time first, and how many.
-    partial: Vec<f64>,
-    gathered: usize,
-    /// The most rows kept.
-    most: usize,
+    /// The sums of the run's rows each kept row gathers, the time first.
+    rows: Coarsened<Vec<f64>>,
 }
 
 impl Thinned {
     /// Columns `names` of a run read from `origin` (their time named `time_name`), to be kept
     /// as at most `most` rows (at least two).
     pub fn new(origin: &str, time_name: &str, names: Vec<String>, most: usize) -> Thinned {
-        let width = names.len() + 1;
-        Thinned {
-            origin: origin.into(),
-            time_name: time_name.into(),
-            names,
-            columns: vec![Vec::new(); width],
-            each: 1,
-            partial: vec![0.0; width],
-            gathered: 0,
-            most: most.max(2),
-        }
+        Thinned { origin: origin.into(), time_name: time_name.into(), names, rows: Coarsened::new(most) }
     }
 
     /// Rows `rows` of `piece` (a piece of the run, in order), its columns by name; a column it
@@ -49,50 +100,38 @@ impl Thinned {
         let columns: Vec<&[f64]> = std::iter::once(Ok(piece.time()))
             .chain(self.names.iter().map(|n| piece.require(n)))
             .collect::<Result<_, _>>()?;
+        let add = |sum: &mut Vec<f64>, row: Vec<f64>| sum.iter_mut().zip(row).for_each(|(s, v)| *s += v);
         for r in rows {
-            for (sum, c) in self.partial.iter_mut().zip(&columns) {
-                *sum += c.get(r).copied().unwrap_or(f64::NAN);
-            }
-            self.gathered += 1;
-            if self.gathered == self.each {
-                self.keep();
-            }
+            let row = columns.iter().map(|c| c.get(r).copied().unwrap_or(f64::NAN)).collect();
+            self.rows.push(row, add);
         }
         Ok(())
-    }
-
-    /// The gathered rows' average kept; the kept rows averaged in pairs where they outgrow
-    /// their bound (an odd last one gathered on towards the next pair).
-    fn keep(&mut self) {
-        let n = self.gathered as f64;
-        for (column, sum) in self.columns.iter_mut().zip(self.partial.iter_mut()) {
-            column.push(*sum / n);
-            *sum = 0.0;
-        }
-        self.gathered = 0;
-        if self.columns[0].len() > self.most {
-            let odd = self.columns[0].len() % 2 == 1;
-            for (column, sum) in self.columns.iter_mut().zip(self.partial.iter_mut()) {
-                if odd {
-                    *sum = column.pop().unwrap_or(0.0) * self.each as f64;
-                }
-                *column = column.chunks_exact(2).map(|p| 0.5 * (p[0] + p[1])).collect();
-            }
-            if odd {
-                self.gathered = self.each;
-            }
-            self.each *= 2;
-        }
     }
 
     /// The run as kept, its samples evenly spaced: the rows gathered last, fewer than a kept
     /// row averages, left out (a re-simulation compares a run sample by sample), unless
     /// nothing else was kept.
-    pub fn frame(mut self) -> Result<Frame, DataError> {
-        if self.gathered > 0 && self.columns[0].is_empty() {
-            self.keep();
+    pub fn frame(self) -> Result<Frame, DataError> {
+        let (each, last) = (self.rows.each(), self.rows.last());
+        let mut sums = self.rows.into_kept();
+        // (a run shorter than a kept row: its one row holds `last` of them)
+        let mut count = each;
+        if last < each {
+            if sums.len() > 1 {
+                sums.pop();
+            } else {
+                count = last;
+            }
         }
-        let mut columns = self.columns.into_iter();
+        let count = count as f64;
+        let width = self.names.len() + 1;
+        let mut columns: Vec<Vec<f64>> = (0..width).map(|_| Vec::with_capacity(sums.len())).collect();
+        for row in &sums {
+            for (column, v) in columns.iter_mut().zip(row) {
+                column.push(v / count);
+            }
+        }
+        let mut columns = columns.into_iter();
         let mut frame = Frame::new(&self.origin, &self.time_name, columns.next().unwrap_or_default())?;
         for (name, values) in self.names.iter().zip(columns) {
             frame.push(name, values)?;

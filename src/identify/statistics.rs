@@ -108,13 +108,12 @@ pub struct Pieces {
 /// (halves of pieces at first; as they grow many, neighbours merged in pairs, and later
 /// pieces gathered as many to a stretch), so that its halves can be told apart once its
 /// length is known.
-#[derive(Default)]
-struct Stretches {
-    stretches: Vec<Moments>,
-    /// The halves of pieces a stretch gathers.
-    each: usize,
-    /// Those the last stretch holds so far.
-    last: usize,
+struct Stretches(crate::data::Coarsened<Moments>);
+
+impl Default for Stretches {
+    fn default() -> Self {
+        Stretches(crate::data::Coarsened::new(Self::MOST))
+    }
 }
 
 impl Stretches {
@@ -122,56 +121,32 @@ impl Stretches {
     const MOST: usize = 64;
 
     fn push(&mut self, m: Moments) {
-        match self.stretches.last_mut() {
-            Some(open) if self.last < self.each => {
-                open.merge(&m);
-                self.last += 1;
-            }
-            _ => {
-                self.stretches.push(m);
-                self.last = 1;
-            }
-        }
-        self.each = self.each.max(1);
-        if self.stretches.len() > Self::MOST {
-            // every stretch but the last holds `each`: merged in pairs, they hold twice as many
-            let all = std::mem::take(&mut self.stretches);
-            let mut all = all.into_iter();
-            while let Some(mut a) = all.next() {
-                if let Some(b) = all.next() {
-                    a.merge(&b);
-                }
-                self.stretches.push(a);
-            }
-            // (an odd number of them: the new one is left alone, the last, holding one)
-            self.each *= 2;
-        }
+        self.0.push(m, |a, b| a.merge(&b));
     }
 
     /// The run's first and second half, cut at the boundary of stretches nearest its middle;
     /// `None` where nothing was read.
     fn halves(self) -> Option<[Moments; 2]> {
-        let total: usize = self.stretches.iter().map(Moments::count).sum();
+        let stretches = self.0.into_kept();
+        let total: usize = stretches.iter().map(Moments::count).sum();
         let mut before = 0;
-        let cut = (0..=self.stretches.len())
+        let cut = (0..=stretches.len())
             .map(|k| {
                 let at = (k, before);
-                before += self.stretches.get(k).map_or(0, Moments::count);
+                before += stretches.get(k).map_or(0, Moments::count);
                 at
             })
             .min_by_key(|&(_, rows)| rows.abs_diff(total - rows))
             .map(|(k, _)| k)?;
         let merged = |part: &[Moments]| {
-            let mut all = part
-                .first()
-                .cloned()
-                .or_else(|| self.stretches.first().map(|m| Moments::new(m.regressors())))?;
+            let mut all =
+                part.first().cloned().or_else(|| stretches.first().map(|m| Moments::new(m.regressors())))?;
             for m in part.iter().skip(1) {
                 all.merge(m);
             }
             Some(all)
         };
-        Some([merged(&self.stretches[..cut])?, merged(&self.stretches[cut..])?])
+        Some([merged(&stretches[..cut])?, merged(&stretches[cut..])?])
     }
 }
 
@@ -960,7 +935,7 @@ mod tests {
         for k in 0..1001 {
             stretches.push(one(k as f64));
         }
-        assert!(stretches.stretches.len() <= Stretches::MOST);
+        assert!(stretches.0.kept().len() <= Stretches::MOST);
         let [first, second] = stretches.halves().unwrap();
         assert!(first.count().abs_diff(second.count()) <= 1001 / 32, "{} {}", first.count(), second.count());
         assert!(first.means()[0] < 500.0 && second.means()[0] > 500.0);
