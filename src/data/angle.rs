@@ -36,6 +36,28 @@ fn unwrap_turns_of(angle: &mut [f64], turn: f64) {
     }
 }
 
+/// `frame`'s columns `values` names, each shifted by the whole turns (2π or 360) that lay its
+/// value at row `at` onto the one given: a piece of a run read in pieces whose angles were
+/// unwrapped on their own (each piece starting within half a turn of 0) laid onto the piece
+/// before it, whose value at that row is given. A column off by anything but whole turns
+/// there (another sample, a repair of its own) is left as it is.
+pub fn laid_on_turns(frame: &mut Frame, at: usize, values: &[(String, f64)]) -> Result<(), DataError> {
+    for (name, before) in values {
+        let Some(column) = frame.column(name) else { continue };
+        let Some(now) = column.get(at) else { continue };
+        let shift = before - now;
+        let whole = [TAU, 360.0].into_iter().any(|turn| {
+            let n = (shift / turn).round();
+            n != 0.0 && (shift - n * turn).abs() <= 1e-9 * shift.abs().max(1.0)
+        });
+        if whole {
+            let shifted = column.iter().map(|v| v + shift).collect();
+            frame.set(name, shifted)?;
+        }
+    }
+    Ok(())
+}
+
 /// The full turn (2π or 360) of a record that reads like an angle on a dial, in radians or
 /// degrees, its units not declared: it stays within one turn (2 % over, for noise), spans
 /// three quarters of it or more, jumps by more than half of it at least once, and moves by
@@ -153,6 +175,21 @@ mod tests {
     /// angles on a dial, and unwrapped back to their turning; a counter that rolls over at
     /// 100, a swing of ±1 rad that never wraps, a record that leaps by a turn but moves by
     /// more than a quarter of one elsewhere: not.
+    /// A piece unwrapped on its own lies whole turns off the piece before: laid onto it at the
+    /// shared row (in radians and in degrees); a column off by anything else is left alone.
+    #[test]
+    fn a_piece_is_laid_onto_the_one_before_by_whole_turns() {
+        let mut f = Frame::new("p.csv", "t", vec![0.0, 1.0, 2.0]).unwrap();
+        f.push("a", vec![0.1, 0.2, 0.3]).unwrap();
+        f.push("d", vec![10.0, 20.0, 30.0]).unwrap();
+        f.push("x", vec![1.0, 2.0, 3.0]).unwrap();
+        let before = [("a".to_string(), 0.2 + 2.0 * TAU), ("d".to_string(), -700.0), ("x".to_string(), 2.5)];
+        laid_on_turns(&mut f, 1, &before).unwrap();
+        assert!((f.column("a").unwrap()[0] - (0.1 + 2.0 * TAU)).abs() < 1e-12);
+        assert_eq!(f.column("d").unwrap(), [-710.0, -700.0, -690.0]);
+        assert_eq!(f.column("x").unwrap(), [1.0, 2.0, 3.0]);
+    }
+
     #[test]
     fn an_angle_on_a_dial_is_found_by_its_full_turns() {
         let truth: Vec<f64> = (0..3000).map(|k| 0.01 * k as f64 + 2.0 * (0.003 * k as f64).sin()).collect();

@@ -29,7 +29,7 @@ mod stream;
 mod thin;
 mod weak;
 
-pub use angle::{turn_of, unwrap_turns, unwrapped, unwrapped_dials, wrapped};
+pub use angle::{laid_on_turns, turn_of, unwrap_turns, unwrapped, unwrapped_dials, wrapped};
 pub use breaks::{breaks, cut_at_breaks, cut_at_gaps, gaps, moving_breaks, Break, Gaps};
 pub use clock::clock_seconds;
 pub use dataset::{velocities_from_track, Dataset, Delimiter, RunSpec, Track};

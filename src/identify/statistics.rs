@@ -274,6 +274,9 @@ impl EquationMoments {
         let (states, _) = model.recorded_motion();
         for chunks in runs {
             let mut run: Option<RunSoFar> = None;
+            // the file's row where the next piece's own rows start, and the variables' values
+            // there as this piece has them
+            let mut boundary: Option<(usize, Vec<(String, f64)>)> = None;
             for chunk in chunks {
                 let mut chunk = chunk?;
                 let shift = |e: IdentifyError| e.shifted(chunk.first_row);
@@ -286,6 +289,24 @@ impl EquationMoments {
                     ))
                 })?;
                 let admitted = model.admitted(&mut chunk.frame).map_err(|e| shift(e.into()))?;
+                // an angle unwrapped piece by piece (on a dial, a compass's heading in rad) starts
+                // each piece within half a turn of 0: laid onto the piece before by whole turns
+                if let Some((row, values)) = boundary.take() {
+                    if let Some(at) = row.checked_sub(chunk.first_row) {
+                        crate::data::laid_on_turns(&mut chunk.frame, at, &values)
+                            .map_err(|e| shift(e.into()))?;
+                    }
+                }
+                let end = chunk.own.end;
+                boundary = Some((
+                    chunk.first_row + end,
+                    model
+                        .vocabulary
+                        .variables()
+                        .iter()
+                        .filter_map(|v| Some((v.clone(), *chunk.frame.column(v)?.get(end)?)))
+                        .collect(),
+                ));
                 // a piece of a run is not cut into runs (the whole run is, where a state breaks;
                 // an input's step cuts nothing)
                 if let Some((row, name, leap)) = crate::data::moving_breaks(&chunk.frame, &states).0.first() {

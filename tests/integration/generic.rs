@@ -2600,6 +2600,39 @@ fn an_angle_that_wraps_on_a_dial_is_read_as_one_angle() {
             assert!(term == name && (c - truth).abs() < 1e-4, "{term} {c}: {out}");
         }
     }
+    // read in pieces of 10 s, each unwrapped on its own and laid onto the one before by whole
+    // turns: the same angle as read whole, so a candidate polynomial in it and the run
+    // re-simulated over 2.7 turns agree (the pieces' record jumped by 2π every 10 s, and the
+    // re-simulation "followed" it for 10 s where the whole run is followed for 93)
+    let read = |more: &[&str]| {
+        let args = [
+            &[
+                "identify",
+                "--data",
+                path,
+                "--states",
+                "theta,omega",
+                "--inputs",
+                "u",
+                "--derivative",
+                "central",
+            ][..],
+            &["--terms", "sin(theta)", "cos(theta)", "theta", "theta^2", "omega", "u", "--format", "json"],
+            more,
+        ]
+        .concat();
+        let (ok, out, err) = termid(&args);
+        assert!(ok, "{err}");
+        let found = json(&out);
+        let retrace = crate::common::check_named(&found, "retrace their runs")["detail"].clone();
+        (chosen_terms(&found["omega_dot"]), retrace)
+    };
+    let (whole, pieces) = (read(&[]), read(&["--chunk-rows", "500"]));
+    assert_eq!(whole.1, pieces.1);
+    assert_eq!(whole.0.len(), pieces.0.len(), "{whole:?} {pieces:?}");
+    for ((a, x), (b, y)) in whole.0.iter().zip(&pieces.0) {
+        assert!(a == b && (x - y).abs() < 1e-6, "{whole:?} {pieces:?}");
+    }
 }
 
 /// Lorenz logged with jittered timestamps (each sample 8-12 ms after the last, as a logger
