@@ -2564,23 +2564,13 @@ fn an_angle_that_wraps_on_a_dial_is_read_as_one_angle() {
     let data = dir.join("pendulum.csv");
     std::fs::write(&data, csv).unwrap();
     let path = data.to_str().unwrap();
-    let (ok, out, err) = termid(&[
-        "identify",
-        "--data",
-        path,
-        "--states",
-        "theta,omega",
-        "--inputs",
-        "u",
-        "--terms",
-        "sin(theta)",
-        "cos(theta)",
-        "theta",
-        "omega",
-        "u",
-        "--format",
-        "json",
-    ]);
+    let identify = |more: &[&str]| {
+        termid(
+            &[&["identify", "--data", path, "--states", "theta,omega", "--inputs", "u"][..], more].concat(),
+        )
+    };
+    let (ok, out, err) =
+        identify(&["--terms", "sin(theta)", "cos(theta)", "theta", "omega", "u", "--format", "json"]);
     assert!(ok, "{err}");
     assert!(
         err.contains("`theta` stays within 2π and jumps by about that at 8 rows")
@@ -2606,22 +2596,12 @@ fn an_angle_that_wraps_on_a_dial_is_read_as_one_angle() {
     // re-simulation "followed" it for 10 s where the whole run is followed for 93)
     let read = |more: &[&str]| {
         let args = [
-            &[
-                "identify",
-                "--data",
-                path,
-                "--states",
-                "theta,omega",
-                "--inputs",
-                "u",
-                "--derivative",
-                "central",
-            ][..],
-            &["--terms", "sin(theta)", "cos(theta)", "theta", "theta^2", "omega", "u", "--format", "json"],
+            &["--derivative", "central", "--terms", "sin(theta)", "cos(theta)", "theta", "theta^2"][..],
+            &["omega", "u", "--format", "json"],
             more,
         ]
         .concat();
-        let (ok, out, err) = termid(&args);
+        let (ok, out, err) = identify(&args);
         assert!(ok, "{err}");
         let found = json(&out);
         let retrace = crate::common::check_named(&found, "retrace their runs")["detail"].clone();
