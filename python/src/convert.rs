@@ -68,7 +68,8 @@ pub(crate) fn frame_of(origin: &str, time: &str, columns: &Bound<'_, PyDict>) ->
         return Err(refuse(format!("{origin}: no time column `{time}` (columns: {})", names.join(", "))));
     };
     let t = column(origin, time, &t)?;
-    let mut frame = Frame::new(origin, time, t.as_array().to_vec()).map_err(fail)?;
+    let mut frame =
+        Frame::new(origin, time, termid::data::in_seconds(time, t.as_array().to_vec())).map_err(fail)?;
     for (name, value) in names.iter().zip(columns.values().iter()) {
         if name != time {
             frame.push(name, column(origin, name, &value)?.as_array().to_vec()).map_err(fail)?;

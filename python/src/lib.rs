@@ -59,6 +59,13 @@ fn time_like(names: Vec<String>) -> Option<String> {
     names.into_iter().find(|n| termid::data::looks_like_time(n))
 }
 
+/// The factor to seconds of a time column whose header says another unit of time
+/// (`Time [ms]`: 0.001), as a run's time is read.
+#[pyfunction]
+fn seconds_per(name: &str) -> Option<f64> {
+    termid::data::seconds_per(name).filter(|f| *f != 1.0)
+}
+
 /// Candidate terms as a user lists them: each text split at its commas outside parentheses
 /// (the command line's `--terms x,x*y`).
 #[pyfunction]
@@ -90,6 +97,7 @@ fn _termid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(version, m)?)?;
     m.add_function(wrap_pyfunction!(monte_carlo_refusal, m)?)?;
     m.add_function(wrap_pyfunction!(time_like, m)?)?;
+    m.add_function(wrap_pyfunction!(seconds_per, m)?)?;
     m.add_function(wrap_pyfunction!(listed, m)?)?;
     m.add_function(wrap_pyfunction!(interleaved, m)?)?;
     Ok(())

@@ -400,9 +400,19 @@ def _time_from(name: str, run: Data, columns: "_Columns", time: str) -> None:
         columns[time] = columns.pop(columns.times[0])
     else:
         like = _termid.time_like(list(columns))
+        factor = _termid.seconds_per(like) if like else None
         raise TermidError(
             f"{name}: no time column `{time}` (columns: {', '.join(columns)})"
-            + (f"; `{like}` looks like time: name it `{time}`, df.rename(columns={{'{like}': '{time}'}})" if like else "")
+            + (
+                f"; `{like}` looks like time: name it `{time}`, "
+                + (
+                    f"in seconds: df.assign({time}=df['{like}'] * {factor:g})"
+                    if factor
+                    else f"df.rename(columns={{'{like}': '{time}'}})"
+                )
+                if like
+                else ""
+            )
         )
 
 

@@ -1010,6 +1010,20 @@ def test_a_run_without_its_model_s_time_column():
     assert z_dot.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
     with pytest.raises(termid.TermidError, match=r"no time column `t` .*`time` looks like time: name it `t`, df.rename\(columns=\{'time': 't'\}\)"):
         model.identify(run.rename(columns={"t": "time"}))
+    # a header that says its unit of time: renamed, its milliseconds would be read as seconds
+    in_ms = run.assign(t=run["t"] * 1000.0).rename(columns={"t": "Time (ms)"})
+    with pytest.raises(termid.TermidError, match=r"name it `t`, in seconds: df.assign\(t=df\['Time \(ms\)'\] \* 0.001\)"):
+        model.identify(in_ms)
+
+
+def test_a_time_column_in_milliseconds_is_read_in_seconds():
+    # `fit` with time='Time (ms)' (as a logger heads it): the header's unit read, the rates per
+    # second, not per millisecond (it was: every rate's coefficient a thousand times too small)
+    lorenz = termid.Model.builtin("lorenz")
+    run = lorenz.simulate(duration=5.0, dt=0.01)[["t", "x", "y", "z"]]
+    in_ms = run.assign(t=run["t"] * 1000.0).rename(columns={"t": "Time (ms)"})
+    fitted = termid.fit(in_ms, "dz/dt", ["x*y", "z", "x", "y"], time="Time (ms)")
+    assert fitted.coefficients.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
 
 
 def test_terms_the_halves_of_a_run_do_not_choose_are_flagged():

@@ -57,7 +57,8 @@ impl Frame {
     pub(super) fn from_table(table: Table, origin: &str, time: &str) -> Result<Frame, DataError> {
         let Table { names, mut columns, text, .. } = table;
         let time_index = super::stream::time_index(origin, time, &names, &text)?;
-        let mut frame = Frame::new(origin, time, std::mem::take(&mut columns[time_index]))?;
+        let seconds = super::in_seconds(time, std::mem::take(&mut columns[time_index]));
+        let mut frame = Frame::new(origin, time, seconds)?;
         for (name, values) in names.iter().zip(columns) {
             if name != time {
                 frame.push(name, values)?;
@@ -79,8 +80,17 @@ impl Frame {
         let mut out = self.names().join(",");
         out.push('\n');
         let cols: Vec<&[f64]> = self.names().iter().filter_map(|n| self.column(n)).collect();
+        let time_name = self.time_name();
         for r in 0..self.len() {
-            let row: Vec<String> = cols.iter().map(|c| format!("{:?}", c[r])).collect();
+            // the time in the unit its header says, as it is read back
+            let row: Vec<String> = cols
+                .iter()
+                .enumerate()
+                .map(|(k, c)| match k {
+                    0 => format!("{:?}", super::dataset::in_unit_of(time_name, c[r])),
+                    _ => format!("{:?}", c[r]),
+                })
+                .collect();
             out.push_str(&row.join(","));
             out.push('\n');
         }

@@ -335,6 +335,33 @@ const UNITS: &[(&str, f64, [i32; 3])] = &[
     ("-", 1.0, [0, 0, 0]),
 ];
 
+/// The factor to seconds of a time column whose header says its unit of time (`Time [ms]`,
+/// `t (min)`, as loggers and spreadsheets write them): a plain file's time read in
+/// milliseconds as seconds makes every rate a thousand times too slow. `None` where the header
+/// names no unit, or one that is not of time.
+pub fn seconds_per(header: &str) -> Option<f64> {
+    let header = header.trim_end();
+    let unit = [('[', ']'), ('(', ')')].iter().find_map(|&(open, close)| {
+        header.strip_suffix(close).and_then(|h| h.rsplit_once(open)).map(|(_, u)| u.trim())
+    })?;
+    UNITS.iter().find(|(n, _, dims)| *n == unit && *dims == [0, 1, 0]).map(|(_, f, _)| *f)
+}
+
+/// A time column's values in seconds, where its header `name` says another unit of time
+/// (`Time [ms]`, `t (min)`): what a plain file or a Python run is read with.
+pub fn in_seconds(name: &str, mut values: Vec<f64>) -> Vec<f64> {
+    if let Some(factor) = seconds_per(name).filter(|f| *f != 1.0) {
+        values.iter_mut().for_each(|v| *v *= factor);
+    }
+    values
+}
+
+/// A time in seconds as a column headed `name` holds it (ms under `Time [ms]`): what a frame
+/// writes, so that reading it back ([`in_seconds`]) gives the same seconds.
+pub(super) fn in_unit_of(name: &str, seconds: f64) -> f64 {
+    seconds_per(name).map_or(seconds, |factor| seconds / factor)
+}
+
 /// "column [unit]" → (column, unit, sign): a leading `-` negates the column.
 fn split_spec(spec: &str) -> (String, Option<String>, f64) {
     let spec = spec.trim();
@@ -896,6 +923,27 @@ mod tests {
     /// Headers that carry their unit, as spreadsheets export them: named by their bare name,
     /// the unit read from the header where the mapping gives none, a mapping that says
     /// another unit refused; a bare name two headers share keeps each header's whole text.
+    /// A time column's header that says its unit of time: read in seconds, and written back in
+    /// its unit (what is read back is the same seconds); a header of another unit, or none, or
+    /// a name with parentheses that hold no unit, is read as it is.
+    #[test]
+    fn a_time_header_says_its_unit() {
+        assert_eq!(seconds_per("Time [ms]"), Some(1e-3));
+        assert_eq!(seconds_per("t (min)"), Some(60.0));
+        assert_eq!(seconds_per("t [s]"), Some(1.0));
+        for plain in ["t", "x [m]", "f(x)", "time (rad)", "ms"] {
+            assert_eq!(seconds_per(plain), None, "{plain}");
+        }
+        assert_eq!(in_seconds("Time (ms)", vec![0.0, 50.0, 100.0]), [0.0, 0.05, 0.1]);
+        assert_eq!(in_seconds("t", vec![0.0, 50.0]), [0.0, 50.0]);
+        let mut f = crate::data::Frame::new("log.csv", "Time (ms)", vec![0.0, 0.05, 0.1]).unwrap();
+        f.push("x", vec![1.0, 2.0, 3.0]).unwrap();
+        let text = f.to_csv();
+        assert!(text.starts_with("Time (ms),x\n0.0,1.0\n50.0,2.0\n100.0,3.0"), "{text}");
+        let back = crate::data::Frame::parse_csv(&text, "log.csv", "Time (ms)").unwrap();
+        assert_eq!(back.time(), f.time());
+    }
+
     #[test]
     fn headers_with_their_units() {
         let dir = std::env::temp_dir().join(format!("termid-header-units-{}", std::process::id()));

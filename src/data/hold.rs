@@ -19,15 +19,26 @@ pub enum Intersample {
     /// held by a DAC, else a line between samples; a column
     /// that repeats a slower sensor's readings between them is read at its readings.
     #[default]
+    #[cfg_attr(
+        feature = "cli",
+        value(
+            help = "Held where the record or the states' rates show a command held by a controller, a generator or a DAC; else a line"
+        )
+    )]
     Auto,
     /// A line between samples, whatever the record shows (a column that repeats a slower
     /// sensor's readings between them is taken as its rows have it too).
+    #[cfg_attr(feature = "cli", value(help = "A line between samples, whatever the record shows"))]
     Linear,
     /// Held from each sample to the next, every input that changes: one that stays put
     /// between isolated jumps ([`held`]), on a clock or not, steps to random levels at random
     /// samples ([`stepped`]), changes at every sample unforeseen by the last ([`white`]), or
     /// moves smoothly from sample to sample (a sine put out through a DAC; MATLAB's
     /// `InterSample = 'zoh'`).
+    #[cfg_attr(
+        feature = "cli",
+        value(help = "Every input that changes held from each sample to the next (a zero-order hold)")
+    )]
     Held,
 }
 

@@ -32,7 +32,7 @@ mod weak;
 pub use angle::{laid_on_turns, turn_of, unwrap_turns, unwrapped, unwrapped_dials, wrapped};
 pub use breaks::{breaks, cut_at_breaks, cut_at_gaps, gaps, moving_breaks, Break, Gaps};
 pub use clock::clock_seconds;
-pub use dataset::{velocities_from_track, Dataset, Delimiter, RunSpec, Track};
+pub use dataset::{in_seconds, seconds_per, velocities_from_track, Dataset, Delimiter, RunSpec, Track};
 pub use delay::delayed;
 pub use derivative::{
     differentiator, CentralDifference, Differentiator, Smoothed, TestFunction, Window, DIFFERENTIATORS,
@@ -295,8 +295,10 @@ impl DataError {
                 if crate::term::is_identifier(n) {
                     format!("; `{n}` looks like time: name it as the time column (`--time {n}`, a model file's `time`)")
                 } else {
-                    // not a name terms can use: a dataset file maps it (its unit read too)
-                    format!("; `{n}` looks like time: map it in a dataset file (`[columns] {time} = \"{n}\"`)")
+                    // a unit of time in its header ([ms], (min)) is read either way
+                    format!(
+                        "; `{n}` looks like time: name it as the time column (`--time \"{n}\"`; its header's unit of time, [ms] or (min), is read) or map it in a dataset file (`[columns] {time} = \"{n}\"`)"
+                    )
                 }
             })
             .unwrap_or_default();

@@ -165,8 +165,8 @@ impl Chunks {
         let to = (own_end + self.context).min(end);
         let slice = |c: &Vec<f64>| c[from - self.held_from..to - self.held_from].to_vec();
         let shift = |e: DataError| e.shifted(from);
-        let mut frame =
-            Frame::new(&self.origin, &self.time_name, slice(&self.held[self.time])).map_err(shift)?;
+        let seconds = super::in_seconds(&self.time_name, slice(&self.held[self.time]));
+        let mut frame = Frame::new(&self.origin, &self.time_name, seconds).map_err(shift)?;
         frame.text = self.source.text().to_vec();
         for (k, name) in self.source.names().iter().enumerate() {
             if k != self.time {

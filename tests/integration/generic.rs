@@ -1955,6 +1955,36 @@ fn a_whole_system_from_its_columns() {
     std::fs::write(dir.join("time.csv"), renamed).unwrap();
     let (ok, _, err) = termid(&["identify", "--data", &p("time.csv"), "--states", "x,v"]);
     assert!(!ok && err.contains("`time` looks like time") && !err.contains("the inputs are"), "{err}");
+    // a time headed with its unit (`Time (ms)`, as loggers write it) is read in seconds: its
+    // milliseconds were read as seconds, every rate a thousand times too slow (ẋ = 0.001v);
+    // a model so identified writes its runs' time back in milliseconds
+    let lines: Vec<String> = std::fs::read_to_string(&data).unwrap().lines().map(String::from).collect();
+    let mut in_ms = String::from("Time (ms),x,v,F\n");
+    for line in &lines[1..] {
+        let (t, rest) = line.split_once(',').unwrap();
+        in_ms += &format!("{},{rest}\n", 1000.0 * t.parse::<f64>().unwrap());
+    }
+    std::fs::write(dir.join("ms.csv"), in_ms).unwrap();
+    let (ms, ms_model, sim) = (p("ms.csv"), p("ms.toml"), p("ms_sim.csv"));
+    let (ok, _, err) =
+        termid(&["identify", "--data", &ms, "--time", "Time (ms)", "--states", "x,v", "--out", &ms_model]);
+    assert!(ok, "{err}");
+    let model = termid::model::Model::load(std::path::Path::new(&ms_model)).unwrap();
+    let v = model
+        .equation("x_dot")
+        .unwrap()
+        .coefficients
+        .iter()
+        .find(|(t, _, _)| t.to_string() == "v")
+        .unwrap()
+        .1;
+    assert!((v - 1.0).abs() < 1e-4, "{v}");
+    let (ok, _, err) =
+        termid(&["simulate", "--model", &ms_model, "--duration", "0.1", "--sample", "0.01", "--out", &sim]);
+    assert!(ok, "{err}");
+    let written = std::fs::read_to_string(&sim).unwrap();
+    let second: Vec<&str> = written.lines().nth(2).unwrap().split(',').collect();
+    assert!(written.starts_with("Time (ms),") && second[0].parse::<f64>().unwrap() == 10.0, "{written}");
 }
 
 /// Equations whose rates fit the rows may still run away when integrated: Lotka-Volterra

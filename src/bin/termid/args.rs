@@ -358,14 +358,15 @@ pub struct IdentifyCommand {
     /// samples and jumps at isolated ones (a digital controller's command, a force stepped by
     /// a rig) is taken as held from each sample to the next, and said; one that does so off
     /// any clock (a relay) switches somewhere between two samples: the integral form leaves
-    /// out the windows that hold a jump, said; else a line. The integral form integrates a
+    /// out the windows that hold a jump, said; else a line, unless a state's rate fits
+    /// clearly better with it held (a random telegraph, an APRBS, a smooth command put out
+    /// through a DAC: held, said). The integral form integrates a
     /// held input piece by piece between its jumps, and a replay into a simulation holds it
     /// over each step. Any column (the state too) that changes only
     /// every few rows on a clock, at most of its ticks, repeats a slower sensor's readings: it
     /// is read at its readings and interpolated between them by cubics, and said; an input so
     /// where a state's rate steps at its changes, or fits clearly better with it held, is a
-    /// controller's command, held (`linear`: neither; `held`: every input that changes at
-    /// isolated rows, by steps large or small).
+    /// controller's command, held (`linear`: neither; `held`: every input that changes).
     /// With --model as the file's `intersample` (which the model written keeps).
     #[arg(long, value_enum)]
     pub intersample: Option<termid::data::Intersample>,
