@@ -362,7 +362,8 @@ pub(super) fn in_unit_of(name: &str, seconds: f64) -> f64 {
     seconds_per(name).map_or(seconds, |factor| seconds / factor)
 }
 
-/// "column [unit]" → (column, unit, sign): a leading `-` negates the column.
+/// "column [unit]" or "column (unit)" with a unit termid knows → (column, unit, sign): a
+/// leading `-` negates the column.
 fn split_spec(spec: &str) -> (String, Option<String>, f64) {
     let spec = spec.trim();
     let (spec, sign) = match spec.strip_prefix('-') {
@@ -373,7 +374,15 @@ fn split_spec(spec: &str) -> (String, Option<String>, f64) {
         Some((col, unit)) if unit.trim_end().ends_with(']') => {
             (col.trim().to_string(), Some(unit.trim_end().trim_end_matches(']').trim().to_string()), sign)
         }
-        _ => (spec.trim().to_string(), None, sign),
+        // in parentheses only a unit termid knows: `f(x)` stays a name
+        _ => match spec.strip_suffix(')').and_then(|s| s.rsplit_once('(')) {
+            Some((col, unit))
+                if !col.trim().is_empty() && UNITS.iter().any(|(n, _, _)| *n == unit.trim()) =>
+            {
+                (col.trim().to_string(), Some(unit.trim().to_string()), sign)
+            }
+            _ => (spec.trim().to_string(), None, sign),
+        },
     }
 }
 
@@ -934,6 +943,11 @@ mod tests {
         for plain in ["t", "x [m]", "f(x)", "time (rad)", "ms"] {
             assert_eq!(seconds_per(plain), None, "{plain}");
         }
+        // a dataset file's mapping reads a unit in parentheses as in brackets (it read
+        // `t = "Time (ms)"` as a column of seconds), a name's own parentheses stay
+        assert_eq!(split_spec("Time (ms)"), ("Time".to_string(), Some("ms".to_string()), 1.0));
+        assert_eq!(split_spec("-rudder (deg)"), ("rudder".to_string(), Some("deg".to_string()), -1.0));
+        assert_eq!(split_spec("f(x)"), ("f(x)".to_string(), None, 1.0));
         assert_eq!(in_seconds("Time (ms)", vec![0.0, 50.0, 100.0]), [0.0, 0.05, 0.1]);
         assert_eq!(in_seconds("t", vec![0.0, 50.0]), [0.0, 50.0]);
         let mut f = crate::data::Frame::new("log.csv", "Time (ms)", vec![0.0, 0.05, 0.1]).unwrap();
