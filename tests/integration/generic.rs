@@ -1985,6 +1985,11 @@ fn a_whole_system_from_its_columns() {
     let written = std::fs::read_to_string(&sim).unwrap();
     let second: Vec<&str> = written.lines().nth(2).unwrap().split(',').collect();
     assert!(written.starts_with("Time (ms),") && second[0].parse::<f64>().unwrap() == 10.0, "{written}");
+    // a state's header that carries its unit is named, with the dataset file that reads it
+    let headed = std::fs::read_to_string(&data).unwrap().replacen("t,x,", "t,x [m],", 1);
+    std::fs::write(dir.join("headed.csv"), headed).unwrap();
+    let (ok, _, err) = termid(&["identify", "--data", &p("headed.csv"), "--states", "x,v"]);
+    assert!(!ok && err.contains("`x [m]` carries its unit") && err.contains("x = \"x [m]\""), "{err}");
 }
 
 /// Equations whose rates fit the rows may still run away when integrated: Lotka-Volterra
