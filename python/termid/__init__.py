@@ -1066,7 +1066,8 @@ class Identified:
     """What ``Model.identify`` returns: the identified model, each equation's fit report
     (``steps`` and ``terms`` as DataFrames) and, for a model of no field's, its ``checks``
     (name, passed, refuses, detail): that the equations retrace the runs without running away,
-    and how long they follow them, that their terms hold on each half of the runs, and that the
+    and how long they follow them, that they follow them as long as their own motion from a
+    nudged start follows itself, that their terms hold on each half of the runs, and that the
     runs' noise leaves them unbiased (a ship's are :meth:`Model.checks`).
 
     >>> lorenz = termid.Model.builtin("lorenz")
@@ -2370,7 +2371,8 @@ class Model:
         """The plug-in's physical checks (stability, damping signs, turning circles), with
         ``runs`` to compare against where a check needs them; for a model of no field's, with
         ``runs``, that its equations retrace them without running away (and how long they
-        follow them) and that their noise leaves its terms unbiased.
+        follow them), that they follow them as long as their own motion allows, and that their
+        noise leaves its terms unbiased.
 
         >>> checks = termid.Model.default().checks()
         >>> {"name", "passed"} <= set(checks.columns)

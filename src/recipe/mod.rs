@@ -17,7 +17,7 @@ pub use halves::{halves_check, halves_check_of_moments};
 pub use noise::{noise_check, noise_check_of_moments};
 pub use parameters::{ParameterOptions, ParameterStage};
 pub use report::Primes;
-pub use retrace::retrace_check;
+pub use retrace::retrace_checks;
 pub use start::{
     checks_of, default_derivative, derivative_method, prepare_runs, Start, ANY_SYSTEM_DERIVATIVE,
 };
@@ -260,7 +260,7 @@ pub fn system_checks(
     frames: &[Frame],
     how: &crate::identify::ModelIdentification<'_>,
 ) -> Vec<Check> {
-    retrace_check(&identified.model, frames)
+    retrace_checks(&identified.model, frames)
         .into_iter()
         .chain(halves_check(identified, frames, how))
         .chain(noise_check(&identified.model, frames))
@@ -279,7 +279,7 @@ pub fn moments_checks(
     intercept: bool,
     runs: &[Frame],
 ) -> Vec<Check> {
-    let retrace = if runs.is_empty() { None } else { retrace_check(&identified.model, runs) };
+    let retrace = if runs.is_empty() { Vec::new() } else { retrace_checks(&identified.model, runs) };
     retrace
         .into_iter()
         .chain(halves_check_of_moments(identified, moments, model, intercept))

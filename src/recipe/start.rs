@@ -286,9 +286,9 @@ pub fn checks_of(model: &Model, prepared: &[Frame]) -> Vec<Check> {
     match crate::plugins::of(model) {
         Some(plugin) => plugin.checks(model, prepared),
         None => identified()
-            .then(|| super::retrace::retrace_check(model, prepared))
-            .flatten()
+            .then(|| super::retrace::retrace_checks(model, prepared))
             .into_iter()
+            .flatten()
             .chain(super::noise::noise_check(model, prepared))
             .collect(),
     }
