@@ -780,7 +780,10 @@ def _index_time(data: Data) -> Optional[np.ndarray]:
         return None
     if not (_is_time(index) or index.dtype.kind in "f" + ("iu" if index.name is not None else "")):
         return None
-    return np.ascontiguousarray(_seconds("the index" + (f" `{index.name}`" if index.name is not None else ""), index), dtype=np.float64)
+    seconds = np.ascontiguousarray(_seconds("the index" + (f" `{index.name}`" if index.name is not None else ""), index), dtype=np.float64)
+    # numbers under a name that says its unit of time (`Time (ms)`), as a time column's are read
+    factor = _termid.seconds_per(str(index.name)) if index.name is not None and not _is_time(index) else None
+    return seconds * factor if factor else seconds
 
 
 def _time_of(data: Data, columns: "_Columns", time: Optional[str], target: str) -> str:

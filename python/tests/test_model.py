@@ -1026,6 +1026,13 @@ def test_a_time_column_in_milliseconds_is_read_in_seconds():
     in_ms = run.assign(t=run["t"] * 1000.0).rename(columns={"t": "Time (ms)"})
     fitted = termid.fit(in_ms, "dz/dt", ["x*y", "z", "x", "y"], time="Time (ms)")
     assert fitted.coefficients.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
+    # so is an index of milliseconds under that name, for a fit and for a model's runs
+    indexed = in_ms.set_index("Time (ms)")
+    fitted = termid.fit(indexed, "dz/dt", ["x*y", "z", "x", "y"])
+    assert fitted.coefficients.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
+    found = termid.Model.from_states(["x", "y", "z"]).identify(indexed)
+    z_dot = found.model.coefficients("z_dot").set_index("term")["value"]
+    assert z_dot.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
 
 
 def test_terms_the_halves_of_a_run_do_not_choose_are_flagged():
