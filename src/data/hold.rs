@@ -275,9 +275,9 @@ fn commanded(
 
 /// Holds column `name` of `frame` (a record that jumps at isolated samples on no clock) where
 /// a recorded state of `motion` (not `name`) has its rate fitted clearly better with it held
-/// from each sample to the next than as a line between them ([`fits_better_held_than_a_line`],
-/// over `motion` and `columns`): a generator's command switched at random samples, not a
-/// relay thrown between them; and says so, after `how` it jumps.
+/// from each sample to the next than as a line between them ([`held_better_than_a_line`]): a
+/// generator's command switched at random samples, not a relay thrown between them; and says
+/// so, after `how` it jumps.
 fn held_on_the_samples(
     frame: &mut Frame,
     name: &str,
@@ -285,24 +285,16 @@ fn held_on_the_samples(
     columns: &[&str],
     how: &str,
 ) -> Result<Option<String>, DataError> {
-    let Some(column) = frame.column(name) else { return Ok(None) };
-    let (states, others) = beside(frame, name, motion, columns);
-    let slices: Vec<&[f64]> = states.iter().map(|(_, c)| *c).collect();
-    let Some((i, share)) = fits_better_held_than_a_line(frame.time(), column, &slices, &others, None) else {
-        return Ok(None);
-    };
-    let note = format!(
-        "{how}, on no clock, but the rate of `{}` is fitted better with it held from each sample to the next than as a line between them ({:.1} % less left over, by a quadratic in the columns over windows of eight samples): a generator's command switched at random samples (a random telegraph, a PRBS, an APRBS), not a relay thrown between them; taken as held. Where it switches between the samples, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)",
-        states[i].0,
-        100.0 * (1.0 - share)
-    );
-    frame.hold(name)?;
-    Ok(Some(note))
+    held_better_than_a_line(frame, name, motion, columns, false, |state, less| {
+        format!(
+            "{how}, on no clock, but the rate of `{state}` is fitted better with it held from each sample to the next than as a line between them ({less:.1} % less left over, by a quadratic in the columns over windows of eight samples): a generator's command switched at random samples (a random telegraph, a PRBS, an APRBS), not a relay thrown between them; taken as held. Where it switches between the samples, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)"
+        )
+    })
 }
 
 /// Holds column `name` of `frame` (a record that moves from sample to sample) where a recorded
 /// state of `motion` has its rate fitted clearly better with it held from each sample to the
-/// next than as a line between them ([`fits_better_held_than_a_line`]): a smooth command a
+/// next than as a line between them ([`held_better_than_a_line`]): a smooth command a
 /// controller or a signal generator puts out through a zero-order hold (a sine or a chirp
 /// through a DAC, MATLAB's default `InterSample = 'zoh'`), whose line between samples runs half
 /// an interval early and biases the damping it drives (a mass-spring-damper under a held sine
@@ -318,19 +310,35 @@ fn held_though_smooth(
     if 2 * changing <= column.len().saturating_sub(1) {
         return Ok(None);
     }
-    let leaps: Vec<usize> = super::breaks(frame.time(), column).into_iter().map(|b| b.row).collect();
+    let origin = frame.origin().to_string();
+    held_better_than_a_line(frame, name, motion, columns, true, |state, less| {
+        format!(
+            "{origin}: `{name}` moves from sample to sample, but the rate of `{state}` is fitted better with it held from each sample to the next than as a line between them ({less:.1} % less left over, by a quadratic in the columns over windows of eight samples): a command put out through a zero-order hold (a controller's, a signal generator's through a DAC), which a line between the samples would run half an interval early; taken as held. Where it is a measured quantity that moves between the samples, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)"
+        )
+    })
+}
+
+/// Holds column `name` of `frame` where the rate of a recorded state of `motion` (not `name`)
+/// is fitted clearly better with it held from each sample to the next than as a line between
+/// them ([`fits_better_held_than_a_line`], over `motion` and `columns`; `smooth`: a record
+/// that moves from sample to sample, the windows that hold a leap of it left out, compared only
+/// where the columns do not foresee it), and says so: `say(the state, per cent less left over)`.
+fn held_better_than_a_line(
+    frame: &mut Frame,
+    name: &str,
+    motion: &[&str],
+    columns: &[&str],
+    smooth: bool,
+    say: impl FnOnce(&str, f64) -> String,
+) -> Result<Option<String>, DataError> {
+    let Some(column) = frame.column(name) else { return Ok(None) };
+    let leaps: Option<Vec<usize>> =
+        smooth.then(|| super::breaks(frame.time(), column).into_iter().map(|b| b.row).collect());
     let (states, others) = beside(frame, name, motion, columns);
     let slices: Vec<&[f64]> = states.iter().map(|(_, c)| *c).collect();
-    let Some((i, share)) = fits_better_held_than_a_line(frame.time(), column, &slices, &others, Some(&leaps))
-    else {
-        return Ok(None);
-    };
-    let note = format!(
-        "{}: `{name}` moves from sample to sample, but the rate of `{}` is fitted better with it held from each sample to the next than as a line between them ({:.1} % less left over, by a quadratic in the columns over windows of eight samples): a command put out through a zero-order hold (a controller's, a signal generator's through a DAC), which a line between the samples would run half an interval early; taken as held. Where it is a measured quantity that moves between the samples, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)",
-        frame.origin(),
-        states[i].0,
-        100.0 * (1.0 - share)
-    );
+    let found = fits_better_held_than_a_line(frame.time(), column, &slices, &others, leaps.as_deref());
+    let Some((i, share)) = found else { return Ok(None) };
+    let note = say(&states[i].0, 100.0 * (1.0 - share));
     frame.hold(name)?;
     Ok(Some(note))
 }
