@@ -421,7 +421,12 @@ fn held_rate_note(
         let marked = f.held().iter().chain(f.switched());
         for h in marked.filter(|h| library.inputs().contains(h)) {
             if let Some(c) = f.column(h) {
-                jumps += crate::data::switches(f.time(), c).len();
+                // a held column jumps at each of its changes (a smooth command held: at every
+                // sample, where its switches, read as a relay's, were none)
+                jumps += match f.is_held(h) {
+                    true => c.windows(2).filter(|w| w[1] != w[0]).count(),
+                    false => crate::data::switches(f.time(), c).len(),
+                };
                 if !held.contains(&h.as_str()) {
                     held.push(h);
                 }

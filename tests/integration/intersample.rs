@@ -684,6 +684,10 @@ fn a_smooth_command_put_out_through_a_dac_is_held() {
     let (line, _) = identified(&held, &["--intersample", "linear"]);
     let damping = chosen_terms(&line["v_dot"]).iter().find(|(t, _)| t == "v").map(|(_, c)| *c);
     assert!(damping.is_none_or(|c| (c + 0.3).abs() > 0.015), "{line}");
+    // a point derivative spreads each of its jumps, one at every sample (it said "0 jumps")
+    let (central, _) = identified(&held, &["--derivative", "central"]);
+    let notes = central["v_dot"]["notes"].to_string();
+    assert!(notes.contains("`F` is held or switched between samples, 1200 jumps in all"), "{notes}");
     let (found, said) = identified(&continuous, &[]);
     assert!(!said.contains("moves from sample to sample"), "{said}");
     assert_true_terms_within(&chosen_terms(&found["v_dot"]), &|_| 1e-4, &found);
