@@ -340,10 +340,7 @@ const UNITS: &[(&str, f64, [i32; 3])] = &[
 /// milliseconds as seconds makes every rate a thousand times too slow. `None` where the header
 /// names no unit, or one that is not of time.
 pub fn seconds_per(header: &str) -> Option<f64> {
-    let header = header.trim_end();
-    let unit = [('[', ']'), ('(', ')')].iter().find_map(|&(open, close)| {
-        header.strip_suffix(close).and_then(|h| h.rsplit_once(open)).map(|(_, u)| u.trim())
-    })?;
+    let unit = split_spec(header).1?;
     UNITS.iter().find(|(n, _, dims)| *n == unit && *dims == [0, 1, 0]).map(|(_, f, _)| *f)
 }
 
