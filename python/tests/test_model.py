@@ -1033,6 +1033,14 @@ def test_a_time_column_in_milliseconds_is_read_in_seconds():
     found = termid.Model.from_states(["x", "y", "z"]).identify(indexed)
     z_dot = found.model.coefficients("z_dot").set_index("term")["value"]
     assert z_dot.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
+    # a model whose time is so named simulates in its unit (it gave seconds under the header
+    # of milliseconds, read back a thousand times too fast) and identifies from what it gives
+    in_ms_model = termid.Model.from_toml(lorenz.to_toml().replace('time = "t"', 'time = "Time (ms)"', 1))
+    simulated = in_ms_model.simulate(duration=5.0, dt=0.01)
+    assert list(simulated["Time (ms)"][:3]) == pytest.approx([0.0, 10.0, 20.0])
+    again = in_ms_model.identify(simulated[["Time (ms)", "x", "y", "z"]])
+    z_dot = again.model.coefficients("z_dot").set_index("term")["value"]
+    assert z_dot.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
 
 
 def test_terms_the_halves_of_a_run_do_not_choose_are_flagged():

@@ -87,7 +87,7 @@ impl Frame {
                 .iter()
                 .enumerate()
                 .map(|(k, c)| match k {
-                    0 => format!("{:?}", super::dataset::in_unit_of(time_name, c[r])),
+                    0 => format!("{:?}", super::in_unit_of(time_name, c[r])),
                     _ => format!("{:?}", c[r]),
                 })
                 .collect();

@@ -355,7 +355,7 @@ pub fn in_seconds(name: &str, mut values: Vec<f64>) -> Vec<f64> {
 
 /// A time in seconds as a column headed `name` holds it (ms under `Time [ms]`): what a frame
 /// writes, so that reading it back ([`in_seconds`]) gives the same seconds.
-pub(super) fn in_unit_of(name: &str, seconds: f64) -> f64 {
+pub fn in_unit_of(name: &str, seconds: f64) -> f64 {
     seconds_per(name).map_or(seconds, |factor| seconds / factor)
 }
 
