@@ -115,23 +115,15 @@ pub(crate) fn frame_columns(f: &Frame) -> Vec<(String, Vec<f64>)> {
     let mut out: Vec<(String, Vec<f64>)> =
         f.names().iter().filter_map(|n| f.column(n).map(|c| (n.clone(), c.to_vec()))).collect();
     if let Some((name, t)) = out.first_mut() {
-        in_its_unit(name, t);
+        *t = termid::data::from_seconds(name, std::mem::take(t));
     }
     out
 }
 
 /// A simulated run as columns: time (in the unit its name says), states, inputs.
 pub(crate) fn trajectory_columns(time: &str, t: Trajectory) -> Vec<(String, Vec<f64>)> {
-    let mut seconds = t.time;
-    in_its_unit(time, &mut seconds);
-    let mut out = vec![(time.to_string(), seconds)];
+    let mut out = vec![(time.to_string(), termid::data::from_seconds(time, t.time))];
     out.extend(t.state_names.into_iter().zip(t.states));
     out.extend(t.input_names.into_iter().zip(t.inputs));
     out
-}
-
-/// A time in seconds as the column `name` holds it (ms under `Time (ms)`): what a run read
-/// back ([`termid::data::in_seconds`]) takes for the same seconds.
-fn in_its_unit(name: &str, seconds: &mut [f64]) {
-    seconds.iter_mut().for_each(|t| *t = termid::data::in_unit_of(name, *t));
 }

@@ -79,18 +79,12 @@ impl Frame {
     pub fn to_csv(&self) -> String {
         let mut out = self.names().join(",");
         out.push('\n');
-        let cols: Vec<&[f64]> = self.names().iter().filter_map(|n| self.column(n)).collect();
-        let time_name = self.time_name();
+        // the time in the unit its header says, as it is read back
+        let time = super::from_seconds(self.time_name(), self.time().to_vec());
+        let mut cols: Vec<&[f64]> = self.names().iter().filter_map(|n| self.column(n)).collect();
+        cols[0] = &time;
         for r in 0..self.len() {
-            // the time in the unit its header says, as it is read back
-            let row: Vec<String> = cols
-                .iter()
-                .enumerate()
-                .map(|(k, c)| match k {
-                    0 => format!("{:?}", super::in_unit_of(time_name, c[r])),
-                    _ => format!("{:?}", c[r]),
-                })
-                .collect();
+            let row: Vec<String> = cols.iter().map(|c| format!("{:?}", c[r])).collect();
             out.push_str(&row.join(","));
             out.push('\n');
         }

@@ -353,10 +353,14 @@ pub fn in_seconds(name: &str, mut values: Vec<f64>) -> Vec<f64> {
     values
 }
 
-/// A time in seconds as a column headed `name` holds it (ms under `Time [ms]`): what a frame
-/// writes, so that reading it back ([`in_seconds`]) gives the same seconds.
-pub fn in_unit_of(name: &str, seconds: f64) -> f64 {
-    seconds_per(name).map_or(seconds, |factor| seconds / factor)
+/// Times in seconds as a column headed `name` holds them (ms under `Time [ms]`): what a frame
+/// writes and a Python run gives, so that reading them back ([`in_seconds`]) gives the same
+/// seconds.
+pub fn from_seconds(name: &str, mut seconds: Vec<f64>) -> Vec<f64> {
+    if let Some(factor) = seconds_per(name).filter(|f| *f != 1.0) {
+        seconds.iter_mut().for_each(|v| *v /= factor);
+    }
+    seconds
 }
 
 /// "column [unit]" or "column (unit)" with a unit termid knows → (column, unit, sign): a

@@ -33,7 +33,7 @@ pub use angle::{laid_on_turns, turn_of, unwrap_turns, unwrapped, unwrapped_dials
 pub use breaks::{breaks, cut_at_breaks, cut_at_gaps, gaps, moving_breaks, Break, Gaps};
 pub use clock::clock_seconds;
 pub use dataset::{
-    in_seconds, in_unit_of, seconds_per, velocities_from_track, Dataset, Delimiter, RunSpec, Track,
+    from_seconds, in_seconds, seconds_per, velocities_from_track, Dataset, Delimiter, RunSpec, Track,
 };
 pub use delay::delayed;
 pub use derivative::{
