@@ -43,6 +43,7 @@ impl std::fmt::Display for Target {
 pub use crate::model::ParamValue;
 
 mod delay;
+mod invariant;
 mod model;
 pub(crate) mod noise;
 mod report;
@@ -622,68 +623,6 @@ fn collinearity_note(moments: &Moments, names: &[String], selection: &Selection)
     Some(note)
 }
 
-/// The smallest eigenvalue of the candidate variables' correlation matrix below which a
-/// combination of them is taken as constant in the rows (round-off of an exact invariant).
-const INVARIANT: f64 = 1e-9;
-
-/// A note where a linear combination of the candidates that are a variable alone is the same
-/// in every row (a null vector of their covariance): a conservation law (a + b + c of a
-/// closed reaction, S + I + R of an epidemic), indicator columns of categories that add up to
-/// one, a variable recorded twice, or a fast state that follows the others at once (x of
-/// dx/dt = −200 (x − y): x − y + ẏ/200 ≈ 0 at every row). Any candidate in one of them is then one in the others,
-/// a back-end keeps one way of writing the equation and leaves the rest out as collinear, and
-/// the system's own terms may be among those left out.
-fn invariant_note(moments: &Moments, names: &[String]) -> Option<String> {
-    let vars: Vec<usize> = (0..names.len()).filter(|&i| crate::term::is_identifier(&names[i])).collect();
-    if vars.len() < 2 || vars.len() > 32 {
-        return None;
-    }
-    let d: Vec<f64> = vars.iter().map(|&i| moments.corrected(i, i).max(0.0).sqrt()).collect();
-    if d.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
-        return None;
-    }
-    let k = vars.len();
-    let r = nalgebra::DMatrix::from_fn(k, k, |i, j| moments.corrected(vars[i], vars[j]) / (d[i] * d[j]));
-    let eigen = nalgebra::SymmetricEigen::new(r);
-    let laws: Vec<String> = (0..k)
-        .filter(|&e| eigen.eigenvalues[e] < INVARIANT)
-        .filter_map(|e| {
-            // in the variables' own scale: w_i / d_i, the largest weight 1
-            let w: Vec<f64> = (0..k).map(|i| eigen.eigenvectors[(i, e)] / d[i]).collect();
-            let top = w.iter().copied().fold(0.0f64, |a, v| if v.abs() > a.abs() { v } else { a });
-            let mut text = String::new();
-            for (i, v) in w.iter().map(|v| v / top).enumerate() {
-                if v.abs() < 1e-6 {
-                    continue;
-                }
-                let sign = match (text.is_empty(), v < 0.0) {
-                    (true, false) => "",
-                    (true, true) => "−",
-                    (false, false) => " + ",
-                    (false, true) => " − ",
-                };
-                let weight = if (v.abs() - 1.0).abs() < 1e-3 {
-                    String::new()
-                } else {
-                    format!("{}·", report::sig(v.abs(), 3))
-                };
-                text += &format!("{sign}{weight}{}", names[vars[i]]);
-            }
-            text.contains(' ').then(|| format!("`{text}`"))
-        })
-        .collect();
-    (!laws.is_empty()).then(|| {
-        format!(
-            "{} the same in every row (a conservation law, categories that add up to one, a \
-             variable recorded twice, or a fast state that follows the others at once): a \
-             candidate in one of these variables is one in the others, so the equation is \
-             written in fewer of them and a term left out as collinear may be the system's, \
-             written in the others",
-            if laws.len() == 1 { format!("{} is", laws[0]) } else { format!("{} are each", laws.join(", ")) }
-        )
-    })
-}
-
 impl Identification<'_> {
     /// The per-run parameter values.
     pub fn run_parameters(&self, frame: &Frame) -> Result<BTreeMap<String, f64>, IdentifyError> {
@@ -1138,6 +1077,12 @@ impl Identification<'_> {
             &folds,
             backend,
         )?;
+        // a law the noise blurs, where no exact one was said
+        let mut pooled = Moments::new(design.names().len());
+        folds.iter().for_each(|f| pooled.merge(f));
+        if invariant::exact_note(&pooled, design.names()).is_none() {
+            fit.selection.notes.extend(invariant::within_noise_note(frames, candidates, design.names()));
+        }
         if let Target::Derivative(state) = target {
             fit.selection.notes.extend(unexplained_note(&fit.selection, state));
             fit.selection.notes.extend(resolution_note(frames, state));
@@ -1292,7 +1237,7 @@ pub(crate) fn fit_folds(
     if let Some(note) = collinearity_note(&moments, names, &selection) {
         selection.notes.push(note);
     }
-    selection.notes.extend(invariant_note(&moments, names));
+    selection.notes.extend(invariant::exact_note(&moments, names));
     let rivals = crate::select::rivals(&problem, &selection);
     // the residual pass for τ is left to the caller (`describe_residuals`): selection itself
     // needs only the sufficient statistics, and is timed against the peers without it

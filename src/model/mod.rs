@@ -70,6 +70,20 @@ pub enum ModelError {
         /// What is wrong.
         message: String,
     },
+    /// A term to force or leave out that no identified equation has among its candidates.
+    #[error(
+        "{file}: `{term}` is no candidate of an equation identified ({role}; their candidates: {candidates})"
+    )]
+    NotACandidate {
+        /// The model file (or what stands for it).
+        file: String,
+        /// The term.
+        term: String,
+        /// What it was to be: forced or excluded.
+        role: String,
+        /// The candidates of the identified equations, a few.
+        candidates: String,
+    },
     /// A term inside a key.
     #[error("{file}:{line}: `{key}`:\n{term}")]
     Term {
@@ -298,6 +312,62 @@ impl Model {
         self.edit(|file| {
             for e in file.equations.values_mut().filter(|e| e.identify) {
                 e.backend = Some(backend.clone());
+            }
+        })
+    }
+
+    /// The model with `forced` terms entering first and `excluded` ones never, in every
+    /// identified equation that has them among its candidates (added to the file's own lists);
+    /// a term that no identified equation has is refused (a misspelt one would change nothing).
+    pub fn with_terms(&self, forced: &[Term], excluded: &[Term]) -> Result<Model, ModelError> {
+        let identified: Vec<&Equation> = self.equations.iter().filter(|e| e.identify).collect();
+        for (terms, role) in [(forced, "forced"), (excluded, "excluded")] {
+            if let Some(t) = terms.iter().find(|t| !identified.iter().any(|e| e.candidates.contains(t))) {
+                let all: Vec<String> =
+                    identified.iter().flat_map(|e| &e.candidates).map(|c| format!("`{c}`")).collect();
+                let mut shown: Vec<&String> = Vec::new();
+                all.iter().for_each(|c| {
+                    if !shown.contains(&c) && shown.len() < 12 {
+                        shown.push(c)
+                    }
+                });
+                let more = if all.iter().any(|c| !shown.contains(&c)) { ", …" } else { "" };
+                return Err(ModelError::NotACandidate {
+                    file: self.path.clone(),
+                    term: t.to_string(),
+                    role: role.into(),
+                    candidates: format!(
+                        "{}{more}",
+                        shown.iter().map(|c| c.as_str()).collect::<Vec<_>>().join(", ")
+                    ),
+                });
+            }
+        }
+        let lists: Vec<(String, Vec<String>, Vec<String>)> = identified
+            .iter()
+            .map(|e| {
+                // each term in the equation's own spelling of it
+                let own = |terms: &[Term]| -> Vec<String> {
+                    terms
+                        .iter()
+                        .filter_map(|t| e.candidates.iter().find(|c| *c == t))
+                        .map(Term::to_string)
+                        .collect()
+                };
+                (e.name.clone(), own(forced), own(excluded))
+            })
+            .collect();
+        self.edit(|file| {
+            for (name, forced, excluded) in lists {
+                if let Some(e) = file.equations.get_mut(&name) {
+                    for (list, add) in [(&mut e.forced, forced), (&mut e.excluded, excluded)] {
+                        add.into_iter().for_each(|t| {
+                            if !list.contains(&t) {
+                                list.push(t)
+                            }
+                        });
+                    }
+                }
             }
         })
     }

@@ -301,10 +301,12 @@ pub struct IdentifyCommand {
     /// A file of candidate terms, one per line (`#` starts a comment).
     #[arg(long)]
     pub terms_file: Option<PathBuf>,
-    /// Terms that always enter first.
+    /// Terms that always enter first (with --model or --states: in every identified equation
+    /// that has them among its candidates). Comma-separated as --terms.
     #[arg(long, num_args = 1..)]
     pub forced: Vec<String>,
-    /// Terms that never enter.
+    /// Terms that never enter (with --model or --states: in every identified equation that
+    /// has them among its candidates). Comma-separated as --terms.
     #[arg(long, num_args = 1..)]
     pub exclude: Vec<String>,
     /// Per-run parameters: `u0=2.01`, `u0=first:u` (first value of u in each run) or `u0=mean:u`.

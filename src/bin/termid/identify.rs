@@ -59,6 +59,7 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
     cmd.refuse_conflicts().map_err(anyhow::Error::msg)?;
     // `--terms x,x*y` as `--states x,y` lists names
     cmd.terms = termid::term::listed(&cmd.terms);
+    (cmd.forced, cmd.exclude) = (termid::term::listed(&cmd.forced), termid::term::listed(&cmd.exclude));
     resolve_derivative(&mut cmd)?;
     if let Some(dir) = &cmd.prepared_svg {
         termid::output::check_folder(dir)?;

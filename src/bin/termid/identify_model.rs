@@ -3,7 +3,7 @@
 //! model file's free parameters, checks, the starts' agreement); this file reads the command
 //! line, prints and writes.
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use termid::identify::Target;
 use termid::recipe::{ParameterOptions, RecipeSettings, RefineOptions};
 use termid::select::Backend;
@@ -37,6 +37,14 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     }
     .keeping_spikes(cmd.keep_spikes)
     .with_intersample(cmd.intersample);
+    if !(cmd.forced.is_empty() && cmd.exclude.is_empty()) {
+        // the command line's terms join the file's (each equation's that has them)
+        let vocabulary = model.vocabulary.clone();
+        let parse = |texts: &[String], flag: &str| {
+            termid::term::parse_terms(texts, &vocabulary).with_context(|| format!("in {flag}"))
+        };
+        model = model.with_terms(&parse(&cmd.forced, "--forced")?, &parse(&cmd.exclude, "--exclude")?)?;
+    }
     if cmd.backend.is_some() {
         // the command line's back-end (with its stepwise options) replaces the file's
         model = model.with_backend(&configure_backend(&cmd)?)?;
