@@ -518,6 +518,15 @@ impl PyModel {
         Ok((PyModel { inner: identified.model }, fits, to_json(&checks)?))
     }
 
+    /// The model with `forced` terms entering first and `excluded` ones never, in every
+    /// identified equation that has them among its candidates (`termid::model::Model::with_terms`).
+    #[pyo3(signature = (forced, excluded))]
+    fn with_terms(&self, forced: Vec<String>, excluded: Vec<String>) -> PyResult<PyModel> {
+        let parse = |texts: &[String]| termid::term::parse_terms(texts, &self.inner.vocabulary).map_err(fail);
+        let model = self.inner.with_terms(&parse(&forced)?, &parse(&excluded)?).map_err(fail)?;
+        Ok(PyModel { inner: model })
+    }
+
     /// The model with each state's initial value the run's first sample of it (a model made
     /// from columns: simulated from where its first run starts).
     fn starting_as(&self, run: Run<'_>) -> PyResult<PyModel> {

@@ -1486,6 +1486,24 @@ class Model:
         """
         return list(self._native.candidates(equation))
 
+    def with_terms(self, forced: Sequence[str] = (), excluded: Sequence[str] = ()) -> "Model":
+        """The model with ``forced`` terms entering first and ``excluded`` ones never, in every
+        identified equation that has them among its candidates (as ``termid identify
+        --forced``/``--exclude``); a term that no such equation has raises ``TermidError``.
+        Where the runs keep a law (an epidemic's S + I + R, said in the fit's notes,
+        ``found.reports["I_dot"]["notes"]``, when noise blurs it), leaving out the candidates in one of its variables writes the
+        rates in the others.
+
+        Parameters: ``forced`` terms that always enter; ``excluded`` terms that never do.
+
+        >>> sir = termid.Model.from_states(["S", "I", "R"], degree=2).with_terms(excluded=["R", "I*R", "R*S", "R^2"])
+        >>> "excluded" in sir.to_toml() and "excluded" not in termid.Model.from_states(["S"]).to_toml()
+        True
+        """
+        if isinstance(forced, str) or isinstance(excluded, str):
+            raise TypeError("forced and excluded are lists of terms (['x*y']), not one string")
+        return Model(self._native.with_terms(list(forced), list(excluded)), self._from_states)
+
     @property
     def parameters(self) -> Dict[str, float]:
         """The named parameters and their values.

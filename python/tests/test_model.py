@@ -1072,3 +1072,36 @@ def test_terms_the_halves_of_a_run_do_not_choose_are_flagged():
     shares = [float(noise["detail"].split(f"`{c}` ")[1].split(" %")[0]) for c in "xyz"]
     assert all(4.5 < s < 5.5 for s in shares), noise["detail"]
     assert any(w.startswith("FLAG the records' noise") for w in recipe.warnings)
+
+
+def test_terms_left_out_of_every_rate_write_a_blurred_law_in_the_rest():
+    # an epidemic, S + I + R = 1, recorded with 1 % noise on each: the fit says the law holds
+    # but for the noise; leaving out the candidates in R writes dI/dt = 0.5·I·S − 0.1·I
+    beta, gamma, h = 0.5, 0.1, 0.1
+    rate = lambda x: np.array([-beta * x[0] * x[1], beta * x[0] * x[1] - gamma * x[1], gamma * x[1]])
+    x, rows = np.array([0.99, 0.01, 0.0]), []
+    for _ in range(1000):
+        rows.append(x)
+        for _ in range(10):
+            k1 = rate(x); k2 = rate(x + 0.005 * k1); k3 = rate(x + 0.005 * k2); k4 = rate(x + 0.01 * k3)
+            x = x + 0.01 / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    rows = np.array(rows)
+    noisy = rows + 0.01 * rows.std(axis=0) * np.random.default_rng(3).normal(size=rows.shape)
+    run = pd.DataFrame({"t": h * np.arange(1000), "S": noisy[:, 0], "I": noisy[:, 1], "R": noisy[:, 2]})
+    model = termid.Model.from_states(["S", "I", "R"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        found = model.identify(run)
+    said = " ".join(found.reports["I_dot"]["notes"])
+    assert "the same in every row but for the records' noise" in said and "the candidates in `R` left out" in said
+    in_r = [t for t in model.candidates("I_dot") if "R" in t]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        written = model.with_terms(excluded=in_r).identify(run)
+    i_dot = written.model.coefficients("I_dot").set_index("term")["value"]
+    assert sorted(i_dot.index) == ["I", "I*S"]
+    assert i_dot["I*S"] == pytest.approx(beta, rel=0.01) and i_dot["I"] == pytest.approx(-gamma, rel=0.01)
+    with pytest.raises(termid.TermidError, match="`I\\^3\\*R` is no candidate of an equation identified"):
+        model.with_terms(excluded=["I^3*R"])
+    with pytest.raises(TypeError):
+        model.with_terms(excluded="R")
