@@ -5,6 +5,39 @@
 
 use chrono::{DateTime, NaiveDateTime, NaiveTime, Timelike};
 
+/// Seconds in a year of 365.25 days.
+const YEAR: f64 = 365.25 * 86_400.0;
+
+/// What to say of a run whose time column (`name`, no unit in its header) starts at
+/// `first`, a number no clock of seconds reaches: 10¹¹ s after 1970 is the year 5139, where a
+/// logger's milliseconds (or micro-, nanoseconds) since 1970 read as seconds make every rate a
+/// thousand (a million, a billion) times too slow. `None` below 10¹¹ or where the header
+/// names its unit ([`super::seconds_per`]).
+pub fn epoch_note(origin: &str, name: &str, first: f64) -> Option<String> {
+    if super::seconds_per(name).is_some() || !(1e11..1e21).contains(&first.abs()) {
+        return None;
+    }
+    let (unit, factor) = match first.abs() {
+        v if v < 1e14 => ("milliseconds", 1e-3),
+        v if v < 1e17 => ("microseconds", 1e-6),
+        _ => ("nanoseconds", 1e-9),
+    };
+    let short = match unit {
+        "milliseconds" => "ms",
+        "microseconds" => "us",
+        _ => "ns",
+    };
+    Some(format!(
+        "{origin}: the time `{name}` starts at {first:.4e}, which as seconds since 1970 is the year {:.0}; as \
+         {unit} since 1970 it is {:.0}: read as seconds, every rate is {} times too slow. Name the unit with the \
+         time column (a header `{name} [{short}]` or `{name}_{short}`; a dataset file's `{name} = \"… [{short}]\"`) \
+         and it is read in seconds",
+        1970.0 + first / YEAR,
+        1970.0 + first * factor / YEAR,
+        crate::output::sig(1.0 / factor, 1)
+    ))
+}
+
 /// The seconds a time stamp stands for; `None` for text that is no time stamp.
 pub fn clock_seconds(text: &str) -> Option<f64> {
     let text = text.trim();
@@ -32,6 +65,22 @@ fn epoch_seconds(whole: i64, nanos: u32) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Milliseconds, microseconds and nanoseconds since 1970 read as seconds are said, with
+    /// the year each makes; seconds since 1970 (1.7e9), a header with its unit and a run of
+    /// hours are not.
+    #[test]
+    fn a_logger_s_epoch_read_as_seconds_is_said() {
+        let said = |first: f64| epoch_note("log.csv", "timestamp", first);
+        assert!(said(1.7e12).unwrap().contains("is the year 55840; as milliseconds since 1970 it is 2024"));
+        assert!(said(1.7e15).unwrap().contains("as microseconds since 1970 it is 2024"));
+        assert!(said(1.7e18).unwrap().contains("as nanoseconds since 1970 it is 2024"));
+        assert!(said(1.7e12).unwrap().contains("every rate is 1000 times too slow"));
+        assert_eq!(said(1.7e9), None);
+        assert_eq!(said(3600.0), None);
+        assert_eq!(epoch_note("log.csv", "timestamp [ms]", 1.7e12), None);
+        assert_eq!(epoch_note("log.csv", "timestamp_ms", 1.7e12), None);
+    }
 
     #[test]
     fn clock_and_date_stamps_are_seconds() {

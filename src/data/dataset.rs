@@ -340,8 +340,33 @@ const UNITS: &[(&str, f64, [i32; 3])] = &[
 /// milliseconds as seconds makes every rate a thousand times too slow. `None` where the header
 /// names no unit, or one that is not of time.
 pub fn seconds_per(header: &str) -> Option<f64> {
-    let unit = split_spec(header).1?;
-    UNITS.iter().find(|(n, _, dims)| *n == unit && *dims == [0, 1, 0]).map(|(_, f, _)| *f)
+    match split_spec(header).1 {
+        Some(unit) => UNITS.iter().find(|(n, _, dims)| *n == unit && *dims == [0, 1, 0]).map(|(_, f, _)| *f),
+        None => suffixed_seconds(header),
+    }
+}
+
+/// Units of time as loggers write them after a name (`timestamp_ms`, `time_us`, `t.sec`),
+/// with their factor to seconds.
+const TIME_SUFFIXES: [(&[&str], f64); 6] = [
+    (&["s", "sec", "secs", "seconds"], 1.0),
+    (&["ms", "msec", "millis"], 1e-3),
+    (&["us", "µs", "μs", "usec", "micros"], 1e-6),
+    (&["ns", "nsec", "nanos"], 1e-9),
+    (&["min", "mins", "minutes"], 60.0),
+    (&["h", "hr", "hrs", "hours"], 3600.0),
+];
+
+/// The factor to seconds of a time header whose last word, after `_`, `.`, `-` or a space,
+/// is a unit of time (`timestamp_ms`: a logger's milliseconds, read as seconds a thousand
+/// times too slow); `None` otherwise (`t`, `time`, `elapsed`).
+fn suffixed_seconds(header: &str) -> Option<f64> {
+    let (name, unit) = header.trim().rsplit_once(['_', '.', '-', ' '])?;
+    if name.trim().is_empty() {
+        return None;
+    }
+    let unit = unit.to_lowercase();
+    TIME_SUFFIXES.iter().find(|(names, _)| names.contains(&unit.as_str())).map(|(_, f)| *f)
 }
 
 /// A time column's values in seconds, where its header `name` says another unit of time
@@ -669,7 +694,11 @@ impl Dataset {
             let Some(lambda) = self.froude else { return Ok(1.0) };
             froude_factor(lambda, unit, &origin, column)
         };
-        let time_factor = factor(time_unit.as_deref(), &origin, time)?;
+        // a logger's unit after the name (`timestamp_ms`) where none is given in brackets
+        let time_factor = match time_unit.as_deref() {
+            None => suffixed_seconds(&time_col).unwrap_or(1.0),
+            unit => factor(unit, &origin, time)?,
+        };
         let time_scale = scale(time_unit.as_deref(), &time_col)?;
         // the file's time in s, for `from` and `to`
         let file_time: Vec<f64> = raw.time().iter().map(|t| t * time_factor).collect();
@@ -941,8 +970,20 @@ mod tests {
         assert_eq!(seconds_per("Time [ms]"), Some(1e-3));
         assert_eq!(seconds_per("t (min)"), Some(60.0));
         assert_eq!(seconds_per("t [s]"), Some(1.0));
-        for plain in ["t", "x [m]", "f(x)", "time (rad)", "ms"] {
+        for plain in ["t", "x [m]", "f(x)", "time (rad)", "ms", "_ms", "x_dot", "time_of_day"] {
             assert_eq!(seconds_per(plain), None, "{plain}");
+        }
+        // a logger's unit after the name: `timestamp_ms` was read as seconds, every rate a
+        // thousand times too slow
+        for (header, factor) in [
+            ("timestamp_ms", 1e-3),
+            ("time_us", 1e-6),
+            ("t.sec", 1.0),
+            ("elapsed min", 60.0),
+            ("t_ns", 1e-9),
+            ("Time_MS", 1e-3),
+        ] {
+            assert_eq!(seconds_per(header), Some(factor), "{header}");
         }
         // a dataset file's mapping reads a unit in parentheses as in brackets (it read
         // `t = "Time (ms)"` as a column of seconds), a name's own parentheses stay
@@ -957,6 +998,16 @@ mod tests {
         assert!(text.starts_with("Time (ms),x\n0.0,1.0\n50.0,2.0\n100.0,3.0"), "{text}");
         let back = crate::data::Frame::parse_csv(&text, "log.csv", "Time (ms)").unwrap();
         assert_eq!(back.time(), f.time());
+        // a dataset file's time mapped onto a logger's `timestamp_ms` (read as seconds before)
+        let dir = std::env::temp_dir().join(format!("termid-suffixed-time-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        write(&dir, "log.csv", "timestamp_ms,x\n1000,1\n1050,2\n1100,3\n");
+        let set: Dataset =
+            toml::from_str("[columns]\nt = \"timestamp_ms\"\nx = \"x\"\n[[runs]]\nfile = \"log.csv\"\n")
+                .unwrap();
+        let (frames, _) = set.read(&dir, "t").unwrap();
+        assert_eq!(frames[0].time(), [1.0, 1.05, 1.1]);
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]

@@ -31,7 +31,7 @@ mod weak;
 
 pub use angle::{laid_on_turns, turn_of, unwrap_turns, unwrapped, unwrapped_dials, wrapped};
 pub use breaks::{breaks, cut_at_breaks, cut_at_gaps, gaps, moving_breaks, Break, Gaps};
-pub use clock::clock_seconds;
+pub use clock::{clock_seconds, epoch_note};
 pub use dataset::{
     from_seconds, in_seconds, seconds_per, velocities_from_track, Dataset, Delimiter, RunSpec, Track,
 };

@@ -990,6 +990,12 @@ impl Model {
     /// the rest every chunk would repeat).
     pub fn admitted(&self, frame: &mut crate::data::Frame) -> Result<Admitted, crate::data::DataError> {
         let mut notes = Vec::new();
+        notes.extend(
+            frame
+                .time()
+                .first()
+                .and_then(|&first| crate::data::epoch_note(frame.origin(), frame.time_name(), first)),
+        );
         if let Some((even, note)) = crate::data::evened(frame)? {
             *frame = even;
             notes.push(note);

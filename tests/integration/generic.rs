@@ -2042,6 +2042,38 @@ fn a_whole_system_from_its_columns() {
     let written = std::fs::read_to_string(&sim).unwrap();
     let second: Vec<&str> = written.lines().nth(2).unwrap().split(',').collect();
     assert!(written.starts_with("Time (ms),") && second[0].parse::<f64>().unwrap() == 10.0, "{written}");
+    // a logger's milliseconds since 1970 under `timestamp_ms` are read in seconds too (they
+    // were read as seconds: ẋ = 0.001v); under a bare `timestamp`, the year they make as
+    // seconds (55 840) is said, with the header that reads them
+    let epoch = std::fs::read_to_string(dir.join("ms.csv")).unwrap();
+    let mut since_1970 = String::from("timestamp_ms,x,v,F\n");
+    for line in epoch.lines().skip(1) {
+        let (t, rest) = line.split_once(',').unwrap();
+        since_1970 += &format!("{},{rest}\n", 1.7e12 + t.parse::<f64>().unwrap());
+    }
+    std::fs::write(dir.join("epoch.csv"), &since_1970).unwrap();
+    let (ok, out, err) = termid(&[
+        "identify",
+        "--data",
+        &p("epoch.csv"),
+        "--time",
+        "timestamp_ms",
+        "--states",
+        "x,v",
+        "--format",
+        "json",
+    ]);
+    assert!(ok && !err.contains("1970"), "{err}");
+    let rate = crate::common::json(&out)["x_dot"]["terms"][0]["coefficient"].as_f64().unwrap();
+    assert!((rate - 1.0).abs() < 1e-4, "{out}");
+    std::fs::write(dir.join("bare.csv"), since_1970.replacen("timestamp_ms", "timestamp", 1)).unwrap();
+    let (ok, _, err) =
+        termid(&["identify", "--data", &p("bare.csv"), "--time", "timestamp", "--states", "x,v"]);
+    assert!(
+        ok && err.contains("as seconds since 1970 is the year 55840; as milliseconds since 1970 it is 2024")
+            && err.contains("`timestamp [ms]`"),
+        "{err}"
+    );
     // a state's header that carries its unit is named, with the dataset file that reads it
     let headed = std::fs::read_to_string(&data).unwrap().replacen("t,x,", "t,x [m],", 1);
     std::fs::write(dir.join("headed.csv"), headed).unwrap();
