@@ -1041,6 +1041,12 @@ def test_a_time_column_in_milliseconds_is_read_in_seconds():
     again = in_ms_model.identify(simulated[["Time (ms)", "x", "y", "z"]])
     z_dot = again.model.coefficients("z_dot").set_index("term")["value"]
     assert z_dot.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
+    # a logger's unit after the name, an index of epoch milliseconds: read in seconds too
+    logged = in_ms.rename(columns={"Time (ms)": "timestamp_ms"})
+    logged = logged.assign(timestamp_ms=logged["timestamp_ms"] + 1.7e12).set_index("timestamp_ms")
+    found = termid.Model.from_states(["x", "y", "z"]).identify(logged)
+    z_dot = found.model.coefficients("z_dot").set_index("term")["value"]
+    assert z_dot.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
 
 
 def test_terms_the_halves_of_a_run_do_not_choose_are_flagged():
