@@ -185,6 +185,12 @@ mod tests {
             Frame::parse_csv("t,u\n0,1,2\n", "a.csv", "t"),
             Err(DataError::Ragged { row: 1, .. })
         ));
+        // a trailing comma on every row (a spreadsheet's export): the empty column is no column
+        let f = Frame::parse_csv("t,u,\n0,1,\n0.2,2,\n", "a.csv", "t").unwrap();
+        assert_eq!(
+            (f.names(), f.column("u").unwrap()),
+            (&["t".to_string(), "u".to_string()][..], &[1.0, 2.0][..])
+        );
         // a time that starts again: runs one after another, said
         let e = Frame::parse_csv("t,u\n0,1\n0.1,2\n0,3\n", "a.csv", "t").unwrap_err().to_string();
         assert!(e.contains("row 3") && e.contains("it starts again: runs one after another?"), "{e}");

@@ -372,7 +372,13 @@ impl<'a> CsvRows<'a> {
         // labels; the first row's error says so
         let units = text.iter().all(|(_, cell)| super::dataset::is_unit(cell));
         let text = if 2 * text.len() > names.len() || units { Vec::new() } else { text };
-        let keep: Vec<usize> = (0..names.len()).filter(|c| !text.iter().any(|(t, _)| t == c)).collect();
+        // a column with neither name nor first reading: the empty cell after a trailing comma,
+        // as spreadsheets export rows (it refused the file, "row 1, column ``: no reading")
+        let unnamed_blank = |c: usize| {
+            names[c].is_empty() && pending && record.get(c).is_some_and(|cell| cell.trim_ascii().is_empty())
+        };
+        let keep: Vec<usize> =
+            (0..names.len()).filter(|&c| !text.iter().any(|(t, _)| *t == c) && !unnamed_blank(c)).collect();
         Ok(CsvRows {
             reader,
             names: keep.iter().map(|&c| names[c].clone()).collect(),
