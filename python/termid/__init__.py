@@ -284,6 +284,11 @@ def _refuse_interleaved(data: pd.DataFrame, found: "_Columns") -> None:
 
 def _columns_of(data: Data) -> "_Columns":
     if isinstance(data, pd.DataFrame):
+        # pandas' name for the empty column after a trailing comma on every row (a spreadsheet's
+        # export), which holds nothing: no column (its name refused the run)
+        blank = [c for c in data.columns if re.fullmatch(r"Unnamed: \d+", str(c)) and data[c].isna().all()]
+        if blank:
+            data = data.drop(columns=blank)
         _once(data.columns)
         if any(getattr(dt, "kind", "O") in "mM" for dt in data.dtypes):
             data = pd.DataFrame(

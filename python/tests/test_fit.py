@@ -582,3 +582,19 @@ def test_the_rows_that_cannot_choose_are_said():
     assert rivals.loc["x1", "rise"] == pytest.approx((175.74 - 74.76) / 7.476, abs=2e-3)
     assert any("hardly tell `x4` from `x2`" in n for n in fitted.notes)
     assert "Notes:\n[1] the rows hardly tell" in str(fitted.summary())
+
+
+def test_the_empty_column_of_a_trailing_comma_is_no_column(tmp_path):
+    # a spreadsheet's export ends every row with a comma: pandas reads an empty `Unnamed: 3`,
+    # whose name refused the run; it holds nothing and is left out (one that holds numbers,
+    # pandas' own index written to the file, is a column as before)
+    t = np.arange(0.0, 10.0, 0.01)
+    lines = ["t,x,u,"] + [f"{a},{np.exp(-a) + 0.1 * np.sin(a)},{np.sin(a)}," for a in t]
+    path = tmp_path / "export.csv"
+    path.write_text("\n".join(lines) + "\n")
+    df = pd.read_csv(path)
+    assert list(df.columns) == ["t", "x", "u", "Unnamed: 3"]
+    fitted = termid.fit(df, "dx/dt", ["x", "u"])
+    assert "x" in fitted.coefficients.index
+    with pytest.raises(termid.TermidError, match="Unnamed: 3"):
+        termid.fit(df.assign(**{"Unnamed: 3": np.arange(len(df), dtype=float)}), "dx/dt", ["x", "u", "Unnamed: 3"])
