@@ -275,6 +275,14 @@ impl Model {
             "the candidates are written about reference values: {}; far from 0 a variable's powers and products move with the lower terms (its square with itself and the constant) and the fit cannot tell them apart",
             said.join("; ")
         );
+        // terms forced or left out (`with_terms`) follow their candidates into the centred library
+        let canonical = |t: &str| self.vocabulary.parse(t).map(|t| t.to_string()).ok();
+        let plain: Vec<Option<String>> = library.iter().map(|t| canonical(t)).collect();
+        let centre = |t: &String| -> String {
+            canonical(t)
+                .and_then(|c| plain.iter().position(|p| p.as_deref() == Some(c.as_str())))
+                .map_or_else(|| t.clone(), |i| centred[i].clone())
+        };
         let mut model = self.edit(|file| {
             for (o, parameter, derived) in &written {
                 let unit = file.states.iter().find(|s| s.name == o.name).map(|s| s.unit.clone());
@@ -302,6 +310,8 @@ impl Model {
             for equation in file.equations.values_mut() {
                 if equation.candidates == library {
                     equation.candidates = centred.clone();
+                    equation.forced = equation.forced.iter().map(centre).collect();
+                    equation.excluded = equation.excluded.iter().map(centre).collect();
                 }
             }
             file.model.provenance =
@@ -409,6 +419,13 @@ mod tests {
         let texts: Vec<String> = candidates.iter().map(|c| c.to_string()).collect();
         assert_eq!(texts, ["1", "x", "y", "Δz", "x^2", "x*y", "x*Δz", "y^2", "y*Δz", "Δz^2"]);
         assert!(about.spec().model.provenance.contains("x, y, Δz to degree 2"));
+        // a term left out of every rate follows its candidate (it was left naming `z^2`, which
+        // the centred library no longer has)
+        let without = model.with_terms(&[], &[model.vocabulary.parse("z^2").unwrap()]).unwrap();
+        let (about_without, _) = without.about_references(&[run(302.3, ["x", "y", "z"])]).unwrap();
+        let left: Vec<String> =
+            about_without.equation("y_dot").unwrap().excluded.iter().map(|t| t.to_string()).collect();
+        assert_eq!(left, ["Δz^2"]);
         assert!(about.about_references(&[run(302.3, ["x", "y", "z"])]).unwrap().1.is_none());
         Model::parse(&about.to_toml(), "again.toml").unwrap();
         // the reference rounds to the decade above the spread: 0.014 → 0.1
