@@ -58,7 +58,20 @@ impl Frame {
         let Table { names, mut columns, text, .. } = table;
         let time_index = super::stream::time_index(origin, time, &names, &text)?;
         let seconds = super::in_seconds(time, std::mem::take(&mut columns[time_index]));
-        let mut frame = Frame::new(origin, time, seconds)?;
+        let mut frame = match Frame::new(origin, time, seconds) {
+            // a time that stands still where the whole row does: the row written twice
+            Err(DataError::TimeNotIncreasing { row, this, previous, .. })
+                if this == previous
+                    && row >= 2
+                    && columns
+                        .iter()
+                        .enumerate()
+                        .all(|(c, v)| c == time_index || v[row - 1] == v[row - 2]) =>
+            {
+                return Err(DataError::RepeatedRow { file: origin.into(), row });
+            }
+            other => other?,
+        };
         for (name, values) in names.iter().zip(columns) {
             if name != time {
                 frame.push(name, values)?;
@@ -164,6 +177,8 @@ mod tests {
         assert!(e.contains("row 2, column `u`") && e.contains("not finite"), "{e}");
         let e = Frame::parse_csv("t,u\n0,1\n0,2\n", "a.csv", "t").unwrap_err().to_string();
         assert!(e.contains("row 2") && e.contains("does not increase"), "{e}");
+        let e = Frame::parse_csv("t,u\n0,1\n0.1,2\n0.1,2\n0.2,3\n", "a.csv", "t").unwrap_err().to_string();
+        assert_eq!(e, "a.csv: row 3 repeats row 2 in every column, its time too (a logger's duplicate): drop it (pandas' `df.drop_duplicates()`)");
         assert!(matches!(Frame::parse_csv("t,u\n", "a.csv", "t"), Err(DataError::Empty { .. })));
         assert!(matches!(Frame::parse_csv("", "a.csv", "t"), Err(DataError::NoHeader { .. })));
         // without time: the file's own cells counted, no column of termid's own named

@@ -188,6 +188,14 @@ pub enum DataError {
         /// It goes back to the first row's time or before (a run that follows another).
         restart: bool,
     },
+    /// A row that repeats the one before in every column (a logger's duplicate).
+    #[error("{file}: row {row} repeats row {} in every column, its time too (a logger's duplicate): drop it (pandas' `df.drop_duplicates()`)", row - 1)]
+    RepeatedRow {
+        /// The file.
+        file: String,
+        /// 1-based data row of the repeat.
+        row: usize,
+    },
     /// A column of the wrong length.
     #[error("{file}: column `{column}` has {found} values, the time column {expected}")]
     Length {
@@ -340,6 +348,7 @@ impl DataError {
             DataError::TimeNotIncreasing { file, row, column, this, previous, restart } => {
                 DataError::TimeNotIncreasing { file, row: file_row(row), column, this, previous, restart }
             }
+            DataError::RepeatedRow { file, row } => DataError::RepeatedRow { file, row: file_row(row) },
             DataError::Unit { file, row, column, message } if row > 0 => {
                 DataError::Unit { file, row: file_row(row), column, message }
             }
