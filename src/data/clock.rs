@@ -17,15 +17,10 @@ pub fn epoch_note(origin: &str, name: &str, first: f64) -> Option<String> {
     if super::seconds_per(name).is_some() || !(1e11..1e21).contains(&first.abs()) {
         return None;
     }
-    let (unit, factor) = match first.abs() {
-        v if v < 1e14 => ("milliseconds", 1e-3),
-        v if v < 1e17 => ("microseconds", 1e-6),
-        _ => ("nanoseconds", 1e-9),
-    };
-    let short = match unit {
-        "milliseconds" => "ms",
-        "microseconds" => "us",
-        _ => "ns",
+    let (unit, short, factor) = match first.abs() {
+        v if v < 1e14 => ("milliseconds", "ms", 1e-3),
+        v if v < 1e17 => ("microseconds", "us", 1e-6),
+        _ => ("nanoseconds", "ns", 1e-9),
     };
     Some(format!(
         "{origin}: the time `{name}` starts at {first:.4e}, which as seconds since 1970 is the year {:.0}; as \

@@ -23,13 +23,8 @@ pub(super) fn exact_note(moments: &Moments, names: &[String]) -> Option<String> 
     if vars.len() < 2 || vars.len() > 32 {
         return None;
     }
-    let d: Vec<f64> = vars.iter().map(|&i| moments.corrected(i, i).max(0.0).sqrt()).collect();
-    if d.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
-        return None;
-    }
     let k = vars.len();
-    let r = nalgebra::DMatrix::from_fn(k, k, |i, j| moments.corrected(vars[i], vars[j]) / (d[i] * d[j]));
-    let eigen = nalgebra::SymmetricEigen::new(r);
+    let (d, eigen) = correlation(k, |i, j| moments.corrected(vars[i], vars[j]))?;
     let laws: Vec<String> = (0..k)
         .filter(|&e| eigen.eigenvalues[e] < INVARIANT)
         .filter_map(|e| {
@@ -48,6 +43,22 @@ pub(super) fn exact_note(moments: &Moments, names: &[String]) -> Option<String> 
             if laws.len() == 1 { format!("{} is", laws[0]) } else { format!("{} are each", laws.join(", ")) }
         )
     })
+}
+
+/// The spreads √Cᵢᵢ of `k` variables whose (co)variances `cov` gives and the eigen-
+/// decomposition of their correlation matrix, whose near null vectors (`wᵢ / dᵢ` in the
+/// variables' own scale) are the combinations that stay the same; `None` where a variable
+/// does not vary.
+fn correlation(
+    k: usize,
+    cov: impl Fn(usize, usize) -> f64,
+) -> Option<(Vec<f64>, nalgebra::SymmetricEigen<f64, nalgebra::Dyn>)> {
+    let d: Vec<f64> = (0..k).map(|i| cov(i, i).max(0.0).sqrt()).collect();
+    if d.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+        return None;
+    }
+    let r = nalgebra::DMatrix::from_fn(k, k, |i, j| cov(i, j) / (d[i] * d[j]));
+    Some((d, nalgebra::SymmetricEigen::new(r)))
 }
 
 /// A combination `Σ wᵢ·namesᵢ` as a reader writes it, the largest weight scaled to 1 and
@@ -123,12 +134,7 @@ pub(super) fn within_noise_note(frames: &[Frame], candidates: &[Term], names: &[
             }
         }
     }
-    let d: Vec<f64> = (0..k).map(|i| cov[(i, i)].max(0.0).sqrt()).collect();
-    if d.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
-        return None;
-    }
-    let r = nalgebra::DMatrix::from_fn(k, k, |i, j| cov[(i, j)] / (d[i] * d[j]));
-    let eigen = nalgebra::SymmetricEigen::new(r);
+    let (d, eigen) = correlation(k, |i, j| cov[(i, j)])?;
     let mut laws: Vec<String> = Vec::new();
     let mut left: Vec<String> = Vec::new();
     for e in (0..k).filter(|&e| (INVARIANT..NEARLY).contains(&eigen.eigenvalues[e])) {

@@ -323,36 +323,28 @@ impl Model {
         let identified: Vec<&Equation> = self.equations.iter().filter(|e| e.identify).collect();
         for (terms, role) in [(forced, "forced"), (excluded, "excluded")] {
             if let Some(t) = terms.iter().find(|t| !identified.iter().any(|e| e.candidates.contains(t))) {
-                let all: Vec<String> =
-                    identified.iter().flat_map(|e| &e.candidates).map(|c| format!("`{c}`")).collect();
-                let mut shown: Vec<&String> = Vec::new();
-                all.iter().for_each(|c| {
-                    if !shown.contains(&c) && shown.len() < 12 {
-                        shown.push(c)
+                // the candidates, each once, in order: the first twelve
+                let mut all: Vec<String> = Vec::new();
+                for c in identified.iter().flat_map(|e| &e.candidates).map(|c| format!("`{c}`")) {
+                    if !all.contains(&c) {
+                        all.push(c);
                     }
-                });
-                let more = if all.iter().any(|c| !shown.contains(&c)) { ", …" } else { "" };
+                }
+                let more = if all.len() > 12 { ", …" } else { "" };
                 return Err(ModelError::NotACandidate {
                     file: self.path.clone(),
                     term: t.to_string(),
                     role: role.into(),
-                    candidates: format!(
-                        "{}{more}",
-                        shown.iter().map(|c| c.as_str()).collect::<Vec<_>>().join(", ")
-                    ),
+                    candidates: format!("{}{more}", all[..all.len().min(12)].join(", ")),
                 });
             }
         }
         let lists: Vec<(String, Vec<String>, Vec<String>)> = identified
             .iter()
             .map(|e| {
-                // each term in the equation's own spelling of it
+                // the terms the equation has, in their canonical spelling
                 let own = |terms: &[Term]| -> Vec<String> {
-                    terms
-                        .iter()
-                        .filter_map(|t| e.candidates.iter().find(|c| *c == t))
-                        .map(Term::to_string)
-                        .collect()
+                    terms.iter().filter(|t| e.candidates.contains(t)).map(Term::to_string).collect()
                 };
                 (e.name.clone(), own(forced), own(excluded))
             })
