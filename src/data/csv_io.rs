@@ -58,20 +58,8 @@ impl Frame {
         let Table { names, mut columns, text, .. } = table;
         let time_index = super::stream::time_index(origin, time, &names, &text)?;
         let seconds = super::in_seconds(time, std::mem::take(&mut columns[time_index]));
-        let mut frame = match Frame::new(origin, time, seconds) {
-            // a time that stands still where the whole row does: the row written twice
-            Err(DataError::TimeNotIncreasing { row, this, previous, .. })
-                if this == previous
-                    && row >= 2
-                    && columns
-                        .iter()
-                        .enumerate()
-                        .all(|(c, v)| c == time_index || v[row - 1] == v[row - 2]) =>
-            {
-                return Err(DataError::RepeatedRow { file: origin.into(), row });
-            }
-            other => other?,
-        };
+        let mut frame =
+            Frame::new(origin, time, seconds).map_err(|e| repeated_row(e, &columns, time_index))?;
         for (name, values) in names.iter().zip(columns) {
             if name != time {
                 frame.push(name, values)?;
@@ -153,6 +141,25 @@ pub(super) fn not_data(e: DataError, file: &str, head: impl FnOnce() -> Vec<u8>)
     DataError::Io {
         file: file.into(),
         message: "not a table of numbers: no number in its first rows (is it a data file? a CSV has a header row and numbers below it)".into(),
+    }
+}
+
+/// [`Frame::new`]'s refusal of a time that does not increase said as a repeated row where the
+/// whole row repeats the one before (a logger's duplicate): `columns` the table's, the time's
+/// own (at `time_index`, taken out) left aside.
+pub(super) fn repeated_row(e: DataError, columns: &[Vec<f64>], time_index: usize) -> DataError {
+    match e {
+        DataError::TimeNotIncreasing { file, row, this, previous, .. }
+            if this == previous
+                && row >= 2
+                && columns
+                    .iter()
+                    .enumerate()
+                    .all(|(c, v)| c == time_index || v.get(row - 1) == v.get(row - 2)) =>
+        {
+            DataError::RepeatedRow { file, row }
+        }
+        e => e,
     }
 }
 

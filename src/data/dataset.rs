@@ -684,7 +684,8 @@ impl Dataset {
         } else {
             stamps
         };
-        let mut raw = Frame::new(&origin, &time_col, stamps)?;
+        let mut raw = Frame::new(&origin, &time_col, stamps)
+            .map_err(|e| super::csv_io::repeated_row(e, &columns, time_index))?;
         for (name, values) in names.iter().zip(columns).filter(|(n, _)| **n != time_col) {
             raw.push(name, values)?;
         }
@@ -1007,6 +1008,10 @@ mod tests {
                 .unwrap();
         let (frames, _) = set.read(&dir, "t").unwrap();
         assert_eq!(frames[0].time(), [1.0, 1.05, 1.1]);
+        // a row the logger wrote twice is named so through a dataset file as in a plain file
+        write(&dir, "log.csv", "timestamp_ms,x\n1000,1\n1050,2\n1050,2\n1100,3\n");
+        let e = set.read(&dir, "t").unwrap_err().to_string();
+        assert!(e.contains("row 3 repeats row 2 in every column"), "{e}");
         std::fs::remove_dir_all(&dir).ok();
     }
 

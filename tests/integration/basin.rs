@@ -347,6 +347,12 @@ fn gaps_cut_runs_and_repeated_time_stamps_are_refused_with_their_row() {
     let mut dup = lines.clone();
     dup.insert(4 + 51, lines[4 + 50].clone());
     std::fs::write(dir.join("dup.dat"), dup.join("\n")).unwrap();
+    // a time stamp repeated on a row of its own (the next row's readings under it)
+    let mut stamp = lines.clone();
+    let time = lines[4 + 50].split_whitespace().next().unwrap();
+    let next = lines[4 + 51].split_whitespace().skip(1).collect::<Vec<_>>().join(" ");
+    stamp.insert(4 + 51, format!("{time} {next}"));
+    std::fs::write(dir.join("stamp.dat"), stamp.join("\n")).unwrap();
     let validated = |file: &str| {
         std::fs::write(dir.join("set.toml"), dataset_toml(&[file])).unwrap();
         let set = dir.join("set.toml").display().to_string();
@@ -362,12 +368,15 @@ fn gaps_cut_runs_and_repeated_time_stamps_are_refused_with_their_row() {
     let (ok, out, err) = termid(&["validate", "--model", "models/oltmann1973.toml", "--dataset", &set]);
     assert!(ok && err.contains("trimmed to") && err.contains("from row 100 to row 101"), "{err}");
     assert!(out.contains("gap.dat [rows 51-100]") && out.contains("gap.dat [rows 101-"), "{out}");
-    let (ok, _, err) = validated("dup.dat");
+    let (ok, _, err) = validated("stamp.dat");
     assert!(
-        !ok && err.contains("dup.dat") && err.contains("row 52") && err.contains("does not increase"),
+        !ok && err.contains("stamp.dat") && err.contains("row 52") && err.contains("does not increase"),
         "{err}"
     );
     assert!(err.contains("`time`"), "{err}");
+    // the whole row written twice: named a logger's duplicate, with its row
+    let (ok, _, err) = validated("dup.dat");
+    assert!(!ok && err.contains("dup.dat") && err.contains("row 52 repeats row 51 in every column"), "{err}");
 }
 
 /// A run at its own approach speed is re-simulated at that speed: with the true model and
