@@ -767,17 +767,7 @@ fn a_conservation_law_seen_through_noise_is_named() {
         let args = ["identify", "--data", data.to_str().unwrap(), "--states", "S,I,R", "--format", "json"];
         let (ok, out, err) = termid(&[&args[..], extra].concat());
         assert!(ok, "{err}");
-        serde_json::from_str::<serde_json::Value>(&out).unwrap()
-    };
-    let chosen = |v: &serde_json::Value| -> Vec<(String, f64)> {
-        let mut terms: Vec<(String, f64)> = v["terms"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|t| (t["term"].as_str().unwrap().to_string(), t["coefficient"].as_f64().unwrap()))
-            .collect();
-        terms.sort_by(|a, b| a.0.cmp(&b.0));
-        terms
+        crate::common::json(&out)
     };
     let found = identified(&[]);
     let notes = found["I_dot"]["notes"].to_string();
@@ -788,7 +778,7 @@ fn a_conservation_law_seen_through_noise_is_named() {
     );
     let holding = "R,R*S,I*R,R^2,R*S^2,I*R*S,R^2*S,I^2*R,I*R^2,R^3";
     let written = identified(&["--exclude", holding]);
-    let got = chosen(&written["I_dot"]);
+    let got = crate::common::chosen_terms(&written["I_dot"]);
     let names: Vec<&str> = got.iter().map(|(n, _)| n.as_str()).collect();
     assert_eq!(names, ["I", "I*S"], "{written}");
     assert!((got[0].1 + gamma).abs() < 0.01 * gamma && (got[1].1 - beta).abs() < 0.01 * beta, "{got:?}");
@@ -1676,13 +1666,7 @@ fn a_model_file_without_a_backend_keeps_every_true_term() {
     assert!(ok, "{err}");
     let fit = &json(&out)["v_dot"];
     assert_eq!(fit["backend"], "stlsq", "{out}");
-    let mut found: Vec<(String, f64)> = fit["terms"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|t| (t["term"].as_str().unwrap().to_string(), t["coefficient"].as_f64().unwrap()))
-        .collect();
-    found.sort_by(|a, b| a.0.cmp(&b.0));
+    let found = crate::common::chosen_terms(fit);
     let truth = [("F", 1.0), ("v", -0.2), ("x", -4.0)];
     assert_eq!(found.iter().map(|f| f.0.as_str()).collect::<Vec<_>>(), truth.map(|t| t.0), "{out}");
     for ((_, got), (name, want)) in found.iter().zip(truth) {
