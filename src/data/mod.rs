@@ -23,6 +23,7 @@ mod repeated;
 mod resample;
 mod savitzky_golay;
 mod search;
+mod separator;
 mod smoothing_spline;
 mod spike;
 mod stream;

@@ -8,6 +8,7 @@ use std::io::{BufRead, BufReader, Read};
 use std::ops::Range;
 use std::path::Path;
 
+use super::separator::{Blanks, Separator};
 use super::{DataError, Frame};
 
 /// Where rows come from: a file's header, then its numeric rows in order.
@@ -285,7 +286,7 @@ pub(super) fn csv_rows(path: &Path) -> Result<CsvRows<'static>, DataError> {
 /// CSV rows read as they are needed: the one CSV reader of termid (a whole file is all its
 /// rows), so a file reads the same in one piece or in chunks.
 pub(super) struct CsvRows<'a> {
-    reader: csv::Reader<LineLimit<Box<dyn Read + 'a>>>,
+    reader: csv::Reader<Box<dyn Read + 'a>>,
     /// Every column's name in the file.
     header: Vec<String>,
     /// The numeric columns: their names, and where they are in a row.
@@ -293,7 +294,8 @@ pub(super) struct CsvRows<'a> {
     keep: Vec<usize>,
     text: Vec<(String, String)>,
     origin: String,
-    semicolons: bool,
+    /// Whether a comma in a cell is a decimal comma ([`Separator::decimal_commas`]).
+    decimal_commas: bool,
     row: usize,
     record: csv::ByteRecord,
     /// The first row, read to tell text columns from numbers, is in `record`, not yet given.
@@ -306,13 +308,14 @@ pub(super) struct CsvRows<'a> {
 const MISSING: [&str; 8] = ["", "null", "NULL", "NA", "N/A", "#N/A", "None", "-"];
 
 impl<'a> CsvRows<'a> {
-    /// Reads the header. A header of semicolons and no comma is a European spreadsheet's
-    /// CSV, whose numbers may also have decimal commas.
+    /// Reads the header. Its separator ([`Separator`]) is told from the first two lines that
+    /// are neither empty nor a comment: a header of semicolons and no comma is a European
+    /// spreadsheet's CSV, whose numbers may also have decimal commas.
     pub(super) fn new(mut input: impl BufRead + 'a, origin: &str) -> Result<CsvRows<'a>, DataError> {
         let io = |e: &dyn std::fmt::Display| DataError::Io { file: origin.into(), message: e.to_string() };
-        // the first line that is neither empty nor a comment decides the delimiter
         let mut peeked = Vec::new();
-        let semicolons = loop {
+        let mut content: Vec<String> = Vec::new();
+        while content.len() < 2 {
             let mut line = Vec::new();
             let n = (&mut input)
                 .take(LONGEST_LINE as u64 + 1)
@@ -327,27 +330,37 @@ impl<'a> CsvRows<'a> {
             peeked.extend_from_slice(&line);
             let text = String::from_utf8_lossy(&line);
             let text = text.trim();
-            if n == 0 || (!text.is_empty() && !text.starts_with('#')) {
-                break text.contains(';') && !text.contains(',');
+            if n == 0 {
+                break;
             }
+            if !text.is_empty() && !text.starts_with('#') {
+                content.push(text.to_string());
+            }
+        }
+        let separator = Separator::of(
+            content.first().map_or("", String::as_str),
+            content.get(1).map_or("", String::as_str),
+        );
+        let decimal_commas = separator.decimal_commas();
+        let limited =
+            LineLimit { inner: std::io::Cursor::new(peeked).chain(input), since_newline: 0, offset: 0 };
+        let rest: Box<dyn Read + 'a> = match separator {
+            Separator::Blanks => Box::new(Blanks::new(BufReader::new(limited))),
+            _ => Box::new(limited),
         };
-        let rest: Box<dyn Read + 'a> = Box::new(std::io::Cursor::new(peeked).chain(input));
         let mut reader = csv::ReaderBuilder::new()
-            .delimiter(if semicolons { b';' } else { b',' })
+            .delimiter(separator.byte())
             // cells are trimmed where they are read as numbers, only if they need it
             .trim(csv::Trim::Headers)
             .flexible(true)
             .comment(Some(b'#'))
-            .from_reader(LineLimit { inner: rest, since_newline: 0, offset: 0 });
+            .from_reader(rest);
         let names: Vec<String> = reader.headers().map_err(|e| io(&e))?.iter().map(str::to_string).collect();
         if names.iter().all(String::is_empty) {
             return Err(DataError::NoHeader { file: origin.into() });
         }
         let refuse = |message: &str| Err(DataError::Io { file: origin.into(), message: message.into() });
-        if names.len() == 1 && names[0].contains('\t') {
-            return refuse("the header is separated by tabs: termid reads commas or semicolons; convert the file, or read it through a dataset file with `delimiter = \"whitespace\"`");
-        }
-        if names.iter().all(|n| number(n.as_bytes(), semicolons).is_some()) {
+        if names.iter().all(|n| number(n.as_bytes(), decimal_commas).is_some()) {
             return refuse("the first row holds numbers, not column names: a CSV needs a header row naming its columns (or a dataset file's `header = [...]`)");
         }
         for (i, h) in names.iter().enumerate() {
@@ -359,9 +372,18 @@ impl<'a> CsvRows<'a> {
         // left out, where a column of numbers refuses a cell that is not one, with its row
         let mut record = csv::ByteRecord::new();
         let pending = reader.read_byte_record(&mut record).map_err(|e| io(&e))?;
+        if separator == Separator::Blanks && pending && record.len() != names.len() {
+            return refuse(&format!(
+                "the columns are separated by blanks, and the header's {} names are {} readings in \
+                 the first row: a name holds a blank (`x [m]`)? Name the columns without blanks, or \
+                 read the file through a dataset file with `header = [...]`",
+                names.len(),
+                record.len()
+            ));
+        }
         let is_text = |cell: &[u8]| {
             let cell = String::from_utf8_lossy(cell.trim_ascii()).into_owned();
-            (!MISSING.contains(&cell.as_str()) && number(cell.as_bytes(), semicolons).is_none())
+            (!MISSING.contains(&cell.as_str()) && number(cell.as_bytes(), decimal_commas).is_none())
                 .then_some(cell)
         };
         let text: Vec<(usize, String)> = match pending && record.len() == names.len() {
@@ -386,7 +408,7 @@ impl<'a> CsvRows<'a> {
             text: text.into_iter().map(|(c, cell)| (names[c].clone(), cell)).collect(),
             header: names,
             origin: origin.into(),
-            semicolons,
+            decimal_commas,
             row: 0,
             record,
             pending,
@@ -422,7 +444,7 @@ impl RowSource for CsvRows<'_> {
             }
             for (k, &c) in self.keep.iter().enumerate() {
                 let cell = &self.record[c];
-                let v = number(cell, self.semicolons).ok_or_else(|| DataError::NotNumeric {
+                let v = number(cell, self.decimal_commas).ok_or_else(|| DataError::NotNumeric {
                     file: self.origin.clone(),
                     row: self.row,
                     column: self.names[k].clone(),
@@ -457,7 +479,7 @@ impl RowSource for CsvRows<'_> {
 /// Rust's own reading of text as the rule wherever the fast reader declines (`NaN`, `inf`,
 /// which the frame then refuses with their row, and anything that is not a number), in a
 /// European file a decimal comma, and a time stamp as seconds ([`super::clock_seconds`]).
-fn number(cell: &[u8], semicolons: bool) -> Option<f64> {
+fn number(cell: &[u8], decimal_commas: bool) -> Option<f64> {
     if let Ok(v) = lexical_core::parse::<f64>(cell) {
         return Some(v);
     }
@@ -468,7 +490,7 @@ fn number(cell: &[u8], semicolons: bool) -> Option<f64> {
     }
     let text = std::str::from_utf8(cell).ok()?;
     match text.parse::<f64>() {
-        Err(_) if semicolons => {
+        Err(_) if decimal_commas => {
             text.replace(',', ".").parse::<f64>().ok().or_else(|| super::clock_seconds(text))
         }
         // a logger's time stamp, in seconds (the run's time is read from its first)

@@ -341,8 +341,8 @@ fn backend_and_choose_with_a_model() {
 }
 
 /// A plain CSV as people write it: ASCII `delta` and `psi` (the model file's aliases of δ and
-/// ψ) and a European spreadsheet's semicolons with decimal commas are read as the model's
-/// names; the same run either way gives the same validation.
+/// ψ) and a European spreadsheet's semicolons with decimal commas, tabs, or blanks aligning
+/// the columns are read as the model's names; the same run either way gives the same validation.
 #[test]
 fn plain_files_with_aliases_and_semicolons() {
     let dir = crate::common::Scratch::new("plain");
@@ -376,8 +376,39 @@ fn plain_files_with_aliases_and_semicolons() {
     let (_, err) = validate(&noisy);
     assert!(err.contains("`u0 = first:u` reads one noisy sample") && err.contains("mean:u:2"), "{err}");
     let (b, _) = validate(&european);
-    let strip = |s: &str| s.lines().filter(|l| !l.contains(".csv")).collect::<Vec<_>>().join("\n");
+    let strip = |s: &str| {
+        s.lines().filter(|l| !l.contains(".csv") && !l.contains(".dat")).collect::<Vec<_>>().join("\n")
+    };
     assert_eq!(strip(&a), strip(&b));
+    // a tab-separated export, and columns aligned by blanks under a comment (a Fortran
+    // program's, `save -ascii`'s): the same run (both refused once, "convert the file")
+    let ascii_text = std::fs::read_to_string(&ascii).unwrap();
+    let tabs = dir.join("tabs.dat");
+    std::fs::write(&tabs, ascii_text.replace(',', "\t")).unwrap();
+    let aligned: Vec<String> = ascii_text
+        .lines()
+        .map(|l| l.split(',').map(|c| format!("{c:>22}")).collect::<Vec<_>>().join("  "))
+        .collect();
+    let blanks = dir.join("blanks.dat");
+    std::fs::write(&blanks, format!("# a basin's logger\n{}\n", aligned.join("\n"))).unwrap();
+    for f in [&tabs, &blanks] {
+        assert_eq!(strip(&a), strip(&validate(f).0), "{}", f.display());
+    }
+    // blanks that part names as well as columns: refused, saying so
+    let spaced = dir.join("spaced.dat");
+    std::fs::write(&spaced, "time [s]  x [m]\n0  1.5\n0.1  1.6\n").unwrap();
+    let (ok, _, err) = termid(&[
+        "identify",
+        "--data",
+        spaced.to_str().unwrap(),
+        "--target",
+        "x",
+        "--terms",
+        "1",
+        "--time",
+        "time [s]",
+    ]);
+    assert!(!ok && err.contains("separated by blanks") && err.contains("4 names are 2 readings"), "{err}");
     // the rudder in degrees in a plain file: refused with its row, pointing to a dataset file
     let mut rows: Vec<Vec<String>> = text.lines().map(|l| l.split(',').map(String::from).collect()).collect();
     let d = rows[0].iter().position(|h| h == "δ").unwrap();

@@ -394,7 +394,8 @@ fn messages_name_the_real_problem() {
         p
     };
     let tabs = w("tabs.csv", "t\tx\n0\t1\n1\t2\n");
-    refused(&["identify", "--data", s(&tabs), "--target", "dx/dt", "--terms", "x"], &["separated by tabs"]);
+    // read as tab-separated (once refused, "convert the file"): its two rows are too few
+    refused(&["identify", "--data", s(&tabs), "--target", "dx/dt", "--terms", "x"], &["2 rows are too few"]);
     let headless = w("headless.csv", "0.0,1.0\n0.1,2.0\n");
     refused(
         &["identify", "--data", s(&headless), "--target", "dx/dt", "--terms", "x"],
