@@ -61,6 +61,13 @@ fn time_like(names: Vec<String>) -> Option<String> {
 
 /// The factor to seconds of a time column whose header says another unit of time
 /// (`Time [ms]`: 0.001), as a run's time is read.
+/// The columns whose names carry a unit termid knows, read by their bare names in SI:
+/// (place, bare name, unit, factor to SI) each ([`termid::data::headers_in_si`]).
+#[pyfunction]
+fn headers_in_si(names: Vec<String>) -> Vec<(usize, String, String, f64)> {
+    termid::data::headers_in_si(&names)
+}
+
 #[pyfunction]
 fn seconds_per(name: &str) -> Option<f64> {
     termid::data::seconds_per(name).filter(|f| *f != 1.0)
@@ -98,6 +105,7 @@ fn _termid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(monte_carlo_refusal, m)?)?;
     m.add_function(wrap_pyfunction!(time_like, m)?)?;
     m.add_function(wrap_pyfunction!(seconds_per, m)?)?;
+    m.add_function(wrap_pyfunction!(headers_in_si, m)?)?;
     m.add_function(wrap_pyfunction!(listed, m)?)?;
     m.add_function(wrap_pyfunction!(interleaved, m)?)?;
     Ok(())

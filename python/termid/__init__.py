@@ -16,7 +16,8 @@ can simulate. This package calls termid's Rust library in the same process.
     ['term', 'value', 'std_error']
 
 Data is given as pandas DataFrames, dicts of numpy arrays or pyarrow Tables (columns named
-as the model's variables, SI units, angles in radians); several runs as a list of them, or a
+as the model's variables, SI units, angles in radians; a name that carries a unit termid knows,
+``x [m]``, ``psi [deg]``, is read as ``x``, ``psi`` in SI, warned); several runs as a list of them, or a
 pandas grouping of one long frame (``df.groupby("experiment")``: each value's rows a run of
 their own, named ``experiment=e1``). Errors are :class:`TermidError`
 carrying termid's located message (file, row, column, or a caret under a term).
@@ -259,7 +260,28 @@ def _columns(data: Data) -> "_Columns":
         found.times = [f.name for f in data.schema if str(f.type).startswith(("timestamp", "duration"))]
     if isinstance(data, pd.DataFrame) and found.left_out:
         _refuse_interleaved(data, found)
-    return found
+    return _in_si(found)
+
+
+def _in_si(found: "_Columns") -> "_Columns":
+    """The columns whose names carry a unit termid knows (``x [m]``, ``psi [deg]``, as
+    ``pd.read_csv`` names a logger's columns) by their bare names in SI, warned, as the command
+    line reads a file's; a time column keeps its name (``time="Time [ms]"`` reads its unit)."""
+    renamed = {i: (bare, unit, f) for i, bare, unit, f in _termid.headers_in_si(list(found))}
+    if not renamed:
+        return found
+    out = _Columns()
+    out.left_out, out.times = found.left_out, found.times
+    said = []
+    for i, (name, values) in enumerate(found.items()):
+        if i not in renamed:
+            out[name] = values
+            continue
+        bare, unit, factor = renamed[i]
+        out[bare] = values if factor == 1.0 else values * factor
+        said.append(f"`{name}` as {bare}" + ("" if factor == 1.0 else f" in SI (× {factor:.6e})"))
+    warnings.warn(f"termid: read by their bare names: {', '.join(said)}", stacklevel=_outside())
+    return out
 
 
 def _refuse_interleaved(data: pd.DataFrame, found: "_Columns") -> None:

@@ -1049,6 +1049,22 @@ def test_a_time_column_in_milliseconds_is_read_in_seconds():
     assert z_dot.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
 
 
+def test_columns_whose_names_carry_their_unit_are_read_by_their_bare_names_in_si():
+    # `pd.read_csv` of a logger's file names its columns `x [m]`: read as x, in SI, warned (a
+    # Model of x, y, z found no column `x`), as the command line reads the file itself
+    lorenz = termid.Model.builtin("lorenz")
+    run = lorenz.simulate(duration=5.0, dt=0.01)[["t", "x", "y", "z"]]
+    headed = run.assign(z=run["z"] * 3.6).rename(columns={"x": "x [m]", "y": "y [m]", "z": "z [km/h]"})
+    with pytest.warns(UserWarning, match=r"read by their bare names: `x \[m\]` as x, .*`z \[km/h\]` as z in SI") as said:
+        found = termid.Model.from_states(["x", "y", "z"]).identify(headed)
+    assert {w.filename for w in said} == {__file__}
+    z_dot = found.model.coefficients("z_dot").set_index("term")["value"]
+    assert z_dot.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
+    with pytest.warns(UserWarning, match="read by their bare names"):
+        fitted = termid.fit(headed, "dz/dt", ["x*y", "z", "x", "y"])
+    assert fitted.coefficients.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
+
+
 def test_terms_the_halves_of_a_run_do_not_choose_are_flagged():
     # Lorenz with 5 % noise on its states: the regression keeps terms the system lacks (errors
     # in the states bias the regressors) at t-values of 3.5 to 6; identified again from each

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use super::stream::Table;
+use super::stream::{RowSource, Table};
 use super::{DataError, Frame};
 
 impl Frame {
@@ -43,7 +43,7 @@ impl Frame {
     /// (`.arrow`, `.feather`, `.ipc`) with the `columnar` feature, CSV otherwise.
     /// Rows of several runs interleaved (told by a column of text) are refused, naming it.
     pub fn read(path: &Path, time: &str) -> Result<Frame, DataError> {
-        let (table, file) = (read_table(path, None)?, path.display().to_string());
+        let (table, file) = (read_plain_table(path, None)?, path.display().to_string());
         super::long::refuse_interleaved(&table, &file)?;
         Frame::from_table(table, &file, time)
     }
@@ -96,14 +96,28 @@ impl Frame {
 /// The numeric columns of a file by name, and its columns of text: columnar by its
 /// extension, else CSV text; with `by`, each row's cell of that column as its label.
 pub(super) fn read_table(path: &Path, by: Option<&str>) -> Result<Table, DataError> {
+    table_of(path, by, |rows| rows)
+}
+
+/// [`read_table`] of a plain file (not one a dataset file maps): headers that carry a unit
+/// read by their bare names in SI ([`super::units_note`]).
+pub(super) fn read_plain_table(path: &Path, by: Option<&str>) -> Result<Table, DataError> {
+    table_of(path, by, super::in_si::InSi::wrap)
+}
+
+fn table_of(
+    path: &Path,
+    by: Option<&str>,
+    read: impl Fn(Box<dyn RowSource>) -> Box<dyn RowSource>,
+) -> Result<Table, DataError> {
     let file = path.display().to_string();
     if super::stream::is_columnar(path) {
-        return super::stream::read_all(super::stream::rows_of(path)?.as_mut(), &file, by);
+        return super::stream::read_all(read(super::stream::rows_of(path)?).as_mut(), &file, by);
     }
     // read as it is parsed: the numbers in memory, not the text as well
     crate::budget::file_size(path)
         .map_err(|e| DataError::Io { file: file.clone(), message: e.to_string() })?;
-    super::stream::read_all(&mut super::stream::csv_rows(path)?, &file, by).map_err(|e| {
+    super::stream::read_all(read(Box::new(super::stream::csv_rows(path)?)).as_mut(), &file, by).map_err(|e| {
         let head = || {
             use std::io::Read;
             let mut head = Vec::new();

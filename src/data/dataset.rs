@@ -417,6 +417,17 @@ fn split_spec(spec: &str) -> (String, Option<String>, f64) {
 /// returns each such column's unit; a header whose bare name another header has keeps its
 /// whole text.
 fn bare_headers(names: &mut [String]) -> BTreeMap<String, String> {
+    let mut units = BTreeMap::new();
+    for (i, bare, unit) in unit_headers(names) {
+        names[i] = bare.clone();
+        units.insert(bare, unit);
+    }
+    units
+}
+
+/// The headers that carry their unit (`x [m]`, `ψ (deg)`): each one's place, bare name and
+/// unit, where no other header has its bare name (`x [m]` beside an `x` is a name of its own).
+fn unit_headers(names: &[String]) -> Vec<(usize, String, String)> {
     let split: Vec<Option<(String, String)>> = names
         .iter()
         .map(|n| match split_spec(n) {
@@ -430,17 +441,24 @@ fn bare_headers(names: &mut [String]) -> BTreeMap<String, String> {
             .enumerate()
             .any(|(i, n)| i != own && (n == bare || split[i].as_ref().is_some_and(|(b, _)| b == bare)))
     };
-    let renames: Vec<(usize, String, String)> = split
+    split
         .iter()
         .enumerate()
         .filter_map(|(i, s)| s.clone().filter(|(bare, _)| !taken(bare, i)).map(|(b, u)| (i, b, u)))
-        .collect();
-    let mut units = BTreeMap::new();
-    for (i, bare, unit) in renames {
-        names[i] = bare.clone();
-        units.insert(bare, unit);
-    }
-    units
+        .collect()
+}
+
+/// A plain file's headers read by their bare names in SI, as a dataset file maps them: each
+/// one's place, bare name, unit and factor to SI. Only units termid knows, and none of time:
+/// a time column keeps its header, whose unit the time is read in ([`in_seconds`]).
+pub fn headers_in_si(names: &[String]) -> Vec<(usize, String, String, f64)> {
+    unit_headers(names)
+        .into_iter()
+        .filter_map(|(i, bare, unit)| {
+            let (_, f, dims) = UNITS.iter().find(|(n, _, _)| *n == unit)?;
+            (*dims != [0, 1, 0]).then_some((i, bare, unit, *f))
+        })
+        .collect()
 }
 
 /// A mapping's column, unit and sign, the unit from the file's header where the mapping

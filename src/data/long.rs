@@ -21,7 +21,7 @@ impl Frame {
                 message: format!("`{by}` is the time column: the runs are told apart by a column that names each row's run"),
             });
         }
-        let table = super::csv_io::read_table(path, Some(by))?;
+        let table = super::csv_io::read_plain_table(path, Some(by))?;
         let (parts, note) = split(table, by, &file)?;
         let runs = parts
             .into_iter()
@@ -154,7 +154,7 @@ fn rows_of_each(labels: &[u32], values: usize) -> Vec<Vec<usize>> {
 /// The columns of numbers in the file `path`, the time among them, as its header has them
 /// (what a model made from the file's columns may name).
 pub fn columns_of(path: &Path) -> Result<Vec<String>, DataError> {
-    Ok(super::stream::rows_of(path)?.names().to_vec())
+    Ok(super::in_si::InSi::wrap(super::stream::rows_of(path)?).names().to_vec())
 }
 
 /// The columns of text in the file `path` (a run's label, a mode: what the runs of a file

@@ -14,6 +14,7 @@ mod derivative;
 mod five_point;
 mod geodetic;
 mod hold;
+mod in_si;
 mod integral;
 mod kalman;
 mod long;
@@ -34,7 +35,8 @@ pub use angle::{laid_on_turns, turn_of, unwrap_turns, unwrapped, unwrapped_dials
 pub use breaks::{breaks, cut_at_breaks, cut_at_gaps, gaps, moving_breaks, Break, Gaps};
 pub use clock::{clock_seconds, epoch_note};
 pub use dataset::{
-    from_seconds, in_seconds, seconds_per, velocities_from_track, Dataset, Delimiter, RunSpec, Track,
+    from_seconds, headers_in_si, in_seconds, seconds_per, velocities_from_track, Dataset, Delimiter, RunSpec,
+    Track,
 };
 pub use delay::delayed;
 pub use derivative::{
@@ -43,6 +45,7 @@ pub use derivative::{
 pub use five_point::FivePoint;
 pub use geodetic::{north_east, radii_of_curvature};
 pub use hold::{held, mark_held, stepped, switches, white, Hold, Intersample};
+pub use in_si::units_note;
 pub use integral::{integral_rows, integral_rows_held, row_overlap, IntegralForm};
 pub use kalman::{KalmanSmoother, NoiseModel};
 pub use long::{columns_of, interleaved, text_columns_of};

@@ -110,9 +110,16 @@ pub struct Chunks {
 impl Chunks {
     /// The run in `path` (CSV text, or Parquet / Arrow IPC by the extension) in chunks of
     /// `size` rows, each with `context` rows of its neighbours on either side; `time` names
-    /// the time column.
+    /// the time column. Headers that carry a unit are read by their bare names in SI
+    /// ([`super::units_note`]).
     pub fn open(path: &Path, time: &str, size: usize, context: usize) -> Result<Chunks, DataError> {
-        Chunks::new(rows_of(path)?, &path.display().to_string(), time, size, context)
+        Chunks::new(
+            super::in_si::InSi::wrap(rows_of(path)?),
+            &path.display().to_string(),
+            time,
+            size,
+            context,
+        )
     }
 
     /// Chunks of rows from any source.

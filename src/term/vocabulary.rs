@@ -95,12 +95,13 @@ impl Vocabulary {
     fn check_new(&self, name: &str) -> Result<String, TermError> {
         let name = normalise_name(name);
         if !is_identifier(&name) {
-            // a column header that carries its unit: a dataset file reads it by its bare name
+            // a column header that carries its unit: plain files and dataset files read it by
+            // its bare name
             let hint = match name.split_once('[') {
                 Some((bare, unit)) if unit.ends_with(']') && is_identifier(bare.trim()) => format!(
-                    " (a header with its unit: map it in a dataset file, `[columns] {} = \"{name}\"`, \
-                     which reads it by its bare name in SI)",
-                    bare.trim()
+                    " (a header with its unit: a file's column `{name}` is read as `{bare}` in SI, a \
+                     dataset file's by `[columns] {bare} = \"{name}\"`)",
+                    bare = bare.trim()
                 ),
                 _ => {
                     // `x.pos`, `y pos`, `z-pos`: the same with `_`, where that makes a name
@@ -370,9 +371,9 @@ mod tests {
     }
 
     #[test]
-    fn a_header_with_its_unit_is_pointed_to_a_dataset_file() {
+    fn a_header_with_its_unit_is_pointed_to_its_bare_name() {
         let e = Vocabulary::new().variable("x [m]").map(|_| ()).unwrap_err().to_string();
-        assert!(e.contains("`[columns] x = \"x [m]\"`"), "{e}");
+        assert!(e.contains("is read as `x` in SI") && e.contains("`[columns] x = \"x [m]\"`"), "{e}");
         let e = Vocabulary::new().variable("x y").map(|_| ()).unwrap_err().to_string();
         assert!(e.contains("`x y` is not a valid name") && e.contains("call it `x_y`"), "{e}");
         let e = Vocabulary::new().variable("x.pos").map(|_| ()).unwrap_err().to_string();

@@ -2058,11 +2058,24 @@ fn a_whole_system_from_its_columns() {
             && err.contains("`timestamp [ms]`"),
         "{err}"
     );
-    // a state's header that carries its unit is named, with the dataset file that reads it
-    let headed = std::fs::read_to_string(&data).unwrap().replacen("t,x,", "t,x [m],", 1);
-    std::fs::write(dir.join("headed.csv"), headed).unwrap();
-    let (ok, _, err) = termid(&["identify", "--data", &p("headed.csv"), "--states", "x,v"]);
-    assert!(!ok && err.contains("`x [m]` carries its unit") && err.contains("x = \"x [m]\""), "{err}");
+    // headers that carry their unit are read by their bare names in SI, as a dataset file
+    // maps them (once refused, "map it in a dataset file"): the velocity in km/h
+    let run = std::fs::read_to_string(&data).unwrap();
+    let mut headed = String::from("t,x [m],v [km/h],F\n");
+    for line in run.lines().skip(1) {
+        let cells: Vec<f64> = line.split(',').map(|c| c.parse().unwrap()).collect();
+        headed += &format!("{},{},{},{}\n", cells[0], cells[1], 3.6 * cells[2], cells[3]);
+    }
+    std::fs::write(dir.join("headed.csv"), &headed).unwrap();
+    let (ok, out, err) =
+        termid(&["identify", "--data", &p("headed.csv"), "--states", "x,v", "--format", "json"]);
+    assert!(ok && err.contains("`x [m]` as x, `v [km/h]` as v in SI (× 2.777778e-1)"), "{err}");
+    let rate = json(&out)["x_dot"]["terms"][0]["coefficient"].as_f64().unwrap();
+    assert!((rate - 1.0).abs() < 1e-4, "{out}");
+    // a unit termid does not know is named
+    std::fs::write(dir.join("furlongs.csv"), headed.replacen("x [m]", "x [furlong]", 1)).unwrap();
+    let (ok, _, err) = termid(&["identify", "--data", &p("furlongs.csv"), "--states", "x,v"]);
+    assert!(!ok && err.contains("`x [furlong]` carries a unit termid does not read"), "{err}");
 }
 
 /// Equations whose rates fit the rows may still run away when integrated: Lotka-Volterra

@@ -26,6 +26,7 @@ pub fn run(cmd: MomentsCommand) -> Result<()> {
                 .iter()
                 .map(|p| Chunks::open(p, &model.spec().model.time, cmd.chunk_rows, 2 * reach + 2))
                 .collect::<Result<Vec<_>, _>>()?;
+            cmd.data.iter().filter_map(|p| termid::data::units_note(p)).for_each(|n| crate::runs::say(&n));
             let (moments, notes) = EquationMoments::of_chunks(&model, &cmd.equation, runs, diff.as_ref())?;
             for n in notes {
                 crate::runs::say(&n);

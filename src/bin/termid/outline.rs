@@ -19,13 +19,15 @@ pub fn model(cmd: &IdentifyCommand) -> Result<Model> {
     }
     let column = |name: &str, flag: &str| -> Result<()> {
         if !columns.iter().any(|c| c == name) {
-            // a header that carries its unit (`x [m]`, as loggers export it) is named by a
-            // dataset file, which reads the unit too
+            // a header that carries a unit termid reads is read by its bare name already: this
+            // one's is not known
             let headed = columns
                 .iter()
                 .find(|c| c.strip_prefix(name).is_some_and(|rest| rest.trim_start().starts_with(['[', '('])));
             let hint = headed.map_or_else(String::new, |c| {
-                format!("; `{c}` carries its unit: map it in a dataset file (`[columns] {name} = \"{c}\"`, read in SI units)")
+                format!(
+                    "; `{c}` carries a unit termid does not read: write the column in SI units as `{name}`"
+                )
             });
             bail!("{flag}: `{name}` is not a column of {first} (its columns: {}){hint}", columns.join(", "));
         }

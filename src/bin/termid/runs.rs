@@ -258,6 +258,9 @@ pub fn load(data: &[PathBuf], by: Option<&str>, datasets: &[PathBuf], time: &str
     check_once(&input_files(data, datasets))?;
     let mut frames = Vec::new();
     for path in data {
+        if let Some(note) = termid::data::units_note(path) {
+            say(&note);
+        }
         let runs = match by {
             Some(by) => {
                 let (runs, note) = Frame::read_by(path, time, by)?;

@@ -1,0 +1,122 @@
+//! A plain file's columns whose headers carry a unit termid knows (`x [m]`, `ψ [deg]`, `u
+//! (kn)`, as loggers and spreadsheets export them), read by their bare names in SI units and
+//! radians, as a dataset file maps them. A time column keeps its header: its unit of time is
+//! read where the time is ([`super::in_seconds`]), so `--time "Time [ms]"` names it.
+
+use std::path::Path;
+
+use super::stream::{rows_of, Labels, RowSource};
+use super::DataError;
+
+/// A source whose unit-carrying columns are renamed to their bare names and scaled to SI.
+pub(super) struct InSi {
+    inner: Box<dyn RowSource>,
+    names: Vec<String>,
+    /// Each column's factor to SI (1 where its header carries no unit).
+    factors: Vec<f64>,
+}
+
+impl InSi {
+    /// `inner` with its unit-carrying columns in SI; `inner` itself where it has none.
+    pub(super) fn wrap(inner: Box<dyn RowSource>) -> Box<dyn RowSource> {
+        let renamed = super::dataset::headers_in_si(inner.names());
+        if renamed.is_empty() {
+            return inner;
+        }
+        let mut names = inner.names().to_vec();
+        let mut factors = vec![1.0; names.len()];
+        for (i, bare, _, f) in renamed {
+            names[i] = bare;
+            factors[i] = f;
+        }
+        Box::new(InSi { inner, names, factors })
+    }
+
+    /// The header a name of this source has in the file.
+    fn header<'a>(&'a self, name: &'a str) -> &'a str {
+        self.names.iter().position(|n| n == name).map_or(name, |i| &self.inner.names()[i])
+    }
+}
+
+impl RowSource for InSi {
+    fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    fn read(&mut self, max: usize, columns: &mut [Vec<f64>]) -> Result<usize, DataError> {
+        let n = self.inner.read(max, columns)?;
+        for (column, &f) in columns.iter_mut().zip(&self.factors).filter(|(_, f)| **f != 1.0) {
+            let from = column.len() - n;
+            column[from..].iter_mut().for_each(|v| *v *= f);
+        }
+        Ok(n)
+    }
+
+    fn text(&self) -> &[(String, String)] {
+        self.inner.text()
+    }
+
+    fn label_by(&mut self, name: &str) -> bool {
+        let header = self.header(name).to_string();
+        self.inner.label_by(&header)
+    }
+
+    fn take_labels(&mut self) -> Vec<(String, Labels)> {
+        let labels = self.inner.take_labels();
+        let bare = |header: String| match self.inner.names().iter().position(|n| *n == header) {
+            Some(i) => self.names[i].clone(),
+            None => header,
+        };
+        labels.into_iter().map(|(header, l)| (bare(header), l)).collect()
+    }
+}
+
+/// What reading the plain file `path` in SI does to its columns' headers, to be said: `None`
+/// where no header carries a unit termid reads (or the file cannot be read: reading it says why).
+pub fn units_note(path: &Path) -> Option<String> {
+    let names = rows_of(path).ok()?.names().to_vec();
+    let renamed = super::dataset::headers_in_si(&names);
+    let read: Vec<String> = renamed
+        .iter()
+        .map(|(i, bare, _, f)| match *f == 1.0 {
+            true => format!("`{}` as {bare}", names[*i]),
+            false => format!("`{}` as {bare} in SI (× {f:.6e})", names[*i]),
+        })
+        .collect();
+    (!read.is_empty()).then(|| format!("{}: read by their bare names: {}", path.display(), read.join(", ")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn headers_with_units_are_read_by_their_bare_names_in_si() {
+        let dir = std::env::temp_dir().join(format!("termid-in-si-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("run.csv");
+        // a time in ms keeps its header; `v` beside `v [kn]` keeps both whole
+        std::fs::write(
+            &path,
+            "Time [ms],x [m],psi (deg),u [kn],v,v [kn],run\n0,1,90,1,0,2,a\n500,2,180,2,0,4,a\n",
+        )
+        .unwrap();
+        let mut rows = InSi::wrap(rows_of(&path).unwrap());
+        assert_eq!(rows.names(), ["Time [ms]", "x", "psi", "u", "v", "v [kn]"]);
+        assert!(rows.label_by("run"));
+        let mut columns = vec![Vec::new(); 6];
+        while rows.read(1, &mut columns).unwrap() > 0 {}
+        assert_eq!(columns[0], [0.0, 500.0]);
+        assert_eq!(columns[1], [1.0, 2.0]);
+        assert_eq!(columns[2], [std::f64::consts::FRAC_PI_2, std::f64::consts::PI]);
+        assert_eq!(columns[3], [1852.0 / 3600.0, 2.0 * 1852.0 / 3600.0]);
+        assert_eq!(columns[5], [2.0, 4.0]);
+        assert_eq!(rows.take_labels()[0].1.values, ["a"]);
+        let note = units_note(&path).unwrap();
+        assert!(note.contains("`x [m]` as x, `psi (deg)` as psi in SI (× 1.745329e-2)"), "{note}");
+        assert!(!note.contains("Time") && !note.contains("`v [kn]`"), "{note}");
+        std::fs::write(&path, "t,x\n0,1\n").unwrap();
+        assert!(units_note(&path).is_none());
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
