@@ -52,10 +52,12 @@ pub fn rivals(problem: &Problem<'_>, selection: &Selection) -> Vec<Rival> {
         let rest: Vec<usize> = set.iter().enumerate().filter(|&(i, _)| i != k).map(|(_, &c)| c).collect();
         let Ok(a) = scaled.swept(&rest, PIVOT) else { continue };
         let base = scaled.residual_share(&a);
-        // sweeping one more column c lowers the residual share by a_cp² / a_cc
+        // sweeping one more column c lowers the residual share by a_cp² / a_cc; a candidate
+        // that is a combination of the chosen terms (`F*x` where F = 1 in every run) fits as
+        // they do by construction, and its rise is rounding alone: no rival
         let best = rivals
             .iter()
-            .filter(|&&c| a[c * m + c] > PIVOT)
+            .filter(|&&c| a[c * m + c] > PIVOT && full[c * m + c] > PIVOT)
             .map(|&c| (c, base - a[c * m + p].powi(2) / a[c * m + c]))
             .min_by(|x, y| x.1.total_cmp(&y.1));
         if let Some((c, share)) = best {
@@ -129,5 +131,33 @@ mod tests {
         let s = rivals(&forced, &selection);
         assert_eq!(s.len(), 1);
         assert_eq!(rival(&s, "x1").instead, "x3");
+    }
+
+    /// A candidate that is a chosen term over again (`F*x` where F = 1 in every run) fits
+    /// exactly as it does: no rival, where rounding alone made it "fit clearly better" by
+    /// fifteen residual variances of a noise-free fit.
+    #[test]
+    fn a_chosen_term_over_again_is_no_rival() {
+        let n = 200;
+        let x: Vec<f64> = (0..n).map(|i| (0.1 * i as f64).sin()).collect();
+        let v: Vec<f64> = (0..n).map(|i| (0.23 * i as f64).cos()).collect();
+        let w: Vec<f64> = (0..n).map(|i| (0.05 * i as f64).powi(2)).collect();
+        let y: Vec<f64> = (0..n).map(|i| -4.0 * x[i] - 0.2 * v[i]).collect();
+        let columns: Vec<f64> = [&x, &v, &x, &w].iter().flat_map(|c| c.iter().copied()).collect();
+        let moments = Moments::of_columns(&columns, &y, None);
+        let names = ["x", "v", "F*x", "w"].map(String::from).to_vec();
+        let problem =
+            Problem { moments: &moments, names: &names, forced: &[], excluded: &[], intercept: false };
+        let term = |i: usize| FittedTerm {
+            term: names[i].clone(),
+            index: i,
+            coefficient: 0.0,
+            std_error: 1.0,
+            t: 0.0,
+        };
+        let selection =
+            Selection { terms: vec![term(0), term(1)], ..Stepwise::default().select(&problem).unwrap() };
+        let s = rivals(&problem, &selection);
+        assert!(s.iter().all(|r| r.instead == "w"), "{s:?}");
     }
 }
