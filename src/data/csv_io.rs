@@ -200,6 +200,17 @@ mod tests {
         assert!(e.contains("row 2") && e.contains("does not increase"), "{e}");
         let e = Frame::parse_csv("t,u\n0,1\n0.1,2\n0.1,2\n0.2,3\n", "a.csv", "t").unwrap_err().to_string();
         assert_eq!(e, "a.csv: row 3 repeats row 2 in every column, its time too (a logger's duplicate): drop it (pandas' `df.drop_duplicates()`)");
+        // a stamp repeated is no run starting again
+        let e = Frame::parse_csv("t,u\n0,1\n0,2\n", "a.csv", "t").unwrap_err().to_string();
+        assert!(!e.contains("starts again"), "{e}");
+        // rows at 100 Hz, their time written to 0.1 s: said as such, not as runs that start again
+        let rows: String = (0..40).map(|i| format!("{:.1},{}\n", 0.01 * i as f64, i)).collect();
+        let e = Frame::parse_csv(&format!("t,u\n{rows}"), "a.csv", "t").unwrap_err().to_string();
+        assert!(
+            e.contains("row 2, column `t`: time 0 repeats the row before's, as 35 of the 40 rows do")
+                && e.contains("written to 0.100 s where the rows come every 0.0103 s"),
+            "{e}"
+        );
         assert!(matches!(Frame::parse_csv("t,u\n", "a.csv", "t"), Err(DataError::Empty { .. })));
         assert!(matches!(Frame::parse_csv("", "a.csv", "t"), Err(DataError::NoHeader { .. })));
         // without time: the file's own cells counted, no column of termid's own named

@@ -192,6 +192,24 @@ pub enum DataError {
         /// It goes back to the first row's time or before (a run that follows another).
         restart: bool,
     },
+    /// A time printed too coarsely for its rows: many rows share each stamp, and it never
+    /// decreases (a logger at 100 Hz writing its time to 0.1 s).
+    #[error("{file}: row {row}, column `{column}`: time {this} repeats the row before's, as {counted}, and it never decreases: it is written to {interval}; write the time with more digits (or as the row's number times the sampling interval)")]
+    CoarseTime {
+        /// The file.
+        file: String,
+        /// 1-based data row of the first repeat.
+        row: usize,
+        /// The time column.
+        column: String,
+        /// That row's time.
+        this: f64,
+        /// How many rows repeat their predecessor's time, of how many, said.
+        counted: String,
+        /// The smallest step between stamps (the time's last digit) and the rows' mean
+        /// interval, said.
+        interval: String,
+    },
     /// A row that repeats the one before in every column (a logger's duplicate).
     #[error("{file}: row {row} repeats row {} in every column, its time too (a logger's duplicate): drop it (pandas' `df.drop_duplicates()`)", row - 1)]
     RepeatedRow {
@@ -353,6 +371,9 @@ impl DataError {
                 DataError::TimeNotIncreasing { file, row: file_row(row), column, this, previous, restart }
             }
             DataError::RepeatedRow { file, row } => DataError::RepeatedRow { file, row: file_row(row) },
+            DataError::CoarseTime { file, row, column, this, counted, interval } => {
+                DataError::CoarseTime { file, row: file_row(row), column, this, counted, interval }
+            }
             DataError::Unit { file, row, column, message } if row > 0 => {
                 DataError::Unit { file, row: file_row(row), column, message }
             }
@@ -457,13 +478,17 @@ impl Frame {
         self.check(name, &values)?;
         if self.columns.is_empty() {
             if let Some(i) = (1..values.len()).find(|&i| values[i] <= values[i - 1]) {
+                if let Some(coarse) = coarse_time(&self.origin, name, &values) {
+                    return Err(coarse);
+                }
                 return Err(DataError::TimeNotIncreasing {
                     file: self.origin.clone(),
                     row: i + 1,
                     column: name.into(),
                     this: values[i],
                     previous: values[i - 1],
-                    restart: values[i] <= values[0],
+                    // a repeated stamp is no restart; a time back at the first row's is
+                    restart: values[i] < values[i - 1] && values[i] <= values[0],
                 });
             }
         }
@@ -769,6 +794,42 @@ impl Frame {
             text: self.text.clone(),
         }
     }
+}
+
+/// Rows that repeat their predecessor's time in at least this share of a time that never
+/// decreases are a time written too coarsely, not a logger's odd duplicate.
+const COARSE_SHARE: f64 = 0.25;
+
+/// The refusal of a time written too coarsely for its rows ([`DataError::CoarseTime`]): it
+/// never decreases and at least [`COARSE_SHARE`] of its rows (three at least) repeat the row
+/// before's. A
+/// repeated stamp read as a run that starts again sent the user looking for runs.
+fn coarse_time(file: &str, column: &str, t: &[f64]) -> Option<DataError> {
+    let steps = t.windows(2).map(|w| w[1] - w[0]);
+    if steps.clone().any(|d| d < 0.0) {
+        return None;
+    }
+    let repeats = steps.clone().filter(|d| *d == 0.0).count();
+    if repeats < 3 || (repeats as f64) < COARSE_SHARE * (t.len() - 1) as f64 {
+        return None;
+    }
+    let first = t.windows(2).position(|w| w[1] == w[0])?;
+    // the difference of two stamps carries their rounding: 0.09999999999999998 for 0.1
+    let printed = steps.filter(|d| *d > 0.0).fold(f64::INFINITY, f64::min);
+    let printed = format!("{printed:.5e}").parse().unwrap_or(printed);
+    let every = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
+    Some(DataError::CoarseTime {
+        file: file.into(),
+        row: first + 2,
+        column: column.into(),
+        this: t[first + 1],
+        counted: format!("{repeats} of the {} rows do", t.len()),
+        interval: format!(
+            "{} s where the rows come every {} s on average",
+            crate::output::sig(printed, 3),
+            crate::output::sig(every, 3)
+        ),
+    })
 }
 
 #[cfg(test)]
