@@ -49,8 +49,39 @@ pub fn clock_seconds(text: &str) -> Option<f64> {
             return Some(epoch_seconds(utc.timestamp(), utc.timestamp_subsec_nanos()));
         }
     }
-    let at = NaiveTime::parse_from_str(text, "%H:%M:%S%.f").ok()?;
+    time_of_day(text)
+}
+
+/// The seconds since midnight of a stamp that is a time of day alone (`23:59:59.980`, no
+/// date): such a clock starts again at midnight, which its reader counts on.
+pub(super) fn time_of_day(text: &str) -> Option<f64> {
+    let at = NaiveTime::parse_from_str(text.trim(), "%H:%M:%S%.f").ok()?;
     Some(f64::from(at.num_seconds_from_midnight()) + f64::from(at.nanosecond()) * 1e-9)
+}
+
+/// A day in seconds.
+const DAY: f64 = 86_400.0;
+
+/// A column of times of day read on past midnight: each reading's seconds since the first
+/// reading's midnight, a day added wherever the clock falls back by over half a day (a log
+/// over midnight read `23:59:59.99` then `00:00:00.00`, which refused it as a run starting
+/// again).
+#[derive(Clone, Debug, Default)]
+pub(super) struct Midnights {
+    last: Option<f64>,
+    days: f64,
+}
+
+impl Midnights {
+    /// `seconds` since midnight as seconds since the first reading's midnight.
+    pub(super) fn read_on(&mut self, seconds: f64) -> f64 {
+        if self.last.is_some_and(|last| seconds + self.days < last - DAY / 2.0) {
+            self.days += DAY;
+        }
+        let on = seconds + self.days;
+        self.last = Some(on);
+        on
+    }
 }
 
 fn epoch_seconds(whole: i64, nanos: u32) -> f64 {

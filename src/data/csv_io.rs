@@ -200,6 +200,12 @@ mod tests {
         assert!(e.contains("row 2") && e.contains("does not increase"), "{e}");
         let e = Frame::parse_csv("t,u\n0,1\n0.1,2\n0.1,2\n0.2,3\n", "a.csv", "t").unwrap_err().to_string();
         assert_eq!(e, "a.csv: row 3 repeats row 2 in every column, its time too (a logger's duplicate): drop it (pandas' `df.drop_duplicates()`)");
+        // a clock of the time of day read on past midnight (it was a run starting again); one
+        // that falls back by an hour is refused still
+        let f = Frame::parse_csv("t,u\n23:59:59.5,1\n00:00:00.0,2\n00:00:00.5,3\n", "a.csv", "t").unwrap();
+        assert_eq!(f.time(), [86_399.5, 86_400.0, 86_400.5]);
+        let e = Frame::parse_csv("t,u\n10:00:00,1\n09:00:00,2\n", "a.csv", "t").unwrap_err().to_string();
+        assert!(e.contains("row 2") && e.contains("does not increase"), "{e}");
         // a stamp repeated is no run starting again
         let e = Frame::parse_csv("t,u\n0,1\n0,2\n", "a.csv", "t").unwrap_err().to_string();
         assert!(!e.contains("starts again"), "{e}");

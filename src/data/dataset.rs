@@ -219,8 +219,9 @@ pub fn velocities_from_earth_fixed(x_dot: &[f64], y_dot: &[f64], heading: &[f64]
 }
 
 /// Time stamps replaced by their least-squares line over the row number. Refused (with the
-/// row) where a stamp lies further from the line than rounding to three significant digits
-/// or two sample intervals explain: a dropout or a change of rate, not rounding.
+/// row) where a stamp lies further from the line than rounding (to three significant digits,
+/// or to the stamps' own last digit: a 100 Hz logger's time to 0.1 s) and two sample
+/// intervals explain: a dropout or a change of rate, not rounding.
 pub fn regular_time(t: &[f64], origin: &str, column: &str) -> Result<(Vec<f64>, f64), DataError> {
     let n = t.len();
     if n < 3 {
@@ -250,8 +251,11 @@ pub fn regular_time(t: &[f64], origin: &str, column: &str) -> Result<(Vec<f64>, 
             message: "regular_time: the time stamps do not increase along the rows".into(),
         });
     }
+    // the stamps' last digit: their smallest step
+    let digit = t.windows(2).map(|w| w[1] - w[0]).filter(|d| *d > 0.0).fold(f64::INFINITY, f64::min);
+    let rounding = if digit.is_finite() { 0.5 * digit } else { 0.0 };
     for (k, (v, l)) in t.iter().zip(&line).enumerate() {
-        if (v - l).abs() > 0.005 * v.abs() + 2.0 * step {
+        if (v - l).abs() > 0.005 * v.abs() + rounding + 2.0 * step {
             return Err(DataError::Unit {
                 file: origin.into(),
                 row: k + 1,
@@ -1357,6 +1361,10 @@ skip = 3
         }
         let e = regular_time(&t, "f.dat", "time").unwrap_err().to_string();
         assert!(e.contains("f.dat") && e.contains("dropout"), "{e}");
+        // a 100 Hz logger's time written to 0.1 s (off by up to 0.05 s: five samples) is rounding
+        let t: Vec<f64> = (0..2000).map(|k| (0.1 * k as f64).round() / 10.0).collect();
+        let (line, step) = regular_time(&t, "f.dat", "time").unwrap();
+        assert!((step - 0.01).abs() < 1e-5 && (line[1999] - 19.99).abs() < 0.01, "{step} {}", line[1999]);
         std::fs::remove_dir_all(&dir).ok();
     }
 

@@ -194,7 +194,7 @@ pub enum DataError {
     },
     /// A time printed too coarsely for its rows: many rows share each stamp, and it never
     /// decreases (a logger at 100 Hz writing its time to 0.1 s).
-    #[error("{file}: row {row}, column `{column}`: time {this} repeats the row before's, as {counted}, and it never decreases: it is written to {interval}; write the time with more digits (or as the row's number times the sampling interval)")]
+    #[error("{file}: row {row}, column `{column}`: time {this} repeats the row before's, as {counted}, and it never decreases: it is written to {interval}; write the time with more digits, or read the file through a dataset file with `regular_time = true` (the stamps' line over the row number)")]
     CoarseTime {
         /// The file.
         file: String,

@@ -8,6 +8,7 @@ use std::io::{BufRead, BufReader, Read};
 use std::ops::Range;
 use std::path::Path;
 
+use super::clock::Midnights;
 use super::separator::{Blanks, Separator};
 use super::{DataError, Frame};
 
@@ -303,6 +304,8 @@ pub(super) struct CsvRows<'a> {
     origin: String,
     /// Whether a comma in a cell is a decimal comma ([`Separator::decimal_commas`]).
     decimal_commas: bool,
+    /// For each numeric column of times of day, the midnights it has passed.
+    midnights: Vec<Option<Midnights>>,
     row: usize,
     record: csv::ByteRecord,
     /// The first row, read to tell text columns from numbers, is in `record`, not yet given.
@@ -408,8 +411,21 @@ impl<'a> CsvRows<'a> {
         };
         let keep: Vec<usize> =
             (0..names.len()).filter(|&c| !text.iter().any(|(t, _)| *t == c) && !unnamed_blank(c)).collect();
+        // columns of times of day (their first cell one) read on past midnight
+        let midnights = keep
+            .iter()
+            .map(|&c| {
+                (pending
+                    && record
+                        .get(c)
+                        .and_then(|cell| std::str::from_utf8(cell).ok())
+                        .is_some_and(|cell| super::clock::time_of_day(cell).is_some()))
+                .then(Midnights::default)
+            })
+            .collect();
         Ok(CsvRows {
             reader,
+            midnights,
             names: keep.iter().map(|&c| names[c].clone()).collect(),
             keep,
             text: text.into_iter().map(|(c, cell)| (names[c].clone(), cell)).collect(),
@@ -457,7 +473,10 @@ impl RowSource for CsvRows<'_> {
                     column: self.names[k].clone(),
                     cell: String::from_utf8_lossy(cell.trim_ascii()).into(),
                 })?;
-                columns[k].push(v);
+                columns[k].push(match &mut self.midnights[k] {
+                    Some(clock) => clock.read_on(v),
+                    None => v,
+                });
             }
             for (c, _, labels) in &mut self.labels {
                 labels.push(&String::from_utf8_lossy(self.record[*c].trim_ascii()));
