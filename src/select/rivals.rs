@@ -91,6 +91,20 @@ mod tests {
         rivals.iter().find(|s| s.chosen == chosen).unwrap()
     }
 
+    /// The candidates at `indices` as a selection's terms (rivals compare sets, not values).
+    fn chosen(names: &[String], indices: &[usize]) -> Vec<FittedTerm> {
+        indices
+            .iter()
+            .map(|&i| FittedTerm {
+                term: names[i].clone(),
+                index: i,
+                coefficient: 0.0,
+                std_error: 1.0,
+                t: 0.0,
+            })
+            .collect()
+    }
+
     /// Hald's cement, against the residual sums of squares of its pairs in Draper & Smith
     /// (Applied Regression Analysis, 1998, §15): {x1, x2} 57.90, {x1, x4} 74.76, {x3, x4}
     /// 175.74, {x2, x3} 415.44 (n − 3 = 10 degrees of freedom).
@@ -111,14 +125,7 @@ mod tests {
         assert_eq!(x1.instead, "x3");
         assert!((x1.rise - (175.74 - 74.76) / (74.76 / 10.0)).abs() < 2e-3, "{x1:?}");
         // {x1, x2}: x2 could as well be x4, within three residual variances
-        let term = |i: usize| FittedTerm {
-            term: names[i].clone(),
-            index: i,
-            coefficient: 0.0,
-            std_error: 1.0,
-            t: 0.0,
-        };
-        selection.terms = vec![term(0), term(1)];
+        selection.terms = chosen(&names, &[0, 1]);
         let s = rivals(&problem, &selection);
         let x2 = rival(&s, "x2");
         assert_eq!(x2.instead, "x4");
@@ -148,15 +155,8 @@ mod tests {
         let names = ["x", "v", "F*x", "w"].map(String::from).to_vec();
         let problem =
             Problem { moments: &moments, names: &names, forced: &[], excluded: &[], intercept: false };
-        let term = |i: usize| FittedTerm {
-            term: names[i].clone(),
-            index: i,
-            coefficient: 0.0,
-            std_error: 1.0,
-            t: 0.0,
-        };
         let selection =
-            Selection { terms: vec![term(0), term(1)], ..Stepwise::default().select(&problem).unwrap() };
+            Selection { terms: chosen(&names, &[0, 1]), ..Stepwise::default().select(&problem).unwrap() };
         let s = rivals(&problem, &selection);
         assert!(s.iter().all(|r| r.instead == "w"), "{s:?}");
     }
