@@ -42,10 +42,15 @@ impl Separator {
         }
     }
 
-    /// Whether a comma inside a cell is a decimal comma: wherever it cannot be a separator,
-    /// as a spreadsheet set to a European language writes numbers.
-    pub(super) fn decimal_commas(self) -> bool {
-        self != Separator::Comma
+    /// Whether a comma inside a cell is a decimal comma, as a spreadsheet set to a European
+    /// language writes numbers: always with semicolons; with tabs or blanks where the first
+    /// row `row` has commas and no point (else `1,234` may be a thousand and more).
+    pub(super) fn decimal_commas(self, row: &str) -> bool {
+        match self {
+            Separator::Comma => false,
+            Separator::Semicolon => true,
+            Separator::Tab | Separator::Blanks => row.contains(',') && !row.contains('.'),
+        }
     }
 }
 
@@ -108,6 +113,12 @@ mod tests {
         // one column, its name with a blank: nothing to split
         assert_eq!(Separator::of("x [m]", "1.5"), Separator::Comma);
         assert_eq!(Separator::of("x", ""), Separator::Comma);
+        // decimal commas where a comma cannot part cells and no point says otherwise
+        assert!(Separator::Semicolon.decimal_commas("1.5;2"));
+        assert!(Separator::Tab.decimal_commas("0,5\t1,25"));
+        assert!(!Separator::Tab.decimal_commas("1,234.5\t2"));
+        assert!(!Separator::Blanks.decimal_commas("0.5  1.25"));
+        assert!(!Separator::Comma.decimal_commas("0,5"));
     }
 
     #[test]

@@ -351,7 +351,7 @@ impl<'a> CsvRows<'a> {
             content.first().map_or("", String::as_str),
             content.get(1).map_or("", String::as_str),
         );
-        let decimal_commas = separator.decimal_commas();
+        let decimal_commas = separator.decimal_commas(content.get(1).map_or("", String::as_str));
         let limited =
             LineLimit { inner: std::io::Cursor::new(peeked).chain(input), since_newline: 0, offset: 0 };
         let rest: Box<dyn Read + 'a> = match separator {
