@@ -205,8 +205,10 @@ fn verdict(identified: &IdentifiedModel, halving: Halving, halves: [Chosen; 2]) 
     } else {
         format!(
             "chosen from all the rows but not from both {}: {}; terms the noise chose \
-             (errors in the states bias the regressors), or that one half does not excite: read them \
-             as uncertain (more or longer runs, less noise, fewer candidates)",
+             (errors in the states bias the regressors), that one half does not excite, or that stand \
+             in for a form the candidates lack (noise-free, Michaelis-Menten's x/(0.5 + x) from \
+             polynomials): read them as uncertain (more or longer runs, less noise, fewer candidates, \
+             the system's own form)",
             match halving {
                 Halving::EachRun => "halves of every run",
                 Halving::EveryOtherRun => "every other run and the rest",
