@@ -251,8 +251,7 @@ pub fn regular_time(t: &[f64], origin: &str, column: &str) -> Result<(Vec<f64>, 
             message: "regular_time: the time stamps do not increase along the rows".into(),
         });
     }
-    // the stamps' last digit: their smallest step
-    let digit = t.windows(2).map(|w| w[1] - w[0]).filter(|d| *d > 0.0).fold(f64::INFINITY, f64::min);
+    let digit = super::stamps_digit(t);
     let rounding = if digit.is_finite() { 0.5 * digit } else { 0.0 };
     for (k, (v, l)) in t.iter().zip(&line).enumerate() {
         if (v - l).abs() > 0.005 * v.abs() + rounding + 2.0 * step {

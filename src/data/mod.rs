@@ -796,6 +796,12 @@ impl Frame {
     }
 }
 
+/// The smallest step between successive distinct time stamps: the last digit they are
+/// written to, where they are rounded (infinite where no stamp follows a smaller one).
+fn stamps_digit(t: &[f64]) -> f64 {
+    t.windows(2).map(|w| w[1] - w[0]).filter(|d| *d > 0.0).fold(f64::INFINITY, f64::min)
+}
+
 /// Rows that repeat their predecessor's time in at least this share of a time that never
 /// decreases are a time written too coarsely, not a logger's odd duplicate.
 const COARSE_SHARE: f64 = 0.25;
@@ -809,13 +815,13 @@ fn coarse_time(file: &str, column: &str, t: &[f64]) -> Option<DataError> {
     if steps.clone().any(|d| d < 0.0) {
         return None;
     }
-    let repeats = steps.clone().filter(|d| *d == 0.0).count();
+    let repeats = steps.filter(|d| *d == 0.0).count();
     if repeats < 3 || (repeats as f64) < COARSE_SHARE * (t.len() - 1) as f64 {
         return None;
     }
     let first = t.windows(2).position(|w| w[1] == w[0])?;
     // the difference of two stamps carries their rounding: 0.09999999999999998 for 0.1
-    let printed = steps.filter(|d| *d > 0.0).fold(f64::INFINITY, f64::min);
+    let printed = stamps_digit(t);
     let printed = format!("{printed:.5e}").parse().unwrap_or(printed);
     let every = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
     Some(DataError::CoarseTime {
