@@ -1084,6 +1084,8 @@ def test_terms_the_halves_of_a_run_do_not_choose_are_flagged():
     x_dot = set(found.model.coefficients("x_dot")["term"])
     assert {"x", "y"} <= x_dot and len(x_dot) > 2
     named = halves["detail"].split("`x_dot`: ")[1].split(";")[0]
+    # with noise measured, noise is the first cause named
+    assert "; terms the noise chose" in halves["detail"] and "next to no noise" not in halves["detail"]
     assert all(f"`{t}`" in named for t in x_dot - {"x", "y"}) and "`x`" not in named.replace("`x*", "")
     with pytest.warns(UserWarning, match="FLAG the terms hold on each half"):
         recipe = model.recipe(run)

@@ -29,7 +29,7 @@ pub(crate) fn note(shares: &[Share]) -> Option<String> {
 /// A variable's noise as a share of its spread.
 pub(crate) struct Share {
     variable: String,
-    share: f64,
+    pub(crate) share: f64,
     /// Measured, not only bounded ([`crate::data::Noise::measured`]).
     measured: bool,
     /// Measured on noise correlated from sample to sample: a lower bound

@@ -97,7 +97,8 @@ pub fn halves_check(
             })
             .collect()
     };
-    Some(verdict(identified, halving, [chosen(first?), chosen(second?)]))
+    let quiet = super::noise::quiet(model, frames);
+    Some(verdict(identified, halving, [chosen(first?), chosen(second?)], quiet))
 }
 
 /// [`halves_check`] of equations identified from their statistics (runs read in pieces, or
@@ -137,7 +138,7 @@ pub fn halves_check_of_moments(
             chosen.insert(m.equation.clone(), (terms, evidence));
         }
     }
-    Some(verdict(identified, Halving::EachRun, halves))
+    Some(verdict(identified, Halving::EachRun, halves, super::noise::quiet_of_moments(moments)))
 }
 
 /// What a half chose: each equation's terms, with the half's rows' worth of independent
@@ -145,8 +146,9 @@ pub fn halves_check_of_moments(
 type Chosen = BTreeMap<String, (Vec<String>, f64)>;
 
 /// The check, from the terms each half chose: passed where every term chosen from all the
-/// rows was chosen from both halves too.
-fn verdict(identified: &IdentifiedModel, halving: Halving, halves: [Chosen; 2]) -> Check {
+/// rows was chosen from both halves too. `quiet`: the records hold next to no noise
+/// ([`super::noise::quiet`]), so that noise is no cause to name first.
+fn verdict(identified: &IdentifiedModel, halving: Halving, halves: [Chosen; 2], quiet: bool) -> Check {
     let none = (Vec::new(), 0.0);
     let (mut unsteady, mut thin) = (Vec::new(), Vec::new());
     for (name, fit) in &identified.fits {
@@ -203,12 +205,21 @@ fn verdict(identified: &IdentifiedModel, halving: Halving, halves: [Chosen; 2]) 
             None => same,
         }
     } else {
+        let causes = if quiet {
+            // noise-free, such terms are the polynomials' stand-ins (Coulomb friction's sign(v),
+            // Michaelis-Menten's x/(0.5 + x)) or what a half does not excite: the form first
+            "the records hold next to no noise (the noise check's reading), so terms that stand in \
+             for a form the candidates lack (Michaelis-Menten's x/(0.5 + x), friction's sign(v) from \
+             polynomials) or that one half does not excite: read them as uncertain (the system's own \
+             form among the candidates, more or longer runs)"
+        } else {
+            "terms the noise chose (errors in the states bias the regressors), that one half does \
+             not excite, or that stand in for a form the candidates lack (noise-free, Michaelis-Menten's \
+             x/(0.5 + x) from polynomials): read them as uncertain (more or longer runs, less noise, \
+             fewer candidates, the system's own form)"
+        };
         format!(
-            "chosen from all the rows but not from both {}: {}; terms the noise chose \
-             (errors in the states bias the regressors), that one half does not excite, or that stand \
-             in for a form the candidates lack (noise-free, Michaelis-Menten's x/(0.5 + x) from \
-             polynomials): read them as uncertain (more or longer runs, less noise, fewer candidates, \
-             the system's own form)",
+            "chosen from all the rows but not from both {}: {}; {causes}",
             match halving {
                 Halving::EachRun => "halves of every run",
                 Halving::EveryOtherRun => "every other run and the rest",

@@ -16,14 +16,26 @@ pub(super) const NAME: &str = "the records' noise leaves the terms unbiased";
 /// measured above 2 % of its spread. `None` where no candidate is nonlinear in a recorded
 /// variable or no such variable is in the runs.
 pub fn noise_check(model: &Model, runs: &[Frame]) -> Option<Check> {
+    noise_check_of(&model_tallies(model, runs))
+}
+
+/// The noise tallies over `runs` of the variables that `model`'s identified equations'
+/// candidates hold nonlinearly.
+fn model_tallies(model: &Model, runs: &[Frame]) -> Vec<(String, NoiseTally)> {
     let candidates = model.equations().iter().filter(|e| e.identify).flat_map(|e| &e.candidates);
-    noise_check_of(&tallies(&held_nonlinearly(candidates, &model.vocabulary), runs))
+    tallies(&held_nonlinearly(candidates, &model.vocabulary), runs)
 }
 
 /// [`noise_check`] of equations identified from their statistics: the noise tallied with
 /// them ([`crate::identify::RunMoments::noise`]), each variable's from the first equation
 /// whose candidates hold it (the others tallied the same rows).
 pub fn noise_check_of_moments(moments: &[EquationMoments]) -> Option<Check> {
+    noise_check_of(&moments_tallies(moments))
+}
+
+/// The noise tallies the statistics hold, each variable's from the first equation whose
+/// candidates hold it.
+fn moments_tallies(moments: &[EquationMoments]) -> Vec<(String, NoiseTally)> {
     let mut pooled: Vec<(String, NoiseTally)> = Vec::new();
     for m in moments {
         let variables: std::collections::BTreeSet<&String> =
@@ -35,7 +47,29 @@ pub fn noise_check_of_moments(moments: &[EquationMoments]) -> Option<Check> {
             }
         }
     }
-    noise_check_of(&pooled)
+    pooled
+}
+
+/// Below this share of its spread a variable's noise is next to none: rounding to six digits
+/// or so, where the noise check reads at most 1e-6 %.
+const QUIET: f64 = 1e-4;
+
+/// Whether the records hold next to no noise: every variable the candidates hold nonlinearly
+/// measured, or bounded, under [`QUIET`] of its spread (none correlated from sample to sample,
+/// which reads less than it is). Terms the halves do not both choose then stand in for a
+/// form the candidates lack or miss the excitation of a half: noise did not choose them.
+pub(super) fn quiet(model: &Model, runs: &[Frame]) -> bool {
+    quiet_of(&model_tallies(model, runs))
+}
+
+/// [`quiet`] of equations identified from their statistics.
+pub(super) fn quiet_of_moments(moments: &[EquationMoments]) -> bool {
+    quiet_of(&moments_tallies(moments))
+}
+
+fn quiet_of(tallies: &[(String, NoiseTally)]) -> bool {
+    let shares = shares(tallies);
+    !shares.is_empty() && shares.iter().all(|s| !s.at_least && s.share < QUIET)
 }
 
 /// The check on the noise `tallies` of the variables the candidates hold nonlinearly.
