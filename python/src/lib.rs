@@ -59,8 +59,6 @@ fn time_like(names: Vec<String>) -> Option<String> {
     names.into_iter().find(|n| termid::data::looks_like_time(n))
 }
 
-/// The factor to seconds of a time column whose header says another unit of time
-/// (`Time [ms]`: 0.001), as a run's time is read.
 /// The columns whose names carry a unit termid knows, read by their bare names in SI:
 /// (place, bare name, unit, factor to SI) each ([`termid::data::headers_in_si`]).
 #[pyfunction]
@@ -68,6 +66,15 @@ fn headers_in_si(names: Vec<String>) -> Vec<(usize, String, String, f64)> {
     termid::data::headers_in_si(&names)
 }
 
+/// Where the time column `time` is among `names`: that name, else that name with a unit of
+/// time (`t [s]`), as a file's time is found ([`termid::data::time_position`]).
+#[pyfunction]
+fn time_position(names: Vec<String>, time: &str) -> Option<usize> {
+    termid::data::time_position(&names, time)
+}
+
+/// The factor to seconds of a time column whose header says another unit of time
+/// (`Time [ms]`: 0.001), as a run's time is read.
 #[pyfunction]
 fn seconds_per(name: &str) -> Option<f64> {
     termid::data::seconds_per(name).filter(|f| *f != 1.0)
@@ -106,6 +113,7 @@ fn _termid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(time_like, m)?)?;
     m.add_function(wrap_pyfunction!(seconds_per, m)?)?;
     m.add_function(wrap_pyfunction!(headers_in_si, m)?)?;
+    m.add_function(wrap_pyfunction!(time_position, m)?)?;
     m.add_function(wrap_pyfunction!(listed, m)?)?;
     m.add_function(wrap_pyfunction!(interleaved, m)?)?;
     Ok(())

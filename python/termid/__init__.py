@@ -412,10 +412,30 @@ def _runs(
     return out
 
 
+def _time_headed(columns: "_Columns", time: str) -> bool:
+    """Whether ``columns`` hold the time ``time``: under that name, or under it with a unit of
+    time (``t [s]``, ``Time (ms)``: renamed ``time``, in seconds, warned), as the command line
+    finds a file's time column."""
+    place = _termid.time_position(list(columns), time)
+    if place is None:
+        return False
+    header = list(columns)[place]
+    if header != time:
+        factor = _termid.seconds_per(header)
+        values = columns.pop(header)
+        columns[time] = values * factor if factor else values
+        said = f"`{header}` as {time}" + (f" in SI (× {factor:.6e})" if factor else "")
+        warnings.warn(f"termid: read by their bare names: {said}", stacklevel=_outside())
+    return True
+
+
 def _time_from(name: str, run: Data, columns: "_Columns", time: str) -> None:
-    """A run without its model's time column ``time`` takes it from its index where that holds
-    times (:func:`_index_time`), else from its one column of date-times or durations (said);
-    else it is refused, a column that looks like time named (as :func:`fit` does)."""
+    """A run without its model's time column ``time`` takes it from a column of that name with
+    a unit of time (:func:`_time_headed`), else from its index where that holds times
+    (:func:`_index_time`), else from its one column of date-times or durations (said); else it
+    is refused, a column that looks like time named (as :func:`fit` does)."""
+    if _time_headed(columns, time):
+        return
     index = _index_time(run)
     if index is not None:
         columns[time] = index
@@ -814,14 +834,15 @@ def _index_time(data: Data) -> Optional[np.ndarray]:
 
 
 def _time_of(data: Data, columns: "_Columns", time: Optional[str], target: str) -> str:
-    """The name of the time of rows whose rate is fitted: ``time``, else a column ``t``, else
+    """The name of the time of rows whose rate is fitted: ``time``, else a column ``t`` (or
+    ``t [s]``, :func:`_time_headed`), else
     the DataFrame's index where it holds times (:func:`_index_time`, added to ``columns`` as
     ``t``), else the one column of date-times or durations, with a warning."""
     if time is not None:
-        if time not in columns:
+        if not _time_headed(columns, time):
             raise TermidError(f"no time column `{time}` (columns: {', '.join(columns)})")
         return time
-    if "t" in columns:
+    if _time_headed(columns, "t"):
         return "t"
     index = _index_time(data)
     if index is not None:

@@ -1129,3 +1129,17 @@ def test_terms_left_out_of_every_rate_write_a_blurred_law_in_the_rest():
         model.with_terms(excluded=["I^3*R"])
     with pytest.raises(TypeError):
         model.with_terms(excluded="R")
+
+
+def test_a_time_column_whose_name_carries_its_unit_is_the_time():
+    # `t [ms]` where the model's time is `t` (as pd.read_csv names a logger's column): read as
+    # t in seconds and said, for a model's runs and for fit (it was refused, naming the column)
+    truth = termid.Model.builtin("lorenz").simulate(duration=5.0, sample=0.01)
+    headed = truth[["t", "x", "y", "z"]].assign(t=truth["t"] * 1e3).rename(columns={"t": "t [ms]"})
+    with pytest.warns(UserWarning, match=r"`t \[ms\]` as t in SI \(× 1.000000e-03\)"):
+        found = termid.Model.from_states(["x", "y", "z"]).identify(headed)
+    z_dot = found.model.coefficients("z_dot").set_index("term")["value"]
+    assert z_dot.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
+    with pytest.warns(UserWarning, match=r"`t \[ms\]` as t"):
+        fitted = termid.fit(headed, "dz/dt", ["x*y", "z", "x", "y"])
+    assert fitted.coefficients.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)

@@ -57,11 +57,11 @@ impl Frame {
     pub(super) fn from_table(table: Table, origin: &str, time: &str) -> Result<Frame, DataError> {
         let Table { names, mut columns, text, .. } = table;
         let time_index = super::stream::time_index(origin, time, &names, &text)?;
-        let seconds = super::in_seconds(time, std::mem::take(&mut columns[time_index]));
+        let seconds = super::in_seconds(&names[time_index], std::mem::take(&mut columns[time_index]));
         let mut frame =
             Frame::new(origin, time, seconds).map_err(|e| repeated_row(e, &columns, time_index))?;
-        for (name, values) in names.iter().zip(columns) {
-            if name != time {
+        for (k, (name, values)) in names.iter().zip(columns).enumerate() {
+            if k != time_index {
                 frame.push(name, values)?;
             }
         }

@@ -349,6 +349,23 @@ pub fn seconds_per(header: &str) -> Option<f64> {
     }
 }
 
+/// Where the time column `time` is among `names`: the column of that name, else the one
+/// whose header is that name with a unit of time (`t [s]`, `Time (ms)`, as loggers and
+/// spreadsheets export them), whose values [`in_seconds`] reads in seconds under its header.
+/// The model's time keeps its name: `--time t` reads `t [ms]` as `t` in seconds.
+pub fn time_position(names: &[String], time: &str) -> Option<usize> {
+    names.iter().position(|n| n == time).or_else(|| {
+        let mut headed = names.iter().enumerate().filter(|(_, n)| {
+            let (bare, unit, sign) = split_spec(n);
+            bare == time && sign > 0.0 && unit.is_some() && seconds_per(n).is_some()
+        });
+        match (headed.next(), headed.next()) {
+            (Some((i, _)), None) => Some(i),
+            _ => None,
+        }
+    })
+}
+
 /// Units of time as loggers write them after a name (`timestamp_ms`, `time_us`, `t.sec`),
 /// with their factor to seconds.
 const TIME_SUFFIXES: [(&[&str], f64); 6] = [

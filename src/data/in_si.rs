@@ -1,7 +1,8 @@
 //! A plain file's columns whose headers carry a unit termid knows (`x [m]`, `ψ [deg]`, `u
 //! (kn)`, as loggers and spreadsheets export them), read by their bare names in SI units and
 //! radians, as a dataset file maps them. A time column keeps its header: its unit of time is
-//! read where the time is ([`super::in_seconds`]), so `--time "Time [ms]"` names it.
+//! read where the time is ([`super::in_seconds`]), so `--time "Time [ms]"` names it, as does
+//! `--time Time` ([`super::time_position`]).
 
 use std::path::Path;
 
@@ -73,9 +74,14 @@ impl RowSource for InSi {
 
 /// What reading the plain file `path` in SI does to its columns' headers, to be said: `None`
 /// where no header carries a unit termid reads (or the file cannot be read: reading it says why).
-pub fn units_note(path: &Path) -> Option<String> {
+/// The time column `time` is said where its header carries its unit (`t [ms]`).
+pub fn units_note(path: &Path, time: &str) -> Option<String> {
     let names = rows_of(path).ok()?.names().to_vec();
-    let renamed = super::dataset::headers_in_si(&names);
+    let mut renamed = super::dataset::headers_in_si(&names);
+    if let Some(i) = super::time_position(&names, time).filter(|&i| names[i] != time) {
+        let seconds = super::seconds_per(&names[i]).unwrap_or(1.0);
+        renamed.insert(0, (i, time.to_string(), String::new(), seconds));
+    }
     let read: Vec<String> = renamed
         .iter()
         .map(|(i, bare, _, f)| match *f == 1.0 {
@@ -112,11 +118,19 @@ mod tests {
         assert_eq!(columns[3], [1852.0 / 3600.0, 2.0 * 1852.0 / 3600.0]);
         assert_eq!(columns[5], [2.0, 4.0]);
         assert_eq!(rows.take_labels()[0].1.values, ["a"]);
-        let note = units_note(&path).unwrap();
+        let note = units_note(&path, "Time [ms]").unwrap();
         assert!(note.contains("`x [m]` as x, `psi (deg)` as psi in SI (× 1.745329e-2)"), "{note}");
         assert!(!note.contains("Time") && !note.contains("`v [kn]`"), "{note}");
+        // the time by its bare name: read in seconds, said
+        let note = units_note(&path, "Time").unwrap();
+        assert!(
+            note.contains("read by their bare names: `Time [ms]` as Time in SI (× 1.000000e-3), `x [m]`"),
+            "{note}"
+        );
+        let frame = crate::data::Frame::read(&path, "Time").unwrap();
+        assert_eq!((frame.time_name(), frame.time()), ("Time", &[0.0, 0.5][..]));
         std::fs::write(&path, "t,x\n0,1\n").unwrap();
-        assert!(units_note(&path).is_none());
+        assert!(units_note(&path, "t").is_none());
         std::fs::remove_dir_all(&dir).ok();
     }
 }

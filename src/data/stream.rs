@@ -98,6 +98,8 @@ pub struct Chunks {
     origin: String,
     time: usize,
     time_name: String,
+    /// The time column's header, whose unit of time its values are read in (`t [ms]`).
+    time_header: String,
     size: usize,
     context: usize,
     /// Rows held, from the file's row `held_from` on.
@@ -133,12 +135,14 @@ impl Chunks {
     ) -> Result<Chunks, DataError> {
         let names = source.names();
         let time_index = time_index(origin, time, names, source.text())?;
+        let time_header = names[time_index].clone();
         let held = vec![Vec::new(); names.len()];
         Ok(Chunks {
             source,
             origin: origin.into(),
             time: time_index,
             time_name: time.into(),
+            time_header,
             size: size.max(1),
             context,
             held,
@@ -174,7 +178,7 @@ impl Chunks {
         let to = (own_end + self.context).min(end);
         let slice = |c: &Vec<f64>| c[from - self.held_from..to - self.held_from].to_vec();
         let shift = |e: DataError| e.shifted(from);
-        let seconds = super::in_seconds(&self.time_name, slice(&self.held[self.time]));
+        let seconds = super::in_seconds(&self.time_header, slice(&self.held[self.time]));
         let mut frame = Frame::new(&self.origin, &self.time_name, seconds).map_err(shift)?;
         frame.text = self.source.text().to_vec();
         for (k, name) in self.source.names().iter().enumerate() {
@@ -525,8 +529,9 @@ fn number(cell: &[u8], decimal_commas: bool) -> Option<f64> {
     }
 }
 
-/// Where the time column `time` is among the numeric columns `names`; refused where it is
-/// missing (a column that looks like time named) or is one of the columns of `text`.
+/// Where the time column `time` is among the numeric columns `names` (or `time` with a unit
+/// of time: [`super::time_position`]); refused where it is missing (a column that looks like
+/// time named) or is one of the columns of `text`.
 pub(super) fn time_index(
     origin: &str,
     time: &str,
@@ -536,7 +541,7 @@ pub(super) fn time_index(
     if let Some((_, cell)) = text.iter().find(|(n, _)| n == time) {
         return Err(DataError::text_column(origin, time, cell));
     }
-    names.iter().position(|n| n == time).ok_or_else(|| DataError::missing_time(origin, time, names))
+    super::time_position(names, time).ok_or_else(|| DataError::missing_time(origin, time, names))
 }
 
 /// Every row of a source, as whole columns, the cells of its columns of text kept as labels;

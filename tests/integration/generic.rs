@@ -2072,6 +2072,24 @@ fn a_whole_system_from_its_columns() {
     assert!(ok && err.contains("`x [m]` as x, `v [km/h]` as v in SI (× 2.777778e-1)"), "{err}");
     let rate = json(&out)["x_dot"]["terms"][0]["coefficient"].as_f64().unwrap();
     assert!((rate - 1.0).abs() < 1e-4, "{out}");
+    // the time too, under the model's time's name with its unit of time (`t [ms]` where the
+    // time is `t`: it was refused, naming `--time "t [ms]"`), whole and in pieces; the time
+    // not taken for an input
+    let mut in_ms = String::from("t [ms],x [m],v [km/h],F\n");
+    for line in headed.lines().skip(1) {
+        let (t, rest) = line.split_once(',').unwrap();
+        in_ms += &format!("{},{rest}\n", 1e3 * t.parse::<f64>().unwrap());
+    }
+    std::fs::write(dir.join("in_ms.csv"), &in_ms).unwrap();
+    let in_ms = p("in_ms.csv");
+    for pieces in [&[][..], &["--chunk-rows", "300"]] {
+        let args = [&["identify", "--data", &in_ms, "--states", "x,v", "--format", "json"], pieces].concat();
+        let (ok, out, err) = termid(&args);
+        assert!(ok && err.contains("`t [ms]` as t in SI (× 1.000000e-3), `x [m]` as x"), "{err}");
+        assert!(err.contains("note: the inputs are F "), "{err}");
+        let rate = json(&out)["x_dot"]["terms"][0]["coefficient"].as_f64().unwrap();
+        assert!((rate - 1.0).abs() < 1e-4, "{out}");
+    }
     // a unit termid does not know is named
     std::fs::write(dir.join("furlongs.csv"), headed.replacen("x [m]", "x [furlong]", 1)).unwrap();
     let (ok, _, err) = termid(&["identify", "--data", &p("furlongs.csv"), "--states", "x,v"]);

@@ -26,7 +26,7 @@ pub fn run(cmd: MomentsCommand) -> Result<()> {
                 .iter()
                 .map(|p| Chunks::open(p, &model.spec().model.time, cmd.chunk_rows, 2 * reach + 2))
                 .collect::<Result<Vec<_>, _>>()?;
-            cmd.data.iter().filter_map(|p| termid::data::units_note(p)).for_each(|n| crate::runs::say(&n));
+            crate::runs::say_units(&cmd.data, &model.spec().model.time);
             let (moments, notes) = EquationMoments::of_chunks(&model, &cmd.equation, runs, diff.as_ref())?;
             for n in notes {
                 crate::runs::say(&n);
@@ -237,6 +237,7 @@ pub fn identify_in_pieces(cmd: &IdentifyCommand, model: &termid::model::Model, r
         .iter()
         .map(|p| termid::data::Chunks::open(p, &model.spec().model.time, rows.max(1), 2 * reach + 2))
         .collect::<Result<Vec<_>, _>>()?;
+    crate::runs::say_units(&cmd.data, &model.spec().model.time);
     let label = format!("statistics of {} in pieces of {rows} rows ({})", names.join(", "), cmd.derivative);
     let pieces = crate::progress::with_spinner(&label, || {
         termid::identify::EquationMoments::of_chunks_each(model, &names, runs, diff.as_ref())

@@ -14,9 +14,10 @@ use crate::args::IdentifyCommand;
 pub fn model(cmd: &IdentifyCommand) -> Result<Model> {
     let (first, columns) = columns(cmd)?;
     // refused before any column is taken for an input (a time column by another name would be)
-    if !columns.contains(&cmd.time) {
+    let Some(time) = termid::data::time_position(&columns, &cmd.time) else {
         return Err(termid::data::DataError::missing_time(&first, &cmd.time, &columns).into());
-    }
+    };
+    let time = columns[time].clone();
     let column = |name: &str, flag: &str| -> Result<()> {
         if !columns.iter().any(|c| c == name) {
             // a header that carries a unit termid reads is read by its bare name already: this
@@ -46,7 +47,7 @@ pub fn model(cmd: &IdentifyCommand) -> Result<Model> {
         None => {
             let rates: Vec<String> = cmd.states.iter().map(|s| format!("{s}_dot")).collect();
             let others = columns.iter().filter(|c| {
-                **c != cmd.time
+                **c != time
                     && !cmd.states.contains(c)
                     && !rates.contains(c)
                     && Some(c.as_str()) != cmd.by.as_deref()

@@ -258,7 +258,7 @@ pub fn load(data: &[PathBuf], by: Option<&str>, datasets: &[PathBuf], time: &str
     check_once(&input_files(data, datasets))?;
     let mut frames = Vec::new();
     for path in data {
-        if let Some(note) = termid::data::units_note(path) {
+        if let Some(note) = termid::data::units_note(path, time) {
             say(&note);
         }
         let runs = match by {
@@ -321,6 +321,12 @@ pub fn mend_spikes(frames: &mut [Frame]) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Says what reading each of the plain files `data` in SI does to its headers
+/// ([`termid::data::units_note`]), `time` the time column's name.
+pub fn say_units(data: &[PathBuf], time: &str) {
+    data.iter().filter_map(|p| termid::data::units_note(p, time)).for_each(|n| say(&n));
 }
 
 /// Says on standard error what reading a run did to it: a unit conversion as `unit:`, any
