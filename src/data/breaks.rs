@@ -295,6 +295,9 @@ const GAP: f64 = 3.0;
 /// on events), not a clock with dropouts.
 const IRREGULAR: f64 = 0.05;
 
+/// Gaps in at least this share of the intervals make a log irregular however few they are.
+const IRREGULAR_FEW: f64 = 0.2;
+
 /// What a record's time says of its gaps ([`gaps`]).
 #[derive(Clone, Debug, PartialEq)]
 pub enum Gaps {
@@ -311,13 +314,16 @@ pub enum Gaps {
 }
 
 /// The gaps of a record's time `t`: intervals over three times the median are dropouts,
-/// unless they are over 5 % of the intervals and more than three (an irregular log).
+/// unless they are over 5 % of the intervals and more than three, or a fifth of them at least
+/// (an irregular log: a dozen samples at 0.25, 0.5, 1, 2, 4 … 24 h, as a pharmacokinetic
+/// study takes them, is no clock with three dropouts).
 pub fn gaps(t: &[f64]) -> Gaps {
     let median = super::median_step(t);
     let rows: Vec<usize> = (1..t.len()).filter(|&i| t[i] - t[i - 1] > GAP * median).collect();
-    if rows.len() > 3 && rows.len() as f64 > IRREGULAR * (t.len() - 1) as f64 {
+    let share = rows.len() as f64 / (t.len() - 1) as f64;
+    if (rows.len() > 3 && share > IRREGULAR) || share >= IRREGULAR_FEW {
         let longest = t.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
-        return Gaps::Irregular { share: rows.len() as f64 / (t.len() - 1) as f64, longest };
+        return Gaps::Irregular { share, longest };
     }
     Gaps::Dropouts(rows)
 }
@@ -336,7 +342,7 @@ pub fn cut_at_gaps(frame: Frame, margin: usize) -> Result<(Vec<Frame>, Vec<Strin
         Gaps::Dropouts(cuts) => cuts,
         Gaps::Irregular { share, longest } => {
             let note = format!(
-                "{}: `{}` steps irregularly ({:.0} % of its intervals over {GAP} times its median, {} s; the longest {} s): a log sampled on events, not a clock with dropouts; taken as it is, its spacing its own",
+                "{}: `{}` steps irregularly ({:.0} % of its intervals over {GAP} times its median, {} s; the longest {} s): a log sampled on events, not a clock with dropouts: not cut at its long intervals",
                 frame.origin(),
                 frame.time_name(),
                 100.0 * share,
@@ -598,6 +604,18 @@ mod tests {
                 && notes[1].contains("30 rows in all"),
             "{notes:?}"
         );
+        // a dozen samples at 0.25, 0.5, 1 … 24 h (a pharmacokinetic study's): three intervals of
+        // eleven over three times the median, an irregular log, not a clock with three dropouts
+        // (it was cut into pieces of at most 9 rows and refused)
+        let dozen = vec![0.0, 0.25, 0.5, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0, 24.0];
+        assert!(matches!(gaps(&dozen), Gaps::Irregular { .. }));
+        let (runs, notes) = cut_at_gaps(run(dozen), 0).unwrap();
+        assert_eq!(runs[0].len(), 12);
+        assert!(notes[0].contains("27 % of its intervals") && notes[0].contains("not cut"), "{notes:?}");
+        // one dropout in a dozen clock samples is still a dropout
+        let mut t = clock(12);
+        t[6..].iter_mut().for_each(|v| *v += 1.0);
+        assert!(matches!(gaps(&t), Gaps::Dropouts(rows) if rows == [6]));
     }
 
     /// A staircase (a state read off a coarse scale every 40 rows) leaps too often to be
