@@ -59,19 +59,22 @@ impl Halving {
 /// The check that each equation of `identified` (from `frames` by `how`) chooses its terms
 /// from the first and from the second half of every run too (runs too short to halve: from
 /// every other one of them and from the rest): flagged (not refusing) where a term is chosen
-/// from all the rows but not from both halves. `None` where it cannot apply: a single run too
-/// short to halve, too few rows in a half, or a half that cannot be identified.
-pub fn halves_check(
-    identified: &IdentifiedModel,
-    frames: &[Frame],
-    how: &ModelIdentification<'_>,
-) -> Option<Check> {
+/// from all the rows but not from both halves. Where it cannot apply (too few rows in a half,
+/// a half that cannot be identified) it is flagged as not checked: the terms are then
+/// unconfirmed, which every check reading "ok" would hide (a dozen samples of a decay chose
+/// two terms its truth lacks).
+pub fn halves_check(identified: &IdentifiedModel, frames: &[Frame], how: &ModelIdentification<'_>) -> Check {
     let (halving, halves) = Halving::of(frames);
     // runs given whole to a half: a run's worth of rows in each, twice FEWEST_ROWS
     let rows = |half: &[Frame]| half.iter().map(Frame::len).sum::<usize>();
     let least = if halving == Halving::EachRun { FEWEST_ROWS } else { 2 * FEWEST_ROWS };
     if halves.iter().any(|h| rows(h) < least) {
-        return None;
+        let (a, b) = (rows(&halves[0]), rows(&halves[1]));
+        let why = format!(
+            "the runs' {} rows are too few to halve: the halves would hold {a} and {b}, each needs {least}",
+            a + b
+        );
+        return unchecked(&why);
     }
     let model: &Model = &identified.model;
     let kept = windows_kept(how.differentiator, frames);
@@ -82,7 +85,7 @@ pub fn halves_check(
         ..*how
     };
     let how = &how;
-    let half = |cut: &[Frame]| identify_model(model, cut, how, &mut |_| {}).ok();
+    let half = |cut: &[Frame]| identify_model(model, cut, how, &mut |_| {});
     // side by side: each half is one run's worth of work per run, which leaves a core idle
     let (first, second) = rayon::join(|| half(&halves[0]), || half(&halves[1]));
     // a half's rows of independent evidence (a weak form's windows overlap) for an equation
@@ -98,16 +101,34 @@ pub fn halves_check(
             .collect()
     };
     let quiet = super::noise::quiet(model, frames);
-    Some(verdict(identified, halving, [chosen(first?), chosen(second?)], quiet))
+    match (first, second) {
+        (Ok(first), Ok(second)) => verdict(identified, halving, [chosen(first), chosen(second)], quiet),
+        (Err(e), _) | (_, Err(e)) => unchecked(&format!("a half of the runs could not be identified ({e})")),
+    }
+}
+
+/// The check where the halves could not be compared (`why`): flagged, since the terms are
+/// then chosen from all the rows at once and confirmed by nothing.
+fn unchecked(why: &str) -> Check {
+    Check {
+        name: NAME.into(),
+        passed: false,
+        refuses: false,
+        detail: format!(
+            "not checked: {why}: the terms rest on all the rows at once, unconfirmed (more or longer \
+             runs confirm them)"
+        ),
+        measure: None,
+    }
 }
 
 /// [`halves_check`] of equations identified from their statistics (runs read in pieces, or
 /// gathered where the rows are: [`EquationMoments`]): each equation fitted again, with
 /// `model`'s back-end, from the statistics of the first and of the second half of every run
 /// ([`EquationMoments::halves`], pooled per shard: a back-end that leaves runs out leaves
-/// shards out, and cannot fit halves of one shard). `None` where it cannot apply: statistics
-/// without halves, a half of fewer rows than runs read whole need, or a half that cannot be
-/// fitted.
+/// shards out, and cannot fit halves of one shard). `None` for statistics without halves
+/// (written before they were kept); flagged as not checked where a half has fewer rows than
+/// runs read whole need, or cannot be fitted.
 pub fn halves_check_of_moments(
     identified: &IdentifiedModel,
     moments: &[EquationMoments],
@@ -130,9 +151,14 @@ pub fn halves_check_of_moments(
                 .collect();
             let rows: usize = part.runs.iter().map(|r| r.moments.count()).sum();
             if rows < FEWEST_ROWS {
-                return None;
+                let why =
+                    format!("a half of the runs holds {rows} rows, under the {FEWEST_ROWS} a half needs");
+                return Some(unchecked(&why));
             }
-            let fit = part.fit(model, intercept).ok()?;
+            let fit = match part.fit(model, intercept) {
+                Ok(fit) => fit,
+                Err(e) => return Some(unchecked(&format!("a half of the runs could not be fitted ({e})"))),
+            };
             let terms = fit.selection.terms.iter().map(|t| t.term.clone()).collect();
             let evidence = part.runs.iter().map(|r| r.moments.independent_rows()).sum();
             chosen.insert(m.equation.clone(), (terms, evidence));
@@ -296,22 +322,29 @@ mod tests {
         let check = |frame: Frame| {
             let frames = [frame];
             let identified = identify_model(&model, &frames, &how, &mut |_| {}).unwrap();
-            halves_check(&identified, &frames, &how).unwrap()
+            halves_check(&identified, &frames, &how)
         };
         let whole = check(run(&|t| (0.7 * t).sin() + 1.0));
         assert!(whole.passed && !whole.refuses, "{}", whole.detail);
         let first_half = check(run(&|t| if t < 8.0 { (0.7 * t).sin() + 1.0 } else { 0.0 }));
         assert!(!first_half.passed && !first_half.refuses, "{}", first_half.detail);
         assert!(first_half.detail.contains("`x_dot`: `u`"), "{}", first_half.detail);
-        // a run too short to halve is not judged
+        // a run too short to halve is flagged as not checked (it was left out, every other
+        // check reading "ok")
         let short = run(&|t| t).slice(0..60);
         let identified = identify_model(&model, std::slice::from_ref(&short), &how, &mut |_| {}).unwrap();
-        assert!(halves_check(&identified, &[short], &how).is_none());
+        let unchecked = halves_check(&identified, &[short], &how);
+        assert!(!unchecked.passed && !unchecked.refuses, "{}", unchecked.detail);
+        assert!(
+            unchecked.detail.starts_with("not checked: the runs' 60 rows are too few to halve: the halves would hold 60 and 0, each needs 100"),
+            "{}",
+            unchecked.detail
+        );
         // runs too short to halve, six of them: every other run against the rest
         let whole = run(&|t| (0.7 * t).sin() + 1.0);
         let pieces: Vec<Frame> = (0..6).map(|k| whole.slice(60 * k..60 * k + 60)).collect();
         let identified = identify_model(&model, &pieces, &how, &mut |_| {}).unwrap();
-        let check = halves_check(&identified, &pieces, &how).unwrap();
+        let check = halves_check(&identified, &pieces, &how);
         assert!(
             check.passed && check.detail.contains("from every other run and from the rest"),
             "{}",
@@ -322,7 +355,7 @@ mod tests {
             .map(|k| if k % 2 == 0 { whole.slice(60 * k..60 * k + 60) } else { run(&|_| 0.0).slice(0..60) })
             .collect();
         let identified = identify_model(&model, &late, &how, &mut |_| {}).unwrap();
-        let check = halves_check(&identified, &late, &how).unwrap();
+        let check = halves_check(&identified, &late, &how);
         assert!(
             !check.passed && check.detail.contains("every other run and the rest: `x_dot`: `u`"),
             "{}",
@@ -332,7 +365,7 @@ mod tests {
         // short one given to a half
         let mixed = [whole.clone(), whole.slice(0..30)];
         let identified = identify_model(&model, &mixed, &how, &mut |_| {}).unwrap();
-        let check = halves_check(&identified, &mixed, &how).unwrap();
+        let check = halves_check(&identified, &mixed, &how);
         assert!(
             check.passed && check.detail.contains("the shorter runs given to the halves in turn"),
             "{}",

@@ -262,7 +262,7 @@ pub fn system_checks(
 ) -> Vec<Check> {
     retrace_checks(&identified.model, frames)
         .into_iter()
-        .chain(halves_check(identified, frames, how))
+        .chain([halves_check(identified, frames, how)])
         .chain(noise_check(&identified.model, frames))
         .collect()
 }

@@ -3057,3 +3057,28 @@ fn a_motion_seen_in_one_coordinate_is_flagged_as_missed() {
     let both = identified("x,v", &dir.join("xv.toml"));
     assert_eq!(check_named(&both, "as long as their own motion allows")["passed"], true, "{both}");
 }
+
+/// A dozen samples of a decay, ẋ = −0.3x, taken at 0.25, 0.5, 1, 2 … 24 h (a pharmacokinetic
+/// study's): read as an irregular log, not cut at its three long intervals (it was refused:
+/// "9 rows are too few for a run between its gaps"); and its rows too few to halve, the halves
+/// check says it did not check the terms (it was left out, every check reading "ok" beside the
+/// cubic's spurious terms).
+#[test]
+fn a_dozen_irregular_samples_are_read_and_their_terms_said_unconfirmed() {
+    use crate::common::Scratch;
+    let dir = Scratch::new("generic-dozen");
+    let mut text = String::from("t,x\n");
+    for t in [0.0, 0.25, 0.5, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0, 24.0] {
+        text += &format!("{t},{}\n", 10.0 * f64::exp(-0.3 * t));
+    }
+    let data = dir.join("dozen.csv");
+    std::fs::write(&data, text).unwrap();
+    let (ok, out, err) = termid(&["identify", "--data", data.to_str().unwrap(), "--states", "x"]);
+    assert!(ok, "{err}");
+    assert!(err.contains("a log sampled on events, not a clock with dropouts: not cut"), "{err}");
+    assert!(
+        out.contains("FLAG the terms hold on each half of the runs: not checked: the runs' ")
+            && out.contains(" rows are too few to halve"),
+        "{out}"
+    );
+}
