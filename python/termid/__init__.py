@@ -400,7 +400,7 @@ def _runs(
     if grouped is not None:
         names = names or [name for name, _ in grouped]
         runs = [run for _, run in grouped]
-    if isinstance(runs, (pd.DataFrame, Mapping, np.ndarray)) or hasattr(runs, "column_names"):
+    if _is_table(runs) or isinstance(runs, (Mapping, np.ndarray)):
         runs = [runs]
     out = []
     for k, run in enumerate(runs):
@@ -1004,10 +1004,24 @@ def fit(
     return Fit(native, target)
 
 
+def _is_table(data: Any) -> bool:
+    """Whether ``data`` is one table of named columns: a pandas DataFrame, a pyarrow Table,
+    anything with ``to_pandas`` or the Arrow PyCapsule interface (a polars DataFrame), or a
+    lazy frame (polars'). Such a table is one run, never a sequence of runs (a polars DataFrame
+    iterates over its columns)."""
+    return (
+        isinstance(data, pd.DataFrame)
+        or hasattr(data, "column_names")
+        or hasattr(data, "to_pandas")
+        or hasattr(data, "__arrow_c_stream__")
+        or (hasattr(data, "collect") and callable(data.collect))
+    )
+
+
 def _is_record(inputs: Any) -> bool:
     """Whether :meth:`Model.simulate`'s ``inputs`` change in time (a table, columns of arrays)
     rather than being constants by name."""
-    if isinstance(inputs, pd.DataFrame) or hasattr(inputs, "column_names") or hasattr(inputs, "to_pandas"):
+    if _is_table(inputs):
         return True
     return isinstance(inputs, Mapping) and any(np.ndim(v) > 0 for v in inputs.values())
 
@@ -1024,6 +1038,12 @@ def _split_by(data: Any, by: str) -> DataFrameGroupBy:
         frame = pd.DataFrame(dict(data))
     elif hasattr(data, "to_pandas"):
         frame = data.to_pandas()
+    elif hasattr(data, "collect") and callable(data.collect):  # a lazy frame (polars)
+        return _split_by(data.collect(), by)
+    elif hasattr(data, "__arrow_c_stream__"):
+        import pyarrow
+
+        frame = pyarrow.table(data).to_pandas()
     else:
         raise TypeError(f"`by` tells apart the runs of a DataFrame, a dict of arrays or a table, not {type(data).__name__}")
     if by not in frame.columns:

@@ -119,7 +119,8 @@ impl Stlsq {
         for j in forced.into_iter().chain(free) {
             let pivot = a[j * m + j];
             if self.collinear(pb, j, pivot)? {
-                out.push((j, pivot));
+                // rounding leaves an exact combination a share of -1e-30: none, said as 0
+                out.push((j, pivot.max(0.0)));
                 continue;
             }
             sweep(&mut a, m, j);
