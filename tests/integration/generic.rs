@@ -2202,6 +2202,8 @@ fn equations_that_run_away_from_their_run_are_refused() {
         !ok && out.contains("== checks ==\nFAIL the equations retrace their runs without running away"),
         "{out}"
     );
+    // among the causes, a state the runs do not record (a lag's second state runs away so)
+    assert!(out.contains("or a state or an input the runs do not record, which no candidate holds"), "{out}");
     assert!(err.contains("coarse.csv: re-simulated from its start") && err.contains("not written"), "{err}");
     assert!(!dir.join("m.toml").exists());
     let (ok, _, err) = termid(&[
