@@ -1144,3 +1144,12 @@ def test_a_time_column_whose_name_carries_its_unit_is_the_time():
     with pytest.warns(UserWarning, match=r"`t \[ms\]` as t"):
         fitted = termid.fit(headed, "dz/dt", ["x*y", "z", "x", "y"])
     assert fitted.coefficients.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
+
+
+def test_rows_newest_first_are_said_to_be():
+    # a database export sorted descending: time decreases at every row; it was refused as a
+    # time that "starts again" at row 2, with the remedy for runs one after another
+    truth = termid.Model.builtin("lorenz").simulate(duration=2.0, sample=0.01)[["t", "x", "y", "z"]]
+    with pytest.raises(termid.TermidError, match=r"time decreases at every row, from 2 to 0: the rows are newest first") as e:
+        termid.Model.from_states(["x", "y", "z"]).identify(truth.iloc[::-1])
+    assert "starts again" not in str(e.value)

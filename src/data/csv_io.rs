@@ -247,6 +247,13 @@ mod tests {
         // a time that starts again: runs one after another, said
         let e = Frame::parse_csv("t,u\n0,1\n0.1,2\n0,3\n", "a.csv", "t").unwrap_err().to_string();
         assert!(e.contains("row 3") && e.contains("it starts again: runs one after another?"), "{e}");
+        // newest first (a database export sorted descending): said so, not a restart at row 2
+        let e = Frame::parse_csv("t,u\n0.2,1\n0.1,2\n0,3\n", "a.csv", "t").unwrap_err().to_string();
+        assert!(
+            e.contains("time decreases at every row, from 0.2 to 0: the rows are newest first")
+                && !e.contains("starts again"),
+            "{e}"
+        );
     }
 
     /// A column whose first cell is text (a run's label, a mode) is left out and said, and

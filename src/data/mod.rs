@@ -192,6 +192,18 @@ pub enum DataError {
         /// It goes back to the first row's time or before (a run that follows another).
         restart: bool,
     },
+    /// Time that decreases at every row: the rows newest first.
+    #[error("{file}: column `{column}`: time decreases at every row, from {first} to {last}: the rows are newest first (a log or a database export sorted descending); sort them by time, oldest first")]
+    TimeDescending {
+        /// The file.
+        file: String,
+        /// The time column.
+        column: String,
+        /// The first row's time.
+        first: f64,
+        /// The last row's time.
+        last: f64,
+    },
     /// A time printed too coarsely for its rows: many rows share each stamp, and it never
     /// decreases (a logger at 100 Hz writing its time to 0.1 s).
     #[error("{file}: row {row}, column `{column}`: time {this} repeats the row before's, as {counted}, and it never decreases: it is written to {interval}; write the time with more digits, or read the file through a dataset file with `regular_time = true` (the stamps' line over the row number)")]
@@ -480,6 +492,14 @@ impl Frame {
             if let Some(i) = (1..values.len()).find(|&i| values[i] <= values[i - 1]) {
                 if let Some(coarse) = coarse_time(&self.origin, name, &values) {
                     return Err(coarse);
+                }
+                if values.len() > 2 && values.windows(2).all(|w| w[1] < w[0]) {
+                    return Err(DataError::TimeDescending {
+                        file: self.origin.clone(),
+                        column: name.into(),
+                        first: values[0],
+                        last: values[values.len() - 1],
+                    });
                 }
                 return Err(DataError::TimeNotIncreasing {
                     file: self.origin.clone(),
