@@ -326,7 +326,10 @@ pub(crate) fn fit(
                 // and a column acting later than recorded leaves its mark on them
                 how.say_delays(&rate, candidates, &frames, &others, &mut fit, &|l| l.plain_remedy())?;
                 // and noise on a variable a candidate holds nonlinearly biases the fit itself
-                fit.selection.notes.extend(termid::identify::noise_note(candidates, vocabulary, &frames));
+                let chosen: Vec<String> = fit.selection.terms.iter().map(|t| t.term.clone()).collect();
+                fit.selection
+                    .notes
+                    .extend(termid::identify::noise_note(candidates, &chosen, vocabulary, &frames));
                 Ok(fit)
             })
             .map_err(fail)?

@@ -13,11 +13,19 @@ use crate::term::{Atom, Term, Vocabulary};
 /// none; 5 %: 25 and two (Lü, FitzHugh-Nagumo). Measured at 1 %, every system passes.
 pub(crate) const SHARE: f64 = 0.02;
 
-/// The note for one equation's `candidates` fitted to a rate over `runs` (a fit without a
-/// model: `identify --target dx/dt --terms …`, Python `fit`), where a variable they hold
-/// nonlinearly is measured noisier than the check allows; `None` otherwise.
-pub fn noise_note(candidates: &[Term], vocabulary: &Vocabulary, runs: &[Frame]) -> Option<String> {
-    note(&shares(&tallies(&held_nonlinearly(candidates, vocabulary), runs)))
+/// The note for one equation fitted to a rate over `runs` (a fit without a model:
+/// `identify --target dx/dt --terms …`, Python `fit`), where a variable the `chosen` of its
+/// `candidates` (their canonical texts) hold nonlinearly is measured noisier than the check
+/// allows; `None` otherwise. Noise in a variable only terms left out hold biases nothing the
+/// fit kept (a logger's unrelated channels beside the states).
+pub fn noise_note(
+    candidates: &[Term],
+    chosen: &[String],
+    vocabulary: &Vocabulary,
+    runs: &[Frame],
+) -> Option<String> {
+    let chosen = candidates.iter().filter(|c| chosen.contains(&c.to_string()));
+    note(&shares(&tallies(&held_nonlinearly(chosen, vocabulary), runs)))
 }
 
 /// The note where some of `shares` are over the limit.
@@ -103,7 +111,7 @@ pub(crate) fn measured(shares: &[&Share]) -> String {
         ""
     };
     format!(
-        "white noise of {} of the spread of the variables the candidates hold nonlinearly (from \
+        "white noise of {} of the spread of the variables the chosen terms hold nonlinearly (from \
          their fourth differences, or their rounding where they move a step at a time){correlated}",
         listed.join(", ")
     )

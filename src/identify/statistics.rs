@@ -1039,7 +1039,7 @@ mod tests {
             let text = v.to_string();
             let read = std::panic::catch_unwind(|| {
                 EquationMoments::from_json(&text, "s.json")
-                    .map(|r| (crate::recipe::noise_check_of_moments(std::slice::from_ref(&r)), r.fit(&lorenz, true).map(|_| ()), r.clone().merge(r).map(|b| crate::recipe::noise_check_of_moments(&[b]))))
+                    .map(|r| (crate::recipe::noise_check_of_moments(std::slice::from_ref(&r), &lorenz), r.fit(&lorenz, true).map(|_| ()), r.clone().merge(r).map(|b| crate::recipe::noise_check_of_moments(&[b], &lorenz))))
             });
             proptest::prop_assert!(read.is_ok(), "from_json panicked");
         }

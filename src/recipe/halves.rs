@@ -164,7 +164,12 @@ pub fn halves_check_of_moments(
             chosen.insert(m.equation.clone(), (terms, evidence));
         }
     }
-    Some(verdict(identified, Halving::EachRun, halves, super::noise::quiet_of_moments(moments)))
+    Some(verdict(
+        identified,
+        Halving::EachRun,
+        halves,
+        super::noise::quiet_of_moments(moments, &identified.model),
+    ))
 }
 
 /// What a half chose: each equation's terms, with the half's rows' worth of independent

@@ -283,7 +283,7 @@ pub fn moments_checks(
     retrace
         .into_iter()
         .chain(halves_check_of_moments(identified, moments, model, intercept))
-        .chain(noise_check_of_moments(moments))
+        .chain(noise_check_of_moments(moments, &identified.model))
         .collect()
 }
 

@@ -240,7 +240,8 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
             identification
                 .say_delays(&target, &candidates, &frames, &columns, &mut fit, &|l| l.plain_remedy())?;
             // noise on a variable a candidate holds nonlinearly biases the fit itself
-            fit.selection.notes.extend(termid::identify::noise_note(&candidates, &vocab, &frames));
+            let chosen: Vec<String> = fit.selection.terms.iter().map(|t| t.term.clone()).collect();
+            fit.selection.notes.extend(termid::identify::noise_note(&candidates, &chosen, &vocab, &frames));
         }
     }
     match cmd.format {
