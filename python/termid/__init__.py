@@ -1220,6 +1220,21 @@ class Identified:
         told = ", ".join(f"{name} ← {t}" for name, t in self.targets.items())
         return f"termid.Identified({self.model.name!r}: {told})"
 
+    def __str__(self) -> str:
+        """What ``print`` (and a notebook) shows: the identified equations and the checks, each
+        as the command line writes it (``ok``, ``FLAG``, ``FAIL``)."""
+        lines = [str(self.model)]
+        if len(self.checks):
+            lines.append("checks:")
+            for _, c in self.checks.iterrows():
+                verdict = "ok  " if c["passed"] else ("FAIL" if c["refuses"] else "FLAG")
+                lines.append(f"  {verdict} {c['name']}: {c['detail']}")
+        return "\n".join(lines)
+
+    def _repr_pretty_(self, printer: Any, cycle: bool) -> None:
+        # IPython and notebooks show what print shows; repr() stays the one-line summary
+        printer.text(repr(self) if cycle else str(self))
+
 
 class Recipe:
     """What :meth:`Model.recipe` returns: the kept ``model``, a DataFrame of the ``starts``
@@ -1251,6 +1266,13 @@ class Recipe:
         self.report = report["report"]
         self.parameters: Optional[Mapping[str, Any]] = self.report.get("parameter_estimate")
         self.text = text
+
+    def __str__(self) -> str:
+        return self.text
+
+    def _repr_pretty_(self, printer: Any, cycle: bool) -> None:
+        # IPython and notebooks show the report, as the command line prints it
+        printer.text(repr(self) if cycle else str(self))
 
     def __repr__(self) -> str:
         kept = self.starts.loc[self.starts["kept"], "derivative"].tolist()

@@ -1153,3 +1153,22 @@ def test_rows_newest_first_are_said_to_be():
     with pytest.raises(termid.TermidError, match=r"time decreases at every row, from 2 to 0: the rows are newest first") as e:
         termid.Model.from_states(["x", "y", "z"]).identify(truth.iloc[::-1])
     assert "starts again" not in str(e.value)
+
+
+def test_an_identification_prints_its_equations_and_checks():
+    # print(found), and a notebook's display (IPython's _repr_pretty_), show the equations and
+    # each check as the command line writes it; repr stays one line
+    truth = termid.Model.builtin("lorenz").simulate(duration=5.0, sample=0.01)[["t", "x", "y", "z"]]
+    found = termid.Model.from_states(["x", "y", "z"]).identify(truth)
+    text = str(found)
+    assert text.splitlines()[1].startswith("  x_dot = ") and "\nchecks:\n  ok   the equations retrace" in text
+    assert text.count("\n  ok   ") == len(found.checks) and "\n" not in repr(found)
+
+    class Printer:
+        said = ""
+
+        def text(self, t):
+            Printer.said += t
+
+    found._repr_pretty_(Printer(), False)
+    assert Printer.said == text
