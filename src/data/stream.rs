@@ -290,8 +290,9 @@ pub(super) fn rows_of(path: &Path) -> Result<Box<dyn RowSource>, DataError> {
 /// The CSV rows of the file at `path`, read as they are needed.
 pub(super) fn csv_rows(path: &Path) -> Result<CsvRows<'static>, DataError> {
     let origin = path.display().to_string();
-    let file = std::fs::File::open(path)
-        .map_err(|e| DataError::Io { file: origin.clone(), message: e.to_string() })?;
+    let io = |e: std::io::Error| DataError::Io { file: origin.clone(), message: e.to_string() };
+    // (a spreadsheet's "Unicode text" export is UTF-16: read as UTF-8)
+    let file = crate::budget::utf16::decoded(std::fs::File::open(path).map_err(io)?).map_err(io)?;
     CsvRows::new(BufReader::with_capacity(1 << 18, file), &origin)
 }
 

@@ -3085,3 +3085,40 @@ fn a_dozen_irregular_samples_are_read_and_their_terms_said_unconfirmed() {
         "{out}"
     );
 }
+
+/// A spreadsheet's "Unicode text" export: UTF-16 (little-endian, with its byte-order mark),
+/// tab-separated. It was refused at its first byte ("byte 3 is NUL: this is not a text
+/// file"); now read as the same text in UTF-8, whole and in pieces, and in big-endian order.
+#[test]
+fn a_utf16_export_reads_as_its_text() {
+    use crate::common::{json, Scratch};
+    let dir = Scratch::new("generic-utf16");
+    let mut text = String::from("t\tx\tv\n");
+    for k in 0..2001 {
+        let t = k as f64 * 0.01;
+        text += &format!("{t}\t{}\t{}\n", (0.9 * t).sin(), 0.9 * (0.9 * t).cos());
+    }
+    let units: Vec<u16> = text.encode_utf16().collect();
+    for (name, bytes) in [
+        (
+            "le.txt",
+            [0xFF, 0xFE].into_iter().chain(units.iter().flat_map(|u| u.to_le_bytes())).collect::<Vec<u8>>(),
+        ),
+        ("be.txt", [0xFE, 0xFF].into_iter().chain(units.iter().flat_map(|u| u.to_be_bytes())).collect()),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let path = path.to_str().unwrap();
+        for pieces in [&[][..], &["--chunk-rows", "500"]] {
+            let args =
+                [&["identify", "--data", path, "--states", "x,v", "--format", "json"], pieces].concat();
+            let (ok, out, err) = termid(&args);
+            assert!(ok, "{name}: {err}");
+            let terms = &json(&out)["x_dot"]["terms"];
+            assert!(
+                terms[0]["term"] == "v" && (terms[0]["coefficient"].as_f64().unwrap() - 1.0).abs() < 1e-4,
+                "{out}"
+            );
+        }
+    }
+}

@@ -1,6 +1,9 @@
 //! Work sizes termid refuses before allocating: a simulation, a resampled run or a set of
 //! Monte-Carlo draws whose memory would exceed [`MEMORY_LIMIT`] is an error that says how
-//! large it would be, not an abort of the process when the allocation fails.
+//! large it would be, not an abort of the process when the allocation fails; text inputs are
+//! read within bounds, UTF-16 ones as UTF-8.
+
+pub(crate) mod utf16;
 
 /// The most memory one product of a command (a trajectory, a resampled run, the draws) may
 /// take: 4 GiB, a sixth of this project's 24 GiB machines.
@@ -137,7 +140,8 @@ pub fn file_size(path: &std::path::Path) -> Result<u64, ReadError> {
 /// The bytes of a file, with the bounds of [`read_text`].
 fn read_bytes(path: &std::path::Path, max_line: usize) -> Result<Vec<u8>, ReadError> {
     use std::io::Read;
-    let mut file = std::fs::File::open(path)?;
+    // UTF-16 with a byte-order mark read as UTF-8 (its NUL high bytes refused it as binary)
+    let mut file = utf16::decoded(std::fs::File::open(path)?)?;
     // the file's own size up front: no copies as the buffer grows
     let size = file_size(path)?;
     let mut bytes = Vec::with_capacity(size as usize + 1);
