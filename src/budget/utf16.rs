@@ -22,7 +22,13 @@ pub fn decoded<'a, R: Read + 'a>(mut inner: R) -> std::io::Result<Box<dyn Read +
         (2, [0xFE, 0xFF]) => true,
         _ => return Ok(Box::new(std::io::Cursor::new(head[..got].to_vec()).chain(inner))),
     };
-    Ok(Box::new(Utf16 { inner, big_endian, raw: Vec::new(), out: Vec::new(), at: 0, ended: false }))
+    Ok(Box::new(Utf16 {
+        inner,
+        big_endian,
+        raw: Vec::new(),
+        out: std::io::Cursor::new(Vec::new()),
+        ended: false,
+    }))
 }
 
 /// A UTF-16 stream as UTF-8, decoded a piece at a time.
@@ -31,9 +37,8 @@ struct Utf16<R> {
     big_endian: bool,
     /// Bytes read and not yet decoded: an odd last byte, or a high surrogate awaiting its pair.
     raw: Vec<u8>,
-    /// Decoded UTF-8 not yet given, from `at`.
-    out: Vec<u8>,
-    at: usize,
+    /// Decoded UTF-8, given from its position.
+    out: std::io::Cursor<Vec<u8>>,
     ended: bool,
 }
 
@@ -42,9 +47,10 @@ impl<R: Read> Utf16<R> {
     fn refill(&mut self) -> std::io::Result<bool> {
         let invalid =
             |what: &str| std::io::Error::new(std::io::ErrorKind::InvalidData, format!("UTF-16 text {what}"));
-        self.out.clear();
-        self.at = 0;
-        while self.out.is_empty() {
+        self.out.set_position(0);
+        let out = self.out.get_mut();
+        out.clear();
+        while out.is_empty() {
             if self.ended {
                 return match self.raw.is_empty() {
                     true => Ok(false),
@@ -73,7 +79,7 @@ impl<R: Read> Utf16<R> {
             }
             for c in char::decode_utf16(units.iter().copied()) {
                 let c = c.map_err(|e| invalid(&format!("holds an unpaired surrogate ({e})")))?;
-                self.out.extend_from_slice(c.encode_utf8(&mut [0; 4]).as_bytes());
+                out.extend_from_slice(c.encode_utf8(&mut [0; 4]).as_bytes());
             }
             self.raw.drain(..2 * units.len());
         }
@@ -83,13 +89,10 @@ impl<R: Read> Utf16<R> {
 
 impl<R: Read> Read for Utf16<R> {
     fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        if self.at == self.out.len() && !self.refill()? {
+        if self.out.position() == self.out.get_ref().len() as u64 && !self.refill()? {
             return Ok(0);
         }
-        let n = buf.len().min(self.out.len() - self.at);
-        buf[..n].copy_from_slice(&self.out[self.at..self.at + n]);
-        self.at += n;
-        Ok(n)
+        self.out.read(buf)
     }
 }
 

@@ -59,43 +59,40 @@ impl Separator {
 pub(super) struct Blanks<R> {
     inner: R,
     line: Vec<u8>,
-    /// The rewritten line and how much of it has been read.
-    out: Vec<u8>,
-    at: usize,
+    /// The rewritten line, read from its position.
+    out: std::io::Cursor<Vec<u8>>,
 }
 
 impl<R: BufRead> Blanks<R> {
     pub(super) fn new(inner: R) -> Blanks<R> {
-        Blanks { inner, line: Vec::new(), out: Vec::new(), at: 0 }
+        Blanks { inner, line: Vec::new(), out: std::io::Cursor::new(Vec::new()) }
     }
 }
 
 impl<R: BufRead> Read for Blanks<R> {
     fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        if self.at == self.out.len() {
+        if self.out.position() == self.out.get_ref().len() as u64 {
             self.line.clear();
-            self.out.clear();
-            self.at = 0;
+            self.out.set_position(0);
+            let out = self.out.get_mut();
+            out.clear();
             if self.inner.read_until(b'\n', &mut self.line)? == 0 {
                 return Ok(0);
             }
             let text = self.line.trim_ascii();
             if text.first() == Some(&b'#') {
-                self.out.extend_from_slice(text);
+                out.extend_from_slice(text);
             } else {
                 for (i, cell) in text.split(u8::is_ascii_whitespace).filter(|c| !c.is_empty()).enumerate() {
                     if i > 0 {
-                        self.out.push(b';');
+                        out.push(b';');
                     }
-                    self.out.extend_from_slice(cell);
+                    out.extend_from_slice(cell);
                 }
             }
-            self.out.push(b'\n');
+            out.push(b'\n');
         }
-        let n = buf.len().min(self.out.len() - self.at);
-        buf[..n].copy_from_slice(&self.out[self.at..self.at + n]);
-        self.at += n;
-        Ok(n)
+        self.out.read(buf)
     }
 }
 
