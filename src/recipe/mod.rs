@@ -260,10 +260,12 @@ pub fn system_checks(
     frames: &[Frame],
     how: &crate::identify::ModelIdentification<'_>,
 ) -> Vec<Check> {
+    // the noise tallied once: its check, and whether the halves' causes put noise first
+    let tallies = noise::model_tallies(&identified.model, frames);
     retrace_checks(&identified.model, frames)
         .into_iter()
-        .chain([halves_check(identified, frames, how)])
-        .chain(noise_check(&identified.model, frames))
+        .chain([halves_check(identified, frames, how, noise::quiet(&tallies))])
+        .chain(noise::noise_check_of(&tallies))
         .collect()
 }
 
@@ -280,10 +282,11 @@ pub fn moments_checks(
     runs: &[Frame],
 ) -> Vec<Check> {
     let retrace = if runs.is_empty() { Vec::new() } else { retrace_checks(&identified.model, runs) };
+    let tallies = noise::moments_tallies(moments, &identified.model);
     retrace
         .into_iter()
-        .chain(halves_check_of_moments(identified, moments, model, intercept))
-        .chain(noise_check_of_moments(moments, &identified.model))
+        .chain(halves_check_of_moments(identified, moments, model, intercept, noise::quiet(&tallies)))
+        .chain(noise::noise_check_of(&tallies))
         .collect()
 }
 

@@ -29,7 +29,7 @@ fn chosen_nonlinearly(model: &Model) -> Vec<String> {
 }
 
 /// The noise tallies over `runs` of the variables [`chosen_nonlinearly`] by `model`.
-fn model_tallies(model: &Model, runs: &[Frame]) -> Vec<(String, NoiseTally)> {
+pub(super) fn model_tallies(model: &Model, runs: &[Frame]) -> Vec<(String, NoiseTally)> {
     tallies(&chosen_nonlinearly(model), runs)
 }
 
@@ -42,7 +42,7 @@ pub fn noise_check_of_moments(moments: &[EquationMoments], model: &Model) -> Opt
 
 /// The noise tallies the statistics hold of the variables [`chosen_nonlinearly`] by `model`
 /// (identified from them), each variable's from the first equation whose candidates hold it.
-fn moments_tallies(moments: &[EquationMoments], model: &Model) -> Vec<(String, NoiseTally)> {
+pub(super) fn moments_tallies(moments: &[EquationMoments], model: &Model) -> Vec<(String, NoiseTally)> {
     let chosen = chosen_nonlinearly(model);
     let mut pooled: Vec<(String, NoiseTally)> = Vec::new();
     for m in moments {
@@ -63,26 +63,18 @@ fn moments_tallies(moments: &[EquationMoments], model: &Model) -> Vec<(String, N
 /// or so, where the noise check reads at most 1e-6 %.
 const QUIET: f64 = 1e-4;
 
-/// Whether the records hold next to no noise: every variable the chosen terms hold nonlinearly
-/// measured, or bounded, under [`QUIET`] of its spread (none correlated from sample to sample,
-/// which reads less than it is). Terms the halves do not both choose then stand in for a
-/// form the candidates lack or miss the excitation of a half: noise did not choose them.
-pub(super) fn quiet(model: &Model, runs: &[Frame]) -> bool {
-    quiet_of(&model_tallies(model, runs))
-}
-
-/// [`quiet`] of equations identified from their statistics.
-pub(super) fn quiet_of_moments(moments: &[EquationMoments], model: &Model) -> bool {
-    quiet_of(&moments_tallies(moments, model))
-}
-
-fn quiet_of(tallies: &[(String, NoiseTally)]) -> bool {
+/// Whether the records hold next to no noise, by the `tallies` of the variables the chosen
+/// terms hold nonlinearly: each measured, or bounded, under [`QUIET`] of its spread (none
+/// correlated from sample to sample, which reads less than it is). Terms the halves do not
+/// both choose then stand in for a form the candidates lack or miss the excitation of a half:
+/// noise did not choose them.
+pub(super) fn quiet(tallies: &[(String, NoiseTally)]) -> bool {
     let shares = shares(tallies);
     !shares.is_empty() && shares.iter().all(|s| !s.at_least && s.share < QUIET)
 }
 
 /// The check on the noise `tallies` of the variables the chosen terms hold nonlinearly.
-fn noise_check_of(tallies: &[(String, NoiseTally)]) -> Option<Check> {
+pub(super) fn noise_check_of(tallies: &[(String, NoiseTally)]) -> Option<Check> {
     let shares = shares(tallies);
     if shares.is_empty() {
         return None;
