@@ -73,6 +73,13 @@ fn time_position(names: Vec<String>, time: &str) -> Option<usize> {
     termid::data::time_position(&names, time)
 }
 
+/// A check as one line a person reads: `ok`, `FLAG` or `FAIL`, the check and its numbers
+/// ([`termid::plugin::Check::line`], as the command line prints it).
+#[pyfunction]
+fn check_line(name: String, passed: bool, refuses: bool, detail: String) -> String {
+    termid::plugin::Check { name, passed, refuses, detail, measure: None }.line()
+}
+
 /// The factor to seconds of a time column whose header says another unit of time
 /// (`Time [ms]`: 0.001), as a run's time is read.
 #[pyfunction]
@@ -114,6 +121,7 @@ fn _termid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(seconds_per, m)?)?;
     m.add_function(wrap_pyfunction!(headers_in_si, m)?)?;
     m.add_function(wrap_pyfunction!(time_position, m)?)?;
+    m.add_function(wrap_pyfunction!(check_line, m)?)?;
     m.add_function(wrap_pyfunction!(listed, m)?)?;
     m.add_function(wrap_pyfunction!(interleaved, m)?)?;
     Ok(())

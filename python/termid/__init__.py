@@ -1227,8 +1227,7 @@ class Identified:
         if len(self.checks):
             lines.append("checks:")
             for _, c in self.checks.iterrows():
-                verdict = "ok  " if c["passed"] else ("FAIL" if c["refuses"] else "FLAG")
-                lines.append(f"  {verdict} {c['name']}: {c['detail']}")
+                lines.append("  " + _termid.check_line(c["name"], bool(c["passed"]), bool(c["refuses"]), c["detail"]))
         return "\n".join(lines)
 
     def _repr_pretty_(self, printer: Any, cycle: bool) -> None:
