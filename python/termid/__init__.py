@@ -263,6 +263,12 @@ def _columns(data: Data) -> "_Columns":
     return _in_si(found)
 
 
+def _read_as(header: str, bare: str, factor: float) -> str:
+    """How a column whose name carries its unit is read, as the command line says it: the
+    header, its bare name, and its factor to SI where that is not 1."""
+    return f"`{header}` as {bare}" + ("" if factor == 1.0 else f" in SI (× {factor:.6e})")
+
+
 def _in_si(found: "_Columns") -> "_Columns":
     """The columns whose names carry a unit termid knows (``x [m]``, ``psi [deg]``, as
     ``pd.read_csv`` names a logger's columns) by their bare names in SI, warned, as the command
@@ -279,7 +285,7 @@ def _in_si(found: "_Columns") -> "_Columns":
             continue
         bare, unit, factor = renamed[i]
         out[bare] = values if factor == 1.0 else values * factor
-        said.append(f"`{name}` as {bare}" + ("" if factor == 1.0 else f" in SI (× {factor:.6e})"))
+        said.append(_read_as(name, bare, factor))
     warnings.warn(f"termid: read by their bare names: {', '.join(said)}", stacklevel=_outside())
     return out
 
@@ -424,8 +430,7 @@ def _time_headed(columns: "_Columns", time: str) -> bool:
         factor = _termid.seconds_per(header)
         values = columns.pop(header)
         columns[time] = values * factor if factor else values
-        said = f"`{header}` as {time}" + (f" in SI (× {factor:.6e})" if factor else "")
-        warnings.warn(f"termid: read by their bare names: {said}", stacklevel=_outside())
+        warnings.warn(f"termid: read by their bare names: {_read_as(header, time, factor or 1.0)}", stacklevel=_outside())
     return True
 
 
