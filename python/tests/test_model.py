@@ -1,4 +1,5 @@
 """Model files from Python: load, write, identify, predict, simulate, validate."""
+import math
 import os
 import pickle
 import re
@@ -210,6 +211,32 @@ def test_a_run_id_column_does_not_break_identification(ship, zigzags):
     base = ship.identify([run], target="column").model.coefficients("r_dot")
     tagged = ship.identify([run.assign(run_id="Z15/10")], target="column").model.coefficients("r_dot")
     pd.testing.assert_frame_equal(tagged, base)
+
+
+def test_states_of_a_millionth_are_simulated_as_closely_as_states_of_one():
+    # A → B in mol/L from 1e-6 (k = 0.5/s): an absolute tolerance of 1e-7, a tenth of the
+    # state, ended A a hundredfold off; it is counted in how large the states start
+    chain = termid.Model.from_toml(
+        """
+        [model]
+        name = "A to B"
+        [[states]]
+        name = "A"
+        initial = 1e-6
+        [[states]]
+        name = "B"
+        [equations.A_dot]
+        state = "A"
+        coefficients = { "A" = -0.5 }
+        [equations.B_dot]
+        state = "B"
+        coefficients = { "A" = 0.5 }
+        """,
+        "chain.toml",
+    )
+    run = chain.simulate(duration=20.0, sample=0.5)
+    assert run.A.iloc[-1] == pytest.approx(1e-6 * math.exp(-10.0), rel=1e-3)
+    assert run.B.iloc[-1] == pytest.approx(1e-6 * (1 - math.exp(-10.0)), rel=1e-6)
 
 
 def test_lorenz_simulated_and_identified_with_the_defaults():

@@ -61,6 +61,9 @@ pub struct Runs {
     /// where they are steady or at the file's value, whichever re-simulates the run better; an
     /// estimate frees them where it frees the runs' initial values.
     pub(super) hidden: Vec<Vec<usize>>,
+    /// How large each of the model's states runs in the records, that the default absolute
+    /// tolerance is counted in ([`Model::size`]).
+    sizes: Vec<f64>,
 }
 
 /// A run's initial state with its `hidden` states (unrecorded, read by the motion) where they
@@ -223,6 +226,16 @@ fn spread(frames: &[Frame], name: &str) -> f64 {
     }
 }
 
+/// How large a state runs in the records (its largest magnitude; 0 where they do not record
+/// it): what the simulator counts its absolute tolerance in ([`System::size_by`]).
+fn largest(frames: &[Frame], name: &str) -> f64 {
+    frames
+        .iter()
+        .flat_map(|f| f.column(name).unwrap_or(&[]).iter())
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, |m, v| m.max(v.abs()))
+}
+
 /// Recorded inputs with an offset and a factor applied.
 struct Transformed {
     replay: Replay,
@@ -308,6 +321,13 @@ impl Runs {
             }
         }
         let system = System::new(model, &Default::default(), false)?;
+        // the default absolute tolerance counted in each state's size in the records (an
+        // absolute 1e-7 is a tenth of a concentration of 1e-6 mol/L)
+        let sizes = {
+            let mut sized = system.clone();
+            model.size(&mut sized, &system.states.iter().map(|s| largest(frames, s)).collect::<Vec<_>>());
+            sized.sizes
+        };
         // a state is compared in the runs that record it: one run or basin without a record of
         // it (a yaw rate without a gyro) does not take it from the others' comparison
         let states: Vec<(usize, String)> = system
@@ -400,6 +420,7 @@ impl Runs {
             inputs: system.inputs.clone(),
             outputs: Vec::new(),
             hidden,
+            sizes,
         };
         // a run starts where its hidden states are steady (a steady approach, a steering lag
         // in a steady turn) unless the file's values re-simulate its record better: a state
@@ -600,6 +621,7 @@ impl Runs {
             inputs: self.inputs.clone(),
             outputs: self.outputs.clone(),
             hidden: Vec::new(),
+            sizes: self.sizes.clone(),
         };
         let mut of = Vec::new();
         for (r, f) in self.frames.iter().enumerate() {
@@ -762,7 +784,8 @@ impl Runs {
         offsets: &[(usize, f64)],
         factors: &[(usize, f64)],
     ) -> Result<Vec<Trajectory>, SimError> {
-        let system = System::new(model, &Default::default(), self.intercepts)?;
+        let mut system = System::new(model, &Default::default(), self.intercepts)?;
+        system.sizes = self.sizes.clone();
         let observer = match self.outputs.is_empty() {
             true => None,
             false => {

@@ -274,6 +274,17 @@ impl Model {
         )
     }
 
+    /// Counts the default absolute tolerance of `system` (this model's) in how large its states
+    /// run (`magnitudes` in its state order: the records' largest, or the initial values), so
+    /// that concentrations of 1e-6 mol/L are followed as closely as metres
+    /// ([`crate::sim::System::size_by`]); an `atol` of the model file's (or a command's) is
+    /// kept as given, in the states' own units.
+    pub fn size(&self, system: &mut crate::sim::System, magnitudes: &[f64]) {
+        if self.spec.simulation.as_ref().and_then(|s| s.atol).is_none() {
+            system.size_by(magnitudes);
+        }
+    }
+
     /// The adaptive method's tolerances set where given (a command's `--rtol`, `--atol`), into
     /// the model's `[simulation]` table; refused where no step control can work with them.
     pub fn set_tolerances(

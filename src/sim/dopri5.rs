@@ -65,6 +65,8 @@ pub(super) struct Dopri5 {
     held_t: f64,
     slope: Vec<f64>,
     tol: Tolerances,
+    /// Each state's absolute tolerance ([`System::absolute_tolerances`]).
+    atol: Vec<f64>,
     /// Whether (`t`, `y`) hold the run's start or a later point.
     started: bool,
     /// The control interval (for the smallest step allowed and the time tolerance).
@@ -97,7 +99,7 @@ impl Dopri5 {
         n: usize,
         m: usize,
         dt: f64,
-        tol: Tolerances,
+        (tol, atol): (Tolerances, Vec<f64>),
         stiff: Option<Rosenbrock>,
         switch: bool,
     ) -> Dopri5 {
@@ -117,6 +119,7 @@ impl Dopri5 {
             held_t: 0.0,
             slope: vec![0.0; m],
             tol,
+            atol,
             started: false,
             dt,
             control: StepControl::default(),
@@ -380,7 +383,7 @@ impl Dopri5 {
         };
         let t = self.t;
         stiff.prepare(system, ws, t, &self.y, &line, self.dt);
-        let tolerance = (self.tol.atol, self.tol.rtol);
+        let tolerance = (&self.atol[..], self.tol.rtol);
         let mut tries = 0usize;
         loop {
             let h = self.h.min(reach - t);
@@ -447,12 +450,13 @@ impl Dopri5 {
             let c = h * w;
             err.iter_mut().zip(&self.k[j]).for_each(|(e, k)| *e += c * k);
         }
-        let (atol, rtol) = (self.tol.atol, self.tol.rtol);
+        let rtol = self.tol.rtol;
         let sum: f64 = err
             .iter()
             .zip(x)
             .zip(&self.trial)
-            .map(|((e, x), y)| {
+            .zip(&self.atol)
+            .map(|(((e, x), y), atol)| {
                 let q = e / (atol + rtol * x.abs().max(y.abs()));
                 q * q
             })

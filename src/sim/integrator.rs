@@ -365,7 +365,8 @@ fn run(
     let implicit =
         (settings.integrator == Integrator::Rosenbrock).then(|| Rosenbrock::new(system)).transpose()?;
     let switch = settings.integrator == Integrator::Dopri5;
-    let mut dopri = Dopri5::new(n, m, dt, system.tolerances, implicit, switch);
+    let mut dopri =
+        Dopri5::new(n, m, dt, (system.tolerances, system.absolute_tolerances()), implicit, switch);
     let end = steps as f64 * dt;
     if adaptive {
         system.tolerances.check()?;
@@ -811,6 +812,41 @@ mod tests {
         let worst_replay = worst(&simulate(&lag, &[0.0], &mut Noisy(7), &settings).unwrap());
         // 4.9e-10; 1.2e-8 when each step ran past its control time and was read off there
         assert!(worst_replay < 3e-9, "{worst_replay}");
+    }
+
+    /// ẋ = −x from 1e-6 (a concentration in mol/L): sized by its start, it is followed within
+    /// the tolerances scaled to it, as ẋ = −x from 1 is within them; counted in its own unit,
+    /// the absolute 1e-7 lets the steps miss it by far more.
+    #[test]
+    fn a_state_of_a_millionth_is_followed_as_closely_as_one_of_one() {
+        let settings = Settings { integrator: Integrator::Dopri5, dt: 0.25, duration: 10.0, sample: 0.25 };
+        let mut lag =
+            System::new(&Lag { k: 1.0, bounds: (f64::NEG_INFINITY, f64::INFINITY) }, &BTreeMap::new(), false)
+                .unwrap();
+        let Tolerances { rtol, atol } = Tolerances::default();
+        let worst = |lag: &System| {
+            let run = simulate(lag, &[1e-6], &mut Constant(vec![0.0]), &settings).unwrap();
+            run.time
+                .iter()
+                .zip(&run.states[0])
+                .map(|(t, x)| {
+                    let exact = 1e-6 * (-t).exp();
+                    (x - exact).abs() / (atol * 1e-6 + rtol * exact)
+                })
+                .fold(0.0f64, f64::max)
+        };
+        let own_unit = worst(&lag);
+        assert!(own_unit > 100.0, "{own_unit}");
+        lag.size_by(&[1e-6]);
+        assert_eq!(lag.absolute_tolerances(), vec![atol * 1e-6]);
+        let sized = worst(&lag);
+        assert!(sized < 2.0, "{sized}");
+        // sizes never loosen a tolerance; a state known only as 0 is as small as the least other
+        lag.size_by(&[1e4]);
+        assert_eq!(lag.sizes, vec![1.0]);
+        lag.states.push("c".into());
+        lag.size_by(&[2e-7, 0.0]);
+        assert_eq!(lag.sizes, vec![2e-7, 2e-7]);
     }
 
     /// The adaptive method on closed forms: ẋ = −x (e^(−t)), a damped oscillator, and an

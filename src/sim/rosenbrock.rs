@@ -89,7 +89,7 @@ impl Rosenbrock {
         line: &dyn Fn(f64, &mut [f64]),
         trial: &mut [f64],
         dense: &mut [[f64; 5]],
-        tolerance: (f64, f64),
+        tolerance: (&[f64], f64),
     ) -> f64 {
         let n = y.len();
         let hd = h * D;
@@ -132,7 +132,7 @@ impl Rosenbrock {
         let sum: f64 = (0..n)
             .map(|i| {
                 let e = h / 6.0 * (self.k1[i] - 2.0 * self.k2[i] + k3[i]);
-                let q = e / (atol + rtol * y[i].abs().max(trial[i].abs()));
+                let q = e / (atol[i] + rtol * y[i].abs().max(trial[i].abs()));
                 q * q
             })
             .sum();

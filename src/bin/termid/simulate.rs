@@ -249,6 +249,13 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
             Ok(frame)
         })
         .transpose()?;
+    // the default absolute tolerance counted in how large the states start
+    let magnitudes: Vec<f64> = x0.iter().map(|v| v.abs()).collect();
+    let sized = |mut system: termid::sim::System| {
+        model.size(&mut system, &magnitudes);
+        system
+    };
+    let system = sized(system);
     let controller = |system: &termid::sim::System| -> Result<Box<dyn Controller>> {
         Ok(match &replayed {
             Some(frame) => Box::new(Replay::new(frame, &system.inputs)?),
@@ -266,13 +273,13 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
     let mc = match cmd.monte_carlo.monte_carlo {
         0 => None,
         n => Some(Draws::run(model, n, cmd.monte_carlo.seed, trajectory_values(&traj), |m| {
-            let system = termid::sim::System::new(m, &BTreeMap::new(), cmd.with_intercept)?;
+            let system = sized(termid::sim::System::new(m, &BTreeMap::new(), cmd.with_intercept)?);
             let t = simulate(&system, &x0, controller(&system)?.as_mut(), &settings)?;
             Ok((final_states(&system, &t), t))
         })?),
     };
     let effects = crate::monte_carlo::parameter_effects(model, mc.is_some(), |m| {
-        let system = termid::sim::System::new(m, &BTreeMap::new(), cmd.with_intercept)?;
+        let system = sized(termid::sim::System::new(m, &BTreeMap::new(), cmd.with_intercept)?);
         let t = simulate(&system, &x0, controller(&system)?.as_mut(), &settings)?;
         Ok(final_states(&system, &t))
     });
