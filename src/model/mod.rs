@@ -586,6 +586,7 @@ impl Model {
             }
         }
         let mut vocab = Vocabulary::new();
+        vocab.with_time(time);
         for (i, s) in spec.states.iter().enumerate() {
             vocab.variable(&s.name).map_err(|e| key_err(&format!("states[{i}].name"), e.to_string()))?;
             if let (Some(lo), Some(hi)) = (s.min, s.max) {

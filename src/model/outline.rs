@@ -59,6 +59,7 @@ impl Outline {
         }
         let names: Vec<&String> = self.states.iter().chain(&self.inputs).collect();
         let mut vocabulary = crate::term::Vocabulary::new();
+        vocabulary.with_time(&self.time);
         for (k, name) in names.iter().enumerate() {
             if **name == self.time {
                 return Err(refuse(format!(

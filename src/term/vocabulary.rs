@@ -27,6 +27,8 @@ pub struct Vocabulary {
     derived: Vec<Derived>,
     aliases: BTreeMap<String, String>,
     open: bool,
+    /// The time's name, which no term holds: named as such where a term uses it.
+    time: Option<String>,
     /// Every declared name → its place in `derived` (None: a variable or parameter), so that
     /// a look-up does not scan (a file of 10⁵ derived variables loads in linear time).
     index: rustc_hash::FxHashMap<String, Option<usize>>,
@@ -90,6 +92,13 @@ impl Vocabulary {
     /// A vocabulary that accepts any identifier as a variable (for ad-hoc use and tests).
     pub fn open() -> Self {
         Vocabulary { open: true, ..Self::default() }
+    }
+
+    /// Names the time (a model's `model.time`), so that a term that uses it is told why no
+    /// term may: it is no variable.
+    pub fn with_time(&mut self, name: &str) -> &mut Self {
+        self.time = Some(name.to_string());
+        self
     }
 
     fn check_new(&self, name: &str) -> Result<String, TermError> {
@@ -253,6 +262,11 @@ impl Vocabulary {
                 None if function(name).is_some() => {
                     Err(at(format!("`{name}` is a function: write `{name}(…)`")))
                 }
+                // a term is a function of the states and inputs at an instant: a simulation's clock
+                // starts at 0, a run's at its first sample, so a term of the time would differ
+                None if self.time.as_deref() == Some(name.as_str()) => Err(at(format!(
+                    "`{name}` is the time, which no term holds (a simulation's clock starts at 0, a run's at its first sample): a forcing that follows the clock, cos(1.2·{name}) or a ramp, is an input: add it to the runs as a column of its own and name it among the inputs"
+                ))),
                 None => Err(at(match self.look_alike(name) {
                     Some(like) => format!(
                         "unknown variable `{name}`: it looks like `{like}` but is spelt with other characters ({} against {})",
@@ -400,6 +414,12 @@ mod tests {
         let e = v.parse("u*w").unwrap_err();
         assert_eq!(e.line_col(), Some((1, 3)));
         assert!(e.to_string().contains("unknown variable `w`"), "{e}");
+        // the time, named as such: a term of the clock is an input's column
+        let mut timed = ship();
+        timed.with_time("t");
+        let e = timed.parse("u*cos(t)").unwrap_err();
+        assert_eq!(e.line_col(), Some((1, 7)));
+        assert!(e.to_string().contains("`t` is the time, which no term holds"), "{e}");
         let e = v.parse("foo(u)").unwrap_err();
         assert!(e.to_string().contains("unknown function `foo`"), "{e}");
         let e = v.parse("abs(u, v)").unwrap_err();

@@ -1964,6 +1964,8 @@ fn a_whole_system_from_its_columns() {
         (&["--states", "x,v", "--target", "dv/dt"], "--target cannot be used with --states"),
         (&["--states", "x,v", "--inputs", "x"], "`x` is named twice"),
         (&["--states", "x,v", "--terms", "x*G"], "unknown variable `G`"),
+        // a forcing written as a function of the clock: the time is no variable of terms
+        (&["--states", "x,v", "--terms", "x,cos(1.2*t)"], "`t` is the time, which no term holds"),
         (&["--states", "x,v", "--degree", "0"], "degree 0"),
     ] {
         let mut args = vec!["identify", "--data", &data];
