@@ -2,8 +2,9 @@
 //! (two records joined in one file, a sensor re-zeroed, a knock). No motion whose rate is
 //! finite crosses one; taken as a motion, every rate and integral across it is wrong and so is
 //! every fit (Lorenz, two runs in one file: ten terms where two are). A run is cut where a
-//! state breaks into runs of its own; an input that leaps alone is a step of the input. So is
-//! a run cut at a gap in its time (a logger's dropout).
+//! state breaks into runs of its own, also where it leaps again and again moving between (a
+//! bouncing ball); an input that leaps alone is a step of the input. So is a run cut at a gap
+//! in its time (a logger's dropout).
 
 use super::{DataError, Frame};
 
@@ -92,9 +93,9 @@ pub fn breaks(t: &[f64], x: &[f64]) -> Vec<Break> {
 /// scale), which cut nothing. Only records that move from sample to sample are looked at: a
 /// command stepped at isolated samples ([`super::held`], a step test's force) or marked held
 /// ([`Frame::is_held`]) jumps by design.
-pub fn moving_breaks<'a>(frame: &Frame, columns: &[&'a str]) -> (Vec<(usize, &'a str, f64)>, Vec<String>) {
+pub fn moving_breaks<'a>(frame: &Frame, columns: &[&'a str]) -> Leaps<'a> {
     let n = frame.len();
-    let (mut found, mut notes) = (Vec::new(), Vec::new());
+    let (mut found, mut notes, mut resets) = (Vec::new(), Vec::new(), Vec::new());
     // a command held or switched for one or two samples and back (a telegraph's pulse) moves
     // the states it drives by a step that stays: no break there (one stepped at every sample,
     // white, pulses everywhere, and its states' steps are all alike rough: none stands out)
@@ -115,7 +116,19 @@ pub fn moving_breaks<'a>(frame: &Frame, columns: &[&'a str]) -> (Vec<(usize, &'a
         let Some(column) = moving(frame, name) else { continue };
         let mut b = breaks(frame.time(), column);
         b.retain(|b| !by_a_command(b.row));
-        if b.len() > 3 && b.len() * ROWS_PER_BREAK > n {
+        if b.len() > 3 && b.len() * ROWS_PER_BREAK > n && moves_between(column, &b) {
+            // a motion reset again and again (a ball's bounces, a relay's resets): the
+            // rates hold between the leaps, none across them
+            notes.push(format!(
+                "{}: `{name}` leaps at {} rows and stays (the first from row {} to row {}, t = {} s), moving between its leaps as much as it leaps: a motion reset at each (an impact, a bounce, a reset), whose rule no rate holds; the run is cut at each into runs of their own: the equations found hold between the leaps, not across them",
+                frame.origin(),
+                b.len(),
+                frame.row(b[0].row - 1),
+                frame.row(b[0].row),
+                crate::output::sig(frame.time()[b[0].row], 3)
+            ));
+            resets.push(*name);
+        } else if b.len() > 3 && b.len() * ROWS_PER_BREAK > n {
             notes.push(format!(
                 "{}: `{name}` leaps at {} rows and stays (from row {}), far beyond its steps beside: too often for records joined in one file; taken as recorded, its rate spikes there",
                 frame.origin(),
@@ -127,7 +140,40 @@ pub fn moving_breaks<'a>(frame: &Frame, columns: &[&'a str]) -> (Vec<(usize, &'a
         found.extend(b.iter().map(|b| (b.row, *name, b.leap)));
     }
     found.sort_by_key(|f| f.0);
-    (found, notes)
+    Leaps { found, notes, resets }
+}
+
+/// What [`moving_breaks`] finds.
+#[derive(Clone, Debug, Default)]
+pub struct Leaps<'a> {
+    /// Where the columns break, as (row, column, leap) in row order: each cuts the run.
+    pub found: Vec<(usize, &'a str, f64)>,
+    /// What to say of the columns that leap too often to be records joined.
+    pub notes: Vec<String>,
+    /// Of those, the columns that move between their leaps as much as they leap (a motion
+    /// reset at each: a bounce), whose leaps are in `found`, said once in `notes`.
+    pub resets: Vec<&'a str>,
+}
+
+/// Whether a record moves between its leaps by a quarter of its typical leap or more, over a
+/// run's rows at least ([`SHORTEST`]), in most pieces between them (a ball's speed between
+/// bounces): not holding still between them as a staircase does (a state read off a coarse
+/// scale, a counter), nor leaping every few rows as a rough record may, whose pieces would
+/// hold no run.
+fn moves_between(x: &[f64], breaks: &[Break]) -> bool {
+    let mut leaps: Vec<f64> = breaks.iter().map(|b| b.leap.abs()).collect();
+    let middle = leaps.len() / 2;
+    let typical = *leaps.select_nth_unstable_by(middle, f64::total_cmp).1;
+    let moved = breaks
+        .windows(2)
+        .filter(|w| {
+            let piece = &x[w[0].row..w[1].row];
+            let (lo, hi) =
+                piece.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+            w[1].row - w[0].row >= SHORTEST && hi - lo >= 0.25 * typical
+        })
+        .count();
+    2 * moved > breaks.len() - 1
 }
 
 /// Column `name` of `frame` where it records a motion that may break: not a command stepped
@@ -152,7 +198,7 @@ pub fn cut_at_breaks(
     inputs: &[&str],
 ) -> Result<(Vec<Frame>, Vec<String>), DataError> {
     let sig = |x: f64| crate::output::sig(x, 3);
-    let (mut found, mut notes) = moving_breaks(&frame, states);
+    let Leaps { mut found, mut notes, resets } = moving_breaks(&frame, states);
     let mut cuts: Vec<usize> = found.iter().map(|f| f.0).collect();
     cuts.dedup();
     // an input's leaps, however many (they cut nothing: no staircase rule)
@@ -204,9 +250,13 @@ pub fn cut_at_breaks(
     for &row in &cuts {
         let leaps: Vec<String> = found
             .iter()
-            .filter(|f| f.0 == row)
+            .filter(|f| f.0 == row && !resets.contains(&f.1))
             .map(|(_, name, leap)| format!("`{name}` (by {})", sig(*leap)))
             .collect();
+        // a reset's leaps are said once, for its column
+        if leaps.is_empty() {
+            continue;
+        }
         let (verb, whose) = if leaps.len() == 1 { ("leaps", "its") } else { ("leap", "their") };
         notes.push(format!(
             "{}: {} {verb} from row {} to row {} (t = {} s), far beyond {whose} steps beside, and {} there: no motion crosses that in one sample (two records joined in one file, a sensor re-zeroed, a knock); the run is cut there into runs of its own",
@@ -616,6 +666,47 @@ mod tests {
         let mut t = clock(12);
         t[6..].iter_mut().for_each(|v| *v += 1.0);
         assert!(matches!(gaps(&t), Gaps::Dropouts(rows) if rows == [6]));
+    }
+
+    /// A ball dropped from 2 m bouncing back at 0.8 of its speed (g = 9.81 m/s², flights of
+    /// 2·0.8ᵏ·v₁/g): its speed leaps at each bounce and moves between them as much: cut at each
+    /// into flights of their own, said once; its height only kinks, and cuts nothing.
+    #[test]
+    fn a_bouncing_motion_is_cut_at_each_bounce() {
+        let g = 9.81;
+        let v1 = (2.0 * g * 2.0f64).sqrt();
+        let first = v1 / g;
+        // the bounce times and the speed leaving each
+        let mut bounces = vec![(first, 0.8 * v1)];
+        while bounces.len() < 8 {
+            let (t, v) = *bounces.last().unwrap();
+            bounces.push((t + 2.0 * v / g, 0.8 * v));
+        }
+        let t: Vec<f64> = (0..480).map(|k| 0.01 * k as f64).collect();
+        let (h, v): (Vec<f64>, Vec<f64>) = t
+            .iter()
+            .map(|&t| match bounces.iter().rev().find(|b| b.0 <= t) {
+                Some(&(tb, vb)) => (vb * (t - tb) - 0.5 * g * (t - tb).powi(2), vb - g * (t - tb)),
+                None => (2.0 - 0.5 * g * t * t, -g * t),
+            })
+            .unzip();
+        let mut f = Frame::new("ball.csv", "t", t.clone()).unwrap();
+        f.push("h", h).unwrap();
+        f.push("v", v).unwrap();
+        let (runs, notes) = cut_at_breaks(f, &["h", "v"], &[]).unwrap();
+        // bounces at 0.639, 1.66, 2.48, 3.13, 3.65, 4.07, 4.41 and 4.68 s: the drop and seven
+        // flights, the last 12 rows too few for a run
+        assert_eq!(runs.len(), 8, "{notes:?}");
+        for (run, b) in runs.iter().skip(1).zip(&bounces) {
+            // each flight starts at the first sample after its bounce
+            assert!(run.time()[0] >= b.0 && run.time()[0] - b.0 < 0.01 + 1e-9, "{} {}", run.time()[0], b.0);
+        }
+        assert_eq!(notes.len(), 2, "{notes:?}");
+        assert!(
+            notes[0].contains("`v` leaps at 8 rows") && notes[0].contains("a motion reset at each"),
+            "{notes:?}"
+        );
+        assert!(notes[1].contains("12 row(s) between breaks"), "{notes:?}");
     }
 
     /// A staircase (a state read off a coarse scale every 40 rows) leaps too often to be

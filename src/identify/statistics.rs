@@ -309,7 +309,9 @@ impl EquationMoments {
                 ));
                 // a piece of a run is not cut into runs (the whole run is, where a state breaks;
                 // an input's step cuts nothing)
-                if let Some((row, name, leap)) = crate::data::moving_breaks(&chunk.frame, &states).0.first() {
+                if let Some((row, name, leap)) =
+                    crate::data::moving_breaks(&chunk.frame, &states).found.first()
+                {
                     return Err(IdentifyError::Setup(format!(
                         "{}: `{name}` leaps by {} from row {} to row {} and stays (records joined in one file, a sensor re-zeroed), where a run read whole is cut into runs of its own; a piece of one cannot be: read the runs whole (--chunk-rows 0), or cut the file there",
                         chunk.frame.origin(),

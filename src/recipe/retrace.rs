@@ -189,7 +189,8 @@ fn retrace_check(model: &Model, runs: &[Frame], followed: &mut Vec<Followed>) ->
                         "{}: re-simulated from its start, `{name}` reaches {} at t = {} s where the run keeps within {} … {}: {remedy}",
                         run.origin(),
                         crate::identify::num(values[k]),
-                        crate::identify::num(sim.time[k]),
+                        // on the record's clock: a piece of a file starts at its own time
+                        crate::identify::num(run.time()[0] + sim.time[k]),
                         crate::identify::num(lo),
                         crate::identify::num(hi)
                     ),
