@@ -34,7 +34,7 @@ import os
 import re
 import sys
 import warnings
-from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import pandas as pd
@@ -734,15 +734,7 @@ class Fit:
         >>> termid.fit(pd.DataFrame({"x": [0.0, 1, 2, 3], "y": [1.0, 3, 5, 7]}), "y", ["1", "x - 1"]).equation(3)
         'y = 3 + 2 (x - 1)'
         """
-        parts = [] if self.intercept is None else [f"{self.intercept:.{precision}g}"]
-        for term, value in self.coefficients.items():
-            # the constant candidate is its coefficient alone; a sum is one term, in parentheses
-            if term == "1":
-                parts.append(f"{value:.{precision}g}")
-            else:
-                shown = f"({term})" if re.search(r".[+-] ", term) else term
-                parts.append(f"{value:.{precision}g} {shown}")
-        return f"{self.target} = " + (" + ".join(parts) if parts else "0").replace("+ -", "- ")
+        return _equation_text(self.target, self.intercept, self.coefficients.items(), precision)
 
     def summary(self, alpha: float = 0.05) -> Summary:
         """R², adjusted R², F, AIC and BIC of the chosen step, and every coefficient with its
@@ -1283,6 +1275,20 @@ class Recipe:
         flags = int((~self.checks["passed"]).sum()) if len(self.checks) else 0
         return f"termid.Recipe(kept {kept[0] if kept else None!r} of {len(self.starts)} starts, {flags} checks not passed)"
 
+
+
+def _equation_text(target: str, intercept: Optional[float], terms: Iterable[Tuple[str, float]], precision: int) -> str:
+    """``target = b0 + c1 term1 + ...``, each number to ``precision`` significant digits: the
+    constant candidate ``1`` its coefficient alone (it read ``-9.81 1``), a sum one term in
+    parentheses."""
+    parts = [] if intercept is None else [f"{intercept:.{precision}g}"]
+    for term, value in terms:
+        if term == "1":
+            parts.append(f"{value:.{precision}g}")
+        else:
+            shown = f"({term})" if re.search(r".[+-] ", term) else term
+            parts.append(f"{value:.{precision}g} {shown}")
+    return f"{target} = " + (" + ".join(parts) if parts else "0").replace("+ -", "- ")
 
 
 def _particulars(particulars: Union[Mapping[str, Any], str, os.PathLike]) -> Tuple[Any, str, List[str]]:
@@ -2536,10 +2542,8 @@ class Model:
         # significant digits), as Fit.equation writes one; repr() stays the one-line summary
         lines = [self.name]
         for equation in self.equations:
-            b0 = self.intercept(equation)
-            parts = [] if b0 is None else [f"{b0:.6g}"]
-            parts += [f"{v:.6g} {t}" for t, v in zip(*(self.coefficients(equation)[c] for c in ("term", "value")))]
-            lines.append(f"  {equation} = " + (" + ".join(parts) if parts else "0").replace("+ -", "- "))
+            terms = zip(*(self.coefficients(equation)[c] for c in ("term", "value")))
+            lines.append("  " + _equation_text(equation, self.intercept(equation), terms, 6))
         return "\n".join(lines)
 
 

@@ -1199,3 +1199,27 @@ def test_an_identification_prints_its_equations_and_checks():
 
     found._repr_pretty_(Printer(), False)
     assert Printer.said == text
+
+
+def test_a_bouncing_ball_is_identified_between_its_bounces_and_printed_as_such():
+    # a ball dropped from 2 m bouncing back at 0.8 of its speed: its speed leaps at each
+    # bounce, moving between them as much; the run is cut there (warned once) and the flights
+    # hold h' = v, v' = -9.81, which print shows as "v_dot = -9.81" (it read "-9.81 1")
+    g, v1 = 9.81, math.sqrt(2 * 9.81 * 2.0)
+    bounces = [(v1 / g, 0.8 * v1)]
+    while bounces[-1][0] < 5.0:
+        t, v = bounces[-1]
+        bounces.append((t + 2 * v / g, 0.8 * v))
+    t = np.arange(501) * 0.01
+    h, v = np.empty_like(t), np.empty_like(t)
+    for k, tk in enumerate(t):
+        past = [b for b in bounces if b[0] <= tk]
+        if past:
+            tb, vb = past[-1]
+            h[k], v[k] = vb * (tk - tb) - 0.5 * g * (tk - tb) ** 2, vb - g * (tk - tb)
+        else:
+            h[k], v[k] = 2.0 - 0.5 * g * tk**2, -g * tk
+    with pytest.warns(UserWarning, match=r"`v` leaps at 9 rows and stays .* a motion reset at each"):
+        found = termid.Model.from_states(["h", "v"]).identify(pd.DataFrame({"t": t, "h": h, "v": v}))
+    assert found.model.coefficients("v_dot")["term"].tolist() == ["1"]
+    assert "\n  v_dot = -9.81\n" in str(found) and bool(found.checks["passed"].all())
