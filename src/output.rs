@@ -420,8 +420,14 @@ pub fn sig(x: f64, n: usize) -> String {
     if !x.is_finite() || !(1e-3..1e5).contains(&x.abs()) {
         return format!("{x:.prec$e}", prec = n - 1);
     }
-    let digits = (n as i32 - 1 - x.abs().log10().floor() as i32).max(0) as usize;
-    format!("{x:.digits$}")
+    let magnitude = x.abs().log10().floor() as i32;
+    let digits = (n as i32 - 1 - magnitude).max(0) as usize;
+    let text = format!("{x:.digits$}");
+    // rounded up into the next decade (99.99 to three figures: "100.0"), one digit fewer
+    match text.trim_start_matches('-').parse::<f64>() {
+        Ok(v) if digits > 0 && v >= 10f64.powi(magnitude + 1) => format!("{x:.prec$}", prec = digits - 1),
+        _ => text,
+    }
 }
 
 #[cfg(test)]
@@ -548,5 +554,18 @@ mod tests {
             replace_folder(&target, build("2")).unwrap();
         }
         let _ = std::fs::remove_dir_all(&d);
+    }
+
+    /// Significant figures as read: a number that rounds up into the next decade keeps as
+    /// many figures (99.99 to three is "100", it read "100.0"; 0.09999 is "0.100").
+    #[test]
+    fn significant_figures_across_a_decade() {
+        assert_eq!(sig(99.99999999, 3), "100");
+        assert_eq!(sig(-99.99999999, 3), "-100");
+        assert_eq!(sig(0.099999, 3), "0.100");
+        assert_eq!(sig(42.87, 3), "42.9");
+        assert_eq!(sig(9.996, 3), "10.0");
+        assert_eq!(sig(0.5, 3), "0.500");
+        assert_eq!(sig(999.7, 2), "1000");
     }
 }
