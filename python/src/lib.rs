@@ -87,6 +87,13 @@ fn seconds_per(name: &str) -> Option<f64> {
     termid::data::seconds_per(name).filter(|f| *f != 1.0)
 }
 
+/// What to say of a time whose own name is a unit of time's (`day`, `time_ms`): read in
+/// seconds all the same, as the command line reads it.
+#[pyfunction]
+fn time_in_seconds(time: &str) -> Option<String> {
+    termid::data::time_in_seconds(time)
+}
+
 /// Candidate terms as a user lists them: each text split at its commas outside parentheses
 /// (the command line's `--terms x,x*y`).
 #[pyfunction]
@@ -119,6 +126,7 @@ fn _termid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(monte_carlo_refusal, m)?)?;
     m.add_function(wrap_pyfunction!(time_like, m)?)?;
     m.add_function(wrap_pyfunction!(seconds_per, m)?)?;
+    m.add_function(wrap_pyfunction!(time_in_seconds, m)?)?;
     m.add_function(wrap_pyfunction!(headers_in_si, m)?)?;
     m.add_function(wrap_pyfunction!(time_position, m)?)?;
     m.add_function(wrap_pyfunction!(check_line, m)?)?;

@@ -415,6 +415,10 @@ def _runs(
         if time is not None and time not in columns:
             _time_from(str(name), run, columns, time)
         out.append((str(name), columns))
+    # a time named by its unit (`day`, an epidemic's day count) is read in seconds: said once
+    said = _termid.time_in_seconds(time) if time is not None and out else None
+    if said:
+        warnings.warn(f"termid: {said}", stacklevel=_outside())
     return out
 
 

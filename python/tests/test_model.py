@@ -1223,3 +1223,14 @@ def test_a_bouncing_ball_is_identified_between_its_bounces_and_printed_as_such()
         found = termid.Model.from_states(["h", "v"]).identify(pd.DataFrame({"t": t, "h": h, "v": v}))
     assert found.model.coefficients("v_dot")["term"].tolist() == ["1"]
     assert "\n  v_dot = -9.81\n" in str(found) and bool(found.checks["passed"].all())
+
+
+def test_a_time_named_by_its_unit_is_read_in_seconds_and_said():
+    # an epidemic's day count: the command line reads `day` in seconds; Python did too,
+    # silently (the native reading), where it now warns as the command line notes it
+    day = np.arange(61.0)
+    run = pd.DataFrame({"day": day, "x": 100.0 * np.exp(-0.1 * day)})
+    with pytest.warns(UserWarning, match=r"the time `day` read in seconds \(× 8\.640000e4\): every rate is per second"):
+        found = termid.Model.from_states(["x"], time="day").identify(run)
+    x = found.model.coefficients("x_dot").set_index("term")["value"]
+    assert x["x"] * 86400.0 == pytest.approx(-0.1, rel=1e-3)

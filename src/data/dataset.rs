@@ -320,6 +320,9 @@ const UNITS: &[(&str, f64, [i32; 3])] = &[
     ("s", 1.0, [0, 1, 0]),
     ("ms", 1e-3, [0, 1, 0]),
     ("min", 60.0, [0, 1, 0]),
+    // a pharmacokinetic study's hours, an epidemic's days
+    ("h", 3600.0, [0, 1, 0]),
+    ("d", 86400.0, [0, 1, 0]),
     ("m", 1.0, [1, 0, 0]),
     ("m/s", 1.0, [1, -1, 0]),
     ("m/s^2", 1.0, [1, -2, 0]),
@@ -368,23 +371,31 @@ pub fn time_position(names: &[String], time: &str) -> Option<usize> {
 
 /// Units of time as loggers write them after a name (`timestamp_ms`, `time_us`, `t.sec`),
 /// with their factor to seconds.
-const TIME_SUFFIXES: [(&[&str], f64); 6] = [
+const TIME_SUFFIXES: [(&[&str], f64); 7] = [
     (&["s", "sec", "secs", "seconds"], 1.0),
     (&["ms", "msec", "millis"], 1e-3),
     (&["us", "µs", "μs", "usec", "micros"], 1e-6),
     (&["ns", "nsec", "nanos"], 1e-9),
     (&["min", "mins", "minutes"], 60.0),
-    (&["h", "hr", "hrs", "hours"], 3600.0),
+    (&["h", "hr", "hrs", "hour", "hours"], 3600.0),
+    (&["d", "day", "days"], 86400.0),
 ];
 
 /// The factor to seconds of a time header whose last word, after `_`, `.`, `-` or a space,
 /// is a unit of time (`timestamp_ms`: a logger's milliseconds, read as seconds a thousand
-/// times too slow); `None` otherwise (`t`, `time`, `elapsed`).
+/// times too slow), or that is such a word of three letters or more alone (`day`, `hours`: an
+/// epidemic's day count read as seconds); `None` otherwise (`t`, `time`, `elapsed`,
+/// `time_of_day`).
 fn suffixed_seconds(header: &str) -> Option<f64> {
-    let (name, unit) = header.trim().rsplit_once(['_', '.', '-', ' '])?;
-    if name.trim().is_empty() {
-        return None;
-    }
+    let unit = match header.trim().rsplit_once(['_', '.', '-', ' ']) {
+        // `time_of_day`, `hour_of_day`: a time of day, not a count of days
+        Some((name, _)) if name.to_lowercase().ends_with("of") => return None,
+        Some((name, unit)) if !name.trim().is_empty() => unit,
+        // a header that is a unit's word alone (`days`, `hours`: a day count), not an
+        // abbreviation (`ms`, `h`, `d` may name anything)
+        _ if header.trim().chars().count() > 2 => header.trim(),
+        _ => return None,
+    };
     let unit = unit.to_lowercase();
     TIME_SUFFIXES.iter().find(|(names, _)| names.contains(&unit.as_str())).map(|(_, f)| *f)
 }
@@ -1009,8 +1020,22 @@ mod tests {
         assert_eq!(seconds_per("Time [ms]"), Some(1e-3));
         assert_eq!(seconds_per("t (min)"), Some(60.0));
         assert_eq!(seconds_per("t [s]"), Some(1.0));
-        for plain in ["t", "x [m]", "f(x)", "time (rad)", "ms", "_ms", "x_dot", "time_of_day"] {
+        for plain in
+            ["t", "x [m]", "f(x)", "time (rad)", "ms", "_ms", "x_dot", "time_of_day", "hour_of_day", "d", "h"]
+        {
             assert_eq!(seconds_per(plain), None, "{plain}");
+        }
+        // a pharmacokinetic study's hours, an epidemic's days, by unit or by name (a day count
+        // was read as seconds, every rate 86 400 times too fast)
+        for (header, factor) in [
+            ("t [h]", 3600.0),
+            ("time (d)", 86400.0),
+            ("day", 86400.0),
+            ("Days", 86400.0),
+            ("hours", 3600.0),
+            ("t_days", 86400.0),
+        ] {
+            assert_eq!(seconds_per(header), Some(factor), "{header}");
         }
         // a logger's unit after the name: `timestamp_ms` was read as seconds, every rate a
         // thousand times too slow

@@ -72,15 +72,31 @@ impl RowSource for InSi {
     }
 }
 
+/// What to say of a time whose own name is a unit of time's (`day`, `time_ms`): it keeps its
+/// name and is read in seconds all the same, so every rate is per second. `None` for one in
+/// seconds or of no unit.
+pub fn time_in_seconds(time: &str) -> Option<String> {
+    super::seconds_per(time)
+        .filter(|f| *f != 1.0)
+        .map(|s| format!("the time `{time}` read in seconds (× {s:.6e}): every rate is per second"))
+}
+
 /// What reading the plain file `path` in SI does to its columns' headers, to be said: `None`
 /// where no header carries a unit termid reads (or the file cannot be read: reading it says why).
 /// The time column `time` is said where its header carries its unit (`t [ms]`).
 pub fn units_note(path: &Path, time: &str) -> Option<String> {
     let names = rows_of(path).ok()?.names().to_vec();
     let mut renamed = super::dataset::headers_in_si(&names);
-    if let Some(i) = super::time_position(&names, time).filter(|&i| names[i] != time) {
-        let seconds = super::seconds_per(&names[i]).unwrap_or(1.0);
-        renamed.insert(0, (i, time.to_string(), String::new(), seconds));
+    // a time named by its unit keeps its name and is read in seconds all the same (`day`, an
+    // epidemic's day count; `time_ms`): said, as every rate is then per second
+    let mut own = None;
+    if let Some(i) = super::time_position(&names, time) {
+        if names[i] != time {
+            let seconds = super::seconds_per(&names[i]).unwrap_or(1.0);
+            renamed.insert(0, (i, time.to_string(), String::new(), seconds));
+        } else {
+            own = time_in_seconds(time);
+        }
     }
     let read: Vec<String> = renamed
         .iter()
@@ -89,7 +105,9 @@ pub fn units_note(path: &Path, time: &str) -> Option<String> {
             false => format!("`{}` as {bare} in SI (× {f:.6e})", names[*i]),
         })
         .collect();
-    (!read.is_empty()).then(|| format!("{}: read by their bare names: {}", path.display(), read.join(", ")))
+    let read = (!read.is_empty()).then(|| format!("read by their bare names: {}", read.join(", ")));
+    let said: Vec<String> = own.into_iter().chain(read).collect();
+    (!said.is_empty()).then(|| format!("{}: {}", path.display(), said.join("; ")))
 }
 
 #[cfg(test)]
@@ -120,7 +138,9 @@ mod tests {
         assert_eq!(rows.take_labels()[0].1.values, ["a"]);
         let note = units_note(&path, "Time [ms]").unwrap();
         assert!(note.contains("`x [m]` as x, `psi (deg)` as psi in SI (× 1.745329e-2)"), "{note}");
-        assert!(!note.contains("Time") && !note.contains("`v [kn]`"), "{note}");
+        // the time under its header with its unit: read in seconds, said as such
+        assert!(note.contains(": the time `Time [ms]` read in seconds (× 1.000000e-3): every rate is per second; read by their bare names: `x [m]`"), "{note}");
+        assert!(!note.contains("`v [kn]`"), "{note}");
         // the time by its bare name: read in seconds, said
         let note = units_note(&path, "Time").unwrap();
         assert!(

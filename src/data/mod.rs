@@ -45,7 +45,7 @@ pub use derivative::{
 pub use five_point::FivePoint;
 pub use geodetic::{north_east, radii_of_curvature};
 pub use hold::{held, mark_held, stepped, switches, white, Hold, Intersample};
-pub use in_si::units_note;
+pub use in_si::{time_in_seconds, units_note};
 pub use integral::{integral_rows, integral_rows_held, row_overlap, IntegralForm};
 pub use kalman::{KalmanSmoother, NoiseModel};
 pub use long::{columns_of, interleaved, text_columns_of};
@@ -311,7 +311,8 @@ pub enum DataError {
 }
 
 /// Whether a column's name says it holds the time: `time`, `Time [s]`, `timestamp`,
-/// `seconds`, `t_s`, … (for an error that names it where the time column was not found).
+/// `seconds`, `t_s`, a unit of time's word or a header with one (`day`, `t [h]`), … (for an
+/// error that names it where the time column was not found).
 pub fn looks_like_time(name: &str) -> bool {
     let n = name.trim().to_lowercase();
     ["time", "timestamp", "sec", "secs", "seconds", "t_s", "t [s]", "t(s)"].iter().any(|w| {
@@ -319,7 +320,7 @@ pub fn looks_like_time(name: &str) -> bool {
             || n.starts_with(&format!("{w} "))
             || n.starts_with(&format!("{w}_"))
             || n.starts_with(&format!("{w}["))
-    })
+    }) || seconds_per(name).is_some()
 }
 
 impl DataError {

@@ -135,7 +135,7 @@ fn missed_check(followed: &[Followed]) -> Option<Check> {
         format!("their own motion, started {off} of each state's span off, follows itself throughout each run, and they follow their runs at least a quarter as long")
     } else {
         format!(
-            "their own motion, started {off} of each state's span off, follows itself for {} % of a run at least (a motion that loses its start: chaos), and they follow their runs at least a quarter as long",
+            "their own motion, started {off} of each state's span off, follows itself for {} % of a run at least (a motion that loses its start: chaos, or a growth from near rest such as an epidemic's, which a start so far off hastens), and they follow their runs at least a quarter as long",
             sig(100.0 * shortest)
         )
     };

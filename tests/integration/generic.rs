@@ -3230,3 +3230,42 @@ fn a_bouncing_ball_is_identified_between_its_bounces() {
         "{out}"
     );
 }
+
+/// An epidemic's day count and a pharmacokinetic study's hours: ẋ = −0.1x per day sampled daily
+/// under `day`, ẋ = −0.3x per hour under `t [h]`. A `t [h]` was "no time column `t`" (hours
+/// unknown), a time named `day` was read as seconds, every rate 86 400 times too fast, unsaid;
+/// both are now read in seconds and said, and a file without `--time` names `day` as the time.
+#[test]
+fn days_and_hours_are_read_as_the_time_in_seconds() {
+    use crate::common::{json, Scratch};
+    let dir = Scratch::new("generic-days");
+    for (header, rate, per, extra) in
+        [("day", 0.1, 86400.0, &["--time", "day"][..]), ("t [h]", 0.3, 3600.0, &[][..])]
+    {
+        let mut text = format!("{header},x\n");
+        for k in 0..=60 {
+            text += &format!("{k},{}\n", 100.0 * (-rate * k as f64).exp());
+        }
+        let data = dir.join("decay.csv");
+        std::fs::write(&data, text).unwrap();
+        let mut args =
+            vec!["identify", "--data", data.to_str().unwrap(), "--states", "x", "--format", "json"];
+        args.extend_from_slice(extra);
+        let (ok, out, err) = termid(&args);
+        assert!(ok, "{header}: {err}");
+        let said = match header {
+            "day" => "the time `day` read in seconds (× 8.640000e4): every rate is per second",
+            _ => "`t [h]` as t in SI (× 3.600000e3)",
+        };
+        assert!(err.contains(said), "{header}: {err}");
+        let terms = terms_of(&json(&out)["x_dot"]);
+        assert!((terms["x"] * per / -rate - 1.0).abs() < 1e-3, "{header}: {terms:?}");
+    }
+    let (ok, _, err) =
+        termid(&["identify", "--data", dir.join("decay.csv").to_str().unwrap(), "--states", "x"]);
+    assert!(ok, "{err}");
+    std::fs::write(dir.join("days.csv"), "day,x\n0,1\n1,0.9\n").unwrap();
+    let (ok, _, err) =
+        termid(&["identify", "--data", dir.join("days.csv").to_str().unwrap(), "--states", "x"]);
+    assert!(!ok && err.contains("`day` looks like time: name it as the time column (`--time day`"), "{err}");
+}
