@@ -663,7 +663,7 @@ impl PyModel {
         let x0: Vec<f64> =
             spec.states.iter().map(|s| initial.get(&s.name).copied().unwrap_or(s.initial)).collect();
         // the default absolute tolerance counted in how large the states start, as the command's
-        self.inner.size(&mut system, &x0.iter().map(|v| v.abs()).collect::<Vec<_>>());
+        system.sizes = self.inner.sizes(&x0.iter().map(|v| v.abs()).collect::<Vec<_>>());
         let u: Vec<f64> = system.inputs.iter().map(|n| inputs.get(n).copied().unwrap_or(0.0)).collect();
         let (integrator, step) = method_of(&self.inner, integrator, dt)?;
         // as the command line: the adaptive method's output interval is free

@@ -62,7 +62,7 @@ pub struct Runs {
     /// estimate frees them where it frees the runs' initial values.
     pub(super) hidden: Vec<Vec<usize>>,
     /// How large each of the model's states runs in the records, that the default absolute
-    /// tolerance is counted in ([`Model::size`]).
+    /// tolerance is counted in ([`Model::sizes`]).
     sizes: Vec<f64>,
 }
 
@@ -227,7 +227,7 @@ fn spread(frames: &[Frame], name: &str) -> f64 {
 }
 
 /// How large a state runs in the records (its largest magnitude; 0 where they do not record
-/// it): what the simulator counts its absolute tolerance in ([`System::size_by`]).
+/// it): what the simulator counts its absolute tolerance in ([`Model::sizes`]).
 fn largest(frames: &[Frame], name: &str) -> f64 {
     frames
         .iter()
@@ -323,11 +323,7 @@ impl Runs {
         let system = System::new(model, &Default::default(), false)?;
         // the default absolute tolerance counted in each state's size in the records (an
         // absolute 1e-7 is a tenth of a concentration of 1e-6 mol/L)
-        let sizes = {
-            let mut sized = system.clone();
-            model.size(&mut sized, &system.states.iter().map(|s| largest(frames, s)).collect::<Vec<_>>());
-            sized.sizes
-        };
+        let sizes = model.sizes(&system.states.iter().map(|s| largest(frames, s)).collect::<Vec<_>>());
         // a state is compared in the runs that record it: one run or basin without a record of
         // it (a yaw rate without a gyro) does not take it from the others' comparison
         let states: Vec<(usize, String)> = system

@@ -274,14 +274,15 @@ impl Model {
         )
     }
 
-    /// Counts the default absolute tolerance of `system` (this model's) in how large its states
-    /// run (`magnitudes` in its state order: the records' largest, or the initial values), so
-    /// that concentrations of 1e-6 mol/L are followed as closely as metres
-    /// ([`crate::sim::System::size_by`]); an `atol` of the model file's (or a command's) is
-    /// kept as given, in the states' own units.
-    pub fn size(&self, system: &mut crate::sim::System, magnitudes: &[f64]) {
-        if self.spec.simulation.as_ref().and_then(|s| s.atol).is_none() {
-            system.size_by(magnitudes);
+    /// The sizes each state's default absolute tolerance is counted in
+    /// ([`crate::sim::System::sizes`]), from how large the states run (`magnitudes` in state
+    /// order: the records' largest, or the initial values; [`crate::sim::sizes_of`]), so that
+    /// concentrations of 1e-6 mol/L are followed as closely as metres; none where the model
+    /// file (or a command) sets its own `atol`, kept as given in the states' own units.
+    pub fn sizes(&self, magnitudes: &[f64]) -> Vec<f64> {
+        match self.spec.simulation.as_ref().and_then(|s| s.atol) {
+            Some(_) => Vec::new(),
+            None => crate::sim::sizes_of(magnitudes),
         }
     }
 

@@ -837,16 +837,13 @@ mod tests {
         };
         let own_unit = worst(&lag);
         assert!(own_unit > 100.0, "{own_unit}");
-        lag.size_by(&[1e-6]);
+        lag.sizes = crate::sim::sizes_of(&[1e-6]);
         assert_eq!(lag.absolute_tolerances(), vec![atol * 1e-6]);
         let sized = worst(&lag);
         assert!(sized < 2.0, "{sized}");
         // sizes never loosen a tolerance; a state known only as 0 is as small as the least other
-        lag.size_by(&[1e4]);
-        assert_eq!(lag.sizes, vec![1.0]);
-        lag.states.push("c".into());
-        lag.size_by(&[2e-7, 0.0]);
-        assert_eq!(lag.sizes, vec![2e-7, 2e-7]);
+        assert_eq!(crate::sim::sizes_of(&[1e4]), vec![1.0]);
+        assert_eq!(crate::sim::sizes_of(&[2e-7, 0.0]), vec![2e-7, 2e-7]);
     }
 
     /// The adaptive method on closed forms: ẋ = −x (e^(−t)), a damped oscillator, and an

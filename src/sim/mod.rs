@@ -13,7 +13,7 @@ mod system;
 pub use controller::{Ahead, Constant, Controller, Delayed, Replay, Watch};
 pub use integrator::{simulate, Integrator, Settings, Tolerances, Trajectory};
 pub use steady::{solve_steady, SteadyProblem, Unknown};
-pub use system::{RightHandSide, System, Workspace};
+pub use system::{sizes_of, RightHandSide, System, Workspace};
 
 /// Why a simulation stopped.
 #[derive(Debug, thiserror::Error)]

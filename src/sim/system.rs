@@ -18,8 +18,8 @@ pub struct System {
     pub tolerances: super::Tolerances,
     /// Each state's size, in its unit, that the absolute tolerance is counted in (empty: 1
     /// each, the tolerance in the states' own units). A caller that knows how large the
-    /// states run (from records) sets it, so that concentrations of 1e-6 mol/L are followed as
-    /// closely as positions of metres: an absolute 1e-7 would be a tenth of them.
+    /// states run (from records, [`sizes_of`]) sets it, so that concentrations of 1e-6 mol/L
+    /// are followed as closely as positions of metres: an absolute 1e-7 would be a tenth of them.
     pub sizes: Vec<f64>,
     /// How much later than given each input acts, s (empty where none does: a dead time).
     pub delays: Vec<f64>,
@@ -41,6 +41,17 @@ enum Slot {
     State(usize),
     Input(usize),
     Param(usize),
+}
+
+/// Each state's size ([`System::sizes`]) from how large it is known to run (its largest
+/// magnitude in records, or its initial value), in state order: never above 1, so a state in
+/// large units keeps the absolute tolerance in its own unit (its relative one governs there) and
+/// nothing is followed less closely than before; one known only as 0 is taken as small as the
+/// smallest other (a product that starts at 0 among reactants of 1e-6 mol/L), or 1.
+pub fn sizes_of(magnitudes: &[f64]) -> Vec<f64> {
+    let known = |m: f64| m.is_finite() && m > 0.0;
+    let least = magnitudes.iter().copied().filter(|&m| known(m)).fold(1.0f64, f64::min);
+    magnitudes.iter().map(|&m| if known(m) { m.min(1.0) } else { least }).collect()
 }
 
 /// What the simulator needs of a model: its states (in integration order, with bounds), inputs,
@@ -155,18 +166,6 @@ impl System {
             out.params[i] = *value;
         }
         Ok(out)
-    }
-
-    /// Sets each state's size ([`System::sizes`]) from how large it is known to run (its
-    /// largest magnitude in records, or its initial value), in `states` order: never above 1, so
-    /// a state in large units keeps the absolute tolerance in its own unit (its relative one
-    /// governs there) and nothing is followed less closely than before; one known only as 0 is
-    /// taken as small as the smallest other (a product that starts at 0 among reactants of
-    /// 1e-6 mol/L), or 1.
-    pub fn size_by(&mut self, magnitudes: &[f64]) {
-        let known = |m: f64| m.is_finite() && m > 0.0;
-        let least = magnitudes.iter().copied().filter(|&m| known(m)).fold(1.0f64, f64::min);
-        self.sizes = magnitudes.iter().map(|&m| if known(m) { m.min(1.0) } else { least }).collect();
     }
 
     /// Each state's absolute tolerance: the tolerances' `atol` in units of its size.

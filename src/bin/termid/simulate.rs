@@ -250,9 +250,9 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
         })
         .transpose()?;
     // the default absolute tolerance counted in how large the states start
-    let magnitudes: Vec<f64> = x0.iter().map(|v| v.abs()).collect();
+    let sizes = model.sizes(&x0.iter().map(|v| v.abs()).collect::<Vec<_>>());
     let sized = |mut system: termid::sim::System| {
-        model.size(&mut system, &magnitudes);
+        system.sizes = sizes.clone();
         system
     };
     let system = sized(system);
