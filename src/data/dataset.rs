@@ -389,7 +389,11 @@ const TIME_SUFFIXES: [(&[&str], f64); 7] = [
 fn suffixed_seconds(header: &str) -> Option<f64> {
     let unit = match header.trim().rsplit_once(['_', '.', '-', ' ']) {
         // `time_of_day`, `hour_of_day`: a time of day, not a count of days
-        Some((name, _)) if name.to_lowercase().ends_with("of") => return None,
+        Some((name, _))
+            if name.rsplit(['_', '.', '-', ' ']).next().is_some_and(|w| w.eq_ignore_ascii_case("of")) =>
+        {
+            return None
+        }
         Some((name, unit)) if !name.trim().is_empty() => unit,
         // a header that is a unit's word alone (`days`, `hours`: a day count), not an
         // abbreviation (`ms`, `h`, `d` may name anything)
@@ -1028,6 +1032,7 @@ mod tests {
         // a pharmacokinetic study's hours, an epidemic's days, by unit or by name (a day count
         // was read as seconds, every rate 86 400 times too fast)
         for (header, factor) in [
+            ("proof_days", 86400.0),
             ("t [h]", 3600.0),
             ("time (d)", 86400.0),
             ("day", 86400.0),
