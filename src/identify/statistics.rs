@@ -313,7 +313,7 @@ impl EquationMoments {
                     crate::data::moving_breaks(&chunk.frame, &states).found.first()
                 {
                     return Err(IdentifyError::Setup(format!(
-                        "{}: `{name}` leaps by {} from row {} to row {} and stays (records joined in one file, a sensor re-zeroed), where a run read whole is cut into runs of its own; a piece of one cannot be: read the runs whole (--chunk-rows 0), or cut the file there",
+                        "{}: `{name}` leaps by {} from row {} to row {} and stays (records joined in one file, a sensor re-zeroed, a motion reset at each of many: a bounce), where a run read whole is cut into runs of its own; a piece of one cannot be: read the runs whole (--chunk-rows 0), or cut the file there",
                         chunk.frame.origin(),
                         crate::output::sig(*leap, 3),
                         chunk.frame.row(row - 1),
