@@ -183,8 +183,20 @@ fn retrace_check(model: &Model, runs: &[Frame], followed: &mut Vec<Followed>) ->
             Err(e) => {
                 return Some(check(
                     false,
-                    format!("{}: re-simulated from its start, {e}: {remedy}", run.origin()),
-                ))
+                    format!(
+                        "{}: re-simulated from its start{}, {e}: {remedy}",
+                        run.origin(),
+                        // the integrator's times count from the start: a piece of a file's
+                        // start said on the record's clock
+                        match run.time()[0] {
+                            0.0 => String::new(),
+                            t0 => format!(
+                                " (t = {} s on the record's clock; the times below from there)",
+                                crate::identify::num(t0)
+                            ),
+                        }
+                    ),
+                ));
             }
         };
         let mut left = sim.time.len();
@@ -356,6 +368,20 @@ mod tests {
             "{}",
             closer.detail
         );
+        // from 1, ẋ = x² runs off to infinity at t = 1 s: in a piece of a file that starts at
+        // t = 100 s (a run cut at a bounce), the integrator's time from the start is said so
+        let late: Vec<f64> = (0..=200).map(|k| 100.0 + k as f64 * 0.1).collect();
+        let mut piece = Frame::new("file.csv [rows 1001-1201]", "t", late.clone()).unwrap();
+        piece.push("x", late.iter().map(|t| 1.0 + 0.01 * t.sin()).collect()).unwrap();
+        let off = retrace_checks(&model, &[piece]).remove(0);
+        assert!(
+            !off.passed
+                && off.detail.starts_with(
+                    "file.csv [rows 1001-1201]: re-simulated from its start (t = 100.000 s on the record's clock; the times below from there), "
+                ),
+            "{}",
+            off.detail
+        );
     }
 
     /// ẋ = x/2 retraces its own exponential run (e^10 at the end: unstable, not running
@@ -379,6 +405,16 @@ mod tests {
         assert!(!away.passed && away.detail.starts_with("long.csv"), "{}", away.detail);
         assert!(!flat.passed && flat.refuses, "{}", flat.detail);
         assert!(flat.detail.contains("run.csv: re-simulated from its start, `x` reaches"), "{}", flat.detail);
+        // the same run as a piece of a file from t = 100 s: where it runs away said on its clock
+        let mut late =
+            Frame::new("file.csv [rows 1001-1201]", "t", (0..=200).map(|k| 100.0 + k as f64 * 0.1).collect())
+                .unwrap();
+        late.push("x", (0..=200).map(|k| 1.0 + 0.01 * (k as f64 * 0.1).sin()).collect()).unwrap();
+        let later = retrace_checks(&model, &[late]).remove(0);
+        let when = |d: &str| {
+            d.split(" at t = ").nth(1).and_then(|r| r.split(' ').next()).map(|v| v.parse::<f64>().unwrap())
+        };
+        assert_eq!(when(&later.detail), when(&flat.detail).map(|t| t + 100.0), "{}", later.detail);
         // an equation that chose no term is a rate of 0, followed while the run stays within a
         // tenth of its span of its start: x = t/20 over 20 s leaves 0 by more than 0.1 after t = 2 s (the next sample, 2.1 s)
         let bare =
