@@ -13,7 +13,7 @@
 
 use super::rosenbrock::{self, Rosenbrock};
 use super::system::{System, Workspace};
-use super::{SimError, Tolerances, Watch};
+use super::{SimError, Watch};
 
 // Dormand & Prince (1980), Table 5.2 of Hairer, Nørsett & Wanner
 const C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
@@ -64,8 +64,8 @@ pub(super) struct Dopri5 {
     held: Vec<f64>,
     held_t: f64,
     slope: Vec<f64>,
-    tol: Tolerances,
-    /// Each state's absolute tolerance ([`System::absolute_tolerances`]).
+    /// The relative tolerance, and each state's absolute one ([`System::absolute_tolerances`]).
+    rtol: f64,
     atol: Vec<f64>,
     /// Whether (`t`, `y`) hold the run's start or a later point.
     started: bool,
@@ -93,16 +93,11 @@ const STIFF_STEPS: u32 = 15;
 const CALM_STEPS: u32 = 6;
 
 impl Dopri5 {
+    /// The steps of `system` (its states, inputs and tolerances) on a control interval `dt`.
     /// `stiff`: linearly implicit steps from the start (else they are taken where the
     /// explicit ones find the model stiff, where `switch`).
-    pub(super) fn new(
-        n: usize,
-        m: usize,
-        dt: f64,
-        (tol, atol): (Tolerances, Vec<f64>),
-        stiff: Option<Rosenbrock>,
-        switch: bool,
-    ) -> Dopri5 {
+    pub(super) fn new(system: &System, dt: f64, stiff: Option<Rosenbrock>, switch: bool) -> Dopri5 {
+        let (n, m) = (system.dim(), system.inputs.len());
         Dopri5 {
             k: std::array::from_fn(|_| vec![0.0; n]),
             stage: vec![0.0; n],
@@ -118,8 +113,8 @@ impl Dopri5 {
             held: vec![f64::NAN; m],
             held_t: 0.0,
             slope: vec![0.0; m],
-            tol,
-            atol,
+            rtol: system.tolerances.rtol,
+            atol: system.absolute_tolerances(),
             started: false,
             dt,
             control: StepControl::default(),
@@ -383,7 +378,7 @@ impl Dopri5 {
         };
         let t = self.t;
         stiff.prepare(system, ws, t, &self.y, &line, self.dt);
-        let tolerance = (&self.atol[..], self.tol.rtol);
+        let tolerance = (&self.atol[..], self.rtol);
         let mut tries = 0usize;
         loop {
             let h = self.h.min(reach - t);
@@ -450,7 +445,7 @@ impl Dopri5 {
             let c = h * w;
             err.iter_mut().zip(&self.k[j]).for_each(|(e, k)| *e += c * k);
         }
-        let rtol = self.tol.rtol;
+        let rtol = self.rtol;
         let sum: f64 = err
             .iter()
             .zip(x)

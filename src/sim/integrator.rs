@@ -365,8 +365,7 @@ fn run(
     let implicit =
         (settings.integrator == Integrator::Rosenbrock).then(|| Rosenbrock::new(system)).transpose()?;
     let switch = settings.integrator == Integrator::Dopri5;
-    let mut dopri =
-        Dopri5::new(n, m, dt, (system.tolerances, system.absolute_tolerances()), implicit, switch);
+    let mut dopri = Dopri5::new(system, dt, implicit, switch);
     let end = steps as f64 * dt;
     if adaptive {
         system.tolerances.check()?;
