@@ -87,15 +87,17 @@ pub(crate) fn backend_of(json: &str) -> PyResult<Backend> {
     Ok(backend)
 }
 
-/// The method and control step asked for, else the model file's `[simulation]`, else the
-/// adaptive Dormand-Prince method at 0.04 s.
+/// The method and control step asked for (`dt` in the model's unit of time), else the model
+/// file's `[simulation]`, else the adaptive Dormand-Prince method at the recorded `runs`'
+/// sample interval, or at 0.04 where there are none.
 pub(crate) fn method_of(
     model: &termid::model::Model,
     integrator: Option<&str>,
     dt: Option<f64>,
+    runs: &[termid::data::Frame],
 ) -> PyResult<(Integrator, f64)> {
     let method = integrator.map(Integrator::by_name).transpose().map_err(fail)?;
-    Ok(model.simulation(method, dt))
+    Ok(model.resimulation(method, dt.map(|dt| dt * model.seconds_per_time()), runs))
 }
 
 pub(crate) fn to_json(value: &impl serde::Serialize) -> PyResult<String> {

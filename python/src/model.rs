@@ -151,7 +151,7 @@ impl PyModel {
         with_intercept: bool,
     ) -> PyResult<(Vec<Frame>, termid::diagnose::Runs)> {
         let frames = self.frames(runs)?;
-        let (integrator, dt) = method_of(&self.inner, integrator, dt)?;
+        let (integrator, dt) = method_of(&self.inner, integrator, dt, &frames)?;
         let data = termid::diagnose::Runs::new(&self.inner, &frames, dt, integrator)
             .map_err(fail)?
             .with_intercepts(with_intercept);
@@ -622,8 +622,9 @@ impl PyModel {
     }
 
     /// Any model from its initial states (the file's, or `initial`) with constant `inputs`
-    /// for `duration` seconds: the run's columns (time, states, inputs), as `termid simulate
-    /// --input` gives them.
+    /// for `duration` seconds (or the unit the model's time is named by: `day`; `sample` and
+    /// `dt` alike): the run's columns (time, states, inputs), as `termid simulate --input`
+    /// gives them.
     #[pyo3(signature = (duration, inputs, initial, dt = None, sample = None, integrator = None, with_intercept = false))]
     #[allow(clippy::too_many_arguments)]
     fn simulate_free<'py>(
@@ -642,6 +643,8 @@ impl PyModel {
                 "duration {duration}: a simulation lasts a positive number of seconds"
             )));
         }
+        let per = self.inner.seconds_per_time();
+        let duration = duration * per;
         let mut system = System::new(&self.inner, &BTreeMap::new(), with_intercept).map_err(fail)?;
         let spec = self.inner.spec();
         for name in initial.keys() {
@@ -665,9 +668,9 @@ impl PyModel {
         // the default absolute tolerance counted in how large the states start, as the command's
         system.sizes = self.inner.sizes(&x0.iter().map(|v| v.abs()).collect::<Vec<_>>());
         let u: Vec<f64> = system.inputs.iter().map(|n| inputs.get(n).copied().unwrap_or(0.0)).collect();
-        let (integrator, step) = method_of(&self.inner, integrator, dt)?;
+        let (integrator, step) = method_of(&self.inner, integrator, dt, &[])?;
         // as the command line: the adaptive method's output interval is free
-        let sample = sample.unwrap_or(step);
+        let sample = sample.map_or(step, |s| s * per);
         let step = if dt.is_none() && integrator.is_adaptive() && sample.is_finite() && sample > 0.0 {
             sample / (sample / step * (1.0 - 1e-9)).ceil().max(1.0)
         } else {
@@ -710,12 +713,13 @@ impl PyModel {
             inputs_given: false,
         };
         let scenario = plugin.scenario(&self.inner, &request).map_err(fail)?;
-        let (integrator, dt) = method_of(&self.inner, integrator, dt)?;
+        let (integrator, dt) = method_of(&self.inner, integrator, dt, &[])?;
+        let per = self.inner.seconds_per_time();
         let settings = Settings {
             integrator,
             dt,
-            duration: duration.unwrap_or_else(|| scenario.default_duration()),
-            sample: sample.unwrap_or(dt),
+            duration: duration.map_or_else(|| scenario.default_duration(), |d| d * per),
+            sample: sample.map_or(dt, |s| s * per),
         };
         let (model, label) = (&self.inner, scenario.label());
         let outcome = py.detach(move || scenario.run(model, &settings)).map_err(fail)?;
@@ -904,7 +908,7 @@ impl PyModel {
         let medium = if over_ground { self.inner.held_medium() } else { vec![] };
         let model = self.inner.freed(&medium, &[]).map_err(refuse)?;
         let hypotheses = termid::plugins::hypotheses(&self.inner);
-        let (integrator, dt) = method_of(&self.inner, integrator, dt)?;
+        let (integrator, dt) = method_of(&self.inner, integrator, dt, &frames)?;
         let settings = termid::diagnose::Settings {
             dt,
             integrator,
@@ -1081,6 +1085,7 @@ impl PyModel {
         let (fit, metrics, stiff) = py
             .detach(|| -> Result<_, termid::diagnose::DiagnoseError> {
                 // one RK4 step per sample by default, a whole fraction of it where the model is stiff
+                let dt = dt.map(|dt| dt * model.seconds_per_time());
                 let (mut runs, stiff) = termid::diagnose::Runs::for_output_error(&model, &frames, dt)?;
                 if let Some(names) = &states {
                     runs = runs.comparing(&model, names)?;

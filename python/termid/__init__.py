@@ -1819,7 +1819,8 @@ class Model:
         DataFrame (or table) of the inputs over its time (a column ``t``, the model's time, or
         an index of times), replayed as :meth:`replay` replays a run's (held where the record
         shows a controller's command), at its rows, for its span (or the first ``duration``
-        seconds of it).
+        seconds of it). A model whose time is named by its unit (``day``, an epidemic's day
+        count) takes ``duration``, ``sample`` and ``dt`` in that unit, as its run's time column.
 
         Parameters: ``dt`` the integration step (default: the model file's method, else
         adaptive Dormand-Prince 5(4) with output every ``sample`` seconds); ``integrator``

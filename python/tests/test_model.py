@@ -1062,9 +1062,10 @@ def test_a_time_column_in_milliseconds_is_read_in_seconds():
     z_dot = found.model.coefficients("z_dot").set_index("term")["value"]
     assert z_dot.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
     # a model whose time is so named simulates in its unit (it gave seconds under the header
-    # of milliseconds, read back a thousand times too fast) and identifies from what it gives
+    # of milliseconds, read back a thousand times too fast), is given its times in it, and
+    # identifies from what it gives
     in_ms_model = termid.Model.from_toml(lorenz.to_toml().replace('time = "t"', 'time = "Time (ms)"', 1))
-    simulated = in_ms_model.simulate(duration=5.0, dt=0.01)
+    simulated = in_ms_model.simulate(duration=5000.0, dt=10.0)
     assert list(simulated["Time (ms)"][:3]) == pytest.approx([0.0, 10.0, 20.0])
     again = in_ms_model.identify(simulated[["Time (ms)", "x", "y", "z"]])
     z_dot = again.model.coefficients("z_dot").set_index("term")["value"]
@@ -1234,3 +1235,19 @@ def test_a_time_named_by_its_unit_is_read_in_seconds_and_said():
         found = termid.Model.from_states(["x"], time="day").identify(run)
     x = found.model.coefficients("x_dot").set_index("term")["value"]
     assert x["x"] * 86400.0 == pytest.approx(-0.1, rel=1e-3)
+
+
+def test_a_model_counted_in_days_is_simulated_for_days():
+    # `duration=60` of a model whose time is `day` ran 60 seconds, its `day` column ending at
+    # 6.9e-4; the run's times are the model's unit's, and so are the times given for it
+    day = np.arange(61.0)
+    run = pd.DataFrame({"day": day, "x": 100.0 * np.exp(-0.1 * day)})
+    with pytest.warns(UserWarning):
+        model = termid.Model.from_states(["x"], time="day").identify(run).model
+    sim = model.simulate(duration=60.0, sample=1.0)
+    assert sim["day"].iloc[-1] == pytest.approx(60.0)
+    assert sim["x"].iloc[-1] == pytest.approx(100.0 * np.exp(-6.0), rel=1e-4)
+    # a record of it re-simulated at its own daily step, not 0.04 s (two million a day)
+    with pytest.warns(UserWarning):
+        again = model.replay(run)[0]
+    assert again["x"].iloc[-1] == pytest.approx(run["x"].iloc[-1], rel=1e-3)

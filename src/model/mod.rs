@@ -261,7 +261,8 @@ impl Model {
 
     /// The method and control step the model is simulated with: what a command asks for,
     /// else the model's `[simulation]` table, else the adaptive Dormand-Prince method at
-    /// Δt = 0.04.
+    /// Δt = 0.04 in the model's unit of time ([`Model::seconds_per_time`]: 0.04 d for an
+    /// epidemic counted in days, not 0.04 s).
     pub fn simulation(
         &self,
         method: Option<crate::sim::Integrator>,
@@ -270,8 +271,49 @@ impl Model {
         let own = self.spec.simulation.as_ref();
         (
             method.or(own.map(|s| s.method)).unwrap_or_default(),
-            dt.or(own.and_then(|s| s.dt)).unwrap_or(DEFAULT_DT),
+            dt.or(own.and_then(|s| s.dt)).unwrap_or(DEFAULT_DT * self.seconds_per_time()),
         )
+    }
+
+    /// The method and control step recorded `runs` are re-simulated with: as
+    /// [`Model::simulation`], but where neither the command nor the model file gives a step
+    /// the adaptive methods take the records' sample interval. Their accuracy is their
+    /// tolerances', and recorded inputs are known only at the samples: a ship's 0.04 s is a
+    /// thousand control steps a sample for an epidemic counted daily, and longer than a
+    /// circuit's whole run sampled every 10 ns.
+    pub fn resimulation(
+        &self,
+        method: Option<crate::sim::Integrator>,
+        dt: Option<f64>,
+        runs: &[crate::data::Frame],
+    ) -> (crate::sim::Integrator, f64) {
+        let (method, step) = self.simulation(method, dt);
+        let given = dt.or(self.spec.simulation.as_ref().and_then(|s| s.dt)).is_some();
+        let sampled = crate::data::sample_step(runs);
+        match !given && method.is_adaptive() && sampled.is_finite() && sampled > 0.0 {
+            true => (method, sampled),
+            false => (method, step),
+        }
+    }
+
+    /// Seconds in one unit of the model's time where its name is a unit's (`day`, `t_ms`: a
+    /// run's time column is read in seconds and written back in it), else 1. A simulation's
+    /// duration, output interval and step given by its user are in that unit, as its run's
+    /// time column is.
+    pub fn seconds_per_time(&self) -> f64 {
+        crate::data::seconds_per(&self.spec.model.time).filter(|f| f.is_finite() && *f > 0.0).unwrap_or(1.0)
+    }
+
+    /// What to say where the model's time is not in seconds ([`Model::seconds_per_time`]):
+    /// a simulation's times are given in its unit, its rates stay per second.
+    pub fn time_note(&self) -> Option<String> {
+        let per = self.seconds_per_time();
+        (per != 1.0).then(|| {
+            format!(
+                "the model's time `{}` is counted in units of {per:.6e} s: a simulation's duration, output interval and step are given in it, as its run's `{}` column; its rates are per second",
+                self.spec.model.time, self.spec.model.time
+            )
+        })
     }
 
     /// The sizes each state's default absolute tolerance is counted in

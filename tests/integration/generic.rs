@@ -2000,7 +2000,8 @@ fn a_whole_system_from_its_columns() {
     assert!(!ok && err.contains("`time` looks like time") && !err.contains("the inputs are"), "{err}");
     // a time headed with its unit (`Time (ms)`, as loggers write it) is read in seconds: its
     // milliseconds were read as seconds, every rate a thousand times too slow (ẋ = 0.001v);
-    // a model so identified writes its runs' time back in milliseconds
+    // a model so identified writes its runs' time back in milliseconds, and is given its
+    // simulation's times in them
     let lines: Vec<String> = std::fs::read_to_string(&data).unwrap().lines().map(String::from).collect();
     let mut in_ms = String::from("Time (ms),x,v,F\n");
     for line in &lines[1..] {
@@ -2023,7 +2024,7 @@ fn a_whole_system_from_its_columns() {
         .1;
     assert!((v - 1.0).abs() < 1e-4, "{v}");
     let (ok, _, err) =
-        termid(&["simulate", "--model", &ms_model, "--duration", "0.1", "--sample", "0.01", "--out", &sim]);
+        termid(&["simulate", "--model", &ms_model, "--duration", "100", "--sample", "10", "--out", &sim]);
     assert!(ok, "{err}");
     let written = std::fs::read_to_string(&sim).unwrap();
     let second: Vec<&str> = written.lines().nth(2).unwrap().split(',').collect();
@@ -3268,4 +3269,52 @@ fn days_and_hours_are_read_as_the_time_in_seconds() {
     let (ok, _, err) =
         termid(&["identify", "--data", dir.join("days.csv").to_str().unwrap(), "--states", "x"]);
     assert!(!ok && err.contains("`day` looks like time: name it as the time column (`--time day`"), "{err}");
+}
+
+/// A model counted in days is simulated for days (`--duration 60` of an epidemic's day count
+/// was 60 s, its run's `day` column ending at 6.9e-4), and records far from a ship's time
+/// scale are re-simulated at their own sample interval: a decay counted daily took a control
+/// step of 0.04 s (2 million a day), one sampled every 0.1 µs was refused ("the integration
+/// step 0.04 s is too long for the shortest run").
+#[test]
+fn a_model_counted_in_days_is_simulated_in_days_and_records_at_their_own_step() {
+    use crate::common::Scratch;
+    let dir = Scratch::new("generic-day-steps");
+    for (header, rate, extra) in [("day", 0.1, &["--time", "day"][..]), ("t", 1e5, &[][..])] {
+        let step = if header == "day" { 1.0 } else { 1e-7 };
+        let mut text = format!("{header},x\n");
+        for k in 0..=60 {
+            text += &format!("{},{}\n", k as f64 * step, 100.0 * (-rate * k as f64 * step).exp());
+        }
+        let (data, model) = (dir.join(format!("{header}.csv")), dir.join(format!("{header}.toml")));
+        std::fs::write(&data, text).unwrap();
+        let (data, model) = (data.to_str().unwrap(), model.to_str().unwrap());
+        let mut args = vec!["identify", "--data", data, "--states", "x", "--out", model];
+        args.extend_from_slice(extra);
+        let (ok, _, err) = termid(&args);
+        assert!(ok, "{header}: {err}");
+        let (ok, out, err) = termid(&["validate", "--model", model, "--data", data]);
+        assert!(ok, "{header}: {err}");
+        let error: f64 = out.split("x ").nth(1).and_then(|s| s.split(' ').next()).unwrap().parse().unwrap();
+        assert!(error < 0.01, "{header}: {out}");
+    }
+    let (model, run) = (dir.join("day.toml"), dir.join("run.csv"));
+    let (ok, out, err) = termid(&[
+        "simulate",
+        "--model",
+        model.to_str().unwrap(),
+        "--duration",
+        "60",
+        "--sample",
+        "1",
+        "--out",
+        run.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(err.contains("the model's time `day` is counted in units of 8.640000e4 s"), "{err}");
+    assert!(out.contains("61 samples to day = 60.0000 (5.18400e6 s)"), "{out}");
+    let text = std::fs::read_to_string(&run).unwrap();
+    let last: Vec<f64> = text.lines().last().unwrap().split(',').map(|v| v.parse().unwrap()).collect();
+    assert_eq!(last[0], 60.0);
+    assert!((last[1] / (100.0 * (-6.0f64).exp()) - 1.0).abs() < 1e-4, "{last:?}");
 }

@@ -595,8 +595,9 @@ pub struct SimulateCommand {
     /// the model file's `[simulation]`, else dopri5.
     #[arg(long, value_enum)]
     pub integrator: Option<Integrator>,
-    /// Control step, s: inputs are taken on its grid; the fixed step of rk4 and b8. Default:
-    /// the model file's `[simulation] dt`, else 0.04.
+    /// Control step, s (or the unit the model's time is named by: `day`): inputs are taken
+    /// on its grid; the fixed step of rk4 and b8. Default: the model file's `[simulation]
+    /// dt`, else 0.04.
     #[arg(allow_negative_numbers = true, long)]
     pub dt: Option<f64>,
     /// Relative tolerance of dopri5. Default: the model file's `[simulation] rtol`, else 1e-6.
@@ -606,10 +607,11 @@ pub struct SimulateCommand {
     /// `[simulation] atol`, else 1e-7.
     #[arg(allow_negative_numbers = true, long)]
     pub atol: Option<f64>,
-    /// Output interval, s (a multiple of the step).
+    /// Output interval, s or the model's unit of time (a multiple of the step).
     #[arg(allow_negative_numbers = true, long, default_value_t = 0.2)]
     pub sample: f64,
-    /// Duration, s (default: the manoeuvre's own).
+    /// Duration, s or the model's unit of time (`day`: days, as the run's column is
+    /// written). Default: the manoeuvre's own.
     #[arg(allow_negative_numbers = true, long)]
     pub duration: Option<f64>,
     /// Write the run as CSV (SI units, angles in rad).
@@ -684,7 +686,8 @@ pub struct CompareCommand {
     /// A recorded run to re-simulate with each back-end's model (its inputs replayed).
     #[arg(long)]
     pub replay: Option<PathBuf>,
-    /// Control step of the re-simulation, s (default: the model file's, else 0.04).
+    /// Control step of the re-simulation, s or the model's unit of time (default: the model
+    /// file's, else the record's sample interval for the adaptive methods).
     #[arg(allow_negative_numbers = true, long)]
     pub dt: Option<f64>,
     /// Time each fit as the median of this many repetitions after the warm-up.
@@ -792,7 +795,8 @@ pub struct ResimArgs {
     /// dopri5.
     #[arg(long, value_enum)]
     pub integrator: Option<Integrator>,
-    /// Control step, s (default: the model file's, else 0.04).
+    /// Control step, s or the model's unit of time (default: the model file's, else the
+    /// records' sample interval for dopri5 and rosenbrock, 0.04 of the model's unit for rk4 and b8).
     #[arg(allow_negative_numbers = true, long)]
     pub dt: Option<f64>,
     /// Relative tolerance of dopri5 (default: the model file's, else 1e-6).

@@ -52,7 +52,8 @@ pub fn run(cmd: EstimateCommand) -> Result<()> {
         None => (frames, sources),
     };
     // one RK4 step per sample by default, a whole fraction of it where the model is stiff
-    let (mut runs, stiff) = Runs::for_output_error(&model, &frames, cmd.dt)?;
+    let given = cmd.dt.map(|dt| dt * model.seconds_per_time());
+    let (mut runs, stiff) = Runs::for_output_error(&model, &frames, given)?;
     if let Some(note) = stiff {
         // beside the report, not in it: JSON on standard output stays one document
         eprintln!("note: {note}");

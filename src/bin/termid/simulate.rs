@@ -11,6 +11,7 @@ use termid::sim::{simulate, Constant, Controller, Integrator, Replay, Settings};
 
 use crate::args::{Format, SimulateCommand};
 use crate::monte_carlo::Draws;
+use termid::identify::sig;
 
 pub fn load_model(path: &Option<std::path::PathBuf>) -> Result<Model> {
     Ok(match path {
@@ -50,6 +51,18 @@ pub fn run(cmd: SimulateCommand) -> Result<()> {
     let mut model = load_model(&cmd.model)?;
     set_parameters(&mut model, &cmd.params)?;
     model.set_tolerances(cmd.rtol, cmd.atol)?;
+    // a model counted in days (an epidemic's) is simulated for days, sampled in days, as its
+    // run's time column is written
+    let per = model.seconds_per_time();
+    if let Some(note) = model.time_note() {
+        crate::runs::say(&note);
+    }
+    let cmd = SimulateCommand {
+        duration: cmd.duration.map(|d| d * per),
+        sample: cmd.sample * per,
+        dt: cmd.dt.map(|d| d * per),
+        ..cmd
+    };
     // the command's method and step, else the model file's, else dopri5 at 0.04 s
     let (integrator, step) = model.simulation(cmd.integrator, None);
     // the adaptive method's accuracy does not hang on the control step: an output interval
@@ -213,6 +226,7 @@ pub fn trajectory_values(t: &termid::sim::Trajectory) -> usize {
 }
 
 fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrator, f64)) -> Result<()> {
+    let per = model.seconds_per_time();
     let system = termid::sim::System::new(model, &BTreeMap::new(), cmd.with_intercept)?;
     let mut x0: Vec<f64> = system
         .states
@@ -295,20 +309,25 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
             .enumerate()
             .map(|(i, s)| Panel {
                 title: s.clone(),
-                // time in seconds, as every model file's; each state by its name and unit
-                x_label: termid::plot::labelled(&model.spec().model.time, "s"),
+                // time in seconds, or in the unit the model's time is named by (`day`) as
+                // its run's column; each state by its name and unit
+                x_label: match per == 1.0 {
+                    true => termid::plot::labelled(&model.spec().model.time, "s"),
+                    false => model.spec().model.time.clone(),
+                },
                 y_label: termid::plot::labelled(
                     s,
                     Some(model.unit(s)).filter(|u| !u.is_empty()).unwrap_or("-"),
                 ),
                 series: {
-                    let mut series = vec![Series::line(s, traj.time.clone(), traj.states[i].clone())];
+                    let time: Vec<f64> = traj.time.iter().map(|t| t / per).collect();
+                    let mut series = vec![Series::line(s, time.clone(), traj.states[i].clone())];
                     if let Some(mc) = mc.as_ref().filter(|mc| mc.usable()) {
                         let signals: Vec<Vec<f64>> =
                             mc.shown().iter().map(|(_, t)| t.states[i].clone()).collect();
                         let (lo, hi) = termid::uncertainty::band(&signals);
                         let label = format!("90 % band ({} draws)", signals.len());
-                        series.insert(0, Series::band(&label, traj.time.clone(), lo, hi));
+                        series.insert(0, Series::band(&label, time, lo, hi));
                     }
                     series
                 },
@@ -339,12 +358,13 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
             )
         }
         Format::Text => {
-            println!(
-                "{}: {} samples to t = {} s",
-                model.spec().model.name,
-                traj.time.len(),
-                traj.time.last().copied().unwrap_or(0.0)
-            );
+            let end = traj.time.last().copied().unwrap_or(0.0);
+            let per = model.seconds_per_time();
+            let to = match per == 1.0 {
+                true => format!("t = {end} s"),
+                false => format!("{} = {} ({} s)", model.spec().model.time, sig(end / per, 6), sig(end, 6)),
+            };
+            println!("{}: {} samples to {to}", model.spec().model.name, traj.time.len());
             for (s, v) in system.states.iter().zip(&last) {
                 println!("  {s} = {}", termid::identify::sig(*v, 6));
             }
