@@ -52,11 +52,13 @@ fn monte_carlo_refusal(draws: usize, ran: usize, first_failure: Option<&str>) ->
     termid::uncertainty::refusal(draws, ran, first_failure)
 }
 
-/// The first of `names` that says it holds the time (`time`, `Time [s]`, `timestamp`, …):
-/// the command line's rule, for an error that names it.
+/// The first of `names` that says it holds the time (`time`, `Time [s]`, `timestamp`, …), and
+/// whether it is the only one (then taken for the time, as the command line takes it).
 #[pyfunction]
-fn time_like(names: Vec<String>) -> Option<String> {
-    names.into_iter().find(|n| termid::data::looks_like_time(n))
+fn time_like(names: Vec<String>) -> Option<(String, bool)> {
+    let mut like = names.into_iter().filter(|n| termid::data::looks_like_time(n));
+    let first = like.next()?;
+    Some((first, like.next().is_none()))
 }
 
 /// The columns whose names carry a unit termid knows, read by their bare names in SI:

@@ -455,8 +455,19 @@ def _time_from(name: str, run: Data, columns: "_Columns", time: str) -> None:
         )
         columns[time] = columns.pop(columns.times[0])
     else:
-        like = _termid.time_like(list(columns))
+        like, only = _termid.time_like(list(columns)) or (None, False)
         factor = _termid.seconds_per(like) if like else None
+        if only:
+            # the one column whose name says it holds the time (`time`, `Time [s]`, `day`), as
+            # the command line takes a file's: a dataframe's `time` needs no renaming
+            said = f"; {_read_as(like, time, factor)}" if factor and factor != 1.0 else ""
+            warnings.warn(
+                f"termid: {name}: the rows' time `{time}` is column `{like}`, the one whose name says so{said}",
+                stacklevel=_outside(),
+            )
+            values = columns.pop(like)
+            columns[time] = values * factor if factor else values
+            return
         raise TermidError(
             f"{name}: no time column `{time}` (columns: {', '.join(columns)})"
             + (
@@ -856,7 +867,14 @@ def _time_of(data: Data, columns: "_Columns", time: Optional[str], target: str) 
             stacklevel=_outside(),
         )
         return columns.times[0]
-    like = _termid.time_like(list(columns))
+    like, only = _termid.time_like(list(columns)) or (None, False)
+    if only:
+        warnings.warn(
+            f"termid: `{target}` is a rate: the rows' time is column `{like}`, the one whose name says so "
+            f"(time='name' names another)",
+            stacklevel=_outside(),
+        )
+        return like
     raise TermidError(
         f"`{target}` is a rate: it needs the rows' time, a column `t`, time='name', or a DataFrame indexed by time"
         + (f"; `{like}` looks like time: time='{like}'" if like else "")

@@ -264,9 +264,13 @@ def test_a_rate_is_an_equation_of_motion_with_the_command_lines_defaults():
     # what it needs, said
     with pytest.raises(termid.TermidError, match="needs the rows' time"):
         termid.fit(df.drop(columns="t"), "dx/dt", library)
-    # a column named like time is named; row labels (a filtered frame's integers) are no time
+    # the one column named like time is the time, said (as the command line takes a file's);
+    # beside another it is named; row labels (a filtered frame's integers) are no time
+    with pytest.warns(UserWarning, match="the rows' time is column `Time`, the one whose name says so"):
+        timed = termid.fit(df.rename(columns={"t": "Time"}), "dx/dt", library)
+    assert timed.coefficients.sort_index().round(3).to_dict() == {"x": -10.0, "y": 10.0}
     with pytest.raises(termid.TermidError, match="`Time` looks like time: time='Time'"):
-        termid.fit(df.rename(columns={"t": "Time"}), "dx/dt", library)
+        termid.fit(df.rename(columns={"t": "Time"}).assign(seconds=df["t"]), "dx/dt", library)
     with pytest.raises(termid.TermidError, match="needs the rows' time"):
         termid.fit(df.drop(columns="t").iloc[::2], "dx/dt", library)
     with pytest.raises(termid.TermidError, match="no column `w`"):

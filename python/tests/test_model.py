@@ -1038,12 +1038,20 @@ def test_a_run_without_its_model_s_time_column():
         found = model.identify(stamped)
     z_dot = found.model.coefficients("z_dot").set_index("term")["value"]
     assert z_dot.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
-    with pytest.raises(termid.TermidError, match=r"no time column `t` .*`time` looks like time: name it `t`, df.rename\(columns=\{'time': 't'\}\)"):
-        model.identify(run.rename(columns={"t": "time"}))
-    # a header that says its unit of time: renamed, its milliseconds would be read as seconds
+    # the one column whose name says it is the time is taken for it, said (a dataframe's
+    # `time` was refused, to be renamed); one in milliseconds is read in seconds
+    with pytest.warns(UserWarning, match="run1: the rows' time `t` is column `time`, the one whose name says so"):
+        found = model.identify(run.rename(columns={"t": "time"}))
+    z_dot = found.model.coefficients("z_dot").set_index("term")["value"]
+    assert z_dot.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
     in_ms = run.assign(t=run["t"] * 1000.0).rename(columns={"t": "Time (ms)"})
+    with pytest.warns(UserWarning, match=r"`Time \(ms\)` as t in SI \(× 1.000000e-03\)"):
+        found = model.identify(in_ms)
+    z_dot = found.model.coefficients("z_dot").set_index("term")["value"]
+    assert z_dot.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
+    # beside another such column, neither is taken: the refusal names the first
     with pytest.raises(termid.TermidError, match=r"name it `t`, in seconds: df.assign\(t=df\['Time \(ms\)'\] \* 0.001\)"):
-        model.identify(in_ms)
+        model.identify(in_ms.assign(seconds=run["t"]))
 
 
 def test_a_time_column_in_milliseconds_is_read_in_seconds():

@@ -339,6 +339,12 @@ const UNITS: &[(&str, f64, [i32; 3])] = &[
     ("N", 1.0, [1, -2, 1]),
     ("N m", 1.0, [2, -2, 1]),
     ("-", 1.0, [0, 0, 0]),
+    // a temperature in degrees Celsius is one in SI (a coherent derived unit): its differences
+    // and rates are kelvin's, and its zero is kept, as every constant of a law in it is
+    // written in it (Newton's cooling towards 20 °C, not 293.15 K)
+    ("°C", 1.0, [0, 0, 0]),
+    ("degC", 1.0, [0, 0, 0]),
+    ("K", 1.0, [0, 0, 0]),
 ];
 
 /// The factor to seconds of a time column whose header says its unit of time (`Time [ms]`,

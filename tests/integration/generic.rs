@@ -1993,10 +1993,25 @@ fn a_whole_system_from_its_columns() {
         .map(|c| c.as_str().unwrap().to_string())
         .collect();
     assert_eq!(listed, ["x", "v", "F", "atan2(x, v)"], "{report}");
-    // a time column by another name is refused with its name, not taken for an input first
+    // a time column by another name, the only one whose name says so, is taken as the time
+    // and said (it was refused, to be named with --time), not taken for an input; beside
+    // another such column it is refused with both names
     let renamed = std::fs::read_to_string(&data).unwrap().replacen("t,", "time,", 1);
-    std::fs::write(dir.join("time.csv"), renamed).unwrap();
-    let (ok, _, err) = termid(&["identify", "--data", &p("time.csv"), "--states", "x,v"]);
+    std::fs::write(dir.join("time.csv"), &renamed).unwrap();
+    let (ok, out, err) =
+        termid(&["identify", "--data", &p("time.csv"), "--states", "x,v", "--format", "json"]);
+    assert!(ok && err.contains("the time is column `time` (there is no column `t`"), "{err}");
+    assert!(!json(&out)["v_dot"]["candidates"].as_array().unwrap().iter().any(|c| c == "time"), "{out}");
+    let two: String = renamed
+        .lines()
+        .enumerate()
+        .map(|(k, l)| match (k, l.split_once(',')) {
+            (0, _) | (_, None) => format!("{}\n", l.replacen("time,", "time,seconds,", 1)),
+            (_, Some((t, rest))) => format!("{t},{t},{rest}\n"),
+        })
+        .collect();
+    std::fs::write(dir.join("two.csv"), two).unwrap();
+    let (ok, _, err) = termid(&["identify", "--data", &p("two.csv"), "--states", "x,v"]);
     assert!(!ok && err.contains("`time` looks like time") && !err.contains("the inputs are"), "{err}");
     // a time headed with its unit (`Time (ms)`, as loggers write it) is read in seconds: its
     // milliseconds were read as seconds, every rate a thousand times too slow (ẋ = 0.001v);
@@ -3265,7 +3280,7 @@ fn days_and_hours_are_read_as_the_time_in_seconds() {
     let (ok, _, err) =
         termid(&["identify", "--data", dir.join("decay.csv").to_str().unwrap(), "--states", "x"]);
     assert!(ok, "{err}");
-    std::fs::write(dir.join("days.csv"), "day,x\n0,1\n1,0.9\n").unwrap();
+    std::fs::write(dir.join("days.csv"), "day,hours,x\n0,0,1\n1,24,0.9\n").unwrap();
     let (ok, _, err) =
         termid(&["identify", "--data", dir.join("days.csv").to_str().unwrap(), "--states", "x"]);
     assert!(!ok && err.contains("`day` looks like time: name it as the time column (`--time day`"), "{err}");
@@ -3317,4 +3332,26 @@ fn a_model_counted_in_days_is_simulated_in_days_and_records_at_their_own_step() 
     let last: Vec<f64> = text.lines().last().unwrap().split(',').map(|v| v.parse().unwrap()).collect();
     assert_eq!(last[0], 60.0);
     assert!((last[1] / (100.0 * (-6.0f64).exp()) - 1.0).abs() < 1e-4, "{last:?}");
+}
+
+/// Newton's cooling logged as a lab writes it: `t [min]`, `T [°C]`. The temperature's unit was
+/// "a unit termid does not read: write the column in SI units" (degrees Celsius are SI's own);
+/// it is read as it is, its zero kept: dT/dt = −k·T + k·20 with k = 0.05 per minute.
+#[test]
+fn a_temperature_in_degrees_celsius_is_read_as_it_is() {
+    use crate::common::{json, Scratch};
+    let dir = Scratch::new("generic-celsius");
+    let mut text = String::from("t [min],T [°C]\n");
+    for k in 0..=120 {
+        text += &format!("{k},{}\n", 20.0 + 70.0 * (-0.05 * k as f64).exp());
+    }
+    let data = dir.join("cooling.csv");
+    std::fs::write(&data, text).unwrap();
+    let (ok, out, err) =
+        termid(&["identify", "--data", data.to_str().unwrap(), "--states", "T", "--format", "json"]);
+    assert!(ok, "{err}");
+    assert!(err.contains("`T [°C]` as T"), "{err}");
+    let terms = terms_of(&json(&out)["T_dot"]);
+    assert!((terms["T"] * 60.0 / -0.05 - 1.0).abs() < 1e-4, "{terms:?}");
+    assert!((terms["1"] * 60.0 / (0.05 * 20.0) - 1.0).abs() < 1e-4, "{terms:?}");
 }

@@ -67,6 +67,16 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
     for (flag, list) in [("--param", &cmd.params), ("--derive", &cmd.derived), ("--alias", &cmd.aliases)] {
         crate::runs::check_names_once(flag, list)?;
     }
+    // plain files with a column `time` (or `Time [s]`, `timestamp`) and no `t`, as most
+    // loggers and dataframes write them: their time, said, not a refusal to be answered
+    if cmd.time == "t" && cmd.model.is_none() && !cmd.no_time {
+        if let Some(name) = crate::runs::time_by_name(&cmd.data, &cmd.time) {
+            crate::runs::say(&format!(
+                "the time is column `{name}` (there is no column `t`; `--time NAME` names another)"
+            ));
+            cmd.time = name;
+        }
+    }
     let mut inputs = crate::runs::input_files(&cmd.data, &cmd.dataset);
     crate::runs::check_once(&inputs)?;
     for (k, m) in cmd.moments.iter().enumerate() {

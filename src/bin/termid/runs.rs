@@ -254,6 +254,22 @@ pub fn replay_frame(path: &Path, time: &str) -> Result<Frame> {
 
 /// The runs of `data` files (each a run, or with `by` the runs its column `by` names) and of
 /// `datasets` files, each cut at a logger's dropout, what reading did said.
+/// The time column of plain files that have no column `time` (`t`, when no `--time` names
+/// another): the one whose name says it holds the time (`time`, `Time [s]`, `timestamp`,
+/// `day`), to be taken and said. `None` where `time` is there, or no column or several look
+/// like time (the missing time's error names them).
+pub fn time_by_name(data: &[PathBuf], time: &str) -> Option<String> {
+    let names = termid::data::columns_of(data.first()?).ok()?;
+    if termid::data::time_position(&names, time).is_some() {
+        return None;
+    }
+    let mut like = names.iter().filter(|n| termid::data::looks_like_time(n));
+    match (like.next(), like.next()) {
+        (Some(name), None) => Some(name.clone()),
+        _ => None,
+    }
+}
+
 pub fn load(data: &[PathBuf], by: Option<&str>, datasets: &[PathBuf], time: &str) -> Result<Vec<Frame>> {
     check_once(&input_files(data, datasets))?;
     let mut frames = Vec::new();
