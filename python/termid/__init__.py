@@ -1415,6 +1415,14 @@ class Model:
             raise TypeError("states, inputs and terms are lists of names (['x', 'y']), not one string")
         if degree is not None and (isinstance(degree, bool) or int(degree) != degree or degree < 0):
             raise TermidError(f"Model.from_states: degree {degree!r} is no degree: give a whole number, 1 or more")
+        for name in [*states, *inputs]:
+            # a dataframe's `tank level`: the remedy in pandas, not in a dataset file
+            fixed = re.sub(r"\W", "_", str(name))
+            if not str(name).isidentifier() and fixed.isidentifier():
+                raise TermidError(
+                    f"Model.from_states: `{name}` is not a valid name (a name is letters, digits and `_`, not a "
+                    f"digit first): rename its column, df.rename(columns={{'{name}': '{fixed}'}}), and call it `{fixed}`"
+                )
         native = _termid.Model.from_states(
             list(states),
             list(inputs),

@@ -1259,3 +1259,15 @@ def test_a_model_counted_in_days_is_simulated_for_days():
     with pytest.warns(UserWarning):
         again = model.replay(run)[0]
     assert again["x"].iloc[-1] == pytest.approx(run["x"].iloc[-1], rel=1e-3)
+
+
+def test_a_column_whose_name_is_no_name_is_refused_with_its_pandas_remedy():
+    # `tank level` was refused with a dataset file's mapping as the remedy; a dataframe's is
+    # a rename, named with the name to call it, which then identifies
+    t = np.arange(0.0, 20.0, 0.1)
+    run = pd.DataFrame({"t": t, "tank level": np.exp(-0.3 * t)})
+    with pytest.raises(termid.TermidError, match=r"df.rename\(columns=\{'tank level': 'tank_level'\}\), and call it `tank_level`"):
+        termid.Model.from_states(["tank level"])
+    found = termid.Model.from_states(["tank_level"]).identify(run.rename(columns={"tank level": "tank_level"}))
+    level = found.model.coefficients("tank_level_dot").set_index("term")["value"]
+    assert level.to_dict() == pytest.approx({"tank_level": -0.3}, rel=1e-4)

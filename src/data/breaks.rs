@@ -120,7 +120,7 @@ pub fn moving_breaks<'a>(frame: &Frame, columns: &[&'a str]) -> Leaps<'a> {
             // a motion reset again and again (a ball's bounces, a relay's resets): the
             // rates hold between the leaps, none across them
             notes.push(format!(
-                "{}: `{name}` leaps at {} rows and stays (the first from row {} to row {}, t = {} s), moving between its leaps as much as it leaps: a motion reset at each (an impact, a bounce, a reset), whose rule no rate holds; the run is cut at each into runs of their own: the equations found hold between the leaps, not across them",
+                "{}: `{name}` leaps at {} rows and stays (the first from row {} to row {}, t = {} s), moving between its leaps as much as it leaps: a motion reset at each (an impact, a bounce, a dose, a reset), whose rule no rate holds; the run is cut at each into runs of their own: the equations found hold between the leaps, not across them",
                 frame.origin(),
                 b.len(),
                 frame.row(b[0].row - 1),
