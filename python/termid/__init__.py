@@ -310,7 +310,18 @@ def _refuse_interleaved(data: pd.DataFrame, found: "_Columns") -> None:
             )
 
 
+def _as_frame(data: Any) -> Any:
+    """A pandas Series (one signal over its index of times) as the one-column DataFrame it
+    is, named by its name; anything else as it is."""
+    if not isinstance(data, pd.Series):
+        return data
+    if data.name is None:
+        raise TermidError("a Series without a name is no column: name it, series.rename('x'), or give a DataFrame")
+    return data.to_frame()
+
+
 def _columns_of(data: Data) -> "_Columns":
+    data = _as_frame(data)
     if isinstance(data, pd.DataFrame):
         # pandas' name for the empty column after a trailing comma on every row (a spreadsheet's
         # export), which holds nothing: no column (its name refused the run)
@@ -834,6 +845,7 @@ def _index_time(data: Data) -> Optional[np.ndarray]:
     """A DataFrame's index as the rows' time in seconds where it holds times: date-times (in a
     time zone or not; seconds from the first), durations, floats, or integers under a name (an
     unnamed integer index is row labels, as a filtered frame keeps); else None."""
+    data = _as_frame(data)
     index = getattr(data, "index", None)
     if not isinstance(data, pd.DataFrame) or isinstance(index, pd.RangeIndex):
         return None
@@ -983,7 +995,17 @@ def fit(
             raise TermidError(f"no column `{target}` to fit (columns: {', '.join(columns)})")
     if isinstance(terms, str):
         # one term, not its characters; several where commas list them ("x*y, z")
-        terms = _termid.listed([terms])
+        listed = _termid.listed([terms])
+        # a formula's `x + u` (statsmodels', R's) is one candidate here, their sum: said
+        summed = [t for t in listed if "+" in re.sub(r"\([^()]*\)", "", re.sub(r"\([^()]*\)", "", t))]
+        if summed:
+            parts = [p.strip() for p in summed[0].split("+")]
+            warnings.warn(
+                f"termid: terms {summed[0]!r} is one candidate, their sum with one coefficient; for a "
+                f"coefficient each, list them: {parts!r} or {', '.join(parts)!r}",
+                stacklevel=_outside(),
+            )
+        terms = listed
     if terms is None:
         terms = [c for c in columns if c not in (target, weights, time_name)]
     terms = list(terms)
@@ -1026,10 +1048,10 @@ def fit(
 def _is_table(data: Any) -> bool:
     """Whether ``data`` is one table of named columns: a pandas DataFrame, a pyarrow Table,
     anything with ``to_pandas`` or the Arrow PyCapsule interface (a polars DataFrame), or a
-    lazy frame (polars'). Such a table is one run, never a sequence of runs (a polars DataFrame
-    iterates over its columns)."""
+    lazy frame (polars'); a named pandas Series, one column. Such a table is one run, never a
+    sequence of runs (a polars DataFrame iterates over its columns)."""
     return (
-        isinstance(data, pd.DataFrame)
+        isinstance(data, (pd.DataFrame, pd.Series))
         or hasattr(data, "column_names")
         or hasattr(data, "to_pandas")
         or hasattr(data, "__arrow_c_stream__")

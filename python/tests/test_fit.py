@@ -602,3 +602,19 @@ def test_the_empty_column_of_a_trailing_comma_is_no_column(tmp_path):
     assert "x" in fitted.coefficients.index
     with pytest.raises(termid.TermidError, match="Unnamed: 3"):
         termid.fit(df.assign(**{"Unnamed: 3": np.arange(len(df), dtype=float)}), "dx/dt", ["x", "u", "Unnamed: 3"])
+
+
+def test_a_series_is_one_named_column_and_a_formula_s_sum_is_said():
+    # a Series over an index of times (one signal) failed deep in Arrow ("Cannot import
+    # schema"); it is the one-column frame it is. `"x + x^2"`, a formula's two terms in
+    # statsmodels or R, is one candidate here, their sum: fitted, and said with the list
+    t = np.arange(0.0, 20.0, 0.01)
+    x = pd.Series(np.exp(-0.3 * t), index=pd.Index(t, name="t"), name="x")
+    assert termid.fit(x, "dx/dt", ["x"]).coefficients.to_dict() == pytest.approx({"x": -0.3}, rel=1e-6)
+    found = termid.Model.from_states(["x"]).identify(x)
+    assert found.model.coefficients("x_dot").set_index("term")["value"].to_dict() == pytest.approx({"x": -0.3}, rel=1e-6)
+    with pytest.raises(termid.TermidError, match="a Series without a name is no column"):
+        termid.fit(x.rename(None), "dx/dt", ["x"])
+    with pytest.warns(UserWarning, match=r"terms 'x \+ x\^2' is one candidate, their sum with one coefficient; for a coefficient each, list them: \['x', 'x\^2'\]"):
+        summed = termid.fit(x, "dx/dt", "x + x^2")
+    assert list(summed.coefficients.index) != ["x", "x^2"]
