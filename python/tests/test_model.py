@@ -1271,3 +1271,17 @@ def test_a_column_whose_name_is_no_name_is_refused_with_its_pandas_remedy():
     found = termid.Model.from_states(["tank_level"]).identify(run.rename(columns={"tank level": "tank_level"}))
     level = found.model.coefficients("tank_level_dot").set_index("term")["value"]
     assert level.to_dict() == pytest.approx({"tank_level": -0.3}, rel=1e-4)
+
+
+def test_a_law_a_cubic_stands_in_for_is_diagnosed_and_identified_again():
+    # a tank draining through an orifice, dh/dt = -0.1*sqrt(h) in closed form: the cubic
+    # library follows it with every check ok; diagnose names the law, and the model it
+    # returns, identified again, keeps it
+    t = np.arange(0.0, 35.0, 0.1)
+    run = pd.DataFrame({"t": t, "h": (2.0 - 0.05 * t) ** 2})
+    found = termid.Model.from_states(["h"]).identify(run)
+    gaps, repaired = found.model.diagnose(run)
+    assert gaps.attrs["effect"]["name"] == "`sqrt(abs(h))` in h_dot, beyond the candidates"
+    assert gaps.attrs["effect"]["coefficients"][0] == pytest.approx(-0.1, rel=1e-3)
+    again = repaired.identify(run).model.coefficients("h_dot").set_index("term")["value"]
+    assert again.to_dict() == pytest.approx({"sqrt(abs(h))": -0.1}, rel=1e-4)

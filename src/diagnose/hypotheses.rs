@@ -1,6 +1,7 @@
 //! The library of candidate effects. Generic: a constant in any equation, each candidate
 //! term the model lacks, an offset and a scale error on any input, and for a model no plug-in
-//! names, the products of its variables beyond its candidates. Plug-ins add their own, with
+//! names, the products of its variables beyond its candidates and the laws a polynomial only
+//! approximates (dry friction, drag, an orifice, a pendulum). Plug-ins add their own, with
 //! the names their users use (see `ship::hypotheses`).
 
 use serde::Serialize;
@@ -186,8 +187,9 @@ const CUBIC_UP_TO: usize = 4;
 /// input to the first power), that is not a candidate already. Where the author's library
 /// lacks the term the system has (a Duffing oscillator's x³ in a quadratic library), the
 /// declared hypotheses cannot name it; this names it as `x^3 in v_dot, beyond the
-/// candidates`. Each equation's coefficients refitted alone come first: the baseline a new
-/// term must beat.
+/// candidates`; and for each state, the laws a cubic stands in for (`sign`, `v*abs(v)`,
+/// `sqrt(abs(h))`, `sin`). Each equation's coefficients refitted alone come first: the
+/// baseline a new term must beat.
 pub fn beyond_candidates(model: &Model) -> Vec<Hypothesis> {
     let spec = model.spec();
     // the states and inputs
@@ -240,6 +242,22 @@ pub fn beyond_candidates(model: &Model) -> Vec<Hypothesis> {
                 name: format!("{}'s coefficients refitted (output error)", eq.name),
                 effect: Effect::Refit { equation: eq.name.clone(), refitted: refitted.clone() },
             });
+        }
+        // the laws a polynomial only approximates: each state's dry friction or relay
+        // (sign), quadratic drag (v·|v|), outflow through an orifice (√|h|, Torricelli's), a
+        // pendulum's gravity (sin θ); a cubic fitted for them follows the runs and fails
+        // beyond (a Coulomb oscillator's viscous stand-in never stops)
+        for v in vars.iter().filter(|v| !inputs.contains(&v.as_str())) {
+            for text in [
+                format!("sign({v})"),
+                format!("{v}*abs({v})"),
+                format!("sqrt(abs({v}))"),
+                format!("sin({v})"),
+            ] {
+                if let Ok(t) = model.vocabulary.parse(&text) {
+                    all.push(t);
+                }
+            }
         }
         for t in all {
             if eq.candidates.contains(&t) || eq.coefficient(&t) != 0.0 {

@@ -470,3 +470,51 @@ fn each_run_is_diagnosed_with_its_own_nuisances() {
         diagnose(&bounded, &runs, &termid::diagnose::generic_hypotheses(&bounded), &settings).unwrap_err();
     assert!(e.to_string().contains("estimating each run's own δ_0 first"), "{e}");
 }
+
+/// The laws a polynomial library only approximates, named by `diagnose`: an oscillator with
+/// dry (Coulomb) friction, ẍ = −4x − 0.5·sign(ẋ), and a tank draining through an orifice,
+/// ḣ = −0.1·√h (Torricelli), each in closed form. Identified from their columns with the
+/// cubic library, both follow their runs with every check "ok" (a viscous −0.40ẋ + 0.024ẋ³
+/// for the friction, which never stops, and a cubic in h that drains below empty); the
+/// diagnosis found "none of those tested". It now names the law, with its coefficient.
+#[test]
+fn laws_beyond_a_polynomial_are_named_with_their_coefficients() {
+    let dir = crate::common::Scratch::new("diagnose-laws");
+    let t: Vec<f64> = (0..=2000).map(|i| i as f64 * 0.005).collect();
+    // each half swing a harmonic one about ±0.125 (the friction over the stiffness), its
+    // amplitude 0.25 less each time: 2.0, 1.75, …
+    let swing = |t: f64| -> (f64, f64) {
+        let k = (t / (std::f64::consts::PI / 2.0)).floor();
+        let sign = if k as i64 % 2 == 0 { 1.0 } else { -1.0 };
+        let (start, centre) = (sign * (2.0 - 0.25 * k), sign * 0.125);
+        let phase = 2.0 * (t - k * std::f64::consts::PI / 2.0);
+        (centre + (start - centre) * phase.cos(), -2.0 * (start - centre) * phase.sin())
+    };
+    let mut friction = String::from("t,x,v\n");
+    let mut tank = String::from("t,h\n");
+    for &t in &t {
+        let (x, v) = swing(t);
+        friction += &format!("{t},{x},{v}\n");
+        tank += &format!("{t},{}\n", (2.0 - 0.05 * t).powi(2));
+    }
+    for (name, text, states, law, want) in [
+        ("friction", friction, "x,v", "`sign(v)` in v_dot, beyond the candidates", -0.5),
+        ("tank", tank, "h", "`sqrt(abs(h))` in h_dot, beyond the candidates", -0.1),
+    ] {
+        let (data, model) = (dir.join(format!("{name}.csv")), dir.join(format!("{name}.toml")));
+        std::fs::write(&data, text).unwrap();
+        let (data, model) = (data.to_str().unwrap(), model.to_str().unwrap());
+        let (ok, out, err) =
+            crate::common::termid(&["identify", "--data", data, "--states", states, "--out", model]);
+        assert!(ok && !out.contains("FLAG"), "{name}: {err}{out}");
+        let (ok, out, err) =
+            crate::common::termid(&["diagnose", "--model", model, "--data", data, "--format", "json"]);
+        assert!(ok, "{name}: {err}");
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        assert_eq!(v["effect"]["name"].as_str(), Some(law), "{name}: {}", v["effect"]);
+        let got = v["effect"]["coefficients"][0].as_f64().unwrap();
+        // (the friction's 1 %: its switches fall between the samples)
+        assert!((got / want - 1.0).abs() < 0.02, "{name}: {got} for {want}");
+        assert!(v["effect"]["explained"].as_f64().unwrap() > 0.99, "{name}: {}", v["effect"]);
+    }
+}
