@@ -8,6 +8,8 @@ from typing import Any, Optional, Sequence
 
 import pandas as pd
 
+from . import _termid
+
 #: One colour per series, kept across panels and figures (measured, simulated).
 COLOURS = {"measured": "#1f77b4", "simulated": "#d62728"}
 
@@ -28,7 +30,7 @@ def run(
 ) -> Any:
     """Stacked panels on one time axis: each column of ``measured`` (every column but the
     time by default) and, where given, the same column of ``simulated``; ``columns`` the
-    columns drawn, ``time`` the time column (seconds).
+    columns drawn, ``time`` the time column (seconds, or the unit its name says: ``day``).
 
     >>> from termid import plot
     >>> ship = termid.Model.default()
@@ -48,7 +50,9 @@ def run(
         ax.set_ylabel(name)
         ax.grid(True, alpha=0.3)
     axes[0, 0].legend(loc="upper right")
-    axes[-1, 0].set_xlabel(f"{time} [s]")
+    # a time named by its unit (`day`, `Time (ms)`) is in it, as a model's run writes it
+    per = _termid.seconds_per(time)
+    axes[-1, 0].set_xlabel(time if per is not None and per != 1.0 else f"{time} [s]")
     fig.tight_layout()
     return fig
 

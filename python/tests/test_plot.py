@@ -20,6 +20,9 @@ def test_a_run_against_its_simulation_shares_one_time_axis(ship, zigzags):
     assert len({ax.get_lines()[0].get_color() for ax in axes}) == 1
     with pytest.raises(ValueError):
         termid.plot.run(run[["t"]])
+    # a time named by its unit is in it, not seconds
+    days = run[["t", "r"]].rename(columns={"t": "day"})
+    assert termid.plot.run(days, time="day").get_axes()[-1].get_xlabel() == "day"
 
 
 def test_a_track_at_equal_scale_and_the_step_table(ship, hald):
