@@ -562,6 +562,27 @@ impl Runs {
         (sigma > 0.0 && sigma.is_finite()).then_some(sigma)
     }
 
+    /// The cost the records' white noise accounts for, in the residuals' scaling: Σ rows ·
+    /// (σ / spread)² over each compared state of each run whose noise its fourth differences
+    /// measure ([`crate::data::white_noise`]; where the motion shows through them, none).
+    /// No effect can close it: what a re-simulation that follows its run still leaves.
+    pub fn white_noise_cost(&self) -> f64 {
+        let mut sum = 0.0;
+        for f in &self.frames {
+            for ((_, name), scale) in self.states.iter().zip(&self.scale) {
+                let Some(column) = f.column(name) else { continue };
+                if let Some(noise) = crate::data::white_noise(column).filter(|n| n.measured) {
+                    sum += column.len() as f64 * (noise.sd / scale).powi(2);
+                }
+            }
+        }
+        if sum.is_finite() {
+            sum
+        } else {
+            0.0
+        }
+    }
+
     /// The share of the compared records' variance that is their noise ([`Runs::noise`] of
     /// each compared state in each run, scaled as its residuals are, over every compared
     /// value; a derived variable's counts as none): what a fit that holds leaves.

@@ -140,12 +140,20 @@ fn text(d: &Diagnosis, out: Option<&std::path::Path>, tested: usize, settings: &
                 s += &format!(" (runner-up: {}, {:.1} %)", r.name, 100.0 * r.explained);
             }
             s += ".\n";
+            // what no effect closes, said where it is a good part of the gap
+            if d.noise >= 0.05 {
+                let share = match d.noise >= termid::diagnose::NOISE_AT_MOST - 1e-9 {
+                    true => "half the gap or more".to_string(),
+                    false => format!("{:.0} % of the gap", 100.0 * d.noise),
+                };
+                s += &format!("  The records' white noise is {share} (no effect closes it).\n");
+            }
             // ranked above it, terms beyond the candidates that add too little to the refit
             if w > 0 {
                 s += &format!(
                     "  Passed over, ranked above it: {w} term(s) beyond the candidates, each closing less than \
-                     {:.0} % of the gap beyond its equation's coefficients refitted alone (`beyond_refit`): they \
-                     fit what the refit leaves.\n",
+                     {:.0} % of the gap beyond the records' noise and its equation's coefficients refitted alone \
+                     (`beyond_refit`): they fit what the refit leaves.\n",
                     100.0 * settings.min_explained
                 );
             }
