@@ -3355,3 +3355,33 @@ fn a_temperature_in_degrees_celsius_is_read_as_it_is() {
     assert!((terms["T"] * 60.0 / -0.05 - 1.0).abs() < 1e-4, "{terms:?}");
     assert!((terms["1"] * 60.0 / (0.05 * 20.0) - 1.0).abs() < 1e-4, "{terms:?}");
 }
+
+/// A model's runs whose time is a column `time` (as most loggers and dataframes name it) were
+/// refused by the model's commands ("name it as the time column (`--time time`…)", an option
+/// `validate` does not have); the one column named as a time is the model's time, said.
+#[test]
+fn a_model_s_commands_take_a_file_s_one_time_column() {
+    use crate::common::Scratch;
+    let dir = Scratch::new("generic-time-column");
+    let (mut by_t, mut by_time) = (String::from("t,x\n"), String::from("time,x\n"));
+    for k in 0..=200 {
+        let (t, x) = (k as f64 * 0.05, (-0.3 * k as f64 * 0.05).exp());
+        by_t += &format!("{t},{x}\n");
+        by_time += &format!("{t},{x}\n");
+    }
+    let (a, b, model) = (dir.join("a.csv"), dir.join("b.csv"), dir.join("m.toml"));
+    std::fs::write(&a, by_t).unwrap();
+    std::fs::write(&b, &by_time).unwrap();
+    let (a, b, model) = (a.to_str().unwrap(), b.to_str().unwrap(), model.to_str().unwrap());
+    let (ok, _, err) = termid(&["identify", "--data", a, "--states", "x", "--out", model]);
+    assert!(ok, "{err}");
+    let (ok, out, err) = termid(&["validate", "--model", model, "--data", b]);
+    assert!(ok, "{err}");
+    assert!(err.contains("the time `t` is column `time`, the one whose name says it is the time"), "{err}");
+    let error: f64 = out.split("x ").nth(1).and_then(|s| s.split(' ').next()).unwrap().parse().unwrap();
+    assert!(error < 1e-4, "{out}");
+    // beside another such column, neither is taken
+    std::fs::write(dir.join("c.csv"), "time,seconds,x\n0,0,1\n1,1,0.74\n").unwrap();
+    let (ok, _, err) = termid(&["validate", "--model", model, "--data", dir.join("c.csv").to_str().unwrap()]);
+    assert!(!ok && err.contains("no time column `t`"), "{err}");
+}

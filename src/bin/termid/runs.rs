@@ -274,17 +274,32 @@ pub fn load(data: &[PathBuf], by: Option<&str>, datasets: &[PathBuf], time: &str
     check_once(&input_files(data, datasets))?;
     let mut frames = Vec::new();
     for path in data {
-        if let Some(note) = termid::data::units_note(path, time) {
+        // a file without the model's time whose one column named as a time is it (`time`,
+        // `Time [s]`, `day`): read as the model's, said, as Python reads a dataframe's
+        let own = time_by_name(std::slice::from_ref(path), time);
+        if let Some(name) = &own {
+            say(&format!(
+                "{}: the time `{time}` is column `{name}`, the one whose name says it is the time",
+                path.display()
+            ));
+        }
+        let column = own.as_deref().unwrap_or(time);
+        if let Some(note) = termid::data::units_note(path, column) {
             say(&note);
         }
-        let runs = match by {
+        let mut runs = match by {
             Some(by) => {
-                let (runs, note) = Frame::read_by(path, time, by)?;
+                let (runs, note) = Frame::read_by(path, column, by)?;
                 say(&note);
                 runs
             }
-            None => vec![Frame::read(path, time).map_err(|e| with_remedy(e, path))?],
+            None => vec![Frame::read(path, column).map_err(|e| with_remedy(e, path))?],
         };
+        if own.is_some() {
+            for frame in &mut runs {
+                frame.rename(column, time)?;
+            }
+        }
         if let Some(note) = runs.first().and_then(Frame::text_note) {
             say(&note);
         }
