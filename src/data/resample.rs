@@ -149,6 +149,10 @@ pub fn uneven(t: &[f64]) -> Option<(usize, f64, f64)> {
         .find(|(_, at, place)| (at - place).abs() > 0.1 * step)
 }
 
+/// Intervals that span this ratio (the longest over the shortest) mark a record sampled on a
+/// log scale, whose close samples one grid loses.
+const LOG_SCALE: f64 = 1000.0;
+
 /// The run on a grid of its median step where its samples are uneven ([`uneven`]), with what
 /// to say of it; `None` where they are even.
 pub fn evened(frame: &Frame) -> Result<Option<(Frame, String)>, DataError> {
@@ -158,7 +162,7 @@ pub fn evened(frame: &Frame) -> Result<Option<(Frame, String)>, DataError> {
     let step = median_step(frame.time());
     // stamps as a person reads them, not as the binary sums leave them
     let short = |v: f64| (v * 1e9).round() / 1e9;
-    let note = format!(
+    let mut note = format!(
         "{}: samples not evenly spaced (row {}: t = {} s where a step of {} s from the first puts it at {} s): resampled onto its median step, {} s (by the cubic through the four nearest samples; a line for a column that steps or leaps), as a re-simulation compares it sample by sample",
         frame.origin(),
         row + 1,
@@ -167,6 +171,21 @@ pub fn evened(frame: &Frame) -> Result<Option<(Frame, String)>, DataError> {
         short(place),
         short(step)
     );
+    // a record sampled on a log scale (stiff kinetics, a relaxation: finely at first, ever
+    // more coarsely) loses on one grid what moved between its close samples: said
+    let intervals: Vec<f64> = frame.time().windows(2).map(|w| w[1] - w[0]).collect();
+    let (shortest, longest) =
+        intervals.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), d| (lo.min(*d), hi.max(*d)));
+    let lost = intervals.iter().filter(|d| **d < 0.5 * step).count();
+    if lost > 0 && shortest > 0.0 && longest >= LOG_SCALE * shortest {
+        note += &format!(
+            "; {lost} of its {} intervals are shorter than half that step (they run from {} s to {} s: a record sampled on a log scale, as stiff kinetics are): what moved within them is lost, and the even run holds {} rows; such a run is identified in pieces of like spacing (a dataset file's `from` and `to`), each resampled onto its own step",
+            intervals.len(),
+            crate::output::sig(shortest, 3),
+            crate::output::sig(longest, 3),
+            ((frame.duration() / step).round() as usize) + 1
+        );
+    }
     let mut even = resample(frame, step).map_err(|e| {
         DataError::Setting(format!(
             "{}: samples not evenly spaced (row {}), and the run cannot be resampled onto its median step: {e}",
@@ -323,6 +342,22 @@ mod tests {
         let short = Frame::new("short.csv", "t", vec![0.0, 0.1, 0.3]).unwrap();
         let e = evened(&short).unwrap_err().to_string();
         assert!(e.starts_with("short.csv: samples not evenly spaced (row 3)"), "{e}");
+        // a dropped sample's intervals span 2: nothing said of a log scale
+        assert!(!note.contains("log scale"), "{note}");
+    }
+
+    /// A relaxation sampled on a log scale (5 per decade from 1 ms to 100 s, as stiff
+    /// kinetics are): one grid of its median step loses the first decades, said with how many
+    /// intervals and what to do.
+    #[test]
+    fn a_record_on_a_log_scale_is_said_to_lose_its_close_samples() {
+        let t: Vec<f64> = (0..=25).map(|k| 10f64.powf(-3.0 + k as f64 / 5.0)).collect();
+        let mut f = Frame::new("relax.csv", "t", t.clone()).unwrap();
+        f.push("x", t.iter().map(|t| (-t).exp()).collect()).unwrap();
+        let (_, note) = evened(&f).unwrap().unwrap();
+        assert!(note.contains("of its 25 intervals are shorter than half that step"), "{note}");
+        assert!(note.contains("a record sampled on a log scale"), "{note}");
+        assert!(note.contains("pieces of like spacing"), "{note}");
     }
 
     fn frame(dt: f64, n: usize, f: impl Fn(f64) -> f64) -> Frame {
