@@ -97,7 +97,7 @@ pub(crate) fn method_of(
     runs: &[termid::data::Frame],
 ) -> PyResult<(Integrator, f64)> {
     let method = integrator.map(Integrator::by_name).transpose().map_err(fail)?;
-    Ok(model.resimulation(method, dt.map(|dt| dt * model.seconds_per_time()), runs))
+    Ok(model.resimulation(method, dt, runs))
 }
 
 pub(crate) fn to_json(value: &impl serde::Serialize) -> PyResult<String> {

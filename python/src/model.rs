@@ -926,7 +926,7 @@ impl PyModel {
         let json = serde_json::json!({
             "location": d.location, "effect": effect, "gap_before": d.gap_before,
             "gap_after": d.gap_after, "candidates": d.candidates,
-            "own_values": d.own_values, "one_value": d.one_value,
+            "own_values": d.own_values, "one_value": d.one_value, "noise": d.noise,
         });
         Ok((to_json(&json)?, d.model.map(|m| PyModel { inner: self.inner.as_declared(&m) })))
     }

@@ -2214,7 +2214,8 @@ class Model:
         model file declares nuisances of each run or source (a rudder indicator's zero,
         ``nuisance = "run"``), each run is diagnosed with its own values, estimated first with
         the rest of the model held: ``attrs["own_values"]`` (a DataFrame of ``name``, ``run``,
-        ``value``, ``std_error``; empty where none). ``raw``: the report as plain values;
+        ``value``, ``std_error``; empty where none) and ``noise`` (the share of the gap that is
+        the records' white noise, at most half). ``raw``: the report as plain values;
         ``dt``, ``integrator``, ``with_intercept`` as for :meth:`simulate`. ``over_ground``: the
         runs are tracked by a satellite receiver, so the model's velocity of the medium (a
         current, ``medium = true``) is estimated among those own values; the model returned
@@ -2241,6 +2242,8 @@ class Model:
                 [{k: v for k, v in c.items() if k in ("name", "explained", "delta_bic", "cost", "declared")} for c in report.get("candidates", [])]
             ),
             "own_values": pd.DataFrame(report.get("own_values", []), columns=["name", "run", "value", "std_error"]),
+            # the share of the gap that is the records' white noise, which no effect closes
+            "noise": report.get("noise"),
         }
         return before, model
 

@@ -1283,5 +1283,6 @@ def test_a_law_a_cubic_stands_in_for_is_diagnosed_and_identified_again():
     gaps, repaired = found.model.diagnose(run)
     assert gaps.attrs["effect"]["name"] == "`sqrt(abs(h))` in h_dot, beyond the candidates"
     assert gaps.attrs["effect"]["coefficients"][0] == pytest.approx(-0.1, rel=1e-3)
+    assert 0.0 <= gaps.attrs["noise"] < 0.05
     again = repaired.identify(run).model.coefficients("h_dot").set_index("term")["value"]
     assert again.to_dict() == pytest.approx({"sqrt(abs(h))": -0.1}, rel=1e-4)

@@ -276,8 +276,9 @@ impl Model {
     }
 
     /// The method and control step recorded `runs` are re-simulated with: as
-    /// [`Model::simulation`], but where neither the command nor the model file gives a step
-    /// the adaptive methods take the records' sample interval. Their accuracy is their
+    /// [`Model::simulation`], the command's step `dt` in the model's unit of time
+    /// ([`Model::seconds_per_time`]); but where neither the command nor the model file gives
+    /// a step the adaptive methods take the records' sample interval. Their accuracy is their
     /// tolerances', and recorded inputs are known only at the samples: a ship's 0.04 s is a
     /// thousand control steps a sample for an epidemic counted daily, and longer than a
     /// circuit's whole run sampled every 10 ns.
@@ -287,6 +288,7 @@ impl Model {
         dt: Option<f64>,
         runs: &[crate::data::Frame],
     ) -> (crate::sim::Integrator, f64) {
+        let dt = dt.map(|dt| dt * self.seconds_per_time());
         let (method, step) = self.simulation(method, dt);
         let given = dt.or(self.spec.simulation.as_ref().and_then(|s| s.dt)).is_some();
         let sampled = crate::data::sample_step(runs);

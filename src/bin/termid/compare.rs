@@ -113,8 +113,7 @@ fn resimulate(model: &termid::model::Model, run: &Frame, dt: Option<f64>) -> Res
     for s in &model.spec().states {
         run.require(&s.name)?;
     }
-    let given = dt.map(|dt| dt * model.seconds_per_time());
-    let (method, dt) = model.resimulation(None, given, std::slice::from_ref(run));
+    let (method, dt) = model.resimulation(None, dt, std::slice::from_ref(run));
     let runs = Runs::new(model, std::slice::from_ref(run), dt, method)?;
     let gap = runs.gap(&simulate_runs(&runs, model)?);
     Ok(gap.runs.into_iter().flat_map(|(_, states)| states).collect())

@@ -27,8 +27,7 @@ pub fn run(cmd: DiagnoseCommand) -> Result<()> {
     let current = crate::runs::medium_to_free(&file, &cmd.runs.dataset, &cmd.runs.hold)?;
     let model = file.freed(&current, &[]).map_err(anyhow::Error::msg)?;
     let hypotheses = termid::plugins::hypotheses(&model);
-    let given = cmd.resim.dt.map(|dt| dt * model.seconds_per_time());
-    let (integrator, dt) = model.resimulation(cmd.resim.integrator, given, &runs);
+    let (integrator, dt) = model.resimulation(cmd.resim.integrator, cmd.resim.dt, &runs);
     let settings =
         Settings { dt, integrator, with_intercepts: cmd.resim.with_intercept, ..Settings::default() };
     let label = format!("trying {} hypotheses on {} runs", hypotheses.len(), runs.len());

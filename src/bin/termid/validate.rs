@@ -25,8 +25,7 @@ pub fn run(cmd: ValidateCommand) -> Result<()> {
     // runs tracked over ground: the day's current is theirs, not the model's
     let current = crate::runs::medium_of_runs(&model, &runs, &sources, &cmd.runs.dataset, &cmd.runs.hold)?;
     let current: Vec<(usize, &str, f64)> = current.iter().map(|(r, n, v)| (*r, n.as_str(), *v)).collect();
-    let given = cmd.resim.dt.map(|dt| dt * model.seconds_per_time());
-    let (integrator, dt) = model.resimulation(cmd.resim.integrator, given, &runs);
+    let (integrator, dt) = model.resimulation(cmd.resim.integrator, cmd.resim.dt, &runs);
     let data = Runs::new(&model, &runs, dt, integrator)?
         .with_intercepts(cmd.resim.with_intercept)
         .with_initial(&[], &current);
