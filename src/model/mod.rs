@@ -308,12 +308,21 @@ impl Model {
 
     /// What to say where the model's time is not in seconds ([`Model::seconds_per_time`]):
     /// a simulation's times are given in its unit, its rates stay per second.
+    /// A file written by hand in that unit (an epidemic's β per day) would be read 86 400 times
+    /// too fast: said with the remedy.
     pub fn time_note(&self) -> Option<String> {
         let per = self.seconds_per_time();
+        let time = &self.spec.model.time;
+        let by_hand = !self.spec.model.provenance.starts_with("identified by termid");
         (per != 1.0).then(|| {
             format!(
-                "the model's time `{}` is counted in units of {per:.6e} s: a simulation's duration, output interval and step are given in it, as its run's `{}` column; its rates are per second",
-                self.spec.model.time, self.spec.model.time
+                "{}: the model's time `{time}` is counted in units of {per:.6e} s: a simulation's duration, output interval and step are given in it, as its run's `{time}` column; its rates are per second{}",
+                self.path,
+                if by_hand {
+                    format!(" (its equations' coefficients and parameters too: where this file writes them per `{time}`, name its time `t`, whose values are taken as they are)")
+                } else {
+                    String::new()
+                }
             )
         })
     }

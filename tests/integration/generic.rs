@@ -3327,7 +3327,18 @@ fn a_model_counted_in_days_is_simulated_in_days_and_records_at_their_own_step() 
     ]);
     assert!(ok, "{err}");
     assert!(err.contains("the model's time `day` is counted in units of 8.640000e4 s"), "{err}");
+    assert!(!err.contains("name its time `t`"), "{err}");
     assert!(out.contains("61 samples to day = 60.0000 (5.18400e6 s)"), "{out}");
+    // a file written by hand in days would be read 86 400 times too fast: said, with the remedy
+    let by_hand = dir.join("by_hand.toml");
+    std::fs::write(
+        &by_hand,
+        "[model]\nname = \"decay\"\ntime = \"day\"\n[[states]]\nname = \"x\"\ninitial = 100.0\n\
+         [equations.x_dot]\nstate = \"x\"\nidentify = false\ncoefficients = { \"x\" = -0.1 }\n",
+    )
+    .unwrap();
+    let (ok, _, err) = termid(&["simulate", "--model", by_hand.to_str().unwrap(), "--duration", "1"]);
+    assert!(ok && err.contains("where this file writes them per `day`, name its time `t`"), "{err}");
     let text = std::fs::read_to_string(&run).unwrap();
     let last: Vec<f64> = text.lines().last().unwrap().split(',').map(|v| v.parse().unwrap()).collect();
     assert_eq!(last[0], 60.0);

@@ -14,10 +14,15 @@ use crate::monte_carlo::Draws;
 use termid::identify::sig;
 
 pub fn load_model(path: &Option<std::path::PathBuf>) -> Result<Model> {
-    Ok(match path {
+    let model = match path {
         Some(p) => termid::plugins::load(p)?,
         None => termid::plugins::default_model(),
-    })
+    };
+    // a model counted in days is simulated in days, its rates per second: said
+    if let Some(note) = model.time_note() {
+        crate::runs::say(&note);
+    }
+    Ok(model)
 }
 
 pub fn run(cmd: SimulateCommand) -> Result<()> {
@@ -54,9 +59,6 @@ pub fn run(cmd: SimulateCommand) -> Result<()> {
     // a model counted in days (an epidemic's) is simulated for days, sampled in days, as its
     // run's time column is written
     let per = model.seconds_per_time();
-    if let Some(note) = model.time_note() {
-        crate::runs::say(&note);
-    }
     let cmd = SimulateCommand {
         duration: cmd.duration.map(|d| d * per),
         sample: cmd.sample * per,
