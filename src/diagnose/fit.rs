@@ -565,7 +565,9 @@ impl Runs {
     /// The cost the records' white noise accounts for, in the residuals' scaling: Σ rows ·
     /// (σ / spread)² over each compared state of each run whose noise its fourth differences
     /// measure ([`crate::data::white_noise`]; where the motion shows through them, none).
-    /// No effect can close it: what a re-simulation that follows its run still leaves.
+    /// No effect can close it: what a re-simulation that follows its run still leaves. Not
+    /// [`Runs::noise_share`]'s second differences, which take a coarse record's motion for
+    /// noise: here an over-reading would make a term's share beyond it look larger.
     pub fn white_noise_cost(&self) -> f64 {
         let mut sum = 0.0;
         for f in &self.frames {
