@@ -750,6 +750,30 @@ class Fit:
         index = data.index if isinstance(data, pd.DataFrame) else None
         return pd.Series(values, index=index, name=self.target)
 
+    def score(self, data: Data) -> float:
+        """R² of the fitted equation on ``data`` (rows it was not fitted to, say), as
+        scikit-learn's ``score`` gives it: 1 − Σ(y − ŷ)² / Σ(y − ȳ)², the target a column of
+        ``data``. A rate (``dx/dt``) is no column: a column of measured rates (``x_dot``) is
+        scored as one, else a model of the rates is judged by re-simulating its runs
+        (:meth:`Model.validate`).
+
+        >>> fitted = termid.fit(pd.DataFrame({"x": [0.0, 1, 2, 3], "y": [1.0, 3, 5, 7]}), "y", "x")
+        >>> round(fitted.score(pd.DataFrame({"x": [4.0, 5.0], "y": [9.0, 11.5]})), 6)
+        0.92
+        """
+        columns = _columns(data)
+        if self.target not in columns:
+            raise TermidError(
+                f"`{self.target}` is not a column of the data ({', '.join(columns)}): a fit is scored against its "
+                "target's values; a rate's fit is judged by re-simulating its runs (Model.validate)"
+            )
+        y = np.asarray(columns[self.target], dtype=np.float64)
+        residual = y - self.predict(data).to_numpy()
+        spread = float(np.sum((y - y.mean()) ** 2))
+        if spread == 0.0:
+            raise TermidError(f"`{self.target}` is the same in every row: R² is not defined")
+        return 1.0 - float(np.sum(residual**2)) / spread
+
     def equation(self, precision: int = 6) -> str:
         """The fitted equation as text, ``y = 62.4 + 1.55 x1 + ...``, each number to
         ``precision`` significant digits.

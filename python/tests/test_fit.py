@@ -618,3 +618,15 @@ def test_a_series_is_one_named_column_and_a_formula_s_sum_is_said():
     with pytest.warns(UserWarning, match=r"terms 'x \+ x\^2' is one candidate, their sum with one coefficient; for a coefficient each, list them: \['x', 'x\^2'\]"):
         summed = termid.fit(x, "dx/dt", "x + x^2")
     assert list(summed.coefficients.index) != ["x", "x^2"]
+
+
+def test_a_fit_is_scored_on_held_out_rows_as_scikit_learn_scores():
+    # R² on rows not fitted to, against numbers worked by hand; a rate is no column
+    fitted = termid.fit(pd.DataFrame({"x": [0.0, 1, 2, 3], "y": [1.0, 3, 5, 7]}), "y", "x")
+    held = pd.DataFrame({"x": [4.0, 5.0, 6.0], "y": [9.0, 11.0, 14.0]})
+    # predictions 9, 11, 13: residuals 0, 0, 1; about the mean 34/3 the squares sum to 38/3
+    assert fitted.score(held) == pytest.approx(1.0 - 1.0 / 12.666666666666666)
+    t = np.arange(0.0, 10.0, 0.01)
+    rate = termid.fit(pd.DataFrame({"t": t, "x": np.exp(-0.3 * t)}), "dx/dt", ["x"])
+    with pytest.raises(termid.TermidError, match="a rate's fit is judged by re-simulating its runs"):
+        rate.score(pd.DataFrame({"t": t, "x": np.exp(-0.3 * t)}))
