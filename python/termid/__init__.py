@@ -247,10 +247,39 @@ def _numeric(items: Any) -> "_Columns":
     return out
 
 
+def _stamps_parsed(data: Data) -> Data:
+    """A DataFrame's columns of ISO 8601 date-times held as text (``pd.read_csv`` without
+    ``parse_dates``) as the date-times they are, as the command line reads a file's stamps;
+    anything else as it is."""
+    if not isinstance(data, pd.DataFrame):
+        return data
+    parsed = {}
+    for j, column in enumerate(data.columns):
+        values = data.iloc[:, j]
+        if values.dtype.kind in "biufcmM":
+            continue
+        first = values.dropna()
+        if first.empty or not re.match(r"\d{4}-\d{2}-\d{2}[T ]\d", str(first.iloc[0])):
+            continue
+        try:
+            stamps = pd.to_datetime(values, format="ISO8601")
+        except (ValueError, TypeError):
+            continue
+        if not stamps.isna().any():
+            parsed[j] = stamps
+    if not parsed:
+        return data
+    data = data.copy()
+    for j, stamps in parsed.items():
+        data.isetitem(j, stamps)
+    return data
+
+
 def _columns(data: Data) -> "_Columns":
     """Columns as contiguous float64 arrays, without copying where the layout allows; time
-    columns (timedelta64, datetime64) in seconds, named in ``times``; columns that hold no
-    numbers left out."""
+    columns (timedelta64, datetime64, ISO 8601 stamps as text) in seconds, named in
+    ``times``; columns that hold no numbers left out."""
+    data = _stamps_parsed(data)
     found = _columns_of(data)
     if isinstance(data, pd.DataFrame):
         found.times = [str(c) for c, dt in zip(data.columns, data.dtypes) if getattr(dt, "kind", "O") in "mM"]

@@ -1286,3 +1286,18 @@ def test_a_law_a_cubic_stands_in_for_is_diagnosed_and_identified_again():
     assert 0.0 <= gaps.attrs["noise"] < 0.05
     again = repaired.identify(run).model.coefficients("h_dot").set_index("term")["value"]
     assert again.to_dict() == pytest.approx({"sqrt(abs(h))": -0.1}, rel=1e-4)
+
+
+def test_iso_stamps_read_as_text_are_the_rows_time():
+    # `pd.read_csv` leaves a logger's ISO stamps as text: the run was "no time column `t`
+    # (columns: x)", the stamps left out unsaid; the command line reads them, and so does this
+    hours = pd.date_range("2024-01-01", periods=200, freq="h")
+    text = pd.DataFrame({"time": hours.strftime("%Y-%m-%dT%H:%M:%S"), "x": 100.0 * np.exp(-0.05 * np.arange(200))})
+    with pytest.warns(UserWarning, match="holds date-times; read as seconds since its first value"):
+        found = termid.Model.from_states(["x"]).identify(text)
+    x = found.model.coefficients("x_dot").set_index("term")["value"]
+    assert x["x"] * 3600.0 == pytest.approx(-0.05, rel=1e-4)
+    # text that is no date is left out as before (a run's label, a year as text)
+    labelled = text.assign(run="a", year="2024")
+    again = termid.Model.from_states(["x"]).identify(labelled).model.coefficients("x_dot").set_index("term")["value"]
+    assert again.to_dict() == pytest.approx(x.to_dict())
