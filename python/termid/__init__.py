@@ -269,10 +269,11 @@ def _stamps_parsed(data: Data) -> Data:
             parsed[j] = stamps
     if not parsed:
         return data
-    data = data.copy()
-    for j, stamps in parsed.items():
-        data.isetitem(j, stamps)
-    return data
+    # column by column, by place (pandas 1.3 has no `isetitem`; names may repeat until `_once`)
+    out = pd.concat([parsed.get(j, data.iloc[:, j]) for j in range(data.shape[1])], axis=1)
+    out.columns = data.columns
+    out.attrs = dict(data.attrs)
+    return out
 
 
 def _columns(data: Data) -> "_Columns":
