@@ -254,7 +254,8 @@ def _stamps_parsed(data: Data) -> Data:
     if not isinstance(data, pd.DataFrame):
         return data
     parsed = {}
-    for j, column in enumerate(data.columns):
+    # (pandas before 2.0 reads no "ISO8601" format: its stamps stay text, left out as before)
+    for j in range(data.shape[1]):
         values = data.iloc[:, j]
         if values.dtype.kind in "biufcmM":
             continue
