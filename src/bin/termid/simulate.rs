@@ -361,7 +361,6 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
         }
         Format::Text => {
             let end = traj.time.last().copied().unwrap_or(0.0);
-            let per = model.seconds_per_time();
             let to = match per == 1.0 {
                 true => format!("t = {end} s"),
                 false => format!("{} = {} ({} s)", model.spec().model.time, sig(end / per, 6), sig(end, 6)),
