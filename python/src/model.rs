@@ -163,15 +163,25 @@ impl PyModel {
 impl PyModel {
     /// Reads a model file (TOML); errors name the file, line and key.
     #[staticmethod]
-    fn load(path: PathBuf) -> PyResult<Self> {
-        Ok(PyModel { inner: termid::plugins::load(&path).map_err(fail)? })
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let inner = termid::plugins::load(&path).map_err(fail)?;
+        // what the command line says as it loads a model (a rate declared per hour, read per
+        // second), a notebook shows as a warning
+        for note in inner.load_notes() {
+            warn(py, note)?;
+        }
+        Ok(PyModel { inner })
     }
 
     /// A model from TOML text; `name` stands for the file in messages.
     #[staticmethod]
     #[pyo3(signature = (text, name = "<text>"))]
-    fn parse(text: &str, name: &str) -> PyResult<Self> {
-        Ok(PyModel { inner: termid::plugins::parse(text, name).map_err(fail)? })
+    fn parse(py: Python<'_>, text: &str, name: &str) -> PyResult<Self> {
+        let inner = termid::plugins::parse(text, name).map_err(fail)?;
+        for note in inner.load_notes() {
+            warn(py, note)?;
+        }
+        Ok(PyModel { inner })
     }
 
     /// The default model: Oltmann's (1973) HSVA 1512 with its Table 2 coefficients.

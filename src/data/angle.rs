@@ -64,23 +64,30 @@ pub fn laid_on_turns(frame: &mut Frame, at: usize, values: &[(String, f64)]) -> 
 /// less than a quarter of it at every other step (a pendulum swinging over the top, read
 /// by atan2 in ±π, a wind direction in 0-360°). A record that so jumps by any other span (a
 /// counter that rolls over, a relaxation reset) is no angle: `None`.
+///
+/// Unwrapped, each wrap's step must also go on as a neighbour's does (the same way, at most
+/// four times as far), or be under a twentieth of a turn (noise about the wrap): a
+/// concentration that leaps from 0 to 256 at its first sample and then decays is no angle,
+/// though it stays within 360 (unwrapped, it would first turn back by 104).
 pub fn turn_of(x: &[f64]) -> Option<f64> {
     let (low, high) = x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
+    let steps: Vec<f64> = x.windows(2).map(|w| w[1] - w[0]).collect();
     [TAU, 360.0].into_iter().find(|&turn| {
         let span = high - low;
-        let steps = x.windows(2).map(|w| (w[1] - w[0]).abs());
-        let (wraps, moves) =
-            steps.fold(
-                (0, true),
-                |(n, ok), s| {
-                    if s > 0.5 * turn {
-                        (n + 1, ok)
-                    } else {
-                        (n, ok && s < 0.25 * turn)
-                    }
-                },
-            );
-        span <= 1.02 * turn && span >= 0.75 * turn && wraps > 0 && moves
+        let wrap = |s: f64| s.abs() > 0.5 * turn;
+        let moves = steps.iter().all(|&s| wrap(s) || s.abs() < 0.25 * turn);
+        let mut wraps = (0..steps.len()).filter(|&k| wrap(steps[k])).peekable();
+        let some = wraps.peek().is_some();
+        let like_neighbours = wraps.all(|k| {
+            let unwrapped = steps[k] - turn.copysign(steps[k]);
+            let beside = [k.checked_sub(1), Some(k + 1)]
+                .into_iter()
+                .flatten()
+                .filter_map(|j| steps.get(j).copied().filter(|s| !wrap(*s)));
+            unwrapped.abs() <= 0.05 * turn
+                || beside.into_iter().any(|s| s * unwrapped > 0.0 && unwrapped.abs() <= 4.0 * s.abs())
+        });
+        span <= 1.02 * turn && span >= 0.75 * turn && some && moves && like_neighbours
     })
 }
 
@@ -207,6 +214,10 @@ mod tests {
         let mut leaps = dial;
         leaps[1500] = leaps[1499] + 2.0;
         assert_eq!(turn_of(&leaps), None);
+        // a concentration dosed from 0, sampled hourly: it leaps by 71 % of 360 at its first
+        // sample and stays within 360, but unwrapped that leap would run backwards
+        let plasma = [0.0, 255.8, 297.2, 279.0, 247.1, 214.6, 185.5, 160.1, 137.7, 118.4, 101.8, 87.5, 75.6];
+        assert_eq!(turn_of(&plasma), None);
     }
 
     #[test]

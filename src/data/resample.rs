@@ -149,6 +149,23 @@ pub fn uneven(t: &[f64]) -> Option<(usize, f64, f64)> {
         .find(|(_, at, place)| (at - place).abs() > 0.1 * step)
 }
 
+/// The shortest interval of a record sampled on a schedule — a pharmacokinetic study's
+/// 0.25, 0.5, 1, 2, 4, 8 h, a survey every day then every week — whose intervals are whole
+/// multiples of it (within 2 %) and whose median is at least twice it: every sample lies on
+/// its grid, where the median step would drop the close samples a fast early phase is read
+/// from. `None` for a clock (the median is the shortest, dropouts and jitter aside), intervals
+/// of no common step (a log scale), or a grid over 20 times the record's rows (or a million).
+fn scheduled_step(t: &[f64]) -> Option<f64> {
+    let intervals: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    let shortest = intervals.iter().copied().fold(f64::INFINITY, f64::min);
+    if shortest.is_nan() || shortest <= 0.0 || median_step(t) < 1.5 * shortest {
+        return None;
+    }
+    let whole = intervals.iter().all(|d| (d / shortest - (d / shortest).round()).abs() <= 0.02);
+    let rows = (t[t.len() - 1] - t[0]) / shortest + 1.0;
+    (whole && rows <= (20 * t.len()).min(1_000_000) as f64).then_some(shortest)
+}
+
 /// Intervals that span this ratio (the longest over the shortest) mark a record sampled on a
 /// log scale, whose close samples one grid loses.
 const LOG_SCALE: f64 = 1000.0;
@@ -159,17 +176,25 @@ pub fn evened(frame: &Frame) -> Result<Option<(Frame, String)>, DataError> {
     let Some((row, at, place)) = uneven(frame.time()) else {
         return Ok(None);
     };
-    let step = median_step(frame.time());
+    let scheduled = scheduled_step(frame.time());
+    let step = scheduled.unwrap_or_else(|| median_step(frame.time()));
     // stamps as a person reads them, not as the binary sums leave them
     let short = |v: f64| (v * 1e9).round() / 1e9;
+    let onto = match scheduled {
+        Some(_) => format!(
+            "its shortest step, {} s, on which every sample lies (its intervals are whole multiples of it, as a sampling schedule's are: the median step, {} s, would lose the close samples)",
+            short(step),
+            short(median_step(frame.time()))
+        ),
+        None => format!("its median step, {} s", short(step)),
+    };
     let mut note = format!(
-        "{}: samples not evenly spaced (row {}: t = {} s where a step of {} s from the first puts it at {} s): resampled onto its median step, {} s (by the cubic through the four nearest samples; a line for a column that steps or leaps), as a re-simulation compares it sample by sample",
+        "{}: samples not evenly spaced (row {}: t = {} s where a step of {} s from the first puts it at {} s): resampled onto {onto} (by the cubic through the four nearest samples; a line for a column that steps or leaps), as a re-simulation compares it sample by sample",
         frame.origin(),
         row + 1,
         short(at),
         short(frame.time()[1] - frame.time()[0]),
         short(place),
-        short(step)
     );
     // a record sampled on a log scale (stiff kinetics, a relaxation: finely at first, ever
     // more coarsely) loses on one grid what moved between its close samples: said
@@ -188,7 +213,7 @@ pub fn evened(frame: &Frame) -> Result<Option<(Frame, String)>, DataError> {
     }
     let mut even = resample(frame, step).map_err(|e| {
         DataError::Setting(format!(
-            "{}: samples not evenly spaced (row {}), and the run cannot be resampled onto its median step: {e}",
+            "{}: samples not evenly spaced (row {}), and the run cannot be resampled onto its step: {e}",
             frame.origin(),
             row + 1
         ))
@@ -339,9 +364,12 @@ mod tests {
         assert!(note.contains("gap.csv") && note.contains("row 8"), "{note}");
         assert!(evened(&frame(0.1, 50, |t| t)).unwrap().is_none());
         // too short to resample: refused, saying why
-        let short = Frame::new("short.csv", "t", vec![0.0, 0.1, 0.3]).unwrap();
+        let short = Frame::new("short.csv", "t", vec![0.0, 0.1, 0.35]).unwrap();
         let e = evened(&short).unwrap_err().to_string();
         assert!(e.starts_with("short.csv: samples not evenly spaced (row 3)"), "{e}");
+        // (on a schedule of whole steps it is evened onto the shortest)
+        let scheduled = Frame::new("short.csv", "t", vec![0.0, 0.1, 0.3]).unwrap();
+        assert_eq!(evened(&scheduled).unwrap().unwrap().0.len(), 4);
         // a dropped sample's intervals span 2: nothing said of a log scale
         assert!(!note.contains("log scale"), "{note}");
     }
@@ -358,6 +386,38 @@ mod tests {
         assert!(note.contains("of its 25 intervals are shorter than half that step"), "{note}");
         assert!(note.contains("a record sampled on a log scale"), "{note}");
         assert!(note.contains("pieces of like spacing"), "{note}");
+    }
+
+    /// A pharmacokinetic schedule (0, 0.25, 0.5, 1, 1.5, 2, 3, 4, 6, 8, 12, 16, 24 h): evened
+    /// onto its shortest step, where every sample lies (the median step, 1 h, kept 7 of its 13
+    /// and lost the absorption); a clock with a dropout, a jittered clock and a log scale keep
+    /// their median step.
+    #[test]
+    fn a_sampling_schedule_is_evened_onto_its_shortest_step() {
+        let hours = [0.0, 0.25, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0, 24.0];
+        let t: Vec<f64> = hours.iter().map(|h| h * 3600.0).collect();
+        assert_eq!(scheduled_step(&t), Some(900.0));
+        let mut f = Frame::new("pk.csv", "t", t.clone()).unwrap();
+        let c = |t: f64| 100.0 * ((-0.15 * t / 3600.0).exp() - (-1.2 * t / 3600.0).exp());
+        f.push("C", t.iter().map(|s| c(*s)).collect()).unwrap();
+        let (even, note) = evened(&f).unwrap().unwrap();
+        assert_eq!(even.len(), 97);
+        assert!(note.contains("its shortest step, 900 s, on which every sample lies"), "{note}");
+        for (k, s) in t.iter().enumerate() {
+            let row = (s / 900.0).round() as usize;
+            assert!(
+                (even.time()[row] - s).abs() < 1e-9 && (even.column("C").unwrap()[row] - c(*s)).abs() < 1e-9,
+                "{k}"
+            );
+        }
+        let dropout: Vec<f64> = (0..50).filter(|k| *k != 20).map(|k| k as f64 * 0.1).collect();
+        assert_eq!(scheduled_step(&dropout), None);
+        let mut seed = 2u64;
+        let jitter: Vec<f64> =
+            (0..50).map(|k| 0.1 * k as f64 + 0.01 * crate::data::test_noise(&mut seed)).collect();
+        assert_eq!(scheduled_step(&jitter), None);
+        let log: Vec<f64> = (0..=25).map(|k| 10f64.powf(-3.0 + k as f64 / 5.0)).collect();
+        assert_eq!(scheduled_step(&log), None);
     }
 
     fn frame(dt: f64, n: usize, f: impl Fn(f64) -> f64) -> Frame {

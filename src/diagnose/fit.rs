@@ -374,8 +374,9 @@ impl Runs {
                     .collect()
             })
             .collect();
-        // each run's declared start (its first samples, the file's values of the rest) and
-        // that with its hidden states where they are steady
+        // each run's declared start (its first samples; the file's values of the rest, or their
+        // own per run where the file reads them off the run: a dose) and that with its hidden
+        // states where they are steady (none that the file sets per run)
         let starts = frames
             .iter()
             .zip(&params)
@@ -384,14 +385,25 @@ impl Runs {
                 let declared: Vec<f64> = system
                     .states
                     .iter()
-                    .map(|s| {
-                        f.column(s).map_or_else(
-                            || model.spec().states.iter().find(|t| &t.name == s).map_or(0.0, |t| t.initial),
-                            |c| c[0],
-                        )
+                    .map(|s| match (f.column(s), model.spec().states.iter().find(|t| &t.name == s)) {
+                        (Some(c), _) => Ok(c[0]),
+                        (None, Some(spec)) => match &spec.per_run {
+                            Some(rule) => ParamValue::Rule(rule.clone())
+                                .resolve(s, f)
+                                .map_err(|e| DiagnoseError::Setup(e.to_string())),
+                            None => Ok(spec.initial),
+                        },
+                        (None, None) => Ok(0.0),
+                    })
+                    .collect::<Result<_, DiagnoseError>>()?;
+                let free: Vec<usize> = hidden
+                    .iter()
+                    .copied()
+                    .filter(|&i| {
+                        model.spec().states.iter().all(|t| t.name != system.states[i] || t.per_run.is_none())
                     })
                     .collect();
-                let steady = steady_hidden(&system.with_parameters(p)?, f, declared.clone(), hidden);
+                let steady = steady_hidden(&system.with_parameters(p)?, f, declared.clone(), &free);
                 Ok((declared, steady))
             })
             .collect::<Result<Vec<_>, DiagnoseError>>()?;

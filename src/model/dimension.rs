@@ -127,6 +127,56 @@ pub fn parse_unit(unit: &str) -> Option<Dimension> {
     Some(out)
 }
 
+/// Units of time a person writes a rate in (`1/h`, `L/min`, `mg·h/L`), with their factor to
+/// seconds: a model file's values are SI, so a parameter declared in one of them is read in
+/// seconds all the same.
+const TIME_UNITS: &[(&str, f64)] = &[
+    ("ms", 1e-3),
+    ("min", 60.0),
+    ("h", 3600.0),
+    ("hr", 3600.0),
+    ("d", 86400.0),
+    ("day", 86400.0),
+    ("week", 604800.0),
+];
+
+/// The factor that takes a value in `unit` to SI where the unit counts time in anything but
+/// seconds (`1/h`: 1/3600; `mg·h/L`: 3600), with the unit in seconds (`1/s`, `mg·s/L`);
+/// `None` where it counts time in seconds or not at all.
+pub fn time_in_seconds(unit: &str) -> Option<(f64, String)> {
+    let mut factor = 1.0;
+    let mut si = String::new();
+    let mut rest = unit;
+    // the unit's words, each with what follows it (a separator, a power, a parenthesis)
+    while !rest.is_empty() {
+        let start = rest.find(|c: char| c.is_alphabetic()).unwrap_or(rest.len());
+        si.push_str(&rest[..start]);
+        rest = &rest[start..];
+        let end = rest.find(|c: char| !c.is_alphabetic()).unwrap_or(rest.len());
+        let word = &rest[..end];
+        rest = &rest[end..];
+        let Some((_, seconds)) = TIME_UNITS.iter().find(|(name, _)| *name == word) else {
+            si.push_str(word);
+            continue;
+        };
+        si.push('s');
+        let power = match rest.chars().next() {
+            Some('²') => 2.0,
+            Some('³') => 3.0,
+            Some('^') => rest[1..]
+                .split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
+                .next()
+                .and_then(|p| p.parse().ok())
+                .unwrap_or(1.0),
+            _ => 1.0,
+        };
+        // a unit of time under the unit's (first) slash divides
+        let under = si.contains('/');
+        factor *= seconds.powf(if under { -power } else { power });
+    }
+    (factor != 1.0).then_some((factor, si))
+}
+
 /// The dimensions of every name of a model: states, inputs and parameters from their units,
 /// derived variables from their definitions.
 pub fn dimensions(model: &Model) -> Result<BTreeMap<String, Dimension>, DimensionError> {
@@ -333,6 +383,25 @@ mod tests {
         assert_eq!(u, "°/s");
         assert_eq!(shown("rad").1, "°");
         assert_eq!(shown("m/s"), (1.0, "m/s".to_string()));
+    }
+
+    /// Rates per hour, minute or day read in seconds, with their SI unit; units that count
+    /// time in seconds or not at all are left alone.
+    #[test]
+    fn units_of_time_other_than_seconds_are_found_with_their_factor() {
+        let close = |u: &str, f: f64, si: &str| {
+            let (got, unit) = time_in_seconds(u).unwrap();
+            assert!((got / f - 1.0).abs() < 1e-12 && unit == si, "{u}: {got} {unit}");
+        };
+        close("1/h", 1.0 / 3600.0, "1/s");
+        close("1/min", 1.0 / 60.0, "1/s");
+        close("L/(mol·h)", 1.0 / 3600.0, "L/(mol·s)");
+        close("mg·h/L", 3600.0, "mg·s/L");
+        close("m/h^2", 1.0 / 3600f64.powi(2), "m/s^2");
+        close("1/day", 1.0 / 86400.0, "1/s");
+        for si in ["1/s", "m/s", "rad/s^2", "mol/L", "", "kg m²", "hPa", "mmHg"] {
+            assert_eq!(time_in_seconds(si), None, "{si}");
+        }
     }
 
     /// Froude scaling of the paper's ship to a 20× larger one: a zigzag's overshoots and

@@ -123,6 +123,11 @@ pub struct StateSpec {
     /// Initial value for simulation.
     #[serde(default)]
     pub initial: f64,
+    /// Where the runs do not record it, its value at each run's start, read off the run as a
+    /// parameter's `per_run` is (`first:dose`: a dose given at the start, of which only the
+    /// concentration it makes is measured).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub per_run: Option<String>,
     /// A simulation leaving [min, max] stops with an error.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min: Option<f64>,

@@ -327,6 +327,47 @@ impl Model {
         })
     }
 
+    /// What to say of a model as it is loaded: its time counted in another unit than seconds
+    /// ([`Model::time_note`]) and each name declared in a unit that counts time otherwise
+    /// ([`Model::unit_notes`]).
+    pub fn load_notes(&self) -> Vec<String> {
+        self.time_note().into_iter().chain(self.unit_notes()).collect()
+    }
+
+    /// A parameter, state or input declared in a unit that counts time in hours, minutes or
+    /// days (a pharmacokinetic rate's `1/h`): a model file's values are SI and its rates per
+    /// second, so ka = 0.5 in `1/h` is read as 0.5 per second, 3600 times too fast, and an
+    /// estimate started there fails or lands on another minimum. Said with the value to write.
+    pub fn unit_notes(&self) -> Vec<String> {
+        let spec = &self.spec;
+        let mut notes = Vec::new();
+        for (name, p) in &spec.parameters {
+            let Some((factor, si)) = dimension::time_in_seconds(&p.unit) else { continue };
+            notes.push(format!(
+                "{}: parameter `{name}` is declared in `{}`, but a model file's values are SI, time in seconds: its value {} is read in `{si}`; where it is {} {}, write `value = {}` and `unit = \"{si}\"` (estimates are written in `{si}`)",
+                self.path,
+                p.unit,
+                crate::output::sig(p.value, 6),
+                crate::output::sig(p.value, 6),
+                p.unit,
+                crate::output::sig(p.value * factor, 6),
+            ));
+        }
+        let declared = spec
+            .states
+            .iter()
+            .map(|s| ("state", &s.name, &s.unit))
+            .chain(spec.inputs.iter().map(|i| ("input", &i.name, &i.unit)));
+        for (what, name, unit) in declared {
+            let Some((_, si)) = dimension::time_in_seconds(unit) else { continue };
+            notes.push(format!(
+                "{}: {what} `{name}` is declared in `{unit}`, but a model file's values are SI, time in seconds: it is read in `{si}` (a record's column headed with its unit is converted to it)",
+                self.path
+            ));
+        }
+        notes
+    }
+
     /// The sizes each state's default absolute tolerance is counted in
     /// ([`crate::sim::System::sizes`]), from how large the states run (`magnitudes` in state
     /// order: the records' largest, or the initial values; [`crate::sim::sizes_of`]), so that
@@ -643,6 +684,11 @@ impl Model {
         vocab.with_time(time);
         for (i, s) in spec.states.iter().enumerate() {
             vocab.variable(&s.name).map_err(|e| key_err(&format!("states[{i}].name"), e.to_string()))?;
+            if let Some(rule) = &s.per_run {
+                ParamValue::Rule(rule.clone())
+                    .check_rule(&s.name)
+                    .map_err(|m| key_err(&format!("states[{i}].per_run"), m.to_string()))?;
+            }
             if let (Some(lo), Some(hi)) = (s.min, s.max) {
                 if lo >= hi {
                     return Err(key_err(

@@ -123,7 +123,14 @@ impl Outline {
             states: self
                 .states
                 .iter()
-                .map(|n| StateSpec { name: n.clone(), unit: String::new(), initial: 0.0, min: None, max: None })
+                .map(|n| StateSpec {
+                    name: n.clone(),
+                    unit: String::new(),
+                    initial: 0.0,
+                    per_run: None,
+                    min: None,
+                    max: None,
+                })
                 .collect(),
             inputs: self
                 .inputs

@@ -282,7 +282,8 @@ pub struct IdentifyCommand {
     #[arg(long, num_args = 1.., value_delimiter = ',')]
     pub states: Vec<String>,
     /// With --states: the columns that drive the states, known from the records
-    /// (comma-separated; given without names: none). Default: every other column of the runs.
+    /// (comma-separated; given without names, or as "": none). Default: every other column of
+    /// the runs.
     #[arg(long, num_args = 0.., value_delimiter = ',', requires = "states")]
     pub inputs: Option<Vec<String>>,
     /// With --states and no candidates named: the degree of the polynomial library (every

@@ -32,7 +32,7 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
         termid::output::check_file(out)?;
     }
     let mut model = match &cmd.model {
-        Some(path) => termid::plugins::load(path)?,
+        Some(path) => crate::simulate::load_model(&Some(path.clone()))?,
         None => crate::outline::model(&cmd)?,
     }
     .keeping_spikes(cmd.keep_spikes)

@@ -39,10 +39,12 @@ pub fn model(cmd: &IdentifyCommand) -> Result<Model> {
     }
     let inputs = match &cmd.inputs {
         Some(named) => {
-            for i in named {
+            // `--inputs ""` (a script's empty list) names none, as `--inputs` alone does
+            let named: Vec<String> = named.iter().filter(|i| !i.trim().is_empty()).cloned().collect();
+            for i in &named {
                 column(i, "--inputs")?;
             }
-            named.clone()
+            named
         }
         None => {
             let rates: Vec<String> = cmd.states.iter().map(|s| format!("{s}_dot")).collect();

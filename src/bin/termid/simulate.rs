@@ -18,8 +18,9 @@ pub fn load_model(path: &Option<std::path::PathBuf>) -> Result<Model> {
         Some(p) => termid::plugins::load(p)?,
         None => termid::plugins::default_model(),
     };
-    // a model counted in days is simulated in days, its rates per second: said
-    if let Some(note) = model.time_note() {
+    // a model counted in days is simulated in days, its rates per second; a rate declared per
+    // hour is read per second: said
+    for note in model.load_notes() {
         crate::runs::say(&note);
     }
     Ok(model)
