@@ -1301,3 +1301,64 @@ def test_iso_stamps_read_as_text_are_the_rows_time():
     labelled = text.assign(run="a", year="2024")
     again = termid.Model.from_states(["x"]).identify(labelled).model.coefficients("x_dot").set_index("term")["value"]
     assert again.to_dict() == pytest.approx(x.to_dict())
+
+
+def test_a_dose_in_a_state_nobody_measures_and_rates_declared_per_hour():
+    # an oral dose: the gut's amount A starts at each subject's dose (`per_run`), only the
+    # plasma's C is measured, on a schedule in hours; ka = 1.2 /h and ke = 0.15 /h come back
+    # from C alone. The same file with its rates declared `1/h` is told they are read per
+    # second, with the value to write.
+    ka, ke = 1.2, 0.15
+    hours = np.array([0.0, 0.25, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0, 24.0])
+    runs = [
+        pd.DataFrame({
+            "t [h]": hours,
+            "C": dose * ka / (ka - ke) * (np.exp(-ke * hours) - np.exp(-ka * hours)),
+            "dose": dose,
+        })
+        for dose in (100.0, 200.0, 400.0)
+    ]
+    text = """
+[model]
+name = "one compartment, oral"
+
+[[states]]
+name = "A"
+per_run = "first:dose"
+
+[[states]]
+name = "C"
+
+[[inputs]]
+name = "dose"
+
+[parameters.ka]
+value = {ka}
+unit = "{unit}"
+free = true
+bounds = [0.0, 100.0]
+
+[parameters.ke]
+value = {ke}
+unit = "{unit}"
+free = true
+bounds = [0.0, 100.0]
+
+[equations.A_dot]
+state = "A"
+identify = false
+coefficients = {{ "ka*A" = -1.0 }}
+
+[equations.C_dot]
+state = "C"
+identify = false
+coefficients = {{ "ka*A" = 1.0, "ke*C" = -1.0 }}
+"""
+    with pytest.warns(UserWarning, match=r"parameter `ka` is declared in `1/h`.*write `value = 1.38889e-4`"):
+        termid.Model.from_toml(text.format(ka=0.5, ke=0.06, unit="1/h"))
+    model = termid.Model.from_toml(text.format(ka=0.5 / 3600, ke=0.06 / 3600, unit="1/s"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        table, _ = model.estimate(runs, states=["C"])
+    per_hour = table["estimate"] * 3600.0
+    assert per_hour.to_dict() == pytest.approx({"ka": ka, "ke": ke}, rel=0.01)
