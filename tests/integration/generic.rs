@@ -2103,7 +2103,11 @@ fn a_whole_system_from_its_columns() {
     for pieces in [&[][..], &["--chunk-rows", "300"]] {
         let args = [&["identify", "--data", &in_ms, "--states", "x,v", "--format", "json"], pieces].concat();
         let (ok, out, err) = termid(&args);
-        assert!(ok && err.contains("`t [ms]` as t in SI (× 1.000000e-3), `x [m]` as x"), "{err}");
+        assert!(
+            ok && err.contains("the time `t [ms]` read in seconds (× 1.000000e-3)")
+                && err.contains("`x [m]` as x"),
+            "{err}"
+        );
         assert!(err.contains("note: the inputs are F "), "{err}");
         let rate = json(&out)["x_dot"]["terms"][0]["coefficient"].as_f64().unwrap();
         assert!((rate - 1.0).abs() < 1e-4, "{out}");
@@ -3269,14 +3273,44 @@ fn days_and_hours_are_read_as_the_time_in_seconds() {
         args.extend_from_slice(extra);
         let (ok, out, err) = termid(&args);
         assert!(ok, "{header}: {err}");
-        let said = match header {
-            "day" => "the time `day` read in seconds (× 8.640000e4): every rate is per second",
-            _ => "`t [h]` as t in SI (× 3.600000e3)",
-        };
-        assert!(err.contains(said), "{header}: {err}");
+        let said = format!("the time `{header}` read in seconds (× {per:.6e}): every rate is per second");
+        assert!(err.contains(&said), "{header}: {err}");
         let terms = terms_of(&json(&out)["x_dot"]);
         assert!((terms["x"] * per / -rate - 1.0).abs() < 1e-3, "{header}: {terms:?}");
     }
+    // the model of a study in hours keeps its time `t [h]`: simulated for 24 hours by
+    // `--duration 24` (named `t`, it ran 24 seconds), its run written in hours
+    let (model, run) = (dir.join("hours.toml"), dir.join("hours.csv"));
+    let (ok, _, err) = termid(&[
+        "identify",
+        "--data",
+        dir.join("decay.csv").to_str().unwrap(),
+        "--states",
+        "x",
+        "--out",
+        model.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(std::fs::read_to_string(&model).unwrap().contains("time = \"t [h]\""));
+    let (ok, _, err) = termid(&[
+        "simulate",
+        "--model",
+        model.to_str().unwrap(),
+        "--initial",
+        "x=100",
+        "--duration",
+        "24",
+        "--sample",
+        "1",
+        "--out",
+        run.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let text = std::fs::read_to_string(&run).unwrap();
+    let last: Vec<f64> =
+        text.lines().last().unwrap().split(',').take(2).map(|c| c.parse().unwrap()).collect();
+    assert!(text.starts_with("t [h],x") && last[0] == 24.0, "{text}");
+    assert!((last[1] / (100.0 * f64::exp(-0.3 * 24.0)) - 1.0).abs() < 1e-3, "{last:?}");
     let (ok, _, err) =
         termid(&["identify", "--data", dir.join("decay.csv").to_str().unwrap(), "--states", "x"]);
     assert!(ok, "{err}");

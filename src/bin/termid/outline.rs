@@ -72,9 +72,16 @@ pub fn model(cmd: &IdentifyCommand) -> Result<Model> {
             usable.into_iter().cloned().collect()
         }
     };
+    // a time headed with its unit (`t [h]`, `Time (ms)`) names the model's time, so that the
+    // model is simulated, and writes its runs, in that unit as a `day` model is: named `t`, a
+    // study's 24 hours were simulated by `--duration 24` for 24 seconds
+    let model_time = match termid::data::seconds_per(&time) {
+        Some(per) if per != 1.0 && time != cmd.time => time.clone(),
+        _ => cmd.time.clone(),
+    };
     let mut outline = Outline {
         name: cmd.states.join(", "),
-        time: cmd.time.clone(),
+        time: model_time,
         states: cmd.states.clone(),
         inputs,
         candidates: Vec::new(),
