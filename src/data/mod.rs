@@ -459,6 +459,10 @@ pub struct Frame {
     file_rows: Option<Vec<usize>>,
     /// The file's columns of text left out (a run's label, a mode), with their first cell.
     text: Vec<(String, String)>,
+    /// Where its rows were laid on an even grid with rows between the record's own samples
+    /// (a sampling schedule's), which rows are samples: a re-simulation is compared at those
+    /// only, as the rows between are the interpolation's. `None`: every row is a sample.
+    recorded: Option<Vec<bool>>,
 }
 
 impl Frame {
@@ -477,6 +481,7 @@ impl Frame {
             first_row: 0,
             file_rows: None,
             text: vec![],
+            recorded: None,
         };
         f.push(time_name, time)?;
         Ok(f)
@@ -731,6 +736,24 @@ impl Frame {
         self
     }
 
+    /// Which rows are the record's own samples where the frame was laid on an even grid with
+    /// rows between them ([`evened`]); `None` where every row is one.
+    pub fn recorded(&self) -> Option<&[bool]> {
+        self.recorded.as_deref()
+    }
+
+    /// Whether row `k` is one of the record's own samples ([`Frame::recorded`]).
+    pub fn is_sample(&self, k: usize) -> bool {
+        self.recorded.as_ref().is_none_or(|r| r.get(k).copied().unwrap_or(true))
+    }
+
+    /// The frame with the rows `recorded` marks as the record's own samples, the rest
+    /// interpolated between them (one flag a row; all marked is `None`).
+    pub(crate) fn with_recorded(mut self, recorded: Vec<bool>) -> Frame {
+        self.recorded = (recorded.len() == self.len() && recorded.iter().any(|r| !r)).then_some(recorded);
+        self
+    }
+
     /// Name of the time column.
     pub fn time_name(&self) -> &str {
         &self.time_name
@@ -813,6 +836,7 @@ impl Frame {
             first_row: self.first_row + if self.file_rows.is_some() { 0 } else { range.start },
             file_rows: self.file_rows.as_ref().map(|r| r[range.clone()].to_vec()),
             text: self.text.clone(),
+            recorded: self.recorded.as_ref().map(|r| r[range.clone()].to_vec()),
         }
     }
 }

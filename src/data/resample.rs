@@ -182,7 +182,7 @@ pub fn evened(frame: &Frame) -> Result<Option<(Frame, String)>, DataError> {
     let short = |v: f64| (v * 1e9).round() / 1e9;
     let onto = match scheduled {
         Some(_) => format!(
-            "its shortest step, {} s, on which every sample lies (its intervals are whole multiples of it, as a sampling schedule's are: the median step, {} s, would lose the close samples)",
+            "its shortest step, {} s, on which every sample lies (its intervals are whole multiples of it, as a sampling schedule's are: the median step, {} s, would lose the close samples; a re-simulation is compared at the samples only)",
             short(step),
             short(median_step(frame.time()))
         ),
@@ -232,6 +232,21 @@ pub fn evened(frame: &Frame) -> Result<Option<(Frame, String)>, DataError> {
             let smooth = cubic_at(frame.time(), x, even.time());
             even.set(name, smooth)?;
         }
+    }
+    // where every sample lies on the grid (a schedule's, a clock's with dropped samples), the
+    // rows between them are the cubic's: a re-simulation is compared at the samples only
+    let t0 = even.time()[0];
+    let mut recorded = vec![false; even.len()];
+    let on_grid = frame.time().iter().all(|s| {
+        let k = ((s - t0) / step).round() as usize;
+        let hit = even.time().get(k).is_some_and(|g| (g - s).abs() <= 1e-6 * step);
+        if hit {
+            recorded[k] = true;
+        }
+        hit
+    });
+    if on_grid {
+        even = even.with_recorded(recorded);
     }
     Ok(Some((even, note)))
 }
@@ -359,8 +374,9 @@ mod tests {
         let (even, note) = evened(&f).unwrap().unwrap();
         assert_eq!(even.len(), 50);
         assert!(uneven(even.time()).is_none());
-        // linear between samples: the dropped one's value comes back
+        // linear between samples: the dropped one's value comes back, compared as none
         assert!((even.column("x").unwrap()[7] - 1.4).abs() < 1e-9);
+        assert!(!even.is_sample(7) && (0..50).filter(|k| even.is_sample(*k)).count() == 49);
         assert!(note.contains("gap.csv") && note.contains("row 8"), "{note}");
         assert!(evened(&frame(0.1, 50, |t| t)).unwrap().is_none());
         // too short to resample: refused, saying why
@@ -403,6 +419,9 @@ mod tests {
         let (even, note) = evened(&f).unwrap().unwrap();
         assert_eq!(even.len(), 97);
         assert!(note.contains("its shortest step, 900 s, on which every sample lies"), "{note}");
+        // the rows between the samples are the cubic's, compared as none
+        assert_eq!(even.recorded().unwrap().iter().filter(|r| **r).count(), 13);
+        assert!(even.is_sample(0) && !even.is_sample(3) && even.is_sample(4) && even.is_sample(96));
         for (k, s) in t.iter().enumerate() {
             let row = (s / 900.0).round() as usize;
             assert!(

@@ -265,6 +265,9 @@ pub struct Estimate {
     /// The share of the records' variance that is their noise, as their second differences
     /// show it ([`Runs::noise`]): what a fit that holds leaves.
     pub noise: f64,
+    /// How many runs' noise is not read (sampled on a schedule, evened between their samples:
+    /// [`crate::data::Frame::recorded`]): their noise counts as none.
+    pub noise_unread: usize,
     /// Where the fit from the model file's values did not follow the records ([`FOLLOWS`]):
     /// the fit again from a start found on segments of the runs, and which was kept.
     pub segmented: Option<Segmented>,
@@ -543,7 +546,9 @@ impl Unknowns {
                     let frame = &runs.frames()[r];
                     let compared =
                         runs.compared().iter().filter(|(_, n)| frame.column(n).is_some()).map(|(i, _)| *i);
-                    let hidden = runs.hidden[r].iter().copied().filter(|_| !held);
+                    // (one the file sets per run, a dose, is known: held there)
+                    let per_run = |i: usize| model.spec().states.get(i).is_some_and(|s| s.per_run.is_some());
+                    let hidden = runs.hidden[r].iter().copied().filter(move |i| !held && !per_run(*i));
                     compared.chain(hidden).map(move |i| (r, i))
                 })
                 .collect()
@@ -957,6 +962,7 @@ fn fit(
         cost_after,
         unexplained: cost_after / every.residual_count().max(1) as f64,
         noise: every.noise_share(),
+        noise_unread: every.frames().iter().filter(|f| f.recorded().is_some()).count(),
         segmented: None,
         finer: 1,
         stopped,
@@ -1280,7 +1286,9 @@ impl Unknowns {
 /// information than their number says); and τ.
 fn data_weight(runs: &Runs, residuals: &[f64], k: usize) -> (f64, Option<f64>) {
     let tau = crate::uncertainty::correlation_time(&runs.series(residuals));
-    let s2 = sum_of_squares(residuals) / (residuals.len() as f64 - k as f64).max(1.0);
+    // counted at the samples: a schedule's rows between them are compared as none
+    let n = runs.residual_count().min(residuals.len());
+    let s2 = sum_of_squares(residuals) / (n as f64 - k as f64).max(1.0);
     (1.0 / (s2.max(1e-300) * tau.unwrap_or(1.0).max(1.0)), tau)
 }
 
@@ -1323,11 +1331,17 @@ impl Estimate {
     pub fn text(&self) -> String {
         use crate::identify::{num, sig};
         let mut out = format!(
-            "== output-error estimate of the free parameters ==\nre-simulation cost (scaled sum of squares) {} → {} ({} % of the records' variance left, their noise {} %); {} iterations; residual correlation time {} samples; stopped: {}\n",
+            "== output-error estimate of the free parameters ==\nre-simulation cost (scaled sum of squares) {} → {} ({} % of the records' variance left, their noise {}); {} iterations; residual correlation time {} samples; stopped: {}\n",
             sig(self.cost_before, 4),
             sig(self.cost_after, 4),
             sig(100.0 * self.unexplained, 2),
-            sig(100.0 * self.noise, 2),
+            match self.noise_unread {
+                0 => format!("{} %", sig(100.0 * self.noise, 2)),
+                n => format!(
+                    "{} %, not read in the {n} run(s) sampled on a schedule, too sparse for it to show",
+                    sig(100.0 * self.noise, 2)
+                ),
+            },
             self.iterations,
             self.correlation_time.map_or("—".into(), |t| format!("{t:.0}")),
             self.stopped

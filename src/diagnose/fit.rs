@@ -459,9 +459,11 @@ impl Runs {
         let f = &self.frames[r];
         self.compared_in(sim).into_iter().flat_map(move |(name, _, sc, simulated)| {
             let meas = f.column(name).unwrap_or(&[]);
-            meas.iter()
-                .enumerate()
-                .map(move |(k, m)| (simulated.get(k).copied().unwrap_or(f64::NAN) - m) / sc)
+            // a row between a schedule's samples is the interpolation's: compared as none
+            meas.iter().enumerate().map(move |(k, m)| match f.is_sample(k) {
+                true => (simulated.get(k).copied().unwrap_or(f64::NAN) - m) / sc,
+                false => 0.0,
+            })
         })
     }
 
@@ -567,7 +569,13 @@ impl Runs {
     /// state is not compared or its record is constant.
     pub fn noise(&self, run: usize, state: usize) -> Option<f64> {
         let (_, name) = self.states.iter().find(|(i, _)| *i == state)?;
-        let x = self.frames.get(run)?.column(name)?;
+        let frame = self.frames.get(run)?;
+        // the rows between a schedule's samples are the cubic's, smooth: they hide the noise,
+        // and the samples' own uneven intervals leave their motion in second differences
+        if frame.recorded().is_some() {
+            return None;
+        }
+        let x = frame.column(name)?;
         let n = x.len().checked_sub(2).filter(|n| *n > 0)?;
         let ss: f64 = x.windows(3).map(|w| (w[2] - 2.0 * w[1] + w[0]).powi(2)).sum();
         let sigma = (ss / (6.0 * n as f64)).sqrt();
@@ -582,7 +590,8 @@ impl Runs {
     /// noise: here an over-reading would make a term's share beyond it look larger.
     pub fn white_noise_cost(&self) -> f64 {
         let mut sum = 0.0;
-        for f in &self.frames {
+        // (the rows between a schedule's samples are the cubic's: no noise read there)
+        for f in self.frames.iter().filter(|f| f.recorded().is_none()) {
             for ((_, name), scale) in self.states.iter().zip(&self.scale) {
                 let Some(column) = f.column(name) else { continue };
                 if let Some(noise) = crate::data::white_noise(column).filter(|n| n.measured) {
@@ -713,6 +722,11 @@ impl Runs {
             let sims = coarse.simulate(model, &[], &[]).ok()?;
             (self.largest_difference(fine, &sims, factor) <= tolerance).then_some(coarse)
         };
+        // runs compared at a schedule's samples only are not coarsened: a coarse grid would
+        // pass between them
+        if self.frames.iter().any(|f| f.recorded().is_some()) {
+            return (1, self.clone());
+        }
         // the first factor that does not hold ends the search
         let mut kept = (1, self.clone());
         for factor in 2..=most {
@@ -777,7 +791,13 @@ impl Runs {
 
     /// Number of compared values.
     pub fn residual_count(&self) -> usize {
-        self.frames.iter().map(|f| self.recorded(f).map(|(_, n)| n).sum::<usize>()).sum()
+        self.frames
+            .iter()
+            .map(|f| {
+                let samples = (0..f.len()).filter(|k| f.is_sample(*k)).count();
+                self.recorded(f).map(|(_, n)| n.min(samples)).sum::<usize>()
+            })
+            .sum()
     }
 
     /// The compared quantities' (states', then derived variables') names in run `f` with their
@@ -1046,7 +1066,9 @@ impl Runs {
             // a quantity the run does not record has an empty series there
             for (_, len) in self.recorded(f) {
                 let end = (at + len).min(residuals.len());
-                out.push(residuals[at..end].to_vec());
+                // a schedule's samples only: the rows between are compared as none
+                let samples = residuals[at..end].iter().enumerate().filter(|(k, _)| f.is_sample(*k));
+                out.push(samples.map(|(_, r)| *r).collect());
                 at = end;
             }
         }
@@ -1134,6 +1156,7 @@ impl Runs {
                             .iter()
                             .take(rows.unwrap_or(usize::MAX))
                             .enumerate()
+                            .filter(|(k, _)| f.is_sample(*k))
                             .map(|(k, m)| simulated.get(k).copied().unwrap_or(f64::NAN) - m)
                             .collect();
                         (name.to_string(), unit.to_string(), d)
@@ -1447,7 +1470,8 @@ pub fn levenberg_marquardt(
             }
         }
     }
-    let n = r.len() as f64;
+    // counted at the samples (a schedule's rows between them are compared as none)
+    let n = data.residual_count().min(r.len()) as f64;
     let k = theta.len() as f64;
     let sigma2 = c / (n - k).max(1.0);
     let covariance = (j.transpose() * &j).try_inverse().map(|inv| inv * sigma2);

@@ -207,7 +207,8 @@ pub fn refine(model: &Model, runs: &Runs, settings: &RefineSettings<'_>) -> Resu
     // correlated in time, so the covariance is widened by their correlation time τ
     let tau = crate::uncertainty::correlation_time(&runs.series(&r));
     let widen = tau.unwrap_or(1.0).max(1.0);
-    let sigma2 = data_cost / (r.len() as f64 - k as f64).max(1.0);
+    let samples = runs.residual_count().min(r.len());
+    let sigma2 = data_cost / (samples as f64 - k as f64).max(1.0);
     let mut info = jtj;
     for i in 0..k {
         info[(i, i)] += prior[i];

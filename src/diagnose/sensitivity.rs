@@ -302,8 +302,10 @@ fn per_run_jacobians<T: Send>(
                 let blocks = blocks.iter().map(|b| (b, x, s)).chain(observed.iter().map(|b| (b, y, sy)));
                 for (&(first, i, sc, meas), values, slopes) in blocks {
                     if let Some(m) = meas.get(t) {
-                        res[first + t] = (values[i] - m) / sc;
-                        let inverse = 1.0 / sc;
+                        // a row between a schedule's samples is compared as none
+                        let sample = frame.is_sample(t);
+                        res[first + t] = if sample { (values[i] - m) / sc } else { 0.0 };
+                        let inverse = if sample { 1.0 / sc } else { 0.0 };
                         let column = &mut jt.as_mut_slice()[(first + t) * k..(first + t + 1) * k];
                         for (out, v) in column.iter_mut().zip(&slopes[i * k..(i + 1) * k]) {
                             *out = v * inverse;
