@@ -7,7 +7,6 @@ use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
 use super::hypotheses::{Effect, Hypothesis};
-use super::sensitivity::Free;
 use super::{DiagnoseError, Gap, Location, RunGap};
 use std::collections::BTreeMap;
 
@@ -1338,42 +1337,6 @@ pub(super) fn residuals(data: &Runs, model: &Model, h: &Hypothesis, theta: &[f64
     r.iter().all(|v| v.is_finite()).then_some(r)
 }
 
-/// The residuals at θ with the normal equations' JᵀJ and Jᵀr: from forward sensitivities
-/// (one re-simulation for every column) where the hypothesis only sets coefficients, else by
-/// central differences ([`jacobian`], two re-simulations a column). A monod growth's diagnosis
-/// refits nine coefficients beside each of 21 laws: by differences it took 2 minutes.
-fn normal_equations(
-    data: &Runs,
-    model: &Model,
-    h: &Hypothesis,
-    theta: &[f64],
-) -> Option<(Vec<f64>, DMatrix<f64>, DVector<f64>)> {
-    let coefficients =
-        matches!(h.effect, Effect::Terms { .. } | Effect::Beyond { .. } | Effect::Refit { .. });
-    if coefficients {
-        let sensitivities = || -> Option<super::sensitivity::Linearised> {
-            let applied = apply(model, h, theta).ok()?;
-            let entries = h
-                .terms()
-                .into_iter()
-                .map(|(eq, text)| applied.vocabulary.parse(&text).ok().map(|t| Free::Term(eq, t)))
-                .collect::<Option<Vec<Free>>>()?;
-            super::sensitivity::linearise(data, &applied, &entries).ok()
-        };
-        // a slope not finite (√|h| through 0) or a step the sensitivities' integration does
-        // not resolve: by differences
-        if let Some(lin) = sensitivities()
-            .filter(|l| l.residuals.iter().all(|v| v.is_finite()) && l.jtj.iter().all(|v| v.is_finite()))
-        {
-            return Some((lin.residuals, lin.jtj, lin.jtr));
-        }
-    }
-    let (r, j) = jacobian(data, model, h, theta)?;
-    let jt = j.transpose();
-    let g = &jt * DVector::from_column_slice(&r);
-    Some((r, &jt * &j, g))
-}
-
 fn jacobian(data: &Runs, model: &Model, h: &Hypothesis, theta: &[f64]) -> Option<(Vec<f64>, DMatrix<f64>)> {
     let r0 = residuals(data, model, h, theta)?;
     // the columns are independent re-simulations: all threads take them
@@ -1431,9 +1394,9 @@ pub fn gauss_newton(
     let mut best =
         cost(&residuals(data, model, h, &theta).ok_or(EstimateError::Diverges("with the unchanged model"))?);
     for _ in 0..iterations {
-        let (_, jtj, g) =
-            normal_equations(data, model, h, &theta).ok_or(EstimateError::Diverges("near the start"))?;
-        let step = jtj.lu().solve(&g).ok_or(EstimateError::Singular)?;
+        let (r, j) = jacobian(data, model, h, &theta).ok_or(EstimateError::Diverges("near the start"))?;
+        let jt = j.transpose();
+        let step = (&jt * &j).lu().solve(&(&jt * DVector::from_vec(r))).ok_or(EstimateError::Singular)?;
         let trial: Vec<f64> = theta.iter().zip(step.iter()).map(|(t, d)| t - d).collect();
         match residuals(data, model, h, &trial) {
             Some(rt) if cost(&rt) < best => {
@@ -1475,11 +1438,13 @@ pub fn levenberg_marquardt(
     theta0: Vec<f64>,
 ) -> Result<Estimated, EstimateError> {
     let mut theta = theta0;
-    let (mut r, mut jtj, mut g) =
-        normal_equations(data, model, h, &theta).ok_or(EstimateError::Diverges("at the start"))?;
+    let (mut r, mut j) = jacobian(data, model, h, &theta).ok_or(EstimateError::Diverges("at the start"))?;
     let mut c = cost(&r);
     let mut lambda = 1e-3;
     for _ in 0..30 {
+        let jt = j.transpose();
+        let jtj = &jt * &j;
+        let g = &jt * DVector::from_vec(r.clone());
         let mut a = jtj.clone();
         for k in 0..a.nrows() {
             a[(k, k)] += lambda * jtj[(k, k)].max(1e-300);
@@ -1490,8 +1455,7 @@ pub fn levenberg_marquardt(
             Some(rt) if cost(&rt) < c => {
                 let improvement = (c - cost(&rt)) / c.max(1e-300);
                 theta = trial;
-                (r, jtj, g) =
-                    normal_equations(data, model, h, &theta).ok_or(EstimateError::Diverges("on the way"))?;
+                (r, j) = jacobian(data, model, h, &theta).ok_or(EstimateError::Diverges("on the way"))?;
                 c = cost(&r);
                 lambda = (lambda / 10.0).max(1e-12);
                 if improvement < 1e-10 {
@@ -1510,6 +1474,6 @@ pub fn levenberg_marquardt(
     let n = data.residual_count().min(r.len()) as f64;
     let k = theta.len() as f64;
     let sigma2 = c / (n - k).max(1.0);
-    let covariance = jtj.try_inverse().map(|inv| inv * sigma2);
+    let covariance = (j.transpose() * &j).try_inverse().map(|inv| inv * sigma2);
     Ok(Estimated { theta, cost: c, covariance })
 }
