@@ -149,21 +149,24 @@ pub fn uneven(t: &[f64]) -> Option<(usize, f64, f64)> {
         .find(|(_, at, place)| (at - place).abs() > 0.1 * step)
 }
 
-/// The shortest interval of a record sampled on a schedule — a pharmacokinetic study's
-/// 0.25, 0.5, 1, 2, 4, 8 h, a survey every day then every week — whose intervals are whole
-/// multiples of it (within 2 %) and whose median is at least twice it: every sample lies on
-/// its grid, where the median step would drop the close samples a fast early phase is read
-/// from. `None` for a clock (the median is the shortest, dropouts and jitter aside), intervals
-/// of no common step (a log scale), or a grid over 20 times the record's rows (or a million).
-fn scheduled_step(t: &[f64]) -> Option<f64> {
+/// The step of a record sampled on a schedule — a pharmacokinetic study's 0.25, 0.5, 1, 2,
+/// 4, 8 h, a survey every day then every week — whose median interval is at least 1.5 times
+/// its shortest: the shortest itself where every interval is a whole multiple of it (within
+/// 2 %: every sample lies on its grid, `true`), else half of it (the schedule's actual times,
+/// 0.27 h for 0.25: each sample on a row of its own, `false`).
+/// The median step would drop the close samples a fast early phase is read from. `None` for a
+/// clock (the median is the shortest, dropouts and jitter aside) and for a grid over 20 times
+/// the record's rows (or a million: a log scale, an event log).
+fn scheduled_step(t: &[f64]) -> Option<(f64, bool)> {
     let intervals: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
     let shortest = intervals.iter().copied().fold(f64::INFINITY, f64::min);
     if shortest.is_nan() || shortest <= 0.0 || median_step(t) < 1.5 * shortest {
         return None;
     }
     let whole = intervals.iter().all(|d| (d / shortest - (d / shortest).round()).abs() <= 0.02);
-    let rows = (t[t.len() - 1] - t[0]) / shortest + 1.0;
-    (whole && rows <= (20 * t.len()).min(1_000_000) as f64).then_some(shortest)
+    let step = if whole { shortest } else { 0.5 * shortest };
+    let rows = (t[t.len() - 1] - t[0]) / step + 1.0;
+    (rows <= (20 * t.len()).min(1_000_000) as f64).then_some((step, whole))
 }
 
 /// Intervals that span this ratio (the longest over the shortest) mark a record sampled on a
@@ -177,14 +180,18 @@ pub fn evened(frame: &Frame) -> Result<Option<(Frame, String)>, DataError> {
         return Ok(None);
     };
     let scheduled = scheduled_step(frame.time());
-    let step = scheduled.unwrap_or_else(|| median_step(frame.time()));
+    let step = scheduled.map_or_else(|| median_step(frame.time()), |(step, _)| step);
     // stamps as a person reads them, not as the binary sums leave them
     let short = |v: f64| (v * 1e9).round() / 1e9;
+    let median = short(median_step(frame.time()));
     let onto = match scheduled {
-        Some(_) => format!(
-            "its shortest step, {} s, on which every sample lies (its intervals are whole multiples of it, as a sampling schedule's are: the median step, {} s, would lose the close samples; a re-simulation is compared at the samples only)",
+        Some((_, true)) => format!(
+            "its shortest step, {} s, on which every sample lies (its intervals are whole multiples of it, as a sampling schedule's are: the median step, {median} s, would lose the close samples; a re-simulation is compared at the samples only)",
             short(step),
-            short(median_step(frame.time()))
+        ),
+        Some((_, false)) => format!(
+            "half its shortest interval, {} s, each sample on a row of its own, a quarter of that interval off at most (the last a step; sampled on a schedule at times of their own: the median step, {median} s, would lose the close samples; a re-simulation is compared at the samples' rows only)",
+            short(step),
         ),
         None => format!("its median step, {} s", short(step)),
     };
@@ -233,13 +240,22 @@ pub fn evened(frame: &Frame) -> Result<Option<(Frame, String)>, DataError> {
             even.set(name, smooth)?;
         }
     }
-    // where every sample lies on the grid (a schedule's, a clock's with dropped samples), the
-    // rows between them are the cubic's: a re-simulation is compared at the samples only
+    // where every sample lies on the grid (a schedule's, a clock's with dropped samples) or
+    // has a row of its own (a schedule's own times on a grid of half its shortest interval),
+    // the rows between them are the cubic's: a re-simulation is compared at the samples' rows
+    // only
     let t0 = even.time()[0];
+    // (the grid ends at the last whole step: the last sample is the last row's, a step off
+    // at most)
+    let reach = match scheduled {
+        Some((_, false)) => step * (1.0 + 1e-9),
+        _ => 1e-6 * step,
+    };
     let mut recorded = vec![false; even.len()];
     let on_grid = frame.time().iter().all(|s| {
-        let k = ((s - t0) / step).round() as usize;
-        let hit = even.time().get(k).is_some_and(|g| (g - s).abs() <= 1e-6 * step);
+        let k = (((s - t0) / step).round() as usize).min(even.len() - 1);
+        let hit = even.time().get(k).is_some_and(|g| (g - s).abs() <= reach)
+            && !recorded[k.min(recorded.len() - 1)];
         if hit {
             recorded[k] = true;
         }
@@ -379,11 +395,10 @@ mod tests {
         assert!(!even.is_sample(7) && (0..50).filter(|k| even.is_sample(*k)).count() == 49);
         assert!(note.contains("gap.csv") && note.contains("row 8"), "{note}");
         assert!(evened(&frame(0.1, 50, |t| t)).unwrap().is_none());
-        // too short to resample: refused, saying why
+        // three samples (their median step 0.25, too long for the run once), evened onto half
+        // the shortest interval; on a schedule of whole steps onto the shortest
         let short = Frame::new("short.csv", "t", vec![0.0, 0.1, 0.35]).unwrap();
-        let e = evened(&short).unwrap_err().to_string();
-        assert!(e.starts_with("short.csv: samples not evenly spaced (row 3)"), "{e}");
-        // (on a schedule of whole steps it is evened onto the shortest)
+        assert_eq!(evened(&short).unwrap().unwrap().0.len(), 8);
         let scheduled = Frame::new("short.csv", "t", vec![0.0, 0.1, 0.3]).unwrap();
         assert_eq!(evened(&scheduled).unwrap().unwrap().0.len(), 4);
         // a dropped sample's intervals span 2: nothing said of a log scale
@@ -412,7 +427,7 @@ mod tests {
     fn a_sampling_schedule_is_evened_onto_its_shortest_step() {
         let hours = [0.0, 0.25, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0, 24.0];
         let t: Vec<f64> = hours.iter().map(|h| h * 3600.0).collect();
-        assert_eq!(scheduled_step(&t), Some(900.0));
+        assert_eq!(scheduled_step(&t), Some((900.0, true)));
         let mut f = Frame::new("pk.csv", "t", t.clone()).unwrap();
         let c = |t: f64| 100.0 * ((-0.15 * t / 3600.0).exp() - (-1.2 * t / 3600.0).exp());
         f.push("C", t.iter().map(|s| c(*s)).collect()).unwrap();
@@ -429,6 +444,22 @@ mod tests {
                 "{k}"
             );
         }
+        // the schedule's own times (0.27 h for 0.25, 1.05 for 1 …): half the shortest interval,
+        // each sample on a row of its own, the last within a step of the grid's end
+        let actual = [0.0, 0.27, 0.52, 1.05, 1.48, 2.03, 3.1, 3.95, 6.05, 8.1, 12.2, 15.9, 24.1];
+        let t: Vec<f64> = actual.iter().map(|h| h * 3600.0).collect();
+        assert_eq!(
+            scheduled_step(&t).map(|(s, whole)| ((s - 450.0).abs() < 1e-9, whole)),
+            Some((true, false))
+        );
+        let mut f = Frame::new("pk.csv", "t", t.clone()).unwrap();
+        f.push("C", t.iter().map(|s| c(*s)).collect()).unwrap();
+        let (even, note) = evened(&f).unwrap().unwrap();
+        assert!(
+            note.contains("half its shortest interval, 450 s, each sample on a row of its own"),
+            "{note}"
+        );
+        assert_eq!(even.recorded().unwrap().iter().filter(|r| **r).count(), 13);
         let dropout: Vec<f64> = (0..50).filter(|k| *k != 20).map(|k| k as f64 * 0.1).collect();
         assert_eq!(scheduled_step(&dropout), None);
         let mut seed = 2u64;
