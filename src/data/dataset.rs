@@ -387,6 +387,12 @@ const TIME_SUFFIXES: [(&[&str], f64); 7] = [
     (&["d", "day", "days"], 86400.0),
 ];
 
+/// The factor to seconds of a unit of time written as a word (`h`, `min`, `days`, `ms`);
+/// `None` for any other word.
+pub fn seconds_of_unit(word: &str) -> Option<f64> {
+    TIME_SUFFIXES.iter().find(|(names, _)| names.contains(&word)).map(|(_, f)| *f)
+}
+
 /// The factor to seconds of a time header whose last word, after `_`, `.`, `-` or a space,
 /// is a unit of time (`timestamp_ms`: a logger's milliseconds, read as seconds a thousand
 /// times too slow), or that is such a word of three letters or more alone (`day`, `hours`: an
@@ -406,8 +412,7 @@ fn suffixed_seconds(header: &str) -> Option<f64> {
         _ if header.trim().chars().count() > 2 => header.trim(),
         _ => return None,
     };
-    let unit = unit.to_lowercase();
-    TIME_SUFFIXES.iter().find(|(names, _)| names.contains(&unit.as_str())).map(|(_, f)| *f)
+    seconds_of_unit(&unit.to_lowercase())
 }
 
 /// A time column's values in seconds, where its header `name` says another unit of time

@@ -254,8 +254,7 @@ pub fn evened(frame: &Frame) -> Result<Option<(Frame, String)>, DataError> {
     let mut recorded = vec![false; even.len()];
     let on_grid = frame.time().iter().all(|s| {
         let k = (((s - t0) / step).round() as usize).min(even.len() - 1);
-        let hit = even.time().get(k).is_some_and(|g| (g - s).abs() <= reach)
-            && !recorded[k.min(recorded.len() - 1)];
+        let hit = (even.time()[k] - s).abs() <= reach && !recorded[k];
         if hit {
             recorded[k] = true;
         }

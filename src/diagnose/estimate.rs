@@ -546,9 +546,7 @@ impl Unknowns {
                     let frame = &runs.frames()[r];
                     let compared =
                         runs.compared().iter().filter(|(_, n)| frame.column(n).is_some()).map(|(i, _)| *i);
-                    // (one the file sets per run, a dose, is known: held there)
-                    let per_run = |i: usize| model.spec().states.get(i).is_some_and(|s| s.per_run.is_some());
-                    let hidden = runs.hidden[r].iter().copied().filter(move |i| !held && !per_run(*i));
+                    let hidden = runs.hidden[r].iter().copied().filter(|_| !held);
                     compared.chain(hidden).map(move |i| (r, i))
                 })
                 .collect()

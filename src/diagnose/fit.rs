@@ -365,18 +365,23 @@ impl Runs {
                     .collect::<Result<BTreeMap<_, _>, DiagnoseError>>()
             })
             .collect::<Result<Vec<_>, _>>()?;
-        // the states a run does not record that the motion depends on (a lag, an engine)
+        // the states a run does not record that the motion depends on (a lag, an engine), but
+        // for those the file sets per run (a dose: known, started there, never estimated)
+        let per_run =
+            |i: usize| model.spec().states.iter().any(|t| t.name == system.states[i] && t.per_run.is_some());
         let hidden: Vec<Vec<usize>> = frames
             .iter()
             .map(|f| {
                 (0..system.dim())
-                    .filter(|&i| system.reads_state(i) && f.column(&system.states[i]).is_none())
+                    .filter(|&i| {
+                        system.reads_state(i) && f.column(&system.states[i]).is_none() && !per_run(i)
+                    })
                     .collect()
             })
             .collect();
         // each run's declared start (its first samples; the file's values of the rest, or their
         // own per run where the file reads them off the run: a dose) and that with its hidden
-        // states where they are steady (none that the file sets per run)
+        // states where they are steady
         let starts = frames
             .iter()
             .zip(&params)
@@ -396,14 +401,7 @@ impl Runs {
                         (None, None) => Ok(0.0),
                     })
                     .collect::<Result<_, DiagnoseError>>()?;
-                let free: Vec<usize> = hidden
-                    .iter()
-                    .copied()
-                    .filter(|&i| {
-                        model.spec().states.iter().all(|t| t.name != system.states[i] || t.per_run.is_none())
-                    })
-                    .collect();
-                let steady = steady_hidden(&system.with_parameters(p)?, f, declared.clone(), &free);
+                let steady = steady_hidden(&system.with_parameters(p)?, f, declared.clone(), hidden);
                 Ok((declared, steady))
             })
             .collect::<Result<Vec<_>, DiagnoseError>>()?;

@@ -127,19 +127,6 @@ pub fn parse_unit(unit: &str) -> Option<Dimension> {
     Some(out)
 }
 
-/// Units of time a person writes a rate in (`1/h`, `L/min`, `mg·h/L`), with their factor to
-/// seconds: a model file's values are SI, so a parameter declared in one of them is read in
-/// seconds all the same.
-const TIME_UNITS: &[(&str, f64)] = &[
-    ("ms", 1e-3),
-    ("min", 60.0),
-    ("h", 3600.0),
-    ("hr", 3600.0),
-    ("d", 86400.0),
-    ("day", 86400.0),
-    ("week", 604800.0),
-];
-
 /// The factor that takes a value in `unit` to SI where the unit counts time in anything but
 /// seconds (`1/h`: 1/3600; `mg·h/L`: 3600), with the unit in seconds (`1/s`, `mg·s/L`);
 /// `None` where it counts time in seconds or not at all.
@@ -155,7 +142,8 @@ pub fn time_in_seconds(unit: &str) -> Option<(f64, String)> {
         let end = rest.find(|c: char| !c.is_alphabetic()).unwrap_or(rest.len());
         let word = &rest[..end];
         rest = &rest[end..];
-        let Some((_, seconds)) = TIME_UNITS.iter().find(|(name, _)| *name == word) else {
+        // a model file's values are SI: a unit of time other than seconds is read in seconds
+        let Some(seconds) = crate::data::seconds_of_unit(word).filter(|s| *s != 1.0) else {
             si.push_str(word);
             continue;
         };
