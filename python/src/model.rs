@@ -159,29 +159,30 @@ impl PyModel {
     }
 }
 
+impl PyModel {
+    /// A model read from a file or text, with what the command line says as it loads one (a
+    /// rate declared per hour, read per second) warned of, as a notebook shows it.
+    fn loaded(py: Python<'_>, inner: termid::model::Model) -> PyResult<Self> {
+        for note in inner.load_notes() {
+            warn(py, note)?;
+        }
+        Ok(PyModel { inner })
+    }
+}
+
 #[pymethods]
 impl PyModel {
     /// Reads a model file (TOML); errors name the file, line and key.
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
-        let inner = termid::plugins::load(&path).map_err(fail)?;
-        // what the command line says as it loads a model (a rate declared per hour, read per
-        // second), a notebook shows as a warning
-        for note in inner.load_notes() {
-            warn(py, note)?;
-        }
-        Ok(PyModel { inner })
+        PyModel::loaded(py, termid::plugins::load(&path).map_err(fail)?)
     }
 
     /// A model from TOML text; `name` stands for the file in messages.
     #[staticmethod]
     #[pyo3(signature = (text, name = "<text>"))]
     fn parse(py: Python<'_>, text: &str, name: &str) -> PyResult<Self> {
-        let inner = termid::plugins::parse(text, name).map_err(fail)?;
-        for note in inner.load_notes() {
-            warn(py, note)?;
-        }
-        Ok(PyModel { inner })
+        PyModel::loaded(py, termid::plugins::parse(text, name).map_err(fail)?)
     }
 
     /// The default model: Oltmann's (1973) HSVA 1512 with its Table 2 coefficients.
