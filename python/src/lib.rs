@@ -61,11 +61,18 @@ fn time_like(names: Vec<String>) -> Option<(String, bool)> {
     Some((first, like.next().is_none()))
 }
 
-/// The columns whose names carry a unit termid knows, read by their bare names in SI:
-/// (place, bare name, unit, factor to SI) each ([`termid::data::headers_in_si`]).
+/// The columns whose names carry their unit, read by their bare names (in SI where termid
+/// knows the unit): (place, bare name, unit, factor to SI) each ([`termid::data::headers_in_si`]).
 #[pyfunction]
 fn headers_in_si(names: Vec<String>) -> Vec<(usize, String, String, f64)> {
     termid::data::headers_in_si(&names)
+}
+
+/// How a header that carries its unit is read, as it is said ([`termid::data::read_as`]); a
+/// time column's `unit` is empty.
+#[pyfunction]
+fn read_as(header: &str, bare: &str, unit: &str, factor: f64) -> String {
+    termid::data::read_as(header, bare, unit, factor)
 }
 
 /// Where the time column `time` is among `names`: that name, else that name with a unit of
@@ -130,6 +137,7 @@ fn _termid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(seconds_per, m)?)?;
     m.add_function(wrap_pyfunction!(time_in_seconds, m)?)?;
     m.add_function(wrap_pyfunction!(headers_in_si, m)?)?;
+    m.add_function(wrap_pyfunction!(read_as, m)?)?;
     m.add_function(wrap_pyfunction!(time_position, m)?)?;
     m.add_function(wrap_pyfunction!(check_line, m)?)?;
     m.add_function(wrap_pyfunction!(listed, m)?)?;

@@ -294,16 +294,11 @@ def _columns(data: Data) -> "_Columns":
     return _in_si(found)
 
 
-def _read_as(header: str, bare: str, factor: float) -> str:
-    """How a column whose name carries its unit is read, as the command line says it: the
-    header, its bare name, and its factor to SI where that is not 1."""
-    return f"`{header}` as {bare}" + ("" if factor == 1.0 else f" in SI (× {factor:.6e})")
-
-
 def _in_si(found: "_Columns") -> "_Columns":
-    """The columns whose names carry a unit termid knows (``x [m]``, ``psi [deg]``, as
-    ``pd.read_csv`` names a logger's columns) by their bare names in SI, warned, as the command
-    line reads a file's; a time column keeps its name (``time="Time [ms]"`` reads its unit)."""
+    """The columns whose names carry their unit (``x [m]``, ``psi [deg]``, ``i [A]``, as
+    ``pd.read_csv`` names a logger's columns) by their bare names, in SI where termid knows the
+    unit and as written where not (``w [rpm]``), warned, as the command line reads a file's; a
+    time column keeps its name (``time="Time [ms]"`` reads its unit)."""
     renamed = {i: (bare, unit, f) for i, bare, unit, f in _termid.headers_in_si(list(found))}
     if not renamed:
         return found
@@ -316,7 +311,7 @@ def _in_si(found: "_Columns") -> "_Columns":
             continue
         bare, unit, factor = renamed[i]
         out[bare] = values if factor == 1.0 else values * factor
-        said.append(_read_as(name, bare, factor))
+        said.append(_termid.read_as(name, bare, unit, factor))
     warnings.warn(f"termid: read by their bare names: {', '.join(said)}", stacklevel=_outside())
     return out
 
@@ -476,7 +471,7 @@ def _time_headed(columns: "_Columns", time: str) -> bool:
         factor = _termid.seconds_per(header)
         values = columns.pop(header)
         columns[time] = values * factor if factor else values
-        warnings.warn(f"termid: read by their bare names: {_read_as(header, time, factor or 1.0)}", stacklevel=_outside())
+        warnings.warn(f"termid: read by their bare names: {_termid.read_as(header, time, '', factor or 1.0)}", stacklevel=_outside())
     return True
 
 
@@ -502,7 +497,7 @@ def _time_from(name: str, run: Data, columns: "_Columns", time: str) -> None:
         if only:
             # the one column whose name says it holds the time (`time`, `Time [s]`, `day`), as
             # the command line takes a file's: a dataframe's `time` needs no renaming
-            said = f"; {_read_as(like, time, factor)}" if factor and factor != 1.0 else ""
+            said = f"; {_termid.read_as(like, time, '', factor)}" if factor and factor != 1.0 else ""
             warnings.warn(
                 f"termid: {name}: the rows' time `{time}` is column `{like}`, the one whose name says so{said}",
                 stacklevel=_outside(),

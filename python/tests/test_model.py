@@ -1045,7 +1045,7 @@ def test_a_run_without_its_model_s_time_column():
     z_dot = found.model.coefficients("z_dot").set_index("term")["value"]
     assert z_dot.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
     in_ms = run.assign(t=run["t"] * 1000.0).rename(columns={"t": "Time (ms)"})
-    with pytest.warns(UserWarning, match=r"`Time \(ms\)` as t in SI \(× 1.000000e-03\)"):
+    with pytest.warns(UserWarning, match=r"`Time \(ms\)` as t in SI \(× 1.000000e-3\)"):
         found = model.identify(in_ms)
     z_dot = found.model.coefficients("z_dot").set_index("term")["value"]
     assert z_dot.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
@@ -1173,7 +1173,7 @@ def test_a_time_column_whose_name_carries_its_unit_is_the_time():
     # t in seconds and said, for a model's runs and for fit (it was refused, naming the column)
     truth = termid.Model.builtin("lorenz").simulate(duration=5.0, sample=0.01)
     headed = truth[["t", "x", "y", "z"]].assign(t=truth["t"] * 1e3).rename(columns={"t": "t [ms]"})
-    with pytest.warns(UserWarning, match=r"`t \[ms\]` as t in SI \(× 1.000000e-03\)"):
+    with pytest.warns(UserWarning, match=r"`t \[ms\]` as t in SI \(× 1.000000e-3\)"):
         found = termid.Model.from_states(["x", "y", "z"]).identify(headed)
     z_dot = found.model.coefficients("z_dot").set_index("term")["value"]
     assert z_dot.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)

@@ -353,8 +353,56 @@ const UNITS: &[(&str, f64, [i32; 3])] = &[
 /// names no unit, or one that is not of time.
 pub fn seconds_per(header: &str) -> Option<f64> {
     match split_spec(header).1 {
-        Some(unit) => UNITS.iter().find(|(n, _, dims)| *n == unit && *dims == [0, 1, 0]).map(|(_, f, _)| *f),
+        Some(unit) => unit_seconds(&unit),
         None => suffixed_seconds(header),
+    }
+}
+
+/// The factor to seconds of a unit of time (`ms`, `h`, `days`, `weeks`, `yr`), of the table or
+/// written as a word; `None` for a unit of anything else.
+fn unit_seconds(unit: &str) -> Option<f64> {
+    match UNITS.iter().find(|(n, _, _)| *n == unit) {
+        Some((_, f, dims)) => (*dims == [0, 1, 0]).then_some(*f),
+        None => seconds_of_unit(&unit.to_lowercase()),
+    }
+}
+
+/// SI's base units and its derived units with names of their own: a header in a product or
+/// quotient of them (`i [A]`, `P [W/m^2]`) holds SI values already.
+const SI_SYMBOLS: &[&str] = &[
+    "m", "kg", "s", "A", "K", "mol", "cd", "N", "Pa", "J", "W", "C", "V", "F", "Ω", "ohm", "Ohm", "S", "Wb",
+    "T", "H", "Hz", "rad", "sr", "lm", "lx", "Bq", "Gy", "Sv", "kat", "1",
+];
+
+/// Whether `unit` is a product or quotient of SI's own symbols with powers (`A`, `V`, `W/m^2`,
+/// `kg m^-3`, `N·m`, `m/s²`): a coherent SI unit, its values read as they are.
+fn is_coherent_si(unit: &str) -> bool {
+    let mut factors = unit.split(['/', '*', '·', ' ', '.']).filter(|f| !f.is_empty()).peekable();
+    factors.peek().is_some()
+        && factors.all(|f| {
+            let symbol = f.split('^').next().unwrap_or(f);
+            let symbol =
+                symbol.trim_end_matches(|c: char| c.is_ascii_digit() || c == '-' || "²³⁻¹".contains(c));
+            SI_SYMBOLS.contains(&symbol)
+        })
+}
+
+/// Whether termid reads a header's unit (`x [m]`, `i [A]`): one of its table, converted, or a
+/// coherent SI one, as it is. Any other (`rpm`, `mg/L`, `%`) is read as written and said so.
+fn unit_is_read(unit: &str) -> bool {
+    UNITS.iter().any(|(n, _, _)| *n == unit) || is_coherent_si(unit)
+}
+
+/// How a header that carries its unit is read, as it is said: the header, its bare name, and
+/// its factor to SI where that is not 1, or that its unit is one termid does not convert.
+pub fn read_as(header: &str, bare: &str, unit: &str, factor: f64) -> String {
+    match (factor == 1.0, unit.is_empty() || unit_is_read(unit) || unit_seconds(unit).is_some()) {
+        (false, _) => format!("`{header}` as {bare} in SI (× {factor:.6e})"),
+        (true, true) => format!("`{header}` as {bare}"),
+        // the model then holds in that unit: a rate of `w [rpm]` is per second of rpm
+        (true, false) => {
+            format!("`{header}` as {bare} in {unit} as written (a unit termid does not convert)")
+        }
     }
 }
 
@@ -377,7 +425,7 @@ pub fn time_position(names: &[String], time: &str) -> Option<usize> {
 
 /// Units of time as loggers write them after a name (`timestamp_ms`, `time_us`, `t.sec`),
 /// with their factor to seconds.
-const TIME_SUFFIXES: [(&[&str], f64); 7] = [
+const TIME_SUFFIXES: [(&[&str], f64); 9] = [
     (&["s", "sec", "secs", "seconds"], 1.0),
     (&["ms", "msec", "millis"], 1e-3),
     (&["us", "µs", "μs", "usec", "micros"], 1e-6),
@@ -385,6 +433,9 @@ const TIME_SUFFIXES: [(&[&str], f64); 7] = [
     (&["min", "mins", "minutes"], 60.0),
     (&["h", "hr", "hrs", "hour", "hours"], 3600.0),
     (&["d", "day", "days"], 86400.0),
+    // an ecologist's weekly counts, a census's years (the Julian year, 365.25 days)
+    (&["wk", "week", "weeks"], 604800.0),
+    (&["yr", "year", "years"], 31_557_600.0),
 ];
 
 /// The factor to seconds of a unit of time written as a word (`h`, `min`, `days`, `ms`);
@@ -446,10 +497,14 @@ fn split_spec(spec: &str) -> (String, Option<String>, f64) {
         Some((col, unit)) if unit.trim_end().ends_with(']') => {
             (col.trim().to_string(), Some(unit.trim_end().trim_end_matches(']').trim().to_string()), sign)
         }
-        // in parentheses only a unit termid knows: `f(x)` stays a name
+        // in parentheses only a unit termid knows, or SI's or a unit of time's after a space
+        // (`Current (A)`, `t (days)`): `f(x)`, `g(T)` stay names
         _ => match spec.strip_suffix(')').and_then(|s| s.rsplit_once('(')) {
             Some((col, unit))
-                if !col.trim().is_empty() && UNITS.iter().any(|(n, _, _)| *n == unit.trim()) =>
+                if !col.trim().is_empty()
+                    && (UNITS.iter().any(|(n, _, _)| *n == unit.trim())
+                        || (col.ends_with(char::is_whitespace)
+                            && (is_coherent_si(unit.trim()) || unit_seconds(unit.trim()).is_some()))) =>
             {
                 (col.trim().to_string(), Some(unit.trim().to_string()), sign)
             }
@@ -495,14 +550,18 @@ fn unit_headers(names: &[String]) -> Vec<(usize, String, String)> {
 }
 
 /// A plain file's headers read by their bare names in SI, as a dataset file maps them: each
-/// one's place, bare name, unit and factor to SI. Only units termid knows, and none of time:
-/// a time column keeps its header, whose unit the time is read in ([`in_seconds`]).
+/// one's place, bare name, unit and factor to SI. A unit of termid's table is converted, a
+/// coherent SI one (`i [A]`) read as it is, any other in brackets (`w [rpm]`, `C [mg/L]`) read
+/// as written, factor 1 ([`read_as`] says so): a model of them holds in those units, where
+/// refusing them refused every field's logger. None of time: a time column keeps its header,
+/// whose unit the time is read in ([`in_seconds`]).
 pub fn headers_in_si(names: &[String]) -> Vec<(usize, String, String, f64)> {
     unit_headers(names)
         .into_iter()
-        .filter_map(|(i, bare, unit)| {
-            let (_, f, dims) = UNITS.iter().find(|(n, _, _)| *n == unit)?;
-            (*dims != [0, 1, 0]).then_some((i, bare, unit, *f))
+        .filter(|(_, _, unit)| unit_seconds(unit).is_none())
+        .map(|(i, bare, unit)| {
+            let f = UNITS.iter().find(|(n, _, _)| *n == unit).map_or(1.0, |(_, f, _)| *f);
+            (i, bare, unit, f)
         })
         .collect()
 }
@@ -955,8 +1014,9 @@ impl Dataset {
 /// Whether a cell names a unit termid knows (`m/s`, `[deg]`, `(s)`): a row of them is a
 /// second header row, not data.
 pub(super) fn is_unit(cell: &str) -> bool {
-    let bare = cell.trim().trim_start_matches(['[', '(']).trim_end_matches([']', ')']);
-    UNITS.iter().any(|(n, _, _)| *n == bare)
+    let cell = cell.trim();
+    let bare = cell.trim_start_matches(['[', '(']).trim_end_matches([']', ')']);
+    unit_is_read(bare) || unit_seconds(bare).is_some() || (cell.starts_with('[') && cell.ends_with(']'))
 }
 
 fn unit_row(
@@ -1030,6 +1090,31 @@ mod tests {
     /// A time column's header that says its unit of time: read in seconds, and written back in
     /// its unit (what is read back is the same seconds); a header of another unit, or none, or
     /// a name with parentheses that hold no unit, is read as it is.
+    /// A header's unit beyond termid's table: SI's own (`i [A]`, `P [W/m^2]`, `Current (A)`)
+    /// read as it is, any other in brackets (`w [rpm]`, `C [mg/L]`, `SOC [%]`) read as written
+    /// and said so, where both were refused; units of time beyond hours (weeks, years) read
+    /// in seconds and never renamed; a name's own parentheses (`f(x)`, `g(T)`) stay a name.
+    #[test]
+    fn a_unit_beyond_the_table_is_read_as_written_and_said() {
+        let names: Vec<String> =
+            ["t [weeks]", "i [A]", "P [W/m^2]", "Current (A)", "w [rpm]", "C [mg/L]", "SOC [%]", "g(T)"]
+                .map(String::from)
+                .to_vec();
+        let read = headers_in_si(&names);
+        let bare: Vec<(&str, f64)> = read.iter().map(|(_, b, _, f)| (b.as_str(), *f)).collect();
+        assert_eq!(bare, [("i", 1.0), ("P", 1.0), ("Current", 1.0), ("w", 1.0), ("C", 1.0), ("SOC", 1.0)]);
+        let said: Vec<String> = read.iter().map(|(i, b, u, f)| read_as(&names[*i], b, u, *f)).collect();
+        assert_eq!(said[0], "`i [A]` as i");
+        assert_eq!(said[3], "`w [rpm]` as w in rpm as written (a unit termid does not convert)");
+        assert_eq!(read_as("v [kn]", "v", "kn", 1852.0 / 3600.0), "`v [kn]` as v in SI (× 5.144444e-1)");
+        assert_eq!(seconds_per("t [weeks]"), Some(604800.0));
+        assert_eq!(seconds_per("t (yr)"), Some(31_557_600.0));
+        assert_eq!(seconds_per("year"), Some(31_557_600.0));
+        assert_eq!(split_spec("g(T)"), ("g(T)".to_string(), None, 1.0));
+        // a second header row of units termid does not convert is still a row of units
+        assert!(is_unit("[rpm]") && is_unit("A") && is_unit("V") && !is_unit("rpm") && !is_unit("run1"));
+    }
+
     #[test]
     fn a_time_header_says_its_unit() {
         assert_eq!(seconds_per("Time [ms]"), Some(1e-3));

@@ -98,13 +98,8 @@ pub fn units_note(path: &Path, time: &str) -> Option<String> {
             own = time_in_seconds(time);
         }
     }
-    let read: Vec<String> = renamed
-        .iter()
-        .map(|(i, bare, _, f)| match *f == 1.0 {
-            true => format!("`{}` as {bare}", names[*i]),
-            false => format!("`{}` as {bare} in SI (× {f:.6e})", names[*i]),
-        })
-        .collect();
+    let read: Vec<String> =
+        renamed.iter().map(|(i, bare, unit, f)| super::read_as(&names[*i], bare, unit, *f)).collect();
     let read = (!read.is_empty()).then(|| format!("read by their bare names: {}", read.join(", ")));
     let said: Vec<String> = own.into_iter().chain(read).collect();
     (!said.is_empty()).then(|| format!("{}: {}", path.display(), said.join("; ")))

@@ -35,7 +35,7 @@ pub use angle::{laid_on_turns, turn_of, unwrap_turns, unwrapped, unwrapped_dials
 pub use breaks::{breaks, cut_at_breaks, cut_at_gaps, gaps, moving_breaks, Break, Gaps, Leaps};
 pub use clock::{clock_seconds, epoch_note};
 pub use dataset::{
-    from_seconds, headers_in_si, in_seconds, seconds_of_unit, seconds_per, time_position,
+    from_seconds, headers_in_si, in_seconds, read_as, seconds_of_unit, seconds_per, time_position,
     velocities_from_track, Dataset, Delimiter, RunSpec, Track,
 };
 pub use delay::delayed;

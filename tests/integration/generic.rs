@@ -2112,10 +2112,21 @@ fn a_whole_system_from_its_columns() {
         let rate = json(&out)["x_dot"]["terms"][0]["coefficient"].as_f64().unwrap();
         assert!((rate - 1.0).abs() < 1e-4, "{out}");
     }
-    // a unit termid does not know is named
+    // a unit termid does not know is read as written, and said (a logger's `i [A]`, `w [rpm]`,
+    // a lab's `C [mg/L]` were refused: every field but the ship's had its columns renamed); one
+    // in parentheses is named, as `f(x)` is a name
     std::fs::write(dir.join("furlongs.csv"), headed.replacen("x [m]", "x [furlong]", 1)).unwrap();
+    let (ok, out, err) =
+        termid(&["identify", "--data", &p("furlongs.csv"), "--states", "x,v", "--format", "json"]);
+    assert!(
+        ok && err.contains("`x [furlong]` as x in furlong as written (a unit termid does not convert)"),
+        "{err}"
+    );
+    let rate = json(&out)["x_dot"]["terms"][0]["coefficient"].as_f64().unwrap();
+    assert!((rate - 1.0).abs() < 1e-4, "{out}");
+    std::fs::write(dir.join("furlongs.csv"), headed.replacen("x [m]", "x (furlong)", 1)).unwrap();
     let (ok, _, err) = termid(&["identify", "--data", &p("furlongs.csv"), "--states", "x,v"]);
-    assert!(!ok && err.contains("`x [furlong]` carries a unit termid does not read"), "{err}");
+    assert!(!ok && err.contains("`x (furlong)` carries in parentheses a unit termid does not know"), "{err}");
 }
 
 /// A pendulum swung to 2.8 rad, identified from the default cubic library (no sine): the cubic

@@ -20,14 +20,14 @@ pub fn model(cmd: &IdentifyCommand) -> Result<Model> {
     let time = columns[time].clone();
     let column = |name: &str, flag: &str| -> Result<()> {
         if !columns.iter().any(|c| c == name) {
-            // a header that carries a unit termid reads is read by its bare name already: this
-            // one's is not known
+            // a header that carries its unit in brackets is read by its bare name already: this
+            // one's is in parentheses and not a unit termid knows (`C (mg/L)`; `f(x)` is a name)
             let headed = columns
                 .iter()
-                .find(|c| c.strip_prefix(name).is_some_and(|rest| rest.trim_start().starts_with(['[', '('])));
+                .find(|c| c.strip_prefix(name).is_some_and(|rest| rest.trim_start().starts_with('(')));
             let hint = headed.map_or_else(String::new, |c| {
                 format!(
-                    "; `{c}` carries a unit termid does not read: write the column in SI units as `{name}`"
+                    "; `{c}` carries in parentheses a unit termid does not know: head it `{name} [unit]` (read as written) or `{name}`"
                 )
             });
             bail!("{flag}: `{name}` is not a column of {first} (its columns: {}){hint}", columns.join(", "));
