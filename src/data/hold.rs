@@ -6,7 +6,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::repeated::{fits_better_held, fits_better_held_than_a_line, kinks_at_changes, repeated};
+use super::repeated::{
+    fits_better_held, fits_better_held_than_a_line, jumps_off_the_samples, kinks_at_changes, repeated, MISFIT,
+};
 use super::{DataError, Frame};
 
 /// How a run's inputs behave between their samples (MATLAB's `InterSample`).
@@ -275,9 +277,10 @@ fn commanded(
 
 /// Holds column `name` of `frame` (a record that jumps at isolated samples on no clock) where
 /// a recorded state of `motion` (not `name`) has its rate fitted clearly better with it held
-/// from each sample to the next than as a line between them ([`held_better_than_a_line`]): a
-/// generator's command switched at random samples, not a relay thrown between them; and says
-/// so, after `how` it jumps.
+/// from each sample to the next than as a line between them ([`held_fit`]): a generator's
+/// command switched at random samples, not a relay thrown between them; and says so, after
+/// `how` it jumps. Where held misfits many of its jumps ([`off_the_samples`]) it is switched
+/// between samples instead.
 fn held_on_the_samples(
     frame: &mut Frame,
     name: &str,
@@ -285,20 +288,74 @@ fn held_on_the_samples(
     columns: &[&str],
     how: &str,
 ) -> Result<Option<String>, DataError> {
-    held_better_than_a_line(frame, name, motion, columns, false, |state, less| {
-        format!(
-            "{how}, on no clock, but the rate of `{state}` is fitted better with it held from each sample to the next than as a line between them ({less:.1} % less left over, by a quadratic in the columns over windows of eight samples): a generator's command switched at random samples (a random telegraph, a PRBS, an APRBS), not a relay thrown between them; taken as held. Where it switches between the samples, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)"
-        )
-    })
+    let Some((state, share)) = held_fit(frame, name, motion, columns, false) else { return Ok(None) };
+    let said = format!(
+        "{how}, on no clock, but the rate of `{state}` is fitted better with it held from each sample to the next than as a line between them ({:.1} % less left over, by a quadratic in the columns over windows of eight samples)",
+        100.0 * (1.0 - share)
+    );
+    let misfit = match off_the_samples(frame, name, motion, columns, &said)? {
+        Misfit::Switched(note) => return Ok(Some(note)),
+        Misfit::Few(off, jumps) => {
+            format!(" (but at {off} of the {jumps} windows that hold a jump, which may fall between samples)")
+        }
+        Misfit::None => String::new(),
+    };
+    frame.hold(name)?;
+    Ok(Some(format!(
+        "{said}{misfit}: a generator's command switched at random samples (a random telegraph, a PRBS, an APRBS), not a relay thrown between them; taken as held. Where it switches between the samples, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)"
+    )))
+}
+
+/// Jumps held misfits at least this share of (`1/OFF_THE_SAMPLES`) make a column switched
+/// between samples rather than held: a few in many bias the fit little, where leaving out
+/// every window that holds a jump would cost many.
+const OFF_THE_SAMPLES: f64 = 20.0;
+
+/// What [`off_the_samples`] found of a column's jumps held.
+enum Misfit {
+    /// Held misfits many: the column switched between samples, and the note.
+    Switched(String),
+    /// Held misfits a few (of so many windows that hold a jump): held all the same.
+    Few(usize, usize),
+    /// Held fits every jump, or the record cannot tell.
+    None,
+}
+
+/// Switches column `name` of `frame` between samples where held misfits a share of the windows
+/// that hold its jumps ([`jumps_off_the_samples`], at least one in [`OFF_THE_SAMPLES`]): jumps
+/// that fall between two samples (a command logged a sample after it acted), which held would
+/// put a whole interval off and bias every coefficient near them (a DC motor's di/dt 1.2 % high
+/// with two of nine steps a sample late); and says so after `said`.
+fn off_the_samples(
+    frame: &mut Frame,
+    name: &str,
+    motion: &[&str],
+    columns: &[&str],
+    said: &str,
+) -> Result<Misfit, DataError> {
+    let Some(column) = frame.column(name) else { return Ok(Misfit::None) };
+    let (states, others) = beside(frame, name, motion, columns);
+    let slices: Vec<&[f64]> = states.iter().map(|(_, c)| *c).collect();
+    let (off, jumps) = match jumps_off_the_samples(frame.time(), column, &slices, &others) {
+        Some((0, _)) | None => return Ok(Misfit::None),
+        Some((off, jumps)) if OFF_THE_SAMPLES * (off as f64) < jumps as f64 => {
+            return Ok(Misfit::Few(off, jumps))
+        }
+        Some(found) => found,
+    };
+    frame.switch(name)?;
+    Ok(Misfit::Switched(format!(
+        "{said}, yet held misfits a state's rate at {off} of the {jumps} windows of eight samples that hold a jump (by over {MISFIT} times the others' spread): those jumps fall between two samples (a command logged a sample after it acted), which held would put a whole interval off and bias every coefficient near them; so a rate's fit leaves out the windows of the weak or integral form that hold a jump. Where every jump is at a sample, say so (identify --intersample held; a model file's `intersample = \"held\"`; Python `intersample=\"held\"`)"
+    )))
 }
 
 /// Holds column `name` of `frame` (a record that moves from sample to sample) where a recorded
 /// state of `motion` has its rate fitted clearly better with it held from each sample to the
-/// next than as a line between them ([`held_better_than_a_line`]): a smooth command a
-/// controller or a signal generator puts out through a zero-order hold (a sine or a chirp
-/// through a DAC, MATLAB's default `InterSample = 'zoh'`), whose line between samples runs half
-/// an interval early and biases the damping it drives (a mass-spring-damper under a held sine
-/// at 20 Hz: −0.332v + 0.034v³ for −0.3v); and says so.
+/// next than as a line between them ([`held_fit`]): a smooth command a controller or a signal
+/// generator puts out through a zero-order hold (a sine or a chirp through a DAC, MATLAB's
+/// default `InterSample = 'zoh'`), whose line between samples runs half an interval early and
+/// biases the damping it drives (a mass-spring-damper under a held sine at 20 Hz: −0.332v +
+/// 0.034v³ for −0.3v); and says so.
 fn held_though_smooth(
     frame: &mut Frame,
     name: &str,
@@ -310,37 +367,34 @@ fn held_though_smooth(
     if 2 * changing <= column.len().saturating_sub(1) {
         return Ok(None);
     }
-    let origin = frame.origin().to_string();
-    held_better_than_a_line(frame, name, motion, columns, true, |state, less| {
-        format!(
-            "{origin}: `{name}` moves from sample to sample, but the rate of `{state}` is fitted better with it held from each sample to the next than as a line between them ({less:.1} % less left over, by a quadratic in the columns over windows of eight samples): a command put out through a zero-order hold (a controller's, a signal generator's through a DAC), which a line between the samples would run half an interval early; taken as held. Where it is a measured quantity that moves between the samples, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)"
-        )
-    })
+    let Some((state, share)) = held_fit(frame, name, motion, columns, true) else { return Ok(None) };
+    frame.hold(name)?;
+    Ok(Some(format!(
+        "{}: `{name}` moves from sample to sample, but the rate of `{state}` is fitted better with it held from each sample to the next than as a line between them ({:.1} % less left over, by a quadratic in the columns over windows of eight samples): a command put out through a zero-order hold (a controller's, a signal generator's through a DAC), which a line between the samples would run half an interval early; taken as held. Where it is a measured quantity that moves between the samples, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)",
+        frame.origin(),
+        100.0 * (1.0 - share)
+    )))
 }
 
-/// Holds column `name` of `frame` where the rate of a recorded state of `motion` (not `name`)
-/// is fitted clearly better with it held from each sample to the next than as a line between
-/// them ([`fits_better_held_than_a_line`], over `motion` and `columns`; `smooth`: a record
-/// that moves from sample to sample, the windows that hold a leap of it left out, compared only
-/// where the columns do not foresee it), and says so: `say(the state, per cent less left over)`.
-fn held_better_than_a_line(
-    frame: &mut Frame,
+/// The recorded state of `motion` (not `name`) whose rate is fitted clearly better with column
+/// `name` of `frame` held from each sample to the next than as a line between them, and how
+/// ([`fits_better_held_than_a_line`], over `motion` and `columns`; `smooth`: a record that
+/// moves from sample to sample, the windows that hold a leap of it left out, compared only
+/// where the columns do not foresee it). `None` where no state's is.
+fn held_fit(
+    frame: &Frame,
     name: &str,
     motion: &[&str],
     columns: &[&str],
     smooth: bool,
-    say: impl FnOnce(&str, f64) -> String,
-) -> Result<Option<String>, DataError> {
-    let Some(column) = frame.column(name) else { return Ok(None) };
+) -> Option<(String, f64)> {
+    let column = frame.column(name)?;
     let leaps: Option<Vec<usize>> =
         smooth.then(|| super::breaks(frame.time(), column).into_iter().map(|b| b.row).collect());
     let (states, others) = beside(frame, name, motion, columns);
     let slices: Vec<&[f64]> = states.iter().map(|(_, c)| *c).collect();
-    let found = fits_better_held_than_a_line(frame.time(), column, &slices, &others, leaps.as_deref());
-    let Some((i, share)) = found else { return Ok(None) };
-    let note = say(&states[i].0, 100.0 * (1.0 - share));
-    frame.hold(name)?;
-    Ok(Some(note))
+    let (i, share) = fits_better_held_than_a_line(frame.time(), column, &slices, &others, leaps.as_deref())?;
+    Some((states[i].0.clone(), share))
 }
 
 /// How column `name` of `frame` stays put between samples and jumps at them (`h`).
@@ -441,6 +495,12 @@ pub fn mark_held(
                     }
                 }
                 if h.on_a_clock() {
+                    // a command on a clock may still act a sample before its log shows it
+                    let said = format!("{how}, every one on a clock of {} samples", h.period);
+                    if let Misfit::Switched(note) = off_the_samples(frame, name, motion, columns, &said)? {
+                        notes.push(note);
+                        continue;
+                    }
                     frame.hold(name)?;
                     notes.push(format!(
                         "{how}, every one on a clock of {} samples: a controller's command, taken as held from each sample to the next (a zero-order hold), not as a line between them; where it moves between its samples, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)",

@@ -197,6 +197,111 @@ pub fn fits_better_held_than_a_line(
     held_or_else(t, x, x, windows, motion, others)
 }
 
+/// A window that holds a jump is misfitted held where its residual exceeds this many times the
+/// root mean square of the windows without one: a jump held a whole interval off its instant
+/// errs by the jump times the interval, far beyond a smooth window's quadrature and noise,
+/// where a jump at a sample fits held as well as any window.
+pub(super) const MISFIT: f64 = 5.0;
+
+/// Of the windows of eight samples that hold a jump of `x` (a record held between samples), how
+/// many a fit held misfits ([`MISFIT`]), for the state of `motion` that shows most, and how
+/// many windows hold a jump: a jump between two samples (a command logged a sample after it
+/// acted), which held puts a whole interval off, against jumps at their samples, which fit
+/// held as well as any window. The rate of each state that moves by itself over each window
+/// of eight samples regressed, as in [`fits_better_held_than_a_line`], on the windows without a
+/// jump, and the windows with one held against that fit. `None` where the record is too short
+/// for the columns or too few windows are without a jump.
+pub fn jumps_off_the_samples(
+    t: &[f64],
+    x: &[f64],
+    motion: &[&[f64]],
+    others: &[&[f64]],
+) -> Option<(usize, usize)> {
+    let n = t.len().min(FIT_ROWS);
+    let terms = quadratic_terms(others.len() + 1);
+    let w = LINE_WINDOW;
+    let kept: Vec<usize> = (0..n.saturating_sub(1) / w).collect();
+    if kept.len() < 3 * terms.len()
+        || others.iter().any(|c| c.len() < n)
+        || motion.iter().any(|m| m.len() < n)
+    {
+        return None;
+    }
+    let held = window_design(t, x, x, &kept, w, &terms, others, true);
+    let jumped: Vec<bool> =
+        kept.iter().map(|row| (row * w..(row + 1) * w).any(|j| x[j + 1] != x[j])).collect();
+    let smooth: Vec<usize> = (0..jumped.len()).filter(|&r| !jumped[r]).collect();
+    if smooth.len() < 3 * terms.len() {
+        return None;
+    }
+    let a = held.select_rows(smooth.iter());
+    let svd = a.clone().svd(true, true);
+    let off = motion.iter().filter(|m| moves_by_itself(m)).filter_map(|m| {
+        let change = |row: usize| m[kept[row] * w + w] - m[kept[row] * w];
+        let y = nalgebra::DVector::from_fn(smooth.len(), |i, _| change(smooth[i]));
+        let fit = svd.solve(&y, 1e-12).ok()?;
+        let spread = ((&y - &a * &fit).norm_squared() / smooth.len() as f64).sqrt();
+        // (rounding: a millionth of the state's changes)
+        let floor = 1e-6 * (y.norm_squared() / smooth.len() as f64).sqrt();
+        let misfit = |r: usize| {
+            let residual = (change(r) - (held.row(r) * &fit)[0]).abs();
+            residual > MISFIT * spread && residual > floor
+        };
+        Some((0..jumped.len()).filter(|&r| jumped[r] && misfit(r)).count())
+    });
+    Some((off.max()?, jumped.iter().filter(|j| **j).count()))
+}
+
+/// The terms a held-or-not fit regresses on, over `k` columns: a constant, each column, and
+/// (up to [`PRODUCTS_UP_TO`] columns) their products.
+fn quadratic_terms(k: usize) -> Vec<(Option<usize>, Option<usize>)> {
+    let mut terms: Vec<(Option<usize>, Option<usize>)> = vec![(None, None)];
+    terms.extend((0..k).map(|i| (Some(i), None)));
+    if k <= PRODUCTS_UP_TO {
+        terms.extend((0..k).flat_map(|i| (i..k).map(move |j| (Some(i), Some(j)))));
+    }
+    terms
+}
+
+/// The integrals of `terms` over the windows of `w` samples starting at `kept` (times `w`),
+/// each column scaled to unit norm: column 0 is `x` held from each sample to the next, or as
+/// `read` (a line between its samples, or its readings interpolated), the others `others`.
+#[allow(clippy::too_many_arguments)]
+fn window_design(
+    t: &[f64],
+    x: &[f64],
+    read: &[f64],
+    kept: &[usize],
+    w: usize,
+    terms: &[(Option<usize>, Option<usize>)],
+    others: &[&[f64]],
+    held: bool,
+) -> nalgebra::DMatrix<f64> {
+    // column i at row `row`, with x held from row `from`
+    let value = |i: usize, row: usize, from: usize| match i {
+        0 if held => x[from],
+        0 => read[row],
+        _ => others[i - 1][row],
+    };
+    let term = |(a, b): (Option<usize>, Option<usize>), row: usize, from: usize| {
+        a.map_or(1.0, |i| value(i, row, from)) * b.map_or(1.0, |j| value(j, row, from))
+    };
+    let mut a = nalgebra::DMatrix::from_fn(kept.len(), terms.len(), |row, c| {
+        let row = kept[row];
+        // the trapezoid over each interval of the window, x held over it where asked
+        (row * w..(row + 1) * w)
+            .map(|j| 0.5 * (t[j + 1] - t[j]) * (term(terms[c], j, j) + term(terms[c], j + 1, j)))
+            .sum()
+    });
+    for mut c in a.column_iter_mut() {
+        let norm = c.norm();
+        if norm > 0.0 {
+            c /= norm;
+        }
+    }
+    a
+}
+
 /// The windows a held-or-not comparison fits over.
 struct Windows<'a> {
     /// Samples in each.
@@ -218,13 +323,7 @@ fn held_or_else(
     others: &[&[f64]],
 ) -> Option<(usize, f64)> {
     let n = t.len().min(FIT_ROWS);
-    let k = others.len() + 1;
-    // the terms: a constant, each column (x first), and their products
-    let mut terms: Vec<(Option<usize>, Option<usize>)> = vec![(None, None)];
-    terms.extend((0..k).map(|i| (Some(i), None)));
-    if k <= PRODUCTS_UP_TO {
-        terms.extend((0..k).flat_map(|i| (i..k).map(move |j| (Some(i), Some(j)))));
-    }
+    let terms = quadratic_terms(others.len() + 1);
     let w = windows_of.samples.max(1);
     let kept: Vec<usize> = (0..n.saturating_sub(1) / w)
         .filter(|row| !windows_of.leaps.iter().any(|&l| l > row * w && l <= (row + 1) * w))
@@ -237,35 +336,8 @@ fn held_or_else(
     {
         return None;
     }
-    let design = |held: bool| {
-        // column i at row `row`, with x held from row `from`
-        let value = |i: usize, row: usize, from: usize| match i {
-            0 if held => x[from],
-            0 => read[row],
-            _ => others[i - 1][row],
-        };
-        let term = |(a, b): (Option<usize>, Option<usize>), row: usize, from: usize| {
-            a.map_or(1.0, |i| value(i, row, from)) * b.map_or(1.0, |j| value(j, row, from))
-        };
-        nalgebra::DMatrix::from_fn(windows, terms.len(), |row, c| {
-            let row = kept[row];
-            // the trapezoid over each interval of the window, x held over it where asked
-            (row * w..(row + 1) * w)
-                .map(|j| 0.5 * (t[j + 1] - t[j]) * (term(terms[c], j, j) + term(terms[c], j + 1, j)))
-                .sum()
-        })
-    };
-    let unit = |a: nalgebra::DMatrix<f64>| {
-        let mut a = a;
-        for mut c in a.column_iter_mut() {
-            let norm = c.norm();
-            if norm > 0.0 {
-                c /= norm;
-            }
-        }
-        a
-    };
-    let (held, read) = (unit(design(true)), unit(design(false)));
+    let held = window_design(t, x, read, &kept, w, &terms, others, true);
+    let read = window_design(t, x, read, &kept, w, &terms, others, false);
     let (held_svd, read_svd) = (held.clone().svd(true, true), read.clone().svd(true, true));
     let left = |a: &nalgebra::DMatrix<f64>,
                 svd: &nalgebra::SVD<f64, nalgebra::Dyn, nalgebra::Dyn>,
@@ -334,7 +406,8 @@ pub fn read_at_readings(
         return Ok(notes);
     }
     for name in columns {
-        if frame.is_held(name) {
+        // a command held, or switched between samples, is no slower sensor's readings
+        if frame.is_held(name) || frame.switched().iter().any(|s| s == name) {
             continue;
         }
         let Some(column) = frame.column(name) else { continue };
@@ -382,7 +455,34 @@ mod tests {
             .collect();
         let found = fits_better_held_than_a_line(&t, &u, &[&y], &[&y], None);
         assert!(found.is_some_and(|(i, share)| i == 0 && share < 0.01), "{found:?}");
+        assert!(
+            jumps_off_the_samples(&t, &u, &[&y], &[&y]).is_some_and(|(off, jumps)| off == 0 && jumps > 100)
+        );
         assert_eq!(fits_better_held_than_a_line(&t, &u, &[&t], &[&t], None), None);
+    }
+
+    /// A command held between samples but logged a sample late at some of its jumps (a DC
+    /// motor's voltage stepped at 0.6 s and logged at 0.6001 s): held puts each such jump a
+    /// whole interval off, and its window misfits, by far more than the windows without a
+    /// jump; the jumps at their samples fit.
+    #[test]
+    fn jumps_between_the_samples_misfit_held() {
+        let (n, dt) = (2000, 0.01);
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
+        // ±1 switched every 100 samples; the jumps at samples 300 and 700 actually an
+        // interval early, so the state (ẏ = u − y, exact per interval) turns a sample before
+        // the record shows it
+        let level = |k: usize| if (k / 100).is_multiple_of(2) { 1.0 } else { -1.0 };
+        let u: Vec<f64> = (0..n).map(level).collect();
+        let acting = |k: usize| if k == 299 || k == 699 { level(k + 1) } else { level(k) };
+        let decay = (-dt).exp();
+        let y: Vec<f64> = std::iter::successors(Some((0, 0.0)), |&(k, y)| {
+            Some((k + 1, y * decay + (1.0 - decay) * acting(k)))
+        })
+        .map(|(_, y)| y)
+        .take(n)
+        .collect();
+        assert_eq!(jumps_off_the_samples(&t, &u, &[&y], &[&y]), Some((2, 19)));
     }
 
     /// A smooth command held from each sample to the next (two sines every 0.05 s) that a
