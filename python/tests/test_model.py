@@ -1100,6 +1100,13 @@ def test_columns_whose_names_carry_their_unit_are_read_by_their_bare_names_in_si
     with pytest.warns(UserWarning, match="read by their bare names"):
         fitted = termid.fit(headed, "dz/dt", ["x*y", "z", "x", "y"])
     assert fitted.coefficients.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
+    # a unit termid does not convert (a bench logger's `[rpm]`, a lab's `[mg/L]`) is read as
+    # written and said (it was refused: no column `x`); SI's own (`[A]`) as it is
+    other = run.rename(columns={"x": "x [A]", "y": "y [rpm]", "z": "z [mg/L]"})
+    with pytest.warns(UserWarning, match=r"`x \[A\]` as x, `y \[rpm\]` as y in rpm as written \(a unit termid does not convert\)"):
+        found = termid.Model.from_states(["x", "y", "z"]).identify(other)
+    z_dot = found.model.coefficients("z_dot").set_index("term")["value"]
+    assert z_dot.to_dict() == pytest.approx({"x*y": 1.0, "z": -8.0 / 3.0}, rel=1e-3)
 
 
 def test_terms_the_halves_of_a_run_do_not_choose_are_flagged():
