@@ -279,8 +279,7 @@ fn commanded(
 /// a recorded state of `motion` (not `name`) has its rate fitted clearly better with it held
 /// from each sample to the next than as a line between them ([`held_fit`]): a generator's
 /// command switched at random samples, not a relay thrown between them; and says so, after
-/// `how` it jumps. Where held misfits many of its jumps ([`off_the_samples`]) it is switched
-/// between samples instead.
+/// `how` it jumps.
 fn held_on_the_samples(
     frame: &mut Frame,
     name: &str,
@@ -293,16 +292,9 @@ fn held_on_the_samples(
         "{how}, on no clock, but the rate of `{state}` is fitted better with it held from each sample to the next than as a line between them ({:.1} % less left over, by a quadratic in the columns over windows of eight samples)",
         100.0 * (1.0 - share)
     );
-    let misfit = match off_the_samples(frame, name, motion, columns, &said)? {
-        Misfit::Switched(note) => return Ok(Some(note)),
-        Misfit::Few(off, jumps) => {
-            format!(" (but at {off} of the {jumps} windows that hold a jump, which may fall between samples)")
-        }
-        Misfit::None => String::new(),
-    };
     frame.hold(name)?;
     Ok(Some(format!(
-        "{said}{misfit}: a generator's command switched at random samples (a random telegraph, a PRBS, an APRBS), not a relay thrown between them; taken as held. Where it switches between the samples, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)"
+        "{said}: a generator's command switched at random samples (a random telegraph, a PRBS, an APRBS), not a relay thrown between them; taken as held. Where it switches between the samples, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)"
     )))
 }
 
@@ -311,41 +303,50 @@ fn held_on_the_samples(
 /// every window that holds a jump would cost many.
 const OFF_THE_SAMPLES: f64 = 20.0;
 
-/// What [`off_the_samples`] found of a column's jumps held.
-enum Misfit {
-    /// Held misfits many: the column switched between samples, and the note.
-    Switched(String),
-    /// Held misfits a few (of so many windows that hold a jump): held all the same.
-    Few(usize, usize),
-    /// Held fits every jump, or the record cannot tell.
-    None,
-}
-
-/// Switches column `name` of `frame` between samples where held misfits a share of the windows
-/// that hold its jumps ([`jumps_off_the_samples`], at least one in [`OFF_THE_SAMPLES`]): jumps
-/// that fall between two samples (a command logged a sample after it acted), which held would
-/// put a whole interval off and bias every coefficient near them (a DC motor's di/dt 1.2 % high
-/// with two of nine steps a sample late); and says so after `said`.
+/// Where held misfits the windows that hold some jumps of column `name` of `frame`
+/// ([`jumps_off_the_samples`]): each such jump that fits once it acts an interval earlier (a
+/// command logged a sample after it acted) moved to the sample before and the column held,
+/// where every misfitted jump does; else, where at least one in [`OFF_THE_SAMPLES`] misfits,
+/// the column switched between samples (jumps between two samples, which held would put a
+/// whole interval off and bias every coefficient near them: a DC motor's di/dt 1.2 % high with
+/// two of nine steps a sample late). What was done, said after `how` it jumps; `None` where
+/// held fits (or the record cannot tell), nothing done.
 fn off_the_samples(
     frame: &mut Frame,
     name: &str,
     motion: &[&str],
     columns: &[&str],
-    said: &str,
-) -> Result<Misfit, DataError> {
-    let Some(column) = frame.column(name) else { return Ok(Misfit::None) };
+    how: &str,
+) -> Result<Option<String>, DataError> {
+    let Some(column) = frame.column(name) else { return Ok(None) };
     let (states, others) = beside(frame, name, motion, columns);
     let slices: Vec<&[f64]> = states.iter().map(|(_, c)| *c).collect();
-    let (off, jumps) = match jumps_off_the_samples(frame.time(), column, &slices, &others) {
-        Some((0, _)) | None => return Ok(Misfit::None),
-        Some((off, jumps)) if OFF_THE_SAMPLES * (off as f64) < jumps as f64 => {
-            return Ok(Misfit::Few(off, jumps))
+    let Some(jumps) = jumps_off_the_samples(frame.time(), column, &slices, &others) else { return Ok(None) };
+    let misfit = format!(
+        "held misfits a state's rate at {} of the {} windows of eight samples that hold a jump (by over {MISFIT} times the others' spread)",
+        jumps.off, jumps.windows
+    );
+    if jumps.off > 0 && jumps.late.len() == jumps.off {
+        let mut moved = column.to_vec();
+        let t = frame.time();
+        let at: Vec<String> = jumps.late.iter().map(|&j| format!("{}", t[j])).collect();
+        for &j in &jumps.late {
+            moved[j] = column[j + 1];
         }
-        Some(found) => found,
-    };
+        frame.overwrite(name, moved)?;
+        frame.hold(name)?;
+        return Ok(Some(format!(
+            "{how}; {misfit}, and fits them where they act an interval before the sample that shows them: a command logged a sample after it acted; those {} jumps moved to the sample before (at t = {}), and the column taken as held from each sample to the next (a zero-order hold). Where they are a relay's between the samples, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)",
+            at.len(),
+            at.join(", ")
+        )));
+    }
+    if jumps.off == 0 || OFF_THE_SAMPLES * (jumps.off as f64) < jumps.windows as f64 {
+        return Ok(None);
+    }
     frame.switch(name)?;
-    Ok(Misfit::Switched(format!(
-        "{said}, yet held misfits a state's rate at {off} of the {jumps} windows of eight samples that hold a jump (by over {MISFIT} times the others' spread): those jumps fall between two samples (a command logged a sample after it acted), which held would put a whole interval off and bias every coefficient near them; so a rate's fit leaves out the windows of the weak or integral form that hold a jump. Where every jump is at a sample, say so (identify --intersample held; a model file's `intersample = \"held\"`; Python `intersample=\"held\"`)"
+    Ok(Some(format!(
+        "{how}; {misfit}: those jumps fall between two samples (a relay, a command switched between them), which held would put a whole interval off and bias every coefficient near them; so a rate's fit leaves out the windows of the weak or integral form that hold a jump (a replay takes it as a line between the samples). Where every jump is at a sample, say so (identify --intersample held; a model file's `intersample = \"held\"`; Python `intersample=\"held\"`)"
     )))
 }
 
@@ -479,7 +480,9 @@ pub fn mark_held(
                         // changes side by side: held where the rates say so, else a line (a
                         // motion read to coarse counts is no relay to leave out windows for)
                         let how = stays_put(frame, name, h);
-                        if let Some(note) = held_on_the_samples(frame, name, motion, columns, &how)? {
+                        if let Some(note) = off_the_samples(frame, name, motion, columns, &how)? {
+                            notes.push(note);
+                        } else if let Some(note) = held_on_the_samples(frame, name, motion, columns, &how)? {
                             notes.push(note);
                         }
                     } else if let Some(note) = held_though_smooth(frame, name, motion, columns)? {
@@ -488,6 +491,15 @@ pub fn mark_held(
                     continue;
                 };
                 let how = stays_put(frame, name, h);
+                // a command, on a clock or not, may act a sample before its log shows it
+                let clock = match h.on_a_clock() {
+                    true => format!("{how}, every one on a clock of {} samples", h.period),
+                    false => format!("{how}, on no clock"),
+                };
+                if let Some(note) = off_the_samples(frame, name, motion, columns, &clock)? {
+                    notes.push(note);
+                    continue;
+                }
                 if !h.on_a_clock() {
                     if let Some(note) = held_on_the_samples(frame, name, motion, columns, &how)? {
                         notes.push(note);
@@ -495,12 +507,6 @@ pub fn mark_held(
                     }
                 }
                 if h.on_a_clock() {
-                    // a command on a clock may still act a sample before its log shows it
-                    let said = format!("{how}, every one on a clock of {} samples", h.period);
-                    if let Misfit::Switched(note) = off_the_samples(frame, name, motion, columns, &said)? {
-                        notes.push(note);
-                        continue;
-                    }
                     frame.hold(name)?;
                     notes.push(format!(
                         "{how}, every one on a clock of {} samples: a controller's command, taken as held from each sample to the next (a zero-order hold), not as a line between them; where it moves between its samples, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)",

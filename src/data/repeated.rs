@@ -203,20 +203,29 @@ pub fn fits_better_held_than_a_line(
 /// where a jump at a sample fits held as well as any window.
 pub(super) const MISFIT: f64 = 5.0;
 
-/// Of the windows of eight samples that hold a jump of `x` (a record held between samples), how
-/// many a fit held misfits ([`MISFIT`]), for the state of `motion` that shows most, and how
-/// many windows hold a jump: a jump between two samples (a command logged a sample after it
-/// acted), which held puts a whole interval off, against jumps at their samples, which fit
-/// held as well as any window. The rate of each state that moves by itself over each window
-/// of eight samples regressed, as in [`fits_better_held_than_a_line`], on the windows without a
-/// jump, and the windows with one held against that fit. `None` where the record is too short
-/// for the columns or too few windows are without a jump.
-pub fn jumps_off_the_samples(
-    t: &[f64],
-    x: &[f64],
-    motion: &[&[f64]],
-    others: &[&[f64]],
-) -> Option<(usize, usize)> {
+/// What a fit held says of the jumps of a record held between samples
+/// ([`jumps_off_the_samples`]).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Jumps {
+    /// The windows of eight samples that hold a jump.
+    pub windows: usize,
+    /// Of those, the ones held misfits ([`MISFIT`]).
+    pub off: usize,
+    /// Of the misfitted, each lone jump that fits held where it acts over the interval before
+    /// the sample that shows it (logged a sample after it acted): that interval's first sample,
+    /// to take the new value.
+    pub late: Vec<usize>,
+}
+
+/// How a fit held meets the jumps of `x` (a record held between samples), for the state of
+/// `motion` that shows most ([`Jumps`]): a jump at its sample fits held as well as any window;
+/// one between two samples misfits by about the jump times the interval, and one logged a
+/// sample after it acted (a command's log late by a sample) fits once it acts an interval
+/// earlier. The rate of each state that moves by itself, over windows of eight samples,
+/// regressed as in [`fits_better_held_than_a_line`] on the windows without a jump, and the
+/// windows with one held against that fit. `None` where the record is too short for the
+/// columns or too few windows are without a jump.
+pub fn jumps_off_the_samples(t: &[f64], x: &[f64], motion: &[&[f64]], others: &[&[f64]]) -> Option<Jumps> {
     let n = t.len().min(FIT_ROWS);
     let terms = quadratic_terms(others.len() + 1);
     let w = LINE_WINDOW;
@@ -227,29 +236,48 @@ pub fn jumps_off_the_samples(
     {
         return None;
     }
-    let held = window_design(t, x, x, &kept, w, &terms, others, true);
-    let jumped: Vec<bool> =
-        kept.iter().map(|row| (row * w..(row + 1) * w).any(|j| x[j + 1] != x[j])).collect();
+    let (held, norms) = scaled(window_design(t, x, x, &kept, w, &terms, others, true), None);
+    let jumps_in =
+        |row: usize| (row * w..(row + 1) * w).filter(|&j| x[j + 1] != x[j]).collect::<Vec<usize>>();
+    let jumped: Vec<bool> = kept.iter().map(|&row| !jumps_in(row).is_empty()).collect();
     let smooth: Vec<usize> = (0..jumped.len()).filter(|&r| !jumped[r]).collect();
     if smooth.len() < 3 * terms.len() {
         return None;
     }
+    // each lone jump acting an interval earlier
+    let mut early = x[..n].to_vec();
+    for &row in &kept {
+        if let [j] = jumps_in(row)[..] {
+            early[j] = x[j + 1];
+        }
+    }
+    let (early, _) = scaled(window_design(t, &early, &early, &kept, w, &terms, others, true), Some(&norms));
     let a = held.select_rows(smooth.iter());
     let svd = a.clone().svd(true, true);
-    let off = motion.iter().filter(|m| moves_by_itself(m)).filter_map(|m| {
+    let found = motion.iter().filter(|m| moves_by_itself(m)).filter_map(|m| {
         let change = |row: usize| m[kept[row] * w + w] - m[kept[row] * w];
         let y = nalgebra::DVector::from_fn(smooth.len(), |i, _| change(smooth[i]));
         let fit = svd.solve(&y, 1e-12).ok()?;
         let spread = ((&y - &a * &fit).norm_squared() / smooth.len() as f64).sqrt();
         // (rounding: a millionth of the state's changes)
         let floor = 1e-6 * (y.norm_squared() / smooth.len() as f64).sqrt();
-        let misfit = |r: usize| {
-            let residual = (change(r) - (held.row(r) * &fit)[0]).abs();
+        let misfit = |design: &nalgebra::DMatrix<f64>, r: usize| {
+            let residual = (change(r) - (design.row(r) * &fit)[0]).abs();
             residual > MISFIT * spread && residual > floor
         };
-        Some((0..jumped.len()).filter(|&r| jumped[r] && misfit(r)).count())
+        let off: Vec<usize> = (0..jumped.len()).filter(|&r| jumped[r] && misfit(&held, r)).collect();
+        let late: Vec<usize> = off
+            .iter()
+            .filter(|&&r| !misfit(&early, r))
+            .filter_map(|&r| match jumps_in(kept[r])[..] {
+                [j] => Some(j),
+                _ => None,
+            })
+            .collect();
+        Some(Jumps { windows: 0, off: off.len(), late })
     });
-    Some((off.max()?, jumped.iter().filter(|j| **j).count()))
+    let most = found.max_by_key(|j| j.off)?;
+    Some(Jumps { windows: jumped.iter().filter(|j| **j).count(), ..most })
 }
 
 /// The terms a held-or-not fit regresses on, over `k` columns: a constant, each column, and
@@ -263,8 +291,8 @@ fn quadratic_terms(k: usize) -> Vec<(Option<usize>, Option<usize>)> {
     terms
 }
 
-/// The integrals of `terms` over the windows of `w` samples starting at `kept` (times `w`),
-/// each column scaled to unit norm: column 0 is `x` held from each sample to the next, or as
+/// The integrals of `terms` over the windows of `w` samples starting at `kept` (times `w`):
+/// column 0 is `x` held from each sample to the next, or as
 /// `read` (a line between its samples, or its readings interpolated), the others `others`.
 #[allow(clippy::too_many_arguments)]
 fn window_design(
@@ -286,20 +314,28 @@ fn window_design(
     let term = |(a, b): (Option<usize>, Option<usize>), row: usize, from: usize| {
         a.map_or(1.0, |i| value(i, row, from)) * b.map_or(1.0, |j| value(j, row, from))
     };
-    let mut a = nalgebra::DMatrix::from_fn(kept.len(), terms.len(), |row, c| {
+    nalgebra::DMatrix::from_fn(kept.len(), terms.len(), |row, c| {
         let row = kept[row];
         // the trapezoid over each interval of the window, x held over it where asked
         (row * w..(row + 1) * w)
             .map(|j| 0.5 * (t[j + 1] - t[j]) * (term(terms[c], j, j) + term(terms[c], j + 1, j)))
             .sum()
-    });
-    for mut c in a.column_iter_mut() {
-        let norm = c.norm();
-        if norm > 0.0 {
-            c /= norm;
+    })
+}
+
+/// `a`'s columns divided by `norms` (their own norms where `None`; a zero column kept), and
+/// the norms: a fit's conditioning, the same for every design of one comparison.
+fn scaled(mut a: nalgebra::DMatrix<f64>, norms: Option<&[f64]>) -> (nalgebra::DMatrix<f64>, Vec<f64>) {
+    let norms: Vec<f64> = match norms {
+        Some(n) => n.to_vec(),
+        None => a.column_iter().map(|c| c.norm()).collect(),
+    };
+    for (mut c, norm) in a.column_iter_mut().zip(&norms) {
+        if *norm > 0.0 {
+            c /= *norm;
         }
     }
-    a
+    (a, norms)
 }
 
 /// The windows a held-or-not comparison fits over.
@@ -336,8 +372,8 @@ fn held_or_else(
     {
         return None;
     }
-    let held = window_design(t, x, read, &kept, w, &terms, others, true);
-    let read = window_design(t, x, read, &kept, w, &terms, others, false);
+    let (held, _) = scaled(window_design(t, x, read, &kept, w, &terms, others, true), None);
+    let (read, _) = scaled(window_design(t, x, read, &kept, w, &terms, others, false), None);
     let (held_svd, read_svd) = (held.clone().svd(true, true), read.clone().svd(true, true));
     let left = |a: &nalgebra::DMatrix<f64>,
                 svd: &nalgebra::SVD<f64, nalgebra::Dyn, nalgebra::Dyn>,
@@ -455,9 +491,7 @@ mod tests {
             .collect();
         let found = fits_better_held_than_a_line(&t, &u, &[&y], &[&y], None);
         assert!(found.is_some_and(|(i, share)| i == 0 && share < 0.01), "{found:?}");
-        assert!(
-            jumps_off_the_samples(&t, &u, &[&y], &[&y]).is_some_and(|(off, jumps)| off == 0 && jumps > 100)
-        );
+        assert!(jumps_off_the_samples(&t, &u, &[&y], &[&y]).is_some_and(|j| j.off == 0 && j.windows > 100));
         assert_eq!(fits_better_held_than_a_line(&t, &u, &[&t], &[&t], None), None);
     }
 
@@ -482,7 +516,23 @@ mod tests {
         .map(|(_, y)| y)
         .take(n)
         .collect();
-        assert_eq!(jumps_off_the_samples(&t, &u, &[&y], &[&y]), Some((2, 19)));
+        let jumps = jumps_off_the_samples(&t, &u, &[&y], &[&y]).unwrap();
+        assert_eq!(jumps, Jumps { windows: 19, off: 2, late: vec![299, 699] });
+        // switched half an interval early instead (a relay between the samples): neither held
+        // at the sample nor an interval early fits
+        let halfway: Vec<f64> = std::iter::successors(Some((0, 0.0)), |&(k, y): &(usize, f64)| {
+            let half = (-dt / 2.0).exp();
+            let y = match k == 299 || k == 699 {
+                true => (y * half + (1.0 - half) * level(k)) * half + (1.0 - half) * level(k + 1),
+                false => y * decay + (1.0 - decay) * level(k),
+            };
+            Some((k + 1, y))
+        })
+        .map(|(_, y)| y)
+        .take(n)
+        .collect();
+        let jumps = jumps_off_the_samples(&t, &u, &[&halfway], &[&halfway]).unwrap();
+        assert_eq!(jumps, Jumps { windows: 19, off: 2, late: vec![] });
     }
 
     /// A smooth command held from each sample to the next (two sines every 0.05 s) that a

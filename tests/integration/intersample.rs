@@ -638,12 +638,17 @@ fn a_rudder_turned_at_its_rate_is_no_switch() {
 
 /// The rudder turned at 5 °/s and read to whole degrees (a change at every other sample or
 /// so, on no clock): not held, though the heading's quadrature error fits a part in 10⁹ of
-/// its changes better with it held (held, the fit took 0.078δ and a dozen spurious terms); a
-/// switch between samples, whose windows are left out.
+/// its changes better with it held (held, the fit took 0.078δ and a dozen spurious terms); held
+/// misfits every window of a change: a switch between samples, whose windows are left out.
 #[test]
 fn a_rudder_read_to_whole_degrees_is_no_command_held() {
     let err = rudder_at_its_rate(5.0, Some(1.0));
-    assert!(!err.contains("taken as held") && err.contains("on no clock: it may jump anywhere"), "{err}");
+    assert!(
+        !err.contains("taken as held")
+            && err.contains("on no clock; held misfits a state's rate")
+            && err.contains("leaves out the windows of the weak or integral form that hold a jump"),
+        "{err}"
+    );
 }
 
 /// A smooth command put out through a DAC (MATLAB's default `InterSample = 'zoh'`): two sines,
