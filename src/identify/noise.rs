@@ -49,6 +49,12 @@ impl Share {
     pub(crate) fn over(&self) -> bool {
         self.measured && self.share > SHARE
     }
+
+    /// Bounded, not measured, by more than the limit: the motion shows through the differences
+    /// of a record this coarse, and the noise under it may be over the limit or none.
+    pub(crate) fn untold(&self) -> bool {
+        !self.measured && self.share > SHARE
+    }
 }
 
 /// The recorded variables that some of `candidates` hold nonlinearly, in the order
