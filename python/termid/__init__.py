@@ -25,6 +25,7 @@ carrying termid's located message (file, row, column, or a caret under a term).
 
 from __future__ import annotations
 
+import contextvars
 import errno
 import functools
 import inspect
@@ -178,6 +179,36 @@ class _Columns(Dict[str, np.ndarray]):
     times: List[str] = []
 
 
+# The index of each DataFrame run being read, by its name in messages: an error's "row 38" is
+# the 38th row, which a DataFrame's user finds by its index label (``df.loc[1037]``).
+_INDEXES: "contextvars.ContextVar[Dict[str, pd.Index]]" = contextvars.ContextVar("termid_indexes")
+
+
+def _note_index(name: str, run: Any) -> None:
+    """Keeps the index of run ``name`` (a DataFrame) for :func:`_located`."""
+    if isinstance(run, pd.DataFrame):
+        indexes = _INDEXES.get(None)
+        if indexes is not None:
+            indexes[name] = run.index
+
+
+def _located(error: TermidError) -> TermidError:
+    """The error with the index label beside each row it names of a DataFrame run read in the
+    call (``run1: row 38`` → ``run1: row 38 (index 1037)``); the error itself where it names
+    none."""
+    text = str(error)
+    for name, index in sorted((_INDEXES.get(None) or {}).items(), key=lambda kv: -len(kv[0])):
+
+        def label(found: "re.Match[str]") -> str:
+            row = int(found.group(1))
+            if not 1 <= row <= len(index):
+                return found.group(0)
+            return f"{found.group(0)} (index {index[row - 1]})"
+
+        text = re.sub(rf"(?<![\w=]){re.escape(name)}: row (\d+)(?! \(index)", label, text)
+    return error if text == str(error) else TermidError(text)
+
+
 def _runs_told_apart(method: Any) -> Any:
     """A method on runs takes them as :func:`fit` does: ``by="run"`` names the column that
     tells the runs of one table apart (its ``runs``, and a recipe's ``held_out``). Its error
@@ -194,17 +225,23 @@ def _runs_told_apart(method: Any) -> Any:
                 if bound.arguments.get(name) is not None and (name == "runs" or isinstance(bound.arguments[name], pd.DataFrame)):
                     bound.arguments[name] = _split_by(bound.arguments[name], by)
             args, kwargs = bound.args, bound.kwargs
+        token = _INDEXES.set({})
         try:
             return method(*args, **kwargs)
         except TermidError as e:
             if "starts again" not in str(e):
-                raise
+                located = _located(e)
+                if located is e:
+                    raise
+                raise located from None
             frames = [a for a in (*args, *kwargs.values()) if isinstance(a, pd.DataFrame)]
             label = next((str(c) for f in frames for c in f.columns if not pd.api.types.is_numeric_dtype(f[c])), "run")
             raise TermidError(
                 f"{e}: give them as a list of runs, grouped by the column that names each row's run, "
                 f"df.groupby('{label}'), or by='{label}'"
             ) from None
+        finally:
+            _INDEXES.reset(token)
 
     # `by` shown in the method's signature, before its keywords of any name
     parameters = list(signature.parameters.values())
@@ -448,6 +485,7 @@ def _runs(
     out = []
     for k, run in enumerate(runs):
         name = names[k] if names else _run_name(run, k)
+        _note_index(str(name), run)
         columns = _columns(run)
         if time is not None and time not in columns:
             _time_from(str(name), run, columns, time)
@@ -1091,7 +1129,12 @@ def fit(
             raise TermidError(
                 f"{e}: give them as a list, fit([run1, run2], ...), or name the column that tells them apart, by='{label}'"
             ) from None
-        raise _explained(e, columns.left_out) from None
+        token = _INDEXES.set({name: run.index for name, run in runs if isinstance(run, pd.DataFrame)})
+        try:
+            located = _located(_explained(e, columns.left_out))
+        finally:
+            _INDEXES.reset(token)
+        raise located from None
     return Fit(native, target)
 
 

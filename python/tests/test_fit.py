@@ -189,8 +189,12 @@ def test_tab_completion_offers_the_public_names_alone():
 
 def test_a_target_that_is_not_a_number_is_named_with_its_row():
     df = pd.DataFrame({"x": [0.0, 1, 2, 3, 4, 5], "y": [1.0, 3.1, np.nan, 7.0, 9.0, 11.2]})
-    with pytest.raises(termid.TermidError, match=r"row 3: the target `y` evaluates to NaN \(check the data there\)"):
+    with pytest.raises(termid.TermidError, match=r"row 3 \(index 2\): the target `y` evaluates to NaN \(check the data there\)"):
         termid.fit(df, "y", "x")
+    # the row's index label beside its number, as a DataFrame's user finds it (df.loc[...])
+    stamped = df.set_index(pd.Index([1000, 1001, 1002, 1003, 1004, 1005]))
+    with pytest.raises(termid.TermidError, match=r"row 3 \(index 1002\): the target `y`"):
+        termid.fit(stamped, "y", "x")
 
 
 def _lorenz(t_end=20.0, dt=0.001, every=10):
@@ -550,8 +554,12 @@ def test_a_column_blank_between_readings_is_refused_with_the_remedy():
     # its row, saying to fill it forward (which the test above reads right)
     df = _lorenz_log("", rows=300)
     df.loc[df.index % 10 != 0, "x"] = np.nan
-    with pytest.raises(termid.TermidError, match=r"row 2, column `x`: value NaN .* fill it forward"):
+    with pytest.raises(termid.TermidError, match=r"row 2 \(index 1\), column `x`: value NaN .* fill it forward"):
         termid.fit(df, "dy/dt", ["x", "y", "x*z"])
+    # a model's runs alike, each run's rows by its own index
+    runs = [_lorenz_log("", rows=300), df.set_index(df.index + 5000)]
+    with pytest.raises(termid.TermidError, match=r"run2: row 2 \(index 5001\), column `x`"):
+        termid.Model.from_states(["x", "y", "z"]).identify(runs)
 
 
 def test_records_joined_in_one_frame_are_cut_into_runs():
