@@ -1016,7 +1016,13 @@ impl Dataset {
 pub(super) fn is_unit(cell: &str) -> bool {
     let cell = cell.trim();
     let bare = cell.trim_start_matches(['[', '(']).trim_end_matches([']', ')']);
-    unit_is_read(bare) || unit_seconds(bare).is_some() || (cell.starts_with('[') && cell.ends_with(']'))
+    // a bare cell only of termid's table: a label column's `A`, `B` (treatment groups) is
+    // no row of amperes; in brackets any unit, in parentheses SI's own or time's
+    UNITS.iter().any(|(n, _, _)| *n == bare)
+        || (cell.starts_with('[') && cell.ends_with(']'))
+        || (cell.starts_with('(')
+            && cell.ends_with(')')
+            && (is_coherent_si(bare) || unit_seconds(bare).is_some()))
 }
 
 fn unit_row(
@@ -1112,7 +1118,8 @@ mod tests {
         assert_eq!(seconds_per("year"), Some(31_557_600.0));
         assert_eq!(split_spec("g(T)"), ("g(T)".to_string(), None, 1.0));
         // a second header row of units termid does not convert is still a row of units
-        assert!(is_unit("[rpm]") && is_unit("A") && is_unit("V") && !is_unit("rpm") && !is_unit("run1"));
+        assert!(is_unit("[rpm]") && is_unit("[A]") && is_unit("(V)") && is_unit("(days)") && is_unit("m"));
+        assert!(!is_unit("rpm") && !is_unit("run1") && !is_unit("A") && !is_unit("(run1)"));
     }
 
     #[test]
