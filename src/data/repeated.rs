@@ -237,19 +237,19 @@ pub fn jumps_off_the_samples(t: &[f64], x: &[f64], motion: &[&[f64]], others: &[
         return None;
     }
     let (held, norms) = scaled(window_design(t, x, x, &kept, w, &terms, others, true), None);
-    let jumps_in =
-        |row: usize| (row * w..(row + 1) * w).filter(|&j| x[j + 1] != x[j]).collect::<Vec<usize>>();
-    let jumped: Vec<bool> = kept.iter().map(|&row| !jumps_in(row).is_empty()).collect();
-    let smooth: Vec<usize> = (0..jumped.len()).filter(|&r| !jumped[r]).collect();
+    // each window's jumps (the intervals over which x changes), and the one of a lone jump
+    let jumps: Vec<Vec<usize>> =
+        kept.iter().map(|&row| (row * w..(row + 1) * w).filter(|&j| x[j + 1] != x[j]).collect()).collect();
+    let lone: Vec<Option<usize>> =
+        jumps.iter().map(|j| if let [j] = j[..] { Some(j) } else { None }).collect();
+    let smooth: Vec<usize> = (0..jumps.len()).filter(|&r| jumps[r].is_empty()).collect();
     if smooth.len() < 3 * terms.len() {
         return None;
     }
     // each lone jump acting an interval earlier
     let mut early = x[..n].to_vec();
-    for &row in &kept {
-        if let [j] = jumps_in(row)[..] {
-            early[j] = x[j + 1];
-        }
+    for &j in lone.iter().flatten() {
+        early[j] = x[j + 1];
     }
     let (early, _) = scaled(window_design(t, &early, &early, &kept, w, &terms, others, true), Some(&norms));
     let a = held.select_rows(smooth.iter());
@@ -265,19 +265,13 @@ pub fn jumps_off_the_samples(t: &[f64], x: &[f64], motion: &[&[f64]], others: &[
             let residual = (change(r) - (design.row(r) * &fit)[0]).abs();
             residual > MISFIT * spread && residual > floor
         };
-        let off: Vec<usize> = (0..jumped.len()).filter(|&r| jumped[r] && misfit(&held, r)).collect();
-        let late: Vec<usize> = off
-            .iter()
-            .filter(|&&r| !misfit(&early, r))
-            .filter_map(|&r| match jumps_in(kept[r])[..] {
-                [j] => Some(j),
-                _ => None,
-            })
-            .collect();
-        Some(Jumps { windows: 0, off: off.len(), late })
+        let off: Vec<usize> =
+            (0..jumps.len()).filter(|&r| !jumps[r].is_empty() && misfit(&held, r)).collect();
+        let late: Vec<usize> = off.iter().filter(|&&r| !misfit(&early, r)).filter_map(|&r| lone[r]).collect();
+        Some((off.len(), late))
     });
-    let most = found.max_by_key(|j| j.off)?;
-    Some(Jumps { windows: jumped.iter().filter(|j| **j).count(), ..most })
+    let (off, late) = found.max_by_key(|(off, _)| *off)?;
+    Some(Jumps { windows: jumps.iter().filter(|j| !j.is_empty()).count(), off, late })
 }
 
 /// The terms a held-or-not fit regresses on, over `k` columns: a constant, each column, and
