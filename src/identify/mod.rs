@@ -364,7 +364,7 @@ fn unexplained_note(selection: &crate::select::Selection, state: &str) -> Option
 }
 
 /// Samples per characteristic period below which a rate's estimate is said to be coarse.
-const SAMPLES_PER_PERIOD: f64 = 16.0;
+pub(crate) const SAMPLES_PER_PERIOD: f64 = 16.0;
 
 /// A note where the rows sample `state`'s motion coarsely: fewer than [`SAMPLES_PER_PERIOD`]
 /// samples in its characteristic period T = 2π·σ(x)/σ(ẋ) (the period of a sinusoid of the
@@ -373,6 +373,31 @@ const SAMPLES_PER_PERIOD: f64 = 16.0;
 /// spurious terms and biased coefficients: Lorenz's z at 17.7 samples a period keeps its
 /// two true terms within 0.02 %, at 12.5 six terms 15 % off, and nothing else in the fit says so.
 fn resolution_note(frames: &[Frame], state: &str) -> Option<String> {
+    let (samples, period) = samples_per_period(frames, state)?;
+    (samples < SAMPLES_PER_PERIOD).then(|| {
+        format!(
+            "the rows sample `{state}` coarsely: {} samples in its characteristic period (2π·σ/σ of its \
+             rate, {} s); below about {SAMPLES_PER_PERIOD} the error of quadrature or differencing \
+             enters the fit as spurious terms and biased coefficients: sample faster, or read these as rough",
+            report::sig(samples, 3),
+            report::sig(period, 3)
+        )
+    })
+}
+
+/// The states of `names` the rows of `frames` sample coarsely ([`resolution_note`]), with their
+/// samples per characteristic period.
+pub(crate) fn coarsely_sampled(frames: &[Frame], names: &[String]) -> Vec<(String, f64)> {
+    names
+        .iter()
+        .filter_map(|n| samples_per_period(frames, n).map(|(s, _)| (n.clone(), s)))
+        .filter(|(_, s)| *s < SAMPLES_PER_PERIOD)
+        .collect()
+}
+
+/// The samples of `frames` in `state`'s characteristic period T = 2π·σ(x)/σ(ẋ), and T (s);
+/// `None` where the runs do not record it or hold too few samples.
+fn samples_per_period(frames: &[Frame], state: &str) -> Option<(f64, f64)> {
     let runs: Vec<(&[f64], &[f64])> =
         frames.iter().filter_map(|f| Some((f.column(state)?, f.time()))).collect();
     let values: Vec<f64> = runs.iter().flat_map(|(x, _)| x.iter().copied()).collect();
@@ -394,15 +419,7 @@ fn resolution_note(frames: &[Frame], state: &str) -> Option<String> {
     };
     let dt = mean(&steps);
     let samples = 2.0 * std::f64::consts::PI * sd(&values) / sd(&rates) / dt;
-    (samples.is_finite() && samples < SAMPLES_PER_PERIOD).then(|| {
-        format!(
-            "the rows sample `{state}` coarsely: {} samples in its characteristic period (2π·σ/σ of its \
-             rate, {} s); below about {SAMPLES_PER_PERIOD} the error of quadrature or differencing \
-             enters the fit as spurious terms and biased coefficients: sample faster, or read these as rough",
-            report::sig(samples, 3),
-            report::sig(samples * dt, 3)
-        )
-    })
+    samples.is_finite().then_some((samples, samples * dt))
 }
 
 /// Said where a rate is estimated at the samples (a point derivative, not the integral form)

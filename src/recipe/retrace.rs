@@ -53,7 +53,9 @@ const MISSED: f64 = 0.25;
 pub fn retrace_checks(model: &Model, runs: &[Frame]) -> Vec<Check> {
     let mut followed = Vec::new();
     let Some(retrace) = retrace_check(model, runs, &mut followed) else { return Vec::new() };
-    let missed = retrace.passed.then(|| missed_check(&followed)).flatten();
+    let states: Vec<String> = model.spec().states.iter().map(|s| s.name.clone()).collect();
+    let coarse = crate::identify::coarsely_sampled(runs, &states);
+    let missed = retrace.passed.then(|| missed_check(&followed, &coarse)).flatten();
     std::iter::once(retrace).chain(missed).collect()
 }
 
@@ -79,8 +81,9 @@ fn within(noisy: bool) -> &'static str {
 /// a few Lyapunov times, as its own nudged motion loses itself; a model that loses its run
 /// long before its own motion would (the oscillator identified from its position alone, 14 %
 /// of its rate explained: followed 1.0 s of 60 s, its own motion throughout) misses the
-/// motion. Flags, does not refuse. `None` where no run was followed.
-fn missed_check(followed: &[Followed]) -> Option<Check> {
+/// motion; among the causes, the states the runs sample `coarse`ly (with their samples per
+/// characteristic period). Flags, does not refuse. `None` where no run was followed.
+fn missed_check(followed: &[Followed], coarse: &[(String, f64)]) -> Option<Check> {
     let check = |passed: bool, detail: String| Check {
         name: "the equations follow their runs as long as their own motion allows".into(),
         passed,
@@ -107,10 +110,19 @@ fn missed_check(followed: &[Followed]) -> Option<Check> {
             true => String::new(),
             false => format!(" (from {} off they run away)", NUDGES[0].1),
         };
+        // a record too coarse for its rates is a cause as likely as any (a yearly census)
+        let coarse = match coarse {
+            [] => String::new(),
+            c => format!(
+                ", or rows too coarse for the rates: {} samples in a characteristic period, under {}",
+                c.iter().map(|(n, s)| format!("`{n}` {}", sig(*s))).collect::<Vec<_>>().join(", "),
+                crate::identify::SAMPLES_PER_PERIOD
+            ),
+        };
         return Some(check(
             false,
             format!(
-                "{origin}: they follow it {} for {} s of {} s, where their own motion, started {off} of each span off, follows itself {own}{closer}: no motion too sensitive to follow (chaos) loses its record so soon; the equations miss it (a state not recorded, a term or an input the candidates lack): read them as rough",
+                "{origin}: they follow it {} for {} s of {} s, where their own motion, started {off} of each span off, follows itself {own}{closer}: no motion too sensitive to follow (chaos) loses its record so soon; the equations miss it (a state not recorded, a term or an input the candidates lack{coarse}): read them as rough",
                 within(*noisy),
                 sig(*until),
                 sig(*of)

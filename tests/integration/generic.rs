@@ -3676,7 +3676,8 @@ fn a_motor_logged_with_its_units_and_late_steps_is_identified_exactly() {
 /// ẏ = 0.024xy − 0.8y per year; ten samples a cycle, no noise at all): the lynx record's sharp
 /// peaks passed for noise of "at least 53 %" of its spread, and a bound of 6.7 % on the hares'
 /// passed as "under 2.0 %". The noise is now not told, and flagged so; the time, a column
-/// `year`, read in seconds, said.
+/// `year`, read in seconds, said; the equations that lose the run early name the rows'
+/// coarseness among the causes.
 #[test]
 fn a_yearly_census_claims_no_noise_it_cannot_see() {
     let dir = crate::common::Scratch::new("generic-census");
@@ -3705,6 +3706,11 @@ fn a_yearly_census_claims_no_noise_it_cannot_see() {
         out.contains(
             "FLAG the records' noise leaves the terms unbiased: not told: white noise of `hare` at most"
         ) && !out.contains("at least"),
+        "{out}"
+    );
+    // the equations lose the run early: among the causes, the rows' coarseness
+    assert!(
+        out.contains("or rows too coarse for the rates: `hare` 9.84, `lynx` 9.61 samples in a characteristic period, under 16"),
         "{out}"
     );
 }
