@@ -279,7 +279,7 @@ fn commanded(
 /// a recorded state of `motion` (not `name`) has its rate fitted clearly better with it held
 /// from each sample to the next than as a line between them ([`held_fit`]): a generator's
 /// command switched at random samples, not a relay thrown between them; and says so, after
-/// `how` it jumps.
+/// `how` it jumps (on no clock).
 fn held_on_the_samples(
     frame: &mut Frame,
     name: &str,
@@ -288,13 +288,10 @@ fn held_on_the_samples(
     how: &str,
 ) -> Result<Option<String>, DataError> {
     let Some((state, share)) = held_fit(frame, name, motion, columns, false) else { return Ok(None) };
-    let said = format!(
-        "{how}, on no clock, but the rate of `{state}` is fitted better with it held from each sample to the next than as a line between them ({:.1} % less left over, by a quadratic in the columns over windows of eight samples)",
-        100.0 * (1.0 - share)
-    );
     frame.hold(name)?;
     Ok(Some(format!(
-        "{said}: a generator's command switched at random samples (a random telegraph, a PRBS, an APRBS), not a relay thrown between them; taken as held. Where it switches between the samples, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)"
+        "{how}, but the rate of `{state}` is fitted better with it held from each sample to the next than as a line between them ({:.1} % less left over, by a quadratic in the columns over windows of eight samples): a generator's command switched at random samples (a random telegraph, a PRBS, an APRBS), not a relay thrown between them; taken as held. Where it switches between the samples, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)",
+        100.0 * (1.0 - share)
     )))
 }
 
@@ -480,9 +477,12 @@ pub fn mark_held(
                         // changes side by side: held where the rates say so, else a line (a
                         // motion read to coarse counts is no relay to leave out windows for)
                         let how = stays_put(frame, name, h);
+                        let unclocked = format!("{how}, on no clock");
                         if let Some(note) = off_the_samples(frame, name, motion, columns, &how)? {
                             notes.push(note);
-                        } else if let Some(note) = held_on_the_samples(frame, name, motion, columns, &how)? {
+                        } else if let Some(note) =
+                            held_on_the_samples(frame, name, motion, columns, &unclocked)?
+                        {
                             notes.push(note);
                         }
                     } else if let Some(note) = held_though_smooth(frame, name, motion, columns)? {
@@ -500,22 +500,17 @@ pub fn mark_held(
                     notes.push(note);
                     continue;
                 }
-                if !h.on_a_clock() {
-                    if let Some(note) = held_on_the_samples(frame, name, motion, columns, &how)? {
-                        notes.push(note);
-                        continue;
-                    }
-                }
                 if h.on_a_clock() {
                     frame.hold(name)?;
                     notes.push(format!(
-                        "{how}, every one on a clock of {} samples: a controller's command, taken as held from each sample to the next (a zero-order hold), not as a line between them; where it moves between its samples, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)",
-                        h.period
+                        "{clock}: a controller's command, taken as held from each sample to the next (a zero-order hold), not as a line between them; where it moves between its samples, say so (identify --intersample linear; a model file's `intersample = \"linear\"`; Python `intersample=\"linear\"`)"
                     ));
+                } else if let Some(note) = held_on_the_samples(frame, name, motion, columns, &clock)? {
+                    notes.push(note);
                 } else {
                     frame.switch(name)?;
                     notes.push(format!(
-                        "{how}, on no clock: it may jump anywhere between two samples (a relay, a switch thrown by the motion), so a rate's fit leaves out the windows of the weak or integral form that hold a jump (a point derivative and a replay take it as a line between the samples, which halves the error of a jump's time on average); where it is a command held from each sample to the next, say so (identify --intersample held; a model file's `intersample = \"held\"`; Python `intersample=\"held\"`)"
+                        "{clock}: it may jump anywhere between two samples (a relay, a switch thrown by the motion), so a rate's fit leaves out the windows of the weak or integral form that hold a jump (a point derivative and a replay take it as a line between the samples, which halves the error of a jump's time on average); where it is a command held from each sample to the next, say so (identify --intersample held; a model file's `intersample = \"held\"`; Python `intersample=\"held\"`)"
                     ));
                 }
             }
