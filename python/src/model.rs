@@ -512,17 +512,22 @@ impl PyModel {
                 Ok::<_, termid::identify::IdentifyError>(identified)
             })
             .map_err(fail)?;
+        // any system: its equations must retrace the runs, its terms hold on each half of them
+        // (a field's model has its checks, `Model.checks`, which read more than the runs);
+        // where they lose their runs, their terms are chosen again by re-simulation
+        let (identified, checks) = match termid::plugins::of(&identified.model) {
+            Some(_) => (identified, vec![]),
+            None => {
+                let (identified, checks, _) =
+                    py.detach(|| termid::recipe::checked_system(&model, identified, &frames, &how));
+                (identified, checks)
+            }
+        };
         let fits = identified
             .fits
             .iter()
             .map(|(n, f)| Ok((n.clone(), to_json(&f.report())?)))
             .collect::<PyResult<_>>()?;
-        // any system: its equations must retrace the runs, its terms hold on each half of them
-        // (a field's model has its checks, `Model.checks`, which read more than the runs)
-        let checks: Vec<termid::plugin::Check> = match termid::plugins::of(&identified.model) {
-            Some(_) => vec![],
-            None => py.detach(|| termid::recipe::system_checks(&identified, &frames, &how)),
-        };
         for c in checks.iter().filter(|c| !c.passed) {
             warn(py, c.line())?;
         }

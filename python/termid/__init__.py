@@ -1273,7 +1273,8 @@ class Identified:
     (name, passed, refuses, detail): that the equations retrace the runs without running away,
     and how long they follow them, that they follow them as long as their own motion from a
     nudged start follows itself, that their terms hold on each half of the runs, and that the
-    runs' noise leaves them unbiased (a ship's are :meth:`Model.checks`).
+    runs' noise leaves them unbiased (a ship's are :meth:`Model.checks`). Where the equations
+    lose their runs, their terms are chosen again by re-simulation, as :meth:`notes` says.
 
     >>> lorenz = termid.Model.builtin("lorenz")
     >>> found = lorenz.identify(lorenz.simulate(duration=5.0))

@@ -688,11 +688,8 @@ pub fn estimate(model: &Model, runs: &Runs, settings: &EstimateSettings) -> Resu
     let unresolved = |runs: &Runs, model: &Model| runs.step_error(model).is_some_and(|e| e > STEP_RESOLVES);
     let mut finer = 1;
     loop {
-        let at = runs.finer(finer);
-        if !finest(&at) && unresolved(&at, model) {
-            finer *= 2;
-            continue;
-        }
+        let at;
+        (finer, at) = runs.resolving(model, finer, STEP_RESOLVES, MOST_STEPS_PER_SAMPLE);
         let mut fit = at_step(model, &at, settings)?;
         if !finest(&at) && unresolved(&at.with_initial(&fit.initial_states, &fit.own_values()), &fit.model) {
             finer *= 2;

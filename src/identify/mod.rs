@@ -51,11 +51,11 @@ mod statistics;
 
 pub use delay::Lag;
 
-pub(crate) use model::RunStatistics;
 pub use model::{
     coefficients_of, describe_residuals_of, equation_design, fit_equation, fit_equation_design,
     identify_model, say_late_inputs, IdentifiedModel, ModelIdentification,
 };
+pub(crate) use model::{store_fit, RunStatistics};
 pub use noise::noise_note;
 pub use report::{num, sig, FitReport, StepReport, TermReport};
 pub use statistics::{

@@ -158,7 +158,7 @@ fn equations_of(model: &Model, how: &ModelIdentification<'_>) -> Result<Vec<Stri
 }
 
 /// Stores a fit's coefficients and intercept as equation `name` of `model`; the terms stored.
-pub(super) fn store_fit(model: &mut Model, name: &str, fit: &Fit) -> Result<Vec<Term>, IdentifyError> {
+pub(crate) fn store_fit(model: &mut Model, name: &str, fit: &Fit) -> Result<Vec<Term>, IdentifyError> {
     let coefficients = coefficients_of(fit, &model.vocabulary)?;
     let terms = coefficients.iter().map(|(t, _, _)| t.clone()).collect();
     model.set_coefficients(name, coefficients, fit.selection.intercept.as_ref().map(|b| b.value));

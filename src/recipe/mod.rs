@@ -9,6 +9,7 @@ mod halves;
 mod noise;
 mod parameters;
 mod report;
+mod resimulated;
 mod retrace;
 mod start;
 
@@ -123,6 +124,13 @@ pub struct RefineOptions {
 }
 
 impl RefineOptions {
+    /// The refinement of terms chosen by re-simulation from rows too coarse for their rates
+    /// (a census read yearly: the weak form's quadrature biases each coefficient by 2 %): every
+    /// state compared, the command line's prior weight and iterations.
+    pub fn of_coarse_rows() -> RefineOptions {
+        RefineOptions { states: None, prior: 1e-4, iterations: 30, step: None }
+    }
+
     /// The step asked for, in whole samples of `frames` (at least one); `None`: not asked.
     fn samples_per_step(&self, frames: &[Frame]) -> Option<usize> {
         let sample = crate::data::sample_step(frames);
@@ -267,6 +275,35 @@ pub fn system_checks(
         .chain([halves_check(identified, frames, how, noise::quiet(&tallies))])
         .chain(noise::noise_check_of(&tallies))
         .collect()
+}
+
+/// A system of no field's identified from `frames` by `how` (`identified`, from `model`), with
+/// its [`system_checks`]; where its equations lose their runs, their terms chosen again by
+/// re-simulation (the fewest of the best subsets per equation that follow the runs), said in
+/// each equation's notes, and the checks of what is kept; and whether the equations lost their
+/// runs (so searched).
+pub fn checked_system(
+    model: &Model,
+    identified: crate::identify::IdentifiedModel,
+    frames: &[Frame],
+    how: &crate::identify::ModelIdentification<'_>,
+) -> (crate::identify::IdentifiedModel, Vec<Check>, bool) {
+    let checks = system_checks(&identified, frames, how);
+    let Some(search) = resimulated::by_resimulation(model, &identified, frames, how, &checks) else {
+        return (identified, checks, false);
+    };
+    let note = resimulated::note(&identified, &search);
+    let (mut kept, checks) = match search.kept {
+        Some(kept) => {
+            let checks = system_checks(&kept, frames, how);
+            (kept, checks)
+        }
+        None => (identified, checks),
+    };
+    for (_, fit) in &mut kept.fits {
+        fit.selection.notes.push(note.clone());
+    }
+    (kept, checks, true)
 }
 
 /// [`system_checks`] of equations identified from their statistics (runs read in pieces, or

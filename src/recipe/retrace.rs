@@ -43,6 +43,17 @@ const NUDGES: [(f64, &str); 2] = [(0.01, "a hundredth"), (1e-4, "a ten-thousandt
 /// motion too sensitive to follow (chaos) but missed.
 const MISSED: f64 = 0.25;
 
+/// The check that the equations stay within [`REACH`] spans of each run.
+const RETRACE_NAME: &str = "the equations retrace their runs without running away";
+
+/// The check that the equations follow each run as long as their own motion allows.
+const MISSED_NAME: &str = "the equations follow their runs as long as their own motion allows";
+
+/// Whether `check` is one of [`retrace_checks`].
+pub(super) fn is_retrace(check: &Check) -> bool {
+    check.name == RETRACE_NAME || check.name == MISSED_NAME
+}
+
 /// The checks that `model`, re-simulated from each run's first sample under its recorded
 /// inputs (adaptive steps, as `validate` does), stays within ten spans of each state's
 /// recorded range over the run, and that it follows each run as long as its own motion
@@ -51,12 +62,22 @@ const MISSED: f64 = 0.25;
 /// lack) is re-simulated as it stands, so how long it follows its runs is said. None where
 /// they cannot apply: a run that lacks a state or an input.
 pub fn retrace_checks(model: &Model, runs: &[Frame]) -> Vec<Check> {
+    retraced(model, runs).0
+}
+
+/// [`retrace_checks`], with the least share of a run the equations follow (0 where they run
+/// away from one or the checks cannot apply).
+pub(super) fn retraced(model: &Model, runs: &[Frame]) -> (Vec<Check>, f64) {
     let mut followed = Vec::new();
-    let Some(retrace) = retrace_check(model, runs, &mut followed) else { return Vec::new() };
+    let Some(retrace) = retrace_check(model, runs, &mut followed) else { return (Vec::new(), 0.0) };
+    let share = match retrace.passed {
+        true => followed.iter().map(|f| f.1 / f.2.max(f64::MIN_POSITIVE)).fold(1.0, f64::min),
+        false => 0.0,
+    };
     let states: Vec<String> = model.spec().states.iter().map(|s| s.name.clone()).collect();
     let coarse = crate::identify::coarsely_sampled(runs, &states);
     let missed = retrace.passed.then(|| missed_check(&followed, &coarse)).flatten();
-    std::iter::once(retrace).chain(missed).collect()
+    (std::iter::once(retrace).chain(missed).collect(), share)
 }
 
 /// How long a run is followed: its origin, the time the re-simulation from its start stays
@@ -85,7 +106,7 @@ fn within(noisy: bool) -> &'static str {
 /// characteristic period). Flags, does not refuse. `None` where no run was followed.
 fn missed_check(followed: &[Followed], coarse: &[(String, f64)]) -> Option<Check> {
     let check = |passed: bool, detail: String| Check {
-        name: "the equations follow their runs as long as their own motion allows".into(),
+        name: MISSED_NAME.into(),
         passed,
         refuses: false,
         detail,
@@ -169,7 +190,7 @@ fn retrace_check(model: &Model, runs: &[Frame], followed: &mut Vec<Followed>) ->
         return None;
     }
     let check = |passed: bool, detail: String| Check {
-        name: "the equations retrace their runs without running away".into(),
+        name: RETRACE_NAME.into(),
         passed,
         refuses: true,
         detail,

@@ -3,7 +3,7 @@
 //! free parameters where it declares any) and checked.
 
 use crate::data::{differentiator, prepare, resample, CentralDifference, Differentiator, Frame, Preparation};
-use crate::diagnose::{Prediction, RefineSettings, Refined, Runs};
+use crate::diagnose::{Prediction, RefineSettings, Refined, Runs, MOST_STEPS_PER_SAMPLE, STEP_RESOLVES};
 use crate::identify::{Fit, ModelIdentification};
 use crate::model::Model;
 use crate::plugin::Check;
@@ -135,6 +135,9 @@ pub fn prepare_runs(
     frames.iter().map(|f| prepare(f, &how).map_err(setup)).collect()
 }
 
+/// Said in each equation's notes where terms chosen by re-simulation were refined unasked.
+const COARSE_REFINED: &str = "refined by output error over the runs (below), unasked: the rates of rows this coarse bias the regression's coefficients, a re-simulation at steps fine enough for the motion does not";
+
 /// One start with `derivative`.
 pub(super) fn identify_start(
     model: &Model,
@@ -191,9 +194,20 @@ pub(super) fn identify_start(
     };
     // said once for the start (not in each fold the choice by prediction fitted)
     crate::identify::say_late_inputs(&mut identified, &prepared, diff.as_ref()).map_err(setup)?;
-    let checks = match crate::plugins::of(model) {
-        Some(_) => checks_of(&identified.model, &prepared),
-        None => super::system_checks(&identified, &prepared, &how),
+    let (identified, checks, resimulated) = match crate::plugins::of(model) {
+        Some(_) => {
+            let checks = checks_of(&identified.model, &prepared);
+            (identified, checks, false)
+        }
+        None => super::checked_system(model, identified, &prepared, &how),
+    };
+    // equations that lost their runs, from rows too coarse for their rates: the regression's
+    // coefficients carry the quadrature's bias, which an output error over the runs does not
+    let coarse = resimulated && !crate::identify::coarsely_sampled(&prepared, &states).is_empty();
+    let of_coarse_rows = RefineOptions::of_coarse_rows();
+    let refinement = match &settings.refine {
+        None if coarse => Some(&of_coarse_rows),
+        asked => asked.as_ref(),
     };
     let mut model = identified.model;
     let mut start = Start {
@@ -211,7 +225,19 @@ pub(super) fn identify_start(
     let in_place = settings.parameters_in_place(validation.is_some());
     start.checks = checks;
     if !in_place {
-        refine_start(&mut start, &mut model, &prepared, validation.as_deref(), settings);
+        refine_start(
+            &mut start,
+            &mut model,
+            &prepared,
+            validation.as_deref(),
+            refinement,
+            settings.intercept,
+        );
+        if start.refined.is_some() && settings.refine.is_none() {
+            for (_, fit) in &mut start.fits {
+                fit.selection.notes.push(COARSE_REFINED.into());
+            }
+        }
     }
     start.model = model;
     start.prepared = prepared;
@@ -243,7 +269,7 @@ pub(super) fn refine_instead(start: &mut Start, settings: &RecipeSettings) {
         return;
     }
     let (mut model, prepared) = (start.model.clone(), std::mem::take(&mut start.prepared));
-    refine_start(start, &mut model, &prepared, None, settings);
+    refine_start(start, &mut model, &prepared, None, settings.refine.as_ref(), settings.intercept);
     (start.model, start.prepared) = (model, prepared);
 }
 
@@ -254,11 +280,12 @@ fn refine_start(
     model: &mut Model,
     prepared: &[Frame],
     validation: Option<&[Frame]>,
-    settings: &RecipeSettings,
+    options: Option<&RefineOptions>,
+    intercept: bool,
 ) {
-    let Some(options) = &settings.refine else { return };
+    let Some(options) = options else { return };
     // a refinement that fails loses nothing: the regression's model is kept
-    match refine(model, prepared, validation, options, settings.intercept) {
+    match refine(model, prepared, validation, options, intercept) {
         Ok(r) => {
             // a refinement must not make a model fail what its field knows it passed
             let after = checks_of(&r.model, prepared);
@@ -325,7 +352,7 @@ pub(super) fn output_error_runs(
 /// for the regression (smoothed initial states: a noisy first sample of a rate would
 /// otherwise drift through its integral), re-simulated at the refinement's step; the costs
 /// reported are the runs' at every sample.
-fn refine(
+pub(super) fn refine(
     model: &Model,
     frames: &[Frame],
     held: Option<&[Frame]>,
@@ -338,15 +365,68 @@ fn refine(
     let runs = runs_of(frames)?;
     let validation = held.map(runs_of).transpose()?;
     let sample = crate::data::sample_step(frames);
-    // the regression's model at every sample: what the step is checked against, and the cost
-    // reported before the refinement
-    let fine = runs.simulate(model, &[], &[]).map_err(|e| e.to_string())?;
-    let (factor, coarse) = match options.samples_per_step(frames) {
-        Some(factor) => (factor, runs.coarser(factor).map_err(|e| e.to_string())?),
-        None => runs.coarsest(model, &fine, super::RESOLVED, super::MOST_SAMPLES_PER_STEP),
+    let asked = options.samples_per_step(frames);
+    // where no step is asked, one that resolves the motion of the regression's model and of
+    // the refined one: a census read yearly, ten samples a cycle, drifts in phase at one RK4
+    // step a sample, which the refinement makes up for with coefficients 2 % off
+    let mut finer = 1;
+    let (runs, validation, mut refined) = loop {
+        let runs = match asked {
+            Some(_) => runs.clone(),
+            None => {
+                let at;
+                (finer, at) = runs.resolving(model, finer, STEP_RESOLVES, MOST_STEPS_PER_SAMPLE);
+                at
+            }
+        };
+        let validation = validation.as_ref().map(|v| v.finer(finer));
+        let refined = refine_at(model, (&runs, validation.as_ref()), options, (asked, finer, sample))?;
+        let finest = finer >= MOST_STEPS_PER_SAMPLE;
+        if asked.is_none() && !finest && runs.step_error(&refined.model).is_some_and(|e| e > STEP_RESOLVES) {
+            finer *= 2;
+            continue;
+        }
+        break (runs, validation, refined);
     };
-    let coarse_validation =
-        validation.as_ref().map(|v| v.coarser(factor).map_err(|e| e.to_string())).transpose()?;
+    let factor = refined.step.map_or(1, |step| (step / sample).round() as usize);
+    if factor > 1 || finer > 1 {
+        // the costs the starts are judged by are the runs' own, at every sample
+        let cost = |runs: &Runs, m: &Model| -> Result<f64, String> {
+            let sims = runs.simulate(m, &[], &[]).map_err(|e| e.to_string())?;
+            Ok(runs.gap(&sims).cost)
+        };
+        refined.cost_before = cost(&runs, model)?;
+        refined.cost_after = cost(&runs, &refined.model)?;
+        if let Some(v) = &validation {
+            refined.validation = Some((cost(v, model)?, cost(v, &refined.model)?));
+        }
+    }
+    if finer > 1 {
+        refined.step = Some(sample / finer as f64);
+    }
+    Ok(refined)
+}
+
+/// [`refine`] at the runs' step (`runs`, `validation`) where it is `finer` than a sample
+/// (no coarser one resolves the motion), else at the coarsest whole number of samples at which
+/// the regression's model re-simulates them as at their samples, or at the step `asked` (in
+/// samples of `sample`); its step set where that is coarser than a sample.
+fn refine_at(
+    model: &Model,
+    (runs, validation): (&Runs, Option<&Runs>),
+    options: &RefineOptions,
+    (asked, finer, sample): (Option<usize>, usize, f64),
+) -> Result<Refined, String> {
+    let (factor, coarse) = match asked {
+        Some(factor) => (factor, runs.coarser(factor).map_err(|e| e.to_string())?),
+        None if finer > 1 => (1, runs.clone()),
+        None => {
+            // the regression's model at every sample: what a coarser step is checked against
+            let fine = runs.simulate(model, &[], &[]).map_err(|e| e.to_string())?;
+            runs.coarsest(model, &fine, super::RESOLVED, super::MOST_SAMPLES_PER_STEP)
+        }
+    };
+    let coarse_validation = validation.map(|v| v.coarser(factor).map_err(|e| e.to_string())).transpose()?;
     let settings = RefineSettings {
         prior_weight: options.prior,
         validation: coarse_validation.as_ref(),
@@ -354,16 +434,6 @@ fn refine(
     };
     let mut refined = crate::diagnose::refine(model, &coarse, &settings).map_err(|e| format!("{e:#}"))?;
     if factor > 1 {
-        // the costs the starts are judged by are the runs' own, at every sample
-        let cost = |runs: &Runs, m: &Model| -> Result<f64, String> {
-            let sims = runs.simulate(m, &[], &[]).map_err(|e| e.to_string())?;
-            Ok(runs.gap(&sims).cost)
-        };
-        refined.cost_before = runs.gap(&fine).cost;
-        refined.cost_after = cost(&runs, &refined.model)?;
-        if let Some(v) = &validation {
-            refined.validation = Some((cost(v, model)?, cost(v, &refined.model)?));
-        }
         refined.step = Some(sample * factor as f64);
     }
     Ok(refined)
