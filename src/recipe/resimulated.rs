@@ -35,6 +35,9 @@ const SEARCH_SECONDS: f64 = 5.0;
 /// `equations`: the combinations of up to T terms in all, each equation at least one, are
 /// C(T, equations).
 fn largest_size(equations: usize) -> usize {
+    if equations == 0 {
+        return 1;
+    }
     let combinations =
         |total: usize| -> f64 { (0..equations).map(|i| (total - i) as f64 / (i + 1) as f64).product() };
     let mut total = equations;
@@ -75,8 +78,9 @@ impl Path {
 pub(crate) struct Search {
     /// The combination kept where it is not the regression's: identified with its terms forced.
     pub kept: Option<IdentifiedModel>,
-    /// The combinations tried, of up to how many terms.
+    /// The combinations tried.
     pub tried: usize,
+    /// The most terms of a combination tried.
     pub most_terms: usize,
     /// Whether each combination was judged refined (rows too coarse for their rates).
     pub refined: bool,
@@ -113,7 +117,7 @@ pub(crate) fn by_resimulation(
     how: &ModelIdentification<'_>,
     checks: &[Check],
 ) -> Option<Search> {
-    if !lose_their_runs(checks) {
+    if !lose_their_runs(checks) || identified.fits.is_empty() {
         return None;
     }
     let names: Vec<&String> = identified.fits.iter().map(|(n, _)| n).collect();
@@ -371,6 +375,7 @@ mod tests {
         assert_eq!(largest_size(1), 200);
         assert_eq!(largest_size(2), 19);
         assert_eq!(largest_size(3), 9);
+        assert_eq!(largest_size(0), 1);
         let up_to = |m: usize, total: usize| -> usize {
             let paths: Vec<Path> = (0..m).map(|_| path(total)).collect();
             (m..=total).map(|t| sizes_totalling(&paths, t).len()).sum()
