@@ -194,7 +194,7 @@ pub(super) fn identify_start(
     };
     // said once for the start (not in each fold the choice by prediction fitted)
     crate::identify::say_late_inputs(&mut identified, &prepared, diff.as_ref()).map_err(setup)?;
-    let (identified, checks, resimulated) = match crate::plugins::of(model) {
+    let (identified, checks, searched) = match crate::plugins::of(model) {
         Some(_) => {
             let checks = checks_of(&identified.model, &prepared);
             (identified, checks, false)
@@ -203,7 +203,7 @@ pub(super) fn identify_start(
     };
     // equations that lost their runs, from rows too coarse for their rates: the regression's
     // coefficients carry the quadrature's bias, which an output error over the runs does not
-    let coarse = resimulated && !crate::identify::coarsely_sampled(&prepared, &states).is_empty();
+    let coarse = searched && !crate::identify::coarsely_sampled(&prepared, &states).is_empty();
     let of_coarse_rows = RefineOptions::of_coarse_rows();
     let refinement = match &settings.refine {
         None if coarse => Some(&of_coarse_rows),

@@ -2189,6 +2189,12 @@ fn polynomials_standing_in_for_a_missing_form_are_flagged() {
     );
 }
 
+/// A coefficient as the output-error refinement of an identification's JSON report left it.
+fn refined(report: &serde_json::Value, equation: &str, term: &str) -> Option<f64> {
+    let all = report["output_error_refinement"]["coefficients"].as_array()?;
+    all.iter().find(|c| c["equation"] == equation && c["term"] == term)?["refined"].as_f64()
+}
+
 /// Equations whose rates fit the rows may still run away when integrated: Lotka-Volterra
 /// sampled ten times a period, noise-free, gives the cubic library's regression spurious
 /// terms that cancel on the samples; re-simulated from the run's start the system they make
@@ -2251,14 +2257,12 @@ fn equations_that_run_away_from_a_coarse_run_are_chosen_again_by_resimulation() 
             .starts_with("terms chosen by re-simulation: the regression's (9 of `x_dot`, 9 of `z_dot`) fit the rates but lose the runs; the best re-simulated terms, 2 of `x_dot`, 2 of `z_dot`")),
         "{out}"
     );
-    let refined = report["output_error_refinement"]["coefficients"].as_array().unwrap();
-    assert_eq!(refined.len(), 4, "{out}");
+    assert_eq!(report["output_error_refinement"]["coefficients"].as_array().map(Vec::len), Some(4), "{out}");
     for (equation, term, truth) in
         [("x_dot", "x", 1.0), ("x_dot", "x*z", -0.5), ("z_dot", "z", -1.5), ("z_dot", "x*z", 0.25)]
     {
-        let c = refined.iter().find(|c| c["equation"] == equation && c["term"] == term).unwrap();
-        let value = c["refined"].as_f64().unwrap();
-        assert!((value / truth - 1.0).abs() < 1e-4, "{equation} {term}: {value}\n{out}");
+        let value = refined(&report, equation, term);
+        assert!(value.is_some_and(|v| (v / truth - 1.0).abs() < 1e-4), "{equation} {term}: {value:?}\n{out}");
     }
     assert!(report["physical_checks"].as_array().unwrap()[..2].iter().all(|c| c["passed"] == true), "{out}");
     // the model written re-identifies as chosen: its terms forced, the others excluded
@@ -3716,9 +3720,15 @@ fn a_yearly_census_claims_no_noise_it_cannot_see() {
     }
     let path = dir.join("census.csv");
     std::fs::write(&path, csv).unwrap();
-    let (ok, out, err) =
-        termid(&["identify", "--data", path.to_str().unwrap(), "--states", "hare,lynx", "--degree", "2"]);
-    assert!(ok, "{err}");
+    let census = |more: &[&str]| {
+        let mut args =
+            vec!["identify", "--data", path.to_str().unwrap(), "--states", "hare,lynx", "--degree", "2"];
+        args.extend(more);
+        let (ok, out, err) = termid(&args);
+        assert!(ok, "{err}");
+        (out, err)
+    };
+    let (out, err) = census(&[]);
     assert!(err.contains("the time `year` read in seconds (× 3.155760e7)"), "{err}");
     assert!(
         out.contains(
@@ -3731,58 +3741,21 @@ fn a_yearly_census_claims_no_noise_it_cannot_see() {
             && out.contains("ok   the equations follow their runs as long as their own motion allows"),
         "{out}"
     );
-    let (ok, out, err) = termid(&[
-        "identify",
-        "--data",
-        path.to_str().unwrap(),
-        "--states",
-        "hare,lynx",
-        "--degree",
-        "2",
-        "--format",
-        "json",
-    ]);
-    assert!(ok, "{err}");
+    let (out, _) = census(&["--format", "json"]);
+    let report = crate::common::json(&out);
+    assert_eq!(report["output_error_refinement"]["coefficients"].as_array().map(Vec::len), Some(4), "{out}");
     // per second in the model; per year here
-    let year = 3.15576e7;
-    let refined = &crate::common::json(&out)["output_error_refinement"]["coefficients"];
-    let found: Vec<(String, f64)> = refined
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|c| {
-            (
-                format!("{} {}", c["equation"].as_str().unwrap(), c["term"].as_str().unwrap()),
-                c["refined"].as_f64().unwrap() * year,
-            )
-        })
-        .collect();
-    assert_eq!(found.len(), 4, "{out}");
-    for (name, truth) in [
-        ("hare_dot hare", 0.55),
-        ("hare_dot hare*lynx", -0.028),
-        ("lynx_dot hare*lynx", 0.024),
-        ("lynx_dot lynx", -0.8),
+    for (equation, term, truth) in [
+        ("hare_dot", "hare", 0.55),
+        ("hare_dot", "hare*lynx", -0.028),
+        ("lynx_dot", "hare*lynx", 0.024),
+        ("lynx_dot", "lynx", -0.8),
     ] {
-        let value = found.iter().find(|(n, _)| n == name).map(|(_, v)| *v);
-        assert!(
-            value.is_some_and(|v| (v / truth - 1.0).abs() < 1e-3),
-            "{name}: {value:?} for {truth}\n{out}"
-        );
+        let value = refined(&report, equation, term).map(|v| v * 3.15576e7);
+        assert!(value.is_some_and(|v| (v / truth - 1.0).abs() < 1e-3), "{equation} {term}: {value:?}\n{out}");
     }
     // read in pieces: the equations lose the run early, and among the causes, the rows' coarseness
-    let (ok, out, err) = termid(&[
-        "identify",
-        "--data",
-        path.to_str().unwrap(),
-        "--states",
-        "hare,lynx",
-        "--degree",
-        "2",
-        "--chunk-rows",
-        "20",
-    ]);
-    assert!(ok, "{err}");
+    let (out, _) = census(&["--chunk-rows", "20"]);
     assert!(
         out.contains("or rows too coarse for the rates: `hare` 9.84, `lynx` 9.61 samples in a characteristic period, under 16"),
         "{out}"
