@@ -351,7 +351,7 @@ const EXPLAINED: f64 = 0.5;
 /// dθ/dt = −0.117θ − 0.078θ² at R² = 0.006, t-values of 3 and every check passed; no
 /// equation of θ alone can turn back as θ does.
 fn unexplained_note(selection: &crate::select::Selection, state: &str) -> Option<String> {
-    let r2 = selection.chosen_step.checked_sub(1).and_then(|k| selection.steps.get(k)).map_or(0.0, |s| s.r2);
+    let r2 = selection.chosen_r2().unwrap_or(0.0);
     (r2 < EXPLAINED).then(|| {
         format!(
             "the chosen terms explain {} % of the variance of `{state}`'s rate: the rest is noise, or \

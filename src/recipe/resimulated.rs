@@ -89,11 +89,13 @@ pub(crate) struct Search {
     pub own_best: bool,
 }
 
-/// One combination scored: its fits per equation, its criterion and the model scored.
+/// One combination scored: its fits per equation, its criterion, the model scored and, where
+/// it was made for the score, its identification with its terms forced.
 struct Scored {
     fits: Vec<Fit>,
     criterion: f64,
     model: Model,
+    forced: Option<IdentifiedModel>,
 }
 
 /// Whether `checks` (a system's) say the equations lose their runs: a retrace check failed.
@@ -200,7 +202,11 @@ pub(crate) fn by_resimulation(
         checks.iter().all(|c| c.passed) && share >= LONGER * retraced(&identified.model, frames).1
     };
     let kept = match best {
-        Some(b) if !own_best && follows(&b) => Some(forced(model, &paths, &b.fits, how, frames)?),
+        // identified with its terms forced once: for its score where it was refined
+        Some(b) if !own_best && follows(&b) => match b.forced {
+            Some(kept) => Some(kept),
+            None => Some(forced(model, &paths, &b.fits, how, frames)?),
+        },
         _ => None,
     };
     Some(Search { kept, tried, most_terms, refined, own_best })
@@ -222,16 +228,17 @@ fn score(
     frames: &[Frame],
     refined: bool,
 ) -> Option<Scored> {
-    let candidate = if refined {
-        let candidate = forced(model, paths, &fits, how, frames)?.model;
+    let (candidate, forced) = if refined {
+        let forced = forced(model, paths, &fits, how, frames)?;
         let options = super::RefineOptions::of_coarse_rows();
-        super::start::refine(&candidate, frames, None, &options, how.intercept).ok()?.model
+        let refined = super::start::refine(&forced.model, frames, None, &options, how.intercept).ok()?;
+        (refined.model, Some(forced))
     } else {
         let mut candidate = identified.model.clone();
         for (path, fit) in paths.iter().zip(&fits) {
             store_fit(&mut candidate, &path.name, fit).ok()?;
         }
-        candidate
+        (candidate, None)
     };
     let runs = super::start::output_error_runs(&candidate, frames, None, how.intercept).ok()?;
     let sims = runs.simulate(&candidate, &[], &[]).ok()?;
@@ -246,13 +253,12 @@ fn score(
     // terms': fitting them takes terms that no record asks for
     let floor = n * super::RESOLVED.powi(2);
     let criterion = n * (cost.max(floor) / n).ln() + k as f64 * n.ln();
-    Some(Scored { fits, criterion, model: candidate })
+    Some(Scored { fits, criterion, model: candidate, forced })
 }
 
 /// The share of a fit's target its chosen terms leave unexplained, 1 − R².
 fn unexplained(fit: &Fit) -> f64 {
-    let s = &fit.selection;
-    s.chosen_step.checked_sub(1).and_then(|k| s.steps.get(k)).map_or(1.0, |step| 1.0 - step.r2)
+    fit.selection.chosen_r2().map_or(1.0, |r2| 1.0 - r2)
 }
 
 /// A fit's chosen terms, sorted.

@@ -222,6 +222,12 @@ impl Selection {
         selection
     }
 
+    /// The chosen step's R² (the share of the target's variance its terms explain); `None`
+    /// where no term was chosen.
+    pub fn chosen_r2(&self) -> Option<f64> {
+        self.chosen_step.checked_sub(1).and_then(|k| self.steps.get(k)).map(|s| s.r2)
+    }
+
     /// The fitted terms after step `k` (1-based).
     pub fn terms_at(&self, k: usize) -> Vec<FittedTerm> {
         let Some(step) = k.checked_sub(1).and_then(|i| self.steps.get(i)) else { return vec![] };
