@@ -715,11 +715,7 @@ impl Runs {
     /// the inputs' resampling show in that difference. Factor 1 (the runs themselves) where no
     /// coarser step holds.
     pub fn coarsest(&self, model: &Model, fine: &[Trajectory], tolerance: f64, most: usize) -> (usize, Runs) {
-        let holds = |factor: usize| -> Option<Runs> {
-            let coarse = self.coarser(factor).ok()?;
-            let sims = coarse.simulate(model, &[], &[]).ok()?;
-            (self.largest_difference(fine, &sims, factor) <= tolerance).then_some(coarse)
-        };
+        let holds = |factor: usize| self.holding(model, fine, factor, tolerance);
         // runs compared at a schedule's samples only are not coarsened: a coarse grid would
         // pass between them
         if self.frames.iter().any(|f| f.recorded().is_some()) {
@@ -734,6 +730,15 @@ impl Runs {
             }
         }
         kept
+    }
+
+    /// These runs coarsened `factor` times ([`Runs::coarser`]) where `model` re-simulates them
+    /// there as it did at their samples (`fine`), within `tolerance` of each compared
+    /// quantity's scale; `None` where it does not.
+    pub fn holding(&self, model: &Model, fine: &[Trajectory], factor: usize, tolerance: f64) -> Option<Runs> {
+        let coarse = self.coarser(factor).ok()?;
+        let sims = coarse.simulate(model, &[], &[]).ok()?;
+        (self.largest_difference(fine, &sims, factor) <= tolerance).then_some(coarse)
     }
 
     /// The largest difference between two simulations of these runs, `a` at every sample and

@@ -76,9 +76,12 @@ pub struct Refined {
     /// Why it stopped.
     pub stopped: String,
     /// The step the runs were re-simulated at where a caller coarsened them
-    /// ([`Runs::coarser`]); the costs are then the runs' at every sample, the correlation time
-    /// in coarse steps.
+    /// ([`Runs::coarser`], `resampled`) or integrated them in finer steps than their samples
+    /// (to resolve the motion); the costs are then the runs' at every sample, the correlation
+    /// time in coarse steps where resampled.
     pub step: Option<f64>,
+    /// Whether the runs were resampled to `step` (coarser than their samples).
+    pub resampled: bool,
     /// Levenberg-Marquardt iterations taken (each one re-simulation; an accepted step also
     /// one linearisation).
     pub iterations: usize,
@@ -262,6 +265,7 @@ pub fn refine(model: &Model, runs: &Runs, settings: &RefineSettings<'_>) -> Resu
         validation,
         stopped,
         step: None,
+        resampled: false,
         iterations,
         correlation_time: tau,
         coefficients,
@@ -280,15 +284,20 @@ impl Refined {
             sig(r.cost_before, 4),
             sig(r.cost_after, 4),
             r.correlation_time.map_or("--".into(), |t| format!("{t:.0}")),
-            if r.step.is_some() { "steps" } else { "samples" },
+            if r.resampled { "steps" } else { "samples" },
             r.stopped,
             r.iterations
         );
-        if let Some(step) = r.step {
-            out += &format!(
-                "re-simulated at a step of {} s (the runs resampled, anti-aliased; there the regression's model re-simulates them as at their samples); the costs at every sample\n",
+        match r.step {
+            Some(step) if r.resampled => out += &format!(
+                "re-simulated at a step of {} s (the runs resampled, anti-aliased; there the regression's model and the refined one re-simulate them as at their samples); the costs at every sample\n",
                 sig(step, 3)
-            );
+            ),
+            Some(step) => out += &format!(
+                "integrated at a step of {} s, finer than the samples: the step that resolves the motion (the regression's model's and the refined one's)\n",
+                sig(step, 3)
+            ),
+            None => {}
         }
         if let Some((b, a)) = r.validation {
             out += &format!("validation runs (not fitted): {} → {}\n", sig(b, 4), sig(a, 4));

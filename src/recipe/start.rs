@@ -370,7 +370,8 @@ pub(super) fn refine(
     // the refined one: a census read yearly, ten samples a cycle, drifts in phase at one RK4
     // step a sample, which the refinement makes up for with coefficients 2 % off
     let mut finer = 1;
-    let (runs, validation, mut refined) = loop {
+    let mut coarsen = true;
+    let (runs, validation, mut refined, factor) = loop {
         let runs = match asked {
             Some(_) => runs.clone(),
             None => {
@@ -380,15 +381,24 @@ pub(super) fn refine(
             }
         };
         let validation = validation.as_ref().map(|v| v.finer(finer));
-        let refined = refine_at(model, (&runs, validation.as_ref()), options, (asked, finer, sample))?;
+        let refined =
+            refine_at(model, (&runs, validation.as_ref()), options, (asked, finer, sample), coarsen)?;
+        // a step coarser than the samples, chosen for the regression's model, must hold the
+        // refined one too: runs coarsened average away a motion faster than the regression's
+        // (a fast state's first samples, off the slow motion it then follows), which the
+        // refinement then cannot fit
+        let factor = refined.step.map_or(1, |step| (step / sample).round() as usize);
+        if asked.is_none() && factor > 1 && !coarse_holds(&runs, &refined.model, factor) {
+            coarsen = false;
+            continue;
+        }
         let finest = finer >= MOST_STEPS_PER_SAMPLE;
         if asked.is_none() && !finest && runs.step_error(&refined.model).is_some_and(|e| e > STEP_RESOLVES) {
             finer *= 2;
             continue;
         }
-        break (runs, validation, refined);
+        break (runs, validation, refined, factor);
     };
-    let factor = refined.step.map_or(1, |step| (step / sample).round() as usize);
     if factor > 1 || finer > 1 {
         // the costs the starts are judged by are the runs' own, at every sample
         let cost = |runs: &Runs, m: &Model| -> Result<f64, String> {
@@ -407,19 +417,27 @@ pub(super) fn refine(
     Ok(refined)
 }
 
+/// Whether `model` re-simulates `runs` coarsened `factor` times as at their samples.
+fn coarse_holds(runs: &Runs, model: &Model, factor: usize) -> bool {
+    runs.simulate(model, &[], &[])
+        .is_ok_and(|fine| runs.holding(model, &fine, factor, super::RESOLVED).is_some())
+}
+
 /// [`refine`] at the runs' step (`runs`, `validation`) where it is `finer` than a sample
-/// (no coarser one resolves the motion), else at the coarsest whole number of samples at which
-/// the regression's model re-simulates them as at their samples, or at the step `asked` (in
-/// samples of `sample`); its step set where that is coarser than a sample.
+/// (no coarser one resolves the motion) or where not to `coarsen`, else at the coarsest whole
+/// number of samples at which the regression's model re-simulates them as at their samples,
+/// or at the step `asked` (in samples of `sample`); its step set where that is coarser than a
+/// sample.
 fn refine_at(
     model: &Model,
     (runs, validation): (&Runs, Option<&Runs>),
     options: &RefineOptions,
     (asked, finer, sample): (Option<usize>, usize, f64),
+    coarsen: bool,
 ) -> Result<Refined, String> {
     let (factor, coarse) = match asked {
         Some(factor) => (factor, runs.coarser(factor).map_err(|e| e.to_string())?),
-        None if finer > 1 => (1, runs.clone()),
+        None if finer > 1 || !coarsen => (1, runs.clone()),
         None => {
             // the regression's model at every sample: what a coarser step is checked against
             let fine = runs.simulate(model, &[], &[]).map_err(|e| e.to_string())?;
@@ -435,6 +453,7 @@ fn refine_at(
     let mut refined = crate::diagnose::refine(model, &coarse, &settings).map_err(|e| format!("{e:#}"))?;
     if factor > 1 {
         refined.step = Some(sample * factor as f64);
+        refined.resampled = true;
     }
     Ok(refined)
 }
@@ -466,5 +485,25 @@ mod tests {
         let given = RefineOptions { step: Some(0.031), ..options };
         let r = refine(&model, &[f], None, &given, false).unwrap();
         assert!(r.step.is_some_and(|s| (s - 0.03).abs() < 1e-9), "{:?}", r.step);
+    }
+
+    /// A coarse step chosen for the regression's slow model does not hold a fast one: ẋ = u +
+    /// b·x from b = −0.05 to the runs' −20 (time constant 0.05 s, sampled every 0.1 s), whose
+    /// whole motion is in the first two samples. Coarsened eight times, the runs average it
+    /// away and RK4 at 0.8 s cannot hold b below −3.5; refined at the samples, in steps that
+    /// resolve it, b comes back.
+    #[test]
+    fn a_motion_faster_than_the_regression_s_is_refined_at_the_samples() {
+        let model = crate::diagnose::fixtures::lag("x", -0.05);
+        let t: Vec<f64> = (0..=100).map(|i| 0.1 * i as f64).collect();
+        let mut f = Frame::new("step", "t", t.clone()).unwrap();
+        f.push("x", t.iter().map(|t| (1.0 - (-20.0 * t).exp()) / 20.0).collect()).unwrap();
+        f.push("u", vec![1.0; t.len()]).unwrap();
+        let options = RefineOptions { states: None, prior: 0.0, iterations: 30, step: None };
+        let r = refine(&model, &[f], None, &options, false).unwrap();
+        let b = r.coefficients.iter().find(|c| c.term == "x").unwrap().refined;
+        assert!((b + 20.0).abs() < 0.2, "b = {b}");
+        assert!(!r.resampled && r.step.is_some_and(|s| s < 0.1), "{:?}", r.step);
+        assert!(r.text().contains("finer than the samples"), "{}", r.text());
     }
 }

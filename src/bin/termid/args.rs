@@ -399,9 +399,10 @@ pub struct IdentifyCommand {
     #[arg(allow_negative_numbers = true, long, value_name = "N", default_value_t = 30, requires = "refine")]
     pub refine_iterations: usize,
     /// With --refine: re-simulate and compare the runs at this step, s (resampled,
-    /// anti-aliased). Default: the coarsest whole number of samples, up to 8, at which every
-    /// run still holds its compared states and inputs (each, resampled and interpolated back,
-    /// within 1 % RMS of its spread); the costs reported are at every sample.
+    /// anti-aliased). Default: the coarsest whole number of samples, up to 8, at which the
+    /// regression's model and the refined one re-simulate the runs as at their samples (every
+    /// compared state within 0.1 % of its spread), or finer steps between the samples where
+    /// those do not resolve the motion; the costs reported are at every sample.
     #[arg(long, value_name = "SECONDS", requires = "refine")]
     pub refine_step: Option<f64>,
     /// With --refine: a dataset file of runs the refinement does not fit but is stopped by
