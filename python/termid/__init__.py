@@ -1272,7 +1272,8 @@ class Identified:
     (``steps`` and ``terms`` as DataFrames) and, for a model of no field's, its ``checks``
     (name, passed, refuses, detail): that the equations retrace the runs without running away,
     and how long they follow them, that they follow them as long as their own motion from a
-    nudged start follows itself, that their terms hold on each half of the runs, and that the
+    nudged start follows itself (and within the records' noise where it follows itself
+    throughout), that their terms hold on each half of the runs, and that the
     runs' noise leaves them unbiased (a ship's are :meth:`Model.checks`). Where the equations
     lose their runs, their terms are chosen again by re-simulation, as :meth:`notes` says.
 
@@ -2642,8 +2643,9 @@ class Model:
         """The plug-in's physical checks (stability, damping signs, turning circles), with
         ``runs`` to compare against where a check needs them; for a model of no field's, with
         ``runs``, that its equations retrace them without running away (and how long they
-        follow them), that they follow them as long as their own motion allows, and that their
-        noise leaves its terms unbiased.
+        follow them), that they follow them as long as their own motion allows (and within
+        the records' noise where that motion follows itself throughout), and that their noise
+        leaves its terms unbiased.
 
         >>> checks = termid.Model.default().checks()
         >>> {"name", "passed"} <= set(checks.columns)

@@ -1023,17 +1023,19 @@ def test_equations_that_run_away_from_a_coarse_run_are_chosen_again():
     x_dot = found.model.coefficients("x_dot").set_index("term")["value"]
     assert x_dot.to_dict() == pytest.approx({"x": 1.0, "x*z": -0.5}, rel=1e-3)
     # the check is kept with the fit, and asked of the model again with any runs
-    assert list(found.checks["passed"]) == [True] * 4 and found.checks["detail"][0].endswith("throughout")
-    # followed as long as its own motion from a nudged start follows itself
+    assert list(found.checks["passed"]) == [True] * 5 and found.checks["detail"][0].endswith("throughout")
+    # followed as long as its own motion from a nudged start follows itself, and within the
+    # records' noise
     assert found.checks["name"][1] == "the equations follow their runs as long as their own motion allows"
-    assert found.checks["name"][2] == "the terms hold on each half of the runs"
+    assert found.checks["name"][2] == "the equations re-simulate their runs within the records' noise"
+    assert found.checks["name"][3] == "the terms hold on each half of the runs"
     # noise-free: the records' noise is bounded far below the 2 % that biases the terms
-    assert found.checks["name"][3] == "the records' noise leaves the terms unbiased"
+    assert found.checks["name"][4] == "the records' noise leaves the terms unbiased"
     again = found.model.checks(coarse)
-    assert list(again["passed"])[:2] == [True, True]
+    assert list(again["passed"])[:3] == [True, True, True]
     # ten samples a cycle: the motion shows through the fourth differences, whose bound is
     # over 2 %: the noise is not told (it passed as "under 2.0 %")
-    assert not again["passed"][2] and again["detail"][2].startswith("not told: white noise of `x` at most")
+    assert not again["passed"][3] and again["detail"][3].startswith("not told: white noise of `x` at most")
 
 
 def test_a_run_without_its_model_s_time_column():

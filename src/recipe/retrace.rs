@@ -43,13 +43,25 @@ const NUDGES: [(f64, &str); 2] = [(0.01, "a hundredth"), (1e-4, "a ten-thousandt
 /// motion too sensitive to follow (chaos) but missed.
 const MISSED: f64 = 0.25;
 
+/// How many times its record's white noise (or [`super::RESOLVED`] of its span, where more) a
+/// state's re-simulation may be off its record, root mean square over a run whose equations'
+/// own motion follows itself throughout: a model that holds the motion is off by the noise of
+/// the records and of its coefficients' estimates alone. The ODE benchmark identified whole
+/// at 1 % noise: FitzHugh-Nagumo's recovered model, whose period the estimates' error shifts,
+/// drifts to 13 times its noise over its 30 s; the others stay within 10.
+const CLOSE: f64 = 20.0;
+
 /// The check that the equations stay within [`REACH`] spans of each run.
 const RETRACE_NAME: &str = "the equations retrace their runs without running away";
 
 /// The check that the equations follow each run as long as their own motion allows.
 const MISSED_NAME: &str = "the equations follow their runs as long as their own motion allows";
 
-/// Whether `check` is one of [`retrace_checks`].
+/// The check that the equations re-simulate a run they follow throughout within its noise.
+const CLOSE_NAME: &str = "the equations re-simulate their runs within the records' noise";
+
+/// Whether `check` is one of [`retrace_checks`] that a search by re-simulation answers (the
+/// equations run away, or lose their runs).
 pub(super) fn is_retrace(check: &Check) -> bool {
     check.name == RETRACE_NAME || check.name == MISSED_NAME
 }
@@ -69,7 +81,8 @@ pub fn retrace_checks(model: &Model, runs: &[Frame]) -> Vec<Check> {
 /// away from one or the checks cannot apply).
 pub(super) fn retraced(model: &Model, runs: &[Frame]) -> (Vec<Check>, f64) {
     let mut followed = Vec::new();
-    let Some(retrace) = retrace_check(model, runs, &mut followed) else { return (Vec::new(), 0.0) };
+    let mut off = Vec::new();
+    let Some(retrace) = retrace_check(model, runs, &mut followed, &mut off) else { return (Vec::new(), 0.0) };
     let share = match retrace.passed {
         true => followed.iter().map(|f| f.1 / f.2.max(f64::MIN_POSITIVE)).fold(1.0, f64::min),
         false => 0.0,
@@ -77,7 +90,64 @@ pub(super) fn retraced(model: &Model, runs: &[Frame]) -> (Vec<Check>, f64) {
     let states: Vec<String> = model.spec().states.iter().map(|s| s.name.clone()).collect();
     let coarse = crate::identify::coarsely_sampled(runs, &states);
     let missed = retrace.passed.then(|| missed_check(&followed, &coarse)).flatten();
-    (std::iter::once(retrace).chain(missed).collect(), share)
+    let close = retrace.passed.then(|| close_check(&off)).flatten();
+    (std::iter::once(retrace).chain(missed).chain(close).collect(), share)
+}
+
+/// How far a run's re-simulation is off it where the equations' own motion follows itself
+/// throughout: the run, and the state furthest off against what [`CLOSE`] allows it, with its
+/// root mean square off, its record's white noise and its span.
+struct Off {
+    run: String,
+    state: String,
+    rms: f64,
+    noise: f64,
+    span: f64,
+}
+
+impl Off {
+    /// What the state may be off: [`CLOSE`] times its noise, or [`super::RESOLVED`] of its
+    /// span where more (a record without noise).
+    fn allowed(&self) -> f64 {
+        (CLOSE * self.noise).max(super::RESOLVED * self.span)
+    }
+}
+
+/// The check that each run whose equations' own motion follows itself throughout (a motion
+/// no chaos or neutral cycle makes lose its start) is re-simulated within [`CLOSE`] times each
+/// state's noise: flagged (not refusing) where a state is further off, which the records'
+/// noise and the coefficients' estimates it leaves cannot explain (a stiff pair's fast state
+/// held only in its first samples, written in nonlinear terms its rows could not tell from
+/// the system's: followed within a tenth throughout, off by 500 times the noise). `None`
+/// where no run's own motion follows itself throughout.
+fn close_check(off: &[Off]) -> Option<Check> {
+    let worst = off.iter().max_by(|a, b| (a.rms / a.allowed()).total_cmp(&(b.rms / b.allowed())))?;
+    let sig = |v: f64| crate::output::sig(v, 2);
+    let share = |v: f64| format!("{} %", sig(100.0 * v / worst.span));
+    let passed = worst.rms <= worst.allowed();
+    let detail = match passed {
+        true => format!(
+            "{} run(s) re-simulated within {CLOSE} times each state's noise (or a thousandth of its span, where more): at most `{}` of {}, {} of its span (root mean square) for noise of {}",
+            off.len(),
+            worst.state,
+            worst.run,
+            share(worst.rms),
+            share(worst.noise)
+        ),
+        false => format!(
+            "{}: `{}` re-simulated {} of its span off its record (root mean square), {} times as far as allowed ({}), where the equations' own motion follows itself throughout: a model that holds the motion is off by the records' noise ({}) and its coefficients' uncertainty alone; the equations miss part of what the run holds (a term the candidates lack, or one the rows could not tell from the terms chosen, such as a fast state's, which its rows hold only where it follows the others): read them as approximate",
+            worst.run,
+            worst.state,
+            share(worst.rms),
+            sig(worst.rms / worst.allowed()),
+            match CLOSE * worst.noise >= super::RESOLVED * worst.span {
+                true => format!("{CLOSE} times its noise"),
+                false => "a thousandth of its span, for a record without noise".into(),
+            },
+            share(worst.noise)
+        ),
+    };
+    Some(Check { name: CLOSE_NAME.into(), passed, refuses: false, detail, measure: None })
 }
 
 /// How long a run is followed: its origin, the time the re-simulation from its start stays
@@ -183,7 +253,12 @@ fn missed_check(followed: &[Followed], coarse: &[(String, f64)]) -> Option<Check
 
 /// The check that `model` stays within ten spans of each run ([`retrace_checks`]), with how
 /// long each run is followed pushed onto `followed`.
-fn retrace_check(model: &Model, runs: &[Frame], followed: &mut Vec<Followed>) -> Option<Check> {
+fn retrace_check(
+    model: &Model,
+    runs: &[Frame],
+    followed: &mut Vec<Followed>,
+    off: &mut Vec<Off>,
+) -> Option<Check> {
     // the states and inputs
     let names = model.vocabulary.variables();
     if runs.is_empty() || runs.iter().any(|r| names.iter().any(|n| r.column(n).is_none())) {
@@ -269,6 +344,9 @@ fn retrace_check(model: &Model, runs: &[Frame], followed: &mut Vec<Followed>) ->
         let (start, end) = (sim.time[0], sim.time[sim.time.len() - 1]);
         let until = sim.time.get(left).map_or(end, |&t| t);
         let own = own_motion(model, &run, step, &sim, &spans).map(|(t, off)| (t - start, off));
+        if own.as_ref().is_ok_and(|(t, _)| *t >= end - start) {
+            off.extend(furthest_off(&run, &sim, &spans));
+        }
         followed.push((run.origin().to_string(), until - start, end - start, own, noisy));
     }
     // the run followed for the least share of its length
@@ -292,6 +370,25 @@ fn retrace_check(model: &Model, runs: &[Frame], followed: &mut Vec<Followed>) ->
             runs.len()
         ),
     ))
+}
+
+/// The state of `run` its re-simulation `sim` is furthest off, against what [`CLOSE`] allows
+/// it (`spans` by name).
+fn furthest_off(run: &Frame, sim: &crate::sim::Trajectory, spans: &[(String, f64)]) -> Option<Off> {
+    sim.state_names
+        .iter()
+        .zip(&sim.states)
+        .filter_map(|(name, values)| {
+            let recorded = run.column(name)?;
+            let (_, span) = spans.iter().find(|(n, _)| n == name)?;
+            let n = values.len().min(recorded.len());
+            let rms =
+                (values.iter().zip(recorded).map(|(v, r)| (v - r).powi(2)).sum::<f64>() / n as f64).sqrt();
+            let noise = crate::data::white_noise(recorded).map_or(0.0, |n| n.sd);
+            let state = name.clone();
+            Some(Off { run: run.origin().to_string(), state, rms, noise, span: *span })
+        })
+        .max_by(|a, b| (a.rms / a.allowed()).total_cmp(&(b.rms / b.allowed())))
 }
 
 /// The time until which `model`'s motion from `run`'s start nudged by the first of
@@ -468,8 +565,13 @@ mod tests {
     fn equations_that_lose_their_run_long_before_their_own_motion_are_flagged() {
         let model = Model::parse(&GROWTH.replace("\"x\" = 0.5", "\"x\" = -0.5"), "decay.toml").unwrap();
         let own = retrace_checks(&model, &[run(|t| (-t / 2.0).exp())]);
-        assert!(own.len() == 2 && own.iter().all(|c| c.passed), "{own:?}");
+        assert!(own.len() == 3 && own.iter().all(|c| c.passed), "{own:?}");
         assert!(own[1].detail.contains("follows itself throughout each run"), "{}", own[1].detail);
+        assert!(
+            own[2].name == CLOSE_NAME && own[2].detail.contains("re-simulated within 20 times"),
+            "{}",
+            own[2].detail
+        );
         let swings = retrace_checks(&model, &[run(f64::cos)]);
         assert!(swings[0].passed, "{}", swings[0].detail);
         assert!(!swings[1].passed && !swings[1].refuses, "{}", swings[1].detail);
@@ -478,5 +580,35 @@ mod tests {
             said.contains("for 1.30 s of 20.0 s") && said.contains("follows itself throughout its 20.0 s"),
             "{said}"
         );
+    }
+
+    /// ẋ = −x/2 against a decay at 0.45 (noise-free): followed within a tenth of the span
+    /// throughout (3.9 % of it at most), and its own motion follows itself throughout, but the
+    /// re-simulation is off by 1.7 % of the span, 17 times the thousandth a record without
+    /// noise is allowed: flagged, not refusing. Against a run with noise of 1 % of the span the
+    /// same model is within twenty times that noise: ok.
+    #[test]
+    fn equations_off_their_run_by_more_than_its_noise_are_flagged() {
+        let model = Model::parse(&GROWTH.replace("\"x\" = 0.5", "\"x\" = -0.5"), "decay.toml").unwrap();
+        let checks = retrace_checks(&model, &[run(|t| (-0.45 * t).exp())]);
+        assert!(checks[0].passed && checks[0].detail.ends_with("throughout"), "{}", checks[0].detail);
+        let close = &checks[2];
+        assert!(close.name == CLOSE_NAME && !close.passed && !close.refuses, "{close:?}");
+        assert!(
+            close.detail.starts_with("run.csv: `x` re-simulated 1.7 % of its span off its record (root mean square), 17 times as far as allowed (a thousandth of its span, for a record without noise)"),
+            "{}",
+            close.detail
+        );
+        // uniform deviates of the spread of normal ones of sd 0.01, one a sample
+        let mut state = 7u64;
+        let noise: Vec<f64> = (0..=200)
+            .map(|_| {
+                state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.01 * 12f64.sqrt()
+            })
+            .collect();
+        let noisy = run(|t| (-0.45 * t).exp() + noise[(t * 10.0).round() as usize]);
+        let close = retrace_checks(&model, &[noisy]).remove(2);
+        assert!(close.passed, "{}", close.detail);
     }
 }

@@ -474,8 +474,10 @@ fn each_run_is_diagnosed_with_its_own_nuisances() {
 /// The laws a polynomial library only approximates, named by `diagnose`: an oscillator with
 /// dry (Coulomb) friction, ẍ = −4x − 0.5·sign(ẋ), and a tank draining through an orifice,
 /// ḣ = −0.1·√h (Torricelli), each in closed form. Identified from their columns with the
-/// cubic library, both follow their runs with every check "ok" (a viscous −0.40ẋ + 0.024ẋ³
-/// for the friction, which never stops, and a cubic in h that drains below empty); the
+/// cubic library, both follow their runs within a tenth of their spans (a viscous −0.40ẋ +
+/// 0.024ẋ³ for the friction, which never stops, and a cubic in h that drains below empty
+/// beyond the run); the friction's is off its noise-free run by 0.67 % of the rate's span,
+/// flagged (every check read "ok"), the tank's within its run by a millionth, ok. The
 /// diagnosis found "none of those tested". It now names the law, with its coefficient.
 #[test]
 fn laws_beyond_a_polynomial_are_named_with_their_coefficients() {
@@ -497,16 +499,20 @@ fn laws_beyond_a_polynomial_are_named_with_their_coefficients() {
         friction += &format!("{t},{x},{v}\n");
         tank += &format!("{t},{}\n", (2.0 - 0.05 * t).powi(2));
     }
-    for (name, text, states, law, want) in [
-        ("friction", friction, "x,v", "`sign(v)` in v_dot, beyond the candidates", -0.5),
-        ("tank", tank, "h", "`sqrt(abs(h))` in h_dot, beyond the candidates", -0.1),
+    let off = "FLAG the equations re-simulate their runs within the records' noise";
+    for (name, text, states, law, want, flags) in [
+        ("friction", friction, "x,v", "`sign(v)` in v_dot, beyond the candidates", -0.5, 1),
+        ("tank", tank, "h", "`sqrt(abs(h))` in h_dot, beyond the candidates", -0.1, 0),
     ] {
         let (data, model) = (dir.join(format!("{name}.csv")), dir.join(format!("{name}.toml")));
         std::fs::write(&data, text).unwrap();
         let (data, model) = (data.to_str().unwrap(), model.to_str().unwrap());
         let (ok, out, err) =
             crate::common::termid(&["identify", "--data", data, "--states", states, "--out", model]);
-        assert!(ok && !out.contains("FLAG"), "{name}: {err}{out}");
+        assert!(
+            ok && out.matches("FLAG").count() == flags && out.matches(off).count() == flags,
+            "{name}: {err}{out}"
+        );
         let (ok, out, err) =
             crate::common::termid(&["diagnose", "--model", model, "--data", data, "--format", "json"]);
         assert!(ok, "{name}: {err}");
