@@ -154,8 +154,16 @@ fn close_check(off: &[Off]) -> Option<Check> {
 /// within a tenth of each state's span of it, the run's length, and the time the same
 /// equations' motion from a start nudged by one of [`NUDGES`] stays so of it (s) with that
 /// nudge's words, or why that motion could not be simulated (it runs away from each).
-/// And whether a state's noise was more than a tenth of its span in the run ([`NOISE_FOLLOWED`]).
-type Followed = (String, f64, f64, Result<(f64, &'static str), String>, bool);
+/// And whether a state's noise was more than a tenth of its span in the run ([`NOISE_FOLLOWED`]),
+/// and its sample step (s) as re-simulated.
+type Followed = (String, f64, f64, Result<(f64, &'static str), String>, bool, f64);
+
+/// The fewest samples of a run the equations' own motion is taken to follow itself for: a
+/// motion that loses a start a hundredth of its span off within fewer is one no record sampled
+/// so could hold as the run holds its motion, not chaos the run shows (a stiff pair's fast
+/// state refined into a motion that loses itself within 3 samples of 1 000, the run itself
+/// followed 1 sample, read "ok").
+const FEWEST_SAMPLES: f64 = 10.0;
 
 /// How closely a run is said to be followed: a tenth of each span, or where the run's noise
 /// set it, that too.
@@ -188,15 +196,23 @@ fn missed_check(followed: &[Followed], coarse: &[(String, f64)]) -> Option<Check
     let followed: Vec<&Followed> = followed.iter().filter(|f| f.3.is_ok()).collect();
     let own = |f: &Followed| f.3.as_ref().map_or(0.0, |t| t.0);
     let off = |f: &Followed| f.3.as_ref().map_or(NUDGES[0].1, |t| t.1);
-    let allows = |f: &Followed| own(f).min(f.2);
+    let allows = |f: &Followed| own(f).max(FEWEST_SAMPLES * f.5).min(f.2);
     let missed = followed.iter().copied().filter(|f| f.1 < f.2 && f.1 < MISSED * allows(f)).min_by(|a, b| {
         (a.1 / allows(a).max(f64::MIN_POSITIVE)).total_cmp(&(b.1 / allows(b).max(f64::MIN_POSITIVE)))
     });
     let sig = |v: f64| crate::output::sig(v, 3);
-    if let Some(f @ (origin, until, of, _, noisy)) = missed {
+    if let Some(f @ (origin, until, of, _, noisy, step)) = missed {
         let (own, off) = (own(f), off(f));
-        let own =
-            if own >= *of { format!("throughout its {} s", sig(*of)) } else { format!("for {} s", sig(own)) };
+        let own = match own {
+            t if t >= *of => format!("throughout its {} s", sig(*of)),
+            t if t < FEWEST_SAMPLES * step => format!(
+                "for {} s, {} sample(s) (a motion that sensitive no record sampled every {} s could hold as this one holds its motion)",
+                sig(t),
+                (t / step).round(),
+                sig(*step)
+            ),
+            t => format!("for {} s", sig(t)),
+        };
         let closer = match off == NUDGES[0].1 {
             true => String::new(),
             false => format!(" (from {} off they run away)", NUDGES[0].1),
@@ -347,14 +363,14 @@ fn retrace_check(
         if own.as_ref().is_ok_and(|(t, _)| *t >= end - start) {
             off.extend(furthest_off(&run, &sim, &spans));
         }
-        followed.push((run.origin().to_string(), until - start, end - start, own, noisy));
+        followed.push((run.origin().to_string(), until - start, end - start, own, noisy, step));
     }
     // the run followed for the least share of its length
     let least = followed
         .iter()
         .min_by(|a, b| (a.1 / a.2.max(f64::MIN_POSITIVE)).total_cmp(&(b.1 / b.2.max(f64::MIN_POSITIVE))));
     let follow = match least {
-        Some((origin, until, of, _, noisy)) if until < of => format!(
+        Some((origin, until, of, _, noisy, _)) if until < of => format!(
             "; they follow them {} for {} s of {} s ({origin}{})",
             within(*noisy),
             crate::output::sig(*until, 3),
@@ -579,6 +595,33 @@ mod tests {
         assert!(
             said.contains("for 1.30 s of 20.0 s") && said.contains("follows itself throughout its 20.0 s"),
             "{said}"
+        );
+    }
+
+    /// ẋ = 20x(1 − x) from 0.01 rises to 1 within half a second, where the run drifts from
+    /// 0.01 to 0.21 over 20 s: bounded (the retrace passes), followed 0.2 s; its own motion from
+    /// a start a hundredth of the run's span off loses itself within two samples of the rise,
+    /// and that is no chaos the run's smooth samples could show: taken as ten samples, the run
+    /// is lost long before (it read "ok").
+    #[test]
+    fn a_motion_lost_within_a_few_samples_is_no_excuse() {
+        let model = Model::parse(
+            &GROWTH
+                .replace("\"x\" = 0.5", "\"x\" = 20.0, \"x^2\" = -20.0")
+                .replace("[\"x\"]", "[\"x\", \"x^2\"]"),
+            "logistic.toml",
+        )
+        .unwrap();
+        let checks = retrace_checks(&model, &[run(|t| 0.01 + t / 100.0)]);
+        assert!(checks[0].passed, "{}", checks[0].detail);
+        let missed = &checks[1];
+        assert!(!missed.passed && !missed.refuses, "{}", missed.detail);
+        assert!(
+            missed
+                .detail
+                .contains("sample(s) (a motion that sensitive no record sampled every 0.100 s could hold"),
+            "{}",
+            missed.detail
         );
     }
 
