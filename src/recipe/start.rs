@@ -462,17 +462,26 @@ fn refine_at(
 mod tests {
     use super::*;
 
+    /// The step response of ẋ = u + b·x (u = 1, from 0) sampled every `step` s for `samples`:
+    /// x = (1 − e^(bt))/−b.
+    fn step_response(b: f64, step: f64, samples: usize) -> Frame {
+        let t: Vec<f64> = (0..=samples).map(|i| step * i as f64).collect();
+        let mut f = Frame::new("step", "t", t.clone()).unwrap();
+        f.push("x", t.iter().map(|t| (1.0 - (b * t).exp()) / -b).collect()).unwrap();
+        f.push("u", vec![1.0; t.len()]).unwrap();
+        f
+    }
+
+    /// Every coefficient refined freely, every state compared, at the step the refinement chooses.
+    const FREE: RefineOptions = RefineOptions { states: None, prior: 0.0, iterations: 30, step: None };
+
     /// The refinement goes at the coarsest step the model allows, and its costs are the runs'
     /// at every sample: ẋ = u + b·x from b = −0.3 to the runs' −0.5.
     #[test]
     fn a_coarse_refinement_reports_the_costs_at_every_sample() {
         let model = crate::diagnose::fixtures::lag("x", -0.3);
-        let t: Vec<f64> = (0..=1000).map(|i| 0.01 * i as f64).collect();
-        let mut f = Frame::new("step", "t", t.clone()).unwrap();
-        f.push("x", t.iter().map(|t| (1.0 - (-0.5 * t).exp()) / 0.5).collect()).unwrap();
-        f.push("u", vec![1.0; t.len()]).unwrap();
-        let options = RefineOptions { states: None, prior: 0.0, iterations: 30, step: None };
-        let r = refine(&model, std::slice::from_ref(&f), None, &options, false).unwrap();
+        let f = step_response(-0.5, 0.01, 1000);
+        let r = refine(&model, std::slice::from_ref(&f), None, &FREE, false).unwrap();
         assert!(r.step.is_some_and(|s| (s - 0.08).abs() < 1e-9), "{:?}", r.step);
         let b = r.coefficients.iter().find(|c| c.term == "x").unwrap().refined;
         assert!((b + 0.5).abs() < 1e-3, "b = {b}");
@@ -482,7 +491,7 @@ mod tests {
         assert_eq!(r.cost_after, at_samples(&r.model));
         assert!(r.text().contains("re-simulated at a step of 0.08"), "{}", r.text());
         // a step given is taken, to the nearest whole number of samples
-        let given = RefineOptions { step: Some(0.031), ..options };
+        let given = RefineOptions { step: Some(0.031), ..FREE };
         let r = refine(&model, &[f], None, &given, false).unwrap();
         assert!(r.step.is_some_and(|s| (s - 0.03).abs() < 1e-9), "{:?}", r.step);
     }
@@ -495,12 +504,7 @@ mod tests {
     #[test]
     fn a_motion_faster_than_the_regression_s_is_refined_at_the_samples() {
         let model = crate::diagnose::fixtures::lag("x", -0.05);
-        let t: Vec<f64> = (0..=100).map(|i| 0.1 * i as f64).collect();
-        let mut f = Frame::new("step", "t", t.clone()).unwrap();
-        f.push("x", t.iter().map(|t| (1.0 - (-20.0 * t).exp()) / 20.0).collect()).unwrap();
-        f.push("u", vec![1.0; t.len()]).unwrap();
-        let options = RefineOptions { states: None, prior: 0.0, iterations: 30, step: None };
-        let r = refine(&model, &[f], None, &options, false).unwrap();
+        let r = refine(&model, &[step_response(-20.0, 0.1, 100)], None, &FREE, false).unwrap();
         let b = r.coefficients.iter().find(|c| c.term == "x").unwrap().refined;
         assert!((b + 20.0).abs() < 0.2, "b = {b}");
         assert!(!r.resampled && r.step.is_some_and(|s| s < 0.1), "{:?}", r.step);
