@@ -111,6 +111,11 @@ impl Off {
     fn allowed(&self) -> f64 {
         (CLOSE * self.noise).max(super::RESOLVED * self.span)
     }
+
+    /// How far off it is against what it may be.
+    fn ratio(&self) -> f64 {
+        self.rms / self.allowed()
+    }
 }
 
 /// The check that each run whose equations' own motion follows itself throughout (a motion
@@ -122,7 +127,7 @@ impl Off {
 /// noise). `None`
 /// where no run's own motion follows itself throughout.
 fn close_check(off: &[Off]) -> Option<Check> {
-    let worst = off.iter().max_by(|a, b| (a.rms / a.allowed()).total_cmp(&(b.rms / b.allowed())))?;
+    let worst = off.iter().max_by(|a, b| a.ratio().total_cmp(&b.ratio()))?;
     let sig = |v: f64| crate::output::sig(v, 2);
     let share = |v: f64| format!("{} %", sig(100.0 * v / worst.span));
     let passed = worst.rms <= worst.allowed();
@@ -140,7 +145,7 @@ fn close_check(off: &[Off]) -> Option<Check> {
             worst.run,
             worst.state,
             share(worst.rms),
-            sig(worst.rms / worst.allowed()),
+            sig(worst.ratio()),
             match CLOSE * worst.noise >= super::RESOLVED * worst.span {
                 true => format!("{CLOSE} times its noise"),
                 false => "a thousandth of its span, for a record without noise".into(),
@@ -325,7 +330,7 @@ fn retrace_check(
             }
         };
         let mut left = sim.time.len();
-        let (mut spans, mut noises) = (Vec::new(), Vec::new());
+        let (mut spans, mut offs) = (Vec::new(), Vec::new());
         let mut noisy = false;
         for (name, values) in sim.state_names.iter().zip(&sim.states) {
             let Some(recorded) = run.column(name) else { continue };
@@ -337,7 +342,10 @@ fn retrace_check(
             // (the last flight of a bouncing ball, its height's noise a tenth of the flight's
             // span: "followed 0.04 s of 0.21 s" by the exact equations)
             let noise = crate::data::white_noise(recorded).map_or(0.0, |n| n.sd);
-            noises.push(noise);
+            let n = values.len().min(recorded.len());
+            let rms =
+                (values.iter().zip(recorded).map(|(v, r)| (v - r).powi(2)).sum::<f64>() / n as f64).sqrt();
+            offs.push(Off { run: run.origin().to_string(), state: name.clone(), rms, noise, span });
             let within = (FOLLOWED * span).max(NOISE_FOLLOWED * noise);
             noisy |= within > FOLLOWED * span;
             if let Some(k) = values.iter().zip(recorded).position(|(v, r)| (v - r).abs() > within) {
@@ -362,8 +370,9 @@ fn retrace_check(
         let (start, end) = (sim.time[0], sim.time[sim.time.len() - 1]);
         let until = sim.time.get(left).map_or(end, |&t| t);
         let own = own_motion(model, &run, step, &sim, &spans).map(|(t, off)| (t - start, off));
+        // the state furthest off, where the own motion follows itself throughout
         if own.as_ref().is_ok_and(|(t, _)| *t >= end - start) {
-            off.extend(furthest_off(&run, &sim, &spans, &noises));
+            off.extend(offs.into_iter().max_by(|a, b| a.ratio().total_cmp(&b.ratio())));
         }
         followed.push((run.origin().to_string(), until - start, end - start, own, noisy, step));
     }
@@ -388,28 +397,6 @@ fn retrace_check(
             runs.len()
         ),
     ))
-}
-
-/// The state of `run` its re-simulation `sim` is furthest off, against what [`CLOSE`] allows
-/// it (the recorded states' `spans` by name and white `noises`, in their order).
-fn furthest_off(
-    run: &Frame,
-    sim: &crate::sim::Trajectory,
-    spans: &[(String, f64)],
-    noises: &[f64],
-) -> Option<Off> {
-    spans
-        .iter()
-        .zip(noises)
-        .filter_map(|((name, span), noise)| {
-            let values = &sim.states[sim.state_names.iter().position(|n| n == name)?];
-            let recorded = run.column(name)?;
-            let n = values.len().min(recorded.len());
-            let rms =
-                (values.iter().zip(recorded).map(|(v, r)| (v - r).powi(2)).sum::<f64>() / n as f64).sqrt();
-            Some(Off { run: run.origin().to_string(), state: name.clone(), rms, noise: *noise, span: *span })
-        })
-        .max_by(|a, b| (a.rms / a.allowed()).total_cmp(&(b.rms / b.allowed())))
 }
 
 /// The time until which `model`'s motion from `run`'s start nudged by the first of
@@ -648,13 +635,9 @@ mod tests {
             close.detail
         );
         // uniform deviates of the spread of normal ones of sd 0.01, one a sample
-        let mut state = 7u64;
-        let noise: Vec<f64> = (0..=200)
-            .map(|_| {
-                state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-                ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.01 * 12f64.sqrt()
-            })
-            .collect();
+        let mut seed = 7u64;
+        let noise: Vec<f64> =
+            (0..=200).map(|_| crate::data::test_noise(&mut seed) * 0.01 * 12f64.sqrt()).collect();
         let noisy = run(|t| (-0.45 * t).exp() + noise[(t * 10.0).round() as usize]);
         let close = retrace_checks(&model, &[noisy]).remove(2);
         assert!(close.passed, "{}", close.detail);
