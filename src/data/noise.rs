@@ -323,6 +323,12 @@ impl NoiseTally {
         })
     }
 
+    /// The noise's standard deviation as [`NoiseTally::share`] reads it (measured, or a bound).
+    pub fn sd(&self) -> Option<f64> {
+        let spread = (self.m2 / self.rows.max(1) as f64).sqrt();
+        self.share().map(|(share, _)| share * spread)
+    }
+
     /// Whether the noise measured read correlated from sample to sample in most of its rows:
     /// the share is then a lower bound.
     pub fn correlated(&self) -> bool {
