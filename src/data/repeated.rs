@@ -215,7 +215,8 @@ pub fn fits_better_held_than_a_line(
 }
 
 /// A window that holds a jump is misfitted held where its residual exceeds this many times the
-/// root mean square of the windows without one: a jump held a whole interval off its instant
+/// fit's error of prediction there (the root mean square of the windows without one, grown by
+/// how far the window's columns lie from theirs: σ√(1 + h), h its leverage): a jump held a whole interval off its instant
 /// errs by the jump times the interval, far beyond a smooth window's quadrature and noise,
 /// where a jump at a sample fits held as well as any window.
 pub(super) const MISFIT: f64 = 5.0;
@@ -240,8 +241,8 @@ pub struct Jumps {
 /// sample after it acted (a command's log late by a sample) fits once it acts an interval
 /// earlier. The rate of each state that moves by itself, over windows of eight samples,
 /// regressed as in [`fits_better_held_than_a_line`] on the windows without a jump, and the
-/// windows with one held against that fit. `None` where the record is too short for the
-/// columns or too few windows are without a jump.
+/// windows with one held against that fit ([`MISFIT`] of its error of prediction at each).
+/// `None` where the record is too short for the columns or too few windows are without a jump.
 pub fn jumps_off_the_samples(t: &[f64], x: &[f64], motion: &[&[f64]], others: &[&[f64]]) -> Option<Jumps> {
     let n = t.len().min(FIT_ROWS);
     let terms = quadratic_terms(others.len() + 1);
@@ -430,6 +431,9 @@ fn held_or_else(
                     .copied()
                     .filter(|&(a, b)| a.is_some_and(|i| i > 0) && b != Some(0))
                     .collect();
+                if theirs.is_empty() {
+                    return None;
+                }
                 let (ends, _) = scaled(
                     nalgebra::DMatrix::from_fn(windows, theirs.len(), |row, c| {
                         at(theirs[c], (kept[row] + 1) * w) - at(theirs[c], kept[row] * w)

@@ -111,9 +111,9 @@ struct Off {
 }
 
 impl Off {
-    /// What the state may be off: [`CLOSE`] times its noise, or [`super::RESOLVED`] of its
-    /// span where more (a record without noise), and what its inputs' switches between
-    /// samples make of it besides.
+    /// What the state may be off: [`CLOSE`] times its noise and what its inputs' noise makes of
+    /// it, or [`super::RESOLVED`] of its span where more (a record without noise), and what its
+    /// inputs' switches between samples make of it besides.
     fn allowed(&self) -> f64 {
         (CLOSE * (self.noise + self.inputs)).max(super::RESOLVED * self.span) + self.instants
     }
@@ -480,8 +480,8 @@ const INPUTS_SEED: u64 = 17;
 
 /// What the white noise of `run`'s measured inputs makes of each state of `model` re-simulated:
 /// the root mean square between `sim`, its replay under the inputs as recorded, and a replay
-/// under them with another draw of the same noise added (each input's [`crate::data::white_noise`]
-/// at its samples) — as far as a replay of the true equations under the recorded inputs is off
+/// under them with another draw of the same noise added (each input's, [`noise_of`]) — as far
+/// as a replay of the true equations under the recorded inputs is off
 /// the motion they made (a mass-spring-damper under a force measured with 2 % noise, its
 /// states without: the equations within 0.2 % of the truth, 0.17 % of the rate's span off,
 /// flagged). Empty where no input is noisy, or a replay cannot be made.
@@ -507,8 +507,8 @@ fn inputs_noise(model: &Model, run: &Frame, step: f64, sim: &crate::sim::Traject
 /// The white noise of column `name` of `run` as the noise check reads it
 /// ([`crate::data::NoiseTally::of`]): what inputs held between samples explain of its
 /// differences is motion, and such an input is its generator's exact values (a state driven by
-/// a random excitation stepped each sample read 4.5 % of noise it did not have, the excitation
-/// itself all noise); at the record's own samples where it was resampled onto a finer grid
+/// a random excitation stepped each sample read 4.5-5.5 % of noise it did not have, the
+/// excitation itself all noise); at the record's own samples where it was resampled onto a finer grid
 /// (a logger's jitter: the cubic's rows between noisy samples are smooth, their noise read
 /// 0.015 % for 1 %). 0 where none is found.
 fn noise_of(run: &Frame, name: &str) -> f64 {
@@ -597,6 +597,19 @@ mod tests {
 
     const GROWTH: &str = "[model]\nname = \"growth\"\nintercept = false\n[[states]]\nname = \"x\"\n\
         [equations.x_dot]\nstate = \"x\"\ncandidates = [\"x\"]\ncoefficients = { \"x\" = 0.5 }\n";
+
+    /// ẋ = the sum of `terms` (term, coefficient) over a state x and an input u.
+    fn driven(terms: &[(&str, f64)]) -> Model {
+        let names: Vec<String> = terms.iter().map(|(t, _)| format!("\"{t}\"")).collect();
+        let values: Vec<String> = terms.iter().map(|(t, c)| format!("\"{t}\" = {c:?}")).collect();
+        let text = format!(
+            "[model]\nname = \"driven\"\nintercept = false\n[[states]]\nname = \"x\"\n[[inputs]]\nname = \"u\"\n\
+             [equations.x_dot]\nstate = \"x\"\ncandidates = [{}]\ncoefficients = {{ {} }}\n",
+            names.join(", "),
+            values.join(", ")
+        );
+        Model::parse(&text, "driven.toml").unwrap()
+    }
 
     fn run(x: impl Fn(f64) -> f64) -> Frame {
         let t: Vec<f64> = (0..=200).map(|k| k as f64 * 0.1).collect();
@@ -786,12 +799,7 @@ mod tests {
     /// allowed too: ok. Where the input is recorded without noise, that is not worth saying.
     #[test]
     fn a_noisy_input_allows_what_its_noise_makes_of_the_states() {
-        let model = Model::parse(
-            "[model]\nname = \"lag\"\nintercept = false\n[[states]]\nname = \"x\"\n[[inputs]]\nname = \"u\"\n\
-             [equations.x_dot]\nstate = \"x\"\ncandidates = [\"x\", \"u\"]\ncoefficients = { \"x\" = -1.0, \"u\" = 1.0 }\n",
-            "lag.toml",
-        )
-        .unwrap();
+        let model = driven(&[("x", -1.0), ("u", 1.0)]);
         let w: f64 = 0.5;
         let t: Vec<f64> = (0..=400).map(|k| k as f64 * 0.1).collect();
         // ẋ = −x + sin ωt from rest
@@ -819,16 +827,7 @@ mod tests {
     /// model is flagged and the exact one is not.
     #[test]
     fn a_held_excitation_is_no_noise_to_allow() {
-        let lag = |damping: f64| {
-            Model::parse(
-                &format!(
-                    "[model]\nname = \"lag\"\nintercept = false\n[[states]]\nname = \"x\"\n[[inputs]]\nname = \"u\"\n\
-                     [equations.x_dot]\nstate = \"x\"\ncandidates = [\"x\", \"u\"]\ncoefficients = {{ \"x\" = {damping}, \"u\" = 1.0 }}\n"
-                ),
-                "lag.toml",
-            )
-            .unwrap()
-        };
+        let lag = |damping: f64| driven(&[("x", damping), ("u", 1.0)]);
         let h: f64 = 0.05;
         let mut seed = 13u64;
         let u: Vec<f64> = (0..800).map(|_| 3.0 * crate::data::test_noise(&mut seed)).collect();
@@ -858,12 +857,7 @@ mod tests {
     /// interval late: 10 % off), nothing is allowed for instants: flagged.
     #[test]
     fn switches_between_samples_allow_what_their_instants_may_make() {
-        let model = Model::parse(
-            "[model]\nname = \"integrator\"\nintercept = false\n[[states]]\nname = \"x\"\n[[inputs]]\nname = \"u\"\n\
-             [equations.x_dot]\nstate = \"x\"\ncandidates = [\"u\"]\ncoefficients = { \"u\" = 1.0 }\n",
-            "integrator.toml",
-        )
-        .unwrap();
+        let model = driven(&[("u", 1.0)]);
         let (h, at) = (0.01, 0.01 / 3.0);
         let t: Vec<f64> = (0..=1000).map(|k| k as f64 * h).collect();
         // the switch instants at 0.1 j + h/3; x integrates the square wave exactly
