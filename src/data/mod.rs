@@ -463,6 +463,10 @@ pub struct Frame {
     /// (a sampling schedule's), which rows are samples: a re-simulation is compared at those
     /// only, as the rows between are the interpolation's. `None`: every row is a sample.
     recorded: Option<Vec<bool>>,
+    /// The columns that repeated a slower sensor's readings, now read at them and
+    /// interpolated between ([`read_at_readings`]), with the rows that are readings: their
+    /// noise is the readings'.
+    readings: Vec<(String, Repeats)>,
 }
 
 impl Frame {
@@ -482,6 +486,7 @@ impl Frame {
             file_rows: None,
             text: vec![],
             recorded: None,
+            readings: vec![],
         };
         f.push(time_name, time)?;
         Ok(f)
@@ -754,6 +759,19 @@ impl Frame {
         self
     }
 
+    /// Where column `name` repeated a slower sensor's readings and was read at them
+    /// ([`read_at_readings`]), the rows that are readings.
+    pub fn readings_of(&self, name: &str) -> Option<Repeats> {
+        self.readings.iter().find(|(n, _)| n == name).map(|(_, r)| *r)
+    }
+
+    /// Column `name` as read at the rows `r` marks as a slower sensor's readings and
+    /// interpolated between them.
+    pub(crate) fn read_at(&mut self, name: &str, r: Repeats) {
+        self.readings.retain(|(n, _)| n != name);
+        self.readings.push((name.into(), r));
+    }
+
     /// Name of the time column.
     pub fn time_name(&self) -> &str {
         &self.time_name
@@ -837,6 +855,14 @@ impl Frame {
             file_rows: self.file_rows.as_ref().map(|r| r[range.clone()].to_vec()),
             text: self.text.clone(),
             recorded: self.recorded.as_ref().map(|r| r[range.clone()].to_vec()),
+            readings: self
+                .readings
+                .iter()
+                .map(|(name, r)| {
+                    let phase = (r.phase + r.period - range.start % r.period) % r.period;
+                    (name.clone(), Repeats { phase, ..*r })
+                })
+                .collect(),
         }
     }
 }

@@ -160,10 +160,38 @@ fn followed(frame: &Frame, name: &str, u: &[f64]) -> bool {
 /// a staircase). `None` where the values move by other amounts, or by single steps over fewer
 /// than ten levels (a command switched between levels is no rounding).
 pub fn quantum(x: &[f64]) -> Option<f64> {
+    grid(x).filter(|g| g.staircase).map(|g| g.step)
+}
+
+/// The grid a record's values sit on: every step between samples a whole number of the
+/// smallest, over ten levels at least.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Grid {
+    /// The smallest step, the grid's.
+    step: f64,
+    /// Whether 80 % of the steps are single ones: a staircase, whose differences misread its
+    /// rounding (a sine printed to a tenth of its amplitude reads 1.8 times its rounding's σ).
+    staircase: bool,
+    /// Whether it rests on a level over a tenth of its intervals at least: where it moves
+    /// slowly its rounding holds it, which its differences do not see. A motion that only
+    /// happens to sit on a grid (a triangle wave whose steps are three of its corners') never
+    /// rests.
+    rests: bool,
+}
+
+/// The share of a record's intervals over which it rests on a level from which its rounding
+/// shows ([`Grid::rests`]).
+const RESTS: f64 = 0.1;
+
+/// The grid `x` sits on ([`Grid`]); `None` where its values move by other amounts, by fewer
+/// than 20 steps, or over fewer than ten levels (a command switched between levels is no
+/// rounding).
+fn grid(x: &[f64]) -> Option<Grid> {
     let steps: Vec<f64> = x.windows(2).map(|w| (w[1] - w[0]).abs()).filter(|d| *d > 0.0).collect();
     if steps.len() < 20 || steps.iter().any(|d| !d.is_finite()) {
         return None;
     }
+    let rests = (x.len() - 1 - steps.len()) as f64 >= RESTS * (x.len() - 1) as f64;
     let q = steps.iter().copied().fold(f64::INFINITY, f64::min);
     let mut single = 0;
     for d in &steps {
@@ -175,7 +203,11 @@ pub fn quantum(x: &[f64]) -> Option<f64> {
         single += usize::from(n == 1.0);
     }
     let (low, high) = x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
-    (single as f64 >= 0.8 * steps.len() as f64 && (high - low) / q >= 9.0).then_some(q)
+    ((high - low) / q >= 9.0).then_some(Grid {
+        step: q,
+        staircase: single as f64 >= 0.8 * steps.len() as f64,
+        rests,
+    })
 }
 
 /// A variable's white noise and spread gathered over records read whole or in pieces and
@@ -219,8 +251,20 @@ impl NoiseTally {
     /// differences is not counted as its noise. Such an input that a record follows is its
     /// generator's exact values, without noise; one that none follows is measured (one
     /// stepped at every sample is then the noise of a value held steady).
+    ///
+    /// A slower sensor's readings, read at them and interpolated between
+    /// ([`Frame::readings_of`]), carry the readings' noise, which the cubics between them hide
+    /// (a swing read every tenth row with noise of 1 % read 5·10⁻¹⁴ %): it is read at the
+    /// readings (without the held inputs' steps, which act between them).
     pub fn of(frame: &Frame, name: &str, own: std::ops::Range<usize>) -> Option<NoiseTally> {
         let x = frame.column(name)?;
+        if let Some(r) = frame.readings_of(name) {
+            let at: Vec<usize> = r.readings(x.len()).collect();
+            let read: Vec<f64> = at.iter().map(|&k| x[k]).collect();
+            let first = at.partition_point(|&k| k < own.start);
+            let own = first..first + at[first..].partition_point(|&k| k < own.end);
+            return Some(Self::of_values(&read, own, true, &[]));
+        }
         // (a column stepped at every sample that no record follows is a value's noise, and may
         // be rounded)
         let command =
@@ -240,16 +284,20 @@ impl NoiseTally {
     fn of_values(x: &[f64], own: std::ops::Range<usize>, rounded: bool, stepped: &[&[f64]]) -> NoiseTally {
         let rows = x.get(own).unwrap_or_default();
         let mut tally = NoiseTally::default();
-        // a record too short for fourth differences still spreads the variable; one read so
-        // coarsely that it moves a step at a time carries its rounding's noise, which its
-        // differences misread (a staircase's: a sine printed to a tenth of its amplitude reads
-        // 1.8 times its rounding's σ)
-        let rounding = quantum(x).filter(|_| rounded).map(|q| Noise {
-            sd: q / 12f64.sqrt(),
-            measured: true,
-            correlated: false,
-        });
-        let found = rounding.or_else(|| white_noise_beside(x, stepped));
+        // a record too short for fourth differences still spreads the variable; one read on a
+        // grid carries its rounding's noise at least, which its differences misread: a
+        // staircase's (a sine printed to a tenth of its amplitude reads 1.8 times its
+        // rounding's σ), and one that rests on a level over stretches where it moves slowly
+        // (an encoder's counts of a decaying swing, its steps of up to four counts: most of
+        // its fourth differences 0, the noise read 0)
+        let rounding = |g: Grid| Noise { sd: g.step / 12f64.sqrt(), measured: true, correlated: false };
+        let found = match grid(x).filter(|_| rounded) {
+            Some(g) if g.staircase => Some(rounding(g)),
+            Some(g) if g.rests => {
+                Some(white_noise_beside(x, stepped).filter(|w| w.sd >= rounding(g).sd).unwrap_or(rounding(g)))
+            }
+            _ => white_noise_beside(x, stepped),
+        };
         if let Some(found) = found {
             let (sum, count) = if found.measured {
                 (&mut tally.noise, &mut tally.noise_rows)
@@ -413,6 +461,23 @@ mod tests {
             None
         );
         assert_eq!(quantum(&noisy), None);
+        // an encoder's counts of a decaying swing (0.01 a count, up to four counts a sample):
+        // no staircase, and most of its fourth differences 0 where it swings slowly; its
+        // rounding is its noise. The noisy sine printed to a thousandth is on a grid too, its
+        // noise its own.
+        let counts: Vec<f64> = (0..1500)
+            .map(|k| {
+                let t = k as f64 * 0.02;
+                ((-0.2 * t).exp() * (2.0 * t).cos() * 100.0).round() / 100.0
+            })
+            .collect();
+        assert_eq!(quantum(&counts), None);
+        assert!(white_noise(&counts).unwrap().sd < 0.1 * 0.01 / 12f64.sqrt());
+        let tally = NoiseTally::of_values(&counts, 0..counts.len(), true, &[]);
+        assert!((tally.sd().unwrap() / (0.01 / 12f64.sqrt()) - 1.0).abs() < 1e-9, "{tally:?}");
+        let printed: Vec<f64> = noisy.iter().map(|v| (v * 1000.0).round() / 1000.0).collect();
+        let tally = NoiseTally::of_values(&printed, 0..printed.len(), true, &[]);
+        assert!((tally.sd().unwrap() / 0.05 - 1.0).abs() < 0.05, "{tally:?}");
         assert_eq!(white_noise(&[1.0; 10]), None);
         // a lynx population of Lotka-Volterra (ẋ = 0.55x − 0.028xy, ẏ = 0.024xy − 0.8y) read
         // yearly for 60 years, ten samples a cycle: its peaks are sharp enough that its fourth
@@ -478,6 +543,36 @@ mod tests {
         assert_eq!(share("u"), 0.0);
         // `w`, stepped alike, drives nothing: noise about 2, measured (a uniform's own reading)
         assert!(share("w") > 0.9, "{}", share("w"));
+    }
+
+    /// A swing read every tenth row with noise of 1 % of its spread and written again until
+    /// the next reading: read at its readings and interpolated by cubics, the rows are smooth
+    /// (its noise read 5·10⁻¹⁴ %, so the closeness check allowed a thousandth of the span and
+    /// flagged the exact equations); its noise is read at the readings, in a piece cut from
+    /// the run too.
+    #[test]
+    fn a_slower_sensor_s_noise_is_read_at_its_readings() {
+        let n = 3000;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 0.01).collect();
+        let swing: Vec<f64> = t.iter().map(|t| (2.0 * t).sin() + 0.5 * (0.7 * t).cos()).collect();
+        let sd = |v: &[f64]| {
+            let m = v.iter().sum::<f64>() / v.len() as f64;
+            (v.iter().map(|y| (y - m).powi(2)).sum::<f64>() / v.len() as f64).sqrt()
+        };
+        let mut seed = 3u64;
+        let e = 0.01 * sd(&swing) * 12f64.sqrt();
+        let read: Vec<f64> = swing.iter().map(|x| x + e * crate::data::test_noise(&mut seed)).collect();
+        let repeated: Vec<f64> = (0..n).map(|k| read[k / 10 * 10]).collect();
+        let mut frame = Frame::new("run.csv", "t", t).unwrap();
+        frame.push("x", repeated).unwrap();
+        crate::data::read_at_readings(&mut frame, &["x"], crate::data::Intersample::Auto).unwrap();
+        assert!(white_noise(frame.column("x").unwrap()).unwrap().sd < 1e-3 * 0.01 * sd(&swing));
+        let share = NoiseTally::of(&frame, "x", 0..n).unwrap().share().unwrap().0;
+        assert!((share - 0.01).abs() < 0.0015, "{share}");
+        let piece = frame.slice(1003..2507);
+        assert_eq!(piece.readings_of("x").unwrap().phase, 7);
+        let share = NoiseTally::of(&piece, "x", 0..piece.len()).unwrap().share().unwrap().0;
+        assert!((share - 0.01).abs() < 0.002, "{share}");
     }
 
     /// A noisy record tallied in pieces (each read across its neighbours' rows, as a run read

@@ -505,6 +505,7 @@ pub fn read_at_readings(
         let mended = between_readings(frame.time(), column, r);
         let readings = r.readings(column.len()).count();
         frame.overwrite(name, mended)?;
+        frame.read_at(name, r);
         notes.push(format!(
             "{}: `{name}` changes only every {} rows and repeats itself in between ({:.0} % of its {readings} readings differ from the one before): a slower sensor's readings written again until the next (a log kept faster than the sensor reads, or several sensors merged and filled forward), whose rate would read zero between readings and a spike at each; read at its readings and interpolated between them by cubics. Where it is a controller's command held from each reading to the next (whose kink in the motion the noise hides here), say so (identify --intersample held; a model file's `intersample = \"held\"`; Python `intersample=\"held\"`); where it truly changes only at those rows, `linear`",
             frame.origin(),

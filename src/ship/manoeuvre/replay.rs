@@ -10,14 +10,14 @@ use crate::sim::Replay;
 /// A recorded run whose inputs are replayed.
 #[derive(Clone, Debug)]
 pub struct Replayed {
-    /// The recording (time column `t`).
-    pub frame: Frame,
+    /// The recording (time column `t`), boxed: a manoeuvre of any other kind is a few numbers.
+    pub frame: Box<Frame>,
 }
 
 impl Replayed {
     /// Reads a recording.
     pub fn read(path: &str) -> Result<Replayed, ShipError> {
-        Ok(Replayed { frame: Frame::read(std::path::Path::new(path), "t")? })
+        Ok(Replayed { frame: Box::new(Frame::read(std::path::Path::new(path), "t")?) })
     }
 
     /// Length of the recording.
