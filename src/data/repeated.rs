@@ -191,14 +191,15 @@ const FORESEEN_MATTERS: f64 = 3e-5;
 /// half interval held the terms absorb, 66 % better held by quadratures' errors alone).
 const STATIC: f64 = 1e-5;
 
-/// A foreseen column whose step at each sample the other columns' steps and values there (and
-/// a constant between the column's leaps) leave less than this share of unexplained, though
-/// those columns carry noise ([`NOISY`]), is a digital controller's command with integral
-/// action (u_k − u_{k−1} = −K_p Δx̃_k + K_i h (r − x̃_k), r stepped at the leaps), computed from
-/// the noisy samples themselves: exact to the digits written (a PI controller at 10 Hz under 1 %
-/// noise: 10⁻²¹), where a state read as an input is integrated from the motion, not from its
-/// noisy record (a position under its velocity measured with 1 % noise: 10⁻³). Noise-free, a
-/// linear system's states meet such a recurrence exactly too: nothing is told.
+/// A foreseen column whose step at each sample the other columns' steps there and a sample
+/// before and their values (and a constant between the column's leaps) leave less than this
+/// share of unexplained, though those columns carry noise ([`NOISY`]), is a digital
+/// controller's command with integral action, computed from the noisy samples themselves: a PID
+/// controller's u_k − u_{k−1} = K_p Δe_k + K_i h e_k + K_d (Δe_k − Δe_{k−1})/h, e = r − x̃ and
+/// r stepped at the leaps. Exact to the digits written (PI and PID controllers at 10 Hz under
+/// 1 % noise: 10⁻²¹), where a state read as an input is integrated from the motion, not from
+/// its noisy record (a position under its velocity measured with 1 % noise: 10⁻³). Noise-free,
+/// a linear system's states meet such a recurrence exactly too: nothing is told.
 const EXACT: f64 = 1e-10;
 
 /// The white noise, as a share of a column's spread, from which the columns a command may be
@@ -206,15 +207,21 @@ const EXACT: f64 = 1e-10;
 const NOISY: f64 = 1e-5;
 
 /// Whether `x`'s step at each sample of the windows `kept` (of `w` samples) is, to [`EXACT`],
-/// a linear function of the other columns' steps and values at that sample and a constant over
-/// each stretch between the `leaps` (a reference stepped), some of those columns noisy
-/// ([`NOISY`]): a digital controller that sums its error (PI), not static ([`STATIC`]) but
-/// computed from the samples alone.
+/// a linear function of the other columns' steps at that sample and the one before, their
+/// values at it, and a constant over each stretch between the `leaps` (a reference stepped;
+/// the two samples from each leap on left out, where a derivative action kicks), some of those
+/// columns noisy ([`NOISY`]): a digital controller that sums its error (PI, PID), not static
+/// ([`STATIC`]) but computed from the samples alone.
 fn integrates_from_samples(x: &[f64], others: &[&[f64]], kept: &[usize], w: usize, leaps: &[usize]) -> bool {
-    let rows: Vec<usize> = kept.iter().flat_map(|&row| row * w + 1..=(row + 1) * w).collect();
+    let rows: Vec<usize> = kept
+        .iter()
+        .flat_map(|&row| row * w + 1..=(row + 1) * w)
+        .filter(|&k| k >= 2 && !leaps.iter().any(|&l| l <= k && k < l + 2))
+        .collect();
     let stretch = |k: usize| leaps.iter().filter(|&&l| l <= k).count();
     let stretches = stretch(usize::MAX) + 1;
-    let columns = 2 * others.len() + stretches;
+    let m = others.len();
+    let columns = 3 * m + stretches;
     let noisy = |c: &[f64]| {
         let mean = c.iter().sum::<f64>() / c.len().max(1) as f64;
         let spread = (c.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / c.len().max(1) as f64).sqrt();
@@ -226,9 +233,10 @@ fn integrates_from_samples(x: &[f64], others: &[&[f64]], kept: &[usize], w: usiz
     let a = nalgebra::DMatrix::from_fn(rows.len(), columns, |i, c| {
         let k = rows[i];
         match c {
-            c if c < others.len() => others[c][k] - others[c][k - 1],
-            c if c < 2 * others.len() => others[c - others.len()][k],
-            c => f64::from(u8::from(stretch(k) == c - 2 * others.len())),
+            c if c < m => others[c][k] - others[c][k - 1],
+            c if c < 2 * m => others[c - m][k - 1] - others[c - m][k - 2],
+            c if c < 3 * m => others[c - 2 * m][k],
+            c => f64::from(u8::from(stretch(k) == c - 3 * m)),
         }
     });
     let y = nalgebra::DVector::from_fn(rows.len(), |i, _| x[rows[i]] - x[rows[i] - 1]);
@@ -734,25 +742,27 @@ mod tests {
     /// them), as they do a state read as an input, but it is their static function (its change
     /// over each window theirs between its ends), and held gains about 10⁻³ of the state's
     /// squared changes (a line put both coefficients 5 % off): held. (Lorenz's x under ẏ,
-    /// above, is no static function of y and z: not compared.) So is a PI controller's
-    /// (u = 2e + 0.5 Σ e h, e = r − x̃), which sums its error at the samples: its step at each
-    /// sample is the state's step and value there, and a constant between the reference's
-    /// steps (a line put both coefficients 4 % off, every check ok); a position read as an
-    /// input beside its velocity (100 samples a period) is that only to its trapezoid's error.
+    /// above, is no static function of y and z: not compared.) So are a PI controller's
+    /// (u = 2e + 0.5 Σ e h, e = r − x̃) and a PID's (0.05 Δe/h added), which sum their error at the samples:
+    /// a step at each sample is the state's steps there and a sample before, its value, and a
+    /// constant between the reference's steps (a line put both coefficients 4 % off, every check
+    /// ok); a position read as an input beside its velocity measured with noise is not.
     #[test]
     fn a_feedback_command_held_by_its_controller_is_found() {
         let (h, n): (f64, usize) = (0.1, 3000);
         let levels = [1.0, -0.5, 2.0, 0.0, 1.5];
         let decay = (-0.2 * h).exp();
         let t: Vec<f64> = (0..n).map(|k| h * k as f64).collect();
-        for integral in [0.0, 0.5] {
-            let (mut x, mut sum, mut seed) = (0.0, 0.0, 21u64);
+        for (integral, derivative) in [(0.0, 0.0), (0.5, 0.0), (0.5, 0.05)] {
+            let (mut x, mut sum, mut seed, mut last) = (0.0, 0.0, 21u64, None);
             let (mut measured, mut command) = (Vec::new(), Vec::new());
             for k in 0..n {
                 let seen = x + 0.028 * crate::data::test_noise(&mut seed);
                 let error = levels[(k / 600) % 5] - seen;
                 sum += error * h;
-                let u = 2.0 * error + integral * sum;
+                let slope = last.map_or(0.0, |e| (error - e) / h);
+                last = Some(error);
+                let u = 2.0 * error + integral * sum + derivative * slope;
                 measured.push(seen);
                 command.push(u);
                 // exact over the interval with u held
@@ -761,7 +771,10 @@ mod tests {
             let leaps: Vec<usize> = crate::data::breaks(&t, &command).into_iter().map(|b| b.row).collect();
             assert_eq!(leaps.len(), 4, "{leaps:?}");
             let found = fits_better_held_than_a_line(&t, &command, &[&measured], &[&measured], Some(&leaps));
-            assert!(found.is_some_and(|(i, share)| i == 0 && share < 0.95), "{integral}: {found:?}");
+            assert!(
+                found.is_some_and(|(i, share)| i == 0 && share < 0.95),
+                "{integral} {derivative}: {found:?}"
+            );
         }
         let step = std::f64::consts::TAU / 100.0;
         let position: Vec<f64> = (0..n).map(|k| (step * k as f64).sin()).collect();
