@@ -2361,6 +2361,7 @@ class Model:
         sources: Optional[Sequence[int]] = None,
         per_source: Sequence[str] = (),
         per_run: Sequence[str] = (),
+        laws: bool = True,
     ) -> "Recipe":
         """The command line's recipe for a model from runs (``termid identify --model`` with
         several ``--derivative`` starts) from ``runs``: each start prepares them by one derivative method
@@ -2385,7 +2386,10 @@ class Model:
         ``refine`` (implied by ``per_source`` and ``per_run``), False not; ``per_source`` names
         those estimated once per source, ``sources`` numbering each run's source (basin),
         ``per_run`` those estimated once per run; the kept start's estimate in ``parameters``
-        of the result.
+        of the result. A model :meth:`from_states` with the polynomial library whose terms
+        fail the checks a stand-in fails (the halves, the re-simulation) is identified again
+        with each state's laws among the candidates (sign, x·|x|, √|x|, sin x), kept where
+        they pass every check in fewer terms, and said; ``laws`` False keeps the polynomials.
 
         ``derivatives``, ``smooth`` and ``refine`` (``"auto"``) left out are the model's
         field's: for a ship the new-ship recipe's (``kinematic``, ``kalman``,
@@ -2426,6 +2430,7 @@ class Model:
             [int(s) for s in sources or []],
             list(per_source),
             list(per_run),
+            laws,
         )
         found = Recipe(self._identified(native, data), json.loads(text_json), text)
         # what the command line prints as warnings (or refuses to write) is said here too

@@ -148,6 +148,7 @@ class Model:
         sources: Sequence[int] = ...,
         per_source: Sequence[str] = ...,
         per_run: Sequence[str] = ...,
+        laws: bool = True,
     ) -> Tuple[str, str, Model]: ...
     def estimate(
         self,

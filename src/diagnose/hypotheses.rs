@@ -243,17 +243,9 @@ pub fn beyond_candidates(model: &Model) -> Vec<Hypothesis> {
                 effect: Effect::Refit { equation: eq.name.clone(), refitted: refitted.clone() },
             });
         }
-        // the laws a polynomial only approximates: each state's dry friction or relay
-        // (sign), quadratic drag (v·|v|), outflow through an orifice (√|h|, Torricelli's), a
-        // pendulum's gravity (sin θ); a cubic fitted for them follows the runs and fails
-        // beyond (a Coulomb oscillator's viscous stand-in never stops)
+        // the laws a polynomial only approximates, each state's ([`crate::term::laws`])
         for v in vars.iter().filter(|v| !inputs.contains(&v.as_str())) {
-            for text in [
-                format!("sign({v})"),
-                format!("{v}*abs({v})"),
-                format!("sqrt(abs({v}))"),
-                format!("sin({v})"),
-            ] {
+            for text in crate::term::laws(v) {
                 if let Ok(t) = model.vocabulary.parse(&text) {
                     all.push(t);
                 }

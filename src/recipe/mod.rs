@@ -6,6 +6,7 @@
 //! saying that prediction is uncertain.
 
 mod halves;
+mod laws;
 mod noise;
 mod parameters;
 mod report;
@@ -61,6 +62,10 @@ pub struct RecipeSettings {
     /// refinement (none: not; [`ParameterOptions::asked`] runs it where the model declares
     /// free parameters).
     pub parameters: Option<ParameterOptions>,
+    /// A system made from its columns with the polynomial library, whose terms fail the checks
+    /// a stand-in fails, is identified again with each state's laws among the candidates and
+    /// those kept where they hold (`laws.rs`).
+    pub laws: bool,
 }
 
 impl RecipeSettings {
@@ -87,6 +92,7 @@ impl Default for RecipeSettings {
             refine: None,
             agree: 0.10,
             parameters: None,
+            laws: true,
         }
     }
 }
@@ -222,6 +228,7 @@ pub fn identify(
     // a model made from columns of variables far from 0: its library about reference values,
     // decided once on the runs as recorded, so that every start and configuration has it
     let setup = |e: crate::model::ModelError| RecipeError::Setup(e.to_string());
+    let outline = model.outline().cloned();
     let (model, note) = model.about_references(frames).map_err(setup)?;
     let model = &model;
     let choose = settings
@@ -257,7 +264,19 @@ pub fn identify(
         // no start's free parameters could be kept: each is refined without them
         starts.par_iter_mut().for_each(|s| start::refine_instead(s, settings));
     }
-    Recipe::of(starts, failed, held.is_some(), settings.agree)
+    let recipe = Recipe::of(starts, failed, held.is_some(), settings.agree)?;
+    let flags = laws::stand_in_flags(&recipe);
+    let extended = match settings.laws && !flags.is_empty() && settings.choose.is_empty() {
+        true => laws::with_laws(model, outline.as_ref()),
+        false => None,
+    };
+    Ok(match extended {
+        Some(extended) => {
+            let again = RecipeSettings { laws: false, ..settings.clone() };
+            laws::kept(recipe, identify(&extended, frames, held, &again), &flags)
+        }
+        None => recipe,
+    })
 }
 
 /// The checks of a system of no field's identified from `frames` by `how`: that its equations

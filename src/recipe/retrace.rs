@@ -55,10 +55,10 @@ const CLOSE: f64 = 20.0;
 const RETRACE_NAME: &str = "the equations retrace their runs without running away";
 
 /// The check that the equations follow each run as long as their own motion allows.
-const MISSED_NAME: &str = "the equations follow their runs as long as their own motion allows";
+pub(super) const MISSED_NAME: &str = "the equations follow their runs as long as their own motion allows";
 
 /// The check that the equations re-simulate a run they follow throughout within its noise.
-const CLOSE_NAME: &str = "the equations re-simulate their runs within the records' noise";
+pub(super) const CLOSE_NAME: &str = "the equations re-simulate their runs within the records' noise";
 
 /// Whether `check` is one of [`retrace_checks`] that a search by re-simulation answers (the
 /// equations run away, or lose their runs).

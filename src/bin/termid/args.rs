@@ -444,6 +444,12 @@ pub struct IdentifyCommand {
     /// identified equations), e.g. `u,v,r,ψ`.
     #[arg(long, value_name = "STATES", requires = "choose")]
     pub compare: Option<String>,
+    /// With --states and the polynomial library (no --terms): keep the polynomials even where
+    /// their terms fail the checks a stand-in fails (the halves, the re-simulation); without it
+    /// the system is identified again with each state's laws among the candidates (sign, x·|x|,
+    /// √|x|, sin x), and those kept where they pass every check in fewer terms, said either way.
+    #[arg(long, requires = "states")]
+    pub no_laws: bool,
     /// Write the model even when it fails a check: a physical check of its plug-in (a ship's:
     /// damping signs, turning circles that complete, plausible speed loss and drift), or, for
     /// a system of no plug-in's, that its equations retrace the runs without running away.

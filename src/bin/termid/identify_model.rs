@@ -114,6 +114,7 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
                     cmd.per_source.clone(),
                     cmd.per_run.clone(),
                 ),
+                laws: !cmd.no_laws,
             };
             let label = format!(
                 "identifying ({} start{})",
