@@ -31,6 +31,8 @@ pub(super) fn with_laws(model: &Model, outline: Option<&crate::model::Outline>) 
     }
     model
         .edit(|file| {
+            file.model.provenance =
+                format!("{}, and each state's laws: sign, x·|x|, √|x|, sin x", file.model.provenance);
             for equation in file.equations.values_mut().filter(|e| e.identify) {
                 for law in &laws {
                     if !equation.candidates.contains(law) {
