@@ -12,10 +12,14 @@ use crate::model::Model;
 const STAND_IN: [&str; 3] = [halves::NAME, retrace::MISSED_NAME, retrace::CLOSE_NAME];
 
 /// `model` (settled about its reference values) with each state of its polynomial library's
-/// `outline` given its laws as candidates of every identified equation; `None` where it was not
-/// made from columns with the polynomial library, or no state can have them (a state written
-/// about a reference value, a heater's temperature in K, has no law of its own).
-pub(super) fn with_laws(model: &Model, outline: Option<&crate::model::Outline>) -> Option<Model> {
+/// `outline` given its laws as candidates of every identified equation, and those laws (their
+/// canonical text); `None` where it was not made from columns with the polynomial library, or
+/// no state can have them (a state written about a reference value, a heater's temperature in
+/// K, has no law of its own).
+pub(super) fn with_laws(
+    model: &Model,
+    outline: Option<&crate::model::Outline>,
+) -> Option<(Model, Vec<String>)> {
     let outline = outline.filter(|o| o.candidates.is_empty())?;
     let about_a_reference =
         |s: &str| model.spec().derived.iter().any(|d| d.definition.starts_with(&format!("{s} - ")));
@@ -24,15 +28,14 @@ pub(super) fn with_laws(model: &Model, outline: Option<&crate::model::Outline>) 
         .iter()
         .filter(|s| !about_a_reference(s))
         .flat_map(|s| crate::term::laws(s))
-        .filter(|l| model.vocabulary.parse(l).is_ok())
+        .filter_map(|l| model.vocabulary.parse(&l).ok().map(|t| t.to_string()))
         .collect();
     if laws.is_empty() {
         return None;
     }
-    model
+    let extended = model
         .edit(|file| {
-            file.model.provenance =
-                format!("{}, and each state's laws: sign, x·|x|, √|x|, sin x", file.model.provenance);
+            file.model.provenance = format!("{}, and each state's laws: {ALL}", file.model.provenance);
             for equation in file.equations.values_mut().filter(|e| e.identify) {
                 for law in &laws {
                     if !equation.candidates.contains(law) {
@@ -41,8 +44,12 @@ pub(super) fn with_laws(model: &Model, outline: Option<&crate::model::Outline>) 
                 }
             }
         })
-        .ok()
+        .ok()?;
+    Some((extended, laws))
 }
+
+/// The laws, in words.
+const ALL: &str = "sign, x·|x|, √|x|, sin x";
 
 /// The stand-in checks ([`STAND_IN`]) the kept start of `recipe` fails, by name.
 pub(super) fn stand_in_flags(recipe: &Recipe) -> Vec<String> {
@@ -55,9 +62,9 @@ pub(super) fn stand_in_flags(recipe: &Recipe) -> Vec<String> {
         .collect()
 }
 
-/// The terms of the identified equations of `recipe`'s kept model, and the laws among them
-/// (each once).
-fn terms(recipe: &Recipe) -> (usize, Vec<String>) {
+/// The number of terms of the identified equations of `recipe`'s kept model, and the `laws`
+/// among them (each once).
+fn terms(recipe: &Recipe, laws: &[String]) -> (usize, Vec<String>) {
     let model = &recipe.kept().model;
     let chosen: Vec<String> = model
         .identifiable()
@@ -65,59 +72,62 @@ fn terms(recipe: &Recipe) -> (usize, Vec<String>) {
         .filter_map(|n| model.equation(n))
         .flat_map(|e| e.coefficients.iter().map(|(t, _, _)| t.to_string()))
         .collect();
-    let mut laws: Vec<String> = Vec::new();
-    for t in chosen.iter().filter(|t| is_law(t)) {
-        if !laws.contains(t) {
-            laws.push(t.clone());
-        }
-    }
-    (chosen.len(), laws)
+    let held = laws.iter().filter(|l| chosen.contains(l)).cloned().collect();
+    (chosen.len(), held)
 }
 
-/// Whether `term` holds a law ([`crate::term::laws`]) of some variable.
-fn is_law(term: &str) -> bool {
-    ["sign(", "abs(", "sin("].iter().any(|f| term.contains(f))
+/// Checks named as a list: "a", "b".
+fn named(checks: impl IntoIterator<Item = String>) -> String {
+    checks.into_iter().map(|c| format!("\"{c}\"")).collect::<Vec<_>>().join(", ")
 }
 
-/// Which of the polynomial library's `polynomials` (whose kept start fails the stand-in
-/// checks `flags`) and the `laws`' recipe to keep, and what to say of it: the laws' where
-/// its kept start passes every check, holds a law and has fewer terms.
+/// Which of the polynomial library's recipe `polynomials` (whose kept start fails the
+/// stand-in checks `flags`) and the recipe with the `laws` among the candidates (`with`) to
+/// keep, the choice said in a note of the kept start: the laws' where its kept start passes
+/// every check, holds a law and has fewer terms.
 pub(super) fn kept(
     polynomials: Recipe,
-    laws: Result<Recipe, super::RecipeError>,
+    with: Result<Recipe, super::RecipeError>,
+    laws: &[String],
     flags: &[String],
 ) -> Recipe {
-    let (before, _) = terms(&polynomials);
-    let failed = flags.iter().map(|f| format!("\"{f}\"")).collect::<Vec<_>>().join(", ");
-    let (mut recipe, note) = match laws {
-        Ok(laws) => {
-            let (after, chosen) = terms(&laws);
-            let passes = laws.kept().checks.iter().all(|c| c.passed);
-            if passes && !chosen.is_empty() && after < before {
-                let note = format!(
-                    "the polynomial library's {before} terms failed {failed}: they stood in for a law; with each state's laws among the candidates (sign, x·|x|, √|x|, sin x) the equations hold in {after} ({}), every check ok: kept. Where the polynomials are wanted, --no-laws (Python `laws=False`) keeps them",
-                    chosen.iter().map(|t| format!("`{t}`")).collect::<Vec<_>>().join(", ")
-                );
-                (laws, note)
-            } else {
-                let why = match (passes, chosen.is_empty()) {
-                    (false, _) => {
-                        let flagged: Vec<String> = laws.kept().checks.iter().filter(|c| !c.passed).map(|c| format!("\"{}\"", c.name)).collect();
-                        format!("they fail {} too", flagged.join(", "))
-                    }
-                    (true, true) => "no law is chosen".to_string(),
-                    (true, false) => format!("{after} terms, no fewer"),
-                };
-                let note = format!(
-                    "the polynomial library's {before} terms failed {failed}; with each state's laws among the candidates (sign, x·|x|, √|x|, sin x) no better ({why}): the polynomials kept, as flagged"
-                );
-                (polynomials, note)
+    let (before, _) = terms(&polynomials, laws);
+    let tried = format!(
+        "the polynomial library's {before} terms failed {}; with each state's laws among the candidates ({ALL})",
+        named(flags.iter().cloned())
+    );
+    let (mut recipe, note) = match with {
+        Ok(with) => {
+            let (after, held) = terms(&with, laws);
+            let failing: Vec<String> =
+                with.kept().checks.iter().filter(|c| !c.passed).map(|c| c.name.clone()).collect();
+            let why = match (failing.is_empty(), held.is_empty()) {
+                (false, _) => Some(format!("they fail {} too", named(failing))),
+                (true, true) => Some("no law is chosen".to_string()),
+                (true, false) if after >= before => Some(format!("{after} terms, no fewer")),
+                (true, false) => None,
+            };
+            match why {
+                None => {
+                    let held: Vec<String> = held.iter().map(|t| format!("`{t}`")).collect();
+                    let note = format!(
+                        "{tried} the equations hold in {after} ({}), every check ok: kept, the polynomials having stood in for a law. Where the polynomials are wanted, --no-laws (Python `laws=False`) keeps them",
+                        held.join(", ")
+                    );
+                    (with, note)
+                }
+                Some(why) => {
+                    (polynomials, format!("{tried} no better ({why}): the polynomials kept, as flagged"))
+                }
             }
         }
-        Err(e) => (polynomials, format!("the polynomial library's {before} terms failed {failed}; with each state's laws among the candidates the system could not be identified ({e}): the polynomials kept, as flagged")),
+        Err(e) => (
+            polynomials,
+            format!("{tried} the system could not be identified ({e}): the polynomials kept, as flagged"),
+        ),
     };
-    let kept = recipe.kept;
-    if let Some((_, fit)) = recipe.starts[kept].fits.first_mut() {
+    let at = recipe.kept;
+    if let Some((_, fit)) = recipe.starts[at].fits.first_mut() {
         fit.selection.notes.push(note);
     }
     recipe

@@ -271,9 +271,9 @@ pub fn identify(
         false => None,
     };
     Ok(match extended {
-        Some(extended) => {
+        Some((extended, added)) => {
             let again = RecipeSettings { laws: false, ..settings.clone() };
-            laws::kept(recipe, identify(&extended, frames, held, &again), &flags)
+            laws::kept(recipe, identify(&extended, frames, held, &again), &added, &flags)
         }
         None => recipe,
     })
