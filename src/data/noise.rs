@@ -281,7 +281,12 @@ impl NoiseTally {
 
     /// The tally of the `own` rows of `x`, its rounding counted where `rounded` allows, less
     /// what the held inputs `stepped` explain ([`white_noise_beside`]).
-    fn of_values(x: &[f64], own: std::ops::Range<usize>, rounded: bool, stepped: &[&[f64]]) -> NoiseTally {
+    pub(crate) fn of_values(
+        x: &[f64],
+        own: std::ops::Range<usize>,
+        rounded: bool,
+        stepped: &[&[f64]],
+    ) -> NoiseTally {
         let rows = x.get(own).unwrap_or_default();
         let mut tally = NoiseTally::default();
         // a record too short for fourth differences still spreads the variable; one read on a

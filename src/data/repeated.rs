@@ -218,14 +218,14 @@ fn integrates_from_samples(x: &[f64], others: &[&[f64]], kept: &[usize], w: usiz
         .flat_map(|&row| row * w + 1..=(row + 1) * w)
         .filter(|&k| k >= 2 && !leaps.iter().any(|&l| l <= k && k < l + 2))
         .collect();
-    let stretch = |k: usize| leaps.iter().filter(|&&l| l <= k).count();
-    let stretches = stretch(usize::MAX) + 1;
+    // each row's stretch between the leaps
+    let stretch: Vec<usize> = rows.iter().map(|&k| leaps.iter().filter(|&&l| l <= k).count()).collect();
     let m = others.len();
-    let columns = 3 * m + stretches;
+    let columns = 3 * m + leaps.len() + 1;
     let noisy = |c: &[f64]| {
-        let mean = c.iter().sum::<f64>() / c.len().max(1) as f64;
-        let spread = (c.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / c.len().max(1) as f64).sqrt();
-        super::white_noise(c).is_some_and(|n| n.measured && n.sd >= NOISY * spread)
+        super::NoiseTally::of_values(c, 0..c.len(), false, &[])
+            .share()
+            .is_some_and(|(share, measured)| measured && share >= NOISY)
     };
     if others.is_empty() || rows.len() < 3 * columns || !others.iter().any(|c| noisy(c)) {
         return false;
@@ -236,7 +236,7 @@ fn integrates_from_samples(x: &[f64], others: &[&[f64]], kept: &[usize], w: usiz
             c if c < m => others[c][k] - others[c][k - 1],
             c if c < 2 * m => others[c - m][k - 1] - others[c - m][k - 2],
             c if c < 3 * m => others[c - 2 * m][k],
-            c => f64::from(u8::from(stretch(k) == c - 3 * m)),
+            c => f64::from(u8::from(stretch[i] == c - 3 * m)),
         }
     });
     let y = nalgebra::DVector::from_fn(rows.len(), |i, _| x[rows[i]] - x[rows[i] - 1]);
