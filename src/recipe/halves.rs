@@ -242,13 +242,16 @@ fn verdict(identified: &IdentifiedModel, halving: Halving, halves: [Chosen; 2], 
             // Michaelis-Menten's x/(0.5 + x)) or what a half does not excite: the form first
             "the records hold next to no noise (the noise check's reading), so terms that stand in \
              for a form the candidates lack (Michaelis-Menten's x/(0.5 + x), friction's sign(v) from \
-             polynomials) or that one half does not excite: read them as uncertain (the system's own \
-             form among the candidates, more or longer runs)"
+             polynomials), that one half does not excite, or that take up a system changing between \
+             the halves (a coefficient drifting over the runs): read them as uncertain (the system's \
+             own form among the candidates, more or longer runs)"
         } else {
             "terms the noise chose (errors in the states bias the regressors), that one half does \
-             not excite, or that stand in for a form the candidates lack (noise-free, Michaelis-Menten's \
-             x/(0.5 + x) from polynomials): read them as uncertain (more or longer runs, less noise, \
-             fewer candidates, the system's own form)"
+             not excite, that stand in for a form the candidates lack (noise-free, Michaelis-Menten's \
+             x/(0.5 + x) from polynomials), or that take up a system changing between the halves (a \
+             coefficient drifting over the runs: a damping 0.2 to 0.6 over a minute chose five such): \
+             read them as uncertain (more or longer runs, less noise, fewer candidates, the system's \
+             own form)"
         };
         format!(
             "chosen from all the rows but not from both {}: {}; {causes}",
