@@ -2362,6 +2362,7 @@ class Model:
         per_source: Sequence[str] = (),
         per_run: Sequence[str] = (),
         laws: bool = True,
+        random_force: bool = True,
     ) -> "Recipe":
         """The command line's recipe for a model from runs (``termid identify --model`` with
         several ``--derivative`` starts) from ``runs``: each start prepares them by one derivative method
@@ -2390,6 +2391,10 @@ class Model:
         fail the checks a stand-in fails (the halves, the re-simulation) is identified again
         with each state's laws among the candidates (sign, x·|x|, √|x|, sin x), kept where
         they pass every check in fewer terms, and said; ``laws`` False keeps the polynomials.
+        One start, not refined, whose runs show a state moved by a random force (process noise:
+        another state's record holds its roughness, so it is motion, not a sensor's noise) is
+        identified again by Itô's steps (the ``ito`` method, whose terms the force does not
+        bias), and said; ``random_force`` False keeps the start's method.
 
         ``derivatives``, ``smooth`` and ``refine`` (``"auto"``) left out are the model's
         field's: for a ship the new-ship recipe's (``kinematic``, ``kalman``,
@@ -2431,6 +2436,7 @@ class Model:
             list(per_source),
             list(per_run),
             laws,
+            random_force,
         )
         found = Recipe(self._identified(native, data), json.loads(text_json), text)
         # what the command line prints as warnings (or refuses to write) is said here too

@@ -51,6 +51,9 @@ pub struct Window {
     /// Whether a run shorter than four windows takes the integral form's windows instead (a
     /// default window; one the user chose is kept, and a run too short for it refused).
     pub shrinks: bool,
+    /// Whether each window's candidates are fitted as the windows before it predict them
+    /// ([`super::Ito`]'s instruments) rather than as they are.
+    pub instrumented: bool,
 }
 
 impl Window {
@@ -69,7 +72,12 @@ impl Window {
     /// The integral form's default windows, which a default window gives way to on a run it
     /// does not suit.
     pub fn fallback() -> Window {
-        Window { intervals: super::IntegralForm::default().window, test: TestFunction::Flat, shrinks: false }
+        Window {
+            intervals: super::IntegralForm::default().window,
+            test: TestFunction::Flat,
+            shrinks: false,
+            instrumented: false,
+        }
     }
 }
 
@@ -172,6 +180,9 @@ pub static DIFFERENTIATORS: &[(&str, &str, MakeDifferentiator)] = &[
             }
             _ => None,
         }
+    }),
+    ("ito", "(no derivative: each interval's change, the candidates instrumented; a record moved by a random force)", |o| {
+        o.is_empty().then(|| Box::new(super::Ito) as Box<dyn Differentiator>)
     }),
     ("kalman", "[:RATIO] (default: maximum likelihood)", |o| match o {
         [] => Some(Box::new(super::KalmanSmoother { ratio: None })),

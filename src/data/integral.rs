@@ -42,7 +42,7 @@ impl Differentiator for IntegralForm {
     }
 
     fn window(&self) -> Option<Window> {
-        Some(Window { intervals: self.window, test: TestFunction::Flat, shrinks: false })
+        Some(Window { intervals: self.window, test: TestFunction::Flat, shrinks: false, instrumented: false })
     }
 }
 
@@ -375,7 +375,7 @@ mod tests {
     use super::*;
 
     pub(crate) fn flat(intervals: usize) -> Window {
-        Window { intervals, test: TestFunction::Flat, shrinks: false }
+        Window { intervals, test: TestFunction::Flat, shrinks: false, instrumented: false }
     }
 
     /// Simpson's rule integrates cubics exactly: x = t⁴/4 with θ = t³ gives the window's

@@ -57,6 +57,7 @@ impl Differentiator for WeakForm {
             intervals: self.window.unwrap_or(Self::WINDOW),
             test: TestFunction::Bump(self.power),
             shrinks: self.window.is_none(),
+            instrumented: false,
         })
     }
 }
@@ -67,7 +68,7 @@ mod tests {
     use super::*;
 
     fn bump(intervals: usize, power: u32) -> Window {
-        Window { intervals, test: TestFunction::Bump(power), shrinks: false }
+        Window { intervals, test: TestFunction::Bump(power), shrinks: false, instrumented: false }
     }
 
     /// −∫ φ′ x dt = ∫ φ ẋ dt for x = sin 3t (closed form ẋ = 3 cos 3t), on an even and on an
@@ -121,7 +122,15 @@ mod tests {
     /// three samples, ρ₁ = 0, so 1; growing with the window.
     #[test]
     fn overlapping_windows_count_for_fewer_rows() {
-        assert_eq!(row_overlap(Window { intervals: 32, test: TestFunction::Flat, shrinks: false }), 1.0);
+        assert_eq!(
+            row_overlap(Window {
+                intervals: 32,
+                test: TestFunction::Flat,
+                shrinks: false,
+                instrumented: false
+            }),
+            1.0
+        );
         assert_eq!(row_overlap(bump(2, 1)), 1.0);
         let (a, b, c) = (row_overlap(bump(16, 4)), row_overlap(bump(32, 4)), row_overlap(bump(64, 4)));
         assert!(a > 3.0 && a < b && b < c, "{a} {b} {c}");
@@ -136,7 +145,7 @@ mod tests {
         let default = WeakForm::default().window().unwrap();
         assert_eq!(default.on_rows(10_000), default);
         assert_eq!(default.on_rows(129), default);
-        let flat = Window { intervals: 8, test: TestFunction::Flat, shrinks: false };
+        let flat = Window { intervals: 8, test: TestFunction::Flat, shrinks: false, instrumented: false };
         assert_eq!(default.on_rows(128), flat);
         let chosen = WeakForm { window: Some(32), power: 4 }.window().unwrap();
         assert_eq!(chosen.on_rows(41), chosen);

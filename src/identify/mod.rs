@@ -791,8 +791,12 @@ impl Identification<'_> {
         window: crate::data::Window,
         parts: &[std::ops::Range<usize>],
     ) -> Result<Vec<Moments>, IdentifyError> {
+        let rows = self.windows(library, target, frame, window)?;
         let Rows { y, columns: integrals, weights, starts: first_rows, window } =
-            self.windows(library, target, frame, window)?;
+            match rows.window.instrumented {
+                true => rows.instrumented(),
+                false => rows,
+            };
         let part = |own: &std::ops::Range<usize>| {
             // the rows of the windows that start on `own` samples (some left out: a switch inside)
             let starts =
@@ -1204,6 +1208,26 @@ struct Rows {
     starts: Vec<usize>,
     /// The windows the run took ([`run_window`]).
     window: crate::data::Window,
+}
+
+impl Rows {
+    /// The rows whose window has one ending before it starts, each candidate as those windows
+    /// predict it ([`crate::data::first_stage`]): what the regression fits where the
+    /// candidates are instrumented (the residuals are still the rows' own).
+    fn instrumented(self) -> Rows {
+        let (has, predicted) =
+            crate::data::first_stage(&self.columns, &self.starts, self.window.intervals + 1);
+        fn kept<T>(v: Vec<T>, has: &[bool]) -> Vec<T> {
+            v.into_iter().zip(has).filter(|(_, h)| **h).map(|(x, _)| x).collect()
+        }
+        Rows {
+            y: kept(self.y, &has),
+            columns: predicted,
+            weights: self.weights.map(|w| kept(w, &has)),
+            starts: kept(self.starts, &has),
+            window: self.window,
+        }
+    }
 }
 
 /// How the residuals grow with the fit's size: the root mean square of the residuals in the

@@ -5,6 +5,7 @@
 //! best; and, where the plausible starts disagree on a manoeuvre the runs did not cover, a flag
 //! saying that prediction is uncertain.
 
+mod force;
 mod halves;
 mod laws;
 mod noise;
@@ -26,7 +27,7 @@ pub use start::{
 
 use rayon::prelude::*;
 
-use crate::data::Frame;
+use crate::data::{Differentiator, Frame};
 use crate::identify::{num, Target};
 use crate::model::Model;
 use crate::plugin::Check;
@@ -66,6 +67,9 @@ pub struct RecipeSettings {
     /// a stand-in fails, is identified again with each state's laws among the candidates and
     /// those kept where they hold (`laws.rs`).
     pub laws: bool,
+    /// A system of one start, not refined, whose records show a state moved by a random force
+    /// (process noise) is identified again by Itô's steps, and that kept (`force.rs`).
+    pub random_force: bool,
 }
 
 impl RecipeSettings {
@@ -93,6 +97,7 @@ impl Default for RecipeSettings {
             agree: 0.10,
             parameters: None,
             laws: true,
+            random_force: true,
         }
     }
 }
@@ -265,6 +270,24 @@ pub fn identify(
         starts.par_iter_mut().for_each(|s| start::refine_instead(s, settings));
     }
     let recipe = Recipe::of(starts, failed, held.is_some(), settings.agree)?;
+    let ito = crate::data::Ito.name();
+    let one_start = settings.derivatives.len() == 1 && settings.derivatives[0] != ito;
+    if settings.random_force && one_start && settings.refine.is_none() && settings.choose.is_empty() {
+        let forced = force::forced_states(&recipe.kept().model, frames);
+        if !forced.is_empty() {
+            let again = RecipeSettings {
+                derivatives: vec![ito.into()],
+                smooth: false,
+                random_force: false,
+                ..settings.clone()
+            };
+            return Ok(force::said(
+                identify(model, frames, held, &again)?,
+                &forced,
+                &settings.derivatives[0],
+            ));
+        }
+    }
     let flags = laws::stand_in_flags(&recipe);
     let extended = match settings.laws && !flags.is_empty() && settings.choose.is_empty() {
         true => laws::with_laws(model, outline.as_ref()),

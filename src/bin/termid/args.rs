@@ -450,6 +450,12 @@ pub struct IdentifyCommand {
     /// √|x|, sin x), and those kept where they pass every check in fewer terms, said either way.
     #[arg(long, requires = "states")]
     pub no_laws: bool,
+    /// Keep the derivative method even where the records show a state moved by a random force
+    /// (process noise: another state's record holds its roughness, so it is motion, not a
+    /// sensor's noise); without it such a system (one start, not refined) is identified again by
+    /// Itô's steps (`--derivative ito`), whose terms the force does not bias, and that is said.
+    #[arg(long)]
+    pub no_random_force: bool,
     /// Write the model even when it fails a check: a physical check of its plug-in (a ship's:
     /// damping signs, turning circles that complete, plausible speed loss and drift), or, for
     /// a system of no plug-in's, that its equations retrace the runs without running away.

@@ -115,6 +115,7 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
                     cmd.per_run.clone(),
                 ),
                 laws: !cmd.no_laws,
+                random_force: !cmd.no_random_force,
             };
             let label = format!(
                 "identifying ({} start{})",
