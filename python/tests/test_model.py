@@ -1408,3 +1408,30 @@ def test_a_law_the_polynomials_stand_in_for_is_found_by_the_recipe():
         cubic = model.recipe(run, laws=False)
     assert "sin(theta)" not in cubic.model.coefficients("omega_dot")["term"].tolist()
     assert "FLAG the equations follow their runs" in cubic.text
+
+
+def test_a_random_force_is_found_by_the_recipe_and_its_damping_identified_unbiased():
+    # an oscillator under a random force (process noise, Euler-Maruyama at 1 ms), read every
+    # 0.02 s for 200 s: its velocity's roughness is in the position's record too, so the recipe
+    # identifies it by Itô's steps (the damping within three standard errors of -0.4), said;
+    # random_force=False keeps the weak form, whose windows take in the force (damping about halved)
+    rng = np.random.default_rng(5)
+    h, every, steps = 0.001, 20, 200_000
+    kicks = 0.3 * np.sqrt(h) * rng.standard_normal(steps)
+    x, v, rows = 1.0, 0.0, []
+    for k in range(steps):
+        if k % every == 0:
+            rows.append((k * h, x, v))
+        x, v = x + h * v, v + h * (-4.0 * x - 0.4 * v) + kicks[k]
+    rows = np.array(rows)
+    run = pd.DataFrame({"t": rows[:, 0], "x": rows[:, 1], "v": rows[:, 2]})
+    model = termid.Model.from_states(["x", "v"], [])
+    with pytest.warns(UserWarning, match="a random force moves `v`"):
+        found = model.recipe(run)
+    v = found.model.coefficients("v_dot").set_index("term")["value"]
+    assert v["v"] == pytest.approx(-0.4, abs=0.15) and v["x"] == pytest.approx(-4.0, abs=0.3)
+    assert "a random force moves `v`" in found.text
+    weak = model.recipe(run, random_force=False)
+    assert "a random force moves" not in weak.text
+    v = weak.model.coefficients("v_dot").set_index("term")["value"]
+    assert v.get("v", 0.0) > -0.3
