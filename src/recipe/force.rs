@@ -93,28 +93,27 @@ struct Misses {
 }
 
 impl Misses {
-    /// The variance of the misses over the `l`th stretch of [`LADDER`], every quarter pooled.
-    fn variance(&self, l: usize) -> Option<f64> {
-        let (s, s2, n) =
-            self.quarters.iter().fold((0.0, 0.0, 0.0), |(a, b, c), q| (a + q[l].0, b + q[l].1, c + q[l].2));
-        let v = s2 / n - (s / n) * (s / n);
-        v.is_finite().then_some(v)
+    /// Every quarter of the runs.
+    const ALL: [usize; 4] = [0, 1, 2, 3];
+
+    /// The variance of the misses over the `l`th stretch of [`LADDER`], `quarters` pooled.
+    fn variance(&self, l: usize, quarters: &[usize]) -> f64 {
+        let (s, s2, n) = quarters.iter().fold((0.0, 0.0, 0.0), |(a, b, c), &q| {
+            let (s, s2, n) = self.quarters[q][l];
+            (a + s, b + s2, c + n)
+        });
+        s2 / n - (s / n) * (s / n)
     }
 
-    /// The growth of the misses' variance per sample of stretch, over `quarters` pooled.
+    /// The growth of the misses' variance per sample of stretch, `quarters` pooled (a line
+    /// through the variances over the stretches of [`LADDER`]).
     fn growth(&self, quarters: &[usize]) -> Option<f64> {
+        let n = LADDER.len() as f64;
         let variance: Vec<(f64, f64)> = LADDER
             .iter()
             .enumerate()
-            .map(|(l, &length)| {
-                let (s, s2, n) = quarters.iter().fold((0.0, 0.0, 0.0), |(a, b, c), &q| {
-                    let (s, s2, n) = self.quarters[q][l];
-                    (a + s, b + s2, c + n)
-                });
-                (length as f64, s2 / n - (s / n) * (s / n))
-            })
+            .map(|(l, &length)| (length as f64, self.variance(l, quarters)))
             .collect();
-        let n = variance.len() as f64;
         let (ml, mv) = variance.iter().fold((0.0, 0.0), |(a, b), (l, v)| (a + l / n, b + v / n));
         let (sxy, sxx) = variance
             .iter()
@@ -126,11 +125,11 @@ impl Misses {
 
 /// The states of the identified `model` that `runs` show moved by a random force: each whose
 /// roughness is measured at least [`ROUGH`] of its spread and grows as a Brownian path's
-/// ([`brownian`]), where another state's equation, which
-/// reads it, integrates it more closely than that roughness in its sensor would allow (the
-/// witness's misses growing at under [`MOTION`] of that, by two standard errors, where that
-/// noise would be most of their growth and show beside the witness's own, [`SEEN`]). Runs of
-/// fewer than [`ROWS`] rows, or without every column the equations read, are not read.
+/// ([`brownian`]), where another state's equation, which reads it, integrates it more closely
+/// than that roughness in its sensor would allow (the witness's misses growing at under
+/// [`MOTION`] of that, by two standard errors, where that noise would be most of their growth
+/// and show beside the witness's own, [`SEEN`]). Runs of fewer than [`ROWS`] rows, or without
+/// every column the equations read, are not read.
 pub(super) fn forced_states(model: &Model, runs: &[Frame]) -> Vec<Forced> {
     let Ok(system) = System::new(model, &Default::default(), false) else {
         return Vec::new();
@@ -171,7 +170,7 @@ pub(super) fn forced_states(model: &Model, runs: &[Frame]) -> Vec<Forced> {
             .map(|c| NoiseTally::of(frame, c, 0..n).and_then(|t| t.sd()).unwrap_or(0.0))
             .collect();
         let sensitivity = |s: usize| -> Vec<Vec<f64>> {
-            let spread = tallies[s].sd().unwrap_or(0.0).max(sd[s]).max(1e-12);
+            let noise = tallies[s].sd().unwrap_or(0.0).max(sd[s]).max(1e-12);
             let nudged = |by: f64| {
                 let moved: Vec<f64> = read[s].iter().map(|v| v + by).collect();
                 let mut all: Vec<&[f64]> = read.clone();
@@ -179,7 +178,7 @@ pub(super) fn forced_states(model: &Model, runs: &[Frame]) -> Vec<Forced> {
                 let (st, inp) = all.split_at(states.len());
                 system.derivatives_on_columns(st, inp)
             };
-            let delta = 1e-3 * spread;
+            let delta = 1e-3 * noise;
             let (up, down) = (nudged(delta), nudged(-delta));
             up.iter()
                 .zip(&down)
@@ -219,7 +218,7 @@ pub(super) fn forced_states(model: &Model, runs: &[Frame]) -> Vec<Forced> {
         let witnessed = (0..states.len()).filter_map(|a| {
             let m = &misses[a][b];
             let (own, others) = (m.own / m.rows, m.others / m.rows);
-            let growth = m.growth(&[0, 1, 2, 3])?;
+            let growth = m.growth(&Misses::ALL)?;
             let quarters: Vec<f64> = (0..4).filter_map(|q| m.growth(&[q])).collect();
             let mean = quarters.iter().sum::<f64>() / quarters.len() as f64;
             let error = (quarters.iter().map(|g| (g - mean) * (g - mean)).sum::<f64>()
@@ -235,7 +234,7 @@ pub(super) fn forced_states(model: &Model, runs: &[Frame]) -> Vec<Forced> {
             let longest = *LADDER.last().unwrap_or(&1) as f64;
             let told = own > 0.0
                 && own >= others
-                && longest * own >= SEEN * m.variance(0)?
+                && longest * own >= SEEN * m.variance(0, &Misses::ALL)
                 && quarters.len() == 4
                 && growth + 2.0 * error < others + MOTION * own;
             told.then(|| (a, (growth - others) / own))
