@@ -288,6 +288,10 @@ pub fn identify(
             ));
         }
     }
+    let recipe = match settings.random_force && one_start && settings.refine.is_none() {
+        true => force::untold(recipe, frames),
+        false => recipe,
+    };
     let flags = laws::stand_in_flags(&recipe);
     let extended = match settings.laws && !flags.is_empty() && settings.choose.is_empty() {
         true => laws::with_laws(model, outline.as_ref()),
