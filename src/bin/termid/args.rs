@@ -236,7 +236,7 @@ pub enum RuleName {
 #[derive(Clone, Debug, Args)]
 #[command(group(ArgGroup::new("system").args(["model", "states"]).multiple(true)))]
 #[command(
-    after_help = "Examples:\n  termid identify --data tests/data/hald.csv --no-time --target y --terms x1 x2 x3 x4\n  termid simulate --model models/lorenz.toml --duration 20 --sample 0.01 --out lorenz.csv\n  termid identify --model models/lorenz.toml --data lorenz.csv --out lorenz_id.toml\n  termid identify --data lorenz.csv --states x,y,z --out lorenz_whole.toml\n  termid identify --model examples/data/ship.toml --dataset examples/data/runs.toml --derivative kinematic,kalman \\\n      --smooth --no-intercept --choose sparse,best-subset --compare u,v,r,ψ --refine u,v,r,ψ --out ship_id.toml\nBack-ends: stepwise (the paper's STPRG), efroymson, best-subset, sparse, stlsq.\nDerivatives: weak[:W[:P]] and integral[:W] (no rate), central, five-point, savitzky-golay[:W:Q], spline[:ALPHA], kalman[:RATIO]; kinematic (ship models).\nRuns: CSV (model names, SI; aliases, semicolons, tabs and aligned blanks read), Parquet, Arrow IPC, or a dataset file (README)."
+    after_help = "Examples:\n  termid identify --data tests/data/hald.csv --no-time --target y --terms x1 x2 x3 x4\n  termid simulate --model models/lorenz.toml --duration 20 --sample 0.01 --out lorenz.csv\n  termid identify --model models/lorenz.toml --data lorenz.csv --out lorenz_id.toml\n  termid identify --data lorenz.csv --states x,y,z --out lorenz_whole.toml\n  termid identify --model examples/data/ship.toml --dataset examples/data/runs.toml --derivative kinematic,kalman \\\n      --smooth --no-intercept --choose sparse,best-subset --compare u,v,r,ψ --refine u,v,r,ψ --out ship_id.toml\nBack-ends: stepwise (the paper's STPRG), efroymson, best-subset, sparse, stlsq.\nDerivatives: weak[:W[:P]], integral[:W] and ito (no rate; ito for a record moved by a random force), central, five-point, savitzky-golay[:W:Q], spline[:ALPHA], kalman[:RATIO]; kinematic (ship models).\nRuns: CSV (model names, SI; aliases, semicolons, tabs and aligned blanks read), Parquet, Arrow IPC, or a dataset file (README)."
 )]
 pub struct IdentifyCommand {
     /// CSV files with a header row; several are combined (the paper's "Komb. Daten").
@@ -338,7 +338,9 @@ pub struct IdentifyCommand {
     /// `weak[:W[:P]]` and `integral[:W]` estimate no derivative: the weak form weighs the
     /// equation over windows of W samples (default 32) by a smooth bump of power P (8), the
     /// integral form takes changes over windows against the candidates' integrals (Simpson).
-    /// Default `auto`: the weak form for any system (the integral form's windows of 8 on runs
+    /// `ito` takes each interval's change against the candidates as the intervals before predict
+    /// them: for a record moved by a random force (process noise), whose terms every other
+    /// method biases. Default `auto`: the weak form for any system (the integral form's windows of 8 on runs
     /// of at most 128 samples), central for a model with a plug-in's table (a ship, as the
     /// paper differentiated).
     #[arg(long, default_value = "auto")]
