@@ -270,9 +270,14 @@ pub fn identify(
         starts.par_iter_mut().for_each(|s| start::refine_instead(s, settings));
     }
     let recipe = Recipe::of(starts, failed, held.is_some(), settings.agree)?;
+    // a random force read where one start of another method is neither refined nor chosen by
+    // re-simulation (which no equation without the force follows for long)
     let ito = crate::data::Ito.name();
-    let one_start = settings.derivatives.len() == 1 && settings.derivatives[0] != ito;
-    if settings.random_force && one_start && settings.refine.is_none() && settings.choose.is_empty() {
+    let plain = settings.random_force
+        && settings.derivatives.len() == 1
+        && settings.derivatives[0] != ito
+        && settings.refine.is_none();
+    if plain && settings.choose.is_empty() {
         let forced = force::forced_states(&recipe.kept().model, frames);
         if !forced.is_empty() {
             let again = RecipeSettings {
@@ -288,7 +293,7 @@ pub fn identify(
             ));
         }
     }
-    let recipe = match settings.random_force && one_start && settings.refine.is_none() {
+    let recipe = match plain {
         true => force::untold(recipe, frames),
         false => recipe,
     };

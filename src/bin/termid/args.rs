@@ -338,11 +338,11 @@ pub struct IdentifyCommand {
     /// `weak[:W[:P]]` and `integral[:W]` estimate no derivative: the weak form weighs the
     /// equation over windows of W samples (default 32) by a smooth bump of power P (8), the
     /// integral form takes changes over windows against the candidates' integrals (Simpson).
-    /// `ito` takes each interval's change against the candidates as the intervals before predict
-    /// them: for a record moved by a random force (process noise), whose terms every other
-    /// method biases. Default `auto`: the weak form for any system (the integral form's windows of 8 on runs
-    /// of at most 128 samples), central for a model with a plug-in's table (a ship, as the
-    /// paper differentiated).
+    /// `ito` takes each interval's change against the candidates as the intervals before
+    /// predict them: for a record moved by a random force (process noise), whose terms every
+    /// other method biases. Default `auto`: the weak form for any system (the integral form's
+    /// windows of 8 on runs of at most 128 samples), central for a model with a plug-in's
+    /// table (a ship, as the paper differentiated).
     #[arg(long, default_value = "auto")]
     pub derivative: String,
     /// Resample every run to this interval [s] before differentiating (low-pass filtered
