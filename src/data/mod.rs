@@ -51,6 +51,7 @@ pub use integral::{integral_rows, integral_rows_held, row_overlap, IntegralForm}
 pub use ito::{first_stage, Ito};
 pub use kalman::{KalmanSmoother, NoiseModel};
 pub use long::{columns_of, interleaved, text_columns_of};
+pub(crate) use noise::fourth_differences_over;
 pub use noise::{quantum, white_noise, Noise, NoiseTally};
 pub use prepare::{prepare, runs_of_rate, Preparation};
 pub use repeated::{

@@ -96,6 +96,13 @@ fn over(x: &[f64], lag: usize, stepped: &[&[f64]]) -> Noise {
     Noise { sd: s4, measured: s4 >= WHITE * s3, correlated: false }
 }
 
+/// The white noise that `x`'s fourth differences over `lag` samples read, whatever the motion
+/// (`over`'s reading alone): how it grows with the lag tells a stationary noise from a path of
+/// independent steps. `None` for a record under 20 samples beyond the differences' reach.
+pub(crate) fn fourth_differences_over(x: &[f64], lag: usize) -> Option<f64> {
+    (x.len() >= 4 * lag + 20).then(|| over(x, lag, &[]).sd)
+}
+
 /// A difference series regressed on the values of inputs that each of its terms spans.
 struct Explained {
     /// What is left of the differences.

@@ -9,6 +9,7 @@
 
 use super::{noise, retrace, Recipe};
 use crate::data::{Frame, NoiseTally};
+use crate::identify::noise::tallies;
 use crate::model::Model;
 use crate::sim::System;
 
@@ -61,31 +62,17 @@ const FASTEST: f64 = 3.0;
 /// noise's stops growing within its correlation; the motion's grows faster: a heater's
 /// temperature read every 2 s with 0.45 % noise grew 1.6, 1.9, then 7.2 times).
 fn brownian(runs: &[Frame], name: &str) -> bool {
+    // each stride's reading, its square pooled over the runs by their rows
     let reading = |stride: usize| {
-        let mut values: Vec<f64> = runs
+        let (sum, rows) = runs
             .iter()
             .filter_map(|f| f.column(name))
-            .flat_map(|x| {
-                (0..x.len().saturating_sub(4 * stride)).map(move |k| {
-                    let at = |j: usize| x[k + j * stride];
-                    (at(4) - 4.0 * at(3) + 6.0 * at(2) - 4.0 * at(1) + at(0)).abs()
-                })
-            })
-            .collect();
-        if values.is_empty() {
-            return None;
-        }
-        let middle = values.len() / 2;
-        let (_, median, _) = values.select_nth_unstable_by(middle, f64::total_cmp);
-        Some(*median * *median)
+            .filter_map(|x| Some((crate::data::fourth_differences_over(x, stride)?, x.len() as f64)))
+            .fold((0.0, 0.0), |(s, n), (sd, rows)| (s + sd * sd * rows, n + rows));
+        (rows > 0.0).then(|| sum / rows)
     };
     let readings: Option<Vec<f64>> = [1, 2, 4, 8].into_iter().map(reading).collect();
     readings.is_some_and(|r| r.windows(2).all(|w| w[1] >= BROWNIAN * w[0] && w[1] <= FASTEST * w[0]))
-}
-
-/// The noise of column `name` over `runs`, pooled.
-fn tally(runs: &[Frame], name: &str) -> NoiseTally {
-    NoiseTally::pooled(runs.iter().filter_map(|f| NoiseTally::of(f, name, 0..f.len())))
 }
 
 /// The share of its spread that the roughness of column `name` over `runs` (`tally`) is, where
@@ -151,7 +138,7 @@ pub(super) fn forced_states(model: &Model, runs: &[Frame]) -> Vec<Forced> {
     };
     let states = system.states.clone();
     let columns: Vec<String> = states.iter().chain(&system.inputs).cloned().collect();
-    let tallies: Vec<NoiseTally> = columns.iter().map(|c| tally(runs, c)).collect();
+    let tallies: Vec<NoiseTally> = tallies(&columns, runs).into_iter().map(|(_, t)| t).collect();
     let rough: Vec<(usize, f64)> =
         (0..states.len()).filter_map(|b| Some((b, brownian_share(runs, &states[b], &tallies[b])?))).collect();
     if rough.is_empty() {
@@ -301,14 +288,12 @@ pub(super) fn said(mut recipe: Recipe, forced: &[Forced], first: &str) -> Recipe
 /// (a state no other one integrates, as a first-order system's): a filtered sensor's noise or a
 /// random force, which the records cannot tell apart, and the method the force needs.
 pub(super) fn untold(mut recipe: Recipe, runs: &[Frame]) -> Recipe {
-    let model = &recipe.kept().model;
-    let rough: Vec<String> = model
-        .spec()
-        .states
+    let states: Vec<String> = recipe.kept().model.spec().states.iter().map(|s| s.name.clone()).collect();
+    let rough: Vec<String> = tallies(&states, runs)
         .iter()
-        .filter_map(|s| {
-            let share = brownian_share(runs, &s.name, &tally(runs, &s.name))?;
-            Some(format!("`{}` ({:.2} % of its spread)", s.name, 100.0 * share))
+        .filter_map(|(state, tally)| {
+            let share = brownian_share(runs, state, tally)?;
+            Some(format!("`{state}` ({:.2} % of its spread)", 100.0 * share))
         })
         .collect();
     if rough.is_empty() {
