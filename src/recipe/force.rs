@@ -277,6 +277,14 @@ pub(super) fn said(mut recipe: Recipe, forced: &[Forced], first: &str) -> Recipe
     if let Some((_, fit)) = start.fits.first_mut() {
         fit.selection.notes.push(note);
     }
+    // the model file says it too: simulated, it follows such a record in the mean only
+    let written = format!(
+        "a random force (process noise) moves {}: identified by Itô's steps (--derivative ito); simulated without the force, the equations follow such a record in the mean only",
+        states.join(", ")
+    );
+    if let Ok(noted) = start.model.edit(|file| file.model.notes.push(written)) {
+        start.model = noted;
+    }
     for check in start.checks.iter_mut().filter(|c| !c.passed && FAILED_BY_FORCE.contains(&c.name.as_str())) {
         check.detail.push_str(&cause);
     }

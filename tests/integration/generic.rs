@@ -3831,7 +3831,7 @@ fn a_yearly_census_claims_no_noise_it_cannot_see() {
 /// both: the weak form's windows take in the force they explain, and the damping comes back
 /// about halved (−0.2, or as v³). `v`'s roughness is in `x`'s record too (motion, not a
 /// sensor's noise), so the recipe identifies the system again by Itô's steps: the damping
-/// within three standard errors (0.05 each) of the truth, and said.
+/// within three standard errors (0.05 each) of the truth, said, and written in the model file.
 #[test]
 fn a_random_force_is_found_and_its_damping_identified_unbiased() {
     use crate::common::{Lcg, Scratch};
@@ -3863,8 +3863,12 @@ fn a_random_force_is_found_and_its_damping_identified_unbiased() {
         let of = |term: &str| terms.iter().find(|(t, _)| t == term).map(|(_, c)| *c);
         (of("x"), of("v"), out.contains("a random force moves `v`"), terms)
     };
-    let (spring, damping_ito, said, terms) = damping(&[]);
+    let written = dir.join("forced.toml");
+    let (spring, damping_ito, said, terms) = damping(&["--out", written.to_str().unwrap()]);
     assert!(said, "{terms:?}");
+    // the model file says it too (simulated without the force, it follows the record in the mean)
+    let file = std::fs::read_to_string(&written).unwrap();
+    assert!(file.contains("a random force (process noise) moves `v`: identified by Itô's steps"), "{file}");
     assert!(spring.is_some_and(|c| (c + 4.0).abs() < 0.3), "{terms:?}");
     assert!(damping_ito.is_some_and(|c| (c + 0.4).abs() < 0.15), "{terms:?}");
     let (_, damping_weak, said, terms) = damping(&["--no-random-force"]);
