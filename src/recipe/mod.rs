@@ -233,7 +233,7 @@ pub fn identify(
     // a model made from columns of variables far from 0: its library about reference values,
     // decided once on the runs as recorded, so that every start and configuration has it
     let setup = |e: crate::model::ModelError| RecipeError::Setup(e.to_string());
-    let outline = model.outline().cloned();
+    let (given, outline) = (model, model.outline().cloned());
     let (model, note) = model.about_references(frames).map_err(setup)?;
     let model = &model;
     let choose = settings
@@ -287,7 +287,8 @@ pub fn identify(
                 ..settings.clone()
             };
             return Ok(force::said(
-                identify(model, frames, held, &again)?,
+                // the model as given: its outline, which the laws' stage reads, kept
+                identify(given, frames, held, &again)?,
                 &forced,
                 &settings.derivatives[0],
             ));
