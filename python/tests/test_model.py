@@ -1414,7 +1414,7 @@ def test_a_random_force_is_found_by_the_recipe_and_its_damping_identified_unbias
     # an oscillator under a random force (process noise, Euler-Maruyama at 1 ms), read every
     # 0.02 s for 200 s: its velocity's roughness is in the position's record too, so the recipe
     # identifies it by Itô's steps (the damping within three standard errors of -0.4), said;
-    # random_force=False keeps the weak form, whose windows take in the force (damping about halved)
+    # random_force=False keeps the weak form, whose windows take in the force (the damping biased)
     rng = np.random.default_rng(5)
     h, every, steps = 0.001, 20, 200_000
     kicks = 0.3 * np.sqrt(h) * rng.standard_normal(steps)

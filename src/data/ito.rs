@@ -2,7 +2,7 @@
 //! in Langevin's equation). A rate estimated on both sides of a sample, or a window's
 //! integral, takes in the force of the very interval it explains, and so do the candidates
 //! over that window: the damping of an oscillator under a random force came back halved by
-//! the weak form. Itô's steps instead: each interval's change against the candidates' trapezoid
+//! central differences and left out by the weak form. Itô's steps instead: each interval's change against the candidates' trapezoid
 //! over it, the candidates fitted as those of the interval two before predict them (two-stage
 //! least squares), which neither that interval's force nor a sensor's white noise at its
 //! samples reaches. Chosen as `--derivative ito`, and by the recipe where a random force is

@@ -4,8 +4,8 @@
 //! witness's changes miss its integral by that noise, more the longer the stretch; a random
 //! force's roughness is motion, which the witness's record holds, and its misses grow at a
 //! quarter of that rate or less. Rates estimated on both sides of a sample take in the force
-//! they explain (the damping of an oscillator under a random force came back halved by the weak
-//! form): such a system is identified by Itô's steps ([`crate::data::Ito`]).
+//! they explain (the damping of an oscillator under a random force came back halved by central
+//! differences, left out by the weak form): such a system is identified by Itô's steps ([`crate::data::Ito`]).
 
 use super::{noise, retrace, Recipe};
 use crate::data::{Frame, NoiseTally};
@@ -326,8 +326,8 @@ mod tests {
 
     /// An oscillator ẍ = −4x − 0.4ẋ + w, sampled every 0.02 s for `seconds` (Euler-Maruyama
     /// at 0.001 s), as a run of columns t, x, v; `force` the random force's intensity and
-    /// `sensor` a white noise added to v alone (a share of v's spread).
-    pub(crate) fn forced_oscillator(force: f64, sensor: f64, seconds: f64, seed: u64) -> Frame {
+    /// `sensor` a white noise added to each column (a share of its spread).
+    fn forced_oscillator(force: f64, sensor: f64, seconds: f64, seed: u64) -> Frame {
         let mut normal = Normal::new(seed);
         let (h, every) = (0.001, 20);
         let (mut x, mut v) = (1.0, 0.0);

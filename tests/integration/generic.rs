@@ -3828,10 +3828,11 @@ fn a_yearly_census_claims_no_noise_it_cannot_see() {
 
 /// An oscillator ẍ = −4x − 0.4ẋ + w under a random force w (process noise of 0.3/√s, by
 /// Euler-Maruyama at 1 ms), read every 0.02 s for 200 s with a sensor's noise of 0.5 % on
-/// both: the weak form's windows take in the force they explain, and the damping comes back
-/// about halved (−0.2, or as v³). `v`'s roughness is in `x`'s record too (motion, not a
-/// sensor's noise), so the recipe identifies the system again by Itô's steps: the damping
-/// within three standard errors (0.05 each) of the truth, said, and written in the model file.
+/// both: the weak form's windows take in the force they explain, and the terms come back
+/// biased (here the spring −3.64 and no damping at all). `v`'s roughness is in `x`'s record
+/// too (motion, not a sensor's noise), so the recipe identifies the system again by Itô's
+/// steps: the damping within three standard errors (0.05 each) of the truth, said, and
+/// written in the model file.
 #[test]
 fn a_random_force_is_found_and_its_damping_identified_unbiased() {
     use crate::common::{Lcg, Scratch};
