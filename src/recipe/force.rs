@@ -125,22 +125,37 @@ impl Misses {
     }
 }
 
-/// The states of the identified `model` that `runs` show moved by a random force: each whose
-/// roughness is measured at least [`ROUGH`] of its spread and grows as a Brownian path's
-/// ([`brownian`]), where another state's equation, which reads it, integrates it more closely
+/// The states of `model` whose roughness over `runs` is measured at least [`ROUGH`] of its
+/// spread and grows as a Brownian path's ([`brownian`]), with that share: those a random force
+/// may move.
+pub(super) fn rough_states(model: &Model, runs: &[Frame]) -> Vec<(String, f64)> {
+    let states: Vec<String> = model.spec().states.iter().map(|s| s.name.clone()).collect();
+    tallies(&states, runs)
+        .into_iter()
+        .filter_map(|(state, tally)| {
+            let share = brownian_share(runs, &state, &tally)?;
+            Some((state, share))
+        })
+        .collect()
+}
+
+/// The states of the identified `model` that `runs` show moved by a random force: each of the
+/// `rough` ones ([`rough_states`]) where another state's equation, which reads it, integrates it more closely
 /// than that roughness in its sensor would allow (the witness's misses growing at under
 /// [`MOTION`] of that, by two standard errors, where that noise would be most of their growth
 /// and show beside the witness's own, [`SEEN`]). Runs of fewer than [`ROWS`] rows, or without
 /// every column the equations read, are not read.
-pub(super) fn forced_states(model: &Model, runs: &[Frame]) -> Vec<Forced> {
+pub(super) fn forced_states(model: &Model, runs: &[Frame], rough: &[(String, f64)]) -> Vec<Forced> {
     let Ok(system) = System::new(model, &Default::default(), false) else {
         return Vec::new();
     };
     let states = system.states.clone();
     let columns: Vec<String> = states.iter().chain(&system.inputs).cloned().collect();
     let tallies: Vec<NoiseTally> = tallies(&columns, runs).into_iter().map(|(_, t)| t).collect();
-    let rough: Vec<(usize, f64)> =
-        (0..states.len()).filter_map(|b| Some((b, brownian_share(runs, &states[b], &tallies[b])?))).collect();
+    let rough: Vec<(usize, f64)> = rough
+        .iter()
+        .filter_map(|(state, share)| Some((states.iter().position(|s| s == state)?, *share)))
+        .collect();
     if rough.is_empty() {
         return Vec::new();
     }
@@ -292,21 +307,18 @@ pub(super) fn said(mut recipe: Recipe, forced: &[Forced], first: &str) -> Recipe
 }
 
 /// `recipe`, whose records show no state moved by a random force ([`forced_states`]), with a
-/// note on each state of its kept model whose roughness nonetheless grows as a Brownian path's
-/// (a state no other one integrates, as a first-order system's): a filtered sensor's noise or a
-/// random force, which the records cannot tell apart, and the method the force needs.
-pub(super) fn untold(mut recipe: Recipe, runs: &[Frame]) -> Recipe {
-    let states: Vec<String> = recipe.kept().model.spec().states.iter().map(|s| s.name.clone()).collect();
-    let rough: Vec<String> = tallies(&states, runs)
-        .iter()
-        .filter_map(|(state, tally)| {
-            let share = brownian_share(runs, state, tally)?;
-            Some(format!("`{state}` ({:.2} % of its spread)", 100.0 * share))
-        })
-        .collect();
+/// note on each of its `rough` states ([`rough_states`]), whose roughness nonetheless grows as
+/// a Brownian path's (a state no other one integrates, as a first-order system's): a filtered
+/// sensor's noise or a random force, which the records cannot tell apart, and the method the
+/// force needs.
+pub(super) fn untold(mut recipe: Recipe, rough: &[(String, f64)]) -> Recipe {
     if rough.is_empty() {
         return recipe;
     }
+    let rough: Vec<String> = rough
+        .iter()
+        .map(|(state, share)| format!("`{state}` ({:.2} % of its spread)", 100.0 * share))
+        .collect();
     let note = format!(
         "the roughness of {} grows as a Brownian path's (its fourth differences spread twice as much over twice the stride): a filtered sensor's noise, or a random force (process noise), whose terms rates estimated over both sides of a sample bias (an Ornstein-Uhlenbeck process's decay came back 24 % short, with two spurious terms); no other state's record holds it to tell which. Where a random force moves it, --derivative ito identifies the terms unbiased",
         rough.join(", ")
@@ -352,6 +364,11 @@ mod tests {
         frame
     }
 
+    /// The states `runs` show moved by a random force, as the recipe reads them.
+    fn told(model: &Model, runs: &[Frame]) -> Vec<Forced> {
+        forced_states(model, runs, &rough_states(model, runs))
+    }
+
     /// The oscillator's model with its true equations.
     fn oscillator() -> Model {
         Model::parse(
@@ -370,15 +387,15 @@ mod tests {
     #[test]
     fn a_random_force_is_told_from_a_sensor_s_noise() {
         let model = oscillator();
-        let forced = forced_states(&model, &[forced_oscillator(0.3, 0.0, 100.0, 1)]);
+        let forced = told(&model, &[forced_oscillator(0.3, 0.0, 100.0, 1)]);
         assert_eq!(forced.len(), 1, "{forced:?}");
         assert_eq!((forced[0].state.as_str(), forced[0].witness.as_str()), ("v", "x"));
         assert!(forced[0].ratio < 0.4, "{forced:?}");
         // with a sensor's noise of 1 % on top, still the force
-        let forced = forced_states(&model, &[forced_oscillator(0.3, 0.01, 100.0, 2)]);
+        let forced = told(&model, &[forced_oscillator(0.3, 0.01, 100.0, 2)]);
         assert_eq!(forced.iter().map(|f| f.state.as_str()).collect::<Vec<_>>(), ["v"], "{forced:?}");
         for sensor in [0.01, 0.05] {
-            let forced = forced_states(&model, &[forced_oscillator(0.0, sensor, 100.0, 3)]);
+            let forced = told(&model, &[forced_oscillator(0.0, sensor, 100.0, 3)]);
             assert!(forced.is_empty(), "{sensor}: {forced:?}");
         }
         // a velocity differenced from the noisy position's record (a ship's u and v from its
@@ -387,7 +404,7 @@ mod tests {
         let (t, x) = (tracked.time().to_vec(), tracked.column("x").unwrap().to_vec());
         let rate = crate::data::CentralDifference.differentiate(&t, &x).unwrap();
         tracked.overwrite("v", rate).unwrap();
-        let forced = forced_states(&model, &[tracked]);
+        let forced = told(&model, &[tracked]);
         assert!(forced.is_empty(), "{forced:?}");
     }
 }

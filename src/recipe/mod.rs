@@ -277,8 +277,13 @@ pub fn identify(
         && settings.derivatives.len() == 1
         && settings.derivatives[0] != ito
         && settings.refine.is_none();
-    if plain && settings.choose.is_empty() {
-        let forced = force::forced_states(&recipe.kept().model, frames);
+    // the states whose roughness grows as a Brownian path's, read once for both stages
+    let rough = match plain {
+        true => force::rough_states(&recipe.kept().model, frames),
+        false => Vec::new(),
+    };
+    if !rough.is_empty() && settings.choose.is_empty() {
+        let forced = force::forced_states(&recipe.kept().model, frames, &rough);
         if !forced.is_empty() {
             let again = RecipeSettings {
                 derivatives: vec![ito.into()],
@@ -294,10 +299,7 @@ pub fn identify(
             ));
         }
     }
-    let recipe = match plain {
-        true => force::untold(recipe, frames),
-        false => recipe,
-    };
+    let recipe = force::untold(recipe, &rough);
     let flags = laws::stand_in_flags(&recipe);
     let extended = match settings.laws && !flags.is_empty() && settings.choose.is_empty() {
         true => laws::with_laws(model, outline.as_ref()),
