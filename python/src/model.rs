@@ -70,7 +70,9 @@ impl PyModel {
                     notes.extend(self.inner.admit(frame)?);
                 }
                 let (cut, more) = self.inner.cut_at_breaks(std::mem::take(&mut frames))?;
-                frames = cut;
+                notes.extend(more);
+                let (estimated, more) = self.inner.estimated_rates(cut)?;
+                frames = estimated;
                 notes.extend(more);
                 Ok(notes)
             })
@@ -246,8 +248,9 @@ impl PyModel {
             ));
         }
         let degree = degree.unwrap_or(termid::model::DEFAULT_DEGREE);
+        let (states, rates) = termid::model::Outline::states_named(&states);
         let outline =
-            termid::model::Outline { name, time, states, inputs, candidates, degree, backend: None };
+            termid::model::Outline { name, time, states, rates, inputs, candidates, degree, backend: None };
         let model = outline.model("Model.from_states").map_err(fail)?;
         Ok(PyModel { inner: model })
     }

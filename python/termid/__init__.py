@@ -1509,7 +1509,10 @@ class Model:
         states and ``inputs`` to ``degree``, the constant among them — selected by sequential
         thresholding (or :meth:`identify`'s ``backend``), as ``termid identify --states`` makes
         it. ``inputs`` are the columns that drive the states (a force, a setpoint), known from
-        the runs. :meth:`identify` (and :meth:`recipe`) starts the identified model's states where the
+        the runs. A state the runs do not record, the rate of one they do, is written ``"v=dx/dt"``
+        (a position recorded alone: ``["x", "v=dx/dt"]``): each run gets it estimated from ``x``'s
+        record by the Kalman smoother (a warning says so), ``x``'s equation is the kinematic
+        ẋ = v, and v's is identified. :meth:`identify` (and :meth:`recipe`) starts the identified model's states where the
         first run starts, so that :meth:`simulate` retraces that run's beginning; :meth:`save` writes it.
         A state or input the runs hold more than 10 spreads from 0 (a temperature in kelvin) is
         written about a round reference value in the library, as the paper's Δu = u - u0: a
@@ -1532,7 +1535,9 @@ class Model:
             raise TypeError("states, inputs and terms are lists of names (['x', 'y']), not one string")
         if degree is not None and (isinstance(degree, bool) or int(degree) != degree or degree < 0):
             raise TermidError(f"Model.from_states: degree {degree!r} is no degree: give a whole number, 1 or more")
-        for name in [*states, *inputs]:
+        # a state the runs do not record, written as another's rate (`v=dx/dt`), by its name
+        named = [str(s).split("=")[0].strip() for s in states]
+        for name in [*named, *inputs]:
             # a dataframe's `tank level`: the remedy in pandas, not in a dataset file
             fixed = re.sub(r"\W", "_", str(name))
             if not str(name).isidentifier() and fixed.isidentifier():

@@ -1435,3 +1435,33 @@ def test_a_random_force_is_found_by_the_recipe_and_its_damping_identified_unbias
     assert "a random force moves" not in weak.text
     v = weak.model.coefficients("v_dot").set_index("term")["value"]
     assert v.get("v", 0.0) > -0.3
+
+
+def test_a_position_recorded_alone_is_identified_with_its_rate_estimated():
+    # a pendulum swinging from 2.8 rad, θ'' = -9.81 sin θ - 0.1 θ', read as its angle alone
+    # with noise of 1 % of its spread: "omega=dtheta/dt" names the rate the record lacks, which
+    # the runs get estimated from the angle (said); the angle's equation is the kinematic
+    # θ' = ω, and ω's comes back as the law within half a percent
+    def rate(s):
+        return np.array([s[1], -9.81 * np.sin(s[0]) - 0.1 * s[1]])
+
+    h, s, rows = 0.005, np.array([2.8, 0.0]), []
+    for k in range(6000):
+        if k % 2 == 0:
+            rows.append((k * h, s[0]))
+        k1 = rate(s)
+        k2 = rate(s + 0.5 * h * k1)
+        k3 = rate(s + 0.5 * h * k2)
+        k4 = rate(s + h * k3)
+        s = s + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+    rows = np.array(rows)
+    noise = 0.01 * rows[:, 1].std() * np.random.default_rng(3).standard_normal(len(rows))
+    run = pd.DataFrame({"t": rows[:, 0], "theta": rows[:, 1] + noise})
+    model = termid.Model.from_states(["theta", "omega=dtheta/dt"])
+    with pytest.warns(UserWarning, match="`omega` is not recorded: estimated as `theta`'s rate"):
+        found = model.recipe(run)
+    omega = found.model.coefficients("omega_dot").set_index("term")["value"]
+    assert sorted(omega.index) == ["omega", "sin(theta)"]
+    assert omega["sin(theta)"] == pytest.approx(-9.81, rel=0.005)
+    assert omega["omega"] == pytest.approx(-0.1, rel=0.1)
+    assert found.model.coefficients("theta_dot")["term"].tolist() == ["omega"]

@@ -21,6 +21,8 @@ pub struct KalmanSmoother {
 struct Pass {
     /// Smoothed states.
     states: Vec<Vector3<f64>>,
+    /// The smoothed rate's variance at each sample, in measurement variances (scaled time).
+    rate_variances: Vec<f64>,
     /// −2 log likelihood with the measurement variance concentrated out.
     deviance: f64,
     /// The measurement variance that maximises the likelihood (data units²).
@@ -94,22 +96,30 @@ fn pass(h: &[f64], y: &[f64], q: f64, smooth: bool) -> Option<Pass> {
         return None;
     }
     if !smooth {
-        return Some(Pass { states: vec![], deviance, variance: sum_v2 / m });
+        return Some(Pass { states: vec![], rate_variances: vec![], deviance, variance: sum_v2 / m });
     }
     // filtered[i] is sample i + 2
     let mut states: Vec<Vector3<f64>> = filtered.iter().map(|(x, _)| *x).collect();
+    let mut covariances: Vec<Matrix3<f64>> = filtered.iter().map(|(_, p)| *p).collect();
     for i in (0..states.len() - 1).rev() {
         let (xf, pf) = filtered[i];
         let (xp, pp) = predicted[i + 1];
         let c = pf * transition(h[i + 2]).transpose() * pp.try_inverse()?;
         states[i] = xf + c * (states[i + 1] - xp);
+        covariances[i] = pf + c * (covariances[i + 1] - pp) * c.transpose();
     }
     // samples 0 and 1: the state at sample 2 carried back along the kinematic model
     let first = states[0];
     let back = |dt: f64| transition(-dt) * first;
     let mut all = vec![back(h[0] + h[1]), back(h[1])];
     all.extend(states);
-    Some(Pass { states: all, deviance, variance: sum_v2 / m })
+    let spread_back = |dt: f64| {
+        let f = transition(-dt);
+        (f * covariances[0] * f.transpose())[(1, 1)]
+    };
+    let mut rate_variances = vec![spread_back(h[0] + h[1]), spread_back(h[1])];
+    rate_variances.extend(covariances.iter().map(|p| p[(1, 1)]));
+    Some(Pass { states: all, rate_variances, deviance, variance: sum_v2 / m })
 }
 
 /// What the likelihood says about a signal's noise: its measurement variance and the
@@ -148,8 +158,23 @@ impl KalmanSmoother {
         })
     }
 
+    /// The rate of `x` at every sample and its standard error's root mean square over them
+    /// (the smoother's own, from its covariance: the noise a regressor made of the rate
+    /// carries, correlated over the smoother's span where a white noise's fourth differences
+    /// read next to none).
+    pub fn rate_with_error(&self, t: &[f64], x: &[f64]) -> Result<(Vec<f64>, f64), DataError> {
+        let ((smoothed, error), _) = self.fitted(t, x)?;
+        Ok((smoothed.rate, error))
+    }
+
     /// The smoothed signal and its rate, and the noise ratio used.
     pub fn fit(&self, t: &[f64], x: &[f64]) -> Result<(Smoothed, f64), DataError> {
+        let ((smoothed, _), ratio) = self.fitted(t, x)?;
+        Ok((smoothed, ratio))
+    }
+
+    /// [`KalmanSmoother::fit`] with the rate's root-mean-square standard error.
+    fn fitted(&self, t: &[f64], x: &[f64]) -> Result<((Smoothed, f64), f64), DataError> {
         let (n, scale, h) = scaled_steps(t, x, "a Kalman smoother")?;
         let x = &x[..n];
         let ratio = match self.ratio {
@@ -166,11 +191,16 @@ impl KalmanSmoother {
         let p = pass(&h, x, ratio, true)
             .filter(|p| p.states.iter().all(|s| s[0].is_finite() && s[1].is_finite()))
             .ok_or_else(fail)?;
+        let mean_variance = p.rate_variances.iter().sum::<f64>() / p.rate_variances.len().max(1) as f64;
+        let error = (p.variance * mean_variance.max(0.0)).sqrt() / scale;
         Ok((
-            Smoothed {
-                value: p.states.iter().map(|s| s[0]).collect(),
-                rate: p.states.iter().map(|s| s[1] / scale).collect(),
-            },
+            (
+                Smoothed {
+                    value: p.states.iter().map(|s| s[0]).collect(),
+                    rate: p.states.iter().map(|s| s[1] / scale).collect(),
+                },
+                error,
+            ),
             ratio,
         ))
     }
@@ -248,5 +278,25 @@ mod tests {
         let nm = KalmanSmoother::noise_model(&t, &x).unwrap();
         let sd = nm.measurement_variance.sqrt();
         assert!((sd / (0.02 / 12f64.sqrt()) - 1.0).abs() < 0.1, "noise sd {sd}");
+    }
+
+    /// The rate's standard error the smoother reports is the error its rate makes: on a sine
+    /// read with noise, at the root mean square of the errors against the sine's own rate
+    /// within a factor of 1.6 either way (the white-jerk model errs on the safe side, as on a
+    /// damped oscillator's position: 2.5 % reported for 2.2 % made), and next to none without
+    /// noise (a hundredth of a percent of the rate's amplitude).
+    #[test]
+    fn the_rate_s_standard_error_is_the_error_it_makes() {
+        let t: Vec<f64> = (0..2000).map(|i| i as f64 * 0.05).collect();
+        let mut seed = 5u64;
+        let x: Vec<f64> = t.iter().map(|t| (0.3 * t).sin() + 0.02 * noise(&mut seed)).collect();
+        let (rate, error) = KalmanSmoother::default().rate_with_error(&t, &x).unwrap();
+        let made = (rate.iter().zip(&t).map(|(r, t)| (r - 0.3 * (0.3 * t).cos()).powi(2)).sum::<f64>()
+            / t.len() as f64)
+            .sqrt();
+        assert!(error / made < 1.6 && made / error < 1.6, "reported {error}, made {made}");
+        let clean: Vec<f64> = t.iter().map(|t| (0.3 * t).sin()).collect();
+        let (_, error) = KalmanSmoother::default().rate_with_error(&t, &clean).unwrap();
+        assert!(error < 1e-4 * 0.3, "{error}");
     }
 }

@@ -470,6 +470,10 @@ pub struct Frame {
     /// interpolated between ([`read_at_readings`]), with the rows that are readings: their
     /// noise is the readings'.
     readings: Vec<(String, Repeats)>,
+    /// The columns not recorded but estimated from others (a velocity from its position's
+    /// record, [`crate::model::Model::estimated_rates`]), each with its standard error (root
+    /// mean square): their noise, which their differences, smooth, do not show.
+    estimated: Vec<(String, f64)>,
 }
 
 impl Frame {
@@ -490,6 +494,7 @@ impl Frame {
             text: vec![],
             recorded: None,
             readings: vec![],
+            estimated: vec![],
         };
         f.push(time_name, time)?;
         Ok(f)
@@ -613,6 +618,20 @@ impl Frame {
             *h = to.into();
         }
         Ok(())
+    }
+
+    /// Adds column `name` estimated from the others (not recorded), with its standard error
+    /// ([`Frame::estimated_error`]), as [`Frame::push`] adds a recorded one.
+    pub fn push_estimated(&mut self, name: &str, values: Vec<f64>, error: f64) -> Result<(), DataError> {
+        self.push(name, values)?;
+        self.estimated.push((name.into(), error));
+        Ok(())
+    }
+
+    /// The standard error of column `name` where it was estimated rather than recorded
+    /// ([`Frame::push_estimated`]).
+    pub fn estimated_error(&self, name: &str) -> Option<f64> {
+        self.estimated.iter().find(|(n, _)| n == name).map(|(_, e)| *e)
     }
 
     /// Takes column `name` as held from each sample to the next (a zero-order hold: its
@@ -866,6 +885,7 @@ impl Frame {
                     (name.clone(), Repeats { phase, ..*r })
                 })
                 .collect(),
+            estimated: self.estimated.clone(),
         }
     }
 }

@@ -229,6 +229,10 @@ pub struct NoiseTally {
     /// The rows of those whose noise read correlated ([`Noise::correlated`]).
     #[serde(default)]
     pub correlated_rows: usize,
+    /// The rows of those not recorded but estimated (a rate from another state's record,
+    /// [`Frame::estimated_error`]): their noise is the estimate's standard error.
+    #[serde(default)]
+    pub estimated_rows: usize,
     /// Σ σ² × rows over the records whose noise was only bounded ([`Noise::measured`]: the
     /// motion shows through).
     pub bound: f64,
@@ -265,6 +269,18 @@ impl NoiseTally {
     /// readings (without the held inputs' steps, which act between them).
     pub fn of(frame: &Frame, name: &str, own: std::ops::Range<usize>) -> Option<NoiseTally> {
         let x = frame.column(name)?;
+        if let Some(error) = frame.estimated_error(name) {
+            // a rate estimated from another record: the smoother's error, smooth itself, is
+            // what a regressor made of it carries
+            let spread = Self::spread(x.get(own).unwrap_or_default());
+            let rows = spread.rows;
+            return Some(NoiseTally {
+                noise: error * error * rows as f64,
+                noise_rows: rows,
+                estimated_rows: rows,
+                ..spread
+            });
+        }
         if let Some(r) = frame.readings_of(name) {
             let at: Vec<usize> = r.readings(x.len()).collect();
             let read: Vec<f64> = at.iter().map(|&k| x[k]).collect();
@@ -362,6 +378,7 @@ impl NoiseTally {
         self.noise += other.noise;
         self.noise_rows = self.noise_rows.saturating_add(other.noise_rows);
         self.correlated_rows = self.correlated_rows.saturating_add(other.correlated_rows);
+        self.estimated_rows = self.estimated_rows.saturating_add(other.estimated_rows);
         self.bound += other.bound;
         self.bound_rows = self.bound_rows.saturating_add(other.bound_rows);
     }
@@ -395,10 +412,17 @@ impl NoiseTally {
         self.correlated_rows as f64 > 0.5 * self.noise_rows as f64
     }
 
+    /// Whether the noise measured is mostly an estimate's standard error (a rate estimated
+    /// from another record), not a record's noise.
+    pub fn estimated(&self) -> bool {
+        self.estimated_rows as f64 > 0.5 * self.noise_rows as f64
+    }
+
     /// Whether rows could have given it: counts that fit, sums not negative, numbers finite.
     pub fn is_consistent(&self) -> bool {
         self.noise_rows.checked_add(self.bound_rows).is_some_and(|n| n <= self.rows)
             && self.correlated_rows <= self.noise_rows
+            && self.estimated_rows <= self.noise_rows
             && [self.noise, self.bound, self.m2].iter().all(|v| v.is_finite() && *v >= 0.0)
             && self.mean.is_finite()
     }

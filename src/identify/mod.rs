@@ -356,8 +356,9 @@ fn unexplained_note(selection: &crate::select::Selection, state: &str) -> Option
         format!(
             "the chosen terms explain {} % of the variance of `{state}`'s rate: the rest is noise, or \
              hangs on what the candidates lack — a state not recorded (a motion that turns back, \
-             seen in one coordinate, needs its rate as a state too), an input, a delay; the \
-             re-simulation says which",
+             seen in one coordinate, needs its rate as a state too: `--states {state},v=d{state}/dt` \
+             estimates it from `{state}`'s record, Python `states=[\"{state}\", \"v=d{state}/dt\"]`), \
+             an input, a delay; the re-simulation says which",
             report::sig(100.0 * r2.max(0.0), 2)
         )
     })

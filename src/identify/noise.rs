@@ -43,6 +43,9 @@ pub(crate) struct Share {
     /// Measured on noise correlated from sample to sample: a lower bound
     /// ([`crate::data::Noise::correlated`]).
     pub(crate) at_least: bool,
+    /// Not recorded but estimated: the share is the estimate's standard error
+    /// ([`NoiseTally::estimated`]).
+    estimated: bool,
 }
 
 impl Share {
@@ -92,6 +95,7 @@ pub(crate) fn shares(tallies: &[(String, NoiseTally)]) -> Vec<Share> {
                 share,
                 measured,
                 at_least: measured && t.correlated(),
+                estimated: t.estimated(),
             })
         })
         .collect()
@@ -107,7 +111,8 @@ pub(crate) fn measured(shares: &[&Share]) -> String {
                 (true, true) => "at least ",
                 (true, false) => "",
             };
-            format!("`{}` {bound}{} %", s.variable, crate::output::sig(100.0 * s.share, 2))
+            let estimated = if s.estimated { " (not recorded: its estimate's standard error)" } else { "" };
+            format!("`{}` {bound}{} %{estimated}", s.variable, crate::output::sig(100.0 * s.share, 2))
         })
         .collect();
     let correlated = if shares.iter().any(|s| s.at_least) {

@@ -259,6 +259,14 @@ impl EquationMoments {
                 model.path, late.name, late.delay
             )));
         }
+        if let Some(state) = model.spec().states.iter().find(|s| s.rate_of.is_some()) {
+            return Err(IdentifyError::Setup(format!(
+                "{}: `{}` is estimated from each run's whole record of `{}` (its `rate_of`), which a piece of a run does not hold: read the runs whole (--chunk-rows 0)",
+                model.path,
+                state.name,
+                state.rate_of.as_deref().unwrap_or_default()
+            )));
+        }
         let eqs = equations.iter().map(|e| model_equation(model, e)).collect::<Result<Vec<_>, _>>()?;
         let designs = eqs
             .iter()

@@ -128,6 +128,11 @@ pub struct StateSpec {
     /// concentration it makes is measured).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub per_run: Option<String>,
+    /// The state whose rate this one is, where the runs do not record it (a velocity beside a
+    /// measured position): each run's column estimated from that state's record by the
+    /// Kalman smoother ([`crate::model::Model::estimated_rates`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rate_of: Option<String>,
     /// A simulation leaving [min, max] stops with an error.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min: Option<f64>,

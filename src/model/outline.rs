@@ -38,6 +38,12 @@ pub struct Outline {
     pub time: String,
     /// The states, each one's rate an equation (`x` gives `x_dot`).
     pub states: Vec<String>,
+    /// States the runs do not record, each the rate of another (`v` → `x` for `v=dx/dt`):
+    /// estimated from that state's record ([`Model::estimated_rates`]), whose equation is then
+    /// the kinematic ẋ = v, known rather than identified (a position measured alone, its
+    /// acceleration the equation of motion).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub rates: BTreeMap<String, String>,
     /// The inputs: known from the runs' records, not integrated.
     pub inputs: Vec<String>,
     /// Every rate's candidate terms; empty: every monomial of the states and inputs to
@@ -50,6 +56,27 @@ pub struct Outline {
 }
 
 impl Outline {
+    /// States as `--states` and Python's `states` name them: a column (`x`), or a state the
+    /// runs do not record as another state's rate (`v=dx/dt`): the names in order, and each
+    /// such state with the state it is the rate of ([`Outline::rates`]).
+    pub fn states_named(named: &[String]) -> (Vec<String>, BTreeMap<String, String>) {
+        let mut rates = BTreeMap::new();
+        let states = named
+            .iter()
+            .map(|n| match n.split_once('=') {
+                Some((state, rate)) => {
+                    let rate = rate.trim();
+                    // `dx/dt`; anything else is kept whole, for the vocabulary to refuse
+                    let of = rate.strip_prefix('d').and_then(|r| r.strip_suffix("/dt")).map(str::trim);
+                    rates.insert(state.trim().to_string(), of.unwrap_or(rate).to_string());
+                    state.trim().to_string()
+                }
+                None => n.trim().to_string(),
+            })
+            .collect();
+        (states, rates)
+    }
+
     /// The names the candidates may use, the states' and the inputs', each checked to be a
     /// name a term can use, neither the time nor named twice.
     pub fn vocabulary(&self, origin: &str) -> Result<crate::term::Vocabulary, ModelError> {
@@ -71,6 +98,25 @@ impl Outline {
                 return Err(refuse(format!("`{name}` is named twice: a name is a state or an input, once")));
             }
             vocabulary.variable(name).map_err(|e| refuse(e.to_string()))?;
+        }
+        for (state, of) in &self.rates {
+            let written = match crate::term::is_identifier(of) {
+                true => format!("`{state}=d{of}/dt`"),
+                false => format!("`{state}={of}`"),
+            };
+            let message = if !crate::term::is_identifier(of) {
+                "a state the runs do not record is written as the rate of one they do, `v=dx/dt`".to_string()
+            } else if of == state {
+                "a state cannot be its own rate".to_string()
+            } else if self.rates.contains_key(of) {
+                // a rate of an estimated rate would differentiate a smoothed signal again
+                format!("`{of}` is not recorded either: a state the runs do not record is the rate of one they do")
+            } else if !self.states.contains(of) {
+                format!("`{of}` is no state named: name it a state too, --states {of},{state}=d{of}/dt")
+            } else {
+                continue;
+            };
+            return Err(refuse(format!("{written}: {message}")));
         }
         Ok(vocabulary)
     }
@@ -128,6 +174,7 @@ impl Outline {
                     unit: String::new(),
                     initial: 0.0,
                     per_run: None,
+                    rate_of: self.rates.get(n).cloned(),
                     min: None,
                     max: None,
                 })
@@ -144,15 +191,19 @@ impl Outline {
                 .states
                 .iter()
                 .map(|s| {
+                    // a state whose rate is another state is known: ẋ = v, kinematics
+                    let rate = self.rates.iter().find(|(_, of)| *of == s).map(|(rate, _)| rate);
                     let equation = EquationSpec {
                         state: s.clone(),
-                        identify: true,
-                        candidates: candidates.clone(),
+                        identify: rate.is_none(),
+                        candidates: if rate.is_none() { candidates.clone() } else { Vec::new() },
                         forced: Vec::new(),
                         excluded: Vec::new(),
-                        backend: Some(backend.clone()),
+                        backend: rate.is_none().then(|| backend.clone()),
                         intercept: None,
-                        coefficients: BTreeMap::new(),
+                        coefficients: rate
+                            .map(|r| BTreeMap::from([(r.clone(), super::CoefficientSpec::Value(1.0))]))
+                            .unwrap_or_default(),
                         covariance: None,
                     };
                     (format!("{s}_dot"), equation)
@@ -355,6 +406,7 @@ mod tests {
             name: "Lorenz".into(),
             time: "t".into(),
             states: vec!["x".into(), "y".into(), "z".into()],
+            rates: BTreeMap::new(),
             inputs: vec![],
             candidates: vec![],
             degree: 2,
@@ -397,6 +449,62 @@ mod tests {
             e.contains("candidate `x*q`") && e.contains('^') && e.contains("unknown variable `q`"),
             "{e}"
         );
+    }
+
+    /// `v=dx/dt` names a state the runs do not record as another's rate: x's equation is the
+    /// kinematic ẋ = v, known; v's is identified over the monomials of x, v and the input. The
+    /// runs get v estimated from x's record (the Kalman smoother's rate, with its standard
+    /// error as the column's noise); a run that records v keeps its own. Rates of what is not a
+    /// state recorded are refused, as is a file's `rate_of` naming the state itself.
+    #[test]
+    fn a_state_not_recorded_is_the_rate_of_one_that_is() {
+        let named =
+            |list: &[&str]| Outline::states_named(&list.iter().map(|s| s.to_string()).collect::<Vec<_>>());
+        let (states, rates) = named(&["x", " v = dx/dt"]);
+        assert_eq!(states, ["x", "v"]);
+        assert_eq!(rates, BTreeMap::from([("v".to_string(), "x".to_string())]));
+        let second = Outline { states, rates, inputs: vec!["u".into()], ..lorenz() };
+        let model = second.model("--states x,v=dx/dt").unwrap();
+        assert_eq!(model.identifiable(), ["v_dot"]);
+        let x = model.equation("x_dot").unwrap();
+        assert!(!x.identify && x.candidates.is_empty());
+        assert_eq!(x.coefficients, [(crate::term::Term::var("v"), 1.0, None)]);
+        assert_eq!(model.equation("v_dot").unwrap().candidates.len(), 10);
+        assert_eq!(model.estimated_states(), ["v"]);
+        let again = Model::parse(&model.to_toml(), "again.toml").unwrap();
+        assert_eq!(again.spec(), model.spec());
+        for (list, says) in [
+            (&["x", "v=dq/dt"][..], "`q` is no state named"),
+            (&["x", "v=dx/dt", "a=dv/dt"][..], "`v` is not recorded either"),
+            (&["x", "v=dv/dt"][..], "its own rate"),
+            (&["x", "v=d2x/dt2"][..], "written as the rate of one they do"),
+        ] {
+            let (states, rates) = named(list);
+            let e = Outline { states, rates, ..lorenz() }.model("--states").unwrap_err().to_string();
+            assert!(e.contains(says), "{list:?}: {e}");
+        }
+        let mut seed = 11u64;
+        let t: Vec<f64> = (0..1000).map(|k| k as f64 * 0.02).collect();
+        let mut run = Frame::new("run.csv", "t", t.clone()).unwrap();
+        run.push("x", t.iter().map(|t| t.sin() + 0.01 * crate::data::test_noise(&mut seed)).collect())
+            .unwrap();
+        run.push("u", vec![0.0; t.len()]).unwrap();
+        let mut recorded = run.clone();
+        recorded.push("v", t.iter().map(|t| t.cos()).collect()).unwrap();
+        let (runs, said) = model.estimated_rates(vec![run, recorded]).unwrap();
+        assert!(said[0].contains("estimated as `x`'s rate in 1 of 2 run(s)"), "{said:?}");
+        let error = runs[0].estimated_error("v").unwrap();
+        let v = runs[0].column("v").unwrap();
+        let made =
+            (v.iter().zip(&t).map(|(v, t)| (v - t.cos()).powi(2)).sum::<f64>() / t.len() as f64).sqrt();
+        assert!(error < 1.6 * made && made < 1.6 * error, "reported {error}, made {made}");
+        let tally = crate::data::NoiseTally::of(&runs[0], "v", 0..t.len()).unwrap();
+        assert!(tally.estimated() && (tally.sd().unwrap() / error - 1.0).abs() < 1e-9);
+        assert_eq!(runs[1].column("v").unwrap()[0], 1.0, "a recorded rate is kept");
+        assert!(runs[1].estimated_error("v").is_none());
+        let own = model.to_toml().replace("rate_of = \"x\"", "rate_of = \"v\"");
+        let e = Model::parse(&own, "own.toml").unwrap_err().to_string();
+        assert!(e.contains("own.toml") && e.contains("states[1].rate_of"), "{e}");
     }
 
     /// A run of Lorenz-like columns: x and y about 0, z about `z0` with spread about 1.

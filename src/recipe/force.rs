@@ -129,7 +129,15 @@ impl Misses {
 /// spread and grows as a Brownian path's ([`brownian`]), with that share: those a random force
 /// may move.
 pub(super) fn rough_states(model: &Model, runs: &[Frame]) -> Vec<(String, f64)> {
-    let states: Vec<String> = model.spec().states.iter().map(|s| s.name.clone()).collect();
+    // (a rate estimated by a smoother is smooth: it cannot show the force)
+    let estimated = model.estimated_states();
+    let states: Vec<String> = model
+        .spec()
+        .states
+        .iter()
+        .map(|s| s.name.clone())
+        .filter(|s| !estimated.contains(&s.as_str()))
+        .collect();
     tallies(&states, runs)
         .into_iter()
         .filter_map(|(state, tally)| {

@@ -278,7 +278,9 @@ pub struct IdentifyCommand {
     /// (comma-separated), each rate over the same candidates (--terms, --terms-file, or every
     /// monomial of the states and inputs to --degree), the rest as with --model: --out writes
     /// the model file (each state starting where the first run starts), which `termid
-    /// simulate --model` runs.
+    /// simulate --model` runs. A state the runs do not record, the rate of one they do, is
+    /// written `v=dx/dt` (a position recorded alone: --states x,v=dx/dt): estimated from x's
+    /// record by the Kalman smoother, ẋ = v kinematics, v's equation identified.
     #[arg(long, num_args = 1.., value_delimiter = ',')]
     pub states: Vec<String>,
     /// With --states: the columns that drive the states, known from the records

@@ -34,7 +34,9 @@ pub fn model(cmd: &IdentifyCommand) -> Result<Model> {
         }
         Ok(())
     };
-    for s in &cmd.states {
+    // `v=dx/dt`: a state the runs do not record, estimated as the rate of one they do
+    let (states, rates) = Outline::states_named(&cmd.states);
+    for s in states.iter().filter(|s| !rates.contains_key(*s)) {
         column(s, "--states")?;
     }
     let inputs = match &cmd.inputs {
@@ -47,11 +49,11 @@ pub fn model(cmd: &IdentifyCommand) -> Result<Model> {
             named
         }
         None => {
-            let rates: Vec<String> = cmd.states.iter().map(|s| format!("{s}_dot")).collect();
+            let dots: Vec<String> = states.iter().map(|s| format!("{s}_dot")).collect();
             let others = columns.iter().filter(|c| {
                 **c != time
-                    && !cmd.states.contains(c)
-                    && !rates.contains(c)
+                    && !states.contains(c)
+                    && !dots.contains(c)
                     && Some(c.as_str()) != cmd.by.as_deref()
             });
             let (usable, unnamed): (Vec<&String>, Vec<&String>) = others.partition(|c| is_identifier(c));
@@ -82,7 +84,8 @@ pub fn model(cmd: &IdentifyCommand) -> Result<Model> {
     let mut outline = Outline {
         name: cmd.states.join(", "),
         time: model_time,
-        states: cmd.states.clone(),
+        states,
+        rates,
         inputs,
         candidates: Vec::new(),
         degree: cmd.degree.unwrap_or(termid::model::DEFAULT_DEGREE),

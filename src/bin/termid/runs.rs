@@ -35,6 +35,8 @@ pub fn load_for(
     }
     let (frames, notes) = model.cut_at_breaks(frames)?;
     notes.iter().for_each(|n| say(n));
+    let (frames, notes) = model.estimated_rates(frames)?;
+    notes.iter().for_each(|n| say(n));
     // a per-run rule that reads one sample of a noisy record: said once, for the first such run
     for (name, rule) in model.parameter_rules() {
         let noisy: Vec<String> = frames.iter().filter_map(|f| rule.noisy_first_sample(&name, f)).collect();
