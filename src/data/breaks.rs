@@ -285,12 +285,30 @@ fn into_pieces(
     let n = frame.len();
     let bounds: Vec<usize> =
         std::iter::once(0).chain(cuts.iter().copied()).chain(std::iter::once(n)).collect();
+    let spans: Vec<(usize, usize)> = bounds
+        .windows(2)
+        .enumerate()
+        .map(|(k, w)| {
+            // the margin only beside a cut, not at the run's own ends
+            let a = if k == 0 { w[0] } else { w[0] + margin };
+            let b = if k + 2 == bounds.len() { w[1] } else { w[1].saturating_sub(margin) };
+            (a, b)
+        })
+        .collect();
+    pieces_of(frame, &spans, what, notes)
+}
+
+/// The rows `spans` (from, to) of `frame` as runs of their own, each named by its origin and
+/// its rows in it; a piece under 21 rows left out, said in `notes` as between `what`.
+pub(super) fn pieces_of(
+    frame: &Frame,
+    spans: &[(usize, usize)],
+    what: &str,
+    notes: &mut Vec<String>,
+) -> Result<Vec<Frame>, DataError> {
     let (mut pieces, mut short) = (Vec::new(), Vec::new());
     let mut longest = 0;
-    for (k, w) in bounds.windows(2).enumerate() {
-        // the margin only beside a cut, not at the run's own ends
-        let a = if k == 0 { w[0] } else { w[0] + margin };
-        let b = if k + 2 == bounds.len() { w[1] } else { w[1].saturating_sub(margin) };
+    for &(a, b) in spans {
         let rows = b.saturating_sub(a);
         longest = longest.max(rows);
         if rows < SHORTEST {

@@ -4,6 +4,7 @@
 
 mod angle;
 mod breaks;
+mod clipped;
 mod clock;
 #[cfg(feature = "columnar")]
 mod columnar;
@@ -34,6 +35,7 @@ mod weak;
 
 pub use angle::{laid_on_turns, turn_of, unwrap_turns, unwrapped, unwrapped_dials, wrapped};
 pub use breaks::{breaks, cut_at_breaks, cut_at_gaps, gaps, moving_breaks, Break, Gaps, Leaps};
+pub use clipped::{clips, cut_at_clips, Clip};
 pub use clock::{clock_seconds, epoch_note};
 pub use dataset::{
     from_seconds, headers_in_si, in_seconds, read_as, seconds_of_unit, seconds_per, time_position,

@@ -1075,8 +1075,10 @@ impl Model {
     }
 
     /// Admitted runs ([`Model::admit`]) cut where a recorded state leaps at one sample and stays
-    /// ([`crate::data::cut_at_breaks`]: records joined in one file, a sensor re-zeroed), each
-    /// piece a run of its own, with what to say (an input that leaps alone is a step of it).
+    /// ([`crate::data::cut_at_breaks`]: records joined in one file, a sensor re-zeroed), and
+    /// around the stretches where one rests pinned at an end of its range
+    /// ([`crate::data::cut_at_clips`]: a sensor clipped at full scale), each piece a run of its
+    /// own, with what to say (an input that leaps alone is a step of it).
     pub fn cut_at_breaks(
         &self,
         frames: Vec<crate::data::Frame>,
@@ -1085,8 +1087,12 @@ impl Model {
         let (mut out, mut notes) = (Vec::new(), Vec::new());
         for frame in frames {
             let (pieces, said) = crate::data::cut_at_breaks(frame, &states, &inputs)?;
-            out.extend(pieces);
             notes.extend(said);
+            for piece in pieces {
+                let (pieces, said) = crate::data::cut_at_clips(piece, &states)?;
+                out.extend(pieces);
+                notes.extend(said);
+            }
         }
         Ok((out, notes))
     }
