@@ -5,13 +5,14 @@
 
 use super::derivative::Differentiator;
 use super::resample::resample;
-use super::{cut_at_breaks, mark_held, read_at_readings, DataError, Frame, Intersample};
+use super::{cut_at_breaks, cut_at_clips, mark_held, read_at_readings, DataError, Frame, Intersample};
 
 /// The runs of one rate, `state`'s, as its fit reads them: every other of `columns` an input
 /// that may be held between samples ([`mark_held`]), any of them (the state too) a slower
 /// sensor's readings, read at them ([`read_at_readings`]), and a run cut where the state leaps
 /// and stays (records joined in one file: [`cut_at_breaks`]; another column's leap alone is a
-/// step of an input). With what was done, a sentence each.
+/// step of an input) and around where it rests pinned at an end of its range (a sensor
+/// clipped: [`cut_at_clips`]). With what was done, a sentence each.
 pub fn runs_of_rate(
     frames: Vec<Frame>,
     state: &str,
@@ -25,7 +26,11 @@ pub fn runs_of_rate(
         notes.extend(read_at_readings(&mut frame, columns, intersample)?);
         let (cut, said) = cut_at_breaks(frame, &[state], &inputs)?;
         notes.extend(said);
-        runs.extend(cut);
+        for piece in cut {
+            let (pieces, said) = cut_at_clips(piece, &[state])?;
+            notes.extend(said);
+            runs.extend(pieces);
+        }
     }
     Ok((runs, notes))
 }
@@ -85,5 +90,21 @@ mod tests {
         let how = Preparation { resample: None, method: &spline, signals: vec!["u".into()], smooth: false };
         let e = prepare(&short2, &how).unwrap_err().to_string();
         assert!(e.contains("short.csv") && e.contains("`u`"), "{e}");
+    }
+
+    /// A rate's runs are cut around where its state rests pinned at the end of its range, as
+    /// a model's are: a swing clipped at ±0.6 by its sensor.
+    #[test]
+    fn a_rate_s_runs_are_cut_around_a_pinned_state() {
+        let t: Vec<f64> = (0..1500).map(|k| k as f64 * 0.02).collect();
+        let mut f = Frame::new("swing.csv", "t", t.clone()).unwrap();
+        f.push("x", t.iter().map(|t| ((-0.05 * t).exp() * (2.0 * t).cos()).clamp(-0.6, 0.6)).collect())
+            .unwrap();
+        f.push("u", t.iter().map(|t| (0.3 * t).sin()).collect()).unwrap();
+        let (runs, notes) = runs_of_rate(vec![f], "x", &["x", "u"], Intersample::Auto).unwrap();
+        assert!(
+            runs.len() > 1 && notes.iter().any(|n| n.contains("`x` rests at its largest value")),
+            "{notes:?}"
+        );
     }
 }
