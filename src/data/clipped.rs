@@ -16,8 +16,9 @@ const PLATEAU: usize = 3;
 /// clipped motion at its full rate (at 80 % of its swing, 60 % of its largest step).
 const MOVING: f64 = 0.1;
 
-/// On a grid of rounded values, the steps into and out of a plateau are at least this many of
-/// its steps (a turning point read to counts rests on the top count over a few samples).
+/// The steps into and out of a plateau are at least this many of the smallest step beside it,
+/// the record's rounding there (a turning point read to counts rests on the top count over a
+/// few samples, arrived at by single counts).
 const COUNTS: f64 = 3.0;
 
 /// Rows either side of a plateau whose steps tell the record's rounding there.
@@ -57,7 +58,6 @@ pub fn clips(frame: &Frame, states: &[&str]) -> Vec<Clip> {
         let middle = steps.len() / 2;
         let typical = *steps.select_nth_unstable_by(middle, f64::total_cmp).1;
         let least = MOVING * typical;
-        let least = super::noise::rounding_step(x).map_or(least, |q| least.max(COUNTS * q));
         let (lo, hi) = x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
         for (value, top) in [(hi, true), (lo, false)] {
             // every stretch at the value, however short, from row to row
@@ -80,7 +80,7 @@ pub fn clips(frame: &Frame, states: &[&str]) -> Vec<Clip> {
             // a record printed to a few significant figures is rounded the coarser the larger
             // it is, on no one grid: its rounding beside the plateau is the smallest step
             // there, which a smooth turning point rests between (MARIN's heading printed to
-            // three figures rests on 18.2° for 60 rows)
+            // three figures rests on 25.0° for 120 rows, arrived at by steps of 0.1°)
             let rounding = |r: &std::ops::Range<usize>| {
                 let beside = r.start.saturating_sub(BESIDE)..r.start.min(x.len() - 1);
                 let after = r.end..(r.end + BESIDE).min(x.len() - 1);

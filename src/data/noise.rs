@@ -170,12 +170,6 @@ pub fn quantum(x: &[f64]) -> Option<f64> {
     grid(x).filter(|g| g.staircase).map(|g| g.step)
 }
 
-/// The smallest step of the grid a record's values sit on, staircase or not ([`quantum`] only
-/// where most steps are single): its rounding.
-pub(crate) fn rounding_step(x: &[f64]) -> Option<f64> {
-    grid(x).map(|g| g.step)
-}
-
 /// The grid a record's values sit on: every step between samples a whole number of the
 /// smallest, over ten levels at least.
 #[derive(Clone, Copy, Debug, PartialEq)]

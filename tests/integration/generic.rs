@@ -3959,9 +3959,8 @@ fn switched_oscillator(x0: f64) -> Vec<[f64; 4]> {
 }
 
 /// [`switched_oscillator`] recorded as its position alone with noise of 1 % (a displacement
-/// sensor): `--states x` cannot turn back
-/// as x does and says how to name the rate; `--states x,v=dx/dt` estimates v from x's record,
-/// writes ẋ = v as kinematics, and identifies v's equation within 1 % of each coefficient,
+/// sensor): `--states x` cannot turn back as x does and says how to name the rate;
+/// `--states x,v=dx/dt` estimates v from x's record, writes ẋ = v as kinematics, and identifies v's equation within 1 % of each coefficient,
 /// every check passing (the re-simulations judged by x, the recorded state). `validate` reads
 /// the written model against the same position-only record.
 #[test]
