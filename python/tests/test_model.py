@@ -1465,3 +1465,32 @@ def test_a_position_recorded_alone_is_identified_with_its_rate_estimated():
     assert omega["sin(theta)"] == pytest.approx(-9.81, rel=0.005)
     assert omega["omega"] == pytest.approx(-0.1, rel=0.1)
     assert found.model.coefficients("theta_dot")["term"].tolist() == ["omega"]
+
+
+def test_a_sensor_pinned_at_the_end_of_its_range_is_cut_around():
+    # a damped oscillator driven by a switched force, x and v read with noise of 1 %, x by a
+    # sensor clipped at ±0.8 after its noise: the pinned stretches are said (a warning) and
+    # cut out, and the pieces between give the truth within 1 % (the light damping within 2 %)
+    def rate(s, u):
+        return np.array([s[1], -4.0 * s[0] - 0.4 * s[1] + 2.0 * u])
+
+    h, s, rows = 0.005, np.array([0.3, 0.0]), []
+    for k in range(12000):
+        u = 1.0 if (k // 2000) % 2 == 0 else -1.0
+        if k % 4 == 0:
+            rows.append((k * h, s[0], s[1], u))
+        k1 = rate(s, u)
+        k2 = rate(s + 0.5 * h * k1, u)
+        k3 = rate(s + 0.5 * h * k2, u)
+        k4 = rate(s + h * k3, u)
+        s = s + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+    rows = np.array(rows)
+    rng = np.random.default_rng(9)
+    x = np.clip(rows[:, 1] + 0.0055 * rng.standard_normal(len(rows)), -0.8, 0.8)
+    run = pd.DataFrame({"t": rows[:, 0], "x": x, "v": rows[:, 2] + 0.011 * rng.standard_normal(len(rows)), "u": rows[:, 3]})
+    with pytest.warns(UserWarning, match="`x` rests at its largest value, 0.800"):
+        found = termid.Model.from_states(["x", "v"], ["u"]).recipe(run)
+    v = found.model.coefficients("v_dot").set_index("term")["value"]
+    assert sorted(v.index) == ["u", "v", "x"]
+    assert v["x"] == pytest.approx(-4.0, rel=0.01) and v["v"] == pytest.approx(-0.4, rel=0.02)
+    assert v["u"] == pytest.approx(2.0, rel=0.01)
