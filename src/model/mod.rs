@@ -697,6 +697,12 @@ impl Model {
                         format!("`{of}` is no other state recorded: `{}` can be estimated as the rate of a state whose record the runs hold (a position's), not of itself or of another estimated rate", s.name),
                     ));
                 }
+                if let Some(other) = spec.states[..i].iter().find(|o| o.rate_of.as_ref() == Some(of)) {
+                    return Err(key_err(
+                        &format!("states[{i}].rate_of"),
+                        format!("`{of}`'s rate is `{}` already: one state is its rate", other.name),
+                    ));
+                }
             }
             if let (Some(lo), Some(hi)) = (s.min, s.max) {
                 if lo >= hi {

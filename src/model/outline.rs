@@ -113,6 +113,8 @@ impl Outline {
                 format!("`{of}` is not recorded either: a state the runs do not record is the rate of one they do")
             } else if !self.states.contains(of) {
                 format!("`{of}` is no state named: name it a state too, --states {of},{state}=d{of}/dt")
+            } else if let Some((other, _)) = self.rates.iter().find(|(o, f)| *f == of && *o != state) {
+                format!("`{of}`'s rate is `{other}` already: one state is its rate")
             } else {
                 continue;
             };
@@ -478,6 +480,7 @@ mod tests {
             (&["x", "v=dx/dt", "a=dv/dt"][..], "`v` is not recorded either"),
             (&["x", "v=dv/dt"][..], "its own rate"),
             (&["x", "v=d2x/dt2"][..], "written as the rate of one they do"),
+            (&["x", "v=dx/dt", "w=dx/dt"][..], "one state is its rate"),
         ] {
             let (states, rates) = named(list);
             let e = Outline { states, rates, ..lorenz() }.model("--states").unwrap_err().to_string();
@@ -505,6 +508,9 @@ mod tests {
         let own = model.to_toml().replace("rate_of = \"x\"", "rate_of = \"v\"");
         let e = Model::parse(&own, "own.toml").unwrap_err().to_string();
         assert!(e.contains("own.toml") && e.contains("states[1].rate_of"), "{e}");
+        let twice = model.to_toml() + "[[states]]\nname = \"w\"\nrate_of = \"x\"\n";
+        let e = Model::parse(&twice, "twice.toml").unwrap_err().to_string();
+        assert!(e.contains("states[2].rate_of") && e.contains("`x`'s rate is `v` already"), "{e}");
     }
 
     /// A run of Lorenz-like columns: x and y about 0, z about `z0` with spread about 1.
