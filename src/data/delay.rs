@@ -27,13 +27,13 @@ pub fn delayed(frame: &Frame, name: &str, seconds: f64, from: f64) -> Result<Fra
         )));
     };
     let mut out = frame.slice(first..t.len());
-    let (mut cursor, mut sample) = (0, 0);
+    let (mut cursor, mut sample, close) = (0, 0, super::on_sample(t));
     let values: Vec<f64> = t[first..]
         .iter()
         .map(|&s| {
             let at = s - seconds;
             if frame.is_held(name) {
-                column[super::sample_at(t, at, &mut sample)]
+                column[super::sample_at(t, at, close, &mut sample)]
             } else {
                 super::interpolate_at(t, column, at, &mut cursor)
             }

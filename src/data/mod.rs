@@ -60,8 +60,8 @@ pub use repeated::{
     between_readings, fits_better_held, kinks_at_changes, read_at_readings, repeated, Repeats,
 };
 pub use resample::{
-    check_gaps, cubic_at, evened, interpolate_at, median_step, on_sample, resample, sample_at, sample_step,
-    uneven,
+    check_gaps, cubic_at, evened, interpolate_at, median_step, on_sample, resample, run_step, sample_at,
+    sample_step, uneven,
 };
 pub use savitzky_golay::SavitzkyGolay;
 pub use smoothing_spline::SmoothingSpline;

@@ -26,13 +26,13 @@ pub fn interpolate_at(t: &[f64], x: &[f64], s: f64, cursor: &mut usize) -> f64 {
     x[i] + w * (x[i + 1] - x[i])
 }
 
-/// The last sample of `t` at or before time `s` (a time within a millionth of a sample
-/// interval of a sample is on it: a grid k·Δt and a record's times round apart); the first
-/// before the record. `cursor` as for [`interpolate_at`]. What a column held between samples
-/// ([`super::Frame::hold`]) reads at `s`: shared by reading it back (a dead time) and by the
-/// simulator's input replay.
-pub fn sample_at(t: &[f64], s: f64, cursor: &mut usize) -> usize {
-    let (n, close) = (t.len(), on_sample(t));
+/// The last sample of `t` at or before time `s` (a time within `close` of a sample is on it,
+/// [`on_sample`] of the record's own times: a grid k·Δt and a record's times round apart); the
+/// first before the record. `cursor` as for [`interpolate_at`]. What a column held between
+/// samples ([`super::Frame::hold`]) reads at `s`: shared by reading it back (a dead time) and
+/// by the simulator's input replay.
+pub fn sample_at(t: &[f64], s: f64, close: f64, cursor: &mut usize) -> usize {
+    let n = t.len();
     if t[*cursor] > s + close {
         *cursor = 0;
     }
@@ -42,9 +42,12 @@ pub fn sample_at(t: &[f64], s: f64, cursor: &mut usize) -> usize {
     *cursor
 }
 
-/// How close to a sample of `t` a time is on it: a millionth of the mean sample interval.
+/// How close to a sample of `t` a time is on it: a millionth of the mean sample interval, or
+/// the times' own rounding where they lie far from zero (a logger's Unix time, 1.7·10⁹ s, is
+/// read to 2.4·10⁻⁷ s where a millionth of a 50 Hz interval is 2·10⁻⁸ s: a held input's
+/// jumps were replayed a sample late).
 pub fn on_sample(t: &[f64]) -> f64 {
-    1e-6 * (t[t.len() - 1] - t[0]) / (t.len() - 1).max(1) as f64
+    (1e-6 * (t[t.len() - 1] - t[0]) / (t.len() - 1).max(1) as f64).max(rounding(t))
 }
 
 /// (t, x) interpolated at every time of `at`.
@@ -122,14 +125,29 @@ fn filter_at(x: &[f64], taps: &[f64], at: impl Iterator<Item = usize>) -> Vec<f6
     at.map(|i| taps.iter().zip(&padded[i..i + taps.len()]).map(|(w, v)| w * v).sum()).collect()
 }
 
-/// The median spacing of a time column.
+/// The median spacing of a time column; where the times lie so far from zero that their own
+/// rounding is over a billionth of it, the mean of the steps within 1 % of the median (a
+/// logger's Unix time, 1.7·10⁹ s, is read to 2.4·10⁻⁷ s: a 50 Hz clock's steps read as
+/// 0.01999998 or 0.02000022 s, and a re-simulation's grid k·Δt on the median fell behind the
+/// record by 2·10⁻⁸ s a step, its held inputs' jumps a sample late).
 pub fn median_step(t: &[f64]) -> f64 {
     let mut steps: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
     if steps.is_empty() {
         return 0.0;
     }
     steps.sort_by(f64::total_cmp);
-    steps[steps.len() / 2]
+    let median = steps[steps.len() / 2];
+    if rounding(t) <= 1e-9 * median.abs() {
+        return median;
+    }
+    let clock: Vec<f64> = steps.into_iter().filter(|d| (d - median).abs() <= 0.01 * median.abs()).collect();
+    clock.iter().sum::<f64>() / clock.len() as f64
+}
+
+/// How far a time column's values may lie from the numbers written: a few units in the last
+/// place of the largest.
+fn rounding(t: &[f64]) -> f64 {
+    4.0 * f64::EPSILON * t[0].abs().max(t[t.len() - 1].abs())
 }
 
 /// The shortest of the runs' median sample intervals: the step that re-simulates every run
@@ -138,12 +156,19 @@ pub fn sample_step(frames: &[Frame]) -> f64 {
     frames.iter().map(|f| median_step(f.time())).fold(f64::INFINITY, f64::min)
 }
 
+/// The step a re-simulation samples a run at: t₁ − t₀, or [`median_step`] where the times'
+/// own rounding blurs t₁ − t₀ (times far from zero). `None` for fewer than two samples.
+pub fn run_step(t: &[f64]) -> Option<f64> {
+    let first = *t.get(1)? - t[0];
+    Some(if rounding(t) <= 1e-9 * first.abs() { first } else { median_step(t) })
+}
+
 /// Where a run's samples are not where a re-simulation compares them: the first row whose
 /// stamp lies more than a tenth of a step off t₀ + k·(t₁ − t₀) (a dropped sample, a clock that
-/// drifts from its first step), with that stamp and its place. `None` where every one is
-/// within it: a re-simulation sampled every t₁ − t₀ meets row k at its k-th sample.
+/// drifts from its first step; [`run_step`] for t₁ − t₀), with that stamp and its place. `None` where every one is within it: a re-simulation sampled
+/// every t₁ − t₀ meets row k at its k-th sample.
 pub fn uneven(t: &[f64]) -> Option<(usize, f64, f64)> {
-    let step = *t.get(1)? - t[0];
+    let step = run_step(t)?;
     (0..t.len())
         .map(|k| (k, t[k], t[0] + k as f64 * step))
         .find(|(_, at, place)| (at - place).abs() > 0.1 * step)
@@ -249,7 +274,7 @@ pub fn evened(frame: &Frame) -> Result<Option<(Frame, String)>, DataError> {
     // at most)
     let reach = match scheduled {
         Some((_, false)) => step * (1.0 + 1e-9),
-        _ => 1e-6 * step,
+        _ => (1e-6 * step).max(rounding(frame.time())),
     };
     let mut recorded = vec![false; even.len()];
     let on_grid = frame.time().iter().all(|s| {
@@ -367,6 +392,28 @@ mod tests {
         let worst = even.time().iter().zip(even.column("x").unwrap()).map(|(s, x)| (x - s.sin()).abs());
         assert!(worst.fold(0.0, f64::max) < 1e-5);
         assert!(even.column("F").unwrap().iter().all(|v| (-1.0..=1.0).contains(v)));
+    }
+
+    /// A 100 Hz clock stamped in Unix time reads its steps as 0.00999999 or 0.01000023 s (the
+    /// stamps' rounding at 1.7·10⁹ s): its step is the clock's, every sample lies on its grid
+    /// (the first step's drift left the grid by a tenth of a step within 10 000 rows), and a
+    /// time counted from the start k·Δt is on sample k.
+    #[test]
+    fn unix_time_stamps_keep_their_clock() {
+        let t: Vec<f64> =
+            (0..30_000).map(|k| format!("{:.2}", 1.7e9 + k as f64 * 0.01).parse().unwrap()).collect();
+        assert!((median_step(&t) - 0.01).abs() < 1e-10, "{}", median_step(&t));
+        assert!((run_step(&t).unwrap() - 0.01).abs() < 1e-10);
+        assert_eq!(uneven(&t), None);
+        let from_start: Vec<f64> = t.iter().map(|s| s - t[0]).collect();
+        let mut cursor = 0;
+        for k in [1, 12_345, 29_999] {
+            assert_eq!(sample_at(&from_start, k as f64 * 0.01, on_sample(&t), &mut cursor), k);
+        }
+        // times near zero keep their first step and a millionth of it
+        let near: Vec<f64> = (0..100).map(|k| k as f64 * 0.01).collect();
+        assert_eq!(run_step(&near), Some(near[1] - near[0]));
+        assert!((on_sample(&near) - 1e-8).abs() < 1e-20);
     }
 
     /// A dropped sample (a step of two) is found where the first step no longer meets the

@@ -409,7 +409,7 @@ impl Runs {
             .iter()
             .map(|f| {
                 let t = f.time();
-                let sample = if t.len() > 1 { t[1] - t[0] } else { dt };
+                let sample = crate::data::run_step(t).unwrap_or(dt);
                 let sub = (sample / dt).round().max(1.0);
                 Settings { integrator, dt: sample / sub, duration: t[t.len() - 1] - t[0], sample }
             })

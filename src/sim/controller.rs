@@ -101,6 +101,9 @@ pub struct Replay {
     /// Where the last lookup of a held input's sample ended (apart from the line's cursor,
     /// which may stand one sample back).
     sample: usize,
+    /// How close to a sample a time is on it, by the record's own times before the shift
+    /// (their rounding far from zero is in the shifted ones too).
+    close: f64,
 }
 
 impl Replay {
@@ -119,6 +122,7 @@ impl Replay {
             held,
             cursor: 0,
             sample: 0,
+            close: crate::data::on_sample(frame.time()),
         })
     }
 
@@ -133,7 +137,7 @@ impl Replay {
 
     /// The last sample at or before `t` ([`crate::data::sample_at`]).
     fn sample_at(&mut self, t: f64) -> usize {
-        crate::data::sample_at(&self.time, t, &mut self.sample)
+        crate::data::sample_at(&self.time, t, self.close, &mut self.sample)
     }
 }
 
@@ -149,7 +153,7 @@ impl Controller for Replay {
             return false;
         }
         let j = self.sample_at(t);
-        if j == 0 || (self.time[j] - t).abs() > crate::data::on_sample(&self.time) {
+        if j == 0 || (self.time[j] - t).abs() > self.close {
             return false;
         }
         let mut jumped = false;
