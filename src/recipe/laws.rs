@@ -2,10 +2,11 @@
 //! polynomials may stand in for a law they only approximate (Torricelli's outflow √h of a
 //! tank came back as twenty terms in h, h², u², …). Identified again with each state's laws
 //! among the candidates ([`crate::term::laws`]), the laws' equations are kept where they pass
-//! every check the polynomials' failed, in fewer terms; either way it is said.
+//! every check the polynomials' failed, in no more terms; either way it is said.
 
 use super::{halves, retrace, Recipe};
 use crate::model::Model;
+use crate::term::Atom;
 
 /// The checks whose failure a stand-in shows: its terms differ between the halves of the runs,
 /// or it re-simulates them no closer than a model off the motion.
@@ -62,6 +63,57 @@ pub(super) fn stand_in_flags(recipe: &Recipe) -> Vec<String> {
         .collect()
 }
 
+/// The powers of one of `states` alone (x², v³) the kept start of `recipe` holds in its
+/// identified equations: what a state's law stands in as (sign v ≈ av + bv³, sin x ≈ x − x³/6,
+/// v·|v| ≈ v³, √h ≈ a + bh − ch²), which may pass every check where the records' noise hides
+/// what it misses (dry friction at 1 % noise as −0.35v + 0.0065v³, every check ok).
+pub(super) fn powers_held(recipe: &Recipe, states: &[String]) -> Vec<String> {
+    let model = &recipe.kept().model;
+    let alone = |t: &crate::term::Term| match t.monomials() {
+        [m] => matches!(m.factors.as_slice(), [(Atom::Var(name), p)] if *p >= 2 && states.contains(name)),
+        _ => false,
+    };
+    let mut held: Vec<String> = model
+        .identifiable()
+        .iter()
+        .filter_map(|n| model.equation(n))
+        .flat_map(|e| e.coefficients.iter().filter(|(t, _, _)| alone(t)).map(|(t, _, _)| t.to_string()))
+        .collect();
+    held.sort();
+    held.dedup();
+    held
+}
+
+/// How much better the kept start of `with` fits its rows than that of `polynomials`, as the
+/// difference of their Bayesian information criteria (the polynomials' less the laws', summed
+/// over the identified equations, each counted in its rows over its residuals' correlation
+/// time: those rows are what is independent). `None` where an equation's rows or target differ.
+fn fits_better(polynomials: &Recipe, with: &Recipe) -> Option<f64> {
+    let mut gain = 0.0;
+    for (name, poly) in &polynomials.kept().fits {
+        let (_, laws) = with.kept().fits.iter().find(|(n, _)| n == name)?;
+        let (a, b) = (&poly.selection, &laws.selection);
+        if a.rows != b.rows || poly.target != laws.target {
+            return None;
+        }
+        let unexplained = |s: &crate::select::Selection| {
+            s.chosen_step
+                .checked_sub(1)
+                .and_then(|k| s.steps.get(k))
+                .map(|step| (1.0 - step.r2).max(f64::MIN_POSITIVE))
+        };
+        let rows = a.rows as f64
+            / poly.correlation_time.unwrap_or(1.0).max(laws.correlation_time.unwrap_or(1.0)).max(1.0);
+        gain += rows * (unexplained(a)? / unexplained(b)?).ln()
+            + (a.terms.len() as f64 - b.terms.len() as f64) * rows.ln();
+    }
+    Some(gain)
+}
+
+/// How much lower the laws' information criterion must be where the polynomials pass every
+/// check: "very strong" evidence (Kass & Raftery 1995).
+const CLEARLY: f64 = 10.0;
+
 /// The number of terms of the identified equations of `recipe`'s kept model, and the `laws`
 /// among them (each once).
 fn terms(recipe: &Recipe, laws: &[String]) -> (usize, Vec<String>) {
@@ -82,29 +134,59 @@ fn named(checks: impl IntoIterator<Item = String>) -> String {
 }
 
 /// Which of the polynomial library's recipe `polynomials` (whose kept start fails the
-/// stand-in checks `flags`) and the recipe with the `laws` among the candidates (`with`) to
-/// keep, the choice said in a note of the kept start: the laws' where its kept start passes
-/// every check, holds a law and has fewer terms.
+/// stand-in checks `flags`, or none where it holds `powers` of a state alone) and the recipe
+/// with the `laws` among the candidates (`with`) to keep, the choice said in a note of the
+/// kept start: the laws' where its kept start passes every check, holds a law and no power
+/// of that law's state alone, has no more terms, and where the polynomials pass every check
+/// too, fits the rows clearly better.
 pub(super) fn kept(
     polynomials: Recipe,
     with: Result<Recipe, super::RecipeError>,
     laws: &[String],
     flags: &[String],
+    powers: &[String],
 ) -> Recipe {
     let (before, _) = terms(&polynomials, laws);
-    let tried = format!(
-        "the polynomial library's {before} terms failed {}; with each state's laws among the candidates ({ALL})",
-        named(flags.iter().cloned())
-    );
+    let tried = match flags.is_empty() {
+        true => format!(
+            "the polynomial library's {before} terms hold {}, a state's power alone, which may stand in for a law of it; with each state's laws among the candidates ({ALL})",
+            powers.iter().map(|t| format!("`{t}`")).collect::<Vec<_>>().join(", ")
+        ),
+        false => format!(
+            "the polynomial library's {before} terms failed {}; with each state's laws among the candidates ({ALL})",
+            named(flags.iter().cloned())
+        ),
+    };
+    let flagged = if flags.is_empty() { "" } else { ", as flagged" };
     let (mut recipe, note) = match with {
         Ok(with) => {
             let (after, held) = terms(&with, laws);
             let failing: Vec<String> =
                 with.kept().checks.iter().filter(|c| !c.passed).map(|c| c.name.clone()).collect();
+            // a law stands in for its state's powers: beside them it is one more stand-in
+            // (Michaelis-Menten's rational rate as all four laws of x, x³ and x: every check ok)
+            let lawful: Vec<String> = held
+                .iter()
+                .filter_map(|l| with.kept().model.vocabulary.parse(l).ok())
+                .flat_map(|t| t.variables())
+                .collect();
+            let beside = powers_held(&with, &lawful);
             let why = match (failing.is_empty(), held.is_empty()) {
                 (false, _) => Some(format!("they fail {} too", named(failing))),
                 (true, true) => Some("no law is chosen".to_string()),
-                (true, false) if after >= before => Some(format!("{after} terms, no fewer")),
+                (true, false) if !beside.is_empty() => Some(format!(
+                    "{} beside its state's laws: they stand in too",
+                    beside.iter().map(|t| format!("`{t}`")).collect::<Vec<_>>().join(", ")
+                )),
+                // (in as many terms, laws that pass where the polynomials fail stand in for
+                // nothing: dry friction's sign(v), whose stand-in v³ re-simulated the run 11
+                // times as far off as allowed, in four terms each)
+                (true, false) if after > before => Some(format!("{after} terms, more than the polynomials'")),
+                // where the polynomials pass every check too, the rows must tell
+                (true, false) if flags.is_empty() => match fits_better(&polynomials, &with) {
+                    Some(gain) if gain > CLEARLY => None,
+                    _ => Some("they fit the rows no clearly better".to_string()),
+                },
                 (true, false) => None,
             };
             match why {
@@ -117,13 +199,13 @@ pub(super) fn kept(
                     (with, note)
                 }
                 Some(why) => {
-                    (polynomials, format!("{tried} no better ({why}): the polynomials kept, as flagged"))
+                    (polynomials, format!("{tried} no better ({why}): the polynomials kept{flagged}"))
                 }
             }
         }
         Err(e) => (
             polynomials,
-            format!("{tried} the system could not be identified ({e}): the polynomials kept, as flagged"),
+            format!("{tried} the system could not be identified ({e}): the polynomials kept{flagged}"),
         ),
     };
     let at = recipe.kept;

@@ -301,14 +301,19 @@ pub fn identify(
     }
     let recipe = force::untold(recipe, &rough);
     let flags = laws::stand_in_flags(&recipe);
-    let extended = match settings.laws && !flags.is_empty() && settings.choose.is_empty() {
+    let powers = match (&outline, flags.is_empty()) {
+        (Some(o), true) => laws::powers_held(&recipe, &o.states),
+        _ => Vec::new(),
+    };
+    let stand_in = !flags.is_empty() || !powers.is_empty();
+    let extended = match settings.laws && stand_in && settings.choose.is_empty() {
         true => laws::with_laws(model, outline.as_ref()),
         false => None,
     };
     Ok(match extended {
         Some((extended, added)) => {
             let again = RecipeSettings { laws: false, ..settings.clone() };
-            laws::kept(recipe, identify(&extended, frames, held, &again), &added, &flags)
+            laws::kept(recipe, identify(&extended, frames, held, &again), &added, &flags, &powers)
         }
         None => recipe,
     })

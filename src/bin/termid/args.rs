@@ -449,9 +449,11 @@ pub struct IdentifyCommand {
     #[arg(long, value_name = "STATES", requires = "choose")]
     pub compare: Option<String>,
     /// With --states and the polynomial library (no --terms): keep the polynomials even where
-    /// their terms fail the checks a stand-in fails (the halves, the re-simulation); without it
-    /// the system is identified again with each state's laws among the candidates (sign, x·|x|,
-    /// √|x|, sin x), and those kept where they pass every check in fewer terms, said either way.
+    /// their terms fail the checks a stand-in fails (the halves, the re-simulation) or hold a
+    /// state's power alone (v³); without it the system is identified again with each state's
+    /// laws among the candidates (sign, x·|x|, √|x|, sin x), and those kept where they pass every
+    /// check in no more terms (and fit the rows clearly better where the polynomials passed
+    /// too), said either way.
     #[arg(long, requires = "states")]
     pub no_laws: bool,
     /// Keep the derivative method even where the records show a state moved by a random force
