@@ -1410,6 +1410,32 @@ def test_a_law_the_polynomials_stand_in_for_is_found_by_the_recipe():
     assert "FLAG the equations follow their runs" in cubic.text
 
 
+def test_a_law_the_noise_lets_a_cubic_stand_in_for_is_found_by_the_recipe():
+    # quadratic drag, v' = -0.5 v|v| + F, F held at random levels, v read with 1 % noise: the
+    # cubic's -0.24v - 0.24v^3 passes every check (kept with nothing said); its v^3, a state's
+    # power alone, has the laws tried, and v|v| fits the rows clearly better in fewer terms
+    rng = np.random.default_rng(11)
+    dt, n = 0.02, 6000
+    levels = rng.uniform(-2.0, 2.0, n // 250 + 1)
+    force = np.array([levels[k // 250] for k in range(n)])
+    v, rows = 0.0, []
+    for k in range(n):
+        rows.append(v)
+        for _ in range(20):
+            h = dt / 20
+            rate = lambda v: -0.5 * v * abs(v) + force[k]
+            k1 = rate(v); k2 = rate(v + 0.5 * h * k1); k3 = rate(v + 0.5 * h * k2); k4 = rate(v + h * k3)
+            v = v + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    rows = np.array(rows)
+    noisy = rows + 0.01 * rows.std() * rng.standard_normal(n)
+    run = pd.DataFrame({"t": np.arange(n) * dt, "v": noisy, "F": force})
+    found = termid.Model.from_states(["v"], ["F"]).recipe(run)
+    rate = found.model.coefficients("v_dot").set_index("term")["value"]
+    assert sorted(rate.index) == ["F", "v*abs(v)"]
+    assert rate["v*abs(v)"] == pytest.approx(-0.5, rel=0.02) and rate["F"] == pytest.approx(1.0, rel=0.02)
+    assert "a state's power alone" in found.text and "kept, the polynomials having stood in for a law" in found.text
+
+
 def test_a_random_force_is_found_by_the_recipe_and_its_damping_identified_unbiased():
     # an oscillator under a random force (process noise, Euler-Maruyama at 1 ms), read every
     # 0.02 s for 200 s: its velocity's roughness is in the position's record too, so the recipe
