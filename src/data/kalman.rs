@@ -163,8 +163,16 @@ impl KalmanSmoother {
     /// carries, correlated over the smoother's span where a white noise's fourth differences
     /// read next to none).
     pub fn rate_with_error(&self, t: &[f64], x: &[f64]) -> Result<(Vec<f64>, f64), DataError> {
-        let ((smoothed, error), _) = self.fitted(t, x)?;
-        Ok((smoothed.rate, error))
+        let ((smoothed, errors), _) = self.fitted(t, x)?;
+        Ok((smoothed.rate, root_mean_square(&errors)))
+    }
+
+    /// The rate of `x` at every sample and its standard error at each (the smoother's own,
+    /// from its covariance: larger towards the record's ends, where one side's samples are
+    /// missing).
+    pub fn rate_with_errors(&self, t: &[f64], x: &[f64]) -> Result<(Vec<f64>, Vec<f64>), DataError> {
+        let ((smoothed, errors), _) = self.fitted(t, x)?;
+        Ok((smoothed.rate, errors))
     }
 
     /// The smoothed signal and its rate, and the noise ratio used.
@@ -173,8 +181,8 @@ impl KalmanSmoother {
         Ok((smoothed, ratio))
     }
 
-    /// [`KalmanSmoother::fit`] with the rate's root-mean-square standard error.
-    fn fitted(&self, t: &[f64], x: &[f64]) -> Result<((Smoothed, f64), f64), DataError> {
+    /// [`KalmanSmoother::fit`] with the rate's standard error at every sample.
+    fn fitted(&self, t: &[f64], x: &[f64]) -> Result<((Smoothed, Vec<f64>), f64), DataError> {
         let (n, scale, h) = scaled_steps(t, x, "a Kalman smoother")?;
         let x = &x[..n];
         let ratio = match self.ratio {
@@ -191,19 +199,25 @@ impl KalmanSmoother {
         let p = pass(&h, x, ratio, true)
             .filter(|p| p.states.iter().all(|s| s[0].is_finite() && s[1].is_finite()))
             .ok_or_else(fail)?;
-        let mean_variance = p.rate_variances.iter().sum::<f64>() / p.rate_variances.len().max(1) as f64;
-        let error = (p.variance * mean_variance.max(0.0)).sqrt() / scale;
+        let errors: Vec<f64> =
+            p.rate_variances.iter().map(|v| (p.variance * v.max(0.0)).sqrt() / scale).collect();
         Ok((
             (
                 Smoothed {
                     value: p.states.iter().map(|s| s[0]).collect(),
                     rate: p.states.iter().map(|s| s[1] / scale).collect(),
                 },
-                error,
+                errors,
             ),
             ratio,
         ))
     }
+}
+
+/// The root mean square of the standard errors `errors` (the square root of their mean
+/// variance).
+fn root_mean_square(errors: &[f64]) -> f64 {
+    (errors.iter().map(|e| e * e).sum::<f64>() / errors.len().max(1) as f64).sqrt()
 }
 
 /// Ratio maximising the likelihood: a grid in decades, then golden section in log ratio.

@@ -177,6 +177,20 @@ pub const DEFAULT_DT: f64 = 0.04;
 
 /// A free parameter's keys make sense: a start within its bounds, a prior with sd > 0, and
 /// not also set per run. Err: (the key under `parameters.NAME`, why).
+/// How many times its median an estimated rate's standard error may be at a run's ends
+/// ([`Model::estimated_rates`]): beyond, the rows are left out.
+const ENDS: f64 = 2.0;
+
+/// The first and last sample of a run whose estimated rate's standard error (`errors`) is
+/// within [`ENDS`] times its median: the rows between them are kept.
+fn settled(errors: &[f64]) -> (usize, usize) {
+    let mut sorted = errors.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let Some(&median) = sorted.get(sorted.len() / 2) else { return (0, 0) };
+    let within = |e: &f64| *e <= ENDS * median;
+    (errors.iter().position(within).unwrap_or(0), errors.iter().rposition(within).unwrap_or(0))
+}
+
 fn check_free(name: &str, p: &ParameterSpec) -> Result<(), (String, String)> {
     let finite = |v: f64| v.is_finite();
     if let Some([lo, hi]) = p.bounds {
@@ -1114,31 +1128,58 @@ impl Model {
         &self,
         mut frames: Vec<crate::data::Frame>,
     ) -> Result<(Vec<crate::data::Frame>, Vec<String>), crate::data::DataError> {
-        let mut notes = Vec::new();
-        for state in &self.spec.states {
-            let Some(of) = &state.rate_of else { continue };
-            let mut estimated = 0;
-            for frame in &mut frames {
-                if frame.column(&state.name).is_some() {
+        let rates: Vec<(&str, &str)> =
+            self.spec.states.iter().filter_map(|s| Some((s.name.as_str(), s.rate_of.as_deref()?))).collect();
+        let mut estimated = vec![0; rates.len()];
+        let mut trimmed = 0;
+        for frame in &mut frames {
+            let mut found = Vec::new();
+            for (k, &(name, of)) in rates.iter().enumerate() {
+                if frame.column(name).is_some() {
                     continue;
                 }
                 let x = frame.require(of)?;
-                let (rate, error) = crate::data::KalmanSmoother::default()
-                    .rate_with_error(frame.time(), x)
+                let (rate, errors) = crate::data::KalmanSmoother::default()
+                    .rate_with_errors(frame.time(), x)
                     .map_err(|e| e.in_run(frame.origin(), Some(of)))?;
-                frame.push_estimated(&state.name, rate, error)?;
-                estimated += 1;
+                found.push((name, rate, errors));
+                estimated[k] += 1;
             }
-            if estimated > 0 {
-                notes.push(format!(
-                    "`{}` is not recorded: estimated as `{of}`'s rate in {estimated} of {} run(s) by a Kalman smoother \
-                     (white jerk, its noise ratio by maximum likelihood); d{of}/dt = {} is kinematics, and the checks \
-                     compare re-simulations with the recorded states alone",
-                    state.name,
-                    frames.len(),
-                    state.name
-                ));
+            // the smoother sees one side only at a run's ends, its rate there up to four times
+            // as uncertain: those rows are left out (a run cut around a pinned sensor has
+            // many ends, which chose u·x² and put x's coefficient 2.9 % off at 1 % noise)
+            let (mut first, mut last) = (0, frame.len().saturating_sub(1));
+            for (_, _, errors) in &found {
+                let (a, b) = settled(errors);
+                (first, last) = (first.max(a), last.min(b));
             }
+            if found.is_empty() || first >= last {
+                continue;
+            }
+            let rows = frame.len();
+            if first > 0 || last + 1 < rows {
+                *frame = frame.slice(first..last + 1);
+                trimmed += first + (rows - 1 - last);
+            }
+            for (name, rate, errors) in found {
+                let kept = &errors[first..=last];
+                let error = (kept.iter().map(|e| e * e).sum::<f64>() / kept.len() as f64).sqrt();
+                frame.push_estimated(name, rate[first..=last].to_vec(), error)?;
+            }
+        }
+        let mut notes = Vec::new();
+        for (&(name, of), &count) in rates.iter().zip(&estimated).filter(|(_, &c)| c > 0) {
+            notes.push(format!(
+                "`{name}` is not recorded: estimated as `{of}`'s rate in {count} of {} run(s) by a Kalman smoother \
+                 (white jerk, its noise ratio by maximum likelihood); d{of}/dt = {name} is kinematics, and the checks \
+                 compare re-simulations with the recorded states alone",
+                frames.len(),
+            ));
+        }
+        if trimmed > 0 {
+            notes.push(format!(
+                "{trimmed} row(s) at the runs' ends left out, where an estimated rate's standard error is over {ENDS} times its median (the smoother sees one side only there)"
+            ));
         }
         Ok((frames, notes))
     }
