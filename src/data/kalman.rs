@@ -158,18 +158,10 @@ impl KalmanSmoother {
         })
     }
 
-    /// The rate of `x` at every sample and its standard error's root mean square over them
-    /// (the smoother's own, from its covariance: the noise a regressor made of the rate
-    /// carries, correlated over the smoother's span where a white noise's fourth differences
-    /// read next to none).
-    pub fn rate_with_error(&self, t: &[f64], x: &[f64]) -> Result<(Vec<f64>, f64), DataError> {
-        let ((smoothed, errors), _) = self.fitted(t, x)?;
-        Ok((smoothed.rate, root_mean_square(&errors)))
-    }
-
-    /// The rate of `x` at every sample and its standard error at each (the smoother's own,
-    /// from its covariance: larger towards the record's ends, where one side's samples are
-    /// missing).
+    /// The rate of `x` at every sample and its standard error at each (the smoother's own, from
+    /// its covariance: the noise a regressor made of the rate carries, correlated over the
+    /// smoother's span where a white noise's fourth differences read next to none; larger
+    /// towards the record's ends, where one side's samples are missing).
     pub fn rate_with_errors(&self, t: &[f64], x: &[f64]) -> Result<(Vec<f64>, Vec<f64>), DataError> {
         let ((smoothed, errors), _) = self.fitted(t, x)?;
         Ok((smoothed.rate, errors))
@@ -212,12 +204,6 @@ impl KalmanSmoother {
             ratio,
         ))
     }
-}
-
-/// The root mean square of the standard errors `errors` (the square root of their mean
-/// variance).
-fn root_mean_square(errors: &[f64]) -> f64 {
-    (errors.iter().map(|e| e * e).sum::<f64>() / errors.len().max(1) as f64).sqrt()
 }
 
 /// Ratio maximising the likelihood: a grid in decades, then golden section in log ratio.
@@ -304,13 +290,15 @@ mod tests {
         let t: Vec<f64> = (0..2000).map(|i| i as f64 * 0.05).collect();
         let mut seed = 5u64;
         let x: Vec<f64> = t.iter().map(|t| (0.3 * t).sin() + 0.02 * noise(&mut seed)).collect();
-        let (rate, error) = KalmanSmoother::default().rate_with_error(&t, &x).unwrap();
+        let rms = |e: Vec<f64>| (e.iter().map(|e| e * e).sum::<f64>() / e.len() as f64).sqrt();
+        let (rate, errors) = KalmanSmoother::default().rate_with_errors(&t, &x).unwrap();
+        let error = rms(errors);
         let made = (rate.iter().zip(&t).map(|(r, t)| (r - 0.3 * (0.3 * t).cos()).powi(2)).sum::<f64>()
             / t.len() as f64)
             .sqrt();
         assert!(error / made < 1.6 && made / error < 1.6, "reported {error}, made {made}");
         let clean: Vec<f64> = t.iter().map(|t| (0.3 * t).sin()).collect();
-        let (_, error) = KalmanSmoother::default().rate_with_error(&t, &clean).unwrap();
+        let error = rms(KalmanSmoother::default().rate_with_errors(&t, &clean).unwrap().1);
         assert!(error < 1e-4 * 0.3, "{error}");
     }
 }
