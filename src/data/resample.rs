@@ -356,9 +356,18 @@ pub fn resample(frame: &Frame, dt: f64) -> Result<Frame, DataError> {
         .then(|| (grid(dt / factor as f64), low_pass(0.8 * 0.5 / factor as f64, 0.2 * 0.5 / factor as f64)));
     let mut out =
         Frame::new(frame.origin(), frame.time_name(), coarse.clone())?.starting_at(frame.row(0) - 1);
+    let close = on_sample(t);
     for name in &frame.names()[1..] {
         let x = frame.require(name)?;
         let values = match &fine {
+            // a command held between samples is read as held, and one that switches between
+            // them as the line across each switch: the filter rang at their jumps (a ±1 force
+            // resampled: u² no longer 1, and u³, u²·x chosen)
+            _ if frame.is_held(name) => {
+                let mut cursor = 0;
+                coarse.iter().map(|&s| x[sample_at(t, s, close, &mut cursor)]).collect()
+            }
+            _ if frame.is_switched(name) => interpolate(t, x, &coarse),
             None => interpolate(t, x, &coarse),
             Some((fine_t, taps)) => {
                 let fine = interpolate(t, x, fine_t);
@@ -366,7 +375,15 @@ pub fn resample(frame: &Frame, dt: f64) -> Result<Frame, DataError> {
                 filter_at(&fine, taps, (0..coarse.len()).map(|i| (i * factor).min(last)))
             }
         };
-        out.push(name, values)?;
+        match frame.estimated_error(name) {
+            Some(error) => out.push_estimated(name, values, error)?,
+            None => out.push(name, values)?,
+        }
+        if frame.is_held(name) {
+            out.hold(name)?;
+        } else if frame.is_switched(name) {
+            out.switch(name)?;
+        }
     }
     Ok(out)
 }
@@ -392,6 +409,26 @@ mod tests {
         let worst = even.time().iter().zip(even.column("x").unwrap()).map(|(s, x)| (x - s.sin()).abs());
         assert!(worst.fold(0.0, f64::max) < 1e-5);
         assert!(even.column("F").unwrap().iter().all(|v| (-1.0..=1.0).contains(v)));
+    }
+
+    /// A force held at ±1 between samples, resampled coarser, reads ±1 at every new sample and
+    /// stays held (the filter rang at each jump, beyond ±1 and between); a rate estimated
+    /// rather than recorded keeps its mark and standard error.
+    #[test]
+    fn a_held_column_is_resampled_as_held() {
+        let t: Vec<f64> = (0..1000).map(|k| k as f64 * 0.01).collect();
+        let mut f = Frame::new("held.csv", "t", t.clone()).unwrap();
+        f.push("u", t.iter().map(|s| if (s / 2.5).floor() as i64 % 2 == 0 { 1.0 } else { -1.0 }).collect())
+            .unwrap();
+        f.hold("u").unwrap();
+        f.push_estimated("v", t.iter().map(|s| s.cos()).collect(), 0.01).unwrap();
+        let coarse = resample(&f, 0.03).unwrap();
+        assert!(coarse.column("u").unwrap().iter().all(|&u| u == 1.0 || u == -1.0));
+        assert!(coarse.is_held("u"));
+        assert_eq!(coarse.estimated_error("v"), Some(0.01));
+        f.release("u");
+        let filtered = resample(&f, 0.03).unwrap();
+        assert!(filtered.column("u").unwrap().iter().any(|&u| u.abs() != 1.0), "a signal is filtered");
     }
 
     /// A 100 Hz clock stamped in Unix time reads its steps as 0.00999999 or 0.01000023 s (the

@@ -130,6 +130,12 @@ pub fn prepare_runs(
             .collect();
     }
     let method = derivative_method(derivative)?;
+    // an integral form (the default weak form) estimates no rate: its rows are the run's own,
+    // resampled where asked (`--resample` was refused as if --smooth were given)
+    let signals = match method.window().is_some() && !smooth && !always {
+        true => &[][..],
+        false => signals,
+    };
     let how =
         Preparation { resample: resample_to, method: method.as_ref(), signals: signals.to_vec(), smooth };
     frames.iter().map(|f| prepare(f, &how).map_err(setup)).collect()

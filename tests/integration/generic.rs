@@ -4190,3 +4190,46 @@ fn a_long_record_under_a_held_command_is_re_simulated_with_its_jumps() {
     assert!(ok, "{err}");
     assert!(out.contains("dv/dt on 29") && !out.contains("FLAG") && !out.contains("FAIL"), "{out}");
 }
+
+/// `--resample` with the default derivative, the weak form (which estimates no rate), resamples
+/// the runs and identifies them (it was refused: "nothing to smooth or draw: leave out --smooth
+/// and --prepared-svg"); the held force is resampled as held, not through the filter, which
+/// rang at each jump (u² no longer 1: u³ and u²·x chosen for a position read alone).
+#[test]
+fn a_run_resampled_is_identified_in_the_weak_form_its_held_force_held() {
+    use crate::common::{Lcg, Scratch};
+    let dir = Scratch::new("generic-resampled");
+    let mut draw = Lcg(61);
+    let (mut both, mut alone) = (String::from("t,x,v,u\n"), String::from("t,x,u\n"));
+    for [t, x, v, u] in switched_oscillator(1.0) {
+        let x = x + 0.0055 * draw.normal();
+        both += &format!("{t:.3},{x},{},{u}\n", v + 0.011 * draw.normal());
+        alone += &format!("{t:.3},{x},{u}\n");
+    }
+    for (name, text, states) in [("both.csv", both, "x,v"), ("alone.csv", alone, "x,v=dx/dt")] {
+        let run = dir.join(name);
+        std::fs::write(&run, text).unwrap();
+        let (ok, out, err) = termid(&[
+            "identify",
+            "--data",
+            run.to_str().unwrap(),
+            "--states",
+            states,
+            "--inputs",
+            "u",
+            "--resample",
+            "0.04",
+            "--format",
+            "json",
+        ]);
+        assert!(ok, "{name}: {err}");
+        let report = crate::common::json(&out);
+        assert!(report["v_dot"]["rows"].as_u64().unwrap() < 1500, "{name}: {out}");
+        let terms = crate::common::chosen_terms(&report["v_dot"]);
+        assert_eq!(terms.len(), 3, "{name}: {terms:?}");
+        for (term, truth) in [("x", -4.0), ("v", -0.4), ("u", 2.0)] {
+            let found = terms.iter().find(|(t, _)| t == term).map(|(_, c)| *c);
+            assert!(found.is_some_and(|c| (c / truth - 1.0).abs() < 0.01), "{name} {term}: {terms:?}");
+        }
+    }
+}
