@@ -10,6 +10,7 @@ mod halves;
 mod laws;
 mod noise;
 mod parameters;
+mod recorded;
 mod report;
 mod resimulated;
 mod retrace;
@@ -310,11 +311,15 @@ pub fn identify(
         true => laws::with_laws(model, outline.as_ref()),
         false => None,
     };
-    Ok(match extended {
+    let recipe = match extended {
         Some((extended, added)) => {
             let again = RecipeSettings { laws: false, ..settings.clone() };
             laws::kept(recipe, identify(&extended, frames, held, &again), &added, &flags, &powers)
         }
+        None => recipe,
+    };
+    Ok(match &outline {
+        Some(o) => recorded::said(recipe, &o.inputs),
         None => recipe,
     })
 }

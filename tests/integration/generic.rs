@@ -4233,3 +4233,28 @@ fn a_run_resampled_is_identified_in_the_weak_form_its_held_force_held() {
         }
     }
 }
+
+/// A log that holds an accelerometer's column beside the velocity, taken among the inputs by
+/// default, every sensor with noise of 1 %: v's rate came back as the record's own,
+/// v̇ = 1.000·a, every check ok and nothing said; now a note names the input that alone
+/// explains the rate and how to leave it out.
+#[test]
+fn an_input_that_records_a_state_s_rate_is_said() {
+    use crate::common::{Lcg, Scratch};
+    let dir = Scratch::new("generic-accelerometer");
+    let mut draw = Lcg(67);
+    let mut text = String::from("t,x,v,u,a\n");
+    for [t, x, v, u] in switched_oscillator(1.0) {
+        // every sensor reads with noise of about 1 % of its spread
+        let a = -4.0 * x - 0.4 * v + 2.0 * u + 0.02 * draw.normal();
+        text += &format!("{t:.3},{},{},{u},{a}\n", x + 0.0055 * draw.normal(), v + 0.011 * draw.normal());
+    }
+    let run = dir.join("imu.csv");
+    std::fs::write(&run, text).unwrap();
+    let run = run.to_str().unwrap();
+    let (ok, out, err) = termid(&["identify", "--data", run, "--states", "x,v"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("`a` alone explains") && out.contains("it is no input"), "{out}");
+    let (ok, out, err) = termid(&["identify", "--data", run, "--states", "x,v", "--inputs", "u"]);
+    assert!(ok && !out.contains("alone explains"), "{out}{err}");
+}
