@@ -457,7 +457,7 @@ fn retrace_check(
 /// smears and the coarse grid moves (a noise-free oscillator under a square wave, 30 000 rows
 /// at 100 Hz: the exact equations were flagged 0.19 % of the rate's span off their record), or
 /// any input that moves faster than the new samples follow. A whole run re-simulated costs
-/// little more: 4.5 s where 4.2 s identified a million such rows.
+/// little more: 4.5 s where 4.1 s identified a million such rows.
 fn thinned(model: &Model, run: &Frame, step: f64) -> Option<Frame> {
     let inputs: Vec<&str> = model.spec().inputs.iter().map(|i| i.name.as_str()).collect();
     if inputs.iter().any(|n| run.is_held(n) || run.switched().iter().any(|s| s == n)) {
