@@ -165,8 +165,9 @@ pub fn run_step(t: &[f64]) -> Option<f64> {
 
 /// Where a run's samples are not where a re-simulation compares them: the first row whose
 /// stamp lies more than a tenth of a step off t₀ + k·(t₁ − t₀) (a dropped sample, a clock that
-/// drifts from its first step; [`run_step`] for t₁ − t₀), with that stamp and its place. `None` where every one is within it: a re-simulation sampled
-/// every t₁ − t₀ meets row k at its k-th sample.
+/// drifts from its first step; [`run_step`] for t₁ − t₀), with that stamp and its place.
+/// `None` where every one is within it: a re-simulation sampled every t₁ − t₀ meets row k at
+/// its k-th sample.
 pub fn uneven(t: &[f64]) -> Option<(usize, f64, f64)> {
     let step = run_step(t)?;
     (0..t.len())
@@ -367,13 +368,12 @@ pub fn resample(frame: &Frame, dt: f64) -> Result<Frame, DataError> {
                 let mut cursor = 0;
                 coarse.iter().map(|&s| x[sample_at(t, s, close, &mut cursor)]).collect()
             }
-            _ if frame.is_switched(name) => interpolate(t, x, &coarse),
-            None => interpolate(t, x, &coarse),
-            Some((fine_t, taps)) => {
+            Some((fine_t, taps)) if !frame.is_switched(name) => {
                 let fine = interpolate(t, x, fine_t);
                 let last = fine.len() - 1;
                 filter_at(&fine, taps, (0..coarse.len()).map(|i| (i * factor).min(last)))
             }
+            _ => interpolate(t, x, &coarse),
         };
         match frame.estimated_error(name) {
             Some(error) => out.push_estimated(name, values, error)?,

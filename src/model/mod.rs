@@ -1148,15 +1148,18 @@ impl Model {
             // the smoother sees one side only at a run's ends, its rate there up to four times
             // as uncertain: those rows are left out (a run cut around a pinned sensor has
             // many ends, which chose u·x² and put x's coefficient 2.9 % off at 1 % noise)
-            let (mut first, mut last) = (0, frame.len().saturating_sub(1));
+            if found.is_empty() {
+                continue;
+            }
+            let rows = frame.len();
+            let (mut first, mut last) = (0, rows - 1);
             for (_, _, errors) in &found {
                 let (a, b) = settled(errors);
                 (first, last) = (first.max(a), last.min(b));
             }
-            if found.is_empty() || first >= last {
-                continue;
+            if first >= last {
+                (first, last) = (0, rows - 1);
             }
-            let rows = frame.len();
             if first > 0 || last + 1 < rows {
                 *frame = frame.slice(first..last + 1);
                 trimmed += first + (rows - 1 - last);

@@ -2247,19 +2247,9 @@ fn a_law_in_as_many_terms_as_its_stand_in_is_kept() {
         }
         let data = dir.join(name);
         std::fs::write(&data, text).unwrap();
-        let (ok, out, err) = termid(&[
-            "identify",
-            "--data",
-            data.to_str().unwrap(),
-            "--states",
-            "x,v",
-            "--inputs",
-            "u",
-            "--format",
-            "json",
-        ]);
-        assert!(ok, "{err}");
-        let terms = crate::common::chosen_terms(&crate::common::json(&out)["v_dot"]);
+        let (report, _) = identified_u(&data, "x,v", &[]);
+        let out = report.to_string();
+        let terms = crate::common::chosen_terms(&report["v_dot"]);
         assert_eq!(terms.len(), 4, "{name}: {terms:?}");
         for (term, truth) in [("x", -4.0), ("v", -0.1), ("sign(v)", -0.5), ("u", 1.0)] {
             let found = terms.iter().find(|(t, _)| t == term).map(|(_, c)| *c);
@@ -2268,7 +2258,7 @@ fn a_law_in_as_many_terms_as_its_stand_in_is_kept() {
         }
         assert!(
             out.contains("kept, the polynomials having stood in for a law")
-                && !out.contains("\"passed\": false"),
+                && !out.contains("\"passed\":false"),
             "{out}"
         );
         assert_eq!(out.contains("hold `v^3`, a state's power alone"), noisy, "{out}");
@@ -3996,6 +3986,17 @@ fn switched_oscillator(x0: f64) -> Vec<[f64; 4]> {
     oscillator_sampled(x0, 20, 60_000)
 }
 
+/// `termid identify --data run --states states --inputs u` with `extra` arguments, its JSON
+/// report and what it said on stderr, or a panic that shows the error.
+fn identified_u(run: &std::path::Path, states: &str, extra: &[&str]) -> (serde_json::Value, String) {
+    let mut args = vec!["identify", "--data", run.to_str().unwrap(), "--states", states, "--inputs", "u"];
+    args.extend(extra);
+    args.extend(["--format", "json"]);
+    let (ok, out, err) = termid(&args);
+    assert!(ok, "{err}");
+    (crate::common::json(&out), err)
+}
+
 /// [`switched_oscillator`] sampled every `every` ms for `steps` ms.
 fn oscillator_sampled(x0: f64, every: usize, steps: usize) -> Vec<[f64; 4]> {
     let h = 0.001;
@@ -4111,20 +4112,8 @@ fn a_sensor_pinned_at_the_end_of_its_range_is_cut_around() {
     }
     let alone = dir.join("position.csv");
     std::fs::write(&alone, text).unwrap();
-    let (ok, out, err) = termid(&[
-        "identify",
-        "--data",
-        alone.to_str().unwrap(),
-        "--states",
-        "x,v=dx/dt",
-        "--inputs",
-        "u",
-        "--format",
-        "json",
-    ]);
-    assert!(ok, "{err}");
+    let (report, err) = identified_u(&alone, "x,v=dx/dt", &[]);
     assert!(err.contains("at the runs' ends left out, where an estimated rate's standard error"), "{err}");
-    let report = crate::common::json(&out);
     let terms = crate::common::chosen_terms(&report["v_dot"]);
     let of = |term: &str| terms.iter().find(|(t, _)| t == term).map(|(_, c)| *c);
     let right = terms.len() == 3
@@ -4150,19 +4139,7 @@ fn a_record_stamped_in_unix_time_is_identified_as_from_zero() {
     }
     let run = dir.join("logged.csv");
     std::fs::write(&run, text).unwrap();
-    let (ok, out, err) = termid(&[
-        "identify",
-        "--data",
-        run.to_str().unwrap(),
-        "--states",
-        "x,v",
-        "--inputs",
-        "u",
-        "--format",
-        "json",
-    ]);
-    assert!(ok, "{err}");
-    let report = crate::common::json(&out);
+    let (report, _) = identified_u(&run, "x,v", &[]);
     let checks = report["physical_checks"].as_array().unwrap();
     assert!(checks.iter().all(|c| c["passed"] == true), "{checks:?}");
     let terms = crate::common::chosen_terms(&report["v_dot"]);
@@ -4209,22 +4186,8 @@ fn a_run_resampled_is_identified_in_the_weak_form_its_held_force_held() {
     for (name, text, states) in [("both.csv", both, "x,v"), ("alone.csv", alone, "x,v=dx/dt")] {
         let run = dir.join(name);
         std::fs::write(&run, text).unwrap();
-        let (ok, out, err) = termid(&[
-            "identify",
-            "--data",
-            run.to_str().unwrap(),
-            "--states",
-            states,
-            "--inputs",
-            "u",
-            "--resample",
-            "0.04",
-            "--format",
-            "json",
-        ]);
-        assert!(ok, "{name}: {err}");
-        let report = crate::common::json(&out);
-        assert!(report["v_dot"]["rows"].as_u64().unwrap() < 1500, "{name}: {out}");
+        let (report, _) = identified_u(&run, states, &["--resample", "0.04"]);
+        assert!(report["v_dot"]["rows"].as_u64().unwrap() < 1500, "{name}: {report}");
         let terms = crate::common::chosen_terms(&report["v_dot"]);
         assert_eq!(terms.len(), 3, "{name}: {terms:?}");
         for (term, truth) in [("x", -4.0), ("v", -0.4), ("u", 2.0)] {
