@@ -4088,15 +4088,12 @@ fn a_sensor_pinned_at_the_end_of_its_range_is_cut_around() {
     }
     let run = dir.join("clipped.csv");
     std::fs::write(&run, text).unwrap();
-    let run = run.to_str().unwrap();
-    let (ok, out, err) =
-        termid(&["identify", "--data", run, "--states", "x,v", "--inputs", "u", "--format", "json"]);
-    assert!(ok, "{err}");
+    let (report, err) = identified_u(&run, "x,v", &[]);
     assert!(
         err.contains("`x` rests at its largest value, 0.800,") && err.contains("smallest value, -0.800,"),
         "{err}"
     );
-    let terms = crate::common::chosen_terms(&crate::common::json(&out)["v_dot"]);
+    let terms = crate::common::chosen_terms(&report["v_dot"]);
     let of = |term: &str| terms.iter().find(|(t, _)| t == term).map(|(_, c)| *c);
     assert_eq!(terms.len(), 3, "{terms:?}");
     for (term, truth) in [("x", -4.0), ("v", -0.4), ("u", 2.0)] {
