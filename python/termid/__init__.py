@@ -2394,8 +2394,8 @@ class Model:
         ``per_run`` those estimated once per run; the kept start's estimate in ``parameters``
         of the result. A model :meth:`from_states` with the polynomial library whose terms
         fail the checks a stand-in fails (the halves, the re-simulation), or that hold a
-        state's power alone (v³), is identified again with each state's laws among the
-        candidates (sign, x·|x|, √|x|, sin x), kept where they pass every check in no more
+        state's or an input's power alone (v³, n³), is identified again with each state's
+        and input's laws among the candidates (sign, x·|x|, √|x|, sin x), kept where they pass every check in no more
         terms (and fit the rows clearly better where the polynomials passed too), and said; ``laws`` False keeps the polynomials.
         One start, not refined, whose runs show a state moved by a random force (process noise:
         another state's record holds its roughness, so it is motion, not a sensor's noise) is

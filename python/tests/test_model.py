@@ -1433,7 +1433,7 @@ def test_a_law_the_noise_lets_a_cubic_stand_in_for_is_found_by_the_recipe():
     rate = found.model.coefficients("v_dot").set_index("term")["value"]
     assert sorted(rate.index) == ["F", "v*abs(v)"]
     assert rate["v*abs(v)"] == pytest.approx(-0.5, rel=0.02) and rate["F"] == pytest.approx(1.0, rel=0.02)
-    assert "a state's power alone" in found.text and "kept, the polynomials having stood in for a law" in found.text
+    assert "a variable's power alone" in found.text and "kept, the polynomials having stood in for a law" in found.text
 
 
 def test_a_random_force_is_found_by_the_recipe_and_its_damping_identified_unbiased():

@@ -1,8 +1,9 @@
 //! A system made from its columns with the polynomial library, whose terms do not hold: the
 //! polynomials may stand in for a law they only approximate (Torricelli's outflow √h of a
-//! tank came back as twenty terms in h, h², u², …). Identified again with each state's laws
-//! among the candidates ([`crate::term::laws`]), the laws' equations are kept where they pass
-//! every check the polynomials' failed, in no more terms; either way it is said.
+//! tank came back as twenty terms in h, h², u², …). Identified again with each state's and
+//! input's laws among the candidates ([`crate::term::laws`]: a propeller's thrust n·|n| is an
+//! input's), the laws' equations are kept where they pass every check the polynomials'
+//! failed, in no more terms; either way it is said.
 
 use super::{halves, retrace, Recipe};
 use crate::model::Model;
@@ -12,11 +13,11 @@ use crate::term::Atom;
 /// or it re-simulates them no closer than a model off the motion.
 const STAND_IN: [&str; 3] = [halves::NAME, retrace::MISSED_NAME, retrace::CLOSE_NAME];
 
-/// `model` (settled about its reference values) with each state of its polynomial library's
-/// `outline` given its laws as candidates of every identified equation, and those laws (their
-/// canonical text); `None` where it was not made from columns with the polynomial library, or
-/// no state can have them (a state written about a reference value, a heater's temperature in
-/// K, has no law of its own).
+/// `model` (settled about its reference values) with each state and input of its polynomial
+/// library's `outline` given its laws as candidates of every identified equation, and those
+/// laws (their canonical text); `None` where it was not made from columns with the polynomial
+/// library, or no variable can have them (one written about a reference value, a heater's
+/// temperature in K, has no law of its own).
 pub(super) fn with_laws(
     model: &Model,
     outline: Option<&crate::model::Outline>,
@@ -27,6 +28,7 @@ pub(super) fn with_laws(
     let laws: Vec<String> = outline
         .states
         .iter()
+        .chain(&outline.inputs)
         .filter(|s| !about_a_reference(s))
         .flat_map(|s| crate::term::laws(s))
         .filter_map(|l| model.vocabulary.parse(&l).ok().map(|t| t.to_string()))
@@ -36,7 +38,8 @@ pub(super) fn with_laws(
     }
     let extended = model
         .edit(|file| {
-            file.model.provenance = format!("{}, and each state's laws: {ALL}", file.model.provenance);
+            file.model.provenance =
+                format!("{}, and each state's and input's laws: {ALL}", file.model.provenance);
             for equation in file.equations.values_mut().filter(|e| e.identify) {
                 for law in &laws {
                     if !equation.candidates.contains(law) {
@@ -63,14 +66,14 @@ pub(super) fn stand_in_flags(recipe: &Recipe) -> Vec<String> {
         .collect()
 }
 
-/// The powers of one of `states` alone (x², v³) the kept start of `recipe` holds in its
-/// identified equations: what a state's law stands in as (sign v ≈ av + bv³, sin x ≈ x − x³/6,
+/// The powers of one of `variables` alone (x², v³, n³) the kept start of `recipe` holds in
+/// its identified equations: what a variable's law stands in as (sign v ≈ av + bv³, sin x ≈ x − x³/6,
 /// v·|v| ≈ v³, √h ≈ a + bh − ch²), which may pass every check where the records' noise hides
 /// what it misses (dry friction at 1 % noise as −0.35v + 0.0065v³, every check ok).
-pub(super) fn powers_held(recipe: &Recipe, states: &[String]) -> Vec<String> {
+pub(super) fn powers_held(recipe: &Recipe, variables: &[String]) -> Vec<String> {
     let model = &recipe.kept().model;
     let alone = |t: &crate::term::Term| match t.monomials() {
-        [m] => matches!(m.factors.as_slice(), [(Atom::Var(name), p)] if *p >= 2 && states.contains(name)),
+        [m] => matches!(m.factors.as_slice(), [(Atom::Var(name), p)] if *p >= 2 && variables.contains(name)),
         _ => false,
     };
     let mut held: Vec<String> = model
@@ -134,10 +137,10 @@ fn named(checks: impl IntoIterator<Item = String>) -> String {
 }
 
 /// Which of the polynomial library's recipe `polynomials` (whose kept start fails the
-/// stand-in checks `flags`, or none where it holds `powers` of a state alone) and the recipe
+/// stand-in checks `flags`, or none where it holds `powers` of a variable alone) and the recipe
 /// with the `laws` among the candidates (`with`) to keep, the choice said in a note of the
 /// kept start: the laws' where its kept start passes every check, holds a law and no power
-/// of that law's state alone, has no more terms, and where the polynomials pass every check
+/// of that law's variable alone, has no more terms, and where the polynomials pass every check
 /// too, fits the rows clearly better.
 pub(super) fn kept(
     polynomials: Recipe,
@@ -149,11 +152,11 @@ pub(super) fn kept(
     let (before, _) = terms(&polynomials, laws);
     let tried = match flags.is_empty() {
         true => format!(
-            "the polynomial library's {before} terms hold {}, a state's power alone, which may stand in for a law of it; with each state's laws among the candidates ({ALL})",
+            "the polynomial library's {before} terms hold {}, a variable's power alone, which may stand in for a law of it; with each state's and input's laws among the candidates ({ALL})",
             powers.iter().map(|t| format!("`{t}`")).collect::<Vec<_>>().join(", ")
         ),
         false => format!(
-            "the polynomial library's {before} terms failed {}; with each state's laws among the candidates ({ALL})",
+            "the polynomial library's {before} terms failed {}; with each state's and input's laws among the candidates ({ALL})",
             named(flags.iter().cloned())
         ),
     };
@@ -175,7 +178,7 @@ pub(super) fn kept(
                 (false, _) => Some(format!("they fail {} too", named(failing))),
                 (true, true) => Some("no law is chosen".to_string()),
                 (true, false) if !beside.is_empty() => Some(format!(
-                    "{} beside its state's laws: they stand in too",
+                    "{} beside its variable's laws: they stand in too",
                     beside.iter().map(|t| format!("`{t}`")).collect::<Vec<_>>().join(", ")
                 )),
                 // (in as many terms, laws that pass where the polynomials fail stand in for

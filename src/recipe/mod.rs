@@ -65,8 +65,8 @@ pub struct RecipeSettings {
     /// free parameters).
     pub parameters: Option<ParameterOptions>,
     /// A system made from its columns with the polynomial library, whose terms fail the checks
-    /// a stand-in fails, is identified again with each state's laws among the candidates and
-    /// those kept where they hold (`laws.rs`).
+    /// a stand-in fails or hold a variable's power alone, is identified again with each state's
+    /// and input's laws among the candidates and those kept where they hold (`laws.rs`).
     pub laws: bool,
     /// A system of one start, not refined, whose records show a state moved by a random force
     /// (process noise) is identified again by Itô's steps, and that kept (`force.rs`).
@@ -303,7 +303,7 @@ pub fn identify(
     let recipe = force::untold(recipe, &rough);
     let flags = laws::stand_in_flags(&recipe);
     let powers = match (&outline, flags.is_empty()) {
-        (Some(o), true) => laws::powers_held(&recipe, &o.states),
+        (Some(o), true) => laws::powers_held(&recipe, &[o.states.clone(), o.inputs.clone()].concat()),
         _ => Vec::new(),
     };
     let stand_in = !flags.is_empty() || !powers.is_empty();

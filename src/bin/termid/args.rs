@@ -450,8 +450,8 @@ pub struct IdentifyCommand {
     pub compare: Option<String>,
     /// With --states and the polynomial library (no --terms): keep the polynomials even where
     /// their terms fail the checks a stand-in fails (the halves, the re-simulation) or hold a
-    /// state's power alone (v³); without it the system is identified again with each state's
-    /// laws among the candidates (sign, x·|x|, √|x|, sin x), and those kept where they pass every
+    /// state's or an input's power alone (v³, n³); without it the system is identified again
+    /// with each state's and input's laws among the candidates (sign, x·|x|, √|x|, sin x), and those kept where they pass every
     /// check in no more terms (and fit the rows clearly better where the polynomials passed
     /// too), said either way.
     #[arg(long, requires = "states")]
