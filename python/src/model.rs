@@ -953,7 +953,7 @@ impl PyModel {
     /// The library's recipe (several derivative starts, choice among back-ends by
     /// prediction, output-error refinement, checks, the starts' agreement): (JSON of every
     /// start and the kept one's report, the report as text, the kept model).
-    #[pyo3(signature = (runs, derivatives, smooth = false, intercept = None, choose = vec![], compare = vec![], refine = None, refine_iterations = 100, refine_prior = 1e-4, held_out = vec![], refine_step = None, parameters = None, sources = vec![], per_source = vec![], per_run = vec![], laws = true, random_force = true))]
+    #[pyo3(signature = (runs, derivatives, smooth = false, intercept = None, choose = vec![], compare = vec![], refine = None, refine_iterations = 100, refine_prior = 1e-4, held_out = vec![], refine_step = None, parameters = None, sources = vec![], per_source = vec![], per_run = vec![], laws = true, random_force = true, dead_times = true))]
     #[allow(clippy::too_many_arguments)]
     fn recipe(
         &self,
@@ -975,6 +975,7 @@ impl PyModel {
         per_run: Vec<String>,
         laws: bool,
         random_force: bool,
+        dead_times: bool,
     ) -> PyResult<(String, String, PyModel)> {
         let frames = self.frames(runs)?;
         let held = if held_out.is_empty() { None } else { Some(self.frames(held_out)?) };
@@ -1008,6 +1009,7 @@ impl PyModel {
             ),
             laws,
             random_force,
+            dead_times,
             ..Default::default()
         };
         let recipe = py

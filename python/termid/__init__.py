@@ -2368,6 +2368,7 @@ class Model:
         per_run: Sequence[str] = (),
         laws: bool = True,
         random_force: bool = True,
+        dead_times: bool = True,
     ) -> "Recipe":
         """The command line's recipe for a model from runs (``termid identify --model`` with
         several ``--derivative`` starts) from ``runs``: each start prepares them by one derivative method
@@ -2400,7 +2401,11 @@ class Model:
         One start, not refined, whose runs show a state moved by a random force (process noise:
         another state's record holds its roughness, so it is motion, not a sensor's noise) is
         identified again by Itô's steps (the ``ito`` method, whose terms the force does not
-        bias), and said; ``random_force`` False keeps the start's method.
+        bias), and said; ``random_force`` False keeps the start's method. A system of no
+        field's whose fit finds an input acting later than recorded (a dead time, said in its
+        notes) is identified again with the input read so (its ``delay`` in the model), kept
+        where it fails no check the inputs as recorded pass, and said; ``dead_times`` False keeps
+        the inputs as recorded.
 
         ``derivatives``, ``smooth`` and ``refine`` (``"auto"``) left out are the model's
         field's: for a ship the new-ship recipe's (``kinematic``, ``kalman``,
@@ -2443,6 +2448,7 @@ class Model:
             list(per_run),
             laws,
             random_force,
+            dead_times,
         )
         found = Recipe(self._identified(native, data), json.loads(text_json), text)
         # what the command line prints as warnings (or refuses to write) is said here too

@@ -1436,6 +1436,34 @@ def test_a_law_the_noise_lets_a_cubic_stand_in_for_is_found_by_the_recipe():
     assert "a variable's power alone" in found.text and "kept, the polynomials having stood in for a law" in found.text
 
 
+def test_an_input_acting_late_is_found_by_the_recipe_and_written_as_its_delay():
+    # a first-order plant whose command acts 0.5 s late, x' = -0.5x + 0.8u(t - 0.5), u a square
+    # wave read every 0.05 s: the recipe identifies it again with u read 0.5 s earlier (the two
+    # true terms, the delay in the model written); dead_times=False keeps u as recorded, biased
+    dt, n = 0.05, 4000
+    u = lambda t: 1.0 if (t % 20.0) < 10.0 else -1.0
+    x, rows = 0.0, []
+    for k in range(n):
+        rows.append(x)
+        for j in range(10):
+            h, t = dt / 10, k * dt + j * dt / 10
+            rate = lambda t, x: -0.5 * x + 0.8 * u(t - 0.5)
+            k1 = rate(t, x); k2 = rate(t + h / 2, x + h / 2 * k1); k3 = rate(t + h / 2, x + h / 2 * k2)
+            k4 = rate(t + h, x + h * k3)
+            x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    t = np.arange(n) * dt
+    run = pd.DataFrame({"t": t, "x": rows, "u": [u(s) for s in np.round(t, 9)]})
+    model = termid.Model.from_states(["x"], ["u"])
+    found = model.recipe(run)
+    rate = found.model.coefficients("x_dot").set_index("term")["value"]
+    assert sorted(rate.index) == ["u", "x"]
+    assert rate["x"] == pytest.approx(-0.5, rel=1e-3) and rate["u"] == pytest.approx(0.8, rel=1e-3)
+    assert "read as acting late, `u` by 0.500 s" in found.text and "delay = 0.5" in found.model.to_toml()
+    recorded = model.recipe(run, dead_times=False)
+    assert "read as acting late" not in recorded.text and "delay = " not in recorded.model.to_toml()
+    assert "`u` acts on dx/dt about 0.500 s later" in recorded.text
+
+
 def test_a_random_force_is_found_by_the_recipe_and_its_damping_identified_unbiased():
     # an oscillator under a random force (process noise, Euler-Maruyama at 1 ms), read every
     # 0.02 s for 200 s: its velocity's roughness is in the position's record too, so the recipe

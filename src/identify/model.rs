@@ -370,12 +370,13 @@ pub fn describe_residuals_of(
 /// Says in each of `identified`'s fits an input of its model that acts later than the file
 /// declares ([`Identification::say_delays`] over the model's inputs, the same runs and
 /// derivative method): once for an identification a user reads, not in every fold of a
-/// cross-validation (the scan fits all candidates some 20 times).
+/// cross-validation (the scan fits all candidates some 20 times). The lags said, each input's
+/// once (the equation's that leaves the least of its residual), later than the file declares.
 pub fn say_late_inputs(
     identified: &mut IdentifiedModel,
     frames: &[Frame],
     differentiator: &dyn Differentiator,
-) -> Result<(), IdentifyError> {
+) -> Result<Vec<super::Lag>, IdentifyError> {
     let model = &identified.model;
     let frames = &*model.acting(frames)?;
     let inputs: Vec<String> = model.spec().inputs.iter().map(|i| i.name.clone()).collect();
@@ -387,16 +388,25 @@ pub fn say_late_inputs(
             lag.column
         )
     };
+    let mut late: Vec<super::Lag> = Vec::new();
     with_identification(model, differentiator, |how| {
         for (name, fit) in &mut identified.fits {
             let candidates = candidates_of(model, fit)?;
             let target = Target::parse(&fit.target);
-            how.say_delays(&target, &candidates, frames, &inputs, fit, &remedy)
-                .map_err(|e| e.in_equation(name))?;
+            for lag in how
+                .say_delays(&target, &candidates, frames, &inputs, fit, &remedy)
+                .map_err(|e| e.in_equation(name))?
+            {
+                match late.iter_mut().find(|l| l.column == lag.column) {
+                    Some(l) if l.share <= lag.share => {}
+                    Some(l) => *l = lag,
+                    None => late.push(lag),
+                }
+            }
         }
         Ok::<_, IdentifyError>(())
     })?;
-    Ok(())
+    Ok(late)
 }
 
 /// The identified coefficients of a fit, as a model stores them (term, value, std. error).

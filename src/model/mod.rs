@@ -1063,6 +1063,23 @@ impl Model {
         Ok(std::borrow::Cow::Owned(out))
     }
 
+    /// The model fed as [`Model::acting`] reads `frames`: its inputs' dead times taken out of
+    /// the model and put in the runs, each run from its longest dead time on. Re-simulated so,
+    /// a run starts where every input's history is recorded (fed from the run's start, an input
+    /// acting 0.5 s late is guessed at its first value for 0.5 s).
+    pub fn as_acting<'a>(
+        &self,
+        frames: &'a [crate::data::Frame],
+    ) -> Result<(Model, std::borrow::Cow<'a, [crate::data::Frame]>), crate::data::DataError> {
+        let frames = self.acting(frames)?;
+        if matches!(frames, std::borrow::Cow::Borrowed(_)) {
+            return Ok((self.clone(), frames));
+        }
+        let mut model = self.clone();
+        model.spec.inputs.iter_mut().for_each(|i| i.delay = 0.0);
+        Ok((model, frames))
+    }
+
     /// The model with its runs' inputs taken between samples as `intersample` says where
     /// given (a command line's `--intersample`), else as its file says.
     pub fn with_intersample(mut self, intersample: Option<crate::data::Intersample>) -> Model {

@@ -5,6 +5,7 @@
 //! best; and, where the plausible starts disagree on a manoeuvre the runs did not cover, a flag
 //! saying that prediction is uncertain.
 
+mod dead_times;
 mod force;
 mod halves;
 mod laws;
@@ -71,6 +72,9 @@ pub struct RecipeSettings {
     /// A system of one start, not refined, whose records show a state moved by a random force
     /// (process noise) is identified again by Itô's steps, and that kept (`force.rs`).
     pub random_force: bool,
+    /// A system of no field's whose regression found an input acting later than recorded is
+    /// identified again with it read so, and that kept where it holds (`dead_times.rs`).
+    pub dead_times: bool,
 }
 
 impl RecipeSettings {
@@ -99,6 +103,7 @@ impl Default for RecipeSettings {
             parameters: None,
             laws: true,
             random_force: true,
+            dead_times: true,
         }
     }
 }
@@ -301,6 +306,21 @@ pub fn identify(
         }
     }
     let recipe = force::untold(recipe, &rough);
+    // inputs that act late: the system identified again with them read so (the laws' stage
+    // within, on the delayed model), that kept where it holds
+    let recipe =
+        match settings.dead_times && settings.choose.is_empty() && crate::plugins::of(model).is_none() {
+            true => {
+                let again = |model: &Model, frames: &[Frame], dead_times: bool| {
+                    identify(model, frames, held, &RecipeSettings { dead_times, ..settings.clone() })
+                };
+                match dead_times::stage(recipe, given, frames, &again) {
+                    Ok(delayed) => return Ok(delayed),
+                    Err(recorded) => recorded,
+                }
+            }
+            false => recipe,
+        };
     let flags = laws::stand_in_flags(&recipe);
     let powers = match (&outline, flags.is_empty()) {
         (Some(o), true) => laws::powers_held(&recipe, &[o.states.clone(), o.inputs.clone()].concat()),

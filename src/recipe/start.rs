@@ -32,6 +32,9 @@ pub struct Start {
     /// of the refinement (which runs only where validation runs stop it, the estimate then
     /// after it where asked for explicitly, or where no start's stage is kept).
     pub parameters: Option<ParameterStage>,
+    /// The inputs the regression found to act later than the model declares (said in the
+    /// fits' notes; [`crate::identify::say_late_inputs`]).
+    pub late: Vec<crate::identify::Lag>,
     /// The physical checks of `model`.
     pub checks: Vec<Check>,
     /// The runs as this start prepared them (for figures).
@@ -199,7 +202,7 @@ pub(super) fn identify_start(
         (chosen.identified, Some(text))
     };
     // said once for the start (not in each fold the choice by prediction fitted)
-    crate::identify::say_late_inputs(&mut identified, &prepared, diff.as_ref()).map_err(setup)?;
+    let late = crate::identify::say_late_inputs(&mut identified, &prepared, diff.as_ref()).map_err(setup)?;
     let (identified, checks, searched) = match crate::plugins::of(model) {
         Some(_) => {
             let checks = checks_of(&identified.model, &prepared);
@@ -225,6 +228,7 @@ pub(super) fn identify_start(
         rejected: None,
         refine_error: None,
         parameters: None,
+        late,
         checks: vec![],
         prepared: vec![],
     };

@@ -316,8 +316,9 @@ pub struct IdentifyCommand {
     #[arg(long = "param", num_args = 1..)]
     pub params: Vec<String>,
     /// Columns that act later than they are recorded (a dead time): `F=0.2` reads F 0.2 s
-    /// earlier against the rest, the runs' first 0.2 s left out. Without it, a rate's fit
-    /// whose residuals show such a delay says so.
+    /// earlier against the rest, the runs' first 0.2 s left out (with --states, the input's
+    /// `delay` in the model written). Without it, a rate's fit whose residuals show such a
+    /// delay says so (with --states, the system is identified again with it: --no-dead-times).
     #[arg(long = "delay", num_args = 1.., value_name = "NAME=SECONDS")]
     pub delays: Vec<String>,
     /// Derived variables: `Δu=u-u0`.
@@ -462,6 +463,12 @@ pub struct IdentifyCommand {
     /// Itô's steps (`--derivative ito`), whose terms the force does not bias, and that is said.
     #[arg(long)]
     pub no_random_force: bool,
+    /// Keep the inputs as recorded even where the regression finds one acting later (a dead
+    /// time: its note says by how much); without it a system of no plug-in's is identified
+    /// again with that input read so (its `delay` under [[inputs]] in the model written), and
+    /// that is kept where it fails no check the inputs as recorded pass, said either way.
+    #[arg(long)]
+    pub no_dead_times: bool,
     /// Write the model even when it fails a check: a physical check of its plug-in (a ship's:
     /// damping signs, turning circles that complete, plausible speed loss and drift), or, for
     /// a system of no plug-in's, that its equations retrace the runs without running away.

@@ -100,8 +100,8 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
         return crate::moments::identify_from_files(cmd);
     }
     if cmd.model.is_some() || !cmd.states.is_empty() {
-        if !cmd.delays.is_empty() {
-            bail!("--delay reads columns of plain runs earlier; with --model declare the dead time in the model file (`delay = SECONDS` in the input's [[inputs]] entry), as its simulation needs it too");
+        if !cmd.delays.is_empty() && cmd.model.is_some() {
+            bail!("--delay reads columns of plain runs earlier, or declares the dead times of --states' inputs; with --model declare the dead time in the model file (`delay = SECONDS` in the input's [[inputs]] entry), as its simulation needs it too");
         }
         return crate::identify_model::run(cmd);
     }
@@ -140,11 +140,7 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
     }
     // after the marking: a held column is read back sample for sample
     for d in &cmd.delays {
-        let (name, seconds) = split_pair(d, "--delay")?;
-        let seconds: f64 =
-            seconds.parse().ok().filter(|s: &f64| s.is_finite() && *s >= 0.0).with_context(|| {
-                format!("--delay `{d}`: `{seconds}` is no delay; give seconds, 0 or more (`F=0.2`)")
-            })?;
+        let (name, seconds) = delay_of(d)?;
         for f in &mut frames {
             *f = termid::data::delayed(f, name, seconds, 0.0)?;
         }
@@ -319,4 +315,14 @@ pub fn configure_backend(cmd: &IdentifyCommand) -> Result<Backend> {
         };
     }
     Ok(backend)
+}
+
+/// One `--delay NAME=SECONDS`: the column and its dead time, s (0 or more).
+pub fn delay_of(d: &str) -> Result<(&str, f64)> {
+    let (name, seconds) = split_pair(d, "--delay")?;
+    let seconds: f64 =
+        seconds.parse().ok().filter(|s: &f64| s.is_finite() && *s >= 0.0).with_context(|| {
+            format!("--delay `{d}`: `{seconds}` is no delay; give seconds, 0 or more (`F=0.2`)")
+        })?;
+    Ok((name, seconds))
 }

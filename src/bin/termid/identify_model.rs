@@ -37,6 +37,21 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     }
     .keeping_spikes(cmd.keep_spikes)
     .with_intersample(cmd.intersample);
+    if !cmd.delays.is_empty() {
+        // --states' inputs acting late, as a model file would declare them
+        let delays = cmd.delays.iter().map(|d| crate::identify::delay_of(d)).collect::<Result<Vec<_>>>()?;
+        let inputs: Vec<String> = model.spec().inputs.iter().map(|i| i.name.clone()).collect();
+        if let Some((name, _)) = delays.iter().find(|(n, _)| !inputs.iter().any(|i| i == n)) {
+            bail!("--delay {name}=…: `{name}` is no input (the inputs: {})", inputs.join(", "));
+        }
+        model = model.edit(|file| {
+            for input in &mut file.inputs {
+                if let Some((_, seconds)) = delays.iter().find(|(n, _)| *n == input.name) {
+                    input.delay = *seconds;
+                }
+            }
+        })?;
+    }
     if !(cmd.forced.is_empty() && cmd.exclude.is_empty()) {
         // the command line's terms join the file's (each equation's that has them)
         let vocabulary = model.vocabulary.clone();
@@ -116,6 +131,7 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
                 ),
                 laws: !cmd.no_laws,
                 random_force: !cmd.no_random_force,
+                dead_times: !cmd.no_dead_times,
             };
             let label = format!(
                 "identifying ({} start{})",

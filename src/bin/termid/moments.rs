@@ -260,6 +260,7 @@ pub fn identify_in_pieces(cmd: &IdentifyCommand, model: &termid::model::Model, r
         rejected: None,
         refine_error: None,
         parameters: None,
+        late: vec![],
         checks,
         prepared: vec![],
     })

@@ -1,0 +1,153 @@
+//! An input that acts later than recorded (a dead time the regression's scan found,
+//! [`crate::identify::Lag`]) biases every coefficient fitted without it: a first-order plant
+//! whose input acts 0.5 s late came back at 1 % noise with gain 0.62 for 0.8 and a spurious x³,
+//! every check ok, the delay only in a note. Identified again with the input read that much
+//! earlier (its `delay` in the model written, which its simulation feeds it by), the delayed
+//! equations are kept where they fail no check the recorded ones pass; either way it is said.
+
+use super::{Recipe, RecipeError};
+use crate::data::{held, stepped, white, Frame};
+use crate::identify::Lag;
+use crate::model::Model;
+
+/// `model` with each of `late`'s inputs acting that much later than it declares (`delay`
+/// under its `[[inputs]]`); `None` where no input is late or the model cannot be so edited.
+fn delayed(model: &Model, late: &[Lag]) -> Option<Model> {
+    if late.is_empty() {
+        return None;
+    }
+    model
+        .edit(|file| {
+            for lag in late {
+                if let Some(input) = file.inputs.iter_mut().find(|i| i.name == lag.column) {
+                    // a whole number of the mean step, to six figures (the file reads 0.5, not
+                    // 0.4999999999999716)
+                    let delay = input.delay + lag.seconds;
+                    input.delay = format!("{delay:.5e}").parse().unwrap_or(delay);
+                }
+            }
+        })
+        .ok()
+}
+
+/// `frames` with each of `late`'s inputs that moves from sample to sample yet was taken as held
+/// (a state's rate fitted better so: a DAC's hold, or the dead time itself, half a sample of
+/// which a hold makes) read as a line between the samples; the inputs released. A multisine
+/// acting 0.5 s late was taken as held (8 % less left over), and its delay read a sample short.
+fn released(frames: &[Frame], late: &[Lag]) -> (Vec<Frame>, Vec<String>) {
+    let mut out = frames.to_vec();
+    let mut names: Vec<String> = Vec::new();
+    for name in late.iter().map(|l| l.column.as_str()) {
+        for frame in &mut out {
+            let Some(column) = frame.column(name) else { continue };
+            let smooth = held(column).is_none() && stepped(column).is_none() && white(column).is_none();
+            if smooth && frame.is_held(name) {
+                frame.release(name);
+                if !names.iter().any(|n| n == name) {
+                    names.push(name.to_string());
+                }
+            }
+        }
+    }
+    (out, names)
+}
+
+/// The recipe as a stage runs it again: a model, its runs, and whether this stage runs within.
+pub(super) type Identify<'a> = dyn Fn(&Model, &[Frame], bool) -> Result<Recipe, RecipeError> + 'a;
+
+/// The dead times' stage after `recorded` (identified from `frames` by `identify`: a model, its
+/// runs, and whether this stage runs within): `Ok` the recipe with its late inputs delayed
+/// where kept, else `Err` the recipe as recorded, for the stages after this one; said either
+/// way. A smooth input taken as held is read as a line first, its delay found again so (a
+/// hold's half sample is the delay's own), where that keeps a delay.
+pub(super) fn stage(
+    recorded: Recipe,
+    given: &Model,
+    frames: &[Frame],
+    identify: &Identify<'_>,
+) -> Result<Recipe, Recipe> {
+    let late = recorded.kept().late.clone();
+    let Some(delayed) = delayed(given, &late) else { return Err(recorded) };
+    let (lines, names) = released(frames, &late);
+    if !names.is_empty() {
+        let declared =
+            |m: &Model, n: &str| m.spec().inputs.iter().find(|i| i.name == n).map_or(0.0, |i| i.delay);
+        if let Ok(mut again) = identify(given, &lines, true) {
+            if names.iter().any(|n| declared(&again.kept().model, n) > declared(given, n)) {
+                let note = format!(
+                    "{} moves from sample to sample and was taken as held (a state's rate fitted better so), which a dead time makes it seem (a hold reads it half a sample late): read as a line between the samples, its dead time found again",
+                    names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
+                );
+                let at = again.kept;
+                if let Some((_, fit)) = again.starts[at].fits.first_mut() {
+                    fit.selection.notes.push(note);
+                }
+                return Ok(again);
+            }
+        }
+    }
+    kept(recorded, identify(&delayed, frames, false), &late, &delayed)
+}
+
+/// The late inputs in words: "`u` 0.500 s".
+fn named(late: &[Lag], model: &Model) -> String {
+    late.iter()
+        .map(|l| {
+            let delay =
+                model.spec().inputs.iter().find(|i| i.name == l.column).map_or(l.seconds, |i| i.delay);
+            format!("`{}` by {} s", l.column, crate::output::sig(delay, 3))
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Which of the recipe as recorded (`recorded`) and the recipe with the `late` inputs delayed
+/// (`with`, from `delayed`) to keep, said in a note of the kept start: the delayed one
+/// (`Ok`) where its kept start fails no check the recorded one passes, else the recorded one
+/// (`Err`), for the stages after this one.
+fn kept(
+    recorded: Recipe,
+    with: Result<Recipe, RecipeError>,
+    late: &[Lag],
+    delayed: &Model,
+) -> Result<Recipe, Recipe> {
+    let failing = |r: &Recipe| -> Vec<String> {
+        r.kept().checks.iter().filter(|c| !c.passed).map(|c| c.name.clone()).collect()
+    };
+    let tried = format!("identified again with the inputs read as acting late, {},", named(late, delayed));
+    let before = failing(&recorded);
+    let (mut recipe, note) = match with {
+        Ok(with) => {
+            let lost: Vec<String> = failing(&with).into_iter().filter(|c| !before.contains(c)).collect();
+            match lost.is_empty() {
+                true => {
+                    let checks = match failing(&with).is_empty() {
+                        true => "every check ok".to_string(),
+                        false => "no check failing that the inputs as recorded pass".to_string(),
+                    };
+                    let note = format!(
+                        "{tried} the equations hold, {checks}: kept (each `delay` under [[inputs]] in the model written, which its simulation feeds the input by). Where the inputs act as recorded, --no-dead-times (Python `dead_times=False`) keeps them so"
+                    );
+                    (Ok(with), note)
+                }
+                false => {
+                    let lost = lost.iter().map(|c| format!("\"{c}\"")).collect::<Vec<_>>().join(", ");
+                    let note = format!(
+                        "{tried} the equations fail {lost}, which the inputs as recorded pass: the inputs kept as recorded, whose coefficients a real dead time biases"
+                    );
+                    (Err(recorded), note)
+                }
+            }
+        }
+        Err(e) => (
+            Err(recorded),
+            format!("{tried} the system could not be identified ({e}): the inputs kept as recorded"),
+        ),
+    };
+    let (Ok(r) | Err(r)) = &mut recipe;
+    let at = r.kept;
+    if let Some((_, fit)) = r.starts[at].fits.first_mut() {
+        fit.selection.notes.push(note);
+    }
+    recipe
+}
