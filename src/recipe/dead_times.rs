@@ -114,7 +114,10 @@ fn kept(
     let failing = |r: &Recipe| -> Vec<String> {
         r.kept().checks.iter().filter(|c| !c.passed).map(|c| c.name.clone()).collect()
     };
-    let tried = format!("identified again with the inputs read as acting late, {},", named(late, delayed));
+    let tried = format!(
+        "identified again with the inputs read as acting late, {} (a dead time, or a lag of about that: an actuator's first-order lag of 0.2 s reads as 0.2 s late, its gain 2 % off),",
+        named(late, delayed)
+    );
     let before = failing(&recorded);
     let (mut recipe, note) = match with {
         Ok(with) => {
@@ -150,4 +153,40 @@ fn kept(
         fit.selection.notes.push(note);
     }
     recipe
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lag(column: &str) -> Lag {
+        Lag { column: column.into(), seconds: 0.5, share: 0.01, longest: 20.0 }
+    }
+
+    /// A late sine taken as held is read as a line again; a late staircase (a controller's
+    /// command) stays held; an input not late is left as it is.
+    #[test]
+    fn only_a_late_smooth_input_taken_as_held_is_released() {
+        let t: Vec<f64> = (0..200).map(|k| 0.05 * k as f64).collect();
+        let mut f = Frame::new("run.csv", "t", t.clone()).unwrap();
+        f.push("u", t.iter().map(|t| (0.7 * t).sin()).collect()).unwrap();
+        f.push("s", (0..200).map(|k| if (k / 40) % 2 == 0 { 1.0 } else { -1.0 }).collect()).unwrap();
+        f.push("w", t.iter().map(|t| (1.3 * t).cos()).collect()).unwrap();
+        for name in ["u", "s", "w"] {
+            f.hold(name).unwrap();
+        }
+        let (out, names) = released(&[f], &[lag("u"), lag("s")]);
+        assert_eq!(names, vec!["u".to_string()]);
+        assert!(!out[0].is_held("u") && out[0].is_held("s") && out[0].is_held("w"));
+    }
+
+    /// The delay written is the declared one plus the lag, to six figures.
+    #[test]
+    fn a_delay_is_written_to_six_figures() {
+        let text = "[model]\nname = \"m\"\ntime = \"t\"\n[[states]]\nname = \"x\"\n[[inputs]]\nname = \"u\"\ndelay = 0.1\n[equations.x_dot]\nstate = \"x\"\ncandidates = [\"x\", \"u\"]\n";
+        let model = Model::parse(text, "m.toml").unwrap();
+        let late = Lag { seconds: 0.39999999999997, ..lag("u") };
+        let delayed = delayed(&model, &[late]).unwrap();
+        assert_eq!(delayed.spec().inputs[0].delay, 0.5);
+    }
 }

@@ -2341,7 +2341,8 @@ fn an_input_acting_late_is_found_and_fitted_so() {
             assert!(found.is_some_and(|c| (c / truth - 1.0).abs() < within), "{name} {term}: {terms:?}");
         }
         assert!(
-            out.contains("identified again with the inputs read as acting late, `u` by 0.500 s, the equations hold, every check ok: kept")
+            out.contains("identified again with the inputs read as acting late, `u` by 0.500 s (a dead time, or a lag of about that")
+                && out.contains("the equations hold, every check ok: kept")
                 && !out.contains("\"passed\":false"),
             "{out}"
         );
