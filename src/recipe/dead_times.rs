@@ -5,7 +5,7 @@
 //! earlier (its `delay` in the model written, which its simulation feeds it by), the delayed
 //! equations are kept where they fail no check the recorded ones pass; either way it is said.
 
-use super::{Recipe, RecipeError};
+use super::{retrace, Recipe, RecipeError};
 use crate::data::{held, stepped, white, Frame};
 use crate::identify::Lag;
 use crate::model::Model;
@@ -30,26 +30,58 @@ fn delayed(model: &Model, late: &[Lag]) -> Option<Model> {
         .ok()
 }
 
-/// `frames` with each of `late`'s inputs that moves from sample to sample yet was taken as held
-/// (a state's rate fitted better so: a DAC's hold, or the dead time itself, half a sample of
-/// which a hold makes) read as a line between the samples; the inputs released. A multisine
-/// acting 0.5 s late was taken as held (8 % less left over), and its delay read a sample short.
-fn released(frames: &[Frame], late: &[Lag]) -> (Vec<Frame>, Vec<String>) {
+/// `frames` with each of `late`'s inputs read between its samples the other way where the dead
+/// time may have decided it: one that moves from sample to sample yet was taken as held (a
+/// state's rate fitted better so: a DAC's hold, or the dead time itself, half a sample of which
+/// a hold makes) as a line; one that stays put between jumps yet was taken as switching between
+/// samples (a held reading misfit the rate at some jumps: the jumps the dead time moves) as
+/// held. The inputs so read again. A multisine acting 0.5 s late was taken as held (8 % less
+/// left over) and its delay read a sample short; an APRBS acting 0.25 s late as switched, a
+/// third of the weak form's windows left out, three spurious terms kept beside the delay.
+fn reread(frames: &[Frame], late: &[String]) -> Result<(Vec<Frame>, Rereads), crate::data::DataError> {
     let mut out = frames.to_vec();
-    let mut names: Vec<String> = Vec::new();
-    for name in late.iter().map(|l| l.column.as_str()) {
+    let mut names: Rereads = Vec::new();
+    for name in late.iter().map(String::as_str) {
         for frame in &mut out {
             let Some(column) = frame.column(name) else { continue };
             let smooth = held(column).is_none() && stepped(column).is_none() && white(column).is_none();
-            if smooth && frame.is_held(name) {
-                frame.release(name);
-                if !names.iter().any(|n| n == name) {
-                    names.push(name.to_string());
-                }
+            let how = match (smooth, frame.is_held(name), frame.is_switched(name)) {
+                (true, true, _) => Reread::AsALine,
+                (false, _, true) => Reread::AsHeld,
+                _ => continue,
+            };
+            match how {
+                Reread::AsALine => frame.release(name),
+                Reread::AsHeld => frame.hold(name)?,
+            }
+            if !names.iter().any(|(n, _)| n == name) {
+                names.push((name.to_string(), how));
             }
         }
     }
-    (out, names)
+    Ok((out, names))
+}
+
+/// The inputs [`reread`] read again, each with how.
+type Rereads = Vec<(String, Reread)>;
+
+/// How a late input is read between its samples again ([`reread`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Reread {
+    /// A smooth input taken as held.
+    AsALine,
+    /// A staircase taken as switching between samples.
+    AsHeld,
+}
+
+impl Reread {
+    /// Why, in words, for input `name`.
+    fn said(self, name: &str) -> String {
+        match self {
+            Reread::AsALine => format!("`{name}` moves from sample to sample and was taken as held (a state's rate fitted better so), which a dead time makes it seem (a hold reads it half a sample late): read as a line between the samples"),
+            Reread::AsHeld => format!("`{name}` stays put between jumps and was taken as switching between samples (a held reading misfit a state's rate at some jumps), which a dead time makes it seem (the jumps act later than recorded): read as held"),
+        }
+    }
 }
 
 /// The recipe as a stage runs it again: a model, its runs, and whether this stage runs within.
@@ -67,17 +99,28 @@ pub(super) fn stage(
     identify: &Identify<'_>,
 ) -> Result<Recipe, Recipe> {
     let late = recorded.kept().late.clone();
-    let Some(delayed) = delayed(given, &late) else { return Err(recorded) };
-    let (lines, names) = released(frames, &late);
+    // the inputs whose reading between samples a dead time may have decided: the late ones;
+    // where the scan found none but the equations miss their runs, every input (a staircase
+    // taken as switching has the windows that would show its delay left out of the scan too:
+    // random levels acting 0.25 s late, flagged, nothing said of a delay)
+    let missed = recorded
+        .kept()
+        .checks
+        .iter()
+        .any(|c| !c.passed && (c.name == retrace::MISSED_NAME || c.name == retrace::CLOSE_NAME));
+    let suspects: Vec<String> = match (late.is_empty(), missed) {
+        (false, _) => late.iter().map(|l| l.column.clone()).collect(),
+        (true, true) => given.spec().inputs.iter().map(|i| i.name.clone()).collect(),
+        (true, false) => return Err(recorded),
+    };
+    let (lines, names) = reread(frames, &suspects).unwrap_or_else(|_| (Vec::new(), Vec::new()));
     if !names.is_empty() {
         let declared =
             |m: &Model, n: &str| m.spec().inputs.iter().find(|i| i.name == n).map_or(0.0, |i| i.delay);
         if let Ok(mut again) = identify(given, &lines, true) {
-            if names.iter().any(|n| declared(&again.kept().model, n) > declared(given, n)) {
-                let note = format!(
-                    "{} moves from sample to sample and was taken as held (a state's rate fitted better so), which a dead time makes it seem (a hold reads it half a sample late): read as a line between the samples, its dead time found again",
-                    names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
-                );
+            if names.iter().any(|(n, _)| declared(&again.kept().model, n) > declared(given, n)) {
+                let said: Vec<String> = names.iter().map(|(n, how)| how.said(n)).collect();
+                let note = format!("{}; its dead time found again so", said.join("; "));
                 let at = again.kept;
                 if let Some((_, fit)) = again.starts[at].fits.first_mut() {
                     fit.selection.notes.push(note);
@@ -86,7 +129,10 @@ pub(super) fn stage(
             }
         }
     }
-    kept(recorded, identify(&delayed, frames, false), &late, &delayed)
+    match delayed(given, &late) {
+        Some(delayed) => kept(recorded, identify(&delayed, frames, false), &late, &delayed),
+        None => Err(recorded),
+    }
 }
 
 /// The late inputs in words: "`u` 0.500 s".
@@ -163,21 +209,25 @@ mod tests {
         Lag { column: column.into(), seconds: 0.5, share: 0.01, longest: 20.0 }
     }
 
-    /// A late sine taken as held is read as a line again; a late staircase (a controller's
-    /// command) stays held; an input not late is left as it is.
+    /// A late sine taken as held is read as a line again, a late staircase taken as switching
+    /// as held; a late staircase held stays held; an input not late is left as it is.
     #[test]
-    fn only_a_late_smooth_input_taken_as_held_is_released() {
+    fn a_late_input_is_read_again_where_its_delay_may_have_decided_its_reading() {
         let t: Vec<f64> = (0..200).map(|k| 0.05 * k as f64).collect();
         let mut f = Frame::new("run.csv", "t", t.clone()).unwrap();
         f.push("u", t.iter().map(|t| (0.7 * t).sin()).collect()).unwrap();
         f.push("s", (0..200).map(|k| if (k / 40) % 2 == 0 { 1.0 } else { -1.0 }).collect()).unwrap();
         f.push("w", t.iter().map(|t| (1.3 * t).cos()).collect()).unwrap();
+        f.push("r", (0..200).map(|k| if (k / 30) % 2 == 0 { 0.5 } else { -0.5 }).collect()).unwrap();
         for name in ["u", "s", "w"] {
             f.hold(name).unwrap();
         }
-        let (out, names) = released(&[f], &[lag("u"), lag("s")]);
-        assert_eq!(names, vec!["u".to_string()]);
-        assert!(!out[0].is_held("u") && out[0].is_held("s") && out[0].is_held("w"));
+        f.switch("r").unwrap();
+        let (out, names) = reread(&[f], &["u".into(), "s".into(), "r".into()]).unwrap();
+        assert_eq!(names, vec![("u".to_string(), Reread::AsALine), ("r".to_string(), Reread::AsHeld)]);
+        let f = &out[0];
+        assert!(!f.is_held("u") && !f.is_switched("u") && f.is_held("s") && f.is_held("w"));
+        assert!(f.is_held("r") && !f.is_switched("r"));
     }
 
     /// The delay written is the declared one plus the lag, to six figures.
