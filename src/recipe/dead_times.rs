@@ -121,10 +121,7 @@ pub(super) fn stage(
             if names.iter().any(|(n, _)| declared(&again.kept().model, n) > declared(given, n)) {
                 let said: Vec<String> = names.iter().map(|(n, how)| how.said(n)).collect();
                 let note = format!("{}; its dead time found again so", said.join("; "));
-                let at = again.kept;
-                if let Some((_, fit)) = again.starts[at].fits.first_mut() {
-                    fit.selection.notes.push(note);
-                }
+                again.say(note);
                 return Ok(again);
             }
         }
@@ -194,10 +191,7 @@ fn kept(
         ),
     };
     let (Ok(r) | Err(r)) = &mut recipe;
-    let at = r.kept;
-    if let Some((_, fit)) = r.starts[at].fits.first_mut() {
-        fit.selection.notes.push(note);
-    }
+    r.say(note);
     recipe
 }
 

@@ -295,11 +295,9 @@ pub(super) fn said(mut recipe: Recipe, forced: &[Forced], first: &str) -> Recipe
         "; a random force moves {}: no equation without it follows such a record for long, and its roughness reads as noise, so this flag does not tell the terms wrong",
         states.join(", ")
     );
+    recipe.say(note);
     let at = recipe.kept;
     let start = &mut recipe.starts[at];
-    if let Some((_, fit)) = start.fits.first_mut() {
-        fit.selection.notes.push(note);
-    }
     // the model file says it too: simulated, it follows such a record in the mean only
     let written = format!(
         "a random force (process noise) moves {}: identified by Itô's steps (--derivative ito); simulated without the force, the equations follow such a record in the mean only",
@@ -331,10 +329,7 @@ pub(super) fn untold(mut recipe: Recipe, rough: &[(String, f64)]) -> Recipe {
         "the roughness of {} grows as a Brownian path's (its fourth differences spread twice as much over twice the stride): a filtered sensor's noise, or a random force (process noise), whose terms rates estimated over both sides of a sample bias (an Ornstein-Uhlenbeck process's decay came back 24 % short, with two spurious terms); no other state's record holds it to tell which. Where a random force moves it, --derivative ito identifies the terms unbiased",
         rough.join(", ")
     );
-    let at = recipe.kept;
-    if let Some((_, fit)) = recipe.starts[at].fits.first_mut() {
-        fit.selection.notes.push(note);
-    }
+    recipe.say(note);
     recipe
 }
 

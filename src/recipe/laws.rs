@@ -211,9 +211,6 @@ pub(super) fn kept(
             format!("{tried} the system could not be identified ({e}): the polynomials kept{flagged}"),
         ),
     };
-    let at = recipe.kept;
-    if let Some((_, fit)) = recipe.starts[at].fits.first_mut() {
-        fit.selection.notes.push(note);
-    }
+    recipe.say(note);
     recipe
 }

@@ -473,6 +473,14 @@ impl Recipe {
         &self.starts[self.kept]
     }
 
+    /// Says `note` in the kept start's first fit (what a stage tried, and why it kept what it
+    /// kept).
+    pub(crate) fn say(&mut self, note: String) {
+        if let Some((_, fit)) = self.starts[self.kept].fits.first_mut() {
+            fit.selection.notes.push(note);
+        }
+    }
+
     /// The kept start's checks with the starts' agreement.
     pub fn checks(&self) -> Vec<Check> {
         self.kept().checks.iter().chain(&self.agreement).cloned().collect()

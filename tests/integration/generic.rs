@@ -2251,11 +2251,12 @@ fn a_law_in_as_many_terms_as_its_stand_in_is_kept() {
         let out = report.to_string();
         let terms = crate::common::chosen_terms(&report["v_dot"]);
         assert_eq!(terms.len(), 4, "{name}: {terms:?}");
-        for (term, truth) in [("x", -4.0), ("v", -0.1), ("sign(v)", -0.5), ("u", 1.0)] {
-            let found = terms.iter().find(|(t, _)| t == term).map(|(_, c)| *c);
-            let within = if noisy { 0.05 } else { 0.01 };
-            assert!(found.is_some_and(|c| (c / truth - 1.0).abs() < within), "{name} {term}: {terms:?}");
-        }
+        coefficients_within(
+            &terms,
+            &[("x", -4.0), ("v", -0.1), ("sign(v)", -0.5), ("u", 1.0)],
+            if noisy { 0.05 } else { 0.01 },
+            name,
+        );
         assert!(
             out.contains("kept, the polynomials having stood in for a law")
                 && !out.contains("\"passed\":false"),
@@ -2292,11 +2293,12 @@ fn an_input_s_law_is_found_where_its_powers_stood_in() {
         let out = report.to_string();
         let terms = crate::common::chosen_terms(&report["v_dot"]);
         assert_eq!(terms.len(), 2, "{name}: {terms:?}");
-        for (term, truth) in [("v*abs(v)", -0.3), ("u*abs(u)", 0.1)] {
-            let found = terms.iter().find(|(t, _)| t == term).map(|(_, c)| *c);
-            let within = if noisy { 0.01 } else { 1e-4 };
-            assert!(found.is_some_and(|c| (c / truth - 1.0).abs() < within), "{name} {term}: {terms:?}");
-        }
+        coefficients_within(
+            &terms,
+            &[("v*abs(v)", -0.3), ("u*abs(u)", 0.1)],
+            if noisy { 0.01 } else { 1e-4 },
+            name,
+        );
         assert!(
             out.contains("kept, the polynomials having stood in for a law")
                 && !out.contains("\"passed\":false"),
@@ -2353,11 +2355,7 @@ fn an_input_acting_late_is_found_and_fitted_so() {
         let out = report.to_string();
         let terms = crate::common::chosen_terms(&report["x_dot"]);
         assert_eq!(terms.len(), 2, "{name}: {terms:?}");
-        for (term, truth) in [("x", -0.5), ("u", 0.8)] {
-            let found = terms.iter().find(|(t, _)| t == term).map(|(_, c)| *c);
-            let within = if noisy { 0.01 } else { 1e-3 };
-            assert!(found.is_some_and(|c| (c / truth - 1.0).abs() < within), "{name} {term}: {terms:?}");
-        }
+        coefficients_within(&terms, &[("x", -0.5), ("u", 0.8)], if noisy { 0.01 } else { 1e-3 }, name);
         assert!(
             out.contains(&format!(
                 "identified again with the inputs read as acting late, `u` by {late:.3} s (a dead time, or a lag of about that"
@@ -4101,6 +4099,15 @@ fn identified_u(run: &std::path::Path, states: &str, extra: &[&str]) -> (serde_j
     (crate::common::json(&out), err)
 }
 
+/// Asserts each of `truths` (term, true coefficient) among the chosen `terms`, within
+/// `within` of the truth (relative); `label` names the record in the message.
+fn coefficients_within(terms: &[(String, f64)], truths: &[(&str, f64)], within: f64, label: &str) {
+    for (term, truth) in truths {
+        let found = terms.iter().find(|(t, _)| t == term).map(|(_, c)| *c);
+        assert!(found.is_some_and(|c| (c / truth - 1.0).abs() < within), "{label} {term}: {terms:?}");
+    }
+}
+
 /// [`switched_oscillator`] sampled every `every` ms for `steps` ms.
 fn oscillator_sampled(x0: f64, every: usize, steps: usize) -> Vec<[f64; 4]> {
     let h = 0.001;
@@ -4244,10 +4251,7 @@ fn a_record_stamped_in_unix_time_is_identified_as_from_zero() {
     let checks = report["physical_checks"].as_array().unwrap();
     assert!(checks.iter().all(|c| c["passed"] == true), "{checks:?}");
     let terms = crate::common::chosen_terms(&report["v_dot"]);
-    for (term, truth) in [("x", -4.0), ("v", -0.4), ("u", 2.0)] {
-        let found = terms.iter().find(|(t, _)| t == term).map(|(_, c)| *c);
-        assert!(found.is_some_and(|c| (c / truth - 1.0).abs() < 1e-4), "{term}: {terms:?}");
-    }
+    coefficients_within(&terms, &[("x", -4.0), ("v", -0.4), ("u", 2.0)], 1e-4, "");
 }
 
 /// A record longer than the retrace re-simulates whole (30 000 rows at 100 Hz) under a command
@@ -4291,10 +4295,7 @@ fn a_run_resampled_is_identified_in_the_weak_form_its_held_force_held() {
         assert!(report["v_dot"]["rows"].as_u64().unwrap() < 1500, "{name}: {report}");
         let terms = crate::common::chosen_terms(&report["v_dot"]);
         assert_eq!(terms.len(), 3, "{name}: {terms:?}");
-        for (term, truth) in [("x", -4.0), ("v", -0.4), ("u", 2.0)] {
-            let found = terms.iter().find(|(t, _)| t == term).map(|(_, c)| *c);
-            assert!(found.is_some_and(|c| (c / truth - 1.0).abs() < 0.01), "{name} {term}: {terms:?}");
-        }
+        coefficients_within(&terms, &[("x", -4.0), ("v", -0.4), ("u", 2.0)], 0.01, name);
     }
 }
 
