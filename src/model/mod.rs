@@ -1068,16 +1068,19 @@ impl Model {
     /// a run starts where every input's history is recorded (fed from the run's start, an input
     /// acting 0.5 s late is guessed at its first value for 0.5 s).
     pub fn as_acting<'a>(
-        &self,
+        &'a self,
         frames: &'a [crate::data::Frame],
-    ) -> Result<(Model, std::borrow::Cow<'a, [crate::data::Frame]>), crate::data::DataError> {
+    ) -> Result<
+        (std::borrow::Cow<'a, Model>, std::borrow::Cow<'a, [crate::data::Frame]>),
+        crate::data::DataError,
+    > {
         let frames = self.acting(frames)?;
         if matches!(frames, std::borrow::Cow::Borrowed(_)) {
-            return Ok((self.clone(), frames));
+            return Ok((std::borrow::Cow::Borrowed(self), frames));
         }
         let mut model = self.clone();
         model.spec.inputs.iter_mut().for_each(|i| i.delay = 0.0);
-        Ok((model, frames))
+        Ok((std::borrow::Cow::Owned(model), frames))
     }
 
     /// The model with its runs' inputs taken between samples as `intersample` says where

@@ -80,9 +80,12 @@ pub fn retrace_checks(model: &Model, runs: &[Frame]) -> Vec<Check> {
 /// [`retrace_checks`], with the least share of a run the equations follow (0 where they run
 /// away from one or the checks cannot apply).
 pub(super) fn retraced(model: &Model, runs: &[Frame]) -> (Vec<Check>, f64) {
-    // inputs that act late: each run re-simulated from where their history is recorded
-    let Ok((model, runs)) = model.as_acting(runs) else { return (Vec::new(), 0.0) };
-    let (model, runs) = (&model, &*runs);
+    // inputs that act late: each run re-simulated from where their history is recorded (a run
+    // too short for its delays, as recorded)
+    let (model, runs) = model
+        .as_acting(runs)
+        .unwrap_or((std::borrow::Cow::Borrowed(model), std::borrow::Cow::Borrowed(runs)));
+    let (model, runs) = (&*model, &*runs);
     let mut followed = Vec::new();
     let mut off = Vec::new();
     let Some(retrace) = retrace_check(model, runs, &mut followed, &mut off) else { return (Vec::new(), 0.0) };
