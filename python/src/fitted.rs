@@ -304,10 +304,12 @@ pub(crate) fn fit(
                 }
                 despiked.push(frame);
             }
-            // every column but the state may be an input held between samples; any column a
-            // slower sensor's readings; the state's leap a cut between runs joined
+            // every column but the state may be an input held between samples (a late one
+            // judged as it acts); any column a slower sensor's readings; the state's leap a cut
+            // between runs joined
+            let late: Vec<(&str, f64)> = delays.iter().map(|(n, s)| (n.as_str(), *s)).collect();
             let (mut frames, notes) =
-                termid::data::runs_of_rate(despiked, state, &all, intersample).map_err(fail)?;
+                termid::data::runs_of_rate(despiked, state, &all, &late, intersample).map_err(fail)?;
             for note in notes {
                 warn(py, note)?;
             }

@@ -508,6 +508,34 @@ def test_a_force_acting_late_is_said_and_fitted_with_its_delay():
     assert not any("acts on" in n for n in late.notes)
 
 
+def test_a_smooth_input_declared_late_is_read_as_it_acts():
+    # ẋ = −0.5x + 0.8u(t − 0.5), u three sines logged every 0.05 s: judged as logged, u reads
+    # as a DAC's hold (a hold reads half a sample late, as the delay does), 1 % off with a
+    # spurious x³; judged as it acts (delays=), a line between its samples and the true terms
+    def u(t):
+        return 1.5 * np.sin(0.31 * t) + np.sin(0.83 * t + 1.0) + 0.5 * np.sin(2.1 * t + 2.0)
+
+    def rate(t, x):
+        return -0.5 * x + (0.8 * u(t - 0.5) if t >= 0.5 else 0.0)
+
+    h, x, rows = 0.005, 0.0, []
+    for k in range(4000):
+        rows.append((0.05 * k, x, u(0.05 * k)))
+        for j in range(10):
+            t = 0.05 * k + h * j
+            k1 = rate(t, x)
+            k2 = rate(t + h / 2, x + h / 2 * k1)
+            k3 = rate(t + h / 2, x + h / 2 * k2)
+            k4 = rate(t + h, x + h * k3)
+            x += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    df = pd.DataFrame(rows, columns=["t", "x", "u"])
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        late = termid.fit(df, "dx/dt", ["x", "u", "x^3"], delays={"u": 0.5})
+    assert late.coefficients.sort_index().round(3).to_dict() == {"u": 0.8, "x": -0.5}
+    assert not any("taken as held" in str(w.message) for w in said), [str(w.message) for w in said]
+
+
 def _lorenz_log(repeated, start=(-8.0, 7.0, 27.0), rows=10_001):
     # Lorenz every 1 ms from `start` (RK4), the columns `repeated` read every 10th row and
     # written again until the next reading (a slower sensor merged and filled forward)

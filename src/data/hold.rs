@@ -442,8 +442,19 @@ pub fn mark_held(
     motion: &[&str],
     intersample: Intersample,
 ) -> Result<Vec<String>, DataError> {
+    mark_held_among(frame, columns, columns, motion, intersample)
+}
+
+/// [`mark_held`] of the columns `marked` alone, each judged beside every other of `columns`.
+pub(super) fn mark_held_among(
+    frame: &mut Frame,
+    marked: &[&str],
+    columns: &[&str],
+    motion: &[&str],
+    intersample: Intersample,
+) -> Result<Vec<String>, DataError> {
     let mut notes = Vec::new();
-    for name in columns {
+    for name in marked {
         let Some(column) = frame.column(name) else { continue };
         match intersample {
             Intersample::Linear => frame.release(name),

@@ -382,10 +382,10 @@ pub fn say_late_inputs(
     let inputs: Vec<String> = model.spec().inputs.iter().map(|i| i.name.clone()).collect();
     let remedy = |lag: &super::Lag| {
         let declared = model.spec().inputs.iter().find(|i| i.name == lag.column).map_or(0.0, |i| i.delay);
+        let (s, name) = (crate::output::sig(declared + lag.seconds, 3), &lag.column);
         format!(
-            "declare it in the model file: `delay = {}` in the [[inputs]] entry of `{}`",
-            crate::output::sig(declared + lag.seconds, 3),
-            lag.column
+            "declare it in the model file: `delay = {s}` in the [[inputs]] entry of `{name}` (a model made \
+             from columns: identify --states … --delay {name}={s})"
         )
     };
     let mut late: Vec<super::Lag> = Vec::new();

@@ -1039,6 +1039,12 @@ impl Model {
         self
     }
 
+    /// The inputs that act late, each with its dead time in seconds (`delay` in its
+    /// `[[inputs]]` entry, where above 0).
+    pub fn dead_times(&self) -> Vec<(&str, f64)> {
+        self.spec.inputs.iter().filter(|i| i.delay > 0.0).map(|i| (i.name.as_str(), i.delay)).collect()
+    }
+
     /// Runs as the model's equations see them: each input with a dead time (`delay` in its
     /// `[[inputs]]` entry) read that much earlier against the rest, every run from its
     /// longest delay on ([`crate::data::delayed`]); the runs themselves where none has one.
@@ -1046,8 +1052,7 @@ impl Model {
         &self,
         frames: &'a [crate::data::Frame],
     ) -> Result<std::borrow::Cow<'a, [crate::data::Frame]>, crate::data::DataError> {
-        let late: Vec<(&str, f64)> =
-            self.spec.inputs.iter().filter(|i| i.delay > 0.0).map(|i| (i.name.as_str(), i.delay)).collect();
+        let late = self.dead_times();
         if late.is_empty() {
             return Ok(std::borrow::Cow::Borrowed(frames));
         }
@@ -1276,7 +1281,15 @@ impl Model {
         }
         let inputs: Vec<&str> = self.spec.inputs.iter().map(|i| i.name.as_str()).collect();
         let states: Vec<&str> = self.spec.states.iter().map(|s| s.name.as_str()).collect();
-        notes.extend(crate::data::mark_held(frame, &inputs, &states, self.spec.model.intersample)?);
+        // an input with a dead time judged as the equations read it, that much late
+        let late = self.dead_times();
+        notes.extend(crate::data::mark_held_acting(
+            frame,
+            &inputs,
+            &late,
+            &states,
+            self.spec.model.intersample,
+        )?);
         // a state, its rate or an input (not a held command) that repeats a slower sensor's
         // readings between them is read at them
         let rates: Vec<String> = self.spec.states.iter().map(|s| format!("{}_dot", s.name)).collect();

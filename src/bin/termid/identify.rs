@@ -128,17 +128,19 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
         // every column but the state may be an input held between samples; any column a slower
         // sensor's readings; the state's leap a cut between runs joined in one file
         let intersample = cmd.intersample.unwrap_or_default();
+        let late = cmd.delays.iter().map(|d| delay_of(d)).collect::<Result<Vec<_>>>()?;
         let mut runs = Vec::new();
         for f in frames {
             let all: Vec<String> = f.names()[1..].to_vec();
             let all: Vec<&str> = all.iter().map(String::as_str).collect();
-            let (cut, notes) = termid::data::runs_of_rate(vec![f], state, &all, intersample)?;
+            let (cut, notes) = termid::data::runs_of_rate(vec![f], state, &all, &late, intersample)?;
             notes.iter().for_each(|n| crate::runs::say(n));
             runs.extend(cut);
         }
         frames = runs;
     }
-    // after the marking: a held column is read back sample for sample
+    // after the marking (a late column judged as it acts): a held column is read back sample
+    // for sample
     for d in &cmd.delays {
         let (name, seconds) = delay_of(d)?;
         for f in &mut frames {

@@ -255,11 +255,18 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
         .and_then(|m| m.strip_prefix("replay:"))
         .map(|file| -> Result<termid::data::Frame> {
             let mut frame = crate::runs::replay_frame(std::path::Path::new(file), &model.spec().model.time)?;
-            // an input held between samples in the record is held in the replay
+            // an input held between samples in the record is held in the replay (one with a
+            // dead time judged as it acts)
             let inputs: Vec<&str> = system.inputs.iter().map(String::as_str).collect();
             let intersample = model.spec().model.intersample;
             let states: Vec<&str> = system.states.iter().map(String::as_str).collect();
-            let mut notes = termid::data::mark_held(&mut frame, &inputs, &states, intersample)?;
+            let mut notes = termid::data::mark_held_acting(
+                &mut frame,
+                &inputs,
+                &model.dead_times(),
+                &states,
+                intersample,
+            )?;
             // and one that repeats a slower sensor's readings, read at them
             notes.extend(termid::data::read_at_readings(&mut frame, &inputs, intersample)?);
             notes.iter().for_each(|n| crate::runs::say(n));
