@@ -12,6 +12,7 @@ pub mod contain;
 pub mod data;
 pub mod diagnose;
 pub mod identify;
+mod linalg;
 pub mod model;
 pub mod output;
 #[cfg(feature = "plot")]

@@ -75,7 +75,11 @@ pub fn uncertain_equations(model: &Model) -> Vec<String> {
 /// A symmetric square root of a covariance (semi-definite matrices, as an exact fit or a term
 /// with zero error gives, have no Cholesky factor; the eigen-decomposition serves for both).
 fn square_root(sigma: nalgebra::DMatrix<f64>) -> nalgebra::DMatrix<f64> {
-    let eig = sigma.symmetric_eigen();
+    let Some(eig) = crate::linalg::symmetric_eigen(sigma.clone()) else {
+        // (a covariance the model file's check decomposed: not reached) the standard errors
+        // alone, their correlations left out, rather than none
+        return nalgebra::DMatrix::from_diagonal(&sigma.diagonal().map(|v| v.max(0.0).sqrt()));
+    };
     &eig.eigenvectors
         * nalgebra::DMatrix::from_diagonal(&eig.eigenvalues.map(|l| l.max(0.0).sqrt()))
         * eig.eigenvectors.transpose()

@@ -88,10 +88,9 @@ pub fn first_stage(columns: &[Vec<f64>], starts: &[usize], lag: usize) -> (Vec<b
         }
     }
     let largest = gram.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-    let coefficients = gram
-        .svd(true, true)
-        .solve(&cross, COLLINEAR * largest)
-        .unwrap_or_else(|_| nalgebra::DMatrix::zeros(q, p));
+    let coefficients = crate::linalg::svd(gram)
+        .and_then(|svd| svd.solve(&cross, COLLINEAR * largest).ok())
+        .unwrap_or_else(|| nalgebra::DMatrix::zeros(q, p));
     let predicted = (0..p)
         .map(|c| rows.iter().map(|&(_, j)| (0..q).map(|k| z(j, k) * coefficients[(k, c)]).sum()).collect())
         .collect();

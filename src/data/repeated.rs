@@ -241,7 +241,7 @@ fn integrates_from_samples(x: &[f64], others: &[&[f64]], kept: &[usize], w: usiz
     });
     let y = nalgebra::DVector::from_fn(rows.len(), |i, _| x[rows[i]] - x[rows[i] - 1]);
     let (a, _) = scaled(a, None);
-    let Ok(fit) = a.clone().svd(true, true).solve(&y, 1e-12) else { return false };
+    let Some(Ok(fit)) = crate::linalg::svd(a.clone()).map(|svd| svd.solve(&y, 1e-12)) else { return false };
     let scale = y.norm_squared();
     scale > 0.0 && (&y - &a * fit).norm_squared() < EXACT * scale
 }
@@ -326,7 +326,7 @@ pub fn jumps_off_the_samples(t: &[f64], x: &[f64], motion: &[&[f64]], others: &[
     }
     let (early, _) = scaled(window_design(t, &early, &early, &kept, w, &terms, others, true), Some(&norms));
     let a = held.select_rows(smooth.iter());
-    let svd = a.clone().svd(true, true);
+    let svd = crate::linalg::svd(a.clone())?;
     // a row's leverage on the smooth windows' fit, xᵀ(AᵀA)⁺x over the directions they determine
     let (v_t, sigma) = (svd.v_t.as_ref()?, &svd.singular_values);
     let determined: Vec<usize> = (0..sigma.len()).filter(|&i| sigma[i] > 1e-12).collect();
@@ -454,7 +454,7 @@ fn held_or_else(
     }
     let (held, _) = scaled(window_design(t, x, read, &kept, w, &terms, others, true), None);
     let (read, _) = scaled(window_design(t, x, read, &kept, w, &terms, others, false), None);
-    let (held_svd, read_svd) = (held.clone().svd(true, true), read.clone().svd(true, true));
+    let (held_svd, read_svd) = (crate::linalg::svd(held.clone())?, crate::linalg::svd(read.clone())?);
     let left = |a: &nalgebra::DMatrix<f64>,
                 svd: &nalgebra::SVD<f64, nalgebra::Dyn, nalgebra::Dyn>,
                 y: &nalgebra::DVector<f64>|
@@ -495,7 +495,7 @@ fn held_or_else(
                     }),
                     None,
                 );
-                let svd = ends.clone().svd(true, true);
+                let svd = crate::linalg::svd(ends.clone())?;
                 let proportional = left(&ends, &svd, &y)? < STATIC * y.norm_squared();
                 match proportional || integrates_from_samples(x, others, &kept, w, windows_of.leaps) {
                     true => FORESEEN_MATTERS,

@@ -58,10 +58,9 @@ impl Differentiator for SavitzkyGolay {
             let span = (t[start + w - 1] - t[start]).max(f64::MIN_POSITIVE);
             let a = DMatrix::from_fn(w, q + 1, |r, c| ((t[start + r] - t[i]) / span).powi(c as i32));
             let b = DVector::from_iterator(w, x[start..start + w].iter().copied());
-            let coef = a
-                .svd(true, true)
-                .solve(&b, 1e-12)
-                .map_err(|e| DataError::UnknownMethod(format!("savitzky-golay fit: {e}"), String::new()))?;
+            let fit = |e: &str| DataError::UnknownMethod(format!("savitzky-golay fit: {e}"), String::new());
+            let svd = crate::linalg::svd(a).ok_or_else(|| fit("its decomposition did not converge"))?;
+            let coef = svd.solve(&b, 1e-12).map_err(fit)?;
             out.push(coef[1] / span);
         }
         Ok(out)

@@ -979,12 +979,11 @@ impl Runs {
                 if jac.iter().any(|v| !v.is_finite()) {
                     continue;
                 }
-                let speed = nalgebra::DMatrix::from_row_slice(n, n, &jac)
-                    .complex_eigenvalues()
-                    .iter()
-                    .filter(|l| l.re < 0.0)
-                    .map(|l| l.norm())
-                    .fold(0.0, f64::max);
+                let Some(modes) = crate::linalg::eigenvalues(nalgebra::DMatrix::from_row_slice(n, n, &jac))
+                else {
+                    continue;
+                };
+                let speed = modes.iter().filter(|l| l.re < 0.0).map(|l| l.norm()).fold(0.0, f64::max);
                 if speed > 0.0 && fastest.is_none_or(|(s, _)| speed > s) {
                     fastest = Some((speed, f.since_start(k)));
                 }

@@ -58,7 +58,7 @@ fn correlation(
         return None;
     }
     let r = nalgebra::DMatrix::from_fn(k, k, |i, j| cov(i, j) / (d[i] * d[j]));
-    Some((d, nalgebra::SymmetricEigen::new(r)))
+    Some((d, crate::linalg::symmetric_eigen(r)?))
 }
 
 /// A combination `Σ wᵢ·namesᵢ` as a reader writes it, the largest weight scaled to 1 and

@@ -52,6 +52,9 @@ pub enum CovarianceError {
     /// A negative eigenvalue beyond round-off.
     #[error("`matrix` is not positive semi-definite (eigenvalue {0:e})")]
     NotPositive(f64),
+    /// Its eigenvalues not found (values that overflow, or a decomposition that never ends).
+    #[error("`matrix`'s eigenvalues could not be found (values near overflow?): give it in units that keep its values nearer 1")]
+    Undecomposed,
 }
 
 impl Model {
@@ -109,7 +112,8 @@ pub(super) fn check(
         }
     }
     let a = nalgebra::DMatrix::from_fn(k, k, |i, j| m[i][j]);
-    let smallest = a.symmetric_eigenvalues().iter().copied().fold(f64::INFINITY, f64::min);
+    let eigen = crate::linalg::symmetric_eigen(a).ok_or(CovarianceError::Undecomposed)?;
+    let smallest = eigen.eigenvalues.iter().copied().fold(f64::INFINITY, f64::min);
     let largest = m.iter().enumerate().map(|(i, r)| r[i]).fold(0.0, f64::max);
     if k > 0 && smallest < -1e-9 * largest {
         return Err(CovarianceError::NotPositive(smallest));

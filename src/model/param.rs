@@ -145,6 +145,6 @@ fn scatter_about_parabola(t: &[f64], x: &[f64]) -> f64 {
     let (t0, span) = (t[0], (t[n - 1] - t[0]).max(f64::MIN_POSITIVE));
     let a = nalgebra::DMatrix::from_fn(n, 3, |i, j| ((t[i] - t0) / span).powi(j as i32));
     let b = nalgebra::DVector::from_column_slice(&x[..n]);
-    let Ok(fit) = a.clone().svd(true, true).solve(&b, 1e-12) else { return 0.0 };
+    let Some(Ok(fit)) = crate::linalg::svd(a.clone()).map(|svd| svd.solve(&b, 1e-12)) else { return 0.0 };
     ((&a * fit - b).norm_squared() / (n - 3) as f64).sqrt()
 }

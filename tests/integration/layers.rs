@@ -8,6 +8,7 @@ use std::path::Path;
 /// `sim::RightHandSide`), the regression back-ends below both; the ship plug-in and the registry of plug-ins are
 /// near the top, and the recipe (which checks its starts by whatever plug-in a model has) on top.
 const LAYERS: &[&str] = &[
+    "linalg",
     "contain",
     "budget",
     "output",
