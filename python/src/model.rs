@@ -485,8 +485,11 @@ impl PyModel {
     }
 
     /// Every identifiable equation (or the named ones) from runs; returns the identified model
-    /// and each fit as JSON.
-    #[pyo3(signature = (runs, derivative = None, equations = vec![], intercept = None, backend = None))]
+    /// and each fit as JSON. A model of no field's is identified as `termid identify --states`
+    /// identifies it: by the library's recipe with one start, its stages (laws, a random force,
+    /// dead times) as asked.
+    #[pyo3(signature = (runs, derivative = None, equations = vec![], intercept = None, backend = None, laws = true, random_force = true, dead_times = true))]
+    #[allow(clippy::too_many_arguments)]
     fn identify(
         &self,
         py: Python<'_>,
@@ -495,9 +498,12 @@ impl PyModel {
         equations: Vec<String>,
         intercept: Option<bool>,
         backend: Option<&str>,
+        laws: bool,
+        random_force: bool,
+        dead_times: bool,
     ) -> PyResult<(PyModel, Fits, String)> {
         // the defaults of `termid identify`: central differences for a plug-in's model (a
-        // ship, as the paper), the integral form for any other; the model file's intercept
+        // ship, as the paper), the weak form for any other; the model file's intercept
         let derivative = derivative.unwrap_or_else(|| self.default_derivative());
         let intercept = intercept.unwrap_or(self.inner.spec().model.intercept);
         let model = match backend {
@@ -505,36 +511,48 @@ impl PyModel {
             None => self.inner.clone(),
         };
         let frames = self.frames(runs)?;
-        let diff = differentiator(derivative).map_err(fail)?;
-        let how = ModelIdentification { equations, differentiator: diff.as_ref(), intercept, target: None };
         // the work without the GIL: other Python threads run meanwhile
-        let identified = py
-            .detach(|| {
-                let mut identified = termid::identify::identify_model(&model, &frames, &how, &mut |_| {})?;
-                termid::identify::say_late_inputs(&mut identified, &frames, diff.as_ref())?;
-                Ok::<_, termid::identify::IdentifyError>(identified)
-            })
-            .map_err(fail)?;
-        // any system: its equations must retrace the runs, its terms hold on each half of them
-        // (a field's model has its checks, `Model.checks`, which read more than the runs);
-        // where they lose their runs, their terms are chosen again by re-simulation
-        let (identified, checks) = match termid::plugins::of(&identified.model) {
-            Some(_) => (identified, vec![]),
+        let (identified, fits, checks) = match termid::plugins::of(&model) {
+            // a field's model has its checks (`Model.checks`), which read more than the runs
+            Some(_) => {
+                let diff = differentiator(derivative).map_err(fail)?;
+                let how =
+                    ModelIdentification { equations, differentiator: diff.as_ref(), intercept, target: None };
+                let identified = py
+                    .detach(|| {
+                        let mut identified =
+                            termid::identify::identify_model(&model, &frames, &how, &mut |_| {})?;
+                        termid::identify::say_late_inputs(&mut identified, &frames, diff.as_ref())?;
+                        Ok::<_, termid::identify::IdentifyError>(identified)
+                    })
+                    .map_err(fail)?;
+                (identified.model, identified.fits, vec![])
+            }
+            // any system: its equations must retrace the runs, its terms hold on each half of
+            // them (chosen again by re-simulation where they lose their runs), its powers not
+            // stand in for a law, its inputs read as they act
             None => {
-                let (identified, checks, _) =
-                    py.detach(|| termid::recipe::checked_system(&model, identified, &frames, &how));
-                (identified, checks)
+                let settings = termid::recipe::RecipeSettings {
+                    equations,
+                    derivatives: vec![derivative.to_string()],
+                    intercept,
+                    laws,
+                    random_force,
+                    dead_times,
+                    ..Default::default()
+                };
+                let mut recipe =
+                    py.detach(|| termid::recipe::identify(&model, &frames, None, &settings)).map_err(fail)?;
+                let kept = recipe.starts.swap_remove(recipe.kept);
+                (kept.model, kept.fits, kept.checks)
             }
         };
-        let fits = identified
-            .fits
-            .iter()
-            .map(|(n, f)| Ok((n.clone(), to_json(&f.report())?)))
-            .collect::<PyResult<_>>()?;
+        let fits =
+            fits.iter().map(|(n, f)| Ok((n.clone(), to_json(&f.report())?))).collect::<PyResult<_>>()?;
         for c in checks.iter().filter(|c| !c.passed) {
             warn(py, c.line())?;
         }
-        Ok((PyModel { inner: identified.model }, fits, to_json(&checks)?))
+        Ok((PyModel { inner: identified }, fits, to_json(&checks)?))
     }
 
     /// The model with `forced` terms entering first and `excluded` ones never, in every

@@ -1537,13 +1537,13 @@ class Model:
             raise TermidError(f"Model.from_states: degree {degree!r} is no degree: give a whole number, 1 or more")
         # a state the runs do not record, written as another's rate (`v=dx/dt`), by its name
         named = [str(s).split("=")[0].strip() for s in states]
-        for name in [*named, *inputs]:
+        for column in [*named, *inputs]:
             # a dataframe's `tank level`: the remedy in pandas, not in a dataset file
-            fixed = re.sub(r"\W", "_", str(name))
-            if not str(name).isidentifier() and fixed.isidentifier():
+            fixed = re.sub(r"\W", "_", str(column))
+            if not str(column).isidentifier() and fixed.isidentifier():
                 raise TermidError(
-                    f"Model.from_states: `{name}` is not a valid name (a name is letters, digits and `_`, not a "
-                    f"digit first): rename its column, df.rename(columns={{'{name}': '{fixed}'}}), and call it `{fixed}`"
+                    f"Model.from_states: `{column}` is not a valid name (a name is letters, digits and `_`, not a "
+                    f"digit first): rename its column, df.rename(columns={{'{column}': '{fixed}'}}), and call it `{fixed}`"
                 )
         native = _termid.Model.from_states(
             list(states),
@@ -1858,11 +1858,19 @@ class Model:
         intercept: Optional[bool] = None,
         backend: Optional[str] = None,
         names: Optional[Sequence[str]] = None,
+        laws: bool = True,
+        random_force: bool = True,
+        dead_times: bool = True,
         **settings: Any,
     ) -> Identified:
         """Every identifiable equation (or ``equations``) from ``runs`` (one run or a list:
         DataFrames, dicts of arrays, Arrow tables), with the model's
         candidates, forced terms and back-end (or ``backend`` with its settings as keywords).
+        A model of no field's (``from_states``, a file of no plug-in) is identified as
+        ``termid identify`` identifies it, by :meth:`recipe` with one start: a power that stands
+        in for a law of a state or an input tried with the laws (``laws``), a random force
+        (``random_force``), inputs found late identified again so (``dead_times``); False keeps
+        each as the regression has it.
 
         ``target``: ``"column"`` explains the runs' rate columns (``r_dot``), ``"derivative"``
         the states' derivatives estimated by ``derivative``; by default the rate columns where
@@ -1880,7 +1888,14 @@ class Model:
         data = _targeted(self._native, _runs(runs, names, self.time), derivative, target, list(equations))
         try:
             native, fits, checks = self._native.identify(
-                data, derivative, list(equations), intercept, _backend(backend, settings)
+                data,
+                derivative,
+                list(equations),
+                intercept,
+                _backend(backend, settings),
+                laws,
+                random_force,
+                dead_times,
             )
         except TermidError as e:
             left_out = {n: k for _, cols in data for n, k in getattr(cols, "left_out", {}).items()}

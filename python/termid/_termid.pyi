@@ -67,6 +67,9 @@ class Model:
         equations: Sequence[str] = ...,
         intercept: Optional[bool] = None,
         backend: Optional[str] = None,
+        laws: bool = True,
+        random_force: bool = True,
+        dead_times: bool = True,
     ) -> Tuple[Model, List[Tuple[str, str]], str]: ...
     def with_terms(self, forced: Sequence[str], excluded: Sequence[str]) -> Model: ...
     def starting_as(self, run: Run) -> Model: ...

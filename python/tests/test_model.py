@@ -1292,12 +1292,15 @@ def test_a_column_whose_name_is_no_name_is_refused_with_its_pandas_remedy():
 
 
 def test_a_law_a_cubic_stands_in_for_is_diagnosed_and_identified_again():
-    # a tank draining through an orifice, dh/dt = -0.1*sqrt(h) in closed form: the cubic
-    # library follows it with every check ok; diagnose names the law, and the model it
-    # returns, identified again, keeps it
+    # a tank draining through an orifice, dh/dt = -0.1*sqrt(h) in closed form: identify
+    # tries the laws where the cubic library's powers stand alone, and finds it; kept to the
+    # polynomials (laws=False), the cubic library follows it with every check ok; diagnose
+    # names the law, and the model it returns, identified again, keeps it
     t = np.arange(0.0, 35.0, 0.1)
     run = pd.DataFrame({"t": t, "h": (2.0 - 0.05 * t) ** 2})
-    found = termid.Model.from_states(["h"]).identify(run)
+    law = termid.Model.from_states(["h"]).identify(run).model.coefficients("h_dot").set_index("term")["value"]
+    assert law.to_dict() == pytest.approx({"sqrt(abs(h))": -0.1}, rel=1e-4)
+    found = termid.Model.from_states(["h"]).identify(run, laws=False)
     gaps, repaired = found.model.diagnose(run)
     assert gaps.attrs["effect"]["name"] == "`sqrt(abs(h))` in h_dot, beyond the candidates"
     assert gaps.attrs["effect"]["coefficients"][0] == pytest.approx(-0.1, rel=1e-3)
@@ -1462,6 +1465,18 @@ def test_an_input_acting_late_is_found_by_the_recipe_and_written_as_its_delay():
     recorded = model.recipe(run, dead_times=False)
     assert "read as acting late" not in recorded.text and "delay = " not in recorded.model.to_toml()
     assert "`u` acts on dx/dt about 0.500 s later" in recorded.text
+    # identify, as `termid identify --states`, runs the same stage; dead_times=False keeps u
+    found = model.identify(run)
+    rate = found.model.coefficients("x_dot").set_index("term")["value"]
+    assert sorted(rate.index) == ["u", "x"] and rate["u"] == pytest.approx(0.8, rel=1e-3)
+    assert "delay = 0.5" in found.model.to_toml()
+    assert "delay = " not in model.identify(run, dead_times=False).model.to_toml()
+
+
+def test_a_model_made_from_columns_is_named_by_its_states():
+    # (the name was the last column checked: `F` for a model of x and v)
+    assert termid.Model.from_states(["x", "v"], ["F"]).name == "x, v"
+    assert termid.Model.from_states(["x"], ["F"], name="spring").name == "spring"
 
 
 def test_a_random_force_is_found_by_the_recipe_and_its_damping_identified_unbiased():
