@@ -238,6 +238,12 @@ fn offset(name: &str, frames: &[Frame]) -> Option<Offset> {
     if n < 2.0 {
         return None;
     }
+    // a constant (g = 9.81 in every row) has nothing to write about a reference: its mean's
+    // rounding left it 1.1·10¹⁴ spreads from 0, written about g0 = 9.8100000000001
+    let first = columns.iter().find_map(|c| c.first())?;
+    if columns.iter().flat_map(|c| c.iter()).all(|v| v == first) {
+        return None;
+    }
     let mean = columns.iter().flat_map(|c| c.iter()).sum::<f64>() / n;
     let variance = columns.iter().flat_map(|c| c.iter()).map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
     let spread = variance.sqrt();
@@ -566,6 +572,13 @@ mod tests {
         fine.push("z", vec![-7.23, -7.25, -7.24, -7.22]).unwrap();
         let (fine, _) = model.about_references(&[fine]).unwrap();
         assert_eq!(fine.parameter_values()["z0"], -7.2);
+        // a constant is no variable far from 0 (its mean's rounding made it 10¹⁴ spreads off)
+        let t: Vec<f64> = (0..4001).map(f64::from).collect();
+        let mut constant = Frame::new("run", "t", t.clone()).unwrap();
+        constant.push("x", t.iter().map(|t| t.sin()).collect()).unwrap();
+        constant.push("y", t.iter().map(|t| t.cos()).collect()).unwrap();
+        constant.push("z", vec![9.81; t.len()]).unwrap();
+        assert!(model.about_references(&[constant]).unwrap().1.is_none());
         // nothing to write anew
         assert!(model.about_references(&[run(3.0, ["x", "y", "z"])]).unwrap().1.is_none());
         let named = Outline { candidates: vec!["x".into(), "z".into()], ..lorenz() }.model("x").unwrap();
