@@ -72,6 +72,22 @@ mod tests {
         }
     }
 
+    /// Where they converge, the bounded decompositions are nalgebra's own to the last bit (the
+    /// same tolerances: a model identified through them is the file it was).
+    #[test]
+    fn bounded_decompositions_are_the_unbounded_ones() {
+        let a = DMatrix::from_fn(20, 5, |i, j| ((i * 7 + j * 3) as f64).sin() + 0.1 * (i * j) as f64);
+        let (mine, theirs) = (svd(a.clone()).unwrap(), a.clone().svd(true, true));
+        assert_eq!(mine.singular_values, theirs.singular_values);
+        assert_eq!(mine.u, theirs.u);
+        let s = a.transpose() * &a;
+        let (mine, theirs) = (symmetric_eigen(s.clone()).unwrap(), s.clone().symmetric_eigen());
+        assert_eq!(mine.eigenvalues, theirs.eigenvalues);
+        let square = DMatrix::from_fn(5, 5, |i, j| ((i * 5 + j) as f64).cos());
+        let mine = eigenvalues(square.clone()).unwrap();
+        assert_eq!(mine.as_slice(), square.complex_eigenvalues().as_slice());
+    }
+
     /// A matrix holding NaN (which no caller should pass, but a product of huge values makes)
     /// is no decomposition, not a loop without end or a panic.
     #[test]
