@@ -124,11 +124,12 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
         // the rows are a time series whose rates are taken: a glitch would be one
         crate::runs::mend_spikes(&mut frames)?;
     }
+    let late = cmd.delays.iter().map(|d| delay_of(d)).collect::<Result<Vec<_>>>()?;
     if let Target::Derivative(state) = &target {
-        // every column but the state may be an input held between samples; any column a slower
-        // sensor's readings; the state's leap a cut between runs joined in one file
+        // every column but the state may be an input held between samples (a late one judged
+        // as it acts); any column a slower sensor's readings; the state's leap a cut between
+        // runs joined in one file
         let intersample = cmd.intersample.unwrap_or_default();
-        let late = cmd.delays.iter().map(|d| delay_of(d)).collect::<Result<Vec<_>>>()?;
         let mut runs = Vec::new();
         for f in frames {
             let all: Vec<String> = f.names()[1..].to_vec();
@@ -139,12 +140,10 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
         }
         frames = runs;
     }
-    // after the marking (a late column judged as it acts): a held column is read back sample
-    // for sample
-    for d in &cmd.delays {
-        let (name, seconds) = delay_of(d)?;
+    // after the marking: a held column is read back sample for sample
+    for (name, seconds) in &late {
         for f in &mut frames {
-            *f = termid::data::delayed(f, name, seconds, 0.0)?;
+            *f = termid::data::delayed(f, name, *seconds, 0.0)?;
         }
     }
     match &target {
