@@ -70,8 +70,7 @@ pub fn mark_held_acting(
     let mut acting = frame.clone();
     for (name, seconds) in &late {
         let column = acting.require(name)?;
-        if super::held(column).is_some() || super::stepped(column).is_some() || super::white(column).is_some()
-        {
+        if super::staircase(column) {
             acting.hold(name)?;
         }
         match delayed(&acting, name, *seconds, longest) {

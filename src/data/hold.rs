@@ -143,6 +143,13 @@ fn sized(x: &[f64], at: Vec<usize>) -> Option<Hold> {
     })
 }
 
+/// Whether `x` changes only at its samples, as far as its record shows: held between jumps at
+/// isolated samples ([`held`]), stepped between random levels ([`stepped`]), or changed at every
+/// sample by as much as its spread ([`white`]); not a record that moves from sample to sample.
+pub fn staircase(x: &[f64]) -> bool {
+    held(x).is_some() || stepped(x).is_some() || white(x).is_some()
+}
+
 /// Lag-one autocorrelations within this of 0 read as white: a record that changes at every
 /// sample by as much as its spread, each change unforeseen by the last (a random excitation
 /// stepped each sample). A motion sampled at its rate correlates near 1; a sine needs fewer

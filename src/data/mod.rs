@@ -47,7 +47,7 @@ pub use derivative::{
 };
 pub use five_point::FivePoint;
 pub use geodetic::{north_east, radii_of_curvature};
-pub use hold::{held, mark_held, stepped, switches, white, Hold, Intersample};
+pub use hold::{held, mark_held, staircase, stepped, switches, white, Hold, Intersample};
 pub use in_si::{time_in_seconds, units_note};
 pub use integral::{integral_rows, integral_rows_held, row_overlap, IntegralForm};
 pub use ito::{first_stage, Ito};

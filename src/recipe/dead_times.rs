@@ -6,7 +6,7 @@
 //! equations are kept where they fail no check the recorded ones pass; either way it is said.
 
 use super::{retrace, Recipe, RecipeError};
-use crate::data::{held, stepped, white, Frame};
+use crate::data::{staircase, Frame};
 use crate::identify::Lag;
 use crate::model::Model;
 
@@ -44,7 +44,7 @@ fn reread(frames: &[Frame], late: &[String]) -> Result<(Vec<Frame>, Rereads), cr
     for name in late.iter().map(String::as_str) {
         for frame in &mut out {
             let Some(column) = frame.column(name) else { continue };
-            let smooth = held(column).is_none() && stepped(column).is_none() && white(column).is_none();
+            let smooth = !staircase(column);
             let how = match (smooth, frame.is_held(name), frame.is_switched(name)) {
                 (true, true, _) => Reread::AsALine,
                 (false, _, true) => Reread::AsHeld,
