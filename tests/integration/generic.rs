@@ -4363,3 +4363,35 @@ fn an_input_that_records_a_state_s_rate_is_said() {
     let (ok, out, err) = termid(&["identify", "--data", run, "--states", "x,v", "--inputs", "u"]);
     assert!(ok && !out.contains("alone explains"), "{out}{err}");
 }
+
+/// A predator-prey cycle whose predators' intake saturates (Rosenzweig-MacArthur,
+/// ẋ = x(1 − x/3) − xy/(1 + 0.8x), ẏ = 0.6xy/(1 + 0.8x) − 0.25y), recorded noise-free for
+/// 200 s: the cubic library stands in for the rational rates with ten terms per equation whose
+/// cycle grows (simulated on, they ran off to 10¹⁰² at 290 s), followed 24 s of the run, their
+/// own motion lost after 47 s as chaos loses itself, and every check read "ok". Chaos stays on
+/// its attractor: continued beyond the run, these equations run away, and it is flagged.
+#[test]
+fn a_stand_in_whose_cycle_runs_away_beyond_its_run_is_no_chaos() {
+    use crate::common::{trajectory, Scratch};
+    let dir = Scratch::new("saturating-intake");
+    let rows = trajectory(&[1.0, 0.5], 0.05, 4001, 10, |_, s| {
+        let intake = s[0] * s[1] / (1.0 + 0.8 * s[0]);
+        vec![s[0] * (1.0 - s[0] / 3.0) - intake, 0.6 * intake - 0.25 * s[1]]
+    });
+    let path = dir.join("cycle.csv");
+    let mut text = String::from("t,x,y\n");
+    for (i, r) in rows.iter().enumerate() {
+        text += &format!("{},{},{}\n", i as f64 * 0.05, r[0], r[1]);
+    }
+    std::fs::write(&path, text).unwrap();
+    let (ok, out, err) =
+        termid(&["identify", "--data", path.to_str().unwrap(), "--states", "x,y", "--format", "json"]);
+    assert!(ok, "{err}");
+    let report = crate::common::json(&out);
+    let missed = crate::common::check_named(&report, "as long as their own motion allows");
+    assert_eq!(missed["passed"], false, "{missed}");
+    assert!(
+        missed["detail"].as_str().unwrap().contains("as a chaotic motion's does, but no chaos runs away"),
+        "{missed}"
+    );
+}
