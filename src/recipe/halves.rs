@@ -276,7 +276,10 @@ fn verdict(identified: &IdentifiedModel, halving: Halving, halves: [Chosen; 2], 
 /// half keeps them, where the default would turn to the integral form's on a half too short
 /// for four windows and the halves would choose by another method than the whole. `None`:
 /// the halves take `differentiator` as it is.
-fn windows_kept(differentiator: &dyn crate::data::Differentiator, frames: &[Frame]) -> Option<WeakForm> {
+pub(super) fn windows_kept(
+    differentiator: &dyn crate::data::Differentiator,
+    frames: &[Frame],
+) -> Option<WeakForm> {
     // (a run with switches may have taken the integral form's windows whole: the halves then
     // take the default as it is, and decide as the whole did)
     let whole = differentiator

@@ -5,13 +5,14 @@
 //! input's), the laws' equations are kept where they pass every check the polynomials'
 //! failed, in no more terms; either way it is said.
 
-use super::{halves, retrace, Recipe};
+use super::{agreement, halves, retrace, Recipe};
 use crate::model::Model;
 use crate::term::Atom;
 
 /// The checks whose failure a stand-in shows: its terms differ between the halves of the runs,
-/// or it re-simulates them no closer than a model off the motion.
-const STAND_IN: [&str; 3] = [halves::NAME, retrace::MISSED_NAME, retrace::CLOSE_NAME];
+/// it re-simulates them no closer than a model off the motion, or runs over other ranges give
+/// its coefficients apart (a cubic's for a pendulum's sine).
+const STAND_IN: [&str; 4] = [halves::NAME, retrace::MISSED_NAME, retrace::CLOSE_NAME, agreement::NAME];
 
 /// `model` (settled about its reference values) with each state and input of its polynomial
 /// library's `outline` given its laws as candidates of every identified equation, and those

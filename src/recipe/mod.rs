@@ -5,6 +5,7 @@
 //! best; and, where the plausible starts disagree on a manoeuvre the runs did not cover, a flag
 //! saying that prediction is uncertain.
 
+mod agreement;
 mod dead_times;
 mod force;
 mod halves;
@@ -345,8 +346,9 @@ pub fn identify(
 }
 
 /// The checks of a system of no field's identified from `frames` by `how`: that its equations
-/// retrace the runs without running away, that its terms hold on each half of them, and that
-/// the records' noise leaves them unbiased.
+/// retrace the runs without running away, that its terms hold on each half of them, that
+/// the records' noise leaves them unbiased, and where there are several runs, that each gives
+/// their coefficients alike.
 pub fn system_checks(
     identified: &crate::identify::IdentifiedModel,
     frames: &[Frame],
@@ -358,6 +360,7 @@ pub fn system_checks(
         .into_iter()
         .chain([halves_check(identified, frames, how, noise::quiet(&tallies))])
         .chain(noise::noise_check_of(&tallies))
+        .chain(agreement::agreement_check(identified, frames, how))
         .collect()
 }
 

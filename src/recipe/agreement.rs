@@ -1,0 +1,196 @@
+//! Whether the runs tell one system: each run identified alone with the terms all the rows
+//! chose, and their coefficients compared. Runs made under different conditions (a load, a
+//! speed, a temperature changed between them) are fitted by all the rows as a compromise that
+//! fits none, and the other checks then say only that the equations miss their runs.
+
+use crate::data::Frame;
+use crate::identify::{identify_model, IdentifiedModel, ModelIdentification};
+use crate::plugin::Check;
+
+/// The check's name.
+pub(super) const NAME: &str = "the runs tell one system";
+
+/// How many honest standard errors (the residuals' correlation counted) two runs' estimates
+/// of a coefficient must be apart to disagree: beyond chance by far (10⁻⁶ for Gaussian
+/// errors), so that a bias the rows' noise makes, which the errors do not count, is not taken
+/// for a change.
+const APART: f64 = 5.0;
+
+/// How far apart, as a share of the larger, two runs' estimates of a coefficient must be to
+/// disagree besides: the bias noise in the states makes (errors in variables) differs with
+/// each run's excitation by a few percent at 1 % noise.
+const SHARE: f64 = 0.1;
+
+/// The fewest rows of a run identified alone.
+const FEWEST_ROWS: usize = 50;
+
+/// A run's estimates: its origin, and each coefficient's equation, term, estimate and honest
+/// standard error.
+type Estimates = (String, Vec<(String, String, f64, f64)>);
+
+/// One coefficient's estimates from two runs that differ most: the equation, the term, and
+/// each run's origin, estimate and honest standard error; with how many standard errors
+/// apart they are.
+struct Apart {
+    equation: String,
+    term: String,
+    runs: [(String, f64, f64); 2],
+    apart: f64,
+}
+
+/// The check that each of two or more runs (of [`FEWEST_ROWS`] at least) identified alone with
+/// the terms of `identified` (each equation's chosen terms forced, its other candidates
+/// excluded) gives each coefficient within [`APART`] honest standard errors or [`SHARE`] of
+/// the other runs': flagged (not refusing) where two runs' estimates differ by both, naming the
+/// coefficient and the two runs. `None` with fewer runs, or where no run can be identified alone.
+pub(super) fn agreement_check(
+    identified: &IdentifiedModel,
+    frames: &[Frame],
+    how: &ModelIdentification<'_>,
+) -> Option<Check> {
+    let runs: Vec<&Frame> = frames.iter().filter(|f| f.len() >= FEWEST_ROWS).collect();
+    if runs.len() < 2 || identified.fits.is_empty() {
+        return None;
+    }
+    let forced = identified
+        .model
+        .edit(|file| {
+            for (name, fit) in &identified.fits {
+                let Some(e) = file.equations.get_mut(name) else { continue };
+                let terms: Vec<String> = fit.selection.terms.iter().map(|t| t.term.clone()).collect();
+                e.excluded = fit.candidates.iter().filter(|c| !terms.contains(c)).cloned().collect();
+                e.forced = terms;
+            }
+        })
+        .ok()?;
+    let kept = super::halves::windows_kept(how.differentiator, frames);
+    let how = ModelIdentification {
+        differentiator: kept.as_ref().map_or(how.differentiator, |k| k as &dyn crate::data::Differentiator),
+        equations: how.equations.clone(),
+        target: how.target.clone(),
+        ..*how
+    };
+    let alone: Vec<Estimates> = runs
+        .iter()
+        .filter_map(|run| {
+            let found = identify_model(&forced, std::slice::from_ref(*run), &how, &mut |_| {}).ok()?;
+            let estimates = found
+                .fits
+                .iter()
+                .flat_map(|(name, fit)| {
+                    let honest = fit.correlation_time.unwrap_or(1.0).max(1.0).sqrt();
+                    fit.selection
+                        .terms
+                        .iter()
+                        .map(move |t| (name.clone(), t.term.clone(), t.coefficient, t.std_error * honest))
+                })
+                .collect();
+            Some((run.origin().to_string(), estimates))
+        })
+        .collect();
+    if alone.len() < 2 {
+        return None;
+    }
+    let mut worst: Option<Apart> = None;
+    for (i, (a, of_a)) in alone.iter().enumerate() {
+        for (b, of_b) in &alone[i + 1..] {
+            for (equation, term, x, sx) in of_a {
+                let Some((_, _, y, sy)) = of_b.iter().find(|(e, t, _, _)| e == equation && t == term) else {
+                    continue;
+                };
+                let apart = (x - y).abs() / (sx * sx + sy * sy).sqrt();
+                let far = (x - y).abs() > SHARE * x.abs().max(y.abs());
+                if far && apart.is_finite() && worst.as_ref().is_none_or(|w| apart > w.apart) {
+                    worst = Some(Apart {
+                        equation: equation.clone(),
+                        term: term.clone(),
+                        runs: [(a.clone(), *x, *sx), (b.clone(), *y, *sy)],
+                        apart,
+                    });
+                }
+            }
+        }
+    }
+    let check = |passed: bool, detail: String| Check {
+        name: NAME.into(),
+        passed,
+        refuses: false,
+        detail,
+        measure: None,
+    };
+    let sig = |v: f64| crate::output::sig(v, 3);
+    Some(match worst.filter(|w| w.apart > APART) {
+        Some(Apart { equation, term, runs: [(a, x, sx), (b, y, sy)], apart }) => check(
+            false,
+            format!(
+                "identified alone with the terms all the rows chose, the runs disagree: `{equation}`'s `{term}` is {} (± {}) from {a} and {} (± {}) from {b}, {} standard errors apart (honest ones, the residuals' correlation counted): a parameter that changed between the runs (a load, a speed, a temperature), or terms standing in for a law the candidates lack over ranges the runs cover differently; the equations of all the rows are a compromise between them: identify the runs apart, or record what changed as an input",
+                sig(x),
+                sig(sx),
+                sig(y),
+                sig(sy),
+                sig(apart)
+            ),
+        ),
+        None => check(
+            true,
+            format!(
+                "{} runs identified alone with the terms all the rows chose give each coefficient within {APART} honest standard errors or {} % of the others'",
+                alone.len(),
+                100.0 * SHARE
+            ),
+        ),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::Model;
+
+    /// ẋ = −a·x + u under u = sin t from rest, in closed form: x = (a sin t − cos t + e^(−at))
+    /// / (a² + 1), sampled every 0.05 s for 30 s.
+    fn lag(name: &str, a: f64) -> Frame {
+        let t: Vec<f64> = (0..600).map(|k| k as f64 * 0.05).collect();
+        let mut f = Frame::new(name, "t", t.clone()).unwrap();
+        let x = t.iter().map(|&t| (a * t.sin() - t.cos() + (-a * t).exp()) / (a * a + 1.0)).collect();
+        f.push("x", x).unwrap();
+        f.push("u", t.iter().map(|t| t.sin()).collect()).unwrap();
+        f
+    }
+
+    /// Two runs of ẋ = −x/2 + u agree; a run of ẋ = −3x/2 + u beside one of them (its lag
+    /// changed between the runs) is flagged, naming `x`'s two estimates (−0.5 and −1.5) and
+    /// the runs.
+    #[test]
+    fn runs_of_two_systems_are_told_apart() {
+        let model = Model::parse(
+            "[model]\nname = \"lag\"\nintercept = false\n[[states]]\nname = \"x\"\n[[inputs]]\nname = \"u\"\n\
+             [equations.x_dot]\nstate = \"x\"\ncandidates = [\"x\", \"u\", \"x^2\"]\n",
+            "lag.toml",
+        )
+        .unwrap();
+        let diff = super::super::derivative_method("integral").unwrap();
+        let how = ModelIdentification {
+            equations: vec![],
+            differentiator: diff.as_ref(),
+            intercept: false,
+            target: None,
+        };
+        let check = |frames: &[Frame]| {
+            let identified = identify_model(&model, frames, &how, &mut |_| {}).unwrap();
+            agreement_check(&identified, frames, &how)
+        };
+        let one = check(&[lag("a.csv", 0.5), lag("b.csv", 0.5).slice(100..600)]).unwrap();
+        assert!(one.passed && one.detail.starts_with("2 runs identified alone"), "{}", one.detail);
+        let two = check(&[lag("a.csv", 0.5), lag("b.csv", 1.5)]).unwrap();
+        assert!(!two.passed && !two.refuses, "{}", two.detail);
+        assert!(
+            two.detail.contains("`x_dot`'s `x` is -0.500 (± ")
+                && two.detail.contains(") from a.csv and -1.50 (± ")
+                && two.detail.contains(") from b.csv"),
+            "{}",
+            two.detail
+        );
+        assert!(check(&[lag("a.csv", 0.5)]).is_none());
+    }
+}
