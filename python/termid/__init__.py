@@ -1273,8 +1273,9 @@ class Identified:
     (name, passed, refuses, detail): that the equations retrace the runs without running away,
     and how long they follow them, that they follow them as long as their own motion from a
     nudged start follows itself (and within the records' noise where it follows itself
-    throughout), that their terms hold on each half of the runs, and that the
-    runs' noise leaves them unbiased (a ship's are :meth:`Model.checks`). Where the equations
+    throughout), that their terms hold on each half of the runs, that the
+    runs' noise leaves them unbiased, and with several runs, that each alone gives the
+    coefficients alike (a ship's are :meth:`Model.checks`). Where the equations
     lose their runs, their terms are chosen again by re-simulation, as :meth:`notes` says.
 
     >>> lorenz = termid.Model.builtin("lorenz")

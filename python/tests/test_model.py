@@ -1563,3 +1563,24 @@ def test_a_sensor_pinned_at_the_end_of_its_range_is_cut_around():
     assert sorted(v.index) == ["u", "v", "x"]
     assert v["x"] == pytest.approx(-4.0, rel=0.01) and v["v"] == pytest.approx(-0.4, rel=0.02)
     assert v["u"] == pytest.approx(2.0, rel=0.01)
+
+
+def test_runs_of_two_systems_are_said_to_disagree():
+    # ẋ = −a·x + u under u = sin t from rest, in closed form; a lag of 0.5 in one run and 1.5
+    # in the other (a parameter that changed between them): all the rows fit a compromise,
+    # each run alone tells its own, and the check names both
+    t = np.arange(600) * 0.05
+
+    def lag(a):
+        x = (a * np.sin(t) - np.cos(t) + np.exp(-a * t)) / (a * a + 1.0)
+        return pd.DataFrame({"t": t, "x": x, "u": np.sin(t)})
+
+    model = termid.Model.from_states(["x"], ["u"])
+    with pytest.warns(UserWarning, match="FLAG the runs tell one system"):
+        found = model.identify([lag(0.5), lag(1.5)])
+    apart = found.checks.set_index("name").loc["the runs tell one system"]
+    assert not apart["passed"] and not apart["refuses"]
+    assert "`x_dot`'s `x` is -0.500 (± " in apart["detail"] and "and -1.50 (± " in apart["detail"]
+    # two runs of one system agree
+    found = model.identify([lag(0.5), lag(0.5).iloc[100:]])
+    assert found.checks.set_index("name").loc["the runs tell one system"]["passed"]
