@@ -146,7 +146,7 @@ pub enum DataError {
         column: String,
     },
     /// A cell is not a number.
-    #[error("{file}: row {row}, column `{column}`: {}", if cell.trim().is_empty() || cell == "null" { NO_READING.to_string() } else { format!("`{cell}` is not a number") })]
+    #[error("{file}: row {row}, column `{column}`: {}", not_a_number(cell))]
     NotNumeric {
         /// The file.
         file: String,
@@ -326,6 +326,24 @@ pub fn looks_like_time(name: &str) -> bool {
             || n.starts_with(&format!("{w}_"))
             || n.starts_with(&format!("{w}["))
     }) || seconds_per(name).is_some()
+}
+
+/// What a cell that gave no number is said to be: no reading (empty, `null`), a number beyond
+/// the range of a double (`1e400`, which reads as infinite), or not a number.
+fn not_a_number(cell: &str) -> String {
+    if cell.trim().is_empty() || cell == "null" {
+        NO_READING.to_string()
+    } else if overflows(cell) {
+        format!("`{cell}` is beyond the largest number a double holds (1.8e308)")
+    } else {
+        format!("`{cell}` is not a number")
+    }
+}
+
+/// Whether a cell's text is digits whose number lies beyond the range of a double (`1e400`,
+/// read as infinite), not an infinity spelled out (`inf`).
+pub(crate) fn overflows(cell: &str) -> bool {
+    cell.bytes().any(|b| b.is_ascii_digit()) && cell.trim().parse::<f64>().is_ok_and(f64::is_infinite)
 }
 
 impl DataError {

@@ -472,12 +472,17 @@ impl RowSource for CsvRows<'_> {
             }
             for (k, &c) in self.keep.iter().enumerate() {
                 let cell = &self.record[c];
-                let v = number(cell, self.decimal_commas).ok_or_else(|| DataError::NotNumeric {
+                let not_numeric = || DataError::NotNumeric {
                     file: self.origin.clone(),
                     row: self.row,
                     column: self.names[k].clone(),
                     cell: String::from_utf8_lossy(cell.trim_ascii()).into(),
-                })?;
+                };
+                let v = number(cell, self.decimal_commas).ok_or_else(not_numeric)?;
+                // digits beyond a double's range read as infinite: said as written (`1e400`)
+                if v.is_infinite() && super::overflows(&String::from_utf8_lossy(cell)) {
+                    return Err(not_numeric());
+                }
                 columns[k].push(match &mut self.midnights[k] {
                     Some(clock) => clock.read_on(v),
                     None => v,
@@ -663,6 +668,14 @@ mod tests {
         let text: &'static str = Box::leak(lines.join("\n").into_boxed_str());
         let e = chunks(text, 50, 2).find_map(Result::err).unwrap().to_string();
         assert!(e.starts_with("a.csv: row 303, column `x`") && e.contains("not finite"), "{e}");
+        // digits beyond a double's range are said as written, not as the infinity they read as
+        lines[303] = format!("{time},-1e400");
+        let text: &'static str = Box::leak(lines.join("\n").into_boxed_str());
+        let e = chunks(text, 50, 2).find_map(Result::err).unwrap().to_string();
+        assert!(
+            e.starts_with("a.csv: row 303, column `x`: `-1e400` is beyond the largest number a double holds"),
+            "{e}"
+        );
         let e = chunks("t,x\n0,1\n0,2\n", 50, 2).find_map(Result::err).unwrap().to_string();
         assert!(e.contains("row 2") && e.contains("does not increase"), "{e}");
         assert!(matches!(chunks("t,x\n", 50, 2).next(), Some(Err(DataError::Empty { .. }))));
