@@ -39,8 +39,8 @@ struct Apart {
 }
 
 /// The check that each of two or more runs (of [`FEWEST_ROWS`] at least) identified alone with
-/// the terms of `identified` (each equation's chosen terms forced, its other candidates
-/// excluded) gives each coefficient within [`APART`] honest standard errors or [`SHARE`] of
+/// the terms of `identified` (each equation's chosen terms forced, but those of a variable the
+/// run holds constant, its other candidates excluded) gives each coefficient within [`APART`] honest standard errors or [`SHARE`] of
 /// the other runs': flagged (not refusing) where two runs' estimates differ by both, naming the
 /// coefficient and the two runs. `None` with fewer runs, or where no run can be identified alone.
 pub(super) fn agreement_check(
@@ -52,17 +52,22 @@ pub(super) fn agreement_check(
     if runs.len() < 2 || identified.fits.is_empty() {
         return None;
     }
-    let forced = identified
-        .model
-        .edit(|file| {
+    // each run's model: the chosen terms forced, but those of a variable the run holds
+    // constant (a free decay beside a forced run: its input 0 throughout), which it cannot tell
+    let vocabulary = &identified.model.vocabulary;
+    let forced = |run: &Frame| {
+        let moves = |name: &String| run.column(name).is_none_or(|x| x.iter().any(|v| *v != x[0]));
+        let told = |term: &String| vocabulary.parse(term).is_ok_and(|t| t.variables().iter().all(moves));
+        identified.model.edit(|file| {
             for (name, fit) in &identified.fits {
                 let Some(e) = file.equations.get_mut(name) else { continue };
-                let terms: Vec<String> = fit.selection.terms.iter().map(|t| t.term.clone()).collect();
+                let terms: Vec<String> =
+                    fit.selection.terms.iter().map(|t| t.term.clone()).filter(told).collect();
                 e.excluded = fit.candidates.iter().filter(|c| !terms.contains(c)).cloned().collect();
                 e.forced = terms;
             }
         })
-        .ok()?;
+    };
     let kept = super::halves::windows_kept(how.differentiator, frames);
     let how = ModelIdentification {
         differentiator: kept.as_ref().map_or(how.differentiator, |k| k as &dyn crate::data::Differentiator),
@@ -73,7 +78,8 @@ pub(super) fn agreement_check(
     let alone: Vec<Estimates> = runs
         .iter()
         .filter_map(|run| {
-            let found = identify_model(&forced, std::slice::from_ref(*run), &how, &mut |_| {}).ok()?;
+            let model = forced(run).ok()?;
+            let found = identify_model(&model, std::slice::from_ref(*run), &how, &mut |_| {}).ok()?;
             let estimates = found
                 .fits
                 .iter()
@@ -160,7 +166,7 @@ mod tests {
 
     /// Two runs of ẋ = −x/2 + u agree; a run of ẋ = −3x/2 + u beside one of them (its lag
     /// changed between the runs) is flagged, naming `x`'s two estimates (−0.5 and −1.5) and
-    /// the runs.
+    /// the runs; so is a free decay of the other lag beside the driven run.
     #[test]
     fn runs_of_two_systems_are_told_apart() {
         let model = Model::parse(
@@ -192,5 +198,22 @@ mod tests {
             two.detail
         );
         assert!(check(&[lag("a.csv", 0.5)]).is_none());
+        // a free decay (u = 0 throughout, x = e^(−at)) beside the driven run: its `u` cannot be
+        // told, its lag can (the run was left out, and nothing said)
+        let decay = |a: f64| {
+            let t: Vec<f64> = (0..200).map(|k| k as f64 * 0.05).collect();
+            let mut f = Frame::new("decay.csv", "t", t.clone()).unwrap();
+            f.push("x", t.iter().map(|&t| (-a * t).exp()).collect()).unwrap();
+            f.push("u", vec![0.0; t.len()]).unwrap();
+            f
+        };
+        let same = check(&[lag("a.csv", 0.5), decay(0.5)]).unwrap();
+        assert!(same.passed, "{}", same.detail);
+        let other = check(&[lag("a.csv", 0.5), decay(1.5)]).unwrap();
+        assert!(
+            !other.passed && other.detail.contains("-1.50 (± ") && other.detail.contains("from decay.csv"),
+            "{}",
+            other.detail
+        );
     }
 }
