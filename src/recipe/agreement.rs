@@ -69,12 +69,7 @@ pub(super) fn agreement_check(
         })
     };
     let kept = super::halves::windows_kept(how.differentiator, frames);
-    let how = ModelIdentification {
-        differentiator: kept.as_ref().map_or(how.differentiator, |k| k as &dyn crate::data::Differentiator),
-        equations: how.equations.clone(),
-        target: how.target.clone(),
-        ..*how
-    };
+    let how = super::halves::keeping(how, &kept);
     let alone: Vec<Estimates> = runs
         .iter()
         .filter_map(|run| {
@@ -151,7 +146,6 @@ pub(super) fn agreement_check(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::Model;
 
     /// ẋ = −a·x + u under u = sin t from rest, in closed form: x = (a sin t − cos t + e^(−at))
     /// / (a² + 1), sampled every 0.05 s for 30 s.
@@ -169,12 +163,7 @@ mod tests {
     /// the runs; so is a free decay of the other lag beside the driven run.
     #[test]
     fn runs_of_two_systems_are_told_apart() {
-        let model = Model::parse(
-            "[model]\nname = \"lag\"\nintercept = false\n[[states]]\nname = \"x\"\n[[inputs]]\nname = \"u\"\n\
-             [equations.x_dot]\nstate = \"x\"\ncandidates = [\"x\", \"u\", \"x^2\"]\n",
-            "lag.toml",
-        )
-        .unwrap();
+        let model = super::super::lag_model();
         let diff = super::super::derivative_method("integral").unwrap();
         let how = ModelIdentification {
             equations: vec![],

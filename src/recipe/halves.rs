@@ -84,13 +84,7 @@ pub fn halves_check(
     }
     let model: &Model = &identified.model;
     let kept = windows_kept(how.differentiator, frames);
-    let how = ModelIdentification {
-        differentiator: kept.as_ref().map_or(how.differentiator, |k| k as &dyn crate::data::Differentiator),
-        equations: how.equations.clone(),
-        target: how.target.clone(),
-        ..*how
-    };
-    let how = &how;
+    let how = &keeping(how, &kept);
     let half = |cut: &[Frame]| identify_model(model, cut, how, &mut |_| {});
     // side by side: each half is one run's worth of work per run, which leaves a core idle
     let (first, second) = rayon::join(|| half(&halves[0]), || half(&halves[1]));
@@ -291,6 +285,20 @@ pub(super) fn windows_kept(
     }
 }
 
+/// `how` with the weak form's windows `kept` ([`windows_kept`]) where the whole runs took
+/// them: a part of the runs identified as the whole was.
+pub(super) fn keeping<'a>(
+    how: &ModelIdentification<'a>,
+    kept: &'a Option<WeakForm>,
+) -> ModelIdentification<'a> {
+    ModelIdentification {
+        differentiator: kept.as_ref().map_or(how.differentiator, |k| k as &dyn crate::data::Differentiator),
+        equations: how.equations.clone(),
+        target: how.target.clone(),
+        ..*how
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -300,12 +308,7 @@ mod tests {
     /// excite it), and the check names it.
     #[test]
     fn a_term_one_half_does_not_choose_is_named() {
-        let model = Model::parse(
-            "[model]\nname = \"lag\"\nintercept = false\n[[states]]\nname = \"x\"\n[[inputs]]\nname = \"u\"\n\
-             [equations.x_dot]\nstate = \"x\"\ncandidates = [\"x\", \"u\", \"x^2\"]\n",
-            "lag.toml",
-        )
-        .unwrap();
+        let model = super::super::lag_model();
         // exact samples of ẋ = −x + u under u = sin(0.7 t) (+ a step), by fine Euler steps
         let run = |u: &dyn Fn(f64) -> f64| {
             let (dt, fine) = (0.05, 200);

@@ -345,6 +345,18 @@ pub fn identify(
     })
 }
 
+/// The tests' model of one state and one input: ẋ of candidates x, u and x² (a first-order
+/// lag's, with one term it lacks).
+#[cfg(test)]
+fn lag_model() -> Model {
+    Model::parse(
+        "[model]\nname = \"lag\"\nintercept = false\n[[states]]\nname = \"x\"\n[[inputs]]\nname = \"u\"\n\
+         [equations.x_dot]\nstate = \"x\"\ncandidates = [\"x\", \"u\", \"x^2\"]\n",
+        "lag.toml",
+    )
+    .unwrap()
+}
+
 /// The checks of a system of no field's identified from `frames` by `how`: that its equations
 /// retrace the runs without running away, that its terms hold on each half of them, that
 /// the records' noise leaves them unbiased, and where there are several runs, that each gives

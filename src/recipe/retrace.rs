@@ -405,8 +405,9 @@ fn retrace_check(
             let (lo, hi) =
                 recorded.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
             let span = (hi - lo).max(f64::EPSILON * hi.abs().max(lo.abs()).max(1.0));
-            spans.push((name.clone(), span));
-            let away = values.iter().position(|v| !(*v >= lo - REACH * span && *v <= hi + REACH * span));
+            let extent = Extent { name: name.clone(), lo, hi, span };
+            let away = values.iter().position(|&v| extent.left(v));
+            spans.push(extent);
             if let Some(k) = away {
                 return Some(check(
                     false,
@@ -503,6 +504,23 @@ fn retrace_check(
     ))
 }
 
+/// A state's range in a run: its lowest and highest value, and its span (at least the
+/// round-off of its size).
+struct Extent {
+    name: String,
+    lo: f64,
+    hi: f64,
+    span: f64,
+}
+
+impl Extent {
+    /// Whether `value` lies beyond [`REACH`] spans of the range (or is not a number): the
+    /// equations ran away.
+    fn left(&self, value: f64) -> bool {
+        !(value >= self.lo - REACH * self.span && value <= self.hi + REACH * self.span)
+    }
+}
+
 /// How much wider a state's range over the second half of a run may be than over its first
 /// for the run to be said not to grow: a chaotic record's halves differ by chance (the ODE
 /// benchmark's records of 40 characteristic periods, noise-free: up to 1.42 times,
@@ -536,7 +554,7 @@ fn beyond(
     run: &Frame,
     step: f64,
     sim: &crate::sim::Trajectory,
-    spans: &[(String, f64)],
+    spans: &[Extent],
 ) -> Option<String> {
     let mut from_end = run.clone();
     for (name, values) in sim.state_names.iter().zip(&sim.states) {
@@ -555,19 +573,14 @@ fn beyond(
         }
     };
     for (name, values) in on.state_names.iter().zip(&on.states) {
-        let (Some(recorded), Some((_, span))) = (run.column(name), spans.iter().find(|(n, _)| n == name))
-        else {
-            continue;
-        };
-        let (lo, hi) =
-            recorded.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
-        if let Some(k) = values.iter().position(|v| !(*v >= lo - REACH * span && *v <= hi + REACH * span)) {
+        let Some(extent) = spans.iter().find(|e| e.name == *name) else { continue };
+        if let Some(k) = values.iter().position(|&v| extent.left(v)) {
             return Some(format!(
                 "`{name}` reaches {} at t = {} s where the run keeps within {} … {}",
                 crate::identify::num(values[k]),
                 on_clock(on.time[k] - on.time[0]),
-                crate::identify::num(lo),
-                crate::identify::num(hi)
+                crate::identify::num(extent.lo),
+                crate::identify::num(extent.hi)
             ));
         }
     }
@@ -708,7 +721,7 @@ fn own_motion(
     run: &Frame,
     step: f64,
     sim: &crate::sim::Trajectory,
-    spans: &[(String, f64)],
+    spans: &[Extent],
 ) -> Result<(f64, &'static str), String> {
     let mut first = None;
     for (nudge, words) in NUDGES {
@@ -726,18 +739,18 @@ fn own_motion_from(
     run: &Frame,
     step: f64,
     sim: &crate::sim::Trajectory,
-    spans: &[(String, f64)],
+    spans: &[Extent],
     nudge: f64,
 ) -> Result<f64, String> {
     let mut nudged = run.clone();
-    for (name, span) in spans {
+    for Extent { name, span, .. } in spans {
         let Some(column) = nudged.column(name) else { continue };
         let moved: Vec<f64> = column.iter().map(|v| v + nudge * span).collect();
         nudged.overwrite(name, moved).map_err(|e| e.to_string())?;
     }
     let twin = replay(model, &nudged, step)?;
     let parts = sim.state_names.iter().zip(&sim.states).filter_map(|(name, values)| {
-        let (_, span) = spans.iter().find(|(n, _)| n == name)?;
+        let span = spans.iter().find(|e| e.name == *name)?.span;
         let other = twin.states.get(twin.state_names.iter().position(|n| n == name)?)?;
         // (a motion that cannot be told, NaN, is one that has left)
         values.iter().zip(other).position(|(a, b)| (a - b).abs() > FOLLOWED * span || (a - b).is_nan())
