@@ -1023,7 +1023,7 @@ def test_equations_that_run_away_from_a_coarse_run_are_chosen_again():
     x_dot = found.model.coefficients("x_dot").set_index("term")["value"]
     assert x_dot.to_dict() == pytest.approx({"x": 1.0, "x*z": -0.5}, rel=1e-3)
     # the check is kept with the fit, and asked of the model again with any runs
-    assert list(found.checks["passed"]) == [True] * 5 and found.checks["detail"][0].endswith("throughout")
+    assert list(found.checks["passed"]) == [True] * 6 and found.checks["detail"][0].endswith("throughout")
     # followed as long as its own motion from a nudged start follows itself, and within the
     # records' noise
     assert found.checks["name"][1] == "the equations follow their runs as long as their own motion allows"
@@ -1031,6 +1031,8 @@ def test_equations_that_run_away_from_a_coarse_run_are_chosen_again():
     assert found.checks["name"][3] == "the terms hold on each half of the runs"
     # noise-free: the records' noise is bounded far below the 2 % that biases the terms
     assert found.checks["name"][4] == "the records' noise leaves the terms unbiased"
+    # the run's halves, each identified alone with the terms, give them alike
+    assert found.checks["name"][5] == "the runs tell one system"
     again = found.model.checks(coarse)
     assert list(again["passed"])[:3] == [True, True, True]
     # ten samples a cycle: the motion shows through the fourth differences, whose bound is

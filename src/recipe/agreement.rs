@@ -38,20 +38,39 @@ struct Apart {
     apart: f64,
 }
 
-/// The check that each of two or more runs (of [`FEWEST_ROWS`] at least) identified alone with
-/// the terms of `identified` (each equation's chosen terms forced, but those of a variable the
-/// run holds constant, its other candidates excluded) gives each coefficient within [`APART`] honest standard errors or [`SHARE`] of
-/// the other runs': flagged (not refusing) where two runs' estimates differ by both, naming the
-/// coefficient and the two runs. `None` with fewer runs, or where no run can be identified alone.
+/// The check that each of two or more runs (of [`FEWEST_ROWS`] at least; of one run, its two
+/// halves: a system that drifts within it) identified alone with the terms of `identified`
+/// (each equation's chosen terms forced, but those of a variable the run holds constant, its
+/// other candidates excluded) gives each coefficient within [`APART`] honest standard errors or
+/// [`SHARE`] of the others': flagged (not refusing) where two estimates differ by both, naming
+/// the coefficient and the two runs. `None` with too few rows, or where fewer than two can be
+/// identified alone.
 pub(super) fn agreement_check(
     identified: &IdentifiedModel,
     frames: &[Frame],
     how: &ModelIdentification<'_>,
 ) -> Option<Check> {
-    let runs: Vec<&Frame> = frames.iter().filter(|f| f.len() >= FEWEST_ROWS).collect();
-    if runs.len() < 2 || identified.fits.is_empty() {
+    if identified.fits.is_empty() {
         return None;
     }
+    let long: Vec<&Frame> = frames.iter().filter(|f| f.len() >= FEWEST_ROWS).collect();
+    let halves;
+    let (runs, split): (Vec<(String, &Frame)>, Option<&str>) = match long.as_slice() {
+        [one] if frames.len() == 1 && one.len() >= 2 * FEWEST_ROWS => {
+            let middle = one.len() / 2;
+            halves = [one.slice(0..middle), one.slice(middle..one.len())];
+            let origin = one.origin();
+            (
+                vec![
+                    (format!("the first half of {origin}"), &halves[0]),
+                    (format!("the second half of {origin}"), &halves[1]),
+                ],
+                Some(origin),
+            )
+        }
+        [] | [_] => return None,
+        many => (many.iter().map(|f| (f.origin().to_string(), *f)).collect(), None),
+    };
     // each run's model: the chosen terms forced, but those of a variable the run holds
     // constant (a free decay beside a forced run: its input 0 throughout), which it cannot tell
     let vocabulary = &identified.model.vocabulary;
@@ -72,7 +91,7 @@ pub(super) fn agreement_check(
     let how = super::halves::keeping(how, &kept);
     let alone: Vec<Estimates> = runs
         .iter()
-        .filter_map(|run| {
+        .filter_map(|(origin, run)| {
             let model = forced(run).ok()?;
             let found = identify_model(&model, std::slice::from_ref(*run), &how, &mut |_| {}).ok()?;
             let estimates = found
@@ -86,7 +105,7 @@ pub(super) fn agreement_check(
                         .map(move |t| (name.clone(), t.term.clone(), t.coefficient, t.std_error * honest))
                 })
                 .collect();
-            Some((run.origin().to_string(), estimates))
+            Some((origin.clone(), estimates))
         })
         .collect();
     if alone.len() < 2 {
@@ -120,11 +139,21 @@ pub(super) fn agreement_check(
         measure: None,
     };
     let sig = |v: f64| crate::output::sig(v, 3);
+    let (which, changed) = match split {
+        Some(origin) => (
+            format!("the halves of {origin}"),
+            "a parameter that drifted within the run (a load, a temperature, a sensor's gain or zero)",
+        ),
+        None => (
+            "the runs".to_string(),
+            "a parameter that changed between the runs (a load, a speed, a temperature)",
+        ),
+    };
     Some(match worst.filter(|w| w.apart > APART) {
         Some(Apart { equation, term, runs: [(a, x, sx), (b, y, sy)], apart }) => check(
             false,
             format!(
-                "identified alone with the terms all the rows chose, the runs disagree: `{equation}`'s `{term}` is {} (± {}) from {a} and {} (± {}) from {b}, {} standard errors apart (honest ones, the residuals' correlation counted): a parameter that changed between the runs (a load, a speed, a temperature), or terms standing in for a law the candidates lack over ranges the runs cover differently; the equations of all the rows are a compromise between them: identify the runs apart, or record what changed as an input",
+                "identified alone with the terms all the rows chose, {which} disagree: `{equation}`'s `{term}` is {} (± {}) from {a} and {} (± {}) from {b}, {} standard errors apart (honest ones, the residuals' correlation counted): {changed}, terms standing in for a law the candidates lack over ranges the rows cover differently, or terms the rows hardly tell from others (a fast state that follows the others), which trade against each other; the equations of all the rows are a compromise between them: identify the parts apart, or record what changed as an input",
                 sig(x),
                 sig(sx),
                 sig(y),
@@ -135,8 +164,11 @@ pub(super) fn agreement_check(
         None => check(
             true,
             format!(
-                "{} runs identified alone with the terms all the rows chose give each coefficient within {APART} honest standard errors or {} % of the others'",
-                alone.len(),
+                "{} identified alone with the terms all the rows chose give each coefficient within {APART} honest standard errors or {} % of the others'",
+                match split {
+                    Some(_) => "the run's two halves".to_string(),
+                    None => format!("{} runs", alone.len()),
+                },
                 100.0 * SHARE
             ),
         ),
@@ -146,6 +178,55 @@ pub(super) fn agreement_check(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// One run of ẋ = −a·x + sin t whose lag steps from 0.5 to 1.5 at 15 s (a load changed in
+    /// the middle of a run), by fine Euler steps: its halves tell the two lags, −0.5 and −1.5;
+    /// the same run without the step agrees with itself.
+    #[test]
+    fn a_lag_that_changes_within_a_run_is_named() {
+        let run = |step: bool| {
+            let (dt, fine) = (0.05, 200);
+            let (mut x, mut t, mut ts, mut xs, mut us) = (0.0_f64, 0.0_f64, vec![], vec![], vec![]);
+            for _ in 0..600 {
+                ts.push(t);
+                xs.push(x);
+                us.push(t.sin());
+                for _ in 0..fine {
+                    let a = if step && t >= 15.0 { 1.5 } else { 0.5 };
+                    x += dt / fine as f64 * (-a * x + t.sin());
+                    t += dt / fine as f64;
+                }
+            }
+            let mut f = Frame::new("run.csv", "t", ts).unwrap();
+            f.push("x", xs).unwrap();
+            f.push("u", us).unwrap();
+            f
+        };
+        let model = super::super::lag_model();
+        let diff = super::super::derivative_method("integral").unwrap();
+        let how = ModelIdentification {
+            equations: vec![],
+            differentiator: diff.as_ref(),
+            intercept: false,
+            target: None,
+        };
+        let check = |frame: Frame| {
+            let frames = [frame];
+            let identified = identify_model(&model, &frames, &how, &mut |_| {}).unwrap();
+            agreement_check(&identified, &frames, &how).unwrap()
+        };
+        let steady = check(run(false));
+        assert!(steady.passed, "{}", steady.detail);
+        let stepped = check(run(true));
+        assert!(!stepped.passed, "{}", stepped.detail);
+        assert!(
+            stepped.detail.contains("the halves of run.csv disagree: `x_dot`'s `x` is -0.50")
+                && stepped.detail.contains("from the first half of run.csv and -1.5")
+                && stepped.detail.contains("a parameter that drifted within the run"),
+            "{}",
+            stepped.detail
+        );
+    }
 
     /// ẋ = −a·x + u under u = sin t from rest, in closed form: x = (a sin t − cos t + e^(−at))
     /// / (a² + 1), sampled every 0.05 s for 30 s.
@@ -186,7 +267,14 @@ mod tests {
             "{}",
             two.detail
         );
-        assert!(check(&[lag("a.csv", 0.5)]).is_none());
+        // one run: its halves agree
+        let halves = check(&[lag("a.csv", 0.5)]).unwrap();
+        assert!(
+            halves.passed && halves.detail.starts_with("the run's two halves identified alone"),
+            "{}",
+            halves.detail
+        );
+        assert!(check(&[lag("a.csv", 0.5).slice(0..99)]).is_none());
         // a free decay (u = 0 throughout, x = e^(−at)) beside the driven run: its `u` cannot be
         // told, its lag can (the run was left out, and nothing said)
         let decay = |a: f64| {

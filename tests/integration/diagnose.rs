@@ -477,8 +477,10 @@ fn each_run_is_diagnosed_with_its_own_nuisances() {
 /// cubic library, both follow their runs within a tenth of their spans (a viscous −0.40ẋ +
 /// 0.024ẋ³ for the friction, which never stops, and a cubic in h that drains below empty
 /// beyond the run); the friction's is off its noise-free run by 0.67 % of the rate's span,
-/// flagged (every check read "ok"), the tank's within its run by a millionth, ok. The
-/// diagnosis found "none of those tested". It now names the law, with its coefficient.
+/// flagged (every check read "ok"), the tank's within its run by a millionth, ok, but the
+/// run's halves give its stand-in's coefficients apart (its constant −0.0585 and −0.0507):
+/// flagged. The diagnosis found "none of those tested". It now names the law, with its
+/// coefficient.
 #[test]
 fn laws_beyond_a_polynomial_are_named_with_their_coefficients() {
     let dir = crate::common::Scratch::new("diagnose-laws");
@@ -500,9 +502,11 @@ fn laws_beyond_a_polynomial_are_named_with_their_coefficients() {
         tank += &format!("{t},{}\n", (2.0 - 0.05 * t).powi(2));
     }
     let off = "FLAG the equations re-simulate their runs within the records' noise";
-    for (name, text, states, law, want, flags) in [
-        ("friction", friction, "x,v", "`sign(v)` in v_dot, beyond the candidates", -0.5, 1),
-        ("tank", tank, "h", "`sqrt(abs(h))` in h_dot, beyond the candidates", -0.1, 0),
+    let apart =
+        "FLAG the runs tell one system: identified alone with the terms all the rows chose, the halves of ";
+    for (name, text, states, law, want, off) in [
+        ("friction", friction, "x,v", "`sign(v)` in v_dot, beyond the candidates", -0.5, off),
+        ("tank", tank, "h", "`sqrt(abs(h))` in h_dot, beyond the candidates", -0.1, apart),
     ] {
         let (data, model) = (dir.join(format!("{name}.csv")), dir.join(format!("{name}.toml")));
         std::fs::write(&data, text).unwrap();
@@ -518,7 +522,7 @@ fn laws_beyond_a_polynomial_are_named_with_their_coefficients() {
             "--no-laws",
         ]);
         assert!(
-            ok && out.matches("FLAG").count() == flags && out.matches(off).count() == flags,
+            ok && out.matches("FLAG").count() == 1 && out.matches(off).count() == 1,
             "{name}: {err}{out}"
         );
         let (ok, out, err) =
