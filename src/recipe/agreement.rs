@@ -185,22 +185,7 @@ mod tests {
     #[test]
     fn a_lag_that_changes_within_a_run_is_named() {
         let run = |step: bool| {
-            let (dt, fine) = (0.05, 200);
-            let (mut x, mut t, mut ts, mut xs, mut us) = (0.0_f64, 0.0_f64, vec![], vec![], vec![]);
-            for _ in 0..600 {
-                ts.push(t);
-                xs.push(x);
-                us.push(t.sin());
-                for _ in 0..fine {
-                    let a = if step && t >= 15.0 { 1.5 } else { 0.5 };
-                    x += dt / fine as f64 * (-a * x + t.sin());
-                    t += dt / fine as f64;
-                }
-            }
-            let mut f = Frame::new("run.csv", "t", ts).unwrap();
-            f.push("x", xs).unwrap();
-            f.push("u", us).unwrap();
-            f
+            super::super::lag_run(0.0, 600, &|t| if step && t >= 15.0 { 1.5 } else { 0.5 }, &f64::sin)
         };
         let model = super::super::lag_model();
         let diff = super::super::derivative_method("integral").unwrap();

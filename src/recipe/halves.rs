@@ -310,23 +310,7 @@ mod tests {
     fn a_term_one_half_does_not_choose_is_named() {
         let model = super::super::lag_model();
         // exact samples of ẋ = −x + u under u = sin(0.7 t) (+ a step), by fine Euler steps
-        let run = |u: &dyn Fn(f64) -> f64| {
-            let (dt, fine) = (0.05, 200);
-            let (mut x, mut t, mut ts, mut xs, mut us) = (0.5, 0.0, vec![], vec![], vec![]);
-            for _ in 0..400 {
-                ts.push(t);
-                xs.push(x);
-                us.push(u(t));
-                for _ in 0..fine {
-                    x += dt / fine as f64 * (-x + u(t));
-                    t += dt / fine as f64;
-                }
-            }
-            let mut f = Frame::new("run.csv", "t", ts).unwrap();
-            f.push("x", xs).unwrap();
-            f.push("u", us).unwrap();
-            f
-        };
+        let run = |u: &dyn Fn(f64) -> f64| super::super::lag_run(0.5, 400, &|_| 1.0, u);
         let diff = super::super::derivative_method("integral").unwrap();
         let how = ModelIdentification {
             equations: vec![],

@@ -345,6 +345,27 @@ pub fn identify(
     })
 }
 
+/// The tests' record of a lag ẋ = −a(t)·x + u(t) from `x0`, `samples` samples at 0.05 s,
+/// by fine Euler steps (200 a sample): `run.csv` of t, x and u.
+#[cfg(test)]
+fn lag_run(x0: f64, samples: usize, a: &dyn Fn(f64) -> f64, u: &dyn Fn(f64) -> f64) -> Frame {
+    let (dt, fine) = (0.05, 200);
+    let (mut x, mut t, mut ts, mut xs, mut us) = (x0, 0.0, vec![], vec![], vec![]);
+    for _ in 0..samples {
+        ts.push(t);
+        xs.push(x);
+        us.push(u(t));
+        for _ in 0..fine {
+            x += dt / fine as f64 * (-a(t) * x + u(t));
+            t += dt / fine as f64;
+        }
+    }
+    let mut f = Frame::new("run.csv", "t", ts).unwrap();
+    f.push("x", xs).unwrap();
+    f.push("u", us).unwrap();
+    f
+}
+
 /// The tests' model of one state and one input: ẋ of candidates x, u and x² (a first-order
 /// lag's, with one term it lacks).
 #[cfg(test)]
