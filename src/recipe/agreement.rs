@@ -179,14 +179,8 @@ pub(super) fn agreement_check(
 mod tests {
     use super::*;
 
-    /// One run of ẋ = −a·x + sin t whose lag steps from 0.5 to 1.5 at 15 s (a load changed in
-    /// the middle of a run), by fine Euler steps: its halves tell the two lags, −0.5 and −1.5;
-    /// the same run without the step agrees with itself.
-    #[test]
-    fn a_lag_that_changes_within_a_run_is_named() {
-        let run = |step: bool| {
-            super::super::lag_run(0.0, 600, &|t| if step && t >= 15.0 { 1.5 } else { 0.5 }, &f64::sin)
-        };
+    /// The agreement check of the tests' lag model identified from `frames` in the integral form.
+    fn agreement_of(frames: &[Frame]) -> Option<Check> {
         let model = super::super::lag_model();
         let diff = super::super::derivative_method("integral").unwrap();
         let how = ModelIdentification {
@@ -195,11 +189,19 @@ mod tests {
             intercept: false,
             target: None,
         };
-        let check = |frame: Frame| {
-            let frames = [frame];
-            let identified = identify_model(&model, &frames, &how, &mut |_| {}).unwrap();
-            agreement_check(&identified, &frames, &how).unwrap()
+        let identified = identify_model(&model, frames, &how, &mut |_| {}).unwrap();
+        agreement_check(&identified, frames, &how)
+    }
+
+    /// One run of ẋ = −a·x + sin t whose lag steps from 0.5 to 1.5 at 15 s (a load changed in
+    /// the middle of a run), by fine Euler steps: its halves tell the two lags, −0.5 and −1.5;
+    /// the same run without the step agrees with itself.
+    #[test]
+    fn a_lag_that_changes_within_a_run_is_named() {
+        let run = |step: bool| {
+            super::super::lag_run(0.0, 600, &|t| if step && t >= 15.0 { 1.5 } else { 0.5 }, &f64::sin)
         };
+        let check = |frame: Frame| agreement_of(&[frame]).unwrap();
         let steady = check(run(false));
         assert!(steady.passed, "{}", steady.detail);
         let stepped = check(run(true));
@@ -229,18 +231,7 @@ mod tests {
     /// the runs; so is a free decay of the other lag beside the driven run.
     #[test]
     fn runs_of_two_systems_are_told_apart() {
-        let model = super::super::lag_model();
-        let diff = super::super::derivative_method("integral").unwrap();
-        let how = ModelIdentification {
-            equations: vec![],
-            differentiator: diff.as_ref(),
-            intercept: false,
-            target: None,
-        };
-        let check = |frames: &[Frame]| {
-            let identified = identify_model(&model, frames, &how, &mut |_| {}).unwrap();
-            agreement_check(&identified, frames, &how)
-        };
+        let check = agreement_of;
         let one = check(&[lag("a.csv", 0.5), lag("b.csv", 0.5).slice(100..600)]).unwrap();
         assert!(one.passed && one.detail.starts_with("2 runs identified alone"), "{}", one.detail);
         let two = check(&[lag("a.csv", 0.5), lag("b.csv", 1.5)]).unwrap();
