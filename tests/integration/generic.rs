@@ -2771,8 +2771,15 @@ fn noise_that_biases_the_terms_is_measured_and_said() {
     assert!(noise["passed"] == false && detail.contains("white noise of `x` "), "{noise}");
     assert!((share_of(detail, "z") - 5.0).abs() < 0.5, "{detail}");
     // re-simulated from the run as kept: central differences of 5 % noise leave equations that
-    // run away (refused, but for --keep-unphysical)
-    assert!(check_named(&report, "retrace their runs")["passed"] == false, "{report}");
+    // run away (refused, but for --keep-unphysical), from the run's start or, where a CPU's
+    // rounding keeps that one bounded, from a start a hundredth of each span off (which the
+    // true equations of some chaos do too: said, not flagged)
+    let retrace = check_named(&report, "retrace their runs");
+    let own = check_named(&report, "as long as their own motion allows");
+    assert!(
+        retrace["passed"] == false || own["detail"].as_str().unwrap().contains("cannot be simulated"),
+        "{report}"
+    );
     let moments = dir.join("y.json").display().to_string();
     let (ok, _, err) = termid(
         &[
