@@ -1415,6 +1415,34 @@ def test_a_law_the_polynomials_stand_in_for_is_found_by_the_recipe():
     assert "FLAG the equations follow their runs" in cubic.text
 
 
+def test_a_rate_that_saturates_is_found_with_its_constant_by_the_recipe():
+    # an enzyme's turnover under a stepped feed, x' = u - 2x/(0.5 + x), noise-free: the cubic
+    # library stands in, flagged, the four laws no better; x is positive in every row, so its
+    # saturating forms are tried with K scanned, and x/(x + 0.5) is found, every check ok
+    dt, n = 0.05, 4001
+    feed = lambda t: [0.6, 1.2, 0.3, 1.5, 0.9, 0.45, 1.3, 0.7][int(t // 25.0) % 8]
+    x, t, rows = 0.3, 0.0, []
+    for k in range(n):
+        rows.append(x)
+        for _ in range(20):
+            h = dt / 20
+            rate = lambda x, t: feed(t) - 2.0 * x / (0.5 + x)
+            k1 = rate(x, t); k2 = rate(x + 0.5 * h * k1, t + 0.5 * h)
+            k3 = rate(x + 0.5 * h * k2, t + 0.5 * h); k4 = rate(x + h * k3, t + h)
+            x, t = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4), t + h
+    times = np.arange(n) * dt
+    run = pd.DataFrame({"t": times, "x": rows, "u": [feed(t) for t in times]})
+    model = termid.Model.from_states(["x"], ["u"])
+    found = model.recipe(run)
+    rate = found.model.coefficients("x_dot").set_index("term")["value"]
+    assert sorted(rate.index) == ["u", "x/(x + 0.5)"], rate
+    assert rate["x/(x + 0.5)"] == pytest.approx(-2.0, rel=1e-3) and rate["u"] == pytest.approx(1.0, rel=1e-3)
+    assert "saturating rates among the candidates" in found.text and "FLAG" not in found.text
+    with pytest.warns(UserWarning, match="FLAG"):
+        cubic = model.recipe(run, laws=False)
+    assert not any("/(x + " in t for t in cubic.model.coefficients("x_dot")["term"])
+
+
 def test_a_law_the_noise_lets_a_cubic_stand_in_for_is_found_by_the_recipe():
     # quadratic drag, v' = -0.5 v|v| + F, F held at random levels, v read with 1 % noise: the
     # cubic's -0.24v - 0.24v^3 passes every check (kept with nothing said); its v^3, a state's

@@ -24,13 +24,8 @@ pub(super) fn with_laws(
     outline: Option<&crate::model::Outline>,
 ) -> Option<(Model, Vec<String>)> {
     let outline = outline.filter(|o| o.candidates.is_empty())?;
-    let about_a_reference =
-        |s: &str| model.spec().derived.iter().any(|d| d.definition.starts_with(&format!("{s} - ")));
-    let laws: Vec<String> = outline
-        .states
+    let laws: Vec<String> = own_variables(model, outline)
         .iter()
-        .chain(&outline.inputs)
-        .filter(|s| !about_a_reference(s))
         .flat_map(|s| crate::term::laws(s))
         .filter_map(|l| model.vocabulary.parse(&l).ok().map(|t| t.to_string()))
         .collect();
@@ -51,6 +46,25 @@ pub(super) fn with_laws(
         })
         .ok()?;
     Some((extended, laws))
+}
+
+/// The states and inputs of `model`'s `outline` that can have laws of their own: not one
+/// written about a reference value (a heater's temperature in K, whose library holds its
+/// difference from it).
+pub(super) fn own_variables(model: &Model, outline: &crate::model::Outline) -> Vec<String> {
+    let about_a_reference =
+        |s: &str| model.spec().derived.iter().any(|d| d.definition.starts_with(&format!("{s} - ")));
+    outline.states.iter().chain(&outline.inputs).filter(|s| !about_a_reference(s)).cloned().collect()
+}
+
+/// The share of its target the chosen terms of `selection` leave unexplained (1 − R², at
+/// least the smallest positive double).
+pub(super) fn unexplained(selection: &crate::select::Selection) -> Option<f64> {
+    selection
+        .chosen_step
+        .checked_sub(1)
+        .and_then(|k| selection.steps.get(k))
+        .map(|step| (1.0 - step.r2).max(f64::MIN_POSITIVE))
 }
 
 /// The laws, in words.
@@ -100,12 +114,6 @@ fn fits_better(polynomials: &Recipe, with: &Recipe) -> Option<f64> {
         if a.rows != b.rows || poly.target != laws.target {
             return None;
         }
-        let unexplained = |s: &crate::select::Selection| {
-            s.chosen_step
-                .checked_sub(1)
-                .and_then(|k| s.steps.get(k))
-                .map(|step| (1.0 - step.r2).max(f64::MIN_POSITIVE))
-        };
         let rows = a.rows as f64
             / poly.correlation_time.unwrap_or(1.0).max(laws.correlation_time.unwrap_or(1.0)).max(1.0);
         gain += rows * (unexplained(a)? / unexplained(b)?).ln()
@@ -137,44 +145,72 @@ fn named(checks: impl IntoIterator<Item = String>) -> String {
     checks.into_iter().map(|c| format!("\"{c}\"")).collect::<Vec<_>>().join(", ")
 }
 
+/// What a stage added to the polynomial library's candidates, and why.
+pub(super) struct Tried<'a> {
+    /// The terms added (canonical text).
+    pub(super) laws: &'a [String],
+    /// The stand-in checks the polynomials' kept start fails.
+    pub(super) flags: &'a [String],
+    /// Where they fail none, the powers of a variable alone they hold.
+    pub(super) powers: &'a [String],
+    /// The added terms in words: "each state's and input's laws among the candidates (…)".
+    pub(super) family: String,
+    /// Whether a power of a chosen law's variable beside it stands in too (sign v beside v³);
+    /// not so for a saturating rate, beside which a logistic growth's x² is its own.
+    pub(super) beside: bool,
+}
+
+impl Tried<'_> {
+    /// The four laws of every state and input ([`ALL`]) added.
+    pub(super) fn laws<'a>(laws: &'a [String], flags: &'a [String], powers: &'a [String]) -> Tried<'a> {
+        Tried {
+            laws,
+            flags,
+            powers,
+            family: format!("each state's and input's laws among the candidates ({ALL})"),
+            beside: true,
+        }
+    }
+}
+
 /// Which of the polynomial library's recipe `polynomials` (whose kept start fails the
-/// stand-in checks `flags`, or none where it holds `powers` of a variable alone) and the recipe
-/// with the `laws` among the candidates (`with`) to keep, the choice said in a note of the
-/// kept start: the laws' where its kept start passes every check, holds a law and no power
-/// of that law's variable alone, has no more terms, and where the polynomials pass every check
-/// too, fits the rows clearly better.
+/// stand-in checks `tried.flags`, or none where it holds `tried.powers` of a variable alone)
+/// and the recipe with the `tried.laws` among the candidates (`with`) to keep, the choice said
+/// in a note of the kept start: the laws' where its kept start passes every check, holds a law
+/// and (where `tried.beside`) no power of that law's variable alone, has no more terms, and
+/// where the polynomials pass every check too, fits the rows clearly better. With whether the
+/// laws' were kept.
 pub(super) fn kept(
     polynomials: Recipe,
     with: Result<Recipe, super::RecipeError>,
-    laws: &[String],
-    flags: &[String],
-    powers: &[String],
-) -> Recipe {
+    tried: &Tried<'_>,
+) -> (Recipe, bool) {
+    let Tried { laws, flags, powers, family, .. } = tried;
     let (before, _) = terms(&polynomials, laws);
-    let tried = match flags.is_empty() {
+    let tried_text = match flags.is_empty() {
         true => format!(
-            "the polynomial library's {before} terms hold {}, a variable's power alone, which may stand in for a law of it; with each state's and input's laws among the candidates ({ALL})",
+            "the polynomial library's {before} terms hold {}, a variable's power alone, which may stand in for a law of it; with {family}",
             powers.iter().map(|t| format!("`{t}`")).collect::<Vec<_>>().join(", ")
         ),
         false => format!(
-            "the polynomial library's {before} terms failed {}; with each state's and input's laws among the candidates ({ALL})",
+            "the polynomial library's {before} terms failed {}; with {family}",
             named(flags.iter().cloned())
         ),
     };
     let flagged = if flags.is_empty() { "" } else { ", as flagged" };
-    let (mut recipe, note) = match with {
+    let (mut recipe, note, lawful) = match with {
         Ok(with) => {
             let (after, held) = terms(&with, laws);
             let failing: Vec<String> =
                 with.kept().checks.iter().filter(|c| !c.passed).map(|c| c.name.clone()).collect();
             // a law stands in for its state's powers: beside them it is one more stand-in
             // (Michaelis-Menten's rational rate as all four laws of x, x³ and x: every check ok)
-            let lawful: Vec<String> = held
+            let of_laws: Vec<String> = held
                 .iter()
                 .filter_map(|l| with.kept().model.vocabulary.parse(l).ok())
                 .flat_map(|t| t.variables())
                 .collect();
-            let beside = powers_held(&with, &lawful);
+            let beside = if tried.beside { powers_held(&with, &of_laws) } else { Vec::new() };
             let why = match (failing.is_empty(), held.is_empty()) {
                 (false, _) => Some(format!("they fail {} too", named(failing))),
                 (true, true) => Some("no law is chosen".to_string()),
@@ -197,21 +233,24 @@ pub(super) fn kept(
                 None => {
                     let held: Vec<String> = held.iter().map(|t| format!("`{t}`")).collect();
                     let note = format!(
-                        "{tried} the equations hold in {after} ({}), every check ok: kept, the polynomials having stood in for a law. Where the polynomials are wanted, --no-laws (Python `laws=False`) keeps them",
+                        "{tried_text} the equations hold in {after} ({}), every check ok: kept, the polynomials having stood in for a law. Where the polynomials are wanted, --no-laws (Python `laws=False`) keeps them",
                         held.join(", ")
                     );
-                    (with, note)
+                    (with, note, true)
                 }
-                Some(why) => {
-                    (polynomials, format!("{tried} no better ({why}): the polynomials kept{flagged}"))
-                }
+                Some(why) => (
+                    polynomials,
+                    format!("{tried_text} no better ({why}): the polynomials kept{flagged}"),
+                    false,
+                ),
             }
         }
         Err(e) => (
             polynomials,
-            format!("{tried} the system could not be identified ({e}): the polynomials kept{flagged}"),
+            format!("{tried_text} the system could not be identified ({e}): the polynomials kept{flagged}"),
+            false,
         ),
     };
     recipe.say(note);
-    recipe
+    (recipe, lawful)
 }

@@ -16,6 +16,7 @@ mod recorded;
 mod report;
 mod resimulated;
 mod retrace;
+mod saturation;
 mod start;
 
 pub use crate::plugin::RecipeDefaults;
@@ -332,12 +333,19 @@ pub fn identify(
         true => laws::with_laws(model, outline.as_ref()),
         false => None,
     };
-    let recipe = match extended {
-        Some((extended, added)) => {
-            let again = RecipeSettings { laws: false, ..settings.clone() };
-            laws::kept(recipe, identify(&extended, frames, held, &again), &added, &flags, &powers)
+    let again = RecipeSettings { laws: false, ..settings.clone() };
+    let again = |extended: &Model| identify(extended, frames, held, &again);
+    let recipe = match (extended, &outline) {
+        (Some((extended, added)), Some(outline)) => {
+            match laws::kept(recipe, again(&extended), &laws::Tried::laws(&added, &flags, &powers)) {
+                // where no law holds, a rate that saturates may (a predator's intake)
+                (recipe, false) => {
+                    saturation::stage(recipe, model, outline, frames, settings, (&flags, &powers), &again)
+                }
+                (recipe, true) => recipe,
+            }
         }
-        None => recipe,
+        _ => recipe,
     };
     Ok(match &outline {
         Some(o) => recorded::said(recipe, &o.inputs),

@@ -4373,10 +4373,12 @@ fn an_input_that_records_a_state_s_rate_is_said() {
 
 /// A predator-prey cycle whose predators' intake saturates (Rosenzweig-MacArthur,
 /// ẋ = x(1 − x/3) − xy/(1 + 0.8x), ẏ = 0.6xy/(1 + 0.8x) − 0.25y), recorded noise-free for
-/// 200 s: the cubic library stands in for the rational rates with ten terms per equation whose
-/// cycle grows (simulated on, they ran off to 10¹⁰² at 290 s), followed 24 s of the run, their
-/// own motion lost after 47 s as chaos loses itself, and every check read "ok". Chaos stays on
-/// its attractor: continued beyond the run, these equations run away, and it is flagged.
+/// 200 s: the cubic library (`--no-laws`) stands in for the rational rates with ten terms per
+/// equation whose cycle grows (simulated on, they ran off to 10¹⁰² at 290 s), followed 24 s
+/// of the run, their own motion lost after 47 s as chaos loses itself, and every check read
+/// "ok". Chaos stays on its attractor: continued beyond the run, these equations run away,
+/// and it is flagged. By default the saturating intake is found: xy/(1 + 0.8x) is
+/// 1.25·xy/(x + 1.25), its K scanned, the truth's five terms, every check ok.
 #[test]
 fn a_stand_in_whose_cycle_runs_away_beyond_its_run_is_no_chaos() {
     use crate::common::{trajectory, Scratch};
@@ -4391,16 +4393,89 @@ fn a_stand_in_whose_cycle_runs_away_beyond_its_run_is_no_chaos() {
         text += &format!("{},{},{}\n", i as f64 * 0.05, r[0], r[1]);
     }
     std::fs::write(&path, text).unwrap();
-    let (ok, out, err) =
-        termid(&["identify", "--data", path.to_str().unwrap(), "--states", "x,y", "--format", "json"]);
-    assert!(ok, "{err}");
-    let report = crate::common::json(&out);
+    let identified = |laws: bool| {
+        let mut args =
+            vec!["identify", "--data", path.to_str().unwrap(), "--states", "x,y", "--format", "json"];
+        if !laws {
+            args.push("--no-laws");
+        }
+        let (ok, out, err) = termid(&args);
+        assert!(ok, "{err}");
+        crate::common::json(&out)
+    };
+    let report = identified(false);
     let missed = crate::common::check_named(&report, "as long as their own motion allows");
     assert_eq!(missed["passed"], false, "{missed}");
     assert!(
         missed["detail"].as_str().unwrap().contains("as a chaotic motion's does, but no chaos runs away"),
         "{missed}"
     );
+    let report = identified(true);
+    let checks = report["physical_checks"].as_array().unwrap();
+    assert!(checks.iter().all(|c| c["passed"] == true), "{report}");
+    let terms = |equation: &str| -> Vec<(String, f64)> {
+        report[equation]["terms"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|t| (t["term"].as_str().unwrap().to_string(), t["coefficient"].as_f64().unwrap()))
+            .collect()
+    };
+    let (prey, predators) = (terms("x_dot"), terms("y_dot"));
+    assert_eq!((prey.len(), predators.len()), (3, 2), "{prey:?} {predators:?}");
+    // the half-saturation written in the term: x*y/(x + K)
+    let intake = |terms: &[(String, f64)]| -> (f64, f64) {
+        let (term, c) = terms.iter().find(|(t, _)| t.starts_with("x*y/(x + ")).expect("the intake");
+        (term.trim_start_matches("x*y/(x + ").trim_end_matches(')').parse().unwrap(), *c)
+    };
+    let ((k, eaten), (k2, grown)) = (intake(&prey), intake(&predators));
+    assert!((k - 1.25).abs() < 0.005 && k == k2, "{prey:?} {predators:?}");
+    assert!((eaten + 1.25).abs() < 0.01 && (grown - 0.75).abs() < 0.01, "{prey:?} {predators:?}");
+}
+
+/// An enzyme's turnover under a stepped feed, ẋ = u − 2x/(0.5 + x), recorded noise-free: the
+/// cubic library's stand-in re-simulates it 1.1 times as far off as a noise-free record allows,
+/// its halves choosing other terms; the saturating form is found with its K, in two terms.
+#[test]
+fn an_enzymes_turnover_is_found_with_its_constant() {
+    use crate::common::{trajectory, Scratch};
+    let dir = Scratch::new("michaelis-menten");
+    let feed = |t: f64| [0.6, 1.2, 0.3, 1.5, 0.9, 0.45, 1.3, 0.7][(t / 25.0) as usize % 8];
+    let rows = trajectory(&[0.3], 0.05, 4001, 20, |t, s| vec![feed(t) - 2.0 * s[0] / (0.5 + s[0])]);
+    let path = dir.join("feed.csv");
+    let mut text = String::from("t,x,u\n");
+    for (i, r) in rows.iter().enumerate() {
+        let t = i as f64 * 0.05;
+        text += &format!("{t},{},{}\n", r[0], feed(t));
+    }
+    std::fs::write(&path, text).unwrap();
+    let (ok, out, err) = termid(&[
+        "identify",
+        "--data",
+        path.to_str().unwrap(),
+        "--states",
+        "x",
+        "--inputs",
+        "u",
+        "--format",
+        "json",
+    ]);
+    assert!(ok, "{err}");
+    let report = crate::common::json(&out);
+    assert!(report["physical_checks"].as_array().unwrap().iter().all(|c| c["passed"] == true), "{report}");
+    let terms = report["x_dot"]["terms"].as_array().unwrap();
+    assert_eq!(terms.len(), 2, "{terms:?}");
+    let turnover =
+        terms.iter().find(|t| t["term"].as_str().unwrap().starts_with("x/(x + ")).expect("x/(x + K)");
+    let k: f64 = turnover["term"]
+        .as_str()
+        .unwrap()
+        .trim_start_matches("x/(x + ")
+        .trim_end_matches(')')
+        .parse()
+        .unwrap();
+    assert!((k - 0.5).abs() < 0.002, "{terms:?}");
+    assert!((turnover["coefficient"].as_f64().unwrap() + 2.0).abs() < 0.01, "{terms:?}");
 }
 
 /// Two runs of one oscillator, ẍ = −4x − c·ẋ + u, whose damping changed between them (c = 0.2,

@@ -1,0 +1,263 @@
+//! Rates that saturate: an enzyme's turnover x/(x + K), a predator's intake xy/(x + K), a
+//! switch's 1/(1 + (x/K)²). The polynomial library stands in for them and fails beyond its
+//! runs (a predator-prey cycle's ten cubic terms whose cycle grows); their half-saturation K
+//! is no coefficient, so it is found by a scan of the regression's information criterion,
+//! each positive variable's in turn, and the system identified again with the saturating
+//! forms at the K found; kept as the laws are (`laws.rs`), either way said.
+
+use super::laws::{self, Tried};
+use super::{start, Recipe, RecipeError, RecipeSettings};
+use crate::data::Frame;
+use crate::identify::{identify_model, Fit, ModelIdentification};
+use crate::model::Model;
+use rayon::prelude::*;
+
+/// The half-saturations tried first, as multiples of each variable's median over the runs:
+/// from an eighth (where x/(x + K) is nearly 1, the library's constant) to eight times (nearly
+/// x/K, its x), [`PER_OCTAVE`] to the octave. Where the records hold no noise, the criterion
+/// dips sharply at the true K and the library's stand-ins make it slope elsewhere as they
+/// please: a Hill switch's K = 1 lies between two grid points an octave apart, the criterion
+/// falling away from it to 2.5.
+const GRID: (f64, f64) = (0.125, 8.0);
+
+/// Grid points to the octave: a quarter-octave (19 %) apart.
+const PER_OCTAVE: usize = 4;
+
+/// Golden-section steps refining the grid's best K within a grid step each side: to 0.01 % of
+/// K, below which a noise-free record's re-simulation no longer tells.
+const REFINE: usize = 16;
+
+/// How much lower the information criterion with a variable's saturating forms must be than
+/// without them for the variable to saturate: "very strong" evidence (Kass & Raftery 1995).
+const CLEARLY: f64 = 10.0;
+
+/// A variable's half-saturation: its name and K.
+type Half = (String, f64);
+
+/// The polynomial library's recipe `polynomials` (the laws' stage having kept it, which its
+/// kept start fails the stand-in checks of `tried`, or holds its powers) and, where a variable
+/// of `model`'s `outline` is positive in every row of `frames`, the system identified again
+/// (`again`) with the saturating forms of those variables whose scan finds them: which to
+/// keep, said in a note ([`laws::kept`]).
+pub(super) fn stage(
+    polynomials: Recipe,
+    model: &Model,
+    outline: &crate::model::Outline,
+    frames: &[Frame],
+    settings: &RecipeSettings,
+    tried: (&[String], &[String]),
+    again: &dyn Fn(&Model) -> Result<Recipe, RecipeError>,
+) -> Recipe {
+    let variables = laws::own_variables(model, outline);
+    let positive: Vec<(String, f64)> =
+        variables.iter().filter_map(|v| median_if_positive(frames, v).map(|m| (v.clone(), m))).collect();
+    if positive.is_empty() {
+        return polynomials;
+    }
+    let Some(halves) = scanned(&polynomials, model, &variables, &positive, settings) else {
+        return polynomials;
+    };
+    let (flags, powers) = tried;
+    let forms = saturating_forms(model, &halves, &variables);
+    let family = format!(
+        "saturating rates among the candidates (x/(x + K), x·y/(x + K), x²/(x² + K²) of {}, K found by a scan of the regression's information criterion)",
+        halves.iter().map(|(v, k)| format!("`{v}` at K = {}", crate::identify::num(*k))).collect::<Vec<_>>().join(", ")
+    );
+    if forms.is_empty() {
+        return polynomials;
+    }
+    let extended = match with_forms(model, &forms, false) {
+        Some(extended) => extended,
+        None => return polynomials,
+    };
+    let tried = Tried { laws: &forms, flags, powers, family, beside: false };
+    laws::kept(polynomials, again(&extended), &tried).0
+}
+
+/// The median of variable `name` over every row of `frames` where it is positive in each
+/// (finite, above 0); `None` where it is not, or no run records it.
+fn median_if_positive(frames: &[Frame], name: &str) -> Option<f64> {
+    let mut values: Vec<f64> = Vec::new();
+    for frame in frames {
+        values.extend_from_slice(frame.column(name)?);
+    }
+    if values.is_empty() || !values.iter().all(|v| v.is_finite() && *v > 0.0) {
+        return None;
+    }
+    values.sort_by(f64::total_cmp);
+    Some(values[values.len() / 2])
+}
+
+/// The saturating forms of each variable of `halves` at its K, among `variables`, as the
+/// model's vocabulary writes them.
+fn saturating_forms(model: &Model, halves: &[Half], variables: &[String]) -> Vec<String> {
+    halves
+        .iter()
+        .flat_map(|(v, k)| crate::term::saturations(v, *k, variables))
+        .filter_map(|f| model.vocabulary.parse(&f).ok().map(|t| t.to_string()))
+        .collect()
+}
+
+/// `model` with `forms` among the candidates of every identified equation; with `every`,
+/// each equation fitted on every candidate (least squares, none left out but the collinear).
+fn with_forms(model: &Model, forms: &[String], every: bool) -> Option<Model> {
+    model
+        .edit(|file| {
+            for equation in file.equations.values_mut().filter(|e| e.identify) {
+                if every {
+                    let all = crate::select::Stlsq { threshold: Some(0.0), ..Default::default() };
+                    equation.backend = Some(crate::select::Backend::Stlsq(all));
+                }
+                for form in forms {
+                    if !equation.candidates.contains(form) {
+                        equation.candidates.push(form.clone());
+                    }
+                }
+            }
+        })
+        .ok()
+}
+
+/// The variables of `positive` (with their medians) that saturate, each with its K: in turn,
+/// the one whose forms lower the regression's information criterion on the kept start's rows
+/// of `polynomials` most, while they do so [`CLEARLY`]. Each variable's K is the one at which
+/// every candidate fitted together leaves least unexplained (smooth in K, where the terms a
+/// selection keeps jump: the best of [`GRID`] refined by golden section), its forms there
+/// judged by the terms the selection keeps. `None` where none saturates, or the rows cannot
+/// be fitted so.
+fn scanned(
+    polynomials: &Recipe,
+    model: &Model,
+    variables: &[String],
+    positive: &[(String, f64)],
+    settings: &RecipeSettings,
+) -> Option<Vec<Half>> {
+    let start = polynomials.kept();
+    let differentiator = start::derivative_method(&start.derivative).ok()?;
+    let how = ModelIdentification {
+        equations: model.identifiable(),
+        differentiator: differentiator.as_ref(),
+        intercept: settings.intercept,
+        target: None,
+    };
+    // each equation's rows counted as independent once per its residuals' correlation time,
+    // the polynomials' throughout, so that every K is judged on one scale
+    let correlation: Vec<(String, f64)> =
+        start.fits.iter().map(|(n, f)| (n.clone(), f.correlation_time.unwrap_or(1.0).max(1.0))).collect();
+    let score = |halves: &[Half], every: bool| -> Option<f64> {
+        let extended = with_forms(model, &saturating_forms(model, halves, variables), every)?;
+        let found = identify_model(&extended, &start.prepared, &how, &mut |_| {}).ok()?;
+        information(&found.fits, &correlation)
+    };
+    let mut best = score(&[], false)?;
+    let mut halves: Vec<Half> = Vec::new();
+    loop {
+        let with = |name: &str, k: f64, every: bool| {
+            let mut h = halves.clone();
+            h.push((name.to_string(), k));
+            score(&h, every).unwrap_or(f64::INFINITY)
+        };
+        let mut round: Option<(f64, &str, f64)> = None;
+        for (name, median) in positive.iter().filter(|(n, _)| !halves.iter().any(|(h, _)| h == n)) {
+            let octaves = (GRID.1 / GRID.0).log2().round() as usize;
+            let grid: Vec<f64> = (0..=octaves * PER_OCTAVE)
+                .map(|i| median * GRID.0 * 2f64.powf(i as f64 / PER_OCTAVE as f64))
+                .collect();
+            let Some((at, k)) =
+                grid.par_iter().map(|k| (with(name, *k, false), *k)).min_by(|a, b| a.0.total_cmp(&b.0))
+            else {
+                continue;
+            };
+            let fine = refined(&|k| with(name, k, true), k, with(name, k, true));
+            let (selected, k) = match with(name, fine, false) {
+                s if s < at => (s, fine),
+                _ => (at, k),
+            };
+            if round.is_none_or(|(r, _, _)| selected < r) {
+                round = Some((selected, name, k));
+            }
+        }
+        match round {
+            Some((s, name, k)) if best - s > CLEARLY => {
+                halves.push((name.to_string(), k));
+                best = s;
+            }
+            _ => break,
+        }
+    }
+    (!halves.is_empty()).then_some(halves)
+}
+
+/// The K within a grid step of `k` (whose criterion is `at_k`) that lowers `criterion` most, by
+/// golden section on ln K.
+fn refined(criterion: &dyn Fn(f64) -> f64, k: f64, at_k: f64) -> f64 {
+    let golden = (5f64.sqrt() - 1.0) / 2.0;
+    let step = std::f64::consts::LN_2 / PER_OCTAVE as f64;
+    let (mut a, mut b) = (k.ln() - step, k.ln() + step);
+    let mut c = b - golden * (b - a);
+    let mut d = a + golden * (b - a);
+    let (mut fc, mut fd) = (criterion(c.exp()), criterion(d.exp()));
+    for _ in 0..REFINE {
+        if fc < fd {
+            (b, d, fd) = (d, c, fc);
+            c = b - golden * (b - a);
+            fc = criterion(c.exp());
+        } else {
+            (a, c, fc) = (c, d, fd);
+            d = a + golden * (b - a);
+            fd = criterion(d.exp());
+        }
+    }
+    let (x, fx) = if fc < fd { (c, fc) } else { (d, fd) };
+    if fx < at_k {
+        x.exp()
+    } else {
+        k
+    }
+}
+
+/// The Bayesian information criterion of `fits`, summed over the equations: each counted in
+/// its rows over its residuals' `correlation` time (the independent ones).
+fn information(fits: &[(String, Fit)], correlation: &[(String, f64)]) -> Option<f64> {
+    let mut total = 0.0;
+    for (name, fit) in fits {
+        let tau = correlation.iter().find(|(n, _)| n == name).map_or(1.0, |(_, t)| *t);
+        let rows = fit.selection.rows as f64 / tau;
+        total +=
+            rows * laws::unexplained(&fit.selection)?.ln() + fit.selection.terms.len() as f64 * rows.ln();
+    }
+    Some(total)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The golden section finds the least of a criterion smooth in ln K within a grid step of
+    /// where it starts, and keeps its start where nothing there is lower.
+    #[test]
+    fn the_golden_section_finds_the_least_within_a_step() {
+        let bowl = |k: f64| (k.ln() - 1.3f64.ln()).powi(2);
+        let k = refined(&bowl, 1.2, bowl(1.2));
+        assert!((k / 1.3 - 1.0).abs() < 1e-4, "{k}");
+        // beyond a grid step (19 %) the least is not reached: its edge, nearest it
+        let k = refined(&bowl, 1.0, bowl(1.0));
+        assert!((k / 2f64.powf(0.25) - 1.0).abs() < 1e-3, "{k}");
+        // a start lower than all about it is kept
+        assert_eq!(refined(&|k: f64| if k == 2.0 { -1.0 } else { 0.0 }, 2.0, -1.0), 2.0);
+    }
+
+    /// A variable's median is taken only where it is positive in every row of every run.
+    #[test]
+    fn only_a_variable_positive_throughout_saturates() {
+        let run = |x: Vec<f64>| {
+            let t: Vec<f64> = (0..x.len()).map(|k| k as f64).collect();
+            let mut f = Frame::new("run.csv", "t", t).unwrap();
+            f.push("x", x).unwrap();
+            f
+        };
+        assert_eq!(median_if_positive(&[run(vec![3.0, 1.0, 2.0]), run(vec![5.0, 4.0])], "x"), Some(3.0));
+        assert_eq!(median_if_positive(&[run(vec![3.0, 1.0]), run(vec![0.0, 4.0])], "x"), None);
+        assert_eq!(median_if_positive(&[run(vec![3.0, 1.0])], "y"), None);
+    }
+}
