@@ -2414,8 +2414,8 @@ class Model:
         state's or an input's power alone (v³, n³), is identified again with each state's
         and input's laws among the candidates (sign, x·|x|, √|x|, sin x), kept where they pass every check in no more
         terms (and fit the rows clearly better where the polynomials passed too), and said; where none holds, with
-        the saturating rates x/(x + K), x·y/(x + K), x²/(x² + K²) of each variable positive in every row, K found by a
-        scan, kept so too; ``laws`` False keeps the polynomials.
+        the saturating rates x/(x + K), x·y/(x + K), x²/(x² + K²) of each variable positive in every row and
+        tanh(x/K) of one of either sign, K found by a scan, kept so too; ``laws`` False keeps the polynomials.
         One start, not refined, whose runs show a state moved by a random force (process noise:
         another state's record holds its roughness, so it is motion, not a sensor's noise) is
         identified again by Itô's steps (the ``ito`` method, whose terms the force does not

@@ -338,11 +338,13 @@ pub fn identify(
     let recipe = match (extended, &outline) {
         (Some((extended, added)), Some(outline)) => {
             match laws::kept(recipe, again(&extended), &laws::Tried::laws(&added, &flags, &powers)) {
-                // where no law holds, a rate that saturates may (a predator's intake)
-                (recipe, false) => {
-                    saturation::stage(recipe, model, outline, frames, settings, (&flags, &powers), &again)
+                // where no law holds and the polynomials fail, a rate that saturates may hold
+                // (a predator's intake); where they pass, its scan of K is not worth its
+                // time (a second for any system of a state's square, Lorenz-84's)
+                (recipe, false) if !flags.is_empty() => {
+                    saturation::stage(recipe, model, outline, frames, settings, &flags, &again)
                 }
-                (recipe, true) => recipe,
+                (recipe, _) => recipe,
             }
         }
         _ => recipe,

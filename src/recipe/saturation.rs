@@ -1,9 +1,9 @@
 //! Rates that saturate: an enzyme's turnover x/(x + K), a predator's intake xy/(x + K), a
-//! switch's 1/(1 + (x/K)²). The polynomial library stands in for them and fails beyond its
-//! runs (a predator-prey cycle's ten cubic terms whose cycle grows); their half-saturation K
-//! is no coefficient, so it is found by a scan of the regression's information criterion,
-//! each positive variable's in turn, and the system identified again with the saturating
-//! forms at the K found; kept as the laws are (`laws.rs`), either way said.
+//! switch's 1/(1 + (x/K)²), an actuator's limit tanh(u/K). The polynomial library stands in
+//! for them and fails beyond its runs (a predator-prey cycle's ten cubic terms whose cycle
+//! grows); their scale K is no coefficient, so it is found by a scan of the regression's
+//! information criterion, each variable's in turn, and the system identified again with the
+//! saturating forms at the K found; kept as the laws are (`laws.rs`), either way said.
 
 use super::laws::{self, Tried};
 use super::{start, Recipe, RecipeError, RecipeSettings};
@@ -31,37 +31,61 @@ const REFINE: usize = 16;
 /// without them for the variable to saturate: "very strong" evidence (Kass & Raftery 1995).
 const CLEARLY: f64 = 10.0;
 
-/// A variable's half-saturation: its name and K.
-type Half = (String, f64);
+/// How a variable saturates: one positive in every row (a population, a concentration) as
+/// x/(x + K) and its kin ([`crate::term::saturations`]), one of either sign (a command, a
+/// voltage) as tanh(x/K).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Shape {
+    Rational,
+    Odd,
+}
 
-/// The polynomial library's recipe `polynomials` (the laws' stage having kept it, which its
-/// kept start fails the stand-in checks of `tried`, or holds its powers) and, where a variable
-/// of `model`'s `outline` is positive in every row of `frames`, the system identified again
-/// (`again`) with the saturating forms of those variables whose scan finds them: which to
-/// keep, said in a note ([`laws::kept`]).
+/// The forms tried, in words.
+const FAMILY: &str = "saturating rates among the candidates (x/(x + K), x·y/(x + K), x²/(x² + K²) of a variable positive in every row, tanh(x/K) of one of either sign)";
+
+/// A variable's saturation: its name, K and shape.
+type Half = (String, f64, Shape);
+
+/// The polynomial library's recipe `polynomials` (the laws' stage having kept it, whose kept
+/// start fails the stand-in checks `flags`) and the system identified again (`again`) with
+/// the saturating forms of the variables of `model`'s `outline` whose scan over `frames`
+/// finds them: which to keep, said in a note ([`laws::kept`]); where the scan finds none,
+/// said so.
 pub(super) fn stage(
     polynomials: Recipe,
     model: &Model,
     outline: &crate::model::Outline,
     frames: &[Frame],
     settings: &RecipeSettings,
-    tried: (&[String], &[String]),
+    flags: &[String],
     again: &dyn Fn(&Model) -> Result<Recipe, RecipeError>,
 ) -> Recipe {
     let variables = laws::own_variables(model, outline);
-    let positive: Vec<(String, f64)> =
-        variables.iter().filter_map(|v| median_if_positive(frames, v).map(|m| (v.clone(), m))).collect();
-    if positive.is_empty() {
+    let scaled: Vec<Half> =
+        variables.iter().filter_map(|v| scale(frames, v).map(|(k, s)| (v.clone(), k, s))).collect();
+    if scaled.is_empty() {
         return polynomials;
     }
-    let Some(halves) = scanned(&polynomials, model, &variables, &positive, settings) else {
+    let Some(halves) = scanned(&polynomials, model, &variables, &scaled, settings) else {
+        let mut polynomials = polynomials;
+        polynomials.say(format!(
+            "with {FAMILY} of {}, K scanned from an eighth to eight times its median, none lowers the regression's information criterion by {CLEARLY} or more at any K: the polynomials kept, as flagged",
+            scaled.iter().map(|(v, _, _)| format!("`{v}`")).collect::<Vec<_>>().join(", ")
+        ));
         return polynomials;
     };
-    let (flags, powers) = tried;
     let forms = saturating_forms(model, &halves, &variables);
     let family = format!(
-        "saturating rates among the candidates (x/(x + K), x·y/(x + K), x²/(x² + K²) of {}, K found by a scan of the regression's information criterion)",
-        halves.iter().map(|(v, k)| format!("`{v}` at K = {}", crate::identify::num(*k))).collect::<Vec<_>>().join(", ")
+        "{FAMILY} ({}, K found by a scan of the regression's information criterion)",
+        halves
+            .iter()
+            .map(|(v, k, s)| format!(
+                "`{v}` {} at K = {}",
+                if *s == Shape::Odd { "as tanh" } else { "as x/(x + K)" },
+                crate::identify::num(*k)
+            ))
+            .collect::<Vec<_>>()
+            .join(", ")
     );
     if forms.is_empty() {
         return polynomials;
@@ -70,22 +94,27 @@ pub(super) fn stage(
         Some(extended) => extended,
         None => return polynomials,
     };
-    let tried = Tried { laws: &forms, flags, powers, family, beside: false };
+    let tried = Tried { laws: &forms, flags, powers: &[], family, beside: false };
     laws::kept(polynomials, again(&extended), &tried).0
 }
 
-/// The median of variable `name` over every row of `frames` where it is positive in each
-/// (finite, above 0); `None` where it is not, or no run records it.
-fn median_if_positive(frames: &[Frame], name: &str) -> Option<f64> {
+/// How variable `name` may saturate over every row of `frames`, with the scale its K is
+/// scanned about: where it is positive in each (finite, above 0), as x/(x + K) about its
+/// median; else as tanh(x/K) about its magnitude's median. `None` where no run records it, a
+/// value is not finite, or it is mostly 0.
+fn scale(frames: &[Frame], name: &str) -> Option<(f64, Shape)> {
     let mut values: Vec<f64> = Vec::new();
     for frame in frames {
         values.extend_from_slice(frame.column(name)?);
     }
-    if values.is_empty() || !values.iter().all(|v| v.is_finite() && *v > 0.0) {
+    if values.is_empty() || !values.iter().all(|v| v.is_finite()) {
         return None;
     }
-    values.sort_by(f64::total_cmp);
-    Some(values[values.len() / 2])
+    let shape = if values.iter().all(|v| *v > 0.0) { Shape::Rational } else { Shape::Odd };
+    let mut magnitudes: Vec<f64> = values.iter().map(|v| v.abs()).collect();
+    magnitudes.sort_by(f64::total_cmp);
+    let median = magnitudes[magnitudes.len() / 2];
+    (median > 0.0).then_some((median, shape))
 }
 
 /// The saturating forms of each variable of `halves` at its K, among `variables`, as the
@@ -93,7 +122,10 @@ fn median_if_positive(frames: &[Frame], name: &str) -> Option<f64> {
 fn saturating_forms(model: &Model, halves: &[Half], variables: &[String]) -> Vec<String> {
     halves
         .iter()
-        .flat_map(|(v, k)| crate::term::saturations(v, *k, variables))
+        .flat_map(|(v, k, shape)| match shape {
+            Shape::Rational => crate::term::saturations(v, *k, variables),
+            Shape::Odd => vec![crate::term::odd_saturation(v, *k)],
+        })
         .filter_map(|f| model.vocabulary.parse(&f).ok().map(|t| t.to_string()))
         .collect()
 }
@@ -118,7 +150,7 @@ fn with_forms(model: &Model, forms: &[String], every: bool) -> Option<Model> {
         .ok()
 }
 
-/// The variables of `positive` (with their medians) that saturate, each with its K: in turn,
+/// The variables of `scaled` (with their scales and shapes) that saturate, each with its K: in turn,
 /// the one whose forms lower the regression's information criterion on the kept start's rows
 /// of `polynomials` most, while they do so [`CLEARLY`]. Each variable's K is the one at which
 /// every candidate fitted together leaves least unexplained (smooth in K, where the terms a
@@ -129,7 +161,7 @@ fn scanned(
     polynomials: &Recipe,
     model: &Model,
     variables: &[String],
-    positive: &[(String, f64)],
+    scaled: &[Half],
     settings: &RecipeSettings,
 ) -> Option<Vec<Half>> {
     let start = polynomials.kept();
@@ -152,34 +184,37 @@ fn scanned(
     let mut best = score(&[], false)?;
     let mut halves: Vec<Half> = Vec::new();
     loop {
-        let with = |name: &str, k: f64, every: bool| {
+        let with = |name: &str, k: f64, shape: Shape, every: bool| {
             let mut h = halves.clone();
-            h.push((name.to_string(), k));
+            h.push((name.to_string(), k, shape));
             score(&h, every).unwrap_or(f64::INFINITY)
         };
-        let mut round: Option<(f64, &str, f64)> = None;
-        for (name, median) in positive.iter().filter(|(n, _)| !halves.iter().any(|(h, _)| h == n)) {
+        let mut round: Option<(f64, &str, f64, Shape)> = None;
+        for (name, median, shape) in scaled.iter().filter(|(n, _, _)| !halves.iter().any(|(h, _, _)| h == n))
+        {
+            let shape = *shape;
+            let with = |k: f64, every: bool| with(name, k, shape, every);
             let octaves = (GRID.1 / GRID.0).log2().round() as usize;
             let grid: Vec<f64> = (0..=octaves * PER_OCTAVE)
                 .map(|i| median * GRID.0 * 2f64.powf(i as f64 / PER_OCTAVE as f64))
                 .collect();
             let Some((at, k)) =
-                grid.par_iter().map(|k| (with(name, *k, false), *k)).min_by(|a, b| a.0.total_cmp(&b.0))
+                grid.par_iter().map(|k| (with(*k, false), *k)).min_by(|a, b| a.0.total_cmp(&b.0))
             else {
                 continue;
             };
-            let fine = refined(&|k| with(name, k, true), k, with(name, k, true));
-            let (selected, k) = match with(name, fine, false) {
+            let fine = refined(&|k| with(k, true), k, with(k, true));
+            let (selected, k) = match with(fine, false) {
                 s if s < at => (s, fine),
                 _ => (at, k),
             };
-            if round.is_none_or(|(r, _, _)| selected < r) {
-                round = Some((selected, name, k));
+            if round.is_none_or(|(r, _, _, _)| selected < r) {
+                round = Some((selected, name, k, shape));
             }
         }
         match round {
-            Some((s, name, k)) if best - s > CLEARLY => {
-                halves.push((name.to_string(), k));
+            Some((s, name, k, shape)) if best - s > CLEARLY => {
+                halves.push((name.to_string(), k, shape));
                 best = s;
             }
             _ => break,
@@ -247,17 +282,22 @@ mod tests {
         assert_eq!(refined(&|k: f64| if k == 2.0 { -1.0 } else { 0.0 }, 2.0, -1.0), 2.0);
     }
 
-    /// A variable's median is taken only where it is positive in every row of every run.
+    /// A variable positive in every row of every run saturates as x/(x + K) about its median,
+    /// one of either sign as tanh(x/K) about its magnitude's.
     #[test]
-    fn only_a_variable_positive_throughout_saturates() {
+    fn a_variable_saturates_by_its_sign() {
         let run = |x: Vec<f64>| {
             let t: Vec<f64> = (0..x.len()).map(|k| k as f64).collect();
             let mut f = Frame::new("run.csv", "t", t).unwrap();
             f.push("x", x).unwrap();
             f
         };
-        assert_eq!(median_if_positive(&[run(vec![3.0, 1.0, 2.0]), run(vec![5.0, 4.0])], "x"), Some(3.0));
-        assert_eq!(median_if_positive(&[run(vec![3.0, 1.0]), run(vec![0.0, 4.0])], "x"), None);
-        assert_eq!(median_if_positive(&[run(vec![3.0, 1.0])], "y"), None);
+        assert_eq!(
+            scale(&[run(vec![3.0, 1.0, 2.0]), run(vec![5.0, 4.0])], "x"),
+            Some((3.0, Shape::Rational))
+        );
+        assert_eq!(scale(&[run(vec![3.0, -1.0]), run(vec![0.0, -4.0])], "x"), Some((3.0, Shape::Odd)));
+        assert_eq!(scale(&[run(vec![0.0, 0.0, 1.0])], "x"), None);
+        assert_eq!(scale(&[run(vec![3.0, 1.0])], "y"), None);
     }
 }

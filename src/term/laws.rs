@@ -28,6 +28,14 @@ pub fn saturations(name: &str, k: f64, others: &[String]) -> Vec<String> {
         .collect()
 }
 
+/// The odd saturation of variable `name` (of either sign) at scale `k`: tanh(x/K), an
+/// actuator's or an amplifier's limit, a neuron's firing; written with its gain 1/K, which
+/// the term keeps (`tanh(2*u)`, not `tanh(u/0.5)`).
+pub fn odd_saturation(name: &str, k: f64) -> String {
+    let gain = format!("{:.4e}", 1.0 / k).parse().unwrap_or(1.0 / k);
+    format!("tanh({gain}*{name})")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -52,6 +60,9 @@ mod tests {
             assert!((at(1.25) - 0.5).abs() < 1e-12, "{form}: {}", at(1.25));
             assert!((at(1e9) - 1.0).abs() < 1e-6, "{form}: {}", at(1e9));
         }
+        let odd = crate::term::parse_expr(&odd_saturation("x", 0.5)).unwrap();
+        let at = |x: f64| vocabulary.interpret(&odd, &|_: &str| x);
+        assert!((at(0.5) - 1f64.tanh()).abs() < 1e-15 && (at(-0.5) + 1f64.tanh()).abs() < 1e-15);
     }
 
     /// Each law parses as a term of its variable alone.

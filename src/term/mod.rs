@@ -15,7 +15,7 @@ pub use canon::{Atom, Monomial, Term};
 pub use compile::{Library, RowScratch, Source, Tangents};
 pub use error::TermError;
 pub use functions::{Function, FUNCTIONS};
-pub use laws::{laws, saturations};
+pub use laws::{laws, odd_saturation, saturations};
 pub use parse::{parse_expr, BinOp, Expr, ExprKind};
 pub use polynomial::{polynomial, polynomial_len};
 pub use vocabulary::{code_points, is_identifier, Derived, Vocabulary};
