@@ -4465,12 +4465,26 @@ fn an_actuators_limit_is_found_with_its_gain() {
         );
     }
     std::fs::write(&path, text).unwrap();
+    let (terms, gain, coefficient) = saturating_form(&path, "x,v", "v_dot", ("tanh(", "*u)"));
+    assert_eq!(terms, 3);
+    assert!((gain - 2.0).abs() < 0.04 && (coefficient - 2.0).abs() < 0.02, "{gain} {coefficient}");
+}
+
+/// `identify` of the run at `path` (`states`, the input `u`), every check passing: how many
+/// terms `equation` holds, and of its term written `prefix`NUMBER`suffix` (a saturating
+/// form), the number and the coefficient.
+fn saturating_form(
+    path: &std::path::Path,
+    states: &str,
+    equation: &str,
+    (prefix, suffix): (&str, &str),
+) -> (usize, f64, f64) {
     let (ok, out, err) = termid(&[
         "identify",
         "--data",
         path.to_str().unwrap(),
         "--states",
-        "x,v",
+        states,
         "--inputs",
         "u",
         "--format",
@@ -4479,13 +4493,14 @@ fn an_actuators_limit_is_found_with_its_gain() {
     assert!(ok, "{err}");
     let report = crate::common::json(&out);
     assert!(report["physical_checks"].as_array().unwrap().iter().all(|c| c["passed"] == true), "{report}");
-    let terms = report["v_dot"]["terms"].as_array().unwrap();
-    assert_eq!(terms.len(), 3, "{terms:?}");
-    let limit = terms.iter().find(|t| t["term"].as_str().unwrap().starts_with("tanh(")).expect("tanh(g*u)");
-    let gain: f64 =
-        limit["term"].as_str().unwrap().trim_start_matches("tanh(").trim_end_matches("*u)").parse().unwrap();
-    assert!((gain - 2.0).abs() < 0.04, "{terms:?}");
-    assert!((limit["coefficient"].as_f64().unwrap() - 2.0).abs() < 0.02, "{terms:?}");
+    let terms = report[equation]["terms"].as_array().unwrap();
+    let form = terms
+        .iter()
+        .find(|t| t["term"].as_str().unwrap().starts_with(prefix))
+        .unwrap_or_else(|| panic!("no {prefix}…{suffix} in {terms:?}"));
+    let text = form["term"].as_str().unwrap();
+    let number = text.trim_start_matches(prefix).trim_end_matches(suffix).parse().unwrap();
+    (terms.len(), number, form["coefficient"].as_f64().unwrap())
 }
 
 /// An enzyme's turnover under a stepped feed, ẋ = u − 2x/(0.5 + x), recorded noise-free: the
@@ -4504,33 +4519,9 @@ fn an_enzymes_turnover_is_found_with_its_constant() {
         text += &format!("{t},{},{}\n", r[0], feed(t));
     }
     std::fs::write(&path, text).unwrap();
-    let (ok, out, err) = termid(&[
-        "identify",
-        "--data",
-        path.to_str().unwrap(),
-        "--states",
-        "x",
-        "--inputs",
-        "u",
-        "--format",
-        "json",
-    ]);
-    assert!(ok, "{err}");
-    let report = crate::common::json(&out);
-    assert!(report["physical_checks"].as_array().unwrap().iter().all(|c| c["passed"] == true), "{report}");
-    let terms = report["x_dot"]["terms"].as_array().unwrap();
-    assert_eq!(terms.len(), 2, "{terms:?}");
-    let turnover =
-        terms.iter().find(|t| t["term"].as_str().unwrap().starts_with("x/(x + ")).expect("x/(x + K)");
-    let k: f64 = turnover["term"]
-        .as_str()
-        .unwrap()
-        .trim_start_matches("x/(x + ")
-        .trim_end_matches(')')
-        .parse()
-        .unwrap();
-    assert!((k - 0.5).abs() < 0.002, "{terms:?}");
-    assert!((turnover["coefficient"].as_f64().unwrap() + 2.0).abs() < 0.01, "{terms:?}");
+    let (terms, k, coefficient) = saturating_form(&path, "x", "x_dot", ("x/(x + ", ")"));
+    assert_eq!(terms, 2);
+    assert!((k - 0.5).abs() < 0.002 && (coefficient + 2.0).abs() < 0.01, "{k} {coefficient}");
 }
 
 /// Two runs of one oscillator, ẍ = −4x − c·ẋ + u, whose damping changed between them (c = 0.2,
