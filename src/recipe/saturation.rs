@@ -43,8 +43,9 @@ enum Shape {
 /// The forms tried, in words.
 const FAMILY: &str = "saturating rates among the candidates (x/(x + K), x·y/(x + K), x²/(x² + K²) of a variable positive in every row, tanh(x/K) of one of either sign)";
 
-/// A variable's saturation: its name, K and shape.
-type Half = (String, f64, Shape);
+/// A variable's saturation: its name, K (its half-saturation, or the scale tanh divides it
+/// by) and shape.
+type Saturation = (String, f64, Shape);
 
 /// The polynomial library's recipe `polynomials` (the laws' stage having kept it, whose kept
 /// start fails the stand-in checks `flags`) and the system identified again (`again`) with
@@ -61,12 +62,12 @@ pub(super) fn stage(
     again: &dyn Fn(&Model) -> Result<Recipe, RecipeError>,
 ) -> Recipe {
     let variables = laws::own_variables(model, outline);
-    let scaled: Vec<Half> =
+    let scaled: Vec<Saturation> =
         variables.iter().filter_map(|v| scale(frames, v).map(|(k, s)| (v.clone(), k, s))).collect();
     if scaled.is_empty() {
         return polynomials;
     }
-    let Some(halves) = scanned(&polynomials, model, &variables, &scaled, settings) else {
+    let Some(found) = scanned(&polynomials, model, &variables, &scaled, settings) else {
         let mut polynomials = polynomials;
         polynomials.say(format!(
             "with {FAMILY} of {}, K scanned from an eighth to eight times its median, none lowers the regression's information criterion by {CLEARLY} or more at any K: the polynomials kept, as flagged",
@@ -74,10 +75,13 @@ pub(super) fn stage(
         ));
         return polynomials;
     };
-    let forms = saturating_forms(model, &halves, &variables);
+    let forms = saturating_forms(model, &found, &variables);
+    if forms.is_empty() {
+        return polynomials;
+    }
     let family = format!(
         "{FAMILY} ({}, K found by a scan of the regression's information criterion)",
-        halves
+        found
             .iter()
             .map(|(v, k, s)| format!(
                 "`{v}` {} at K = {}",
@@ -87,9 +91,6 @@ pub(super) fn stage(
             .collect::<Vec<_>>()
             .join(", ")
     );
-    if forms.is_empty() {
-        return polynomials;
-    }
     let extended = match with_forms(model, &forms, false) {
         Some(extended) => extended,
         None => return polynomials,
@@ -117,10 +118,10 @@ fn scale(frames: &[Frame], name: &str) -> Option<(f64, Shape)> {
     (median > 0.0).then_some((median, shape))
 }
 
-/// The saturating forms of each variable of `halves` at its K, among `variables`, as the
+/// The saturating forms of each variable of `found` at its K, among `variables`, as the
 /// model's vocabulary writes them.
-fn saturating_forms(model: &Model, halves: &[Half], variables: &[String]) -> Vec<String> {
-    halves
+fn saturating_forms(model: &Model, found: &[Saturation], variables: &[String]) -> Vec<String> {
+    found
         .iter()
         .flat_map(|(v, k, shape)| match shape {
             Shape::Rational => crate::term::saturations(v, *k, variables),
@@ -150,20 +151,20 @@ fn with_forms(model: &Model, forms: &[String], every: bool) -> Option<Model> {
         .ok()
 }
 
-/// The variables of `scaled` (with their scales and shapes) that saturate, each with its K: in turn,
-/// the one whose forms lower the regression's information criterion on the kept start's rows
-/// of `polynomials` most, while they do so [`CLEARLY`]. Each variable's K is the one at which
-/// every candidate fitted together leaves least unexplained (smooth in K, where the terms a
-/// selection keeps jump: the best of [`GRID`] refined by golden section), its forms there
-/// judged by the terms the selection keeps. `None` where none saturates, or the rows cannot
-/// be fitted so.
+/// The variables of `scaled` (with their scales and shapes) that saturate, each with its K:
+/// in turn, the one whose forms lower the regression's information criterion on the kept
+/// start's rows of `polynomials` most, while they do so [`CLEARLY`]. A variable's K is the
+/// best of [`GRID`] by the terms the selection keeps, refined within a grid step by golden
+/// section on every candidate fitted together (smooth in K, where the terms a selection keeps
+/// jump) and taken where the selection's criterion there is lower still. `None` where none
+/// saturates, or the rows cannot be fitted so.
 fn scanned(
     polynomials: &Recipe,
     model: &Model,
     variables: &[String],
-    scaled: &[Half],
+    scaled: &[Saturation],
     settings: &RecipeSettings,
-) -> Option<Vec<Half>> {
+) -> Option<Vec<Saturation>> {
     let start = polynomials.kept();
     let differentiator = start::derivative_method(&start.derivative).ok()?;
     let how = ModelIdentification {
@@ -176,27 +177,26 @@ fn scanned(
     // the polynomials' throughout, so that every K is judged on one scale
     let correlation: Vec<(String, f64)> =
         start.fits.iter().map(|(n, f)| (n.clone(), f.correlation_time.unwrap_or(1.0).max(1.0))).collect();
-    let score = |halves: &[Half], every: bool| -> Option<f64> {
-        let extended = with_forms(model, &saturating_forms(model, halves, variables), every)?;
-        let found = identify_model(&extended, &start.prepared, &how, &mut |_| {}).ok()?;
-        information(&found.fits, &correlation)
+    let score = |found: &[Saturation], every: bool| -> Option<f64> {
+        let extended = with_forms(model, &saturating_forms(model, found, variables), every)?;
+        let fitted = identify_model(&extended, &start.prepared, &how, &mut |_| {}).ok()?;
+        information(&fitted.fits, &correlation)
     };
     let mut best = score(&[], false)?;
-    let mut halves: Vec<Half> = Vec::new();
+    let mut found: Vec<Saturation> = Vec::new();
     loop {
         let with = |name: &str, k: f64, shape: Shape, every: bool| {
-            let mut h = halves.clone();
+            let mut h = found.clone();
             h.push((name.to_string(), k, shape));
             score(&h, every).unwrap_or(f64::INFINITY)
         };
         let mut round: Option<(f64, &str, f64, Shape)> = None;
-        for (name, median, shape) in scaled.iter().filter(|(n, _, _)| !halves.iter().any(|(h, _, _)| h == n))
-        {
+        for (name, about, shape) in scaled.iter().filter(|(n, _, _)| !found.iter().any(|(h, _, _)| h == n)) {
             let shape = *shape;
             let with = |k: f64, every: bool| with(name, k, shape, every);
             let octaves = (GRID.1 / GRID.0).log2().round() as usize;
             let grid: Vec<f64> = (0..=octaves * PER_OCTAVE)
-                .map(|i| median * GRID.0 * 2f64.powf(i as f64 / PER_OCTAVE as f64))
+                .map(|i| about * GRID.0 * 2f64.powf(i as f64 / PER_OCTAVE as f64))
                 .collect();
             let Some((at, k)) =
                 grid.par_iter().map(|k| (with(*k, false), *k)).min_by(|a, b| a.0.total_cmp(&b.0))
@@ -214,13 +214,13 @@ fn scanned(
         }
         match round {
             Some((s, name, k, shape)) if best - s > CLEARLY => {
-                halves.push((name.to_string(), k, shape));
+                found.push((name.to_string(), k, shape));
                 best = s;
             }
             _ => break,
         }
     }
-    (!halves.is_empty()).then_some(halves)
+    (!found.is_empty()).then_some(found)
 }
 
 /// The K within a grid step of `k` (whose criterion is `at_k`) that lowers `criterion` most, by
