@@ -57,16 +57,6 @@ pub(super) fn own_variables(model: &Model, outline: &crate::model::Outline) -> V
     outline.states.iter().chain(&outline.inputs).filter(|s| !about_a_reference(s)).cloned().collect()
 }
 
-/// The share of its target the chosen terms of `selection` leave unexplained (1 − R², at
-/// least the smallest positive double).
-pub(super) fn unexplained(selection: &crate::select::Selection) -> Option<f64> {
-    selection
-        .chosen_step
-        .checked_sub(1)
-        .and_then(|k| selection.steps.get(k))
-        .map(|step| (1.0 - step.r2).max(f64::MIN_POSITIVE))
-}
-
 /// The laws, in words.
 const ALL: &str = "sign, x·|x|, √|x|, sin x";
 
@@ -116,15 +106,22 @@ fn fits_better(polynomials: &Recipe, with: &Recipe) -> Option<f64> {
         }
         let rows = a.rows as f64
             / poly.correlation_time.unwrap_or(1.0).max(laws.correlation_time.unwrap_or(1.0)).max(1.0);
-        gain += rows * (unexplained(a)? / unexplained(b)?).ln()
-            + (a.terms.len() as f64 - b.terms.len() as f64) * rows.ln();
+        gain += information(a, rows)? - information(b, rows)?;
     }
     Some(gain)
 }
 
+/// The Bayesian information criterion of the terms `selection` chose, its rows counted as
+/// `rows` independent ones.
+pub(super) fn information(selection: &crate::select::Selection, rows: f64) -> Option<f64> {
+    // 1 − R², at least the smallest positive double (a noise-free fit's may be 0)
+    let unexplained = (1.0 - selection.chosen_r2()?).max(f64::MIN_POSITIVE);
+    Some(rows * unexplained.ln() + selection.terms.len() as f64 * rows.ln())
+}
+
 /// How much lower the laws' information criterion must be where the polynomials pass every
 /// check: "very strong" evidence (Kass & Raftery 1995).
-const CLEARLY: f64 = 10.0;
+pub(super) const CLEARLY: f64 = 10.0;
 
 /// The number of terms of the identified equations of `recipe`'s kept model, and the `laws`
 /// among them (each once).

@@ -5,7 +5,7 @@
 //! information criterion, each variable's in turn, and the system identified again with the
 //! saturating forms at the K found; kept as the laws are (`laws.rs`), either way said.
 
-use super::laws::{self, Tried};
+use super::laws::{self, Tried, CLEARLY};
 use super::{start, Recipe, RecipeError, RecipeSettings};
 use crate::data::Frame;
 use crate::identify::{identify_model, Fit, ModelIdentification};
@@ -26,10 +26,6 @@ const PER_OCTAVE: usize = 4;
 /// Golden-section steps refining the grid's best K within a grid step each side: to 0.01 % of
 /// K, below which a noise-free record's re-simulation no longer tells.
 const REFINE: usize = 16;
-
-/// How much lower the information criterion with a variable's saturating forms must be than
-/// without them for the variable to saturate: "very strong" evidence (Kass & Raftery 1995).
-const CLEARLY: f64 = 10.0;
 
 /// How a variable saturates: one positive in every row (a population, a concentration) as
 /// x/(x + K) and its kin ([`crate::term::saturations`]), one of either sign (a command, a
@@ -251,15 +247,13 @@ fn refined(criterion: &dyn Fn(f64) -> f64, k: f64, at_k: f64) -> f64 {
     }
 }
 
-/// The Bayesian information criterion of `fits`, summed over the equations: each counted in
+/// The Bayesian information criterion of `fits` ([`laws::information`]), summed over the equations: each counted in
 /// its rows over its residuals' `correlation` time (the independent ones).
 fn information(fits: &[(String, Fit)], correlation: &[(String, f64)]) -> Option<f64> {
     let mut total = 0.0;
     for (name, fit) in fits {
         let tau = correlation.iter().find(|(n, _)| n == name).map_or(1.0, |(_, t)| *t);
-        let rows = fit.selection.rows as f64 / tau;
-        total +=
-            rows * laws::unexplained(&fit.selection)?.ln() + fit.selection.terms.len() as f64 * rows.ln();
+        total += laws::information(&fit.selection, fit.selection.rows as f64 / tau)?;
     }
     Some(total)
 }
