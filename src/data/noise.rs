@@ -54,14 +54,23 @@ pub fn white_noise(x: &[f64]) -> Option<Noise> {
 /// difference spans) is motion, not noise. ẋ = −x + 2u with u white and held read "at
 /// least 12 %" of a record that had none.
 pub fn white_noise_beside(x: &[f64], stepped: &[&[f64]]) -> Option<Noise> {
+    white_noise_of(x, None, stepped)
+}
+
+/// [`white_noise_beside`] of a record sampled at `times` (or evenly, `None`): unevenly spaced
+/// samples (a logger's jitter) are differenced by the polynomials through their neighbours at
+/// their own times, which leave a smooth motion nothing as even differences do (read as if
+/// even, a jitter of a fifth of the step made the Lotka-Volterra cycle's motion read 0.1 % of
+/// its span as noise it did not have).
+fn white_noise_of(x: &[f64], times: Option<&[f64]>, stepped: &[&[f64]]) -> Option<Noise> {
     if x.len() < 20 || x.iter().any(|v| !v.is_finite()) {
         return None;
     }
-    let one = over(x, 1, stepped);
+    let one = over(x, times, 1, stepped);
     if !one.measured || x.len() < 4 * 2 + 20 {
         return Some(one);
     }
-    let two = over(x, 2, stepped);
+    let two = over(x, times, 2, stepped);
     if two.sd > MOTION * one.sd {
         // the motion's own fourth difference, not noise: it bounds the noise from above
         return Some(Noise { measured: false, ..one });
@@ -78,13 +87,19 @@ pub fn white_noise_beside(x: &[f64], stepped: &[&[f64]]) -> Option<Noise> {
 /// read "at least 53 %" noise of a record that had none.
 const MOTION: f64 = 4.0;
 
-/// The noise read off the differences of `x` over `lag` samples, less what the `stepped`
-/// inputs' values explain of them.
-fn over(x: &[f64], lag: usize, stepped: &[&[f64]]) -> Noise {
-    let third: Vec<f64> = (0..x.len() - 3 * lag)
-        .map(|k| x[k + 3 * lag] - 3.0 * x[k + 2 * lag] + 3.0 * x[k + lag] - x[k])
-        .collect();
-    let fourth: Vec<f64> = (0..third.len() - lag).map(|k| third[k + lag] - third[k]).collect();
+/// The noise read off the differences of `x` (sampled at `times`, or evenly) over `lag`
+/// samples, less what the `stepped` inputs' values explain of them.
+fn over(x: &[f64], times: Option<&[f64]>, lag: usize, stepped: &[&[f64]]) -> Noise {
+    let (third, fourth) = match times {
+        Some(t) => timed_differences(x, t, lag),
+        None => {
+            let third: Vec<f64> = (0..x.len() - 3 * lag)
+                .map(|k| x[k + 3 * lag] - 3.0 * x[k + 2 * lag] + 3.0 * x[k + lag] - x[k])
+                .collect();
+            let fourth: Vec<f64> = (0..third.len() - lag).map(|k| third[k + lag] - third[k]).collect();
+            (third, fourth)
+        }
+    };
     let (third, fourth) = match stepped {
         [] => (third, fourth),
         _ => (
@@ -96,11 +111,46 @@ fn over(x: &[f64], lag: usize, stepped: &[&[f64]]) -> Noise {
     Noise { sd: s4, measured: s4 >= WHITE * s3, correlated: false }
 }
 
+/// The third and fourth differences over `lag` samples of `x` sampled at `times`, unevenly:
+/// each sample less the polynomial through the samples before it (the third: a quadratic
+/// through three) or about it (the fourth: a cubic through the two each side) at its time,
+/// scaled so that white noise spreads it as it spreads the even differences (by √20 and √70
+/// over the root of one plus the polynomial's squared weights). At even steps they are the
+/// even differences: the cubic through x₋₂, x₋₁, x₁, x₂ is (−x₋₂ + 4x₋₁ + 4x₁ − x₂)/6 at 0.
+fn timed_differences(x: &[f64], t: &[f64], lag: usize) -> (Vec<f64>, Vec<f64>) {
+    // sample `at` less the polynomial through the samples `through` at its time, scaled
+    let left = |at: usize, through: &[usize], scale: f64| -> f64 {
+        let mut predicted = 0.0;
+        let mut squares = 1.0;
+        for &i in through {
+            let w: f64 =
+                through.iter().filter(|&&j| j != i).map(|&j| (t[at] - t[j]) / (t[i] - t[j])).product();
+            predicted += w * x[i];
+            squares += w * w;
+        }
+        let r = (x[at] - predicted) * scale / squares.sqrt();
+        // (a frame's times increase, so the weights are finite; should two samples share
+        // a time, their difference tells nothing)
+        if r.is_finite() {
+            r
+        } else {
+            0.0
+        }
+    };
+    let third: Vec<f64> = (0..x.len().saturating_sub(3 * lag))
+        .map(|k| left(k + 3 * lag, &[k, k + lag, k + 2 * lag], THIRD.sqrt()))
+        .collect();
+    let fourth: Vec<f64> = (0..x.len().saturating_sub(4 * lag))
+        .map(|k| left(k + 2 * lag, &[k, k + lag, k + 3 * lag, k + 4 * lag], FOURTH.sqrt()))
+        .collect();
+    (third, fourth)
+}
+
 /// The white noise that `x`'s fourth differences over `lag` samples read, whatever the motion
 /// (`over`'s reading alone): how it grows with the lag tells a stationary noise from a path of
 /// independent steps. `None` for a record under 20 samples beyond the differences' reach.
 pub(crate) fn fourth_differences_over(x: &[f64], lag: usize) -> Option<f64> {
-    (x.len() >= 4 * lag + 20).then(|| over(x, lag, &[]).sd)
+    (x.len() >= 4 * lag + 20).then(|| over(x, None, lag, &[]).sd)
 }
 
 /// A difference series regressed on the values of inputs that each of its terms spans.
@@ -286,7 +336,7 @@ impl NoiseTally {
             let read: Vec<f64> = at.iter().map(|&k| x[k]).collect();
             let first = at.partition_point(|&k| k < own.start);
             let own = first..first + at[first..].partition_point(|&k| k < own.end);
-            return Some(Self::of_values(&read, own, true, &[]));
+            return Some(Self::of_values(&read, None, own, true, &[]));
         }
         // (a column stepped at every sample that no record follows is a value's noise, and may
         // be rounded)
@@ -299,13 +349,27 @@ impl NoiseTally {
             return Some(NoiseTally { noise_rows: spread.rows, ..spread });
         }
         let others: Vec<&[f64]> = stepped.iter().filter(|(c, _)| *c != name).map(|(_, u)| *u).collect();
-        Some(Self::of_values(x, own, !command, &others))
+        if frame.recorded().is_some() {
+            // resampled onto a finer grid (a logger's jitter): the cubics' rows between the
+            // samples are smooth (1 % of noise read 0.092 %), so it is read at the samples, at
+            // their own times
+            let at: Vec<usize> = (0..x.len()).filter(|&k| frame.is_sample(k)).collect();
+            let pick = |v: &[f64]| -> Vec<f64> { at.iter().map(|&k| v[k]).collect() };
+            let first = at.partition_point(|&k| k < own.start);
+            let own = first..first + at[first..].partition_point(|&k| k < own.end);
+            let others: Vec<Vec<f64>> = others.iter().map(|u| pick(u)).collect();
+            let others: Vec<&[f64]> = others.iter().map(Vec::as_slice).collect();
+            return Some(Self::of_values(&pick(x), Some(&pick(frame.time())), own, !command, &others));
+        }
+        Some(Self::of_values(x, None, own, !command, &others))
     }
 
-    /// The tally of the `own` rows of `x`, its rounding counted where `rounded` allows, less
-    /// what the held inputs `stepped` explain ([`white_noise_beside`]).
+    /// The tally of the `own` rows of `x` (sampled at `times`, or evenly), its rounding counted
+    /// where `rounded` allows, less what the held inputs `stepped` explain
+    /// ([`white_noise_beside`]).
     pub(crate) fn of_values(
         x: &[f64],
+        times: Option<&[f64]>,
         own: std::ops::Range<usize>,
         rounded: bool,
         stepped: &[&[f64]],
@@ -321,10 +385,10 @@ impl NoiseTally {
         let rounding = |g: Grid| Noise { sd: g.step / 12f64.sqrt(), measured: true, correlated: false };
         let found = match grid(x).filter(|_| rounded) {
             Some(g) if g.staircase => Some(rounding(g)),
-            Some(g) if g.rests => {
-                Some(white_noise_beside(x, stepped).filter(|w| w.sd >= rounding(g).sd).unwrap_or(rounding(g)))
-            }
-            _ => white_noise_beside(x, stepped),
+            Some(g) if g.rests => Some(
+                white_noise_of(x, times, stepped).filter(|w| w.sd >= rounding(g).sd).unwrap_or(rounding(g)),
+            ),
+            _ => white_noise_of(x, times, stepped),
         };
         if let Some(found) = found {
             let (sum, count) = if found.measured {
@@ -476,14 +540,14 @@ mod tests {
         let found = white_noise(&correlated).unwrap();
         assert!(found.measured && found.correlated && (0.45..0.6).contains(&(found.sd / 0.05)), "{found:?}");
         assert!(!white_noise(&noisy).unwrap().correlated);
-        assert!((over(&correlated, 1, &[]).sd / 0.05 - 0.36).abs() < 0.03);
+        assert!((over(&correlated, None, 1, &[]).sd / 0.05 - 0.36).abs() < 0.03);
         assert_eq!(white_noise(&[1.0; 100]), Some(Noise { sd: 0.0, measured: true, correlated: false }));
         // the sine printed to a tenth of its amplitude moves a step at a time: its rounding
         // is noise of 0.1/√12 the differences read as 0; a command switched between three
         // levels, or steps of more than one, are no rounding
         let printed: Vec<f64> = clean.iter().map(|v| (v * 10.0).round() / 10.0).collect();
         assert!((quantum(&printed).unwrap() - 0.1).abs() < 1e-12);
-        let tally = NoiseTally::of_values(&printed, 0..printed.len(), true, &[]);
+        let tally = NoiseTally::of_values(&printed, None, 0..printed.len(), true, &[]);
         let (share, measured) = tally.share().unwrap();
         let sd = share * std::f64::consts::FRAC_1_SQRT_2;
         assert!(
@@ -509,10 +573,10 @@ mod tests {
             .collect();
         assert_eq!(quantum(&counts), None);
         assert!(white_noise(&counts).unwrap().sd < 0.1 * 0.01 / 12f64.sqrt());
-        let tally = NoiseTally::of_values(&counts, 0..counts.len(), true, &[]);
+        let tally = NoiseTally::of_values(&counts, None, 0..counts.len(), true, &[]);
         assert!((tally.sd().unwrap() / (0.01 / 12f64.sqrt()) - 1.0).abs() < 1e-9, "{tally:?}");
         let printed: Vec<f64> = noisy.iter().map(|v| (v * 1000.0).round() / 1000.0).collect();
-        let tally = NoiseTally::of_values(&printed, 0..printed.len(), true, &[]);
+        let tally = NoiseTally::of_values(&printed, None, 0..printed.len(), true, &[]);
         assert!((tally.sd().unwrap() / 0.05 - 1.0).abs() < 0.05, "{tally:?}");
         assert_eq!(white_noise(&[1.0; 10]), None);
         // a lynx population of Lotka-Volterra (ẋ = 0.55x − 0.028xy, ẏ = 0.024xy − 0.8y) read
@@ -536,9 +600,53 @@ mod tests {
                 now
             })
             .collect();
-        assert!(over(&lynx, 1, &[]).measured && over(&lynx, 2, &[]).sd > MOTION * over(&lynx, 1, &[]).sd);
+        assert!(
+            over(&lynx, None, 1, &[]).measured
+                && over(&lynx, None, 2, &[]).sd > MOTION * over(&lynx, None, 1, &[]).sd
+        );
         let found = white_noise(&lynx).unwrap();
         assert!(!found.measured && !found.correlated, "{found:?}");
+    }
+
+    /// A sine sampled at times jittered by up to a fifth of the step (a logger's clock): read
+    /// at those times, its motion leaves nothing and noise of 1 % of its amplitude reads 1 %
+    /// within 10 %; read as if even, the motion alone reads as noise. Evened onto a finer grid
+    /// (the recipe's preparation), the frame's noise is read at its samples: the cubics' rows
+    /// between them are smooth.
+    #[test]
+    fn jittered_samples_are_read_at_their_own_times() {
+        let mut seed = 11u64;
+        let n = 4000;
+        let t: Vec<f64> =
+            (0..n).map(|k| 0.05 * (k as f64 + 0.4 * crate::data::test_noise(&mut seed))).collect();
+        let clean: Vec<f64> = t.iter().map(|t| (0.9 * t).sin()).collect();
+        let timed = white_noise_of(&clean, Some(&t), &[]).unwrap();
+        assert!(timed.sd < 1e-6, "{timed:?}");
+        assert!(white_noise(&clean).unwrap().sd > 1e-3, "{:?}", white_noise(&clean));
+        let noisy: Vec<f64> =
+            clean.iter().map(|x| x + 0.01 * 12f64.sqrt() * crate::data::test_noise(&mut seed)).collect();
+        let read = white_noise_of(&noisy, Some(&t), &[]).unwrap();
+        assert!(read.measured && (read.sd / 0.01 - 1.0).abs() < 0.1, "{read:?}");
+        // (uniform noise reads 5 % high by the median, as the same noise on the sine at even
+        // steps does)
+        let at_even: Vec<f64> = (0..n).map(|k| noisy[k] - clean[k] + (0.045 * k as f64).sin()).collect();
+        assert!((read.sd / white_noise(&at_even).unwrap().sd - 1.0).abs() < 0.01, "{read:?}");
+        // at even steps the timed differences are the even ones
+        let even: Vec<f64> = (0..n).map(|k| 0.05 * k as f64).collect();
+        let (third, fourth) = timed_differences(&noisy, &even, 1);
+        assert!((third[7] - (noisy[10] - 3.0 * noisy[9] + 3.0 * noisy[8] - noisy[7])).abs() < 1e-12);
+        let d4 = noisy[7] - 4.0 * noisy[8] + 6.0 * noisy[9] - 4.0 * noisy[10] + noisy[11];
+        assert!((fourth[7] - d4).abs() < 1e-12, "{} {d4}", fourth[7]);
+        let mut frame = Frame::new("logger.csv", "t", t).unwrap();
+        frame.push("x", noisy).unwrap();
+        let (fine, _) = super::super::resample::evened(&frame).unwrap().unwrap();
+        assert!(fine.len() > 2 * n);
+        // (a sample's row holds the cubic through its four nearest at the grid's time, a
+        // quarter of a row off at most, which smooths its noise a little: 0.94 % read; its
+        // rows read as one record, 0.03 % at most)
+        let sd = NoiseTally::of(&fine, "x", 0..fine.len()).unwrap().sd().unwrap();
+        assert!((sd / 0.01 - 1.0).abs() < 0.1, "{sd}");
+        assert!(white_noise(fine.column("x").unwrap()).unwrap().sd < 0.001);
     }
 
     /// ẋ = −x + 2u under u white and held from each sample to the next (exact steps): the
@@ -624,12 +732,13 @@ mod tests {
         };
         let x: Vec<f64> =
             (0..10_000).map(|k| 3.0 * (k as f64 * 0.01).sin() + 5.0 + 0.1 * uniform()).collect();
-        let whole = NoiseTally::of_values(&x, 0..x.len(), true, &[]);
+        let whole = NoiseTally::of_values(&x, None, 0..x.len(), true, &[]);
         let mut pieces = NoiseTally::default();
         for start in (0..x.len()).step_by(1000) {
             let (from, to) = (start.saturating_sub(6), (start + 1006).min(x.len()));
             pieces.merge(&NoiseTally::of_values(
                 &x[from..to],
+                None,
                 start - from..start - from + 1000.min(x.len() - start),
                 true,
                 &[],
@@ -640,7 +749,7 @@ mod tests {
         let (a, b) = (whole.share().unwrap(), pieces.share().unwrap());
         assert!(a.1 && b.1 && (a.0 / b.0 - 1.0).abs() < 0.05, "{a:?} {b:?}");
         let mut short = whole.clone();
-        short.merge(&NoiseTally::of_values(&[100.0; 5], 0..5, true, &[]));
+        short.merge(&NoiseTally::of_values(&[100.0; 5], None, 0..5, true, &[]));
         assert_eq!(
             (short.noise, short.noise_rows, short.rows),
             (whole.noise, whole.noise_rows, whole.rows + 5)

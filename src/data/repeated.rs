@@ -223,7 +223,7 @@ fn integrates_from_samples(x: &[f64], others: &[&[f64]], kept: &[usize], w: usiz
     let m = others.len();
     let columns = 3 * m + leaps.len() + 1;
     let noisy = |c: &[f64]| {
-        super::NoiseTally::of_values(c, 0..c.len(), false, &[])
+        super::NoiseTally::of_values(c, None, 0..c.len(), false, &[])
             .share()
             .is_some_and(|(share, measured)| measured && share >= NOISY)
     };

@@ -676,17 +676,11 @@ fn inputs_noise(model: &Model, run: &Frame, step: f64, sim: &crate::sim::Traject
 /// ([`crate::data::NoiseTally::of`]): what inputs held between samples explain of its
 /// differences is motion, and such an input is its generator's exact values (a state driven by
 /// a random excitation stepped each sample read 4.5-5.5 % of noise it did not have, the
-/// excitation itself all noise); at the record's own samples where it was resampled onto a finer grid
-/// (a logger's jitter: the cubic's rows between noisy samples are smooth, their noise read
-/// 0.015 % for 1 %). 0 where none is found.
+/// excitation itself all noise); at the record's own samples where it was resampled onto a
+/// finer grid (a logger's jitter: the cubic's rows between noisy samples are smooth, their
+/// noise read 0.015 % for 1 %). 0 where none is found.
 fn noise_of(run: &Frame, name: &str) -> f64 {
-    match (run.recorded(), run.column(name)) {
-        (Some(_), Some(x)) => {
-            let samples: Vec<f64> = (0..x.len()).filter(|&k| run.is_sample(k)).map(|k| x[k]).collect();
-            crate::data::white_noise(&samples).map_or(0.0, |n| n.sd)
-        }
-        _ => crate::data::NoiseTally::of(run, name, 0..run.len()).and_then(|t| t.sd()).unwrap_or(0.0),
-    }
+    crate::data::NoiseTally::of(run, name, 0..run.len()).and_then(|t| t.sd()).unwrap_or(0.0)
 }
 
 /// `model` re-simulated from `run`'s start under its inputs, every `step` s (adaptive steps).
