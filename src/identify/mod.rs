@@ -53,7 +53,7 @@ pub use delay::Lag;
 
 pub use model::{
     coefficients_of, describe_residuals_of, equation_design, fit_equation, fit_equation_design,
-    identify_model, say_late_inputs, IdentifiedModel, ModelIdentification,
+    identify_model, say_late_inputs, select_model, IdentifiedModel, ModelIdentification,
 };
 pub(crate) use model::{store_fit, RunStatistics};
 pub use noise::noise_note;
@@ -1071,6 +1071,44 @@ impl Identification<'_> {
         self.fit_design(target, &design, forced, excluded, frames, backend)
     }
 
+    /// The statistics [`Identification::fit_design`] selects from: each run's moments (the
+    /// folds) and the `forced` and `excluded` terms' columns of `design`.
+    fn folds_of(
+        &self,
+        target: &Target,
+        design: &Design,
+        forced: &[Term],
+        excluded: &[Term],
+        frames: &[Frame],
+    ) -> Result<Folds, IdentifyError> {
+        wake_a_worker(frames, design.candidates().len());
+        if frames.is_empty() {
+            return Err(IdentifyError::Setup("no data: give at least one run".into()));
+        }
+        let (forced, excluded) =
+            (design.columns_of(forced, "forced")?, design.columns_of(excluded, "excluded")?);
+        // per run, for the back-ends that cross-validate; together they are "Komb. Daten"
+        let folds = self.moments_of_runs(&design.library, design.candidates(), target, frames)?;
+        Ok(Folds { forced, excluded, folds })
+    }
+
+    /// The selection of [`Identification::fit_design`] alone: the back-end on the runs'
+    /// statistics, without the notes, rivals and covariance a reader wants (a scan that judges
+    /// many fits by their criterion alone: the saturations' scan of K spent half its time on
+    /// them).
+    pub fn select_design(
+        &self,
+        target: &Target,
+        design: &Design,
+        forced: &[Term],
+        excluded: &[Term],
+        frames: &[Frame],
+        backend: &dyn Selector,
+    ) -> Result<Selection, IdentifyError> {
+        let Folds { forced, excluded, folds } = self.folds_of(target, design, forced, excluded, frames)?;
+        Ok(select_folds(design.names(), &forced, &excluded, self.intercept, &folds, backend)?.1)
+    }
+
     /// [`Identification::fit`] with the candidates already compiled.
     pub fn fit_design(
         &self,
@@ -1081,15 +1119,8 @@ impl Identification<'_> {
         frames: &[Frame],
         backend: &dyn Selector,
     ) -> Result<Fit, IdentifyError> {
-        wake_a_worker(frames, design.candidates().len());
-        if frames.is_empty() {
-            return Err(IdentifyError::Setup("no data: give at least one run".into()));
-        }
         let candidates = design.candidates();
-        let (forced, excluded) =
-            (design.columns_of(forced, "forced")?, design.columns_of(excluded, "excluded")?);
-        // per run, for the back-ends that cross-validate; together they are "Komb. Daten"
-        let folds = self.moments_of_runs(&design.library, candidates, target, frames)?;
+        let Folds { forced, excluded, folds } = self.folds_of(target, design, forced, excluded, frames)?;
         let mut fit = fit_folds(
             &target.to_string(),
             design.names(),
@@ -1269,12 +1300,8 @@ pub(crate) fn fit_folds(
     folds: &[Moments],
     backend: &dyn Selector,
 ) -> Result<Fit, IdentifyError> {
-    let mut moments = Moments::new(names.len());
-    for f in folds {
-        moments.merge(f);
-    }
+    let (moments, mut selection) = select_folds(names, forced, excluded, intercept, folds, backend)?;
     let problem = Problem { moments: &moments, names, forced, excluded, intercept };
-    let mut selection = backend.select_with_folds(&problem, folds)?;
     let covariance = covariance_of(&moments, &selection);
     if let Some(note) = collinearity_note(&moments, names, &selection) {
         selection.notes.push(note);
@@ -1292,6 +1319,35 @@ pub(crate) fn fit_folds(
         residual_growth: None,
         rivals,
     })
+}
+
+/// The runs' statistics an equation is selected from ([`Identification::fit_design`]).
+struct Folds {
+    /// The forced terms' columns.
+    forced: Vec<usize>,
+    /// The excluded terms' columns.
+    excluded: Vec<usize>,
+    /// Each run's moments.
+    folds: Vec<Moments>,
+}
+
+/// The `folds` merged, and the back-end's selection from them (given the folds, for those that
+/// cross-validate).
+fn select_folds(
+    names: &[String],
+    forced: &[usize],
+    excluded: &[usize],
+    intercept: bool,
+    folds: &[Moments],
+    backend: &dyn Selector,
+) -> Result<(Moments, Selection), IdentifyError> {
+    let mut moments = Moments::new(names.len());
+    for f in folds {
+        moments.merge(f);
+    }
+    let problem = Problem { moments: &moments, names, forced, excluded, intercept };
+    let selection = backend.select_with_folds(&problem, folds)?;
+    Ok((moments, selection))
 }
 
 /// Wakes a sleeping worker where the rows of `frames` will be gathered in parallel, so that

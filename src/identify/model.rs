@@ -72,6 +72,41 @@ pub fn identify_model(
     Ok(IdentifiedModel { model: identified, fits })
 }
 
+/// The selections [`identify_model`] makes of `model`'s equations that `how` names, alone:
+/// each back-end on the runs' statistics, without the notes, rivals, covariances and
+/// residuals' description a reader wants (a scan that judges many fits by their criterion:
+/// the saturations' scan of K spent half its time on them).
+pub fn select_model(
+    model: &Model,
+    frames: &[Frame],
+    how: &ModelIdentification<'_>,
+) -> Result<Vec<(String, crate::select::Selection)>, IdentifyError> {
+    let names = equations_of(model, how)?;
+    let (model, _) = model.about_references(frames).map_err(|e| IdentifyError::Setup(e.to_string()))?;
+    let frames = &*model.acting(frames)?;
+    let rules = model.parameter_rules();
+    let identification = Identification {
+        vocabulary: &model.vocabulary,
+        parameters: &rules,
+        differentiator: how.differentiator,
+        intercept: how.intercept,
+        weights: None,
+    };
+    names
+        .iter()
+        .map(|name| {
+            let eq = model_equation(&model, name)?;
+            let target = how.target.clone().unwrap_or_else(|| default_target(eq, frames));
+            let design = Design::new(&eq.candidates, &model.vocabulary)?;
+            let backend = eq.backend.build();
+            identification
+                .select_design(&target, &design, &eq.forced, &eq.excluded, frames, backend.as_ref())
+                .map(|selection| (name.clone(), selection))
+                .map_err(|e| e.in_equation(name))
+        })
+        .collect()
+}
+
 /// An input that holds one value through every run: its name, the value, and whether it
 /// varies about it by its noise alone (recorded with a sensor's noise, not exactly).
 pub(super) type Held = (String, f64, bool);

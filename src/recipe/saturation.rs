@@ -8,8 +8,9 @@
 use super::laws::{self, Tried, CLEARLY};
 use super::{start, Recipe, RecipeError, RecipeSettings};
 use crate::data::Frame;
-use crate::identify::{identify_model, Fit, ModelIdentification};
+use crate::identify::{select_model, ModelIdentification};
 use crate::model::Model;
+use crate::select::Selection;
 use rayon::prelude::*;
 
 /// The half-saturations tried first, as multiples of each variable's median over the runs:
@@ -175,8 +176,8 @@ fn scanned(
         start.fits.iter().map(|(n, f)| (n.clone(), f.correlation_time.unwrap_or(1.0).max(1.0))).collect();
     let score = |found: &[Saturation], every: bool| -> Option<f64> {
         let extended = with_forms(model, &saturating_forms(model, found, variables), every)?;
-        let fitted = identify_model(&extended, &start.prepared, &how, &mut |_| {}).ok()?;
-        information(&fitted.fits, &correlation)
+        let selections = select_model(&extended, &start.prepared, &how).ok()?;
+        information(&selections, &correlation)
     };
     let mut best = score(&[], false)?;
     let mut found: Vec<Saturation> = Vec::new();
@@ -247,13 +248,14 @@ fn refined(criterion: &dyn Fn(f64) -> f64, k: f64, at_k: f64) -> f64 {
     }
 }
 
-/// The Bayesian information criterion of `fits` ([`laws::information`]), summed over the equations: each counted in
-/// its rows over its residuals' `correlation` time (the independent ones).
-fn information(fits: &[(String, Fit)], correlation: &[(String, f64)]) -> Option<f64> {
+/// The Bayesian information criterion of each equation's `selections` ([`laws::information`]),
+/// summed: each counted in its rows over its residuals' `correlation` time (the independent
+/// ones).
+fn information(selections: &[(String, Selection)], correlation: &[(String, f64)]) -> Option<f64> {
     let mut total = 0.0;
-    for (name, fit) in fits {
+    for (name, selection) in selections {
         let tau = correlation.iter().find(|(n, _)| n == name).map_or(1.0, |(_, t)| *t);
-        total += laws::information(&fit.selection, fit.selection.rows as f64 / tau)?;
+        total += laws::information(selection, selection.rows as f64 / tau)?;
     }
     Some(total)
 }
