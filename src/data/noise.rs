@@ -351,8 +351,8 @@ impl NoiseTally {
         let others: Vec<&[f64]> = stepped.iter().filter(|(c, _)| *c != name).map(|(_, u)| *u).collect();
         if frame.recorded().is_some() {
             // resampled onto a finer grid (a logger's jitter): the cubics' rows between the
-            // samples are smooth (1 % of noise read 0.092 %), so it is read at the samples, at
-            // their own times
+            // samples are smooth (noise of 3 % of the spread read 0.09 %), so it is read at
+            // the samples, at their own times
             let at: Vec<usize> = (0..x.len()).filter(|&k| frame.is_sample(k)).collect();
             let pick = |v: &[f64]| -> Vec<f64> { at.iter().map(|&k| v[k]).collect() };
             let first = at.partition_point(|&k| k < own.start);

@@ -84,27 +84,21 @@ pub fn select_model(
     let names = equations_of(model, how)?;
     let (model, _) = model.about_references(frames).map_err(|e| IdentifyError::Setup(e.to_string()))?;
     let frames = &*model.acting(frames)?;
-    let rules = model.parameter_rules();
-    let identification = Identification {
-        vocabulary: &model.vocabulary,
-        parameters: &rules,
-        differentiator: how.differentiator,
-        intercept: how.intercept,
-        weights: None,
-    };
-    names
-        .iter()
-        .map(|name| {
-            let eq = model_equation(&model, name)?;
-            let target = how.target.clone().unwrap_or_else(|| default_target(eq, frames));
-            let design = Design::new(&eq.candidates, &model.vocabulary)?;
-            let backend = eq.backend.build();
-            identification
-                .select_design(&target, &design, &eq.forced, &eq.excluded, frames, backend.as_ref())
-                .map(|selection| (name.clone(), selection))
-                .map_err(|e| e.in_equation(name))
-        })
-        .collect()
+    with_identification(&model, how.differentiator, how.intercept, |identification| {
+        names
+            .iter()
+            .map(|name| {
+                let eq = model_equation(&model, name)?;
+                let target = how.target.clone().unwrap_or_else(|| default_target(eq, frames));
+                let design = Design::new(&eq.candidates, &model.vocabulary)?;
+                let backend = eq.backend.build();
+                identification
+                    .select_design(&target, &design, &eq.forced, &eq.excluded, frames, backend.as_ref())
+                    .map(|selection| (name.clone(), selection))
+                    .map_err(|e| e.in_equation(name))
+            })
+            .collect()
+    })
 }
 
 /// An input that holds one value through every run: its name, the value, and whether it
@@ -321,16 +315,8 @@ pub fn fit_equation_design(
     let target = target.unwrap_or_else(|| default_target(eq, frames));
     // inputs with a dead time read back as they act
     let frames = &*model.acting(frames)?;
-    let rules = model.parameter_rules();
-    let identification = Identification {
-        vocabulary: &model.vocabulary,
-        parameters: &rules,
-        differentiator,
-        intercept,
-        weights: None,
-    };
     let backend = eq.backend.build();
-    match design {
+    with_identification(model, differentiator, intercept, |identification| match design {
         Some(d) if d.candidates() != eq.candidates.as_slice() => Err(IdentifyError::Setup(format!(
             "{}: the compiled design given for `{equation}` is of other candidates",
             model.path
@@ -339,7 +325,7 @@ pub fn fit_equation_design(
         None => {
             identification.fit(&target, &eq.candidates, &eq.forced, &eq.excluded, frames, backend.as_ref())
         }
-    }
+    })
 }
 
 /// An equation's target where none is named: the column `<state>_dot` where every run has
@@ -365,11 +351,12 @@ pub(super) fn model_equation<'m>(model: &'m Model, equation: &str) -> Result<&'m
 }
 
 /// `run` given the identification of `model`'s equations as [`fit_equation`] makes it (its
-/// vocabulary and per-run parameters, a fitted intercept) with `differentiator`: the residual
-/// passes over a fit already made.
+/// vocabulary and per-run parameters) with `differentiator`, an intercept fitted where
+/// `intercept` (the residual passes over a fit already made take it so).
 fn with_identification<T>(
     model: &Model,
     differentiator: &dyn Differentiator,
+    intercept: bool,
     run: impl FnOnce(&Identification<'_>) -> T,
 ) -> T {
     let rules = model.parameter_rules();
@@ -377,7 +364,7 @@ fn with_identification<T>(
         vocabulary: &model.vocabulary,
         parameters: &rules,
         differentiator,
-        intercept: true,
+        intercept,
         weights: None,
     })
 }
@@ -397,7 +384,7 @@ pub fn describe_residuals_of(
 ) -> Result<(), IdentifyError> {
     let candidates = candidates_of(model, fit)?;
     let frames = &*model.acting(frames)?;
-    with_identification(model, differentiator, |how| {
+    with_identification(model, differentiator, true, |how| {
         how.describe_residuals(&Target::parse(&fit.target), &candidates, frames, fit)
     })
 }
@@ -424,7 +411,7 @@ pub fn say_late_inputs(
         )
     };
     let mut late: Vec<super::Lag> = Vec::new();
-    with_identification(model, differentiator, |how| {
+    with_identification(model, differentiator, true, |how| {
         for (name, fit) in &mut identified.fits {
             let candidates = candidates_of(model, fit)?;
             let target = Target::parse(&fit.target);
