@@ -334,9 +334,7 @@ impl NoiseTally {
         if let Some(r) = frame.readings_of(name) {
             let at: Vec<usize> = r.readings(x.len()).collect();
             let read: Vec<f64> = at.iter().map(|&k| x[k]).collect();
-            let first = at.partition_point(|&k| k < own.start);
-            let own = first..first + at[first..].partition_point(|&k| k < own.end);
-            return Some(Self::of_values(&read, None, own, true, &[]));
+            return Some(Self::of_values(&read, None, among(&at, own), true, &[]));
         }
         // (a column stepped at every sample that no record follows is a value's noise, and may
         // be rounded)
@@ -355,11 +353,10 @@ impl NoiseTally {
             // the samples, at their own times
             let at: Vec<usize> = (0..x.len()).filter(|&k| frame.is_sample(k)).collect();
             let pick = |v: &[f64]| -> Vec<f64> { at.iter().map(|&k| v[k]).collect() };
-            let first = at.partition_point(|&k| k < own.start);
-            let own = first..first + at[first..].partition_point(|&k| k < own.end);
             let others: Vec<Vec<f64>> = others.iter().map(|u| pick(u)).collect();
             let others: Vec<&[f64]> = others.iter().map(Vec::as_slice).collect();
-            return Some(Self::of_values(&pick(x), Some(&pick(frame.time())), own, !command, &others));
+            let times = pick(frame.time());
+            return Some(Self::of_values(&pick(x), Some(&times), among(&at, own), !command, &others));
         }
         Some(Self::of_values(x, None, own, !command, &others))
     }
@@ -490,6 +487,13 @@ impl NoiseTally {
             && [self.noise, self.bound, self.m2].iter().all(|v| v.is_finite() && *v >= 0.0)
             && self.mean.is_finite()
     }
+}
+
+/// The places in `at` (rows, increasing) of the rows `own`: a run's own rows among the
+/// readings or samples a record is read at.
+fn among(at: &[usize], own: std::ops::Range<usize>) -> std::ops::Range<usize> {
+    let first = at.partition_point(|&k| k < own.start);
+    first..first + at[first..].partition_point(|&k| k < own.end)
 }
 
 /// 1.4826 times the median absolute value: the standard deviation of Gaussian values about 0.
