@@ -184,7 +184,7 @@ impl Compiled {
 /// over `runs` (by name, each with the columns of `columns`, the first) where there are
 /// several; a column is explained by the rows of `columns` alone.
 #[pyfunction]
-#[pyo3(signature = (target, columns, terms, backend = "{\"method\": \"stepwise\"}", intercept = true, forced = vec![], excluded = vec![], parameters = BTreeMap::new(), weights = None, time = None, derivative = None, keep_spikes = false, intersample = "auto", delays = BTreeMap::new(), runs = vec![]))]
+#[pyo3(signature = (target, columns, terms, backend = "{\"method\": \"stepwise\"}", intercept = true, forced = vec![], excluded = vec![], parameters = BTreeMap::new(), weights = None, time = None, derivative = None, keep_spikes = false, intersample = "auto", delays = BTreeMap::new(), lags = BTreeMap::new(), runs = vec![]))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn fit(
     py: Python<'_>,
@@ -202,6 +202,7 @@ pub(crate) fn fit(
     keep_spikes: bool,
     intersample: &str,
     delays: BTreeMap<String, f64>,
+    lags: BTreeMap<String, f64>,
     runs: Vec<(String, Bound<'_, PyDict>)>,
 ) -> PyResult<PyFit> {
     let intersample = match intersample {
@@ -308,8 +309,10 @@ pub(crate) fn fit(
             // judged as it acts); any column a slower sensor's readings; the state's leap a cut
             // between runs joined
             let late: Vec<(&str, f64)> = delays.iter().map(|(n, s)| (n.as_str(), *s)).collect();
+            let lagging: Vec<(&str, f64)> = lags.iter().map(|(n, s)| (n.as_str(), *s)).collect();
             let (mut frames, notes) =
-                termid::data::runs_of_rate(despiked, state, &all, &late, intersample).map_err(fail)?;
+                termid::data::runs_of_rate(despiked, state, &all, &late, &lagging, intersample)
+                    .map_err(fail)?;
             for note in notes {
                 warn(py, note)?;
             }
@@ -318,6 +321,12 @@ pub(crate) fn fit(
             for (name, seconds) in &delays {
                 for frame in &mut frames {
                     *frame = termid::data::delayed(frame, name, *seconds, 0.0).map_err(fail)?;
+                }
+            }
+            // and through their lags, from where the lags' start at rest has died away
+            if !lagging.is_empty() {
+                for frame in &mut frames {
+                    *frame = termid::data::lagged(frame, &lagging, 0.0).map_err(fail)?;
                 }
             }
             let others: Vec<String> = all.iter().filter(|c| **c != state).map(|c| c.to_string()).collect();

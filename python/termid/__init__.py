@@ -997,6 +997,7 @@ def fit(
     keep_spikes: bool = False,
     intersample: str = "auto",
     delays: Optional[Mapping[str, float]] = None,
+    lags: Optional[Mapping[str, float]] = None,
     by: Optional[str] = None,
     **settings: Any,
 ) -> Fit:
@@ -1042,7 +1043,11 @@ def fit(
     left out, with a warning);
     ``delays`` columns that act later than recorded (a dead time), in seconds, e.g.
     ``{"F": 0.2}``: read that much earlier against the rest, the rows' first seconds left out
-    (without it, a rate's ``notes`` say a delay the residuals show); ``by`` a column that
+    (without it, a rate's ``notes`` say a delay the residuals show, or a first-order lag where
+    one explains them better); ``lags`` columns that act through a first-order lag (an
+    actuator that follows its command as ẏ = (u − y)/T), its time constant in seconds, e.g.
+    ``{"u": 0.5}``: read through it, at rest at the first value, the rows' first five time
+    constants left out (after ``delays`` where both name a column); ``by`` a column that
     tells the runs of ``data`` apart (runs one after another in one frame, the long format):
     the rows of each of its values are a run of their own, as a list of runs would be.
 
@@ -1120,6 +1125,7 @@ def fit(
             keep_spikes,
             intersample,
             dict(delays or {}),
+            dict(lags or {}),
             [(name, dict(c)) for (name, _), c in zip(runs, every)] if rate and len(runs) > 1 else [],
         )
     except TermidError as e:
@@ -2421,7 +2427,8 @@ class Model:
         identified again by Itô's steps (the ``ito`` method, whose terms the force does not
         bias), and said; ``random_force`` False keeps the start's method. A system of no
         field's whose fit finds an input acting later than recorded (a dead time, said in its
-        notes) is identified again with the input read so (its ``delay`` in the model), kept
+        notes, or a first-order lag where one explains the rates better) is identified again
+        with the input read so (its ``delay`` or ``lag`` in the model), kept
         where it fails no check the inputs as recorded pass, and said; ``dead_times`` False keeps
         the inputs as recorded.
 

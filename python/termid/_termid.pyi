@@ -221,6 +221,7 @@ def fit(
     keep_spikes: bool = False,
     intersample: str = "auto",
     delays: Dict[str, float] = ...,
+    lags: Dict[str, float] = ...,
     runs: Sequence[Tuple[str, Columns]] = ...,
 ) -> Fit: ...
 def methods() -> Tuple[List[str], List[str]]: ...

@@ -536,6 +536,36 @@ def test_a_smooth_input_declared_late_is_read_as_it_acts():
     assert not any("taken as held" in str(w.message) for w in said), [str(w.message) for w in said]
 
 
+def test_an_input_through_a_first_order_lag_is_said_and_fitted_through_it():
+    # ẋ = −0.5x + 0.8y, ẏ = (u − y)/0.5 (an actuator's lag), u three sines logged every
+    # 0.05 s, the actuator starting from 0: the notes say the lag (better than a dead time
+    # over the same rows) and how to fit it; read through it (lags=), the true terms
+    def u(t):
+        return 1.5 * np.sin(0.31 * t) + np.sin(0.83 * t + 1.0) + 0.5 * np.sin(2.1 * t + 2.0)
+
+    def rate(t, s):
+        return np.array([-0.5 * s[0] + 0.8 * s[1], (u(t) - s[1]) / 0.5])
+
+    h, s, rows = 0.005, np.zeros(2), []
+    for k in range(4000):
+        rows.append((0.05 * k, s[0], u(0.05 * k)))
+        for j in range(10):
+            t = 0.05 * k + h * j
+            k1 = rate(t, s)
+            k2 = rate(t + h / 2, s + h / 2 * k1)
+            k3 = rate(t + h / 2, s + h / 2 * k2)
+            k4 = rate(t + h, s + h * k3)
+            s = s + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    df = pd.DataFrame(rows, columns=["t", "x", "u"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plain = termid.fit(df, "dx/dt", ["x", "u", "x^3"])
+        lagged = termid.fit(df, "dx/dt", ["x", "u", "x^3"], lags={"u": 0.5})
+    assert any("a first-order lag of 0.500 s" in n and 'lags={"u": 0.500}' in n for n in plain.notes), plain.notes
+    assert lagged.coefficients.sort_index().round(3).to_dict() == {"u": 0.8, "x": -0.5}
+    assert not any("acts on" in n for n in lagged.notes)
+
+
 def _lorenz_log(repeated, start=(-8.0, 7.0, 27.0), rows=10_001):
     # Lorenz every 1 ms from `start` (RK4), the columns `repeated` read every 10th row and
     # written again until the next reading (a slower sensor merged and filled forward)

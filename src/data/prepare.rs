@@ -9,7 +9,7 @@ use super::{cut_at_breaks, cut_at_clips, mark_held_acting, read_at_readings, Dat
 
 /// The runs of one rate, `state`'s, as its fit reads them: every other of `columns` an input
 /// that may be held between samples ([`super::mark_held`]; one of `late` judged as it acts, that many
-/// seconds late: [`mark_held_acting`]), any of them (the state too) a slower
+/// seconds late, one of `lags` by its record alone: [`mark_held_acting`]), any of them (the state too) a slower
 /// sensor's readings, read at them ([`read_at_readings`]), and a run cut where the state leaps
 /// and stays (records joined in one file: [`cut_at_breaks`]; another column's leap alone is a
 /// step of an input) and around where it rests pinned at an end of its range (a sensor
@@ -19,12 +19,13 @@ pub fn runs_of_rate(
     state: &str,
     columns: &[&str],
     late: &[(&str, f64)],
+    lags: &[(&str, f64)],
     intersample: Intersample,
 ) -> Result<(Vec<Frame>, Vec<String>), DataError> {
     let inputs: Vec<&str> = columns.iter().copied().filter(|n| *n != state).collect();
     let (mut runs, mut notes) = (Vec::new(), Vec::new());
     for mut frame in frames {
-        notes.extend(mark_held_acting(&mut frame, &inputs, late, columns, intersample)?);
+        notes.extend(mark_held_acting(&mut frame, &inputs, late, lags, columns, intersample)?);
         notes.extend(read_at_readings(&mut frame, columns, intersample)?);
         let (cut, said) = cut_at_breaks(frame, &[state], &inputs)?;
         notes.extend(said);
@@ -103,7 +104,7 @@ mod tests {
         f.push("x", t.iter().map(|t| ((-0.05 * t).exp() * (2.0 * t).cos()).clamp(-0.6, 0.6)).collect())
             .unwrap();
         f.push("u", t.iter().map(|t| (0.3 * t).sin()).collect()).unwrap();
-        let (runs, notes) = runs_of_rate(vec![f], "x", &["x", "u"], &[], Intersample::Auto).unwrap();
+        let (runs, notes) = runs_of_rate(vec![f], "x", &["x", "u"], &[], &[], Intersample::Auto).unwrap();
         assert!(
             runs.len() > 1 && notes.iter().any(|n| n.contains("`x` rests at its largest value")),
             "{notes:?}"

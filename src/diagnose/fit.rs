@@ -157,6 +157,9 @@ impl RightHandSide for WithOutputs<'_> {
     fn delays(&self) -> Vec<f64> {
         self.model.delays()
     }
+    fn lags(&self) -> Vec<f64> {
+        self.model.lags()
+    }
     fn parameters(&self) -> BTreeMap<String, f64> {
         self.model.parameters()
     }

@@ -364,10 +364,10 @@ fn integrate(
     let mut recorded = Replay::new(&runs.frames[r], &system.inputs)?;
     // inputs that act late reach the system that much later, as in the simulator
     let mut late;
-    let replay: &mut dyn Controller = if system.delays.is_empty() {
+    let replay: &mut dyn Controller = if system.delays.is_empty() && system.lags.is_empty() {
         &mut recorded
     } else {
-        late = crate::sim::Delayed::new(&mut recorded, &system.delays);
+        late = crate::sim::Delayed::new(&mut recorded, &system.delays, &system.lags);
         &mut late
     };
     let mut ws = system.workspace();

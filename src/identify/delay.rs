@@ -2,12 +2,13 @@
 //! candidates fitted all together with the input read d seconds earlier, for d on a grid up to
 //! a tenth of the shortest run. Where some d leaves far less of the target unexplained than
 //! none, the fit without it is biased (a mass-spring-damper whose force acts 0.2 s late: gain
-//! 1.71 for 2 and three spurious terms) and is said, with the delay that explains it.
+//! 1.71 for 2 and three spurious terms) and is said, with the delay that explains it, or the
+//! first-order lag (an actuator's) that explains it better over the same rows.
 
 use nalgebra::{DMatrix, DVector};
 
 use super::{Identification, IdentifyError, Target};
-use crate::data::{delayed, Frame};
+use crate::data::{delayed, lagged, Frame};
 use crate::select::Moments;
 use crate::term::{Library, Term};
 
@@ -22,6 +23,10 @@ pub struct Lag {
     pub share: f64,
     /// The longest delay tried, s.
     pub longest: f64,
+    /// The time constant of a first-order lag (an actuator's, s) that explains the rate better
+    /// than the dead time does, over the same rows, where one does: a lag of 0.5 s read as
+    /// 0.45 s late left stand-in terms (u·x², u²·x, x³) beside it.
+    pub first_order: Option<f64>,
 }
 
 /// A delay is said where it leaves at most this share of the residual sum of squares of none:
@@ -88,17 +93,20 @@ impl Identification<'_> {
             return Ok(Vec::new());
         }
         let mut out = Vec::new();
+        let rss_of = |runs: &[Frame]| -> Result<(f64, f64), IdentifyError> {
+            let mut m = Moments::new(library.len());
+            for part in self.moments_of_runs(&library, candidates, target, runs)? {
+                m.merge(&part);
+            }
+            Ok(full_rss(&m, self.intercept))
+        };
         for column in columns.iter().filter(|c| library.inputs().contains(c)) {
             let rss = |samples: usize| -> Result<(f64, f64), IdentifyError> {
                 let runs = frames
                     .iter()
                     .map(|f| delayed(f, column, samples as f64 * step, longest))
                     .collect::<Result<Vec<_>, _>>()?;
-                let mut m = Moments::new(library.len());
-                for part in self.moments_of_runs(&library, candidates, target, &runs)? {
-                    m.merge(&part);
-                }
-                Ok(full_rss(&m, self.intercept))
+                rss_of(&runs)
             };
             let (none, total) = rss(0)?;
             if none <= NEGLIGIBLE * total {
@@ -108,45 +116,124 @@ impl Identification<'_> {
                 Ok(if samples == 0 { none } else { rss(samples)?.0 })
             };
             let grid: Vec<usize> = GRID.iter().copied().filter(|&k| k as f64 * step <= longest).collect();
-            let mut tried: Vec<(usize, f64)> =
+            let tried: Vec<(usize, f64)> =
                 grid.iter().map(|&k| Ok((k, rss(k)?))).collect::<Result<_, IdentifyError>>()?;
             let best = (0..tried.len()).min_by(|&a, &b| tried[a].1.total_cmp(&tried[b].1)).unwrap_or(0);
             if best == 0 || tried[best].1 > SHARE * none || none - tried[best].1 <= GAIN * total {
                 continue;
             }
-            // sample by sample between the grid's neighbours (a valley: ternary search)
-            let (mut lo, mut hi) = (tried[best - 1].0, tried.get(best + 1).map_or(tried[best].0, |t| t.0));
-            while hi - lo > 2 {
-                let (a, b) = (lo + (hi - lo) / 3, hi - (hi - lo) / 3);
-                let (ra, rb) = (rss(a)?, rss(b)?);
-                tried.extend([(a, ra), (b, rb)]);
-                if ra <= rb {
-                    hi = b;
-                } else {
-                    lo = a;
-                }
-            }
-            for k in lo..=hi {
-                if !tried.iter().any(|t| t.0 == k) {
-                    let r = rss(k)?;
-                    tried.push((k, r));
-                }
-            }
-            let (k, r) = tried.iter().copied().min_by(|a, b| a.1.total_cmp(&b.1)).unwrap_or((0, none));
-            out.push(Lag { column: column.clone(), seconds: k as f64 * step, share: r / none, longest });
+            let (k, r) = valley(&rss, tried, best, 0)?;
+            let seconds = k as f64 * step;
+            let first_order =
+                first_order(&|runs| Ok(rss_of(runs)?.0), frames, column, seconds, step, shortest)?;
+            out.push(Lag { column: column.clone(), seconds, share: r / none, longest, first_order });
         }
         Ok(out)
     }
+}
+
+/// The time constant of a first-order lag of `column` that leaves less of the rate (`rss_of`
+/// the runs) than its dead time of `seconds` does, over the same rows (from five of the
+/// longest time constant tried on, [`crate::data::SETTLED`]), where one does: time constants
+/// of 1 to 256 samples (each about √2 times the last) up to twice the dead time, refined to the
+/// sample between the best one's neighbours. None where the rows from there on are fewer
+/// than half the `shortest` run's.
+fn first_order(
+    rss_of: &dyn Fn(&[Frame]) -> Result<f64, IdentifyError>,
+    frames: &[Frame],
+    column: &str,
+    seconds: f64,
+    step: f64,
+    shortest: f64,
+) -> Result<Option<f64>, IdentifyError> {
+    // a lag of T reads as a dead time a little short of T (0.5 s as 0.45 s)
+    let top = 2.0 * seconds + step;
+    let from = crate::data::SETTLED * top;
+    if !(seconds > 0.0 && from <= 0.5 * shortest) {
+        return Ok(None);
+    }
+    let dead = {
+        let runs = frames.iter().map(|f| delayed(f, column, seconds, from)).collect::<Result<Vec<_>, _>>()?;
+        rss_of(&runs)?
+    };
+    // read between its samples as a lag's input is ([`crate::data::mark_held_acting`]): held
+    // where a staircase, else a line (a smooth command through an actuator of 0.5 s was taken
+    // as held by the rates' fit, and a held reading's half sample put the lag a sample short)
+    let read: Vec<Frame> = frames
+        .iter()
+        .map(|f| {
+            let mut f = f.clone();
+            match f.column(column).is_some_and(crate::data::staircase) {
+                true => f.hold(column)?,
+                false => f.release(column),
+            }
+            Ok(f)
+        })
+        .collect::<Result<_, crate::data::DataError>>()?;
+    let rss = |samples: usize| -> Result<f64, IdentifyError> {
+        let runs = read
+            .iter()
+            .map(|f| lagged(f, &[(column, samples as f64 * step)], from))
+            .collect::<Result<Vec<_>, _>>()?;
+        rss_of(&runs)
+    };
+    let grid: Vec<usize> = GRID.iter().copied().filter(|&k| k >= 1 && k as f64 * step <= top).collect();
+    let tried: Vec<(usize, f64)> =
+        grid.iter().map(|&k| Ok((k, rss(k)?))).collect::<Result<_, IdentifyError>>()?;
+    let Some(best) = (0..tried.len()).min_by(|&a, &b| tried[a].1.total_cmp(&tried[b].1)) else {
+        return Ok(None);
+    };
+    let (k, r) = valley(&rss, tried, best, 1)?;
+    Ok((r < dead).then_some(k as f64 * step))
+}
+
+/// The bottom of a scan's valley: `tried` (samples, residual) on a grid, its best at index
+/// `best`, searched sample by sample between the best one's neighbours on the grid (ternary
+/// search; from `least` where the best is the first), by `rss`; the best of all tried.
+fn valley(
+    rss: &dyn Fn(usize) -> Result<f64, IdentifyError>,
+    mut tried: Vec<(usize, f64)>,
+    best: usize,
+    least: usize,
+) -> Result<(usize, f64), IdentifyError> {
+    let (mut lo, mut hi) = (
+        best.checked_sub(1).map_or(least, |b| tried[b].0),
+        tried.get(best + 1).map_or(tried[best].0, |t| t.0),
+    );
+    while hi - lo > 2 {
+        let (a, b) = (lo + (hi - lo) / 3, hi - (hi - lo) / 3);
+        let (ra, rb) = (rss(a)?, rss(b)?);
+        tried.extend([(a, ra), (b, rb)]);
+        if ra <= rb {
+            hi = b;
+        } else {
+            lo = a;
+        }
+    }
+    for k in lo..=hi {
+        if !tried.iter().any(|t| t.0 == k) {
+            let r = rss(k)?;
+            tried.push((k, r));
+        }
+    }
+    Ok(tried.iter().copied().min_by(|a, b| a.1.total_cmp(&b.1)).unwrap_or(tried[best]))
 }
 
 impl Lag {
     /// What the lag means for the fit of `target`, and `remedy`: how to fit it.
     pub fn note(&self, target: &Target, remedy: &str) -> String {
         let s = crate::output::sig(self.seconds, 3);
+        let lag = match self.first_order {
+            Some(t) => format!(
+                "; a first-order lag of {} s (an actuator's) explains it better still, over the same rows",
+                crate::output::sig(t, 3)
+            ),
+            None => String::new(),
+        };
         format!(
             "`{}` acts on {target} about {s} s later than the rows have it (a dead time, or a lag \
              of about that): read {s} s earlier, the candidates all together leave {} % of the \
-             residual sum of squares they leave without (delays of 0 to {} s tried), so the \
+             residual sum of squares they leave without (delays of 0 to {} s tried){lag}, so the \
              coefficients above are biased; {remedy}",
             self.column,
             crate::output::sig(100.0 * self.share, 2),
@@ -154,10 +241,15 @@ impl Lag {
         )
     }
 
-    /// How plain runs fit it: `--delay` on the command line, `delays=` in Python.
+    /// How plain runs fit it: `--delay` (or `--lag`, for a first-order lag) on the command
+    /// line, `delays=` (`lags=`) in Python.
     pub fn plain_remedy(&self) -> String {
-        let s = crate::output::sig(self.seconds, 3);
-        format!("fit it so with --delay {}={s} (Python `delays={{\"{}\": {s}}}`)", self.column, self.column)
+        let (flag, python, seconds) = match self.first_order {
+            Some(t) => ("--lag", "lags", t),
+            None => ("--delay", "delays", self.seconds),
+        };
+        let s = crate::output::sig(seconds, 3);
+        format!("fit it so with {flag} {}={s} (Python `{python}={{\"{}\": {s}}}`)", self.column, self.column)
     }
 }
 

@@ -403,11 +403,15 @@ pub fn say_late_inputs(
     let frames = &*model.acting(frames)?;
     let inputs: Vec<String> = model.spec().inputs.iter().map(|i| i.name.clone()).collect();
     let remedy = |lag: &super::Lag| {
-        let declared = model.spec().inputs.iter().find(|i| i.name == lag.column).map_or(0.0, |i| i.delay);
-        let (s, name) = (crate::output::sig(declared + lag.seconds, 3), &lag.column);
+        let input = model.spec().inputs.iter().find(|i| i.name == lag.column);
+        let (key, seconds) = match lag.first_order.filter(|_| input.is_none_or(|i| i.lag == 0.0)) {
+            Some(t) => ("lag", t),
+            None => ("delay", input.map_or(0.0, |i| i.delay) + lag.seconds),
+        };
+        let (s, name) = (crate::output::sig(seconds, 3), &lag.column);
         format!(
-            "declare it in the model file: `delay = {s}` in the [[inputs]] entry of `{name}` (a model made \
-             from columns: identify --states … --delay {name}={s})"
+            "declare it in the model file: `{key} = {s}` in the [[inputs]] entry of `{name}` (a model made \
+             from columns: identify --states … --{key} {name}={s})"
         )
     };
     let mut late: Vec<super::Lag> = Vec::new();

@@ -157,6 +157,12 @@ pub struct InputSpec {
     /// column that much earlier against the rest, simulation feeds it that much later.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub delay: f64,
+    /// The time constant of a first-order lag it acts through, s (an actuator that follows
+    /// its command as ẏ = (u − y)/T): identification reads its column through the lag,
+    /// simulation feeds it so, at rest at its first value at the start. After `delay` where
+    /// both are given.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub lag: f64,
 }
 
 fn is_zero(v: &f64) -> bool {

@@ -735,6 +735,12 @@ impl Model {
                     format!("{} is no dead time: give seconds, 0 or more", s.delay),
                 ));
             }
+            if !(s.lag >= 0.0 && s.lag.is_finite()) {
+                return Err(key_err(
+                    &format!("inputs[{i}].lag"),
+                    format!("{} is no first-order lag's time constant: give seconds, 0 or more", s.lag),
+                ));
+            }
         }
         for (name, p) in &spec.parameters {
             vocab.parameter(name).map_err(|e| key_err(&format!("parameters.{name}"), e.to_string()))?;
@@ -1045,15 +1051,23 @@ impl Model {
         self.spec.inputs.iter().filter(|i| i.delay > 0.0).map(|i| (i.name.as_str(), i.delay)).collect()
     }
 
+    /// The inputs that act through a first-order lag, each with its time constant in seconds
+    /// (`lag` in its `[[inputs]]` entry, where above 0).
+    pub fn first_order_lags(&self) -> Vec<(&str, f64)> {
+        self.spec.inputs.iter().filter(|i| i.lag > 0.0).map(|i| (i.name.as_str(), i.lag)).collect()
+    }
+
     /// Runs as the model's equations see them: each input with a dead time (`delay` in its
     /// `[[inputs]]` entry) read that much earlier against the rest, every run from its
-    /// longest delay on ([`crate::data::delayed`]); the runs themselves where none has one.
+    /// longest delay on ([`crate::data::delayed`]), and then each with a first-order lag (`lag`)
+    /// read through it, from five of the slowest lag's time constants on
+    /// ([`crate::data::lagged`]); the runs themselves where none has either.
     pub fn acting<'a>(
         &self,
         frames: &'a [crate::data::Frame],
     ) -> Result<std::borrow::Cow<'a, [crate::data::Frame]>, crate::data::DataError> {
-        let late = self.dead_times();
-        if late.is_empty() {
+        let (late, lags) = (self.dead_times(), self.first_order_lags());
+        if late.is_empty() && lags.is_empty() {
             return Ok(std::borrow::Cow::Borrowed(frames));
         }
         let longest = late.iter().map(|(_, d)| *d).fold(0.0, f64::max);
@@ -1064,12 +1078,17 @@ impl Model {
                     *f = crate::data::delayed(f, name, *delay, longest)?;
                 }
             }
+            // (each from the run's start, where a lag's start at rest is put, every run from
+            // five of the slowest lag's time constants on, whatever its own inputs)
+            let slowest = lags.iter().map(|(_, t)| *t).fold(0.0, f64::max);
+            let own: Vec<(&str, f64)> = lags.iter().copied().filter(|(n, _)| f.column(n).is_some()).collect();
+            *f = crate::data::lagged(f, &own, crate::data::SETTLED * slowest)?;
         }
         Ok(std::borrow::Cow::Owned(out))
     }
 
-    /// The model fed as [`Model::acting`] reads `frames`: its inputs' dead times taken out of
-    /// the model and put in the runs, each run from its longest dead time on. Re-simulated so,
+    /// The model fed as [`Model::acting`] reads `frames`: its inputs' dead times and lags taken
+    /// out of the model and put in the runs, each run from its longest dead time on. Re-simulated so,
     /// a run starts where every input's history is recorded (fed from the run's start, an input
     /// acting 0.5 s late is guessed at its first value for 0.5 s).
     pub fn as_acting<'a>(
@@ -1084,7 +1103,7 @@ impl Model {
             return Ok((std::borrow::Cow::Borrowed(self), frames));
         }
         let mut model = self.clone();
-        model.spec.inputs.iter_mut().for_each(|i| i.delay = 0.0);
+        model.spec.inputs.iter_mut().for_each(|i| (i.delay, i.lag) = (0.0, 0.0));
         Ok((std::borrow::Cow::Owned(model), frames))
     }
 
@@ -1281,12 +1300,14 @@ impl Model {
         }
         let inputs: Vec<&str> = self.spec.inputs.iter().map(|i| i.name.as_str()).collect();
         let states: Vec<&str> = self.spec.states.iter().map(|s| s.name.as_str()).collect();
-        // an input with a dead time judged as the equations read it, that much late
+        // an input with a dead time judged as the equations read it, that much late; one with a
+        // lag by its record
         let late = self.dead_times();
         notes.extend(crate::data::mark_held_acting(
             frame,
             &inputs,
             &late,
+            &self.first_order_lags(),
             &states,
             self.spec.model.intersample,
         )?);

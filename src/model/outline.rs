@@ -184,7 +184,7 @@ impl Outline {
             inputs: self
                 .inputs
                 .iter()
-                .map(|n| InputSpec { name: n.clone(), unit: String::new(), initial: 0.0, delay: 0.0 })
+                .map(|n| InputSpec { name: n.clone(), unit: String::new(), initial: 0.0, delay: 0.0, lag: 0.0 })
                 .collect(),
             parameters: BTreeMap::new(),
             derived: Vec::new(),

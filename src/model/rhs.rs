@@ -17,6 +17,10 @@ impl crate::sim::RightHandSide for Model {
         self.spec.inputs.iter().map(|i| i.delay).collect()
     }
 
+    fn lags(&self) -> Vec<f64> {
+        self.spec.inputs.iter().map(|i| i.lag).collect()
+    }
+
     fn tolerances(&self) -> crate::sim::Tolerances {
         let d = crate::sim::Tolerances::default();
         match &self.spec.simulation {

@@ -11,23 +11,33 @@ use crate::identify::Lag;
 use crate::model::Model;
 
 /// `model` with each of `late`'s inputs acting that much later than it declares (`delay`
-/// under its `[[inputs]]`); `None` where no input is late or the model cannot be so edited.
+/// under its `[[inputs]]`), or through the first-order lag that explains it better (`lag`,
+/// where the input declares none); `None` where no input is late or the model cannot be so
+/// edited.
 fn delayed(model: &Model, late: &[Lag]) -> Option<Model> {
     if late.is_empty() {
         return None;
     }
+    // a whole number of the mean step, to six figures (the file reads 0.5, not
+    // 0.4999999999999716)
+    let rounded = |v: f64| format!("{v:.5e}").parse().unwrap_or(v);
     model
         .edit(|file| {
             for lag in late {
                 if let Some(input) = file.inputs.iter_mut().find(|i| i.name == lag.column) {
-                    // a whole number of the mean step, to six figures (the file reads 0.5, not
-                    // 0.4999999999999716)
-                    let delay = input.delay + lag.seconds;
-                    input.delay = format!("{delay:.5e}").parse().unwrap_or(delay);
+                    match lag.first_order.filter(|_| input.lag == 0.0) {
+                        Some(t) => input.lag = rounded(t),
+                        None => input.delay = rounded(input.delay + lag.seconds),
+                    }
                 }
             }
         })
         .ok()
+}
+
+/// How late input `name` acts in `model`: its dead time and its lag's time constant.
+fn lateness(model: &Model, name: &str) -> f64 {
+    model.spec().inputs.iter().find(|i| i.name == name).map_or(0.0, |i| i.delay + i.lag)
 }
 
 /// `frames` with each of `late`'s inputs read between its samples the other way where the dead
@@ -115,10 +125,8 @@ pub(super) fn stage(
     };
     let (lines, names) = reread(frames, &suspects).unwrap_or_else(|_| (Vec::new(), Vec::new()));
     if !names.is_empty() {
-        let declared =
-            |m: &Model, n: &str| m.spec().inputs.iter().find(|i| i.name == n).map_or(0.0, |i| i.delay);
         if let Ok(mut again) = identify(given, &lines, true) {
-            if names.iter().any(|(n, _)| declared(&again.kept().model, n) > declared(given, n)) {
+            if names.iter().any(|(n, _)| lateness(&again.kept().model, n) > lateness(given, n)) {
                 let said: Vec<String> = names.iter().map(|(n, how)| how.said(n)).collect();
                 let note = format!("{}; its dead time found again so", said.join("; "));
                 again.say(note);
@@ -132,13 +140,20 @@ pub(super) fn stage(
     }
 }
 
-/// The late inputs in words: "`u` 0.500 s".
+/// The late inputs in words, as `model` declares them: "`u` by 0.500 s", "`u` through a
+/// first-order lag of 0.500 s".
 fn named(late: &[Lag], model: &Model) -> String {
     late.iter()
-        .map(|l| {
-            let delay =
-                model.spec().inputs.iter().find(|i| i.name == l.column).map_or(l.seconds, |i| i.delay);
-            format!("`{}` by {} s", l.column, crate::output::sig(delay, 3))
+        .filter_map(|l| model.spec().inputs.iter().find(|i| i.name == l.column))
+        .map(|i| {
+            let (name, sig) = (&i.name, |v: f64| crate::output::sig(v, 3));
+            match (i.delay > 0.0, i.lag > 0.0) {
+                (true, true) => {
+                    format!("`{name}` by {} s through a first-order lag of {} s", sig(i.delay), sig(i.lag))
+                }
+                (false, true) => format!("`{name}` through a first-order lag of {} s", sig(i.lag)),
+                _ => format!("`{name}` by {} s", sig(i.delay)),
+            }
         })
         .collect::<Vec<_>>()
         .join(", ")
@@ -158,7 +173,7 @@ fn kept(
         r.kept().checks.iter().filter(|c| !c.passed).map(|c| c.name.clone()).collect()
     };
     let tried = format!(
-        "identified again with the inputs read as acting late, {} (a dead time, or a lag of about that: an actuator's first-order lag of 0.2 s reads as 0.2 s late, its gain 2 % off),",
+        "identified again with the inputs read as acting late, {} (a dead time, or a first-order lag, an actuator's, where one of the time constant explains the rates better over the same rows),",
         named(late, delayed)
     );
     let before = failing(&recorded);
@@ -172,7 +187,7 @@ fn kept(
                         false => "no check failing that the inputs as recorded pass".to_string(),
                     };
                     let note = format!(
-                        "{tried} the equations hold, {checks}: kept (each `delay` under [[inputs]] in the model written, which its simulation feeds the input by). Where the inputs act as recorded, --no-dead-times (Python `dead_times=False`) keeps them so"
+                        "{tried} the equations hold, {checks}: kept (each `delay` or `lag` under [[inputs]] in the model written, which its simulation feeds the input by). Where the inputs act as recorded, --no-dead-times (Python `dead_times=False`) keeps them so"
                     );
                     (Ok(with), note)
                 }
@@ -200,7 +215,7 @@ mod tests {
     use super::*;
 
     fn lag(column: &str) -> Lag {
-        Lag { column: column.into(), seconds: 0.5, share: 0.01, longest: 20.0 }
+        Lag { column: column.into(), seconds: 0.5, share: 0.01, longest: 20.0, first_order: None }
     }
 
     /// A late sine taken as held is read as a line again, a late staircase taken as switching

@@ -169,22 +169,35 @@ impl Controller for Replay {
     }
 }
 
-/// A controller's inputs acting later than it gives them (a dead time per input, s): asked at
-/// every control time as usual, it answers with what `inner` gave `delay` before (between
-/// two control times a line from the one's value to the other's value before any jump there;
-/// before the start, the first). A held input's jumps arrive whole, `delay` later.
+/// A controller's inputs acting later than it gives them (a dead time per input, s, and a
+/// first-order lag's time constant, s): asked at every control time as usual, it answers with
+/// what `inner` gave `delay` before (between two control times a line from the one's value to
+/// the other's value before any jump there; before the start, the first), passed through the
+/// lag (ẏ = (u − y)/T, exact for that line between control times, at rest at the first value
+/// at the start). A held input's jumps arrive whole, `delay` later; through a lag they do not
+/// jump.
 pub struct Delayed<'a> {
     inner: &'a mut dyn Controller,
     delays: Vec<f64>,
+    lags: Vec<f64>,
     /// (control time, inputs given, inputs just before where they jumped there)
     history: Vec<(f64, Vec<f64>, Option<Vec<f64>>)>,
+    /// The lags' outputs at the last control time (empty before the first).
+    lagged: Vec<f64>,
     scratch: Vec<f64>,
 }
 
 impl<'a> Delayed<'a> {
-    /// `inner`'s inputs, input k acting `delays[k]` seconds later.
-    pub fn new(inner: &'a mut dyn Controller, delays: &[f64]) -> Delayed<'a> {
-        Delayed { inner, delays: delays.to_vec(), history: Vec::new(), scratch: vec![0.0; delays.len()] }
+    /// `inner`'s inputs, input k acting `delays[k]` seconds later through a first-order lag of
+    /// `lags[k]` seconds (either list short or empty: 0 for the inputs it does not reach).
+    pub fn new(inner: &'a mut dyn Controller, delays: &[f64], lags: &[f64]) -> Delayed<'a> {
+        let m = delays.len().max(lags.len());
+        let (delays, lags) = (Self::padded(delays, m), Self::padded(lags, m));
+        Delayed { inner, delays, lags, history: Vec::new(), lagged: Vec::new(), scratch: vec![0.0; m] }
+    }
+
+    fn padded(values: &[f64], m: usize) -> Vec<f64> {
+        (0..m).map(|k| values.get(k).copied().unwrap_or(0.0)).collect()
     }
 
     /// Input `k` at time `s` as given (`left`: just before `s`, where it jumped there).
@@ -218,12 +231,15 @@ impl Controller for Delayed<'_> {
         if self.history.last().is_some_and(|e| e.0 >= t) {
             // asked again at an earlier or the same time (a new run): start over
             self.history.clear();
+            self.lagged.clear();
         }
         self.history.push((t, given, before));
+        let previous = (self.history.len() > 1).then(|| self.history[self.history.len() - 2].0);
         // what no delay reaches back to any more, dropped in batches (a long run's memory stays
         // at about twice the longest delay's control steps); the first value stays for the
         // times before the start
-        let reach = t - self.delays.iter().copied().fold(0.0, f64::max);
+        // (from the last control time on: a lag reads the step since)
+        let reach = previous.unwrap_or(t) - self.delays.iter().copied().fold(0.0, f64::max);
         let stale = self.history.partition_point(|e| e.0 < reach).saturating_sub(1);
         if stale > 1 && stale > self.history.len() / 2 {
             self.history.drain(1..stale);
@@ -231,11 +247,40 @@ impl Controller for Delayed<'_> {
         for (k, o) in out.iter_mut().enumerate() {
             *o = self.given(k, t - self.delays.get(k).copied().unwrap_or(0.0), false);
         }
+        if self.lags.iter().all(|&l| l <= 0.0) {
+            return;
+        }
+        match previous {
+            // at rest at the first value
+            None => self.lagged = out.to_vec(),
+            Some(p) => {
+                for (k, &lag) in self.lags.iter().enumerate().filter(|(_, l)| **l > 0.0) {
+                    // the input over the step: a line from its value after the last control
+                    // time to its value before this one (u = u₀ + b s: y₁ = u₁ − bT + (y₀ − u₀ + bT)
+                    // e^(−h/T))
+                    let d = self.delays[k];
+                    let (u0, u1) = (self.given(k, p - d, false), self.given(k, t - d, true));
+                    let h = t - p;
+                    let bt = (u1 - u0) / h * lag;
+                    self.lagged[k] = u1 - bt + (self.lagged[k] - u0 + bt) * (-h / lag).exp();
+                }
+            }
+        }
+        for (k, o) in out.iter_mut().enumerate() {
+            if self.lags[k] > 0.0 {
+                *o = self.lagged[k];
+            }
+        }
     }
 
     fn before(&mut self, t: f64, out: &mut [f64]) -> bool {
         let mut jumped = false;
         for (k, o) in out.iter_mut().enumerate() {
+            if self.lags.get(k).is_some_and(|&l| l > 0.0) {
+                // a lag's output does not jump
+                *o = self.lagged[k];
+                continue;
+            }
             let s = t - self.delays.get(k).copied().unwrap_or(0.0);
             *o = self.given(k, s, true);
             jumped |= *o != self.given(k, s, false);
@@ -298,7 +343,7 @@ mod tests {
         f.push("u", t.iter().map(|t| 10.0 * t).collect()).unwrap();
         f.hold("F").unwrap();
         let mut replay = Replay::new(&f, &["F".to_string(), "u".to_string()]).unwrap();
-        let mut late = Delayed::new(&mut replay, &[0.2, 0.15]);
+        let mut late = Delayed::new(&mut replay, &[0.2, 0.15], &[]);
         let mut out = [0.0; 2];
         for (k, want) in [(0, [1.0, 0.0]), (1, [1.0, 0.0]), (2, [1.0, 0.5]), (3, [1.0, 1.5]), (4, [4.0, 2.5])]
         {
@@ -325,13 +370,40 @@ mod tests {
             }
         }
         let mut ramp = Ramp;
-        let mut late = Delayed::new(&mut ramp, &[0.2]);
+        let mut late = Delayed::new(&mut ramp, &[0.2], &[]);
         let mut out = [0.0];
         for k in 0..10_000 {
             let t = 0.01 * k as f64;
             late.input(t, &[], &mut out);
             assert!((out[0] - (t - 0.2).max(0.0)).abs() < 1e-9, "t = {t}: {}", out[0]);
             assert!(late.history.len() < 50, "{} kept at t = {t}", late.history.len());
+        }
+    }
+
+    /// Through a lag of 0.5 s: a unit step given at 0.1 s (held) reaches 1 − e^(−(t − 0.1)/0.5)
+    /// at each control time; delayed by 0.2 s as well, 0.2 s later; a ramp 2t beside it,
+    /// lagged 0.3 s, is 2(t − 0.3(1 − e^(−t/0.3))), exactly; none jumps.
+    #[test]
+    fn a_lagged_controller_answers_through_the_lag() {
+        let t: Vec<f64> = (0..41).map(|k| 0.05 * k as f64).collect();
+        let mut f = Frame::new("rig.csv", "t", t.clone()).unwrap();
+        f.push("F", t.iter().map(|&t| if t >= 0.1 - 1e-12 { 1.0 } else { 0.0 }).collect()).unwrap();
+        f.push("u", t.iter().map(|t| 2.0 * t).collect()).unwrap();
+        f.hold("F").unwrap();
+        for delay in [0.0, 0.2] {
+            let mut replay = Replay::new(&f, &["F".to_string(), "u".to_string()]).unwrap();
+            let mut late = Delayed::new(&mut replay, &[delay], &[0.5, 0.3]);
+            let mut out = [0.0; 2];
+            for k in 0..200 {
+                let t = 0.01 * k as f64;
+                late.input(t, &[], &mut out);
+                let on = t - 0.1 - delay;
+                let want = if on > 1e-9 { 1.0 - (-on / 0.5f64).exp() } else { 0.0 };
+                assert!((out[0] - want).abs() < 1e-9, "t = {t}: {} for {want}", out[0]);
+                let ramp = 2.0 * (t - 0.3 * (1.0 - (-t / 0.3f64).exp()));
+                assert!((out[1] - ramp).abs() < 1e-9, "t = {t}: {} for {ramp}", out[1]);
+                assert!(!late.before(t, &mut out), "t = {t}");
+            }
         }
     }
 }

@@ -290,9 +290,10 @@ pub fn simulate(
     controller: &mut dyn Controller,
     settings: &Settings,
 ) -> Result<Trajectory, SimError> {
-    if !system.delays.is_empty() {
-        // inputs that act late: the controller's answers fed to the system that much later
-        let mut late = super::Delayed::new(controller, &system.delays);
+    if !(system.delays.is_empty() && system.lags.is_empty()) {
+        // inputs that act late: the controller's answers fed to the system that much later,
+        // through their lags
+        let mut late = super::Delayed::new(controller, &system.delays, &system.lags);
         return run(system, x0, &mut late, settings);
     }
     run(system, x0, controller, settings)

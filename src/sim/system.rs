@@ -23,6 +23,9 @@ pub struct System {
     pub sizes: Vec<f64>,
     /// How much later than given each input acts, s (empty where none does: a dead time).
     pub delays: Vec<f64>,
+    /// The time constant of the first-order lag each input acts through, s (empty where none
+    /// does).
+    pub lags: Vec<f64>,
     rhs: Library,
     /// (scratch slot, state index) and (scratch slot, input index) of the library inputs
     /// that change from row to row; parameters (scratch slot, parameter index) sit in the
@@ -79,6 +82,11 @@ pub trait RightHandSide {
     fn delays(&self) -> Vec<f64> {
         Vec::new()
     }
+    /// The time constant of the first-order lag each input acts through, s, in `inputs` order
+    /// (an actuator's; none by default).
+    fn lags(&self) -> Vec<f64> {
+        Vec::new()
+    }
 }
 
 impl System {
@@ -133,12 +141,11 @@ impl System {
                 Slot::Param(i) => param_slots.push((slot(j)?, *i)),
             }
         }
-        let delays = model.delays();
-        let delays = if delays.iter().any(|d| *d > 0.0) {
-            (0..inputs.len()).map(|k| delays.get(k).copied().unwrap_or(0.0)).collect()
-        } else {
-            Vec::new()
+        let per_input = |values: Vec<f64>| match values.iter().any(|d| *d > 0.0) {
+            true => (0..inputs.len()).map(|k| values.get(k).copied().unwrap_or(0.0)).collect(),
+            false => Vec::new(),
         };
+        let (delays, lags) = (per_input(model.delays()), per_input(model.lags()));
         Ok(System {
             states,
             inputs,
@@ -146,6 +153,7 @@ impl System {
             tolerances: model.tolerances(),
             sizes: Vec::new(),
             delays,
+            lags,
             rhs,
             state_slots,
             input_slots,

@@ -446,7 +446,7 @@ fn a_force_acting_late_is_said_and_fitted_with_its_delay() {
         "--delay",
         "F=0.2",
     ]);
-    assert!(!ok && err.contains("declare the dead time in the model file"), "{err}");
+    assert!(!ok && err.contains("declare them in the model file"), "{err}");
     let args = ["identify", "--data", data.to_str().unwrap(), "--target", "dv/dt", "--terms", "x", "--delay"];
     for bad in ["F=-1", "F=soon", "F"] {
         let (ok, _, err) = termid(&[&args[..], &[bad]].concat());
@@ -480,7 +480,7 @@ fn a_model_declares_its_dead_time() {
     let (ok, text, err) = termid(&["identify", "--model", &undeclared, "--data", data, "--out", out]);
     assert!(ok, "{err}");
     assert!(
-        text.contains("identified again with the inputs read as acting late, `F` by 0.200 s (a dead time, or a lag of about that")
+        text.contains("identified again with the inputs read as acting late, `F` by 0.200 s (a dead time, or a first-order lag")
             && text.contains("the equations hold, every check ok: kept"),
         "{text}"
     );

@@ -321,6 +321,12 @@ pub struct IdentifyCommand {
     /// delay says so (with --states, the system is identified again with it: --no-dead-times).
     #[arg(long = "delay", num_args = 1.., value_name = "NAME=SECONDS")]
     pub delays: Vec<String>,
+    /// Columns that act through a first-order lag (an actuator that follows its command as
+    /// ẏ = (u − y)/T): `u=0.5` reads u through a lag of 0.5 s, at rest at its first value
+    /// (with --states, the input's `lag` in the model written). After --delay where both are
+    /// given.
+    #[arg(long = "lag", num_args = 1.., value_name = "NAME=SECONDS")]
+    pub lags: Vec<String>,
     /// Derived variables: `Δu=u-u0`.
     #[arg(long = "derive", num_args = 1..)]
     pub derived: Vec<String>,

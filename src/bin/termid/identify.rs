@@ -100,8 +100,8 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
         return crate::moments::identify_from_files(cmd);
     }
     if cmd.model.is_some() || !cmd.states.is_empty() {
-        if !cmd.delays.is_empty() && cmd.model.is_some() {
-            bail!("--delay reads columns of plain runs earlier, or declares the dead times of --states' inputs; with --model declare the dead time in the model file (`delay = SECONDS` in the input's [[inputs]] entry), as its simulation needs it too");
+        if !(cmd.delays.is_empty() && cmd.lags.is_empty()) && cmd.model.is_some() {
+            bail!("--delay and --lag read columns of plain runs earlier or through a lag, or declare them of --states' inputs; with --model declare them in the model file (`delay = SECONDS` or `lag = SECONDS` in the input's [[inputs]] entry), as its simulation needs them too");
         }
         return crate::identify_model::run(cmd);
     }
@@ -124,7 +124,8 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
         // the rows are a time series whose rates are taken: a glitch would be one
         crate::runs::mend_spikes(&mut frames)?;
     }
-    let late = cmd.delays.iter().map(|d| delay_of(d)).collect::<Result<Vec<_>>>()?;
+    let late = cmd.delays.iter().map(|d| seconds_of(d, "--delay")).collect::<Result<Vec<_>>>()?;
+    let lags = cmd.lags.iter().map(|d| seconds_of(d, "--lag")).collect::<Result<Vec<_>>>()?;
     if let Target::Derivative(state) = &target {
         // every column but the state may be an input held between samples (a late one judged
         // as it acts); any column a slower sensor's readings; the state's leap a cut between
@@ -134,7 +135,7 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
         for f in frames {
             let all: Vec<String> = f.names()[1..].to_vec();
             let all: Vec<&str> = all.iter().map(String::as_str).collect();
-            let (cut, notes) = termid::data::runs_of_rate(vec![f], state, &all, &late, intersample)?;
+            let (cut, notes) = termid::data::runs_of_rate(vec![f], state, &all, &late, &lags, intersample)?;
             notes.iter().for_each(|n| crate::runs::say(n));
             runs.extend(cut);
         }
@@ -144,6 +145,11 @@ pub fn run(mut cmd: IdentifyCommand) -> Result<()> {
     for (name, seconds) in &late {
         for f in &mut frames {
             *f = termid::data::delayed(f, name, *seconds, 0.0)?;
+        }
+    }
+    if !lags.is_empty() {
+        for f in &mut frames {
+            *f = termid::data::lagged(f, &lags, 0.0)?;
         }
     }
     match &target {
@@ -318,12 +324,13 @@ pub fn configure_backend(cmd: &IdentifyCommand) -> Result<Backend> {
     Ok(backend)
 }
 
-/// One `--delay NAME=SECONDS`: the column and its dead time, s (0 or more).
-pub fn delay_of(d: &str) -> Result<(&str, f64)> {
-    let (name, seconds) = split_pair(d, "--delay")?;
+/// One `--delay NAME=SECONDS` or `--lag NAME=SECONDS` (`flag`): the column and its dead time
+/// or lag, s (0 or more).
+pub fn seconds_of<'a>(d: &'a str, flag: &str) -> Result<(&'a str, f64)> {
+    let (name, seconds) = split_pair(d, flag)?;
     let seconds: f64 =
         seconds.parse().ok().filter(|s: &f64| s.is_finite() && *s >= 0.0).with_context(|| {
-            format!("--delay `{d}`: `{seconds}` is no delay; give seconds, 0 or more (`F=0.2`)")
+            format!("{flag} `{d}`: `{seconds}` is no time; give seconds, 0 or more (`F=0.2`)")
         })?;
     Ok((name, seconds))
 }

@@ -37,18 +37,27 @@ pub fn run(cmd: IdentifyCommand) -> Result<()> {
     }
     .keeping_spikes(cmd.keep_spikes)
     .with_intersample(cmd.intersample);
-    if !cmd.delays.is_empty() {
-        // --states' inputs acting late, as a model file would declare them
-        let delays = cmd.delays.iter().map(|d| crate::identify::delay_of(d)).collect::<Result<Vec<_>>>()?;
-        let inputs: Vec<String> = model.spec().inputs.iter().map(|i| i.name.clone()).collect();
-        if let Some((name, _)) = delays.iter().find(|(n, _)| !inputs.iter().any(|i| i == n)) {
-            bail!("--delay {name}=…: `{name}` is no input (the inputs: {})", inputs.join(", "));
-        }
+    if !(cmd.delays.is_empty() && cmd.lags.is_empty()) {
+        // --states' inputs acting late or through a lag, as a model file would declare them
+        let read = |given: &[String], flag: &str| -> Result<Vec<(String, f64)>> {
+            let inputs: Vec<String> = model.spec().inputs.iter().map(|i| i.name.clone()).collect();
+            given
+                .iter()
+                .map(|d| {
+                    let (name, seconds) = crate::identify::seconds_of(d, flag)?;
+                    if !inputs.iter().any(|i| i == name) {
+                        bail!("{flag} {name}=…: `{name}` is no input (the inputs: {})", inputs.join(", "));
+                    }
+                    Ok((name.to_string(), seconds))
+                })
+                .collect()
+        };
+        let (delays, lags) = (read(&cmd.delays, "--delay")?, read(&cmd.lags, "--lag")?);
+        let of = |given: &[(String, f64)], name: &str| given.iter().find(|(n, _)| n == name).map(|(_, s)| *s);
         model = model.edit(|file| {
             for input in &mut file.inputs {
-                if let Some((_, seconds)) = delays.iter().find(|(n, _)| *n == input.name) {
-                    input.delay = *seconds;
-                }
+                input.delay = of(&delays, &input.name).unwrap_or(input.delay);
+                input.lag = of(&lags, &input.name).unwrap_or(input.lag);
             }
         })?;
     }

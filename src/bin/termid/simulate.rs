@@ -264,6 +264,7 @@ fn generic_run(cmd: &SimulateCommand, model: &Model, (integrator, dt): (Integrat
                 &mut frame,
                 &inputs,
                 &model.dead_times(),
+                &model.first_order_lags(),
                 &states,
                 intersample,
             )?;
