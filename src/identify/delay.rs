@@ -17,9 +17,10 @@ use crate::term::{Library, Term};
 pub struct Lag {
     /// The column.
     pub column: String,
-    /// How much later it acts, s.
+    /// How much later it acts, s (0 where a first-order lag explains it and no dead time does).
     pub seconds: f64,
-    /// The residual sum of squares of all candidates with it delayed so, over that without.
+    /// The residual sum of squares of all candidates with it delayed so, over that without
+    /// (where no dead time is found, `seconds` 0: through its first-order lag).
     pub share: f64,
     /// The longest delay tried, s.
     pub longest: f64,
@@ -46,6 +47,20 @@ const NEGLIGIBLE: f64 = 1e-8;
 /// candidates (a fast state that follows another and the input) leaves rounding and quadrature
 /// error that the input read one sample off takes up, a valley of the scan that is no delay.
 const GAIN: f64 = 1e-6;
+
+/// A first-order lag found where no dead time is (a hidden state of its own, which may stand
+/// in for another the records lack) is said only where it leaves at most this share of the
+/// residual of the input as recorded: a mass-spring recorded by its position alone had its
+/// missing velocity's part halved by a lag of 0.96 s (0.49 left); an actuator's lag of 2 s
+/// left 3·10⁻⁸ noise-free, 0.006 at noise of 1 % of span.
+const LAG_SHARE: f64 = 0.1;
+
+/// … and only where it explains more than this share of the target's sum of squares (what is
+/// left without it, RMS a hundredth of the target's spread): a rudder turned at its rate
+/// between samples 0.1 s apart, its corners cut by the line between them, left 1.3·10⁻⁶ of the
+/// heading's rate, 88 % of which a lag of one sample took up, and the fit through it chose
+/// two spurious terms.
+const LAG_GAIN: f64 = 1e-4;
 
 /// How many rows a rate's residuals must be correlated over for the scan: a square wave acting
 /// 0.5 s late, its misfit in bursts after each of its jumps, left 1.46 (the scan asked for 1.5
@@ -120,42 +135,63 @@ impl Identification<'_> {
                 grid.iter().map(|&k| Ok((k, rss(k)?))).collect::<Result<_, IdentifyError>>()?;
             let best = (0..tried.len()).min_by(|&a, &b| tried[a].1.total_cmp(&tried[b].1)).unwrap_or(0);
             if best == 0 || tried[best].1 > SHARE * none || none - tried[best].1 <= GAIN * total {
+                // no dead time; a first-order lag of some length may still explain it (one of
+                // 2 s behind a mass-spring reads as no dead time at all: its input is not
+                // only late but smoothed)
+                if let Some((t, share)) = first_order(&rss_of, frames, column, 0.0, step, shortest)? {
+                    out.push(Lag {
+                        column: column.clone(),
+                        seconds: 0.0,
+                        share,
+                        longest,
+                        first_order: Some(t),
+                    });
+                }
                 continue;
             }
             let (k, r) = valley(&rss, tried, best, 0)?;
             let seconds = k as f64 * step;
-            let first_order =
-                first_order(&|runs| Ok(rss_of(runs)?.0), frames, column, seconds, step, shortest)?;
+            let first_order = first_order(&rss_of, frames, column, seconds, step, shortest)?.map(|(t, _)| t);
             out.push(Lag { column: column.clone(), seconds, share: r / none, longest, first_order });
         }
         Ok(out)
     }
 }
 
-/// The time constant of a first-order lag of `column` that leaves less of the rate (`rss_of`
-/// the runs) than its dead time of `seconds` does, over the same rows (from five of the
-/// longest time constant tried on, [`crate::data::SETTLED`]), where one does: time constants
-/// of 1 to 256 samples (each about √2 times the last) up to twice the dead time, refined to the
-/// sample between the best one's neighbours. None where the rows from there on are fewer
-/// than half the `shortest` run's.
+/// The residual sum of squares of a rate over some runs, and the rate's own sum of squares.
+type Residuals<'a> = dyn Fn(&[Frame]) -> Result<(f64, f64), IdentifyError> + 'a;
+
+/// The time constant of a first-order lag of `column` that explains the rate better than its
+/// dead time of `seconds` (0: none found) does, over the same rows, with the share of the
+/// residual sum of squares it leaves of that of the column as recorded there, where one does
+/// (`rss_of` the runs: the residual sum of squares and the target's): time constants of 1 to
+/// 256 samples (each about √2 times the last) up to twice the dead time (a lag of T reads as a
+/// dead time a little short of T: 0.5 s as 0.45 s), or without one up to a tenth of the
+/// `shortest` run, refined to the sample between the best one's neighbours, all over the rows
+/// from five of the longest tried on ([`crate::data::SETTLED`]: where a lag's start at rest
+/// has died away); found where the best leaves less than the dead time, and at most half of
+/// the residual of the column as recorded there, explaining more than 10⁻⁶ of the target;
+/// without a dead time, at most a tenth, explaining more than 10⁻⁴ ([`LAG_SHARE`], [`LAG_GAIN`]).
+/// None where those rows are fewer than half the shortest run's.
 fn first_order(
-    rss_of: &dyn Fn(&[Frame]) -> Result<f64, IdentifyError>,
+    rss_of: &Residuals<'_>,
     frames: &[Frame],
     column: &str,
     seconds: f64,
     step: f64,
     shortest: f64,
-) -> Result<Option<f64>, IdentifyError> {
-    // a lag of T reads as a dead time a little short of T (0.5 s as 0.45 s)
-    let top = 2.0 * seconds + step;
+) -> Result<Option<(f64, f64)>, IdentifyError> {
+    let top = if seconds > 0.0 { 2.0 * seconds + step } else { 0.1 * shortest };
     let from = crate::data::SETTLED * top;
-    if !(seconds > 0.0 && from <= 0.5 * shortest) {
+    if from > 0.5 * shortest * (1.0 + 1e-9) {
         return Ok(None);
     }
-    let dead = {
-        let runs = frames.iter().map(|f| delayed(f, column, seconds, from)).collect::<Result<Vec<_>, _>>()?;
-        rss_of(&runs)?
+    let read_late = |delay: f64| -> Result<(f64, f64), IdentifyError> {
+        let runs = frames.iter().map(|f| delayed(f, column, delay, from)).collect::<Result<Vec<_>, _>>()?;
+        rss_of(&runs)
     };
+    let (none, total) = read_late(0.0)?;
+    let dead = if seconds > 0.0 { read_late(seconds)?.0 } else { none };
     // read between its samples as a lag's input is ([`crate::data::mark_held_acting`]): held
     // where a staircase, else a line (a smooth command through an actuator of 0.5 s was taken
     // as held by the rates' fit, and a held reading's half sample put the lag a sample short)
@@ -175,7 +211,7 @@ fn first_order(
             .iter()
             .map(|f| lagged(f, &[(column, samples as f64 * step)], from))
             .collect::<Result<Vec<_>, _>>()?;
-        rss_of(&runs)
+        Ok(rss_of(&runs)?.0)
     };
     let grid: Vec<usize> = GRID.iter().copied().filter(|&k| k >= 1 && k as f64 * step <= top).collect();
     let tried: Vec<(usize, f64)> =
@@ -184,7 +220,11 @@ fn first_order(
         return Ok(None);
     };
     let (k, r) = valley(&rss, tried, best, 1)?;
-    Ok((r < dead).then_some(k as f64 * step))
+    let found = match seconds > 0.0 {
+        true => r < dead && r <= SHARE * none && none - r > GAIN * total,
+        false => r <= LAG_SHARE * none && none - r > LAG_GAIN * total,
+    };
+    Ok(found.then_some((k as f64 * step, r / none)))
 }
 
 /// The bottom of a scan's valley: `tried` (samples, residual) on a grid, its best at index
@@ -223,6 +263,18 @@ impl Lag {
     /// What the lag means for the fit of `target`, and `remedy`: how to fit it.
     pub fn note(&self, target: &Target, remedy: &str) -> String {
         let s = crate::output::sig(self.seconds, 3);
+        if let (Some(t), true) = (self.first_order, self.seconds == 0.0) {
+            return format!(
+                "`{}` acts on {target} through a first-order lag of about {} s (an actuator's, \
+                 a valve's): read through it, the candidates all together leave {} % of the \
+                 residual sum of squares they leave without (time constants up to {} s tried; \
+                 no dead time explains it), so the coefficients above are biased; {remedy}",
+                self.column,
+                crate::output::sig(t, 3),
+                crate::output::sig(100.0 * self.share, 2),
+                crate::output::sig(self.longest, 3),
+            );
+        }
         let lag = match self.first_order {
             Some(t) => format!(
                 "; a first-order lag of {} s (an actuator's) explains it better still, over the same rows",

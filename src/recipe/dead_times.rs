@@ -21,6 +21,13 @@ fn delayed(model: &Model, late: &[Lag]) -> Option<Model> {
     // a whole number of the mean step, to six figures (the file reads 0.5, not
     // 0.4999999999999716)
     let rounded = |v: f64| format!("{v:.5e}").parse().unwrap_or(v);
+    let changes = late.iter().any(|l| {
+        let input = model.spec().inputs.iter().find(|i| i.name == l.column);
+        l.seconds > 0.0 || (l.first_order.is_some() && input.is_some_and(|i| i.lag == 0.0))
+    });
+    if !changes {
+        return None;
+    }
     model
         .edit(|file| {
             for lag in late {
