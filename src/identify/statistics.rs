@@ -259,6 +259,12 @@ impl EquationMoments {
                 model.path, late.name, late.delay
             )));
         }
+        if let Some(lagging) = model.spec().inputs.iter().find(|i| i.lag > 0.0) {
+            return Err(IdentifyError::Setup(format!(
+                "{}: `{}` acts through a first-order lag of {} s (its `lag`), whose state a piece of a run cannot carry over from the rows before it: read the runs whole (--chunk-rows 0)",
+                model.path, lagging.name, lagging.lag
+            )));
+        }
         if let Some(state) = model.spec().states.iter().find(|s| s.rate_of.is_some()) {
             return Err(IdentifyError::Setup(format!(
                 "{}: `{}` is estimated from each run's whole record of `{}` (its `rate_of`), which a piece of a run does not hold: read the runs whole (--chunk-rows 0)",

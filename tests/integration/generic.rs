@@ -4743,7 +4743,8 @@ fn an_actuators_first_order_lag_is_found_and_fitted_so() {
 
 /// A first-order plant ẋ = −x + y behind a lag of 0.5 s (`lag = 0.5`), replaying a command
 /// that steps from 0 to 1 at t = 1 s (held between its samples): x = 1 − 2e^(−s) + e^(−2s),
-/// s = t − 1, the lag's output reaching the plant smoothly; a lag below 0 is refused by its key.
+/// s = t − 1, the lag's output reaching the plant smoothly; read in pieces (`moments
+/// --chunk-rows`) it is refused, and a lag below 0 by its key.
 #[test]
 fn a_model_declares_its_inputs_first_order_lag() {
     use crate::common::Scratch;
@@ -4784,6 +4785,22 @@ fn a_model_declares_its_inputs_first_order_lag() {
         let want = 1.0 - 2.0 * (-s).exp() + (-2.0 * s).exp();
         assert!((x - want).abs() < 1e-3, "t = {t}: {x} for {want}");
     }
+    // read in pieces, a lag's state would start afresh in each: refused
+    let moments = dir.join("x.moments");
+    let (ok, _, err) = termid(&[
+        "moments",
+        "--model",
+        path.to_str().unwrap(),
+        "--equation",
+        "x_dot",
+        "--data",
+        out.to_str().unwrap(),
+        "--chunk-rows",
+        "20",
+        "--out",
+        moments.to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("first-order lag") && err.contains("--chunk-rows 0"), "{err}");
     std::fs::write(&path, model("-0.5")).unwrap();
     let (ok, _, err) = termid(&["simulate", "--model", path.to_str().unwrap(), "--input", "u=1"]);
     assert!(!ok && err.contains("inputs[0].lag") && err.contains("no first-order lag"), "{err}");
