@@ -1088,7 +1088,8 @@ impl Model {
     }
 
     /// The model fed as [`Model::acting`] reads `frames`: its inputs' dead times and lags taken
-    /// out of the model and put in the runs, each run from its longest dead time on. Re-simulated so,
+    /// out of the model and put in the runs, each run from its longest dead time (and five of
+    /// its slowest lag's time constants) on. Re-simulated so,
     /// a run starts where every input's history is recorded (fed from the run's start, an input
     /// acting 0.5 s late is guessed at its first value for 0.5 s).
     pub fn as_acting<'a>(

@@ -12,7 +12,7 @@ use crate::model::Model;
 
 /// `model` with each of `late`'s inputs acting that much later than it declares (`delay`
 /// under its `[[inputs]]`), or through the first-order lag that explains it better (`lag`,
-/// where the input declares none); `None` where no input is late or the model cannot be so
+/// where the input declares none); `None` where that changes nothing or the model cannot be so
 /// edited.
 fn delayed(model: &Model, late: &[Lag]) -> Option<Model> {
     if late.is_empty() {
@@ -21,14 +21,7 @@ fn delayed(model: &Model, late: &[Lag]) -> Option<Model> {
     // a whole number of the mean step, to six figures (the file reads 0.5, not
     // 0.4999999999999716)
     let rounded = |v: f64| format!("{v:.5e}").parse().unwrap_or(v);
-    let changes = late.iter().any(|l| {
-        let input = model.spec().inputs.iter().find(|i| i.name == l.column);
-        l.seconds > 0.0 || (l.first_order.is_some() && input.is_some_and(|i| i.lag == 0.0))
-    });
-    if !changes {
-        return None;
-    }
-    model
+    let edited = model
         .edit(|file| {
             for lag in late {
                 if let Some(input) = file.inputs.iter_mut().find(|i| i.name == lag.column) {
@@ -39,7 +32,9 @@ fn delayed(model: &Model, late: &[Lag]) -> Option<Model> {
                 }
             }
         })
-        .ok()
+        .ok()?;
+    // (a lag found without a dead time, where the input declares one already, changes nothing)
+    (edited.spec().inputs != model.spec().inputs).then_some(edited)
 }
 
 /// How late input `name` acts in `model`: its dead time and its lag's time constant.
