@@ -19,8 +19,7 @@ pub fn delayed(frame: &Frame, name: &str, seconds: f64, from: f64) -> Result<Fra
     let column = frame.require(name)?;
     let t = frame.time();
     let start = t[0] + from.max(seconds);
-    let first = t.iter().position(|&s| s >= start - 1e-9 * (t[t.len() - 1] - t[0]).max(1.0));
-    let Some(first) = first.filter(|&f| f + 1 < t.len()) else {
+    let Some(first) = first_row_from(t, start) else {
         return Err(DataError::Setting(format!(
             "{}: `{name}` delayed by {seconds} s leaves fewer than two rows of the run's {} s",
             frame.origin(),
@@ -42,6 +41,25 @@ pub fn delayed(frame: &Frame, name: &str, seconds: f64, from: f64) -> Result<Fra
         .collect();
     out.overwrite(name, values)?;
     Ok(out)
+}
+
+/// The first of the rows `t` at or after `start` (to a part in 10⁹ of the run's span), where
+/// it leaves at least two rows.
+fn first_row_from(t: &[f64], start: f64) -> Option<usize> {
+    let first = t.iter().position(|&s| s >= start - 1e-9 * (t[t.len() - 1] - t[0]).max(1.0));
+    first.filter(|&f| f + 1 < t.len())
+}
+
+/// Whether an input read through a first-order lag is held between its samples (`intersample`
+/// as asked; `Auto`: where a staircase, [`super::staircase`], else a line: the rates' fits,
+/// which read it through a lag that makes it seem late, would take a smooth one for a DAC's
+/// hold).
+pub fn held_through_lag(column: &[f64], intersample: super::Intersample) -> bool {
+    match intersample {
+        super::Intersample::Linear => false,
+        super::Intersample::Held => column.windows(2).any(|w| w[1] != w[0]),
+        super::Intersample::Auto => super::staircase(column),
+    }
 }
 
 /// How many time constants of a lag a run is read from ([`lagged`]): the lag is started at rest
@@ -68,8 +86,7 @@ pub fn lagged(frame: &Frame, lags: &[(&str, f64)], from: f64) -> Result<Frame, D
     let slowest = lags.iter().map(|(_, s)| *s).fold(0.0, f64::max);
     let t = frame.time();
     let start = t[0] + from.max(SETTLED * slowest);
-    let first = t.iter().position(|&s| s >= start - 1e-9 * (t[t.len() - 1] - t[0]).max(1.0));
-    let Some(first) = first.filter(|&f| f + 1 < t.len()) else {
+    let Some(first) = first_row_from(t, start) else {
         let names: Vec<String> = lags.iter().map(|(n, s)| format!("`{n}` through a lag of {s} s")).collect();
         return Err(DataError::Setting(format!(
             "{}: {}, read from {} s on (where the lags' start at rest has died away), leaves fewer than two rows of the run's {} s",
@@ -108,10 +125,8 @@ pub fn lagged(frame: &Frame, lags: &[(&str, f64)], from: f64) -> Result<Frame, D
 /// itself; the rest as logged. A staircase keeps its steps where it is read late (the sample
 /// before); a smooth column is read by a line. All judged as logged where a run is too short
 /// for its dead times. One of `lags` (`(name, seconds)`, a first-order lag it acts through)
-/// is judged by its record alone: held where it is a staircase ([`super::staircase`]), else a
-/// line (the rates' fits, which read it through a lag that makes it seem late, would take a
-/// smooth one for a DAC's hold: an actuator's lag of 0.5 s, 10 % less left over so); as asked
-/// where `intersample` is not `Auto`. What was found, said as the model reads it.
+/// is judged by its record alone ([`held_through_lag`]: an actuator's lag of 0.5 s made a
+/// smooth command fit 10 % better held). What was found, said as the model reads it.
 pub fn mark_held_acting(
     frame: &mut Frame,
     columns: &[&str],
@@ -126,13 +141,7 @@ pub fn mark_held_acting(
         .map(|(n, _)| *n)
         .collect();
     for name in &lagged {
-        let column = frame.require(name)?;
-        let hold = match intersample {
-            super::Intersample::Linear => false,
-            super::Intersample::Held => column.windows(2).any(|w| w[1] != w[0]),
-            super::Intersample::Auto => super::staircase(column),
-        };
-        match hold {
+        match held_through_lag(frame.require(name)?, intersample) {
             true => frame.hold(name)?,
             false => frame.release(name),
         }

@@ -41,7 +41,7 @@ pub use dataset::{
     from_seconds, headers_in_si, in_seconds, read_as, seconds_of_unit, seconds_per, time_position,
     velocities_from_track, Dataset, Delimiter, RunSpec, Track,
 };
-pub use delay::{delayed, lagged, mark_held_acting, SETTLED};
+pub use delay::{delayed, held_through_lag, lagged, mark_held_acting, SETTLED};
 pub use derivative::{
     differentiator, CentralDifference, Differentiator, Smoothed, TestFunction, Window, DIFFERENTIATORS,
 };

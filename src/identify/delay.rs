@@ -192,14 +192,15 @@ fn first_order(
     };
     let (none, total) = read_late(0.0)?;
     let dead = if seconds > 0.0 { read_late(seconds)?.0 } else { none };
-    // read between its samples as a lag's input is ([`crate::data::mark_held_acting`]): held
-    // where a staircase, else a line (a smooth command through an actuator of 0.5 s was taken
-    // as held by the rates' fit, and a held reading's half sample put the lag a sample short)
+    // read between its samples as a lag's input is (a smooth command through an actuator of
+    // 0.5 s was taken as held by the rates' fit, and a held reading's half sample put the lag a
+    // sample short)
     let read: Vec<Frame> = frames
         .iter()
         .map(|f| {
             let mut f = f.clone();
-            match f.column(column).is_some_and(crate::data::staircase) {
+            let auto = crate::data::Intersample::Auto;
+            match f.column(column).is_some_and(|c| crate::data::held_through_lag(c, auto)) {
                 true => f.hold(column)?,
                 false => f.release(column),
             }
